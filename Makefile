@@ -1,0 +1,36 @@
+# locust: `make demo` and `make test` do all the set-up on a fresh machine.
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+PYTHON ?= python3
+export MUJOCO_GL ?= osmesa
+export PYOPENGL_PLATFORM ?= osmesa
+
+.PHONY: demo test test-all bench install sysdeps clean
+
+$(VENV)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[test]'
+	touch $@
+
+install: $(VENV)/.installed
+
+sysdeps:
+	@bash scripts/sysdeps.sh
+
+demo: install sysdeps
+	$(VENV)/bin/locust demo --out demo-out
+
+# Fast tests (the default, well under 15 minutes). pytest exits 5 when it collects nothing.
+test: install sysdeps
+	$(PY) -m pytest -q; rc=$$?; [ $$rc -eq 5 ] && { echo "no tests collected"; exit 0; }; exit $$rc
+
+# Everything, including the slow system tests.
+test-all: install sysdeps
+	$(PY) -m pytest -q -m "slow or not slow"
+
+bench: install
+	$(PY) bench/sim_speed.py
+
+clean:
+	rm -rf $(VENV) demo-out .pytest_cache

@@ -1,0 +1,98 @@
+"""The ``locust`` command: a thin table of verbs, each in its job's own ``cli`` module.
+
+Commands are imported only when used, so ``locust --help`` and the quick commands
+start fast even though the simulation, vision and CAD libraries are heavy. Any
+:class:`~locust.errors.LocustError` is turned here, once, into one clear message.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import sys
+
+import click
+
+from . import __version__
+from .errors import LocustError
+
+# verb -> (module, attribute, one-line help shown by `locust --help`)
+COMMANDS: dict[str, tuple[str, str, str]] = {
+    "params": ("locust.params_cli", "params", "Show or write robot parameters (presets, robot.toml, --set)."),
+    "sim": ("locust.sim.cli", "sim", "Simulate the hop schedule in MuJoCo, audited."),
+    "sweep": ("locust.sim.sweep_cli", "sweep", "Sweep design parameters over a grid, in parallel."),
+    "optimize": ("locust.sim.sweep_cli", "optimize", "Optimise hop distance with Optuna."),
+    "ports": ("locust.device.cli", "ports", "List serial ports and mark the likely ESP32."),
+    "flash": ("locust.device.cli", "flash", "Copy the MicroPython firmware to the board (mpremote)."),
+    "hop": ("locust.device.cli", "hop", "Run the bang-bang hop schedule on the robot; save a run record."),
+    "virtual": ("locust.device.cli", "virtual", "Start a virtual robot on a pseudo-terminal."),
+    "track": ("locust.track.cli", "track", "Extract marker tracks (nose, foot) from video."),
+    "calibrate": ("locust.calibrate.cli", "calibrate", "Fit stiffness, damping, servo gains, friction."),
+    "report": ("locust.report.cli", "report", "Compare simulation and measurement in an HTML report."),
+    "demo": ("locust.report.demo_cli", "demo", "Run the whole toolkit end to end on the virtual robot."),
+    "fab": ("locust.fab.cli", "fab", "Generate the five-layer laminate cut files (DXF)."),
+}
+
+
+class LazyGroup(click.Group):
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return [name for name in COMMANDS if _available(name)]
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        if name not in COMMANDS:
+            return None
+        module, attr, _ = COMMANDS[name]
+        try:
+            return getattr(importlib.import_module(module), attr)
+        except ModuleNotFoundError as exc:
+            if exc.name and exc.name.startswith("locust"):
+                return None
+            raise
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(name, COMMANDS[name][2]) for name in self.list_commands(ctx)]
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except LocustError as exc:
+            click.secho(f"error: {exc.message}", fg="red", err=True)
+            if exc.hint:
+                click.echo(f"  hint: {exc.hint}", err=True)
+            ctx.exit(exc.exit_code)
+
+
+def _available(name: str) -> bool:
+    try:
+        return importlib.util.find_spec(COMMANDS[name][0]) is not None
+    except ModuleNotFoundError:  # its package is not there yet
+        return False
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
+@click.version_option(__version__, prog_name="locust")
+def cli() -> None:
+    """locust: firmware-plus-host toolkit for the foldable four-bar hopping robot.
+
+    \b
+    Typical flow:
+      locust flash --port sim            put the firmware on a board (or the virtual robot)
+      locust hop --port sim --cycles 6   run the hop schedule, save a run record
+      locust track video.mp4             nose and foot tracks from video
+      locust calibrate beam tracks.csv   identify the physics, update robot.toml
+      locust sim --preset seed --json    simulate the hop, audited
+      locust sweep --vary scale=0:0.05:30 --out sweep/
+      locust report --measured ...       simulation against reality
+      locust fab --from-robot seed       laminate cut files
+    """
+
+
+def main() -> None:
+    cli(prog_name="locust")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

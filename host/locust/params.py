@@ -1,0 +1,370 @@
+"""Robot parameters: one typed model, read from and written to ``robot.toml``.
+
+Every number the toolkit uses about the robot lives here, with its unit in its name and
+its provenance beside it: ``default`` (a reasonable value nobody measured), ``seed`` (the
+team's notebook, Part 2), ``preset:<name>``, ``override`` (``--set`` on the command line)
+or ``fit:<recording>`` (identified by ``locust calibrate``, with an uncertainty and a date).
+
+Presets:
+
+- ``seed``: the notebook's Part 2 robot, run the corrected way (settled on the floor before
+  the schedule starts, servo commands at the servo's 50 Hz PWM rate, converged solver
+  settings, audited).
+- ``small`` / ``medium`` / ``large``: the physical leg sets of Part 3, +0 / +1 / +2 cm on
+  every link of the seed design.
+- ``seed-notebook``: the notebook's Part 2 simulation exactly (dropped from 8 cm with the
+  schedule already running, 60 Hz control frames of ``int(1/60/dt)`` steps, Euler at
+  dt = 1e-4 s, 50 solver iterations, tolerance 1e-8), for reproducing its figures.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any
+
+from .errors import ParamsError
+from .fileio import atomic_write_text
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Linkage and chassis geometry (the notebook's Part 1-2 values)."""
+
+    ground_m: float = 0.04          # blue link: chassis, between the two fixed pivots
+    crank_m: float = 0.04           # yellow link: servo horn
+    coupler_m: float = 0.02         # green link
+    leg_m: float = 0.06             # red link: the leg, foot at its far end
+    crank_start_deg: float = -90.0  # crank angle in the assembled pose (0 = along the ground link)
+    body_length_m: float = 0.12
+    body_width_m: float = 0.12
+    body_thickness_m: float = 0.001
+    body_mass_kg: float = 0.05
+    leg_mount_x_m: float = 0.04     # centre of each ground link in the chassis frame
+    leg_mount_y_m: float = 0.045    # lateral offset of each leg (left +, right -)
+    link_width_m: float = 0.03
+    link_thickness_m: float = 0.001
+    link_density_kg_per_m3: float = 1000.0
+    nose_x_m: float = -0.06         # nose marker in the chassis frame
+    body_pitch_deg: float = -30.0   # initial chassis attitude (notebook: euler 180 -30 180)
+    drop_height_m: float = 0.08     # initial chassis height
+
+
+@dataclass(frozen=True)
+class Compliance:
+    """Hinge compliance of the folded cardstock (cantilever-beam experiment)."""
+
+    hinge_stiffness_nm_per_rad: float = 0.056375
+    hinge_damping_nms_per_rad: float = 0.00056375
+
+
+@dataclass(frozen=True)
+class Servo:
+    """Hobby servo: a position servo, force = clip(kp*(cmd-q) - kv*qdot, +-limit)."""
+
+    kp_nm_per_rad: float = 20.0
+    kv_nms_per_rad: float = 0.0069
+    torque_limit_nm: float = 0.15
+    travel_deg: float = 45.0         # mechanical travel either side of rest
+    pulse_min_us: float = 500.0      # pulse at -range_deg/2
+    pulse_max_us: float = 2500.0     # pulse at +range_deg/2
+    range_deg: float = 180.0         # angle swept by pulse_min..pulse_max
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Friction (ramp critical-angle experiment: mu = tan(theta))."""
+
+    foot_friction: float = 1.7
+    floor_friction: float = 1.6
+    torsional_friction: float = 0.006
+    rolling_friction: float = 0.00005
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """Open-loop bang-bang hop schedule."""
+
+    push_deg: float = -30.0
+    push_s: float = 0.3
+    wait_s: float = 1.0
+    cycles: int = 6
+
+
+@dataclass(frozen=True)
+class Solver:
+    """How the simulation is run (not a property of the robot, but of the result)."""
+
+    timestep_s: float = 1e-4
+    integrator: str = "euler"        # euler | implicitfast | implicit | rk4
+    iterations: int = 50
+    tolerance: float = 1e-8
+    control_hz: float = 50.0         # rate at which servo commands change (PWM period)
+    settle_s: float = 0.5            # time on the floor, servos at rest, before the schedule
+
+
+SECTIONS: dict[str, type] = {
+    "geometry": Geometry,
+    "compliance": Compliance,
+    "servo": Servo,
+    "contact": Contact,
+    "schedule": Schedule,
+    "solver": Solver,
+}
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """Where a value came from."""
+
+    source: str = "default"
+    uncertainty: float | None = None  # one standard deviation, in the value's own unit
+    date: str | None = None
+    note: str | None = None
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A complete, named parameter set."""
+
+    name: str = "seed"
+    geometry: Geometry = field(default_factory=Geometry)
+    compliance: Compliance = field(default_factory=Compliance)
+    servo: Servo = field(default_factory=Servo)
+    contact: Contact = field(default_factory=Contact)
+    schedule: Schedule = field(default_factory=Schedule)
+    solver: Solver = field(default_factory=Solver)
+    provenance: dict[str, Provenance] = field(default_factory=dict, compare=False)
+
+    # -- dotted access ---------------------------------------------------------------
+    def get(self, key: str) -> Any:
+        section, name = _split_key(key)
+        return getattr(getattr(self, section), name)
+
+    def source_of(self, key: str) -> Provenance:
+        _split_key(key)
+        return self.provenance.get(key, Provenance())
+
+    def with_values(self, values: dict[str, Any], source: str | Provenance = "override") -> "Robot":
+        """A copy with ``values`` (dotted keys) replaced, each recorded with ``source``."""
+        prov = source if isinstance(source, Provenance) else Provenance(source=source)
+        sections = {name: getattr(self, name) for name in SECTIONS}
+        provenance = dict(self.provenance)
+        for key, raw in values.items():
+            section, name = _split_key(key)
+            sections[section] = replace(sections[section], **{name: _coerce(key, raw)})
+            provenance[key] = prov
+        return replace(self, provenance=provenance, **sections)
+
+    def with_provenance(self, key: str, prov: Provenance) -> "Robot":
+        _split_key(key)
+        return replace(self, provenance={**self.provenance, key: prov})
+
+    def renamed(self, name: str) -> "Robot":
+        return replace(self, name=name)
+
+    def link_lengths_m(self) -> tuple[float, float, float, float]:
+        g = self.geometry
+        return (g.ground_m, g.crank_m, g.coupler_m, g.leg_m)
+
+    def flat(self) -> dict[str, Any]:
+        """Every value by its dotted name."""
+        return {key: self.get(key) for key in all_keys()}
+
+
+def all_keys() -> list[str]:
+    return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls)]
+
+
+def _split_key(key: str) -> tuple[str, str]:
+    section, _, name = key.partition(".")
+    cls = SECTIONS.get(section)
+    if cls is None or name not in {f.name for f in fields(cls)}:
+        close = [k for k in all_keys() if k.endswith("." + name) or k.startswith(section + ".")]
+        hint = f"did you mean {', '.join(close[:4])}?" if close else "run `locust params` to list every key"
+        raise ParamsError(f"unknown robot parameter {key!r}", hint)
+    return section, name
+
+
+def _coerce(key: str, raw: Any) -> Any:
+    section, name = _split_key(key)
+    ftype = {f.name: f.type for f in fields(SECTIONS[section])}[name]
+    try:
+        if ftype in ("float", float):
+            value = float(raw)
+            if not math.isfinite(value):
+                raise ValueError("not finite")
+            return value
+        if ftype in ("int", int):
+            value = float(raw)
+            if value != int(value):
+                raise ValueError("not a whole number")
+            return int(value)
+        return str(raw)
+    except (TypeError, ValueError) as exc:
+        raise ParamsError(f"bad value {raw!r} for {key}: {exc}", f"{key} takes a {ftype}") from None
+
+
+def parse_set_options(items: tuple[str, ...] | list[str]) -> dict[str, str]:
+    """``["geometry.leg_m=0.07", ...]`` -> ``{"geometry.leg_m": "0.07"}``, keys checked."""
+    out: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip() or not value.strip():
+            raise ParamsError(f"--set {item!r} is not KEY=VALUE", "e.g. --set servo.kp_nm_per_rad=25")
+        _split_key(key.strip())
+        out[key.strip()] = value.strip()
+    return out
+
+
+# -- presets ------------------------------------------------------------------------
+_SEED_SOURCE = Provenance(source="seed", note="notebook Part 2")
+
+
+def _seed() -> Robot:
+    measured = [
+        "geometry.ground_m", "geometry.crank_m", "geometry.coupler_m", "geometry.leg_m",
+        "geometry.crank_start_deg", "geometry.body_length_m", "geometry.body_width_m",
+        "geometry.body_thickness_m", "geometry.body_mass_kg", "geometry.leg_mount_x_m",
+        "geometry.leg_mount_y_m", "geometry.link_width_m", "geometry.link_thickness_m",
+        "geometry.nose_x_m", "geometry.body_pitch_deg", "geometry.drop_height_m",
+        "compliance.hinge_stiffness_nm_per_rad", "compliance.hinge_damping_nms_per_rad",
+        "servo.kp_nm_per_rad", "servo.kv_nms_per_rad", "servo.torque_limit_nm",
+        "servo.travel_deg", "contact.foot_friction", "contact.floor_friction",
+        "contact.torsional_friction", "contact.rolling_friction", "schedule.push_deg",
+        "schedule.push_s", "schedule.wait_s", "schedule.cycles",
+    ]
+    return Robot(name="seed", provenance={k: _SEED_SOURCE for k in measured})
+
+
+def _scaled(base: Robot, name: str, added_m: float) -> Robot:
+    g = base.geometry
+    values = {
+        "geometry.ground_m": round(g.ground_m + added_m, 9),
+        "geometry.crank_m": round(g.crank_m + added_m, 9),
+        "geometry.coupler_m": round(g.coupler_m + added_m, 9),
+        "geometry.leg_m": round(g.leg_m + added_m, 9),
+    }
+    note = f"notebook Part 3 leg set: +{added_m * 100:g} cm on every link"
+    return base.with_values(values, Provenance(source=f"preset:{name}", note=note)).renamed(name)
+
+
+def _seed_notebook() -> Robot:
+    prov = Provenance(source="seed", note="notebook Part 2 simulation loop, reproduced exactly")
+    return _seed().with_values(
+        {
+            "solver.timestep_s": 1e-4, "solver.integrator": "euler", "solver.iterations": 50,
+            "solver.tolerance": 1e-8, "solver.control_hz": 60.0, "solver.settle_s": 0.0,
+        },
+        prov,
+    ).renamed("seed-notebook")
+
+
+PRESETS = {
+    "seed": _seed,
+    "small": lambda: _scaled(_seed(), "small", 0.0),
+    "medium": lambda: _scaled(_seed(), "medium", 0.01),
+    "large": lambda: _scaled(_seed(), "large", 0.02),
+    "seed-notebook": _seed_notebook,
+}
+
+
+def preset(name: str) -> Robot:
+    try:
+        return PRESETS[name]()
+    except KeyError:
+        raise ParamsError(f"unknown preset {name!r}", f"choose one of {', '.join(PRESETS)}") from None
+
+
+# -- TOML ---------------------------------------------------------------------------
+def load_robot(path: str | Path) -> Robot:
+    """Read a robot.toml. Missing values fall back to the seed preset's."""
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ParamsError(f"{path}: no such file", "give the path of a robot.toml, or use --preset") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParamsError(f"{path}: not valid TOML ({exc})", "fix the file, or regenerate it with `locust params --write`") from None
+    robot = preset(str(doc.get("base", "seed"))) if doc.get("base", "seed") in PRESETS else preset("seed")
+    robot = robot.renamed(str(doc.get("name", path.stem)))
+    for section, table in doc.items():
+        if section in ("name", "base"):
+            continue
+        if section not in SECTIONS or not isinstance(table, dict):
+            raise ParamsError(f"{path}: unknown section [{section}]", f"sections are {', '.join(SECTIONS)}")
+        for name, entry in table.items():
+            key = f"{section}.{name}"
+            try:
+                _split_key(key)
+            except ParamsError as exc:
+                raise ParamsError(f"{path}: {exc.message}", exc.hint) from None
+            if isinstance(entry, dict):
+                if "value" not in entry:
+                    raise ParamsError(f"{path}: {key} has no 'value'", "write it as {value = ..., source = \"...\"}")
+                prov = Provenance(
+                    source=str(entry.get("source", "default")),
+                    uncertainty=None if entry.get("uncertainty") is None else float(entry["uncertainty"]),
+                    date=None if entry.get("date") is None else str(entry["date"]),
+                    note=None if entry.get("note") is None else str(entry["note"]),
+                )
+                value = entry["value"]
+            else:
+                prov, value = Provenance(source=f"file:{path.name}"), entry
+            try:
+                robot = robot.with_values({key: value}, prov)
+            except ParamsError as exc:
+                raise ParamsError(f"{path}: {exc.message}", exc.hint) from None
+    return robot
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(value)
+    return '"' + str(value).replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def to_toml(robot: Robot) -> str:
+    lines = [
+        "# locust robot parameters. Each value: {value, source, uncertainty (1 sigma), date, note}.",
+        "# source: default | seed | preset:<name> | override | fit:<recording>.",
+        f"name = {_toml_value(robot.name)}",
+        "",
+    ]
+    for section in SECTIONS:
+        lines.append(f"[{section}]")
+        for f in fields(SECTIONS[section]):
+            key = f"{section}.{f.name}"
+            prov = robot.source_of(key)
+            parts = [f"value = {_toml_value(robot.get(key))}", f"source = {_toml_value(prov.source)}"]
+            for attr in ("uncertainty", "date", "note"):
+                v = getattr(prov, attr)
+                if v is not None:
+                    parts.append(f"{attr} = {_toml_value(v)}")
+            lines.append(f"{f.name} = {{ {', '.join(parts)} }}")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def save_robot(robot: Robot, path: str | Path) -> Path:
+    return atomic_write_text(path, to_toml(robot))
+
+
+def resolve_robot(preset_name: str | None = None, config: str | Path | None = None,
+                  sets: tuple[str, ...] | list[str] = ()) -> Robot:
+    """The robot a command runs on: ``--config`` file, else ``--preset``, then ``--set``."""
+    robot = load_robot(config) if config else preset(preset_name or "seed")
+    overrides = parse_set_options(sets)
+    return robot.with_values(overrides, "override") if overrides else robot
+
+
+def as_dict(robot: Robot) -> dict[str, Any]:
+    """Plain nested dict of values (for JSON and hashing)."""
+    return {"name": robot.name, **{s: dataclasses.asdict(getattr(robot, s)) for s in SECTIONS}}

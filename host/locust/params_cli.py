@@ -1,0 +1,52 @@
+"""``locust params``: show the parameters a command would run on, or write a robot.toml."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+
+from . import params as P
+from .errors import ParamsError
+
+
+def robot_options(func):
+    """The shared --preset / --config / --set options of every command that needs a robot."""
+    func = click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
+                        help="Override any parameter by its dotted name, e.g. --set servo.kp_nm_per_rad=25. Repeatable.")(func)
+    func = click.option("--config", type=click.Path(dir_okay=False, path_type=Path), default=None,
+                        help="A robot.toml (e.g. calibration/robot.toml); overrides --preset.")(func)
+    func = click.option("--preset", type=click.Choice(list(P.PRESETS)), default="seed", show_default=True,
+                        help="Built-in parameter set.")(func)
+    return func
+
+
+@click.command()
+@robot_options
+@click.option("--json", "as_json", is_flag=True, help="Print values as JSON.")
+@click.option("--write", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Write the resulting parameter set to this robot.toml (refuses to overwrite).")
+@click.option("--force", is_flag=True, help="With --write: overwrite an existing file.")
+def params(preset, config, sets, as_json, write, force):
+    """Show the robot parameters, with their source and uncertainty.
+
+    Every key can be overridden on any command with --set KEY=VALUE.
+    """
+    robot = P.resolve_robot(preset, config, sets)
+    if write:
+        if write.exists() and not force:
+            raise ParamsError(f"{write} exists", "choose another path, or add --force to overwrite it")
+        P.save_robot(robot, write)
+        click.echo(f"wrote {write}")
+        return
+    if as_json:
+        out = {k: {"value": v, **{a: b for a, b in vars(robot.source_of(k)).items() if b is not None}}
+               for k, v in robot.flat().items()}
+        click.echo(json.dumps({"name": robot.name, "values": out}, indent=2))
+        return
+    click.echo(f"# {robot.name}")
+    for key, value in robot.flat().items():
+        prov = robot.source_of(key)
+        unc = f" ± {prov.uncertainty:g}" if prov.uncertainty is not None else ""
+        click.echo(f"{key:42s} {value!s:>12}{unc:12s}  [{prov.source}]")

@@ -1,0 +1,1 @@
+"""Four-bar solver, MuJoCo model builder, audited hop rollout."""
