@@ -1,0 +1,198 @@
+"""Cantilever beam with a tip mass: damped oscillation -> stiffness and damping.
+
+The tip moves as a damped linear oscillator after the mass is dropped on it::
+
+    d(t) = c + exp(-zeta*wn*tau) * (A*cos(wd*tau) + B*sin(wd*tau)),  tau = t - t0,
+    wd = wn*sqrt(1 - zeta^2)
+
+fitted by least squares to the tip's displacement along the direction it moves most
+(the first principal axis of the track, so the camera need not be level). Then, with the
+oscillating mass m (tip mass plus 33/140 of the beam's own mass, Rayleigh's cantilever
+result):
+
+    k = m*wn^2 [N/m],  b = 2*zeta*m*wn [N*s/m]
+
+Hinge mapping for the model (pseudo-rigid-body, one lumped hinge at the clamp): the beam
+is a rigid bar of length L on a torsional spring, the mass at its tip, small angles
+(tip displacement = L*theta). Equal tip force for equal deflection gives
+
+    k_rot = k*L^2 [N*m/rad],  b_rot = b*L^2 [N*m*s/rad].
+
+Assumptions: small deflection (tip motion << L), mass concentrated at the tip, linear
+viscous damping, the clamp rigid, the cardstock hinge of the robot made of the same
+material and width as the beam.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy import optimize
+
+from ..errors import CalibrationError
+from .curves import Curves
+from .fitstats import Estimate, covariance
+
+RAYLEIGH_TIP_FRACTION = 33.0 / 140.0  # share of a cantilever's own mass moving with its tip
+MAPPING = ("k_rot = k*L^2, b_rot = b*L^2: rigid bar of length L on a torsional spring at the clamp, "
+           "mass at the tip, small angles, viscous damping")
+MIN_SAMPLES = 20
+MIN_CYCLES = 1.5
+
+
+@dataclass(frozen=True)
+class BeamFit:
+    source: str
+    mass_kg: float
+    effective_mass_kg: float
+    length_m: float | None
+    natural_frequency_hz: Estimate
+    damping_ratio: Estimate
+    damped_frequency_hz: float
+    stiffness_n_per_m: Estimate
+    damping_ns_per_m: Estimate
+    hinge_stiffness_nm_per_rad: Estimate | None
+    hinge_damping_nms_per_rad: Estimate | None
+    amplitude_m: float
+    rms_residual_m: float
+    n_samples: int
+    fit_start_s: float
+    fit_end_s: float
+    mapping: str
+    curves: Curves
+
+    def summary(self) -> dict:
+        out = {"experiment": "beam", "source": self.source, "mass_kg": self.mass_kg,
+               "effective_mass_kg": self.effective_mass_kg, "length_m": self.length_m}
+        for name in ("natural_frequency_hz", "damping_ratio", "stiffness_n_per_m", "damping_ns_per_m",
+                     "hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad"):
+            est = getattr(self, name)
+            out[name] = None if est is None else est.as_dict()
+        out.update(damped_frequency_hz=self.damped_frequency_hz, amplitude_m=self.amplitude_m,
+                   rms_residual_m=self.rms_residual_m, n_samples=self.n_samples,
+                   fit_window_s=[self.fit_start_s, self.fit_end_s], mapping=self.mapping)
+        return out
+
+
+def principal_displacement(x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
+    """Displacement along the direction the tip moves most (sign: towards +y, else +x)."""
+    pts = np.column_stack([x_m - np.mean(x_m), y_m - np.mean(y_m)])
+    _, _, vt = np.linalg.svd(pts, full_matrices=False)
+    axis = vt[0]
+    if abs(axis[1]) >= 1e-12 and axis[1] < 0 or abs(axis[1]) < 1e-12 and axis[0] < 0:
+        axis = -axis
+    return pts @ axis + (np.mean(x_m) * axis[0] + np.mean(y_m) * axis[1])
+
+
+def damped_oscillation(t_s: np.ndarray, p: np.ndarray, t0_s: float) -> np.ndarray:
+    c, a, b, fn_hz, zeta = p
+    wn = 2 * np.pi * fn_hz
+    wd = wn * np.sqrt(max(1.0 - zeta**2, 1e-12))
+    tau = t_s - t0_s
+    env = np.exp(-zeta * wn * tau)
+    return c + env * (a * np.cos(wd * tau) + b * np.sin(wd * tau))
+
+
+def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, length_m: float | None = None,
+             beam_mass_kg: float = 0.0, start_s: float | None = None, end_s: float | None = None,
+             source: str = "beam") -> BeamFit:
+    """Fit a damped oscillation to the tip displacement; see the module docstring."""
+    if not mass_kg > 0:
+        raise CalibrationError(f"--mass-kg must be positive (got {mass_kg})", "weigh the dropped mass, in kg")
+    if length_m is not None and not length_m > 0:
+        raise CalibrationError(f"--length-m must be positive (got {length_m})", "the beam's free length, in m")
+    t_s = np.asarray(t_s, dtype=float)
+    d = np.asarray(displacement_m, dtype=float)
+    if np.ptp(d) < 1e-9:
+        raise CalibrationError(f"{source}: flat signal, the tip does not move ({np.ptp(d):.3g} m peak to peak)",
+                               "check the marker (is it on the beam tip?) and the scale of the track")
+    window = _window(t_s, d, start_s, end_s)
+    t, y = t_s[window], d[window]
+    if len(t) < MIN_SAMPLES:
+        raise CalibrationError(f"{source}: only {len(t)} samples in the fit window (need {MIN_SAMPLES})",
+                               "film at a higher frame rate (see calibration/protocols/beam.md) or widen --start-s/--end-s")
+    t0 = float(t[0])
+    fs_hz = 1.0 / float(np.median(np.diff(t)))
+    fn0 = _dominant_frequency_hz(t, y - np.median(y[len(y) * 3 // 4:]))
+    best = None
+    for zeta0 in (0.02, 0.1, 0.3):
+        p0 = np.array([np.median(y[len(y) * 3 // 4:]), y[0] - np.median(y[len(y) * 3 // 4:]), 0.0, fn0, zeta0])
+        lo = [-np.inf, -np.inf, -np.inf, fn0 * 0.3, 1e-4]
+        hi = [np.inf, np.inf, np.inf, min(fn0 * 3.0, fs_hz / 2), 0.95]
+        p0[3] = np.clip(p0[3], lo[3] * 1.0001, hi[3] * 0.9999)
+        res = optimize.least_squares(lambda p: damped_oscillation(t, p, t0) - y, p0, bounds=(lo, hi),
+                                     x_scale="jac", method="trf")
+        if best is None or res.cost < best.cost:
+            best = res
+    p, r = best.x, best.fun
+    cov = covariance(best.jac, r)
+    rms = float(np.sqrt(np.mean(r**2)))
+    amp = float(np.hypot(p[1], p[2]))
+    if amp < 5 * rms:
+        raise CalibrationError(
+            f"{source}: flat signal, no oscillation above the noise (amplitude {amp * 1e3:.3g} mm, "
+            f"residual {rms * 1e3:.3g} mm)",
+            "drop the mass from higher, or track the tip more closely (see calibration/protocols/beam.md)",
+        )
+    fn, zeta = float(p[3]), float(p[4])
+    cycles = (t[-1] - t[0]) * fn
+    if cycles < MIN_CYCLES:
+        raise CalibrationError(f"{source}: the fit window covers {cycles:.2g} oscillations (need {MIN_CYCLES})",
+                               "record longer after the drop")
+    if fs_hz < 8 * fn:
+        raise CalibrationError(f"{source}: {fs_hz:.3g} frames/s for a {fn:.3g} Hz oscillation (need 8 frames a cycle)",
+                               "film in slow motion (see calibration/protocols/beam.md)")
+    m = mass_kg + RAYLEIGH_TIP_FRACTION * beam_mass_kg
+    wn = 2 * np.pi * fn
+    grad_fn = np.array([0, 0, 0, 1.0, 0])
+    grad_zeta = np.array([0, 0, 0, 0, 1.0])
+    k = m * wn**2
+    b = 2 * zeta * m * wn
+    grad_k = grad_fn * 2 * k / fn
+    grad_b = 2 * m * 2 * np.pi * (zeta * grad_fn + fn * grad_zeta)
+    hinge_k = hinge_b = None
+    if length_m is not None:
+        hinge_k = cov.estimate(k * length_m**2, grad_k * length_m**2)
+        hinge_b = cov.estimate(b * length_m**2, grad_b * length_m**2)
+    fine_t = np.linspace(t[0], t[-1], max(20 * len(t), 2000))
+    curves = Curves(x=t, data=y * 1e3, model=(y - r) * 1e3, x_label="t [s]",
+                    y_label="tip displacement [mm]", title=f"beam: {Path(source).name}",
+                    model_x=fine_t, model_fine=damped_oscillation(fine_t, p, t0) * 1e3)
+    return BeamFit(
+        source=source, mass_kg=mass_kg, effective_mass_kg=m, length_m=length_m,
+        natural_frequency_hz=cov.estimate(fn, grad_fn), damping_ratio=cov.estimate(zeta, grad_zeta),
+        damped_frequency_hz=fn * float(np.sqrt(1 - zeta**2)),
+        stiffness_n_per_m=cov.estimate(k, grad_k), damping_ns_per_m=cov.estimate(b, grad_b),
+        hinge_stiffness_nm_per_rad=hinge_k, hinge_damping_nms_per_rad=hinge_b, amplitude_m=amp,
+        rms_residual_m=rms, n_samples=len(t), fit_start_s=float(t[0]), fit_end_s=float(t[-1]),
+        mapping=MAPPING, curves=curves,
+    )
+
+
+def _window(t_s: np.ndarray, d: np.ndarray, start_s: float | None, end_s: float | None) -> np.ndarray:
+    """Samples to fit: from the first big swing after the drop (or ``start_s``) to ``end_s``.
+
+    Before the drop the tip is at rest and the impact itself is not a free oscillation, so
+    the fit starts at the largest excursion from the final rest position in the first half
+    of the record: the first swing after the impact.
+    """
+    end = t_s[-1] if end_s is None else end_s
+    if start_s is None:
+        rest = np.median(d[len(d) * 4 // 5:])
+        half = max(len(d) // 2, 1)
+        start_s = t_s[int(np.argmax(np.abs(d[:half] - rest)))]
+    return (t_s >= start_s) & (t_s <= end)
+
+
+def _dominant_frequency_hz(t: np.ndarray, u: np.ndarray) -> float:
+    """Peak of the zero-padded spectrum, resampled to a uniform grid first."""
+    n = len(t)
+    tu = np.linspace(t[0], t[-1], n)
+    uu = np.interp(tu, t, u) * np.hanning(n)
+    nfft = 16 * int(2 ** np.ceil(np.log2(n)))
+    spec = np.abs(np.fft.rfft(uu - uu.mean(), nfft))
+    freqs = np.fft.rfftfreq(nfft, tu[1] - tu[0])
+    spec[freqs < 1.0 / (t[-1] - t[0])] = 0  # not the record's own length
+    return float(freqs[int(np.argmax(spec))])

@@ -1,0 +1,157 @@
+"""Synthetic recordings of the three experiments, from known parameters, with realistic noise.
+
+Used by ``calibration/make_synthetic.py`` (the demo recordings) and by the tests (truth to
+compare the fits with). Everything here is SYNTHETIC: made from a model, not measured.
+
+Noise figures are those of a phone filming in slow motion: a tracked point is good to
+about half a pixel, which at 0.6 mm/px is 0.3 mm; a horn tip 5 cm from the axis tracked to
+0.25 mm gives 0.3 deg of angle; a protractor or phone inclinometer reads a ramp to 0.5 deg.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .servo import ServoGains, ServoRig, rig_model, simulate_deg
+
+G = 9.81
+
+
+@dataclass(frozen=True)
+class BeamTruth:
+    mass_kg: float = 0.010
+    length_m: float = 0.05
+    hinge_stiffness_nm_per_rad: float = 0.056375      # the seed's value
+    damping_ratio: float = 0.04                        # a lightly damped cardstock strip
+    drop_height_m: float = 0.02
+    fps: float = 240.0
+    duration_s: float = 1.5
+    drop_at_s: float = 0.1
+    noise_m: float = 0.0003
+
+    @property
+    def stiffness_n_per_m(self) -> float:
+        return self.hinge_stiffness_nm_per_rad / self.length_m**2
+
+    @property
+    def damping_ns_per_m(self) -> float:
+        return 2 * self.damping_ratio * math.sqrt(self.stiffness_n_per_m * self.mass_kg)
+
+    @property
+    def hinge_damping_nms_per_rad(self) -> float:
+        return self.damping_ns_per_m * self.length_m**2
+
+    @property
+    def natural_frequency_hz(self) -> float:
+        return math.sqrt(self.stiffness_n_per_m / self.mass_kg) / (2 * math.pi)
+
+
+def beam_tip_track(truth: BeamTruth, rng: np.random.Generator, tilt_deg: float = 3.0):
+    """(t_s, x_m, y_m) of the beam tip: at rest, then the mass lands on it at ``drop_at_s``.
+
+    Exact solution of m*y'' + b*y' + k*y = -m*g from y = 0, y' = -sqrt(2*g*h); the camera
+    is tilted by ``tilt_deg`` (the fit must not need a level camera).
+    """
+    t = np.arange(int(truth.duration_s * truth.fps)) / truth.fps
+    wn = 2 * math.pi * truth.natural_frequency_hz
+    zeta = truth.damping_ratio
+    wd = wn * math.sqrt(1 - zeta**2)
+    y_eq = -truth.mass_kg * G / truth.stiffness_n_per_m
+    v0 = -math.sqrt(2 * G * truth.drop_height_m)
+    tau = np.clip(t - truth.drop_at_s, 0, None)
+    a = -y_eq
+    b = (v0 + zeta * wn * a) / wd
+    y = np.where(t < truth.drop_at_s, 0.0, y_eq + np.exp(-zeta * wn * tau) * (a * np.cos(wd * tau) + b * np.sin(wd * tau)))
+    tilt = math.radians(tilt_deg)
+    x_m = 0.05 - math.sin(tilt) * y + rng.normal(0, truth.noise_m, len(t))
+    y_m = 0.12 + math.cos(tilt) * y + rng.normal(0, truth.noise_m, len(t))
+    return t, x_m, y_m
+
+
+@dataclass(frozen=True)
+class ServoTruth:
+    """A servo whose step leaves the linear range visible (limit/kp = 14 deg)."""
+
+    kp_nm_per_rad: float = 0.6
+    kv_nms_per_rad: float = 0.04
+    torque_limit_nm: float = 0.15
+    inertia_kgm2: float = 4e-4          # ~100 g battery pack 6 cm from the axis
+    gravity_moment_nm: float = 0.03
+    start_deg: float = 0.0
+    target_deg: float = 180.0
+    step_at_s: float = 0.05
+    fps: float = 240.0
+    duration_s: float = 0.6
+    noise_deg: float = 0.3
+
+    @property
+    def gains(self) -> ServoGains:
+        return ServoGains(self.kp_nm_per_rad, self.kv_nms_per_rad, self.torque_limit_nm)
+
+    @property
+    def rig(self) -> ServoRig:
+        return ServoRig(self.inertia_kgm2, self.gravity_moment_nm)
+
+
+STALL_SERVO = ServoTruth(kp_nm_per_rad=20.0, kv_nms_per_rad=0.0069, torque_limit_nm=0.15,
+                         inertia_kgm2=4e-4, gravity_moment_nm=0.2, start_deg=-60.0, target_deg=90.0)
+"""The seed's gains lifting a weight too heavy for them (the notebook's stall test): the horn
+stalls where 0.2*cos(angle) = 0.15 N*m, torque-limited for the whole step, so kp and kv
+cannot be identified, the limit can."""
+
+
+def servo_step(truth: ServoTruth, rng: np.random.Generator):
+    """(t_s, angle_deg, command_deg): the rig model stepped from rest, plus angle noise."""
+    t = np.arange(int(truth.duration_s * truth.fps)) / truth.fps
+    command = np.where(t < truth.step_at_s, truth.start_deg, truth.target_deg)
+    # rest under gravity before the step: the servo sags by M*cos(angle)/kp
+    sag = math.degrees(truth.gravity_moment_nm * math.cos(math.radians(truth.start_deg)) / truth.kp_nm_per_rad)
+    angle = simulate_deg(rig_model(truth.rig), [truth.gains], t, command, truth.start_deg - sag)[0]
+    return t, angle + rng.normal(0, truth.noise_deg, len(t)), command
+
+
+@dataclass(frozen=True)
+class RampTruth:
+    mu_static: float = 1.7          # the seed's foot friction
+    trials: int = 10
+    scatter_deg: float = 0.8        # trial-to-trial scatter of the critical angle
+    reading_deg: float = 0.5        # reading error of the inclinometer
+
+    @property
+    def critical_angle_deg(self) -> float:
+        return math.degrees(math.atan(self.mu_static))
+
+
+def ramp_angles(truth: RampTruth, rng: np.random.Generator) -> np.ndarray:
+    sd = math.hypot(truth.scatter_deg, truth.reading_deg)
+    return np.round(truth.critical_angle_deg + rng.normal(0, sd, truth.trials), 1)
+
+
+def ramp_tilt_track(truth: RampTruth, rng: np.random.Generator, *, fps: float = 60.0, rate_deg_per_s: float = 4.0,
+                    board_m: float = 0.30, noise_m: float = 0.0005, mu_kinetic_ratio: float = 0.8):
+    """One tilting trial filmed from the side: markers ``ramp_a`` (hinge end), ``ramp_b`` (far
+    end of the board) and ``robot``. Returns (t_s, {marker: (x_m, y_m)}, critical_angle_deg)."""
+    crit = truth.critical_angle_deg
+    t = np.arange(int((crit + 8) / rate_deg_per_s * fps)) / fps
+    theta = np.radians(rate_deg_per_s * t)
+    tc = math.radians(crit) / math.radians(rate_deg_per_s)
+    s = np.full(len(t), 0.2)
+    mu_k = truth.mu_static * mu_kinetic_ratio
+    v = 0.0
+    for i in range(1, len(t)):
+        if t[i] > tc:
+            a = G * (math.sin(theta[i]) - mu_k * math.cos(theta[i]))
+            v += max(a, 0.0) / fps
+            s[i] = max(s[i - 1] - v / fps, 0.0)
+    along = np.column_stack([np.cos(theta), np.sin(theta)])
+    normal = np.column_stack([-np.sin(theta), np.cos(theta)])
+    pts = {
+        "ramp_a": np.zeros((len(t), 2)),
+        "ramp_b": board_m * along,
+        "robot": s[:, None] * along + 0.01 * normal,
+    }
+    out = {k: (v[:, 0] + rng.normal(0, noise_m, len(t)), v[:, 1] + rng.normal(0, noise_m, len(t))) for k, v in pts.items()}
+    return t, out, crit

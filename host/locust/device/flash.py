@@ -1,0 +1,185 @@
+"""Copy the firmware to a board with mpremote's Python API, verify it, reset, shake hands.
+
+mpremote is pinned (1.29.0): its Python API changes between releases. The steps:
+
+1. open the port (mpremote's ``SerialTransport``) and, if the locust firmware is running,
+   ask it for the REPL with the ``repl`` command (it ignores Ctrl-C so that noise on the
+   line cannot stop it);
+2. enter the raw REPL without a soft reset (on the unix port a soft reset ends the process);
+3. write each file (optionally compiled with ``mpy-cross``), then compare the board's
+   SHA-256 of every file with ours;
+4. write ``config.json`` if the board has none (or when asked), soft-reset (Ctrl-D from
+   the friendly REPL runs ``main.py``; the USB port stays up), and complete the handshake.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import DeviceError
+from ..firmware import config as fw_config
+from ..firmware import protocol as P
+from .link import Link
+
+FIRMWARE_DIR = Path(P.__file__).resolve().parent
+NOT_FLASHED = ("__init__.py",)
+KEEP_SOURCE = ("main.py", "boot.py")  # the board runs these as source
+
+NO_MICROPYTHON_HINT = (
+    "this board does not run MicroPython yet. Install it once, e.g. with mpflash "
+    "(`pip install mpflash && mpflash flash --port PORT`) or esptool "
+    "(`pip install esptool && esptool.py --port PORT erase_flash && esptool.py --port PORT "
+    "--baud 460800 write_flash 0x1000 ESP32_GENERIC-<version>.bin`, firmware from "
+    "https://micropython.org/download/ESP32_GENERIC/), then run `locust flash` again"
+)
+
+
+@dataclass(frozen=True)
+class FlashedFile:
+    name: str
+    size_bytes: int
+    sha256: str
+
+
+@dataclass
+class FlashResult:
+    port: str
+    compiled: bool
+    firmware_version: str
+    board: str
+    config_written: bool
+    files: list[FlashedFile] = field(default_factory=list)
+    elapsed_s: float = 0.0
+
+
+def firmware_files() -> list[Path]:
+    return sorted(p for p in FIRMWARE_DIR.glob("*.py") if p.name not in NOT_FLASHED)
+
+
+def mpy_version(header: bytes) -> tuple[int, int]:
+    """(version, sub-version) of a .mpy header; the board reports the same in sys.implementation._mpy."""
+    if len(header) < 3 or header[:1] != b"M":
+        raise DeviceError("mpy-cross wrote an invalid .mpy file", "check the mpy-cross installation")
+    return header[1], header[2] & 3
+
+
+def build(compile_mpy: bool, workdir: Path) -> list[tuple[str, bytes]]:
+    """[(name on the board, contents)] for every firmware file."""
+    out = []
+    for src in firmware_files():
+        if not compile_mpy or src.name in KEEP_SOURCE:
+            out.append((src.name, src.read_bytes()))
+            continue
+        dest = workdir / (src.stem + ".mpy")
+        proc = subprocess.run([sys.executable, "-m", "mpy_cross", "-o", str(dest), str(src)],
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise DeviceError(f"mpy-cross failed on {src.name}: {proc.stderr.strip()}",
+                              "flash without --compile, or fix the file")
+        out.append((dest.name, dest.read_bytes()))
+    return out
+
+
+def _transport(port: str):
+    from mpremote.transport import TransportError
+    from mpremote.transport_serial import SerialTransport
+
+    try:
+        return SerialTransport(port, baudrate=115200)
+    except TransportError as exc:
+        raise DeviceError(f"cannot open {port}: {exc}", "check the cable and `locust ports`") from None
+
+
+def _release_console(transport, tries: int = 3) -> bool:
+    """Ask a running locust firmware for the REPL; False if nothing answered (plain REPL, or none)."""
+    reader = P.LineReader(limit=4096)
+    for attempt in range(tries):
+        transport.serial.write(P.encode({"id": 900 + attempt, "cmd": "repl"}))
+        deadline = time.monotonic() + 0.6
+        while time.monotonic() < deadline:
+            waiting = transport.serial.in_waiting
+            data = transport.serial.read(waiting) if waiting else b""
+            if not data:
+                time.sleep(0.01)
+            for line in reader.feed(data):
+                try:
+                    msg = P.decode(line) if line else None
+                except P.ProtocolError:
+                    continue
+                if msg and msg.get("id") == 900 + attempt and msg.get("ok"):
+                    time.sleep(0.1)  # let main.py end and the REPL print its prompt
+                    return True
+    return False
+
+
+def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
+          progress: Callable[[str], None] = lambda s: None) -> FlashResult:
+    from mpremote.transport import TransportError
+
+    if config is not None and fw_config.problems(config):
+        raise DeviceError("bad servo config: " + "; ".join(fw_config.problems(config)),
+                          "see docs/device.md for the keys and their limits")
+    t_start = time.monotonic()
+    transport = _transport(port)
+    try:
+        progress("connecting")
+        _release_console(transport)
+        try:
+            transport.enter_raw_repl(soft_reset=False)
+        except TransportError:
+            raise DeviceError(f"no MicroPython REPL answered on {port}", NO_MICROPYTHON_HINT) from None
+        transport.exec("import sys")
+        impl, board_mpy, platform = transport.eval("(sys.implementation.name, getattr(sys.implementation, '_mpy', 0), sys.platform)")
+        if impl != "micropython":
+            raise DeviceError(f"{port} runs {impl}, not MicroPython", NO_MICROPYTHON_HINT)
+        with tempfile.TemporaryDirectory(prefix="locust-flash-") as tmp:
+            files = build(compile_mpy, Path(tmp))
+        if compile_mpy:
+            ours = mpy_version(next(data for name, data in files if name.endswith(".mpy")))
+            theirs = (board_mpy & 0xFF, (board_mpy >> 8) & 3)
+            if ours != theirs:
+                raise DeviceError(f"the board reads .mpy v{theirs[0]}.{theirs[1]}, mpy-cross writes v{ours[0]}.{ours[1]}",
+                                  "flash without --compile, or install the mpy-cross matching the board's MicroPython")
+        result = FlashResult(port=port, compiled=compile_mpy, firmware_version="", board=platform,
+                             config_written=False)
+        for name, data in files:
+            progress(f"copying {name}")
+            transport.fs_writefile(name, data)
+            other = name[:-3] + (".py" if name.endswith(".mpy") else ".mpy")
+            if other not in KEEP_SOURCE and transport.fs_exists(other):
+                transport.fs_rmfile(other)  # a stale .py would be imported before the new .mpy
+        for name, data in files:
+            progress(f"verifying {name}")
+            digest = hashlib.sha256(data).hexdigest()
+            if transport.fs_hashfile(name, "sha256").hex() != digest:
+                raise DeviceError(f"{name} on the board does not match the copy sent (SHA-256)",
+                                  "flash again; if it persists, the board's filesystem may be full or failing")
+            result.files.append(FlashedFile(name, len(data), digest))
+        if config is not None or not transport.fs_exists(fw_config.FILE):
+            progress(f"writing {fw_config.FILE}")
+            transport.fs_writefile(fw_config.FILE, json.dumps(config or fw_config.default()).encode())
+            result.config_written = True
+        progress("resetting")
+        transport.exit_raw_repl()
+        transport.serial.write(b"\x04")  # soft reset from the friendly REPL: runs main.py
+    except TransportError as exc:
+        raise DeviceError(f"mpremote failed on {port}: {exc}", "reset the board and run `locust flash` again") from None
+    finally:
+        transport.close()
+    progress("handshake")
+    with Link(port) as link:
+        hello = link.hello(wait_s=8.0)
+    if hello.get("version") != P.VERSION:
+        raise DeviceError(f"the board reports firmware {hello.get('version')} after flashing {P.VERSION}",
+                          "reset the board (a stale .py/.mpy may shadow the new files) and flash again")
+    result.firmware_version = hello["version"]
+    result.elapsed_s = time.monotonic() - t_start
+    return result

@@ -1,0 +1,109 @@
+"""Run the hop schedule on the robot and keep the run record up to date as phases arrive.
+
+The firmware times the phases itself (``ticks_us``) and reports each one live; the host
+sends a heartbeat all along, so that a host that dies or a cable that is pulled leaves the
+robot at rest within the heartbeat timeout. Whatever happens, ``run.json`` holds what
+arrived, with status ``complete`` only when every phase was reported and the firmware
+finished the schedule.
+"""
+
+from __future__ import annotations
+
+import queue
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from ..errors import DeviceError
+from ..firmware import protocol as P
+from . import record as R
+from .link import CLOSED, Link
+
+
+def _phase(ev: dict) -> R.Phase:
+    return R.Phase(int(ev["cycle"]), str(ev["phase"]), int(ev["commanded_us"]), int(ev["measured_us"]))
+
+
+def _fetch_report(link: Link, rec: R.RunRecord) -> None:
+    """Ask for the firmware's own list of phases: fills any event lost on the line."""
+    start = 0
+    while True:
+        msg = link.call("report", start=start)
+        for cycle, phase, commanded_us, measured_us in msg["phases"]:
+            rec.add_phase(R.Phase(cycle, phase, commanded_us, measured_us))
+        start += len(msg["phases"])
+        if not msg["phases"] or start >= msg["total"]:
+            return
+
+
+def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
+            on_phase: Callable[[R.Phase], None] = lambda p: None) -> R.RunRecord:
+    rec = R.RunRecord(schedule=schedule, port=link.port, message="running")
+    R.write(rec, directory)
+    try:
+        hello = link.hello()
+        rec.firmware_version = hello.get("version")
+        if hello.get("hopping"):
+            link.call("stop")
+        link.start_heartbeat(schedule.heartbeat_ms / 4000.0)
+        reply = link.request("hop", cycles=schedule.cycles, push_deg=schedule.push_deg,
+                             push_ms=schedule.push_ms, wait_ms=schedule.wait_ms,
+                             heartbeat_ms=schedule.heartbeat_ms)
+        if not reply.get("ok"):
+            rec.status, rec.message = R.ERROR, f"{reply.get('error')}: {reply.get('detail')}"
+            R.write(rec, directory)
+            raise DeviceError(f"the robot refused the hop: {rec.message}",
+                              "see `locust hop --help` and docs/protocol.md for the limits")
+        hop_id = reply["id"]
+        deadline = time.monotonic() + schedule.duration_s + 3.0
+        while True:
+            try:
+                ev = link.events.get(timeout=max(0.1, deadline - time.monotonic()))
+            except queue.Empty:
+                raise DeviceError("the robot stopped reporting mid-hop",
+                                  "check the cable and the power; the record keeps what arrived") from None
+            if ev is CLOSED:
+                raise link.lost_error()
+            if ev.get("ev") == P.EV_BOOT:
+                raise DeviceError("the robot rebooted mid-hop (brown-out or reset?)",
+                                  "check the servo power supply: two servos pushing can sag the ESP32's supply")
+            if ev.get("hop") != hop_id:
+                continue
+            if ev.get("ev") == P.EV_PHASE:
+                phase = _phase(ev)
+                rec.add_phase(phase)
+                R.write(rec, directory)
+                on_phase(phase)
+            elif ev.get("ev") == P.EV_DONE:
+                rec.firmware_status = ev.get("status")
+                break
+        link.stop_heartbeat()
+        if len(rec.phases) < schedule.phases:
+            _fetch_report(link, rec)
+    except KeyboardInterrupt:
+        _stop_quietly(link)
+        rec.status, rec.message = R.INCOMPLETE, "interrupted (Ctrl-C); the robot was sent to rest"
+        R.write(rec, directory)
+        raise DeviceError(f"hop interrupted after {len(rec.phases)} of {schedule.phases} phases; "
+                          f"partial record in {directory / R.RECORD_NAME}") from None
+    except DeviceError as exc:
+        _stop_quietly(link)
+        if rec.status != R.ERROR:
+            rec.status, rec.message = R.INCOMPLETE, exc.message
+        R.write(rec, directory)
+        raise DeviceError(f"{exc.message} (after {len(rec.phases)} of {schedule.phases} phases; "
+                          f"partial record in {directory / R.RECORD_NAME})", exc.hint) from None
+    finally:
+        link.stop_heartbeat()
+    complete = rec.firmware_status == P.HOP_COMPLETE and len(rec.phases) == schedule.phases
+    rec.status = R.COMPLETE if complete else R.INCOMPLETE
+    rec.message = None if complete else f"firmware ended the hop: {rec.firmware_status}"
+    R.write(rec, directory)
+    return rec
+
+
+def _stop_quietly(link: Link) -> None:
+    try:
+        link.request("stop", timeout_s=0.5)
+    except (DeviceError, KeyboardInterrupt):
+        pass

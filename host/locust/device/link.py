@@ -1,0 +1,193 @@
+"""The host end of the serial protocol: framed requests with ids, replies, events, heartbeat.
+
+The framing, message names and limits come from the firmware's own ``protocol.py``
+(imported here as ``locust.firmware.protocol``), so the two ends cannot drift apart.
+A reader thread splits the byte stream into frames: replies go to whoever waits on their
+request id, events to a queue; anything else on the line (REPL text, noise) is counted
+and dropped.
+"""
+
+from __future__ import annotations
+
+import collections
+import queue
+import threading
+import time
+
+import serial
+
+from ..errors import DeviceError
+from ..firmware import protocol as P
+
+CLOSED = {"ev": "link_closed"}  # put on the event queue when the port goes away
+
+
+class Link:
+    def __init__(self, port: str, baud: int = 115200, timeout_s: float = 1.0):
+        self.port = port
+        self.timeout_s = timeout_s
+        self.events: queue.Queue = queue.Queue()
+        self.unsolicited: collections.deque = collections.deque(maxlen=200)  # replies with no waiter
+        self.noise_lines = 0
+        self.error: Exception | None = None
+        self._pending: dict[int, queue.Queue] = {}
+        self._lock = threading.Lock()
+        self._write_lock = threading.Lock()
+        self._next_id = 1
+        self._heartbeat_stop: threading.Event | None = None
+        ser = serial.Serial()
+        ser.port = port
+        ser.baudrate = baud
+        ser.timeout = 0.05
+        # DTR and RTS drive EN and GPIO0 through the ESP32 boards' auto-reset circuit:
+        # keep both released, or opening the port can reset the board mid-hop.
+        ser.dtr = False
+        ser.rts = False
+        try:
+            ser.open()
+        except (serial.SerialException, OSError) as exc:
+            raise DeviceError(f"cannot open serial port {port}: {exc}",
+                              "check the cable and the port name (`locust ports`), and that no other "
+                              "program (a serial monitor, mpremote) holds the port") from None
+        ser.reset_input_buffer()
+        self.serial = ser
+        self._reader = threading.Thread(target=self._read_loop, name="locust-link-reader", daemon=True)
+        self._reader.start()
+
+    # -- reading ---------------------------------------------------------------------
+    def _read_loop(self) -> None:
+        lines = P.LineReader(limit=64 * 1024)
+        while self.error is None:
+            try:
+                data = self.serial.read(max(1, self.serial.in_waiting))
+            except (serial.SerialException, OSError, TypeError, AttributeError) as exc:
+                if self.serial.is_open:  # not a close() of ours: the cable went away
+                    self.error = exc
+                break
+            for line in lines.feed(data):
+                self._dispatch(line)
+        self.events.put(CLOSED)
+        with self._lock:
+            for waiter in self._pending.values():
+                waiter.put(CLOSED)
+
+    def _dispatch(self, line: bytes | None) -> None:
+        try:
+            msg = P.decode(line) if line is not None else None
+        except P.ProtocolError:
+            msg = None
+        if msg is None:
+            self.noise_lines += 1
+        elif "ev" in msg:
+            self.events.put(msg)
+        else:
+            with self._lock:
+                waiter = self._pending.pop(msg.get("id"), None)
+            (waiter.put(msg) if waiter else self.unsolicited.append(msg))
+
+    # -- writing -------------------------------------------------------------------
+    def write(self, data: bytes) -> None:
+        try:
+            with self._write_lock:
+                self.serial.write(data)
+        except (serial.SerialException, OSError) as exc:
+            self.error = self.error or exc
+            raise DeviceError(f"lost the serial port {self.port}: {exc}",
+                              "check the USB cable; the robot returns to rest on its own when the host goes silent") from None
+
+    def _new_id(self) -> int:
+        with self._lock:
+            req_id = self._next_id
+            self._next_id = self._next_id % P.MAX_ID + 1
+            return req_id
+
+    def request(self, cmd: str, timeout_s: float | None = None, **args) -> dict:
+        """Send ``cmd`` and wait for its reply (ok or not); DeviceError on timeout or lost port."""
+        if self.error is not None:
+            raise self.lost_error()
+        req_id = self._new_id()
+        waiter: queue.Queue = queue.Queue(maxsize=1)
+        with self._lock:
+            self._pending[req_id] = waiter
+        self.write(P.encode({"id": req_id, "cmd": cmd, **args}))
+        try:
+            msg = waiter.get(timeout=self.timeout_s if timeout_s is None else timeout_s)
+        except queue.Empty:
+            with self._lock:
+                self._pending.pop(req_id, None)
+            raise DeviceError(f"no reply to {cmd!r} from {self.port} within "
+                              f"{self.timeout_s if timeout_s is None else timeout_s:g} s",
+                              "is the locust firmware running? run `locust flash --port "
+                              f"{self.port}` (or reset the board)") from None
+        if msg is CLOSED:
+            raise self.lost_error()
+        return msg
+
+    def call(self, cmd: str, timeout_s: float | None = None, **args) -> dict:
+        """Like request(), but an error reply raises DeviceError."""
+        msg = self.request(cmd, timeout_s, **args)
+        if not msg.get("ok"):
+            raise DeviceError(f"the robot refused {cmd!r}: {msg.get('error')}: {msg.get('detail')}",
+                              "see docs/protocol.md for the limits of each command")
+        return msg
+
+    def lost_error(self) -> DeviceError:
+        return DeviceError(f"lost the serial port {self.port}: {self.error}",
+                           "check the USB cable; the robot returns to rest on its own when the host goes silent")
+
+    # -- handshake and heartbeat -----------------------------------------------------
+    def hello(self, wait_s: float = 3.0) -> dict:
+        """The identity/version handshake, retried for ``wait_s`` (a board may be booting)."""
+        deadline = time.monotonic() + wait_s
+        while True:
+            try:
+                msg = self.request("hello", timeout_s=min(0.5, max(0.05, deadline - time.monotonic())))
+                break
+            except DeviceError:
+                if self.error is not None or time.monotonic() >= deadline:
+                    raise DeviceError(f"no locust firmware answered on {self.port}",
+                                      "flash it with `locust flash --port "
+                                      f"{self.port}` (a board without MicroPython needs that first: see "
+                                      "`locust flash --help`)") from None
+        if not msg.get("ok") or msg.get("name") != P.NAME:
+            raise DeviceError(f"{self.port} answered but is not the locust firmware: {msg}",
+                              f"flash it with `locust flash --port {self.port}`")
+        if msg.get("protocol") != P.PROTOCOL:
+            raise DeviceError(f"firmware {msg.get('version')} speaks protocol {msg.get('protocol')}, "
+                              f"this host speaks {P.PROTOCOL}",
+                              f"flash the matching firmware with `locust flash --port {self.port}`")
+        return msg
+
+    def start_heartbeat(self, interval_s: float) -> None:
+        """Ping every ``interval_s`` until stop_heartbeat(): the robot's proof the host is alive."""
+        self.stop_heartbeat()
+        stop = threading.Event()
+        self._heartbeat_stop = stop
+
+        def beat() -> None:
+            while not stop.wait(interval_s) and self.error is None:
+                try:
+                    self.write(P.encode({"id": 0, "cmd": "ping"}))
+                except DeviceError:
+                    return
+
+        threading.Thread(target=beat, name="locust-link-heartbeat", daemon=True).start()
+
+    def stop_heartbeat(self) -> None:
+        if self._heartbeat_stop is not None:
+            self._heartbeat_stop.set()
+            self._heartbeat_stop = None
+
+    def close(self) -> None:
+        self.stop_heartbeat()
+        try:
+            self.serial.close()
+        except (serial.SerialException, OSError):
+            pass
+        self._reader.join(timeout=1.0)
+
+    def __enter__(self) -> "Link":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

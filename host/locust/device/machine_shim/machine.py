@@ -1,0 +1,102 @@
+# A `machine` module for the MicroPython unix port: the virtual robot's hardware.
+#
+# MicroPython code (it runs inside the interpreter, not on the host). It shadows the unix
+# port's own `machine` (found first on MICROPYPATH) and offers what the firmware uses:
+# Pin, PWM at a period, reset. Every PWM change is written as one line
+#     P <pin> <duty_ns> <ticks_us>\n
+# to the FIFO named by $LOCUST_PWM_FIFO, where the host turns it back into a horn angle
+# and feeds the plant. `reset()` writes "R" and the host reboots the interpreter.
+
+import os
+import time
+
+_fifo = None
+
+
+def _emit(line):
+    global _fifo
+    if _fifo is None:
+        path = os.getenv("LOCUST_PWM_FIFO")
+        _fifo = open(path, "wb") if path else False
+    if _fifo:
+        _fifo.write(line.encode())
+
+
+class Pin:
+    IN = 0
+    OUT = 1
+
+    def __init__(self, id, mode=-1, value=None, **kw):
+        self.id = id
+        self._value = value or 0
+
+    def value(self, v=None):
+        if v is None:
+            return self._value
+        self._value = 1 if v else 0
+
+    def __repr__(self):
+        return "Pin(%s)" % self.id
+
+
+class PWM:
+    def __init__(self, pin, freq=50, duty_ns=None, duty_u16=None, duty=None, **kw):
+        self.pin = pin.id if isinstance(pin, Pin) else int(pin)
+        self._freq = freq
+        self._ns = 0
+        if duty_ns is not None:
+            self.duty_ns(duty_ns)
+        elif duty_u16 is not None:
+            self.duty_u16(duty_u16)
+        elif duty is not None:
+            self.duty(duty)
+
+    def _period_ns(self):
+        return 1000000000 // self._freq
+
+    def freq(self, f=None):
+        if f is None:
+            return self._freq
+        self._freq = int(f)
+        self.duty_ns(self._ns)
+
+    def duty_ns(self, ns=None):
+        if ns is None:
+            return self._ns
+        self._ns = max(0, min(int(ns), self._period_ns()))
+        _emit("P %d %d %d\n" % (self.pin, self._ns, time.ticks_us()))
+
+    def duty_u16(self, v=None):
+        if v is None:
+            return self._ns * 65535 // self._period_ns()
+        self.duty_ns(int(v) * self._period_ns() // 65535)
+
+    def duty(self, v=None):  # the ESP32's 10-bit duty
+        if v is None:
+            return self._ns * 1023 // self._period_ns()
+        self.duty_ns(int(v) * self._period_ns() // 1023)
+
+    def deinit(self):
+        self._ns = 0
+        _emit("P %d 0 %d\n" % (self.pin, time.ticks_us()))
+
+
+def reset():
+    _emit("R\n")
+    time.sleep(1)
+
+
+def soft_reset():
+    raise SystemExit
+
+
+def unique_id():
+    return b"virtual0"
+
+
+def freq():
+    return 240000000
+
+
+def idle():
+    time.sleep_ms(1)

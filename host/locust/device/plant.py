@@ -1,0 +1,89 @@
+"""What the virtual robot's servos drive: a plant that takes horn angles over time.
+
+- ``RecordingPlant`` keeps every command in memory; tests and ``--plant record`` use it.
+- ``MujocoPlant`` drives the simulation engineer's live MuJoCo model
+  (``locust.sim.live.LiveSim``), so a hop on the virtual robot moves the simulated robot.
+
+A plant gets ``command(t_s, left_deg, right_deg)``: horn angles in firmware units (rest 0,
+push -30 on both legs) taking effect at ``t_s`` seconds since the virtual robot started.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol
+
+from ..errors import DeviceError
+
+PLANTS = ("auto", "mujoco", "record")
+
+
+class Plant(Protocol):
+    def command(self, t_s: float, left_deg: float, right_deg: float) -> None: ...
+
+    def close(self, t_s: float) -> dict: ...
+
+
+@dataclass(frozen=True)
+class ServoCommand:
+    t_s: float
+    left_deg: float
+    right_deg: float
+
+
+class RecordingPlant:
+    def __init__(self):
+        self.commands: list[ServoCommand] = []
+        self._lock = threading.Lock()
+
+    def command(self, t_s: float, left_deg: float, right_deg: float) -> None:
+        with self._lock:
+            self.commands.append(ServoCommand(t_s, left_deg, right_deg))
+
+    def close(self, t_s: float) -> dict:
+        return {"plant": "record", "commands": len(self.commands)}
+
+
+class MujocoPlant:
+    """The live MuJoCo model, stepped up to each command's time."""
+
+    def __init__(self, robot, video_path: Path | None = None):
+        try:
+            from ..sim.live import LiveSim
+        except ImportError as exc:
+            raise DeviceError(f"the live MuJoCo model is not available ({exc})",
+                              "use --plant record, or install the simulation part of locust") from None
+        self.sim = LiveSim(robot, video_path=str(video_path) if video_path else None)
+
+    def command(self, t_s: float, left_deg: float, right_deg: float) -> None:
+        self.sim.advance_to(t_s)
+        self.sim.set_servo_angles_deg(left_deg, right_deg)
+
+    def close(self, t_s: float) -> dict:
+        self.sim.advance_to(t_s)
+        return {"plant": "mujoco", **(self.sim.close() or {})}
+
+
+def mujoco_available() -> bool:
+    import importlib.util
+
+    try:
+        return importlib.util.find_spec("locust.sim.live") is not None
+    except ImportError:
+        return False
+
+
+def make_plant(kind: str, robot=None, video_path: Path | None = None) -> Plant:
+    """``auto`` is the MuJoCo model when it is installed (or a video is asked for), else a recorder."""
+    if kind == "auto":
+        kind = "mujoco" if (video_path is not None or mujoco_available()) else "record"
+    if kind == "mujoco":
+        if robot is None:
+            from ..params import preset
+            robot = preset("seed")
+        return MujocoPlant(robot, video_path)
+    if kind == "record":
+        return RecordingPlant()
+    raise DeviceError(f"unknown plant {kind!r}", f"choose one of {', '.join(PLANTS)}")

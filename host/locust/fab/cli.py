@@ -1,0 +1,147 @@
+"""``locust fab``: laminate cut files from an outline DXF or from the robot's link lengths."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import click
+
+from ..errors import FabError
+from . import export, flat_pattern, laminate, preview
+from .design import LayerMap, design_from_drawing, parse_layer_options
+from .dxf_read import UNIT_BY_NAME, read_drawing
+from .summary import summary, summary_text
+
+
+def _robot(spec: str):
+    from .. import params
+
+    if spec in params.PRESETS:
+        return params.preset(spec)
+    path = Path(spec)
+    if path.suffix.lower() == ".toml" or path.exists():
+        return params.load_robot(path)
+    raise FabError(f"--from-robot {spec!r}: neither a preset nor a robot.toml",
+                   f"give one of {', '.join(params.PRESETS)} or the path of a robot.toml")
+
+
+def _cad_check(out: Path, names: list[str]) -> dict:
+    from . import cadcheck
+
+    results = {}
+    with click.progressbar(names, label="LibreCAD", file=sys.stderr,
+                           show_pos=True) if sys.stderr.isatty() else _plain(names) as bar:
+        for name in bar:
+            d = cadcheck.check_dxf(out / name)
+            results[name] = {"painted_paths": d.painted_paths, "segments": d.segments}
+    return results
+
+
+class _plain:
+    def __init__(self, items):
+        self.items = items
+
+    def __enter__(self):
+        return self.items
+
+    def __exit__(self, *exc):
+        return False
+
+
+@click.command()
+@click.argument("dxf", required=False, type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--from-robot", "from_robot", metavar="PRESET_OR_TOML", default=None,
+              help="Draw the leg's flat pattern from a robot's four link lengths (a preset such as "
+                   "seed/medium/large, or a robot.toml) instead of reading a DXF.")
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="Write the cut files, previews and summary.json into this new folder "
+                   "(refused if it holds files). Without it nothing is written.")
+@click.option("--json", "as_json", is_flag=True, help="Print the manufacturing summary as JSON.")
+@click.option("--layer", "layers", multiple=True, metavar="ROLE=NAME",
+              help="Map a drawing layer (shell pattern) to a role: body, hinge, holes or cuts. "
+                   "Replaces that role's defaults; repeatable.")
+@click.option("--units", type=click.Choice(list(UNIT_BY_NAME)), default=None,
+              help="Drawing units, overriding $INSUNITS (a unitless drawing is read as mm).")
+@click.option("--gap-tol-mm", type=float, default=0.01, show_default=True,
+              help="Join open outline pieces whose ends are this close.")
+@click.option("--recover", is_flag=True, help="Read a damaged DXF with ezdxf's recover mode.")
+@click.option("--hinge-width-mm", type=float, default=1.0, show_default=True,
+              help="Width of the cut-out made from a fold line on a hinge layer.")
+@click.option("--stack", default=",".join(laminate.SEED_STACK), show_default=True,
+              help="Layer materials, top to bottom (rigid, adhesive, flexible).")
+@click.option("--mirror", multiple=True, metavar="LAYER",
+              help="Mirror this layer's cut files (e.g. adhesive_bottom, cut liner side up). Repeatable.")
+@click.option("--kerf-mm", type=float, default=0.05, show_default=True, help="Laser kerf (cut width).")
+@click.option("--support-width-mm", type=float, default=2.0, show_default=True,
+              help="Support web: release cut this far outside the outline.")
+@click.option("--jig-diameter-mm", type=float, default=5.0, show_default=True, help="Alignment hole diameter.")
+@click.option("--jig-spacing-mm", type=float, default=10.0, show_default=True,
+              help="Alignment holes this far out from the body's corners.")
+@click.option("--glue-tab-mm", type=float, default=20.0, show_default=True, help="With --from-robot: glue tab length.")
+@click.option("--slot-width-mm", type=float, default=1.0, show_default=True, help="With --from-robot: hinge slot width.")
+@click.option("--slot-length-mm", type=float, default=13.0, show_default=True, help="With --from-robot: hinge slot length.")
+@click.option("--no-preview", is_flag=True, help="Skip the PNG previews.")
+@click.option("--cad-check", is_flag=True, help="Open every written DXF in LibreCAD (headless) and check it draws.")
+def fab(dxf, from_robot, out, as_json, layers, units, gap_tol_mm, recover, hinge_width_mm, stack, mirror,
+        kerf_mm, support_width_mm, jig_diameter_mm, jig_spacing_mm, glue_tab_mm, slot_width_mm,
+        slot_length_mm, no_preview, cad_check):
+    """Generate the five-layer laminate cut files (DXF, mm).
+
+    \b
+    From a drawing (layers plate/body = outline, hinge_*/joints = hinges, holes, cuts):
+      locust fab zz.dxf --out cut/
+      locust fab flipper.dxf --layer body=outline --mirror adhesive_bottom --out cut/
+    From the robot's link lengths (the leg's flat pattern; hinges at the running sums of
+    ground, crank, coupler, leg):
+      locust fab --from-robot seed --json
+      locust fab --from-robot calibration/robot.toml --out cut/
+
+    Writes rigid_top, adhesive_top, flexible, adhesive_bottom, rigid_bottom,
+    combined_cut_pattern, first_pass_cuts and final_perimeter (.dxf), cut_pattern.png,
+    laminate_layers.png and summary.json. Areas are as designed; cut paths are
+    kerf-compensated. Nothing is written unless every file could be made.
+    """
+    if (dxf is None) == (from_robot is None):
+        raise FabError("give a DXF drawing or --from-robot, not both" if dxf else "nothing to draw",
+                       "e.g. `locust fab zz.dxf --out cut/` or `locust fab --from-robot seed --json`")
+    hinges_x = None
+    fp = None
+    if from_robot:
+        fp = flat_pattern.from_robot(_robot(from_robot), glue_tab_mm=glue_tab_mm,
+                                     slot_width_mm=slot_width_mm, slot_length_mm=slot_length_mm)
+        design = flat_pattern.design(fp)
+        hinges_x = fp.hinges_x_mm
+    else:
+        drawing = read_drawing(dxf, units=units, gap_tol_mm=gap_tol_mm, recover=recover)
+        layer_map = LayerMap().with_overrides(parse_layer_options(layers))
+        design = design_from_drawing(drawing, layer_map, hinge_width_mm=hinge_width_mm, gap_tol_mm=gap_tol_mm)
+
+    specs = laminate.stack_from_materials(stack.split(","), tuple(mirror))
+    process = laminate.Process(kerf_mm=kerf_mm, support_width_mm=support_width_mm,
+                               jig_diameter_mm=jig_diameter_mm, jig_spacing_mm=jig_spacing_mm)
+    lam = laminate.build(design, specs, process)
+
+    files: dict[str, bytes] = {}
+    if out is not None:
+        files = export.cut_files(lam)
+        if fp is not None:
+            files["flat_pattern.dxf"] = flat_pattern.drawing_bytes(fp)
+        if not no_preview:
+            files.update(preview.preview_files(lam))
+    names = sorted(files) + (["summary.json"] if out is not None else [])
+    result = summary(lam, hinges_x_mm=hinges_x, files=names, out_dir=str(out) if out else None)
+    if out is not None:
+        files["summary.json"] = (json.dumps(result, indent=2) + "\n").encode()
+        export.publish(out, files)
+        if cad_check:
+            result["cad_check"] = _cad_check(out, [n for n in names if n.endswith(".dxf")])
+    if as_json:
+        click.echo(json.dumps(result, indent=2))
+    else:
+        click.echo(summary_text(result))
+        if out is None:
+            click.echo("(no --out: nothing written)")
+        if "cad_check" in result:
+            click.echo(f"LibreCAD drew every file: {sum(v['segments'] for v in result['cad_check'].values())} segments")

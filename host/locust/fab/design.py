@@ -1,0 +1,210 @@
+"""From drawing contours to a design: what is body, hinge, hole and slit.
+
+Layers are given roles by name (case-insensitive shell patterns). The defaults cover the
+seed's ``plate`` / ``hinge_N`` and the course files' ``body`` / ``joints`` /
+``hinge_mountain`` / ``hinge_valley`` / ``holes`` / ``cuts``:
+
+- body: closed outlines; nested loops alternate material and hole (even-odd), touching
+  pieces are joined. An open body outline is an error that names the gap.
+- hinge: a closed outline is a hinge slot, used as drawn; an open path is a fold line,
+  cut out ``hinge_width_mm`` wide (flat ends) across the body.
+- holes: closed outlines cut through every layer.
+- cuts: closed outlines cut through every layer; open paths are slits (a single pass of
+  the beam, zero width as designed).
+"""
+
+from __future__ import annotations
+
+import fnmatch
+from dataclasses import dataclass, field
+
+import numpy as np
+from shapely import unary_union
+from shapely.geometry import LineString, MultiPolygon, Polygon
+from shapely.validation import explain_validity
+
+from ..errors import FabError
+from .dxf_read import Contour, Drawing
+
+ROLES = ("body", "hinge", "holes", "cuts")
+
+DEFAULT_LAYER_MAP: dict[str, tuple[str, ...]] = {
+    "body": ("plate", "body", "outline"),
+    "hinge": ("hinge", "hinge_*", "hinges", "joints", "joint", "joint_*", "hinge_mountain",
+              "hinge_valley", "mountain", "valley", "fold", "folds"),
+    "holes": ("holes", "hole", "hole_*"),
+    "cuts": ("cuts", "cut", "cut_*", "slits"),
+}
+
+
+@dataclass(frozen=True)
+class HingeCut:
+    """One hinge: a slot cut out of the rigid and adhesive layers."""
+
+    layer: str
+    kind: str                      # "slot" (closed outline as drawn) or "fold" (fold line)
+    polygon: Polygon               # the cut-out, mm, inside the body
+
+    @property
+    def area_mm2(self) -> float:
+        return float(self.polygon.area)
+
+    def table_row(self) -> dict:
+        x0, y0, x1, y1 = self.polygon.bounds
+        return {"layer": self.layer, "kind": self.kind,
+                "center_x_mm": round((x0 + x1) / 2, 4), "center_y_mm": round((y0 + y1) / 2, 4),
+                "y_min_mm": round(y0, 4), "y_max_mm": round(y1, 4),
+                "width_mm": round(x1 - x0, 4), "height_mm": round(y1 - y0, 4),
+                "area_mm2": round(self.area_mm2, 4)}
+
+
+@dataclass(frozen=True)
+class Design:
+    """A flat part as designed, in millimetres."""
+
+    body: Polygon | MultiPolygon
+    hinges: tuple[HingeCut, ...] = ()
+    holes: tuple[Polygon, ...] = ()                # through every layer
+    slits: tuple[LineString, ...] = ()             # through every layer, zero width
+    source: str = ""
+    units: str = "mm"
+    units_from: str = ""
+    layer_roles: dict[str, str] = field(default_factory=dict)    # drawing layer -> role
+    ignored_layers: tuple[str, ...] = ()
+
+    @property
+    def bounds_mm(self) -> tuple[float, float, float, float]:
+        return tuple(float(v) for v in self.body.bounds)
+
+    def hinge_union(self):
+        return unary_union([h.polygon for h in self.hinges])
+
+    def hole_union(self):
+        return unary_union(list(self.holes))
+
+
+@dataclass(frozen=True)
+class LayerMap:
+    patterns: dict[str, tuple[str, ...]] = field(default_factory=lambda: dict(DEFAULT_LAYER_MAP))
+
+    def with_overrides(self, items: dict[str, list[str]]) -> "LayerMap":
+        """``{"body": ["outline_a"], ...}``: these names replace the role's defaults."""
+        for role in items:
+            if role not in ROLES:
+                raise FabError(f"unknown layer role {role!r}", f"roles are {', '.join(ROLES)}")
+        return LayerMap({**self.patterns, **{r: tuple(v) for r, v in items.items()}})
+
+    def role_of(self, layer: str) -> str | None:
+        name = layer.lower()
+        for role in ROLES:
+            if any(fnmatch.fnmatchcase(name, p.lower()) for p in self.patterns[role]):
+                return role
+        return None
+
+
+def parse_layer_options(items: tuple[str, ...] | list[str]) -> dict[str, list[str]]:
+    """``("body=outline", "hinge=fold_*", "hinge=creases")`` -> ``{"body": [...], ...}``."""
+    out: dict[str, list[str]] = {}
+    for item in items:
+        role, sep, pattern = item.partition("=")
+        if not sep or not pattern.strip():
+            raise FabError(f"--layer {item!r}: expected ROLE=NAME", "e.g. --layer body=outline --layer hinge=folds")
+        out.setdefault(role.strip().lower(), []).append(pattern.strip())
+    return out
+
+
+def _fmt(p) -> str:
+    return f"({p[0]:.3f}, {p[1]:.3f}) mm"
+
+
+def open_outline_error(layer: str, opens: list[Contour], gap_tol_mm: float) -> FabError:
+    """Name the smallest gap between the loose ends of an open outline."""
+    ends = [(c, which, np.asarray(getattr(c, which))) for c in opens for which in ("start_mm", "end_mm")]
+    best = None
+    for i, (ci, wi, pi) in enumerate(ends):
+        for cj, wj, pj in ends[i + 1:]:
+            if ci is cj and len(opens) > 1:
+                continue
+            d = float(np.hypot(*(pi - pj)))
+            if best is None or d < best[0]:
+                best = (d, pi, pj, ci, cj)
+    d, pa, pb, ca, cb = best
+    pieces = ", ".join(dict.fromkeys(ca.entities + cb.entities))
+    if len(pieces) > 120:
+        pieces = pieces[:119] + "…"
+    return FabError(
+        f"layer {layer!r}: the outline is not closed: a gap of {d:.4g} mm between {_fmt(pa)} "
+        f"and {_fmt(pb)} ({pieces})",
+        f"close the outline in the CAD program, or join pieces this far apart with "
+        f"--gap-tol {d * 1.5:.3g} (mm; now {gap_tol_mm:g})",
+    )
+
+
+def _polygon(contour: Contour) -> Polygon:
+    poly = Polygon(contour.points_mm)
+    if not poly.is_valid:
+        raise FabError(
+            f"layer {contour.layer!r}: outline {', '.join(contour.entities[:3])} crosses itself "
+            f"({explain_validity(poly)})",
+            "fix the outline in the CAD program so it does not cross itself",
+        )
+    return poly
+
+
+def even_odd(polys: list[Polygon]):
+    """Material of nested loops: inside an even number of others is material, odd is a hole."""
+    depth = [sum(1 for j, q in enumerate(polys) if j != i and q.contains(p)) for i, p in enumerate(polys)]
+    geom = Polygon()
+    for d, p in sorted(zip(depth, polys), key=lambda t: t[0]):
+        geom = geom.union(p) if d % 2 == 0 else geom.difference(p)
+    return geom
+
+
+def fold_cutout(line: LineString, width_mm: float, body) -> Polygon | MultiPolygon:
+    return line.buffer(width_mm / 2, cap_style="flat", join_style="mitre").intersection(body)
+
+
+def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
+                        hinge_width_mm: float = 1.0, gap_tol_mm: float = 0.01) -> Design:
+    layer_map = layer_map or LayerMap()
+    roles = {layer: layer_map.role_of(layer) for layer in drawing.layers()}
+    by_role: dict[str, list[Contour]] = {r: [] for r in ROLES}
+    for c in drawing.contours:
+        if roles[c.layer]:
+            by_role[roles[c.layer]].append(c)
+
+    if not by_role["body"]:
+        found = ", ".join(drawing.layers()) or "none with curves"
+        raise FabError(
+            f"{drawing.path}: no body outline: no layer named like {', '.join(layer_map.patterns['body'])} "
+            f"(layers with curves: {found})",
+            "name the outline's layer with --layer body=NAME",
+        )
+    for role in ("body", "holes"):
+        opens = [c for c in by_role[role] if not c.closed]
+        for layer in dict.fromkeys(c.layer for c in opens):
+            raise open_outline_error(layer, [c for c in opens if c.layer == layer], gap_tol_mm)
+
+    body = even_odd([_polygon(c) for c in by_role["body"]])
+    if body.is_empty or body.area <= 0:
+        raise FabError(f"{drawing.path}: the body outline encloses no area", "check the body layer")
+
+    hinges: list[HingeCut] = []
+    for c in by_role["hinge"]:
+        if c.closed:
+            poly = _polygon(c)
+            hinges.append(HingeCut(c.layer, "slot", poly))
+        else:
+            cut = fold_cutout(LineString(c.points_mm), hinge_width_mm, body)
+            if not cut.is_empty:
+                hinges.append(HingeCut(c.layer, "fold", cut))
+    hinges.sort(key=lambda h: (round(h.polygon.bounds[0], 6), round(h.polygon.bounds[1], 6)))
+
+    holes = tuple(_polygon(c) for c in by_role["holes"] + by_role["cuts"] if c.closed)
+    slits = tuple(LineString(c.points_mm) for c in by_role["cuts"] if not c.closed)
+    return Design(
+        body=body, hinges=tuple(hinges), holes=holes, slits=slits, source=str(drawing.path),
+        units=drawing.units, units_from=drawing.units_from,
+        layer_roles={k: v for k, v in roles.items() if v},
+        ignored_layers=tuple(k for k, v in roles.items() if not v),
+    )

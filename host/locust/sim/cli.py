@@ -1,0 +1,85 @@
+"""``locust sim``: simulate the hop schedule on the MuJoCo model, audited."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import click
+
+from ..errors import GeometryError, SimError
+from ..params_cli import robot_options
+from ..params import resolve_robot
+
+
+@click.command()
+@robot_options
+@click.option("--cycles", type=click.IntRange(1, 1000), default=None,
+              help="Hop cycles to run (default: schedule.cycles of the robot).")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (exit 0 even when invalid).")
+@click.option("--video", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Render an MP4 (offscreen) and write the true marker pixels beside it (<video>.truth.csv).")
+@click.option("--camera", type=click.Choice(["track", "fixed"]), default="track", show_default=True,
+              help="For --video: follow the robot, or hold still (for measuring with `locust track`).")
+@click.option("--check-convergence", is_flag=True,
+              help="Rerun at half the time step and report the relative change.")
+def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence):
+    """Settle the robot on the floor, then run the bang-bang hop schedule.
+
+    Every run is audited (non-finite state, loop closure, energy, MuJoCo warnings). A run
+    that fails its audit is reported invalid with the reasons, and exits 1 unless --json.
+
+    \b
+    Examples:
+      locust sim --preset seed --json
+      locust sim --preset seed-notebook --json          # the notebook's Part 2 figures
+      locust sim --preset large --set servo.torque_limit_nm=0.2 --video large.mp4
+    """
+    from .run import check_convergence as converge, invalid_result, run
+
+    robot = resolve_robot(preset, config, sets)
+    try:
+        result = run(robot, cycles=cycles)
+    except GeometryError as exc:
+        if not as_json:
+            raise
+        result = invalid_result(robot, exc.message + (f" ({exc.hint})" if exc.hint else ""), cycles)
+    if check_convergence and result.valid:
+        result.convergence = converge(robot, result, cycles=cycles)
+    if video is not None:
+        if not result.valid:
+            raise SimError("not rendering an invalid simulation", "fix the reasons listed above first")
+        from .video import render_video
+
+        info = render_video(robot, video, cycles=cycles, camera=camera)
+        result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
+
+    if as_json:
+        click.echo(json.dumps(result.to_json(), indent=2))
+        return
+    _print_human(result)
+    if not result.valid:
+        sys.exit(1)
+
+
+def _print_human(r) -> None:
+    verdict = click.style("valid", fg="green") if r.valid else click.style("INVALID", fg="red")
+    click.echo(f"{r.robot}: {verdict} ({r.cycles} cycles, dt {r.timestep_s:g} s, {r.wall_s:.1f} s wall)")
+    for reason in r.reasons:
+        click.echo(f"  reason: {reason}")
+    if not r.valid:
+        return
+    click.echo(f"  distance        {r.distance_m * 100:8.2f} cm")
+    click.echo(f"  max nose height {r.max_nose_height_m * 100:8.2f} cm")
+    click.echo(f"  linkage         {r.grashof}, transmission {r.transmission_deg:.0f} deg")
+    click.echo("  hop  distance_cm  nose_apex_cm  com_apex_cm  flight_ms")
+    for h in r.hops:
+        click.echo(f"  {h.cycle:3d}  {h.distance_m * 100:11.2f}  {h.nose_apex_m * 100:12.2f}  "
+                   f"{h.com_apex_m * 100:11.2f}  {h.flight_s * 1000:9.1f}")
+    if r.convergence:
+        c = r.convergence
+        click.echo(f"  convergence at dt/2: distance {c['distance_rel_change'] * 100:.2f} %, "
+                   f"nose height {c['max_nose_height_rel_change'] * 100:.2f} %")
+    for note in r.notes:
+        click.echo(f"  note: {note}")

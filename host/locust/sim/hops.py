@@ -1,0 +1,69 @@
+"""Per-hop figures from a simulated trajectory.
+
+One hop per schedule cycle (push + wait). Heights are apexes above the standing height: the
+robot's pose at the end of the settle phase (or, with no settle phase, at the end of the run,
+when it stands still after the last wait).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .rollout import Trajectory
+
+
+@dataclass(frozen=True)
+class Hop:
+    cycle: int
+    distance_m: float            # chassis x travelled during the cycle
+    nose_apex_m: float           # highest nose point above standing nose height
+    com_apex_m: float            # highest centre of mass above standing height
+    flight_s: float              # longest time with no part of the robot on the floor
+
+
+@dataclass(frozen=True)
+class HopSummary:
+    hops: list[Hop]
+    distance_m: float            # chassis x, start of the schedule -> end of the run
+    max_nose_height_m: float     # highest nose point during the run (the notebook's metric)
+    standing_nose_m: float
+    standing_com_m: float
+
+
+def _longest_run(mask: np.ndarray) -> int:
+    if not mask.any():
+        return 0
+    padded = np.concatenate(([0], mask.astype(np.int8), [0]))
+    edges = np.flatnonzero(np.diff(padded))
+    return int((edges[1::2] - edges[::2]).max())
+
+
+def summarise(traj: Trajectory) -> HopSummary:
+    s, sd, plan = traj.built.sensors, traj.sensordata, traj.plan
+    nose_z = sd[:, s.nose_pos][:, 2]
+    com_z = sd[:, s.com_pos][:, 2]
+    x = sd[:, s.chassis_pos][:, 0]
+    airborne = sd[:, s.floor_contact][:, 0] < 0.5
+    stand = plan.settle_steps - 1 if plan.settle_steps > 0 else len(x) - 1
+    standing_nose, standing_com = float(nose_z[stand]), float(com_z[stand])
+    x_start = float(x[plan.settle_steps - 1]) if plan.settle_steps > 0 else float(traj.initial_sensordata[s.chassis_pos][0])
+
+    hops = []
+    starts = plan.cycle_start_steps
+    for c in range(len(starts) - 1):
+        a, b = int(starts[c]), int(starts[c + 1])
+        x_a = float(x[a - 1]) if a > 0 else x_start
+        hops.append(Hop(
+            cycle=c + 1,
+            distance_m=float(x[b - 1] - x_a),
+            nose_apex_m=float(nose_z[a:b].max() - standing_nose),
+            com_apex_m=float(com_z[a:b].max() - standing_com),
+            flight_s=_longest_run(airborne[a:b]) * traj.timestep_s,
+        ))
+    run_nose = nose_z[plan.settle_steps:]
+    if plan.settle_steps == 0:  # the notebook counts the drop too
+        run_nose = np.concatenate(([traj.initial_sensordata[s.nose_pos][2]], nose_z))
+    return HopSummary(hops=hops, distance_m=float(x[-1] - x_start), max_nose_height_m=float(run_nose.max()),
+                      standing_nose_m=standing_nose, standing_com_m=standing_com)

@@ -1,0 +1,274 @@
+"""Build the hopper's MuJoCo model from a :class:`~locust.params.Robot` with ``MjSpec``.
+
+The chassis is a free body (a thin plate); each leg is a planar four-bar hung from it:
+ground link (fixed to the chassis) -> crank (servo joint) -> coupler (knee hinge) ->
+leg (ankle hinge) -> loop closed back onto the ground link's front pivot by a ``connect``
+equality. Every body is placed in the assembled pose from :mod:`.fourbar`, so the loop is
+closed before the first step (``connect`` anchors are defined in the assembled pose).
+
+Numbers come from the robot parameters only; each one's provenance is in ``robot.toml``.
+The structure follows the notebook's Part 2 model so that the ``seed-notebook`` preset
+reproduces its figures; differences a preset asks for are parameter values, not code paths.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from ..errors import SimError
+from ..markers import MARKER_COLOURS, hex_to_rgb01
+from ..params import Robot
+from .fourbar import Assembly, assemble
+
+SIDES = ("L", "R")  # left leg at +y (faces the default camera), right leg at -y
+LINK_RGBA = {  # the notebook's colours
+    "ground": (0.2, 0.6, 1.0, 1.0),
+    "crank": (0.8, 0.8, 0.0, 1.0),
+    "coupler": (0.0, 1.0, 0.0, 1.0),
+    "leg": (1.0, 0.0, 0.0, 1.0),
+}
+MARKER_RADIUS_M = 0.006
+INTEGRATORS = {
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+}
+
+
+@dataclass(frozen=True)
+class SensorLayout:
+    """Column slices of ``sensordata`` (one row per step in a rollout)."""
+
+    nose_pos: slice
+    foot_pos: slice          # left foot (knee point, the lowest point of the linkage)
+    com_pos: slice           # centre of mass of the whole robot
+    chassis_pos: slice
+    loop_a: dict[str, slice]  # loop anchor on the ground link, per side
+    loop_b: dict[str, slice]  # loop anchor on the leg's end, per side
+    floor_contact: slice     # 1 when any part of the robot touches the floor
+    energy_potential: slice
+    energy_kinetic: slice
+    actuator_force: slice    # one column per servo
+    actuator_velocity: slice
+
+
+@dataclass(frozen=True)
+class BuiltModel:
+    model: mujoco.MjModel
+    assembly: Assembly
+    sensors: SensorLayout
+    servo_actuators: tuple[int, int]   # actuator ids (L, R)
+    link_lengths_m: tuple[float, float, float, float]  # ground, crank, coupler, leg
+
+
+def _quat_euler_deg(x: float, y: float, z: float) -> np.ndarray:
+    q = np.zeros(4)
+    mujoco.mju_euler2Quat(q, np.radians([x, y, z]), "xyz")
+    return q
+
+
+def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
+    """The model as an ``MjSpec`` (raises ``GeometryError`` for a linkage that cannot close)."""
+    g, c, s, k, sol = robot.geometry, robot.compliance, robot.servo, robot.contact, robot.solver
+    asm = assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, g.crank_start_deg)
+    if sol.integrator not in INTEGRATORS:
+        raise SimError(f"solver.integrator = {sol.integrator!r} is not known",
+                       f"choose one of {', '.join(INTEGRATORS)}")
+
+    spec = mujoco.MjSpec()
+    spec.modelname = f"locust-{robot.name}"
+    spec.compiler.degree = False
+    spec.option.timestep = sol.timestep_s
+    spec.option.integrator = INTEGRATORS[sol.integrator]
+    spec.option.iterations = int(sol.iterations)
+    spec.option.tolerance = sol.tolerance
+    spec.option.gravity = [0.0, 0.0, -9.81]
+    spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
+    # MuJoCo's autoreset would silently restart a diverged run: the audit must see it.
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
+    spec.visual.global_.offwidth = 1280
+    spec.visual.global_.offheight = 720
+    spec.visual.quality.shadowsize = 2048
+    spec.visual.map.fogstart = 100
+    spec.visual.map.fogend = 1000
+
+    spec.add_texture(name="grid", type=mujoco.mjtTexture.mjTEXTURE_2D,
+                     builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER, width=512, height=512,
+                     rgb1=[0.2, 0.2, 0.25], rgb2=[0.15, 0.15, 0.2])
+    mat = spec.add_material(name="floor", texrepeat=[5, 5], texuniform=True, reflectance=0.2)
+    mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
+    for colour_name, (hex_colour, _) in MARKER_COLOURS.items():
+        spec.add_material(name=f"marker_{colour_name}", rgba=[*hex_to_rgb01(hex_colour), 1.0], emission=1.0)
+
+    world = spec.worldbody
+    world.add_light(pos=[-2, -5, 5], dir=[0.5, 0.5, -1], castshadow=True)
+    world.add_light(pos=[5, 5, 8], dir=[-0.5, -0.5, -1], castshadow=True)
+    world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[10, 5, 0.1],
+                   material="floor", friction=[k.floor_friction, k.torsional_friction, k.rolling_friction],
+                   contype=FLOOR_BITS[0], conaffinity=FLOOR_BITS[1])
+
+    chassis = world.add_body(name="chassis", pos=[0, 0, g.drop_height_m],
+                             quat=_quat_euler_deg(180.0, g.body_pitch_deg, 180.0))
+    chassis.add_freejoint(name="free")
+    chassis.add_geom(name="plate", type=mujoco.mjtGeom.mjGEOM_BOX,
+                     size=[g.body_length_m / 2, g.body_width_m / 2, g.body_thickness_m / 2],
+                     rgba=[0.1, 0.1, 0.1, 1], mass=g.body_mass_kg,
+                     contype=ROBOT_BITS[bool(k.self_collision)][0], conaffinity=ROBOT_BITS[bool(k.self_collision)][1])
+    chassis.add_site(name="nose", pos=[g.nose_x_m, 0, 0], size=[0.005, 0, 0], rgba=[1, 0, 0, 1])
+    _marker(chassis, "nose", [g.nose_x_m, 0, 0])
+
+    half_w, half_t = g.link_width_m / 2, g.link_thickness_m / 2
+    foot_material = [k.foot_friction, k.torsional_friction, k.rolling_friction]
+    rho, selfc = g.link_density_kg_per_m3, bool(k.self_collision)
+    for side in SIDES:
+        y = g.leg_mount_y_m if side == "L" else -g.leg_mount_y_m
+        ground = chassis.add_body(name=f"{side}_ground", pos=[g.leg_mount_x_m, y, 0])
+        _ghost_box(ground, g.ground_m, half_w, half_t, LINK_RGBA["ground"], rho)
+        ground.add_site(name=f"{side}_loop_a", pos=[g.ground_m / 2, 0, 0])
+        # Joint angles about +y turn +x toward -z, the mirror of the fourbar frame's
+        # counter-clockwise angles: pass the fourbar angles through unchanged and the
+        # chain is the mirror image of the planar solution, closed at the same anchor.
+        crank = ground.add_body(name=f"{side}_crank", pos=[-g.ground_m / 2, 0, 0],
+                                quat=_quat_euler_deg(0, asm.crank_deg, 0))
+        crank.add_joint(name=f"{side}_servo", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
+                        range=[-math.radians(s.travel_deg), math.radians(s.travel_deg)],
+                        limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+                        stiffness=c.hinge_stiffness_nm_per_rad, damping=c.hinge_damping_nms_per_rad)
+        _link_box(crank, g.crank_m, half_w, half_t, LINK_RGBA["crank"], foot_material, rho, selfc)
+        coupler = crank.add_body(name=f"{side}_coupler", pos=[g.crank_m, 0, 0],
+                                 quat=_quat_euler_deg(0, asm.coupler_rel_deg, 0))
+        _hinge(coupler, f"{side}_knee", c)
+        _link_box(coupler, g.coupler_m, half_w, half_t, LINK_RGBA["coupler"], foot_material, rho, selfc)
+        leg = coupler.add_body(name=f"{side}_leg", pos=[g.coupler_m, 0, 0],
+                               quat=_quat_euler_deg(0, asm.leg_rel_deg, 0))
+        _hinge(leg, f"{side}_ankle", c)
+        _link_box(leg, g.leg_m, half_w, half_t, LINK_RGBA["leg"], foot_material, rho, selfc)
+        leg.add_site(name=f"{side}_foot", pos=[0, 0, 0], size=[0.004, 0, 0])
+        if side == "L":
+            _marker(leg, "foot", [0, g.link_width_m / 2 + MARKER_RADIUS_M, 0])
+        end = leg.add_body(name=f"{side}_end", pos=[g.leg_m, 0, 0])
+        end.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.005, 0, 0], contype=0, conaffinity=0, density=rho,
+                     rgba=list(LINK_RGBA["ground"]))
+        end.add_site(name=f"{side}_loop_b", pos=[0, 0, 0])
+        spec.add_equality(name=f"{side}_loop", type=mujoco.mjtEq.mjEQ_CONNECT,
+                          objtype=mujoco.mjtObj.mjOBJ_BODY, name1=f"{side}_ground", name2=f"{side}_end",
+                          data=[g.ground_m / 2, 0, 0] + [0.0] * 7 + [1.0, 0.0],  # as MJCF fills it
+                          solref=[sol.loop_timeconst_s, 1.0],
+                          solimp=[min(0.9, sol.loop_dmax), sol.loop_dmax, 0.001, 0.5, 2.0])
+        act = spec.add_actuator(name=f"{side}_servo", target=f"{side}_servo",
+                                trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        act.set_to_position(kp=s.kp_nm_per_rad, kv=s.kv_nms_per_rad)
+        act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        act.ctrlrange = [-math.radians(s.travel_deg), math.radians(s.travel_deg)]
+        # The torque limit is always applied: a hobby servo stalls at its rated torque.
+        act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        act.forcerange = [-s.torque_limit_nm, s.torque_limit_nm]
+
+    _add_sensors(spec)
+    return spec, asm
+
+
+def _hinge(body, name: str, c) -> None:
+    body.add_joint(name=name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
+                   stiffness=c.hinge_stiffness_nm_per_rad, damping=c.hinge_damping_nms_per_rad)
+
+
+# Collision bits: the floor collides with everything; robot parts collide with the floor and,
+# when contact.self_collision is on (the notebook's model), with each other.
+FLOOR_BITS = (1, 3)       # contype, conaffinity
+ROBOT_BITS = {True: (1, 1), False: (2, 1)}
+
+
+def _link_box(body, length_m: float, half_w: float, half_t: float, rgba, friction,
+              density: float, self_collision: bool) -> None:
+    contype, conaffinity = ROBOT_BITS[self_collision]
+    body.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, pos=[length_m / 2, 0, 0],
+                  size=[length_m / 2, half_w, half_t], rgba=list(rgba), friction=list(friction),
+                  density=density, contype=contype, conaffinity=conaffinity)
+
+
+def _ghost_box(body, length_m: float, half_w: float, half_t: float, rgba, density: float) -> None:
+    body.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, pos=[0, 0, 0], size=[length_m / 2, half_w, half_t],
+                  rgba=list(rgba), contype=0, conaffinity=0, density=density)
+
+
+def _marker(body, name: str, pos) -> None:
+    """A massless, non-colliding emissive dot for the video tracker."""
+    body.add_geom(name=f"marker_{name}", type=mujoco.mjtGeom.mjGEOM_SPHERE, pos=list(pos),
+                  size=[MARKER_RADIUS_M, 0, 0], material=f"marker_{name}", contype=0, conaffinity=0,
+                  mass=0.0, group=1)
+
+
+def _add_sensors(spec: mujoco.MjSpec) -> None:
+    def add(name, stype, objtype=None, objname="", **kw):
+        sensor = spec.add_sensor(name=name, type=stype, **kw)
+        if objtype is not None:
+            sensor.objtype, sensor.objname = objtype, objname
+        return sensor
+
+    T, O = mujoco.mjtSensor, mujoco.mjtObj
+    add("nose_pos", T.mjSENS_FRAMEPOS, O.mjOBJ_SITE, "nose")
+    add("foot_pos", T.mjSENS_FRAMEPOS, O.mjOBJ_SITE, "L_foot")
+    add("com_pos", T.mjSENS_SUBTREECOM, O.mjOBJ_BODY, "chassis")
+    add("chassis_pos", T.mjSENS_FRAMEPOS, O.mjOBJ_BODY, "chassis")
+    for side in SIDES:
+        add(f"{side}_loop_a", T.mjSENS_FRAMEPOS, O.mjOBJ_SITE, f"{side}_loop_a")
+        add(f"{side}_loop_b", T.mjSENS_FRAMEPOS, O.mjOBJ_SITE, f"{side}_loop_b")
+    contact = add("floor_contact", T.mjSENS_CONTACT, O.mjOBJ_XBODY, "chassis",
+                  reftype=O.mjOBJ_GEOM, refname="floor")
+    contact.intprm = [1, 0, 1]  # data = found; one match is enough
+    add("energy_potential", T.mjSENS_E_POTENTIAL)
+    add("energy_kinetic", T.mjSENS_E_KINETIC)
+    for side in SIDES:
+        add(f"{side}_servo_force", T.mjSENS_ACTUATORFRC, O.mjOBJ_ACTUATOR, f"{side}_servo")
+    for side in SIDES:
+        add(f"{side}_servo_vel", T.mjSENS_ACTUATORVEL, O.mjOBJ_ACTUATOR, f"{side}_servo")
+
+
+def _layout(model: mujoco.MjModel) -> SensorLayout:
+    def sl(name: str) -> slice:
+        sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, name)
+        adr, dim = int(model.sensor_adr[sid]), int(model.sensor_dim[sid])
+        return slice(adr, adr + dim)
+
+    def span(first: str, last: str) -> slice:
+        return slice(sl(first).start, sl(last).stop)
+
+    return SensorLayout(
+        nose_pos=sl("nose_pos"), foot_pos=sl("foot_pos"), com_pos=sl("com_pos"),
+        chassis_pos=sl("chassis_pos"),
+        loop_a={side: sl(f"{side}_loop_a") for side in SIDES},
+        loop_b={side: sl(f"{side}_loop_b") for side in SIDES},
+        floor_contact=sl("floor_contact"),
+        energy_potential=sl("energy_potential"), energy_kinetic=sl("energy_kinetic"),
+        actuator_force=span("L_servo_force", "R_servo_force"),
+        actuator_velocity=span("L_servo_vel", "R_servo_vel"),
+    )
+
+
+def build(robot: Robot) -> BuiltModel:
+    """Compile the robot's model. Raises ``GeometryError`` or ``SimError`` with the reason."""
+    spec, asm = build_spec(robot)
+    try:
+        model = spec.compile()
+    except ValueError as exc:  # MuJoCo's compiler reports bad values this way
+        raise SimError(f"MuJoCo could not compile the model: {exc}",
+                       "check the robot parameters named in the message") from None
+    ids = tuple(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, f"{s}_servo") for s in SIDES)
+    return BuiltModel(model=model, assembly=asm, sensors=_layout(model), servo_actuators=ids,
+                      link_lengths_m=robot.link_lengths_m())  # type: ignore[arg-type]
+
+
+def loop_closure_error_m(model: mujoco.MjModel, data: mujoco.MjData) -> float:
+    """Largest distance between the two anchors of any loop ``connect``, after ``mj_forward``."""
+    worst = 0.0
+    for side in SIDES:
+        a = data.site(f"{side}_loop_a").xpos
+        b = data.site(f"{side}_loop_b").xpos
+        worst = max(worst, float(np.linalg.norm(a - b)))
+    return worst

@@ -1,0 +1,93 @@
+"""One audited simulation: build, roll out, audit, summarise -> :class:`SimResult`."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..errors import GeometryError
+from ..params import Robot
+from .audit import audit
+from .hops import Hop, summarise
+from .model import build
+from .rollout import simulate
+
+
+@dataclass
+class SimResult:
+    robot: str
+    valid: bool
+    reasons: list[str]
+    distance_m: float
+    max_nose_height_m: float
+    hops: list[Hop]
+    cycles: int
+    timestep_s: float
+    duration_s: float
+    wall_s: float
+    loop_residual_max_m: float
+    energy_surplus_max_j: float
+    servo_work_j: float
+    grashof: str = ""
+    transmission_deg: float = float("nan")
+    notes: list[str] = field(default_factory=list)
+    convergence: dict[str, float] | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        out = dataclasses.asdict(self)
+        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+
+
+def invalid_result(robot: Robot, reason: str, cycles: int | None = None) -> SimResult:
+    nan = float("nan")
+    return SimResult(robot=robot.name, valid=False, reasons=[reason], distance_m=nan, max_nose_height_m=nan,
+                     hops=[], cycles=cycles or robot.schedule.cycles, timestep_s=robot.solver.timestep_s,
+                     duration_s=0.0, wall_s=0.0, loop_residual_max_m=nan, energy_surplus_max_j=nan,
+                     servo_work_j=nan)
+
+
+def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None) -> SimResult:
+    """Simulate and audit. An impossible linkage raises :class:`GeometryError`."""
+    if timestep_s is not None:
+        robot = robot.with_values({"solver.timestep_s": timestep_s})
+    built = build(robot)
+    traj = simulate(robot, cycles=cycles, built=built)
+    verdict = audit(traj)
+    summary = summarise(traj) if verdict.valid else None
+    nan = float("nan")
+    notes = list(verdict.notes)
+    asm = built.assembly
+    lo, hi = 40.0, 140.0
+    if not lo <= asm.transmission_deg <= hi:
+        notes.append(f"poor transmission angle {asm.transmission_deg:.0f} deg at the start (outside {lo:g}-{hi:g})")
+    return SimResult(
+        robot=robot.name, valid=verdict.valid, reasons=verdict.reasons,
+        distance_m=summary.distance_m if summary else nan,
+        max_nose_height_m=summary.max_nose_height_m if summary else nan,
+        hops=summary.hops if summary else [],
+        cycles=len(traj.plan.cycle_start_steps) - 1, timestep_s=traj.timestep_s,
+        duration_s=traj.plan.duration_s, wall_s=traj.wall_s,
+        loop_residual_max_m=verdict.loop_residual_max_m, energy_surplus_max_j=verdict.energy_surplus_max_j,
+        servo_work_j=verdict.servo_work_j, grashof=asm.grashof, transmission_deg=asm.transmission_deg,
+        notes=notes,
+    )
+
+
+def check_convergence(robot: Robot, result: SimResult, cycles: int | None = None) -> dict[str, float]:
+    """Rerun at half the time step; relative change of distance and nose height."""
+    half = run(robot, cycles=cycles, timestep_s=result.timestep_s / 2)
+    def rel(a: float, b: float) -> float:
+        return abs(a - b) / abs(b) if b else float("inf")
+    return {
+        "half_timestep_s": half.timestep_s,
+        "half_valid": float(half.valid),
+        "half_distance_m": half.distance_m,
+        "half_max_nose_height_m": half.max_nose_height_m,
+        "distance_rel_change": rel(result.distance_m, half.distance_m),
+        "max_nose_height_rel_change": rel(result.max_nose_height_m, half.max_nose_height_m),
+    }
+
+
+__all__ = ["SimResult", "run", "check_convergence", "invalid_result", "GeometryError"]

@@ -1,0 +1,21 @@
+"""Marker tracks from video: the command-line replacement for clicking in Tracker.
+
+Pixels in, metres and seconds out. Every pixel coordinate in this package uses
+OpenCV's convention: the origin is the centre of the top-left pixel, x to the right,
+y down. World coordinates are metres with y up.
+
+Modules, one job each:
+
+- :mod:`.video`     decoding, clip settings (start/end/step/fps), bad-file errors
+- :mod:`.predict`   Tracker's constant-acceleration look-ahead for search windows
+- :mod:`.color`     coloured stickers: colour-picked, coverage-weighted centroid
+- :mod:`.template`  Tracker's autotracker: evolving template, Gaussian sub-pixel peak
+- :mod:`.aruco`     ArUco markers (``cv2.aruco``) with sub-pixel corners
+- :mod:`.spec`      ``--marker NAME=SPEC`` parsing and the default marker set
+- :mod:`.calib`     pixel -> metre calibration (stick or ArUco size), origin, axes
+- :mod:`.runner`    the frame loop that ties video, markers and calibration together
+- :mod:`.export`    CSV + JSON sidecar
+- :mod:`.trk`       Tracker's .trk/.trz reader and its text-export layout
+- :mod:`.overlay`   PNG / video of the tracks drawn on the footage
+- :mod:`.synth`     synthetic videos with known sub-pixel truth
+"""

@@ -1,0 +1,82 @@
+"""Pixels to metres: scale, origin and axes, as Tracker's calibration stick and axes.
+
+World coordinates are metres, y up. ``angle_deg`` is the direction of the world x axis
+measured counter-clockwise (as seen on screen) from the image x axis, as in Tracker's
+``ImageCoordSystem``. The origin is a pixel position (OpenCV convention); by default the
+centre of the bottom-left pixel, so a robot on the floor has y >= 0.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from ..errors import TrackError
+
+NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+
+
+@dataclass(frozen=True)
+class Calibration:
+    m_per_px: float  # NaN: no scale given, world columns stay empty
+    origin_x_px: float
+    origin_y_px: float
+    angle_deg: float = 0.0
+    source: str = "none"
+
+    def to_world(self, px: np.ndarray, py: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Image pixels -> world metres (y up). NaN stays NaN."""
+        a = math.radians(self.angle_deg)
+        dx = np.asarray(px, float) - self.origin_x_px
+        dy = -(np.asarray(py, float) - self.origin_y_px)
+        x = self.m_per_px * (dx * math.cos(a) + dy * math.sin(a))
+        y = self.m_per_px * (-dx * math.sin(a) + dy * math.cos(a))
+        return x, y
+
+    def as_dict(self) -> dict:
+        d = asdict(self)
+        d["m_per_px"] = None if not math.isfinite(self.m_per_px) else self.m_per_px
+        return d
+
+
+def parse_scale(text: str) -> tuple[float, float, float, float, float]:
+    """``X1,Y1,X2,Y2=LENGTH_M`` -> the stick's two ends (px) and its length (m)."""
+    m = re.fullmatch(rf"\s*({NUM})\s*,\s*({NUM})\s*,\s*({NUM})\s*,\s*({NUM})\s*=\s*({NUM})\s*", text)
+    if not m:
+        raise TrackError(f"--scale {text!r}: expected X1,Y1,X2,Y2=LENGTH_M",
+                         "give both ends of a stick of known length in pixels, e.g. --scale 272.2,446.1,273.2,47.4=1.0")
+    x1, y1, x2, y2, length = map(float, m.groups())
+    if not length > 0:
+        raise TrackError(f"--scale {text!r}: the length must be positive (metres)")
+    if math.hypot(x2 - x1, y2 - y1) < 1.0:
+        raise TrackError(f"--scale {text!r}: the two ends are less than a pixel apart",
+                         "use the two ends of the stick, as far apart as it shows")
+    return x1, y1, x2, y2, length
+
+
+def parse_point(text: str, option: str) -> tuple[float, float]:
+    m = re.fullmatch(rf"\s*({NUM})\s*,\s*({NUM})\s*", text)
+    if not m:
+        raise TrackError(f"{option} {text!r}: expected X,Y in pixels", f"e.g. {option} 131.3,207.9")
+    return float(m.group(1)), float(m.group(2))
+
+
+def parse_aruco_scale(text: str) -> tuple[int, float]:
+    m = re.fullmatch(rf"\s*(\d+)\s*=\s*({NUM})\s*", text)
+    if not m or not float(m.group(2)) > 0:
+        raise TrackError(f"--scale-aruco {text!r}: expected ID=SIDE_M (the printed side length in metres)",
+                         "e.g. --scale-aruco 7=0.04 for a 4 cm marker")
+    return int(m.group(1)), float(m.group(2))
+
+
+def m_per_px_from_stick(x1: float, y1: float, x2: float, y2: float, length_m: float) -> float:
+    return length_m / math.hypot(x2 - x1, y2 - y1)
+
+
+def build(height_px: int, m_per_px: float = math.nan, origin: tuple[float, float] | None = None,
+          angle_deg: float = 0.0, source: str = "none") -> Calibration:
+    ox, oy = origin if origin is not None else (0.0, float(height_px - 1))
+    return Calibration(m_per_px, ox, oy, angle_deg, source)

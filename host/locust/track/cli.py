@@ -1,0 +1,175 @@
+"""``locust track``: marker tracks from video, or from a Tracker project."""
+
+from __future__ import annotations
+
+import math
+import sys
+from contextlib import nullcontext
+from pathlib import Path
+
+import click
+
+from ..errors import TrackError
+from . import calib, export, overlay, trk
+from .aruco import DEFAULT_DICTIONARY, side_px_in_video
+from .runner import track_video
+from .spec import ModelOptions, parse_markers
+from .video import Clip, probe
+
+
+def _progress(length: int, label: str):
+    """A progress bar on stderr, only on a terminal."""
+    if not sys.stderr.isatty():
+        return nullcontext(None)
+    return click.progressbar(length=length, label=label, file=sys.stderr)
+
+
+def _outputs(base: Path, fmt: str, overlay_kind: str) -> dict[str, Path]:
+    stem = base.name[: -len(base.suffix)] if base.suffix in (".csv", ".txt") else base.name
+    folder = base.parent
+    out = {"tracks": folder / f"{stem}{'.txt' if fmt == 'tracker' else '.csv'}", "sidecar": folder / f"{stem}.json"}
+    if overlay_kind == "png":
+        out["overlay"] = folder / f"{stem}.png"
+    elif overlay_kind == "video":
+        out["overlay"] = folder / f"{stem}.overlay.mp4"
+    return out
+
+
+def _refuse_overwrite(paths: dict[str, Path], force: bool) -> None:
+    taken = [str(p) for p in paths.values() if p.exists()]
+    if taken and not force:
+        raise TrackError(f"output exists: {', '.join(taken)}", "choose another --out, or add --force to replace it")
+
+
+def _base_path(out: Path | None, source: Path) -> Path:
+    default_stem = f"{source.stem}.tracks"
+    if out is None:
+        return source.with_name(default_stem)
+    if out.is_dir():
+        return out / default_stem
+    return out
+
+
+@click.command(context_settings={"max_content_width": 100})
+@click.argument("video", required=False, type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--marker", "markers", multiple=True, metavar="NAME=SPEC",
+              help="A marker to track; repeatable. SPEC is color:#RRGGBB, template:X,Y@FRAME or aruco:ID[@DICT]. "
+                   "Default: the robot's nose (#ff00ff) and foot (#00ffff) colours.")
+@click.option("--color-tol", default=80, show_default=True, type=click.IntRange(1, 255),
+              help="Colour markers: largest per-channel difference (0-255) still counted as the marker.")
+@click.option("--search", "search_px", default=40, show_default=True, type=click.IntRange(4, 2000),
+              help="Half-size (px) of the search window around each predicted position.")
+@click.option("--template-radius", default=8, show_default=True, type=click.IntRange(2, 200),
+              help="Template markers: radius (px) of the circular template (Tracker's mask is 16 px across).")
+@click.option("--accept", default=4.0, show_default=True, type=float,
+              help="Template markers: least peak height (Tracker's 'automark' level) to accept a match.")
+@click.option("--evolve", default=20.0, show_default=True, type=click.FloatRange(0, 100),
+              help="Template markers: percent of each accepted match blended into the template.")
+@click.option("--scale", metavar="X1,Y1,X2,Y2=LENGTH_M",
+              help="Calibration stick: two pixel points and the distance between them in metres.")
+@click.option("--scale-aruco", metavar="ID=SIDE_M",
+              help="Calibrate from an ArUco marker's printed side length (m), measured where it first appears.")
+@click.option("--aruco-dict", default=DEFAULT_DICTIONARY, show_default=True,
+              help="ArUco dictionary for --scale-aruco.")
+@click.option("--origin", metavar="X,Y", help="World origin in pixels. Default: centre of the bottom-left pixel.")
+@click.option("--angle", default=0.0, show_default=True, type=float,
+              help="Direction of the world x axis, degrees counter-clockwise from the image x axis (as Tracker).")
+@click.option("--start", default=0, show_default=True, type=int, help="First frame of the clip.")
+@click.option("--end", default=None, type=int, help="Last frame of the clip (inclusive). Default: the last frame.")
+@click.option("--step", default=1, show_default=True, type=int, help="Track every STEP-th frame.")
+@click.option("--fps", default=None, type=float,
+              help="True frame rate, for slow-motion footage whose file rate is wrong. Default: the file's rate.")
+@click.option("--out", type=click.Path(path_type=Path),
+              help="Output file (or folder). Default: <video>.tracks.csv beside the video, with .json and .png.")
+@click.option("--format", "fmt", type=click.Choice(["csv", "tracker"]), default="csv", show_default=True,
+              help="csv: frame, t_s, <name>_px/_py/_x_m/_y_m/_ok. tracker: Tracker's text export layout.")
+@click.option("--overlay", "overlay_kind", type=click.Choice(["png", "video", "none"]), default="png",
+              show_default=True, help="Draw the tracks on the last frame (png) or on the whole clip (video).")
+@click.option("--force", is_flag=True, help="Replace existing output files.")
+@click.option("--from-trk", type=click.Path(dir_okay=False, path_type=Path),
+              help="Convert the point tracks of a Tracker project (.trk or .trz) instead of tracking a video.")
+@click.option("--track", "trk_names", multiple=True, metavar="NAME",
+              help="With --from-trk: only these Tracker tracks (repeatable). Default: all point masses.")
+def track(video, markers, color_tol, search_px, template_radius, accept, evolve, scale, scale_aruco, aruco_dict,
+          origin, angle, start, end, step, fps, out, fmt, overlay_kind, force, from_trk, trk_names):
+    """Extract marker tracks (nose, foot) from VIDEO, as Tracker's autotracker would, in batch.
+
+    \b
+    Pixels follow OpenCV: origin at the centre of the top-left pixel, x right, y down.
+    World columns are metres, y up, once a scale is given (--scale or --scale-aruco).
+    A marker not found in a frame is nan with <name>_ok = 0; it is never filled in.
+
+    \b
+    Examples:
+      locust track hop.mp4                                  nose + foot by colour
+      locust track hop.mp4 --scale 100,400,500,400=0.30 --origin 100,400
+      locust track toss.mp4 --marker ball=template:131.28,207.86@2
+      locust track slowmo.mp4 --fps 240 --start 30 --end 400
+      locust track --from-trk experiment.trz --format tracker
+    """
+    if from_trk is not None:
+        if video is not None:
+            raise TrackError("give either VIDEO or --from-trk, not both", "track a video, or convert a Tracker project")
+        return _convert_trk(from_trk, list(trk_names), out, fmt, force)
+    if video is None:
+        raise TrackError("no video given", "usage: locust track VIDEO [--marker NAME=SPEC ...]; see --help")
+
+    info = probe(video)
+    clip = Clip(start, end, step, fps).resolved(info)
+    options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0)
+    models = parse_markers(list(markers), options)
+    calibration = _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle)
+    paths = _outputs(_base_path(out, video), fmt, overlay_kind)
+    _refuse_overwrite(paths, force)
+
+    n = len(clip.frames())
+    with _progress(n, f"tracking {video.name}") as bar:
+        result = track_video(info, clip, models, calibration, progress=bar.update if bar else None)
+    written = _write(result, paths, fmt)
+    if "overlay" in paths:
+        if overlay_kind == "png":
+            written.append(overlay.write_png(result, paths["overlay"]))
+        else:
+            with _progress(n, "overlay video") as bar:
+                written.append(overlay.write_video(result, paths["overlay"], bar.update if bar else None))
+    _report(result, written)
+
+
+def _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle) -> calib.Calibration:
+    if scale and scale_aruco:
+        raise TrackError("give --scale or --scale-aruco, not both", "one calibration per run")
+    m_per_px, source = math.nan, "none"
+    if scale:
+        x1, y1, x2, y2, length = calib.parse_scale(scale)
+        m_per_px, source = calib.m_per_px_from_stick(x1, y1, x2, y2, length), f"stick {scale}"
+    elif scale_aruco:
+        marker_id, side_m = calib.parse_aruco_scale(scale_aruco)
+        frame, side = side_px_in_video(info, clip, marker_id, aruco_dict)
+        m_per_px, source = side_m / side, f"aruco {marker_id} side {side_m} m = {side:.3f} px on frame {frame}"
+    point = calib.parse_point(origin, "--origin") if origin else None
+    return calib.build(info.height_px, m_per_px, point, angle, source)
+
+
+def _write(result, paths: dict[str, Path], fmt: str) -> list[Path]:
+    if fmt == "tracker":
+        trk.write_tracker_text(result, paths["tracks"])
+        from ..fileio import atomic_write_json
+
+        atomic_write_json(paths["sidecar"], export.sidecar(result, paths["tracks"]))
+        return [paths["tracks"], paths["sidecar"]]
+    return list(export.write_tracks(result, paths["tracks"]))
+
+
+def _convert_trk(path: Path, names: list[str], out, fmt: str, force: bool) -> None:
+    project = trk.read_project(path)
+    result = trk.project_result(project, names or None)
+    paths = _outputs(_base_path(out, path), fmt, "none")
+    _refuse_overwrite(paths, force)
+    _report(result, _write(result, paths, fmt))
+
+
+def _report(result, written: list[Path]) -> None:
+    for line in export.summary_lines(result):
+        click.echo(line)
+    for p in written:
+        click.echo(f"wrote {p}")

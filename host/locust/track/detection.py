@@ -1,0 +1,47 @@
+"""What every marker model returns for one frame."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Optional, Protocol
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Detection:
+    """A marker's position in one frame, in pixels (OpenCV convention).
+
+    ``score`` is the model's own confidence (see each model); ``ok`` is false when the
+    marker was not found, and then ``px``/``py`` are NaN -- never a guess.
+    """
+
+    px: float
+    py: float
+    score: float
+    ok: bool
+
+    @staticmethod
+    def missing(score: float = math.nan) -> "Detection":
+        return Detection(math.nan, math.nan, score, False)
+
+    def point(self) -> Optional[tuple[float, float]]:
+        return (self.px, self.py) if self.ok else None
+
+
+class MarkerModel(Protocol):
+    """One tracked marker. ``locate`` is called once per frame, in frame order."""
+
+    name: str
+    spec: str
+
+    def locate(self, frame: int, image_bgr: np.ndarray) -> Detection: ...
+
+
+def window(centre: tuple[float, float], half_px: int, shape: tuple[int, ...]) -> tuple[int, int, int, int]:
+    """Integer window ``(x0, y0, x1, y1)`` (exclusive end) of half-size ``half_px`` around
+    ``centre``, clipped to an image of ``shape``."""
+    cx, cy = int(round(centre[0])), int(round(centre[1]))
+    h, w = shape[:2]
+    return max(cx - half_px, 0), max(cy - half_px, 0), min(cx + half_px + 1, w), min(cy + half_px + 1, h)

@@ -1,0 +1,87 @@
+"""Tracks drawn on the footage: a PNG to glance at, or a whole annotated video."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import Callable, Optional
+
+import cv2
+import numpy as np
+
+from ..errors import TrackError
+from ..fileio import atomic_write_bytes
+from .runner import MarkerTrack, TrackResult
+from .video import read_frame, read_frames
+
+PALETTE_BGR = [(255, 0, 255), (255, 255, 0), (0, 255, 255), (0, 128, 255), (255, 128, 0), (128, 255, 0)]
+
+
+def _colour(track: MarkerTrack, k: int) -> tuple[int, int, int]:
+    if track.spec.lower().startswith(("color:#", "colour:#")):
+        h = track.spec.split("#", 1)[1]
+        return int(h[4:6], 16), int(h[2:4], 16), int(h[0:2], 16)
+    return PALETTE_BGR[k % len(PALETTE_BGR)]
+
+
+def draw_tracks(image: np.ndarray, result: TrackResult, upto: int | None = None) -> np.ndarray:
+    """Draw each marker's path (and its latest point) on a copy of ``image``."""
+    out = image.copy()
+    n = len(result.frames) if upto is None else upto + 1
+    shift = 4  # sub-pixel drawing: coordinates in 1/16 px
+    for k, tr in enumerate(result.markers):
+        colour = _colour(tr, k)
+        pts = np.stack([tr.px[:n], tr.py[:n]], axis=1)
+        good = tr.ok[:n]
+        # break the path where the marker was missing
+        for seg in np.split(np.arange(n), np.flatnonzero(~good) + 1):
+            seg = seg[good[seg]] if seg.size else seg
+            if seg.size >= 2:
+                poly = np.round(pts[seg] * (1 << shift)).astype(np.int32)
+                cv2.polylines(out, [poly], False, colour, 1, cv2.LINE_AA, shift)
+        for i in np.flatnonzero(good):
+            c = tuple(int(v) for v in np.round(pts[i] * (1 << shift)))
+            cv2.circle(out, c, 3 << shift, colour, 1, cv2.LINE_AA, shift)
+        last = np.flatnonzero(good)
+        if last.size:
+            x, y = pts[last[-1]]
+            cv2.putText(out, tr.name, (int(x) + 8, int(y) - 8), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv2.LINE_AA)
+    cal = result.calibration
+    o = (int(round(cal.origin_x_px)), int(round(cal.origin_y_px)))
+    a = np.radians(cal.angle_deg)
+    cv2.arrowedLine(out, o, (int(o[0] + 40 * np.cos(a)), int(o[1] - 40 * np.sin(a))), (0, 0, 255), 1, cv2.LINE_AA)
+    cv2.arrowedLine(out, o, (int(o[0] - 40 * np.sin(a)), int(o[1] - 40 * np.cos(a))), (0, 255, 0), 1, cv2.LINE_AA)
+    return out
+
+
+def write_png(result: TrackResult, path: Path) -> Path:
+    """The clip's last frame with every track on it."""
+    if result.video is None:
+        raise TrackError("no video to draw on", "give the video to draw tracks on")
+    image = read_frame(result.video, int(result.frames[-1]))
+    ok, png = cv2.imencode(".png", draw_tracks(image, result))
+    return atomic_write_bytes(path, png.tobytes())
+
+
+def write_video(result: TrackResult, path: Path, progress: Optional[Callable[[int], None]] = None) -> Path:
+    """The whole clip with the tracks growing frame by frame (MPEG-4, at the clip's rate)."""
+    v = result.video
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".mp4", dir=path.parent)
+    os.close(fd)
+    writer = cv2.VideoWriter(tmp, cv2.VideoWriter_fourcc(*"mp4v"), float(result.clip.fps), (v.width_px, v.height_px))
+    try:
+        if not writer.isOpened():
+            raise TrackError(f"cannot write an overlay video at {path}", "check the folder is writable")
+        for i, (_, image) in enumerate(read_frames(v, result.clip)):
+            writer.write(draw_tracks(image, result, upto=i))
+            if progress:
+                progress(1)
+        writer.release()
+        os.replace(tmp, path)
+    except BaseException:
+        writer.release()
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+

@@ -1,0 +1,77 @@
+"""The frame loop: decode each frame of the clip once, let every marker find itself."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+import numpy as np
+
+from ..errors import TrackError
+from .calib import Calibration
+from .video import Clip, VideoInfo, read_frames
+
+
+@dataclass
+class MarkerTrack:
+    name: str
+    spec: str
+    px: np.ndarray
+    py: np.ndarray
+    score: np.ndarray
+    ok: np.ndarray
+
+    def found(self) -> int:
+        return int(self.ok.sum())
+
+
+@dataclass
+class TrackResult:
+    """Tracks of one clip. ``video`` is None for tracks read from a Tracker project."""
+
+    video: Optional[VideoInfo]
+    clip: Clip
+    frames: np.ndarray
+    t_s: np.ndarray
+    markers: list[MarkerTrack]
+    calibration: Calibration
+    source: str = "locust track"
+
+    def world(self, track: MarkerTrack) -> tuple[np.ndarray, np.ndarray]:
+        return self.calibration.to_world(track.px, track.py)
+
+
+def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibration,
+                progress: Optional[Callable[[int], None]] = None, require_found: bool = True) -> TrackResult:
+    """Run every marker model over a resolved ``clip`` of the video ``info``.
+
+    ``progress(n)`` is called after each frame. With ``require_found`` a marker that was
+    never found anywhere in the clip raises TrackError (nothing is written then).
+    """
+    frames = np.array(list(clip.frames()), dtype=int)
+    n = len(frames)
+    for model in models:  # a template's key frame must be read, or nothing can be matched
+        key = getattr(model, "key_frame", None)
+        if key is not None and key not in clip.frames():
+            raise TrackError(f"marker {model.name}: key frame {key} is not in the clip "
+                             f"(frames {clip.start}..{clip.end} step {clip.step})",
+                             f"start the clip at or before frame {key} with a step that reaches it")
+    cols = {m.name: (np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan), np.zeros(n, bool)) for m in models}
+    for i, (frame, image) in enumerate(read_frames(info, clip)):
+        for model in models:
+            det = model.locate(frame, image)
+            px, py, score, ok = cols[model.name]
+            px[i], py[i], score[i], ok[i] = det.px, det.py, det.score, det.ok
+        if progress:
+            progress(1)
+    tracks = [MarkerTrack(m.name, m.spec, *cols[m.name]) for m in models]
+    if require_found:
+        lost = [t for t in tracks if t.found() == 0]
+        if lost:
+            raise TrackError(
+                f"marker(s) never found in frames {clip.start}..{clip.end} of {info.path.name}: "
+                + ", ".join(f"{t.name} ({t.spec})" for t in lost),
+                "check the colour with --color-tol, the template point and frame, or the ArUco id; "
+                "--marker NAME=SPEC replaces the default nose/foot colours")
+    t_s = np.array([clip.time_s(int(f)) for f in frames])
+    return TrackResult(info, clip, frames, t_s, tracks, calibration)

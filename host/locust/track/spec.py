@@ -1,0 +1,80 @@
+"""``--marker NAME=SPEC`` parsing, and the default marker set.
+
+Specs::
+
+    color:#RRGGBB          a coloured sticker (tolerance: --color-tol)
+    template:X,Y@FRAME     Tracker's autotracker, template around (X, Y) on FRAME
+    aruco:ID[@DICT]        an ArUco marker (default dictionary DICT_4X4_50)
+
+With no ``--marker`` the markers are the robot's own colours from
+:data:`locust.markers.MARKER_COLOURS` (nose magenta, foot cyan), which the simulation
+renders too.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ..errors import TrackError
+from ..markers import MARKER_COLOURS
+from .aruco import DEFAULT_DICTIONARY, ArucoMarker
+from .color import ColorMarker, parse_hex
+from .template import TemplateMarker
+
+NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)"
+
+
+@dataclass(frozen=True)
+class ModelOptions:
+    """Settings shared by all markers of one run."""
+
+    color_tol: int = 80
+    search_half_px: int = 40
+    template_radius_px: int = 8
+    accept: float = 4.0
+    evolve: float = 0.2
+
+
+def default_specs() -> list[str]:
+    return [f"{name}=color:{hex_colour}" for name, (hex_colour, _) in MARKER_COLOURS.items()]
+
+
+def parse_marker(text: str, options: ModelOptions = ModelOptions()):
+    """One ``NAME=SPEC`` string -> a marker model (see the module doc)."""
+    name, sep, spec = text.partition("=")
+    name, spec = name.strip(), spec.strip()
+    if not sep or not NAME_RE.match(name):
+        raise TrackError(f"--marker {text!r}: expected NAME=SPEC with a name of letters, digits and _",
+                         "e.g. --marker nose=color:#ff00ff or --marker ball=template:131.3,207.9@2")
+    kind, _, arg = spec.partition(":")
+    kind = kind.lower()
+    if kind in ("color", "colour"):
+        return ColorMarker(name, spec, parse_hex(arg), tolerance=options.color_tol,
+                           search_half_px=options.search_half_px)
+    if kind == "template":
+        m = re.fullmatch(rf"\s*({NUM})\s*,\s*({NUM})\s*@\s*(\d+)\s*", arg)
+        if not m:
+            raise TrackError(f"--marker {text!r}: template spec must be template:X,Y@FRAME",
+                             "give the pixel position of the feature on a frame, e.g. template:131.28,207.86@2")
+        return TemplateMarker(name, spec, float(m.group(1)), float(m.group(2)), int(m.group(3)),
+                              radius_px=options.template_radius_px, search_half_px=options.search_half_px,
+                              accept=options.accept, evolve=options.evolve)
+    if kind == "aruco":
+        m = re.fullmatch(r"\s*(\d+)\s*(?:@\s*(DICT_\w+)\s*)?", arg)
+        if not m:
+            raise TrackError(f"--marker {text!r}: ArUco spec must be aruco:ID or aruco:ID@DICT_4X4_50",
+                             "give the marker's id number, e.g. aruco:7")
+        return ArucoMarker(name, spec, int(m.group(1)), m.group(2) or DEFAULT_DICTIONARY)
+    raise TrackError(f"--marker {text!r}: unknown marker kind {kind!r}",
+                     "use color:#RRGGBB, template:X,Y@FRAME or aruco:ID")
+
+
+def parse_markers(texts: list[str] | tuple[str, ...], options: ModelOptions = ModelOptions()) -> list:
+    models = [parse_marker(t, options) for t in (texts or default_specs())]
+    names = [m.name for m in models]
+    dupes = sorted({n for n in names if names.count(n) > 1})
+    if dupes:
+        raise TrackError(f"marker name(s) used twice: {', '.join(dupes)}", "give each --marker its own name")
+    return models

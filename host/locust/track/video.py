@@ -1,0 +1,173 @@
+"""Video decoding and clip settings.
+
+Decoding goes through OpenCV's FFmpeg backend. Bad input is caught here, once, and
+turned into a :class:`~locust.errors.TrackError` naming the file and frame: a file that
+is not a video, a still image, and a video that ends before its header says it should
+(truncated by a copy or a full card).
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterator
+
+# FFmpeg's own log lines ("moov atom not found" ...) are noise next to our error
+# message; the level must be set before the first capture is opened.
+os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
+
+import cv2  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ..errors import TrackError  # noqa: E402
+
+
+@dataclass(frozen=True)
+class VideoInfo:
+    path: Path
+    width_px: int
+    height_px: int
+    frame_count: int
+    file_fps: float
+
+
+@dataclass(frozen=True)
+class Clip:
+    """Which frames to read and what time they are.
+
+    ``end`` is inclusive (like Tracker's end frame); ``None`` means the last frame.
+    ``fps`` overrides the file's rate (slow-motion footage is often stored at 30 fps
+    while filmed at 240 fps). Time is ``t_s = (frame - start) / fps``, zero at the
+    clip's first frame, as in Tracker.
+    """
+
+    start: int = 0
+    end: int | None = None
+    step: int = 1
+    fps: float | None = None
+
+    def resolved(self, info: VideoInfo) -> "Clip":
+        last = info.frame_count - 1
+        end = last if self.end is None else self.end
+        fps = self.fps if self.fps is not None else info.file_fps
+        if self.step < 1:
+            raise TrackError(f"--step {self.step}: the step must be 1 or more", "use --step 1 to read every frame")
+        if not 0 <= self.start <= last:
+            raise TrackError(f"--start {self.start} is outside {info.path.name} (frames 0..{last})",
+                             f"choose a start frame between 0 and {last}")
+        if not self.start <= end <= last:
+            raise TrackError(f"--end {end} is outside frames {self.start}..{last} of {info.path.name}",
+                             f"choose an end frame between {self.start} and {last}")
+        if not (fps and np.isfinite(fps) and fps > 0):
+            raise TrackError(f"{info.path.name} has no usable frame rate ({fps!r})",
+                             "give the real frame rate with --fps, e.g. --fps 240")
+        return Clip(self.start, end, self.step, float(fps))
+
+    def frames(self) -> range:
+        assert self.end is not None, "resolve the clip first"
+        return range(self.start, self.end + 1, self.step)
+
+    def time_s(self, frame: int) -> float:
+        assert self.fps is not None, "resolve the clip first"
+        return (frame - self.start) / self.fps
+
+
+def probe(path: str | os.PathLike) -> VideoInfo:
+    """Open ``path`` and read its size, frame count and rate, or raise TrackError."""
+    path = Path(path)
+    if not path.is_file():
+        raise TrackError(f"{path}: no such file", "check the path of the video")
+    if path.stat().st_size == 0:
+        raise TrackError(f"{path}: the file is empty", "copy the video again from the camera")
+    cap = cv2.VideoCapture(str(path))
+    try:
+        if not cap.isOpened():
+            raise TrackError(f"{path}: not a readable video (FFmpeg could not open it; "
+                             "it is not a video, or a damaged or truncated one)",
+                             "check the file plays in a video player; re-copy it from the camera")
+        count = cap.get(cv2.CAP_PROP_FRAME_COUNT)
+        info = VideoInfo(path, int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT)),
+                         int(count) if 0 < count < 1e9 else 0, float(cap.get(cv2.CAP_PROP_FPS) or 0.0))
+    finally:
+        cap.release()
+    if info.frame_count < 2 or info.width_px <= 0:
+        raise TrackError(f"{path}: not a video (it has {max(info.frame_count, 0)} frames; a still image?)",
+                         "give a video file (mp4, avi, mov) of the hop")
+    return info
+
+
+def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8) -> Iterator[tuple[int, np.ndarray]]:
+    """Yield ``(frame_index, bgr_image)`` for every frame of a resolved ``clip``.
+
+    Frames are decoded in order (seeking is inexact in many codecs); skipped frames are
+    grabbed without conversion. Decoding runs in a thread ``prefetch`` frames ahead of
+    the caller (OpenCV releases the GIL while it decodes), so tracking a frame overlaps
+    decoding the next ones. Raises TrackError if the file ends early.
+    """
+    out: queue.Queue = queue.Queue(maxsize=max(prefetch, 1))
+    stop = threading.Event()
+
+    def put(item) -> bool:
+        while not stop.is_set():
+            try:
+                out.put(item, timeout=0.1)
+                return True
+            except queue.Full:
+                continue
+        return False
+
+    def decode() -> None:
+        cap = cv2.VideoCapture(str(info.path))
+        try:
+            index = 0
+            for frame in clip.frames():
+                while index < frame:
+                    if not cap.grab():
+                        put(_EndedEarly(index))
+                        return
+                    index += 1
+                ok, image = cap.read()
+                if not ok or image is None:
+                    put(_EndedEarly(index))
+                    return
+                index += 1
+                if not put((frame, image)):
+                    return
+            put(None)
+        finally:
+            cap.release()
+
+    worker = threading.Thread(target=decode, name=f"decode {info.path.name}", daemon=True)
+    worker.start()
+    try:
+        while True:
+            item = out.get()
+            if item is None:
+                return
+            if isinstance(item, _EndedEarly):
+                _ended_early(info, item.index)
+            yield item
+    finally:
+        stop.set()
+        worker.join()
+
+
+@dataclass(frozen=True)
+class _EndedEarly:
+    index: int
+
+
+def read_frame(info: VideoInfo, frame: int) -> np.ndarray:
+    """One decoded frame (for overlays and calibration)."""
+    for _, image in read_frames(info, Clip(frame, frame, 1, 1.0)):
+        return image
+    raise TrackError(f"{info.path}: frame {frame} could not be read")  # pragma: no cover
+
+
+def _ended_early(info: VideoInfo, index: int) -> None:
+    raise TrackError(f"{info.path}: decoding stopped at frame {index}, but the file says it has "
+                     f"{info.frame_count} frames: the video is truncated or damaged",
+                     f"re-copy the file, or track the readable part with --end {max(index - 1, 0)}")

@@ -1,0 +1,57 @@
+"""Robot parameters: presets, overrides, TOML round trip, errors."""
+
+import pytest
+
+from locust import params as P
+from locust.errors import ParamsError
+
+
+def test_presets_add_one_and_two_cm_to_every_link():
+    seed = P.preset("seed").link_lengths_m()
+    for name, added in (("small", 0.0), ("medium", 0.01), ("large", 0.02)):
+        got = P.preset(name).link_lengths_m()
+        assert got == pytest.approx(tuple(v + added for v in seed), abs=1e-12)
+    assert seed == (0.04, 0.04, 0.02, 0.06)
+
+
+def test_seed_notebook_runs_the_notebook_way():
+    nb = P.preset("seed-notebook")
+    assert (nb.solver.timestep_s, nb.solver.control_hz, nb.solver.settle_s) == (1e-4, 60.0, 0.0)
+    assert nb.source_of("servo.kp_nm_per_rad").source == "seed"
+
+
+def test_set_overrides_and_records_provenance():
+    r = P.resolve_robot("seed", None, ["servo.kp_nm_per_rad=25", "contact.self_collision=true"])
+    assert r.servo.kp_nm_per_rad == 25.0 and r.contact.self_collision is True
+    assert r.source_of("servo.kp_nm_per_rad").source == "override"
+
+
+@pytest.mark.parametrize("item, fragment", [
+    ("servo.kp=3", "unknown robot parameter"),
+    ("servo.kp_nm_per_rad", "is not KEY=VALUE"),
+    ("servo.kp_nm_per_rad=abc", "bad value"),
+    ("schedule.cycles=2.5", "not a whole number"),
+])
+def test_bad_set_options(item, fragment):
+    with pytest.raises(ParamsError) as err:
+        P.resolve_robot("seed", None, [item])
+    assert fragment in err.value.message
+
+
+def test_toml_round_trip_keeps_values_and_uncertainty(tmp_path):
+    fitted = P.preset("medium").with_values(
+        {"compliance.hinge_stiffness_nm_per_rad": 0.061},
+        P.Provenance(source="fit:beam.csv", uncertainty=0.002, date="2026-11-21"))
+    path = P.save_robot(fitted, tmp_path / "robot.toml")
+    back = P.load_robot(path)
+    assert back.flat() == fitted.flat()
+    prov = back.source_of("compliance.hinge_stiffness_nm_per_rad")
+    assert (prov.source, prov.uncertainty, prov.date) == ("fit:beam.csv", 0.002, "2026-11-21")
+
+
+def test_broken_toml_names_the_file(tmp_path):
+    bad = tmp_path / "robot.toml"
+    bad.write_text("[servo]\nkp_nm_per_rad = = 3\n")
+    with pytest.raises(ParamsError) as err:
+        P.load_robot(bad)
+    assert str(bad) in err.value.message

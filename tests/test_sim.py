@@ -1,0 +1,68 @@
+"""The hop simulation: reproduction of the notebook, audit, refusal of broken designs."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from locust.params import preset
+from locust.sim.model import build, loop_closure_error_m
+from locust.sim.run import run
+
+import mujoco
+
+
+@pytest.mark.parametrize("name", ["seed", "medium", "large", "seed-notebook"])
+def test_model_is_built_closed(name):
+    built = build(preset(name))
+    data = mujoco.MjData(built.model)
+    mujoco.mj_forward(built.model, data)
+    assert loop_closure_error_m(built.model, data) < 1e-6
+
+
+def test_torque_limit_always_applied():
+    m = build(preset("seed").with_values({"servo.torque_limit_nm": 0.2})).model
+    assert m.actuator_forcelimited.all() and (m.actuator_forcerange == [[-0.2, 0.2]] * 2).all()
+
+
+def test_seed_notebook_reproduces_part2_baseline():
+    # notebook Part 2: 59.12 cm and 6.76 cm over 6 hops; within 5 %
+    r = run(preset("seed-notebook"))
+    assert r.valid, r.reasons
+    assert r.distance_m == pytest.approx(0.5912, rel=0.05)
+    assert r.max_nose_height_m == pytest.approx(0.0676, rel=0.05)
+    assert len(r.hops) == 6
+
+
+def test_seed_six_hops_valid_and_airborne():
+    r = run(preset("seed"), cycles=6)
+    assert r.valid, r.reasons
+    assert len(r.hops) == 6
+    assert all(h.flight_s > 0.02 for h in r.hops)            # each cycle leaves the floor
+    assert sum(h.distance_m for h in r.hops) == pytest.approx(r.distance_m, rel=1e-9)
+    assert r.loop_residual_max_m < 0.002                     # the corrected loop stays closed
+
+
+def test_unstable_servo_is_caught_by_the_audit():
+    # 1e5 N*m/rad with no damping and no torque limit to speak of: the integrator blows up
+    wild = preset("seed").with_values({
+        "servo.kp_nm_per_rad": 1e5, "servo.kv_nms_per_rad": 0.0, "servo.torque_limit_nm": 1e4,
+        "compliance.hinge_damping_nms_per_rad": 0.0})
+    r = run(wild, cycles=1)
+    assert not r.valid
+    assert any("energy" in reason for reason in r.reasons)
+    assert r.energy_surplus_max_j > 1.0                      # joules from nowhere
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "locust.cli", *args], capture_output=True, text=True)
+
+
+def test_cli_refuses_impossible_linkage_with_reason():
+    out = _cli("sim", "--preset", "seed", "--set", "geometry.coupler_m=0.2", "--json")
+    doc = json.loads(out.stdout)
+    assert doc["valid"] is False and "geometry.coupler_m" in doc["reasons"][0]
+    human = _cli("sim", "--preset", "seed", "--set", "geometry.coupler_m=0.2")
+    assert human.returncode == 2 and "Traceback" not in human.stderr
+    assert "cannot close" in human.stderr

@@ -1,0 +1,96 @@
+"""`locust track` against Tracker's own example project (BallToss.trz, Open Source Physics)."""
+
+from __future__ import annotations
+
+import zipfile
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from locust.cli import cli
+from locust.track import trk
+
+
+@pytest.fixture(scope="module")
+def balltoss(shared_data, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("balltoss")
+    with zipfile.ZipFile(shared_data / "tracker" / "BallToss.trz") as z:
+        z.extractall(folder)
+    return folder
+
+
+def _tracker_points(folder) -> dict[int, tuple[float, float]]:
+    """Tracker's stored ball steps, in Tracker's own image coordinates (no conversion)."""
+    project = trk.read_project(folder / "BallToss_BallToss.trk")
+    return {f: (x - trk.TRACKER_TO_OPENCV_PX, y - trk.TRACKER_TO_OPENCV_PX)
+            for f, (x, y) in project.points["ball"].items()}
+
+
+def test_template_tracker_matches_trackers_autotracker(balltoss, monkeypatch):
+    monkeypatch.chdir(balltoss)
+    res = CliRunner().invoke(cli, ["track", "videos/BallToss_new_BallToss.mp4",
+                                   "--marker", "ball=template:131.28,207.86@2"])
+    assert res.exit_code == 0, res.output
+    df = pd.read_csv(balltoss / "videos" / "BallToss_new_BallToss.tracks.csv")
+    ref = _tracker_points(balltoss)
+    frames = list(range(3, 13))
+    got = df.set_index("frame").loc[frames]
+    assert got["ball_ok"].all(), "a frame is missing"
+    # A template marker reports the key point plus the displacement it measured, and so
+    # does Tracker; comparing displacements from the key frame makes the comparison
+    # independent of the half pixel between Tracker's and OpenCV's pixel origins.
+    key = np.array(ref[2])
+    ours = got[["ball_px", "ball_py"]].to_numpy() - np.array([131.28, 207.86])
+    theirs = np.array([ref[f] for f in frames]) - key
+    err = np.hypot(*(ours - theirs).T)
+    assert err.mean() < 1.0, err
+    assert err.mean() < 0.6  # measured 0.46 px
+    assert err.max() < 1.0
+
+
+def test_trk_reader_reproduces_trackers_world_data(shared_data):
+    project = trk.read_project(shared_data / "tracker" / "BallToss.trz")
+    assert sorted(project.points["ball"]) == list(range(2, 13))
+    assert project.calibration.m_per_px == pytest.approx(1 / 398.70891559670895)
+    # Tracker's image origin is the top-left corner; OpenCV's the top-left pixel centre
+    assert project.points["ball"][3] == pytest.approx((176.10010427528672 - 0.5, 154.66110531803963 - 0.5))
+    assert project.clip.fps == pytest.approx(1000 / 66.0)
+    result = trk.project_result(project)
+    ball = result.markers[0]
+    x, y = result.world(ball)
+    assert (x[2], y[2]) == pytest.approx((0.0, 0.0), abs=1e-12)  # the axes origin sits on the first step
+    # published figure (shared/data/README): a parabola through Tracker's data gives g ~ 10.3 m/s^2
+    c = np.polyfit(result.t_s[ball.ok], y[ball.ok], 2)
+    assert -2 * c[0] == pytest.approx(10.3, abs=0.1)
+
+
+def test_from_trk_cli_writes_trackers_text_layout(shared_data, tmp_path):
+    out = tmp_path / "balltoss.txt"
+    res = CliRunner().invoke(cli, ["track", "--from-trk", str(shared_data / "tracker" / "BallToss.trz"),
+                                   "--format", "tracker", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    table = trk.read_tracker_text(out)["ball"]
+    project = trk.read_project(shared_data / "tracker" / "BallToss.trz")
+    result = trk.project_result(project)
+    x, y = result.world(result.markers[0])
+    ok = result.markers[0].ok
+    assert np.isnan(table["x"][~ok]).all()
+    np.testing.assert_allclose(table["t"][ok], result.t_s[ok], atol=1e-6)
+    np.testing.assert_allclose(table["x"][ok], x[ok], atol=1e-5)
+    np.testing.assert_allclose(table["y"][ok], y[ok], atol=1e-5)
+    assert (tmp_path / "balltoss.json").is_file()
+
+
+def test_from_trk_reads_cupsclips_tracks(shared_data, tmp_path):
+    with zipfile.ZipFile(shared_data / "tracker" / "CupsClips.zip") as z:
+        names = [n for n in z.namelist() if n.lower().endswith(".trk")]
+        z.extract(names[0], tmp_path)
+    project = trk.read_project(tmp_path / names[0])
+    assert {"cup 3", "cup 7"} <= set(project.points)
+    res = CliRunner().invoke(cli, ["track", "--from-trk", str(tmp_path / names[0]), "--out", str(tmp_path / "cups.csv")])
+    assert res.exit_code == 0, res.output
+    df = pd.read_csv(tmp_path / "cups.csv")
+    assert {"cup_3_px", "cup_7_y_m", "cup_7_ok"} <= set(df.columns)
+    assert df["cup_3_ok"].sum() == len(project.points["cup 3"])
