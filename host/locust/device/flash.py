@@ -64,11 +64,14 @@ def firmware_files() -> list[Path]:
     return sorted(p for p in FIRMWARE_DIR.glob("*.py") if p.name not in NOT_FLASHED)
 
 
-def mpy_version(header: bytes) -> tuple[int, int]:
-    """(version, sub-version) of a .mpy header; the board reports the same in sys.implementation._mpy."""
+def mpy_version(header: bytes) -> int:
+    """The .mpy format version of a header (bytecode-only files carry no sub-version or arch).
+
+    The board reports its own in the low byte of ``sys.implementation._mpy``.
+    """
     if len(header) < 3 or header[:1] != b"M":
         raise DeviceError("mpy-cross wrote an invalid .mpy file", "check the mpy-cross installation")
-    return header[1], header[2] & 3
+    return header[1]
 
 
 def build(compile_mpy: bool, workdir: Path) -> list[tuple[str, bytes]]:
@@ -121,7 +124,7 @@ def _release_console(transport, tries: int = 3) -> bool:
 
 
 def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
-          progress: Callable[[str], None] = lambda s: None) -> FlashResult:
+          progress: Callable[[str], None] = lambda s: None, repl_timeout_s: float = 10.0) -> FlashResult:
     from mpremote.transport import TransportError
 
     if config is not None and fw_config.problems(config):
@@ -133,7 +136,7 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
         progress("connecting")
         _release_console(transport)
         try:
-            transport.enter_raw_repl(soft_reset=False)
+            transport.enter_raw_repl(soft_reset=False, timeout_overall=repl_timeout_s)
         except TransportError:
             raise DeviceError(f"no MicroPython REPL answered on {port}", NO_MICROPYTHON_HINT) from None
         transport.exec("import sys")
@@ -144,16 +147,17 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
             files = build(compile_mpy, Path(tmp))
         if compile_mpy:
             ours = mpy_version(next(data for name, data in files if name.endswith(".mpy")))
-            theirs = (board_mpy & 0xFF, (board_mpy >> 8) & 3)
+            theirs = board_mpy & 0xFF
             if ours != theirs:
-                raise DeviceError(f"the board reads .mpy v{theirs[0]}.{theirs[1]}, mpy-cross writes v{ours[0]}.{ours[1]}",
+                raise DeviceError(f"the board reads .mpy v{theirs}, mpy-cross writes v{ours}",
                                   "flash without --compile, or install the mpy-cross matching the board's MicroPython")
         result = FlashResult(port=port, compiled=compile_mpy, firmware_version="", board=platform,
                              config_written=False)
         for name, data in files:
             progress(f"copying {name}")
             transport.fs_writefile(name, data)
-            other = name[:-3] + (".py" if name.endswith(".mpy") else ".mpy")
+            stem, ext = name.rsplit(".", 1)
+            other = stem + (".py" if ext == "mpy" else ".mpy")
             if other not in KEEP_SOURCE and transport.fs_exists(other):
                 transport.fs_rmfile(other)  # a stale .py would be imported before the new .mpy
         for name, data in files:

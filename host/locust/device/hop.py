@@ -45,6 +45,8 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
         rec.firmware_version = hello.get("version")
         if hello.get("hopping"):
             link.call("stop")
+        while not link.events.empty():  # a boot event from before we connected is old news
+            link.events.get_nowait()
         link.start_heartbeat(schedule.heartbeat_ms / 4000.0)
         reply = link.request("hop", cycles=schedule.cycles, push_deg=schedule.push_deg,
                              push_ms=schedule.push_ms, wait_ms=schedule.wait_ms,

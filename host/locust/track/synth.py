@@ -140,6 +140,8 @@ def write_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: s
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     writer = cv2.VideoWriter(tmp, cv2.VideoWriter_fourcc(*fourcc), fps, size)
+    if fourcc == "MJPG":
+        writer.set(cv2.VIDEOWRITER_PROP_QUALITY, 90)
     try:
         if not writer.isOpened():
             raise RuntimeError(f"OpenCV cannot encode {fourcc} to {path}")

@@ -1,0 +1,118 @@
+"""Ramp tilted until the robot slides: static friction mu = tan(critical angle).
+
+From several trials (one critical angle each) the estimate is ``mu = tan(mean angle)``,
+with the 95% interval ``tan(mean +- t * s / sqrt(n))`` (Student's t on the angles; tan is
+monotonic below 90 deg) and a one-sigma uncertainty ``sec^2(mean) * s / sqrt(n)``.
+
+A trial can also come from a side-view track of the ramp (markers at both ends of the
+board) and the robot: the ramp angle is that of the board, and the robot starts to slide
+when its distance along the board leaves its resting value. The onset is located by
+fitting "at rest, then sliding with constant acceleration" to the distance along the board,
+which finds it to a fraction of a frame instead of waiting for the slip to exceed a
+threshold.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import CalibrationError
+from .curves import Curves
+from .fitstats import Estimate, t95
+
+MIN_TRIALS = 2
+
+
+@dataclass(frozen=True)
+class RampFit:
+    source: str
+    mu_static: Estimate
+    mean_angle_deg: float
+    std_angle_deg: float
+    n_trials: int
+    angles_deg: list[float] = field(repr=False)
+    curves: Curves = field(repr=False)
+
+    def summary(self) -> dict:
+        return {"experiment": "ramp", "source": self.source, "mu_static": self.mu_static.as_dict(),
+                "mean_angle_deg": self.mean_angle_deg, "std_angle_deg": self.std_angle_deg,
+                "n_trials": self.n_trials, "angles_deg": self.angles_deg}
+
+
+def fit_ramp(angles_deg: np.ndarray, source: str = "ramp") -> RampFit:
+    a = np.asarray(angles_deg, dtype=float)
+    a = a[np.isfinite(a)]
+    if len(a) < MIN_TRIALS:
+        raise CalibrationError(f"{source}: {len(a)} trial{'s' if len(a) != 1 else ''} (need at least {MIN_TRIALS} "
+                               "for a confidence interval)", "repeat the tilt at least 5 times and record each angle")
+    if np.any((a <= 0) | (a >= 90)):
+        bad = a[(a <= 0) | (a >= 90)][0]
+        raise CalibrationError(f"{source}: critical angle {bad:g} deg is not between 0 and 90 deg",
+                               "angles are in degrees from the horizontal")
+    mean, sd, n = float(a.mean()), float(a.std(ddof=1)), len(a)
+    se = sd / math.sqrt(n)
+    k = t95(n - 1)
+    mu = math.tan(math.radians(mean))
+    std = se * math.radians(1.0) / math.cos(math.radians(mean)) ** 2
+    lo, hi = (math.tan(math.radians(min(max(mean + s * k * se, 0.0), 89.999))) for s in (-1, 1))
+    trials = np.arange(1, n + 1, dtype=float)
+    curves = Curves(x=trials, data=np.tan(np.radians(a)), model=np.full(n, mu), x_label="trial",
+                    y_label="tan(critical angle)", title=f"ramp: {source}")
+    return RampFit(source=source, mu_static=Estimate(mu, std, lo, hi), mean_angle_deg=mean, std_angle_deg=sd,
+                   n_trials=n, angles_deg=[float(x) for x in a], curves=curves)
+
+
+@dataclass(frozen=True)
+class SlipOnset:
+    critical_angle_deg: float
+    onset_s: float
+    slip_m: float          # how far the robot slid by the end of the record
+
+
+def critical_angle_from_track(t_s: np.ndarray, ramp_a: tuple[np.ndarray, np.ndarray],
+                              ramp_b: tuple[np.ndarray, np.ndarray], robot: tuple[np.ndarray, np.ndarray], *,
+                              source: str = "ramp", min_slip_m: float = 0.005) -> SlipOnset:
+    """Ramp angle when the robot starts to slide, from a side-view track (see module doc)."""
+    t = np.asarray(t_s, dtype=float)
+    ax, ay = ramp_a
+    bx, by = ramp_b
+    rx, ry = robot
+    keep = np.isfinite(t) & np.isfinite(ax) & np.isfinite(ay) & np.isfinite(bx) & np.isfinite(by) & np.isfinite(rx) & np.isfinite(ry)
+    t, ax, ay, bx, by, rx, ry = (v[keep] for v in (t, ax, ay, bx, by, rx, ry))
+    if len(t) < 10:
+        raise CalibrationError(f"{source}: only {len(t)} frames with all three markers (need 10)",
+                               "check that the ramp ends and the robot were found in the track")
+    ux, uy = bx - ax, by - ay
+    length = np.hypot(ux, uy)
+    angle = np.degrees(np.arctan2(np.abs(uy), np.abs(ux)))
+    s = ((rx - ax) * ux + (ry - ay) * uy) / length
+    disp = np.abs(s - np.median(s[: max(len(s) // 10, 3)]))
+    if np.ptp(angle) < 1.0:
+        raise CalibrationError(f"{source}: flat signal, the ramp does not tilt ({np.ptp(angle):.2g} deg)",
+                               "check the ramp markers (one at each end of the board)")
+    moved = np.flatnonzero(disp > min_slip_m)
+    if len(moved) == 0:
+        raise CalibrationError(f"{source}: the robot never slides (largest move {disp.max() * 1e3:.2g} mm)",
+                               "tilt the ramp further, or check the robot marker")
+    first = int(moved[0])
+    onset = _onset_time(t, s, first)
+    return SlipOnset(critical_angle_deg=float(np.interp(onset, t, angle)), onset_s=onset, slip_m=float(disp[-1]))
+
+
+def _onset_time(t: np.ndarray, s: np.ndarray, first: int) -> float:
+    """Best break time tc for s = s0 (t < tc), s0 + 0.5*a*(t - tc)^2 (t >= tc), searched on a
+    fine grid between the last quiet frames and the first clear slip."""
+    lo = max(first - int(0.5 / np.median(np.diff(t))), 0)
+    window = slice(lo, min(first + 8, len(t)))
+    tw, sw = t[window], s[window]
+    best_tc, best_cost = tw[0], np.inf
+    for tc in np.linspace(tw[0], t[first], 400):
+        basis = np.column_stack([np.ones_like(tw), 0.5 * np.clip(tw - tc, 0, None) ** 2])
+        coef, *_ = np.linalg.lstsq(basis, sw, rcond=None)
+        cost = float(np.sum((basis @ coef - sw) ** 2))
+        if cost < best_cost:
+            best_tc, best_cost = tc, cost
+    return float(best_tc)

@@ -1,0 +1,1 @@
+"""Simulation-versus-reality reports and the end-to-end demo."""
