@@ -2,7 +2,7 @@
 
 Writes a synthetic 1280x720 hop video (locust.track.synth: known sub-pixel truth) twice:
 MPEG-4 part 2 (OpenCV's encoder, about 1 Mbit/s: far less data than a camera writes, so it
-decodes unusually fast) and motion-JPEG at quality 90 (tens of Mbit/s, as webcams and
+decodes unusually fast) and motion-JPEG at quality 90 (about 7 Mbit/s, as webcams and
 many action cameras record). For each it times, alternately and several times each:
 
 - decode: every frame decoded to BGR by OpenCV, nothing else;

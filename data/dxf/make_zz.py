@@ -46,7 +46,8 @@ def build() -> ezdxf.document.Drawing:
 
 def main(out: str | None = None) -> Path:
     path = Path(out) if out else Path(__file__).with_name("zz.dxf")
-    doc = build()
+    ezdxf.options.write_fixed_meta_data_for_testing = True    # fixed dates and GUIDs:
+    doc = build()                                              # the same bytes every run
     doc.saveas(path)
     print(f"wrote {path} (rebuilt from the notebook's description)")
     return path

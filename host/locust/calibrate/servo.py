@@ -213,14 +213,8 @@ def fit_servo(t_s: np.ndarray, angle_deg: np.ndarray, command_deg: np.ndarray, r
     gains = ServoGains(*p)
     sat, peak = _torque_profile(model, gains, t, u, angle0, step_i)
     profile = _profile_ok(residual, logp, r)
-    identifiable, notes = _identifiability(est, gains, sat, peak, r, logp, bounds, step_deg)
     final_error_deg = float(np.mean(np.abs(u - q)[-max(len(q) // 5, 1):]))
-    if final_error_deg > max(5.0, 3 * math.degrees(gains.torque_limit_nm / gains.kp_nm_per_rad)):
-        for name in PARAMS[:2]:
-            identifiable[name] = False
-        notes.append(f"the horn stalled {final_error_deg:.3g} deg short of the command: the servo was torque-limited "
-                     "for the whole step, so kp_nm_per_rad and kv_nms_per_rad are not identifiable (the torque "
-                     "limit is, from the stall); repeat with a load the servo can lift")
+    identifiable, notes = _identifiability(est, gains, sat, peak, r, logp, bounds, step_deg, final_error_deg)
     for name, flat in profile.items():
         if identifiable[name] and not flat:
             identifiable[name] = False
@@ -328,7 +322,8 @@ def _torque_profile(model, gains: ServoGains, t, u, angle0, step_i) -> tuple[flo
 
 
 def _identifiability(est, gains: ServoGains, sat: float, peak: float, r: np.ndarray, logp: np.ndarray,
-                     bounds: tuple[np.ndarray, np.ndarray], step_deg: float) -> tuple[dict[str, bool], list[str]]:
+                     bounds: tuple[np.ndarray, np.ndarray], step_deg: float,
+                     final_error_deg: float) -> tuple[dict[str, bool], list[str]]:
     ok = {name: bool(np.isfinite(e.std) and e.relative_std <= MAX_RELATIVE_STD) for name, e in zip(PARAMS, est)}
     notes = []
     for i, name in enumerate(PARAMS):
@@ -343,13 +338,18 @@ def _identifiability(est, gains: ServoGains, sat: float, peak: float, r: np.ndar
         return ok, notes
     noise_deg = float(np.degrees(np.sqrt(np.mean(r**2))))
     linear_deg = math.degrees(gains.torque_limit_nm / gains.kp_nm_per_rad)
+    if final_error_deg > max(5.0, 3 * math.degrees(gains.torque_limit_nm / gains.kp_nm_per_rad)):
+        ok["kp_nm_per_rad"] = ok["kv_nms_per_rad"] = False
+        notes.append(f"the horn stalled {final_error_deg:.3g} deg short of the command: the servo was torque-limited "
+                     "for the whole step, so kp_nm_per_rad and kv_nms_per_rad are not identifiable (the torque "
+                     "limit is, from the stall); repeat with a load the servo can lift")
     if not ok["kp_nm_per_rad"] and not notes:
         notes.append(
             f"kp_nm_per_rad is not identifiable from this recording: the servo is torque-limited for "
             f"{100 * sat:.0f}% of the samples after the step and its linear range (|error| < limit/kp = "
             f"{linear_deg:.2g} deg) is hidden in the angle noise ({noise_deg:.2g} deg RMS); "
             "use a heavier load or a smaller step so that the approach to the target is visible")
-    if not ok["kv_nms_per_rad"] and len(notes) <= 1:
+    if not ok["kv_nms_per_rad"] and not notes:
         notes.append("kv_nms_per_rad is not identifiable from this recording: the velocity term never acts "
                      "outside the torque limit long enough to be seen")
     if peak < gains.torque_limit_nm * 1.001:

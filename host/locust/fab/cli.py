@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import sys
 from pathlib import Path
@@ -30,24 +31,14 @@ def _robot(spec: str):
 def _cad_check(out: Path, names: list[str]) -> dict:
     from . import cadcheck
 
+    bar = (click.progressbar(names, label="LibreCAD", file=sys.stderr, show_pos=True)
+           if sys.stderr.isatty() else contextlib.nullcontext(names))
     results = {}
-    with click.progressbar(names, label="LibreCAD", file=sys.stderr,
-                           show_pos=True) if sys.stderr.isatty() else _plain(names) as bar:
-        for name in bar:
+    with bar as items:
+        for name in items:
             d = cadcheck.check_dxf(out / name)
             results[name] = {"painted_paths": d.painted_paths, "segments": d.segments}
     return results
-
-
-class _plain:
-    def __init__(self, items):
-        self.items = items
-
-    def __enter__(self):
-        return self.items
-
-    def __exit__(self, *exc):
-        return False
 
 
 @click.command()
@@ -92,7 +83,7 @@ def fab(dxf, from_robot, out, as_json, layers, units, gap_tol_mm, recover, hinge
     \b
     From a drawing (layers plate/body = outline, hinge_*/joints = hinges, holes, cuts):
       locust fab zz.dxf --out cut/
-      locust fab flipper.dxf --layer body=outline --mirror adhesive_bottom --out cut/
+      locust fab part.dxf --layer body=outline --mirror adhesive_bottom --out cut/
     From the robot's link lengths (the leg's flat pattern; hinges at the running sums of
     ground, crank, coupler, leg):
       locust fab --from-robot seed --json
@@ -106,6 +97,8 @@ def fab(dxf, from_robot, out, as_json, layers, units, gap_tol_mm, recover, hinge
     if (dxf is None) == (from_robot is None):
         raise FabError("give a DXF drawing or --from-robot, not both" if dxf else "nothing to draw",
                        "e.g. `locust fab zz.dxf --out cut/` or `locust fab --from-robot seed --json`")
+    if out is not None:
+        export.check_out(out)
     hinges_x = None
     fp = None
     if from_robot:

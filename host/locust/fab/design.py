@@ -136,7 +136,7 @@ def open_outline_error(layer: str, opens: list[Contour], gap_tol_mm: float) -> F
         f"layer {layer!r}: the outline is not closed: a gap of {d:.4g} mm between {_fmt(pa)} "
         f"and {_fmt(pb)} ({pieces})",
         f"close the outline in the CAD program, or join pieces this far apart with "
-        f"--gap-tol {d * 1.5:.3g} (mm; now {gap_tol_mm:g})",
+        f"--gap-tol-mm {d * 1.5:.3g} (now {gap_tol_mm:g})",
     )
 
 

@@ -98,7 +98,7 @@ def open_document(path: str | Path, *, recover: bool = False):
 
 
 def _short(exc: Exception, n: int = 160) -> str:
-    text = " ".join(str(exc).split())
+    text = " ".join(str(exc).split()).removeprefix(f"{type(exc).__name__}: ")
     return text if len(text) <= n else text[: n - 1] + "…"
 
 

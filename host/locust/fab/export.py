@@ -141,14 +141,20 @@ def cut_files(lam: Laminate) -> dict[str, bytes]:
     return files
 
 
-def publish(out_dir: str | os.PathLike, files: dict[str, bytes]) -> Path:
-    """Write ``files`` into ``out_dir`` all at once: staged in a hidden sibling folder and
-    renamed into place, so a failure leaves nothing behind. Never writes into a folder
-    that already holds files."""
+def check_out(out_dir: str | os.PathLike) -> Path:
+    """Refuse, before any work, a destination that holds files."""
     out = Path(out_dir)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise FabError(f"{out} already exists and is not an empty folder",
                        "choose a new --out folder; results are never overwritten")
+    return out
+
+
+def publish(out_dir: str | os.PathLike, files: dict[str, bytes]) -> Path:
+    """Write ``files`` into ``out_dir`` all at once: staged in a hidden sibling folder and
+    renamed into place, so a failure leaves nothing behind. Never writes into a folder
+    that already holds files."""
+    out = check_out(out_dir)
     out.parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
     try:

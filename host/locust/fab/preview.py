@@ -66,7 +66,7 @@ def cut_pattern_png(lam: Laminate) -> bytes:
         xs, ys = s.xy
         ax.plot(xs, ys, color="#8e44ad", lw=1.2, label="slits" if i == 0 else None)
     _frame(ax, lam, f"cut pattern: {d.source}")
-    ax.legend(loc="upper right", fontsize=7)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
     return _png(fig)
 
 

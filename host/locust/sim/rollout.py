@@ -29,6 +29,7 @@ class Trajectory:
     final_qpos: np.ndarray
     warnings: dict[str, int]         # MuJoCo warning name -> count
     wall_s: float
+    states: np.ndarray | None = None  # (nstep, nstate) FULLPHYSICS states, kept on request (video)
 
     @property
     def timestep_s(self) -> float:
@@ -49,16 +50,16 @@ def initial_state(built: BuiltModel) -> tuple[np.ndarray, np.ndarray]:
 
 
 def simulate(robot: Robot, cycles: int | None = None, timestep_s: float | None = None,
-             built: BuiltModel | None = None) -> Trajectory:
+             built: BuiltModel | None = None, keep_states: bool = False) -> Trajectory:
     """Simulate settle + ``cycles`` hop cycles; the model is built unless given."""
     if timestep_s is not None:
         robot = robot.with_values({"solver.timestep_s": timestep_s})
     built = built or build(robot)
     plan = control_plan(robot.schedule, robot.solver, cycles)
-    return simulate_built(built, plan)
+    return simulate_built(built, plan, keep_states=keep_states)
 
 
-def simulate_built(built: BuiltModel, plan: ControlPlan) -> Trajectory:
+def simulate_built(built: BuiltModel, plan: ControlPlan, keep_states: bool = False) -> Trajectory:
     model = built.model
     state0, sensor0 = initial_state(built)
     control = np.zeros((1, plan.nstep, model.nu))
@@ -75,4 +76,5 @@ def simulate_built(built: BuiltModel, plan: ControlPlan) -> Trajectory:
         for i in range(len(data.warning)) if data.warning[i].number
     }
     return Trajectory(built=built, plan=plan, initial_sensordata=sensor0,
-                      sensordata=sensordata[0], final_qpos=final_qpos, warnings=warnings, wall_s=wall)
+                      sensordata=sensordata[0], final_qpos=final_qpos, warnings=warnings, wall_s=wall,
+                      states=state[0] if keep_states else None)

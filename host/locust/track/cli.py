@@ -10,6 +10,7 @@ from pathlib import Path
 import click
 
 from ..errors import TrackError
+from ..fileio import atomic_write_json
 from . import calib, export, overlay, trk
 from .aruco import DEFAULT_DICTIONARY, side_px_in_video
 from .runner import track_video
@@ -153,8 +154,6 @@ def _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle) -> c
 def _write(result, paths: dict[str, Path], fmt: str) -> list[Path]:
     if fmt == "tracker":
         trk.write_tracker_text(result, paths["tracks"])
-        from ..fileio import atomic_write_json
-
         atomic_write_json(paths["sidecar"], export.sidecar(result, paths["tracks"]))
         return [paths["tracks"], paths["sidecar"]]
     return list(export.write_tracks(result, paths["tracks"]))

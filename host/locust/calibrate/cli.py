@@ -1,0 +1,236 @@
+"""``locust calibrate beam|servo|ramp``: recordings in, fitted values (and robot.toml) out."""
+
+from __future__ import annotations
+
+import json
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+
+import click
+import numpy as np
+
+from ..errors import CalibrationError
+from . import beam as B
+from . import ramp as R
+from . import servo as S
+from .fitstats import Estimate
+from .plots import plot_fit
+from .recordings import clean_samples, read_table
+from .write import DEFAULT_ROBOT_TOML, write_fitted
+
+
+def output_options(func):
+    """--write [PATH], --json, --plot PATH / --no-plot: shared by the three experiments."""
+    func = click.option("--no-plot", is_flag=True, help="Do not draw the fit plot.")(func)
+    func = click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+                        help="Fit plot (data, model, residuals) [default: <recording>-fit.png beside it].")(func)
+    func = click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")(func)
+    func = click.option("--write", "write_path", type=click.Path(dir_okay=False, path_type=Path),
+                        is_flag=False, flag_value=str(DEFAULT_ROBOT_TOML), default=None,
+                        help=f"Update this robot.toml with the fitted values only [bare --write: {DEFAULT_ROBOT_TOML}]. "
+                             "Other values are kept; a new file starts from the seed preset.")(func)
+    return func
+
+
+@click.group()
+def calibrate() -> None:
+    """Identify the robot's physics from the Part 2 experiments.
+
+    \b
+    beam   cardstock cantilever, dropped tip mass  -> hinge stiffness, damping
+    servo  servo step carrying a battery           -> kp, kv, torque limit
+    ramp   ramp tilted until the robot slides      -> static friction mu
+
+    Each prints the fitted values with 95% confidence intervals, draws a fit plot, and with
+    --write updates robot.toml (only the fitted values, each with source fit:<file>, its
+    uncertainty and the date). How to film each experiment: calibration/protocols/.
+    """
+
+
+@calibrate.command()
+@click.argument("tracks", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--mass-kg", type=float, required=True, help="Dropped tip mass [kg].")
+@click.option("--marker", default=None, help="Marker of the beam tip in the track [default: the only one].")
+@click.option("--length-m", type=float, default=None,
+              help="Free length of the beam, clamp to mass [m]; needed for the hinge values (k*L^2, b*L^2).")
+@click.option("--beam-mass-kg", type=float, default=0.0, show_default=True,
+              help="The beam's own mass [kg]; 33/140 of it is added to the oscillating mass.")
+@click.option("--start-s", type=float, default=None, help="Fit from this time [default: the first swing after the drop].")
+@click.option("--end-s", type=float, default=None, help="Fit up to this time [default: end of the track].")
+@output_options
+def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, write_path, as_json, plot_path, no_plot):
+    """Fit the beam tip's damped oscillation: stiffness, damping, and the model's hinge values.
+
+    TRACKS is a `locust track` CSV or a Tracker text export of the beam tip (metres).
+    """
+    table = read_table(tracks)
+    x, y = table.marker(marker)
+    t, x, y = clean_samples(tracks, "the beam tip", table.time_s(), x, y, min_samples=B.MIN_SAMPLES)
+    fit = B.fit_beam(t, B.principal_displacement(x, y), mass_kg, length_m=length_m, beam_mass_kg=beam_mass_kg,
+                     start_s=start_s, end_s=end_s, source=str(tracks))
+    values = {}
+    if fit.hinge_stiffness_nm_per_rad is not None:
+        values = {"compliance.hinge_stiffness_nm_per_rad": fit.hinge_stiffness_nm_per_rad,
+                  "compliance.hinge_damping_nms_per_rad": fit.hinge_damping_nms_per_rad}
+    elif write_path:
+        raise CalibrationError("--write needs --length-m: the hinge values are k*L^2 and b*L^2",
+                               "measure the beam's free length from the clamp to the mass")
+    note = f"beam L={length_m} m, m={mass_kg} kg; {B.MAPPING}"
+    _finish(fit, tracks, values, note, write_path, as_json, plot_path, no_plot,
+            subtitle=f"fn {fit.natural_frequency_hz.value:.4g} Hz, zeta {fit.damping_ratio.value:.3g}")
+
+
+@calibrate.command()
+@click.argument("data", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--inertia-kgm2", type=float, required=True, help="Load inertia about the servo axis [kg*m^2].")
+@click.option("--gravity-moment-nm", type=float, default=0.0, show_default=True,
+              help="Moment of the load's weight with the horn horizontal (angle 0) [N*m]; 0 for a horizontal rig.")
+@click.option("--pivot", default=None, metavar="X,Y",
+              help="Servo axis in the track's coordinates [m]: DATA is then a track of the horn tip.")
+@click.option("--step", "step", default=None, metavar="FROM,TO,AT_S",
+              help="With --pivot: the commanded step, degrees from the horizontal, and when it was sent [s].")
+@click.option("--marker", default=None, help="With --pivot: marker of the horn tip [default: the only one].")
+@output_options
+def servo(data, inertia_kgm2, gravity_moment_nm, pivot, step, marker, write_path, as_json, plot_path, no_plot):
+    """Identify kp, kv and torque limit of the position servo from a step response.
+
+    DATA is a CSV with t_s, angle_deg, command_deg (degrees from the horizontal), or with
+    --pivot and --step a track of the horn tip. The rig is simulated in MuJoCo with the
+    same position actuator as the robot model; parameters the recording cannot determine
+    are reported as not identifiable and never written.
+    """
+    t, angle, command = _servo_series(data, pivot, step, marker)
+    rig = S.ServoRig(inertia_kgm2=inertia_kgm2, gravity_moment_nm=gravity_moment_nm)
+    with _progress(60, "fitting servo") as tick:
+        fit = S.fit_servo(t, angle, command, rig, source=str(data), progress=tick)
+    keys = {"kp_nm_per_rad": "servo.kp_nm_per_rad", "kv_nms_per_rad": "servo.kv_nms_per_rad",
+            "torque_limit_nm": "servo.torque_limit_nm"}
+    values = {keys[n]: getattr(fit, n) for n in S.PARAMS if fit.identifiable[n]}
+    note = f"servo step, J={inertia_kgm2} kg*m^2, M={gravity_moment_nm} N*m"
+    _finish(fit, data, values, note, write_path, as_json, plot_path, no_plot,
+            subtitle=f"RMS residual {fit.rms_residual_deg:.3g} deg")
+
+
+@calibrate.command()
+@click.argument("data", nargs=-1, required=True, type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--ramp-markers", default="ramp_a,ramp_b", show_default=True, metavar="A,B",
+              help="For a ramp video track: markers at the two ends of the board.")
+@click.option("--robot-marker", default="robot", show_default=True, help="For a ramp video track: the robot's marker.")
+@click.option("--into", type=click.Choice(["foot", "floor"]), default="foot", show_default=True,
+              help="Which friction the result is written to (contact.foot_friction or contact.floor_friction).")
+@output_options
+def ramp(data, ramp_markers, robot_marker, into, write_path, as_json, plot_path, no_plot):
+    """Static friction from critical ramp angles: mu = tan(mean angle), with a 95% interval.
+
+    DATA: CSVs with an angle_deg column (one trial a row, degrees), and/or side-view
+    tracks of a tilting ramp (one trial each).
+    """
+    angles = []
+    for path in data:
+        angles.extend(_ramp_angles(path, ramp_markers, robot_marker))
+    source = str(data[0]) if len(data) == 1 else "+".join(p.name for p in data)
+    fit = R.fit_ramp(np.array(angles), source=source)
+    values = {f"contact.{into}_friction": fit.mu_static}
+    note = f"ramp, {fit.n_trials} trials, mean angle {fit.mean_angle_deg:.4g} deg"
+    _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot,
+            subtitle=f"mu {fit.mu_static.value:.4g} from {fit.n_trials} trials",
+            recording_name=Path(source) if len(data) == 1 else Path("ramp"), source_name=Path(source).name)
+
+
+# -- helpers ------------------------------------------------------------------------
+def _servo_series(data: Path, pivot: str | None, step: str | None, marker: str | None):
+    table = read_table(data)
+    if pivot is None:
+        t, angle, command = table.require("t_s", "angle_deg", "command_deg", purpose="a servo step")
+        return clean_samples(data, "the servo angle", t, angle, command, min_samples=S.MIN_SAMPLES)
+    px, py = _floats(pivot, 2, "--pivot", "X,Y in metres, e.g. --pivot 0.10,0.05")
+    if step is None:
+        raise CalibrationError("--pivot needs --step FROM,TO,AT_S (the track holds no command)",
+                               "e.g. --step 0,180,0.05 for a 0->180 deg step sent at t = 0.05 s")
+    a_from, a_to, at_s = _floats(step, 3, "--step", "FROM,TO,AT_S, e.g. --step 0,180,0.05")
+    x, y = table.marker(marker)
+    t, x, y = clean_samples(data, "the horn tip", table.time_s(), x, y, min_samples=S.MIN_SAMPLES)
+    return t, S.horn_angle_deg(x, y, px, py), np.where(t < at_s, a_from, a_to)
+
+
+def _ramp_angles(path: Path, ramp_markers: str, robot_marker: str) -> list[float]:
+    table = read_table(path)
+    if table.has("angle_deg"):
+        return [float(a) for a in table.columns["angle_deg"] if np.isfinite(a)]
+    names = [n.strip() for n in ramp_markers.split(",")]
+    if len(names) != 2 or not table.markers():
+        table.require("angle_deg", purpose="ramp trials (or a track with ramp and robot markers)")
+    onset = R.critical_angle_from_track(table.time_s(), table.marker(names[0]), table.marker(names[1]),
+                                        table.marker(robot_marker), source=str(path))
+    return [onset.critical_angle_deg]
+
+
+def _floats(text: str, n: int, option: str, hint: str) -> list[float]:
+    try:
+        vals = [float(v) for v in text.split(",")]
+    except ValueError:
+        vals = []
+    if len(vals) != n:
+        raise CalibrationError(f"{option} {text!r}: expected {n} numbers", hint)
+    return vals
+
+
+@contextmanager
+def _progress(length: int, label: str):
+    """A progress bar on stderr when it is a terminal; silent otherwise."""
+    if not sys.stderr.isatty():
+        yield lambda n=1: None
+        return
+    with click.progressbar(length=length, label=label, file=sys.stderr) as bar:
+        yield bar.update
+
+
+def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_path: Path | None,
+            as_json: bool, plot_path: Path | None, no_plot: bool, *, subtitle: str,
+            recording_name: Path | None = None, source_name: str | None = None) -> None:
+    recording_name = recording_name or recording
+    out = fit.summary()
+    if not no_plot:
+        plot_path = plot_path or recording.with_name(f"{Path(recording_name).stem}-fit.png")
+        out["plot"] = str(plot_fit(fit.curves, plot_path, subtitle))
+    if write_path:
+        if values:
+            write_fitted(write_path, values, source_name or recording.name, note=note)
+        out["written"] = {"path": str(write_path), "keys": list(values)}
+    if as_json:
+        click.echo(json.dumps(out, indent=2, default=_jsonable))
+        return
+    _print_text(out)
+
+
+def _print_text(out: dict) -> None:
+    click.echo(f"# {out['experiment']}: {out['source']}")
+    for key, val in out.items():
+        if key in ("experiment", "source", "notes", "written", "plot", "angles_deg"):
+            continue
+        if isinstance(val, dict) and "value" in val:
+            flag = "" if val.get("identifiable", True) else "   NOT IDENTIFIABLE"
+            if val["std"] is None:
+                click.echo(f"{key:30s} {val['value']:<12.6g} (undetermined){flag}")
+            else:
+                lo, hi = val["ci95"]
+                click.echo(f"{key:30s} {val['value']:<12.6g} ± {val['std']:.3g} (1σ)  95% CI [{lo:.6g}, {hi:.6g}]{flag}")
+        elif val is not None:
+            click.echo(f"{key:30s} {val if not isinstance(val, float) else format(val, '.6g')}")
+    for note in out.get("notes", []):
+        click.echo(f"note: {note}")
+    if "plot" in out:
+        click.echo(f"plot: {out['plot']}")
+    if "written" in out:
+        keys = out["written"]["keys"]
+        click.echo(f"wrote {', '.join(keys)} to {out['written']['path']}" if keys
+                   else f"nothing written to {out['written']['path']}: no value was identifiable")
+
+
+def _jsonable(obj):
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, Path):
+        return str(obj)
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")

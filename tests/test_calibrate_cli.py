@@ -1,0 +1,142 @@
+"""`locust calibrate` end to end on the shipped synthetic recordings: fit, plot, --write,
+--json, Tracker exports, and clear errors (naming the file) for bad input."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from locust.calibrate.recordings import read_table
+from locust.cli import cli
+from locust.params import load_robot, preset
+
+ROOT = Path(__file__).resolve().parents[1]
+RECORDINGS = ROOT / "calibration" / "recordings"
+
+
+@pytest.fixture()
+def recs(tmp_path):
+    for name in ("synthetic_beam.csv", "synthetic_beam_tracker.txt", "synthetic_servo.csv",
+                 "synthetic_ramp.csv", "synthetic_ramp_track.csv"):
+        shutil.copy(RECORDINGS / name, tmp_path / name)
+    return tmp_path
+
+
+def run(*args):
+    res = CliRunner().invoke(cli, list(map(str, args)))
+    return res
+
+
+def test_recordings_are_labelled_synthetic():
+    for path in RECORDINGS.glob("synthetic_*.csv"):
+        table = read_table(path)
+        assert path.name.startswith("synthetic_")
+        assert table.comments and "SYNTHETIC" in table.comments[0]
+
+
+def test_beam_json_and_write_then_ramp_and_servo(recs):
+    toml = recs / "robot.toml"
+    res = run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--length-m", 0.05,
+              "--json", "--write", toml)
+    assert res.exit_code == 0, res.output
+    out = json.loads(res.output)
+    assert out["natural_frequency_hz"]["value"] == pytest.approx(7.5578, rel=0.01)   # header truth
+    assert out["damping_ratio"]["value"] == pytest.approx(0.04, rel=0.05)
+    assert out["stiffness_n_per_m"]["value"] == pytest.approx(22.55, rel=0.02)
+    assert Path(out["plot"]).stat().st_size > 10_000
+    robot = load_robot(toml)
+    k = robot.get("compliance.hinge_stiffness_nm_per_rad")
+    assert k == pytest.approx(0.056375, rel=0.02)
+    prov = robot.source_of("compliance.hinge_stiffness_nm_per_rad")
+    assert prov.source == "fit:synthetic_beam.csv" and prov.uncertainty > 0 and prov.date
+    # everything not fitted is the seed's, with the seed's provenance
+    seed = preset("seed")
+    assert robot.get("servo.kp_nm_per_rad") == seed.get("servo.kp_nm_per_rad")
+    assert robot.source_of("servo.kp_nm_per_rad").source == "seed"
+
+    res = run("calibrate", "ramp", recs / "synthetic_ramp.csv", "--write", toml, "--no-plot")
+    assert res.exit_code == 0, res.output
+    robot = load_robot(toml)
+    angles = read_table(recs / "synthetic_ramp.csv").columns["angle_deg"]
+    assert robot.get("contact.foot_friction") == pytest.approx(math.tan(math.radians(angles.mean())), rel=0.01)
+    assert robot.get("compliance.hinge_stiffness_nm_per_rad") == k     # kept
+
+    res = run("calibrate", "servo", recs / "synthetic_servo.csv", "--inertia-kgm2", 4e-4,
+              "--gravity-moment-nm", 0.03, "--write", toml, "--no-plot")
+    assert res.exit_code == 0, res.output
+    robot = load_robot(toml)
+    assert robot.get("servo.kp_nm_per_rad") == pytest.approx(0.6, rel=0.10)
+    assert robot.get("servo.kv_nms_per_rad") == pytest.approx(0.04, rel=0.10)
+    assert robot.get("servo.torque_limit_nm") == pytest.approx(0.15, rel=0.05)
+    assert robot.source_of("servo.torque_limit_nm").source == "fit:synthetic_servo.csv"
+    assert robot.get("contact.foot_friction") == pytest.approx(1.7, rel=0.03)   # kept
+
+
+def test_tracker_export_gives_the_same_fit(recs):
+    a = json.loads(run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--json", "--no-plot").output)
+    b = json.loads(run("calibrate", "beam", recs / "synthetic_beam_tracker.txt", "--mass-kg", 0.01, "--json",
+                       "--no-plot").output)
+    assert b["natural_frequency_hz"]["value"] == pytest.approx(a["natural_frequency_hz"]["value"], rel=2e-3)
+
+
+def test_tracker_multi_export_with_decimal_commas(tmp_path):
+    text = "#multi:\n\tcm A\t\tcm B\t\nt\tx\ty\tx\ty\n0,0\t1,5\t2,0\t3,0\t4,0\n0,1\t1,6\t\t3,1\t4,1\n"
+    path = tmp_path / "multi.txt"
+    path.write_text(text)
+    table = read_table(path)
+    assert table.markers() == ["cm_A", "cm_B"]
+    x, y = table.marker("cm_A")
+    assert list(x) == [1.5, 1.6] and y[0] == 2.0 and math.isnan(y[1])
+
+
+def test_ramp_track_and_trials_together(recs):
+    res = run("calibrate", "ramp", recs / "synthetic_ramp_track.csv", recs / "synthetic_ramp.csv", "--json",
+              "--no-plot")
+    out = json.loads(res.output)
+    assert out["n_trials"] == 11
+    assert out["angles_deg"][0] == pytest.approx(math.degrees(math.atan(1.7)), abs=0.6)
+
+
+@pytest.mark.parametrize("content, args, message", [
+    ("t_s,angle_deg\n0,1\n0.1,2\n", ["servo", "--inertia-kgm2", "1e-4"], "missing column command_deg"),
+    ("frame,t_s,tip_x_m,tip_y_m\n0,0,0,0\n1,0.1,0,0.001\n", ["beam", "--mass-kg", "0.01"], "only 2 usable samples"),
+    ("t_s,angle_deg,command_deg\n" + "".join(f"{i / 240},0.0,{0 if i < 10 else 90}\n" for i in range(100)),
+     ["servo", "--inertia-kgm2", "1e-4"], "flat signal"),
+    ("t_s,angle_deg,command_deg\n0,1,0\n0.1,abc,0\n", ["servo", "--inertia-kgm2", "1e-4"], "line 3: column 'angle_deg'"),
+    ("trial,angle_deg\n1,59\n", ["ramp"], "need at least 2"),
+])
+def test_bad_input_names_the_file(tmp_path, content, args, message):
+    path = tmp_path / "bad.csv"
+    path.write_text(content)
+    toml = tmp_path / "robot.toml"
+    res = run("calibrate", args[0], path, *args[1:], "--write", toml)
+    assert res.exit_code == 2
+    assert "error:" in res.output and message in res.output and "hint:" in res.output
+    if args[0] != "ramp":
+        assert "bad.csv" in res.output
+    assert "Traceback" not in res.output
+    assert not toml.exists()        # nothing half-written
+
+
+def test_missing_file_and_write_without_length(recs):
+    res = run("calibrate", "beam", recs / "nope.csv", "--mass-kg", 0.01)
+    assert res.exit_code == 2 and "nope.csv: no such file" in res.output
+    res = run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--write", recs / "r.toml")
+    assert res.exit_code == 2 and "--length-m" in res.output and not (recs / "r.toml").exists()
+
+
+def test_sim_runs_with_the_written_robot(recs):
+    """`locust sim --config <written robot.toml>` runs on the fitted values."""
+    pytest.importorskip("locust.sim.cli", reason="the simulation command is not installed")
+    toml = recs / "robot.toml"
+    assert run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--length-m", 0.05,
+               "--write", toml, "--no-plot").exit_code == 0
+    res = run("sim", "--config", toml, "--cycles", 1, "--json")
+    assert res.exit_code == 0, res.output
+    out = json.loads(res.output[res.output.index("{"):])
+    assert out["robot"] == "calibrated" and out["valid"] is True

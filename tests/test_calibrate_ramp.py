@@ -1,0 +1,45 @@
+"""Ramp: mu = tan(mean critical angle) with a Student-t interval; slip onset from a track."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from locust.calibrate import ramp as R
+from locust.calibrate import synthetic as S
+from locust.errors import CalibrationError
+
+
+def test_mu_is_tan_of_mean_angle():
+    truth = S.RampTruth()
+    angles = S.ramp_angles(truth, np.random.default_rng(21))
+    fit = R.fit_ramp(angles)
+    assert fit.mu_static.value == pytest.approx(math.tan(math.radians(np.mean(angles))), rel=0.01)
+    assert fit.mu_static.value == pytest.approx(truth.mu_static, rel=0.03)
+    assert fit.mu_static.ci95_low < truth.mu_static < fit.mu_static.ci95_high
+
+
+def test_interval_by_hand():
+    """Three trials 40, 41, 42 deg: mean 41, s = 1, t(0.975, 2) = 4.303."""
+    fit = R.fit_ramp(np.array([40.0, 41.0, 42.0]))
+    half = 4.302653 * 1 / math.sqrt(3)
+    assert fit.mu_static.ci95_low == pytest.approx(math.tan(math.radians(41 - half)), rel=1e-6)
+    assert fit.mu_static.ci95_high == pytest.approx(math.tan(math.radians(41 + half)), rel=1e-6)
+    assert fit.mu_static.std == pytest.approx(math.radians(1 / math.sqrt(3)) / math.cos(math.radians(41)) ** 2)
+
+
+def test_critical_angle_from_tilt_track():
+    truth = S.RampTruth()
+    for seed in (1, 2):
+        t, markers, crit = S.ramp_tilt_track(truth, np.random.default_rng(seed), fps=30.0, rate_deg_per_s=6.0)
+        onset = R.critical_angle_from_track(t, markers["ramp_a"], markers["ramp_b"], markers["robot"])
+        assert onset.critical_angle_deg == pytest.approx(crit, abs=0.6)
+
+
+def test_bad_ramp_input():
+    with pytest.raises(CalibrationError, match="need at least 2"):
+        R.fit_ramp(np.array([59.0]))
+    with pytest.raises(CalibrationError, match="not between 0 and 90"):
+        R.fit_ramp(np.array([59.0, 95.0]))

@@ -1,0 +1,113 @@
+"""End to end over a pseudo-terminal: mpremote flashes the virtual robot, the link drives it.
+
+Everything here speaks the real wire format to the real firmware running in the real
+MicroPython interpreter; only the servos are virtual (a recording plant).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import pty
+import time
+
+import pytest
+
+from locust.device import record as R
+from locust.device.flash import firmware_files, flash
+from locust.device.hop import run_hop
+from locust.device.link import Link
+from locust.device.plant import RecordingPlant
+from locust.device.virtual import PWM_PERIOD_S, VirtualRobot
+from locust.errors import DeviceError
+from locust.firmware import protocol as P
+
+
+@pytest.fixture(scope="module")
+def robot(tmp_path_factory):
+    flash_dir = tmp_path_factory.mktemp("flash")
+    plant = RecordingPlant()
+    with VirtualRobot(flash_dir, plant) as vr:
+        result = flash(vr.device_path)
+        yield vr, plant, result
+
+
+def test_flash_copies_verifies_and_shakes_hands(robot):
+    vr, _, result = robot
+    assert result.firmware_version == P.VERSION
+    assert sorted(f.name for f in result.files) == sorted(p.name for p in firmware_files())
+    for f in result.files:  # what landed in the flash folder is byte-identical
+        assert hashlib.sha256((vr.flash_dir / f.name).read_bytes()).hexdigest() == f.sha256
+    assert result.config_written and (vr.flash_dir / "config.json").exists()
+    assert vr.boots >= 2  # the soft reset rebooted the interpreter into main.py
+
+
+def test_hop_phases_on_time_and_servos_follow(robot, tmp_path):
+    vr, plant, _ = robot
+    schedule = R.HopSchedule(cycles=2, push_deg=-30.0, push_ms=100, wait_ms=150)
+    t_start = vr.now_s()
+    with Link(vr.device_path) as link:
+        rec = run_hop(link, schedule, tmp_path)
+    assert rec.status == R.COMPLETE and len(rec.phases) == 4
+    assert [p.commanded_us for p in rec.phases] == [0, 100_000, 250_000, 350_000]
+    for p in rec.phases:
+        assert 0 <= p.error_us <= 2000
+    pushes = [c for c in plant.commands if c.t_s > t_start and c.left_deg < -1]
+    assert pushes and all(abs(c.left_deg + 30) < 0.01 for c in pushes)
+    assert any(abs(c.right_deg + 30) < 0.01 for c in pushes)  # the mirrored leg, same horn angle
+    writes = [w for w in vr.pwm_writes if w.t_written_s > t_start and w.servo]
+    for w in writes:  # each duty change lands at the next 20 ms PWM period
+        assert 0 <= w.t_effect_s - w.t_written_s <= PWM_PERIOD_S + 1e-9
+
+
+def test_silent_host_leaves_servos_at_rest_within_heartbeat(robot):
+    vr, _, _ = robot
+    with Link(vr.device_path) as link:
+        link.hello()
+        reply = link.call("hop", cycles=3, push_ms=300, wait_ms=1000, heartbeat_ms=250)
+        t_last_frame = vr.now_s()  # the host says nothing more
+        done = None
+        while done is None:
+            ev = link.events.get(timeout=5)
+            if ev.get("ev") == P.EV_DONE and ev.get("hop") == reply["id"]:
+                done = ev
+    assert done["status"] == P.HOP_HEARTBEAT and done["phases"] == 1
+    last = [w for w in vr.pwm_writes if w.servo][-2:]
+    assert {w.servo for w in last} == {"left", "right"}
+    for w in last:
+        assert abs(w.horn_deg) < 1e-6
+        assert w.t_written_s - t_last_frame < 0.250 + 0.005  # rest commanded within the timeout
+
+
+def test_errors_over_the_wire_and_busy(robot):
+    vr, _, _ = robot
+    with Link(vr.device_path) as link:
+        assert link.request("pose", left_deg=80, right_deg=0)["error"] == P.E_RANGE
+        assert link.request("warp")["error"] == P.E_UNKNOWN
+        link.write(b"$not json*00000000\n")
+        link.write(P.encode({"id": 77, "cmd": "ping"}).replace(b"ping", b"pong"))
+        assert link.call("ping")["ok"]
+        errors = [m["error"] for m in link.unsolicited]
+        assert P.E_CHECKSUM in errors
+        bad_id = link.request("pose", left_deg=10, right_deg=-10)
+        assert bad_id["ok"] and (bad_id["left_deg"], bad_id["right_deg"]) == (10, -10)
+        assert link.call("rest")["ok"]
+
+
+def test_flash_on_a_port_without_micropython_names_the_installer():
+    master, slave = pty.openpty()  # nothing answers on the other side
+    try:
+        with pytest.raises(DeviceError) as err:
+            flash(os.ttyname(slave), repl_timeout_s=0.5)
+        assert "mpflash" in err.value.hint and "esptool" in err.value.hint
+    finally:
+        os.close(master)
+        os.close(slave)
+
+
+def test_hop_without_firmware_is_a_clear_error(tmp_path):
+    with VirtualRobot(tmp_path / "empty-flash") as vr, Link(vr.device_path) as link:
+        t0 = time.monotonic()
+        with pytest.raises(DeviceError, match="no locust firmware"):
+            link.hello(wait_s=1.0)
+        assert time.monotonic() - t0 < 3

@@ -1,0 +1,113 @@
+"""``locust fab`` end to end through the real CLI root (errors become exit code 2)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import ezdxf
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from locust import params
+from locust.cli import cli
+
+ZZ = Path(__file__).resolve().parents[1] / "data" / "dxf" / "zz.dxf"
+
+
+def _run(*args):
+    result = CliRunner().invoke(cli, ["fab", *map(str, args)])
+    assert "Traceback" not in result.output
+    if result.exception and not isinstance(result.exception, SystemExit):
+        raise result.exception
+    return result
+
+
+@pytest.mark.parametrize("name,hinges", [("seed", [40, 80, 100, 160]), ("medium", [50, 100, 130, 200]),
+                                         ("large", [60, 120, 160, 240])])
+def test_from_robot_json_hinges(name, hinges):
+    result = _run("--from-robot", name, "--json")
+    assert result.exit_code == 0, result.output
+    s = json.loads(result.output)
+    assert s["hinges_x_mm"] == pytest.approx(hinges, abs=1e-6)
+    assert s["files"] == [] and s["out"] is None
+
+
+def test_from_robot_toml_follows_its_link_lengths(tmp_path):
+    robot = params.preset("seed").with_values({"geometry.ground_m": 0.045, "geometry.leg_m": 0.07})
+    params.save_robot(robot, tmp_path / "robot.toml")
+    s = json.loads(_run("--from-robot", tmp_path / "robot.toml", "--json").output)
+    assert s["hinges_x_mm"] == pytest.approx([45, 85, 105, 175], abs=1e-6)
+    assert s["bounds_mm"]["width"] == pytest.approx(195)
+
+
+def test_zz_out_writes_every_file_and_previews(tmp_path):
+    out = tmp_path / "cut"
+    result = _run(ZZ, "--out", out, "--json")
+    assert result.exit_code == 0, result.output
+    s = json.loads(result.output)
+    assert s["areas_mm2"]["rigid_top"] == pytest.approx(5348.86, rel=5e-4)
+    assert s["areas_mm2"]["flexible"] == pytest.approx(5400.0, rel=5e-4)
+    assert [row["center_x_mm"] for row in s["slots"]] == pytest.approx([40, 80, 100, 160])
+    assert [row["height_mm"] for row in s["slots"]] == pytest.approx([13.0] * 4, abs=1e-3)
+    names = sorted(p.name for p in out.iterdir())
+    assert names == sorted(s["files"])
+    for stem in ("rigid_top", "adhesive_top", "flexible", "adhesive_bottom", "rigid_bottom",
+                 "combined_cut_pattern", "first_pass_cuts", "final_perimeter"):
+        ezdxf.readfile(out / f"{stem}.dxf")                      # strict read
+    assert json.loads((out / "summary.json").read_text())["areas_mm2"] == s["areas_mm2"]
+    import matplotlib.image as mpimg
+    img = mpimg.imread(out / "cut_pattern.png")[..., :3]
+    red = (img[..., 0] > 0.8) & (img[..., 1] < 0.5) & (img[..., 2] < 0.5)   # hinge cut-outs drawn
+    assert red.sum() > 50 and img.std() > 0.05
+    assert "wrote" in _run(ZZ, "--out", tmp_path / "again").output
+
+
+@pytest.mark.parametrize("content", [b"\x00\x01garbage" * 200, "TRUNCATED"])
+def test_bad_dxf_clear_error_nothing_written(tmp_path, content):
+    bad = tmp_path / "bad.dxf"
+    if content == "TRUNCATED":
+        text = ZZ.read_text()
+        content = text[: len(text) * 2 // 3].encode()
+    bad.write_bytes(content)
+    out = tmp_path / "out"
+    result = _run(bad, "--out", out)
+    assert result.exit_code == 2
+    assert result.output.startswith("error: ") and "not a readable DXF" in result.output
+    assert "hint:" in result.output
+    assert not out.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.dxf"]     # no staging left over
+
+
+def test_existing_out_folder_is_never_overwritten(tmp_path):
+    out = tmp_path / "cut"
+    out.mkdir()
+    (out / "mine.txt").write_text("keep")
+    result = _run(ZZ, "--out", out)
+    assert result.exit_code == 2 and "never overwritten" in result.output
+    assert [p.name for p in out.iterdir()] == ["mine.txt"] and (out / "mine.txt").read_text() == "keep"
+
+
+def test_usage_errors(tmp_path):
+    assert _run().exit_code == 2
+    assert _run(ZZ, "--from-robot", "seed").exit_code == 2
+    r = _run("--from-robot", "nonesuch")
+    assert r.exit_code == 2 and "neither a preset nor a robot.toml" in r.output
+    r = _run(ZZ, "--layer", "body=nothing_here")
+    assert r.exit_code == 2 and "no body outline" in r.output
+
+
+def test_fold_line_drawing_with_layer_mapping_and_mirror(tmp_path):
+    doc = ezdxf.new("R2010", units=4)
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (60, 0), (60, 20), (0, 20)], close=True, dxfattribs={"layer": "Outline"})
+    msp.add_line((20, 0), (20, 20), dxfattribs={"layer": "creases"})
+    doc.saveas(tmp_path / "synthetic_strip.dxf")
+    result = _run(tmp_path / "synthetic_strip.dxf", "--layer", "body=outline", "--layer", "hinge=creases",
+                  "--hinge-width-mm", "2", "--mirror", "rigid_bottom", "--json")
+    s = json.loads(result.output)
+    assert s["areas_mm2"]["rigid_top"] == pytest.approx(1200 - 40)
+    assert s["areas_mm2"]["flexible"] == pytest.approx(1200)
+    assert s["stack"][-1] == {"name": "rigid_bottom", "material": "rigid", "mirror": True}
+    assert np.isclose(s["hinges_x_mm"], [20]).all()
