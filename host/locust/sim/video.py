@@ -7,8 +7,10 @@ The camera looks at the robot's left side (the left leg is at +y, the foot marke
 Beside ``<stem>.mp4`` go two sidecars, both simulated ground truth:
 
 - ``<stem>.truth.csv``: per frame, each marker's true pixel centre (OpenCV convention:
-  origin at the centre of the top-left pixel, x right, y down), whether its centre can be
-  seen, and its true world position (x forward along the floor, z up, metres);
+  origin at the centre of the top-left pixel, x right, y down), the share of it the camera
+  sees (``seen_frac``: a marker lying on the floor or behind a link is partly hidden, and a
+  colour blob's centroid is then off its true centre), ``visible`` (at least half seen), and
+  its true world position (x forward along the floor, z up, metres);
 - ``<stem>.camera.json``: the pinhole camera (intrinsics, extrinsics per frame or fixed)
   and, for the fixed camera, metres per pixel at the robot's planes.
 
@@ -48,6 +50,10 @@ AZIMUTH_DEG = -90.0                        # look along -y: from the robot's lef
 ELEVATION_DEG = 0.0                        # horizontal
 MARGIN_M = 0.04                            # empty border around the robot in the fixed view
 TRACK_HALF_WIDTH_OF_BODY = 2.0             # track view: half the image width, in body lengths
+VISIBLE_FRAC = 0.5                         # truth says a marker is visible when this much of it is seen
+# sample points on a unit disc: the centre and two rings of eight (for the seen fraction)
+_DISC_SAMPLES = np.vstack([[0.0, 0.0]] + [
+    [[r * math.cos(a), r * math.sin(a)] for a in np.arange(8) * math.pi / 4] for r in (0.5, 0.9)])
 
 
 @dataclass(frozen=True)
@@ -205,7 +211,7 @@ class _TruthRow:
     frame: int
     t_s: float
     px: dict[str, tuple[float, float]]
-    visible: dict[str, bool]
+    seen_frac: dict[str, float]
     world_m: dict[str, np.ndarray]
 
 
@@ -270,30 +276,44 @@ class ClipRecorder:
         self.writer.write(cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
         world = {n: d.geom_xpos[g].copy() for n, g in self.marker_ids.items()}
         px = {n: tuple(float(v) for v in cam.project(world[n])[0]) for n in MARKERS}
-        visible = {n: self._visible(cam, world[n], px[n], self.marker_ids[n]) for n in MARKERS}
-        self.rows.append(_TruthRow(len(self.rows), float(t_s), px, visible, world))
+        seen = {n: self._seen_fraction(cam, world[n], self.marker_ids[n]) if self._in_image(px[n]) else 0.0
+                for n in MARKERS}
+        self.rows.append(_TruthRow(len(self.rows), float(t_s), px, seen, world))
         self.cameras.append(cam)
 
-    def _visible(self, cam: PinholeCamera, point_m: np.ndarray, px: tuple[float, float], geom_id: int) -> bool:
-        """The marker's centre is inside the image and the first thing a ray from the camera meets."""
-        if not (-0.5 <= px[0] <= self.width - 0.5 and -0.5 <= px[1] <= self.height - 0.5):
-            return False
-        ray = point_m - cam.position_m
-        dist = float(np.linalg.norm(ray))
-        hit = np.array([-1], dtype=np.int32)
-        first = mujoco.mj_ray(self.model, self.data, cam.position_m, ray / dist, None, 1, -1, hit)
-        return int(hit[0]) == geom_id or first < 0 or first >= dist - float(self.model.geom_size[geom_id][0]) - 1e-6
+    def _in_image(self, px: tuple[float, float]) -> bool:
+        return -0.5 <= px[0] <= self.width - 0.5 and -0.5 <= px[1] <= self.height - 0.5
+
+    def _seen_fraction(self, cam: PinholeCamera, centre_m: np.ndarray, geom_id: int) -> float:
+        """Share of the marker's disc (as the camera sees it) that no other geom hides.
+
+        Rays go from the camera centre to the disc's centre and to two rings (0.5 and 0.9
+        radius) across the line of sight; a ray that meets the marker first sees it.
+        """
+        radius = float(self.model.geom_size[geom_id][0])
+        sight = centre_m - cam.position_m
+        sight /= np.linalg.norm(sight)
+        across = np.cross(sight, cam.rotation[1])
+        across /= np.linalg.norm(across)
+        other = np.cross(sight, across)
+        seen, hit = 0, np.array([-1], dtype=np.int32)
+        for target in centre_m + radius * _DISC_SAMPLES @ np.vstack([across, other]):
+            ray = target - cam.position_m
+            mujoco.mj_ray(self.model, self.data, cam.position_m, ray / np.linalg.norm(ray), None, 1, -1, hit)
+            seen += int(hit[0]) == geom_id
+        return seen / len(_DISC_SAMPLES)
 
     def truth_csv(self) -> str:
         lines = [f"# simulated ground truth: MuJoCo render of robot {self.robot_name!r}, camera {self.camera}; "
                  "pixels in the OpenCV convention (origin at the centre of the top-left pixel, x right, y down); "
                  "world x along the floor, z up, metres",
                  ",".join(["frame", "t_s"] + [f"{n}_{c}" for n in MARKERS
-                                              for c in ("px", "py", "visible", "x_m", "z_m")])]
+                                              for c in ("px", "py", "visible", "seen_frac", "x_m", "z_m")])]
         for r in self.rows:
             cells = [str(r.frame), f"{r.t_s:.6f}"]
             for n in MARKERS:
-                cells += [f"{r.px[n][0]:.4f}", f"{r.px[n][1]:.4f}", str(int(r.visible[n])),
+                cells += [f"{r.px[n][0]:.4f}", f"{r.px[n][1]:.4f}", str(int(r.seen_frac[n] >= VISIBLE_FRAC)),
+                          f"{r.seen_frac[n]:.3f}",
                           f"{r.world_m[n][0]:.6f}", f"{r.world_m[n][2]:.6f}"]
             lines.append(",".join(cells))
         return "\n".join(lines) + "\n"
