@@ -39,6 +39,10 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence)
     from .run import check_convergence as converge, invalid_result, run
 
     robot = resolve_robot(preset, config, sets)
+    if video is not None:
+        from .video import check_video_path
+
+        check_video_path(video)  # fail before simulating, not after
     try:
         result = run(robot, cycles=cycles)
     except GeometryError as exc:

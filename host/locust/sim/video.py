@@ -41,6 +41,7 @@ from ..errors import SimError  # noqa: E402
 from ..fileio import atomic_write_json, atomic_write_text  # noqa: E402
 from ..markers import MARKER_COLOURS  # noqa: E402
 from ..params import Robot  # noqa: E402
+from .audit import audit  # noqa: E402
 from .model import build  # noqa: E402
 from .rollout import simulate  # noqa: E402
 
@@ -51,9 +52,9 @@ ELEVATION_DEG = 0.0                        # horizontal
 MARGIN_M = 0.04                            # empty border around the robot in the fixed view
 TRACK_HALF_WIDTH_OF_BODY = 2.0             # track view: half the image width, in body lengths
 VISIBLE_FRAC = 0.5                         # truth says a marker is visible when this much of it is seen
-# sample points on a unit disc: the centre and two rings of eight (for the seen fraction)
-_DISC_SAMPLES = np.vstack([[0.0, 0.0]] + [
-    [[r * math.cos(a), r * math.sin(a)] for a in np.arange(8) * math.pi / 4] for r in (0.5, 0.9)])
+# sample points on a unit disc for the seen fraction: the centre and three rings of twelve
+_DISC_SAMPLES = np.vstack([[[0.0, 0.0]]] + [
+    [[r * math.cos(a), r * math.sin(a)] for a in np.arange(12) * math.pi / 6] for r in (0.35, 0.65, 0.95)])
 
 
 @dataclass(frozen=True)
@@ -233,6 +234,7 @@ class ClipRecorder:
     camera: str
     view: CameraView
     robot_name: str = ""
+    shadows: bool = True      # two shadow maps cost about two thirds of an OSMesa frame
     rows: list[_TruthRow] = field(default_factory=list)
     cameras: list[PinholeCamera] = field(default_factory=list)
 
@@ -251,6 +253,9 @@ class ClipRecorder:
                            "or MUJOCO_GL=egl on a GPU") from None
         self.path.parent.mkdir(parents=True, exist_ok=True)
         fd, self.tmp_path = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".mp4", dir=self.path.parent)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.fchmod(fd, 0o666 & ~umask)  # mkstemp makes 0600; the video gets ordinary permissions
         os.close(fd)
         self.writer = cv2.VideoWriter(self.tmp_path, cv2.VideoWriter_fourcc(*"mp4v"), float(self.fps),
                                       (self.width, self.height))
@@ -271,6 +276,10 @@ class ClipRecorder:
         mujoco.mj_camlight(self.model, d)   # lights are placed here, not in mj_kinematics
         view = self.view.at_x(float(d.xpos[self.chassis_id][0])) if self.camera == "track" else self.view
         self.renderer.update_scene(d, camera=view.mjv_camera())
+        # No floor reflections: a mirrored marker is a second blob of the marker's colour,
+        # which a matte table does not show and which would merge with a foot on the floor.
+        self.renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+        self.renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = int(self.shadows)
         cam = pinhole_from_scene(self.renderer.scene, self.width, self.height)
         rgb = self.renderer.render()
         self.writer.write(cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
@@ -287,8 +296,8 @@ class ClipRecorder:
     def _seen_fraction(self, cam: PinholeCamera, centre_m: np.ndarray, geom_id: int) -> float:
         """Share of the marker's disc (as the camera sees it) that no other geom hides.
 
-        Rays go from the camera centre to the disc's centre and to two rings (0.5 and 0.9
-        radius) across the line of sight; a ray that meets the marker first sees it.
+        Rays go from the camera centre to points of the disc across the line of sight
+        (``_DISC_SAMPLES``); a ray that meets the marker first sees it.
         """
         radius = float(self.model.geom_size[geom_id][0])
         sight = centre_m - cam.position_m
@@ -407,6 +416,10 @@ def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = Non
     path = check_video_path(path)
     built = build(robot)
     traj = simulate(robot, cycles=cycles, built=built, keep_states=True)
+    verdict = audit(traj)
+    if not verdict.valid:
+        raise SimError(f"not rendering an invalid simulation: {'; '.join(verdict.reasons)}",
+                       "run `locust sim` on the same robot and fix the reasons it lists")
     model, s = built.model, built.sensors
     dt, nq = traj.timestep_s, model.nq
     times = frame_times_s(traj.plan.duration_s, fps)

@@ -1,0 +1,241 @@
+"""The simulated robot driven live: servo commands arrive as the virtual robot runs.
+
+The virtual robot (the firmware under the MicroPython unix port) sets horn angles as its
+schedule runs; :class:`LiveSim` steps the same MuJoCo model ``locust sim`` uses
+(``mj_step``, one physics step at a time, with ``data.ctrl`` holding the current commands)
+up to each new time, and can render a video of it. Closing it audits the whole record
+with :func:`.audit.audit` (non-finite state, loop closure, energy, MuJoCo warnings) and
+summarises it with :func:`.hops.summarise`, so a live run is judged like any other.
+
+Time: ``t_s = 0`` is the end of the settle phase (``solver.settle_s`` on the floor, servos
+at rest), which runs when the model is made. Commands hold until the next one, exactly as
+the rollout's control plan holds each 50 Hz tick, so driving it with the schedule at the
+control rate reproduces ``run(robot)`` step for step.
+
+Memory: every step's sensor row is kept for the audit (31 numbers, about 5 MB per
+simulated second at dt = 5e-5 s).
+"""
+
+from __future__ import annotations
+
+# .video first: it picks the offscreen GL backend, which MuJoCo reads when first imported.
+from .video import ClipRecorder, check_video_path, frame_views, validate_size  # isort: skip
+
+import math  # noqa: E402
+import threading  # noqa: E402
+import time  # noqa: E402
+from dataclasses import dataclass  # noqa: E402
+
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ..errors import SimError  # noqa: E402
+from ..params import Robot  # noqa: E402
+from .audit import audit  # noqa: E402
+from .hops import summarise  # noqa: E402
+from .model import build  # noqa: E402
+from .rollout import Trajectory  # noqa: E402
+from .schedule import ControlPlan  # noqa: E402
+
+SIDES = ("left", "right")
+
+
+@dataclass(frozen=True)
+class LiveResult:
+    distance_m: float            # chassis x, end of the settle phase -> now
+    max_nose_height_m: float     # highest nose point since the settle phase
+    sim_time_s: float            # simulated time since the settle phase
+    valid: bool
+    reasons: list[str]
+    realtime_factor: float       # simulated seconds per wall second spent stepping (and rendering)
+    video_path: str | None = None
+    frames: int = 0
+
+    def to_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+class LiveSim:
+    """Step the robot's model in time with servo commands given as they happen.
+
+    ``LiveSim(robot, video_path=None, fps=30)`` builds the model and settles it;
+    ``set_servo_angles_deg(left, right)`` sets the horn angles (vs rest, the robot's frame:
+    both -30 during a push) that hold from now on; ``advance_to(t_s)`` steps physics up to
+    ``t_s`` seconds after the settle phase; ``close()`` finishes the video and returns the
+    audited summary as a dict.
+    """
+
+    def __init__(self, robot: Robot, video_path: str | None = None, fps: int = 30,
+                 width: int = 640, height: int = 360):
+        path = None
+        if video_path is not None:
+            validate_size(fps, width, height)
+            path = check_video_path(video_path)
+        self.robot = robot
+        self.built = build(robot)
+        self.model = self.built.model
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_forward(self.model, self.data)
+        self.dt = float(self.model.opt.timestep)
+        self._initial_sensordata = self.data.sensordata.copy()
+        W = mujoco.mjtWarning
+        self._divergence_warnings = [self.data.warning[int(w)]   # live views of the counters
+                                     for w in (W.mjWARN_BADQACC, W.mjWARN_BADQVEL, W.mjWARN_BADQPOS)]
+        self._chunks: list[np.ndarray] = []      # per-step sensor rows, in order
+        self._ctrl_chunks: list[np.ndarray] = []  # per-step left command (rad), for the record's plan
+        self._steps = 0
+        self._stepping_wall_s = 0.0
+        self._diverged = False
+        self._result: LiveResult | None = None
+        self._lock = threading.Lock()
+        self._fps = fps
+        self._recorder: ClipRecorder | None = None
+        self._next_frame = 0
+
+        self._run_to(int(round(robot.solver.settle_s / self.dt)))
+        self._settle_steps = self._steps
+        if path is not None:
+            self._recorder = self._open_video(path, fps, width, height)
+
+    # -- commands -------------------------------------------------------------------
+    def set_servo_angles_deg(self, left_deg: float, right_deg: float) -> None:
+        """Horn angles vs rest (push = -30 on both legs); they hold until the next call."""
+        for side, value in zip(SIDES, (left_deg, right_deg)):
+            if not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise SimError(f"servo command {side} = {value!r} deg is not a finite number",
+                               "send horn angles in degrees, e.g. -30 for a push")
+        with self._lock:
+            self._check_open()
+            for act, value in zip(self.built.servo_actuators, (left_deg, right_deg)):
+                self.data.ctrl[act] = math.radians(float(value))
+
+    def advance_to(self, t_s: float) -> None:
+        """Step physics up to ``t_s`` seconds after the settle phase (an earlier time does nothing)."""
+        if not isinstance(t_s, (int, float)) or not math.isfinite(t_s) or t_s < 0:
+            raise SimError(f"advance_to({t_s!r}): time must be a finite number of seconds >= 0",
+                           "pass the seconds since the virtual robot started")
+        with self._lock:
+            self._check_open()
+            self._run_to(self._settle_steps + int(round(t_s / self.dt)))
+
+    @property
+    def sim_time_s(self) -> float:
+        return (self._steps - getattr(self, "_settle_steps", self._steps)) * self.dt
+
+    # -- stepping -------------------------------------------------------------------
+    def _run_to(self, target_step: int) -> None:
+        while self._steps < target_step and not self._diverged:
+            stop = target_step
+            if self._recorder is not None:
+                frame_step = self._frame_step(self._next_frame)
+                while frame_step == self._steps:  # the frame's time has come: draw it before moving on
+                    self._render_frame()
+                    frame_step = self._frame_step(self._next_frame)
+                stop = min(stop, frame_step)
+            self._step(stop - self._steps)
+
+    def _step(self, n: int) -> None:
+        m, d, bad = self.model, self.data, self._divergence_warnings
+        rows = np.empty((n, m.nsensordata))
+        t0 = time.perf_counter()
+        for i in range(n):
+            mujoco.mj_step(m, d)
+            rows[i] = d.sensordata
+            if bad[0].number or bad[1].number or bad[2].number:
+                # MuJoCo flagged a diverging state: stop there, as mujoco.rollout does, and
+                # leave the verdict to the audit (stepping on would only feed it NaNs)
+                rows = rows[:i + 1]
+                self._diverged = True
+                break
+        self._stepping_wall_s += time.perf_counter() - t0
+        self._steps += len(rows)
+        self._chunks.append(rows)
+        self._ctrl_chunks.append(np.full(len(rows), d.ctrl[self.built.servo_actuators[0]]))
+        if not (np.isfinite(rows[-1]).all() and np.isfinite(d.qpos).all()):
+            self._diverged = True
+
+    # -- video ----------------------------------------------------------------------
+    def _frame_step(self, k: int) -> int:
+        return self._settle_steps + int(round(k / (self._fps * self.dt)))
+
+    def _open_video(self, path, fps: int, width: int, height: int) -> ClipRecorder:
+        """A tracking camera framed on the settled robot, with room above it to hop."""
+        s = self.built.sensors
+        row = self._chunks[-1][-1] if self._chunks else self._initial_sensordata
+        pose = np.vstack([row[s.nose_pos], row[s.foot_pos], row[s.chassis_pos], row[s.com_pos]])
+        headroom = pose + [0.0, 0.0, self.robot.geometry.body_length_m]
+        _, view = frame_views(np.vstack([pose, headroom]), pose[2:3, 0], self.robot.geometry.body_length_m, 0.0,
+                              float(self.model.vis.global_.fovy), width / height)
+        # no shadows: they would cost more than the physics and leave the run slower than real time
+        return ClipRecorder(self.model, path, fps, width, height, "track", view, robot_name=self.robot.name,
+                            shadows=False)
+
+    def _render_frame(self) -> None:
+        t0 = time.perf_counter()
+        self._recorder.add_frame(self.data.qpos, self._next_frame / self._fps)
+        self._stepping_wall_s += time.perf_counter() - t0
+        self._next_frame += 1
+
+    # -- the end --------------------------------------------------------------------
+    def _check_open(self) -> None:
+        if self._result is not None:
+            raise SimError("the live simulation is closed", "make a new LiveSim for another run")
+
+    def close(self) -> dict:
+        """Finish the video; audit and summarise the run. Calling it again returns the same."""
+        with self._lock:
+            if self._result is None:
+                self._result = self._finish()
+            return self._result.to_dict()
+
+    def _finish(self) -> LiveResult:
+        video_path, frames = None, 0
+        if self._recorder is not None:
+            if self._recorder.frames == 0:
+                self._recorder.abort()
+            else:
+                info = self._recorder.finish()
+                video_path, frames = str(info.video_path), info.frames
+        traj = self.trajectory()
+        sim_s = self.sim_time_s
+        rtf = self._steps * self.dt / self._stepping_wall_s if self._stepping_wall_s > 0 else math.inf
+        if traj.sensordata.shape[0] == 0:
+            return LiveResult(0.0, float(self._initial_sensordata[self.built.sensors.nose_pos][2]), 0.0, True, [],
+                              rtf, video_path, frames)
+        verdict = audit(traj)
+        nan = float("nan")
+        if not verdict.valid:
+            distance, nose = nan, nan
+        elif self._steps > self._settle_steps:
+            summary = summarise(traj)
+            distance, nose = summary.distance_m, summary.max_nose_height_m
+        else:  # nothing happened after the settle phase
+            distance, nose = 0.0, float(traj.sensordata[-1, self.built.sensors.nose_pos][2])
+        return LiveResult(distance, nose, sim_s, verdict.valid, verdict.reasons, rtf, video_path, frames)
+
+    def trajectory(self) -> Trajectory:
+        """The record so far, in the rollout's form (one row per physics step, settle included)."""
+        nsd = self.model.nsensordata
+        sd = np.concatenate(self._chunks) if self._chunks else np.empty((0, nsd))
+        ctrl = np.concatenate(self._ctrl_chunks) if self._ctrl_chunks else np.empty(0)
+        settle = getattr(self, "_settle_steps", self._steps)
+        plan = ControlPlan(ctrl_rad=ctrl, timestep_s=self.dt, steps_per_tick=1, settle_steps=settle,
+                           cycle_start_steps=np.array([settle, self._steps]))
+        warnings = {mujoco.mjtWarning(i).name: int(self.data.warning[i].number)
+                    for i in range(len(self.data.warning)) if self.data.warning[i].number}
+        return Trajectory(built=self.built, plan=plan, initial_sensordata=self._initial_sensordata,
+                          sensordata=sd, final_qpos=self.data.qpos.copy(), warnings=warnings,
+                          wall_s=self._stepping_wall_s)
+
+    def __enter__(self) -> "LiveSim":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._result is None and self._recorder is not None and exc[0] is not None:
+            self._recorder.abort()   # a failed run leaves no half-written video
+            self._result = LiveResult(float("nan"), float("nan"), self.sim_time_s, False, ["aborted"], math.nan)
+        elif self._result is None:
+            self.close()
+
+
+__all__ = ["LiveSim", "LiveResult"]

@@ -1,0 +1,172 @@
+"""The rendered hop video against its own truth sidecars.
+
+The truth pixels are projected through the camera MuJoCo rendered with; here they are
+checked against what is actually in the MP4: the centroid of each marker's colour blob.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+
+os.environ.setdefault("MUJOCO_GL", "osmesa")
+
+import cv2  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+import pytest  # noqa: E402
+
+from locust.errors import SimError  # noqa: E402
+from locust.markers import MARKER_COLOURS  # noqa: E402
+from locust.params import preset  # noqa: E402
+from locust.sim.video import VISIBLE_FRAC, render_video  # noqa: E402
+
+W, H, FPS = 320, 240, 30
+FULLY_SEEN = 0.8         # frames where a marker is at least this much in view (not on the floor)
+VISIBLE = VISIBLE_FRAC     # the truth's own "visible" threshold
+
+
+def _frames(path) -> np.ndarray:
+    cap = cv2.VideoCapture(str(path))
+    out = []
+    while True:
+        ok, frame = cap.read()
+        if not ok:
+            break
+        out.append(frame)
+    cap.release()
+    return np.array(out)
+
+
+def _hue_opencv(hex_colour: str) -> int:
+    bgr = np.uint8([[[int(hex_colour[5:7], 16), int(hex_colour[3:5], 16), int(hex_colour[1:3], 16)]]])
+    return int(cv2.cvtColor(bgr, cv2.COLOR_BGR2HSV)[0, 0, 0])
+
+
+def blob_centroid(frame_bgr: np.ndarray, hex_colour: str) -> tuple[float, float] | None:
+    """Centroid of the largest blob of a saturated, bright pixel of the marker's hue."""
+    hsv = cv2.cvtColor(frame_bgr, cv2.COLOR_BGR2HSV)
+    dh = np.abs(((hsv[..., 0].astype(int) - _hue_opencv(hex_colour) + 90) % 180) - 90)
+    mask = ((dh < 12) & (hsv[..., 1] > 100) & (hsv[..., 2] > 120)).astype(np.uint8)
+    n, _, stats, centres = cv2.connectedComponentsWithStats(mask)
+    if n < 2:
+        return None
+    k = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    return float(centres[k][0]), float(centres[k][1])
+
+
+@pytest.fixture(scope="module")
+def clips(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("video")
+    robot = preset("seed")
+    infos = {cam: render_video(robot, folder / f"hop-{cam}.mp4", cycles=1, camera=cam, fps=FPS, width=W, height=H)
+             for cam in ("track", "fixed")}
+    return robot, infos
+
+
+def test_frame_count_is_duration_times_fps(clips):
+    robot, infos = clips
+    duration_s = robot.solver.settle_s + robot.schedule.push_s + robot.schedule.wait_s   # 1 cycle
+    expected = round(duration_s * FPS)
+    assert expected == 54
+    for info in infos.values():
+        assert info.frames == expected
+        assert len(_frames(info.video_path)) == expected
+        truth = pd.read_csv(info.truth_path, comment="#")
+        assert len(truth) == expected
+        assert truth.t_s.iloc[-1] == pytest.approx((expected - 1) / FPS, abs=1e-6)
+
+
+def _blob_errors(infos, min_seen_frac: float) -> tuple[np.ndarray, int]:
+    """Blob centroid - true pixel centre, for every marker seen at least ``min_seen_frac``."""
+    errors, misses = [], 0
+    for info in infos.values():
+        frames = _frames(info.video_path)
+        truth = pd.read_csv(info.truth_path, comment="#")
+        for name, (hex_colour, _) in MARKER_COLOURS.items():
+            for i in np.flatnonzero(truth[f"{name}_seen_frac"] >= min_seen_frac):
+                c = blob_centroid(frames[i], hex_colour)
+                if c is None:
+                    misses += 1
+                    continue
+                errors.append((c[0] - truth[f"{name}_px"][i], c[1] - truth[f"{name}_py"][i]))
+    return np.array(errors).reshape(-1, 2), misses
+
+
+def _rms(err: np.ndarray) -> float:
+    return float(np.sqrt((err ** 2).sum(axis=1).mean()))
+
+
+def test_truth_pixels_match_marker_blobs(clips):
+    """Projection check: true pixel centre vs colour-blob centroid in the decoded MP4.
+
+    Fully seen markers (in flight) test the projection itself, to a fraction of a pixel (a
+    half-pixel slip in the pixel convention would fail it); markers flagged visible include
+    those half sunk in the floor when the robot stands, whose blob is only their top half.
+    """
+    _, infos = clips
+    err, misses = _blob_errors(infos, FULLY_SEEN)
+    assert misses == 0
+    assert len(err) >= 10, "too few frames with a fully seen marker to judge the projection"
+    assert _rms(err) <= 0.5, f"fully seen: truth vs blob RMS {_rms(err):.2f} px over {len(err)} markers"
+    err, misses = _blob_errors(infos, VISIBLE)
+    assert misses == 0 and len(err) >= 40
+    assert _rms(err) <= 1.5, f"visible: truth vs blob RMS {_rms(err):.2f} px over {len(err)} markers"
+
+
+def test_truth_world_positions_are_the_audited_run(clips):
+    """Frame k shows the rollout's state at t = k / fps: the nose marker is the nose sensor there."""
+    from locust.sim.rollout import simulate
+
+    robot, infos = clips
+    traj = simulate(robot, cycles=1)
+    nose = traj.sensordata[:, traj.built.sensors.nose_pos]
+    truth = pd.read_csv(infos["fixed"].truth_path, comment="#")
+    # mj_step evaluates sensors before it integrates: sensor row k is the pose at t = k dt
+    rows = np.rint(truth.t_s.to_numpy() / traj.timestep_s).astype(int)
+    np.testing.assert_allclose(truth.nose_x_m, nose[rows, 0], atol=2e-6)
+    np.testing.assert_allclose(truth.nose_z_m, nose[rows, 2], atol=2e-6)
+
+
+def test_fixed_camera_has_static_background(clips):
+    """The floor in front of the robot does not change in the fixed clip; it slides in the tracking one."""
+    _, infos = clips
+    changed = {}
+    for cam, info in infos.items():
+        grey = np.array([cv2.cvtColor(f, cv2.COLOR_BGR2GRAY) for f in _frames(info.video_path)]).astype(int)
+        floor = grey[:, int(0.8 * H):]      # floor between the camera and the robot
+        span = floor.max(axis=0) - floor.min(axis=0)
+        changed[cam] = float((span > 8).mean())
+        if cam == "fixed":
+            assert int(span.max()) <= 6   # codec noise only
+    assert changed["fixed"] == 0.0
+    assert changed["track"] > 0.5           # the same measure sees a moving camera
+
+
+def test_fixed_camera_metres_per_pixel(clips):
+    """m/px at the nose's plane turns the true pixel track into the true metric track."""
+    _, infos = clips
+    cam = json.loads(infos["fixed"].camera_path.read_text())
+    assert cam["camera"] == "fixed" and cam["width_px"] == W and cam["height_px"] == H
+    m_per_px = cam["m_per_px"]["nose_plane"]["m_per_px"]
+    truth = pd.read_csv(infos["fixed"].truth_path, comment="#")
+    dx_m = truth.nose_x_m.iloc[-1] - truth.nose_x_m.iloc[0]
+    dpx = truth.nose_px.iloc[-1] - truth.nose_px.iloc[0]
+    assert abs(dx_m) > 0.1                                      # the robot hopped
+    assert -dpx * m_per_px == pytest.approx(dx_m, rel=0.02)     # +x runs right to left in this view
+
+
+def test_refuses_to_overwrite_and_bad_names(tmp_path):
+    robot = preset("seed")
+    existing = tmp_path / "clip.mp4"
+    existing.write_bytes(b"user's video")
+    with pytest.raises(SimError, match="not overwriting"):
+        render_video(robot, existing, cycles=1, width=W, height=H)
+    assert existing.read_bytes() == b"user's video"
+    with pytest.raises(SimError, match=r"\.mp4"):
+        render_video(robot, tmp_path / "clip.avi", cycles=1)
+    with pytest.raises(SimError, match="camera"):
+        render_video(robot, tmp_path / "other.mp4", camera="overhead")
+    with pytest.raises(SimError, match="width"):
+        render_video(robot, tmp_path / "other.mp4", width=7)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["clip.mp4"]
