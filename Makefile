@@ -31,6 +31,7 @@ test-all: install sysdeps
 
 bench: install
 	$(PY) bench/sim_speed.py
+	$(PY) bench/track_speed.py
 
 clean:
 	rm -rf $(VENV) demo-out .pytest_cache
