@@ -135,10 +135,13 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
     try:
         progress("connecting")
         _release_console(transport)
+        # mpremote reads a pty with blocking reads: bound them while a silent port is possible
+        transport.serial.timeout = 1.0
         try:
             transport.enter_raw_repl(soft_reset=False, timeout_overall=repl_timeout_s)
         except TransportError:
             raise DeviceError(f"no MicroPython REPL answered on {port}", NO_MICROPYTHON_HINT) from None
+        transport.serial.timeout = None
         transport.exec("import sys")
         impl, board_mpy, platform = transport.eval("(sys.implementation.name, getattr(sys.implementation, '_mpy', 0), sys.platform)")
         if impl != "micropython":

@@ -76,7 +76,7 @@ class Link:
             msg = P.decode(line) if line is not None else None
         except P.ProtocolError:
             msg = None
-        if msg is None:
+        if msg is None or ("ev" not in msg and "ok" not in msg):  # noise, or a REPL echoing our request
             self.noise_lines += 1
         elif "ev" in msg:
             self.events.put(msg)

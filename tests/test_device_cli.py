@@ -1,0 +1,154 @@
+"""The acceptance runs, as a user types them: `locust flash/hop/virtual` in subprocesses."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import serial
+
+from locust.firmware import protocol as P
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "firmware"))
+from lcg import Lcg  # noqa: E402  (the firmware tests' generator: same numbers in MicroPython)
+
+LOCUST = [sys.executable, "-m", "locust.cli"]
+
+
+def _run(args, env, timeout=90):
+    return subprocess.run(LOCUST + args, capture_output=True, text=True, env=env, timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def env(tmp_path_factory):
+    env = dict(os.environ, LOCUST_VIRTUAL_DIR=str(tmp_path_factory.mktemp("virtual")))
+    proc = _run(["flash", "--port", "sim"], env)
+    assert proc.returncode == 0, proc.stderr
+    assert "files verified by SHA-256" in proc.stdout
+    return env
+
+
+def test_flash_then_hop_six_cycles_on_time(env, tmp_path):
+    proc = _run(["hop", "--port", "sim", "--cycles", "6", "--json", "--plant", "record", "--out", str(tmp_path / "run")], env)
+    assert proc.returncode == 0, proc.stderr
+    rec = json.loads(proc.stdout)
+    assert rec["status"] == "complete" and rec["firmware_version"] == P.VERSION
+    assert len(rec["phases"]) == 12
+    assert [(p["cycle"], p["phase"]) for p in rec["phases"][:2]] == [(1, "push"), (1, "wait")]
+    for p in rec["phases"]:
+        assert abs(p["measured_ms"] - p["commanded_ms"]) <= 2.0, p
+    assert rec["phases"][-1]["commanded_ms"] == 5 * 1300 + 300
+    assert rec["jitter"]["max_abs_ms"] <= 2.0
+    assert json.loads((tmp_path / "run" / "run.json").read_text()) == rec
+
+
+def test_ctrl_c_keeps_an_incomplete_record(env, tmp_path):
+    out = tmp_path / "D"
+    proc = subprocess.Popen(LOCUST + ["hop", "--port", "sim", "--cycles", "6", "--plant", "record", "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    deadline = time.monotonic() + 30
+    phases = 0
+    while phases < 3 and time.monotonic() < deadline:
+        time.sleep(0.05)
+        try:
+            phases = len(json.loads((out / "run.json").read_text())["phases"])
+        except (OSError, ValueError):
+            pass
+    proc.send_signal(signal.SIGINT)
+    _, stderr = proc.communicate(timeout=30)
+    assert proc.returncode == 2, stderr
+    assert "interrupted" in stderr and "Traceback" not in stderr
+    rec = json.loads((out / "run.json").read_text())
+    assert rec["status"] == "incomplete"
+    assert 3 <= len(rec["phases"]) < 12
+    assert [p["commanded_ms"] for p in rec["phases"]] == [0, 300, 1300, 1600, 2600, 2900][:len(rec["phases"])]
+
+
+def test_bad_input_is_a_clear_error_and_nothing_is_lost(env, tmp_path):
+    out = tmp_path / "bad"
+    proc = _run(["hop", "--port", "sim", "--push-deg", "-80", "--plant", "record", "--out", str(out)], env)
+    assert proc.returncode == 2 and "error:" in proc.stderr and "out_of_range" in proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert json.loads((out / "run.json").read_text())["status"] == "error"
+    again = _run(["hop", "--port", "sim", "--plant", "record", "--out", str(out)], env)
+    assert again.returncode == 2 and "never overwritten" in again.stderr
+    assert json.loads((out / "run.json").read_text())["status"] == "error"  # untouched
+
+
+def _fuzz_frames(n, seed=4):
+    """n lines, each answered by exactly one reply: random, corrupted and out-of-range frames."""
+    rng = Lcg(seed)
+    frames = []
+    for i in range(n):
+        kind = i % 8
+        if kind == 0:
+            line = rng.bytes(1 + rng.below(200))
+        elif kind == 1:  # a valid frame with one flipped bit
+            good = bytearray(P.encode({"id": i, "cmd": "pose", "left_deg": 1, "right_deg": 1})[:-1])
+            good[1 + rng.below(len(good) - 2)] ^= 1 << rng.below(7)
+            line = bytes(good)
+        elif kind == 2:
+            body = rng.bytes(rng.below(80))
+            line = b"$" + body + b"*" + P.crc_hex(body).encode()
+        elif kind == 3:
+            line = b"$" + rng.bytes(300 + rng.below(2000))
+        elif kind == 4:
+            line = P.encode({"id": i, "cmd": "pose", "left_deg": rng.below(400) - 200,
+                             "right_deg": rng.below(400) - 200})[:-1]
+        elif kind == 5:
+            line = P.encode({"id": i, "cmd": ["hop", "fly", "config", "report"][rng.below(4)],
+                             "cycles": rng.below(5) - 1, "key": "left.travel_deg", "value": 200})[:-1]
+        elif kind == 6:
+            line = P.encode({"id": rng.next(), "cmd": "pose", "left_deg": 1e308 * 10, "right_deg": "x"})[:-1]
+        else:
+            line = bytes([3, 4, 1, 2, 0x1B]) + rng.bytes(8)  # the REPL's control characters
+        line = line.replace(b"\n", b"").replace(b"\r", b"") or b"?"
+        frames.append(line + b"\n")
+    return frames
+
+
+def test_fuzzed_virtual_robot_survives_and_then_hops(env, tmp_path):
+    log = tmp_path / "pwm.csv"
+    vproc = subprocess.Popen(LOCUST + ["virtual", "--plant", "record", "--pwm-log", str(log)],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        device = vproc.stdout.readline().strip()
+        assert device.startswith("/dev/pts/")
+        frames = _fuzz_frames(3000)
+        replies = []
+        with serial.Serial(device, timeout=2) as port:
+            time.sleep(0.3)
+            port.reset_input_buffer()
+            reader = P.LineReader(limit=1 << 16)
+            for start in range(0, len(frames), 20):
+                batch = frames[start:start + 20]
+                port.write(b"".join(batch))
+                while len(replies) < start + len(batch):
+                    data = port.read(max(1, port.in_waiting))
+                    assert data, f"no reply after {len(replies)} of {len(frames)} frames"
+                    replies += [P.decode(line) for line in reader.feed(data) if line]
+        assert len(replies) == len(frames)  # one reply each: nothing crashed, nothing dropped
+        assert not [r for r in replies if r.get("error") == P.E_INTERNAL]
+        assert sum(r.get("error") == P.E_CHECKSUM for r in replies) >= 375
+        assert sum(r.get("error") == P.E_TOO_LONG for r in replies) == 375
+        moved = sum(1 for r in replies if r.get("ok") and "left_deg" in r)
+        assert moved > 0
+        hop = _run(["hop", "--port", device, "--cycles", "1", "--json", "--out", str(tmp_path / "after")], env)
+        assert hop.returncode == 0, hop.stderr
+        rec = json.loads(hop.stdout)
+        assert rec["status"] == "complete" and len(rec["phases"]) == 2
+        assert all(abs(p["error_ms"]) <= 2.0 for p in rec["phases"])
+    finally:
+        vproc.send_signal(signal.SIGTERM)
+        vproc.communicate(timeout=30)
+    assert vproc.returncode == 0
+    rows = [line.split(",") for line in log.read_text().splitlines()[2:]]
+    angles = [float(r[5]) for r in rows if r[5]]
+    assert len(angles) > 2 * moved
+    assert max(abs(a) for a in angles) <= 45.0 + 1e-3  # never outside the servo travel
