@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 from typing import Callable, Optional
 
@@ -13,7 +11,7 @@ import numpy as np
 from ..errors import TrackError
 from ..fileio import atomic_write_bytes
 from .runner import MarkerTrack, TrackResult
-from .video import read_frame, read_frames
+from .video import encode_video, read_frame, read_frames
 
 PALETTE_BGR = [(255, 0, 255), (255, 255, 0), (0, 255, 255), (0, 128, 255), (255, 128, 0), (128, 255, 0)]
 
@@ -67,21 +65,12 @@ def write_png(result: TrackResult, path: Path) -> Path:
 def write_video(result: TrackResult, path: Path, progress: Optional[Callable[[int], None]] = None) -> Path:
     """The whole clip with the tracks growing frame by frame (MPEG-4, at the clip's rate)."""
     v = result.video
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".mp4", dir=path.parent)
-    os.close(fd)
-    writer = cv2.VideoWriter(tmp, cv2.VideoWriter_fourcc(*"mp4v"), float(result.clip.fps), (v.width_px, v.height_px))
-    try:
-        if not writer.isOpened():
-            raise TrackError(f"cannot write an overlay video at {path}", "check the folder is writable")
+
+    def drawn():
         for i, (_, image) in enumerate(read_frames(v, result.clip)):
-            writer.write(draw_tracks(image, result, upto=i))
+            yield draw_tracks(image, result, upto=i)
             if progress:
                 progress(1)
-        writer.release()
-        os.replace(tmp, path)
-    except BaseException:
-        writer.release()
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+
+    return encode_video(Path(path), drawn(), float(result.clip.fps), (v.width_px, v.height_px))
 

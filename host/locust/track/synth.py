@@ -18,7 +18,6 @@ chosen frames; the truth marks those frames not visible.
 from __future__ import annotations
 
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,6 +27,7 @@ import numpy as np
 from ..fileio import atomic_write_text
 from ..markers import MARKER_COLOURS
 from .color import parse_hex
+from .video import encode_video as write_video  # synthetic clips are written like any other
 
 SUPERSAMPLE = 8
 SHIFT = 4  # cv2 drawing: coordinates in 1/16 of a (supersampled) pixel
@@ -131,29 +131,6 @@ def render_hop_frame(i: int, truth: SynthTruth, floor: np.ndarray, radius_px: fl
         r = int(3 * radius_px)
         cv2.rectangle(img, (int(fx) - r, int(fy) - r), (int(fx) + r, int(fy) + r), (90, 92, 95), -1)
     return camera(img, rng)
-
-
-def write_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: str = "mp4v") -> Path:
-    """Encode ``frames`` (an iterable of BGR images) to ``path`` atomically."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    writer = cv2.VideoWriter(tmp, cv2.VideoWriter_fourcc(*fourcc), fps, size)
-    if fourcc == "MJPG":
-        writer.set(cv2.VIDEOWRITER_PROP_QUALITY, 90)
-    try:
-        if not writer.isOpened():
-            raise RuntimeError(f"OpenCV cannot encode {fourcc} to {path}")
-        for frame in frames:
-            writer.write(frame)
-        writer.release()
-        os.replace(tmp, path)
-    except BaseException:
-        writer.release()
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
 
 
 def make_hop_video(path: str | os.PathLike, width: int = 640, height: int = 360, n_frames: int = 48,

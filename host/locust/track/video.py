@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import queue
+import tempfile
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -171,3 +172,26 @@ def _ended_early(info: VideoInfo, index: int) -> None:
     raise TrackError(f"{info.path}: decoding stopped at frame {index}, but the file says it has "
                      f"{info.frame_count} frames: the video is truncated or damaged",
                      f"re-copy the file, or track the readable part with --end {max(index - 1, 0)}")
+
+
+def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: str = "mp4v") -> Path:
+    """Encode ``frames`` (an iterable of BGR images) to ``path`` atomically."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    writer = cv2.VideoWriter(tmp, cv2.VideoWriter_fourcc(*fourcc), fps, size)
+    if fourcc == "MJPG":
+        writer.set(cv2.VIDEOWRITER_PROP_QUALITY, 90)
+    try:
+        if not writer.isOpened():
+            raise TrackError(f"OpenCV cannot encode {fourcc} to {path}", "check the folder is writable and the codec name")
+        for frame in frames:
+            writer.write(frame)
+        writer.release()
+        os.replace(tmp, path)
+    except BaseException:
+        writer.release()
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
