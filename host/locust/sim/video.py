@@ -38,7 +38,7 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ..errors import SimError  # noqa: E402
-from ..fileio import atomic_write_json, atomic_write_text  # noqa: E402
+from ..fileio import atomic_write_json, atomic_write_text, temp_beside  # noqa: E402
 from ..markers import MARKER_COLOURS  # noqa: E402
 from ..params import Robot  # noqa: E402
 from .audit import audit  # noqa: E402
@@ -251,11 +251,7 @@ class ClipRecorder:
             raise SimError(f"cannot open an offscreen OpenGL context ({type(exc).__name__}: {exc})",
                            "install OSMesa (apt-get install libosmesa6) and run with MUJOCO_GL=osmesa, "
                            "or MUJOCO_GL=egl on a GPU") from None
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, self.tmp_path = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".mp4", dir=self.path.parent)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.fchmod(fd, 0o666 & ~umask)  # mkstemp makes 0600; the video gets ordinary permissions
+        fd, self.tmp_path = temp_beside(self.path, suffix=".mp4")
         os.close(fd)
         self.writer = cv2.VideoWriter(self.tmp_path, cv2.VideoWriter_fourcc(*"mp4v"), float(self.fps),
                                       (self.width, self.height))

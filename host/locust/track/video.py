@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import queue
-import tempfile
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +23,7 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ..errors import TrackError  # noqa: E402
+from ..fileio import temp_beside  # noqa: E402
 
 
 @dataclass(frozen=True)
@@ -177,8 +177,7 @@ def _ended_early(info: VideoInfo, index: int) -> None:
 def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: str = "mp4v") -> Path:
     """Encode ``frames`` (an iterable of BGR images) to ``path`` atomically."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    fd, tmp = temp_beside(path, suffix=path.suffix)
     os.close(fd)
     writer = cv2.VideoWriter(tmp, cv2.VideoWriter_fourcc(*fourcc), fps, size)
     if fourcc == "MJPG":
