@@ -253,7 +253,9 @@ def _seed() -> Robot:
     return Robot(name="seed", provenance={k: _SEED_SOURCE for k in measured})
 
 
-def _scaled(base: Robot, name: str, added_m: float) -> Robot:
+def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
+                      note: str | None = None) -> Robot:
+    """``base`` with the same length added to all four links (the seed's ``scale`` variable)."""
     g = base.geometry
     values = {
         "geometry.ground_m": round(g.ground_m + added_m, 9),
@@ -261,8 +263,21 @@ def _scaled(base: Robot, name: str, added_m: float) -> Robot:
         "geometry.coupler_m": round(g.coupler_m + added_m, 9),
         "geometry.leg_m": round(g.leg_m + added_m, 9),
     }
-    note = f"notebook Part 3 leg set: +{added_m * 100:g} cm on every link"
-    return base.with_values(values, Provenance(source=f"preset:{name}", note=note)).renamed(name)
+    note = note or f"+{added_m * 100:g} cm on every link"
+    return base.with_values(values, Provenance(source=source, note=note))
+
+
+LEG_SETS_M = {"small": 0.0, "medium": 0.01, "large": 0.02}   # notebook Part 3: added to every link
+
+
+def leg_set(base: Robot, name: str) -> Robot:
+    """The physical leg set ``name`` (small/medium/large) built on ``base``'s parameters."""
+    try:
+        added = LEG_SETS_M[name]
+    except KeyError:
+        raise ParamsError(f"unknown leg set {name!r}", f"choose one of {', '.join(LEG_SETS_M)}") from None
+    note = f"notebook Part 3 leg set: +{added * 100:g} cm on every link"
+    return with_added_length(base, added, source=f"preset:{name}", note=note).renamed(name)
 
 
 def _seed_notebook() -> Robot:
@@ -279,9 +294,9 @@ def _seed_notebook() -> Robot:
 
 PRESETS = {
     "seed": _seed,
-    "small": lambda: _scaled(_seed(), "small", 0.0),
-    "medium": lambda: _scaled(_seed(), "medium", 0.01),
-    "large": lambda: _scaled(_seed(), "large", 0.02),
+    "small": lambda: leg_set(_seed(), "small"),
+    "medium": lambda: leg_set(_seed(), "medium"),
+    "large": lambda: leg_set(_seed(), "large"),
     "seed-notebook": _seed_notebook,
 }
 

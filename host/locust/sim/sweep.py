@@ -1,0 +1,110 @@
+"""``run_sweep``: a grid of designs, checked, simulated, audited, stored as they finish.
+
+    from locust.sim.sweep import run_sweep
+    summary = run_sweep(preset("seed"), [parse_axis("scale=0:0.05:30", base)], cycles=3,
+                        out=Path("sweep-out"))
+
+The folder gets ``results.csv`` (one row per design), ``sweep.json`` (the request, the best
+valid design, timing) and the landscape plots. Rerunning into the same folder resumes.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..params import Robot
+from .sweep_design import Axis, evaluate
+from .sweep_exec import default_jobs, mapper
+from .sweep_store import SweepStore
+
+
+@dataclass(frozen=True)
+class Task:
+    """One design to run: everything the worker needs, picklable."""
+
+    base: Robot
+    design: int
+    values: tuple[tuple[str, float], ...]
+    cycles: int
+
+
+def run_task(task: Task) -> dict[str, Any]:
+    row: dict[str, Any] = {"design": task.design, **dict(task.values)}
+    row.update(evaluate(task.base, dict(task.values), task.cycles))
+    return row
+
+
+def grid(axes: list[Axis]) -> list[dict[str, float]]:
+    """Every combination, the last axis varying fastest; design ``i`` is the i-th."""
+    names = [a.name for a in axes]
+    return [dict(zip(names, combo)) for combo in itertools.product(*(a.values() for a in axes))]
+
+
+def best_row(rows: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """The valid design that went farthest (lowest design number on a tie); never an invalid one."""
+    valid = [r for r in rows if r["valid"] and math.isfinite(r["distance_m"])]
+    return max(valid, key=lambda r: (r["distance_m"], -r["design"])) if valid else None
+
+
+def request(base: Robot, axes: list[Axis], cycles: int) -> dict[str, Any]:
+    return {"base": base.name, "parameters": base.flat(), "vary": [a.to_dict() for a in axes], "cycles": cycles}
+
+
+@dataclass
+class SweepSummary:
+    folder: Path
+    rows: list[dict[str, Any]]
+    best: dict[str, Any] | None
+    computed: int
+    resumed: int
+    wall_s: float
+    finished: bool
+    plots: list[Path]
+
+    @property
+    def designs_per_s(self) -> float:
+        return self.computed / self.wall_s if self.wall_s > 0 else float("nan")
+
+
+def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: str = "local",
+              jobs: int | None = None, progress: Callable[[int], None] | None = None,
+              plots: bool = True) -> SweepSummary:
+    """Run (or resume) the sweep into ``out``. ``progress(n)`` is called as each design finishes.
+
+    An interrupt (Ctrl-C) leaves every finished row on disk and re-raises.
+    """
+    jobs = jobs or default_jobs()
+    designs = grid(axes)
+    names = [a.name for a in axes]
+    meta = {"request": request(base, axes, cycles), "designs": len(designs), "scheduler": scheduler, "jobs": jobs}
+    store = SweepStore.open(out, meta, names)
+    resumed = len(store.done)
+    todo = [Task(base, i, tuple(v.items()), cycles) for i, v in enumerate(designs) if i not in store.done]
+    t0 = time.perf_counter()
+    finished = False
+    try:
+        with mapper(scheduler, jobs) as run_map:
+            for row in run_map(run_task, todo):
+                store.append(row)
+                if progress:
+                    progress(1)
+        finished = True
+    finally:
+        wall = time.perf_counter() - t0
+        store.close(finished)
+        rows = [store.done[i] for i in sorted(store.done)]
+        best = best_row(rows)
+        store.write_meta(done=len(rows), finished=finished, best=best, last_run={
+            "computed": len(rows) - resumed, "wall_s": wall, "scheduler": scheduler, "jobs": jobs})
+    made: list[Path] = []
+    if plots and rows:
+        from .sweep_plot import plot_landscape
+
+        made = plot_landscape(rows, axes, best, out, base)
+    return SweepSummary(Path(out), rows, best, len(rows) - resumed, resumed, wall, finished, made)

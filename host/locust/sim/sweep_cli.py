@@ -1,0 +1,146 @@
+"""``locust sweep`` and ``locust optimize``: design search on the audited simulation."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import click
+
+from ..errors import SweepError
+from ..params import resolve_robot
+from ..params_cli import robot_options
+
+
+def _bar(length: int, label: str):
+    return click.progressbar(length=length, label=label, file=sys.stderr, show_pos=True, show_eta=True)
+
+
+def _describe(row: dict, names: list[str]) -> str:
+    where = ", ".join(f"{n}={row[n]:.6g}" for n in names)
+    return (f"design {row['design']} ({where}): {row['distance_m'] * 100:.2f} cm, "
+            f"highest nose {row['max_nose_height_m'] * 100:.2f} cm, {row['hops']} airborne hops")
+
+
+@click.command()
+@robot_options
+@click.option("--vary", "varies", multiple=True, required=True, metavar="NAME=START:STOP:N",
+              help="A parameter by dotted name, or `scale` (metres added to all four links), "
+                   "with N values from START to STOP. Repeat for a grid.")
+@click.option("--cycles", type=click.IntRange(1, 100), default=3, show_default=True, help="Hop cycles per design.")
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
+              help="Folder for results.csv, sweep.json and plots. Rerun with the same folder to resume.")
+@click.option("--jobs", type=click.IntRange(1, 1024), default=None,
+              help="Parallel workers (default: every local core).")
+@click.option("--scheduler", default="local", show_default=True, metavar="local|dask-local|tcp://HOST:PORT",
+              help="local: a process per core; dask-local: a Dask LocalCluster; tcp://...: a Dask cluster.")
+@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
+def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json):
+    """Simulate a grid of designs and report the best valid one.
+
+    Each design is checked before simulation (the four-bar assembles and stays closed over the
+    commanded crank range) and audited after; a design that fails is kept in results.csv with
+    `valid` False and the reason, and is never chosen as best. Rows are written as designs
+    finish, so an interrupted sweep resumes where it stopped.
+
+    \b
+    Examples:
+      locust sweep --preset seed --vary scale=0:0.05:30 --cycles 3 --out sweep-scale
+      locust sweep --vary geometry.leg_m=0.04:0.1:7 --vary geometry.crank_m=0.03:0.06:4 --out grid
+      locust sweep --vary scale=0:0.05:30 --scheduler tcp://10.0.0.5:8786 --out cluster-run
+    """
+    from .sweep import grid, run_sweep
+    from .sweep_design import parse_axis
+    from .sweep_exec import check_scheduler
+
+    base = resolve_robot(preset, config, sets)
+    axes = [parse_axis(v, base) for v in varies]
+    names = [a.name for a in axes]
+    if len(set(names)) != len(names):
+        raise SweepError(f"--vary names a parameter twice: {', '.join(names)}", "give each parameter one --vary")
+    check_scheduler(scheduler)
+    total = len(grid(axes))
+    with _bar(total, f"sweep ({scheduler})") as bar:
+        try:
+            summary = run_sweep(base, axes, cycles, out, scheduler=scheduler, jobs=jobs, progress=bar.update)
+        except KeyboardInterrupt:
+            click.echo(f"\ninterrupted: finished designs are in {out}/results.csv; "
+                       "rerun the same command to resume", err=True)
+            sys.exit(130)
+    rows = summary.rows
+    valid = [r for r in rows if r["valid"]]
+    if as_json:
+        click.echo(json.dumps({"folder": str(summary.folder), "designs": len(rows), "valid": len(valid),
+                               "computed": summary.computed, "resumed": summary.resumed,
+                               "wall_s": summary.wall_s, "best": summary.best,
+                               "plots": [str(p) for p in summary.plots]}, indent=2, default=str))
+        return
+    click.echo(f"{len(rows)} designs ({summary.resumed} from an earlier run, {summary.computed} computed in "
+               f"{summary.wall_s:.1f} s), {len(valid)} valid")
+    reasons: dict[str, int] = {}
+    for r in rows:
+        if not r["valid"]:
+            key = r["reason"].split(":")[0]
+            reasons[key] = reasons.get(key, 0) + 1
+    for reason, n in sorted(reasons.items(), key=lambda kv: -kv[1]):
+        click.echo(f"  invalid x{n}: {reason}")
+    if summary.best is None:
+        click.echo("no valid design: nothing to recommend")
+    else:
+        click.echo("best valid " + _describe(summary.best, names))
+    click.echo(f"results: {summary.folder / 'results.csv'}")
+    for p in summary.plots:
+        click.echo(f"plot: {p}")
+
+
+@click.command()
+@robot_options
+@click.option("--vary", "varies", multiple=True, required=True, metavar="NAME=LOW:HIGH",
+              help="A parameter (dotted name or `scale`) and its range. Repeat for several.")
+@click.option("--trials", type=click.IntRange(1, 100000), default=50, show_default=True)
+@click.option("--cycles", type=click.IntRange(1, 100), default=3, show_default=True)
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
+              help="Folder for trials.csv, optimize.json, history.png (and the journal by default).")
+@click.option("--storage", default=None, metavar="URL",
+              help="Optuna storage: a journal file path (default OUT/study.journal) or an RDB URL "
+                   "such as sqlite:///study.db to share a study between machines.")
+@click.option("--study", "study_name", default="locust", show_default=True, help="Study name in the storage.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Sampler seed.")
+@click.option("--jobs", type=click.IntRange(1, 1024), default=1, show_default=True,
+              help="Trials run at once in this process (the simulation releases the GIL).")
+def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_name, seed, jobs):
+    """Search continuous parameter ranges for the farthest hop (Optuna TPE).
+
+    Invalid designs are pruned with their reason and never become the best. Rerunning with the
+    same --out (or --storage) continues the study.
+
+    \b
+    Example:
+      locust optimize --vary geometry.leg_m=0.05:0.09 --vary geometry.crank_start_deg=-110:-70 \\
+          --vary schedule.push_deg=-40:-20 --vary schedule.push_s=0.15:0.4 --trials 60 --out opt
+    """
+    from .optimize import run_optimize
+    from .sweep_design import parse_bound
+
+    base = resolve_robot(preset, config, sets)
+    bounds = [parse_bound(v, base) for v in varies]
+    if len({b.name for b in bounds}) != len(bounds):
+        raise SweepError("--vary names a parameter twice", "give each parameter one --vary")
+    with _bar(trials, "optimize") as bar:
+        try:
+            summary = run_optimize(base, bounds, trials, cycles, out, storage=storage, study_name=study_name,
+                                   seed=seed, jobs=jobs, progress=bar.update)
+        except KeyboardInterrupt:
+            click.echo(f"\ninterrupted: finished trials are kept in the study; rerun to continue", err=True)
+            sys.exit(130)
+    click.echo(f"study {summary.study_name!r}: {summary.trials} trials, {summary.complete} valid, "
+               f"{summary.pruned} pruned as invalid")
+    if summary.best is None:
+        click.echo("no valid design yet")
+    else:
+        b = summary.best
+        where = ", ".join(f"{x.name}={b[x.name]:.6g}" for x in bounds)
+        click.echo(f"best: trial {b['trial']} ({where}): {b['distance_m'] * 100:.2f} cm, "
+                   f"highest nose {b['max_nose_height_m'] * 100:.2f} cm")
+    click.echo(f"results: {out / 'trials.csv'}, {out / 'optimize.json'}, {out / 'history.png'}")

@@ -1,0 +1,178 @@
+"""One design of a sweep: which values it varies, the robot they make, and its checked result.
+
+``NAME`` is any numeric robot parameter by its dotted name, or ``scale``: the same length (m)
+added to all four links, the seed notebook's sweep variable. A design is checked before it is
+simulated (the four-bar assembles at the start angle and stays closed over the whole crank
+range the schedule commands) and audited after (:mod:`locust.sim.audit`); a design that fails
+either is a row with ``valid`` false and the reason, never a result.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import GeometryError, LocustError, SweepError
+from ..params import Provenance, Robot, all_keys, with_added_length
+from .fourbar import assemble
+
+SCALE = "scale"
+RESULT_FIELDS = ("valid", "reason", "distance_m", "max_nose_height_m", "nose_apex_max_m",
+                 "com_apex_max_m", "hops", "grashof", "transmission_deg")
+CRANK_CHECK_STEP_DEG = 1.0
+
+
+@dataclass(frozen=True)
+class Axis:
+    """``NAME=START:STOP:N``: N values from START to STOP inclusive (``numpy.linspace``)."""
+
+    name: str
+    start: float
+    stop: float
+    n: int
+
+    def values(self) -> list[float]:
+        return [float(v) for v in np.linspace(self.start, self.stop, self.n)]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "start": self.start, "stop": self.stop, "n": self.n}
+
+
+@dataclass(frozen=True)
+class Bound:
+    """``NAME=LOW:HIGH``: a continuous range for the optimiser."""
+
+    name: str
+    low: float
+    high: float
+
+
+def check_name(name: str, base: Robot) -> None:
+    if name == SCALE:
+        return
+    if name not in all_keys():
+        close = [k for k in all_keys() if name.split(".")[-1] in k][:4]
+        hint = f"did you mean {', '.join(close)}?" if close else "use `scale` or a dotted name from `locust params`"
+        raise SweepError(f"--vary {name!r}: no such robot parameter", hint)
+    value = base.get(name)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SweepError(f"--vary {name!r}: the parameter is not a number ({value!r})",
+                         "vary a numeric parameter, e.g. geometry.leg_m or schedule.push_deg")
+
+
+def _numbers(text: str, parts: int, what: str, item: str) -> list[float]:
+    fields = text.split(":")
+    if len(fields) != parts:
+        raise SweepError(f"--vary {item!r} is not {what}", f"e.g. --vary scale=0:0.05:30" if parts == 3
+                         else "e.g. --vary geometry.leg_m=0.05:0.09")
+    try:
+        out = [float(f) for f in fields]
+    except ValueError:
+        raise SweepError(f"--vary {item!r}: {text!r} holds something that is not a number",
+                         f"write {what}") from None
+    if not all(math.isfinite(v) for v in out):
+        raise SweepError(f"--vary {item!r}: values must be finite", f"write {what}")
+    return out
+
+
+def _split(item: str) -> tuple[str, str]:
+    name, sep, rest = item.partition("=")
+    if not sep or not name.strip() or not rest.strip():
+        raise SweepError(f"--vary {item!r} is not NAME=RANGE", "e.g. --vary scale=0:0.05:30")
+    return name.strip(), rest.strip()
+
+
+def parse_axis(item: str, base: Robot) -> Axis:
+    name, rest = _split(item)
+    check_name(name, base)
+    start, stop, n = _numbers(rest, 3, "START:STOP:N", item)
+    if n != int(n) or n < 1:
+        raise SweepError(f"--vary {item!r}: N = {n:g} must be a whole number of designs >= 1",
+                         "e.g. --vary scale=0:0.05:30")
+    if int(n) == 1 and start != stop:
+        raise SweepError(f"--vary {item!r}: one design cannot span {start:g}..{stop:g}", "use N >= 2")
+    return Axis(name, start, stop, int(n))
+
+
+def parse_bound(item: str, base: Robot) -> Bound:
+    name, rest = _split(item)
+    check_name(name, base)
+    low, high = _numbers(rest, 2, "LOW:HIGH", item)
+    if not low < high:
+        raise SweepError(f"--vary {item!r}: LOW {low:g} must be below HIGH {high:g}", "e.g. --vary geometry.leg_m=0.05:0.09")
+    return Bound(name, low, high)
+
+
+def design_robot(base: Robot, values: dict[str, float]) -> Robot:
+    """``base`` with the design's values; ``scale`` first, named parameters over it."""
+    robot = base
+    if SCALE in values:
+        robot = with_added_length(robot, values[SCALE])
+    named = {k: v for k, v in values.items() if k != SCALE}
+    if named:
+        robot = robot.with_values(named, Provenance(source="sweep"))
+    return robot
+
+
+def precheck(robot: Robot) -> str | None:
+    """Why the design cannot be built or driven, or None.
+
+    The loop must assemble at the start angle and stay closed over every crank angle the
+    schedule commands (start .. start + push): a linkage that locks part way would have the
+    servo stall against its own loop.
+    """
+    g, sch = robot.geometry, robot.schedule
+    try:
+        assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, g.crank_start_deg)
+    except GeometryError as exc:
+        return str(exc)
+    if abs(sch.push_deg) > robot.servo.travel_deg:
+        return f"push {sch.push_deg:g} deg is beyond the servo travel of +-{robot.servo.travel_deg:g} deg"
+    n = max(2, int(math.ceil(abs(sch.push_deg) / CRANK_CHECK_STEP_DEG)) + 1)
+    for q in np.linspace(0.0, sch.push_deg, n)[1:]:
+        try:
+            assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, g.crank_start_deg + float(q))
+        except GeometryError as exc:
+            return f"the linkage locks before the push angle: {exc}"
+    return None
+
+
+def invalid_row(reason: str, grashof: str = "", transmission_deg: float = math.nan) -> dict[str, Any]:
+    nan = math.nan
+    return {"valid": False, "reason": reason, "distance_m": nan, "max_nose_height_m": nan,
+            "nose_apex_max_m": nan, "com_apex_max_m": nan, "hops": 0, "grashof": grashof,
+            "transmission_deg": transmission_deg}
+
+
+def evaluate(base: Robot, values: dict[str, float], cycles: int) -> dict[str, Any]:
+    """Check, simulate and audit one design -> the result fields of its row.
+
+    A pure function of its arguments: whichever process or machine runs it, the row is the same.
+    """
+    from .run import run
+
+    try:
+        robot = design_robot(base, values)
+    except LocustError as exc:
+        return invalid_row(str(exc))
+    reason = precheck(robot)
+    if reason:
+        return invalid_row(reason)
+    try:
+        result = run(robot, cycles=cycles)
+    except LocustError as exc:
+        return invalid_row(str(exc))
+    if not result.valid:
+        return invalid_row("; ".join(result.reasons), result.grashof, result.transmission_deg)
+    hops = result.hops
+    return {
+        "valid": True, "reason": "", "distance_m": result.distance_m,
+        "max_nose_height_m": result.max_nose_height_m,
+        "nose_apex_max_m": max(h.nose_apex_m for h in hops),
+        "com_apex_max_m": max(h.com_apex_m for h in hops),
+        "hops": sum(1 for h in hops if h.flight_s > 0),
+        "grashof": result.grashof, "transmission_deg": result.transmission_deg,
+    }

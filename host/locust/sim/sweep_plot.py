@@ -1,0 +1,102 @@
+"""Landscape plots of a sweep: 1-D curves and 2-D heat maps, invalid designs shown as such."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..params import LEG_SETS_M, Robot, preset
+from ..plotting import pyplot, save_png
+from .sweep_design import SCALE, Axis
+
+METRICS = (("distance_m", "distance (cm)"), ("max_nose_height_m", "highest nose point (cm)"))
+
+
+def _leg_set_marks(axis: Axis, base: Robot) -> list[tuple[str, float]]:
+    """Where the physical Small/Medium/Large leg sets sit on a ``scale`` axis of the seed."""
+    if axis.name != SCALE or base.link_lengths_m() != preset("seed").link_lengths_m():
+        return []
+    lo, hi = sorted((axis.start, axis.stop))
+    return [(name.capitalize(), v) for name, v in LEG_SETS_M.items() if lo - 1e-12 <= v <= hi + 1e-12]
+
+
+def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robot, path: Path) -> Path:
+    plt = pyplot()
+    x_scale, unit = (100.0, " (cm)") if axis.name == SCALE or axis.name.endswith("_m") else (1.0, "")
+    label = ("added length on every link" if axis.name == SCALE else axis.name) + unit
+    fig, panels = plt.subplots(1, 2, figsize=(11, 4.2))
+    ok = [r for r in rows if r["valid"]]
+    bad = [r for r in rows if not r["valid"]]
+    for ax, (key, ylab) in zip(panels, METRICS):
+        # with several axes, each value's best over the others
+        by_x: dict[float, float] = {}
+        for r in ok:
+            by_x[r[axis.name]] = max(by_x.get(r[axis.name], -math.inf), r[key])
+        xs = sorted(by_x)
+        ax.plot([x * x_scale for x in xs], [by_x[x] * 100 for x in xs], "o-", ms=4, color="#1f77b4",
+                label=f"valid ({len(ok)})")
+        if bad:
+            ax.plot([r[axis.name] * x_scale for r in bad], [0.0] * len(bad), "x", color="#d62728",
+                    label=f"invalid ({len(bad)}): not a result")
+        if best is not None:
+            ax.plot(best[axis.name] * x_scale, best[key] * 100, "*", ms=14, color="#ff7f0e",
+                    label="best valid (distance)")
+        for name, v in _leg_set_marks(axis, base):
+            ax.axvline(v * x_scale, color="0.4", ls=":", lw=1)
+            ax.text(v * x_scale, ax.get_ylim()[1], f" {name}", rotation=90, va="top", fontsize=8, color="0.3")
+        ax.set_xlabel(label)
+        ax.set_ylabel(ylab)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="best")
+    panels[0].set_title("distance over the run")
+    panels[1].set_title("jump height (highest nose point)")
+    fig.suptitle(f"sweep of {base.name}", fontsize=10)
+    return save_png(fig, path)
+
+
+def _heatmap(rows: list[dict[str, Any]], ax_a: Axis, ax_b: Axis, path: Path) -> Path:
+    plt = pyplot()
+    va, vb = ax_a.values(), ax_b.values()
+    fig, panels = plt.subplots(1, 2, figsize=(12, 4.8))
+    for ax, (key, title) in zip(panels, METRICS):
+        grid = np.full((len(vb), len(va)), np.nan)
+        for r in rows:
+            if r["valid"]:
+                i, j = vb.index(r[ax_b.name]), va.index(r[ax_a.name])
+                grid[i, j] = np.fmax(grid[i, j], r[key] * 100)
+        img = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis",
+                        extent=_extent(va) + _extent(vb))
+        fig.colorbar(img, ax=ax, label=title)
+        bad = np.isnan(grid)
+        if bad.any():
+            jj, ii = np.meshgrid(va, vb)
+            ax.plot(jj[bad], ii[bad], "x", color="#d62728", ms=5, label="invalid (no valid design)")
+            ax.legend(fontsize=8, loc="upper right")
+        ax.set_xlabel(ax_a.name)
+        ax.set_ylabel(ax_b.name)
+        ax.set_title(title + ("" if len(rows) == grid.size else ", best over the other axes"), fontsize=9)
+    return save_png(fig, path)
+
+
+def _extent(values: list[float]) -> list[float]:
+    if len(values) == 1:
+        return [values[0] - 0.5, values[0] + 0.5]
+    step = (values[-1] - values[0]) / (len(values) - 1)
+    return [values[0] - step / 2, values[-1] + step / 2]
+
+
+def _safe(name: str) -> str:
+    return name.replace(".", "_")
+
+
+def plot_landscape(rows: list[dict[str, Any]], axes: list[Axis], best: dict | None, out: Path,
+                   base: Robot) -> list[Path]:
+    out = Path(out)
+    made = [_curve(rows, a, best, base, out / f"curve_{_safe(a.name)}.png") for a in axes if a.n > 1]
+    for a, b in itertools.combinations([a for a in axes if a.n > 1], 2):
+        made.append(_heatmap(rows, a, b, out / f"heatmap_{_safe(a.name)}__{_safe(b.name)}.png"))
+    return made

@@ -1,0 +1,219 @@
+"""Design sweep and optimisation: checks, storage, resume, schedulers, Optuna."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from locust.errors import SweepError
+from locust.params import preset
+from locust.sim.sweep import best_row, run_sweep
+from locust.sim.sweep_design import evaluate, parse_axis, parse_bound, precheck, design_robot
+
+LOCUST = [sys.executable, "-c", "from locust.cli import main; main()"]
+
+
+def read_rows(folder: Path) -> list[dict[str, str]]:
+    with open(folder / "results.csv", newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+# -- parsing ---------------------------------------------------------------------------
+@pytest.mark.parametrize("item, fragment", [
+    ("scale", "NAME=RANGE"),
+    ("scale=0:0.05", "START:STOP:N"),
+    ("scale=0:x:3", "not a number"),
+    ("scale=0:0.05:2.5", "whole number"),
+    ("geometry.nope_m=0:1:3", "no such robot parameter"),
+    ("solver.integrator=0:1:3", "not a number"),
+])
+def test_bad_vary_is_refused_with_reason(item, fragment):
+    with pytest.raises(SweepError) as exc:
+        parse_axis(item, preset("seed"))
+    assert fragment in str(exc.value)
+
+
+def test_axis_values_are_linspace_inclusive():
+    axis = parse_axis("scale=0:0.05:30", preset("seed"))
+    values = axis.values()
+    assert len(values) == 30 and values[0] == 0.0 and values[-1] == pytest.approx(0.05, abs=1e-15)
+    assert values[1] == pytest.approx(0.05 / 29, rel=1e-12)
+
+
+def test_scale_adds_the_same_length_to_every_link():
+    robot = design_robot(preset("seed"), {"scale": 0.02})
+    assert robot.link_lengths_m() == pytest.approx((0.06, 0.06, 0.04, 0.08), abs=1e-12)
+    assert robot.link_lengths_m() == pytest.approx(preset("large").link_lengths_m(), abs=1e-12)
+
+
+def test_linkage_that_locks_during_the_push_is_caught_at_the_hand_computed_angle():
+    # crank tip to front pivot: d = 0.08 |sin(theta/2)|; coupler 0.005 + leg 0.06 = 0.065
+    # closes at -90 deg (d = 5.66 cm) but not past theta = -2 asin(0.065/0.08) = -108.7 deg.
+    reason = precheck(design_robot(preset("seed"), {"geometry.coupler_m": 0.005}))
+    assert reason is not None and "locks before the push angle" in reason
+    assert "crank -109 deg" in reason
+    assert precheck(preset("seed")) is None
+
+
+# -- the sweep -------------------------------------------------------------------------
+def test_impossible_linkages_are_rejected_with_reasons_and_never_best(tmp_path):
+    # coupler 0.005: locks during the push; 0.155: |coupler - leg| = 9.5 cm > 5.66 cm, cannot
+    # close; 0.205: longer than the other three together (14 cm). 0.055 and 0.105 can be built.
+    base = preset("seed")
+    axis = parse_axis("geometry.coupler_m=0.005:0.205:5", base)
+    summary = run_sweep(base, [axis], cycles=1, out=tmp_path / "s", jobs=1)
+    rows = {round(r["geometry.coupler_m"], 6): r for r in summary.rows}
+    assert len(rows) == 5
+    assert not rows[0.005]["valid"] and "locks before the push angle" in rows[0.005]["reason"]
+    assert not rows[0.155]["valid"] and "cannot close" in rows[0.155]["reason"]
+    assert not rows[0.205]["valid"] and "shorter than the other three" in rows[0.205]["reason"]
+    for bad in (0.005, 0.155, 0.205):
+        assert math.isnan(rows[bad]["distance_m"])
+    best = summary.best
+    assert best is not None and best["valid"]
+    assert round(best["geometry.coupler_m"], 6) in (0.055, 0.105)
+    valid = [r for r in summary.rows if r["valid"]]
+    assert best["distance_m"] == max(r["distance_m"] for r in valid)
+    # the row is the simulation's own figure
+    direct = evaluate(base, {"geometry.coupler_m": best["geometry.coupler_m"]}, 1)
+    assert direct["distance_m"] == best["distance_m"]
+    assert (tmp_path / "s" / "curve_geometry_coupler_m.png").stat().st_size > 10_000
+    meta = json.loads((tmp_path / "s" / "sweep.json").read_text())
+    assert meta["best"]["design"] == best["design"] and meta["finished"] is True
+
+
+def test_best_row_ignores_invalid_rows_even_with_larger_numbers():
+    rows = [{"design": 0, "valid": False, "distance_m": 9.0}, {"design": 1, "valid": True, "distance_m": 0.2},
+            {"design": 2, "valid": True, "distance_m": 0.3}]
+    assert best_row(rows)["design"] == 2
+    assert best_row([rows[0]]) is None
+
+
+def test_a_folder_holding_another_sweep_or_other_files_is_refused(tmp_path):
+    base = preset("seed")
+    out = tmp_path / "s"
+    run_sweep(base, [parse_axis("geometry.coupler_m=0.205:0.21:2", base)], cycles=1, out=out, jobs=1)
+    before = (out / "results.csv").read_bytes()
+    with pytest.raises(SweepError, match="different sweep"):
+        run_sweep(base, [parse_axis("geometry.coupler_m=0.205:0.22:2", base)], cycles=1, out=out, jobs=1)
+    assert (out / "results.csv").read_bytes() == before
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("mine")
+    with pytest.raises(SweepError, match="not a sweep folder"):
+        run_sweep(base, [parse_axis("scale=0:0.01:2", base)], cycles=1, out=other, jobs=1)
+    assert sorted(p.name for p in other.iterdir()) == ["notes.txt"]
+
+
+def test_killed_sweep_resumes_without_recomputing(tmp_path):
+    out = tmp_path / "s"
+    args = ["sweep", "--preset", "seed", "--vary", "geometry.leg_m=0.055:0.07:4", "--cycles", "1",
+            "--jobs", "1", "--out", str(out), "--json"]
+    proc = subprocess.Popen(LOCUST + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        if (out / "results.csv").exists() and len(read_rows(out)) >= 2:
+            break
+        time.sleep(0.05)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    done_before = read_rows(out)
+    assert 2 <= len(done_before) < 4, "the sweep finished before it could be killed"
+    # a line cut short by the kill is dropped, not read as a result
+    with open(out / "results.csv", "a") as fh:
+        fh.write("3,0.07,Tr")
+    rerun = subprocess.run(LOCUST + args, capture_output=True, text=True, timeout=300)
+    assert rerun.returncode == 0, rerun.stderr
+    report = json.loads(rerun.stdout)
+    assert report["resumed"] == len(done_before)
+    assert report["computed"] == 4 - len(done_before)
+    rows = read_rows(out)
+    assert [int(r["design"]) for r in rows] == [0, 1, 2, 3]
+    for old in done_before:  # finished rows kept exactly as written
+        assert rows[int(old["design"])] == old
+
+
+def test_schedulers_give_identical_results(tmp_path):
+    base = preset("seed")
+    axis = parse_axis("geometry.leg_m=0.055:0.07:3", base)
+    serial = run_sweep(base, [axis], cycles=1, out=tmp_path / "serial", jobs=1, plots=False)
+    pool = run_sweep(base, [axis], cycles=1, out=tmp_path / "pool", jobs=2, plots=False)
+    dask = run_sweep(base, [axis], cycles=1, out=tmp_path / "dask", scheduler="dask-local", jobs=2, plots=False)
+    assert serial.rows == pool.rows == dask.rows
+    files = {(tmp_path / name / "results.csv").read_bytes() for name in ("serial", "pool", "dask")}
+    assert len(files) == 1
+    assert sum(r["valid"] for r in serial.rows) >= 2
+
+
+def test_unreachable_dask_scheduler_is_a_clear_error(tmp_path):
+    base = preset("seed")
+    with pytest.raises(SweepError, match="cannot reach the Dask scheduler"):
+        run_sweep(base, [parse_axis("scale=0:0.01:2", base)], cycles=1, out=tmp_path / "s",
+                  scheduler="tcp://127.0.0.1:9", jobs=1)
+
+
+def test_sweep_cli_bad_input_exits_2_without_traceback(tmp_path):
+    r = subprocess.run(LOCUST + ["sweep", "--vary", "scale=0:0.05", "--out", str(tmp_path / "x")],
+                       capture_output=True, text=True)
+    assert r.returncode == 2
+    assert "START:STOP:N" in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "x").exists()
+
+
+# -- optimisation ----------------------------------------------------------------------
+def test_optimize_prunes_invalid_designs_and_keeps_the_study(tmp_path):
+    from locust.sim.optimize import run_optimize
+
+    base = preset("seed")
+    # couplers above 0.1166 m cannot close at the start angle (|coupler - leg| > 5.66 cm)
+    bounds = [parse_bound("geometry.coupler_m=0.01:0.2", base)]
+    first = run_optimize(base, bounds, trials=5, cycles=1, folder=tmp_path / "o", seed=3)
+    assert first.trials == 5 and first.complete + first.pruned == 5
+    meta = json.loads((tmp_path / "o" / "optimize.json").read_text())
+    for reason in meta["pruned_reasons"].values():
+        assert reason  # every pruned trial carries its reason
+    if first.best is not None:
+        assert first.best["geometry.coupler_m"] <= 0.1166
+        assert precheck(design_robot(base, {"geometry.coupler_m": first.best["geometry.coupler_m"]})) is None
+    # the journal keeps the study: a second run continues it
+    again = run_optimize(base, bounds, trials=2, cycles=1, folder=tmp_path / "o", seed=4)
+    assert again.trials == 7
+    assert (tmp_path / "o" / "history.png").stat().st_size > 5_000
+
+
+def test_optimize_on_sqlite_storage(tmp_path):
+    from locust.sim.optimize import run_optimize
+
+    base = preset("seed")
+    url = f"sqlite:///{tmp_path / 'study.db'}"
+    bounds = [parse_bound("geometry.coupler_m=0.15:0.2", base)]  # all impossible: all pruned
+    s = run_optimize(base, bounds, trials=3, cycles=1, folder=tmp_path / "o", storage=url)
+    assert (s.trials, s.complete, s.pruned, s.best) == (3, 0, 3, None)
+    assert (tmp_path / "study.db").stat().st_size > 0
+
+
+# -- the seed's experiment, corrected (slow: 2 x 30 designs) ---------------------------
+@pytest.mark.slow
+def test_seed_scale_sweep_local_and_dask_local_agree(tmp_path):
+    outs = []
+    for scheduler in ("local", "dask-local"):
+        out = tmp_path / scheduler
+        r = subprocess.run(LOCUST + ["sweep", "--preset", "seed", "--vary", "scale=0:0.05:30", "--cycles", "3",
+                                     "--out", str(out), "--scheduler", scheduler],
+                           capture_output=True, text=True, timeout=1200)
+        assert r.returncode == 0, r.stderr
+        assert (out / "curve_scale.png").stat().st_size > 10_000
+        outs.append(read_rows(out))
+    assert len(outs[0]) == 30 and outs[0] == outs[1]
+    valid = [r for r in outs[0] if r["valid"] == "True"]
+    assert valid
+    assert max(float(r["max_nose_height_m"]) for r in valid) < 0.30
