@@ -2,19 +2,14 @@
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
-from ..fileio import atomic_write_bytes
+from ..plotting import pyplot, save_png
 from .curves import Curves
 
 
 def plot_fit(curves: Curves, path: str | Path, subtitle: str = "") -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(7.5, 5.5), sharex=True,
                                       gridspec_kw={"height_ratios": [3, 1.2]})
     discrete = curves.model_x is None
@@ -33,7 +28,4 @@ def plot_fit(curves: Curves, path: str | Path, subtitle: str = "") -> Path:
     bottom.set_xlabel(curves.x_label)
     bottom.grid(alpha=0.3)
     fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
-    return atomic_write_bytes(path, buf.getvalue())
+    return save_png(fig, path, dpi=110)

@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-import io
-
+from ..plotting import png_bytes, pyplot
 from .export import polygons
 from .laminate import Laminate
 
@@ -38,20 +37,8 @@ def _frame(ax, lam: Laminate, title: str) -> None:
     ax.set_ylabel("y (mm)")
 
 
-def _png(fig) -> bytes:
-    import matplotlib.pyplot as plt
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=130, bbox_inches="tight")
-    plt.close(fig)
-    return buf.getvalue()
-
-
 def cut_pattern_png(lam: Laminate) -> bytes:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     d = lam.design
     fig, ax = plt.subplots(figsize=(10, 4))
@@ -67,14 +54,11 @@ def cut_pattern_png(lam: Laminate) -> bytes:
         ax.plot(xs, ys, color="#8e44ad", lw=1.2, label="slits" if i == 0 else None)
     _frame(ax, lam, f"cut pattern: {d.source}")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
-    return _png(fig)
+    return png_bytes(fig, dpi=130)
 
 
 def layers_png(lam: Laminate) -> bytes:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from .laminate import sheet_bounds
 
@@ -93,7 +77,7 @@ def layers_png(lam: Laminate) -> bytes:
         mirror = ", mirrored" if layer.spec.mirror else ""
         _frame(ax, lam, f"{layer.spec.name} ({layer.spec.material}{mirror}): {layer.area_mm2:.2f} mm²")
     fig.tight_layout()
-    return _png(fig)
+    return png_bytes(fig, dpi=130)
 
 
 def preview_files(lam: Laminate) -> dict[str, bytes]:
