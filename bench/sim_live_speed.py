@@ -35,7 +35,7 @@ def drive(robot, cycles: int, video: Path | None) -> float:
     sch, hz = robot.schedule, robot.solver.control_hz
     cycle_s = sch.push_s + sch.wait_s
     t = time.perf_counter()
-    sim = LiveSim(robot, video_path=str(video) if video else None, fps=30, width=640, height=360)
+    sim = LiveSim(robot, video_path=str(video) if video else None, fps=30, width=640, height=360, cycles=cycles)
     for i in range(int(cycles * cycle_s * hz + 1e-9)):
         angle = sch.push_deg if (i / hz) % cycle_s < sch.push_s else 0.0
         sim.set_servo_angles_deg(angle, angle)

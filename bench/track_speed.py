@@ -6,18 +6,25 @@ decodes unusually fast) and motion-JPEG at quality 90 (about 7 Mbit/s, as webcam
 many action cameras record). For each it times, alternately and several times each:
 
 - decode: every frame decoded to BGR by OpenCV, nothing else;
-- track:  the same decoding plus the two default colour markers (nose, foot).
+- track:  the same decoding plus the two default colour markers (nose, foot);
+- before: the same with the tracking package as it was at ``--before REV`` (read from
+  git into a temporary package), so an optimisation is judged in the same run, on the
+  same machine load, against the code it replaced.
 
-The last line is ``track/decode ratio R ...``: tracking frame rate over decoding frame
-rate for the MPEG-4 video, then for the motion-JPEG one (1.0 = tracking costs nothing
-beyond decoding; goal >= 0.75).
+The last lines are ``track/decode ratio R ...`` (tracking frame rate over decoding frame
+rate, MPEG-4 then motion-JPEG; 1.0 = tracking costs nothing beyond decoding; goal >= 0.75)
+and the same for ``before``.
 
-    python bench/track_speed.py [--frames 240] [--repeats 3]
+    python bench/track_speed.py [--frames 240] [--repeats 3] [--before 053160a | --before none]
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
+import importlib.util
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -38,19 +45,64 @@ def decode_only(info, clip) -> float:
     return time.perf_counter() - t
 
 
-def decode_and_track(info, clip):
+def decode_and_track(info, clip, package=None):
+    """Decode + track the two default markers with the current package, or with ``package``
+    (an older copy: its own probe, clip, markers and frame loop)."""
+    if package is not None:
+        info = package.video.probe(info.path)
+        clip = package.video.Clip().resolved(info)
+        run, markers, calibration = package.runner.track_video, package.spec.parse_markers([]), \
+            package.calib.build(info.height_px)
+    else:
+        run, markers, calibration = track_video, parse_markers([]), build(info.height_px)
     t = time.perf_counter()
-    result = track_video(info, clip, parse_markers([]), build(info.height_px))
+    result = run(info, clip, markers, calibration)
     return time.perf_counter() - t, result
+
+
+class _Package:
+    def __init__(self, name: str):
+        self.video = importlib.import_module(f"{name}.video")
+        self.runner = importlib.import_module(f"{name}.runner")
+        self.spec = importlib.import_module(f"{name}.spec")
+        self.calib = importlib.import_module(f"{name}.calib")
+
+
+def load_before(rev: str, folder: Path):
+    """``host/locust/track`` as it was at git revision ``rev``, imported as ``locust.track_before``."""
+    root = Path(__file__).resolve().parents[1]
+    try:
+        names = subprocess.run(["git", "-C", str(root), "ls-tree", "--name-only", rev, "host/locust/track/"],
+                               capture_output=True, text=True, check=True).stdout.split()
+        for name in names:
+            if name.endswith(".py"):
+                text = subprocess.run(["git", "-C", str(root), "show", f"{rev}:{name}"],
+                                      capture_output=True, text=True, check=True).stdout
+                (folder / Path(name).name).write_text(text)
+    except (OSError, subprocess.CalledProcessError) as exc:
+        print(f"no 'before' run: cannot read host/locust/track at {rev} from git ({exc})")
+        return None
+    spec = importlib.util.spec_from_file_location("locust.track_before", folder / "__init__.py",
+                                                  submodule_search_locations=[str(folder)])
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["locust.track_before"] = module
+    spec.loader.exec_module(module)
+    return _Package("locust.track_before")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--frames", type=int, default=240)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--before", default="053160a",
+                    help="git revision whose tracking package is timed beside the current one ('none': skip)")
     args = ap.parse_args()
     ratios = []
     with tempfile.TemporaryDirectory() as tmp:
+        before = None
+        if args.before != "none":
+            (Path(tmp) / "before").mkdir()
+            before = load_before(args.before, Path(tmp) / "before")
         for fourcc, ext in (("mp4v", "mp4"), ("MJPG", "avi")):
             path = Path(tmp) / f"bench_hop_synthetic.{ext}"
             t = time.perf_counter()
@@ -59,31 +111,41 @@ def main() -> None:
             mbit_s = path.stat().st_size * 8 / (args.frames / 60.0) / 1e6
             print(f"synthetic video {fourcc}: 1280x720, {args.frames} frames at 60 fps, {mbit_s:.1f} Mbit/s "
                   f"({time.perf_counter() - t:.1f} s to make)")
-            ratios.append((fourcc, mbit_s, measure(path, truth, args.repeats)))
-    print("track/decode ratio " + " ".join(f"{r:.3f}" for _, _, r in ratios) + " ("
-          + ", ".join(f"{c} {m:.0f} Mbit/s" for c, m, _ in ratios) + "; goal >= 0.75)")
+            ratios.append((fourcc, mbit_s, *measure(path, truth, args.repeats, before)))
+    what = ", ".join(f"{c} {m:.0f} Mbit/s" for c, m, *_ in ratios)
+    if before is not None:
+        print(f"before ({args.before}) track/decode ratio " + " ".join(f"{r[3]:.3f}" for r in ratios) + f" ({what})")
+    print("track/decode ratio " + " ".join(f"{r[2]:.3f}" for r in ratios) + f" ({what}; goal >= 0.75)")
 
 
-def measure(path: Path, truth, repeats: int) -> float:
+def measure(path: Path, truth, repeats: int, before=None) -> tuple[float, float]:
+    """Best-of-``repeats`` decode time over track time, now and (if given) before."""
     info = probe(path)
     clip = Clip().resolved(info)
-    decode_s, track_s, result = [], [], None
+    times: dict[str, list[float]] = {"decode": [], "track": [], "before": []}
+    results = {}
     for _ in range(repeats):
-        decode_s.append(decode_only(info, clip))
-        dt, result = decode_and_track(info, clip)
-        track_s.append(dt)
-    d, k = min(decode_s), min(track_s)
+        times["decode"].append(decode_only(info, clip))
+        dt, results["track"] = decode_and_track(info, clip)
+        times["track"].append(dt)
+        if before is not None:
+            dt, results["before"] = decode_and_track(info, clip, before)
+            times["before"].append(dt)
     n = len(clip.frames())
-    print(f"  decode            {d:7.3f} s  {n / d:7.1f} frames/s  (best of {repeats})")
-    print(f"  decode + track 2  {k:7.3f} s  {n / k:7.1f} frames/s  (best of {repeats})")
-    for tr in result.markers:
-        vis = truth.visible[tr.name]
-        err = np.hypot(tr.px - truth.px[tr.name], tr.py - truth.py[tr.name])[vis]
-        hidden_ok = bool((~tr.ok[~vis]).all())
-        print(f"  {tr.name:5s} RMS error {np.sqrt(np.nanmean(err ** 2)):.3f} px, max {np.nanmax(err):.3f} px, "
-              f"found {int(tr.ok[vis].sum())}/{int(vis.sum())} visible, "
-              f"{int((~vis).sum())} occluded frames nan: {hidden_ok}")
-    return d / k
+    best = {k: min(v) for k, v in times.items() if v}
+    for k, label in (("decode", "decode"), ("track", "decode + track 2"), ("before", "before: decode + track 2")):
+        if k in best:
+            print(f"  {label:26s} {best[k]:7.3f} s  {n / best[k]:7.1f} frames/s  (best of {repeats})")
+    for kind, result in results.items():
+        for tr in result.markers:
+            vis = truth.visible[tr.name]
+            err = np.hypot(tr.px - truth.px[tr.name], tr.py - truth.py[tr.name])[vis]
+            hidden_ok = bool((~tr.ok[~vis]).all())
+            print(f"  {kind:6s} {tr.name:5s} RMS error {np.sqrt(np.nanmean(err ** 2)):.3f} px, "
+                  f"max {np.nanmax(err):.3f} px, found {int(tr.ok[vis].sum())}/{int(vis.sum())} visible, "
+                  f"{int((~vis).sum())} occluded frames nan: {hidden_ok}")
+    return best["decode"] / best["track"], best["decode"] / best["before"] if "before" in best else float("nan")
+
 
 if __name__ == "__main__":
     main()

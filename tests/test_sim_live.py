@@ -2,14 +2,19 @@
 
 from __future__ import annotations
 
+import json
 import math
 import os
 
 os.environ.setdefault("MUJOCO_GL", "osmesa")
 
 import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
+from click.testing import CliRunner  # noqa: E402
+
+from locust.cli import cli  # noqa: E402
 
 from locust.errors import SimError  # noqa: E402
 from locust.params import preset  # noqa: E402
@@ -60,7 +65,7 @@ def test_left_and_right_are_independent(seed):
 
 def test_live_video_frames_and_truth(seed, tmp_path):
     path = tmp_path / "live.mp4"
-    sim = LiveSim(seed, video_path=str(path), fps=30, width=160, height=120)
+    sim = LiveSim(seed, video_path=str(path), fps=30, width=160, height=120, camera="track")
     drive_schedule(sim, seed, cycles=1)
     out = sim.close()
     frames = round(1.3 * 30)
@@ -70,6 +75,34 @@ def test_live_video_frames_and_truth(seed, tmp_path):
     assert truth.t_s.iloc[-1] == pytest.approx((frames - 1) / 30)
     # the nose marker's true track covers the hop the summary reports
     assert truth.nose_x_m.iloc[-1] - truth.nose_x_m.iloc[0] == pytest.approx(out["distance_m"], abs=0.01)
+
+
+def test_live_fixed_video_tracks_into_metres(tmp_path):
+    """The virtual robot's default video: a fixed camera framed on the planned run (2 cycles
+    here), camera.json beside it, and `locust track` turns it into world metres."""
+    robot = preset("seed").with_values({"schedule.cycles": 2})
+    path = tmp_path / "live.mp4"
+    sim = LiveSim(robot, video_path=str(path))          # 640x360, fixed camera
+    drive_schedule(sim, robot, cycles=2)
+    out = sim.close()
+    assert out["valid"] and out["frames"] == round(2.6 * 30)
+    truth = pd.read_csv(tmp_path / "live.truth.csv", comment="#")
+    camera = json.loads((tmp_path / "live.camera.json").read_text())
+    assert camera["camera"] == "fixed" and (camera["width_px"], camera["height_px"]) == (640, 360)
+    for name in ("nose", "foot"):   # the whole run stays in the picture, clear of the edges
+        assert truth[f"{name}_px"].between(10, 630).all() and truth[f"{name}_py"].between(10, 350).all()
+        assert (truth[f"{name}_seen_frac"] >= 0.9).mean() >= 0.95
+    res = CliRunner().invoke(cli, ["track", str(path), "--overlay", "none"])
+    assert res.exit_code == 0, res.output
+    tracks = pd.read_csv(tmp_path / "live.tracks.csv")
+    for name in ("nose", "foot"):
+        assert tracks[f"{name}_ok"].all()
+        px_err = np.hypot(tracks[f"{name}_px"] - truth[f"{name}_px"], tracks[f"{name}_py"] - truth[f"{name}_py"])
+        m_err = np.hypot(tracks[f"{name}_x_m"] - truth[f"{name}_x_m"], tracks[f"{name}_y_m"] - truth[f"{name}_z_m"])
+        assert float(np.sqrt(np.mean(px_err ** 2))) <= 0.5          # measured 0.11 / 0.10 px
+        assert float(np.sqrt(np.mean(m_err ** 2))) <= 1e-3          # measured 0.17 / 0.15 mm
+    # the tracked hop is the one the live summary reports (nose marker start -> end)
+    assert tracks.nose_x_m.iloc[-1] - tracks.nose_x_m.iloc[0] == pytest.approx(out["distance_m"], abs=0.01)
 
 
 def test_bad_commands_raise_and_nothing_is_written(seed, tmp_path):

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 # name -> (#RRGGBB, where it sits)
 MARKER_COLOURS: dict[str, tuple[str, str]] = {
-    "nose": ("#ff00ff", "front edge of the chassis"),
-    "foot": ("#00ffff", "tip of the left leg (the leg facing the camera)"),
+    "nose": ("#ff00ff", "chassis side facing the camera, just behind and above the front edge"),
+    "foot": ("#00ffff", "on the left leg's outer face, 25 mm up from the foot (the leg facing the camera)"),
 }
 
 

@@ -24,7 +24,8 @@ def _info(msg: str) -> None:
 
 def _plant_options(func):
     func = click.option("--video", type=click.Path(dir_okay=False, path_type=Path), default=None,
-                        help="With the virtual robot: render the simulated robot to this video.")(func)
+                        help="With the virtual robot: render the simulated robot to this video (fixed camera framed on the "
+                             "planned hops, with .truth.csv and .camera.json beside it for `locust track`).")(func)
     func = click.option("--plant", type=click.Choice(PLANTS), default="auto", show_default=True,
                         help="With the virtual robot: what the servos drive (mujoco: the live model; "
                              "record: only record the commands; auto: mujoco when installed).")(func)
@@ -135,6 +136,10 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
                              push_ms=push_ms or round(s.push_s * 1000), wait_ms=wait_ms or round(s.wait_s * 1000),
                              heartbeat_ms=heartbeat_ms)
     directory = R.run_dir(out)
+    # the virtual robot's fixed video camera is framed on this schedule's planned run
+    robot = robot.with_values({"schedule.cycles": schedule.cycles, "schedule.push_deg": schedule.push_deg,
+                               "schedule.push_s": schedule.push_ms / 1000, "schedule.wait_s": schedule.wait_ms / 1000},
+                              "locust hop options")
     with open_port(port, plant=plant, video=video, robot=robot, info=_info) as device:
         with Link(device) as link:
             show = sys.stderr.isatty()

@@ -3,6 +3,9 @@
 - ``RecordingPlant`` keeps every command in memory; tests and ``--plant record`` use it.
 - ``MujocoPlant`` drives the simulation engineer's live MuJoCo model
   (``locust.sim.live.LiveSim``), so a hop on the virtual robot moves the simulated robot.
+  Its video has a fixed camera framed on the robot's planned schedule (``robot.schedule``:
+  ``locust hop`` puts its own options there), with ``.truth.csv`` and ``.camera.json``
+  beside it, so ``locust track`` gives metres.
 
 A plant gets ``command(t_s, left_deg, right_deg)``: horn angles in firmware units (rest 0,
 push -30 on both legs) taking effect at ``t_s`` seconds since the virtual robot started.

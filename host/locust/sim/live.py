@@ -19,7 +19,7 @@ simulated second at dt = 5e-5 s).
 from __future__ import annotations
 
 # .video first: it picks the offscreen GL backend, which MuJoCo reads when first imported.
-from .video import ClipRecorder, check_video_path, frame_views, validate_size  # isort: skip
+from .video import CAMERAS, ClipRecorder, check_video_path, frame_views, validate_size  # isort: skip
 
 import math  # noqa: E402
 import threading  # noqa: E402
@@ -34,10 +34,14 @@ from ..params import Robot  # noqa: E402
 from .audit import audit  # noqa: E402
 from .hops import summarise  # noqa: E402
 from .model import build  # noqa: E402
-from .rollout import Trajectory  # noqa: E402
+from .rollout import Trajectory, simulate  # noqa: E402
 from .schedule import ControlPlan  # noqa: E402
 
 SIDES = ("left", "right")
+# The fixed camera is framed on a batch rollout of the planned schedule; the live run's
+# commands arrive a few ms off that plan, so its hops land a little apart from the
+# rollout's: the frame holds this much more of the run's length on each side.
+LIVE_SLACK_OF_RUN = 0.15
 
 
 @dataclass(frozen=True)
@@ -63,12 +67,18 @@ class LiveSim:
     both -30 during a push) that hold from now on; ``advance_to(t_s)`` steps physics up to
     ``t_s`` seconds after the settle phase; ``close()`` finishes the video and returns the
     audited summary as a dict.
+
+    The video's camera is ``fixed`` (default: it holds still where the planned run --
+    ``robot.schedule``, ``cycles`` of it -- stays in view, so ``locust track`` turns the
+    video into metres with its ``camera.json``) or ``track`` (follows the chassis).
     """
 
     def __init__(self, robot: Robot, video_path: str | None = None, fps: int = 30,
-                 width: int = 640, height: int = 360):
+                 width: int = 640, height: int = 360, camera: str = "fixed", cycles: int | None = None):
         path = None
         if video_path is not None:
+            if camera not in CAMERAS:
+                raise SimError(f"camera {camera!r} is not known", f"choose one of {', '.join(CAMERAS)}")
             validate_size(fps, width, height)
             path = check_video_path(video_path)
         self.robot = robot
@@ -92,10 +102,12 @@ class LiveSim:
         self._recorder: ClipRecorder | None = None
         self._next_frame = 0
 
+        # framed before the settle phase: the rollout must not see this model's own state
+        fixed_view = self._planned_view(cycles, width / height) if path is not None and camera == "fixed" else None
         self._run_to(int(round(robot.solver.settle_s / self.dt)))
         self._settle_steps = self._steps
         if path is not None:
-            self._recorder = self._open_video(path, fps, width, height)
+            self._recorder = self._open_video(path, fps, width, height, fixed_view)
 
     # -- commands -------------------------------------------------------------------
     def set_servo_angles_deg(self, left_deg: float, right_deg: float) -> None:
@@ -158,15 +170,36 @@ class LiveSim:
     def _frame_step(self, k: int) -> int:
         return self._settle_steps + int(round(k / (self._fps * self.dt)))
 
-    def _open_video(self, path, fps: int, width: int, height: int) -> ClipRecorder:
-        """A tracking camera framed on the settled robot, with room above it to hop."""
+    def _planned_view(self, cycles: int | None, aspect: float):
+        """The fixed view that holds the planned run: a batch rollout of the schedule, padded.
+
+        The live run cannot know its future; the rollout of the same model, settings and
+        schedule is what it will do when the commands arrive on time (they do, within a few
+        ms on the virtual robot). Rows past a blow-up are left out.
+        """
+        s, g = self.built.sensors, self.robot.geometry
+        traj = simulate(self.robot, cycles=cycles, built=self.built)
+        sd = traj.sensordata[np.isfinite(traj.sensordata).all(axis=1)]
+        sd = np.vstack([self._initial_sensordata[None, :], sd])
+        points = np.vstack([sd[:, s.nose_pos], sd[:, s.foot_pos], sd[:, s.chassis_pos], sd[:, s.com_pos]])
+        slack = LIVE_SLACK_OF_RUN * float(np.ptp(points[:, 0])) + g.body_length_m / 2
+        lo, hi = points[np.argmin(points[:, 0])], points[np.argmax(points[:, 0])]
+        points = np.vstack([points, lo - [slack, 0.0, 0.0], hi + [slack, 0.0, 0.0]])
+        fixed, _ = frame_views(points, points[:1, 0], g.body_length_m, 0.0, float(self.model.vis.global_.fovy), aspect)
+        return fixed
+
+    def _open_video(self, path, fps: int, width: int, height: int, fixed_view=None) -> ClipRecorder:
+        """The fixed camera given, or a tracking camera framed on the settled robot with room above it to hop."""
+        # no shadows: they would cost more than the physics and leave the run slower than real time
+        if fixed_view is not None:
+            return ClipRecorder(self.model, path, fps, width, height, "fixed", fixed_view,
+                                robot_name=self.robot.name, shadows=False)
         s = self.built.sensors
         row = self._chunks[-1][-1] if self._chunks else self._initial_sensordata
         pose = np.vstack([row[s.nose_pos], row[s.foot_pos], row[s.chassis_pos], row[s.com_pos]])
         headroom = pose + [0.0, 0.0, self.robot.geometry.body_length_m]
         _, view = frame_views(np.vstack([pose, headroom]), pose[2:3, 0], self.robot.geometry.body_length_m, 0.0,
                               float(self.model.vis.global_.fovy), width / height)
-        # no shadows: they would cost more than the physics and leave the run slower than real time
         return ClipRecorder(self.model, path, fps, width, height, "track", view, robot_name=self.robot.name,
                             shadows=False)
 

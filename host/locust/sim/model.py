@@ -31,7 +31,12 @@ LINK_RGBA = {  # the notebook's colours
     "coupler": (0.0, 1.0, 0.0, 1.0),
     "leg": (1.0, 0.0, 0.0, 1.0),
 }
-MARKER_RADIUS_M = 0.006
+# Tracker markers: flat emissive discs facing the camera (+y), drawn only (no mass, no contact).
+# Their size keeps them a few pixels across when a fixed 640x360 camera frames a six-hop run
+# (about 2.5 mm per pixel); they sit clear of the floor (see _marker) so that the floor does
+# not hide half of them whenever the robot stands.
+MARKER_RADIUS_M = 0.010
+MARKER_HALF_THICKNESS_M = 0.0001
 INTEGRATORS = {
     "euler": mujoco.mjtIntegrator.mjINT_EULER,
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
@@ -120,7 +125,10 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
                      rgba=[0.1, 0.1, 0.1, 1], mass=g.body_mass_kg,
                      contype=ROBOT_BITS[bool(k.self_collision)][0], conaffinity=ROBOT_BITS[bool(k.self_collision)][1])
     chassis.add_site(name="nose", pos=[g.nose_x_m, 0, 0], size=[0.005, 0, 0], rgba=[1, 0, 0, 1])
-    _marker(chassis, "nose", [g.nose_x_m, 0, 0])
+    # nose dot: on the chassis' camera-facing side, up and back from the nose edge (which
+    # touches the floor when the robot stands nose-down)
+    _marker(chassis, "nose", [g.nose_x_m + MARKER_NOSE_BACK * MARKER_RADIUS_M, g.body_width_m / 2,
+                              -MARKER_NOSE_UP * MARKER_RADIUS_M])
 
     half_w, half_t = g.link_width_m / 2, g.link_thickness_m / 2
     foot_material = [k.foot_friction, k.torsional_friction, k.rolling_friction]
@@ -149,8 +157,8 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
         _hinge(leg, f"{side}_ankle", c)
         _link_box(leg, g.leg_m, half_w, half_t, LINK_RGBA["leg"], foot_material, rho, selfc)
         leg.add_site(name=f"{side}_foot", pos=[0, 0, 0], size=[0.004, 0, 0])
-        if side == "L":
-            _marker(leg, "foot", [0, g.link_width_m / 2 + MARKER_RADIUS_M, 0])
+        if side == "L":   # foot dot: on the leg's camera-facing face, up the leg from the foot
+            _marker(leg, "foot", [MARKER_FOOT_UP * MARKER_RADIUS_M, g.link_width_m / 2, 0])
         end = leg.add_body(name=f"{side}_end", pos=[g.leg_m, 0, 0])
         end.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.005, 0, 0], contype=0, conaffinity=0, density=rho,
                      rgba=list(LINK_RGBA["ground"]))
@@ -197,11 +205,25 @@ def _ghost_box(body, length_m: float, half_w: float, half_t: float, rgba, densit
                   rgba=list(rgba), contype=0, conaffinity=0, density=density)
 
 
-def _marker(body, name: str, pos) -> None:
-    """A massless, non-colliding emissive dot for the video tracker."""
-    body.add_geom(name=f"marker_{name}", type=mujoco.mjtGeom.mjGEOM_SPHERE, pos=list(pos),
-                  size=[MARKER_RADIUS_M, 0, 0], material=f"marker_{name}", contype=0, conaffinity=0,
-                  mass=0.0, group=1)
+# where the dots sit, in dot radii: the foot dot up the leg from the foot; the nose dot back
+# along the chassis from the nose edge and up from its plate (chassis -z is up)
+MARKER_FOOT_UP = 2.5
+MARKER_NOSE_BACK = 1.5
+MARKER_NOSE_UP = 1.5
+
+
+def _marker(body, name: str, face_pos) -> None:
+    """A massless, non-colliding emissive disc for the video tracker.
+
+    ``face_pos``: where the disc's back face touches the body (body frame); the disc's
+    axis is the body's +y, so it faces the camera and stays parallel to the image plane
+    while the body turns in the plane of motion.
+    """
+    x, y, z = face_pos
+    body.add_geom(name=f"marker_{name}", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+                  pos=[x, y + MARKER_HALF_THICKNESS_M, z], quat=_quat_euler_deg(-90.0, 0.0, 0.0),
+                  size=[MARKER_RADIUS_M, MARKER_HALF_THICKNESS_M, 0], material=f"marker_{name}",
+                  contype=0, conaffinity=0, mass=0.0, group=1)
 
 
 def _add_sensors(spec: mujoco.MjSpec) -> None:

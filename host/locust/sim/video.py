@@ -10,9 +10,12 @@ Beside ``<stem>.mp4`` go two sidecars, both simulated ground truth:
   origin at the centre of the top-left pixel, x right, y down), the share of it the camera
   sees (``seen_frac``: a marker lying on the floor or behind a link is partly hidden, and a
   colour blob's centroid is then off its true centre), ``visible`` (at least half seen), and
-  its true world position (x forward along the floor, z up, metres);
-- ``<stem>.camera.json``: the pinhole camera (intrinsics, extrinsics per frame or fixed)
-  and, for the fixed camera, metres per pixel at the robot's planes.
+  its true world position (the centre of the disc's camera-facing face: x forward along the
+  floor, z up, metres);
+- ``<stem>.camera.json``: the pinhole camera (intrinsics, extrinsics per frame or fixed),
+  the plane ``y = const`` each marker's visible centre moves in (``marker_planes``: the
+  markers are flat discs facing the camera), with which ``locust track`` maps pixels to
+  metres exactly, and, for the fixed camera, metres per pixel at the robot's planes.
 
 The pixels are projected through the camera MuJoCo itself rendered with
 (``renderer.scene.camera`` after ``update_scene``), so the truth and the image agree.
@@ -279,30 +282,42 @@ class ClipRecorder:
         cam = pinhole_from_scene(self.renderer.scene, self.width, self.height)
         rgb = self.renderer.render()
         self.writer.write(cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
-        world = {n: d.geom_xpos[g].copy() for n, g in self.marker_ids.items()}
+        world = {n: self._marker_face_m(g) for n, g in self.marker_ids.items()}
         px = {n: tuple(float(v) for v in cam.project(world[n])[0]) for n in MARKERS}
         seen = {n: self._seen_fraction(cam, world[n], self.marker_ids[n]) if self._in_image(px[n]) else 0.0
                 for n in MARKERS}
         self.rows.append(_TruthRow(len(self.rows), float(t_s), px, seen, world))
         self.cameras.append(cam)
 
+    def _marker_face_m(self, geom_id: int) -> np.ndarray:
+        """Centre of what the camera sees of a marker: a disc's camera-facing face, a sphere's centre."""
+        centre = self.data.geom_xpos[geom_id].copy()
+        if self.model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
+            axis = self.data.geom_xmat[geom_id].reshape(3, 3)[:, 2]
+            centre += np.sign(axis[1]) * axis * float(self.model.geom_size[geom_id][1])  # the +y face
+        return centre
+
     def _in_image(self, px: tuple[float, float]) -> bool:
         return -0.5 <= px[0] <= self.width - 0.5 and -0.5 <= px[1] <= self.height - 0.5
 
     def _seen_fraction(self, cam: PinholeCamera, centre_m: np.ndarray, geom_id: int) -> float:
-        """Share of the marker's disc (as the camera sees it) that no other geom hides.
+        """Share of the marker (as the camera sees it) that no other geom hides.
 
-        Rays go from the camera centre to points of the disc across the line of sight
-        (``_DISC_SAMPLES``); a ray that meets the marker first sees it.
+        Rays go from the camera centre to points spread over what the camera sees of the
+        marker (``_DISC_SAMPLES``): a disc's face, or a sphere's disc across the line of
+        sight; a ray that meets the marker first sees it.
         """
         radius = float(self.model.geom_size[geom_id][0])
-        sight = centre_m - cam.position_m
-        sight /= np.linalg.norm(sight)
-        across = np.cross(sight, cam.rotation[1])
-        across /= np.linalg.norm(across)
-        other = np.cross(sight, across)
+        if self.model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
+            axes = self.data.geom_xmat[geom_id].reshape(3, 3)[:, :2].T   # the face's own two axes
+        else:
+            sight = centre_m - cam.position_m
+            sight /= np.linalg.norm(sight)
+            across = np.cross(sight, cam.rotation[1])
+            across /= np.linalg.norm(across)
+            axes = np.vstack([across, np.cross(sight, across)])
         seen, hit = 0, np.array([-1], dtype=np.int32)
-        for target in centre_m + radius * _DISC_SAMPLES @ np.vstack([across, other]):
+        for target in centre_m + radius * _DISC_SAMPLES @ axes:
             ray = target - cam.position_m
             mujoco.mj_ray(self.model, self.data, cam.position_m, ray / np.linalg.norm(ray), None, 1, -1, hit)
             seen += int(hit[0]) == geom_id
@@ -334,9 +349,14 @@ class ClipRecorder:
                                             "elevation_deg": self.view.elevation_deg},
             "intrinsics": first.intrinsics(),
         }
+        planes = self.marker_planes()
+        out["marker_planes"] = {
+            "note": "each marker's visible centre moves in the world plane y = plane_y_m (world: x along "
+                    "the floor, y toward the camera, z up); truth x_m, z_m are in that plane",
+            **planes}
         if self.camera == "fixed":
             out["extrinsics"] = first.extrinsics()
-            out["m_per_px"] = self._m_per_px(first)
+            out["m_per_px"] = self._m_per_px(first, planes)
         else:
             out["rotation_world_to_camera"] = first.rotation.tolist()
             out["extrinsics_per_frame"] = [{"frame": r.frame, "t_s": r.t_s, "position_m": c.position_m.tolist(),
@@ -344,12 +364,19 @@ class ClipRecorder:
                                            for r, c in zip(self.rows, self.cameras)]
         return out
 
-    def _m_per_px(self, cam: PinholeCamera) -> dict:
+    def marker_planes(self) -> dict:
+        """The plane y = const each marker's visible centre moves in, and how far it strays from it."""
+        out = {}
+        for n in MARKERS:
+            y = np.array([r.world_m[n][1] for r in self.rows])
+            out[n] = {"plane_y_m": float(np.mean(y)), "max_off_plane_m": float(np.max(np.abs(y - np.mean(y))))}
+        return out
+
+    def _m_per_px(self, cam: PinholeCamera, planes: dict) -> dict:
         """Metres per pixel where each marker moves, and at the chassis mid-plane."""
-        planes = {"chassis_mid_plane": 0.0}
-        planes.update({f"{n}_plane": float(np.mean([r.world_m[n][1] for r in self.rows])) for n in MARKERS})
+        ys = {"chassis_mid_plane": 0.0, **{f"{n}_plane": p["plane_y_m"] for n, p in planes.items()}}
         return {name: {"plane_y_m": y, "m_per_px": cam.m_per_px_at_depth(float(cam.to_camera([0.0, y, 0.0])[0, 2]))}
-                for name, y in planes.items()}
+                for name, y in ys.items()}
 
     def finish(self) -> VideoInfo:
         try:

@@ -11,7 +11,7 @@ import click
 
 from ..errors import TrackError
 from ..fileio import atomic_write_json
-from . import calib, export, overlay, trk
+from . import calib, camera, export, overlay, trk
 from .aruco import DEFAULT_DICTIONARY, side_px_in_video
 from .runner import track_video
 from .spec import ModelOptions, parse_markers
@@ -72,6 +72,9 @@ def _base_path(out: Path | None, source: Path) -> Path:
               help="Calibrate from an ArUco marker's printed side length (m), measured where it first appears.")
 @click.option("--aruco-dict", default=DEFAULT_DICTIONARY, show_default=True,
               help="ArUco dictionary for --scale-aruco.")
+@click.option("--camera-json", type=click.Path(dir_okay=False, path_type=Path),
+              help="Pinhole camera of a simulated video (world metres through each marker's plane). "
+                   "Default: <video>.camera.json beside the video, used when no --scale/--scale-aruco/--origin is given.")
 @click.option("--origin", metavar="X,Y", help="World origin in pixels. Default: centre of the bottom-left pixel.")
 @click.option("--angle", default=0.0, show_default=True, type=float,
               help="Direction of the world x axis, degrees counter-clockwise from the image x axis (as Tracker).")
@@ -92,17 +95,18 @@ def _base_path(out: Path | None, source: Path) -> Path:
 @click.option("--track", "trk_names", multiple=True, metavar="NAME",
               help="With --from-trk: only these Tracker tracks (repeatable). Default: all point masses.")
 def track(video, markers, color_tol, search_px, template_radius, accept, evolve, scale, scale_aruco, aruco_dict,
-          origin, angle, start, end, step, fps, out, fmt, overlay_kind, force, from_trk, trk_names):
+          camera_json, origin, angle, start, end, step, fps, out, fmt, overlay_kind, force, from_trk, trk_names):
     """Extract marker tracks (nose, foot) from VIDEO, as Tracker's autotracker would, in batch.
 
     \b
     Pixels follow OpenCV: origin at the centre of the top-left pixel, x right, y down.
-    World columns are metres, y up, once a scale is given (--scale or --scale-aruco).
+    World columns are metres, y up, once a scale is given (--scale or --scale-aruco), or
+    through the pinhole camera of a simulated video (its <video>.camera.json, found beside it).
     A marker not found in a frame is nan with <name>_ok = 0; it is never filled in.
 
     \b
     Examples:
-      locust track hop.mp4                                  nose + foot by colour
+      locust track hop.mp4                                  nose + foot by colour (metres from hop.camera.json)
       locust track hop.mp4 --scale 100,400,500,400=0.30 --origin 100,400
       locust track toss.mp4 --marker ball=template:131.28,207.86@2
       locust track slowmo.mp4 --fps 240 --start 30 --end 400
@@ -119,7 +123,7 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
     clip = Clip(start, end, step, fps).resolved(info)
     options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0)
     models = parse_markers(list(markers), options)
-    calibration = _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle)
+    calibration = _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, camera_json)
     paths = _outputs(_base_path(out, video), fmt, overlay_kind)
     _refuse_overwrite(paths, force)
 
@@ -136,9 +140,17 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
     _report(result, written)
 
 
-def _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle) -> calib.Calibration:
+def _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, camera_json=None):
     if scale and scale_aruco:
         raise TrackError("give --scale or --scale-aruco, not both", "one calibration per run")
+    by_hand = bool(scale or scale_aruco or origin)
+    if camera_json is not None:
+        if by_hand:
+            raise TrackError("give --camera-json or --scale/--scale-aruco/--origin, not both", "one calibration per run")
+        return camera.load(camera_json, info.width_px, info.height_px)
+    beside = camera.camera_json_beside(info.path)
+    if not by_hand and beside.is_file():
+        return camera.load(beside, info.width_px, info.height_px)
     m_per_px, source = math.nan, "none"
     if scale:
         x1, y1, x2, y2, length = calib.parse_scale(scale)

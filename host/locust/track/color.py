@@ -16,6 +16,7 @@ would be pulled toward the visible part: such frames are reported as not found.
 from __future__ import annotations
 
 import math
+import statistics
 from collections import deque
 from dataclasses import dataclass, field
 
@@ -49,6 +50,11 @@ class ColorMarker:
     partial_fraction: float = 0.6  # below this share of the usual area: partly hidden
     history: MotionHistory = field(default_factory=MotionHistory)
     _areas: deque = field(default_factory=lambda: deque(maxlen=15))
+    _usual_area: float = 0.0       # median of _areas, kept up to date as areas arrive
+
+    def __post_init__(self) -> None:
+        self._lo = np.array([max(c - self.tolerance, 0) for c in self.bgr], dtype=np.uint8)
+        self._hi = np.array([min(c + self.tolerance, 255) for c in self.bgr], dtype=np.uint8)
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
         centre = self.history.search_centre()
@@ -56,7 +62,7 @@ class ColorMarker:
         if centre is not None and self._areas:
             # a tight window first (three radii around the prediction): cheap, and the
             # blob must lie wholly inside it; otherwise the full search window
-            radius = math.sqrt(float(np.median(self._areas)) / math.pi)
+            radius = math.sqrt(self._usual_area / math.pi)
             det = self._locate_in(image_bgr, window(centre, int(3 * radius) + 6, image_bgr.shape), centre, True)
         if det is None and centre is not None:
             det = self._locate_in(image_bgr, window(centre, self.search_half_px, image_bgr.shape), centre)
@@ -68,49 +74,87 @@ class ColorMarker:
 
     def _locate_in(self, image, box, centre, whole_inside: bool = False) -> Detection | None:
         x0, y0, x1, y1 = box
-        roi = image[y0:y1, x0:x1]
-        lo = tuple(max(c - self.tolerance, 0) for c in self.bgr)
-        hi = tuple(min(c + self.tolerance, 255) for c in self.bgr)
-        core = (cv2.inRange(roi, lo, hi) > 0).astype(np.uint8)
-        n, labels, stats, cents = cv2.connectedComponentsWithStats(core, connectivity=8)
+        roi = image[y0:y1, x0:x1]          # a view: nothing outside the window is converted
+        core = cv2.inRange(roi, self._lo, self._hi)
+        if not cv2.hasNonZero(core):   # labelling an empty frame costs milliseconds: a hidden marker
+            return None
+        n, labels = cv2.connectedComponents(core, connectivity=8)
         if n <= 1:
             return None
+        if n == 2:   # one blob (the usual case): its statistics cost less than OpenCV's general ones
+            stats = np.array([[0, 0, 0, 0, 0], [*cv2.boundingRect(core), cv2.countNonZero(core)]])
+            cents = None
+        else:
+            n, labels, stats, cents = cv2.connectedComponentsWithStats(core, connectivity=8)
         areas = stats[1:, cv2.CC_STAT_AREA]
         candidates = np.flatnonzero(areas >= self.min_area_px) + 1
         if candidates.size == 0:
             return None
-        if centre is None:
+        if candidates.size == 1:
+            best = int(candidates[0])
+        elif centre is None:
             best = candidates[np.argmax(stats[candidates, cv2.CC_STAT_AREA])]
         else:
             d = np.hypot(cents[candidates, 0] + x0 - centre[0], cents[candidates, 1] + y0 - centre[1])
             best = candidates[np.argmin(d)]
-        if whole_inside and _touches_edge(stats[best], roi.shape, box, image.shape):
-            return None
+        if _touches_edge(stats[best], roi.shape, box, image.shape):
+            if whole_inside:
+                return None
+            # the window cut the blob (the prediction was off): look again around what it saw
+            bx, by, bw, bh = (int(v) for v in stats[best, :4])
+            seen_at = (x0 + bx + bw / 2, y0 + by + bh / 2)
+            radius = math.sqrt(self._usual_area / math.pi) if self._areas else max(bw, bh)
+            return self._locate_in(image, window(seen_at, int(3 * radius) + 6, image.shape), seen_at, True)
         area = float(stats[best, cv2.CC_STAT_AREA])
-        usual = float(np.median(self._areas)) if self._areas else area
+        usual = self._usual_area if self._areas else area
         score = area / usual
         if self._areas and score < self.partial_fraction:
             return Detection.missing(score)
         self._areas.append(area)
-        px, py = _coverage_centroid(roi, labels == best)
-        return Detection(px + x0, py + y0, score, True)
+        self._usual_area = statistics.median(self._areas)
+        # the centroid needs the blob and four pixels around it (two dilations of 5x5)
+        bx, by, bw, bh = (int(v) for v in stats[best, :4])
+        cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
+        cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
+        blob = labels[cy0:cy1, cx0:cx1] == best
+        px, py = _coverage_centroid(roi[cy0:cy1, cx0:cx1], blob)
+        return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
+
+
+RING_PX = 4
+_KERNEL_5 = np.ones((5, 5), np.uint8)
+_KERNEL_3 = np.ones((3, 3), np.uint8)
 
 
 def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]:
-    """Centroid of per-pixel coverage over ``blob`` grown by two pixels."""
-    blob_u8 = blob.astype(np.uint8)
-    grown = cv2.dilate(blob_u8, np.ones((5, 5), np.uint8))
-    ring = cv2.dilate(grown, np.ones((5, 5), np.uint8)) & ~grown & 1
+    """Centroid of per-pixel coverage over ``blob`` grown by two pixels.
+
+    ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
+    """
+    blob_u8 = blob.view(np.uint8)
+    grown = cv2.dilate(blob_u8, _KERNEL_5)
+    ring = cv2.dilate(grown, _KERNEL_5) & ~grown & 1
     luma = roi.astype(np.float32) @ LUMA_BGR
-    inner = cv2.erode(blob_u8, np.ones((3, 3), np.uint8)).astype(bool)
-    level = float(np.median(luma[inner])) if inner.any() else float(np.median(luma[blob]))
-    background = float(np.median(luma[ring.astype(bool)])) if ring.any() else 0.0
+    inner = cv2.erode(blob_u8, _KERNEL_3).view(bool)
+    level = float(_median(luma[inner])) if inner.any() else float(_median(luma[blob]))
+    ring_b = ring.view(bool)
+    background = float(_median(luma[ring_b])) if ring_b.any() else 0.0
     if abs(level - background) >= 20:
         cover = np.clip((luma - background) / (level - background), 0.0, 1.0)
     else:  # sticker as bright as its surround: fall back to the colour core alone
         cover = blob.astype(np.float32)
-    m = cv2.moments((cover * grown).astype(np.float32))
+    m = cv2.moments(cover * grown)
     return m["m10"] / m["m00"], m["m01"] / m["m00"]
+
+
+def _median(values: np.ndarray) -> np.floating:
+    """``np.median`` of a 1-D float32 array, without its general-purpose overhead."""
+    n = values.size
+    k = n // 2
+    if n % 2:
+        return np.partition(values, k)[k]
+    part = np.partition(values, (k - 1, k))
+    return (part[k - 1] + part[k]) / np.float32(2)
 
 
 def _touches_edge(stat: np.ndarray, roi_shape, box, image_shape) -> bool:

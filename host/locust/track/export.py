@@ -82,12 +82,7 @@ def summary_lines(result: TrackResult) -> list[str]:
             shown = ", ".join(str(int(f)) for f in missing[:8]) + (" ..." if missing.size > 8 else "")
             line += f"; missing frames {shown}"
         lines.append(line)
-    cal = result.calibration
-    if math.isfinite(cal.m_per_px):
-        lines.append(f"scale {cal.m_per_px * 1000:.5g} mm/px ({cal.source}), origin ({cal.origin_x_px:.2f}, "
-                     f"{cal.origin_y_px:.2f}) px, x axis {cal.angle_deg:g} deg")
-    else:
-        lines.append("no scale given (--scale or --scale-aruco): the *_x_m/*_y_m columns are nan")
+    lines.append(result.calibration.summary())
     return lines
 
 

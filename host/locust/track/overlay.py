@@ -45,11 +45,10 @@ def draw_tracks(image: np.ndarray, result: TrackResult, upto: int | None = None)
         if last.size:
             x, y = pts[last[-1]]
             cv2.putText(out, tr.name, (int(x) + 8, int(y) - 8), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv2.LINE_AA)
-    cal = result.calibration
-    o = (int(round(cal.origin_x_px)), int(round(cal.origin_y_px)))
-    a = np.radians(cal.angle_deg)
-    cv2.arrowedLine(out, o, (int(o[0] + 40 * np.cos(a)), int(o[1] - 40 * np.sin(a))), (0, 0, 255), 1, cv2.LINE_AA)
-    cv2.arrowedLine(out, o, (int(o[0] - 40 * np.sin(a)), int(o[1] - 40 * np.cos(a))), (0, 255, 0), 1, cv2.LINE_AA)
+    origin, x_dir, y_dir = result.calibration.axes_px()
+    o = (int(round(origin[0])), int(round(origin[1])))
+    for direction, colour in ((x_dir, (0, 0, 255)), (y_dir, (0, 255, 0))):
+        cv2.arrowedLine(out, o, (int(o[0] + 40 * direction[0]), int(o[1] + 40 * direction[1])), colour, 1, cv2.LINE_AA)
     return out
 
 

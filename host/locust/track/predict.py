@@ -30,32 +30,24 @@ def predict_next(history: Iterable[Optional[Point]]) -> Optional[Point]:
             _predict_axis([p[1] if p else None for p in prev]))
 
 
-def _diffs(values: list[Optional[float]], order: int) -> list[Optional[float]]:
-    out = []
-    for i in range(LOOKBACK):
-        window = values[i:i + order + 1]
-        if len(window) < order + 1 or any(v is None for v in window):
-            out.append(None)
-            continue
-        coeffs = {1: (1, -1), 2: (1, -2, 1), 3: (1, -3, 3, -1)}[order]
-        out.append(sum(c * v for c, v in zip(coeffs, window)))
-    return out
-
-
-def _mean_abs(values: list[Optional[float]]) -> float:
-    present = [v for v in values if v is not None]
-    return abs(sum(present) / len(present)) if present else 0.0
-
-
 def _predict_axis(p: list[Optional[float]]) -> float:
-    vel, acc, jerk = _diffs(p, 1), _diffs(p, 2), _diffs(p, 3)
-    accel_valid = p[2] is not None and (p[3] is None or abs(jerk[0]) < _mean_abs(acc))
-    veloc_valid = p[2] is None or abs(acc[0]) < _mean_abs(vel)
-    if accel_valid:
-        return 3 * p[0] - 3 * p[1] + p[2]
-    if veloc_valid:
-        return 2 * p[0] - p[1]
-    return p[0]
+    """One axis; ``p[0]`` the latest position, ``p[1]`` known, older ones possibly ``None``.
+
+    Tracker's rule, written out for the four-step lookback: the mean acceleration is over
+    the two second differences the four steps hold, the mean velocity over the three first
+    differences.
+    """
+    p0, p1, p2, p3 = p
+    if p2 is None:          # two positions: constant velocity
+        return 2 * p0 - p1
+    if p3 is None:          # three: constant acceleration
+        return 3 * p0 - 3 * p1 + p2
+    acc0, acc1 = p0 - 2 * p1 + p2, p1 - 2 * p2 + p3
+    if abs(p0 - 3 * p1 + 3 * p2 - p3) < abs((acc0 + acc1) / 2):      # jerk small against acceleration
+        return 3 * p0 - 3 * p1 + p2
+    if abs(acc0) < abs(((p0 - p1) + (p1 - p2) + (p2 - p3)) / 3):     # acceleration small against velocity
+        return 2 * p0 - p1
+    return p0
 
 
 class MotionHistory:

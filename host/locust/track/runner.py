@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import TrackError
 from .calib import Calibration
+from .camera import PlaneCalibration
 from .video import Clip, VideoInfo, read_frames
 
 
@@ -34,14 +35,14 @@ class TrackResult:
     frames: np.ndarray
     t_s: np.ndarray
     markers: list[MarkerTrack]
-    calibration: Calibration
+    calibration: Calibration | PlaneCalibration
     source: str = "locust track"
 
     def world(self, track: MarkerTrack) -> tuple[np.ndarray, np.ndarray]:
-        return self.calibration.to_world(track.px, track.py)
+        return self.calibration.to_world(track.px, track.py, track.name, self.frames)
 
 
-def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibration,
+def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibration | PlaneCalibration,
                 progress: Optional[Callable[[int], None]] = None, require_found: bool = True) -> TrackResult:
     """Run every marker model over a resolved ``clip`` of the video ``info``.
 
