@@ -46,6 +46,7 @@ from .plant import Plant, RecordingPlant
 
 SHIM_DIR = Path(__file__).resolve().parent / "machine_shim"
 PWM_PERIOD_S = 0.020
+PLANT_CLOSE_TIMEOUT_S = 600.0  # the simulation may still be rendering its video when the hop ends
 TICKS_PERIOD = 1 << 30  # MicroPython's ticks wrap at least this often
 
 
@@ -177,8 +178,13 @@ class VirtualRobot:
                 proc.kill()
                 proc.wait()
         self._plant_queue.put(None)
+        plant_unfinished = False
         for thread in self._threads:
-            thread.join(timeout=5)
+            # the plant thread finishes the simulation and its video: that can take a while
+            # on a loaded machine, and leaving early would lose the video
+            plant = thread.name.endswith("-plant")
+            thread.join(timeout=PLANT_CLOSE_TIMEOUT_S if plant else 5)
+            plant_unfinished |= plant and thread.is_alive()
         for fd in (self._ma, self._sa, self._mb, self._sb, self._fifo, self._fifo_keep):
             try:
                 os.close(fd)
@@ -187,6 +193,9 @@ class VirtualRobot:
         shutil.rmtree(self._tmp, ignore_errors=True)
         if self._log:
             self._log.close()
+        if plant_unfinished:
+            raise DeviceError(f"the virtual robot's simulation did not finish within {PLANT_CLOSE_TIMEOUT_S:g} s "
+                              "of the hop (its video was not written)", "rerun on a less loaded machine, or without --video")
         return self.summary or {}
 
     def __enter__(self) -> "VirtualRobot":

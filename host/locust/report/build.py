@@ -1,0 +1,240 @@
+"""Build a report: simulate each configuration, compare with its trials, draw, write.
+
+Everything is computed first; only then is a new folder made (never an existing one) and
+``report.html``, ``dashboard.png`` and ``report.json`` written into it, each atomically: a
+bad input stops the report before anything is written.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Callable
+
+from .. import __version__
+from ..errors import ReportError
+from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, unique_dir
+from ..params import Provenance, Robot
+from . import figures as F
+from . import page as H
+from .compare import Comparison, compare, timing_rows
+from .configs import Configuration, configuration
+from .landscape import Landscape, read_landscape
+from .measured import Trial
+from .predict import predict
+
+REPORT_NAME = "report.html"
+DASHBOARD_NAME = "dashboard.png"
+JSON_NAME = "report.json"
+
+
+@dataclass(frozen=True)
+class ReportResult:
+    folder: Path
+    html_path: Path
+    dashboard_path: Path
+    json_path: Path
+    comparisons: list[Comparison]
+    figures: list[str]
+
+
+def run_schedule(name: str, trials: list[Trial]) -> dict | None:
+    """The schedule the trials' run records share (push_deg, push_s, wait_s, cycles), if any."""
+    seen = {}
+    for t in trials:
+        s = t.schedule
+        if s is None:
+            continue
+        key = (float(s["push_deg"]), float(s["push_ms"]), float(s["wait_ms"]))
+        seen.setdefault(key, []).append(t)
+    if not seen:
+        return None
+    if len(seen) > 1:
+        desc = "; ".join(f"{', '.join(t.label for t in ts)}: push {k[0]:g} deg {k[1]:g} ms, wait {k[2]:g} ms"
+                         for k, ts in seen.items())
+        raise ReportError(f"configuration {name}: its runs used different schedules ({desc})",
+                          "give runs of one schedule per configuration (or name them as separate configurations)")
+    (push_deg, push_ms, wait_ms), ts = next(iter(seen.items()))
+    return {"push_deg": push_deg, "push_s": push_ms / 1000.0, "wait_s": wait_ms / 1000.0,
+            "cycles": max(int(t.schedule["cycles"]) for t in ts), "source": str(ts[0].run_path)}
+
+
+def with_run_schedule(robot: Robot, sched: dict | None) -> Robot:
+    """The robot running the schedule its runs recorded (only the values that differ change)."""
+    if sched is None:
+        return robot
+    changed = {f"schedule.{k}": sched[k] for k in ("push_deg", "push_s", "wait_s")
+               if not math.isclose(robot.get(f"schedule.{k}"), sched[k], rel_tol=0, abs_tol=1e-9)}
+    if not changed:
+        return robot
+    return robot.with_values(changed, Provenance(source=f"run:{sched['source']}", note="schedule of the measured run"))
+
+
+def parameter_rows(robot: Robot) -> list[dict]:
+    rows = []
+    for key, value in robot.flat().items():
+        prov = robot.source_of(key)
+        rows.append({"key": key, "value": f"{value:.6g}" if isinstance(value, float) else str(value),
+                     "uncertainty": prov.uncertainty, "source": prov.source, "date": prov.date, "note": prov.note})
+    return rows
+
+
+def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, robot_source: str,
+                 cycles: int | None = None, sweep: Path | None = None, added: dict[str, float] | None = None,
+                 marker: str = "nose", progress: Callable[[str], None] | None = None) -> ReportResult:
+    progress = progress or (lambda msg: None)
+    added = added or {}
+    unknown = sorted(set(added) - set(measured))
+    if unknown:
+        raise ReportError(f"--added names {', '.join(unknown)}, which no --measured input is",
+                          f"configurations given: {', '.join(measured)}")
+    land = read_landscape(sweep) if sweep is not None else None   # fail early on a bad sweep folder
+    t0 = time.perf_counter()
+
+    configs: dict[str, Configuration] = {}
+    comps: list[Comparison] = []
+    for name, trials in measured.items():
+        cfg = configuration(base, name, added.get(name))
+        sched = run_schedule(name, trials)
+        cfg = Configuration(cfg.name, cfg.added_m, with_run_schedule(cfg.robot, sched))
+        configs[name] = cfg
+        n_cycles = cycles or (sched["cycles"] if sched else cfg.robot.schedule.cycles)
+        period = cfg.robot.schedule.push_s + cfg.robot.schedule.wait_s
+        progress(f"simulating {cfg.label} ({n_cycles} cycles)")
+        pred = predict(name, cfg.robot, n_cycles, marker)
+        comps.append(compare(pred, trials, n_cycles, period))
+
+    progress("drawing figures")
+    labels = {name: cfg.label for name, cfg in configs.items()}
+    names_text = ", ".join(labels.values())
+    figs = [
+        H.Figure("overlay", f"Displacement and height vs time: {names_text}",
+                 "Nose forward travel and height above standing, every measured trial (solid) and the audited "
+                 "simulation (dashed), on the schedule's clock (t = 0 at the first push; grey lines: cycle starts).",
+                 F.overlay_figure(comps)),
+        H.Figure("jump", f"Jump height, measured against predicted: {names_text}",
+                 "Highest nose point above standing; measured bars show the mean over trials with ±1 sd "
+                 "error bars where repeated trials exist; hatched bars are the simulation's.",
+                 F.bars_figure(comps, "jump")),
+        H.Figure("hops", f"Each hop, measured against predicted: {names_text}",
+                 "Per-hop distance and nose apex of every trial (dots) and the simulation (dashed).",
+                 F.hops_figure(comps)),
+    ]
+    if land is not None:
+        figs.append(H.Figure("landscape", f"Sweep landscape with {names_text} marked",
+                             f"Simulated distance per hop over the sweep in {land.folder} (invalid designs as red "
+                             "crosses at zero), with each physical design's prediction (open circle) and "
+                             "measurement (filled square, ±1 sd).", F.landscape_figure(land, comps, configs)))
+    figs.append(H.Figure("timing", f"Firmware timing of the runs: {names_text}",
+                         "Start of every phase as the firmware measured it, minus the commanded start.",
+                         F.timing_figure(comps)))
+    dash = F.dashboard(comps, land, configs)
+
+    timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
+    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker)
+    doc = report_json(base, robot_source, comps, configs, timing, land, marker)
+
+    folder = unique_dir(out, "report")
+    html_path = atomic_write_text(folder / REPORT_NAME, html_text)
+    dash_path = atomic_write_bytes(folder / DASHBOARD_NAME, dash)
+    json_path = atomic_write_json(folder / JSON_NAME, {**doc, "wall_s": round(time.perf_counter() - t0, 2)})
+    return ReportResult(folder, html_path, dash_path, json_path, comps, [f.key for f in figs])
+
+
+def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker: str) -> str:
+    items = [
+        "Predicted distances are locust.sim.run.run()'s audited result for each configuration, unchanged: "
+        "the chassis travel from the first push to the end of the last cycle, and over each cycle.",
+        f"Predicted heights are those of the model's {marker} marker (the disc the camera follows, where the "
+        f"sticker goes), from the same rollout: a point on a pitching body rises by its own amount, so the "
+        f"model's {marker} site would not be the same point.",
+        f"Measured figures come from the {marker} track. The schedule's start is placed by the same rule in "
+        "both: the marker's first motion of more than 3 mm from where it stood, with the simulated delay "
+        "between the first push and that motion; nothing is fitted to make them agree.",
+        "Hop distance: marker x at rest at the end of a cycle minus at its start; apex: highest marker point "
+        "in the cycle above the standing height. Errors are measured minus predicted; ± is one sample "
+        "standard deviation over repeated trials.",
+    ]
+    for c in comps:
+        r = c.prediction.result
+        if not r.valid:
+            items.append(f"{c.config}: the simulation failed its audit ({'; '.join(r.reasons)}): no prediction.")
+        for note in getattr(r, "notes", []):
+            items.append(f"{c.config} simulation: {note}")
+        for m in c.trials:
+            gaps = [h.hop for h in m.hops if not math.isfinite(h.distance_m)]
+            if gaps:
+                items.append(f"{c.config} {m.trial.label}: the track does not cover hop(s) "
+                             f"{', '.join(map(str, gaps))}.")
+        if not c.trials:
+            items.append(f"{c.config}: no track given, prediction only.")
+    if land is not None and not land.finished:
+        items.append(f"The sweep in {land.folder} did not finish: the landscape shows {land.designs} designs only.")
+    if land is not None and land.base != base.name:
+        items.append(f"The sweep's base robot is {land.base!r}, the report's is {base.name!r}: the landscape "
+                     "may not be the same robot.")
+    return "<ul class=\"note\">" + "".join(f"<li>{H.esc(i)}</li>" for i in items) + "</ul>"
+
+
+def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, land, marker: str) -> str:
+    labels = {n: c.label for n, c in configs.items()}
+    added = {n: c.added_m for n, c in configs.items()}
+    inputs = []
+    for c in comps:
+        for t in c.all_trials:
+            inputs.append("<tr>" + H.td(labels[c.config], left=True) + H.td(t.label, left=True)
+                          + H.td(str(t.track.path) if t.track else "—", left=True)
+                          + H.td(str(t.run_path) if t.run_path else "—", left=True) + "</tr>")
+    sections = [
+        ("Summary", H.summary_table(comps, labels, added)),
+        ("Figures", "".join(H.figure_html(f) for f in figs)),
+        ("Per-hop errors", H.hop_table(comps, labels)),
+        ("Firmware timing", H.timing_table(timing, labels)),
+        ("Parameters", f"<p class=\"note\">Robot {H.esc(base.name)} from {H.esc(robot_source)}; each configuration "
+                       "adds its length to all four links.</p>"
+                       + H.links_table([(labels[n], c.robot.link_lengths_m()) for n, c in configs.items()])
+                       + H.params_table(parameter_rows(base))),
+        ("Inputs", H.table(["configuration", "trial", "track", "run record"], inputs, left_cols=4, id_="inputs")),
+        ("How the numbers are made", _notes(comps, land, base, marker)),
+    ]
+    meta = [f"robot: {base.name} ({robot_source})",
+            f"configurations: {', '.join(labels.values())}; cycles: "
+            + ", ".join(f"{labels[c.config]} {c.cycles}" for c in comps),
+            f"generated {time.strftime('%Y-%m-%d %H:%M:%S %z')} by locust {__version__}"]
+    return H.page("Simulation against measurement", meta, sections)
+
+
+def report_json(base: Robot, robot_source: str, comps, configs, timing, land, marker: str) -> dict:
+    out = {"robot": base.name, "robot_source": robot_source, "locust_version": __version__, "marker": marker,
+           "sweep": str(land.folder) if land else None, "configurations": []}
+    for c in comps:
+        cfg = configs[c.config]
+        out["configurations"].append({
+            "name": c.config, "added_m": cfg.added_m, "cycles": c.cycles, "period_s": c.period_s,
+            "link_lengths_m": list(cfg.robot.link_lengths_m()),
+            "predicted": c.prediction.result.to_json(),
+            "predicted_jump_m": c.predicted_jump_m,
+            "predicted_marker_hops": [asdict(h) for h in c.prediction.hops],
+            "onset_latency_s": c.prediction.onset_latency_s,
+            "measured": {"trials": c.distance.n, "distance_m": asdict(c.distance),
+                         "hop_distance_m": asdict(c.hop_distance), "jump_m": asdict(c.jump)},
+            "hops": [{**asdict(r), "distance_error_m": r.distance_error_m, "apex_error_m": r.apex_error_m}
+                     for r in c.rows],
+            "trials": [{"label": t.label, "track": str(t.track.path) if t.track else None,
+                        "run": str(t.run_path) if t.run_path else None} for t in c.all_trials],
+        })
+    out["timing"] = [asdict(r) for r in timing]
+    return _finite(out)
+
+
+def _finite(obj):
+    """NaN/inf -> None, so report.json is strict JSON."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    return obj

@@ -1,0 +1,69 @@
+"""``locust report``: simulation against measurement, as one HTML page and a PNG dashboard."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from ..params import resolve_robot
+from ..params_cli import robot_options
+
+
+def _stage(msg: str) -> None:
+    click.echo(f"report: {msg}", err=True)
+
+
+@click.command()
+@click.option("--measured", "measured", multiple=True, required=True, metavar="[NAME=]PATH[,PATH...]",
+              help="Trials: a folder (track *.tracks.csv and/or run.json), a track file or a run.json. "
+                   "NAME= gives the configuration (small/medium/large or any name); without it the "
+                   "folder's name does (hops/medium-2/ -> medium). Repeatable; several paths = repeated trials.")
+@robot_options
+@click.option("--added", "added", multiple=True, metavar="NAME=METRES",
+              help="Length added to every link for configuration NAME (small/medium/large default to 0/0.01/0.02).")
+@click.option("--sweep", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="A `locust sweep --out` folder: its landscape is drawn with the physical designs marked.")
+@click.option("--cycles", type=click.IntRange(1, 100), default=None,
+              help="Hop cycles to simulate and measure [the run records' cycles, else the robot's schedule].")
+@click.option("--marker", default="nose", show_default=True,
+              help="Marker compared: its track (x forward, y up, metres) against the model's marker of that name.")
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=Path("reports"), show_default=True,
+              help="Parent folder; the report goes into a new report/ (report-2/, ...) inside, never over another.")
+def report(measured, config, preset, sets, added, sweep, cycles, marker, out):
+    """Compare simulation and measurement for each configuration in one self-contained HTML page.
+
+    Each configuration (Small/Medium/Large: the --config/--preset robot with +0/+1/+2 cm on
+    all four links) is simulated with those parameters, audited, and compared with its tracks:
+    displacement and height against time, jump height (± 1 sd over repeated trials), per-hop
+    errors, the parameters with their source and uncertainty, the sweep landscape with the
+    designs marked (--sweep), and the firmware timing of the runs. Writes report.html (figures
+    embedded), dashboard.png and report.json.
+
+    \b
+    Examples:
+      locust report --measured runs/small-1 --measured runs/small-2 --measured runs/large-1 \\
+                    --config calibration/robot.toml
+      locust report --measured medium=a.tracks.csv,b.tracks.csv --preset seed --sweep sweep/ --cycles 6
+    """
+    from .build import build_report
+    from .configs import parse_added
+    from .measured import parse_measured
+
+    robot = resolve_robot(preset, config, sets)
+    groups = parse_measured(list(measured), marker=marker)
+    source = str(config) if config else f"preset {preset}"
+    if sets:
+        source += " with " + ", ".join(sets)
+    result = build_report(robot, groups, out, robot_source=source, cycles=cycles, sweep=sweep,
+                          added=parse_added(added), marker=marker, progress=_stage)
+    for c in result.comparisons:
+        r = c.prediction.result
+        pred = f"predicted {r.distance_m * 100:.2f} cm" if r.valid else "simulation INVALID"
+        meas = (f"measured {c.distance.mean * 100:.2f} cm over {c.distance.n} trial(s)" if c.distance.n
+                else "no track")
+        click.echo(f"{c.config:8s} {pred}, {meas}", err=True)
+    click.echo(f"dashboard: {result.dashboard_path}", err=True)
+    click.echo(str(result.html_path))
+    sys.stdout.flush()

@@ -1,0 +1,167 @@
+"""Measured against predicted: per-hop rows, per-configuration summaries, firmware timing.
+
+Across repeated trials a configuration's figure is the mean of the trials' own figures
+(mean distance per hop, highest apex, total distance) with the sample standard deviation
+(n - 1) when there are at least two trials.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .measure import Aligned, MeasuredHop, align, measure_hops
+from .measured import Trial
+from .predict import Prediction
+
+
+@dataclass(frozen=True)
+class Stat:
+    mean: float
+    std: float | None        # None with fewer than two values
+    n: int
+
+
+def stat(values: list[float]) -> Stat:
+    v = np.asarray([x for x in values if math.isfinite(x)], dtype=float)
+    if v.size == 0:
+        return Stat(math.nan, None, 0)
+    return Stat(float(v.mean()), float(v.std(ddof=1)) if v.size >= 2 else None, int(v.size))
+
+
+@dataclass(frozen=True)
+class HopRow:
+    config: str
+    trial: str
+    hop: int
+    measured_distance_m: float
+    predicted_distance_m: float
+    measured_apex_m: float
+    predicted_apex_m: float
+
+    @property
+    def distance_error_m(self) -> float:
+        return self.measured_distance_m - self.predicted_distance_m
+
+    @property
+    def apex_error_m(self) -> float:
+        return self.measured_apex_m - self.predicted_apex_m
+
+
+@dataclass(frozen=True)
+class MeasuredTrial:
+    trial: Trial
+    trace: Aligned
+    hops: list[MeasuredHop]
+
+    @property
+    def total_distance_m(self) -> float:
+        return float(sum(h.distance_m for h in self.hops))
+
+    @property
+    def mean_hop_m(self) -> float:
+        return float(np.mean([h.distance_m for h in self.hops])) if self.hops else math.nan
+
+    @property
+    def jump_m(self) -> float:
+        apexes = [h.apex_m for h in self.hops if math.isfinite(h.apex_m)]
+        return max(apexes) if apexes else math.nan
+
+
+@dataclass(frozen=True)
+class Comparison:
+    config: str
+    prediction: Prediction
+    all_trials: list[Trial]   # every trial given, with or without a track
+    trials: list[MeasuredTrial]
+    rows: list[HopRow]
+    cycles: int
+    period_s: float
+    distance: Stat            # measured total distance over the cycles
+    hop_distance: Stat        # measured mean distance per hop
+    jump: Stat                # measured highest nose apex above standing
+
+    @property
+    def predicted_distance_m(self) -> float:
+        return self.prediction.result.distance_m
+
+    @property
+    def predicted_hop_distance_m(self) -> float:
+        return self.predicted_distance_m / self.cycles
+
+    @property
+    def predicted_jump_m(self) -> float:
+        """Highest apex of the tracked marker in the simulation (what a camera would see)."""
+        apexes = [h.apex_m for h in self.prediction.hops if math.isfinite(h.apex_m)]
+        return max(apexes) if apexes else math.nan
+
+
+def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: float) -> Comparison:
+    """Measure every trial with a track on the prediction's clock and pair hop by hop.
+
+    Predicted hop distance: run()'s chassis travel over the cycle (the robot is at rest at
+    both ends, so the marker travels the same); predicted apex: the simulated marker's.
+    """
+    latency = prediction.onset_latency_s if prediction.valid else 0.0
+    measured = []
+    for trial in trials:
+        if trial.track is None:
+            continue
+        tr = trial.track
+        trace = align(tr.t_s, tr.x_m, tr.y_m, latency, where=str(tr.path))
+        measured.append(MeasuredTrial(trial, trace, measure_hops(trace, period_s, trial_cycles(trial, cycles))))
+    sim_hops = {h.cycle: h for h in prediction.result.hops}          # run(): chassis travel per hop
+    sim_apex = {h.hop: h.apex_m for h in prediction.hops}            # the tracked marker's apex
+    nan = math.nan
+    rows = []
+    for m in measured:
+        for h in m.hops:
+            p = sim_hops.get(h.hop)
+            rows.append(HopRow(prediction.config, m.trial.label, h.hop, h.distance_m,
+                               p.distance_m if p else nan, h.apex_m, sim_apex.get(h.hop, nan)))
+    return Comparison(
+        config=prediction.config, prediction=prediction, all_trials=list(trials), trials=measured, rows=rows, cycles=cycles,
+        period_s=period_s, distance=stat([m.total_distance_m for m in measured]),
+        hop_distance=stat([m.mean_hop_m for m in measured]), jump=stat([m.jump_m for m in measured]),
+    )
+
+
+def trial_cycles(trial: Trial, default: int) -> int:
+    sched = trial.schedule
+    return int(sched["cycles"]) if sched else default
+
+
+@dataclass(frozen=True)
+class TimingRow:
+    config: str
+    trial: str
+    status: str
+    phases: int
+    phases_expected: int
+    firmware: str
+    jitter: object | None        # locust.device.record.Jitter: start errors, ms
+
+
+def timing_rows(config: str, trials: list[Trial]) -> list[TimingRow]:
+    """Phase start errors (measured - commanded, firmware clock) of each run record.
+
+    Recomputed from the record's phases with the device layer's own :func:`jitter`, so a
+    record that lost its summary still has one.
+    """
+    from ..device.record import Phase, jitter
+
+    rows = []
+    for t in trials:
+        if t.run is None:
+            continue
+        phases = [Phase(int(p.get("cycle", 0)), str(p.get("phase", "?")),
+                        int(round(p["commanded_ms"] * 1000)), int(round(p["measured_ms"] * 1000)))
+                  for p in t.run["phases"]]
+        rows.append(TimingRow(
+            config=config, trial=t.label, status=str(t.run.get("status", "?")), phases=len(phases),
+            phases_expected=int(t.run.get("phases_expected", 2 * int(t.run["schedule"]["cycles"]))),
+            firmware=str(t.run.get("firmware_version", "?")), jitter=jitter(phases),
+        ))
+    return rows

@@ -1,0 +1,83 @@
+"""The configurations a report compares: named leg sets built on one identified robot.
+
+A configuration is the base robot (``--config robot.toml`` or ``--preset``) with the same
+length added to all four links: ``small`` / ``medium`` / ``large`` are the notebook's
+physical leg sets (+0 / +1 / +2 cm), any other name is the base as it is unless
+``--added NAME=METRES`` gives its added length.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import ReportError
+from ..params import LEG_SETS_M, Robot, with_added_length
+
+_TRIAL_SUFFIX = re.compile(r"(?:[-_.]|^)(?:(?:trial|run|take)[-_.]?)?\d+$", re.IGNORECASE)
+_NAME_OK = re.compile(r"^[A-Za-z][A-Za-z0-9_+-]*$")
+
+
+@dataclass(frozen=True)
+class Configuration:
+    name: str          # lower case key: "small"
+    added_m: float     # length added to every link of the base robot
+    robot: Robot
+
+    @property
+    def label(self) -> str:
+        """Display name: "Small"."""
+        return self.name[:1].upper() + self.name[1:]
+
+
+def configuration(base: Robot, name: str, added_m: float | None = None) -> Configuration:
+    """The configuration ``name`` on ``base``: a known leg set, or ``base`` plus ``added_m``."""
+    key = check_name(name)
+    if added_m is None:
+        added_m = LEG_SETS_M.get(key, 0.0)
+    note = f"report configuration {key}: +{added_m * 100:g} cm on every link"
+    robot = with_added_length(base, added_m, source=f"leg-set:{key}", note=note) if added_m else base
+    return Configuration(name=key, added_m=float(added_m), robot=robot.renamed(key))
+
+
+def check_name(name: str) -> str:
+    key = name.strip().lower()
+    if not _NAME_OK.match(key):
+        raise ReportError(f"configuration name {name!r} is not a plain name",
+                          "use letters, digits, - or _, e.g. small, medium, large, v2")
+    return key
+
+
+def name_from_path(path: Path) -> str:
+    """A trial's configuration from where it lies: its folder's name less a trial number.
+
+    ``hops/small/run.json`` -> small; ``hops/medium-2/`` -> medium; ``large_trial3/`` -> large.
+    """
+    folder = path if path.is_dir() else path.parent
+    for part in (folder.name, folder.parent.name):
+        stem = _TRIAL_SUFFIX.sub("", part)
+        if stem and _NAME_OK.match(stem) and stem.lower() not in ("trial", "run", "runs", "hops", "tracks"):
+            return stem.lower()
+    raise ReportError(f"{path}: cannot tell which configuration this trial is",
+                      "name it on the command line: --measured small=PATH")
+
+
+def sort_key(name: str) -> tuple[int, str]:
+    """Known leg sets in size order first, then the rest by name."""
+    order = list(LEG_SETS_M)
+    return (order.index(name), "") if name in order else (len(order), name)
+
+
+def parse_added(items: tuple[str, ...] | list[str]) -> dict[str, float]:
+    """``["v2=0.015"]`` -> ``{"v2": 0.015}`` (metres added to every link)."""
+    out: dict[str, float] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        try:
+            out[check_name(name)] = float(value)
+        except ValueError:
+            sep = ""
+        if not sep:
+            raise ReportError(f"--added {item!r} is not NAME=METRES", "e.g. --added v2=0.015")
+    return out

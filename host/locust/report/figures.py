@@ -1,0 +1,269 @@
+"""The report's figures (matplotlib, Agg), each drawn on given axes so the HTML page and the
+PNG dashboard share them. Measured: solid, coloured by configuration; predicted: dashed or
+hatched. An invalid simulation is written in its panel, never drawn as a prediction.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..plotting import png_bytes, pyplot
+from .compare import Comparison
+from .configs import Configuration
+from .landscape import SCALE, Landscape, design_value
+
+COLOURS = {"small": "#1f77b4", "medium": "#ff7f0e", "large": "#2ca02c"}   # the seed dashboard's
+OTHER = ["#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"]
+CM = 100.0
+
+
+def colour(name: str, names: list[str]) -> str:
+    if name in COLOURS:
+        return COLOURS[name]
+    others = [n for n in names if n not in COLOURS]
+    return OTHER[others.index(name) % len(OTHER)] if name in others else OTHER[0]
+
+
+def _label(c: Comparison) -> str:
+    return c.config[:1].upper() + c.config[1:]
+
+
+def _invalid_note(ax, c: Comparison) -> None:
+    reasons = "; ".join(c.prediction.result.reasons)[:90]
+    ax.text(0.02, 0.04, f"simulation INVALID: {reasons}", transform=ax.transAxes, fontsize=7, color="#b00020",
+            wrap=True)
+
+
+def draw_traces(ax, c: Comparison, names: list[str], which: str) -> None:
+    """Nose forward travel (``which='x'``) or height (``'y'``) against time, one configuration."""
+    col = colour(c.config, names)
+    for i, m in enumerate(c.trials):
+        ax.plot(m.trace.t_s, getattr(m.trace, f"{which}_m") * CM, color=col, lw=1.4, alpha=0.85,
+                label="measured" if i == 0 else None)
+    p = c.prediction
+    if p.trace is not None:
+        ax.plot(p.trace.t_s, getattr(p.trace, f"{which}_m") * CM, "--", color="black", lw=1.2, label="predicted")
+    else:
+        _invalid_note(ax, c)
+    for k in range(c.cycles + 1):
+        ax.axvline(k * c.period_s, color="#bbbbbb", lw=0.6, zorder=0)
+    ax.grid(True, ls=":", alpha=0.5)
+
+
+def overlay_figure(comps: list[Comparison]) -> bytes:
+    plt = pyplot()
+    names = [c.config for c in comps]
+    fig, axes = plt.subplots(2, len(comps), figsize=(4.2 * len(comps), 6.2), squeeze=False, sharex="col")
+    for j, c in enumerate(comps):
+        draw_traces(axes[0, j], c, names, "x")
+        draw_traces(axes[1, j], c, names, "y")
+        axes[0, j].set_title(f"{_label(c)}: nose displacement", loc="left", fontsize=10)
+        axes[1, j].set_title(f"{_label(c)}: nose height", loc="left", fontsize=10)
+        axes[1, j].set_xlabel("time since first push (s)")
+        axes[0, j].legend(frameon=False, fontsize=8, loc="upper left")
+    axes[0, 0].set_ylabel("forward (cm)")
+    axes[1, 0].set_ylabel("above standing (cm)")
+    fig.suptitle("Displacement and height vs time: measured (solid) and predicted (dashed)", fontsize=11)
+    fig.tight_layout()
+    return png_bytes(fig)
+
+
+def draw_bars(ax, comps: list[Comparison], what: str) -> None:
+    """Measured (mean, +-1 sd across trials) beside predicted, per configuration."""
+    names = [c.config for c in comps]
+    x = np.arange(len(comps))
+    w = 0.38
+    if what == "jump":
+        meas = [c.jump for c in comps]
+        pred = [c.predicted_jump_m for c in comps]
+    else:
+        meas = [c.hop_distance for c in comps]
+        pred = [c.predicted_hop_distance_m for c in comps]
+    cols = [colour(n, names) for n in names]
+    heights = [s.mean * CM if s.n else 0.0 for s in meas]
+    errs = [(s.std or 0.0) * CM for s in meas]
+    ax.bar(x - w / 2, heights, w, color=cols, yerr=errs, capsize=4, label="measured (mean ± 1 sd)", zorder=3)
+    pv = [p * CM if math.isfinite(p) else 0.0 for p in pred]
+    ax.bar(x + w / 2, pv, w, color="white", edgecolor=cols, hatch="//", lw=1.2, label="predicted", zorder=3)
+    for i, (s, p) in enumerate(zip(meas, pred)):
+        if s.n:
+            ax.annotate(f"{s.mean * CM:.2f}" + (f"±{s.std * CM:.2f}" if s.std is not None else ""),
+                        (x[i] - w / 2, heights[i]), xytext=(0, 3), textcoords="offset points",
+                        ha="center", fontsize=7)
+        ax.annotate(f"{p * CM:.2f}" if math.isfinite(p) else "invalid", (x[i] + w / 2, pv[i]), xytext=(0, 3),
+                    textcoords="offset points", ha="center", fontsize=7,
+                    color="black" if math.isfinite(p) else "#b00020")
+    ax.set_xticks(x, [_label(c) for c in comps])
+    ax.axhline(0, color="black", lw=0.6)
+    ax.yaxis.grid(True, ls="--", alpha=0.5, zorder=0)
+    ax.legend(frameon=False, fontsize=8)
+
+
+def bars_figure(comps: list[Comparison], what: str) -> bytes:
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(max(5.0, 2.2 * len(comps)), 4.0))
+    draw_bars(ax, comps, what)
+    if what == "jump":
+        ax.set_title("Jump height: highest nose point above standing", loc="left", fontsize=10)
+        ax.set_ylabel("height (cm)")
+    else:
+        ax.set_title("Distance per hop", loc="left", fontsize=10)
+        ax.set_ylabel("distance (cm)")
+    fig.tight_layout()
+    return png_bytes(fig)
+
+
+def hops_figure(comps: list[Comparison]) -> bytes:
+    """Per-hop distance and apex, every trial, against the prediction."""
+    plt = pyplot()
+    names = [c.config for c in comps]
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+    for c in comps:
+        col = colour(c.config, names)
+        for key, ax in (("distance", axes[0]), ("apex", axes[1])):
+            xs = [r.hop for r in c.rows]
+            ys = [getattr(r, f"measured_{key}_m") * CM for r in c.rows]
+            ax.plot(xs, ys, "o", color=col, ms=5, alpha=0.8, label=f"{_label(c)} measured")
+            if c.prediction.valid:
+                if key == "distance":   # run()'s chassis travel per hop
+                    px, pv = [h.cycle for h in c.prediction.result.hops], [h.distance_m for h in c.prediction.result.hops]
+                else:                   # the simulated marker's apex
+                    px, pv = [h.hop for h in c.prediction.hops], [h.apex_m for h in c.prediction.hops]
+                ax.plot(px, [v * CM for v in pv], "--", color=col, lw=1.2, label=f"{_label(c)} predicted")
+    axes[0].set_title("Distance of each hop", loc="left", fontsize=10)
+    axes[1].set_title("Nose apex of each hop", loc="left", fontsize=10)
+    for ax, unit in zip(axes, ("distance (cm)", "apex above standing (cm)")):
+        ax.set_xlabel("hop")
+        ax.set_ylabel(unit)
+        ax.grid(True, ls=":", alpha=0.5)
+        ax.xaxis.get_major_locator().set_params(integer=True)
+    axes[1].legend(frameon=False, fontsize=7, loc="best")
+    fig.tight_layout()
+    return png_bytes(fig)
+
+
+def _axis_scale(name: str) -> tuple[float, str]:
+    if name == SCALE:
+        return CM, "added length on every link (cm)"
+    return (CM, f"{name} (cm)") if name.endswith("_m") else (1.0, name)
+
+
+def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[str, Configuration]) -> None:
+    names = [c.config for c in comps]
+    first = land.names[0]
+    k, xlabel = _axis_scale(first)
+    xs = land.values[first] * k
+    hop = land.hop_distance_m * CM
+    if len(land.names) == 1:
+        order = np.argsort(xs)
+        ok = land.valid[order]
+        ax.plot(xs[order][ok], hop[order][ok], "o-", color="#555555", ms=3.5, lw=1.0,
+                label=f"simulated designs ({land.designs})")
+        bad = ~land.valid
+        if bad.any():
+            ax.plot(xs[bad], np.zeros(bad.sum()), "x", color="#b00020", ms=7, label="invalid (failed audit)")
+        for c in comps:
+            cfg = configs[c.config]
+            xv = design_value(cfg, first) * k
+            col = colour(c.config, names)
+            ax.axvline(xv, color=col, ls=":", lw=1.0)
+            if c.prediction.valid:
+                ax.plot([xv], [c.predicted_hop_distance_m * CM], "o", mfc="white", mec=col, mew=2, ms=8)
+            if c.hop_distance.n:
+                ax.errorbar([xv], [c.hop_distance.mean * CM], yerr=[(c.hop_distance.std or 0.0) * CM], fmt="s",
+                            color=col, ms=7, capsize=4, label=f"{_label(c)}: measured ■, predicted ○")
+            else:
+                ax.plot([], [], "o", mfc="white", mec=col, label=f"{_label(c)}: predicted ○")
+        ax.set_ylabel("distance per hop (cm)")
+    else:
+        second = land.names[1]
+        k2, ylabel = _axis_scale(second)
+        ys = land.values[second] * k2
+        sc = ax.scatter(xs[land.valid], ys[land.valid], c=hop[land.valid], cmap="viridis", s=28)
+        ax.figure.colorbar(sc, ax=ax, label="distance per hop (cm)")
+        bad = ~land.valid
+        if bad.any():
+            ax.plot(xs[bad], ys[bad], "x", color="#b00020", ms=6, label="invalid (failed audit)")
+        for c in comps:
+            cfg = configs[c.config]
+            ax.plot([design_value(cfg, first) * k], [design_value(cfg, second) * k2], "*", ms=14,
+                    color=colour(c.config, names), mec="black", label=_label(c))
+        ax.set_ylabel(ylabel)
+    ax.set_xlabel(xlabel)
+    ax.set_title(f"Sweep landscape ({land.designs} designs, {land.cycles} cycles, base {land.base}) "
+                 "with the physical designs", loc="left", fontsize=9)
+    ax.grid(True, ls=":", alpha=0.5)
+    ax.legend(frameon=False, fontsize=7)
+
+
+def landscape_figure(land: Landscape, comps: list[Comparison], configs: dict[str, Configuration]) -> bytes:
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    draw_landscape(ax, land, comps, configs)
+    fig.tight_layout()
+    return png_bytes(fig)
+
+
+def draw_timing(ax, comps: list[Comparison]) -> None:
+    """Phase start error (measured - commanded, firmware clock) of every run, per phase."""
+    names = [c.config for c in comps]
+    drawn = False
+    for c in comps:
+        for m in (t for t in c.all_trials if t.run is not None):
+            errs = [p["measured_ms"] - p["commanded_ms"] for p in m.run["phases"]]
+            ax.plot(np.arange(1, len(errs) + 1), errs, "o-", ms=3, lw=1, color=colour(c.config, names),
+                    label=f"{_label(c)} {m.label}")
+            drawn = True
+    if not drawn:
+        ax.text(0.5, 0.5, "no run records given", transform=ax.transAxes, ha="center", va="center")
+    ax.xaxis.get_major_locator().set_params(integer=True)
+    ax.set_xlabel("phase (push, wait, push, ...)")
+    ax.set_ylabel("start error (ms)")
+    ax.set_title("Firmware timing: phase start, measured - commanded", loc="left", fontsize=10)
+    ax.grid(True, ls=":", alpha=0.5)
+    if drawn:
+        ax.legend(frameon=False, fontsize=7, ncol=2)
+
+
+def timing_figure(comps: list[Comparison]) -> bytes:
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(8, 3.6))
+    draw_timing(ax, comps)
+    fig.tight_layout()
+    return png_bytes(fig)
+
+
+def dashboard(comps: list[Comparison], land: Landscape | None, configs: dict[str, Configuration]) -> bytes:
+    """One PNG like the seed's dashboard, measured and predicted together."""
+    plt = pyplot()
+    names = [c.config for c in comps]
+    fig, axes = plt.subplots(2, 2, figsize=(14, 9.5))
+    ax = axes[0, 0]
+    for c in comps:
+        col = colour(c.config, names)
+        for i, m in enumerate(c.trials):
+            ax.plot(m.trace.t_s, m.trace.x_m * CM, color=col, lw=1.6, alpha=0.85,
+                    label=f"{_label(c)} measured" if i == 0 else None)
+        if c.prediction.trace is not None:
+            ax.plot(c.prediction.trace.t_s, c.prediction.trace.x_m * CM, "--", color=col, lw=1.2,
+                    label=f"{_label(c)} predicted")
+    ax.set_title("Longitudinal displacement (nose)", loc="left", fontsize=11)
+    ax.set_xlabel("time since first push (s)")
+    ax.set_ylabel("displacement (cm)")
+    ax.grid(True, ls=":", alpha=0.5)
+    ax.legend(frameon=False, fontsize=8, loc="upper left")
+    draw_bars(axes[0, 1], comps, "jump")
+    axes[0, 1].set_title("Max vertical jump height (nose above standing)", loc="left", fontsize=11)
+    axes[0, 1].set_ylabel("height (cm)")
+    if land is not None:
+        draw_landscape(axes[1, 0], land, comps, configs)
+    else:
+        draw_bars(axes[1, 0], comps, "distance")
+        axes[1, 0].set_title("Distance per hop", loc="left", fontsize=11)
+        axes[1, 0].set_ylabel("distance (cm)")
+    draw_timing(axes[1, 1], comps)
+    fig.suptitle("locust: simulation against measurement, " + ", ".join(_label(c) for c in comps), fontsize=13)
+    fig.tight_layout()
+    return png_bytes(fig, dpi=100)

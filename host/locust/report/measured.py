@@ -1,0 +1,163 @@
+"""Measured inputs of a report: marker tracks and run records, grouped by configuration.
+
+``--measured`` takes ``NAME=PATH[,PATH...]`` or plain paths. Each path is one trial:
+
+- a folder holding a track (``*.tracks.csv``, or one CSV/Tracker export with marker columns)
+  and/or a ``run.json`` (the record ``locust hop`` wrote);
+- a track file (``locust track`` CSV or Tracker text export); a ``run.json`` beside it is
+  its run record;
+- a ``run.json``; a single ``*.tracks.csv`` beside it is its track.
+
+A plain path's configuration comes from its folder's name (see
+:func:`.configs.name_from_path`). Tracks are read with the calibration layer's reader, so
+the formats are the same everywhere.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..calibrate.recordings import read_table
+from ..errors import CalibrationError, ReportError
+from .configs import check_name, name_from_path, sort_key
+
+RUN_NAME = "run.json"
+TRACK_GLOB = "*.tracks.csv"
+
+
+@dataclass(frozen=True)
+class Track:
+    """One marker's positions, lost frames removed: time (s), x forward and y up (m)."""
+
+    path: Path
+    marker: str
+    t_s: np.ndarray
+    x_m: np.ndarray
+    y_m: np.ndarray
+    frames: int          # rows in the file, lost ones included
+
+
+@dataclass(frozen=True)
+class Trial:
+    config: str
+    label: str                       # short name shown in tables: the trial's folder
+    track: Track | None
+    run_path: Path | None
+    run: dict | None = field(default=None, compare=False)
+
+    @property
+    def schedule(self) -> dict | None:
+        return (self.run or {}).get("schedule")
+
+
+def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose") -> dict[str, list[Trial]]:
+    """``--measured`` values -> trials per configuration, in leg-set order."""
+    if not items:
+        raise ReportError("no measured inputs", "give --measured small=runs/small-1,runs/small-2 (or plain paths)")
+    groups: dict[str, list[Trial]] = {}
+    for item in items:
+        name, paths = _split_item(item)
+        for raw in paths:
+            path = Path(raw)
+            trial = load_trial(path, name or name_from_path(path), marker)
+            groups.setdefault(trial.config, []).append(trial)
+    for name, trials in groups.items():
+        seen: set[tuple] = set()
+        for t in trials:
+            key = (t.track.path.resolve() if t.track else None, t.run_path.resolve() if t.run_path else None)
+            if key in seen:
+                raise ReportError(f"configuration {name}: the trial {t.label} is given twice",
+                                  "list each trial once")
+            seen.add(key)
+    return {k: groups[k] for k in sorted(groups, key=sort_key)}
+
+
+def _split_item(item: str) -> tuple[str | None, list[str]]:
+    name, sep, rest = item.partition("=")
+    if sep and name and "/" not in name and not Path(item).exists():
+        paths = [p for p in rest.split(",") if p.strip()]
+        if not paths:
+            raise ReportError(f"--measured {item!r} names no path", "e.g. --measured small=runs/s1,runs/s2")
+        return check_name(name), [p.strip() for p in paths]
+    return None, [item]
+
+
+def load_trial(path: Path, config: str, marker: str = "nose") -> Trial:
+    if not path.exists():
+        raise ReportError(f"{path}: no such file or folder", "check the --measured path")
+    if path.is_dir():
+        run_path = path / RUN_NAME if (path / RUN_NAME).is_file() else None
+        track_path = _one_track(path, required=run_path is None)
+        label = path.name
+    elif path.name.endswith(".json"):
+        run_path, track_path, label = path, _one_track(path.parent, required=False), path.parent.name
+    else:
+        beside = path.parent / RUN_NAME
+        run_path, track_path, label = (beside if beside.is_file() else None), path, path.parent.name or path.stem
+    run = read_run(run_path) if run_path else None
+    track = read_track(track_path, marker) if track_path else None
+    return Trial(config=config, label=label, track=track, run_path=run_path, run=run)
+
+
+def _one_track(folder: Path, required: bool) -> Path | None:
+    found = sorted(folder.glob(TRACK_GLOB))
+    if len(found) > 1:
+        raise ReportError(f"{folder}: several tracks ({', '.join(p.name for p in found)})",
+                          "give the track file itself as the --measured path")
+    if found:
+        return found[0]
+    if required:
+        raise ReportError(f"{folder}: no track (*.tracks.csv) and no run.json",
+                          "run `locust track VIDEO` there, or give the track file's path")
+    return None
+
+
+def read_track(path: Path, marker: str = "nose") -> Track:
+    """The ``marker``'s positions in ``path``; lost frames dropped, time sorted."""
+    try:
+        table = read_table(path)
+        t = table.time_s()
+        x, y = table.marker(marker)
+    except CalibrationError as exc:
+        raise ReportError(exc.message, exc.hint) from None
+    ok = np.isfinite(t) & np.isfinite(x) & np.isfinite(y)
+    if not ok.any():
+        scaled = np.isfinite(table.columns.get(f"{marker}_px", np.array([np.nan]))).any()
+        hint = ("the track has pixels but no metres: run `locust track` with --scale or --scale-aruco"
+                if scaled else f"the {marker} marker was never found: check the video and the marker colour")
+        raise ReportError(f"{path}: no {marker} position in metres in any frame", hint)
+    if ok.sum() < 10:
+        raise ReportError(f"{path}: only {int(ok.sum())} frames with a {marker} position",
+                          "a report needs the whole hop: track the full clip")
+    order = np.argsort(t[ok], kind="stable")
+    tt = t[ok][order]
+    if np.any(np.diff(tt) <= 0):
+        raise ReportError(f"{path}: repeated time stamps in t_s", "export the track again; each frame needs its own time")
+    return Track(path=path, marker=marker, t_s=tt, x_m=x[ok][order], y_m=y[ok][order], frames=table.n_rows)
+
+
+def read_run(path: Path) -> dict:
+    """A run record (``locust hop``): checked for the fields the report uses."""
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ReportError(f"{path}: no such file", "give the run.json that `locust hop` wrote") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ReportError(f"{path}: not a readable JSON run record ({exc})",
+                          "give the run.json that `locust hop` wrote") from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("phases"), list) or not isinstance(doc.get("schedule"), dict):
+        raise ReportError(f"{path}: not a run record (no 'schedule' and 'phases')",
+                          "give the run.json that `locust hop` wrote")
+    sched = doc["schedule"]
+    for key in ("cycles", "push_deg", "push_ms", "wait_ms"):
+        if not isinstance(sched.get(key), (int, float)) or isinstance(sched.get(key), bool):
+            raise ReportError(f"{path}: schedule.{key} is missing or not a number", "the record is damaged; rerun the hop")
+    for i, ph in enumerate(doc["phases"]):
+        if not isinstance(ph, dict) or not all(isinstance(ph.get(k), (int, float)) for k in ("commanded_ms", "measured_ms")):
+            raise ReportError(f"{path}: phase {i + 1} has no commanded_ms/measured_ms numbers",
+                              "the record is damaged; rerun the hop")
+    return doc

@@ -1,0 +1,171 @@
+"""The report as one self-contained HTML page: figures embedded as base64 PNG, no scripts,
+no outside resources (a Content-Security-Policy forbids them, so a browser proves it).
+
+Every number cell carries ``data-config`` and ``data-field`` so tests and scripts can read
+the page's figures back exactly as printed.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+from dataclasses import dataclass
+
+from .compare import Comparison, TimingRow
+
+CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
+STYLE = """
+body{font:14px/1.45 system-ui,-apple-system,'DejaVu Sans',sans-serif;margin:2em auto;max-width:1180px;color:#222;padding:0 1em}
+h1{font-size:1.6em;margin-bottom:.2em}h2{margin-top:1.8em;border-bottom:1px solid #ddd;padding-bottom:.2em}
+table{border-collapse:collapse;margin:.6em 0;font-size:13px}th,td{border:1px solid #ddd;padding:3px 8px;text-align:right}td{white-space:nowrap}td.l{white-space:normal}
+th{background:#f4f4f4}td.l,th.l{text-align:left}tr.invalid td{color:#b00020}
+figure{margin:1em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{color:#555;font-size:13px}
+.meta{color:#555}.note{color:#555;font-size:13px}code{background:#f6f6f6;padding:0 3px}
+"""
+
+
+@dataclass(frozen=True)
+class Figure:
+    key: str
+    title: str
+    caption: str
+    png: bytes
+
+
+def esc(value) -> str:
+    return html.escape(str(value), quote=True)
+
+
+def cm(value: float, digits: int = 2) -> str:
+    return f"{value * 100:.{digits}f}" if value is not None and math.isfinite(value) else "—"
+
+
+def cm_pm(mean: float, std: float | None) -> str:
+    if not math.isfinite(mean):
+        return "—"
+    return cm(mean) + (f" ± {std * 100:.2f}" if std is not None else "")
+
+
+def pct(err: float, ref: float) -> str:
+    if not (math.isfinite(err) and math.isfinite(ref)) or ref == 0:
+        return "—"
+    return f"{100 * err / abs(ref):+.1f} %"
+
+
+def td(text: str, config: str | None = None, field: str | None = None, left: bool = False) -> str:
+    attrs = "" if not left else ' class="l"'
+    if config is not None:
+        attrs += f' data-config="{esc(config)}"'
+    if field is not None:
+        attrs += f' data-field="{esc(field)}"'
+    return f"<td{attrs}>{esc(text)}</td>"
+
+
+def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = "") -> str:
+    head = "".join(f'<th class="l">{esc(h)}</th>' if i < left_cols else f"<th>{esc(h)}</th>"
+                   for i, h in enumerate(headers))
+    ident = f' id="{esc(id_)}"' if id_ else ""
+    return f"<table{ident}><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>"
+
+
+def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[str, float]) -> str:
+    rows = []
+    for c in comps:
+        name = c.config
+        valid = c.prediction.valid
+        dist_err = c.distance.mean - c.predicted_distance_m
+        jump_err = c.jump.mean - c.predicted_jump_m
+        cells = [
+            td(labels[name], left=True), td(f"+{added[name] * 100:g}"), td(str(c.distance.n), name, "trials"),
+            td(cm(c.predicted_distance_m), name, "predicted_distance_cm"),
+            td(cm_pm(c.distance.mean, c.distance.std), name, "measured_distance_cm"),
+            td(cm(dist_err), name, "distance_error_cm"), td(pct(dist_err, c.predicted_distance_m)),
+            td(cm(c.predicted_hop_distance_m), name, "predicted_hop_distance_cm"),
+            td(cm_pm(c.hop_distance.mean, c.hop_distance.std), name, "measured_hop_distance_cm"),
+            td(cm(c.predicted_jump_m), name, "predicted_jump_cm"),
+            td(cm_pm(c.jump.mean, c.jump.std), name, "measured_jump_cm"),
+            td(cm(jump_err), name, "jump_error_cm"), td(pct(jump_err, c.predicted_jump_m)),
+            td("valid" if valid else "INVALID: " + "; ".join(c.prediction.result.reasons), name, "sim_status",
+               left=True),
+        ]
+        rows.append(f'<tr{"" if valid else " class=invalid"}>{"".join(cells)}</tr>')
+    headers = ["configuration", "added (cm)", "trials", "predicted distance (cm)", "measured distance (cm)",
+               "error (cm)", "error", "predicted per hop (cm)", "measured per hop (cm)",
+               "predicted jump (cm)", "measured jump (cm)", "error (cm)", "error", "simulation"]
+    return table(headers, rows, id_="summary")
+
+
+def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
+    rows = []
+    for c in comps:
+        for r in c.rows:
+            key = f"{r.trial}#{r.hop}"
+            rows.append("<tr>" + "".join([
+                td(labels[c.config], left=True), td(r.trial, left=True), td(str(r.hop)),
+                td(cm(r.measured_distance_m), c.config, f"hop_measured_distance_cm:{key}"),
+                td(cm(r.predicted_distance_m), c.config, f"hop_predicted_distance_cm:{key}"),
+                td(cm(r.distance_error_m)), td(pct(r.distance_error_m, r.predicted_distance_m)),
+                td(cm(r.measured_apex_m), c.config, f"hop_measured_apex_cm:{key}"),
+                td(cm(r.predicted_apex_m), c.config, f"hop_predicted_apex_cm:{key}"),
+                td(cm(r.apex_error_m)), td(pct(r.apex_error_m, r.predicted_apex_m)),
+            ]) + "</tr>")
+    if not rows:
+        return '<p class="note">No tracks were given: nothing measured to compare hop by hop.</p>'
+    headers = ["configuration", "trial", "hop", "measured distance (cm)", "predicted (cm)", "error (cm)", "error",
+               "measured apex (cm)", "predicted (cm)", "error (cm)", "error"]
+    return table(headers, rows, left_cols=2, id_="hops")
+
+
+def timing_table(rows: list[TimingRow], labels: dict[str, str]) -> str:
+    if not rows:
+        return '<p class="note">No run records were given.</p>'
+    out = []
+    for r in rows:
+        j = r.jitter
+
+        def ms(attr: str) -> str:
+            return f"{getattr(j, attr):.3f}" if j is not None else "—"
+
+        out.append("<tr>" + "".join([
+            td(labels[r.config], left=True), td(r.trial, left=True), td(r.status, left=True), td(r.firmware),
+            td(f"{r.phases}/{r.phases_expected}"), td(ms("mean_ms"), r.config, f"jitter_mean_ms:{r.trial}"),
+            td(ms("std_ms")), td(ms("max_abs_ms"), r.config, f"jitter_max_abs_ms:{r.trial}"),
+            td(ms("max_late_ms")), td(ms("max_early_ms")),
+        ]) + "</tr>")
+    headers = ["configuration", "trial", "status", "firmware", "phases", "mean (ms)", "sd (ms)",
+               "max |error| (ms)", "max late (ms)", "max early (ms)"]
+    return table(headers, out, left_cols=3, id_="timing")
+
+
+def params_table(param_rows: list[dict]) -> str:
+    rows = []
+    for p in param_rows:
+        unc = p["uncertainty"]
+        rows.append("<tr>" + "".join([
+            td(p["key"], left=True), td(p["value"], None, f"param:{p['key']}"),
+            td("" if unc is None else f"± {unc:.3g}"), td(p["source"], left=True), td(p["date"] or "", left=True),
+            td(p["note"] or "", left=True),
+        ]) + "</tr>")
+    return table(["parameter", "value", "uncertainty (1 sd)", "source", "date", "note"], rows, id_="params")
+
+
+def links_table(link_rows: list[tuple[str, tuple[float, float, float, float]]]) -> str:
+    rows = ["<tr>" + td(name, left=True) + "".join(td(f"{v * 100:.2f}") for v in links) + "</tr>"
+            for name, links in link_rows]
+    return table(["configuration", "ground (cm)", "crank (cm)", "coupler (cm)", "leg (cm)"], rows, id_="links")
+
+
+def figure_html(fig: Figure) -> str:
+    data = base64.b64encode(fig.png).decode("ascii")
+    return (f'<figure id="fig-{esc(fig.key)}"><img src="data:image/png;base64,{data}" alt="{esc(fig.title)}">'
+            f"<figcaption><b>{esc(fig.title)}.</b> {esc(fig.caption)}</figcaption></figure>")
+
+
+def page(title: str, meta_lines: list[str], sections: list[tuple[str, str]]) -> str:
+    meta = "".join(f"<div>{esc(line)}</div>" for line in meta_lines)
+    body = "".join(f"<h2>{esc(h)}</h2>{content}" for h, content in sections)
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
+            f"<title>{esc(title)}</title><style>{STYLE}</style></head>"
+            f"<body><h1>{esc(title)}</h1><div class=\"meta\">{meta}</div>{body}</body></html>\n")

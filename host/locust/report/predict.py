@@ -1,0 +1,89 @@
+"""What the simulation predicts for one configuration: the audited result and the tracked
+marker's trace.
+
+The result is :func:`locust.sim.run.run`'s, unchanged: the predicted distances are the
+pipeline's own. The camera follows a marker (the ``marker_<name>`` disc the model carries
+where the sticker goes, e.g. on the chassis' side, up and back from the nose edge), not the
+model's ``nose`` site, and a point on a pitching body rises by its own amount: so the
+predicted trace and apexes are those of the same marker, from the same deterministic rollout
+(:func:`locust.sim.rollout.simulate`, states kept, thinned to ``TRACE_HZ``), measured with the
+same functions as the track. A run that fails its audit is kept as invalid, with its
+reasons, and has no trace.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import GeometryError, ReportError
+from ..params import Robot
+from .measure import Aligned, MeasuredHop, measure_hops, onset_time
+
+TRACE_HZ = 240.0
+LEAD_S = 0.3             # standing time kept before the first push
+
+
+@dataclass
+class Prediction:
+    config: str
+    robot: Robot
+    result: object                 # locust.sim.run.SimResult
+    trace: Aligned | None          # the marker on the schedule's clock; None when invalid
+    hops: list[MeasuredHop]        # the marker's hops, measured like a track's (empty when invalid)
+    onset_latency_s: float         # first marker motion after the first push (nan when invalid)
+
+    @property
+    def valid(self) -> bool:
+        return bool(self.result.valid)
+
+
+def predict(config: str, robot: Robot, cycles: int, marker: str = "nose") -> Prediction:
+    from ..sim.run import invalid_result, run
+
+    try:
+        result = run(robot, cycles=cycles)
+    except GeometryError as exc:
+        reason = exc.message + (f" ({exc.hint})" if exc.hint else "")
+        return Prediction(config, robot, invalid_result(robot, reason, cycles), None, [], math.nan)
+    if not result.valid:
+        return Prediction(config, robot, result, None, [], math.nan)
+    trace = simulated_marker(robot, cycles, marker)
+    onset, _, _ = onset_time(trace.t_s, trace.x_m, trace.y_m, where=f"simulated {config}")
+    period = robot.schedule.push_s + robot.schedule.wait_s
+    return Prediction(config, robot, result, trace, measure_hops(trace, period, cycles), onset)
+
+
+def simulated_marker(robot: Robot, cycles: int, marker: str = "nose") -> Aligned:
+    from ..sim.rollout import simulate
+
+    return marker_trace(simulate(robot, cycles=cycles, keep_states=True), marker)
+
+
+def marker_trace(traj, marker: str) -> Aligned:
+    """The ``marker_<marker>`` disc's centre, t = 0 at the first push, from where it stood
+    at the end of the settle phase; x forward, y up."""
+    import mujoco
+
+    model = traj.built.model
+    gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"marker_{marker}")
+    if gid < 0:
+        raise ReportError(f"the model carries no {marker!r} marker to compare the track with",
+                          "track a marker the model has: nose or foot (--marker)")
+    dt, settle = traj.timestep_s, traj.plan.settle_steps
+    stride = max(1, int(round(1.0 / (TRACE_HZ * dt))))
+    stand = max(settle - 1, 0)
+    first = max(0, settle - int(round(LEAD_S / dt)))
+    rows = np.unique(np.concatenate(([stand], np.arange(first, len(traj.states), stride))))
+    data = mujoco.MjData(model)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    pos = np.empty((rows.size, 3))
+    for i, r in enumerate(rows):
+        mujoco.mj_setState(model, data, traj.states[r], spec)
+        mujoco.mj_kinematics(model, data)
+        pos[i] = data.geom_xpos[gid]
+    x0, z0 = pos[rows == stand][0, [0, 2]]
+    return Aligned(t_s=(rows + 1 - settle) * dt, x_m=pos[:, 0] - x0, y_m=pos[:, 2] - z0,
+                   onset_s=math.nan, start_s=0.0)

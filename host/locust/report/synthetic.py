@@ -1,0 +1,86 @@
+"""SYNTHETIC measured trials for testing reports against known truth.
+
+``write_synthetic_trial`` simulates a "true" robot (any parameter set, e.g. the model with a
+different friction), samples its nose like a side camera would (``fps``, a standing lead
+before the first push, Gaussian position noise, a few lost frames) and writes what
+``locust track`` and ``locust hop`` would have written: ``synthetic.tracks.csv`` (first line
+``# synthetic``) and a ``run.json`` built with the device layer's own record types, its
+phase start errors drawn at random (labelled synthetic in its ``message``). The truth is
+returned: the true robot's per-hop chassis travel (``run()``) and its nose marker's highest
+point in each cycle above standing (from the 240 Hz trace the camera samples).
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..fileio import atomic_write_json, atomic_write_text
+from ..params import Robot
+
+TRACK_NAME = "synthetic.tracks.csv"
+
+
+@dataclass(frozen=True)
+class SyntheticTruth:
+    hop_distance_m: list[float]
+    hop_apex_m: list[float]
+    distance_m: float
+    track_path: Path
+    run_path: Path
+
+
+def simulated_nose(robot: Robot, cycles: int):
+    """The true robot's audited result and its nose marker's trace (schedule clock, 240 Hz)."""
+    from ..sim.run import run
+    from .predict import simulated_marker
+
+    result = run(robot, cycles=cycles)
+    if not result.valid:
+        raise ValueError(f"the synthetic truth robot's simulation is invalid: {result.reasons}")
+    return result, simulated_marker(robot, cycles, "nose")
+
+
+def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int = 0, fps: float = 30.0,
+                          noise_m: float = 0.0005, camera_lead_s: float = 0.25, lost_frames: int = 3,
+                          truth=None) -> SyntheticTruth:
+    """Write one synthetic trial into ``folder``; ``truth`` reuses a :func:`simulated_nose`."""
+    from ..device.record import COMPLETE, HopSchedule, Phase, RunRecord
+
+    result, trace = truth or simulated_nose(robot, cycles)
+    rng = np.random.default_rng(seed)
+    t_sched = np.arange(-camera_lead_s, trace.t_s[-1], 1.0 / fps)
+    x = np.interp(t_sched, trace.t_s, trace.x_m) + rng.normal(0, noise_m, t_sched.size) + 0.10
+    y = np.interp(t_sched, trace.t_s, trace.y_m) + rng.normal(0, noise_m, t_sched.size) + 0.05
+    ok = np.ones(t_sched.size, dtype=bool)
+    ok[rng.choice(np.arange(12, t_sched.size), size=lost_frames, replace=False)] = False
+
+    out = io.StringIO()
+    out.write(f"# synthetic: simulated nose of robot {robot.name!r}, {cycles} cycles, {fps:g} frames/s, "
+              f"noise {noise_m * 1000:g} mm sd, seed {seed}\n")
+    out.write("frame,t_s,nose_px,nose_py,nose_x_m,nose_y_m,nose_ok\n")
+    for i in range(t_sched.size):
+        xs, ys = (f"{x[i]:.6f}", f"{y[i]:.6f}") if ok[i] else ("nan", "nan")
+        out.write(f"{i},{i / fps:.6f},nan,nan,{xs},{ys},{int(ok[i])}\n")
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    track_path = atomic_write_text(folder / TRACK_NAME, out.getvalue())
+
+    s = robot.schedule
+    sched = HopSchedule(cycles=cycles, push_deg=s.push_deg, push_ms=round(s.push_s * 1000),
+                        wait_ms=round(s.wait_s * 1000))
+    record = RunRecord(schedule=sched, port="synthetic", status=COMPLETE, firmware_version="synthetic",
+                       firmware_status=COMPLETE, message="synthetic run record (random phase start errors)")
+    period_us = (sched.push_ms + sched.wait_ms) * 1000
+    for c in range(cycles):
+        for name, offset_us in (("push", 0), ("wait", sched.push_ms * 1000)):
+            commanded = c * period_us + offset_us
+            record.add_phase(Phase(c + 1, name, commanded, commanded + int(rng.integers(20, 400))))
+    run_path = atomic_write_json(folder / "run.json", record.to_dict())
+    period_s = s.push_s + s.wait_s
+    apex = [float(trace.y_m[(trace.t_s >= c * period_s) & (trace.t_s < (c + 1) * period_s)].max())
+            for c in range(cycles)]
+    return SyntheticTruth([h.distance_m for h in result.hops], apex, result.distance_m, track_path, run_path)

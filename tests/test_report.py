@@ -1,0 +1,245 @@
+"""`locust report` on SYNTHETIC measured trials of known truth, a real sweep, and a browser.
+
+The "measured" trials are the simulated nose of a true robot that differs from the model
+(foot friction 1.2 instead of 1.7), sampled like a 30 frames/s camera with 0.5 mm noise and
+lost frames (locust.report.synthetic); the model's predictions must be run()'s own numbers.
+"""
+
+from __future__ import annotations
+
+import base64
+import re
+import shutil
+import subprocess
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from locust.cli import cli
+from locust.params import Provenance, leg_set, preset, save_robot
+from locust.report.synthetic import simulated_nose, write_synthetic_trial
+from locust.sim.run import run
+from locust.sim.sweep import run_sweep
+from locust.sim.sweep_design import Axis
+
+CYCLES = 2
+TRUE_FOOT_FRICTION = 1.2
+CAMERA_LEAD_S = 0.25
+
+
+class Cells(HTMLParser):
+    """Every <td data-config data-field> cell's text, and every <img>."""
+
+    def __init__(self):
+        super().__init__()
+        self.cells: dict[tuple[str, str], str] = {}
+        self.images: list[dict] = []
+        self._key = None
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag == "td" and "data-field" in a:
+            self._key = (a.get("data-config", ""), a["data-field"])
+            self.cells[self._key] = ""
+        if tag == "img":
+            self.images.append(a)
+
+    def handle_data(self, data):
+        if self._key:
+            self.cells[self._key] += data
+
+    def handle_endtag(self, tag):
+        if tag == "td":
+            self._key = None
+
+
+def parse(path: Path) -> Cells:
+    p = Cells()
+    p.feed(path.read_text(encoding="utf-8"))
+    return p
+
+
+def invoke(*args):
+    return CliRunner().invoke(cli, ["report", *map(str, args)])
+
+
+@pytest.fixture(scope="module")
+def world(tmp_path_factory):
+    root = tmp_path_factory.mktemp("report")
+    seed = preset("seed")
+    truth = {}
+    for name, trials in (("small", 2), ("medium", 1)):
+        true_robot = leg_set(seed, name).with_values({"contact.foot_friction": TRUE_FOOT_FRICTION})
+        sim = simulated_nose(true_robot, CYCLES)
+        for k in range(1, trials + 1):
+            truth[f"{name}-{k}"] = write_synthetic_trial(root / "hops" / f"{name}-{k}", true_robot, CYCLES,
+                                                         seed=k, camera_lead_s=CAMERA_LEAD_S, truth=sim)
+    sweep = run_sweep(seed, [Axis("scale", 0.0, 0.01, 2)], CYCLES, root / "sweep", jobs=1, plots=False)
+    res = invoke("--measured", root / "hops" / "small-1", "--measured", root / "hops" / "small-2",
+                 "--measured", root / "hops" / "medium-1", "--preset", "seed", "--sweep", root / "sweep",
+                 "--out", root / "out")
+    assert res.exit_code == 0, res.output
+    html = Path(res.stdout.strip().splitlines()[-1])
+    return {"root": root, "truth": truth, "html": html, "cells": parse(html), "sweep": sweep}
+
+
+def cm(value_m: float) -> str:
+    return f"{value_m * 100:.2f}"
+
+
+def marker_apexes(robot, cycles, marker="nose"):
+    """Highest point of the model's marker disc in each cycle, above where it stood after the
+    settle phase: straight from MuJoCo, every physics step."""
+    import mujoco
+    import numpy as np
+
+    from locust.sim.rollout import simulate
+
+    traj = simulate(robot, cycles=cycles, keep_states=True)
+    model, data = traj.built.model, mujoco.MjData(traj.built.model)
+    gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"marker_{marker}")
+    z = np.empty(len(traj.states))
+    for i, state in enumerate(traj.states):
+        mujoco.mj_setState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        mujoco.mj_kinematics(model, data)
+        z[i] = data.geom_xpos[gid, 2]
+    starts = traj.plan.cycle_start_steps
+    stand = z[traj.plan.settle_steps - 1]
+    return [float(z[starts[c]:starts[c + 1]].max() - stand) for c in range(cycles)]
+
+
+def test_predictions_are_the_pipelines_own(world):
+    """Distances: run()'s, to the printed 0.01 cm. Apexes: the simulated nose marker's (what
+    the camera follows), within 0.02 cm of MuJoCo's marker position at every step (the
+    report thins the trace to 240 Hz: about 0.002 cm lower at the top of the arc)."""
+    cells = world["cells"].cells
+    for name in ("small", "medium"):
+        robot = leg_set(preset("seed"), name)
+        r = run(robot, cycles=CYCLES)
+        assert r.valid
+        assert cells[(name, "predicted_distance_cm")] == cm(r.distance_m)
+        for h in r.hops:
+            assert cells[(name, f"hop_predicted_distance_cm:{name}-1#{h.cycle}")] == cm(h.distance_m)
+        apexes = marker_apexes(robot, CYCLES)
+        assert float(cells[(name, "predicted_jump_cm")]) == pytest.approx(max(apexes) * 100, abs=0.02)
+        for k, a in enumerate(apexes, start=1):
+            assert float(cells[(name, f"hop_predicted_apex_cm:{name}-1#{k}")]) == pytest.approx(a * 100, abs=0.02)
+    # the sweep's design at scale 0 / 0.01 is the same robot as Small / Medium: same number
+    rows = {round(r["scale"], 6): r for r in world["sweep"].rows}
+    assert cells[("small", "predicted_distance_cm")] == cm(rows[0.0]["distance_m"])
+    assert cells[("medium", "predicted_distance_cm")] == cm(rows[0.01]["distance_m"])
+
+
+def test_measured_hops_match_the_synthetic_truth(world):
+    """Hop distance within 1.5 mm of the true robot's (0.5 mm noise, median of ~6 rest frames);
+    apex within 5 mm and never above truth + 1.5 mm: a 30 frames/s camera samples the peak
+    up to 1/60 s away from it, which can only lower it (about 1-3 mm here)."""
+    cells = world["cells"].cells
+    for label, truth in world["truth"].items():
+        name = label.split("-")[0]
+        for k, (d_true, a_true) in enumerate(zip(truth.hop_distance_m, truth.hop_apex_m), start=1):
+            d = float(cells[(name, f"hop_measured_distance_cm:{label}#{k}")]) / 100
+            a = float(cells[(name, f"hop_measured_apex_cm:{label}#{k}")]) / 100
+            assert d == pytest.approx(d_true, abs=0.0015), (label, k)
+            assert a == pytest.approx(a_true, abs=0.005), (label, k)
+            assert a <= a_true + 0.0015
+    # the true robot hops differently from the model: the report shows a real error
+    err = float(cells[("small", "distance_error_cm")])
+    true_total = world["truth"]["small-1"].distance_m
+    model_total = run(leg_set(preset("seed"), "small"), cycles=CYCLES).distance_m
+    assert err == pytest.approx((true_total - model_total) * 100, abs=0.2)
+    assert abs(err) > 1.0
+
+
+def test_repeated_trials_have_error_bars_and_timing_is_the_records(world):
+    cells = world["cells"].cells
+    assert cells[("small", "trials")] == "2" and cells[("medium", "trials")] == "1"
+    assert "±" in cells[("small", "measured_jump_cm")]          # two trials: mean ± sd
+    assert "±" not in cells[("medium", "measured_jump_cm")]     # one trial: no error bar
+    import json
+
+    rec = json.loads((world["root"] / "hops" / "small-1" / "run.json").read_text())
+    assert cells[("small", "jitter_mean_ms:small-1")] == f"{rec['jitter']['mean_ms']:.3f}"
+    assert cells[("small", "jitter_max_abs_ms:small-1")] == f"{rec['jitter']['max_abs_ms']:.3f}"
+
+
+def test_report_is_self_contained_with_named_figures(world):
+    html_path = world["html"]
+    text = html_path.read_text(encoding="utf-8")
+    images = world["cells"].images
+    assert len(images) >= 4                                   # overlay, jump, hops, landscape, timing
+    for img in images:
+        assert img["src"].startswith("data:image/png;base64,")
+        png = base64.b64decode(img["src"].split(",", 1)[1])
+        assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000
+    named = [img["alt"] for img in images if "Small" in img["alt"] and "Medium" in img["alt"]]
+    assert len(named) >= 3
+    assert not re.search(r"(src|href)=\"(https?:|file:|//)", text)
+    assert "<script" not in text
+    assert (html_path.parent / "dashboard.png").stat().st_size > 50_000
+    # parameter table with provenance
+    assert world["cells"].cells[("", "param:contact.foot_friction")] == "1.7"
+    assert "fig-landscape" in text
+
+
+def test_changing_a_calibrated_friction_changes_the_predictions(world, tmp_path):
+    """Foot friction 1.7 -> 0.8 (as if refitted): run() moves Small by about 5.5 cm over two
+    hops; the simulation is deterministic, so any difference above the printed 0.01 cm is
+    the input's. The report must print the new run()'s number and the new provenance."""
+    changed = preset("seed").with_values({"contact.foot_friction": 0.8},
+                                         Provenance(source="fit:ramp-test", uncertainty=0.03, date="2026-01-01"))
+    toml = save_robot(changed, tmp_path / "robot.toml")
+    res = invoke("--measured", f"small={world['root'] / 'hops' / 'small-1'}", "--config", toml,
+                 "--out", tmp_path / "out")
+    assert res.exit_code == 0, res.output
+    cells = parse(Path(res.stdout.strip().splitlines()[-1])).cells
+    before = float(world["cells"].cells[("small", "predicted_distance_cm")])
+    after = float(cells[("small", "predicted_distance_cm")])
+    assert abs(after - before) > 1.0
+    assert cells[("small", "predicted_distance_cm")] == cm(run(leg_set(changed, "small"), cycles=CYCLES).distance_m)
+    assert cells[("", "param:contact.foot_friction")] == "0.8"
+    # the measured side did not move: same track, same numbers
+    assert cells[("small", "hop_measured_distance_cm:small-1#1")] == \
+        world["cells"].cells[("small", "hop_measured_distance_cm:small-1#1")]
+
+
+PROBE = """<script>
+window.__errors = [];
+window.addEventListener('error', e => window.__errors.push('error: ' + String(e.message || e.target.src || '?').slice(0, 80)), true);
+document.addEventListener('securitypolicyviolation', e => window.__errors.push('csp: ' + String(e.blockedURI).slice(0, 80)));
+window.addEventListener('load', () => {
+  const imgs = Array.from(document.images);
+  const drawn = imgs.filter(i => i.complete && i.naturalWidth > 0 && i.naturalHeight > 0);
+  document.body.setAttribute('data-images', imgs.length);
+  document.body.setAttribute('data-drawn', drawn.length);
+  document.body.setAttribute('data-min-width', Math.min(...imgs.map(i => i.naturalWidth)));
+  document.body.setAttribute('data-errors', window.__errors.join(' | '));
+});
+</script>"""
+
+
+def test_report_loads_in_headless_chromium(world, tmp_path):
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    if not chromium:
+        pytest.skip("chromium not installed (Debian package `chromium`)")
+    text = world["html"].read_text(encoding="utf-8")
+    # the probe is added to this copy only; its CSP allows inline script, nothing else changes
+    probe = text.replace("style-src 'unsafe-inline'", "style-src 'unsafe-inline'; script-src 'unsafe-inline'")
+    probe = probe.replace("</body>", PROBE + "</body>")
+    page = tmp_path / "probe.html"
+    page.write_text(probe, encoding="utf-8")
+    proc = subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--enable-logging=stderr",
+                           "--v=0", "--virtual-time-budget=5000", "--dump-dom", page.as_uri()],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    body = re.search(r"<body([^>]*)>", proc.stdout).group(1)
+    attrs = dict(re.findall(r'(data-[\w-]+)="([^"]*)"', body))
+    n_images = len(world["cells"].images)
+    assert int(attrs["data-images"]) == n_images
+    assert int(attrs["data-drawn"]) == n_images, attrs
+    assert int(attrs["data-min-width"]) > 300
+    assert attrs["data-errors"] == ""
+    console = [ln for ln in proc.stderr.splitlines() if "CONSOLE" in ln or "Refused" in ln]
+    assert console == []

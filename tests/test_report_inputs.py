@@ -1,0 +1,211 @@
+"""Report inputs: hop measurement on traces of known truth, configuration names, sweep
+folders (SYNTHETIC results.csv written here), and bad input turned into clear errors with
+nothing written."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from locust.cli import cli
+from locust.errors import ReportError
+from locust.params import preset
+from locust.report.configs import configuration, name_from_path, parse_added
+from locust.report.landscape import design_value, read_landscape
+from locust.report.measure import align, measure_hops, onset_time
+from locust.report.measured import parse_measured
+
+
+def staircase(fps=30.0, lead_s=0.4, period_s=1.3, hops=(0.20, 0.25, 0.15), apex=(0.05, 0.08, 0.03), noise=0.0, seed=0):
+    """A SYNTHETIC nose: stands, then each cycle jumps forward by hops[k] along a parabola of
+    height apex[k] during the first 0.4 s of the cycle, then rests. Camera clock starts lead_s early."""
+    t = np.arange(0, lead_s + period_s * len(hops) + 0.3, 1 / fps)
+    ts = t - lead_s
+    x = np.zeros_like(t)
+    y = np.zeros_like(t)
+    done = 0.0
+    for k, (d, a) in enumerate(zip(hops, apex)):
+        u = np.clip((ts - k * period_s) / 0.4, 0, 1)
+        active = (ts >= k * period_s) & (ts < (k + 1) * period_s)
+        x[active] = done + d * u[active]
+        y[active] = 4 * a * u[active] * (1 - u[active])
+        done += d
+    x[ts >= len(hops) * period_s] = done
+    rng = np.random.default_rng(seed)
+    return t, x + 0.3 + rng.normal(0, noise, t.size), y + 0.02 + rng.normal(0, noise, t.size)
+
+
+def test_onset_and_hops_on_a_known_trace():
+    t, x, y = staircase()
+    onset, x0, y0 = onset_time(t, x, y)
+    # the first 3 mm of travel: x = 0.2*u and y = 0.2*u(1-u) -> about u = 0.011, 4.4 ms after 0.4 s
+    assert onset == pytest.approx(0.4 + 0.0044, abs=0.002)
+    assert (x0, y0) == pytest.approx((0.3, 0.02))
+    trace = align(t, x, y, onset_latency_s=0.0044)
+    assert trace.start_s == pytest.approx(0.4, abs=0.002)
+    hops = measure_hops(trace, 1.3, 3)
+    assert [h.distance_m for h in hops] == pytest.approx([0.20, 0.25, 0.15], abs=1e-9)
+    # apex sampled at 30 frames/s: the parabola's top is missed by at most a(1-(1-2*dt/0.4)^2)
+    for h, a in zip(hops, (0.05, 0.08, 0.03)):
+        assert a * (1 - 0.0278) - 1e-9 <= h.apex_m <= a + 1e-12
+
+
+def test_noise_and_a_short_track():
+    t, x, y = staircase(noise=0.0005, seed=3)
+    trace = align(t, x, y, 0.0044)
+    hops = measure_hops(trace, 1.3, 3)
+    # median of the 6 frames of the last 0.2 s of a cycle: sd about 0.5 mm * 1.25 / sqrt(6) each end
+    assert [h.distance_m for h in hops] == pytest.approx([0.20, 0.25, 0.15], abs=0.0015)
+    cut = t < 0.4 + 3 * 1.3 - 0.5       # the clip stops half a second before hop 3 ends
+    hops = measure_hops(align(t[cut], x[cut], y[cut], 0.0044), 1.3, 3)
+    assert math.isfinite(hops[1].distance_m) and math.isnan(hops[2].distance_m) and math.isnan(hops[2].apex_m)
+
+
+def test_a_track_that_starts_moving_or_never_moves_is_refused():
+    t, x, y = staircase(lead_s=0.0)
+    with pytest.raises(ReportError, match="already moving"):
+        onset_time(t, x, y)
+    with pytest.raises(ReportError, match="never moves"):
+        onset_time(t, np.full_like(t, 0.3), np.full_like(t, 0.02))
+
+
+def test_configuration_names_and_added_lengths():
+    seed = preset("seed")
+    large = configuration(seed, "Large")
+    assert large.name == "large" and large.label == "Large" and large.added_m == 0.02
+    assert large.robot.link_lengths_m() == pytest.approx((0.06, 0.06, 0.04, 0.08))
+    assert large.robot.source_of("geometry.leg_m").source == "leg-set:large"
+    v2 = configuration(seed, "v2", 0.015)
+    assert v2.robot.get("geometry.crank_m") == pytest.approx(0.055)
+    assert configuration(seed, "other").robot.link_lengths_m() == seed.link_lengths_m()
+    assert name_from_path(Path("runs/medium-2/run.json")) == "medium"
+    assert name_from_path(Path("runs/small/trial-3/x.tracks.csv")) == "small"
+    assert name_from_path(Path("runs/v2/x.csv")) == "v2"
+    with pytest.raises(ReportError, match="cannot tell"):
+        name_from_path(Path("data/runs/20260101-120000/run.json"))
+    assert parse_added(["v2=0.015"]) == {"v2": 0.015}
+    with pytest.raises(ReportError):
+        parse_added(["v2"])
+
+
+def write_sweep(folder: Path, rows: list[str], vary="scale", cycles=3) -> Path:
+    folder.mkdir(parents=True)
+    (folder / "sweep.json").write_text(json.dumps({"request": {"base": "seed", "vary": [
+        {"name": vary, "start": 0.0, "stop": 0.03, "n": len(rows)}], "cycles": cycles}, "finished": True}))
+    head = f"design,{vary},valid,reason,distance_m,max_nose_height_m,nose_apex_max_m,com_apex_max_m,hops,wall_s\n"
+    (folder / "results.csv").write_text(head + "\n".join(rows) + "\n")
+    return folder
+
+
+def test_sweep_landscape_reads_and_places_designs(tmp_path):
+    # SYNTHETIC sweep results (numbers made up for the reader; not a simulation)
+    folder = write_sweep(tmp_path / "synthetic-sweep", [
+        "0,0.0,True,,0.60,0.1,0.09,0.05,3,1.0",
+        "1,0.01,True,,0.90,0.1,0.09,0.05,3,1.0",
+        "2,0.02,False,energy audit failed,nan,nan,nan,nan,0,1.0",
+    ])
+    land = read_landscape(folder)
+    assert land.names == ["scale"] and land.cycles == 3 and land.designs == 3
+    assert list(land.valid) == [True, True, False]
+    assert land.hop_distance_m[:2] == pytest.approx([0.20, 0.30])
+    assert math.isnan(land.hop_distance_m[2])            # an invalid design is never a number
+    seed = preset("seed")
+    assert design_value(configuration(seed, "medium"), "scale") == 0.01
+    assert design_value(configuration(seed, "large"), "geometry.leg_m") == pytest.approx(0.08)
+
+
+@pytest.mark.parametrize("rows, message", [
+    (["0,0.0,maybe,,0.6,0.1,0.09,0.05,3,1.0"], "line 2: 'valid' is not True/False"),
+    ([], "no designs"),
+])
+def test_bad_sweep_folders(tmp_path, rows, message):
+    folder = write_sweep(tmp_path / "s", rows)
+    with pytest.raises(ReportError, match=message):
+        read_landscape(folder)
+
+
+def report(*args):
+    return CliRunner().invoke(cli, ["report", *map(str, args)])
+
+
+def make_trial(folder: Path, track: str | None = None, run: dict | None = None) -> Path:
+    folder.mkdir(parents=True)
+    if track is not None:
+        (folder / "hop.tracks.csv").write_text(track)
+    if run is not None:
+        (folder / "run.json").write_text(json.dumps(run))
+    return folder
+
+
+PIXELS_ONLY = "frame,t_s,nose_px,nose_py,nose_x_m,nose_y_m,nose_ok\n" + "".join(
+    f"{i},{i / 30:.6f},{100 + i},{200},nan,nan,1\n" for i in range(40))
+
+
+@pytest.mark.parametrize("setup, message, hint", [
+    (lambda d: d / "missing", "no such file or folder", "check the --measured path"),
+    (lambda d: make_trial(d / "small", track=PIXELS_ONLY), "no nose position in metres", "--scale"),
+    (lambda d: make_trial(d / "small", run={"status": "complete"}), "not a run record", "locust hop"),
+    (lambda d: make_trial(d / "small", track="frame,t_s,nose_x_m,nose_y_m\n0,0.0,0.1,0.1\n1,0.03,abc,0.1\n"), "line 3", "fix or delete"),
+    (lambda d: make_trial(d / "2026"), "no track", "locust track"),
+])
+def test_bad_measured_inputs_are_clear_errors_and_write_nothing(tmp_path, setup, message, hint):
+    path = setup(tmp_path)
+    out = tmp_path / "out"
+    res = report("--measured", path, "--out", out)
+    assert res.exit_code == 2, res.output
+    assert "Traceback" not in res.output and res.exception is None or isinstance(res.exception, SystemExit)
+    assert "error:" in res.output and message in res.output
+    if hint:
+        assert "hint:" in res.output and hint in res.output
+    assert not out.exists()
+
+
+def test_runs_with_different_schedules_are_refused_before_simulating(tmp_path):
+    run = {"status": "complete", "schedule": {"cycles": 2, "push_deg": -30, "push_ms": 300, "wait_ms": 1000},
+           "phases": []}
+    a = make_trial(tmp_path / "small-1", run=run)
+    b = make_trial(tmp_path / "small-2", run={**run, "schedule": {**run["schedule"], "push_ms": 250}})
+    res = report("--measured", a, "--measured", b, "--out", tmp_path / "out")
+    assert res.exit_code == 2 and "different schedules" in res.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_missing_sweep_folder_fails_before_any_simulation(tmp_path):
+    run = {"status": "complete", "schedule": {"cycles": 2, "push_deg": -30, "push_ms": 300, "wait_ms": 1000},
+           "phases": []}
+    trial = make_trial(tmp_path / "small-1", run=run)
+    res = report("--measured", trial, "--sweep", tmp_path / "nowhere", "--out", tmp_path / "out")
+    assert res.exit_code == 2 and "no sweep.json" in res.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_measured_groups_by_name_and_folder(tmp_path):
+    run = {"status": "complete", "schedule": {"cycles": 2, "push_deg": -30, "push_ms": 300, "wait_ms": 1000},
+           "phases": [{"cycle": 1, "phase": "push", "commanded_ms": 0.0, "measured_ms": 0.2}]}
+    a = make_trial(tmp_path / "large-1", run=run)
+    b = make_trial(tmp_path / "x", run=run)
+    groups = parse_measured([str(a), f"Medium={b}"])
+    assert list(groups) == ["medium", "large"]            # leg-set order, not argument order
+    assert groups["large"][0].label == "large-1" and groups["large"][0].track is None
+    with pytest.raises(ReportError, match="given twice"):
+        parse_measured([str(a), f"large={a}"])
+
+
+def test_demo_virtual_robot_carries_the_recordings_truth():
+    """The demo's virtual robot is built from the bundled recordings' '# truth:' headers,
+    which replay the seed's identified values (calibration/make_synthetic.py)."""
+    from locust.params import preset
+    from locust.report.demo_cli import CALIBRATIONS, RECORDINGS, recording_truth
+
+    truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])
+    assert truth == pytest.approx({
+        "compliance.hinge_stiffness_nm_per_rad": 0.056375, "compliance.hinge_damping_nms_per_rad": 0.00056375,
+        "servo.torque_limit_nm": 0.15, "contact.foot_friction": 1.7}, rel=1e-6)
+    seed = preset("seed")
+    for key, value in truth.items():
+        assert seed.get(key) == pytest.approx(value, rel=1e-6), key
