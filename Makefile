@@ -32,6 +32,7 @@ test-all: install sysdeps
 bench: install
 	$(PY) bench/sim_speed.py
 	$(PY) bench/track_speed.py
+	$(PY) bench/sweep_speed.py --skip-grid
 
 clean:
 	rm -rf $(VENV) demo-out .pytest_cache
