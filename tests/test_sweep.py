@@ -217,3 +217,21 @@ def test_seed_scale_sweep_local_and_dask_local_agree(tmp_path):
     valid = [r for r in outs[0] if r["valid"] == "True"]
     assert valid
     assert max(float(r["max_nose_height_m"]) for r in valid) < 0.30
+
+
+def test_a_second_sweep_into_a_running_sweeps_folder_is_refused(tmp_path):
+    import fcntl
+
+    from locust.sim.sweep_store import LOCK
+
+    base = preset("seed")
+    axis = parse_axis("geometry.coupler_m=0.205:0.21:2", base)
+    out = tmp_path / "s"
+    run_sweep(base, [axis], cycles=1, out=out, jobs=1, plots=False)
+    with open(out / LOCK, "w") as held:          # as a running sweep holds it
+        fcntl.flock(held, fcntl.LOCK_EX)
+        with pytest.raises(SweepError, match="another sweep is running"):
+            run_sweep(base, [axis], cycles=1, out=out, jobs=1, plots=False)
+    # released: the same sweep reopens (everything already done, nothing recomputed)
+    again = run_sweep(base, [axis], cycles=1, out=out, jobs=1, plots=False)
+    assert (again.resumed, again.computed) == (2, 0)

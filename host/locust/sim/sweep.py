@@ -97,10 +97,9 @@ def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: 
         finished = True
     finally:
         wall = time.perf_counter() - t0
-        store.close(finished)
         rows = [store.done[i] for i in sorted(store.done)]
         best = best_row(rows)
-        store.write_meta(done=len(rows), finished=finished, best=best, last_run={
+        store.close(finished, done=len(rows), finished=finished, best=best, last_run={
             "computed": len(rows) - resumed, "wall_s": wall, "scheduler": scheduler, "jobs": jobs})
     made: list[Path] = []
     if plots and rows:

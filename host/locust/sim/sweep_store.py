@@ -10,6 +10,7 @@ the same whatever ran it. Floats are written with ``repr``: they read back bit f
 from __future__ import annotations
 
 import csv
+import fcntl
 import io
 import json
 import math
@@ -24,6 +25,7 @@ from .sweep_design import RESULT_FIELDS
 
 RESULTS = "results.csv"
 META = "sweep.json"
+LOCK = ".sweep.lock"
 _FLOATS = {"distance_m", "max_nose_height_m", "nose_apex_max_m", "com_apex_max_m", "transmission_deg"}
 
 
@@ -65,6 +67,7 @@ class SweepStore:
     axis_names: list[str]
     done: dict[int, dict[str, Any]] = field(default_factory=dict)
     _fh: io.TextIOBase | None = None
+    _lock_fd: int | None = None
 
     @property
     def results_path(self) -> Path:
@@ -89,9 +92,21 @@ class SweepStore:
             raise SweepError(f"{folder} exists and is not a sweep folder; refusing to write into it",
                              "choose a new or empty --out folder")
         folder.mkdir(parents=True, exist_ok=True)
-        store._rewrite(sorted(store.done))
+        store._lock()
         atomic_write_json(meta_path, meta)
+        store._rewrite(sorted(store.done))
         return store
+
+    def _lock(self) -> None:
+        """One sweep at a time per folder: a second one would compute and append the same rows."""
+        fd = os.open(self.folder / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            raise SweepError(f"another sweep is running in {self.folder}",
+                             "wait for it to finish (or stop it), or use another --out folder") from None
+        self._lock_fd = fd
 
     def _read_rows(self) -> dict[int, dict[str, Any]]:
         """Rows already finished; a line cut short by an interrupt is dropped."""
@@ -131,12 +146,17 @@ class SweepStore:
         self._fh.flush()
         os.fsync(self._fh.fileno())
 
-    def close(self, finished: bool) -> None:
+    def close(self, complete: bool, **meta: Any) -> None:
+        """Stop appending; when finished, rewrite the rows in design order; record ``meta``."""
         if self._fh is not None:
             self._fh.close()
             self._fh = None
-        if finished:
+        if complete:
             self._rewrite(sorted(self.done))
+        self.write_meta(**meta)
+        if self._lock_fd is not None:
+            os.close(self._lock_fd)   # releases the lock
+            self._lock_fd = None
 
     def write_meta(self, **extra: Any) -> None:
         self.meta.update(extra)
