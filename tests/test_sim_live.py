@@ -18,7 +18,7 @@ from locust.cli import cli  # noqa: E402
 
 from locust.errors import SimError  # noqa: E402
 from locust.params import preset  # noqa: E402
-from locust.sim.live import LiveSim  # noqa: E402
+from locust.sim.live import PREROLL_S, LiveSim  # noqa: E402
 from locust.sim.run import run  # noqa: E402
 
 
@@ -68,7 +68,7 @@ def test_live_video_frames_and_truth(seed, tmp_path):
     sim = LiveSim(seed, video_path=str(path), fps=30, width=160, height=120, camera="track")
     drive_schedule(sim, seed, cycles=1)
     out = sim.close()
-    frames = round(1.3 * 30)
+    frames = round((PREROLL_S + 1.3) * 30)   # the clip opens on the robot standing
     assert out["frames"] == frames and out["video_path"] == str(path)
     truth = pd.read_csv(tmp_path / "live.truth.csv", comment="#")
     assert len(truth) == frames
@@ -85,7 +85,7 @@ def test_live_fixed_video_tracks_into_metres(tmp_path):
     sim = LiveSim(robot, video_path=str(path))          # 640x360, fixed camera
     drive_schedule(sim, robot, cycles=2)
     out = sim.close()
-    assert out["valid"] and out["frames"] == round(2.6 * 30)
+    assert out["valid"] and out["frames"] == round((PREROLL_S + 2.6) * 30)
     truth = pd.read_csv(tmp_path / "live.truth.csv", comment="#")
     camera = json.loads((tmp_path / "live.camera.json").read_text())
     assert camera["camera"] == "fixed" and (camera["width_px"], camera["height_px"]) == (640, 360)
@@ -137,3 +137,19 @@ def test_a_blown_up_live_run_is_reported_invalid(seed):
     assert math.isnan(live["distance_m"])
     assert any("loop closure broken" in r for r in live["reasons"])
     assert any("loop closure broken" in r for r in ref.reasons)
+
+
+def test_live_video_opens_on_the_robot_standing(tmp_path):
+    """The first PREROLL_S of the clip come before time 0: the robot stands still in them."""
+    robot = preset("seed")
+    path = tmp_path / "live.mp4"
+    sim = LiveSim(robot, video_path=str(path), width=320, height=240, cycles=1)
+    drive_schedule(sim, robot, cycles=1)
+    sim.close()
+    truth = pd.read_csv(tmp_path / "live.truth.csv", comment="#")
+    still = truth[truth.t_s < PREROLL_S - 1e-9]
+    assert len(still) == round(PREROLL_S * 30)
+    for name in ("nose", "foot"):   # settled: under 0.1 mm of motion while standing
+        assert float(np.ptp(still[f"{name}_x_m"])) < 1e-4 and float(np.ptp(still[f"{name}_z_m"])) < 1e-4
+    moved = np.hypot(truth.nose_x_m - truth.nose_x_m.iloc[0], truth.nose_z_m - truth.nose_z_m.iloc[0])
+    assert truth.t_s[moved > 1e-3].iloc[0] >= PREROLL_S   # the first push comes after it

@@ -42,6 +42,7 @@ SIDES = ("left", "right")
 # commands arrive a few ms off that plan, so its hops land a little apart from the
 # rollout's: the frame holds this much more of the run's length on each side.
 LIVE_SLACK_OF_RUN = 0.15
+PREROLL_S = 0.5   # a video opens on the robot standing still this long before time 0
 
 
 @dataclass(frozen=True)
@@ -105,9 +106,13 @@ class LiveSim:
         # framed before the settle phase: the rollout must not see this model's own state
         fixed_view = self._planned_view(cycles, width / height) if path is not None and camera == "fixed" else None
         self._run_to(int(round(robot.solver.settle_s / self.dt)))
-        self._settle_steps = self._steps
+        self._video_start = self._steps
         if path is not None:
+            # a clip starts with the robot standing, as a real one would: filmed, at rest,
+            # before the first command can arrive (the report finds the first push by it)
             self._recorder = self._open_video(path, fps, width, height, fixed_view)
+            self._run_to(self._steps + int(round(PREROLL_S / self.dt)))
+        self._settle_steps = self._steps
 
     # -- commands -------------------------------------------------------------------
     def set_servo_angles_deg(self, left_deg: float, right_deg: float) -> None:
@@ -168,7 +173,7 @@ class LiveSim:
 
     # -- video ----------------------------------------------------------------------
     def _frame_step(self, k: int) -> int:
-        return self._settle_steps + int(round(k / (self._fps * self.dt)))
+        return self._video_start + int(round(k / (self._fps * self.dt)))
 
     def _planned_view(self, cycles: int | None, aspect: float):
         """The fixed view that holds the planned run: a batch rollout of the schedule, padded.
