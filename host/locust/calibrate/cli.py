@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import json
-import sys
-from contextlib import contextmanager
 from pathlib import Path
 
 import click
 import numpy as np
 
 from ..errors import CalibrationError
+from ..progress import progress
 from . import beam as B
 from . import ramp as R
 from . import servo as S
@@ -102,8 +101,8 @@ def servo(data, inertia_kgm2, gravity_moment_nm, pivot, step, marker, write_path
     """
     t, angle, command = _servo_series(data, pivot, step, marker)
     rig = S.ServoRig(inertia_kgm2=inertia_kgm2, gravity_moment_nm=gravity_moment_nm)
-    with _progress(60, "fitting servo") as tick:
-        fit = S.fit_servo(t, angle, command, rig, source=str(data), progress=tick)
+    with progress(length=60, label="fitting servo") as bar:
+        fit = S.fit_servo(t, angle, command, rig, source=str(data), progress=bar.update)
     keys = {"kp_nm_per_rad": "servo.kp_nm_per_rad", "kv_nms_per_rad": "servo.kv_nms_per_rad",
             "torque_limit_nm": "servo.torque_limit_nm"}
     values = {keys[n]: getattr(fit, n) for n in S.PARAMS if fit.identifiable[n]}
@@ -174,16 +173,6 @@ def _floats(text: str, n: int, option: str, hint: str) -> list[float]:
     if len(vals) != n:
         raise CalibrationError(f"{option} {text!r}: expected {n} numbers", hint)
     return vals
-
-
-@contextmanager
-def _progress(length: int, label: str):
-    """A progress bar on stderr when it is a terminal; silent otherwise."""
-    if not sys.stderr.isatty():
-        yield lambda n=1: None
-        return
-    with click.progressbar(length=length, label=label, file=sys.stderr) as bar:
-        yield bar.update
 
 
 def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_path: Path | None,

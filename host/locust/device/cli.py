@@ -12,6 +12,7 @@ import click
 from ..errors import DeviceError
 from ..params import resolve_robot
 from ..params_cli import robot_options
+from ..progress import progress
 from . import record as R
 from .plant import PLANTS
 
@@ -142,8 +143,7 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
                               "locust hop options")
     with open_port(port, plant=plant, video=video, robot=robot, info=_info) as device:
         with Link(device) as link:
-            show = sys.stderr.isatty()
-            with click.progressbar(length=schedule.phases, label="hop", file=sys.stderr if show else _Null()) as bar:
+            with progress(length=schedule.phases, label="hop") as bar:
                 rec = run_hop(link, schedule, directory,
                               on_phase=lambda p: (bar.update(1), setattr(bar, "label", f"cycle {p.cycle} {p.phase}")))
     path = directory / R.RECORD_NAME
@@ -159,17 +159,6 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
 
 def _interrupt(signum, frame):
     raise KeyboardInterrupt
-
-
-class _Null:
-    def write(self, s):
-        pass
-
-    def flush(self):
-        pass
-
-    def isatty(self):
-        return False
 
 
 @click.command()

@@ -29,6 +29,7 @@ import click
 
 from ..errors import ReportError
 from ..fileio import atomic_write_json, atomic_write_text, unique_dir
+from ..progress import progress
 
 LEG_SETS = ("small", "medium", "large")
 RECORDINGS = Path(__file__).resolve().parents[3] / "calibration" / "recordings"
@@ -116,7 +117,7 @@ class Demo:
         self.say(f"      {wall:.1f} s")
 
     def bar(self, items, label: str):
-        return click.progressbar(items, label=label, file=self.stderr, show_pos=True)
+        return progress(items, label=label, show_pos=True)
 
     def say(self, msg: str) -> None:
         click.echo(msg, file=self.stderr)

@@ -11,10 +11,7 @@ import click
 from ..errors import SweepError
 from ..params import resolve_robot
 from ..params_cli import robot_options
-
-
-def _bar(length: int, label: str):
-    return click.progressbar(length=length, label=label, file=sys.stderr, show_pos=True, show_eta=True)
+from ..progress import progress
 
 
 def _describe(row: dict, names: list[str]) -> str:
@@ -61,7 +58,7 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json):
         raise SweepError(f"--vary names a parameter twice: {', '.join(names)}", "give each parameter one --vary")
     check_scheduler(scheduler)
     total = len(grid(axes))
-    with _bar(total, f"sweep ({scheduler})") as bar:
+    with progress(length=total, label=f"sweep ({scheduler})", show_pos=True, show_eta=True) as bar:
         try:
             summary = run_sweep(base, axes, cycles, out, scheduler=scheduler, jobs=jobs, progress=bar.update)
         except KeyboardInterrupt:
@@ -127,12 +124,12 @@ def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_n
     bounds = [parse_bound(v, base) for v in varies]
     if len({b.name for b in bounds}) != len(bounds):
         raise SweepError("--vary names a parameter twice", "give each parameter one --vary")
-    with _bar(trials, "optimize") as bar:
+    with progress(length=trials, label="optimize", show_pos=True, show_eta=True) as bar:
         try:
             summary = run_optimize(base, bounds, trials, cycles, out, storage=storage, study_name=study_name,
                                    seed=seed, jobs=jobs, progress=bar.update)
         except KeyboardInterrupt:
-            click.echo(f"\ninterrupted: finished trials are kept in the study; rerun to continue", err=True)
+            click.echo("\ninterrupted: finished trials are kept in the study; rerun to continue", err=True)
             sys.exit(130)
     click.echo(f"study {summary.study_name!r}: {summary.trials} trials, {summary.complete} valid, "
                f"{summary.pruned} pruned as invalid")

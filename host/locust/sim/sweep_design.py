@@ -66,7 +66,7 @@ def check_name(name: str, base: Robot) -> None:
 def _numbers(text: str, parts: int, what: str, item: str) -> list[float]:
     fields = text.split(":")
     if len(fields) != parts:
-        raise SweepError(f"--vary {item!r} is not {what}", f"e.g. --vary scale=0:0.05:30" if parts == 3
+        raise SweepError(f"--vary {item!r} is not {what}", "e.g. --vary scale=0:0.05:30" if parts == 3
                          else "e.g. --vary geometry.leg_m=0.05:0.09")
     try:
         out = [float(f) for f in fields]

@@ -29,13 +29,9 @@ import os
 os.environ.setdefault("MUJOCO_GL", "osmesa")
 
 import math  # noqa: E402
-import sys  # noqa: E402
-import tempfile  # noqa: E402
-from contextlib import nullcontext  # noqa: E402
 from dataclasses import dataclass, field  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import click  # noqa: E402
 import cv2  # noqa: E402
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
@@ -44,6 +40,7 @@ from ..errors import SimError  # noqa: E402
 from ..fileio import atomic_write_json, atomic_write_text, temp_beside  # noqa: E402
 from ..markers import MARKER_COLOURS  # noqa: E402
 from ..params import Robot  # noqa: E402
+from ..progress import progress  # noqa: E402
 from .audit import audit  # noqa: E402
 from .model import build  # noqa: E402
 from .rollout import simulate  # noqa: E402
@@ -410,10 +407,6 @@ def frame_times_s(duration_s: float, fps: int) -> np.ndarray:
     return np.arange(int(round(duration_s * fps))) / fps
 
 
-def _progress(length: int, label: str):
-    if not sys.stderr.isatty():
-        return nullcontext(None)
-    return click.progressbar(length=length, label=label, file=sys.stderr)
 
 
 def validate_size(fps: int, width: int, height: int) -> None:
@@ -457,11 +450,10 @@ def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = Non
     rec = ClipRecorder(model, path, fps, width, height, camera, fixed if camera == "fixed" else track,
                        robot_name=robot.name)
     try:
-        with _progress(len(times), "rendering") as bar:
+        with progress(length=len(times), label="rendering") as bar:
             for t, row in zip(times, rows):
                 rec.add_frame(qpos0 if row < 0 else traj.states[row, 1:1 + nq], float(t))
-                if bar is not None:
-                    bar.update(1)
+                bar.update(1)
     except BaseException:
         rec.abort()
         raise

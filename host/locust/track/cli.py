@@ -3,26 +3,18 @@
 from __future__ import annotations
 
 import math
-import sys
-from contextlib import nullcontext
 from pathlib import Path
 
 import click
 
 from ..errors import TrackError
 from ..fileio import atomic_write_json
+from ..progress import progress
 from . import calib, camera, export, overlay, trk
 from .aruco import DEFAULT_DICTIONARY, side_px_in_video
 from .runner import track_video
 from .spec import ModelOptions, parse_markers
 from .video import Clip, probe
-
-
-def _progress(length: int, label: str):
-    """A progress bar on stderr, only on a terminal."""
-    if not sys.stderr.isatty():
-        return nullcontext(None)
-    return click.progressbar(length=length, label=label, file=sys.stderr)
 
 
 def _outputs(base: Path, fmt: str, overlay_kind: str) -> dict[str, Path]:
@@ -128,15 +120,15 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
     _refuse_overwrite(paths, force)
 
     n = len(clip.frames())
-    with _progress(n, f"tracking {video.name}") as bar:
-        result = track_video(info, clip, models, calibration, progress=bar.update if bar else None)
+    with progress(length=n, label=f"tracking {video.name}") as bar:
+        result = track_video(info, clip, models, calibration, progress=bar.update)
     written = _write(result, paths, fmt)
     if "overlay" in paths:
         if overlay_kind == "png":
             written.append(overlay.write_png(result, paths["overlay"]))
         else:
-            with _progress(n, "overlay video") as bar:
-                written.append(overlay.write_video(result, paths["overlay"], bar.update if bar else None))
+            with progress(length=n, label="overlay video") as bar:
+                written.append(overlay.write_video(result, paths["overlay"], bar.update))
     _report(result, written)
 
 
