@@ -64,11 +64,18 @@ class Compliance:
 
 @dataclass(frozen=True)
 class Servo:
-    """Hobby servo: a position servo, force = clip(kp*(cmd-q) - kv*qdot, +-limit)."""
+    """Hobby servo (docs/servo.md): torque = clip(kp*(cmd-q) - kv*qdot, +-stall) - (stall/noload)*qdot,
+    with the gearbox's reflected rotor inertia (armature) on the servo joint.
 
-    kp_nm_per_rad: float = 20.0
-    kv_nms_per_rad: float = 0.0069
-    torque_limit_nm: float = 0.15
+    Defaults: an SG90 identified from a real step response (the course's AA-battery recording,
+    fitted by ``locust calibrate servo``) with the datasheet's stall torque; see SG90_SOURCE.
+    """
+
+    kp_nm_per_rad: float = 0.46            # proportional gain inside the torque clamp
+    stall_torque_nm: float = 0.15          # datasheet: 1.5-1.8 kg*cm
+    noload_speed_rad_per_s: float = 10.1   # inf: no speed limit (the notebook's model)
+    armature_kgm2: float = 1.2e-4          # rotor inertia x gear ratio^2, at the output shaft
+    kv_nms_per_rad: float = 0.0            # velocity feedback inside the clamp (notebook: 0.0069)
     travel_deg: float = 45.0         # mechanical travel either side of rest
     pulse_min_us: float = 500.0      # pulse at -range_deg/2
     pulse_max_us: float = 2500.0     # pulse at +range_deg/2
@@ -179,6 +186,10 @@ class Robot:
         return {key: self.get(key) for key in all_keys()}
 
 
+# keys for which +inf is a meaningful value ("no limit")
+UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s"})
+
+
 def all_keys() -> list[str]:
     return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls)]
 
@@ -208,6 +219,8 @@ def _coerce(key: str, raw: Any) -> Any:
             raise ValueError("not true/false")
         if ftype in ("float", float):
             value = float(raw)
+            if key in UNBOUNDED_KEYS and value == math.inf:
+                return value
             if not math.isfinite(value):
                 raise ValueError("not finite")
             return value
@@ -235,6 +248,22 @@ def parse_set_options(items: tuple[str, ...] | list[str]) -> dict[str, str]:
 
 # -- presets ------------------------------------------------------------------------
 _SEED_SOURCE = Provenance(source="seed", note="notebook Part 2")
+# The SG90 as identified by `locust calibrate servo sg90_aa_battery_step.csv --inertia-kgm2 3.3e-6
+# --stall-torque-nm 0.15` (a real SG90 swinging an AA battery, filmed at 30 frames/s; the
+# course's servo experiment). Uncertainties: the fit's 1 sigma (docs/servo.md has the figures).
+_SG90_FIT = "fit:sg90_aa_battery_step.csv"
+_SG90_DATE = "2026-11-23"
+SG90_SOURCE = {
+    "servo.stall_torque_nm": Provenance(source="datasheet:SG90", uncertainty=0.015,
+                                        note="1.5-1.8 kg*cm at 4.8-6 V; the fit's split of the ratios"),
+    "servo.noload_speed_rad_per_s": Provenance(source=_SG90_FIT, uncertainty=0.1, date=_SG90_DATE,
+                                               note="datasheet: 0.1 s/60 deg = 10.5 rad/s at 4.8 V"),
+    "servo.armature_kgm2": Provenance(source=_SG90_FIT, uncertainty=3e-5, date=_SG90_DATE,
+                                      note="reflected rotor inertia, with stall torque 0.15 N*m"),
+    "servo.kp_nm_per_rad": Provenance(source=_SG90_FIT, uncertainty=0.05, date=_SG90_DATE,
+                                      note="with stall torque 0.15 N*m"),
+    "servo.kv_nms_per_rad": Provenance(source="model", note="a hobby servo has no velocity feedback"),
+}
 
 
 def _seed() -> Robot:
@@ -245,12 +274,13 @@ def _seed() -> Robot:
         "geometry.leg_mount_y_m", "geometry.link_width_m", "geometry.link_thickness_m",
         "geometry.nose_x_m", "geometry.body_pitch_deg", "geometry.drop_height_m",
         "compliance.hinge_stiffness_nm_per_rad", "compliance.hinge_damping_nms_per_rad",
-        "servo.kp_nm_per_rad", "servo.kv_nms_per_rad", "servo.torque_limit_nm",
-        "servo.travel_deg", "contact.foot_friction", "contact.floor_friction",
+        "servo.stall_torque_nm", "servo.travel_deg", "contact.foot_friction", "contact.floor_friction",
         "contact.torsional_friction", "contact.rolling_friction", "schedule.push_deg",
         "schedule.push_s", "schedule.wait_s", "schedule.cycles",
     ]
-    return Robot(name="seed", provenance={k: _SEED_SOURCE for k in measured})
+    provenance = {k: _SEED_SOURCE for k in measured}
+    provenance.update(SG90_SOURCE)
+    return Robot(name="seed", provenance=provenance)
 
 
 def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
@@ -283,7 +313,9 @@ def leg_set(base: Robot, name: str) -> Robot:
 def _seed_notebook() -> Robot:
     prov = Provenance(source="seed", note="notebook Part 2 simulation loop, reproduced exactly")
     return _seed().with_values(
-        {
+        {   # the notebook's servo: a stiff position actuator, no speed limit, no rotor inertia
+            "servo.kp_nm_per_rad": 20.0, "servo.kv_nms_per_rad": 0.0069, "servo.stall_torque_nm": 0.15,
+            "servo.noload_speed_rad_per_s": math.inf, "servo.armature_kgm2": 0.0,
             "solver.timestep_s": 1e-4, "solver.integrator": "euler", "solver.iterations": 50,
             "solver.tolerance": 1e-8, "solver.control_hz": 60.0, "solver.settle_s": 0.0,
             "contact.self_collision": True, "solver.loop_timeconst_s": 0.02, "solver.loop_dmax": 0.95,
@@ -356,7 +388,7 @@ def _toml_value(value: Any) -> str:
     if isinstance(value, int):
         return str(value)
     if isinstance(value, float):
-        return repr(value)
+        return repr(value)  # 'inf' and 'nan' are TOML too
     return '"' + str(value).replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 

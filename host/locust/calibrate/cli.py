@@ -38,7 +38,7 @@ def calibrate() -> None:
 
     \b
     beam   cardstock cantilever, dropped tip mass  -> hinge stiffness, damping
-    servo  servo step carrying a battery           -> kp, kv, torque limit
+    servo  servo steps carrying a battery         -> no-load speed, armature, kp
     ramp   ramp tilted until the robot slides      -> static friction mu
 
     Each prints the fitted values with 95% confidence intervals, draws a fit plot, and with
@@ -81,34 +81,61 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, write_
 
 
 @calibrate.command()
-@click.argument("data", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--inertia-kgm2", type=float, required=True, help="Load inertia about the servo axis [kg*m^2].")
-@click.option("--gravity-moment-nm", type=float, default=0.0, show_default=True,
-              help="Moment of the load's weight with the horn horizontal (angle 0) [N*m]; 0 for a horizontal rig.")
+@click.argument("data", nargs=-1, required=True, type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--inertia-kgm2", type=float, multiple=True, required=True,
+              help="Load inertia about the servo axis [kg*m^2]; once, or once per DATA in the same order.")
+@click.option("--stall-torque-nm", type=float, default=None,
+              help="Stall torque [N*m] from a stall test or the datasheet (SG90: about 0.15). It splits the "
+                   "ratios one load gives; leave it out when DATA holds two loads or a load held against gravity.")
+@click.option("--gravity-moment-nm", type=float, multiple=True,
+              help="Moment of the load's weight with the horn horizontal (angle 0) [N*m]; once, or once per DATA "
+                   "[default: 0, a horizontal rig].")
 @click.option("--pivot", default=None, metavar="X,Y",
               help="Servo axis in the track's coordinates [m]: DATA is then a track of the horn tip.")
 @click.option("--step", "step", default=None, metavar="FROM,TO,AT_S",
               help="With --pivot: the commanded step, degrees from the horizontal, and when it was sent [s].")
 @click.option("--marker", default=None, help="With --pivot: marker of the horn tip [default: the only one].")
 @output_options
-def servo(data, inertia_kgm2, gravity_moment_nm, pivot, step, marker, write_path, as_json, plot_path, no_plot):
-    """Identify kp, kv and torque limit of the position servo from a step response.
+def servo(data, inertia_kgm2, stall_torque_nm, gravity_moment_nm, pivot, step, marker, write_path, as_json,
+          plot_path, no_plot):
+    """Identify the hobby servo (no-load speed, armature, kp) from step responses.
 
-    DATA is a CSV with t_s, angle_deg, command_deg (degrees from the horizontal), or with
-    --pivot and --step a track of the horn tip. The rig is simulated in MuJoCo with the
-    same position actuator as the robot model; parameters the recording cannot determine
-    are reported as not identifiable and never written.
+    DATA is a CSV with t_s, angle_deg, command_deg (degrees from the horizontal; several
+    steps, as a square-wave command gives, are fitted together), or with --pivot and --step
+    a track of the horn tip. The rig is simulated in MuJoCo with the robot model's servo
+    (docs/servo.md); the firmware-to-camera timing (a delay and, with three or more command
+    edges, the clock ratio) is fitted beside it and reported. Parameters the recordings
+    cannot determine are reported as not identifiable and never written.
+
+    \b
+    Example (a real SG90 swinging an AA battery):
+      locust calibrate servo sg90_aa_battery_step.csv --inertia-kgm2 3.3e-6 --stall-torque-nm 0.15
     """
-    t, angle, command = _servo_series(data, pivot, step, marker)
-    rig = S.ServoRig(inertia_kgm2=inertia_kgm2, gravity_moment_nm=gravity_moment_nm)
-    with progress(length=60, label="fitting servo") as bar:
-        fit = S.fit_servo(t, angle, command, rig, source=str(data), progress=bar.update)
-    keys = {"kp_nm_per_rad": "servo.kp_nm_per_rad", "kv_nms_per_rad": "servo.kv_nms_per_rad",
-            "torque_limit_nm": "servo.torque_limit_nm"}
-    values = {keys[n]: getattr(fit, n) for n in S.PARAMS if fit.identifiable[n]}
-    note = f"servo step, J={inertia_kgm2} kg*m^2, M={gravity_moment_nm} N*m"
-    _finish(fit, data, values, note, write_path, as_json, plot_path, no_plot,
-            subtitle=f"RMS residual {fit.rms_residual_deg:.3g} deg")
+    inertias = _per_recording(inertia_kgm2, len(data), "--inertia-kgm2")
+    moments = _per_recording(gravity_moment_nm or (0.0,), len(data), "--gravity-moment-nm")
+    if pivot is not None and len(data) > 1:
+        raise CalibrationError("--pivot takes one horn track", "fit tracks one at a time, or give angle CSVs")
+    recordings = []
+    for path, inertia, moment in zip(data, inertias, moments):
+        t, angle, command = _servo_series(path, pivot, step, marker)
+        recordings.append(S.StepRecording(t, angle, command, S.ServoRig(inertia, moment), source=str(path)))
+    with progress(length=3 * 60, label="fitting servo") as bar:
+        fit = S.fit_servo(recordings, stall_torque_nm, progress=bar.update)
+    values = {f"servo.{n}": fit.estimates[n] for n in S.PARAMS
+              if fit.identifiable[n] and not (n == "stall_torque_nm" and fit.stall_torque_given)}
+    note = (f"servo steps, J={','.join(map(str, inertias))} kg*m^2, M={','.join(map(str, moments))} N*m"
+            + (f", stall torque {stall_torque_nm} N*m given" if stall_torque_nm else ""))
+    _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot,
+            subtitle=f"RMS residual {fit.rms_residual_deg:.3g} deg", source_name=Path(fit.source).name)
+
+
+def _per_recording(values: tuple[float, ...], n: int, option: str) -> list[float]:
+    if len(values) == 1:
+        return list(values) * n
+    if len(values) != n:
+        raise CalibrationError(f"{option} given {len(values)} times for {n} recordings",
+                               f"give {option} once (for every recording) or once per recording, in order")
+    return list(values)
 
 
 @calibrate.command()
@@ -200,11 +227,15 @@ def _print_text(out: dict) -> None:
             continue
         if isinstance(val, dict) and "value" in val:
             flag = "" if val.get("identifiable", True) else "   NOT IDENTIFIABLE"
-            if val["std"] is None:
+            if val.get("given"):
+                click.echo(f"{key:30s} {val['value']:<12.6g} (given)")
+            elif val["std"] is None:
                 click.echo(f"{key:30s} {val['value']:<12.6g} (undetermined){flag}")
             else:
                 lo, hi = val["ci95"]
                 click.echo(f"{key:30s} {val['value']:<12.6g} ± {val['std']:.3g} (1σ)  95% CI [{lo:.6g}, {hi:.6g}]{flag}")
+        elif isinstance(val, list) and all(isinstance(v, float) for v in val):
+            click.echo(f"{key:30s} {', '.join(format(v, '.6g') for v in val)}")
         elif val is not None:
             click.echo(f"{key:30s} {val if not isinstance(val, float) else format(val, '.6g')}")
     for note in out.get("notes", []):

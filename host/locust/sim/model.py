@@ -23,6 +23,7 @@ from ..errors import SimError
 from ..markers import MARKER_COLOURS, hex_to_rgb01
 from ..params import Robot
 from .fourbar import Assembly, assemble
+from .servo import configure as configure_servo
 
 SIDES = ("L", "R")  # left leg at +y (faces the default camera), right leg at -y
 LINK_RGBA = {  # the notebook's colours
@@ -143,10 +144,11 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
         # chain is the mirror image of the planar solution, closed at the same anchor.
         crank = ground.add_body(name=f"{side}_crank", pos=[-g.ground_m / 2, 0, 0],
                                 quat=_quat_euler_deg(0, asm.crank_deg, 0))
-        crank.add_joint(name=f"{side}_servo", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
-                        range=[-math.radians(s.travel_deg), math.radians(s.travel_deg)],
-                        limited=mujoco.mjtLimited.mjLIMITED_TRUE,
-                        stiffness=c.hinge_stiffness_nm_per_rad, damping=c.hinge_damping_nms_per_rad)
+        # the crank turns on the servo shaft, in parallel with the laminate's folded hinge
+        servo_joint = crank.add_joint(name=f"{side}_servo", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
+                                      range=[-math.radians(s.travel_deg), math.radians(s.travel_deg)],
+                                      limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+                                      stiffness=c.hinge_stiffness_nm_per_rad)
         _link_box(crank, g.crank_m, half_w, half_t, LINK_RGBA["crank"], foot_material, rho, selfc)
         coupler = crank.add_body(name=f"{side}_coupler", pos=[g.crank_m, 0, 0],
                                  quat=_quat_euler_deg(0, asm.coupler_rel_deg, 0))
@@ -170,12 +172,9 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
                           solimp=[min(0.9, sol.loop_dmax), sol.loop_dmax, 0.001, 0.5, 2.0])
         act = spec.add_actuator(name=f"{side}_servo", target=f"{side}_servo",
                                 trntype=mujoco.mjtTrn.mjTRN_JOINT)
-        act.set_to_position(kp=s.kp_nm_per_rad, kv=s.kv_nms_per_rad)
+        configure_servo(servo_joint, act, s, joint_damping_nms_per_rad=c.hinge_damping_nms_per_rad)
         act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
         act.ctrlrange = [-math.radians(s.travel_deg), math.radians(s.travel_deg)]
-        # The torque limit is always applied: a hobby servo stalls at its rated torque.
-        act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
-        act.forcerange = [-s.torque_limit_nm, s.torque_limit_nm]
 
     _add_sensors(spec)
     return spec, asm

@@ -7,6 +7,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from ..errors import GeometryError
 from ..params import Robot
 from .audit import audit
@@ -30,6 +32,8 @@ class SimResult:
     loop_residual_max_m: float
     energy_surplus_max_j: float
     servo_work_j: float
+    servo_peak_speed_rad_per_s: float = float("nan")     # fastest crank speed during the schedule
+    servo_noload_speed_rad_per_s: float = float("nan")   # the servo's top speed (inf: none)
     grashof: str = ""
     transmission_deg: float = float("nan")
     notes: list[str] = field(default_factory=list)
@@ -70,9 +74,17 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
         cycles=len(traj.plan.cycle_start_steps) - 1, timestep_s=traj.timestep_s,
         duration_s=traj.plan.duration_s, wall_s=traj.wall_s,
         loop_residual_max_m=verdict.loop_residual_max_m, energy_surplus_max_j=verdict.energy_surplus_max_j,
-        servo_work_j=verdict.servo_work_j, grashof=asm.grashof, transmission_deg=asm.transmission_deg,
+        servo_work_j=verdict.servo_work_j, servo_peak_speed_rad_per_s=peak_servo_speed(traj),
+        servo_noload_speed_rad_per_s=robot.servo.noload_speed_rad_per_s, grashof=asm.grashof, transmission_deg=asm.transmission_deg,
         notes=notes,
     )
+
+
+def peak_servo_speed(traj) -> float:
+    """Largest |crank speed| of either servo once the schedule has started."""
+    vel = traj.sensordata[traj.plan.settle_steps:, traj.built.sensors.actuator_velocity]
+    finite = vel[np.isfinite(vel)]
+    return float(np.abs(finite).max()) if finite.size else float("nan")
 
 
 def check_convergence(robot: Robot, result: SimResult, cycles: int | None = None) -> dict[str, float]:

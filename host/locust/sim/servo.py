@@ -1,0 +1,63 @@
+"""The hobby servo as MuJoCo elements: one definition for the robot model and the test rig.
+
+An SG90-class servo is a DC motor behind a gearbox, driven by a proportional controller
+whose drive saturates. At the output shaft (see docs/servo.md)::
+
+    torque = clip(kp * (command - angle) - kv * velocity, -stall, +stall) - b * velocity
+    b      = stall / noload_speed          (back-EMF and gear friction, outside the clamp)
+    (J_load + armature) * acceleration = torque + load torques
+
+so the horn cannot turn faster than the no-load speed however large the error, and the
+rotor's inertia, reflected through the gearbox (gear ratio squared), slows every start.
+
+MuJoCo does each part itself: a ``position`` actuator with a force range is the clamped
+controller; the joint's ``damping`` is ``b`` and its ``armature`` the reflected rotor
+inertia, both integrated implicitly by the ``implicitfast`` and ``implicit`` integrators.
+``kv`` (velocity feedback inside the clamp) is 0 for a hobby servo; the notebook's model,
+which had neither ``b`` nor armature, used it.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import mujoco
+
+from ..params import Servo
+
+
+def back_emf_damping_nms_per_rad(servo: Servo) -> float:
+    """``b = stall / no-load speed``; 0 for a servo with no speed limit (``inf``)."""
+    if math.isinf(servo.noload_speed_rad_per_s):
+        return 0.0
+    return servo.stall_torque_nm / servo.noload_speed_rad_per_s
+
+
+def configure(joint: mujoco.MjsJoint, actuator: mujoco.MjsActuator, servo: Servo,
+              joint_damping_nms_per_rad: float = 0.0) -> None:
+    """Make ``actuator`` (on ``joint``) the servo; ``joint_damping`` is the joint's own
+    (a flexure hinge in parallel with the servo), added to the servo's."""
+    damping = list(joint.damping)   # [linear, higher-order terms]
+    damping[0] = joint_damping_nms_per_rad + back_emf_damping_nms_per_rad(servo)
+    joint.damping = damping
+    joint.armature = servo.armature_kgm2
+    actuator.set_to_position(kp=servo.kp_nm_per_rad, kv=servo.kv_nms_per_rad)
+    # the drive saturates: a hobby servo never exceeds its stall torque
+    actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+    actuator.forcerange = [-servo.stall_torque_nm, servo.stall_torque_nm]
+
+
+def with_servo(model: mujoco.MjModel, servo: Servo, joint_damping_nms_per_rad: float = 0.0,
+               dof: int = 0, actuator: int = 0) -> mujoco.MjModel:
+    """A copy of a compiled ``model`` whose servo (``actuator`` on ``dof``) is ``servo``:
+    the same numbers :func:`configure` gives, without recompiling (for batched fits)."""
+    m = copy.copy(model)
+    kp, kv = servo.kp_nm_per_rad, servo.kv_nms_per_rad
+    m.actuator_gainprm[actuator, 0] = kp
+    m.actuator_biasprm[actuator, :3] = (0.0, -kp, -kv)
+    m.actuator_forcerange[actuator] = (-servo.stall_torque_nm, servo.stall_torque_nm)
+    m.dof_damping[dof] = joint_damping_nms_per_rad + back_emf_damping_nms_per_rad(servo)
+    m.dof_armature[dof] = servo.armature_kgm2
+    mujoco.mj_setConst(m, mujoco.MjData(m))  # armature enters the constant mass-matrix terms
+    return m
