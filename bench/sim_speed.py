@@ -1,84 +1,90 @@
-"""Single-design simulation speed: the notebook's method against locust's routes, side by side.
+"""Single-design simulation speed: the notebook's own loop against locust's default, side by side.
 
-The notebook's method is its Part 2 loop (per-step Python, ``data.site(name)`` lookups,
-dt = 1e-4 s). The reference for accuracy is the same notebook model at half the step
-(dt = 5e-5 s). Each locust route runs the same design (the ``seed-notebook`` physics) through
-``mujoco.rollout`` with one change, so what each change buys is visible. All timings are
-taken in this one run, interleaved, best of ``--repeat``.
+The notebook's method is its Part 2 loop as written (per-step Python, ``data.site(name)``
+lookups, Euler at dt = 1e-4 s, its own model). locust's is ``locust.sim.run.run`` on the
+``seed`` preset (the hobby servo of docs/servo.md) at the package default, and a few other
+routes on the same model so that what each choice buys, and costs in accuracy, is visible.
+Every route runs the seed design for 3 hops on one core; all timings are taken in this one
+run, interleaved, best of ``--repeat``. Accuracy: each route against itself at half the step
+(the convergence check ``locust sim --check-convergence`` makes) and against the converged
+reference (rk4 at 1/8 of the default step).
 
-Last line: ``sim speedup <R>x, deviation <D>% vs dt/2 reference`` for the fastest route whose
-deviation is within 1 % (or, if none is, the most accurate route, said plainly).
+Last line: ``sim speedup <N>x at deviation <D>% (<M> mm per hop) vs dt/2``: N is the
+notebook loop's time over the package default's, D and M the default's distance change at
+dt/2.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
 
+os.environ.setdefault("OMP_NUM_THREADS", "1")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from notebook_reference import notebook_run  # noqa: E402
 
 from locust.params import preset  # noqa: E402
-from locust.sim.model import build  # noqa: E402
-from locust.sim.rollout import simulate_built  # noqa: E402
-from locust.sim.schedule import control_plan  # noqa: E402
+from locust.sim.run import run  # noqa: E402
 
-ROUTES = [
-    ("rollout, notebook settings (euler, dt 1e-4)", {}),
-    ("rollout + implicitfast", {"solver.integrator": "implicitfast"}),
-    ("rollout + 5 solver iterations, tol 1e-6", {"solver.iterations": 5, "solver.tolerance": 1e-6}),
-    ("rollout + no self-collision (contact geometry)", {"contact.self_collision": False}),
-    ("rollout + implicitfast, dt 2e-4", {"solver.integrator": "implicitfast", "solver.timestep_s": 2e-4}),
-    ("rollout + rk4, dt 2e-4", {"solver.integrator": "rk4", "solver.timestep_s": 2e-4}),
-    ("rollout, dt 5e-5 (converged)", {"solver.timestep_s": 5e-5}),
+CYCLES = 3
+ROUTES = [   # (name, solver overrides); the first is the package default
+    ("locust default (rk4)", {}),
+    ("implicitfast, same step", {"solver.integrator": "implicitfast"}),
+    ("implicitfast, step / 10", {"solver.integrator": "implicitfast", "solver.timestep_s": None}),
+    ("rk4, step x 2", {"solver.timestep_s": None}),
 ]
 
 
-def time_route(overrides: dict, repeat: int) -> tuple[float, float]:
-    robot = preset("seed-notebook").with_values(overrides) if overrides else preset("seed-notebook")
-    built = build(robot)
-    plan = control_plan(robot.schedule, robot.solver)
-    best, dist = float("inf"), float("nan")
+def robot_for(overrides: dict, scale: float = 1.0):
+    base = preset("seed")
+    dt = base.solver.timestep_s
+    values = dict(overrides)
+    if "solver.timestep_s" in values:
+        values["solver.timestep_s"] = dt / 10 if values.get("solver.integrator") == "implicitfast" else dt * 2
+    values["solver.timestep_s"] = values.get("solver.timestep_s", dt) * scale
+    return base.with_values(values)
+
+
+def timed(fn, repeat: int):
+    best, out = float("inf"), None
     for _ in range(repeat):
         t0 = time.perf_counter()
-        traj = simulate_built(built, plan)
+        out = fn()
         best = min(best, time.perf_counter() - t0)
-        dist = float(traj.final_qpos[0] - traj.initial_sensordata[traj.built.sensors.chassis_pos][0])
-    return best, dist
+    return best, out
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
 
-    ref_dist, _ = notebook_run(dt=5e-5)
-    print(f"reference: notebook model at dt 5e-5 s: {ref_dist * 100:.2f} cm")
-    nb_best, nb_dist = float("inf"), float("nan")
+    default = preset("seed")
+    ref = run(default.with_values({"solver.timestep_s": default.solver.timestep_s / 8}), cycles=CYCLES)
+    print(f"reference: seed, rk4 at {default.solver.timestep_s / 8:g} s: {ref.distance_m * 1000:.3f} mm "
+          f"({ref.distance_m * 1000 / CYCLES:.3f} mm per hop), nose {ref.max_nose_height_m * 1000:.3f} mm")
+    nb_t, _ = timed(lambda: notebook_run(dt=1e-4, num_hops=CYCLES), args.repeat)
+    print(f"{'route':34s} {'dt_s':>8s} {'time_s':>7s} {'speedup':>7s} {'mm/hop':>7s} "
+          f"{'dt/2 %':>7s} {'dt/2 mm/hop':>11s} {'ref %':>6s}")
+    print(f"{'notebook loop (its model, euler)':34s} {1e-4:8.1e} {nb_t:7.3f} {1.0:7.2f}")
     rows = []
-    for _ in range(args.repeat):
-        t0 = time.perf_counter()
-        nb_dist, _ = notebook_run(dt=1e-4)
-        nb_best = min(nb_best, time.perf_counter() - t0)
-    nb_dev = abs(nb_dist - ref_dist) / ref_dist * 100
-    print(f"{'route':50s} {'time_s':>8s} {'speedup':>8s} {'dist_cm':>8s} {'dev_%':>6s}")
-    print(f"{'notebook loop (python per step, dt 1e-4)':50s} {nb_best:8.3f} {1.0:8.2f} {nb_dist * 100:8.2f} {nb_dev:6.2f}")
     for name, overrides in ROUTES:
-        t, dist = time_route(overrides, args.repeat)
-        dev = abs(dist - ref_dist) / ref_dist * 100
-        rows.append((name, t, nb_best / t, dist, dev))
-        print(f"{name:50s} {t:8.3f} {nb_best / t:8.2f} {dist * 100:8.2f} {dev:6.2f}", flush=True)
-    within = [r for r in rows if r[4] <= 1.0]
-    if within:
-        best = max(within, key=lambda r: r[2])
-        print(f"best route within 1 %: {best[0]}")
-    else:
-        best = min(rows, key=lambda r: r[4])
-        print(f"no route is within 1 % of the reference; most accurate: {best[0]}")
-    print(f"sim speedup {best[2]:.2f}x, deviation {best[4]:.2f}% vs dt/2 reference")
+        robot = robot_for(overrides)
+        t, r = timed(lambda robot=robot: run(robot, cycles=CYCLES), args.repeat)
+        half = run(robot_for(overrides, 0.5), cycles=CYCLES)
+        dev_half = abs(r.distance_m - half.distance_m) / abs(half.distance_m) * 100
+        mm_half = abs(r.distance_m - half.distance_m) * 1000 / CYCLES
+        dev_ref = abs(r.distance_m - ref.distance_m) / abs(ref.distance_m) * 100
+        rows.append((name, nb_t / t, dev_half, mm_half))
+        valid = "" if r.valid else "  INVALID: " + "; ".join(r.reasons)
+        print(f"{name:34s} {robot.solver.timestep_s:8.1e} {t:7.3f} {nb_t / t:7.2f} {r.distance_m * 1000 / CYCLES:7.3f} "
+              f"{dev_half:7.2f} {mm_half:11.3f} {dev_ref:6.2f}{valid}", flush=True)
+    _, speedup, dev, mm = rows[0]
+    print(f"sim speedup {speedup:.1f}x at deviation {dev:.2f}% ({mm:.3f} mm per hop) vs dt/2")
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ RECORDINGS = ROOT / "calibration" / "recordings"
 
 @pytest.fixture()
 def recs(tmp_path):
-    for name in ("synthetic_beam.csv", "synthetic_beam_tracker.txt", "synthetic_servo.csv",
+    for name in ("synthetic_beam.csv", "synthetic_beam_tracker.txt", "synthetic_servo.csv", "synthetic_servo_heavy.csv",
                  "synthetic_ramp.csv", "synthetic_ramp_track.csv"):
         shutil.copy(RECORDINGS / name, tmp_path / name)
     return tmp_path
@@ -59,7 +59,7 @@ def test_beam_json_and_write_then_ramp_and_servo(recs):
     # everything not fitted is the seed's, with the seed's provenance
     seed = preset("seed")
     assert robot.get("servo.kp_nm_per_rad") == seed.get("servo.kp_nm_per_rad")
-    assert robot.source_of("servo.kp_nm_per_rad").source == "seed"
+    assert robot.source_of("servo.kp_nm_per_rad").source == "fit:sg90_aa_battery_step.csv"
 
     res = run("calibrate", "ramp", recs / "synthetic_ramp.csv", "--write", toml, "--no-plot")
     assert res.exit_code == 0, res.output
@@ -68,15 +68,36 @@ def test_beam_json_and_write_then_ramp_and_servo(recs):
     assert robot.get("contact.foot_friction") == pytest.approx(math.tan(math.radians(angles.mean())), rel=0.01)
     assert robot.get("compliance.hinge_stiffness_nm_per_rad") == k     # kept
 
-    res = run("calibrate", "servo", recs / "synthetic_servo.csv", "--inertia-kgm2", 4e-4,
-              "--gravity-moment-nm", 0.03, "--write", toml, "--no-plot")
+    res = run("calibrate", "servo", recs / "synthetic_servo.csv", "--inertia-kgm2", 1.5e-5,
+              "--stall-torque-nm", 0.15, "--write", toml, "--no-plot")
     assert res.exit_code == 0, res.output
     robot = load_robot(toml)
-    assert robot.get("servo.kp_nm_per_rad") == pytest.approx(0.6, rel=0.10)
-    assert robot.get("servo.kv_nms_per_rad") == pytest.approx(0.04, rel=0.10)
-    assert robot.get("servo.torque_limit_nm") == pytest.approx(0.15, rel=0.05)
-    assert robot.source_of("servo.torque_limit_nm").source == "fit:synthetic_servo.csv"
+    # header truth: the preset SG90 (noload 10.2 rad/s, armature 3.1e-4 kg*m^2, kp 0.26 N*m/rad)
+    assert robot.get("servo.noload_speed_rad_per_s") == pytest.approx(10.2, rel=0.01)
+    assert robot.get("servo.armature_kgm2") == pytest.approx(3.1e-4, rel=0.05)
+    assert robot.get("servo.kp_nm_per_rad") == pytest.approx(0.26, rel=0.05)
+    assert robot.source_of("servo.armature_kgm2").source == "fit:synthetic_servo.csv"
+    assert robot.source_of("servo.stall_torque_nm").source == "datasheet:SG90"    # given, not fitted
     assert robot.get("contact.foot_friction") == pytest.approx(1.7, rel=0.03)   # kept
+
+
+def test_servo_two_loads_json(recs):
+    res = run("calibrate", "servo", recs / "synthetic_servo.csv", recs / "synthetic_servo_heavy.csv",
+              "--inertia-kgm2", 1.5e-5, "--inertia-kgm2", 1e-3, "--json", "--no-plot")
+    assert res.exit_code == 0, res.output
+    out = json.loads(res.output)
+    # header truth: stall 0.15 N*m, no-load 10.2 rad/s, delay 12 ms, clock ratio 1.002
+    assert out["stall_torque_nm"]["value"] == pytest.approx(0.15, rel=0.02) and out["stall_torque_nm"]["identifiable"]
+    assert out["noload_speed_rad_per_s"]["value"] == pytest.approx(10.2, rel=0.01)
+    assert out["command_delay_s"] == pytest.approx([0.012, 0.012], abs=0.002)
+    assert out["command_clock_ratio"] == pytest.approx([1.002, 1.002], abs=3e-4)
+    assert len(out["rms_per_recording_deg"]) == 2
+
+    res = run("calibrate", "servo", recs / "synthetic_servo.csv", "--inertia-kgm2", 1.5e-5, "--no-plot")
+    assert res.exit_code != 0 and "stall torque is needed" in res.output
+    res = run("calibrate", "servo", recs / "synthetic_servo.csv", recs / "synthetic_servo_heavy.csv",
+              "--inertia-kgm2", 1.5e-5, "--inertia-kgm2", 1e-3, "--inertia-kgm2", 1e-3, "--no-plot")
+    assert res.exit_code != 0 and "--inertia-kgm2 given 3 times for 2 recordings" in res.output
 
 
 def test_tracker_export_gives_the_same_fit(recs):

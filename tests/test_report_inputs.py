@@ -205,7 +205,8 @@ def test_demo_virtual_robot_carries_the_recordings_truth():
     truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])
     assert truth == pytest.approx({
         "compliance.hinge_stiffness_nm_per_rad": 0.056375, "compliance.hinge_damping_nms_per_rad": 0.00056375,
-        "servo.torque_limit_nm": 0.15, "contact.foot_friction": 1.7}, rel=1e-6)
+        "servo.noload_speed_rad_per_s": 10.2, "servo.armature_kgm2": 3.1e-4, "servo.kp_nm_per_rad": 0.26,
+        "servo.stall_torque_nm": 0.15, "contact.foot_friction": 1.7}, rel=1e-6)
     seed = preset("seed")
     for key, value in truth.items():
         assert seed.get(key) == pytest.approx(value, rel=1e-6), key

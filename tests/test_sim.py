@@ -1,6 +1,7 @@
 """The hop simulation: reproduction of the notebook, audit, refusal of broken designs."""
 
 import json
+import math
 import subprocess
 import sys
 
@@ -21,9 +22,21 @@ def test_model_is_built_closed(name):
     assert loop_closure_error_m(built.model, data) < 1e-6
 
 
-def test_torque_limit_always_applied():
-    m = build(preset("seed").with_values({"servo.torque_limit_nm": 0.2})).model
+def test_servo_is_the_hobby_servo_on_each_crank():
+    """Stall torque clamps the drive; back-EMF damping stall/noload and the reflected rotor
+    inertia sit on the crank joint, beside the hinge's own damping (docs/servo.md)."""
+    robot = preset("seed").with_values({"servo.stall_torque_nm": 0.2})
+    m = build(robot).model
     assert m.actuator_forcelimited.all() and (m.actuator_forcerange == [[-0.2, 0.2]] * 2).all()
+    dofs = m.jnt_dofadr[m.actuator_trnid[:, 0]]
+    b = 0.2 / robot.servo.noload_speed_rad_per_s + robot.compliance.hinge_damping_nms_per_rad
+    assert m.dof_damping[dofs] == pytest.approx([b, b], rel=1e-12)
+    assert m.dof_armature[dofs] == pytest.approx([robot.servo.armature_kgm2] * 2, rel=1e-12)
+    # the notebook's servo: no speed limit, no rotor
+    nb = build(preset("seed-notebook")).model
+    nb_dofs = nb.jnt_dofadr[nb.actuator_trnid[:, 0]]
+    assert list(nb.dof_armature[nb_dofs]) == [0.0, 0.0]
+    assert nb.dof_damping[nb_dofs] == pytest.approx([robot.compliance.hinge_damping_nms_per_rad] * 2, rel=1e-12)
 
 
 def test_seed_notebook_reproduces_part2_baseline():
@@ -39,7 +52,8 @@ def test_seed_six_hops_valid_and_airborne():
     r = run(preset("seed"), cycles=6)
     assert r.valid, r.reasons
     assert len(r.hops) == 6
-    assert all(h.flight_s > 0.02 for h in r.hops)            # each cycle leaves the floor
+    # the SG90 push lifts the robot off the floor for a few milliseconds each cycle
+    assert all(h.flight_s >= 0.005 for h in r.hops)
     assert sum(h.distance_m for h in r.hops) == pytest.approx(r.distance_m, rel=1e-9)
     assert r.loop_residual_max_m < 0.002                     # the corrected loop stays closed
 
@@ -47,7 +61,8 @@ def test_seed_six_hops_valid_and_airborne():
 def test_unstable_servo_is_caught_by_the_audit():
     # 1e5 N*m/rad with no damping and no torque limit to speak of: the integrator blows up
     wild = preset("seed").with_values({
-        "servo.kp_nm_per_rad": 1e5, "servo.kv_nms_per_rad": 0.0, "servo.torque_limit_nm": 1e4,
+        "servo.kp_nm_per_rad": 1e5, "servo.kv_nms_per_rad": 0.0, "servo.stall_torque_nm": 1e4,
+        "servo.noload_speed_rad_per_s": math.inf, "servo.armature_kgm2": 0.0, "solver.integrator": "implicitfast",
         "compliance.hinge_damping_nms_per_rad": 0.0})
     r = run(wild, cycles=1)
     assert not r.valid

@@ -45,7 +45,7 @@ def test_live_two_cycles_match_the_rollout(seed):
     assert ref.valid and live["valid"], live["reasons"]
     assert live["reasons"] == []
     assert live["sim_time_s"] == pytest.approx(2 * 1.3, abs=1e-9)
-    assert ref.distance_m > 0.3          # two real hops (~23 cm each for the seed robot)
+    assert ref.distance_m > 0.005        # two hops (about 3.3 mm each for the seed robot on its SG90s)
     assert live["distance_m"] == pytest.approx(ref.distance_m, rel=0.02)
     assert live["max_nose_height_m"] == pytest.approx(ref.max_nose_height_m, rel=0.02)
     assert sim.close() == live           # closing twice gives the same answer
@@ -58,7 +58,8 @@ def test_left_and_right_are_independent(seed):
     m, d = sim.model, sim.data
     q = {side: math.degrees(d.qpos[m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{side}_servo")]])
          for side in ("L", "R")}
-    assert q["L"] < -15.0                # the pushed horn swung most of the way to -30 deg
+    # the pushed horn swung towards -30 deg, held short by the legs' load (kp 0.26 N*m/rad)
+    assert q["L"] < -10.0
     assert abs(q["R"]) < 3.0             # the resting one held near 0
     assert sim.close()["sim_time_s"] == pytest.approx(0.3)
 
@@ -127,8 +128,10 @@ def test_bad_commands_raise_and_nothing_is_written(seed, tmp_path):
 
 
 def test_a_blown_up_live_run_is_reported_invalid(seed):
-    """dt = 10 ms tears the seed's linkage apart (the rollout's audit says so): the live audit agrees."""
-    coarse = seed.with_values({"solver.timestep_s": 0.01})
+    """A servo of 1e5 N*m/rad with no rotor and no speed limit tears the linkage apart at the
+    default step (the rollout's audit says so): the live audit agrees."""
+    coarse = seed.with_values({"servo.kp_nm_per_rad": 1e5, "servo.stall_torque_nm": 1e4, "servo.armature_kgm2": 0.0,
+                               "servo.noload_speed_rad_per_s": math.inf, "compliance.hinge_damping_nms_per_rad": 0.0})
     ref = run(coarse, cycles=1)
     sim = LiveSim(coarse)
     drive_schedule(sim, coarse, cycles=1)

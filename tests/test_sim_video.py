@@ -61,7 +61,8 @@ def blob_centroid(frame_bgr: np.ndarray, hex_colour: str) -> tuple[float, float]
 @pytest.fixture(scope="module")
 def clips(tmp_path_factory):
     folder = tmp_path_factory.mktemp("video")
-    robot = preset("seed")
+    # the notebook's servo hops about 10 cm, which puts the camera framing to work
+    robot = preset("seed-notebook").with_values({"solver.settle_s": 0.5})
     infos = {cam: render_video(robot, folder / f"hop-{cam}.mp4", cycles=1, camera=cam, fps=FPS, width=W, height=H)
              for cam in ("track", "fixed")}
     return robot, infos
@@ -203,7 +204,7 @@ def test_fixed_camera_metres_per_pixel(clips):
     truth = pd.read_csv(infos["fixed"].truth_path, comment="#")
     dx_m = truth.nose_x_m.iloc[-1] - truth.nose_x_m.iloc[0]
     dpx = truth.nose_px.iloc[-1] - truth.nose_px.iloc[0]
-    assert abs(dx_m) > 0.1                                      # the robot hopped
+    assert abs(dx_m) > 0.05                                     # the robot hopped
     assert -dpx * m_per_px == pytest.approx(dx_m, rel=0.02)     # +x runs right to left in this view
 
 

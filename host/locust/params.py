@@ -71,10 +71,10 @@ class Servo:
     fitted by ``locust calibrate servo``) with the datasheet's stall torque; see SG90_SOURCE.
     """
 
-    kp_nm_per_rad: float = 0.46            # proportional gain inside the torque clamp
+    kp_nm_per_rad: float = 0.26            # proportional gain inside the torque clamp
     stall_torque_nm: float = 0.15          # datasheet: 1.5-1.8 kg*cm
-    noload_speed_rad_per_s: float = 10.1   # inf: no speed limit (the notebook's model)
-    armature_kgm2: float = 1.2e-4          # rotor inertia x gear ratio^2, at the output shaft
+    noload_speed_rad_per_s: float = 10.2   # inf: no speed limit (the notebook's model)
+    armature_kgm2: float = 3.1e-4          # rotor inertia x gear ratio^2, at the output shaft
     kv_nms_per_rad: float = 0.0            # velocity feedback inside the clamp (notebook: 0.0069)
     travel_deg: float = 45.0         # mechanical travel either side of rest
     pulse_min_us: float = 500.0      # pulse at -range_deg/2
@@ -107,10 +107,11 @@ class Schedule:
 class Solver:
     """How the simulation is run (not a property of the robot, but of the result)."""
 
-    timestep_s: float = 5e-5         # converged to ~1 % (see `locust sim --check-convergence`)
-    integrator: str = "euler"        # euler | implicitfast | implicit | rk4
-    iterations: int = 50
-    tolerance: float = 1e-8
+    # rk4 at 1 ms: every preset within 1 % or 0.1 mm per hop of dt/2 (docs/servo.md has the table)
+    timestep_s: float = 1e-3
+    integrator: str = "rk4"          # euler | implicitfast | implicit | rk4
+    iterations: int = 10
+    tolerance: float = 1e-6
     control_hz: float = 50.0         # rate at which servo commands change (PWM period)
     settle_s: float = 0.5            # time on the floor, servos at rest, before the schedule
     loop_timeconst_s: float = 0.002  # stiffness of the loop-closing connect (notebook: 0.02)
@@ -256,12 +257,12 @@ _SG90_DATE = "2026-11-23"
 SG90_SOURCE = {
     "servo.stall_torque_nm": Provenance(source="datasheet:SG90", uncertainty=0.015,
                                         note="1.5-1.8 kg*cm at 4.8-6 V; the fit's split of the ratios"),
-    "servo.noload_speed_rad_per_s": Provenance(source=_SG90_FIT, uncertainty=0.1, date=_SG90_DATE,
+    "servo.noload_speed_rad_per_s": Provenance(source=_SG90_FIT, uncertainty=0.06, date=_SG90_DATE,
                                                note="datasheet: 0.1 s/60 deg = 10.5 rad/s at 4.8 V"),
-    "servo.armature_kgm2": Provenance(source=_SG90_FIT, uncertainty=3e-5, date=_SG90_DATE,
-                                      note="reflected rotor inertia, with stall torque 0.15 N*m"),
-    "servo.kp_nm_per_rad": Provenance(source=_SG90_FIT, uncertainty=0.05, date=_SG90_DATE,
-                                      note="with stall torque 0.15 N*m"),
+    "servo.armature_kgm2": Provenance(source=_SG90_FIT, uncertainty=3.3e-5, date=_SG90_DATE,
+                                      note="reflected rotor inertia; scales with the stall torque 0.15 N*m"),
+    "servo.kp_nm_per_rad": Provenance(source=_SG90_FIT, uncertainty=0.019, date=_SG90_DATE,
+                                      note="scales with the stall torque 0.15 N*m"),
     "servo.kv_nms_per_rad": Provenance(source="model", note="a hobby servo has no velocity feedback"),
 }
 
@@ -328,7 +329,10 @@ PRESETS = {
     "seed": _seed,
     "small": lambda: leg_set(_seed(), "small"),
     "medium": lambda: leg_set(_seed(), "medium"),
-    "large": lambda: leg_set(_seed(), "large"),
+    # Large's hops are a fraction of a millimetre: rk4 at 1 ms moves them by 0.16 mm per hop
+    # at dt/2, at 0.25 ms by 0.002 mm (docs/servo.md)
+    "large": lambda: leg_set(_seed(), "large").with_values(
+        {"solver.timestep_s": 2.5e-4}, Provenance(source="preset:large", note="converged step, docs/servo.md")),
     "seed-notebook": _seed_notebook,
 }
 

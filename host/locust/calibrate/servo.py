@@ -28,10 +28,11 @@ its range, or when halving and doubling it changes the fit by less than the nois
 
 from __future__ import annotations
 
+import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Callable
 
 import mujoco
 import numpy as np
@@ -195,7 +196,7 @@ def simulate_deg(model: mujoco.MjModel, servos: list[Servo], timings: list[Timin
     t, u = rec.t_s, rec.command_deg
     t_out = t if t_out is None else np.asarray(t_out, dtype=float)
     dt = model.opt.timestep
-    nstep = int(math.ceil((t[-1] - t[0]) / dt)) + 1
+    nstep = math.ceil((t[-1] - t[0]) / dt) + 1
     held = np.radians(np.concatenate([[u[0]], u[rec.edges]]))   # command before the first edge, after each
     steps = np.arange(nstep)
     ctrl = np.empty((len(servos), nstep, 1))
@@ -283,7 +284,6 @@ def fit_servo(recordings: list[StepRecording], stall_torque_nm: float | None = N
     layout = _Layout(fitted, tuple(len(r.edges) >= MIN_EDGES_FOR_CLOCK for r in recs), stall_torque_nm)
     models = [rig_model(r.rig) for r in recs]
     angle0 = [float(r.angle_deg[0]) for r in recs]
-    weights = [1.0 / math.sqrt(len(r.t_s)) for r in recs]   # each recording counts alike per sample
 
     def residual(x: np.ndarray) -> np.ndarray:
         xs = np.atleast_2d(np.asarray(x).T).reshape(-1, layout.size)
@@ -416,37 +416,37 @@ def _speed_guess(rec: StepRecording) -> float:
 
 
 def _grid_starts(recs, layout: _Layout, residual, bounds) -> list[np.ndarray]:
-    """Starting points: a grid of armature, linear range (stall/kp) and delay around the
-    measured top speed, simulated in one batch; the best few, spread over armatures."""
+    """Starting points: a grid of no-load speed (at and above the fastest speed seen: a load
+    slows the servo), armature, linear range (stall/kp) and delay, simulated in one batch;
+    the best few with distinct speed and armature."""
     stall = layout.stall_given or 0.15
-    noload = max(_speed_guess(rec) for rec in recs) * 1.02
+    seen_speed = max(_speed_guess(rec) for rec in recs) * 1.02
     frame_s = float(np.median(np.diff(recs[0].t_s)))
     j = recs[0].rig.inertia_kgm2
-    timing = [_timing_guess(rec, noload) for rec in recs]
     cands = []
-    for tau_s in (0.002, 0.01, 0.03):                        # mechanical time constant (J+Ja)/b
-        armature = max(tau_s * stall / noload - j, LOWER["armature_kgm2"] * 10)
-        for linear_deg in (3.0, 10.0, 25.0):
-            for delay_frames in (-1.0, -0.5, 0.0, 0.5):
-                x = [math.log(noload), math.log(armature), math.log(stall / math.radians(linear_deg))]
-                if "stall_torque_nm" in layout.fitted:
-                    x.append(math.log(stall))
-                for has_clock, (delay_s, ratio) in zip(layout.clock, timing):
-                    x.append((delay_s - tau_s + delay_frames * frame_s) / DELAY_SCALE_S)
-                    if has_clock:
-                        x.append((ratio - 1.0) / CLOCK_SCALE)
-                cands.append(x)
+    for noload in (seen_speed, 1.5 * seen_speed, 2.5 * seen_speed):
+        timing = [_timing_guess(rec, noload) for rec in recs]
+        for tau_s in (0.002, 0.01, 0.03):                        # mechanical time constant (J+Ja)/b
+            armature = max(tau_s * stall / noload - j, LOWER["armature_kgm2"] * 10)
+            for linear_deg in (3.0, 10.0, 25.0):
+                for delay_frames in (-1.0, -0.5, 0.0, 0.5):
+                    x = [math.log(noload), math.log(armature), math.log(stall / math.radians(linear_deg))]
+                    if "stall_torque_nm" in layout.fitted:
+                        x.append(math.log(stall))
+                    for has_clock, (delay_s, ratio) in zip(layout.clock, timing):
+                        x.append((delay_s - tau_s + delay_frames * frame_s) / DELAY_SCALE_S)
+                        if has_clock:
+                            x.append((ratio - 1.0) / CLOCK_SCALE)
+                    cands.append(x)
     lo, hi = bounds
     xs = np.clip(np.array(cands), lo + 1e-6, hi - 1e-6)
     cost = np.sum(residual(xs.T) ** 2, axis=0)
-    order = np.argsort(cost)
     picked, seen = [], set()
-    for i in order:
-        key = round(xs[i, 1], 3)
-        if key in seen:
-            continue
-        seen.add(key)
-        picked.append(xs[i])
+    for i in np.argsort(cost):
+        key = (round(xs[i, 0], 3), round(xs[i, 1], 3))
+        if key not in seen:
+            seen.add(key)
+            picked.append(xs[i])
         if len(picked) == STARTS:
             break
     return picked
@@ -458,7 +458,7 @@ def _timing_guess(rec: StepRecording, noload: float) -> tuple[float, float]:
     t, q, u = rec.t_s, rec.angle_deg, rec.command_deg
     edge_t, cross_t = [], []
     edges = list(rec.edges) + [len(t)]
-    for i, end in zip(edges[:-1], edges[1:]):
+    for i, end in itertools.pairwise(edges):
         start = q[i - 1]
         mid = 0.5 * (start + u[i])
         side = np.sign(q[i - 1:end] - mid)

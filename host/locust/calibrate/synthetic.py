@@ -11,11 +11,12 @@ about half a pixel, which at 0.6 mm/px is 0.3 mm; a horn tip 5 cm from the axis 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from .servo import ServoGains, ServoRig, rig_model, simulate_deg
+from ..params import Servo
+from .servo import ServoRig, StepRecording, Timing, rig_model, simulate_deg
 
 G = 9.81
 
@@ -73,43 +74,65 @@ def beam_tip_track(truth: BeamTruth, rng: np.random.Generator, tilt_deg: float =
 
 @dataclass(frozen=True)
 class ServoTruth:
-    """A servo whose step leaves the linear range visible (limit/kp = 14 deg)."""
+    """A servo rig filmed through a square-wave command: the servo (locust.params.Servo), the
+    load, the camera and the firmware-to-camera timing. Default: the preset SG90 swinging a
+    load five times the course's AA battery, filmed at 60 frames/s."""
 
-    kp_nm_per_rad: float = 0.6
-    kv_nms_per_rad: float = 0.04
-    torque_limit_nm: float = 0.15
-    inertia_kgm2: float = 4e-4          # ~100 g battery pack 6 cm from the axis
-    gravity_moment_nm: float = 0.03
+    servo: Servo = field(default_factory=Servo)
+    inertia_kgm2: float = 1.5e-5        # a 20 g weight 2.7 cm from the axis
+    gravity_moment_nm: float = 0.0      # 0: horizontal rig
     start_deg: float = 0.0
-    target_deg: float = 180.0
-    step_at_s: float = 0.05
-    fps: float = 240.0
-    duration_s: float = 0.6
+    target_deg: float = 120.0
+    edges: int = 3                      # command changes, one every half period
+    half_period_s: float = 0.8
+    first_edge_s: float = 0.2
+    fps: float = 60.0
     noise_deg: float = 0.3
-
-    @property
-    def gains(self) -> ServoGains:
-        return ServoGains(self.kp_nm_per_rad, self.kv_nms_per_rad, self.torque_limit_nm)
+    delay_s: float = 0.012              # command edge to servo (a PWM period at most, plus latency)
+    clock_ratio: float = 1.002          # camera clock / firmware clock
+    timestep_s: float = 2.5e-4          # finer than the fit's, so the fit does not meet its own grid
 
     @property
     def rig(self) -> ServoRig:
-        return ServoRig(self.inertia_kgm2, self.gravity_moment_nm)
+        return ServoRig(self.inertia_kgm2, self.gravity_moment_nm, timestep_s=self.timestep_s)
+
+    @property
+    def duration_s(self) -> float:
+        return self.first_edge_s + self.edges * self.half_period_s
 
 
-STALL_SERVO = ServoTruth(kp_nm_per_rad=20.0, kv_nms_per_rad=0.0069, torque_limit_nm=0.15,
-                         inertia_kgm2=4e-4, gravity_moment_nm=0.2, start_deg=-60.0, target_deg=90.0)
-"""The seed's gains lifting a weight too heavy for them (the notebook's stall test): the horn
-stalls where 0.2*cos(angle) = 0.15 N*m, torque-limited for the whole step, so kp and kv
-cannot be identified, the limit can."""
+STALL_SERVO = ServoTruth(inertia_kgm2=4e-4, gravity_moment_nm=0.2, start_deg=-90.0, target_deg=90.0, edges=1,
+                         half_period_s=1.0, fps=120.0, delay_s=0.0, clock_ratio=1.0)
+"""The SG90 lifting a weight too heavy for it (the notebook's stall test): from hanging
+straight down the horn rises until 0.2*cos(angle) = 0.15 N*m and stalls there, 131 deg short
+of the command, torque-limited for the whole step. With the gravity moment given the stall
+torque is identifiable; kp is not (any kp that saturates the drive fits alike)."""
+
+
+def _rest_deg(truth: ServoTruth) -> float:
+    """Where the horn rests before the first edge: servo torque kp*(start - q), clipped at the
+    stall torque, holds the load's moment M*cos(q) (bisection; the torque falls as q rises)."""
+    s, m = truth.servo, truth.gravity_moment_nm
+    lo, hi = truth.start_deg - 90.0, truth.start_deg + 90.0
+
+    def net(q_deg: float) -> float:
+        drive = s.kp_nm_per_rad * math.radians(truth.start_deg - q_deg)
+        return max(-s.stall_torque_nm, min(s.stall_torque_nm, drive)) - m * math.cos(math.radians(q_deg))
+
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if net(mid) > 0 else (lo, mid)
+    return 0.5 * (lo + hi)
 
 
 def servo_step(truth: ServoTruth, rng: np.random.Generator):
     """(t_s, angle_deg, command_deg): the rig model stepped from rest, plus angle noise."""
     t = np.arange(int(truth.duration_s * truth.fps)) / truth.fps
-    command = np.where(t < truth.step_at_s, truth.start_deg, truth.target_deg)
-    # rest under gravity before the step: the servo sags by M*cos(angle)/kp
-    sag = math.degrees(truth.gravity_moment_nm * math.cos(math.radians(truth.start_deg)) / truth.kp_nm_per_rad)
-    angle = simulate_deg(rig_model(truth.rig), [truth.gains], t, command, truth.start_deg - sag)[0]
+    n_edges = np.clip(np.floor((t - truth.first_edge_s) / truth.half_period_s) + 1, 0, truth.edges)
+    command = np.where(n_edges % 2 == 1, truth.target_deg, truth.start_deg)
+    rec = StepRecording(t, np.zeros_like(t), command, truth.rig, source="synthetic")
+    angle = simulate_deg(rig_model(truth.rig), [truth.servo], [Timing(truth.delay_s, truth.clock_ratio)], rec,
+                         _rest_deg(truth))[0]
     return t, angle + rng.normal(0, truth.noise_deg, len(t)), command
 
 

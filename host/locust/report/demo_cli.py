@@ -7,7 +7,7 @@ the demo exercises the same code paths a user does:
 2. ``locust hop --port sim --preset P --video``: Small, Medium and Large hop on the virtual
    robot (the firmware under MicroPython driving the MuJoCo model), filmed;
 3. ``locust track``: nose and foot tracks from those videos;
-4. ``locust calibrate``: beam, servo (stall) and ramp fits from the bundled synthetic
+4. ``locust calibrate``: beam, servo and ramp fits from the bundled synthetic
    recordings into the demo's ``robot.toml``;
 5. ``locust sweep``: a small ``scale`` sweep of the calibrated robot;
 6. ``locust report``: the calibrated model against the measured hops.
@@ -33,12 +33,11 @@ from ..progress import progress
 
 LEG_SETS = ("small", "medium", "large")
 RECORDINGS = Path(__file__).resolve().parents[3] / "calibration" / "recordings"
-# (subcommand, recording, its options); the stall recording is the seed's servo under a heavy
-# load: it identifies the torque limit (its kp, kv are not identifiable and are not written).
-# synthetic_servo.csv is a softer servo than the one on the virtual robot, so it is left out.
+# (subcommand, recording, its options); the servo recording is the preset SG90 on a light
+# load, split with the datasheet's stall torque (no-load speed, armature and kp are written).
 CALIBRATIONS = (
     ("beam", "synthetic_beam.csv", ["--mass-kg", "0.01", "--length-m", "0.05"]),
-    ("servo", "synthetic_servo_stall.csv", ["--inertia-kgm2", "4e-4", "--gravity-moment-nm", "0.2"]),
+    ("servo", "synthetic_servo.csv", ["--inertia-kgm2", "1.5e-5", "--stall-torque-nm", "0.15"]),
     ("ramp", "synthetic_ramp.csv", []),
 )
 
@@ -49,7 +48,10 @@ CALIBRATIONS = (
 TRUTH_KEYS = {
     "hinge_stiffness_nm_per_rad": "compliance.hinge_stiffness_nm_per_rad",
     "hinge_damping_nms_per_rad": "compliance.hinge_damping_nms_per_rad",
-    "torque_limit_nm": "servo.torque_limit_nm",
+    "noload_speed_rad_per_s": "servo.noload_speed_rad_per_s",
+    "armature_kgm2": "servo.armature_kgm2",
+    "kp_nm_per_rad": "servo.kp_nm_per_rad",
+    "stall_torque_nm": "servo.stall_torque_nm",
     "mu_static": "contact.foot_friction",
 }
 

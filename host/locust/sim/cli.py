@@ -34,7 +34,7 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence)
     Examples:
       locust sim --preset seed --json
       locust sim --preset seed-notebook --json          # the notebook's Part 2 figures
-      locust sim --preset large --set servo.torque_limit_nm=0.2 --video large.mp4
+      locust sim --preset large --set servo.stall_torque_nm=0.18 --video large.mp4
     """
     from .run import check_convergence as converge, invalid_result, run
 
@@ -83,7 +83,10 @@ def _print_human(r) -> None:
                    f"{h.com_apex_m * 100:11.2f}  {h.flight_s * 1000:9.1f}")
     if r.convergence:
         c = r.convergence
-        click.echo(f"  convergence at dt/2: distance {c['distance_rel_change'] * 100:.2f} %, "
-                   f"nose height {c['max_nose_height_rel_change'] * 100:.2f} %")
+        verdict = "converged" if c["converged"] else "NOT converged (within 1 % or 0.1 mm asked)"
+        click.echo(f"  convergence at dt/2 ({c['half_timestep_s']:g} s): distance "
+                   f"{c['distance_change_mm_per_hop']:.3f} mm per hop ({c['distance_rel_change'] * 100:.2f} %), "
+                   f"nose height {c['max_nose_height_change_mm']:.3f} mm ({c['max_nose_height_rel_change'] * 100:.2f} %): "
+                   f"{verdict}")
     for note in r.notes:
         click.echo(f"  note: {note}")

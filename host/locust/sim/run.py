@@ -87,18 +87,35 @@ def peak_servo_speed(traj) -> float:
     return float(np.abs(finite).max()) if finite.size else float("nan")
 
 
-def check_convergence(robot: Robot, result: SimResult, cycles: int | None = None) -> dict[str, float]:
-    """Rerun at half the time step; relative change of distance and nose height."""
+CONVERGED_REL = 0.01     # a result is converged in the step when its dt/2 change is within 1 %
+CONVERGED_MM = 0.1       # ... or within 0.1 mm (per hop for the distance)
+
+
+def check_convergence(robot: Robot, result: SimResult, cycles: int | None = None) -> dict[str, float | bool]:
+    """Rerun at half the time step: change of distance (mm per hop and %) and of nose height
+    (mm and %); ``converged`` when each is within 1 % or 0.1 mm (per hop)."""
     half = run(robot, cycles=cycles, timestep_s=result.timestep_s / 2)
+    hops = max(len(result.hops), 1)
+
     def rel(a: float, b: float) -> float:
         return abs(a - b) / abs(b) if b else float("inf")
+
+    dist_mm = abs(result.distance_m - half.distance_m) * 1000 / hops
+    nose_mm = abs(result.max_nose_height_m - half.max_nose_height_m) * 1000
+    dist_rel = rel(result.distance_m, half.distance_m)
+    nose_rel = rel(result.max_nose_height_m, half.max_nose_height_m)
+    converged = bool(half.valid and (dist_rel <= CONVERGED_REL or dist_mm <= CONVERGED_MM)
+                     and (nose_rel <= CONVERGED_REL or nose_mm <= CONVERGED_MM))
     return {
         "half_timestep_s": half.timestep_s,
-        "half_valid": float(half.valid),
+        "half_valid": half.valid,
         "half_distance_m": half.distance_m,
         "half_max_nose_height_m": half.max_nose_height_m,
-        "distance_rel_change": rel(result.distance_m, half.distance_m),
-        "max_nose_height_rel_change": rel(result.max_nose_height_m, half.max_nose_height_m),
+        "distance_change_mm_per_hop": dist_mm,
+        "distance_rel_change": dist_rel,
+        "max_nose_height_change_mm": nose_mm,
+        "max_nose_height_rel_change": nose_rel,
+        "converged": converged,
     }
 
 
