@@ -250,6 +250,10 @@ class _Layout:
             timings.append(Timing(delay, ratio))
         return Servo(**{k: float(v) for k, v in values.items()}), timings
 
+    def timing_scales(self) -> list[float]:
+        """Physical size of one solver unit of each timing variable, in order."""
+        return [s for has_clock in self.clock for s in ((DELAY_SCALE_S, CLOCK_SCALE) if has_clock else (DELAY_SCALE_S,))]
+
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         lo = [math.log(LOWER[n]) for n in self.fitted]
         hi = [math.log(UPPER[n]) for n in self.fitted]
@@ -315,13 +319,7 @@ def fit_servo(recordings: list[StepRecording], stall_torque_nm: float | None = N
                                   [b.reshape(-1, 1) for b in bounds])
     nphys = len(fitted)
     phys = np.exp(x[:nphys])
-    scale = np.concatenate([phys, np.full(layout.size - nphys, 1.0)])
-    tscale = []
-    for has_clock in layout.clock:
-        tscale.append(DELAY_SCALE_S)
-        if has_clock:
-            tscale.append(CLOCK_SCALE)
-    scale[nphys:] = tscale
+    scale = np.concatenate([phys, layout.timing_scales()])
     # d r / d p = d r / d x / (d p / d x): p = exp(x) for the physical ones, p = scale*x for timing
     cov = covariance(jac / scale[None, :], r)
     servo, timings = layout.unpack(x)
@@ -332,16 +330,8 @@ def fit_servo(recordings: list[StepRecording], stall_torque_nm: float | None = N
         estimates["stall_torque_nm"] = Estimate(stall_torque_nm, 0.0, stall_torque_nm, stall_torque_nm)
         identifiable["stall_torque_nm"] = True
     tvals = np.concatenate([[t.delay_s] + ([t.clock_ratio] if c else []) for t, c in zip(timings, layout.clock)])
-    tests = [cov.parameter(np.concatenate([phys, tvals]), nphys + j) for j in range(len(tvals))]
-    timing_std, j = [], 0
-    for has_clock in layout.clock:
-        d_std = tests[j].std
-        j += 1
-        c_std = 0.0
-        if has_clock:
-            c_std = tests[j].std
-            j += 1
-        timing_std.append((d_std, c_std))
+    stds = iter([cov.parameter(np.concatenate([phys, tvals]), nphys + j).std for j in range(len(tvals))])
+    timing_std = [(next(stds), next(stds) if has_clock else 0.0) for has_clock in layout.clock]
 
     rms_deg = float(np.degrees(np.sqrt(np.mean(r**2))))
     per_rec, k0 = [], 0
