@@ -145,12 +145,12 @@ def test_measured_hops_match_the_synthetic_truth(world):
             assert d == pytest.approx(d_true, abs=0.0015), (label, k)
             assert a == pytest.approx(a_true, abs=0.005), (label, k)
             assert a <= a_true + 0.0015
-    # the true robot (softer hinges) hops 2 mm farther than the model over the two hops: the
+    # the true robot (softer hinges) hops 3.2 mm farther than the model over the two hops: the
     # report shows that error, to the measurement's resolution
     err = float(cells[("small", "distance_error_cm")])
     true_total = world["truth"]["small-1"].distance_m
     model_total = run(leg_set(preset("seed"), "small"), cycles=CYCLES).distance_m
-    assert (true_total - model_total) * 100 == pytest.approx(0.2, abs=0.03)
+    assert (true_total - model_total) * 100 == pytest.approx(0.32, abs=0.03)
     assert err == pytest.approx((true_total - model_total) * 100, abs=0.06)
 
 

@@ -8,9 +8,10 @@ or ``fit:<recording>`` (identified by ``locust calibrate``, with an uncertainty 
 Presets:
 
 - ``seed``: the notebook's Part 2 robot, run the corrected way: settled on the floor before
-  the schedule starts, servo commands at the servo's 50 Hz PWM rate, a time step at which the
-  hop distance has converged (5e-5 s), links that collide with the floor but not with their
-  own chassis (a flexure hinge does not collide with the plate it is folded from), audited.
+  the schedule starts, servo commands at the servo's 50 Hz PWM rate, the SG90 servo model, a
+  near-rigid loop closure, rounded link edges on the floor, links that collide with the floor
+  but not with their own chassis (a flexure hinge does not collide with the plate it is folded
+  from), a time step at which the hop has converged (docs/servo.md), audited.
 - ``small`` / ``medium`` / ``large``: the physical leg sets of Part 3, +0 / +1 / +2 cm on
   every link of the seed design.
 - ``seed-notebook``: the notebook's Part 2 simulation exactly (dropped from 8 cm with the
@@ -91,6 +92,9 @@ class Contact:
     torsional_friction: float = 0.006
     rolling_friction: float = 0.00005
     self_collision: bool = False     # links collide with the chassis and each other (notebook: yes)
+    # a link's edge on the floor is a rounded line (a capsule of the laminate's thickness);
+    # False: sharp box corners, the notebook's model (docs/servo.md, "Contact and loop")
+    rounded_edges: bool = True
 
 
 @dataclass(frozen=True)
@@ -107,15 +111,19 @@ class Schedule:
 class Solver:
     """How the simulation is run (not a property of the robot, but of the result)."""
 
-    # rk4 at 1 ms: every preset within 1 % or 0.1 mm per hop of dt/2 (docs/servo.md has the table)
-    timestep_s: float = 1e-3
+    # rk4 at 2.5 ms: the seed design within 0.1 mm per hop of dt/2 (docs/servo.md has the table)
+    timestep_s: float = 2.5e-3
     integrator: str = "rk4"          # euler | implicitfast | implicit | rk4
     iterations: int = 10
     tolerance: float = 1e-6
     control_hz: float = 50.0         # rate at which servo commands change (PWM period)
     settle_s: float = 0.5            # time on the floor, servos at rest, before the schedule
-    loop_timeconst_s: float = 0.002  # stiffness of the loop-closing connect (notebook: 0.02)
-    loop_dmax: float = 0.99          # its impedance at rest (notebook: 0.95); 1 = rigid
+    # the loop-closing connect: impedance 1 = rigid. Near-rigid by default (the folded linkage
+    # does not stretch: anchors stay within about 10 um under load), so its time constant only
+    # sets how fast a drift is corrected and need not be near the step (docs/servo.md)
+    loop_timeconst_s: float = 0.01   # (notebook: 0.02)
+    loop_dmin: float = 0.9999        # impedance at zero violation (notebook: 0.9)
+    loop_dmax: float = 0.9999        # impedance at full violation (notebook: 0.95)
 
 
 SECTIONS: dict[str, type] = {
@@ -319,7 +327,8 @@ def _seed_notebook() -> Robot:
             "servo.noload_speed_rad_per_s": math.inf, "servo.armature_kgm2": 0.0,
             "solver.timestep_s": 1e-4, "solver.integrator": "euler", "solver.iterations": 50,
             "solver.tolerance": 1e-8, "solver.control_hz": 60.0, "solver.settle_s": 0.0,
-            "contact.self_collision": True, "solver.loop_timeconst_s": 0.02, "solver.loop_dmax": 0.95,
+            "contact.self_collision": True, "contact.rounded_edges": False,
+            "solver.loop_timeconst_s": 0.02, "solver.loop_dmin": 0.9, "solver.loop_dmax": 0.95,
         },
         prov,
     ).renamed("seed-notebook")
@@ -328,11 +337,15 @@ def _seed_notebook() -> Robot:
 PRESETS = {
     "seed": _seed,
     "small": lambda: leg_set(_seed(), "small"),
-    "medium": lambda: leg_set(_seed(), "medium"),
-    # Large's hops are a fraction of a millimetre: rk4 at 1 ms moves them by 0.16 mm per hop
-    # at dt/2, at 0.25 ms by 0.002 mm (docs/servo.md)
+    # Medium sits near a threshold (its crank tips and couplers touch the floor): at 2 ms and
+    # 0.5 ms it lands on the other side of it, 0.12 mm per hop away; 0.25 ms is within
+    # 0.01 mm per hop of 0.125 ms (docs/servo.md)
+    "medium": lambda: leg_set(_seed(), "medium").with_values(
+        {"solver.timestep_s": 2.5e-4}, Provenance(source="preset:medium", note="converged step, docs/servo.md")),
+    # Large's hops are about half a millimetre: at 2.5 ms its dt/2 change is 0.1 mm per hop,
+    # at 2 ms 0.01 mm (docs/servo.md)
     "large": lambda: leg_set(_seed(), "large").with_values(
-        {"solver.timestep_s": 2.5e-4}, Provenance(source="preset:large", note="converged step, docs/servo.md")),
+        {"solver.timestep_s": 2e-3}, Provenance(source="preset:large", note="converged step, docs/servo.md")),
     "seed-notebook": _seed_notebook,
 }
 

@@ -97,6 +97,9 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
     # MuJoCo's autoreset would silently restart a diverged run: the audit must see it.
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
+    # one robot is one constraint island: discovering islands costs a tenth of a step and
+    # changes nothing in the result (bench/sim_speed.py)
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_ISLAND
     spec.visual.global_.offwidth = 1280
     spec.visual.global_.offheight = 720
     spec.visual.quality.shadowsize = 2048
@@ -133,7 +136,7 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
 
     half_w, half_t = g.link_width_m / 2, g.link_thickness_m / 2
     foot_material = [k.foot_friction, k.torsional_friction, k.rolling_friction]
-    rho, selfc = g.link_density_kg_per_m3, bool(k.self_collision)
+    rho, selfc, rounded = g.link_density_kg_per_m3, bool(k.self_collision), bool(k.rounded_edges)
     for side in SIDES:
         y = g.leg_mount_y_m if side == "L" else -g.leg_mount_y_m
         ground = chassis.add_body(name=f"{side}_ground", pos=[g.leg_mount_x_m, y, 0])
@@ -149,15 +152,15 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
                                       range=[-math.radians(s.travel_deg), math.radians(s.travel_deg)],
                                       limited=mujoco.mjtLimited.mjLIMITED_TRUE,
                                       stiffness=c.hinge_stiffness_nm_per_rad)
-        _link_box(crank, g.crank_m, half_w, half_t, LINK_RGBA["crank"], foot_material, rho, selfc)
+        _link_box(crank, g.crank_m, half_w, half_t, LINK_RGBA["crank"], foot_material, rho, selfc, rounded)
         coupler = crank.add_body(name=f"{side}_coupler", pos=[g.crank_m, 0, 0],
                                  quat=_quat_euler_deg(0, asm.coupler_rel_deg, 0))
         _hinge(coupler, f"{side}_knee", c)
-        _link_box(coupler, g.coupler_m, half_w, half_t, LINK_RGBA["coupler"], foot_material, rho, selfc)
+        _link_box(coupler, g.coupler_m, half_w, half_t, LINK_RGBA["coupler"], foot_material, rho, selfc, rounded)
         leg = coupler.add_body(name=f"{side}_leg", pos=[g.coupler_m, 0, 0],
                                quat=_quat_euler_deg(0, asm.leg_rel_deg, 0))
         _hinge(leg, f"{side}_ankle", c)
-        _link_box(leg, g.leg_m, half_w, half_t, LINK_RGBA["leg"], foot_material, rho, selfc)
+        _link_box(leg, g.leg_m, half_w, half_t, LINK_RGBA["leg"], foot_material, rho, selfc, rounded)
         leg.add_site(name=f"{side}_foot", pos=[0, 0, 0], size=[0.004, 0, 0])
         if side == "L":   # foot dot: on the leg's camera-facing face, up the leg from the foot
             _marker(leg, "foot", [MARKER_FOOT_UP * MARKER_RADIUS_M, g.link_width_m / 2, 0])
@@ -169,7 +172,7 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
                           objtype=mujoco.mjtObj.mjOBJ_BODY, name1=f"{side}_ground", name2=f"{side}_end",
                           data=[g.ground_m / 2, 0, 0] + [0.0] * 7 + [1.0, 0.0],  # as MJCF fills it
                           solref=[sol.loop_timeconst_s, 1.0],
-                          solimp=[min(0.9, sol.loop_dmax), sol.loop_dmax, 0.001, 0.5, 2.0])
+                          solimp=[sol.loop_dmin, sol.loop_dmax, 0.001, 0.5, 2.0])
         act = spec.add_actuator(name=f"{side}_servo", target=f"{side}_servo",
                                 trntype=mujoco.mjtTrn.mjTRN_JOINT)
         configure_servo(servo_joint, act, s, joint_damping_nms_per_rad=c.hinge_damping_nms_per_rad)
@@ -191,12 +194,26 @@ FLOOR_BITS = (1, 3)       # contype, conaffinity
 ROBOT_BITS = {True: (1, 1), False: (2, 1)}
 
 
+# group of the rounded contact edges: hidden in renders (the box is what the camera sees)
+CONTACT_EDGE_GROUP = 3
+
+
 def _link_box(body, length_m: float, half_w: float, half_t: float, rgba, friction,
-              density: float, self_collision: bool) -> None:
+              density: float, self_collision: bool, rounded_edges: bool) -> None:
+    """A laminate link: a box that carries its mass and is drawn. It touches the floor with
+    its box corners, or with ``rounded_edges`` through a massless capsule along the link of the
+    laminate's thickness: in the plane of motion its profile is the link's (length by
+    thickness, ends rounded), a rolling edge with one contact per end instead of four
+    corners that the contact jumps between (docs/servo.md, "Contact and loop")."""
     contype, conaffinity = ROBOT_BITS[self_collision]
+    box_bits = (0, 0) if rounded_edges else (contype, conaffinity)
     body.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, pos=[length_m / 2, 0, 0],
                   size=[length_m / 2, half_w, half_t], rgba=list(rgba), friction=list(friction),
-                  density=density, contype=contype, conaffinity=conaffinity)
+                  density=density, contype=box_bits[0], conaffinity=box_bits[1])
+    if rounded_edges:
+        body.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[half_t, 0, 0, length_m - half_t, 0, 0],
+                      size=[half_t, 0, 0], density=0.0, friction=list(friction), contype=contype,
+                      conaffinity=conaffinity, group=CONTACT_EDGE_GROUP, rgba=list(rgba))
 
 
 def _ghost_box(body, length_m: float, half_w: float, half_t: float, rgba, density: float) -> None:
