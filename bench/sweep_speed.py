@@ -34,9 +34,9 @@ from locust.params import preset  # noqa: E402
 from locust.sim.model import build  # noqa: E402
 from locust.sim.rollout import initial_state, simulate_built  # noqa: E402
 from locust.sim.schedule import control_plan  # noqa: E402
-from locust.sim.sweep import run_sweep  # noqa: E402
-from locust.sim.sweep_design import design_robot, parse_axis  # noqa: E402
-from locust.sim.sweep_exec import default_jobs  # noqa: E402
+from locust.sweep.run import run_sweep  # noqa: E402
+from locust.sweep.design import design_robot, parse_axis  # noqa: E402
+from locust.sweep.execute import default_jobs  # noqa: E402
 
 
 def notebook_loop_on(built, plan) -> float:

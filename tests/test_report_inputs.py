@@ -200,7 +200,7 @@ def test_demo_virtual_robot_carries_the_recordings_truth():
     """The demo's virtual robot is built from the bundled recordings' '# truth:' headers,
     which replay the seed's identified values (calibration/make_synthetic.py)."""
     from locust.params import preset
-    from locust.report.demo_cli import CALIBRATIONS, RECORDINGS, recording_truth
+    from locust.demo import CALIBRATIONS, RECORDINGS, recording_truth
 
     truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])
     assert truth == pytest.approx({

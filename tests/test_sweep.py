@@ -16,8 +16,8 @@ import pytest
 
 from locust.errors import SweepError
 from locust.params import preset
-from locust.sim.sweep import best_row, run_sweep
-from locust.sim.sweep_design import evaluate, parse_axis, parse_bound, precheck, design_robot
+from locust.sweep.run import best_row, run_sweep
+from locust.sweep.design import evaluate, parse_axis, parse_bound, precheck, design_robot
 
 LOCUST = [sys.executable, "-c", "from locust.cli import main; main()"]
 
@@ -171,7 +171,7 @@ def test_sweep_cli_bad_input_exits_2_without_traceback(tmp_path):
 
 # -- optimisation ----------------------------------------------------------------------
 def test_optimize_prunes_invalid_designs_and_keeps_the_study(tmp_path):
-    from locust.sim.optimize import run_optimize
+    from locust.sweep.optimize import run_optimize
 
     base = preset("seed")
     # couplers above 0.1166 m cannot close at the start angle (|coupler - leg| > 5.66 cm)
@@ -191,7 +191,7 @@ def test_optimize_prunes_invalid_designs_and_keeps_the_study(tmp_path):
 
 
 def test_optimize_on_sqlite_storage(tmp_path):
-    from locust.sim.optimize import run_optimize
+    from locust.sweep.optimize import run_optimize
 
     base = preset("seed")
     url = f"sqlite:///{tmp_path / 'study.db'}"
@@ -222,7 +222,7 @@ def test_seed_scale_sweep_local_and_dask_local_agree(tmp_path):
 def test_a_second_sweep_into_a_running_sweeps_folder_is_refused(tmp_path):
     import fcntl
 
-    from locust.sim.sweep_store import LOCK
+    from locust.sweep.store import LOCK
 
     base = preset("seed")
     axis = parse_axis("geometry.coupler_m=0.205:0.21:2", base)

@@ -20,8 +20,8 @@ from .errors import LocustError
 COMMANDS: dict[str, tuple[str, str, str]] = {
     "params": ("locust.params_cli", "params", "Show or write robot parameters (presets, robot.toml, --set)."),
     "sim": ("locust.sim.cli", "sim", "Simulate the hop schedule in MuJoCo, audited."),
-    "sweep": ("locust.sim.sweep_cli", "sweep", "Sweep design parameters over a grid, in parallel."),
-    "optimize": ("locust.sim.sweep_cli", "optimize", "Optimise hop distance with Optuna."),
+    "sweep": ("locust.sweep.cli", "sweep", "Sweep design parameters over a grid, in parallel."),
+    "optimize": ("locust.sweep.cli", "optimize", "Optimise hop distance with Optuna."),
     "ports": ("locust.device.cli", "ports", "List serial ports and mark the likely ESP32."),
     "flash": ("locust.device.cli", "flash", "Copy the MicroPython firmware to the board (mpremote)."),
     "hop": ("locust.device.cli", "hop", "Run the bang-bang hop schedule on the robot; save a run record."),
@@ -29,7 +29,7 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
     "track": ("locust.track.cli", "track", "Extract marker tracks (nose, foot) from video."),
     "calibrate": ("locust.calibrate.cli", "calibrate", "Fit stiffness, damping, servo gains, friction."),
     "report": ("locust.report.cli", "report", "Compare simulation and measurement in an HTML report."),
-    "demo": ("locust.report.demo_cli", "demo", "Run the whole toolkit end to end on the virtual robot."),
+    "demo": ("locust.demo", "demo", "Run the whole toolkit end to end on the virtual robot."),
     "fab": ("locust.fab.cli", "fab", "Generate the five-layer laminate cut files (DXF)."),
 }
 

@@ -1,6 +1,6 @@
 """``run_sweep``: a grid of designs, checked, simulated, audited, stored as they finish.
 
-    from locust.sim.sweep import run_sweep
+    from locust.sweep.run import run_sweep
     summary = run_sweep(preset("seed"), [parse_axis("scale=0:0.05:30", base)], cycles=3,
                         out=Path("sweep-out"))
 
@@ -19,9 +19,9 @@ from pathlib import Path
 from typing import Any
 
 from ..params import Robot
-from .sweep_design import Axis, evaluate
-from .sweep_exec import default_jobs, mapper
-from .sweep_store import SweepStore
+from .design import Axis, evaluate
+from .execute import default_jobs, mapper
+from .store import SweepStore
 
 
 @dataclass(frozen=True)
@@ -103,7 +103,7 @@ def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: 
             "computed": len(rows) - resumed, "wall_s": wall, "scheduler": scheduler, "jobs": jobs})
     made: list[Path] = []
     if plots and rows:
-        from .sweep_plot import plot_landscape
+        from .plot import plot_landscape
 
         made = plot_landscape(rows, axes, best, out, base)
     return SweepSummary(Path(out), rows, best, len(rows) - resumed, resumed, wall, finished, made)

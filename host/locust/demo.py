@@ -27,12 +27,12 @@ from pathlib import Path
 
 import click
 
-from ..errors import ReportError
-from ..fileio import atomic_write_json, atomic_write_text, unique_dir
-from ..progress import progress
+from .errors import ReportError
+from .fileio import atomic_write_json, atomic_write_text, unique_dir
+from .progress import progress
 
 LEG_SETS = ("small", "medium", "large")
-RECORDINGS = Path(__file__).resolve().parents[3] / "calibration" / "recordings"
+RECORDINGS = Path(__file__).resolve().parents[2] / "calibration" / "recordings"
 # (subcommand, recording, its options); the servo recording is the preset SG90 on a light
 # load, split with the datasheet's stall torque (no-load speed, armature and kp are written).
 CALIBRATIONS = (

@@ -18,7 +18,7 @@ from typing import Any
 from ..errors import SweepError
 from ..fileio import atomic_write_json, atomic_write_text
 from ..params import Robot
-from .sweep_design import Bound, evaluate
+from .design import Bound, evaluate
 
 RDB_PREFIXES = ("sqlite:", "postgresql", "mysql", "oracle", "mssql")
 

@@ -21,7 +21,7 @@ from typing import Any
 
 from ..errors import SweepError
 from ..fileio import atomic_write_json, atomic_write_text
-from .sweep_design import RESULT_FIELDS
+from .design import RESULT_FIELDS
 
 RESULTS = "results.csv"
 META = "sweep.json"

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import GeometryError, LocustError, SweepError
 from ..params import Provenance, Robot, all_keys, with_added_length
-from .fourbar import assemble
+from ..sim.fourbar import assemble
 
 SCALE = "scale"
 RESULT_FIELDS = ("valid", "reason", "distance_m", "max_nose_height_m", "nose_apex_max_m",
@@ -152,7 +152,7 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int) -> dict[str, An
 
     A pure function of its arguments: whichever process or machine runs it, the row is the same.
     """
-    from .run import run
+    from ..sim.run import run
 
     try:
         robot = design_robot(base, values)

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..params import LEG_SETS_M, Robot, preset
 from ..plotting import pyplot, save_png
-from .sweep_design import SCALE, Axis
+from .design import SCALE, Axis
 
 METRICS = (("distance_m", "distance (cm)"), ("max_nose_height_m", "highest nose point (cm)"))
 
