@@ -16,18 +16,14 @@ with the ratios live/rollout and live+video/live.
 
 from __future__ import annotations
 
-import os
+import argparse
+import tempfile
+import time
+from pathlib import Path
 
-os.environ.setdefault("MUJOCO_GL", "osmesa")
-
-import argparse  # noqa: E402
-import tempfile  # noqa: E402
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
-
-from locust.params import preset  # noqa: E402
-from locust.sim.live import LiveSim  # noqa: E402
-from locust.sim.rollout import simulate  # noqa: E402
+from locust.params import preset
+from locust.sim.live import LiveSim  # importing locust.sim picks the offscreen GL backend
+from locust.sim.rollout import simulate
 
 
 def drive(robot, cycles: int, video: Path | None) -> float:

@@ -30,6 +30,12 @@ LIMITS = {
 
 
 def default():
+    """The config used while config.json is missing or invalid.
+
+    Its pulse range and travel are the robot parameters' (``locust.params.Servo``): this
+    file cannot import the host, so it keeps a copy, and a host test checks the two agree.
+    The host writes config.json from ``params.Servo`` itself (``locust flash``).
+    """
     return {
         "left": {"pin": 18, "pulse_min_us": 500, "pulse_max_us": 2500, "range_deg": 180,
                  "trim_deg": 0.0, "direction": 1, "travel_deg": 45},

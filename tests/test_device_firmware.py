@@ -37,3 +37,20 @@ def test_unit_tests_pass_under_micropython():
                                            capture_output=True, text=True).stdout
     last = proc.stdout.strip().splitlines()[-1]
     assert last == f"RESULT {expected} 0", proc.stdout[-3000:] + proc.stderr[-2000:]
+
+
+def test_firmware_fallback_servo_config_is_the_robot_parameters():
+    """The board's built-in config (used until config.json exists) keeps a copy of the pulse
+    range and travel, as it cannot import the host; the host writes them from params.Servo."""
+    from locust.device.flash import servo_config
+    from locust.firmware import config as fw_config
+    from locust.params import Servo
+
+    keys = ("pulse_min_us", "pulse_max_us", "range_deg", "travel_deg")
+    written = servo_config(Servo())
+    assert fw_config.problems(written) == []
+    for name in fw_config.SERVOS:
+        assert {k: fw_config.default()[name][k] for k in keys} == {k: getattr(Servo(), k) for k in keys}
+        assert {k: written[name][k] for k in keys} == {k: getattr(Servo(), k) for k in keys}
+    narrow = servo_config(Servo(pulse_min_us=600.0, pulse_max_us=2400.0, travel_deg=40.0))
+    assert narrow["right"]["pulse_min_us"] == 600.0 and narrow["left"]["travel_deg"] == 40.0

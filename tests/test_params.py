@@ -55,3 +55,23 @@ def test_broken_toml_names_the_file(tmp_path):
     with pytest.raises(ParamsError) as err:
         P.load_robot(bad)
     assert str(bad) in err.value.message
+
+
+def test_a_misspelt_base_preset_is_refused(tmp_path):
+    """Before: `base = "meduim"` silently loaded the seed."""
+    path = tmp_path / "robot.toml"
+    path.write_text('name = "mine"\nbase = "meduim"\n')
+    with pytest.raises(P.ParamsError, match="base = 'meduim' is not a preset"):
+        P.load_robot(path)
+    path.write_text('name = "mine"\nbase = "medium"\n')
+    assert P.load_robot(path).geometry.leg_m == pytest.approx(0.07)   # Medium: +1 cm on the seed's 6 cm
+
+
+@pytest.mark.parametrize("raw", ['"big"', "-0.1", "nan", "true"])
+def test_an_uncertainty_that_is_not_a_number_is_an_error_not_a_traceback(tmp_path, raw):
+    path = tmp_path / "robot.toml"
+    path.write_text(f'[servo]\nkp_nm_per_rad = {{ value = 0.26, source = "fit:x", uncertainty = {raw} }}\n')
+    with pytest.raises(P.ParamsError, match=r"servo.kp_nm_per_rad has uncertainty = .* not a number >= 0"):
+        P.load_robot(path)
+    path.write_text('[servo]\nkp_nm_per_rad = { value = 0.26, source = "fit:x", uncertainty = 0.019 }\n')
+    assert P.load_robot(path).source_of("servo.kp_nm_per_rad").uncertainty == 0.019

@@ -19,6 +19,7 @@ from locust.report.configs import configuration, name_from_path, parse_added
 from locust.report.landscape import design_value, read_landscape
 from locust.report.measure import align, measure_hops, onset_time
 from locust.report.measured import parse_measured
+from locust.sweep.store import columns as sweep_columns
 
 
 def staircase(fps=30.0, lead_s=0.4, period_s=1.3, hops=(0.20, 0.25, 0.15), apex=(0.05, 0.08, 0.03), noise=0.0, seed=0):
@@ -97,17 +98,17 @@ def write_sweep(folder: Path, rows: list[str], vary="scale", cycles=3) -> Path:
     folder.mkdir(parents=True)
     (folder / "sweep.json").write_text(json.dumps({"request": {"base": "seed", "vary": [
         {"name": vary, "start": 0.0, "stop": 0.03, "n": len(rows)}], "cycles": cycles}, "finished": True}))
-    head = f"design,{vary},valid,reason,distance_m,max_nose_height_m,nose_apex_max_m,com_apex_max_m,hops,wall_s\n"
-    (folder / "results.csv").write_text(head + "\n".join(rows) + "\n")
+    head = ",".join(sweep_columns([vary])) + "\n"
+    (folder / "results.csv").write_text(head + "".join(row + "\n" for row in rows))
     return folder
 
 
 def test_sweep_landscape_reads_and_places_designs(tmp_path):
     # SYNTHETIC sweep results (numbers made up for the reader; not a simulation)
     folder = write_sweep(tmp_path / "synthetic-sweep", [
-        "0,0.0,True,,0.60,0.1,0.09,0.05,3,1.0",
-        "1,0.01,True,,0.90,0.1,0.09,0.05,3,1.0",
-        "2,0.02,False,energy audit failed,nan,nan,nan,nan,0,1.0",
+        "0,0.0,True,,0.60,0.1,0.09,0.05,3,crank-rocker,80.0",
+        "1,0.01,True,,0.90,0.1,0.09,0.05,3,crank-rocker,80.0",
+        "2,0.02,False,energy audit failed,nan,nan,nan,nan,0,crank-rocker,80.0",
     ])
     land = read_landscape(folder)
     assert land.names == ["scale"] and land.cycles == 3 and land.designs == 3
@@ -120,7 +121,10 @@ def test_sweep_landscape_reads_and_places_designs(tmp_path):
 
 
 @pytest.mark.parametrize("rows, message", [
-    (["0,0.0,maybe,,0.6,0.1,0.09,0.05,3,1.0"], "line 2: 'valid' is not True/False"),
+    (["0,0.0,maybe,,0.6,0.1,0.09,0.05,3,crank-rocker,80.0"], "line 2: malformed row .valid = 'maybe'"),
+    # a malformed row before the last is never skipped (only a torn last line is dropped)
+    (["0,0.0,True,,0.6,0.1,0.09,0.05,3,crank-rocker,80.0", "1,0.01,True,,oops,0.1,0.09,0.05,3,crank-rocker,80.0",
+      "2,0.02,True,,0.6,0.1,0.09,0.05,3,crank-rocker,80.0"], "line 3: malformed row"),
     ([], "no designs"),
 ])
 def test_bad_sweep_folders(tmp_path, rows, message):
@@ -186,7 +190,7 @@ def test_a_missing_sweep_folder_fails_before_any_simulation(tmp_path):
 
 def test_measured_groups_by_name_and_folder(tmp_path):
     run = {"status": "complete", "schedule": {"cycles": 2, "push_deg": -30, "push_ms": 300, "wait_ms": 1000},
-           "phases": [{"cycle": 1, "phase": "push", "commanded_ms": 0.0, "measured_ms": 0.2}]}
+           "phases": [{"cycle": 1, "phase": "push", "commanded_us": 0, "measured_us": 200}]}
     a = make_trial(tmp_path / "large-1", run=run)
     b = make_trial(tmp_path / "x", run=run)
     groups = parse_measured([str(a), f"Medium={b}"])

@@ -7,22 +7,20 @@ checked against what is actually in the MP4: the centroid of each marker's colou
 from __future__ import annotations
 
 import json
-import os
 
-os.environ.setdefault("MUJOCO_GL", "osmesa")
+import cv2
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
 
-import cv2  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-import pytest  # noqa: E402
-
-from click.testing import CliRunner  # noqa: E402
-
-from locust.cli import cli  # noqa: E402
-from locust.errors import SimError  # noqa: E402
-from locust.markers import MARKER_COLOURS  # noqa: E402
-from locust.params import preset  # noqa: E402
-from locust.sim.video import VISIBLE_FRAC, render_video  # noqa: E402
+from locust.cli import cli
+from locust.errors import SimError
+from locust.markers import MARKER_COLOURS
+from locust.params import preset
+from locust.sim.clip import VISIBLE_FRAC, render_video
+from locust.sim.rollout import simulate
+from locust.sim.run import run
 
 W, H, FPS = 320, 240, 30
 FULLY_SEEN = 0.8         # frames where a marker is at least this much in view (not on the floor)
@@ -206,6 +204,16 @@ def test_fixed_camera_metres_per_pixel(clips):
     dpx = truth.nose_px.iloc[-1] - truth.nose_px.iloc[0]
     assert abs(dx_m) > 0.05                                     # the robot hopped
     assert -dpx * m_per_px == pytest.approx(dx_m, rel=0.02)     # +x runs right to left in this view
+
+
+def test_renders_an_audited_run_without_simulating_again(clips, tmp_path):
+    robot, infos = clips
+    traj = run(robot, cycles=1, keep_states=True).trajectory
+    info = render_video(robot, tmp_path / "again.mp4", camera="fixed", fps=FPS, width=W, height=H, trajectory=traj)
+    assert info.truth_path.read_text() == infos["fixed"].truth_path.read_text()
+    assert info.camera_path.read_text() == infos["fixed"].camera_path.read_text()
+    with pytest.raises(SimError, match="kept no states"):
+        render_video(robot, tmp_path / "stateless.mp4", trajectory=simulate(robot, cycles=1))
 
 
 def test_refuses_to_overwrite_and_bad_names(tmp_path):

@@ -235,3 +235,38 @@ def test_a_second_sweep_into_a_running_sweeps_folder_is_refused(tmp_path):
     # released: the same sweep reopens (everything already done, nothing recomputed)
     again = run_sweep(base, [axis], cycles=1, out=out, jobs=1, plots=False)
     assert (again.resumed, again.computed) == (2, 0)
+
+
+def test_results_csv_round_trips_through_its_owner_and_only_a_torn_last_line_is_dropped(tmp_path):
+    """results.csv is written and read back by locust.sweep.store alone: every field comes back
+    bit for bit (floats by repr, nan, bools, ints); an interrupt's torn last line is dropped on
+    reading, a malformed row anywhere else is an error naming its line."""
+    from locust.sweep.store import SweepStore, read_results
+
+    rows = [  # SYNTHETIC rows (made-up figures, not simulations)
+        {"design": 0, "scale": 0.0, "valid": True, "reason": "", "distance_m": 0.009292704540008771,
+         "max_nose_height_m": 0.1 + 0.2, "nose_apex_max_m": 1e-17, "com_apex_max_m": 2.5e-3, "hops": 3,
+         "grashof": "change-point", "transmission_deg": 77.15523372599155},
+        {"design": 1, "scale": 0.01, "valid": False, "reason": "energy audit failed, twice", "distance_m": math.nan,
+         "max_nose_height_m": math.nan, "nose_apex_max_m": math.nan, "com_apex_max_m": math.nan, "hops": 0,
+         "grashof": "crank-rocker", "transmission_deg": 80.0},
+    ]
+    request = {"base": "seed", "vary": [{"name": "scale", "start": 0.0, "stop": 0.01, "n": 2}], "cycles": 3}
+    store = SweepStore.open(tmp_path / "s", {"request": request}, ["scale"])
+    for row in rows:
+        store.append(row)
+    store.close(True, finished=True)
+    back = read_results(tmp_path / "s")
+    assert back.axis_names == ["scale"] and back.cycles == 3 and back.base == "seed" and back.finished
+    assert back.rows[0] == rows[0]
+    assert back.rows[1]["valid"] is False and back.rows[1]["reason"] == "energy audit failed, twice"
+    assert all(math.isnan(back.rows[1][k]) for k in ("distance_m", "max_nose_height_m"))
+
+    path = tmp_path / "s" / "results.csv"
+    text = path.read_text()
+    path.write_text(text + "2,0.02,True,,0.0")            # an interrupt cut the row being appended
+    assert [r["design"] for r in read_results(tmp_path / "s").rows] == [0, 1]
+    lines = text.splitlines(keepends=True)
+    path.write_text(lines[0] + lines[1].replace("True", "Ture") + lines[2])
+    with pytest.raises(SweepError, match="line 2: malformed row"):
+        read_results(tmp_path / "s")

@@ -11,6 +11,7 @@ from click.testing import CliRunner
 
 from locust.cli import cli
 from locust.track import trk
+from locust.track.tracker_text import read_tracker_export
 
 
 @pytest.fixture(scope="module")
@@ -71,15 +72,16 @@ def test_from_trk_cli_writes_trackers_text_layout(shared_data, tmp_path):
     res = CliRunner().invoke(cli, ["track", "--from-trk", str(shared_data / "tracker" / "BallToss.trz"),
                                    "--format", "tracker", "--out", str(out)])
     assert res.exit_code == 0, res.output
-    table = trk.read_tracker_text(out)["ball"]
+    table = read_tracker_export(out).tracks["ball"]
     project = trk.read_project(shared_data / "tracker" / "BallToss.trz")
     result = trk.project_result(project)
     x, y = result.world(result.markers[0])
     ok = result.markers[0].ok
-    assert np.isnan(table["x"][~ok]).all()
-    np.testing.assert_allclose(table["t"][ok], result.t_s[ok], atol=1e-6)
-    np.testing.assert_allclose(table["x"][ok], x[ok], atol=1e-5)
-    np.testing.assert_allclose(table["y"][ok], y[ok], atol=1e-5)
+    assert len(table.x_m) == len(result.frames)           # frames without a step are rows of empty cells
+    assert np.isnan(table.x_m[~ok]).all()
+    np.testing.assert_allclose(table.t_s[ok], result.t_s[ok], atol=1e-6)
+    np.testing.assert_allclose(table.x_m[ok], x[ok], atol=1e-5)
+    np.testing.assert_allclose(table.y_m[ok], y[ok], atol=1e-5)
     assert (tmp_path / "balltoss.json").is_file()
 
 

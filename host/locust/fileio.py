@@ -51,18 +51,36 @@ def atomic_write_text(path: str | os.PathLike, text: str) -> Path:
 
 
 def atomic_write_json(path: str | os.PathLike, obj: Any) -> Path:
-    return atomic_write_text(path, json.dumps(obj, indent=2, sort_keys=False, default=_jsonable) + "\n")
+    """Write ``obj`` as strict JSON (:func:`json_text`), atomically."""
+    return atomic_write_text(path, json_text(obj))
 
 
-def _jsonable(obj: Any) -> Any:
+def json_text(obj: Any) -> str:
+    """Strict JSON, indented, with a final newline: the one place where a number that JSON
+    cannot hold (NaN, +-inf: an undetermined figure) becomes ``null``, numpy values become
+    plain ones and paths strings. Every JSON file and every ``--json`` output goes through it."""
+    return json.dumps(_strict(obj), indent=2, allow_nan=False) + "\n"
+
+
+def _strict(obj: Any) -> Any:
+    import math
+
     import numpy as np
 
-    if isinstance(obj, np.generic):
-        return obj.item()
+    if isinstance(obj, dict):
+        return {k: _strict(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_strict(v) for v in obj]
     if isinstance(obj, np.ndarray):
-        return obj.tolist()
+        return _strict(obj.tolist())
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
     if isinstance(obj, Path):
         return str(obj)
+    if obj is None or isinstance(obj, (str, int, bool)):
+        return obj
     raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
 
 

@@ -31,6 +31,9 @@ from typing import Any
 from .errors import ParamsError
 from .fileio import atomic_write_text
 
+# Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
+GRAVITY_M_PER_S2 = 9.81
+
 
 @dataclass(frozen=True)
 class Geometry:
@@ -358,6 +361,16 @@ def preset(name: str) -> Robot:
 
 
 # -- TOML ---------------------------------------------------------------------------
+def _uncertainty(path: Path, key: str, raw: Any) -> float | None:
+    """One standard deviation, a finite number >= 0 in the value's unit, or absent."""
+    if raw is None:
+        return None
+    if isinstance(raw, bool) or not isinstance(raw, (int, float)) or not math.isfinite(raw) or raw < 0:
+        raise ParamsError(f"{path}: {key} has uncertainty = {raw!r}, not a number >= 0",
+                          "write one standard deviation in the value's own unit, e.g. uncertainty = 0.01, or leave it out")
+    return float(raw)
+
+
 def load_robot(path: str | Path) -> Robot:
     """Read a robot.toml. Missing values fall back to the seed preset's."""
     path = Path(path)
@@ -367,8 +380,10 @@ def load_robot(path: str | Path) -> Robot:
         raise ParamsError(f"{path}: no such file", "give the path of a robot.toml, or use --preset") from None
     except tomllib.TOMLDecodeError as exc:
         raise ParamsError(f"{path}: not valid TOML ({exc})", "fix the file, or regenerate it with `locust params --write`") from None
-    robot = preset(str(doc.get("base", "seed"))) if doc.get("base", "seed") in PRESETS else preset("seed")
-    robot = robot.renamed(str(doc.get("name", path.stem)))
+    base = doc.get("base", "seed")
+    if base not in PRESETS:
+        raise ParamsError(f"{path}: base = {base!r} is not a preset", f"choose one of {', '.join(PRESETS)}")
+    robot = preset(base).renamed(str(doc.get("name", path.stem)))
     for section, table in doc.items():
         if section in ("name", "base"):
             continue
@@ -385,7 +400,7 @@ def load_robot(path: str | Path) -> Robot:
                     raise ParamsError(f"{path}: {key} has no 'value'", "write it as {value = ..., source = \"...\"}")
                 prov = Provenance(
                     source=str(entry.get("source", "default")),
-                    uncertainty=None if entry.get("uncertainty") is None else float(entry["uncertainty"]),
+                    uncertainty=_uncertainty(path, key, entry.get("uncertainty")),
                     date=None if entry.get("date") is None else str(entry["date"]),
                     note=None if entry.get("note") is None else str(entry["note"]),
                 )

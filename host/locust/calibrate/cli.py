@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-import json
+import math
 from pathlib import Path
 
 import click
 import numpy as np
 
 from ..errors import CalibrationError
+from ..fileio import json_text
 from ..progress import progress
 from . import beam as B
 from . import ramp as R
@@ -215,7 +216,7 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
             write_fitted(write_path, values, source_name or recording.name, note=note)
         out["written"] = {"path": str(write_path), "keys": list(values)}
     if as_json:
-        click.echo(json.dumps(out, indent=2, default=_jsonable))
+        click.echo(json_text(out), nl=False)
         return
     _print_text(out)
 
@@ -229,7 +230,7 @@ def _print_text(out: dict) -> None:
             flag = "" if val.get("identifiable", True) else "   NOT IDENTIFIABLE"
             if val.get("given"):
                 click.echo(f"{key:30s} {val['value']:<12.6g} (given)")
-            elif val["std"] is None:
+            elif val["std"] is None or not math.isfinite(val["std"]):
                 click.echo(f"{key:30s} {val['value']:<12.6g} (undetermined){flag}")
             else:
                 lo, hi = val["ci95"]
@@ -246,11 +247,3 @@ def _print_text(out: dict) -> None:
         keys = out["written"]["keys"]
         click.echo(f"wrote {', '.join(keys)} to {out['written']['path']}" if keys
                    else f"nothing written to {out['written']['path']}: no value was identifiable")
-
-
-def _jsonable(obj):
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, Path):
-        return str(obj)
-    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")

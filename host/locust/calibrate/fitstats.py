@@ -27,11 +27,10 @@ class Estimate:
     def relative_std(self) -> float:
         return self.std / abs(self.value) if self.value else float("inf")
 
-    def as_dict(self) -> dict[str, float | None | list[float | None]]:
-        """JSON-ready; an undetermined std or bound is ``None`` (JSON has no infinity)."""
-        def fin(v: float) -> float | None:
-            return v if np.isfinite(v) else None
-        return {"value": self.value, "std": fin(self.std), "ci95": [fin(self.ci95_low), fin(self.ci95_high)]}
+    def as_dict(self) -> dict[str, float | list[float]]:
+        """For JSON output: an undetermined std or bound stays ``inf``/``nan`` here and is
+        written ``null`` (:func:`locust.fileio.json_text`)."""
+        return {"value": self.value, "std": self.std, "ci95": [self.ci95_low, self.ci95_high]}
 
 
 @dataclass(frozen=True)

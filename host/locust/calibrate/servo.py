@@ -39,12 +39,11 @@ import numpy as np
 from mujoco import minimize, rollout
 
 from ..errors import CalibrationError
-from ..params import Servo
+from ..params import GRAVITY_M_PER_S2, Servo
 from ..sim.servo import configure, with_servo
 from .curves import Curves
 from .fitstats import Estimate, covariance
 
-G_M_PER_S2 = 9.81
 PARAMS = ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "stall_torque_nm")
 # search box of the physical parameters (wide: an SG90 sits well inside it)
 LOWER = {"noload_speed_rad_per_s": 0.5, "armature_kgm2": 1e-8, "kp_nm_per_rad": 1e-3, "stall_torque_nm": 1e-3}
@@ -158,8 +157,8 @@ def rig_model(rig: ServoRig, servo: Servo | None = None) -> mujoco.MjModel:
     if moment > 0:
         # A point-like load at radius r with m*g*r = M and m*r^2 <= J: put half the inertia
         # in the load's offset, the rest about its own centre.
-        r = 0.5 * j * G_M_PER_S2 / moment
-        mass = moment / (G_M_PER_S2 * r)
+        r = 0.5 * j * GRAVITY_M_PER_S2 / moment
+        mass = moment / (GRAVITY_M_PER_S2 * r)
         x = math.copysign(r, rig.gravity_moment_nm)
     else:
         mass, x = 1.0, 0.0
@@ -168,7 +167,7 @@ def rig_model(rig: ServoRig, servo: Servo | None = None) -> mujoco.MjModel:
     spec.modelname = "servo_rig"
     spec.option.timestep = rig.timestep_s
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    spec.option.gravity = [0.0, 0.0, -G_M_PER_S2]
+    spec.option.gravity = [0.0, 0.0, -GRAVITY_M_PER_S2]
     # a diverging candidate must show as NaN (and be rejected), not be silently reset
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
     horn = spec.worldbody.add_body(name="horn", mass=mass, ipos=[x, 0, 0], inertia=[jc, jc, jc])

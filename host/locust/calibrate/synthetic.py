@@ -15,10 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..params import Servo
+from ..params import GRAVITY_M_PER_S2, Servo
 from .servo import ServoRig, StepRecording, Timing, rig_model, simulate_deg
-
-G = 9.81
 
 
 @dataclass(frozen=True)
@@ -60,8 +58,8 @@ def beam_tip_track(truth: BeamTruth, rng: np.random.Generator, tilt_deg: float =
     wn = 2 * math.pi * truth.natural_frequency_hz
     zeta = truth.damping_ratio
     wd = wn * math.sqrt(1 - zeta**2)
-    y_eq = -truth.mass_kg * G / truth.stiffness_n_per_m
-    v0 = -math.sqrt(2 * G * truth.drop_height_m)
+    y_eq = -truth.mass_kg * GRAVITY_M_PER_S2 / truth.stiffness_n_per_m
+    v0 = -math.sqrt(2 * GRAVITY_M_PER_S2 * truth.drop_height_m)
     tau = np.clip(t - truth.drop_at_s, 0, None)
     a = -y_eq
     b = (v0 + zeta * wn * a) / wd
@@ -166,7 +164,7 @@ def ramp_tilt_track(truth: RampTruth, rng: np.random.Generator, *, fps: float = 
     v = 0.0
     for i in range(1, len(t)):
         if t[i] > tc:
-            a = G * (math.sin(theta[i]) - mu_k * math.cos(theta[i]))
+            a = GRAVITY_M_PER_S2 * (math.sin(theta[i]) - mu_k * math.cos(theta[i]))
             v += max(a, 0.0) / fps
             s[i] = max(s[i - 1] - v / fps, 0.0)
     along = np.column_stack([np.cos(theta), np.sin(theta)])

@@ -10,13 +10,14 @@ from pathlib import Path
 import click
 
 from ..errors import DeviceError
-from ..params import resolve_robot
+from ..params import Schedule, resolve_robot
 from ..params_cli import robot_options
 from ..progress import progress
 from . import record as R
 from .plant import PLANTS
 
 PORT_HELP = "Serial port (e.g. /dev/ttyUSB0), or 'sim' for the virtual robot. Default: the one likely ESP32."
+ROBOT_SCHEDULE = Schedule()   # the robot parameters' default schedule, named in the hop options' help
 
 
 def _info(msg: str) -> None:
@@ -69,11 +70,12 @@ def flash(port, compile_mpy, reset_config, servo_sets, preset, config, sets):
     ($LOCUST_VIRTUAL_DIR/flash, default ~/.cache/locust/virtual/flash).
     """
     from .flash import flash as do_flash
+    from .flash import servo_config
     from .link import Link
     from .session import open_port
 
     edits = [_parse_servo_set(s) for s in servo_sets]
-    servo_cfg = _config_from_robot(resolve_robot(preset, config, sets)) if reset_config else None
+    servo_cfg = servo_config(resolve_robot(preset, config, sets).servo) if reset_config else None
     with open_port(port, plant="record", info=_info) as device:
         result = do_flash(device, compile_mpy=compile_mpy, config=servo_cfg, progress=lambda s: _info(f"  {s}"))
         if edits:
@@ -96,25 +98,18 @@ def _parse_servo_set(item: str) -> tuple[str, float]:
         raise DeviceError(f"--servo {item!r} is not KEY=NUMBER", "e.g. --servo left.trim_deg=-1.5") from None
 
 
-def _config_from_robot(robot) -> dict:
-    from ..firmware import config as fw_config
-
-    cfg = fw_config.default()
-    s = robot.servo
-    for name in fw_config.SERVOS:
-        cfg[name].update(pulse_min_us=s.pulse_min_us, pulse_max_us=s.pulse_max_us,
-                         range_deg=s.range_deg, travel_deg=s.travel_deg)
-    return cfg
-
-
 @click.command()
 @click.option("--port", default=None, help=PORT_HELP)
-@click.option("--cycles", type=click.IntRange(1, 1000), default=None, help="Hop cycles [robot schedule: 6].")
-@click.option("--push-deg", type=float, default=None, help="Horn angle of the push, deg [robot schedule: -30].")
-@click.option("--push-ms", type=click.IntRange(20, 10000), default=None, help="Push time, ms [robot schedule: 300].")
-@click.option("--wait-ms", type=click.IntRange(20, 60000), default=None, help="Wait (rest) time, ms [robot schedule: 1000].")
-@click.option("--heartbeat-ms", type=click.IntRange(100, 10000), default=500, show_default=True,
-              help="The robot returns to rest if the host is silent this long.")
+@click.option("--cycles", type=click.IntRange(*R.hop_range("cycles")), default=None,
+              help=f"Hop cycles [robot schedule: {ROBOT_SCHEDULE.cycles}].")
+@click.option("--push-deg", type=float, default=None,
+              help=f"Horn angle of the push, deg [robot schedule: {ROBOT_SCHEDULE.push_deg:g}].")
+@click.option("--push-ms", type=click.IntRange(*R.hop_range("push_ms")), default=None,
+              help=f"Push time, ms [robot schedule: {ROBOT_SCHEDULE.push_s * 1000:g}].")
+@click.option("--wait-ms", type=click.IntRange(*R.hop_range("wait_ms")), default=None,
+              help=f"Wait (rest) time, ms [robot schedule: {ROBOT_SCHEDULE.wait_s * 1000:g}].")
+@click.option("--heartbeat-ms", type=click.IntRange(*R.hop_range("heartbeat_ms")), default=R.hop_default("heartbeat_ms"),
+              show_default=True, help="The robot returns to rest if the host is silent this long.")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Directory for run.json (must not hold one). Default: data/runs/<timestamp>/.")
 @click.option("--json", "as_json", is_flag=True, help="Print the run record as JSON.")

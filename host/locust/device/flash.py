@@ -8,7 +8,8 @@ mpremote is pinned (1.29.0): its Python API changes between releases. The steps:
 2. enter the raw REPL without a soft reset (on the unix port a soft reset ends the process);
 3. write each file (optionally compiled with ``mpy-cross``), then compare the board's
    SHA-256 of every file with ours;
-4. write ``config.json`` if the board has none (or when asked), soft-reset (Ctrl-D from
+4. write ``config.json`` if the board has none (or when asked; pulse range and travel from
+   the robot parameters, :func:`servo_config`), soft-reset (Ctrl-D from
    the friendly REPL runs ``main.py``; the USB port stays up), and complete the handshake.
 """
 
@@ -27,6 +28,7 @@ from pathlib import Path
 from ..errors import DeviceError
 from ..firmware import config as fw_config
 from ..firmware import protocol as P
+from ..params import Servo
 from .link import Link
 
 FIRMWARE_DIR = Path(P.__file__).resolve().parent
@@ -40,6 +42,17 @@ NO_MICROPYTHON_HINT = (
     "--baud 460800 write_flash 0x1000 ESP32_GENERIC-<version>.bin`, firmware from "
     "https://micropython.org/download/ESP32_GENERIC/), then run `locust flash` again"
 )
+
+
+def servo_config(servo: Servo) -> dict:
+    """The board's ``config.json`` for ``servo``: its pulse range and travel, the firmware's pins,
+    trims and directions. The firmware keeps its own copy of the default pulse range (it cannot
+    import the host); the host always writes these from :class:`locust.params.Servo`."""
+    cfg = fw_config.default()
+    for name in fw_config.SERVOS:
+        cfg[name].update(pulse_min_us=servo.pulse_min_us, pulse_max_us=servo.pulse_max_us,
+                         range_deg=servo.range_deg, travel_deg=servo.travel_deg)
+    return cfg
 
 
 @dataclass(frozen=True)
@@ -172,7 +185,7 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
             result.files.append(FlashedFile(name, len(data), digest))
         if config is not None or not transport.fs_exists(fw_config.FILE):
             progress(f"writing {fw_config.FILE}")
-            transport.fs_writefile(fw_config.FILE, json.dumps(config or fw_config.default()).encode())
+            transport.fs_writefile(fw_config.FILE, json.dumps(config or servo_config(Servo())).encode())
             result.config_written = True
         progress("resetting")
         transport.exit_raw_repl()

@@ -3,10 +3,17 @@
 ``data/runs/<timestamp>/run.json`` (or ``--out DIR``): written when the hop starts and again
 as every phase arrives, atomically, so an interrupted run still leaves a readable record of
 what happened. A record is never overwritten by another run.
+
+This module owns the format both ways: :func:`write` puts a :class:`RunRecord` on disk and
+:func:`read_run_record` gives it back, equal to what was written. Phase times are kept in
+the firmware's native microseconds; the file also carries them in milliseconds for people,
+converted by :func:`us_to_ms` alone. The schedule's limits and defaults are the protocol's
+``hop`` command's (``locust.firmware.protocol.COMMANDS``), read here, never retyped.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import time
 from dataclasses import asdict, dataclass, field
@@ -14,20 +21,43 @@ from pathlib import Path
 
 from ..errors import DeviceError
 from ..fileio import atomic_write_json, unique_dir
+from ..firmware import protocol as P
 
 COMPLETE = "complete"
 INCOMPLETE = "incomplete"
 ERROR = "error"
 RECORD_NAME = "run.json"
+READ_HINT = "give the run.json that `locust hop` wrote"
+DAMAGED_HINT = "the record is damaged; rerun the hop"
+
+# the protocol's `hop` arguments: name -> (kind, lowest, highest, default)
+HOP_ARGS = P.COMMANDS["hop"]
+
+
+def hop_range(name: str) -> tuple[int | float, int | float]:
+    """(lowest, highest) the firmware accepts for the ``hop`` argument ``name``."""
+    return HOP_ARGS[name][1], HOP_ARGS[name][2]
+
+
+def hop_default(name: str) -> int | float:
+    """The value the firmware uses for the ``hop`` argument ``name`` when none is sent."""
+    return HOP_ARGS[name][3]
+
+
+def us_to_ms(us: int) -> float:
+    """Microseconds (the firmware's clock) to milliseconds: the one conversion of phase times."""
+    return us / 1000.0
 
 
 @dataclass(frozen=True)
 class HopSchedule:
-    cycles: int = 6
-    push_deg: float = -30.0
-    push_ms: int = 300
-    wait_ms: int = 1000
-    heartbeat_ms: int = 500
+    """What a hop commands; the defaults are the protocol's (:func:`hop_default`)."""
+
+    cycles: int = hop_default("cycles")
+    push_deg: float = float(hop_default("push_deg"))
+    push_ms: int = hop_default("push_ms")
+    wait_ms: int = hop_default("wait_ms")
+    heartbeat_ms: int = hop_default("heartbeat_ms")
 
     @property
     def phases(self) -> int:
@@ -49,13 +79,25 @@ class Phase:
     def error_us(self) -> int:
         return self.measured_us - self.commanded_us
 
+    @property
+    def commanded_ms(self) -> float:
+        return us_to_ms(self.commanded_us)
+
+    @property
+    def measured_ms(self) -> float:
+        return us_to_ms(self.measured_us)
+
+    @property
+    def error_ms(self) -> float:
+        return us_to_ms(self.error_us)
+
     def to_dict(self) -> dict:
         return {
             "cycle": self.cycle,
             "phase": self.phase,
-            "commanded_ms": self.commanded_us / 1000.0,
-            "measured_ms": self.measured_us / 1000.0,
-            "error_ms": self.error_us / 1000.0,
+            "commanded_ms": self.commanded_ms,
+            "measured_ms": self.measured_ms,
+            "error_ms": self.error_ms,
             "commanded_us": self.commanded_us,
             "measured_us": self.measured_us,
         }
@@ -76,7 +118,7 @@ class Jitter:
 def jitter(phases: list[Phase]) -> Jitter | None:
     if not phases:
         return None
-    errs = [p.error_us / 1000.0 for p in phases]
+    errs = [p.error_ms for p in phases]
     mean = sum(errs) / len(errs)
     std = math.sqrt(sum((e - mean) ** 2 for e in errs) / len(errs))
     return Jitter(n=len(errs), mean_ms=round(mean, 4), std_ms=round(std, 4),
@@ -86,6 +128,8 @@ def jitter(phases: list[Phase]) -> Jitter | None:
 
 @dataclass
 class RunRecord:
+    """One hop's ``run.json``: the schedule, the firmware, the phases as they arrived, the verdict."""
+
     schedule: HopSchedule
     port: str
     status: str = INCOMPLETE
@@ -131,4 +175,59 @@ def run_dir(out: Path | None, root: Path = Path("data/runs")) -> Path:
 
 
 def write(record: RunRecord, directory: Path) -> Path:
+    """Write ``record`` as ``directory/run.json`` (atomically); the path written."""
     return atomic_write_json(Path(directory) / RECORD_NAME, record.to_dict())
+
+
+def read_run_record(path: Path) -> RunRecord:
+    """A ``run.json`` back as the :class:`RunRecord` that :func:`write` wrote.
+
+    Phase times are read in their native microseconds; the derived fields (each phase's
+    milliseconds, ``phases_expected``, ``jitter``) are not read, they follow from the rest.
+    A file that is not a run record, or a damaged one, raises :class:`DeviceError` naming
+    the file and the field.
+    """
+    path = Path(path)
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise DeviceError(f"{path}: no such file", READ_HINT) from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise DeviceError(f"{path}: not a readable JSON run record ({exc})", READ_HINT) from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("phases"), list) or not isinstance(doc.get("schedule"), dict):
+        raise DeviceError(f"{path}: not a run record (no 'schedule' and 'phases')", READ_HINT)
+    sched = doc["schedule"]
+    values = {}
+    for key in ("cycles", "push_deg", "push_ms", "wait_ms", "heartbeat_ms"):
+        value = sched.get(key, hop_default(key) if key == "heartbeat_ms" else None)
+        if not _is_number(value):
+            raise DeviceError(f"{path}: schedule.{key} is missing or not a number", DAMAGED_HINT)
+        if key == "push_deg":
+            values[key] = float(value)
+        elif value == int(value):
+            values[key] = int(value)
+        else:
+            raise DeviceError(f"{path}: schedule.{key} = {value} is not a whole number", DAMAGED_HINT)
+    phases = []
+    for i, ph in enumerate(doc["phases"]):
+        if not isinstance(ph, dict) or not all(_is_int(ph.get(k)) for k in ("commanded_us", "measured_us")):
+            raise DeviceError(f"{path}: phase {i + 1} has no commanded_us/measured_us integers", DAMAGED_HINT)
+        cycle = ph.get("cycle")
+        phases.append(Phase(cycle if _is_int(cycle) else 0, str(ph.get("phase", "?")), ph["commanded_us"], ph["measured_us"]))
+    return RunRecord(
+        schedule=HopSchedule(**values), port=str(doc.get("port") or ""), status=str(doc.get("status") or INCOMPLETE),
+        firmware_version=_text(doc.get("firmware_version")), firmware_status=_text(doc.get("firmware_status")),
+        message=_text(doc.get("message")), started_at=str(doc.get("started_at") or ""), phases=phases,
+    )
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _text(value) -> str | None:
+    return None if value is None else str(value)

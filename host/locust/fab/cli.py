@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import contextlib
-import json
 import sys
 from pathlib import Path
 
 import click
 
 from ..errors import FabError
+from ..fileio import json_text
 from . import export, flat_pattern, laminate, preview
 from .design import LayerMap, design_from_drawing, parse_layer_options
 from .dxf_read import UNIT_BY_NAME, read_drawing
@@ -126,12 +126,12 @@ def fab(dxf, from_robot, out, as_json, layers, units, gap_tol_mm, recover, hinge
     names = sorted(files) + (["summary.json"] if out is not None else [])
     result = summary(lam, hinges_x_mm=hinges_x, files=names, out_dir=str(out) if out else None)
     if out is not None:
-        files["summary.json"] = (json.dumps(result, indent=2) + "\n").encode()
+        files["summary.json"] = json_text(result).encode()
         export.publish(out, files)
         if cad_check:
             result["cad_check"] = _cad_check(out, [n for n in names if n.endswith(".dxf")])
     if as_json:
-        click.echo(json.dumps(result, indent=2))
+        click.echo(json_text(result), nl=False)
     else:
         click.echo(summary_text(result))
         if out is None:

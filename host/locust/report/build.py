@@ -44,10 +44,10 @@ def run_schedule(name: str, trials: list[Trial]) -> dict | None:
     """The schedule the trials' run records share (push_deg, push_s, wait_s, cycles), if any."""
     seen = {}
     for t in trials:
-        s = t.schedule
-        if s is None:
+        if t.record is None:
             continue
-        key = (float(s["push_deg"]), float(s["push_ms"]), float(s["wait_ms"]))
+        s = t.record.schedule
+        key = (float(s.push_deg), float(s.push_ms), float(s.wait_ms))
         seen.setdefault(key, []).append(t)
     if not seen:
         return None
@@ -58,7 +58,7 @@ def run_schedule(name: str, trials: list[Trial]) -> dict | None:
                           "give runs of one schedule per configuration (or name them as separate configurations)")
     (push_deg, push_ms, wait_ms), ts = next(iter(seen.items()))
     return {"push_deg": push_deg, "push_s": push_ms / 1000.0, "wait_s": wait_ms / 1000.0,
-            "cycles": max(int(t.schedule["cycles"]) for t in ts), "source": str(ts[0].run_path)}
+            "cycles": max(t.record.schedule.cycles for t in ts), "source": str(ts[0].run_path)}
 
 
 def with_run_schedule(robot: Robot, sched: dict | None) -> Robot:
@@ -226,15 +226,4 @@ def report_json(base: Robot, robot_source: str, comps, configs, timing, land, ma
                         "run": str(t.run_path) if t.run_path else None} for t in c.all_trials],
         })
     out["timing"] = [asdict(r) for r in timing]
-    return _finite(out)
-
-
-def _finite(obj):
-    """NaN/inf -> None, so report.json is strict JSON."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_finite(v) for v in obj]
-    return obj
+    return out   # written by atomic_write_json: NaN/inf become null there

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..device.record import Jitter, jitter
 from .measure import Aligned, MeasuredHop, align, measure_hops
 from .measured import Trial
 from .predict import Prediction
@@ -129,8 +130,8 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
 
 
 def trial_cycles(trial: Trial, default: int) -> int:
-    sched = trial.schedule
-    return int(sched["cycles"]) if sched else default
+    """The cycles the trial's run record commanded; ``default`` without a record."""
+    return trial.record.schedule.cycles if trial.record else default
 
 
 @dataclass(frozen=True)
@@ -141,7 +142,7 @@ class TimingRow:
     phases: int
     phases_expected: int
     firmware: str
-    jitter: object | None        # locust.device.record.Jitter: start errors, ms
+    jitter: Jitter | None        # start errors, ms
 
 
 def timing_rows(config: str, trials: list[Trial]) -> list[TimingRow]:
@@ -150,18 +151,13 @@ def timing_rows(config: str, trials: list[Trial]) -> list[TimingRow]:
     Recomputed from the record's phases with the device layer's own :func:`jitter`, so a
     record that lost its summary still has one.
     """
-    from ..device.record import Phase, jitter
-
     rows = []
     for t in trials:
-        if t.run is None:
+        rec = t.record
+        if rec is None:
             continue
-        phases = [Phase(int(p.get("cycle", 0)), str(p.get("phase", "?")),
-                        int(round(p["commanded_ms"] * 1000)), int(round(p["measured_ms"] * 1000)))
-                  for p in t.run["phases"]]
         rows.append(TimingRow(
-            config=config, trial=t.label, status=str(t.run.get("status", "?")), phases=len(phases),
-            phases_expected=int(t.run.get("phases_expected", 2 * int(t.run["schedule"]["cycles"]))),
-            firmware=str(t.run.get("firmware_version", "?")), jitter=jitter(phases),
+            config=config, trial=t.label, status=rec.status, phases=len(rec.phases),
+            phases_expected=rec.schedule.phases, firmware=rec.firmware_version or "?", jitter=jitter(rec.phases),
         ))
     return rows

@@ -12,7 +12,8 @@ import numpy as np
 from ..plotting import png_bytes, pyplot
 from .compare import Comparison
 from .configs import Configuration
-from .landscape import SCALE, Landscape, design_value
+from ..sweep.design import SCALE
+from .landscape import Landscape, design_value
 
 COLOURS = {"small": "#1f77b4", "medium": "#ff7f0e", "large": "#2ca02c"}   # the seed dashboard's
 OTHER = ["#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"]
@@ -211,8 +212,8 @@ def draw_timing(ax, comps: list[Comparison]) -> None:
     names = [c.config for c in comps]
     drawn = False
     for c in comps:
-        for m in (t for t in c.all_trials if t.run is not None):
-            errs = [p["measured_ms"] - p["commanded_ms"] for p in m.run["phases"]]
+        for m in (t for t in c.all_trials if t.record is not None):
+            errs = [p.error_ms for p in m.record.phases]
             ax.plot(np.arange(1, len(errs) + 1), errs, "o-", ms=3, lw=1, color=colour(c.config, names),
                     label=f"{_label(c)} {m.label}")
             drawn = True

@@ -1,25 +1,22 @@
 """A sweep's landscape (``locust sweep --out DIR``) and where the physical designs sit on it.
 
-Reads ``DIR/sweep.json`` (``base``, ``vary`` [{name, start, stop, n}], ``cycles``) and
-``DIR/results.csv`` (``design``, one column per varied name, ``valid``, ``reason``,
-``distance_m``, ...). A configuration's position on a ``scale`` axis is the length it adds
+``DIR/sweep.json`` and ``DIR/results.csv`` are read by their owner,
+:func:`locust.sweep.store.read_results`. A configuration's position on a ``scale`` axis is the length it adds
 to every link; on a dotted parameter's axis, that parameter's value in its robot.
 """
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import LocustError, ReportError
+from ..errors import LocustError, ReportError, SweepError
+from ..sweep.design import SCALE
+from ..sweep.store import read_results
 from .configs import Configuration
-
-SCALE = "scale"
-NEEDED = ("design", "valid", "distance_m")
 
 
 @dataclass(frozen=True)
@@ -44,47 +41,19 @@ class Landscape:
 
 
 def read_landscape(folder: Path) -> Landscape:
-    import pandas as pd
-
-    folder = Path(folder)
-    meta_path, csv_path = folder / "sweep.json", folder / "results.csv"
-    hint = "give the --out folder of a finished `locust sweep`"
-    for p in (meta_path, csv_path):
-        if not p.is_file():
-            raise ReportError(f"--sweep {folder}: no {p.name}", hint)
+    """The landscape of a sweep folder, read by its owner (:mod:`locust.sweep.store`)."""
     try:
-        meta = json.loads(meta_path.read_text(encoding="utf-8"))
-        req = meta.get("request", meta)   # what was asked; older folders keep it at the top
-        names = [str(v["name"]) for v in req["vary"]]
-        cycles = int(req["cycles"])
-    except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
-        raise ReportError(f"{meta_path}: not a sweep description ({exc})", hint) from None
-    if not names or cycles < 1:
-        raise ReportError(f"{meta_path}: no varied parameter or no cycles", hint)
-    try:
-        table = pd.read_csv(csv_path)
-    except (OSError, ValueError) as exc:
-        raise ReportError(f"{csv_path}: cannot be read as CSV ({exc})", hint) from None
-    missing = [c for c in (*NEEDED, *names) if c not in table.columns]
-    if missing:
-        raise ReportError(f"{csv_path}: missing columns {', '.join(missing)}", hint)
-    if table.empty:
-        raise ReportError(f"{csv_path}: no designs", "the sweep has not finished any design yet")
-    valid = table["valid"].astype(str).str.lower().map({"true": True, "false": False})
-    if valid.isna().any():
-        line = int(valid.isna().to_numpy().argmax()) + 2
-        raise ReportError(f"{csv_path}, line {line}: 'valid' is not True/False", hint)
-    try:
-        values = {n: table[n].to_numpy(dtype=float) for n in names}
-        distance = table["distance_m"].to_numpy(dtype=float)
-    except ValueError as exc:
-        raise ReportError(f"{csv_path}: a non-number in a value column ({exc})", hint) from None
-    valid_arr = valid.to_numpy(dtype=bool)
-    distance = np.where(valid_arr, distance, np.nan)
-    reasons = ["" if pd.isna(v) else str(v) for v in table["reason"]] if "reason" in table.columns else [""] * len(table)
-    return Landscape(folder=folder, base=str(req.get("base", "?")), names=names, cycles=cycles,
-                     values=values, valid=valid_arr, distance_m=distance, reason=reasons,
-                     finished=bool(meta.get("finished", True)))
+        res = read_results(Path(folder))
+    except SweepError as exc:
+        raise ReportError(f"--sweep {folder}: {exc.message}", exc.hint) from None
+    if not res.rows:
+        raise ReportError(f"--sweep {folder}: no designs in results.csv", "the sweep has not finished any design yet")
+    valid = np.array(res.column("valid"), dtype=bool)
+    distance = np.where(valid, np.array(res.column("distance_m"), dtype=float), np.nan)
+    return Landscape(folder=res.folder, base=res.base, names=res.axis_names, cycles=res.cycles,
+                     values={n: np.array(res.column(n), dtype=float) for n in res.axis_names},
+                     valid=valid, distance_m=distance, reason=[str(r) for r in res.column("reason")],
+                     finished=res.finished)
 
 
 def design_value(config: Configuration, name: str) -> float:

@@ -3,30 +3,31 @@
 ``--measured`` takes ``NAME=PATH[,PATH...]`` or plain paths. Each path is one trial:
 
 - a folder holding a track (``*.tracks.csv``, or one CSV/Tracker export with marker columns)
-  and/or a ``run.json`` (the record ``locust hop`` wrote);
+  and/or a ``run.json`` (the record ``locust hop`` wrote, read with
+  :func:`locust.device.record.read_run_record`);
 - a track file (``locust track`` CSV or Tracker text export); a ``run.json`` beside it is
   its run record;
 - a ``run.json``; a single ``*.tracks.csv`` beside it is its track.
 
 A plain path's configuration comes from its folder's name (see
-:func:`.configs.name_from_path`). Tracks are read with the calibration layer's reader, so
-the formats are the same everywhere.
+:func:`.configs.name_from_path`). Tracks are read by the track layer that writes them
+(:func:`locust.track.tracks_csv.read_track_file`), so the formats are the same everywhere.
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..calibrate.recordings import read_table
-from ..errors import CalibrationError, ReportError
+from ..device.record import RECORD_NAME as RUN_NAME
+from ..device.record import RunRecord, read_run_record
+from ..errors import DeviceError, ReportError, TrackError
+from ..track.tracks_csv import TRACKS_CSV_SUFFIX, read_track_file
 from .configs import check_name, name_from_path, sort_key
 
-RUN_NAME = "run.json"
-TRACK_GLOB = "*.tracks.csv"
+TRACK_GLOB = f"*{TRACKS_CSV_SUFFIX}"
 
 
 @dataclass(frozen=True)
@@ -47,11 +48,8 @@ class Trial:
     label: str                       # short name shown in tables: the trial's folder
     track: Track | None
     run_path: Path | None
-    run: dict | None = field(default=None, compare=False)
+    record: RunRecord | None = field(default=None, compare=False)
 
-    @property
-    def schedule(self) -> dict | None:
-        return (self.run or {}).get("schedule")
 
 
 def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose") -> dict[str, list[Trial]]:
@@ -98,9 +96,9 @@ def load_trial(path: Path, config: str, marker: str = "nose") -> Trial:
     else:
         beside = path.parent / RUN_NAME
         run_path, track_path, label = (beside if beside.is_file() else None), path, path.parent.name or path.stem
-    run = read_run(run_path) if run_path else None
+    record = read_run(run_path) if run_path else None
     track = read_track(track_path, marker) if track_path else None
-    return Trial(config=config, label=label, track=track, run_path=run_path, run=run)
+    return Trial(config=config, label=label, track=track, run_path=run_path, record=record)
 
 
 def _one_track(folder: Path, required: bool) -> Path | None:
@@ -119,14 +117,14 @@ def _one_track(folder: Path, required: bool) -> Path | None:
 def read_track(path: Path, marker: str = "nose") -> Track:
     """The ``marker``'s positions in ``path``; lost frames dropped, time sorted."""
     try:
-        table = read_table(path)
-        t = table.time_s()
-        x, y = table.marker(marker)
-    except CalibrationError as exc:
+        tracks = read_track_file(path)
+        t = tracks.time_s()
+        x, y = tracks.positions(marker)
+    except TrackError as exc:
         raise ReportError(exc.message, exc.hint) from None
     ok = np.isfinite(t) & np.isfinite(x) & np.isfinite(y)
     if not ok.any():
-        scaled = np.isfinite(table.columns.get(f"{marker}_px", np.array([np.nan]))).any()
+        scaled = tracks.has_pixels(marker)
         hint = ("the track has pixels but no metres: run `locust track` with --scale or --scale-aruco"
                 if scaled else f"the {marker} marker was never found: check the video and the marker colour")
         raise ReportError(f"{path}: no {marker} position in metres in any frame", hint)
@@ -137,27 +135,12 @@ def read_track(path: Path, marker: str = "nose") -> Track:
     tt = t[ok][order]
     if np.any(np.diff(tt) <= 0):
         raise ReportError(f"{path}: repeated time stamps in t_s", "export the track again; each frame needs its own time")
-    return Track(path=path, marker=marker, t_s=tt, x_m=x[ok][order], y_m=y[ok][order], frames=table.n_rows)
+    return Track(path=path, marker=marker, t_s=tt, x_m=x[ok][order], y_m=y[ok][order], frames=tracks.n_rows)
 
 
-def read_run(path: Path) -> dict:
-    """A run record (``locust hop``): checked for the fields the report uses."""
+def read_run(path: Path) -> RunRecord:
+    """A run record (``locust hop``), read by the device layer that writes it."""
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ReportError(f"{path}: no such file", "give the run.json that `locust hop` wrote") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ReportError(f"{path}: not a readable JSON run record ({exc})",
-                          "give the run.json that `locust hop` wrote") from None
-    if not isinstance(doc, dict) or not isinstance(doc.get("phases"), list) or not isinstance(doc.get("schedule"), dict):
-        raise ReportError(f"{path}: not a run record (no 'schedule' and 'phases')",
-                          "give the run.json that `locust hop` wrote")
-    sched = doc["schedule"]
-    for key in ("cycles", "push_deg", "push_ms", "wait_ms"):
-        if not isinstance(sched.get(key), (int, float)) or isinstance(sched.get(key), bool):
-            raise ReportError(f"{path}: schedule.{key} is missing or not a number", "the record is damaged; rerun the hop")
-    for i, ph in enumerate(doc["phases"]):
-        if not isinstance(ph, dict) or not all(isinstance(ph.get(k), (int, float)) for k in ("commanded_ms", "measured_ms")):
-            raise ReportError(f"{path}: phase {i + 1} has no commanded_ms/measured_ms numbers",
-                              "the record is damaged; rerun the hop")
-    return doc
+        return read_run_record(path)
+    except DeviceError as exc:
+        raise ReportError(exc.message, exc.hint) from None

@@ -5,10 +5,10 @@ The result is :func:`locust.sim.run.run`'s, unchanged: the predicted distances a
 pipeline's own. The camera follows a marker (the ``marker_<name>`` disc the model carries
 where the sticker goes, e.g. on the chassis' side, up and back from the nose edge), not the
 model's ``nose`` site, and a point on a pitching body rises by its own amount: so the
-predicted trace and apexes are those of the same marker, from the same deterministic rollout
-(:func:`locust.sim.rollout.simulate`, states kept, thinned to ``TRACE_HZ``), measured with the
-same functions as the track. A run that fails its audit is kept as invalid, with its
-reasons, and has no trace.
+predicted trace and apexes are those of the same marker, from the very rollout the result
+comes from (``run(..., keep_states=True)``, thinned to ``TRACE_HZ``; the marker is posed by
+:func:`locust.sim.kinematics.marker_positions`), measured with the same functions as the
+track. A run that fails its audit is kept as invalid, with its reasons, and has no trace.
 """
 
 from __future__ import annotations
@@ -44,32 +44,25 @@ def predict(config: str, robot: Robot, cycles: int, marker: str = "nose") -> Pre
     from ..sim.run import invalid_result, run
 
     try:
-        result = run(robot, cycles=cycles)
+        result = run(robot, cycles=cycles, keep_states=True)
     except GeometryError as exc:
         reason = exc.message + (f" ({exc.hint})" if exc.hint else "")
         return Prediction(config, robot, invalid_result(robot, reason, cycles), None, [], math.nan)
+    traj, result.trajectory = result.trajectory, None   # the states are not kept past the trace
     if not result.valid:
         return Prediction(config, robot, result, None, [], math.nan)
-    trace = simulated_marker(robot, cycles, marker)
+    trace = marker_trace(traj, marker)
     onset, _, _ = onset_time(trace.t_s, trace.x_m, trace.y_m, where=f"simulated {config}")
     period = robot.schedule.push_s + robot.schedule.wait_s
     return Prediction(config, robot, result, trace, measure_hops(trace, period, cycles), onset)
 
 
-def simulated_marker(robot: Robot, cycles: int, marker: str = "nose") -> Aligned:
-    from ..sim.rollout import simulate
-
-    return marker_trace(simulate(robot, cycles=cycles, keep_states=True), marker)
-
-
 def marker_trace(traj, marker: str) -> Aligned:
     """The ``marker_<marker>`` disc's centre, t = 0 at the first push, from where it stood
-    at the end of the settle phase; x forward, y up."""
-    import mujoco
+    at the end of the settle phase; x forward, y up. ``traj`` must have kept its states."""
+    from ..sim.kinematics import carries_marker, marker_positions
 
-    model = traj.built.model
-    gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"marker_{marker}")
-    if gid < 0:
+    if not carries_marker(traj, marker):
         raise ReportError(f"the model carries no {marker!r} marker to compare the track with",
                           "track a marker the model has: nose or foot (--marker)")
     dt, settle = traj.timestep_s, traj.plan.settle_steps
@@ -77,13 +70,7 @@ def marker_trace(traj, marker: str) -> Aligned:
     stand = max(settle - 1, 0)
     first = max(0, settle - int(round(LEAD_S / dt)))
     rows = np.unique(np.concatenate(([stand], np.arange(first, len(traj.states), stride))))
-    data = mujoco.MjData(model)
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    pos = np.empty((rows.size, 3))
-    for i, r in enumerate(rows):
-        mujoco.mj_setState(model, data, traj.states[r], spec)
-        mujoco.mj_kinematics(model, data)
-        pos[i] = data.geom_xpos[gid]
+    pos = marker_positions(traj, marker, rows)
     x0, z0 = pos[rows == stand][0, [0, 2]]
     return Aligned(t_s=(rows + 1 - settle) * dt, x_m=pos[:, 0] - x0, y_m=pos[:, 2] - z0,
                    onset_s=math.nan, start_s=0.0)

@@ -12,13 +12,11 @@ point in each cycle above standing (from the 240 Hz trace the camera samples).
 
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..fileio import atomic_write_json, atomic_write_text
 from ..params import Robot
 
 TRACK_NAME = "synthetic.tracks.csv"
@@ -36,12 +34,13 @@ class SyntheticTruth:
 def simulated_nose(robot: Robot, cycles: int):
     """The true robot's audited result and its nose marker's trace (schedule clock, 240 Hz)."""
     from ..sim.run import run
-    from .predict import simulated_marker
+    from .predict import marker_trace
 
-    result = run(robot, cycles=cycles)
+    result = run(robot, cycles=cycles, keep_states=True)
     if not result.valid:
         raise ValueError(f"the synthetic truth robot's simulation is invalid: {result.reasons}")
-    return result, simulated_marker(robot, cycles, "nose")
+    traj, result.trajectory = result.trajectory, None
+    return result, marker_trace(traj, "nose")
 
 
 def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int = 0, fps: float = 30.0,
@@ -49,6 +48,8 @@ def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int 
                           truth=None) -> SyntheticTruth:
     """Write one synthetic trial into ``folder``; ``truth`` reuses a :func:`simulated_nose`."""
     from ..device.record import COMPLETE, HopSchedule, Phase, RunRecord
+    from ..device.record import write as write_record
+    from ..track.tracks_csv import MarkerColumns, TracksCsv, write_tracks_csv
 
     result, trace = truth or simulated_nose(robot, cycles)
     rng = np.random.default_rng(seed)
@@ -58,16 +59,16 @@ def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int 
     ok = np.ones(t_sched.size, dtype=bool)
     ok[rng.choice(np.arange(12, t_sched.size), size=lost_frames, replace=False)] = False
 
-    out = io.StringIO()
-    out.write(f"# synthetic: simulated nose of robot {robot.name!r}, {cycles} cycles, {fps:g} frames/s, "
-              f"noise {noise_m * 1000:g} mm sd, seed {seed}\n")
-    out.write("frame,t_s,nose_px,nose_py,nose_x_m,nose_y_m,nose_ok\n")
-    for i in range(t_sched.size):
-        xs, ys = (f"{x[i]:.6f}", f"{y[i]:.6f}") if ok[i] else ("nan", "nan")
-        out.write(f"{i},{i / fps:.6f},nan,nan,{xs},{ys},{int(ok[i])}\n")
+    nan = np.full(t_sched.size, np.nan)
+    tracks = TracksCsv(
+        frame=np.arange(t_sched.size), t_s=np.arange(t_sched.size) / fps,
+        markers={"nose": MarkerColumns("nose", px=nan, py=nan, x_m=np.where(ok, x, np.nan),
+                                       y_m=np.where(ok, y, np.nan), ok=ok)},
+        comments=(f"synthetic: simulated nose of robot {robot.name!r}, {cycles} cycles, {fps:g} frames/s, "
+                  f"noise {noise_m * 1000:g} mm sd, seed {seed}",))
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    track_path = atomic_write_text(folder / TRACK_NAME, out.getvalue())
+    track_path = write_tracks_csv(folder / TRACK_NAME, tracks)
 
     s = robot.schedule
     sched = HopSchedule(cycles=cycles, push_deg=s.push_deg, push_ms=round(s.push_s * 1000),
@@ -79,7 +80,7 @@ def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int 
         for name, offset_us in (("push", 0), ("wait", sched.push_ms * 1000)):
             commanded = c * period_us + offset_us
             record.add_phase(Phase(c + 1, name, commanded, commanded + int(rng.integers(20, 400))))
-    run_path = atomic_write_json(folder / "run.json", record.to_dict())
+    run_path = write_record(record, folder)
     period_s = s.push_s + s.wait_s
     apex = [float(trace.y_m[(trace.t_s >= c * period_s) & (trace.t_s < (c + 1) * period_s)].max())
             for c in range(cycles)]

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import click
 
 from ..errors import GeometryError, SimError
+from ..fileio import json_text
 from ..params_cli import robot_options
 from ..params import resolve_robot
 
@@ -40,11 +40,11 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence)
 
     robot = resolve_robot(preset, config, sets)
     if video is not None:
-        from .video import check_video_path
+        from .clip import check_video_path
 
         check_video_path(video)  # fail before simulating, not after
     try:
-        result = run(robot, cycles=cycles)
+        result = run(robot, cycles=cycles, keep_states=video is not None)  # the video reuses the rollout
     except GeometryError as exc:
         if not as_json:
             raise
@@ -54,13 +54,13 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence)
     if video is not None:
         if not result.valid:
             raise SimError("not rendering an invalid simulation", "fix the reasons listed above first")
-        from .video import render_video
+        from .clip import render_video
 
-        info = render_video(robot, video, cycles=cycles, camera=camera)
+        info = render_video(robot, video, cycles=cycles, camera=camera, trajectory=result.trajectory)
         result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
 
     if as_json:
-        click.echo(json.dumps(result.to_json(), indent=2))
+        click.echo(json_text(result.to_json()), nl=False)
         return
     _print_human(result)
     if not result.valid:

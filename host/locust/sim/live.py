@@ -18,24 +18,23 @@ simulated second at dt = 2.5e-3 s, 5 MB at 5e-5 s).
 
 from __future__ import annotations
 
-# .video first: it picks the offscreen GL backend, which MuJoCo reads when first imported.
-from .video import CAMERAS, ClipRecorder, check_video_path, frame_views, validate_size  # isort: skip
+import math
+import threading
+import time
+from dataclasses import dataclass
 
-import math  # noqa: E402
-import threading  # noqa: E402
-import time  # noqa: E402
-from dataclasses import dataclass  # noqa: E402
+import mujoco
+import numpy as np
 
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..errors import SimError  # noqa: E402
-from ..params import Robot  # noqa: E402
-from .audit import audit  # noqa: E402
-from .hops import summarise  # noqa: E402
-from .model import build  # noqa: E402
-from .rollout import Trajectory, simulate  # noqa: E402
-from .schedule import ControlPlan  # noqa: E402
+from ..errors import SimError
+from ..params import Robot
+from .audit import audit
+from .camera import CAMERAS, frame_views
+from .clip import ClipRecorder, check_video_path, validate_size
+from .hops import summarise
+from .model import build
+from .rollout import Trajectory, simulate
+from .schedule import ControlPlan
 
 SIDES = ("left", "right")
 # The fixed camera is framed on a batch rollout of the planned schedule; the live run's

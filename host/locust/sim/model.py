@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import SimError
 from ..markers import MARKER_COLOURS, hex_to_rgb01
-from ..params import Robot
+from ..params import GRAVITY_M_PER_S2, Robot
 from .fourbar import Assembly, assemble
 from .servo import configure as configure_servo
 
@@ -93,7 +93,7 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     spec.option.integrator = INTEGRATORS[sol.integrator]
     spec.option.iterations = int(sol.iterations)
     spec.option.tolerance = sol.tolerance
-    spec.option.gravity = [0.0, 0.0, -9.81]
+    spec.option.gravity = [0.0, 0.0, -GRAVITY_M_PER_S2]
     spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
     # MuJoCo's autoreset would silently restart a diverged run: the audit must see it.
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET

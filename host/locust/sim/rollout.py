@@ -29,7 +29,7 @@ class Trajectory:
     final_qpos: np.ndarray
     warnings: dict[str, int]         # MuJoCo warning name -> count
     wall_s: float
-    states: np.ndarray | None = None  # (nstep, nstate) FULLPHYSICS states, kept on request (video)
+    states: np.ndarray | None = None  # (nstep, nstate) FULLPHYSICS states, kept on request (video, traces)
 
     @property
     def timestep_s(self) -> float:

@@ -1,9 +1,13 @@
-"""One audited simulation: build, roll out, audit, summarise -> :class:`SimResult`."""
+"""One audited simulation: build, roll out, audit, summarise -> :class:`SimResult`.
+
+``run(robot, keep_states=True)`` also keeps the rollout the result was computed from
+(``SimResult.trajectory``, with every step's state), so a video or a marker's trace can be
+taken from the same simulation instead of a second one.
+"""
 
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -12,9 +16,10 @@ import numpy as np
 from ..errors import GeometryError
 from ..params import Robot
 from .audit import audit
+from .fourbar import GOOD_TRANSMISSION_DEG
 from .hops import Hop, summarise
 from .model import build
-from .rollout import simulate
+from .rollout import Trajectory, simulate
 
 
 @dataclass
@@ -38,10 +43,16 @@ class SimResult:
     transmission_deg: float = float("nan")
     notes: list[str] = field(default_factory=list)
     convergence: dict[str, float] | None = None
+    # the rollout behind the figures, states included: only with run(..., keep_states=True);
+    # never part of the JSON
+    trajectory: Trajectory | None = field(default=None, repr=False, compare=False)
 
     def to_json(self) -> dict[str, Any]:
-        out = dataclasses.asdict(self)
-        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+        """Every field but the trajectory; NaN and inf become null where it is written
+        (:func:`locust.fileio.json_text`)."""
+        out = dataclasses.asdict(dataclasses.replace(self, trajectory=None))
+        del out["trajectory"]
+        return out
 
 
 def invalid_result(robot: Robot, reason: str, cycles: int | None = None) -> SimResult:
@@ -52,18 +63,24 @@ def invalid_result(robot: Robot, reason: str, cycles: int | None = None) -> SimR
                      servo_work_j=nan)
 
 
-def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None) -> SimResult:
-    """Simulate and audit. An impossible linkage raises :class:`GeometryError`."""
+def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None,
+        keep_states: bool = False) -> SimResult:
+    """Simulate and audit. An impossible linkage raises :class:`GeometryError`.
+
+    With ``keep_states`` the result carries the :class:`~.rollout.Trajectory` it was computed
+    from, every step's full physics state kept (``result.trajectory.states``); without it,
+    ``result.trajectory`` is None. The figures are the same either way.
+    """
     if timestep_s is not None:
         robot = robot.with_values({"solver.timestep_s": timestep_s})
     built = build(robot)
-    traj = simulate(robot, cycles=cycles, built=built)
+    traj = simulate(robot, cycles=cycles, built=built, keep_states=keep_states)
     verdict = audit(traj)
     summary = summarise(traj) if verdict.valid else None
     nan = float("nan")
     notes = list(verdict.notes)
     asm = built.assembly
-    lo, hi = 40.0, 140.0
+    lo, hi = GOOD_TRANSMISSION_DEG
     if not lo <= asm.transmission_deg <= hi:
         notes.append(f"poor transmission angle {asm.transmission_deg:.0f} deg at the start (outside {lo:g}-{hi:g})")
     return SimResult(
@@ -76,7 +93,7 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
         loop_residual_max_m=verdict.loop_residual_max_m, energy_surplus_max_j=verdict.energy_surplus_max_j,
         servo_work_j=verdict.servo_work_j, servo_peak_speed_rad_per_s=peak_servo_speed(traj),
         servo_noload_speed_rad_per_s=robot.servo.noload_speed_rad_per_s, grashof=asm.grashof, transmission_deg=asm.transmission_deg,
-        notes=notes,
+        notes=notes, trajectory=traj if keep_states else None,
     )
 
 

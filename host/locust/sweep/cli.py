@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import click
 
 from ..errors import SweepError
+from ..fileio import json_text
 from ..params import resolve_robot
 from ..params_cli import robot_options
 from ..progress import progress
@@ -68,10 +68,10 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json):
     rows = summary.rows
     valid = [r for r in rows if r["valid"]]
     if as_json:
-        click.echo(json.dumps({"folder": str(summary.folder), "designs": len(rows), "valid": len(valid),
-                               "computed": summary.computed, "resumed": summary.resumed,
-                               "wall_s": summary.wall_s, "best": summary.best,
-                               "plots": [str(p) for p in summary.plots]}, indent=2, default=str))
+        click.echo(json_text({"folder": str(summary.folder), "designs": len(rows), "valid": len(valid),
+                              "computed": summary.computed, "resumed": summary.resumed,
+                              "wall_s": summary.wall_s, "best": summary.best,
+                              "plots": [str(p) for p in summary.plots]}), nl=False)
         return
     click.echo(f"{len(rows)} designs ({summary.resumed} from an earlier run, {summary.computed} computed in "
                f"{summary.wall_s:.1f} s), {len(valid)} valid")

@@ -41,7 +41,7 @@ def _cell(value: Any) -> str:
     return str(value)
 
 
-def _parse(row: dict[str, str], axis_names: list[str]) -> dict[str, Any]:
+def _parse(row: dict[str, str | None], axis_names: list[str]) -> dict[str, Any]:
     out: dict[str, Any] = {"design": int(row["design"])}
     for name in axis_names:
         out[name] = float(row[name])
@@ -58,6 +58,72 @@ def _parse(row: dict[str, str], axis_names: list[str]) -> dict[str, Any]:
         else:
             out[name] = raw
     return out
+
+
+def read_rows(path: Path, axis_names: list[str]) -> list[dict[str, Any]]:
+    """The rows of ``results.csv``, typed (``design`` int, axis values and figures float,
+    ``valid`` bool, ``hops`` int), in file order.
+
+    Only a torn last line is dropped: an interrupt can cut the row being appended, and a
+    finished row always ends with a newline. Any other row that does not parse is an error
+    naming its line, never skipped."""
+    try:
+        with open(path, encoding="utf-8", newline="") as fh:
+            text = fh.read()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SweepError(f"{path}: unreadable ({exc})", "use a new --out folder") from None
+    torn = bool(text) and not text.endswith("\n")
+    reader = csv.DictReader(io.StringIO(text, newline=""))
+    if reader.fieldnames != columns(axis_names):
+        raise SweepError(f"{path}: unexpected columns {reader.fieldnames}",
+                         f"expected {', '.join(columns(axis_names))}; use a new --out folder")
+    raw = list(reader)
+    rows = []
+    for k, row in enumerate(raw):
+        try:
+            rows.append(_parse(row, axis_names))
+        except (KeyError, TypeError, ValueError) as exc:
+            if torn and k == len(raw) - 1:
+                break
+            raise SweepError(f"{path}, line {k + 2}: malformed row ({exc})",
+                             "the file was edited or damaged: restore it, or rerun the sweep in a new --out folder") from None
+    return rows
+
+
+@dataclass(frozen=True)
+class SweepResults:
+    """A sweep folder read back: what was asked and every finished row."""
+
+    folder: Path
+    base: str                          # the base robot's name
+    axis_names: list[str]              # varied names, in order
+    cycles: int
+    rows: list[dict[str, Any]]         # typed rows (see :func:`read_rows`), in file order
+    finished: bool                     # False: an interrupted sweep, some designs missing
+
+    def column(self, name: str) -> list[Any]:
+        return [row[name] for row in self.rows]
+
+
+def read_results(folder: Path) -> SweepResults:
+    """Read a ``locust sweep --out`` folder (``sweep.json`` and ``results.csv``)."""
+    folder = Path(folder)
+    meta_path, csv_path = folder / META, folder / RESULTS
+    hint = "give the --out folder of a `locust sweep`"
+    for p in (meta_path, csv_path):
+        if not p.is_file():
+            raise SweepError(f"{folder}: no {p.name}", hint)
+    try:
+        meta = json.loads(meta_path.read_text(encoding="utf-8"))
+        req = meta.get("request", meta)   # what was asked; older folders keep it at the top
+        names = [str(v["name"]) for v in req["vary"]]
+        cycles = int(req["cycles"])
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+        raise SweepError(f"{meta_path}: not a sweep description ({exc})", hint) from None
+    if not names or cycles < 1:
+        raise SweepError(f"{meta_path}: no varied parameter or no cycles", hint)
+    return SweepResults(folder=folder, base=str(req.get("base", "?")), axis_names=names, cycles=cycles,
+                        rows=read_rows(csv_path, names), finished=bool(meta.get("finished", True)))
 
 
 @dataclass
@@ -109,22 +175,10 @@ class SweepStore:
         self._lock_fd = fd
 
     def _read_rows(self) -> dict[int, dict[str, Any]]:
-        """Rows already finished; a line cut short by an interrupt is dropped."""
-        done: dict[int, dict[str, Any]] = {}
+        """Rows already finished (a last line cut short by an interrupt is dropped)."""
         if not self.results_path.exists():
-            return done
-        with open(self.results_path, newline="") as fh:
-            reader = csv.DictReader(fh)
-            if reader.fieldnames != columns(self.axis_names):
-                raise SweepError(f"{self.results_path}: unexpected columns {reader.fieldnames}",
-                                 "use a new --out folder")
-            for row in reader:
-                try:
-                    parsed = _parse(row, self.axis_names)
-                except (KeyError, TypeError, ValueError):
-                    continue
-                done[parsed["design"]] = parsed
-        return done
+            return {}
+        return {row["design"]: row for row in read_rows(self.results_path, self.axis_names)}
 
     def _rewrite(self, order: list[int]) -> None:
         buf = io.StringIO()

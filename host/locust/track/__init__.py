@@ -14,8 +14,15 @@ Modules, one job each:
 - :mod:`.spec`      ``--marker NAME=SPEC`` parsing and the default marker set
 - :mod:`.calib`     pixel -> metre calibration (stick or ArUco size), origin, axes
 - :mod:`.runner`    the frame loop that ties video, markers and calibration together
-- :mod:`.export`    CSV + JSON sidecar
-- :mod:`.trk`       Tracker's .trk/.trz reader and its text-export layout
+- :mod:`.export`    a result as the tracks CSV + JSON sidecar
+- :mod:`.trk`       Tracker's .trk/.trz reader; a result in its text-export layout
 - :mod:`.overlay`   PNG / video of the tracks drawn on the footage
 - :mod:`.synth`     synthetic videos with known sub-pixel truth
+
+The files, each owned by one module (writer, reader and typed object side by side):
+
+- :mod:`.tracks_csv`   ``<video>.tracks.csv``, the tracks everyone reads
+- :mod:`.tracker_text` Tracker's text export (*File > Export > Data*)
+- :mod:`.camera`       ``<video>.camera.json``, the pinhole camera of a simulated video
+- :mod:`.delimited`    the tokenizer under every table of samples (also the calibration CSVs)
 """

@@ -14,6 +14,7 @@ from . import calib, camera, export, overlay, trk
 from .aruco import DEFAULT_DICTIONARY, side_px_in_video
 from .runner import track_video
 from .spec import ModelOptions, parse_markers
+from .tracks_csv import tracks_csv_beside
 from .video import Clip, probe
 
 
@@ -35,7 +36,7 @@ def _refuse_overwrite(paths: dict[str, Path], force: bool) -> None:
 
 
 def _base_path(out: Path | None, source: Path) -> Path:
-    default_stem = f"{source.stem}.tracks"
+    default_stem = tracks_csv_beside(source).with_suffix("").name   # hop.tracks (.csv, .json, .png)
     if out is None:
         return source.with_name(default_stem)
     if out.is_dir():

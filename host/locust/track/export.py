@@ -1,41 +1,39 @@
 """Tracks to files: the CSV everyone reads, and a JSON sidecar with how they were made.
 
-CSV columns: ``frame``, ``t_s``, then per marker ``<name>_px``, ``<name>_py`` (pixels,
-OpenCV convention), ``<name>_x_m``, ``<name>_y_m`` (world, y up; ``nan`` without a
-scale), ``<name>_ok`` (1/0). A marker not found is ``nan`` with ok 0.
+The CSV's layout, writer and reader are :mod:`.tracks_csv`'s (columns ``frame``, ``t_s``,
+then per marker ``<name>_px``, ``<name>_py`` in pixels, OpenCV convention, ``<name>_x_m``,
+``<name>_y_m`` in world metres, y up, ``nan`` without a scale, and ``<name>_ok`` 1/0; a
+marker not found is ``nan`` with ok 0). This module turns a
+:class:`~.runner.TrackResult` into one, and writes the sidecar beside it.
 """
 
 from __future__ import annotations
 
-import io
 import math
 from pathlib import Path
 
 import numpy as np
 
 from .. import __version__
-from ..fileio import atomic_write_json, atomic_write_text
+from ..fileio import atomic_write_json
 from .runner import TrackResult
+from .tracks_csv import MarkerColumns, TracksCsv, tracks_csv_text, write_tracks_csv
 
 PIXEL_CONVENTION = "OpenCV: origin at the centre of the top-left pixel, x right, y down"
 
 
-def csv_text(result: TrackResult) -> str:
-    head = ["frame", "t_s"]
-    cols: list[np.ndarray] = []
+def tracks_of(result: TrackResult) -> TracksCsv:
+    """The tracks CSV of ``result``: pixels, world metres through its calibration, found or not."""
+    markers = {}
     for tr in result.markers:
-        head += [f"{tr.name}_px", f"{tr.name}_py", f"{tr.name}_x_m", f"{tr.name}_y_m", f"{tr.name}_ok"]
         xm, ym = result.world(tr)
-        cols += [tr.px, tr.py, xm, ym, tr.ok]
-    out = io.StringIO()
-    out.write(",".join(head) + "\n")
-    for i, frame in enumerate(result.frames):
-        row = [str(int(frame)), _fmt(result.t_s[i], 6)]
-        for k, col in enumerate(cols):
-            kind = k % 5
-            row.append(str(int(bool(col[i]))) if kind == 4 else _fmt(col[i], 4 if kind < 2 else 6))
-        out.write(",".join(row) + "\n")
-    return out.getvalue()
+        markers[tr.name] = MarkerColumns(tr.name, tr.px, tr.py, xm, ym, np.asarray(tr.ok, dtype=bool))
+    return TracksCsv(frame=np.asarray(result.frames, dtype=int), t_s=result.t_s, markers=markers)
+
+
+def csv_text(result: TrackResult) -> str:
+    """The text of ``result``'s tracks CSV."""
+    return tracks_csv_text(tracks_of(result))
 
 
 def sidecar(result: TrackResult, csv_path: Path) -> dict:
@@ -64,7 +62,7 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
 def write_tracks(result: TrackResult, csv_path: Path) -> tuple[Path, Path]:
     """Write ``csv_path`` and its sidecar ``<stem>.json``, each atomically."""
     json_path = csv_path.with_suffix(".json")
-    atomic_write_text(csv_path, csv_text(result))
+    write_tracks_csv(csv_path, tracks_of(result))
     atomic_write_json(json_path, sidecar(result, csv_path))
     return csv_path, json_path
 
@@ -84,10 +82,6 @@ def summary_lines(result: TrackResult) -> list[str]:
         lines.append(line)
     lines.append(result.calibration.summary())
     return lines
-
-
-def _fmt(value: float, digits: int) -> str:
-    return "nan" if not math.isfinite(value) else f"{value:.{digits}f}"
 
 
 def _json_num(value: float):

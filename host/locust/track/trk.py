@@ -1,5 +1,8 @@
 """Tracker (Open Source Physics) files: read ``.trk``/``.trz`` projects, write its text export.
 
+The text export's layout, reader and typed object are :mod:`.tracker_text`'s; this module
+turns a :class:`~.runner.TrackResult` into one.
+
 Pixel convention. Tracker's image coordinates are measured from the top-left *corner*
 of the image (``ImageCoordSystem``: "pixel position relative to the top left corner";
 Java2D draws pixel (i, j) over the square [i, i+1) x [j, j+1)), so the centre of pixel i
@@ -16,17 +19,17 @@ from __future__ import annotations
 
 import io
 import math
+import xml.etree.ElementTree as ET
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
-import xml.etree.ElementTree as ET
 
 import numpy as np
 
 from ..errors import TrackError
-from ..fileio import atomic_write_text
 from .calib import Calibration
 from .runner import MarkerTrack, TrackResult
+from .tracker_text import TrackerExport, TrackerTrack, tracker_export_text, write_tracker_export
 from .video import Clip
 
 TRACKER_TO_OPENCV_PX = -0.5
@@ -164,43 +167,27 @@ def _safe_name(name: str) -> str:
     return out if out and out[0].isalpha() else f"m_{out}"
 
 
-# --- Tracker's text export -----------------------------------------------------------
+# --- Tracker's text export (the format itself: :mod:`.tracker_text`) ------------------
 
-def tracker_text(result: TrackResult) -> str:
-    """Tracker's "Export Data" layout: a row of track names, a row of ``t x y`` per track,
-    then tab-separated world values (m, s); a missing step is an empty cell."""
-    names, heads, cols = [], [], []
+def tracker_export(result: TrackResult) -> TrackerExport:
+    """Tracks as Tracker exports them: per track ``t``, ``x``, ``y`` in world units (m, s),
+    NaN (an empty cell) where the marker was not found."""
+    tracks = {}
     for tr in result.markers:
         x, y = result.world(tr)
         if not np.isfinite(result.calibration.m_per_px):
             x, y = tr.px, tr.py  # no scale: Tracker exports pixels then, too
-        names += [tr.name, "", ""]
-        heads += ["t", "x", "y"]
-        cols += [np.where(tr.ok, result.t_s, np.nan), np.where(tr.ok, x, np.nan), np.where(tr.ok, y, np.nan)]
-    lines = ["\t".join(names), "\t".join(heads)]
-    for i in range(len(result.frames)):
-        lines.append("\t".join("" if not np.isfinite(c[i]) else f"{c[i]:.6g}" for c in cols))
-    return "\n".join(lines) + "\n"
+        tracks[tr.name] = TrackerTrack(tr.name, np.where(tr.ok, result.t_s, np.nan), np.where(tr.ok, x, np.nan),
+                                       np.where(tr.ok, y, np.nan))
+    return TrackerExport(tracks)
+
+
+def tracker_text(result: TrackResult) -> str:
+    """Tracker's "Export Data" layout of ``result``: a row of track names, a row of ``t x y``
+    per track, then tab-separated world values (m, s); a missing step is an empty cell."""
+    return tracker_export_text(tracker_export(result))
 
 
 def write_tracker_text(result: TrackResult, path: Path) -> Path:
-    return atomic_write_text(path, tracker_text(result))
-
-
-def read_tracker_text(path: str | Path) -> dict[str, dict[str, np.ndarray]]:
-    """Read Tracker's text export (as written above, or by Tracker) -> name -> {t, x, y}."""
-    rows = [line.rstrip("\n").split("\t") for line in Path(path).read_text().splitlines()]
-    if len(rows) < 2:
-        raise TrackError(f"{path}: too short for a Tracker text export", "export with Tracker's File > Export > Data")
-    names, heads, body = rows[0], rows[1], rows[2:]
-    out: dict[str, dict[str, np.ndarray]] = {}
-    current = None
-    for j, head in enumerate(heads):
-        if j < len(names) and names[j].strip():
-            current = names[j].strip()
-            out[current] = {}
-        if current is None:
-            continue
-        out[current][head.strip()] = np.array([float(r[j]) if j < len(r) and r[j].strip() else math.nan
-                                               for r in body])
-    return out
+    """Write ``result`` in Tracker's text export layout, atomically."""
+    return write_tracker_export(path, tracker_export(result))

@@ -11,19 +11,19 @@ from __future__ import annotations
 import os
 import queue
 import threading
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator
+
+import cv2
+import numpy as np
+
+from ..errors import TrackError
+from ..fileio import temp_beside
 
 # FFmpeg's own log lines ("moov atom not found" ...) are noise next to our error
-# message; the level must be set before the first capture is opened.
+# message; OpenCV reads the level when it opens its first capture, not on import.
 os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
-
-import cv2  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..errors import TrackError  # noqa: E402
-from ..fileio import temp_beside  # noqa: E402
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,7 @@ class Clip:
     step: int = 1
     fps: float | None = None
 
-    def resolved(self, info: VideoInfo) -> "Clip":
+    def resolved(self, info: VideoInfo) -> Clip:
         last = info.frame_count - 1
         end = last if self.end is None else self.end
         fps = self.fps if self.fps is not None else info.file_fps

@@ -1,10 +1,7 @@
-"""Render the simulated hop to an MP4, with the true marker pixels beside it.
+"""Record the simulated hop as an MP4, with the true marker pixels beside it.
 
-The camera looks at the robot's left side (the left leg is at +y, the foot marker on its
-+y face) from +y, horizontally, with the floor in view. ``track`` follows the chassis in x;
-``fixed`` holds still where the whole run stays in view, the camera ``locust track`` wants.
-
-Beside ``<stem>.mp4`` go two sidecars, both simulated ground truth:
+Frames are rendered through a :class:`.camera.CameraView` (``track`` follows the chassis,
+``fixed`` holds still). Beside ``<stem>.mp4`` go two sidecars, both simulated ground truth:
 
 - ``<stem>.truth.csv``: per frame, each marker's true pixel centre (OpenCV convention:
   origin at the centre of the top-left pixel, x right, y down), the share of it the camera
@@ -18,162 +15,35 @@ Beside ``<stem>.mp4`` go two sidecars, both simulated ground truth:
   metres exactly, and, for the fixed camera, metres per pixel at the robot's planes.
 
 The pixels are projected through the camera MuJoCo itself rendered with
-(``renderer.scene.camera`` after ``update_scene``), so the truth and the image agree.
+(:func:`.camera.pinhole_from_scene`), so the truth and the image agree.
 """
 
 from __future__ import annotations
 
+import math
 import os
+from dataclasses import dataclass, field
+from pathlib import Path
 
-# Offscreen GL must be chosen before MuJoCo loads its GL bindings: OSMesa needs no display.
-os.environ.setdefault("MUJOCO_GL", "osmesa")
+import cv2
+import mujoco
+import numpy as np
 
-import math  # noqa: E402
-from dataclasses import dataclass, field  # noqa: E402
-from pathlib import Path  # noqa: E402
+from ..errors import SimError
+from ..fileio import atomic_write_text, temp_beside
+from ..markers import MARKER_COLOURS
+from ..params import Robot
+from ..progress import progress
+from ..track.camera import CameraFile, MarkerPlane, camera_json_beside, write_camera_json
+from .audit import audit
+from .camera import CAMERAS, CameraView, PinholeCamera, frame_views, pinhole_from_scene
+from .rollout import Trajectory, simulate
 
-import cv2  # noqa: E402
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..errors import SimError  # noqa: E402
-from ..fileio import atomic_write_json, atomic_write_text, temp_beside  # noqa: E402
-from ..markers import MARKER_COLOURS  # noqa: E402
-from ..params import Robot  # noqa: E402
-from ..progress import progress  # noqa: E402
-from .audit import audit  # noqa: E402
-from .model import build  # noqa: E402
-from .rollout import simulate  # noqa: E402
-
-CAMERAS = ("track", "fixed")
 MARKERS = tuple(MARKER_COLOURS)           # ("nose", "foot"): geoms "marker_<name>"
-AZIMUTH_DEG = -90.0                        # look along -y: from the robot's left side
-ELEVATION_DEG = 0.0                        # horizontal
-MARGIN_M = 0.04                            # empty border around the robot in the fixed view
-TRACK_HALF_WIDTH_OF_BODY = 2.0             # track view: half the image width, in body lengths
 VISIBLE_FRAC = 0.5                         # truth says a marker is visible when this much of it is seen
 # sample points on a unit disc for the seen fraction: the centre and three rings of twelve
 _DISC_SAMPLES = np.vstack([[[0.0, 0.0]]] + [
     [[r * math.cos(a), r * math.sin(a)] for a in np.arange(12) * math.pi / 6] for r in (0.35, 0.65, 0.95)])
-
-
-@dataclass(frozen=True)
-class CameraView:
-    """Where MuJoCo's free camera stands: it looks at ``lookat_m`` from ``distance_m``."""
-
-    lookat_m: tuple[float, float, float]
-    distance_m: float
-    azimuth_deg: float = AZIMUTH_DEG
-    elevation_deg: float = ELEVATION_DEG
-
-    def at_x(self, x_m: float) -> "CameraView":
-        return CameraView((x_m, self.lookat_m[1], self.lookat_m[2]), self.distance_m,
-                          self.azimuth_deg, self.elevation_deg)
-
-    def mjv_camera(self) -> mujoco.MjvCamera:
-        cam = mujoco.MjvCamera()
-        cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-        cam.lookat[:] = self.lookat_m
-        cam.distance = self.distance_m
-        cam.azimuth = self.azimuth_deg
-        cam.elevation = self.elevation_deg
-        return cam
-
-
-@dataclass(frozen=True)
-class PinholeCamera:
-    """OpenCV pinhole model of one rendered frame: ``uv ~ K (R X + t)``.
-
-    Camera frame: x right, y down, z forward (into the scene); pixels: origin at the centre
-    of the top-left pixel.
-    """
-
-    width_px: int
-    height_px: int
-    fx_px: float
-    fy_px: float
-    cx_px: float
-    cy_px: float
-    rotation: np.ndarray      # (3, 3) world -> camera
-    position_m: np.ndarray    # (3,) camera centre in the world
-
-    @property
-    def translation_m(self) -> np.ndarray:
-        return -self.rotation @ self.position_m
-
-    def to_camera(self, points_m: np.ndarray) -> np.ndarray:
-        return (np.atleast_2d(points_m) - self.position_m) @ self.rotation.T
-
-    def project(self, points_m: np.ndarray) -> np.ndarray:
-        """World points (N, 3) in metres -> pixel centres (N, 2)."""
-        pc = self.to_camera(points_m)
-        return np.column_stack([self.fx_px * pc[:, 0] / pc[:, 2] + self.cx_px,
-                                self.fy_px * pc[:, 1] / pc[:, 2] + self.cy_px])
-
-    def m_per_px_at_depth(self, depth_m: float) -> float:
-        return depth_m / self.fx_px
-
-    def intrinsics(self) -> dict:
-        return {"fx_px": self.fx_px, "fy_px": self.fy_px, "cx_px": self.cx_px, "cy_px": self.cy_px,
-                "K": [[self.fx_px, 0.0, self.cx_px], [0.0, self.fy_px, self.cy_px], [0.0, 0.0, 1.0]]}
-
-    def extrinsics(self) -> dict:
-        return {"rotation_world_to_camera": self.rotation.tolist(),
-                "translation_m": self.translation_m.tolist(), "position_m": self.position_m.tolist()}
-
-
-def pinhole_from_scene(scene: mujoco.MjvScene, width_px: int, height_px: int) -> PinholeCamera:
-    """The pinhole camera MuJoCo renders ``scene`` with, in a ``width_px`` x ``height_px`` viewport.
-
-    OpenGL maps the near-plane window [left, right] x [bottom, top] onto the viewport; with
-    ``frustum_width`` 0 the width follows the viewport's aspect ratio. Pixel i spans window
-    coordinates [i, i + 1], so its centre is at i + 0.5: OpenCV's index is window - 0.5.
-    """
-    cams = [scene.camera[0], scene.camera[1]]   # the two eyes coincide without stereo
-    gl = cams[0]
-    if gl.orthographic:
-        raise SimError("the render camera is orthographic", "use a perspective (free) camera")
-    pos = np.mean([c.pos for c in cams], axis=0).astype(float)
-    forward = np.asarray(gl.forward, dtype=float)
-    up = np.asarray(gl.up, dtype=float)
-    right = np.cross(forward, up)
-    rotation = np.vstack([right, -up, forward])
-    near, top, bottom, centre = float(gl.frustum_near), float(gl.frustum_top), float(gl.frustum_bottom), \
-        float(gl.frustum_center)
-    height_n = top - bottom
-    width_n = float(gl.frustum_width) or height_n * width_px / height_px
-    fx = width_px * near / width_n
-    fy = height_px * near / height_n
-    cx = (width_px - 1) / 2 - width_px * centre / width_n
-    cy = (height_px - 1) / 2 + height_px * (top + bottom) / (2 * height_n)
-    return PinholeCamera(width_px, height_px, fx, fy, cx, cy, rotation, pos)
-
-
-# -- framing -----------------------------------------------------------------------
-def _distance_to_fit(half_width_m: float, half_height_m: float, fovy_deg: float, aspect: float) -> float:
-    tan_half = math.tan(math.radians(fovy_deg) / 2)
-    return max(half_height_m / tan_half, half_width_m / (tan_half * aspect))
-
-
-def frame_views(points_m: np.ndarray, chassis_x_m: np.ndarray, body_length_m: float, plane_y_m: float,
-                fovy_deg: float, aspect: float) -> tuple[CameraView, CameraView]:
-    """The fixed view that holds every point of the run, and the tracking view (at x = 0).
-
-    ``points_m`` (N, 3): positions the robot reaches (nose, foot, chassis ...). Both views
-    look horizontally at the plane ``y = plane_y_m``; the floor (z = 0) stays in the frame.
-    """
-    x_lo, x_hi = float(np.min(points_m[:, 0])) - MARGIN_M, float(np.max(points_m[:, 0])) + MARGIN_M
-    z_lo = min(0.0, float(np.min(points_m[:, 2]))) - MARGIN_M
-    z_hi = float(np.max(points_m[:, 2])) + MARGIN_M
-    z_mid = (z_lo + z_hi) / 2
-    # the camera stands at +y: what is nearer to it than the plane needs the wider view
-    nearer_m = max(0.0, float(np.max(points_m[:, 1])) - plane_y_m) + MARGIN_M
-    fixed = CameraView(((x_lo + x_hi) / 2, plane_y_m, z_mid),
-                       nearer_m + _distance_to_fit((x_hi - x_lo) / 2, (z_hi - z_lo) / 2, fovy_deg, aspect))
-    track_half_w = TRACK_HALF_WIDTH_OF_BODY * body_length_m
-    track = CameraView((float(chassis_x_m[0]), plane_y_m, z_mid),
-                       nearer_m + _distance_to_fit(track_half_w, (z_hi - z_lo) / 2, fovy_deg, aspect))
-    return fixed, track
 
 
 # -- one clip: frames, truth rows, sidecars ------------------------------------------
@@ -190,8 +60,8 @@ class VideoInfo:
 
 
 def sidecar_paths(path: Path) -> tuple[Path, Path]:
-    stem = path.with_suffix("")
-    return stem.with_name(stem.name + ".truth.csv"), stem.with_name(stem.name + ".camera.json")
+    """A clip's two sidecars: ``<stem>.truth.csv`` and ``<stem>.camera.json``."""
+    return path.with_name(path.stem + ".truth.csv"), camera_json_beside(path)
 
 
 def check_video_path(path: str | os.PathLike) -> Path:
@@ -247,7 +117,7 @@ class ClipRecorder:
         self.chassis_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
         try:
             self.renderer = mujoco.Renderer(m, height=self.height, width=self.width)
-        except Exception as exc:  # GL backends raise many types (ImportError, RuntimeError, mujoco.FatalError)
+        except Exception as exc:  # noqa: BLE001 - GL backends raise many types (ImportError, RuntimeError, ...)
             raise SimError(f"cannot open an offscreen OpenGL context ({type(exc).__name__}: {exc})",
                            "install OSMesa (apt-get install libosmesa6) and run with MUJOCO_GL=osmesa, "
                            "or MUJOCO_GL=egl on a GPU") from None
@@ -321,9 +191,9 @@ class ClipRecorder:
         return seen / len(_DISC_SAMPLES)
 
     def truth_csv(self) -> str:
-        lines = [f"# simulated ground truth: MuJoCo render of robot {self.robot_name!r}, camera {self.camera}; "
-                 "pixels in the OpenCV convention (origin at the centre of the top-left pixel, x right, y down); "
-                 "world x along the floor, z up, metres",
+        lines = [(f"# simulated ground truth: MuJoCo render of robot {self.robot_name!r}, camera {self.camera}; "
+                  "pixels in the OpenCV convention (origin at the centre of the top-left pixel, x right, y down); "
+                  "world x along the floor, z up, metres"),
                  ",".join(["frame", "t_s"] + [f"{n}_{c}" for n in MARKERS
                                               for c in ("px", "py", "visible", "seen_frac", "x_m", "z_m")])]
         for r in self.rows:
@@ -335,31 +205,19 @@ class ClipRecorder:
             lines.append(",".join(cells))
         return "\n".join(lines) + "\n"
 
-    def camera_json(self) -> dict:
+    def camera_file(self) -> CameraFile:
+        """The camera this clip was rendered with, as its owner (:mod:`locust.track.camera`) writes it."""
         first = self.cameras[0]
-        out = {
-            "note": "simulated camera (MuJoCo free camera); OpenCV pinhole convention: camera x right, "
-                    "y down, z forward; pixel origin at the centre of the top-left pixel",
-            "camera": self.camera, "width_px": self.width, "height_px": self.height, "fps": self.fps,
-            "frames": self.frames, "view": {"lookat_m": list(self.view.lookat_m), "distance_m": self.view.distance_m,
-                                            "azimuth_deg": self.view.azimuth_deg,
-                                            "elevation_deg": self.view.elevation_deg},
-            "intrinsics": first.intrinsics(),
-        }
-        planes = self.marker_planes()
-        out["marker_planes"] = {
-            "note": "each marker's visible centre moves in the world plane y = plane_y_m (world: x along "
-                    "the floor, y toward the camera, z up); truth x_m, z_m are in that plane",
-            **planes}
-        if self.camera == "fixed":
-            out["extrinsics"] = first.extrinsics()
-            out["m_per_px"] = self._m_per_px(first, planes)
-        else:
-            out["rotation_world_to_camera"] = first.rotation.tolist()
-            out["extrinsics_per_frame"] = [{"frame": r.frame, "t_s": r.t_s, "position_m": c.position_m.tolist(),
-                                            "translation_m": c.translation_m.tolist()}
-                                           for r, c in zip(self.rows, self.cameras)]
-        return out
+        K = np.array([[first.fx_px, 0.0, first.cx_px], [0.0, first.fy_px, first.cy_px], [0.0, 0.0, 1.0]])
+        fixed = self.camera == "fixed"
+        return CameraFile(
+            camera=self.camera, width_px=self.width, height_px=self.height, K=K, rotation=first.rotation,
+            positions_m=(first.position_m[None, :] if fixed else np.array([c.position_m for c in self.cameras])),
+            marker_planes={n: MarkerPlane(**p) for n, p in self.marker_planes().items()},
+            fps=self.fps, frames=self.frames,
+            frame_t_s=None if fixed else np.array([r.t_s for r in self.rows]),
+            view={"lookat_m": list(self.view.lookat_m), "distance_m": self.view.distance_m,
+                  "azimuth_deg": self.view.azimuth_deg, "elevation_deg": self.view.elevation_deg})
 
     def marker_planes(self) -> dict:
         """The plane y = const each marker's visible centre moves in, and how far it strays from it."""
@@ -369,12 +227,6 @@ class ClipRecorder:
             out[n] = {"plane_y_m": float(np.mean(y)), "max_off_plane_m": float(np.max(np.abs(y - np.mean(y))))}
         return out
 
-    def _m_per_px(self, cam: PinholeCamera, planes: dict) -> dict:
-        """Metres per pixel where each marker moves, and at the chassis mid-plane."""
-        ys = {"chassis_mid_plane": 0.0, **{f"{n}_plane": p["plane_y_m"] for n, p in planes.items()}}
-        return {name: {"plane_y_m": y, "m_per_px": cam.m_per_px_at_depth(float(cam.to_camera([0.0, y, 0.0])[0, 2]))}
-                for name, y in ys.items()}
-
     def finish(self) -> VideoInfo:
         try:
             self.writer.release()
@@ -383,7 +235,7 @@ class ClipRecorder:
                 raise SimError(f"no frames to write to {self.path}", "simulate for at least one frame period")
             truth_path, camera_path = sidecar_paths(self.path)
             atomic_write_text(truth_path, self.truth_csv())
-            atomic_write_json(camera_path, self.camera_json())
+            write_camera_json(camera_path, self.camera_file())
             os.replace(self.tmp_path, self.path)
         except BaseException:
             self.abort()
@@ -404,9 +256,7 @@ class ClipRecorder:
 
 def frame_times_s(duration_s: float, fps: int) -> np.ndarray:
     """One frame every 1/fps from t = 0: ``round(duration * fps)`` frames."""
-    return np.arange(int(round(duration_s * fps))) / fps
-
-
+    return np.arange(round(duration_s * fps)) / fps
 
 
 def validate_size(fps: int, width: int, height: int) -> None:
@@ -420,23 +270,32 @@ def validate_size(fps: int, width: int, height: int) -> None:
 
 
 def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = None, camera: str = "track",
-                 fps: int = 30, width: int = 1280, height: int = 720) -> VideoInfo:
+                 fps: int = 30, width: int = 1280, height: int = 720,
+                 trajectory: Trajectory | None = None) -> VideoInfo:
     """Simulate settle + ``cycles`` hops and render them to ``path`` (MP4), with truth sidecars.
 
     Frames sample the same rollout ``locust sim`` audits, at t = k / fps from the start of
     the simulation (the settle phase included); the frame count is duration x fps.
+
+    ``trajectory``: a rollout of ``robot`` already made with its states kept (e.g.
+    ``run(robot, keep_states=True).trajectory``) is rendered as it is, not simulated again;
+    ``cycles`` is then the trajectory's own.
     """
     if camera not in CAMERAS:
         raise SimError(f"camera {camera!r} is not known", f"choose one of {', '.join(CAMERAS)}")
     validate_size(fps, width, height)
     path = check_video_path(path)
-    built = build(robot)
-    traj = simulate(robot, cycles=cycles, built=built, keep_states=True)
+    if trajectory is None:
+        trajectory = simulate(robot, cycles=cycles, keep_states=True)
+    elif trajectory.states is None:
+        raise SimError("the trajectory to render kept no states",
+                       "simulate it with keep_states=True, or let render_video simulate")
+    traj = trajectory
     verdict = audit(traj)
     if not verdict.valid:
         raise SimError(f"not rendering an invalid simulation: {'; '.join(verdict.reasons)}",
                        "run `locust sim` on the same robot and fix the reasons it lists")
-    model, s = built.model, built.sensors
+    model, s = traj.built.model, traj.built.sensors
     dt, nq = traj.timestep_s, model.nq
     times = frame_times_s(traj.plan.duration_s, fps)
     # state row i is the state after step i + 1, at t = (i + 1) dt; t = 0 is the built pose
@@ -460,5 +319,5 @@ def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = Non
     return rec.finish()
 
 
-__all__ = ["CameraView", "ClipRecorder", "PinholeCamera", "VideoInfo", "render_video", "pinhole_from_scene",
-           "frame_times_s", "check_video_path", "validate_size"]
+__all__ = ["MARKERS", "VISIBLE_FRAC", "ClipRecorder", "VideoInfo", "check_video_path", "frame_times_s",
+           "render_video", "sidecar_paths", "validate_size"]

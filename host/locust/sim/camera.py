@@ -1,0 +1,148 @@
+"""The simulated camera: where MuJoCo's free camera stands, and the pinhole model it renders with.
+
+The camera looks at the robot's left side (the left leg is at +y, the foot marker on its
++y face) from +y, horizontally, with the floor in view. ``track`` follows the chassis in x;
+``fixed`` holds still where the whole run stays in view, the camera ``locust track`` wants.
+
+:func:`pinhole_from_scene` reads the camera MuJoCo itself rendered with
+(``renderer.scene.camera`` after ``update_scene``) as an OpenCV pinhole model, so pixels
+projected through it agree with the image.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from ..errors import SimError
+
+CAMERAS = ("track", "fixed")
+AZIMUTH_DEG = -90.0                        # look along -y: from the robot's left side
+ELEVATION_DEG = 0.0                        # horizontal
+MARGIN_M = 0.04                            # empty border around the robot in the fixed view
+TRACK_HALF_WIDTH_OF_BODY = 2.0             # track view: half the image width, in body lengths
+
+
+@dataclass(frozen=True)
+class CameraView:
+    """Where MuJoCo's free camera stands: it looks at ``lookat_m`` from ``distance_m``."""
+
+    lookat_m: tuple[float, float, float]
+    distance_m: float
+    azimuth_deg: float = AZIMUTH_DEG
+    elevation_deg: float = ELEVATION_DEG
+
+    def at_x(self, x_m: float) -> CameraView:
+        return CameraView((x_m, self.lookat_m[1], self.lookat_m[2]), self.distance_m,
+                          self.azimuth_deg, self.elevation_deg)
+
+    def mjv_camera(self) -> mujoco.MjvCamera:
+        cam = mujoco.MjvCamera()
+        cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+        cam.lookat[:] = self.lookat_m
+        cam.distance = self.distance_m
+        cam.azimuth = self.azimuth_deg
+        cam.elevation = self.elevation_deg
+        return cam
+
+
+@dataclass(frozen=True)
+class PinholeCamera:
+    """OpenCV pinhole model of one rendered frame: ``uv ~ K (R X + t)``.
+
+    Camera frame: x right, y down, z forward (into the scene); pixels: origin at the centre
+    of the top-left pixel.
+    """
+
+    width_px: int
+    height_px: int
+    fx_px: float
+    fy_px: float
+    cx_px: float
+    cy_px: float
+    rotation: np.ndarray      # (3, 3) world -> camera
+    position_m: np.ndarray    # (3,) camera centre in the world
+
+    @property
+    def translation_m(self) -> np.ndarray:
+        return -self.rotation @ self.position_m
+
+    def to_camera(self, points_m: np.ndarray) -> np.ndarray:
+        return (np.atleast_2d(points_m) - self.position_m) @ self.rotation.T
+
+    def project(self, points_m: np.ndarray) -> np.ndarray:
+        """World points (N, 3) in metres -> pixel centres (N, 2)."""
+        pc = self.to_camera(points_m)
+        return np.column_stack([self.fx_px * pc[:, 0] / pc[:, 2] + self.cx_px,
+                                self.fy_px * pc[:, 1] / pc[:, 2] + self.cy_px])
+
+    def m_per_px_at_depth(self, depth_m: float) -> float:
+        return depth_m / self.fx_px
+
+    def intrinsics(self) -> dict:
+        return {"fx_px": self.fx_px, "fy_px": self.fy_px, "cx_px": self.cx_px, "cy_px": self.cy_px,
+                "K": [[self.fx_px, 0.0, self.cx_px], [0.0, self.fy_px, self.cy_px], [0.0, 0.0, 1.0]]}
+
+    def extrinsics(self) -> dict:
+        return {"rotation_world_to_camera": self.rotation.tolist(),
+                "translation_m": self.translation_m.tolist(), "position_m": self.position_m.tolist()}
+
+
+def pinhole_from_scene(scene: mujoco.MjvScene, width_px: int, height_px: int) -> PinholeCamera:
+    """The pinhole camera MuJoCo renders ``scene`` with, in a ``width_px`` x ``height_px`` viewport.
+
+    OpenGL maps the near-plane window [left, right] x [bottom, top] onto the viewport; with
+    ``frustum_width`` 0 the width follows the viewport's aspect ratio. Pixel i spans window
+    coordinates [i, i + 1], so its centre is at i + 0.5: OpenCV's index is window - 0.5.
+    """
+    cams = [scene.camera[0], scene.camera[1]]   # the two eyes coincide without stereo
+    gl = cams[0]
+    if gl.orthographic:
+        raise SimError("the render camera is orthographic", "use a perspective (free) camera")
+    pos = np.mean([c.pos for c in cams], axis=0).astype(float)
+    forward = np.asarray(gl.forward, dtype=float)
+    up = np.asarray(gl.up, dtype=float)
+    right = np.cross(forward, up)
+    rotation = np.vstack([right, -up, forward])
+    near, top, bottom, centre = float(gl.frustum_near), float(gl.frustum_top), float(gl.frustum_bottom), \
+        float(gl.frustum_center)
+    height_n = top - bottom
+    width_n = float(gl.frustum_width) or height_n * width_px / height_px
+    fx = width_px * near / width_n
+    fy = height_px * near / height_n
+    cx = (width_px - 1) / 2 - width_px * centre / width_n
+    cy = (height_px - 1) / 2 + height_px * (top + bottom) / (2 * height_n)
+    return PinholeCamera(width_px, height_px, fx, fy, cx, cy, rotation, pos)
+
+
+# -- framing -----------------------------------------------------------------------
+def _distance_to_fit(half_width_m: float, half_height_m: float, fovy_deg: float, aspect: float) -> float:
+    tan_half = math.tan(math.radians(fovy_deg) / 2)
+    return max(half_height_m / tan_half, half_width_m / (tan_half * aspect))
+
+
+def frame_views(points_m: np.ndarray, chassis_x_m: np.ndarray, body_length_m: float, plane_y_m: float,
+                fovy_deg: float, aspect: float) -> tuple[CameraView, CameraView]:
+    """The fixed view that holds every point of the run, and the tracking view (at x = 0).
+
+    ``points_m`` (N, 3): positions the robot reaches (nose, foot, chassis ...). Both views
+    look horizontally at the plane ``y = plane_y_m``; the floor (z = 0) stays in the frame.
+    """
+    x_lo, x_hi = float(np.min(points_m[:, 0])) - MARGIN_M, float(np.max(points_m[:, 0])) + MARGIN_M
+    z_lo = min(0.0, float(np.min(points_m[:, 2]))) - MARGIN_M
+    z_hi = float(np.max(points_m[:, 2])) + MARGIN_M
+    z_mid = (z_lo + z_hi) / 2
+    # the camera stands at +y: what is nearer to it than the plane needs the wider view
+    nearer_m = max(0.0, float(np.max(points_m[:, 1])) - plane_y_m) + MARGIN_M
+    fixed = CameraView(((x_lo + x_hi) / 2, plane_y_m, z_mid),
+                       nearer_m + _distance_to_fit((x_hi - x_lo) / 2, (z_hi - z_lo) / 2, fovy_deg, aspect))
+    track_half_w = TRACK_HALF_WIDTH_OF_BODY * body_length_m
+    track = CameraView((float(chassis_x_m[0]), plane_y_m, z_mid),
+                       nearer_m + _distance_to_fit(track_half_w, (z_hi - z_lo) / 2, fovy_deg, aspect))
+    return fixed, track
+
+
+__all__ = ["CAMERAS", "CameraView", "PinholeCamera", "frame_views", "pinhole_from_scene"]

@@ -1,0 +1,49 @@
+"""Where points on the model are at kept states: forward kinematics over a rollout.
+
+A rollout made with its states kept (``simulate(..., keep_states=True)`` or
+``run(..., keep_states=True).trajectory``) holds every step's full physics state; posing a
+private ``MjData`` from a state row (``mj_kinematics``: positions only, no dynamics) gives
+where any geom was at that step.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from ..errors import SimError
+from .rollout import Trajectory
+
+
+def _marker_geom(model: mujoco.MjModel, marker: str) -> int:
+    return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"marker_{marker}")
+
+
+def carries_marker(traj: Trajectory, marker: str) -> bool:
+    """Whether the trajectory's model carries the ``marker_<marker>`` disc."""
+    return _marker_geom(traj.built.model, marker) >= 0
+
+
+def marker_positions(traj: Trajectory, marker: str, rows: np.ndarray) -> np.ndarray:
+    """World position (N, 3), metres, of the ``marker_<marker>`` geom's centre at state rows ``rows``.
+
+    Row i is the state after physics step i + 1 (as in ``traj.states``).
+    """
+    if traj.states is None:
+        raise SimError("the trajectory kept no states to pose the model from",
+                       "simulate with keep_states=True")
+    model = traj.built.model
+    gid = _marker_geom(model, marker)
+    if gid < 0:
+        raise SimError(f"the model carries no {marker!r} marker", "use a marker the model has: nose or foot")
+    data = mujoco.MjData(model)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    pos = np.empty((len(rows), 3))
+    for i, r in enumerate(rows):
+        mujoco.mj_setState(model, data, traj.states[r], spec)
+        mujoco.mj_kinematics(model, data)
+        pos[i] = data.geom_xpos[gid]
+    return pos
+
+
+__all__ = ["carries_marker", "marker_positions"]

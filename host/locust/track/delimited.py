@@ -1,0 +1,153 @@
+"""Delimited text of numbers: the one tokenizer under every table of samples locust reads.
+
+The tracks CSV (:mod:`.tracks_csv`), Tracker's text export (:mod:`.tracker_text`) and the
+calibration layer's plain CSV (:mod:`locust.calibrate.recordings`) are all lines of
+delimited numbers under a header; this module splits them, and each format's own module
+gives the columns their meaning.
+
+- ``#`` lines are comments, kept in order (Tracker 6's ``#multi:`` line is a marker of its
+  layout, not a comment); blank lines are skipped, but a line of tabs alone is a row of
+  empty cells (Tracker's layout for a frame where no track has a step);
+- the delimiter is a tab, ``;`` or ``,``: the first of these found in the first 20 lines;
+- the header is the line above the first all-numeric row; the line above the header, if
+  any, is Tracker's row of track names (or its title line);
+- with a delimiter other than ``,``, a decimal comma reads as a decimal point (Tracker in
+  such a locale); ``true``/``false`` (and ``yes``/``no``) read as 1/0 in a column whose
+  name ends in ``_ok``; an empty cell is NaN.
+
+Every problem is a :class:`~locust.errors.TrackError` naming the file, and the line or
+column, with a hint.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import TrackError
+
+_TRUE = {"true", "yes", "1"}
+_FALSE = {"false", "no", "0"}
+_NUMERIC = re.compile(r"[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?|nan|NaN|true|false|True|False")
+
+
+@dataclass(frozen=True)
+class DelimitedText:
+    """One file split into comments, header and data rows (each row with its line number)."""
+
+    path: Path
+    comments: tuple[str, ...]
+    multi: bool                              # Tracker 6's ``#multi:`` line was there
+    delimiter: str
+    header: list[str]
+    header_line: int
+    names_row: list[str] | None              # the line above the header, if any
+    rows: list[tuple[int, list[str]]]
+
+    @property
+    def tracker_layout(self) -> bool:
+        """Laid out as Tracker exports: ``#multi:``, a names or title line, or a header ``t ...``."""
+        return self.multi or self.names_row is not None or self.header[:1] == ["t"]
+
+    def columns(self, names: list[str]) -> np.ndarray:
+        """The data as floats, one column per name (``names`` label the header's columns in
+        messages and decide where ``true``/``false`` is allowed); a short row is NaN-padded."""
+        data = np.full((len(self.rows), len(names)), np.nan)
+        for k, (lineno, row) in enumerate(self.rows):
+            if len(row) > len(names) and any(f.strip() for f in row[len(names):]):
+                raise TrackError(f"{self.path}, line {lineno}: {len(row)} fields, header has {len(names)}",
+                                 "every row needs the same columns as the header")
+            for j, raw in enumerate(row[: len(names)]):
+                data[k, j] = _number(raw, self.delimiter, self.path, lineno, names[j])
+        return data
+
+
+def read_text(path: str | Path) -> str:
+    """The file's text (UTF-8, a byte-order mark dropped), or a TrackError naming it."""
+    path = Path(path)
+    try:
+        return path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise TrackError(f"{path}: no such file", "check the path of the recording") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise TrackError(f"{path}: cannot be read as text ({exc})", "give a CSV or a Tracker text export") from None
+
+
+def split_text(text: str, path: str | Path) -> DelimitedText:
+    """Split ``text`` (the contents of ``path``) into comments, header and data rows."""
+    path = Path(path)
+    # a line of tabs alone is a row of empty cells (a frame no track has), not a blank line
+    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() or "\t" in ln]
+    comments = tuple(ln.lstrip("#").strip() for _, ln in lines if ln.startswith("#") and not _is_multi(ln))
+    multi = any(_is_multi(ln) for _, ln in lines)
+    body = [(n, ln) for n, ln in lines if not ln.startswith("#")]
+    if not body:
+        raise TrackError(f"{path}: empty recording (no header, no data)", "export the data again")
+    delim = _delimiter([ln for _, ln in body[:20]])
+    rows = [(n, next(csv.reader(io.StringIO(ln), delimiter=delim))) for n, ln in body]
+    first_data = next((i for i, (_, r) in enumerate(rows) if _numeric_row(r)), None)
+    if first_data is None:
+        raise TrackError(f"{path}: no numeric rows under the header", "the file holds no samples")
+    above = [i for i in range(first_data) if not _empty_row(rows[i][1])]
+    if not above:
+        raise TrackError(f"{path}: no header line", "the first line must name the columns, e.g. t_s,angle_deg")
+    header_line, header = rows[above[-1]]
+    return DelimitedText(path=path, comments=comments, multi=multi, delimiter=delim,
+                         header=[h.strip() for h in header], header_line=header_line,
+                         names_row=rows[above[-2]][1] if len(above) >= 2 else None,
+                         rows=rows[above[-1] + 1:])
+
+
+def check_names(names: list[str], path: Path, lineno: int) -> None:
+    """Every column named, no name twice."""
+    seen: set[str] = set()
+    for n in names:
+        if not n:
+            raise TrackError(f"{path}, line {lineno}: a column has no name", "name every column in the header")
+        if n in seen:
+            raise TrackError(f"{path}, line {lineno}: column {n!r} appears twice", "give each column one name")
+        seen.add(n)
+
+
+def _is_multi(line: str) -> bool:
+    return line.strip().lower().startswith("#multi")
+
+
+def _delimiter(lines: list[str]) -> str:
+    sample = "\n".join(lines)
+    for d in ("\t", ";", ","):
+        if d in sample:
+            return d
+    return ","  # one column
+
+
+def _empty_row(row: list[str]) -> bool:
+    return not any(f.strip() for f in row)
+
+
+def _numeric_row(row: list[str]) -> bool:
+    fields = [f.strip() for f in row if f.strip()]
+    return bool(fields) and all(_NUMERIC.fullmatch(f) is not None for f in fields)
+
+
+def _number(raw: str, delim: str, path: Path, lineno: int, column: str) -> float:
+    f = raw.strip()
+    if not f:
+        return np.nan
+    low = f.lower()
+    if low in _TRUE and column.endswith("_ok"):
+        return 1.0
+    if low in _FALSE and column.endswith("_ok"):
+        return 0.0
+    if delim != ",":
+        f = f.replace(",", ".")  # Tracker in a decimal-comma locale
+    try:
+        return float(f)
+    except ValueError:
+        raise TrackError(f"{path}, line {lineno}: column {column!r} holds {raw!r}, not a number",
+                         "fix or delete that line") from None

@@ -1,0 +1,215 @@
+"""Tracker's text export (*File > Export > Data*): its one writer, its one reader, its typed object.
+
+Tracker (Open Source Physics) exports a data table as tab-separated text:
+
+- an optional title line (the track's name), or Tracker 6's ``#multi:`` line followed by
+  a row of track names, each above the first column of its track;
+- a header of Tracker's column names (``t x y ...``);
+- one row per step; an empty cell is a step the track does not have (NaN here). In a
+  decimal-comma locale the numbers have decimal commas.
+
+Tracker writes positions in its calibration unit: calibrate Tracker in metres, and the
+``x``/``y`` columns read as ``x_m``/``y_m``. ``locust track --format tracker`` writes the
+same layout (:func:`tracker_export_text`): a row of track names, then ``t x y`` for every
+track, with ``t`` empty where that track has no step.
+
+A track is known by its *marker name*: its Tracker name with every run of characters other
+than letters, digits and ``_`` made one ``_`` (``cm A`` -> ``cm_A``), as in the tracks CSV.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import TrackError
+from ..fileio import atomic_write_text
+from .delimited import DelimitedText, check_names, read_text, split_text
+from .tracks_csv import missing_time, no_marker
+
+DEFAULT_TRACK = "track"   # the name of columns no title or names row claims
+
+
+@dataclass(frozen=True, eq=False)
+class TrackerTrack:
+    """One track of an export: its name as Tracker wrote it and its columns (NaN where empty).
+
+    ``t_s`` is the track's own ``t`` column, or the table's shared one; a column the export
+    does not have is None. ``other`` holds further columns (``v``, ``vx``, ``theta`` ...)
+    under Tracker's header names.
+    """
+
+    name: str
+    t_s: np.ndarray | None
+    x_m: np.ndarray | None
+    y_m: np.ndarray | None
+    other: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, TrackerTrack):
+            return NotImplemented
+        return (self.name == other.name and all(_same(getattr(self, c), getattr(other, c)) for c in ("t_s", "x_m", "y_m"))
+                and self.other.keys() == other.other.keys()
+                and all(_same(v, other.other[k]) for k, v in self.other.items()))
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True, eq=False)
+class TrackerExport:
+    """A Tracker text export: its tracks by marker name, and its ``#`` comment lines.
+
+    Equality compares the contents (NaN equal to NaN), not ``path``.
+    """
+
+    tracks: dict[str, TrackerTrack]
+    comments: tuple[str, ...] = ()
+    path: Path | None = None
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, TrackerExport):
+            return NotImplemented
+        return self.tracks == other.tracks and self.comments == other.comments
+
+    __hash__ = None  # type: ignore[assignment]
+
+    @property
+    def n_rows(self) -> int:
+        lengths = [len(a) for t in self.tracks.values() for a in (t.t_s, t.x_m, t.y_m, *t.other.values())
+                   if a is not None]
+        return max(lengths, default=0)
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The export's columns under locust's names: ``t_s`` (the tracks' times as one
+        column), then per track ``<marker>_x_m``, ``<marker>_y_m`` and ``<marker>_<column>``."""
+        return tuple(self._labelled())
+
+    def column(self, name: str) -> np.ndarray:
+        """One column by its name in :attr:`columns`."""
+        return self._labelled()[name]
+
+    def markers_with_positions(self) -> list[str]:
+        """Tracks with both an ``x`` and a ``y`` column."""
+        return [m for m, t in self.tracks.items() if t.x_m is not None and t.y_m is not None]
+
+    def time_s(self) -> np.ndarray:
+        """The time of each row: the tracks' ``t`` columns as one, which must agree where
+        two have a value; an export without ``t`` is refused."""
+        times: list[np.ndarray] = []
+        for t in self.tracks.values():
+            if t.t_s is not None and not any(t.t_s is s for s in times):
+                times.append(t.t_s)
+        if not times:
+            raise missing_time(self.path, self.columns)
+        out = times[0].copy()
+        for t in times[1:]:
+            both = np.isfinite(out) & np.isfinite(t)
+            clash = both & ~np.isclose(out, t, rtol=1e-9, atol=0.0)
+            if clash.any():
+                row = int(np.argmax(clash))
+                raise TrackError(f"{self.path}: the tracks' times disagree in data row {row + 1} "
+                                 f"({out[row]:g} s and {t[row]:g} s)", "export the tracks from one data table")
+            out = np.where(np.isfinite(out), out, t)
+        return out
+
+    def positions(self, marker: str) -> tuple[np.ndarray, np.ndarray]:
+        """``marker``'s x and y (Tracker's unit: metres when calibrated so), NaN where it has no step."""
+        track = self.tracks.get(marker)
+        if track is None or track.x_m is None or track.y_m is None:
+            raise no_marker(self.path, marker, self.markers_with_positions())
+        return track.x_m.copy(), track.y_m.copy()
+
+    def has_pixels(self, marker: str) -> bool:
+        """Always False: a text export holds world values only."""
+        return False
+
+    def _labelled(self) -> dict[str, np.ndarray]:
+        out: dict[str, np.ndarray] = {}
+        if any(t.t_s is not None for t in self.tracks.values()):
+            out["t_s"] = self.time_s()
+        for marker, t in self.tracks.items():
+            if t.x_m is not None:
+                out[f"{marker}_x_m"] = t.x_m
+            if t.y_m is not None:
+                out[f"{marker}_y_m"] = t.y_m
+            out.update({f"{marker}_{marker_name(h)}": v for h, v in t.other.items()})
+        return out
+
+    @classmethod
+    def from_delimited(cls, doc: DelimitedText) -> TrackerExport:
+        """The tracks in a file already split by :func:`.delimited.split_text`."""
+        header, names_row = doc.header, doc.names_row
+        current = DEFAULT_TRACK
+        if names_row is not None and len(names_row) == 1 and names_row[0].strip():
+            current, names_row = names_row[0].strip(), None          # a title line: the track's name
+        owners = []
+        for j in range(len(header)):
+            if names_row is not None and j < len(names_row) and names_row[j].strip():
+                current = names_row[j].strip()
+            owners.append(current)
+        markers = [marker_name(o) for o in owners]
+        labels = ["t_s" if h == "t" else f"{m}_{h}_m" if h in ("x", "y") else f"{m}_{marker_name(h)}"
+                  for h, m in zip(header, markers)]
+        check_names([f"{m}_t_s" if h == "t" else lab for h, m, lab in zip(header, markers, labels)],
+                    doc.path, doc.header_line)
+        data = doc.columns(labels)
+        shared = next((data[:, j] for j, h in enumerate(header) if h == "t"), None)
+        groups: dict[str, dict] = {}
+        for j, (h, owner, m) in enumerate(zip(header, owners, markers)):
+            g = groups.setdefault(m, {"name": owner, "other": {}})
+            if h in ("t", "x", "y"):
+                g[h] = data[:, j]
+            else:
+                g["other"][h] = data[:, j]
+        tracks = {m: TrackerTrack(g["name"], g.get("t", shared), g.get("x"), g.get("y"), g["other"])
+                  for m, g in groups.items() if "x" in g or "y" in g or g["other"]}   # not a lone shared t
+        return cls(tracks=tracks, comments=doc.comments, path=doc.path)
+
+
+def marker_name(name: str) -> str:
+    """A Tracker name as a marker name: ``cm A`` -> ``cm_A`` (``track`` when nothing is left)."""
+    return re.sub(r"\W+", "_", name.strip()).strip("_") or DEFAULT_TRACK
+
+
+def tracker_export_text(export: TrackerExport) -> str:
+    """Tracker's layout: a row of track names, a row of Tracker's column names, then
+    tab-separated values (6 significant digits); a NaN is an empty cell."""
+    names: list[str] = []
+    heads: list[str] = []
+    cols: list[np.ndarray] = []
+    for track in export.tracks.values():
+        parts = [(h, v) for h, v in (("t", track.t_s), ("x", track.x_m), ("y", track.y_m), *track.other.items())
+                 if v is not None]
+        names += [track.name] + [""] * (len(parts) - 1)
+        heads += [h for h, _ in parts]
+        cols += [np.asarray(v, dtype=float) for _, v in parts]
+    lines = [f"# {c}" for c in export.comments] + ["\t".join(names), "\t".join(heads)]
+    for i in range(export.n_rows):
+        lines.append("\t".join("" if not math.isfinite(c[i]) else f"{c[i]:.6g}" for c in cols))
+    return "\n".join(lines) + "\n"
+
+
+def write_tracker_export(path: Path, export: TrackerExport) -> Path:
+    """Write ``export`` to ``path`` atomically."""
+    return atomic_write_text(path, tracker_export_text(export))
+
+
+def parse_tracker_export(text: str, path: str | Path) -> TrackerExport:
+    """The tracks in ``text`` (the contents of ``path``)."""
+    return TrackerExport.from_delimited(split_text(text, path))
+
+
+def read_tracker_export(path: str | Path) -> TrackerExport:
+    """Read a Tracker text export; a :class:`~locust.errors.TrackError` names the file and line of any fault."""
+    return parse_tracker_export(read_text(path), path)
+
+
+def _same(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    if a is None or b is None:
+        return a is None and b is None
+    return a.shape == b.shape and bool(np.array_equal(a, b, equal_nan=True))

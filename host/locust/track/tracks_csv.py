@@ -1,0 +1,250 @@
+"""The tracks CSV (``<video>.tracks.csv``): its one writer, its one reader, its typed object.
+
+``locust track`` writes it; the report and the calibration layer read it back through
+:func:`read_tracks_csv` (or :func:`read_track_file`, which also takes Tracker's text
+export). Layout: ``#`` comment lines (the file's own notes, e.g. ``# synthetic: ...``),
+then one header line and one row per frame::
+
+    frame,t_s,<m>_px,<m>_py,<m>_x_m,<m>_y_m,<m>_ok        (the last five once per marker)
+
+- ``frame``: video frame index; ``t_s``: seconds since the clip's first frame (6 decimals);
+- ``<m>_px``, ``<m>_py``: pixels in OpenCV's convention, origin at the centre of the
+  top-left pixel, x right, y down (4 decimals);
+- ``<m>_x_m``, ``<m>_y_m``: world metres, y up (6 decimals); ``nan`` without a calibration;
+- ``<m>_ok``: 1 where the marker was found, 0 where not; its cells are then ``nan``.
+
+The reader also takes what other programs make of the file (the tokenizer is
+:mod:`.delimited`): ``true``/``false`` in ``_ok``, ``;`` or tab delimiters with decimal
+commas, a marker with some of its columns left out (NaN; without ``_ok`` every row counts
+as found), and columns of no marker (kept in :attr:`TracksCsv.other`). A row whose ``_ok``
+is false is a lost frame: :meth:`TracksCsv.positions` gives NaN there, never a position.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import TrackError
+from ..fileio import atomic_write_text
+from .delimited import DelimitedText, check_names, read_text, split_text
+
+if TYPE_CHECKING:
+    from .tracker_text import TrackerExport
+
+TRACKS_CSV_SUFFIX = ".tracks.csv"
+MARKER_COLUMNS = ("px", "py", "x_m", "y_m", "ok")   # per marker, in the order written
+
+
+def tracks_csv_beside(video: Path) -> Path:
+    """``hop.mp4`` -> ``hop.tracks.csv``: where ``locust track`` writes a video's tracks."""
+    return video.with_name(video.stem + TRACKS_CSV_SUFFIX)
+
+
+@dataclass(frozen=True, eq=False)
+class MarkerColumns:
+    """One marker's columns: pixels (OpenCV convention), world metres (y up), found or not."""
+
+    name: str
+    px: np.ndarray
+    py: np.ndarray
+    x_m: np.ndarray
+    y_m: np.ndarray
+    ok: np.ndarray          # bool: found in that frame
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, MarkerColumns):
+            return NotImplemented
+        return self.name == other.name and all(_same(getattr(self, c), getattr(other, c)) for c in MARKER_COLUMNS)
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True, eq=False)
+class TracksCsv:
+    """A tracks CSV: per frame its index and time, per marker its columns, and the file's notes.
+
+    Equality compares the contents (NaN equal to NaN), not ``path`` or ``header``.
+    """
+
+    frame: np.ndarray                                       # int, video frame index
+    t_s: np.ndarray                                         # seconds since the clip's first frame
+    markers: dict[str, MarkerColumns]
+    comments: tuple[str, ...] = ()                          # the ``#`` lines, without the ``#``
+    other: dict[str, np.ndarray] = field(default_factory=dict)   # columns of no marker, as read
+    path: Path | None = None                                # where it was read from
+    header: tuple[str, ...] | None = None                   # the columns as read (None: as written)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, TracksCsv):
+            return NotImplemented
+        return (_same(self.frame, other.frame) and _same(self.t_s, other.t_s) and self.markers == other.markers
+                and self.comments == other.comments and self.other.keys() == other.other.keys()
+                and all(_same(v, other.other[k]) for k, v in self.other.items()))
+
+    __hash__ = None  # type: ignore[assignment]
+
+    @property
+    def n_rows(self) -> int:
+        return len(self.t_s)
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The file's columns: as read, or the layout :func:`tracks_csv_text` writes."""
+        if self.header is not None:
+            return self.header
+        return ("frame", "t_s", *(f"{m}_{c}" for m in self.markers for c in MARKER_COLUMNS), *self.other)
+
+    def column(self, name: str) -> np.ndarray:
+        """One column by its name in the file, as floats (``_ok`` as 1.0/0.0)."""
+        if name == "frame":
+            return self.frame.astype(float)
+        if name == "t_s":
+            return self.t_s
+        if name in self.other:
+            return self.other[name]
+        marker, kind = _marker_column(name) or ("", "")
+        if marker in self.markers:
+            return getattr(self.markers[marker], kind).astype(float)
+        raise KeyError(name)
+
+    def markers_with_positions(self) -> list[str]:
+        """Markers with both world columns in the file."""
+        cols = set(self.columns)
+        return [m for m in self.markers if f"{m}_x_m" in cols and f"{m}_y_m" in cols]
+
+    def time_s(self) -> np.ndarray:
+        """The ``t_s`` column; a file without one is refused."""
+        if "t_s" not in self.columns:
+            raise missing_time(self.path, self.columns)
+        return self.t_s
+
+    def positions(self, marker: str) -> tuple[np.ndarray, np.ndarray]:
+        """``marker``'s world x and y (m), NaN in the frames where it was lost."""
+        if marker not in self.markers_with_positions():
+            raise no_marker(self.path, marker, self.markers_with_positions())
+        m = self.markers[marker]
+        return np.where(m.ok, m.x_m, np.nan), np.where(m.ok, m.y_m, np.nan)
+
+    def has_pixels(self, marker: str) -> bool:
+        """Whether ``marker`` has a finite pixel position anywhere (tracked, even if not in metres)."""
+        m = self.markers.get(marker)
+        return m is not None and bool(np.isfinite(m.px).any())
+
+    @classmethod
+    def from_delimited(cls, doc: DelimitedText) -> TracksCsv:
+        """The tracks in a file already split by :func:`.delimited.split_text`."""
+        names = list(doc.header)
+        check_names(names, doc.path, doc.header_line)
+        data = doc.columns(names)
+        n = len(data)
+        cols = {name: data[:, j] for j, name in enumerate(names)}
+        frame = cols.get("frame", np.arange(n, dtype=float))
+        if not (np.isfinite(frame).all() and np.all(frame == np.round(frame))):
+            bad = int(np.argmax(~np.isfinite(frame) | (frame != np.round(frame))))
+            raise TrackError(f"{doc.path}, line {doc.rows[bad][0]}: frame {frame[bad]:g} is not a frame number",
+                             "fix or delete that line")
+        markers: dict[str, dict[str, np.ndarray]] = {}
+        other: dict[str, np.ndarray] = {}
+        for name, values in cols.items():
+            if name in ("frame", "t_s"):
+                continue
+            split = _marker_column(name)
+            if split is None:
+                other[name] = values
+            else:
+                markers.setdefault(split[0], {})[split[1]] = values
+        nan = np.full(n, np.nan)
+        return cls(frame=frame.astype(int), t_s=cols.get("t_s", nan.copy()),
+                   markers={m: MarkerColumns(m, c.get("px", nan.copy()), c.get("py", nan.copy()),
+                                             c.get("x_m", nan.copy()), c.get("y_m", nan.copy()),
+                                             c["ok"] > 0.5 if "ok" in c else np.ones(n, bool))
+                            for m, c in markers.items()},
+                   comments=doc.comments, other=other, path=doc.path, header=tuple(names))
+
+
+def tracks_csv_text(tracks: TracksCsv) -> str:
+    """The file's text: comments, header, one row per frame (``nan`` for a missing value)."""
+    out = io.StringIO()
+    for line in tracks.comments:
+        out.write(f"# {line}\n")
+    head = ["frame", "t_s"]
+    cols: list[tuple[np.ndarray, int]] = []       # values, decimals (-1: the 0/1 of ok)
+    for m in tracks.markers.values():
+        head += [f"{m.name}_{c}" for c in MARKER_COLUMNS]
+        cols += [(m.px, 4), (m.py, 4), (m.x_m, 6), (m.y_m, 6), (m.ok, -1)]
+    for name, values in tracks.other.items():
+        head.append(name)
+        cols.append((values, 6))
+    out.write(",".join(head) + "\n")
+    for i, frame in enumerate(tracks.frame):
+        row = [str(int(frame)), _fmt(tracks.t_s[i], 6)]
+        row += [str(int(bool(v[i]))) if digits < 0 else _fmt(v[i], digits) for v, digits in cols]
+        out.write(",".join(row) + "\n")
+    return out.getvalue()
+
+
+def write_tracks_csv(path: Path, tracks: TracksCsv) -> Path:
+    """Write ``tracks`` to ``path`` atomically."""
+    return atomic_write_text(path, tracks_csv_text(tracks))
+
+
+def parse_tracks_csv(text: str, path: str | Path) -> TracksCsv:
+    """The tracks in ``text`` (the contents of ``path``)."""
+    return TracksCsv.from_delimited(split_text(text, path))
+
+
+def read_tracks_csv(path: str | Path) -> TracksCsv:
+    """Read a tracks CSV; a :class:`~locust.errors.TrackError` names the file and line of any fault."""
+    return parse_tracks_csv(read_text(path), path)
+
+
+def read_track_file(path: str | Path) -> TracksCsv | TrackerExport:
+    """A marker track in either layout ``locust track`` writes: a tracks CSV
+    (:class:`TracksCsv`) or Tracker's text export (:class:`.tracker_text.TrackerExport`).
+    Both answer ``time_s()``, ``positions(marker)``, ``has_pixels(marker)`` and ``n_rows``."""
+    from . import tracker_text  # it builds on this module's errors
+
+    doc = split_text(read_text(path), path)
+    return tracker_text.TrackerExport.from_delimited(doc) if doc.tracker_layout else TracksCsv.from_delimited(doc)
+
+
+def is_tracks_header(names: list[str]) -> bool:
+    """Whether a header names marker columns (``<m>_px``, ``<m>_py``, ``<m>_x_m``, ``<m>_y_m``)."""
+    kinds = [_marker_column(n) for n in names]
+    return any(k is not None and k[1] != "ok" for k in kinds)
+
+
+def missing_time(path: Path | None, columns) -> TrackError:
+    """The error for a track file without a time column."""
+    return TrackError(f"{path}: missing column t_s for time (found: {', '.join(columns) or 'none'})",
+                      "the file needs the columns t_s")
+
+
+def no_marker(path: Path | None, marker: str, names: list[str]) -> TrackError:
+    """The error for a marker the file has no positions of (``names``: the markers it has)."""
+    return TrackError(f"{path}: no marker {marker!r} (markers: {', '.join(names) or 'none'})",
+                      "check the name given with --marker")
+
+
+def _marker_column(name: str) -> tuple[str, str] | None:
+    for kind in ("x_m", "y_m", "px", "py", "ok"):
+        if name.endswith("_" + kind) and len(name) > len(kind) + 1:
+            return name[: -len(kind) - 1], kind
+    return None
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    a, b = np.asarray(a), np.asarray(b)
+    if a.dtype.kind in "fc" or b.dtype.kind in "fc":
+        return a.shape == b.shape and bool(np.array_equal(a, b, equal_nan=True))
+    return bool(np.array_equal(a, b))
+
+
+def _fmt(value: float, digits: int) -> str:
+    return "nan" if not math.isfinite(value) else f"{value:.{digits}f}"

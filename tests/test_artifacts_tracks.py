@@ -1,0 +1,186 @@
+"""The track layer's files, each through its one owner: write -> read back -> equal.
+
+- the tracks CSV (locust.track.tracks_csv), lost frames (NaN, ok 0) included, and what
+  other programs make of it (true/false, semicolons and decimal commas);
+- Tracker's text export (locust.track.tracker_text): steps a track does not have, a frame
+  no track has, Tracker 6's shared time column, per-track time columns;
+- camera.json (locust.track.camera): a fixed and a following camera, a plane without its
+  stray distance (null in JSON, NaN here).
+
+Numbers here are SYNTHETIC (chosen to survive the files' decimals exactly).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from locust.calibrate.recordings import read_table
+from locust.errors import TrackError
+from locust.track import camera as cam
+from locust.track import tracker_text as tt
+from locust.track import tracks_csv as tc
+
+NAN = math.nan
+
+
+def _tracks() -> tc.TracksCsv:
+    ok = np.array([True, True, False, True])
+    nose = tc.MarkerColumns("nose", np.array([10.5, 11.25, NAN, 13.0]), np.array([200.0, 199.5, NAN, 197.125]),
+                            np.array([0.1, 0.105, NAN, 0.115]), np.array([0.02, 0.025, NAN, 0.03]), ok)
+    foot = tc.MarkerColumns("foot", np.array([5.0, 5.5, 6.0, 6.5]), np.array([220.0] * 4),
+                            np.full(4, NAN), np.full(4, NAN), np.ones(4, bool))      # pixels only: no scale
+    return tc.TracksCsv(frame=np.array([3, 4, 5, 6]), t_s=np.array([0.0, 1 / 30, 2 / 30, 0.1]),
+                        markers={"nose": nose, "foot": foot}, comments=("synthetic: four frames", "truth: none"))
+
+
+def test_tracks_csv_round_trip_keeps_lost_frames_and_notes(tmp_path):
+    tracks = _tracks()
+    path = tc.write_tracks_csv(tmp_path / "hop.tracks.csv", tracks)
+    text = path.read_text()
+    header = "frame,t_s,nose_px,nose_py,nose_x_m,nose_y_m,nose_ok,foot_px,foot_py,foot_x_m,foot_y_m,foot_ok"
+    assert text.splitlines()[:3] == ["# synthetic: four frames", "# truth: none", header]
+    assert text.splitlines()[5] == "5,0.066667,nan,nan,nan,nan,0,6.0000,220.0000,nan,nan,1"
+    back = tc.read_tracks_csv(path)
+    t_written = np.round(tracks.t_s, 6)
+    assert back == tc.TracksCsv(tracks.frame, t_written, tracks.markers, tracks.comments)
+    assert back.path == path and back.columns == tuple(text.splitlines()[2].split(","))
+    assert tc.tracks_csv_text(back) == text                               # and the text again, byte for byte
+    x, y = back.positions("nose")
+    assert np.isnan(x[2]) and np.isnan(y[2]) and x[3] == 0.115
+    assert back.markers_with_positions() == ["nose", "foot"]
+    assert back.has_pixels("foot") and not back.has_pixels("tail")
+    assert back != _tracks() and back.frame.dtype.kind == "i"            # time was rounded to 6 decimals
+
+
+def test_tracks_csv_reader_takes_what_other_programs_write(tmp_path):
+    ours = "frame,t_s,n_px,n_py,n_x_m,n_y_m,n_ok\n0,0.5,1.25,2.0,0.1,0.2,1\n1,0.6,nan,nan,nan,nan,0\n"
+    theirs = "frame;t_s;n_px;n_py;n_x_m;n_y_m;n_ok\n0;0,5;1,25;2;0,1;0,2;true\n1;0,6;;;;;false\n"
+    assert tc.parse_tracks_csv(theirs, "theirs.csv") == tc.parse_tracks_csv(ours, "ours.csv")
+    # columns left out are NaN, no _ok counts every row as found, columns of no marker are kept
+    part = tc.parse_tracks_csv("t_s,tip_x_m,tip_y_m,temp_c\n0,1,2,20.5\n", "part.csv")
+    assert list(part.frame) == [0] and np.isnan(part.markers["tip"].px).all() and part.markers["tip"].ok.all()
+    assert part.other["temp_c"][0] == 20.5 and part.columns == ("t_s", "tip_x_m", "tip_y_m", "temp_c")
+    assert tc.parse_tracks_csv(tc.tracks_csv_text(part), "again.csv") == part
+
+
+@pytest.mark.parametrize("text, words", [
+    ("frame,t_s,n_x_m,n_y_m\n0,0.0,0.1,0.1\n1,0.03,abc,0.1\n", "line 3: column 'n_x_m' holds 'abc'"),
+    ("frame,t_s,n_x_m,n_x_m\n0,0,1,2\n", "appears twice"),
+    ("frame,t_s,n_x_m,n_y_m\n0.5,0,1,2\n", "line 2: frame 0.5 is not a frame number"),
+    ("", "empty recording"),
+])
+def test_bad_tracks_csv_names_file_and_line(tmp_path, text, words):
+    path = tmp_path / "bad.tracks.csv"
+    path.write_text(text)
+    with pytest.raises(TrackError, match=words) as err:
+        tc.read_tracks_csv(path)
+    assert str(path) in err.value.message and err.value.hint
+
+
+def test_track_files_are_named_beside_the_video(tmp_path):
+    video = tmp_path / "hop.mp4"
+    assert tc.tracks_csv_beside(video) == tmp_path / "hop.tracks.csv"
+    assert cam.camera_json_beside(video) == tmp_path / "hop.camera.json"
+
+
+def test_report_synthetic_track_is_what_the_owner_writes(tmp_path):
+    """The SYNTHETIC trial the report tests use reads back and writes out to the same bytes."""
+    from locust.params import preset
+    from locust.report.synthetic import write_synthetic_trial
+
+    truth = write_synthetic_trial(tmp_path, preset("seed"), 1, lost_frames=3)
+    tracks = tc.read_tracks_csv(truth.track_path)
+    assert tracks.comments[0].startswith("synthetic:") and int((~tracks.markers["nose"].ok).sum()) == 3
+    assert tc.tracks_csv_text(tracks) == truth.track_path.read_text()
+
+
+def _export() -> tt.TrackerExport:
+    # row 4: a frame where no track has a step (a row of empty cells in the file)
+    ball = tt.TrackerTrack("ball", np.array([NAN, 0.05, 0.1, NAN]), np.array([NAN, 0.125, 0.25, NAN]),
+                           np.array([NAN, 1.5, 1.25, NAN]))
+    cup = tt.TrackerTrack("cup 3", np.array([0.0, 0.05, NAN, NAN]), np.array([1.0, 1.5, NAN, NAN]),
+                          np.array([2.0, 2.5, NAN, NAN]), {"v": np.array([3.0, NAN, NAN, NAN])})
+    return tt.TrackerExport({"ball": ball, "cup_3": cup})
+
+
+def test_tracker_text_round_trip_keeps_missing_steps_and_empty_frames(tmp_path):
+    export = _export()
+    path = tt.write_tracker_export(tmp_path / "e.txt", export)
+    lines = path.read_text().splitlines()
+    assert lines[:2] == ["ball\t\t\tcup 3\t\t\t", "t\tx\ty\tt\tx\ty\tv"]
+    assert lines[-1] == "\t\t\t\t\t\t"
+    back = tt.read_tracker_export(path)
+    assert back == export and back.n_rows == 4
+    assert tt.tracker_export_text(back) == path.read_text()
+    np.testing.assert_array_equal(back.time_s(), [0.0, 0.05, 0.1, NAN])   # the tracks' times as one
+    x, _ = back.positions("cup_3")
+    assert x[0] == 1.0 and np.isnan(x[2])
+    assert back.columns == ("t_s", "ball_x_m", "ball_y_m", "cup_3_x_m", "cup_3_y_m", "cup_3_v")
+    assert tc.read_track_file(path) == export                             # the dispatcher sees Tracker
+
+
+def test_tracker_6_multi_export_shares_one_time_column():
+    text = "#multi:\n\tcm A\t\tcm B\t\nt\tx\ty\tx\ty\n0,0\t1,5\t2,0\t3,0\t4,0\n0,1\t1,6\t\t3,1\t4,1\n"
+    export = tt.parse_tracker_export(text, "multi.txt")
+    assert list(export.tracks) == ["cm_A", "cm_B"] and export.tracks["cm_A"].name == "cm A"
+    assert export.tracks["cm_A"].t_s is export.tracks["cm_B"].t_s
+    np.testing.assert_array_equal(export.tracks["cm_A"].y_m, [2.0, NAN])
+    titled = tt.parse_tracker_export("tip\nt\tx\ty\n0\t1\t2\n", "tip.txt")
+    assert list(titled.tracks) == ["tip"] and titled.tracks["tip"].x_m[0] == 1.0
+    with pytest.raises(TrackError, match="times disagree in data row 1"):
+        tt.parse_tracker_export("a\t\t\tb\t\t\nt\tx\ty\tt\tx\ty\n0\t1\t2\t0.5\t3\t4\n", "x.txt").time_s()
+
+
+def test_calibration_tables_come_from_the_owners(tmp_path):
+    csv_path = tc.write_tracks_csv(tmp_path / "a.tracks.csv", _tracks())
+    txt_path = tt.write_tracker_export(tmp_path / "a.txt", _export())
+    table = read_table(csv_path)
+    assert isinstance(table.tracks, tc.TracksCsv) and table.kind == "csv" and table.markers() == ["nose", "foot"]
+    assert np.isnan(table.marker("nose")[0][2])                          # ok 0 is never a position
+    table = read_table(txt_path)
+    assert isinstance(table.tracks, tt.TrackerExport) and table.kind == "tracker"
+    np.testing.assert_array_equal(table.time_s(), [0.0, 0.05, 0.1, NAN])
+    (tmp_path / "servo.csv").write_text("t_s,angle_deg,command_deg\n0,1,0\n")
+    assert read_table(tmp_path / "servo.csv").tracks is None
+
+
+K = np.array([[217.25, 0.0, 159.5], [0.0, 217.25, 89.5], [0.0, 0.0, 1.0]])
+ROTATION = np.array([[-1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, -1.0, 0.0]])
+
+
+@pytest.mark.parametrize("kind", ["fixed", "track"])
+def test_camera_json_round_trip(tmp_path, kind):
+    n = 1 if kind == "fixed" else 3
+    camera = cam.CameraFile(camera=kind, width_px=320, height_px=180, K=K, rotation=ROTATION,
+                            positions_m=np.array([[0.1 * k, 0.6, 0.05] for k in range(n)]),
+                            marker_planes={"nose": cam.MarkerPlane(0.0602, 0.0015), "foot": cam.MarkerPlane(-0.02)},
+                            fps=30, frames=n, frame_t_s=None if kind == "fixed" else np.arange(n) / 30,
+                            view={"lookat_m": [0.1, 0.0, 0.05], "distance_m": 0.6, "azimuth_deg": 90.0,
+                                  "elevation_deg": 0.0})
+    path = cam.write_camera_json(cam.camera_json_beside(tmp_path / "hop.mp4"), camera)
+    doc = json.loads(path.read_text())
+    assert doc["marker_planes"]["foot"]["max_off_plane_m"] is None         # NaN is null in the file
+    assert ("m_per_px" in doc) == (kind == "fixed")
+    back = cam.read_camera_json(path)
+    assert back == camera and math.isnan(back.marker_planes["foot"].max_off_plane_m)
+    cal = cam.load(path, 320, 180)
+    assert cal.planes_y_m == {"nose": 0.0602, "foot": -0.02} and cal.camera == kind
+    np.testing.assert_array_equal(cal.positions_m, camera.positions_m)
+    with pytest.raises(TrackError, match="describes a 320x180 camera"):
+        cam.load(path, 640, 360)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["fixed", "track"])
+def test_simulations_camera_json_reads_back_to_the_same_bytes(tmp_path, kind):
+    """What the MuJoCo render writes is a CameraFile: read and written again, byte for byte."""
+    from locust.params import preset
+    from locust.sim.clip import render_video
+
+    info = render_video(preset("seed"), tmp_path / "hop.mp4", cycles=1, camera=kind, fps=30, width=160, height=120)
+    assert info.camera_path == cam.camera_json_beside(info.video_path)
+    again = cam.write_camera_json(tmp_path / "again.json", cam.read_camera_json(info.camera_path))
+    assert again.read_text() == info.camera_path.read_text()
