@@ -25,10 +25,9 @@ from pathlib import Path
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from notebook_reference import notebook_run  # noqa: E402
-
-from locust.params import preset  # noqa: E402
-from locust.sim.run import run  # noqa: E402
+from locust.params import preset
+from locust.sim.run import run
+from notebook_reference import notebook_run
 
 CYCLES = 3
 ROUTES = [   # (name, solver overrides); the first is the package default

@@ -28,15 +28,14 @@ import mujoco
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from notebook_sweep import notebook_sweep  # noqa: E402
-
-from locust.params import preset  # noqa: E402
-from locust.sim.model import build  # noqa: E402
-from locust.sim.rollout import initial_state, simulate_built  # noqa: E402
-from locust.sim.schedule import control_plan  # noqa: E402
-from locust.sweep.run import run_sweep  # noqa: E402
-from locust.sweep.design import design_robot, parse_axis  # noqa: E402
-from locust.sweep.execute import default_jobs  # noqa: E402
+from locust.params import preset
+from locust.sim.model import build
+from locust.sim.rollout import initial_state, simulate_built
+from locust.sim.schedule import control_plan
+from locust.sweep.design import design_robot, parse_axis
+from locust.sweep.execute import default_jobs
+from locust.sweep.run import run_sweep
+from notebook_sweep import notebook_sweep
 
 
 def notebook_loop_on(built, plan) -> float:

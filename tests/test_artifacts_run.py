@@ -6,6 +6,7 @@ import json
 
 import click
 import pytest
+
 from locust.device import cli as device_cli
 from locust.device import record as R
 from locust.errors import DeviceError, ReportError

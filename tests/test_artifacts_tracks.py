@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 import pytest
+
 from locust.calibrate.recordings import read_table
 from locust.errors import TrackError
 from locust.track import camera as cam

@@ -10,6 +10,7 @@ import math
 import mujoco
 import numpy as np
 import pytest
+
 from locust.calibrate import servo as SV
 from locust.calibrate import synthetic as S
 from locust.calibrate.recordings import read_table

@@ -16,7 +16,7 @@ import serial
 from locust.firmware import protocol as P
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "firmware"))
-from lcg import Lcg  # noqa: E402  (the firmware tests' generator: same numbers in MicroPython)
+from lcg import Lcg
 
 LOCUST = [sys.executable, "-m", "locust.cli"]
 

@@ -21,8 +21,8 @@ from locust.cli import cli
 from locust.params import Provenance, leg_set, preset, save_robot
 from locust.report.synthetic import simulated_nose, write_synthetic_trial
 from locust.sim.run import run
-from locust.sweep.run import run_sweep
 from locust.sweep.design import Axis
+from locust.sweep.run import run_sweep
 
 CYCLES = 2
 TRUE_HINGE_STIFFNESS = 0.02   # N*m/rad: a softer cardstock hinge than the model's 0.056

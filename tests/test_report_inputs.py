@@ -203,8 +203,8 @@ def test_measured_groups_by_name_and_folder(tmp_path):
 def test_demo_virtual_robot_carries_the_recordings_truth():
     """The demo's virtual robot is built from the bundled recordings' '# truth:' headers,
     which replay the seed's identified values (calibration/make_synthetic.py)."""
-    from locust.params import preset
     from locust.demo import CALIBRATIONS, RECORDINGS, recording_truth
+    from locust.params import preset
 
     truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])
     assert truth == pytest.approx({

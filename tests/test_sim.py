@@ -5,13 +5,12 @@ import math
 import subprocess
 import sys
 
+import mujoco
 import pytest
 
 from locust.params import preset
 from locust.sim.model import build, loop_closure_error_m
 from locust.sim.run import run
-
-import mujoco
 
 
 @pytest.mark.parametrize("name", ["seed", "medium", "large", "seed-notebook"])

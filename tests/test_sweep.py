@@ -16,8 +16,8 @@ import pytest
 
 from locust.errors import SweepError
 from locust.params import preset
+from locust.sweep.design import design_robot, evaluate, parse_axis, parse_bound, precheck
 from locust.sweep.run import best_row, run_sweep
-from locust.sweep.design import evaluate, parse_axis, parse_bound, precheck, design_robot
 
 LOCUST = [sys.executable, "-c", "from locust.cli import main; main()"]
 

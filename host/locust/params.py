@@ -23,10 +23,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
+
+import tomllib
 
 from .errors import ParamsError
 from .fileio import atomic_write_text
@@ -171,7 +172,7 @@ class Robot:
         _split_key(key)
         return self.provenance.get(key, Provenance())
 
-    def with_values(self, values: dict[str, Any], source: str | Provenance = "override") -> "Robot":
+    def with_values(self, values: dict[str, Any], source: str | Provenance = "override") -> Robot:
         """A copy with ``values`` (dotted keys) replaced, each recorded with ``source``."""
         prov = source if isinstance(source, Provenance) else Provenance(source=source)
         sections = {name: getattr(self, name) for name in SECTIONS}
@@ -182,11 +183,11 @@ class Robot:
             provenance[key] = prov
         return replace(self, provenance=provenance, **sections)
 
-    def with_provenance(self, key: str, prov: Provenance) -> "Robot":
+    def with_provenance(self, key: str, prov: Provenance) -> Robot:
         _split_key(key)
         return replace(self, provenance={**self.provenance, key: prov})
 
-    def renamed(self, name: str) -> "Robot":
+    def renamed(self, name: str) -> Robot:
         return replace(self, name=name)
 
     def link_lengths_m(self) -> tuple[float, float, float, float]:

@@ -15,7 +15,7 @@ class _Silent:
     def __init__(self, items: Iterable | None):
         self._items = items
 
-    def __enter__(self) -> "_Silent":
+    def __enter__(self) -> _Silent:
         return self
 
     def __exit__(self, *exc: Any) -> bool:

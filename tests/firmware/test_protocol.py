@@ -19,7 +19,7 @@ def test_pure_crc_matches_library():
     rng = Lcg(7)
     for n in (0, 1, 5, 64, 255):
         data = rng.bytes(n)
-        assert "{:08x}".format(P._crc32_pure(data)) == P.crc_hex(data)
+        assert f"{P._crc32_pure(data):08x}" == P.crc_hex(data)
 
 
 def test_roundtrip():

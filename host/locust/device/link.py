@@ -186,7 +186,7 @@ class Link:
             pass
         self._reader.join(timeout=1.0)
 
-    def __enter__(self) -> "Link":
+    def __enter__(self) -> Link:
         return self
 
     def __exit__(self, *exc) -> None:

@@ -119,7 +119,7 @@ class VirtualRobot:
         self.summary: dict | None = None
 
     # -- lifecycle ---------------------------------------------------------------------
-    def start(self) -> "VirtualRobot":
+    def start(self) -> VirtualRobot:
         self._ma, self._sa = os.openpty()     # the interpreter's console
         self._mb, self._sb = os.openpty()     # the clients' side: /dev/pts/N
         for fd in (self._sa, self._sb):
@@ -198,7 +198,7 @@ class VirtualRobot:
                               "of the hop (its video was not written)", "rerun on a less loaded machine, or without --video")
         return self.summary or {}
 
-    def __enter__(self) -> "VirtualRobot":
+    def __enter__(self) -> VirtualRobot:
         return self.start()
 
     def __exit__(self, *exc) -> None:

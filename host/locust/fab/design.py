@@ -87,7 +87,7 @@ class Design:
 class LayerMap:
     patterns: dict[str, tuple[str, ...]] = field(default_factory=lambda: dict(DEFAULT_LAYER_MAP))
 
-    def with_overrides(self, items: dict[str, list[str]]) -> "LayerMap":
+    def with_overrides(self, items: dict[str, list[str]]) -> LayerMap:
         """``{"body": ["outline_a"], ...}``: these names replace the role's defaults."""
         for role in items:
             if role not in ROLES:

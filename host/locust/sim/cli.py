@@ -9,8 +9,8 @@ import click
 
 from ..errors import GeometryError, SimError
 from ..fileio import json_text
-from ..params_cli import robot_options
 from ..params import resolve_robot
+from ..params_cli import robot_options
 
 
 @click.command()
@@ -36,7 +36,8 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence)
       locust sim --preset seed-notebook --json          # the notebook's Part 2 figures
       locust sim --preset large --set servo.stall_torque_nm=0.18 --video large.mp4
     """
-    from .run import check_convergence as converge, invalid_result, run
+    from .run import check_convergence as converge
+    from .run import invalid_result, run
 
     robot = resolve_robot(preset, config, sets)
     if video is not None:

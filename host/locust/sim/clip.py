@@ -117,7 +117,7 @@ class ClipRecorder:
         self.chassis_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
         try:
             self.renderer = mujoco.Renderer(m, height=self.height, width=self.width)
-        except Exception as exc:  # noqa: BLE001 - GL backends raise many types (ImportError, RuntimeError, ...)
+        except Exception as exc:
             raise SimError(f"cannot open an offscreen OpenGL context ({type(exc).__name__}: {exc})",
                            "install OSMesa (apt-get install libosmesa6) and run with MUJOCO_GL=osmesa, "
                            "or MUJOCO_GL=egl on a GPU") from None

@@ -264,7 +264,7 @@ class LiveSim:
                           sensordata=sd, final_qpos=self.data.qpos.copy(), warnings=warnings,
                           wall_s=self._stepping_wall_s)
 
-    def __enter__(self) -> "LiveSim":
+    def __enter__(self) -> LiveSim:
         return self
 
     def __exit__(self, *exc) -> None:

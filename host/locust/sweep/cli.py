@@ -47,9 +47,9 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json):
       locust sweep --vary geometry.leg_m=0.04:0.1:7 --vary geometry.crank_m=0.03:0.06:4 --out grid
       locust sweep --vary scale=0:0.05:30 --scheduler tcp://10.0.0.5:8786 --out cluster-run
     """
-    from .run import grid, run_sweep
     from .design import parse_axis
     from .execute import check_scheduler
+    from .run import grid, run_sweep
 
     base = resolve_robot(preset, config, sets)
     axes = [parse_axis(v, base) for v in varies]
@@ -117,8 +117,8 @@ def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_n
       locust optimize --vary geometry.leg_m=0.05:0.09 --vary geometry.crank_start_deg=-110:-70 \\
           --vary schedule.push_deg=-40:-20 --vary schedule.push_s=0.15:0.4 --trials 60 --out opt
     """
-    from .optimize import run_optimize
     from .design import parse_bound
+    from .optimize import run_optimize
 
     base = resolve_robot(preset, config, sets)
     bounds = [parse_bound(v, base) for v in varies]

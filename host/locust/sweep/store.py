@@ -140,7 +140,7 @@ class SweepStore:
         return self.folder / RESULTS
 
     @classmethod
-    def open(cls, folder: Path, meta: dict[str, Any], axis_names: list[str]) -> "SweepStore":
+    def open(cls, folder: Path, meta: dict[str, Any], axis_names: list[str]) -> SweepStore:
         """Start a sweep in ``folder`` or resume the same sweep there."""
         folder = Path(folder)
         store = cls(folder, meta, axis_names)

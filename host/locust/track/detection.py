@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Optional, Protocol
+from typing import Protocol
 
 import numpy as np
 
@@ -23,10 +23,10 @@ class Detection:
     ok: bool
 
     @staticmethod
-    def missing(score: float = math.nan) -> "Detection":
+    def missing(score: float = math.nan) -> Detection:
         return Detection(math.nan, math.nan, score, False)
 
-    def point(self) -> Optional[tuple[float, float]]:
+    def point(self) -> tuple[float, float] | None:
         return (self.px, self.py) if self.ok else None
 
 

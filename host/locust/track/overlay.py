@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable, Optional
 
 import cv2
 import numpy as np
@@ -61,7 +61,7 @@ def write_png(result: TrackResult, path: Path) -> Path:
     return atomic_write_bytes(path, png.tobytes())
 
 
-def write_video(result: TrackResult, path: Path, progress: Optional[Callable[[int], None]] = None) -> Path:
+def write_video(result: TrackResult, path: Path, progress: Callable[[int], None] | None = None) -> Path:
     """The whole clip with the tracks growing frame by frame (MPEG-4, at the clip's rate)."""
     v = result.video
 

@@ -11,14 +11,14 @@ window within a frame or two.
 from __future__ import annotations
 
 from collections import deque
-from typing import Iterable, Optional
+from collections.abc import Iterable
 
 Point = tuple[float, float]
 
 LOOKBACK = 4  # Tracker's predictionLookback
 
 
-def predict_next(history: Iterable[Optional[Point]]) -> Optional[Point]:
+def predict_next(history: Iterable[Point | None]) -> Point | None:
     """Predicted next position from ``history`` (oldest first, ``None`` = not found)."""
     prev = list(history)[-LOOKBACK:][::-1]  # prev[0] is the latest
     prev += [None] * (LOOKBACK - len(prev))
@@ -30,7 +30,7 @@ def predict_next(history: Iterable[Optional[Point]]) -> Optional[Point]:
             _predict_axis([p[1] if p else None for p in prev]))
 
 
-def _predict_axis(p: list[Optional[float]]) -> float:
+def _predict_axis(p: list[float | None]) -> float:
     """One axis; ``p[0]`` the latest position, ``p[1]`` known, older ones possibly ``None``.
 
     Tracker's rule, written out for the four-step lookback: the mean acceleration is over
@@ -54,10 +54,10 @@ class MotionHistory:
     """The last few positions of one marker and the search centre they predict."""
 
     def __init__(self) -> None:
-        self._points: deque[Optional[Point]] = deque(maxlen=LOOKBACK)
-        self.last_found: Optional[Point] = None
+        self._points: deque[Point | None] = deque(maxlen=LOOKBACK)
+        self.last_found: Point | None = None
 
-    def add(self, point: Optional[Point]) -> None:
+    def add(self, point: Point | None) -> None:
         self._points.append(point)
         if point is not None:
             self.last_found = point
@@ -66,6 +66,6 @@ class MotionHistory:
         """True when the last two positions are both known."""
         return len(self._points) >= 2 and self._points[-1] is not None and self._points[-2] is not None
 
-    def search_centre(self) -> Optional[Point]:
+    def search_centre(self) -> Point | None:
         """The look-ahead prediction, or the last position seen when there is none."""
         return predict_next(self._points) or self.last_found

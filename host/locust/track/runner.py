@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable, Optional
 
 import numpy as np
 
@@ -30,7 +30,7 @@ class MarkerTrack:
 class TrackResult:
     """Tracks of one clip. ``video`` is None for tracks read from a Tracker project."""
 
-    video: Optional[VideoInfo]
+    video: VideoInfo | None
     clip: Clip
     frames: np.ndarray
     t_s: np.ndarray
@@ -43,7 +43,7 @@ class TrackResult:
 
 
 def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibration | PlaneCalibration,
-                progress: Optional[Callable[[int], None]] = None, require_found: bool = True) -> TrackResult:
+                progress: Callable[[int], None] | None = None, require_found: bool = True) -> TrackResult:
     """Run every marker model over a resolved ``clip`` of the video ``info``.
 
     ``progress(n)`` is called after each frame. With ``require_found`` a marker that was
