@@ -21,8 +21,10 @@ sysdeps:
 demo: install sysdeps
 	$(VENV)/bin/locust demo --out demo-out
 
-# Fast tests (the default, well under 15 minutes). pytest exits 5 when it collects nothing.
+# Lint, then the fast tests (the default, well under 15 minutes). pytest exits 5 when it
+# collects nothing.
 test: install sysdeps
+	$(VENV)/bin/ruff check host tests bench
 	$(PY) -m pytest -q; rc=$$?; [ $$rc -eq 5 ] && { echo "no tests collected"; exit 0; }; exit $$rc
 
 # Everything, including the slow system tests.

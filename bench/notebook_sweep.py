@@ -46,7 +46,8 @@ def sweep_xml(delta_L: float) -> str | None:
         vec_green = P3 - P2
         deg_green = math.degrees(math.atan2(vec_green[1], vec_green[0])) - theta_rad  # the bug, kept
         vec_red = P4 - P3
-        deg_red = math.degrees(math.atan2(vec_red[1], vec_red[0])) - math.degrees(math.atan2(vec_green[1], vec_green[0]))
+        deg_red = (math.degrees(math.atan2(vec_red[1], vec_red[0]))
+                   - math.degrees(math.atan2(vec_green[1], vec_green[0])))
     except Exception:
         return None
 

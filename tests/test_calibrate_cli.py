@@ -101,7 +101,8 @@ def test_servo_two_loads_json(recs):
 
 
 def test_tracker_export_gives_the_same_fit(recs):
-    a = json.loads(run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--json", "--no-plot").output)
+    a = json.loads(run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--json",
+                       "--no-plot").output)
     b = json.loads(run("calibrate", "beam", recs / "synthetic_beam_tracker.txt", "--mass-kg", 0.01, "--json",
                        "--no-plot").output)
     assert b["natural_frequency_hz"]["value"] == pytest.approx(a["natural_frequency_hz"]["value"], rel=2e-3)
@@ -130,7 +131,8 @@ def test_ramp_track_and_trials_together(recs):
     ("frame,t_s,tip_x_m,tip_y_m\n0,0,0,0\n1,0.1,0,0.001\n", ["beam", "--mass-kg", "0.01"], "only 2 usable samples"),
     ("t_s,angle_deg,command_deg\n" + "".join(f"{i / 240},0.0,{0 if i < 10 else 90}\n" for i in range(100)),
      ["servo", "--inertia-kgm2", "1e-4"], "flat signal"),
-    ("t_s,angle_deg,command_deg\n0,1,0\n0.1,abc,0\n", ["servo", "--inertia-kgm2", "1e-4"], "line 3: column 'angle_deg'"),
+    ("t_s,angle_deg,command_deg\n0,1,0\n0.1,abc,0\n", ["servo", "--inertia-kgm2", "1e-4"],
+     "line 3: column 'angle_deg'"),
     ("trial,angle_deg\n1,59\n", ["ramp"], "need at least 2"),
 ])
 def test_bad_input_names_the_file(tmp_path, content, args, message):

@@ -35,7 +35,8 @@ def env(tmp_path_factory):
 
 
 def test_flash_then_hop_six_cycles_on_time(env, tmp_path):
-    proc = _run(["hop", "--port", "sim", "--cycles", "6", "--json", "--plant", "record", "--out", str(tmp_path / "run")], env)
+    proc = _run(["hop", "--port", "sim", "--cycles", "6", "--json", "--plant", "record",
+                 "--out", str(tmp_path / "run")], env)
     assert proc.returncode == 0, proc.stderr
     rec = json.loads(proc.stdout)
     assert rec["status"] == "complete" and rec["firmware_version"] == P.VERSION

@@ -12,7 +12,8 @@ from locust.errors import DeviceError
 
 
 def test_jitter_known_values():
-    phases = [R.Phase(1, "push", 0, 500), R.Phase(1, "wait", 300_000, 298_500), R.Phase(2, "push", 1_300_000, 1_301_000)]
+    phases = [R.Phase(1, "push", 0, 500), R.Phase(1, "wait", 300_000, 298_500),
+              R.Phase(2, "push", 1_300_000, 1_301_000)]
     j = R.jitter(phases)
     # errors 0.5, -1.5, 1.0 ms: mean 0, population sd sqrt((0.25+2.25+1)/3)
     assert j.mean_ms == pytest.approx(0.0, abs=1e-9)

@@ -211,8 +211,10 @@ def test_changing_a_calibrated_stiffness_changes_the_predictions(world, tmp_path
 
 PROBE = """<script>
 window.__errors = [];
-window.addEventListener('error', e => window.__errors.push('error: ' + String(e.message || e.target.src || '?').slice(0, 80)), true);
-document.addEventListener('securitypolicyviolation', e => window.__errors.push('csp: ' + String(e.blockedURI).slice(0, 80)));
+window.addEventListener('error', e => window.__errors.push(
+  'error: ' + String(e.message || e.target.src || '?').slice(0, 80)), true);
+document.addEventListener('securitypolicyviolation', e => window.__errors.push(
+  'csp: ' + String(e.blockedURI).slice(0, 80)));
 window.addEventListener('load', () => {
   const imgs = Array.from(document.images);
   const drawn = imgs.filter(i => i.complete && i.naturalWidth > 0 && i.naturalHeight > 0);

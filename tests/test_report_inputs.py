@@ -154,7 +154,8 @@ PIXELS_ONLY = "frame,t_s,nose_px,nose_py,nose_x_m,nose_y_m,nose_ok\n" + "".join(
     (lambda d: d / "missing", "no such file or folder", "check the --measured path"),
     (lambda d: make_trial(d / "small", track=PIXELS_ONLY), "no nose position in metres", "--scale"),
     (lambda d: make_trial(d / "small", run={"status": "complete"}), "not a run record", "locust hop"),
-    (lambda d: make_trial(d / "small", track="frame,t_s,nose_x_m,nose_y_m\n0,0.0,0.1,0.1\n1,0.03,abc,0.1\n"), "line 3", "fix or delete"),
+    (lambda d: make_trial(d / "small", track="frame,t_s,nose_x_m,nose_y_m\n0,0.0,0.1,0.1\n1,0.03,abc,0.1\n"),
+     "line 3", "fix or delete"),
     (lambda d: make_trial(d / "2026"), "no track", "locust track"),
 ])
 def test_bad_measured_inputs_are_clear_errors_and_write_nothing(tmp_path, setup, message, hint):

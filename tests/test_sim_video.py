@@ -172,7 +172,8 @@ def test_track_gives_world_metres_through_camera_json(clips, camera, tmp_path):
         assert ok[seen].mean() >= 0.95
         use = seen & ok
         px_err = np.hypot(tracks[f"{name}_px"] - truth[f"{name}_px"], tracks[f"{name}_py"] - truth[f"{name}_py"])[use]
-        m_err = np.hypot(tracks[f"{name}_x_m"] - truth[f"{name}_x_m"], tracks[f"{name}_y_m"] - truth[f"{name}_z_m"])[use]
+        m_err = np.hypot(tracks[f"{name}_x_m"] - truth[f"{name}_x_m"],
+                         tracks[f"{name}_y_m"] - truth[f"{name}_z_m"])[use]
         px_rms, m_rms = float(np.sqrt(np.mean(px_err ** 2))), float(np.sqrt(np.mean(m_err ** 2)))
         assert px_rms <= 0.5, f"{camera} {name}: pixel RMS {px_rms:.3f}"
         assert m_rms <= 1e-3, f"{camera} {name}: world RMS {m_rms * 1000:.3f} mm"

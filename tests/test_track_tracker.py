@@ -91,7 +91,8 @@ def test_from_trk_reads_cupsclips_tracks(shared_data, tmp_path):
         z.extract(names[0], tmp_path)
     project = trk.read_project(tmp_path / names[0])
     assert {"cup 3", "cup 7"} <= set(project.points)
-    res = CliRunner().invoke(cli, ["track", "--from-trk", str(tmp_path / names[0]), "--out", str(tmp_path / "cups.csv")])
+    res = CliRunner().invoke(cli, ["track", "--from-trk", str(tmp_path / names[0]),
+                                   "--out", str(tmp_path / "cups.csv")])
     assert res.exit_code == 0, res.output
     df = pd.read_csv(tmp_path / "cups.csv")
     assert {"cup_3_px", "cup_7_y_m", "cup_7_ok"} <= set(df.columns)

@@ -368,7 +368,8 @@ def _uncertainty(path: Path, key: str, raw: Any) -> float | None:
         return None
     if isinstance(raw, bool) or not isinstance(raw, (int, float)) or not math.isfinite(raw) or raw < 0:
         raise ParamsError(f"{path}: {key} has uncertainty = {raw!r}, not a number >= 0",
-                          "write one standard deviation in the value's own unit, e.g. uncertainty = 0.01, or leave it out")
+                          "write one standard deviation in the value's own unit, "
+                          "e.g. uncertainty = 0.01, or leave it out")
     return float(raw)
 
 
@@ -380,7 +381,8 @@ def load_robot(path: str | Path) -> Robot:
     except FileNotFoundError:
         raise ParamsError(f"{path}: no such file", "give the path of a robot.toml, or use --preset") from None
     except tomllib.TOMLDecodeError as exc:
-        raise ParamsError(f"{path}: not valid TOML ({exc})", "fix the file, or regenerate it with `locust params --write`") from None
+        raise ParamsError(f"{path}: not valid TOML ({exc})",
+                          "fix the file, or regenerate it with `locust params --write`") from None
     base = doc.get("base", "seed")
     if base not in PRESETS:
         raise ParamsError(f"{path}: base = {base!r} is not a preset", f"choose one of {', '.join(PRESETS)}")

@@ -112,7 +112,8 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
     t, y = t_s[window], d[window]
     if len(t) < MIN_SAMPLES:
         raise CalibrationError(f"{source}: only {len(t)} samples in the fit window (need {MIN_SAMPLES})",
-                               "film at a higher frame rate (see calibration/protocols/beam.md) or widen --start-s/--end-s")
+                               "film at a higher frame rate (see calibration/protocols/beam.md) "
+                               "or widen --start-s/--end-s")
     t0 = float(t[0])
     fs_hz = 1.0 / float(np.median(np.diff(t)))
     fn0 = _dominant_frequency_hz(t, y - np.median(y[len(y) * 3 // 4:]))

@@ -28,7 +28,8 @@ def output_options(func):
     func = click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")(func)
     func = click.option("--write", "write_path", type=click.Path(dir_okay=False, path_type=Path),
                         is_flag=False, flag_value=str(DEFAULT_ROBOT_TOML), default=None,
-                        help=f"Update this robot.toml with the fitted values only [bare --write: {DEFAULT_ROBOT_TOML}]. "
+                        help="Update this robot.toml with the fitted values only "
+                             f"[bare --write: {DEFAULT_ROBOT_TOML}]. "
                              "Other values are kept; a new file starts from the seed preset.")(func)
     return func
 
@@ -56,7 +57,8 @@ def calibrate() -> None:
               help="Free length of the beam, clamp to mass [m]; needed for the hinge values (k*L^2, b*L^2).")
 @click.option("--beam-mass-kg", type=float, default=0.0, show_default=True,
               help="The beam's own mass [kg]; 33/140 of it is added to the oscillating mass.")
-@click.option("--start-s", type=float, default=None, help="Fit from this time [default: the first swing after the drop].")
+@click.option("--start-s", type=float, default=None,
+              help="Fit from this time [default: the first swing after the drop].")
 @click.option("--end-s", type=float, default=None, help="Fit up to this time [default: end of the track].")
 @output_options
 def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, write_path, as_json, plot_path, no_plot):
@@ -234,7 +236,8 @@ def _print_text(out: dict) -> None:
                 click.echo(f"{key:30s} {val['value']:<12.6g} (undetermined){flag}")
             else:
                 lo, hi = val["ci95"]
-                click.echo(f"{key:30s} {val['value']:<12.6g} ± {val['std']:.3g} (1σ)  95% CI [{lo:.6g}, {hi:.6g}]{flag}")
+                click.echo(f"{key:30s} {val['value']:<12.6g} ± {val['std']:.3g} (1σ)  "
+                           f"95% CI [{lo:.6g}, {hi:.6g}]{flag}")
         elif isinstance(val, list) and all(isinstance(v, float) for v in val):
             click.echo(f"{key:30s} {', '.join(format(v, '.6g') for v in val)}")
         elif val is not None:

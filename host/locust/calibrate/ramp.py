@@ -80,7 +80,8 @@ def critical_angle_from_track(t_s: np.ndarray, ramp_a: tuple[np.ndarray, np.ndar
     ax, ay = ramp_a
     bx, by = ramp_b
     rx, ry = robot
-    keep = np.isfinite(t) & np.isfinite(ax) & np.isfinite(ay) & np.isfinite(bx) & np.isfinite(by) & np.isfinite(rx) & np.isfinite(ry)
+    keep = (np.isfinite(t) & np.isfinite(ax) & np.isfinite(ay) & np.isfinite(bx) & np.isfinite(by)
+            & np.isfinite(rx) & np.isfinite(ry))
     t, ax, ay, bx, by, rx, ry = (v[keep] for v in (t, ax, ay, bx, by, rx, ry))
     if len(t) < 10:
         raise CalibrationError(f"{source}: only {len(t)} frames with all three markers (need 10)",

@@ -152,7 +152,8 @@ def rig_model(rig: ServoRig, servo: Servo | None = None) -> mujoco.MjModel:
     """One hinge (axis -y, so positive angles lift a load hanging along +x) and the servo."""
     if not (rig.inertia_kgm2 > 0 and math.isfinite(rig.inertia_kgm2)):
         raise CalibrationError(f"--inertia-kgm2 must be positive (got {rig.inertia_kgm2})",
-                               "the load's moment of inertia about the servo axis, e.g. m*r^2 for a battery at radius r")
+                               "the load's moment of inertia about the servo axis, "
+                               "e.g. m*r^2 for a battery at radius r")
     j, moment = rig.inertia_kgm2, abs(rig.gravity_moment_nm)
     if moment > 0:
         # A point-like load at radius r with m*g*r = M and m*r^2 <= J: put half the inertia
@@ -251,7 +252,8 @@ class _Layout:
 
     def timing_scales(self) -> list[float]:
         """Physical size of one solver unit of each timing variable, in order."""
-        return [s for has_clock in self.clock for s in ((DELAY_SCALE_S, CLOCK_SCALE) if has_clock else (DELAY_SCALE_S,))]
+        return [s for has_clock in self.clock
+                for s in ((DELAY_SCALE_S, CLOCK_SCALE) if has_clock else (DELAY_SCALE_S,))]
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         lo = [math.log(LOWER[n]) for n in self.fitted]

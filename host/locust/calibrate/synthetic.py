@@ -63,7 +63,8 @@ def beam_tip_track(truth: BeamTruth, rng: np.random.Generator, tilt_deg: float =
     tau = np.clip(t - truth.drop_at_s, 0, None)
     a = -y_eq
     b = (v0 + zeta * wn * a) / wd
-    y = np.where(t < truth.drop_at_s, 0.0, y_eq + np.exp(-zeta * wn * tau) * (a * np.cos(wd * tau) + b * np.sin(wd * tau)))
+    y = np.where(t < truth.drop_at_s, 0.0,
+                 y_eq + np.exp(-zeta * wn * tau) * (a * np.cos(wd * tau) + b * np.sin(wd * tau)))
     tilt = math.radians(tilt_deg)
     x_m = 0.05 - math.sin(tilt) * y + rng.normal(0, truth.noise_m, len(t))
     y_m = 0.12 + math.cos(tilt) * y + rng.normal(0, truth.noise_m, len(t))
@@ -174,5 +175,6 @@ def ramp_tilt_track(truth: RampTruth, rng: np.random.Generator, *, fps: float = 
         "ramp_b": board_m * along,
         "robot": s[:, None] * along + 0.01 * normal,
     }
-    out = {k: (v[:, 0] + rng.normal(0, noise_m, len(t)), v[:, 1] + rng.normal(0, noise_m, len(t))) for k, v in pts.items()}
+    out = {k: (v[:, 0] + rng.normal(0, noise_m, len(t)), v[:, 1] + rng.normal(0, noise_m, len(t)))
+           for k, v in pts.items()}
     return t, out, crit

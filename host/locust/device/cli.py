@@ -26,8 +26,9 @@ def _info(msg: str) -> None:
 
 def _plant_options(func):
     func = click.option("--video", type=click.Path(dir_okay=False, path_type=Path), default=None,
-                        help="With the virtual robot: render the simulated robot to this video (fixed camera framed on the "
-                             "planned hops, with .truth.csv and .camera.json beside it for `locust track`).")(func)
+                        help="With the virtual robot: render the simulated robot to this video "
+                             "(fixed camera framed on the planned hops, "
+                             "with .truth.csv and .camera.json beside it for `locust track`).")(func)
     func = click.option("--plant", type=click.Choice(PLANTS), default="auto", show_default=True,
                         help="With the virtual robot: what the servos drive (mujoco: the live model; "
                              "record: only record the commands; auto: mujoco when installed).")(func)
@@ -108,8 +109,9 @@ def _parse_servo_set(item: str) -> tuple[str, float]:
               help=f"Push time, ms [robot schedule: {ROBOT_SCHEDULE.push_s * 1000:g}].")
 @click.option("--wait-ms", type=click.IntRange(*R.hop_range("wait_ms")), default=None,
               help=f"Wait (rest) time, ms [robot schedule: {ROBOT_SCHEDULE.wait_s * 1000:g}].")
-@click.option("--heartbeat-ms", type=click.IntRange(*R.hop_range("heartbeat_ms")), default=R.hop_default("heartbeat_ms"),
-              show_default=True, help="The robot returns to rest if the host is silent this long.")
+@click.option("--heartbeat-ms", type=click.IntRange(*R.hop_range("heartbeat_ms")),
+              default=R.hop_default("heartbeat_ms"), show_default=True,
+              help="The robot returns to rest if the host is silent this long.")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Directory for run.json (must not hold one). Default: data/runs/<timestamp>/.")
 @click.option("--json", "as_json", is_flag=True, help="Print the run record as JSON.")
@@ -158,7 +160,8 @@ def _interrupt(signum, frame):
 
 @click.command()
 @click.option("--flash-dir", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="The virtual robot's flash folder. Default: $LOCUST_VIRTUAL_DIR/flash or ~/.cache/locust/virtual/flash.")
+              help="The virtual robot's flash folder. "
+                   "Default: $LOCUST_VIRTUAL_DIR/flash or ~/.cache/locust/virtual/flash.")
 @click.option("--pwm-log", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Write every PWM change (and the horn angle it means) to this CSV file (must not exist).")
 @_plant_options

@@ -156,7 +156,8 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
             raise DeviceError(f"no MicroPython REPL answered on {port}", NO_MICROPYTHON_HINT) from None
         transport.serial.timeout = None
         transport.exec("import sys")
-        impl, board_mpy, platform = transport.eval("(sys.implementation.name, getattr(sys.implementation, '_mpy', 0), sys.platform)")
+        impl, board_mpy, platform = transport.eval(
+            "(sys.implementation.name, getattr(sys.implementation, '_mpy', 0), sys.platform)")
         if impl != "micropython":
             raise DeviceError(f"{port} runs {impl}, not MicroPython", NO_MICROPYTHON_HINT)
         with tempfile.TemporaryDirectory(prefix="locust-flash-") as tmp:

@@ -93,7 +93,8 @@ class Link:
         except (serial.SerialException, OSError) as exc:
             self.error = self.error or exc
             raise DeviceError(f"lost the serial port {self.port}: {exc}",
-                              "check the USB cable; the robot returns to rest on its own when the host goes silent") from None
+                              "check the USB cable; "
+                              "the robot returns to rest on its own when the host goes silent") from None
 
     def _new_id(self) -> int:
         with self._lock:

@@ -194,7 +194,8 @@ def read_run_record(path: Path) -> RunRecord:
         raise DeviceError(f"{path}: no such file", READ_HINT) from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise DeviceError(f"{path}: not a readable JSON run record ({exc})", READ_HINT) from None
-    if not isinstance(doc, dict) or not isinstance(doc.get("phases"), list) or not isinstance(doc.get("schedule"), dict):
+    if (not isinstance(doc, dict) or not isinstance(doc.get("phases"), list)
+            or not isinstance(doc.get("schedule"), dict)):
         raise DeviceError(f"{path}: not a run record (no 'schedule' and 'phases')", READ_HINT)
     sched = doc["schedule"]
     values = {}
@@ -213,7 +214,8 @@ def read_run_record(path: Path) -> RunRecord:
         if not isinstance(ph, dict) or not all(_is_int(ph.get(k)) for k in ("commanded_us", "measured_us")):
             raise DeviceError(f"{path}: phase {i + 1} has no commanded_us/measured_us integers", DAMAGED_HINT)
         cycle = ph.get("cycle")
-        phases.append(Phase(cycle if _is_int(cycle) else 0, str(ph.get("phase", "?")), ph["commanded_us"], ph["measured_us"]))
+        phases.append(Phase(cycle if _is_int(cycle) else 0, str(ph.get("phase", "?")),
+                            ph["commanded_us"], ph["measured_us"]))
     return RunRecord(
         schedule=HopSchedule(**values), port=str(doc.get("port") or ""), status=str(doc.get("status") or INCOMPLETE),
         firmware_version=_text(doc.get("firmware_version")), firmware_status=_text(doc.get("firmware_status")),

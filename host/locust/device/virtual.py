@@ -195,7 +195,8 @@ class VirtualRobot:
             self._log.close()
         if plant_unfinished:
             raise DeviceError(f"the virtual robot's simulation did not finish within {PLANT_CLOSE_TIMEOUT_S:g} s "
-                              "of the hop (its video was not written)", "rerun on a less loaded machine, or without --video")
+                              "of the hop (its video was not written)",
+                              "rerun on a less loaded machine, or without --video")
         return self.summary or {}
 
     def __enter__(self) -> VirtualRobot:

@@ -71,8 +71,10 @@ def _cad_check(out: Path, names: list[str]) -> dict:
 @click.option("--jig-spacing-mm", type=float, default=10.0, show_default=True,
               help="Alignment holes this far out from the body's corners.")
 @click.option("--glue-tab-mm", type=float, default=20.0, show_default=True, help="With --from-robot: glue tab length.")
-@click.option("--slot-width-mm", type=float, default=1.0, show_default=True, help="With --from-robot: hinge slot width.")
-@click.option("--slot-length-mm", type=float, default=13.0, show_default=True, help="With --from-robot: hinge slot length.")
+@click.option("--slot-width-mm", type=float, default=1.0, show_default=True,
+              help="With --from-robot: hinge slot width.")
+@click.option("--slot-length-mm", type=float, default=13.0, show_default=True,
+              help="With --from-robot: hinge slot length.")
 @click.option("--no-preview", is_flag=True, help="Skip the PNG previews.")
 @click.option("--cad-check", is_flag=True, help="Open every written DXF in LibreCAD (headless) and check it draws.")
 def fab(dxf, from_robot, out, as_json, layers, units, gap_tol_mm, recover, hinge_width_mm, stack, mirror,

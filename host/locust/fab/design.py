@@ -121,8 +121,8 @@ def open_outline_error(layer: str, opens: list[Contour], gap_tol_mm: float) -> F
     """Name the smallest gap between the loose ends of an open outline."""
     ends = [(c, which, np.asarray(getattr(c, which))) for c in opens for which in ("start_mm", "end_mm")]
     best = None
-    for i, (ci, wi, pi) in enumerate(ends):
-        for cj, wj, pj in ends[i + 1:]:
+    for i, (ci, _wi, pi) in enumerate(ends):
+        for cj, _wj, pj in ends[i + 1:]:
             if ci is cj and len(opens) > 1:
                 continue
             d = float(np.hypot(*(pi - pj)))

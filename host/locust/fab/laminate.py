@@ -52,7 +52,8 @@ class Process:
     def check(self) -> None:
         for name in ("kerf_mm", "support_width_mm", "jig_diameter_mm", "jig_spacing_mm"):
             if not getattr(self, name) >= 0:
-                raise FabError(f"process: {name} = {getattr(self, name)!r} must be >= 0", f"give --{name.replace('_', '-')} >= 0")
+                raise FabError(f"process: {name} = {getattr(self, name)!r} must be >= 0",
+                               f"give --{name.replace('_', '-')} >= 0")
         if self.jig_diameter_mm / 2 >= self.jig_spacing_mm:
             raise FabError(
                 f"process: alignment holes ({self.jig_diameter_mm:g} mm) would cut into the body "
@@ -68,7 +69,8 @@ def stack_from_materials(materials: tuple[str, ...] | list[str], mirror: tuple[s
     materials = [m.strip().lower() for m in materials if m.strip()]
     bad = [m for m in materials if m not in MATERIALS]
     if bad or not materials:
-        raise FabError(f"layer stack {','.join(materials) or '(empty)'}: unknown material {', '.join(bad) or ''}".rstrip(),
+        raise FabError(f"layer stack {','.join(materials) or '(empty)'}: "
+                       f"unknown material {', '.join(bad) or ''}".rstrip(),
                        f"list materials top to bottom from {', '.join(MATERIALS)}, e.g. --stack {','.join(SEED_STACK)}")
     if "flexible" not in materials:
         raise FabError("layer stack has no flexible layer: the hinges would not hold together",
@@ -140,7 +142,8 @@ def build(design: Design, stack: tuple[LayerSpec, ...] | None = None, process: P
         if layer.part.is_empty:
             raise FabError(f"layer {layer.spec.name}: nothing left after the cut-outs",
                            "check that hinge slots and holes lie inside the body, not over it")
-    release = design.body.buffer(process.support_width_mm, join_style="mitre") if process.support_width_mm else design.body
+    release = (design.body.buffer(process.support_width_mm, join_style="mitre") if process.support_width_mm
+               else design.body)
     x0, _, x1, _ = design.bounds_mm
     return Laminate(design, process, layers, alignment_holes(design.bounds_mm, process), release, (x0 + x1) / 2)
 

@@ -56,7 +56,8 @@ def summary_text(s: dict) -> str:
         lines.append(f"  {'layer':16s} {'kind':5s} {'x mm':>9s} {'y range mm':>19s} {'w x h mm':>15s}")
         for row in s["slots"]:
             lines.append(f"  {row['layer']:16s} {row['kind']:5s} {row['center_x_mm']:9.3f} "
-                         f"{row['y_min_mm']:9.3f}-{row['y_max_mm']:<9.3f} {row['width_mm']:6.3f} x {row['height_mm']:<7.3f}")
+                         f"{row['y_min_mm']:9.3f}-{row['y_max_mm']:<9.3f} "
+                         f"{row['width_mm']:6.3f} x {row['height_mm']:<7.3f}")
     lines.append(f"holes: {s['holes']}   slits: {s['slits']}   alignment holes: {len(s['alignment_holes_mm'])} x "
                  f"{p['jig_diameter_mm']:g} mm, {p['jig_spacing_mm']:g} mm out from the corners")
     lines.append(f"kerf: {p['kerf_mm']:g} mm (outer contours out, holes in, by half)")

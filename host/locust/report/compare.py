@@ -123,7 +123,8 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
             rows.append(HopRow(prediction.config, m.trial.label, h.hop, h.distance_m,
                                p.distance_m if p else nan, h.apex_m, sim_apex.get(h.hop, nan)))
     return Comparison(
-        config=prediction.config, prediction=prediction, all_trials=list(trials), trials=measured, rows=rows, cycles=cycles,
+        config=prediction.config, prediction=prediction, all_trials=list(trials), trials=measured, rows=rows,
+        cycles=cycles,
         period_s=period_s, distance=stat([m.total_distance_m for m in measured]),
         hop_distance=stat([m.mean_hop_m for m in measured]), jump=stat([m.jump_m for m in measured]),
     )

@@ -129,7 +129,8 @@ def hops_figure(comps: list[Comparison]) -> bytes:
             ax.plot(xs, ys, "o", color=col, ms=5, alpha=0.8, label=f"{_label(c)} measured")
             if c.prediction.valid:
                 if key == "distance":   # run()'s chassis travel per hop
-                    px, pv = [h.cycle for h in c.prediction.result.hops], [h.distance_m for h in c.prediction.result.hops]
+                    px = [h.cycle for h in c.prediction.result.hops]
+                    pv = [h.distance_m for h in c.prediction.result.hops]
                 else:                   # the simulated marker's apex
                     px, pv = [h.hop for h in c.prediction.hops], [h.apex_m for h in c.prediction.hops]
                 ax.plot(px, [v * CM for v in pv], "--", color=col, lw=1.2, label=f"{_label(c)} predicted")

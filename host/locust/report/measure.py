@@ -2,9 +2,10 @@
 
 The camera's clock and the firmware's are not the same, so the schedule's start is found in
 the track itself: the nose's first departure of more than ``ONSET_M`` from its first frame
-(interpolated between frames); where it stood is the median of the frames before that. The simulation's nose trace goes through the same detector,
-and the measured start is put where the simulated one is relative to its first push, so
-the two are lined up by the same rule, never by fitting one to the other.
+(interpolated between frames); where it stood is the median of the frames before that. The
+simulation's nose trace goes through the same detector, and the measured start is put where
+the simulated one is relative to its first push, so the two are lined up by the same rule,
+never by fitting one to the other.
 
 Per hop (schedule cycle ``k`` of period ``T``: ``[start + (k-1)T, start + kT)``):
 

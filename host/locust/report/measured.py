@@ -134,7 +134,8 @@ def read_track(path: Path, marker: str = "nose") -> Track:
     order = np.argsort(t[ok], kind="stable")
     tt = t[ok][order]
     if np.any(np.diff(tt) <= 0):
-        raise ReportError(f"{path}: repeated time stamps in t_s", "export the track again; each frame needs its own time")
+        raise ReportError(f"{path}: repeated time stamps in t_s",
+                          "export the track again; each frame needs its own time")
     return Track(path=path, marker=marker, t_s=tt, x_m=x[ok][order], y_m=y[ok][order], frames=tracks.n_rows)
 
 

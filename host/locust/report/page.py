@@ -15,10 +15,13 @@ from dataclasses import dataclass
 from .compare import Comparison, TimingRow
 
 CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
+# a backslash at a line's end joins the next line to it (no newline in the CSS)
 STYLE = """
-body{font:14px/1.45 system-ui,-apple-system,'DejaVu Sans',sans-serif;margin:2em auto;max-width:1180px;color:#222;padding:0 1em}
+body{font:14px/1.45 system-ui,-apple-system,'DejaVu Sans',sans-serif;\
+margin:2em auto;max-width:1180px;color:#222;padding:0 1em}
 h1{font-size:1.6em;margin-bottom:.2em}h2{margin-top:1.8em;border-bottom:1px solid #ddd;padding-bottom:.2em}
-table{border-collapse:collapse;margin:.6em 0;font-size:13px}th,td{border:1px solid #ddd;padding:3px 8px;text-align:right}td{white-space:nowrap}td.l{white-space:normal}
+table{border-collapse:collapse;margin:.6em 0;font-size:13px}\
+th,td{border:1px solid #ddd;padding:3px 8px;text-align:right}td{white-space:nowrap}td.l{white-space:normal}
 th{background:#f4f4f4}td.l,th.l{text-align:left}tr.invalid td{color:#b00020}
 figure{margin:1em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{color:#555;font-size:13px}
 .meta{color:#555}.note{color:#555;font-size:13px}code{background:#f6f6f6;padding:0 3px}
@@ -122,9 +125,7 @@ def timing_table(rows: list[TimingRow], labels: dict[str, str]) -> str:
         return '<p class="note">No run records were given.</p>'
     out = []
     for r in rows:
-        j = r.jitter
-
-        def ms(attr: str) -> str:
+        def ms(attr: str, j=r.jitter) -> str:
             return f"{getattr(j, attr):.3f}" if j is not None else "—"
 
         out.append("<tr>" + "".join([

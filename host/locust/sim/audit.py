@@ -51,7 +51,8 @@ def audit(traj: Trajectory) -> Audit:
         reasons.append(f"non-finite state from t = {first * traj.timestep_s:.4f} s (step {first})")
     sd_ok = sd[finite_rows] if finite_rows.any() else sd[:0]
 
-    residual0 = max(float(np.linalg.norm(traj.initial_sensordata[s.loop_a[side]] - traj.initial_sensordata[s.loop_b[side]]))
+    residual0 = max(float(np.linalg.norm(traj.initial_sensordata[s.loop_a[side]]
+                                         - traj.initial_sensordata[s.loop_b[side]]))
                     for side in s.loop_a)
     if residual0 > ASSEMBLY_RESIDUAL_LIMIT_M:
         reasons.append(f"model built open: loop anchors {residual0 * 1e6:.3g} um apart before the first step "

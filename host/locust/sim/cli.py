@@ -87,7 +87,8 @@ def _print_human(r) -> None:
         verdict = "converged" if c["converged"] else "NOT converged (within 1 % or 0.1 mm asked)"
         click.echo(f"  convergence at dt/2 ({c['half_timestep_s']:g} s): distance "
                    f"{c['distance_change_mm_per_hop']:.3f} mm per hop ({c['distance_rel_change'] * 100:.2f} %), "
-                   f"nose height {c['max_nose_height_change_mm']:.3f} mm ({c['max_nose_height_rel_change'] * 100:.2f} %): "
+                   f"nose height {c['max_nose_height_change_mm']:.3f} mm "
+                   f"({c['max_nose_height_rel_change'] * 100:.2f} %): "
                    f"{verdict}")
     for note in r.notes:
         click.echo(f"  note: {note}")

@@ -44,14 +44,14 @@ def grashof_class(ground_m: float, crank_m: float, coupler_m: float, leg_m: floa
     ``"non-grashof"`` (triple rocker: no link turns fully).
     """
     links = [ground_m, crank_m, coupler_m, leg_m]
-    s, l = min(links), max(links)
-    p_plus_q = sum(links) - s - l
+    shortest_m, longest_m = min(links), max(links)
+    p_plus_q = sum(links) - shortest_m - longest_m
     tol = 1e-12 * max(links)
-    if s + l > p_plus_q + tol:
+    if shortest_m + longest_m > p_plus_q + tol:
         return "non-grashof"
-    if abs(s + l - p_plus_q) <= tol:
+    if abs(shortest_m + longest_m - p_plus_q) <= tol:
         return "change-point"
-    shortest = links.index(s)
+    shortest = links.index(shortest_m)
     return {0: "double-crank", 1: "crank-rocker", 2: "double-rocker", 3: "crank-rocker"}[shortest]
 
 
@@ -106,7 +106,8 @@ def assemble(ground_m: float, crank_m: float, coupler_m: float, leg_m: float,
     p3 = (p2[0] + a * dx / d + h * dz / d, p2[1] + a * dz / d - h * dx / d)
     coupler_deg = math.degrees(math.atan2(p3[1] - p2[1], p3[0] - p2[0]))
     leg_deg = math.degrees(math.atan2(p4[1] - p3[1], p4[0] - p3[0]))
-    transmission = math.degrees(math.acos(max(-1.0, min(1.0, (coupler_m**2 + leg_m**2 - d**2) / (2 * coupler_m * leg_m)))))
+    transmission = math.degrees(math.acos(max(-1.0, min(1.0, (coupler_m**2 + leg_m**2 - d**2)
+                                                             / (2 * coupler_m * leg_m)))))
     closure = math.hypot(p4[0] - p3[0], p4[1] - p3[1]) - leg_m
     return Assembly(
         p1_m=p1, p2_m=p2, p3_m=p3, p4_m=p4,

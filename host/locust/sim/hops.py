@@ -48,7 +48,8 @@ def summarise(traj: Trajectory) -> HopSummary:
     airborne = sd[:, s.floor_contact][:, 0] < 0.5
     stand = plan.settle_steps - 1 if plan.settle_steps > 0 else len(x) - 1
     standing_nose, standing_com = float(nose_z[stand]), float(com_z[stand])
-    x_start = float(x[plan.settle_steps - 1]) if plan.settle_steps > 0 else float(traj.initial_sensordata[s.chassis_pos][0])
+    x_start = (float(x[plan.settle_steps - 1]) if plan.settle_steps > 0
+               else float(traj.initial_sensordata[s.chassis_pos][0]))
 
     hops = []
     starts = plan.cycle_start_steps

@@ -249,23 +249,23 @@ def _add_sensors(spec: mujoco.MjSpec) -> None:
             sensor.objtype, sensor.objname = objtype, objname
         return sensor
 
-    T, O = mujoco.mjtSensor, mujoco.mjtObj
-    add("nose_pos", T.mjSENS_FRAMEPOS, O.mjOBJ_SITE, "nose")
-    add("foot_pos", T.mjSENS_FRAMEPOS, O.mjOBJ_SITE, "L_foot")
-    add("com_pos", T.mjSENS_SUBTREECOM, O.mjOBJ_BODY, "chassis")
-    add("chassis_pos", T.mjSENS_FRAMEPOS, O.mjOBJ_BODY, "chassis")
+    T, Obj = mujoco.mjtSensor, mujoco.mjtObj
+    add("nose_pos", T.mjSENS_FRAMEPOS, Obj.mjOBJ_SITE, "nose")
+    add("foot_pos", T.mjSENS_FRAMEPOS, Obj.mjOBJ_SITE, "L_foot")
+    add("com_pos", T.mjSENS_SUBTREECOM, Obj.mjOBJ_BODY, "chassis")
+    add("chassis_pos", T.mjSENS_FRAMEPOS, Obj.mjOBJ_BODY, "chassis")
     for side in SIDES:
-        add(f"{side}_loop_a", T.mjSENS_FRAMEPOS, O.mjOBJ_SITE, f"{side}_loop_a")
-        add(f"{side}_loop_b", T.mjSENS_FRAMEPOS, O.mjOBJ_SITE, f"{side}_loop_b")
-    contact = add("floor_contact", T.mjSENS_CONTACT, O.mjOBJ_XBODY, "chassis",
-                  reftype=O.mjOBJ_GEOM, refname="floor")
+        add(f"{side}_loop_a", T.mjSENS_FRAMEPOS, Obj.mjOBJ_SITE, f"{side}_loop_a")
+        add(f"{side}_loop_b", T.mjSENS_FRAMEPOS, Obj.mjOBJ_SITE, f"{side}_loop_b")
+    contact = add("floor_contact", T.mjSENS_CONTACT, Obj.mjOBJ_XBODY, "chassis",
+                  reftype=Obj.mjOBJ_GEOM, refname="floor")
     contact.intprm = [1, 0, 1]  # data = found; one match is enough
     add("energy_potential", T.mjSENS_E_POTENTIAL)
     add("energy_kinetic", T.mjSENS_E_KINETIC)
     for side in SIDES:
-        add(f"{side}_servo_force", T.mjSENS_ACTUATORFRC, O.mjOBJ_ACTUATOR, f"{side}_servo")
+        add(f"{side}_servo_force", T.mjSENS_ACTUATORFRC, Obj.mjOBJ_ACTUATOR, f"{side}_servo")
     for side in SIDES:
-        add(f"{side}_servo_vel", T.mjSENS_ACTUATORVEL, O.mjOBJ_ACTUATOR, f"{side}_servo")
+        add(f"{side}_servo_vel", T.mjSENS_ACTUATORVEL, Obj.mjOBJ_ACTUATOR, f"{side}_servo")
 
 
 def _layout(model: mujoco.MjModel) -> SensorLayout:

@@ -92,7 +92,8 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
         duration_s=traj.plan.duration_s, wall_s=traj.wall_s,
         loop_residual_max_m=verdict.loop_residual_max_m, energy_surplus_max_j=verdict.energy_surplus_max_j,
         servo_work_j=verdict.servo_work_j, servo_peak_speed_rad_per_s=peak_servo_speed(traj),
-        servo_noload_speed_rad_per_s=robot.servo.noload_speed_rad_per_s, grashof=asm.grashof, transmission_deg=asm.transmission_deg,
+        servo_noload_speed_rad_per_s=robot.servo.noload_speed_rad_per_s, grashof=asm.grashof,
+        transmission_deg=asm.transmission_deg,
         notes=notes, trajectory=traj if keep_states else None,
     )
 

@@ -102,7 +102,8 @@ def parse_bound(item: str, base: Robot) -> Bound:
     check_name(name, base)
     low, high = _numbers(rest, 2, "LOW:HIGH", item)
     if not low < high:
-        raise SweepError(f"--vary {item!r}: LOW {low:g} must be below HIGH {high:g}", "e.g. --vary geometry.leg_m=0.05:0.09")
+        raise SweepError(f"--vary {item!r}: LOW {low:g} must be below HIGH {high:g}",
+                         "e.g. --vary geometry.leg_m=0.05:0.09")
     return Bound(name, low, high)
 
 

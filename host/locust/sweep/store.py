@@ -86,7 +86,8 @@ def read_rows(path: Path, axis_names: list[str]) -> list[dict[str, Any]]:
             if torn and k == len(raw) - 1:
                 break
             raise SweepError(f"{path}, line {k + 2}: malformed row ({exc})",
-                             "the file was edited or damaged: restore it, or rerun the sweep in a new --out folder") from None
+                             "the file was edited or damaged: "
+                             "restore it, or rerun the sweep in a new --out folder") from None
     return rows
 
 

@@ -206,7 +206,8 @@ class PlaneCalibration:
             index = np.asarray(frames if frames is not None else np.arange(px.size), dtype=int)
             if index.size and (index.min() < 0 or index.max() >= len(self.positions_m)):
                 raise TrackError(f"{self.path} holds camera positions for frames 0..{len(self.positions_m) - 1}, "
-                                 f"but frame {int(index.max())} was tracked", "track the video the camera file came with")
+                                 f"but frame {int(index.max())} was tracked",
+                                 "track the video the camera file came with")
             centre = self.positions_m[index]
         with np.errstate(divide="ignore", invalid="ignore"):
             s = (self.planes_y_m[marker] - centre[..., 1]) / rays[..., 1]
@@ -242,7 +243,8 @@ def load(path: str | Path, width_px: int, height_px: int) -> PlaneCalibration:
     camera = read_camera_json(path)
     if (camera.width_px, camera.height_px) != (width_px, height_px):
         raise TrackError(f"{path} describes a {camera.width_px}x{camera.height_px} camera, but the video is "
-                         f"{width_px}x{height_px}", "track the video the camera file came with, or give --scale instead")
+                         f"{width_px}x{height_px}",
+                         "track the video the camera file came with, or give --scale instead")
     return camera.calibration(path)
 
 

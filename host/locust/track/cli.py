@@ -67,7 +67,8 @@ def _base_path(out: Path | None, source: Path) -> Path:
               help="ArUco dictionary for --scale-aruco.")
 @click.option("--camera-json", type=click.Path(dir_okay=False, path_type=Path),
               help="Pinhole camera of a simulated video (world metres through each marker's plane). "
-                   "Default: <video>.camera.json beside the video, used when no --scale/--scale-aruco/--origin is given.")
+                   "Default: <video>.camera.json beside the video, "
+                   "used when no --scale/--scale-aruco/--origin is given.")
 @click.option("--origin", metavar="X,Y", help="World origin in pixels. Default: centre of the bottom-left pixel.")
 @click.option("--angle", default=0.0, show_default=True, type=float,
               help="Direction of the world x axis, degrees counter-clockwise from the image x axis (as Tracker).")
@@ -139,7 +140,8 @@ def _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, came
     by_hand = bool(scale or scale_aruco or origin)
     if camera_json is not None:
         if by_hand:
-            raise TrackError("give --camera-json or --scale/--scale-aruco/--origin, not both", "one calibration per run")
+            raise TrackError("give --camera-json or --scale/--scale-aruco/--origin, not both",
+                             "one calibration per run")
         return camera.load(camera_json, info.width_px, info.height_px)
     beside = camera.camera_json_beside(info.path)
     if not by_hand and beside.is_file():

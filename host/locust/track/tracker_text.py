@@ -52,7 +52,8 @@ class TrackerTrack:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, TrackerTrack):
             return NotImplemented
-        return (self.name == other.name and all(_same(getattr(self, c), getattr(other, c)) for c in ("t_s", "x_m", "y_m"))
+        return (self.name == other.name
+                and all(_same(getattr(self, c), getattr(other, c)) for c in ("t_s", "x_m", "y_m"))
                 and self.other.keys() == other.other.keys()
                 and all(_same(v, other.other[k]) for k, v in self.other.items()))
 

@@ -56,7 +56,8 @@ def read_project(path: str | Path) -> TrackerProject:
             with zipfile.ZipFile(path) as z:
                 names = sorted(n for n in z.namelist() if n.lower().endswith(".trk"))
                 if not names:
-                    raise TrackError(f"{path}: a zip without a .trk file", "give a Tracker project (.trz) or tab (.trk)")
+                    raise TrackError(f"{path}: a zip without a .trk file",
+                                     "give a Tracker project (.trz) or tab (.trk)")
                 text = z.read(names[0])
         else:
             text = path.read_bytes()

@@ -184,7 +184,8 @@ def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: 
         writer.set(cv2.VIDEOWRITER_PROP_QUALITY, 90)
     try:
         if not writer.isOpened():
-            raise TrackError(f"OpenCV cannot encode {fourcc} to {path}", "check the folder is writable and the codec name")
+            raise TrackError(f"OpenCV cannot encode {fourcc} to {path}",
+                             "check the folder is writable and the codec name")
         for frame in frames:
             writer.write(frame)
         writer.release()
