@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
 
 from . import params as P
 from .errors import ParamsError
+from .fileio import json_text
 
 
 def robot_options(func):
@@ -44,7 +44,7 @@ def params(preset, config, sets, as_json, write, force):
     if as_json:
         out = {k: {"value": v, **{a: b for a, b in vars(robot.source_of(k)).items() if b is not None}}
                for k, v in robot.flat().items()}
-        click.echo(json.dumps({"name": robot.name, "values": out}, indent=2))
+        click.echo(json_text({"name": robot.name, "values": out}), nl=False)
         return
     click.echo(f"# {robot.name}")
     for key, value in robot.flat().items():

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import signal
 import sys
 from pathlib import Path
@@ -10,6 +9,7 @@ from pathlib import Path
 import click
 
 from ..errors import DeviceError
+from ..fileio import json_text
 from ..params import Schedule, resolve_robot
 from ..params_cli import robot_options
 from ..progress import progress
@@ -43,7 +43,7 @@ def ports(as_json):
 
     found = list_serial_ports()
     if as_json:
-        click.echo(json.dumps([{**vars(p), "vid_pid": p.vid_pid} for p in found], indent=2))
+        click.echo(json_text([{**vars(p), "vid_pid": p.vid_pid} for p in found]), nl=False)
         return
     if not found:
         click.echo("no serial ports found (use --port sim for the virtual robot)")
@@ -145,7 +145,7 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
                               on_phase=lambda p: (bar.update(1), setattr(bar, "label", f"cycle {p.cycle} {p.phase}")))
     path = directory / R.RECORD_NAME
     if as_json:
-        click.echo(json.dumps(rec.to_dict(), indent=2))
+        click.echo(json_text(rec.to_dict()), nl=False)
     j = R.jitter(rec.phases)
     _info(f"{rec.status}: {len(rec.phases)}/{schedule.phases} phases"
           + (f", start error max {j.max_abs_ms:.3f} ms (mean {j.mean_ms:.3f}, sd {j.std_ms:.3f})" if j else "")

@@ -49,9 +49,8 @@ class Calibration:
                 f"{self.origin_y_px:.2f}) px, x axis {self.angle_deg:g} deg")
 
     def as_dict(self) -> dict:
-        d = asdict(self)
-        d["m_per_px"] = None if not math.isfinite(self.m_per_px) else self.m_per_px
-        return d
+        """For the JSON sidecar (no scale: ``m_per_px`` nan, written ``null``)."""
+        return asdict(self)
 
 
 def parse_scale(text: str) -> tuple[float, float, float, float, float]:

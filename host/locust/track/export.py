@@ -9,7 +9,6 @@ marker not found is ``nan`` with ok 0). This module turns a
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -55,7 +54,7 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
         "markers": [{"name": t.name, "spec": t.spec, "frames": len(t.ok), "found": t.found(),
                      "missing_frames": [int(f) for f in result.frames[~t.ok]]} for t in result.markers],
         "scores": {"frame": [int(f) for f in result.frames],
-                   **{t.name: [_json_num(s) for s in t.score] for t in result.markers}},
+                   **{t.name: [float(s) for s in t.score] for t in result.markers}},
     }
 
 
@@ -83,6 +82,3 @@ def summary_lines(result: TrackResult) -> list[str]:
     lines.append(result.calibration.summary())
     return lines
 
-
-def _json_num(value: float):
-    return float(value) if math.isfinite(value) else None
