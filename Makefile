@@ -10,6 +10,9 @@ export PYOPENGL_PLATFORM ?= osmesa
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
+	@# the load-testing tool "locust" shares our package and command name: refuse to mix them
+	@# (an old install of this toolkit under that name is replaced)
+	@$(PY) scripts/check_shadowing.py $(VENV)
 	$(PY) -m pip install -q -e '.[test]'
 	touch $@
 

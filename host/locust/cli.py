@@ -90,7 +90,33 @@ def cli() -> None:
     """
 
 
+# the load-testing tool published on PyPI as "locust" installs the same package and command
+SHADOWING_DISTRIBUTION = "locust"
+
+
+OUR_SUMMARY = "Firmware-plus-host toolkit for a foldable four-bar hopping robot"
+
+
+def shadowing_install() -> str | None:
+    """The version of the unrelated "locust" distribution installed beside this one, if any
+    (an old install of this toolkit under that name is not it)."""
+    import importlib.metadata as md
+
+    try:
+        meta = md.metadata(SHADOWING_DISTRIBUTION)
+    except md.PackageNotFoundError:
+        return None
+    return None if (meta.get("Summary") or "").startswith(OUR_SUMMARY) else meta.get("Version", "?")
+
+
 def main() -> None:
+    other = shadowing_install()
+    if other is not None:
+        click.secho(f"error: the load-testing tool 'locust' {other} is installed in this environment; it and "
+                    "this toolkit (locust-hopper) share the package and command name `locust`", fg="red", err=True)
+        click.echo("  hint: install locust-hopper in its own virtual environment (`make install` makes one), "
+                   "or `pip uninstall locust` here", err=True)
+        sys.exit(2)
     cli(prog_name="locust")
 
 
