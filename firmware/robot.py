@@ -1,9 +1,13 @@
 # The robot's command loop: frames in on the USB serial console, replies and events out.
 #
 # Nothing that arrives may crash it: every line is decoded and checked by protocol.py, and
-# any error (even a bug here) becomes an error reply while the loop carries on. Ctrl-C is
-# switched off while it runs (0x03 is just a byte of a bad frame); the `repl` command hands
-# the console back to the MicroPython REPL, which is how `locust flash` gets in.
+# any error (even a bug here) becomes an error reply while the loop carries on.
+#
+# Ctrl-C (0x03) stops the loop while it idles, as it stops main.py on any MicroPython
+# board: the servos go to rest and the console is the REPL (mpremote gets in this way; Ctrl-D
+# there, a soft reset, runs main.py again). While a hop runs Ctrl-C is switched off, so a
+# stray 0x03 is just a byte of a bad frame and cannot stop the legs half-way. The `repl`
+# command also hands the console back to the REPL (`locust flash` uses it).
 
 import gc
 import sys
@@ -22,16 +26,33 @@ SPIN_US = 4000
 MAX_POLL_MS = 50
 
 
+CTRL_C = 0x03
+
+
 class Console:
-    """The USB serial console (stdin/stdout) as a byte port."""
+    """The USB serial console (stdin/stdout) as a byte port.
+
+    ``ctrl_c(on)`` says whether Ctrl-C stops the command loop (KeyboardInterrupt). On the
+    ESP32 the console driver raises it itself (``micropython.kbd_intr(3)``) and the byte never
+    reaches stdin; where the console hands 0x03 over as a byte (the unix port behind the
+    virtual robot's raw pseudo-terminal), read() raises it, leaving the bytes after it unread
+    for the REPL. Switched off, 0x03 is an ordinary byte on both.
+    """
 
     def __init__(self):
+        import micropython
         import select
         self._in = sys.stdin.buffer
         self._out = sys.stdout.buffer
         self._pollin = select.POLLIN
         self._poller = select.poll()
         self._poller.register(sys.stdin, select.POLLIN)
+        self._kbd_intr = micropython.kbd_intr
+        self.ctrl_c(True)
+
+    def ctrl_c(self, on):
+        self.interruptible = on
+        self._kbd_intr(CTRL_C if on else -1)
 
     def _ready(self, timeout_ms):
         for _, ev in self._poller.poll(timeout_ms):
@@ -48,6 +69,8 @@ class Console:
             b = self._in.read(1)  # poll said ready: one byte never blocks
             if not b:
                 break
+            if b[0] == CTRL_C and self.interruptible:
+                raise KeyboardInterrupt
             data += b
             if not self._ready(0):
                 break
@@ -74,6 +97,12 @@ class Controller:
         self.quit = False
 
     # -- I/O ---------------------------------------------------------------------
+    def ctrl_c(self, on):
+        """Let Ctrl-C stop the loop (on) or make 0x03 a plain byte (off), if the port can."""
+        allow = getattr(self.port, "ctrl_c", None)
+        if allow is not None:
+            allow(on)
+
     def send(self, msg):
         self.port.write(P.encode(msg))
 
@@ -193,6 +222,7 @@ class Controller:
         self.status = None
         self.hop = {"id": req_id, "stop": False}
         status = P.HOP_COMPLETE
+        self.ctrl_c(False)  # a stray 0x03 on the line must not stop the legs mid-hop
         gc.collect()  # collect now, not in the middle of a phase's timing
         t0 = ticks_us()
         self.last_rx = t0
@@ -215,6 +245,7 @@ class Controller:
         finally:
             self.servos.rest()
             self.hop = None
+            self.ctrl_c(True)
         self.status = status
         late = [abs(p[3] - p[2]) for p in self.phases]
         self.send(P.event(P.EV_DONE, hop=req_id, status=status, phases=len(self.phases),
@@ -242,16 +273,24 @@ class Controller:
                     pass
 
 
+STOPPED = b"\r\nlocust: Ctrl-C stopped the command loop, servos at rest; Ctrl-D restarts it\r\n"
+
+
 def main():
-    import micropython
     from machine import PWM, Pin
     from servo import Servos
 
     cfg, bad = config.load()
-    ctl = Controller(Console(), lambda c: Servos(c, PWM, Pin), cfg, bad)
-    micropython.kbd_intr(-1)  # 0x03 is data here; `repl` gives the REPL back
+    console = Console()
+    ctl = Controller(console, lambda c: Servos(c, PWM, Pin), cfg, bad)
+    interrupted = False
     try:
         ctl.run()
+    except KeyboardInterrupt:  # Ctrl-C while idle: main.py ends, the REPL takes the console
+        interrupted = True
     finally:
-        micropython.kbd_intr(3)
+        console.ctrl_c(False)  # a second Ctrl-C (some tools send two) must not cut the rest short
         ctl.servos.rest()
+        console.ctrl_c(True)  # the REPL's own Ctrl-C
+    if interrupted:
+        console.write(STOPPED)

@@ -20,3 +20,18 @@ def shared_data() -> Path:
     if not SHARED_DATA.is_dir():
         pytest.skip(f"reference data not found at {SHARED_DATA} (clone with ../shared beside it)")
     return SHARED_DATA
+
+
+@pytest.fixture(scope="module")
+def env(tmp_path_factory):
+    """An environment whose virtual robot (``--port sim``) has the firmware flashed: one per
+    test module, in its own folder."""
+    import subprocess
+    import sys
+
+    env = dict(os.environ, LOCUST_VIRTUAL_DIR=str(tmp_path_factory.mktemp("virtual")))
+    proc = subprocess.run([sys.executable, "-m", "locust.cli", "flash", "--port", "sim"],
+                          capture_output=True, text=True, env=env, timeout=90, check=False)
+    assert proc.returncode == 0, proc.stderr
+    assert "files verified by SHA-256" in proc.stdout
+    return env

@@ -142,7 +142,11 @@ def test_calibration_tables_come_from_the_owners(tmp_path):
     assert isinstance(table.tracks, tc.TracksCsv) and table.kind == "csv" and table.markers() == ["nose", "foot"]
     assert np.isnan(table.marker("nose")[0][2])                          # ok 0 is never a position
     table = read_table(txt_path)
-    assert isinstance(table.tracks, tt.TrackerExport) and table.kind == "tracker"
+    # a Tracker export comes through the track layer's one import (locust.track.importing), as tracks
+    assert isinstance(table.tracks, tc.TracksCsv) and table.kind == "tracker"
+    for marker in ("ball", "cup_3"):
+        for got, want in zip(table.marker(marker), _export().positions(marker)):
+            np.testing.assert_array_equal(got, want)
     np.testing.assert_array_equal(table.time_s(), [0.0, 0.05, 0.1, NAN])
     (tmp_path / "servo.csv").write_text("t_s,angle_deg,command_deg\n0,1,0\n")
     assert read_table(tmp_path / "servo.csv").tracks is None

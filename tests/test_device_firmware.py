@@ -54,3 +54,61 @@ def test_firmware_fallback_servo_config_is_the_robot_parameters():
         assert {k: written[name][k] for k in keys} == {k: getattr(Servo(), k) for k in keys}
     narrow = servo_config(Servo(pulse_min_us=600.0, pulse_max_us=2400.0, travel_deg=40.0))
     assert narrow["right"]["pulse_min_us"] == 600.0 and narrow["left"]["travel_deg"] == 40.0
+
+
+def _micropython(script: str, stdin: bytes = b"") -> str:
+    """Run a script under the MicroPython unix port with the firmware and its unit tests on the path."""
+    env = dict(os.environ, MICROPYPATH=f"{ROOT / 'firmware'}:{UNIT_DIR}:{SHIM_DIR}")
+    proc = subprocess.run([micropython_executable(), "-c", script], input=stdin, capture_output=True,
+                          timeout=60, env=env, cwd=UNIT_DIR)
+    assert proc.returncode == 0, (proc.stdout + proc.stderr).decode(errors="replace")[-3000:]
+    return proc.stdout.decode().strip().splitlines()[-1]
+
+
+def test_console_ctrl_c_stops_the_loop_only_while_allowed():
+    """Where 0x03 reaches stdin as a byte (the virtual robot), the console raises KeyboardInterrupt
+    at it, leaving what follows for the REPL; switched off (a hop), 0x03 is an ordinary byte."""
+    script = """
+import sys, robot
+c = robot.Console()
+out = []
+try:
+    c.read(1000)
+except KeyboardInterrupt:
+    out.append("interrupt")
+out.append(sys.stdin.buffer.read(3))
+c.ctrl_c(False)
+out.append(c.read(1000))
+c.ctrl_c(True)
+print(repr(out), c.interruptible)
+"""
+    assert _micropython(script, stdin=b"ab\x03\r\x01Z\x03ef") == "['interrupt', b'\\r\\x01Z', b'\\x03ef'] True"
+
+
+def test_hop_switches_ctrl_c_off_and_back_on():
+    script = """
+import config, robot
+import test_controller as T
+
+class Port(T.ScriptedPort):
+    def __init__(self):
+        super().__init__()
+        self.calls = []
+        self.during = []
+
+    def ctrl_c(self, on):
+        self.calls.append(on)
+
+    def write(self, data):
+        self.during.append(self.calls[-1] if self.calls else None)
+        super().write(data)
+
+port = Port()
+ctl = robot.Controller(port, T.RecordingServos, config.default(), (), "/tmp/locust_fw_ctrl_c.json")
+ctl.handle_line(T._req(1, "hop", cycles=1, push_ms=20, wait_ms=20, heartbeat_ms=5000)[:-1])
+ctl.step(0)
+events = [m.get("ev") for m in port.messages()]
+print(port.calls, port.during, events)
+"""
+    # the reply goes out before the hop starts, the phase events with Ctrl-C off, `done` once it is back on
+    assert _micropython(script) == "[False, True] [None, False, False, True] [None, 'phase', 'phase', 'done']"

@@ -185,7 +185,8 @@ def demo(out, cycles, trials, designs, jobs):
         d.call(["sweep", "--config", str(robot_toml), "--vary", f"scale=0:0.03:{designs}", "--cycles", str(cycles),
                 "--out", str(folder / "sweep"), *(["--jobs", str(jobs)] if jobs else [])])
     with d.stage(6, total, "report: the calibrated model against the measured hops"):
-        measured = [arg for _, trial in trials_dirs for arg in ("--measured", str(trial))]
+        # each trial named by its leg set: the report need not guess it from the folder name
+        measured = [arg for name, trial in trials_dirs for arg in ("--measured", f"{name}={trial}")]
         printed = d.call(["report", *measured, "--config", str(robot_toml), "--sweep", str(folder / "sweep"),
                           "--out", str(folder)])
     report_path = Path(printed.strip().splitlines()[-1])

@@ -32,6 +32,7 @@ import numpy as np
 from scipy import optimize
 
 from ..errors import CalibrationError
+from ..track.importing import units_hint
 from .curves import Curves
 from .fitstats import Estimate, covariance
 
@@ -40,6 +41,10 @@ MAPPING = ("k_rot = k*L^2, b_rot = b*L^2: rigid bar of length L on a torsional s
            "mass at the tip, small angles, viscous damping")
 MIN_SAMPLES = 20
 MIN_CYCLES = 1.5
+# plausible peak-to-peak swing of the tip: a 1-3 cm drop (calibration/protocols/beam.md), less than
+# the beam is long; without --length-m, that of a desk-sized beam
+SWING_OF_LENGTH = (1 / 500, 1.0, 0.1)       # (least, most, typical) swing as a share of L
+SWING_M = (1e-4, 0.25, 0.01)                # (least, most, typical) without L
 
 
 @dataclass(frozen=True)
@@ -84,6 +89,24 @@ def principal_displacement(x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
     if abs(axis[1]) >= 1e-12 and axis[1] < 0 or abs(axis[1]) < 1e-12 and axis[0] < 0:
         axis = -axis
     return pts @ axis + (np.mean(x_m) * axis[0] + np.mean(y_m) * axis[1])
+
+
+def tip_swing_warning(swing_m: float, length_m: float | None, units: str = "m",
+                      source: str = "beam") -> str | None:
+    """A warning when the tip's peak-to-peak swing is not plausible for the beam (a 5 cm beam
+    whose tip swings 0.9 m: the track is in cm), naming the ``--units`` that would make it so."""
+    if length_m is not None and length_m > 0:
+        low, high, typical = (f * length_m for f in SWING_OF_LENGTH)
+        beam = f"a {length_m:g} m beam"
+    else:
+        low, high, typical = SWING_M
+        beam = "a desk-sized beam (no --length-m)"
+    if low <= swing_m <= high:
+        return None
+    size = "more" if swing_m > high else "less"
+    limit = high if swing_m > high else low
+    return (f"{source}: the beam tip swings {swing_m:.3g} m peak to peak, {size} than {limit:.3g} m "
+            f"is plausible for {beam}: {units_hint(swing_m, low, high, typical, units)}")
 
 
 def damped_oscillation(t_s: np.ndarray, p: np.ndarray, t0_s: float) -> np.ndarray:

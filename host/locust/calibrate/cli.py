@@ -11,6 +11,7 @@ import numpy as np
 from ..errors import CalibrationError
 from ..fileio import json_text
 from ..progress import progress
+from ..track.importing import ImportOptions, import_options
 from . import beam as B
 from . import ramp as R
 from . import servo as S
@@ -60,16 +61,21 @@ def calibrate() -> None:
 @click.option("--start-s", type=float, default=None,
               help="Fit from this time [default: the first swing after the drop].")
 @click.option("--end-s", type=float, default=None, help="Fit up to this time [default: end of the track].")
+@import_options
 @output_options
-def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, write_path, as_json, plot_path, no_plot):
+def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, imports, write_path, as_json, plot_path,
+         no_plot):
     """Fit the beam tip's damped oscillation: stiffness, damping, and the model's hinge values.
 
-    TRACKS is a `locust track` CSV or a Tracker text export of the beam tip (metres).
+    TRACKS is a `locust track` CSV, a Tracker text export or a t,x,y CSV of the beam tip
+    (metres, or --units cm|mm).
     """
-    table = read_table(tracks)
+    table = read_table(tracks, imports)
     x, y = table.marker(marker)
     t, x, y = clean_samples(tracks, "the beam tip", table.time_s(), x, y, min_samples=B.MIN_SAMPLES)
-    fit = B.fit_beam(t, B.principal_displacement(x, y), mass_kg, length_m=length_m, beam_mass_kg=beam_mass_kg,
+    displacement = B.principal_displacement(x, y)
+    warning = B.tip_swing_warning(float(np.ptp(displacement)), length_m, imports.units, source=str(tracks))
+    fit = B.fit_beam(t, displacement, mass_kg, length_m=length_m, beam_mass_kg=beam_mass_kg,
                      start_s=start_s, end_s=end_s, source=str(tracks))
     values = {}
     if fit.hinge_stiffness_nm_per_rad is not None:
@@ -80,7 +86,8 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, write_
                                "measure the beam's free length from the clamp to the mass")
     note = f"beam L={length_m} m, m={mass_kg} kg; {B.MAPPING}"
     _finish(fit, tracks, values, note, write_path, as_json, plot_path, no_plot,
-            subtitle=f"fn {fit.natural_frequency_hz.value:.4g} Hz, zeta {fit.damping_ratio.value:.3g}")
+            subtitle=f"fn {fit.natural_frequency_hz.value:.4g} Hz, zeta {fit.damping_ratio.value:.3g}",
+            warnings=[warning] if warning else [])
 
 
 @calibrate.command()
@@ -98,8 +105,9 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, write_
 @click.option("--step", "step", default=None, metavar="FROM,TO,AT_S",
               help="With --pivot: the commanded step, degrees from the horizontal, and when it was sent [s].")
 @click.option("--marker", default=None, help="With --pivot: marker of the horn tip [default: the only one].")
+@import_options
 @output_options
-def servo(data, inertia_kgm2, stall_torque_nm, gravity_moment_nm, pivot, step, marker, write_path, as_json,
+def servo(data, inertia_kgm2, stall_torque_nm, gravity_moment_nm, pivot, step, marker, imports, write_path, as_json,
           plot_path, no_plot):
     """Identify the hobby servo (no-load speed, armature, kp) from step responses.
 
@@ -118,9 +126,12 @@ def servo(data, inertia_kgm2, stall_torque_nm, gravity_moment_nm, pivot, step, m
     moments = _per_recording(gravity_moment_nm or (0.0,), len(data), "--gravity-moment-nm")
     if pivot is not None and len(data) > 1:
         raise CalibrationError("--pivot takes one horn track", "fit tracks one at a time, or give angle CSVs")
+    if pivot is None and not imports.identity:
+        raise CalibrationError("--units, --rename and --mirror apply to a horn track (--pivot), not to angles",
+                               "leave them out for t_s,angle_deg,command_deg recordings")
     recordings = []
     for path, inertia, moment in zip(data, inertias, moments):
-        t, angle, command = _servo_series(path, pivot, step, marker)
+        t, angle, command = _servo_series(path, pivot, step, marker, imports)
         recordings.append(S.StepRecording(t, angle, command, S.ServoRig(inertia, moment), source=str(path)))
     with progress(length=3 * 60, label="fitting servo") as bar:
         fit = S.fit_servo(recordings, stall_torque_nm, progress=bar.update)
@@ -148,28 +159,37 @@ def _per_recording(values: tuple[float, ...], n: int, option: str) -> list[float
 @click.option("--robot-marker", default="robot", show_default=True, help="For a ramp video track: the robot's marker.")
 @click.option("--into", type=click.Choice(["foot", "floor"]), default="foot", show_default=True,
               help="Which friction the result is written to (contact.foot_friction or contact.floor_friction).")
+@import_options
 @output_options
-def ramp(data, ramp_markers, robot_marker, into, write_path, as_json, plot_path, no_plot):
+def ramp(data, ramp_markers, robot_marker, into, imports, write_path, as_json, plot_path, no_plot):
     """Static friction from critical ramp angles: mu = tan(mean angle), with a 95% interval.
 
     DATA: CSVs with an angle_deg column (one trial a row, degrees), and/or side-view
-    tracks of a tilting ramp (one trial each).
+    tracks of a tilting ramp (one trial each; --units, --rename, --mirror act on them).
     """
-    angles = []
+    angles, warnings, tracks = [], [], 0
     for path in data:
-        angles.extend(_ramp_angles(path, ramp_markers, robot_marker))
+        found, warning, is_track = _ramp_angles(path, ramp_markers, robot_marker, imports)
+        angles.extend(found)
+        warnings += [warning] if warning else []
+        tracks += is_track
+    if tracks == 0 and not imports.identity:
+        raise CalibrationError("--units, --rename and --mirror apply to ramp tracks; these are angle tables",
+                               "leave them out for angle_deg recordings")
     source = str(data[0]) if len(data) == 1 else "+".join(p.name for p in data)
     fit = R.fit_ramp(np.array(angles), source=source)
     values = {f"contact.{into}_friction": fit.mu_static}
     note = f"ramp, {fit.n_trials} trials, mean angle {fit.mean_angle_deg:.4g} deg"
     _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot,
             subtitle=f"mu {fit.mu_static.value:.4g} from {fit.n_trials} trials",
-            recording_name=Path(source) if len(data) == 1 else Path("ramp"), source_name=Path(source).name)
+            recording_name=Path(source) if len(data) == 1 else Path("ramp"), source_name=Path(source).name,
+            warnings=warnings)
 
 
 # -- helpers ------------------------------------------------------------------------
-def _servo_series(data: Path, pivot: str | None, step: str | None, marker: str | None):
-    table = read_table(data)
+def _servo_series(data: Path, pivot: str | None, step: str | None, marker: str | None,
+                  imports: ImportOptions):
+    table = read_table(data, imports)
     if pivot is None:
         t, angle, command = table.require("t_s", "angle_deg", "command_deg", purpose="a servo step")
         return clean_samples(data, "the servo angle", t, angle, command, min_samples=S.MIN_SAMPLES)
@@ -183,16 +203,20 @@ def _servo_series(data: Path, pivot: str | None, step: str | None, marker: str |
     return t, S.horn_angle_deg(x, y, px, py), np.where(t < at_s, a_from, a_to)
 
 
-def _ramp_angles(path: Path, ramp_markers: str, robot_marker: str) -> list[float]:
-    table = read_table(path)
+def _ramp_angles(path: Path, ramp_markers: str, robot_marker: str,
+                 imports: ImportOptions) -> tuple[list[float], str | None, bool]:
+    """The trials' angles in ``path``, a plausibility warning, and whether it was a track."""
+    table = read_table(path, imports)
     if table.has("angle_deg"):
-        return [float(a) for a in table.columns["angle_deg"] if np.isfinite(a)]
+        return [float(a) for a in table.columns["angle_deg"] if np.isfinite(a)], None, table.tracks is not None
     names = [n.strip() for n in ramp_markers.split(",")]
     if len(names) != 2 or not table.markers():
         table.require("angle_deg", purpose="ramp trials (or a track with ramp and robot markers)")
-    onset = R.critical_angle_from_track(table.time_s(), table.marker(names[0]), table.marker(names[1]),
-                                        table.marker(robot_marker), source=str(path))
-    return [onset.critical_angle_deg]
+    a, b = table.marker(names[0]), table.marker(names[1])
+    onset = R.critical_angle_from_track(table.time_s(), a, b, table.marker(robot_marker), source=str(path))
+    board = np.hypot(b[0] - a[0], b[1] - a[1])
+    board_m = float(np.median(board[np.isfinite(board)])) if np.isfinite(board).any() else float("nan")
+    return [onset.critical_angle_deg], R.board_length_warning(board_m, imports.units, str(path)), True
 
 
 def _floats(text: str, n: int, option: str, hint: str) -> list[float]:
@@ -207,9 +231,13 @@ def _floats(text: str, n: int, option: str, hint: str) -> list[float]:
 
 def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_path: Path | None,
             as_json: bool, plot_path: Path | None, no_plot: bool, *, subtitle: str,
-            recording_name: Path | None = None, source_name: str | None = None) -> None:
+            recording_name: Path | None = None, source_name: str | None = None,
+            warnings: list[str] | None = None) -> None:
     recording_name = recording_name or recording
     out = fit.summary()
+    out["warnings"] = list(warnings or [])
+    for warning in out["warnings"]:
+        click.echo(f"warning: {warning}", err=True)
     if not no_plot:
         plot_path = plot_path or recording.with_name(f"{Path(recording_name).stem}-fit.png")
         out["plot"] = str(plot_fit(fit.curves, plot_path, subtitle))
@@ -226,7 +254,7 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
 def _print_text(out: dict) -> None:
     click.echo(f"# {out['experiment']}: {out['source']}")
     for key, val in out.items():
-        if key in ("experiment", "source", "notes", "written", "plot", "angles_deg"):
+        if key in ("experiment", "source", "notes", "warnings", "written", "plot", "angles_deg"):
             continue
         if isinstance(val, dict) and "value" in val:
             flag = "" if val.get("identifiable", True) else "   NOT IDENTIFIABLE"

@@ -20,10 +20,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import CalibrationError
+from ..track.importing import units_hint
 from .curves import Curves
 from .fitstats import Estimate, t95
 
 MIN_TRIALS = 2
+BOARD_M = (0.05, 3.0, 0.3)     # (least, most, typical) length between the ramp's two markers
 
 
 @dataclass(frozen=True)
@@ -70,6 +72,16 @@ class SlipOnset:
     critical_angle_deg: float
     onset_s: float
     slip_m: float          # how far the robot slid by the end of the record
+
+
+def board_length_warning(length_m: float, units: str = "m", source: str = "ramp") -> str | None:
+    """A warning when the distance between the ramp's markers is not a board's, naming the
+    ``--units`` that would make it one."""
+    low, high, typical = BOARD_M
+    if not math.isfinite(length_m) or low <= length_m <= high:
+        return None
+    return (f"{source}: the ramp's markers are {length_m:.3g} m apart, not the {low:g}-{high:g} m of a ramp "
+            f"board: {units_hint(length_m, low, high, typical, units)}")
 
 
 def critical_angle_from_track(t_s: np.ndarray, ramp_a: tuple[np.ndarray, np.ndarray],

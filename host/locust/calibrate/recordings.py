@@ -11,11 +11,14 @@ All three become one :class:`Table` of numeric columns, with marker positions un
 - Tracker (Open Source Physics) *File > Export > Data*, read by
   :mod:`locust.track.tracker_text`: an optional title line (the track name) or Tracker 6's
   ``#multi:`` line followed by a row of track names, then a header (``t x y ...``), tab
-  separated, possibly with decimal commas. Tracker writes positions in its calibration
-  unit: calibrate Tracker in metres.
+  separated, possibly with decimal commas; or a plain ``t,x,y`` CSV of one marker (``nose``).
+  Tracker writes positions in its calibration unit: ``--units cm`` for a Tracker in cm.
 
-The three share one tokenizer (:mod:`locust.track.delimited`). Every problem is a
-:class:`~locust.errors.CalibrationError` naming the file, and the line or column, with a hint.
+Every track (the last two) goes through :func:`locust.track.importing.import_tracks`'s
+conversion, so ``--units``, ``--rename`` and ``--mirror`` act here as in ``locust track
+--import``; a plain CSV has no positions and is read as it is. The three share one tokenizer
+(:mod:`locust.track.delimited`). Every problem is a :class:`~locust.errors.CalibrationError`
+naming the file, and the line or column, with a hint.
 """
 
 from __future__ import annotations
@@ -27,8 +30,8 @@ import numpy as np
 
 from ..errors import CalibrationError, TrackError
 from ..track.delimited import check_names, read_text, split_text
-from ..track.tracker_text import TrackerExport
-from ..track.tracks_csv import TracksCsv, is_tracks_header
+from ..track.importing import AS_IS, ImportOptions, track_layout, tracks_from_delimited
+from ..track.tracks_csv import TracksCsv
 
 
 @dataclass(frozen=True)
@@ -39,7 +42,8 @@ class Table:
     columns: dict[str, np.ndarray]
     kind: str = "csv"                        # csv | tracker
     comments: tuple[str, ...] = field(default=())
-    tracks: TracksCsv | TrackerExport | None = field(default=None, compare=False, repr=False)  # marker files
+    tracks: TracksCsv | None = field(default=None, compare=False, repr=False)   # marker files, in metres
+    units: str = "m"                         # the unit the file's positions were in (--units)
 
     @property
     def n_rows(self) -> int:
@@ -86,32 +90,31 @@ class Table:
         return t
 
 
-def read_table(path: str | Path) -> Table:
-    """Read a recording; see the module docstring for the formats understood."""
+def read_table(path: str | Path, imports: ImportOptions = AS_IS) -> Table:
+    """Read a recording; see the module docstring for the formats understood. ``imports``
+    (``--units``, ``--rename``, ``--mirror``) converts a track; a plain CSV is read as it is."""
     path = Path(path)
     try:
         text = read_text(path)
     except TrackError as exc:
         raise CalibrationError(exc.message, exc.hint) from None
-    return parse_table(text, path)
+    return parse_table(text, path, imports)
 
 
-def parse_table(text: str, path: Path) -> Table:
+def parse_table(text: str, path: Path, imports: ImportOptions = AS_IS) -> Table:
     """The recording in ``text`` (the contents of ``path``), in whichever of the three formats."""
     try:
         doc = split_text(text, path)
-        if doc.tracker_layout:
-            tracks: TracksCsv | TrackerExport | None = TrackerExport.from_delimited(doc)
-        elif is_tracks_header(doc.header):
-            tracks = TracksCsv.from_delimited(doc)
-        else:
+        layout = track_layout(doc)
+        if layout is None:
             check_names(doc.header, path, doc.header_line)
             data = doc.columns(doc.header)
             return Table(path=path, columns={n: data[:, j] for j, n in enumerate(doc.header)},
                          comments=doc.comments)
+        tracks = tracks_from_delimited(doc, imports)
         return Table(path=path, columns={n: tracks.column(n) for n in tracks.columns},
-                     kind="tracker" if isinstance(tracks, TrackerExport) else "csv",
-                     comments=doc.comments, tracks=tracks)
+                     kind="tracker" if layout == "tracker" else "csv", comments=doc.comments, tracks=tracks,
+                     units=imports.units)
     except TrackError as exc:
         raise CalibrationError(exc.message, exc.hint) from None
 

@@ -1,4 +1,4 @@
-"""``locust ports``, ``locust flash``, ``locust hop``, ``locust virtual``: thin wrappers."""
+"""``locust ports``, ``flash``, ``hop``, ``pose``, ``repl``, ``virtual``: thin wrappers."""
 
 from __future__ import annotations
 
@@ -152,6 +152,91 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
           + f"; record {path}")
     if rec.status != R.COMPLETE:
         raise DeviceError(f"the hop did not complete: {rec.message}", f"the partial record is in {path}")
+
+
+@click.command(context_settings={"ignore_unknown_options": True})  # `pose -20 10`: -20 is an angle
+@click.argument("left_deg", type=float, required=False)
+@click.argument("right_deg", type=float, required=False)
+@click.option("--rest", is_flag=True, help="Both horns to rest (0 deg, the servos' centre).")
+@click.option("--port", default=None, help=PORT_HELP)
+def pose(left_deg, right_deg, rest, port):
+    """Move both servo horns to LEFT_DEG RIGHT_DEG and hold them there: for assembly and trim.
+
+    \b
+    Centring, before the horns go on:
+      locust pose --rest            both servos to their centre (horn 0 deg) and hold
+    then push each horn onto its spline as close to its rest position as the splines allow.
+    Trimming the rest of the error:
+      locust pose 0 0               look at the legs at rest
+      locust flash --servo left.trim_deg=2.5   (shaft deg; reversed on the mirrored right leg)
+    Checking the travel and the direction of each leg:
+      locust pose -20 10            left horn -20 deg, right horn +10 deg
+
+    Angles are horn degrees from rest in the firmware's units: push is negative and both legs
+    use the same sign (the right servo is mirrored by its config's direction). The protocol
+    allows -90..90; the robot refuses anything beyond its servo travel (travel_deg, +-45 deg
+    by default). Negative angles can be typed directly or after `--` (`locust pose -- -20 -20`).
+
+    The pose holds after the command ends, until the robot is told otherwise: another pose, or
+    a hop, a servo config change, Ctrl-C into the REPL or a reset, which all leave it at rest.
+    With --port sim the virtual robot lives only as long as the command: use `locust virtual`
+    and its /dev/pts/N to watch a pose there.
+    """
+    from .link import Link
+    from .pose import check_angles
+    from .pose import pose as do_pose
+    from .session import open_port
+
+    given = [a for a in (left_deg, right_deg) if a is not None]
+    if rest and given:
+        raise DeviceError("give either LEFT_DEG RIGHT_DEG or --rest, not both", "e.g. `locust pose -20 10`")
+    if not rest and len(given) != 2:
+        raise DeviceError("a pose needs both angles, LEFT_DEG and RIGHT_DEG (or --rest)",
+                          "e.g. `locust pose -20 10`, `locust pose --rest`; see `locust pose --help`")
+    if not rest:
+        left_deg, right_deg = check_angles(left_deg, right_deg)  # before any port is opened
+    with open_port(port, plant="record", info=_info) as device:
+        with Link(device) as link:
+            left, right = do_pose(link, None if rest else left_deg, None if rest else right_deg)
+    click.echo(f"{'rest' if rest else 'pose'}: left {left:g} deg, right {right:g} deg (horn, from rest) "
+               f"on {port or device}; held until another command moves the servos or a reset")
+
+
+@click.command()
+@click.option("--port", default=None, help=PORT_HELP)
+def repl(port):
+    """Open MicroPython's REPL on the robot (mpremote connect PORT repl); leave with Ctrl-] or Ctrl-X.
+
+    \b
+    In the REPL session:
+      Ctrl-C      stops the locust command loop (servos to rest) and gives the >>> prompt;
+                  ignored while a hop runs
+      Ctrl-D      at the >>> prompt: soft reset, main.py starts the command loop again
+      Ctrl-] or Ctrl-X   leave mpremote (the board stays as it is)
+
+    Until Ctrl-C the command loop owns the console: nothing is echoed, and a line you type is
+    answered with a bad_frame reply. For scripts, `mpremote connect PORT exec "..."` gets in
+    the same way (its own Ctrl-C); `locust hop`/`pose` need the command loop again (Ctrl-D
+    here, `locust flash`, or a reset).
+
+    With --port sim a virtual robot runs (its /dev/pts/N is printed) for as long as the REPL
+    session; to use the same virtual robot with other commands too, start `locust virtual`
+    and pass its /dev/pts/N as --port.
+    """
+    from .repl import require_terminal, run_repl
+    from .session import open_port
+
+    require_terminal()  # before a virtual robot is started for nothing
+    # a closed terminal (SIGHUP) or a kill (SIGTERM) must still stop a --port sim virtual robot
+    previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        with open_port(port, plant="record", info=_info) as device:
+            _info(f"mpremote REPL on {device}: Ctrl-C for the >>> prompt, Ctrl-D there restarts the firmware, "
+                  "Ctrl-] or Ctrl-X leaves")
+            run_repl(device)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 def _interrupt(signum, frame):

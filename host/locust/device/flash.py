@@ -3,8 +3,8 @@
 mpremote is pinned (1.29.0): its Python API changes between releases. The steps:
 
 1. open the port (mpremote's ``SerialTransport``) and, if the locust firmware is running,
-   ask it for the REPL with the ``repl`` command (it ignores Ctrl-C so that noise on the
-   line cannot stop it);
+   ask it for the REPL with the ``repl`` command (mpremote's Ctrl-C would stop an idle
+   firmware too; the request is answered, so a running firmware is known to have let go);
 2. enter the raw REPL without a soft reset (on the unix port a soft reset ends the process);
 3. write each file (optionally compiled with ``mpy-cross``), then compare the board's
    SHA-256 of every file with ours;
@@ -36,11 +36,11 @@ NOT_FLASHED = ("__init__.py",)
 KEEP_SOURCE = ("main.py", "boot.py")  # the board runs these as source
 
 NO_MICROPYTHON_HINT = (
-    "this board does not run MicroPython yet. Install it once, e.g. with mpflash "
-    "(`pip install mpflash && mpflash flash --port PORT`) or esptool "
-    "(`pip install esptool && esptool.py --port PORT erase_flash && esptool.py --port PORT "
-    "--baud 460800 write_flash 0x1000 ESP32_GENERIC-<version>.bin`, firmware from "
-    "https://micropython.org/download/ESP32_GENERIC/), then run `locust flash` again"
+    "this board does not run MicroPython yet. Install it once with esptool: erase the flash, "
+    "then write the .bin for your chip at its offset (classic ESP32 and ESP32-S2: 0x1000; "
+    "ESP32-S3 and C3: 0x0), e.g. `esptool --chip esp32 --port PORT write-flash -z 0x1000 "
+    "ESP32_GENERIC-<version>.bin`; docs/hardware.md, \"Installing MicroPython\", has every "
+    "chip's command and download page. Then run `locust flash` again"
 )
 
 

@@ -20,6 +20,8 @@ from ..errors import DeviceError
 from ..firmware import protocol as P
 
 CLOSED = {"ev": "link_closed"}  # put on the event queue when the port goes away
+REPL_PROMPT = b">>> "           # the friendly REPL echoing a frame: `>>> ${"id":...`
+RAW_REPL = b"raw REPL; CTRL-B to exit"
 
 
 class Link:
@@ -29,6 +31,7 @@ class Link:
         self.events: queue.Queue = queue.Queue()
         self.unsolicited: collections.deque = collections.deque(maxlen=200)  # replies with no waiter
         self.noise_lines = 0
+        self.repl_seen = False  # a MicroPython REPL prompt was among the noise: no command loop
         self.error: Exception | None = None
         self._pending: dict[int, queue.Queue] = {}
         self._lock = threading.Lock()
@@ -78,7 +81,11 @@ class Link:
             msg = None
         if msg is None or ("ev" not in msg and "ok" not in msg):  # noise, or a REPL echoing our request
             self.noise_lines += 1
+            if line is not None and (REPL_PROMPT in line or RAW_REPL in line):
+                self.repl_seen = True
         elif "ev" in msg:
+            if msg["ev"] == P.EV_BOOT:
+                self.repl_seen = False  # the command loop (re)started
             self.events.put(msg)
         else:
             with self._lock:
@@ -145,6 +152,13 @@ class Link:
                 msg = self.request("hello", timeout_s=min(0.5, max(0.05, deadline - time.monotonic())))
                 break
             except DeviceError:
+                if self.error is None and time.monotonic() >= deadline and self.repl_seen:
+                    port = self.port
+                    raise DeviceError(f"no locust firmware answered on {port}: it is at the MicroPython REPL "
+                                      "(after Ctrl-C, mpremote or `locust repl`, or with no main.py)",
+                                      f"restart the firmware: Ctrl-D at the >>> prompt of `locust repl --port {port}` "
+                                      f"(a soft reset runs main.py), `mpremote connect {port} reset`, "
+                                      f"or `locust flash --port {port}` (which also installs it)") from None
                 if self.error is not None or time.monotonic() >= deadline:
                     raise DeviceError(f"no locust firmware answered on {self.port}",
                                       "flash it with `locust flash --port "

@@ -14,7 +14,10 @@ What runs where:
   ``config.json`` (pins, pulse range, trim, direction) and handed to the plant at the start of
   the next 20 ms PWM period, as the ESP32's PWM hardware does;
 - when the interpreter exits (Ctrl-D soft reset, ``machine.reset()``) it is started again and
-  ``soft reboot`` is printed, as a board reboots without dropping its USB port.
+  ``soft reboot`` is printed, as a board reboots without dropping its USB port. Like a board,
+  a soft reset from the raw REPL (mpremote's ``exec``, ``run``, ``fs``...) comes back in the
+  raw REPL without running ``main.py``; any other reboot runs ``main.py``. The console's mode
+  is read off what the interpreter prints (the raw REPL's banner, the ``>>>`` prompt).
 
 The interpreter runs with real-time scheduling when the host allows it (otherwise at a raised
 or normal priority): an MCU does not share its core with a compiler and a browser.
@@ -48,6 +51,9 @@ SHIM_DIR = Path(__file__).resolve().parent / "machine_shim"
 PWM_PERIOD_S = 0.020
 PLANT_CLOSE_TIMEOUT_S = 600.0  # the simulation may still be rendering its video when the hop ends
 TICKS_PERIOD = 1 << 30  # MicroPython's ticks wrap at least this often
+RAW_REPL_BANNER = b"raw REPL; CTRL-B to exit\r\n"
+FRIENDLY_PROMPT = b"\n>>> "
+CTRL_A = b"\x01"
 
 
 def virtual_home() -> Path:
@@ -83,6 +89,24 @@ def _set_nonblocking(fd: int) -> None:
     fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) | os.O_NONBLOCK)
 
 
+def _last_new(buf: bytes, marker: bytes, seen: int) -> int:
+    """Where ``marker`` last occurs in ``buf`` ending past ``buf[:seen]`` (already searched), or -1."""
+    i = buf.rfind(marker)
+    return i if i >= 0 and i + len(marker) > seen else -1
+
+
+def _read_pty(fd: int) -> bytes:
+    """What a pseudo-terminal's master holds now (b"" if nothing, or no process on the other side)."""
+    try:
+        return os.read(fd, 4096)
+    except (BlockingIOError, InterruptedError):
+        return b""
+    except OSError as exc:
+        if exc.errno == errno.EIO:
+            return b""
+        raise
+
+
 def _raise_priority() -> None:  # runs in the child before exec
     try:
         os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(10))
@@ -116,6 +140,11 @@ class VirtualRobot:
         self._period_anchor: dict[int, float] = {}
         self._last_angle = {"left": 0.0, "right": 0.0}
         self._log = None
+        self._raw_repl = False         # the console is in the raw REPL (read off its output)
+        self._console_lock = threading.Lock()
+        self._console_tail = b""
+        self._raw_boot_pending = False  # rebooted from the raw REPL: enter it again at the prompt
+        self._pwm_pending = b""
         self.summary: dict | None = None
 
     # -- lifecycle ---------------------------------------------------------------------
@@ -144,10 +173,13 @@ class VirtualRobot:
             self._threads.append(thread)
         return self
 
-    def _boot(self) -> None:
+    def _boot(self, raw_repl: bool = False) -> None:
         termios.tcflush(self._sa, termios.TCIFLUSH)
-        # a board runs main.py after boot, then its REPL; without main.py, only the REPL
-        args = [self._mp, "-i", "main.py"] if (self.flash_dir / "main.py").exists() else [self._mp]
+        # a board runs main.py after boot, then its REPL; without main.py, only the REPL.
+        # A soft reset from the raw REPL skips main.py and stays in the raw REPL.
+        run_main = not raw_repl and (self.flash_dir / "main.py").exists()
+        args = [self._mp, "-i", "main.py"] if run_main else [self._mp]
+        self._raw_boot_pending = raw_repl
         env = dict(os.environ, MICROPYPATH=f"{SHIM_DIR}:.frozen:{self.flash_dir / 'lib'}",
                    LOCUST_PWM_FIFO=self._fifo_path)
         env.pop("PYTHONPATH", None)
@@ -177,14 +209,20 @@ class VirtualRobot:
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
-        self._plant_queue.put(None)
-        plant_unfinished = False
+        plant_thread = None
         for thread in self._threads:
-            # the plant thread finishes the simulation and its video: that can take a while
-            # on a loaded machine, and leaving early would lose the video
-            plant = thread.name.endswith("-plant")
-            thread.join(timeout=PLANT_CLOSE_TIMEOUT_S if plant else 5)
-            plant_unfinished |= plant and thread.is_alive()
+            if thread.name.endswith("-plant"):
+                plant_thread = thread
+            else:
+                thread.join(timeout=5)
+        self._drain_pwm()  # the last PWM writes (a pose, the rest after a hop) may still be in the FIFO
+        self._plant_queue.put(None)
+        # the plant thread finishes the simulation and its video: that can take a while
+        # on a loaded machine, and leaving early would lose the video
+        plant_unfinished = False
+        if plant_thread is not None:
+            plant_thread.join(timeout=PLANT_CLOSE_TIMEOUT_S)
+            plant_unfinished = plant_thread.is_alive()
         for fd in (self._ma, self._sa, self._mb, self._sb, self._fifo, self._fifo_keep):
             try:
                 os.close(fd)
@@ -219,9 +257,21 @@ class VirtualRobot:
                 continue
             if self._stopping.is_set():
                 break
+            self._settle_console()  # its last words (the REPL mode) before the reboot's
             self._to_client(b"\r\nMPY: soft reboot\r\n")
             time.sleep(0.05)
-            self._boot()
+            self._boot(raw_repl=self._raw_repl)
+
+    def _settle_console(self, timeout_s: float = 1.0) -> None:
+        """Wait until the bridge has passed on (and read the REPL mode from) all the interpreter printed."""
+        import select
+
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            with self._console_lock:  # the bridge reads and watches the console under it
+                if not select.select([self._ma], [], [], 0)[0]:
+                    return
+            time.sleep(0.005)
 
     def _to_client(self, data: bytes) -> None:
         try:
@@ -235,41 +285,58 @@ class VirtualRobot:
 
         while not self._stopping.is_set():
             ready, _, _ = select.select([self._ma, self._mb], [], [], 0.2)
-            for fd in ready:
-                try:
-                    data = os.read(fd, 4096)
-                except (BlockingIOError, InterruptedError):
-                    continue
-                except OSError as exc:
-                    if exc.errno == errno.EIO:
-                        continue
-                    raise
-                if fd == self._ma:
-                    self._to_client(data)
-                else:
+            if self._ma in ready:
+                with self._console_lock:
+                    data = _read_pty(self._ma)
+                    if data:
+                        self._watch_console(data)
+                        self._to_client(data)
+            if self._mb in ready:
+                data = _read_pty(self._mb)
+                if data:
                     try:
                         os.write(self._ma, data)
                     except (BlockingIOError, OSError):
                         pass  # the interpreter is not reading: input overrun
 
+    def _watch_console(self, data: bytes) -> None:
+        """Follow the console's REPL mode in the interpreter's output (the last marker wins)."""
+        buf = self._console_tail + data
+        seen = len(self._console_tail)
+        raw, friendly = _last_new(buf, RAW_REPL_BANNER, seen), _last_new(buf, FRIENDLY_PROMPT, seen)
+        if raw >= 0 or friendly >= 0:
+            self._raw_repl = raw > friendly
+        self._console_tail = buf[-(max(len(RAW_REPL_BANNER), len(FRIENDLY_PROMPT)) - 1):]
+        if self._raw_boot_pending and friendly >= 0:
+            self._raw_boot_pending = False
+            try:
+                os.write(self._ma, CTRL_A)  # back into the raw REPL, as the board stays there
+            except OSError:
+                pass
+
     def _read_pwm(self) -> None:
         import select
 
-        pending = b""
         while not self._stopping.is_set():
             ready, _, _ = select.select([self._fifo], [], [], 0.2)
-            if not ready:
-                continue
+            if ready:
+                self._drain_pwm()
+
+    def _drain_pwm(self) -> None:
+        """Read what the FIFO holds now; queue each PWM write for the plant."""
+        while True:
             try:
                 chunk = os.read(self._fifo, 65536)
-            except BlockingIOError:
-                continue
+            except (BlockingIOError, OSError):
+                return
+            if not chunk:
+                return
             now_us = int(time.monotonic() * 1e6)
-            pending += chunk
-            *lines, pending = pending.split(b"\n")
+            *lines, self._pwm_pending = (self._pwm_pending + chunk).split(b"\n")
             for line in lines:
                 parts = line.split()
                 if parts[:1] == [b"R"]:
+                    self._raw_repl = False  # a hard reset boots into main.py
                     with self._proc_lock:
                         if self._proc and self._proc.poll() is None:
                             self._proc.kill()  # machine.reset(): the supervisor reboots it

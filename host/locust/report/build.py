@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from .. import __version__
@@ -19,11 +19,13 @@ from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, u
 from ..params import Provenance, Robot
 from . import figures as F
 from . import page as H
+from .checks import VIRTUAL, Notice, notices, recorded_on
 from .compare import Comparison, compare, timing_rows
 from .configs import Configuration, configuration
 from .landscape import Landscape, read_landscape
 from .measured import Trial
 from .predict import predict
+from .sidebyside import plan_side_by_side, write_side_by_side
 
 REPORT_NAME = "report.html"
 DASHBOARD_NAME = "dashboard.png"
@@ -38,6 +40,8 @@ class ReportResult:
     json_path: Path
     comparisons: list[Comparison]
     figures: list[str]
+    warnings: list[Notice] = field(default_factory=list)   # checks.notices: printed, on the page, in the JSON
+    side_by_side: list = field(default_factory=list)    # sidebyside.SideBySide per trial, with --side-by-side
 
 
 def run_schedule(name: str, trials: list[Trial]) -> dict | None:
@@ -83,7 +87,8 @@ def parameter_rows(robot: Robot) -> list[dict]:
 
 def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, robot_source: str,
                  cycles: int | None = None, sweep: Path | None = None, added: dict[str, float] | None = None,
-                 marker: str = "nose", progress: Callable[[str], None] | None = None) -> ReportResult:
+                 marker: str = "nose", progress: Callable[[str], None] | None = None,
+                 side_by_side: bool = False) -> ReportResult:
     progress = progress or (lambda msg: None)
     added = added or {}
     unknown = sorted(set(added) - set(measured))
@@ -103,7 +108,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
         n_cycles = cycles or (sched["cycles"] if sched else cfg.robot.schedule.cycles)
         period = cfg.robot.schedule.push_s + cfg.robot.schedule.wait_s
         progress(f"simulating {cfg.label} ({n_cycles} cycles)")
-        pred = predict(name, cfg.robot, n_cycles, marker)
+        pred = predict(name, cfg.robot, n_cycles, marker, keep_states=side_by_side)
         comps.append(compare(pred, trials, n_cycles, period))
 
     progress("drawing figures")
@@ -133,14 +138,21 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     dash = F.dashboard(comps, land, configs)
 
     timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
-    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker)
-    doc = report_json(base, robot_source, comps, configs, timing, land, marker)
+    warnings = notices(comps)
+    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings)
+    doc = report_json(base, robot_source, comps, configs, timing, land, marker, warnings)
+
+    sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
 
     folder = unique_dir(out, "report")
     html_path = atomic_write_text(folder / REPORT_NAME, html_text)
     dash_path = atomic_write_bytes(folder / DASHBOARD_NAME, dash)
+    videos = write_side_by_side(sbs_plan, folder, progress) if sbs_plan is not None else []
+    if sbs_plan is not None:
+        doc["side_by_side"] = [v.to_json() for v in videos]
     json_path = atomic_write_json(folder / JSON_NAME, {**doc, "wall_s": round(time.perf_counter() - t0, 2)})
-    return ReportResult(folder, html_path, dash_path, json_path, comps, [f.key for f in figs])
+    return ReportResult(folder, html_path, dash_path, json_path, comps, [f.key for f in figs],
+                        warnings=warnings, side_by_side=videos)
 
 
 def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker: str) -> str:
@@ -178,16 +190,29 @@ def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker:
     return "<ul class=\"note\">" + "".join(f"<li>{H.esc(i)}</li>" for i in items) + "</ul>"
 
 
-def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, land, marker: str) -> str:
+def _track_reading(t) -> str:
+    """How a trial's track was read: ``metres``, ``cm -> m, mirrored``."""
+    if t.track is None:
+        return "—"
+    return ("metres" if t.track.units == "m" else f"{t.track.units} -> m") + (", mirrored" if t.track.mirrored else "")
+
+
+def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, land, marker: str,
+                warnings: Sequence[Notice] = ()) -> str:
     labels = {n: c.label for n, c in configs.items()}
     added = {n: c.added_m for n, c in configs.items()}
     inputs = []
     for c in comps:
         for t in c.all_trials:
+            where, why = recorded_on(t.record)
             inputs.append("<tr>" + H.td(labels[c.config], left=True) + H.td(t.label, left=True)
                           + H.td(str(t.track.path) if t.track else "—", left=True)
-                          + H.td(str(t.run_path) if t.run_path else "—", left=True) + "</tr>")
-    sections = [
+                          + H.td(str(t.run_path) if t.run_path else "—", left=True)
+                          + H.td(t.config_from, c.config, f"config_from:{t.label}", left=True)
+                          + H.td(where or "—", c.config, f"recorded_on:{t.label}", left=True)
+                          + H.td(_track_reading(t), left=True) + "</tr>")
+    sections = [("Warnings", H.warnings_list(warnings))] if warnings else []
+    sections += [
         ("Summary", H.summary_table(comps, labels, added)),
         ("Figures", "".join(H.figure_html(f) for f in figs)),
         ("Per-hop errors", H.hop_table(comps, labels)),
@@ -196,19 +221,35 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
                        "adds its length to all four links.</p>"
                        + H.links_table([(labels[n], c.robot.link_lengths_m()) for n, c in configs.items()])
                        + H.params_table(parameter_rows(base))),
-        ("Inputs", H.table(["configuration", "trial", "track", "run record"], inputs, left_cols=4, id_="inputs")),
+        ("Inputs", H.table(["configuration", "trial", "track", "run record", "configuration from", "recorded on",
+                            "track read in"], inputs, left_cols=7, id_="inputs")),
         ("How the numbers are made", _notes(comps, land, base, marker)),
     ]
     meta = [f"robot: {base.name} ({robot_source})",
             f"configurations: {', '.join(labels.values())}; cycles: "
             + ", ".join(f"{labels[c.config]} {c.cycles}" for c in comps),
             f"generated {time.strftime('%Y-%m-%d %H:%M:%S %z')} by locust {__version__}"]
+    trials = [t for c in comps for t in c.all_trials]
+    virtual = [t for t in trials if recorded_on(t.record)[0] == VIRTUAL]
+    if virtual:
+        meta.insert(1, f"measured trials: {len(virtual)} of {len(trials)} recorded on the virtual robot "
+                       "(the simulated robot, not the physical one)")
     return H.page("Simulation against measurement", meta, sections)
 
 
-def report_json(base: Robot, robot_source: str, comps, configs, timing, land, marker: str) -> dict:
+def _trial_json(t) -> dict:
+    where, why = recorded_on(t.record)
+    return {"label": t.label, "track": str(t.track.path) if t.track else None,
+            "run": str(t.run_path) if t.run_path else None, "config_from": t.config_from,
+            "recorded_on": where, "recorded_on_because": why,
+            "track_units": t.track.units if t.track else None, "track_mirrored": t.track.mirrored if t.track else None}
+
+
+def report_json(base: Robot, robot_source: str, comps, configs, timing, land, marker: str,
+                warnings: Sequence[Notice] = ()) -> dict:
     out = {"robot": base.name, "robot_source": robot_source, "locust_version": __version__, "marker": marker,
-           "sweep": str(land.folder) if land else None, "configurations": []}
+           "sweep": str(land.folder) if land else None, "warnings": [w.to_json() for w in warnings],
+           "configurations": []}
     for c in comps:
         cfg = configs[c.config]
         out["configurations"].append({
@@ -222,8 +263,7 @@ def report_json(base: Robot, robot_source: str, comps, configs, timing, land, ma
                          "hop_distance_m": asdict(c.hop_distance), "jump_m": asdict(c.jump)},
             "hops": [{**asdict(r), "distance_error_m": r.distance_error_m, "apex_error_m": r.apex_error_m}
                      for r in c.rows],
-            "trials": [{"label": t.label, "track": str(t.track.path) if t.track else None,
-                        "run": str(t.run_path) if t.run_path else None} for t in c.all_trials],
+            "trials": [_trial_json(t) for t in c.all_trials],
         })
     out["timing"] = [asdict(r) for r in timing]
     return out   # written by atomic_write_json: NaN/inf become null there

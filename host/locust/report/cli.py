@@ -9,6 +9,7 @@ import click
 
 from ..params import resolve_robot
 from ..params_cli import robot_options
+from ..track.importing import import_options
 
 
 def _stage(msg: str) -> None:
@@ -31,7 +32,11 @@ def _stage(msg: str) -> None:
               help="Marker compared: its track (x forward, y up, metres) against the model's marker of that name.")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=Path("reports"), show_default=True,
               help="Parent folder; the report goes into a new report/ (report-2/, ...) inside, never over another.")
-def report(measured, config, preset, sets, added, sweep, cycles, marker, out):
+@click.option("--side-by-side", "side_by_side", is_flag=True,
+              help="Also write <trial>.side_by_side.mp4 for each trial with a video: the filmed hop beside the "
+                   "simulation from the same camera (its camera.json), on the schedule's clock.")
+@import_options
+def report(measured, config, preset, sets, added, sweep, cycles, marker, out, side_by_side, imports):
     """Compare simulation and measurement for each configuration in one self-contained HTML page.
 
     Each configuration (Small/Medium/Large: the --config/--preset robot with +0/+1/+2 cm on
@@ -52,18 +57,23 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out):
     from .measured import parse_measured
 
     robot = resolve_robot(preset, config, sets)
-    groups = parse_measured(list(measured), marker=marker)
+    groups = parse_measured(list(measured), marker=marker, imports=imports)
     source = str(config) if config else f"preset {preset}"
     if sets:
         source += " with " + ", ".join(sets)
     result = build_report(robot, groups, out, robot_source=source, cycles=cycles, sweep=sweep,
-                          added=parse_added(added), marker=marker, progress=_stage)
+                          added=parse_added(added), marker=marker, progress=_stage, side_by_side=side_by_side)
     for c in result.comparisons:
         r = c.prediction.result
         pred = f"predicted {r.distance_m * 100:.2f} cm" if r.valid else "simulation INVALID"
         meas = (f"measured {c.distance.mean * 100:.2f} cm over {c.distance.n} trial(s)" if c.distance.n
                 else "no track")
         click.echo(f"{c.config:8s} {pred}, {meas}", err=True)
+    for warning in result.warnings:
+        click.echo(f"warning: {warning.message}", err=True)
     click.echo(f"dashboard: {result.dashboard_path}", err=True)
+    for v in result.side_by_side:
+        if v.path is not None:
+            click.echo(f"side by side: {v.path}", err=True)
     click.echo(str(result.html_path))
     sys.stdout.flush()

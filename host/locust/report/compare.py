@@ -13,8 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..device.record import Jitter, jitter
+from ..errors import ReportError
 from .measure import Aligned, MeasuredHop, align, measure_hops
-from .measured import Trial
+from .measured import Trial, span_hint
 from .predict import Prediction
 
 
@@ -111,7 +112,11 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
         if trial.track is None:
             continue
         tr = trial.track
-        trace = align(tr.t_s, tr.x_m, tr.y_m, latency, where=str(tr.path))
+        try:
+            trace = align(tr.t_s, tr.x_m, tr.y_m, latency, where=str(tr.path))
+        except ReportError as exc:
+            hint = span_hint(tr)        # noise in mm read as metres looks like a robot already moving
+            raise ReportError(exc.message, f"{hint}; {exc.hint}" if hint else exc.hint) from None
         measured.append(MeasuredTrial(trial, trace, measure_hops(trace, period_s, trial_cycles(trial, cycles))))
     sim_hops = {h.cycle: h for h in prediction.result.hops}          # run(): chassis travel per hop
     sim_apex = {h.hop: h.apex_m for h in prediction.hops}            # the tracked marker's apex

@@ -10,8 +10,10 @@
 - a ``run.json``; a single ``*.tracks.csv`` beside it is its track.
 
 A plain path's configuration comes from its folder's name (see
-:func:`.configs.name_from_path`). Tracks are read by the track layer that writes them
-(:func:`locust.track.tracks_csv.read_track_file`), so the formats are the same everywhere.
+:func:`.configs.name_from_path`); the trial remembers that it was guessed (``config_from``).
+Tracks are read by the track layer's one import (:func:`locust.track.importing.import_tracks`:
+a tracks CSV, a Tracker text export or a ``t,x,y`` CSV, with ``--units``, ``--rename`` and
+``--mirror``), so the formats and conversions are the same everywhere.
 """
 
 from __future__ import annotations
@@ -24,10 +26,13 @@ import numpy as np
 from ..device.record import RECORD_NAME as RUN_NAME
 from ..device.record import RunRecord, read_run_record
 from ..errors import DeviceError, ReportError, TrackError
-from ..track.tracks_csv import TRACKS_CSV_SUFFIX, read_track_file
+from ..track.importing import AS_IS, DESK_SPAN_M, TYPICAL_SPAN_M, ImportOptions, import_tracks, units_hint
+from ..track.tracks_csv import TRACKS_CSV_SUFFIX
 from .configs import check_name, name_from_path, sort_key
 
 TRACK_GLOB = f"*{TRACKS_CSV_SUFFIX}"
+CONFIG_GIVEN = "given"                   # --measured NAME=PATH
+CONFIG_FROM_FOLDER = "folder name"       # guessed by name_from_path
 
 
 @dataclass(frozen=True)
@@ -40,6 +45,8 @@ class Track:
     x_m: np.ndarray
     y_m: np.ndarray
     frames: int          # rows in the file, lost ones included
+    units: str = "m"     # the unit the file's positions were in (--units)
+    mirrored: bool = False
 
 
 @dataclass(frozen=True)
@@ -49,11 +56,13 @@ class Trial:
     track: Track | None
     run_path: Path | None
     record: RunRecord | None = field(default=None, compare=False)
+    config_from: str = CONFIG_GIVEN      # how its configuration was known: given, or guessed from its folder
 
 
-
-def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose") -> dict[str, list[Trial]]:
-    """``--measured`` values -> trials per configuration, in leg-set order."""
+def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose",
+                   imports: ImportOptions = AS_IS) -> dict[str, list[Trial]]:
+    """``--measured`` values -> trials per configuration, in leg-set order; ``imports``
+    (``--units``, ``--rename``, ``--mirror``) converts every track."""
     if not items:
         raise ReportError("no measured inputs", "give --measured small=runs/small-1,runs/small-2 (or plain paths)")
     groups: dict[str, list[Trial]] = {}
@@ -61,7 +70,10 @@ def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose") -> 
         name, paths = _split_item(item)
         for raw in paths:
             path = Path(raw)
-            trial = load_trial(path, name or name_from_path(path), marker)
+            if name:
+                trial = load_trial(path, name, marker, imports)
+            else:
+                trial = load_trial(path, name_from_path(path), marker, imports, config_from=CONFIG_FROM_FOLDER)
             groups.setdefault(trial.config, []).append(trial)
     for name, trials in groups.items():
         seen: set[tuple] = set()
@@ -84,7 +96,8 @@ def _split_item(item: str) -> tuple[str | None, list[str]]:
     return None, [item]
 
 
-def load_trial(path: Path, config: str, marker: str = "nose") -> Trial:
+def load_trial(path: Path, config: str, marker: str = "nose", imports: ImportOptions = AS_IS,
+               config_from: str = CONFIG_GIVEN) -> Trial:
     if not path.exists():
         raise ReportError(f"{path}: no such file or folder", "check the --measured path")
     if path.is_dir():
@@ -97,8 +110,8 @@ def load_trial(path: Path, config: str, marker: str = "nose") -> Trial:
         beside = path.parent / RUN_NAME
         run_path, track_path, label = (beside if beside.is_file() else None), path, path.parent.name or path.stem
     record = read_run(run_path) if run_path else None
-    track = read_track(track_path, marker) if track_path else None
-    return Trial(config=config, label=label, track=track, run_path=run_path, record=record)
+    track = read_track(track_path, marker, imports) if track_path else None
+    return Trial(config=config, label=label, track=track, run_path=run_path, record=record, config_from=config_from)
 
 
 def _one_track(folder: Path, required: bool) -> Path | None:
@@ -114,10 +127,10 @@ def _one_track(folder: Path, required: bool) -> Path | None:
     return None
 
 
-def read_track(path: Path, marker: str = "nose") -> Track:
-    """The ``marker``'s positions in ``path``; lost frames dropped, time sorted."""
+def read_track(path: Path, marker: str = "nose", imports: ImportOptions = AS_IS) -> Track:
+    """The ``marker``'s positions in ``path`` (converted by ``imports``); lost frames dropped, time sorted."""
     try:
-        tracks = read_track_file(path)
+        tracks = import_tracks(path, options=imports)
         t = tracks.time_s()
         x, y = tracks.positions(marker)
     except TrackError as exc:
@@ -136,7 +149,8 @@ def read_track(path: Path, marker: str = "nose") -> Track:
     if np.any(np.diff(tt) <= 0):
         raise ReportError(f"{path}: repeated time stamps in t_s",
                           "export the track again; each frame needs its own time")
-    return Track(path=path, marker=marker, t_s=tt, x_m=x[ok][order], y_m=y[ok][order], frames=tracks.n_rows)
+    return Track(path=path, marker=marker, t_s=tt, x_m=x[ok][order], y_m=y[ok][order], frames=tracks.n_rows,
+                 units=imports.units, mirrored=imports.mirror)
 
 
 def read_run(path: Path) -> RunRecord:
@@ -145,3 +159,12 @@ def read_run(path: Path) -> RunRecord:
         return read_run_record(path)
     except DeviceError as exc:
         raise ReportError(exc.message, exc.hint) from None
+
+
+def span_hint(track: Track) -> str | None:
+    """What to say when a track spans more than a desk robot's camera sees (its units are off)."""
+    span = float(max(np.ptp(track.x_m), np.ptp(track.y_m))) if len(track.x_m) else 0.0
+    if span <= DESK_SPAN_M:
+        return None
+    return (f"the {track.marker} track spans {span:.3g} m, more than the {DESK_SPAN_M:g} m a camera on a desk "
+            f"robot sees: {units_hint(span, 1e-3, DESK_SPAN_M, TYPICAL_SPAN_M, track.units)}")

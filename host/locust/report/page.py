@@ -25,6 +25,7 @@ th,td{border:1px solid #ddd;padding:3px 8px;text-align:right}td{white-space:nowr
 th{background:#f4f4f4}td.l,th.l{text-align:left}tr.invalid td{color:#b00020}
 figure{margin:1em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{color:#555;font-size:13px}
 .meta{color:#555}.note{color:#555;font-size:13px}code{background:#f6f6f6;padding:0 3px}
+ul.warn{background:#fff6e5;border:1px solid #f0c36d;padding:.6em 1em .6em 2.2em}ul.warn li{margin:.2em 0}
 """
 
 
@@ -137,6 +138,13 @@ def timing_table(rows: list[TimingRow], labels: dict[str, str]) -> str:
     headers = ["configuration", "trial", "status", "firmware", "phases", "mean (ms)", "sd (ms)",
                "max |error| (ms)", "max late (ms)", "max early (ms)"]
     return table(headers, out, left_cols=3, id_="timing")
+
+
+def warnings_list(notices) -> str:
+    """The report's warnings (:class:`.checks.Notice`), each with its kind, configuration and trial."""
+    items = "".join(f'<li data-kind="{esc(n.kind)}" data-config="{esc(n.config)}" data-trial="{esc(n.trial)}">'
+                    f"{esc(n.message)}</li>" for n in notices)
+    return f'<ul class="warn" id="warnings">{items}</ul>'
 
 
 def params_table(param_rows: list[dict]) -> str:

@@ -14,7 +14,7 @@ track. A run that fails its audit is kept as invalid, with its reasons, and has 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -34,13 +34,17 @@ class Prediction:
     trace: Aligned | None          # the marker on the schedule's clock; None when invalid
     hops: list[MeasuredHop]        # the marker's hops, measured like a track's (empty when invalid)
     onset_latency_s: float         # first marker motion after the first push (nan when invalid)
+    # the rollout itself, every step's state: only with predict(..., keep_states=True) and a valid run
+    trajectory: object | None = field(default=None, repr=False)
 
     @property
     def valid(self) -> bool:
         return bool(self.result.valid)
 
 
-def predict(config: str, robot: Robot, cycles: int, marker: str = "nose") -> Prediction:
+def predict(config: str, robot: Robot, cycles: int, marker: str = "nose", keep_states: bool = False) -> Prediction:
+    """``keep_states``: keep the rollout (``Prediction.trajectory``) for a video of it
+    (:mod:`.sidebyside`); otherwise its states go once the trace is taken."""
     from ..sim.run import invalid_result, run
 
     try:
@@ -54,7 +58,8 @@ def predict(config: str, robot: Robot, cycles: int, marker: str = "nose") -> Pre
     trace = marker_trace(traj, marker)
     onset, _, _ = onset_time(trace.t_s, trace.x_m, trace.y_m, where=f"simulated {config}")
     period = robot.schedule.push_s + robot.schedule.wait_s
-    return Prediction(config, robot, result, trace, measure_hops(trace, period, cycles), onset)
+    return Prediction(config, robot, result, trace, measure_hops(trace, period, cycles), onset,
+                      traj if keep_states else None)
 
 
 def marker_trace(traj, marker: str) -> Aligned:

@@ -94,9 +94,11 @@ class PinholeCamera:
 def pinhole_from_scene(scene: mujoco.MjvScene, width_px: int, height_px: int) -> PinholeCamera:
     """The pinhole camera MuJoCo renders ``scene`` with, in a ``width_px`` x ``height_px`` viewport.
 
-    OpenGL maps the near-plane window [left, right] x [bottom, top] onto the viewport; with
-    ``frustum_width`` 0 the width follows the viewport's aspect ratio. Pixel i spans window
+    OpenGL maps the near-plane window [left, right] x [bottom, top] onto the viewport, with
+    left/right = ``frustum_center`` -/+ ``frustum_width`` (MuJoCo's renderer reads it as the
+    half-width; 0: the width follows the viewport's aspect ratio). Pixel i spans window
     coordinates [i, i + 1], so its centre is at i + 0.5: OpenCV's index is window - 0.5.
+    :func:`set_scene_pinhole` is the inverse.
     """
     cams = [scene.camera[0], scene.camera[1]]   # the two eyes coincide without stereo
     gl = cams[0]
@@ -110,12 +112,44 @@ def pinhole_from_scene(scene: mujoco.MjvScene, width_px: int, height_px: int) ->
     near, top, bottom, centre = float(gl.frustum_near), float(gl.frustum_top), float(gl.frustum_bottom), \
         float(gl.frustum_center)
     height_n = top - bottom
-    width_n = float(gl.frustum_width) or height_n * width_px / height_px
+    width_n = 2 * float(gl.frustum_width) or height_n * width_px / height_px
     fx = width_px * near / width_n
     fy = height_px * near / height_n
     cx = (width_px - 1) / 2 - width_px * centre / width_n
     cy = (height_px - 1) / 2 + height_px * (top + bottom) / (2 * height_n)
     return PinholeCamera(width_px, height_px, fx, fy, cx, cy, rotation, pos)
+
+
+def free_camera_at(cam: PinholeCamera, distance_m: float = 1.0) -> CameraView:
+    """MuJoCo's free camera standing where ``cam`` stands and looking where it looks.
+
+    The free camera has no roll and its own field of view: :func:`set_scene_pinhole` then
+    puts ``cam``'s exact orientation and intrinsics on the scene. Rendering through this view
+    first places what follows the camera (the headlight) where ``cam`` is.
+    """
+    f = np.asarray(cam.rotation[2], dtype=float)
+    azimuth = math.degrees(math.atan2(f[1], f[0]))
+    elevation = math.degrees(math.asin(max(-1.0, min(1.0, float(f[2])))))
+    lookat = np.asarray(cam.position_m, dtype=float) + distance_m * f
+    return CameraView(tuple(float(v) for v in lookat), distance_m, azimuth, elevation)
+
+
+def set_scene_pinhole(scene: mujoco.MjvScene, cam: PinholeCamera) -> None:
+    """Make ``scene`` (after ``update_scene``) render through ``cam`` in a ``cam.width_px`` x
+    ``cam.height_px`` viewport: its pose (world -> camera rotation, centre) and intrinsics
+    (fx, fy, cx, cy), the inverse of :func:`pinhole_from_scene`. The near and far planes stay
+    MuJoCo's."""
+    w, h = cam.width_px, cam.height_px
+    for gl in (scene.camera[0], scene.camera[1]):
+        near = float(gl.frustum_near)
+        gl.pos[:] = cam.position_m
+        gl.forward[:] = cam.rotation[2]
+        gl.up[:] = -np.asarray(cam.rotation[1])
+        gl.frustum_center = ((w - 1) / 2 - cam.cx_px) * near / cam.fx_px
+        gl.frustum_width = w * near / cam.fx_px / 2           # the half-width, as MuJoCo reads it
+        middle = (cam.cy_px - (h - 1) / 2) * near / cam.fy_px
+        gl.frustum_top = middle + h * near / cam.fy_px / 2
+        gl.frustum_bottom = middle - h * near / cam.fy_px / 2
 
 
 # -- framing -----------------------------------------------------------------------
@@ -145,4 +179,5 @@ def frame_views(points_m: np.ndarray, chassis_x_m: np.ndarray, body_length_m: fl
     return fixed, track
 
 
-__all__ = ["CAMERAS", "CameraView", "PinholeCamera", "frame_views", "pinhole_from_scene"]
+__all__ = ["CAMERAS", "CameraView", "PinholeCamera", "frame_views", "free_camera_at", "pinhole_from_scene",
+           "set_scene_pinhole"]

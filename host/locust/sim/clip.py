@@ -36,7 +36,15 @@ from ..params import Robot
 from ..progress import progress
 from ..track.camera import CameraFile, MarkerPlane, camera_json_beside, write_camera_json
 from .audit import audit
-from .camera import CAMERAS, CameraView, PinholeCamera, frame_views, pinhole_from_scene
+from .camera import (
+    CAMERAS,
+    CameraView,
+    PinholeCamera,
+    frame_views,
+    free_camera_at,
+    pinhole_from_scene,
+    set_scene_pinhole,
+)
 from .rollout import Trajectory, simulate
 
 MARKERS = tuple(MARKER_COLOURS)           # ("nose", "foot"): geoms "marker_<name>"
@@ -44,6 +52,59 @@ VISIBLE_FRAC = 0.5                         # truth says a marker is visible when
 # sample points on a unit disc for the seen fraction: the centre and three rings of twelve
 _DISC_SAMPLES = np.vstack([[[0.0, 0.0]]] + [
     [[r * math.cos(a), r * math.sin(a)] for a in np.arange(12) * math.pi / 6] for r in (0.35, 0.65, 0.95)])
+
+
+# -- one frame: the model posed and rendered through a camera -------------------------
+class PoseRenderer:
+    """Renders the model, posed at given joint positions, offscreen through a camera.
+
+    ``pose(qpos)`` poses a private ``MjData`` (positions only: kinematics, centres of mass,
+    lights; a simulation's own data is never touched). ``render(camera)`` renders it through
+    a :class:`.camera.CameraView` (MuJoCo's free camera, as :func:`.camera.frame_views`
+    frames it) or a :class:`.camera.PinholeCamera` (any pose and intrinsics of a
+    ``width`` x ``height`` camera, e.g. a filmed video's ``camera.json``), and returns the
+    RGB image with the pinhole camera it was rendered through. No floor reflections: a
+    mirrored marker is a second blob of the marker's colour, which a matte table does not
+    show and which would merge with a foot on the floor.
+    """
+
+    def __init__(self, model: mujoco.MjModel, width: int, height: int, shadows: bool = True):
+        self.model, self.width, self.height, self.shadows = model, width, height, shadows
+        model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
+        model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
+        self.data = mujoco.MjData(model)
+        try:
+            self.renderer = mujoco.Renderer(model, height=height, width=width)
+        except Exception as exc:
+            raise SimError(f"cannot open an offscreen OpenGL context ({type(exc).__name__}: {exc})",
+                           "install OSMesa (apt-get install libosmesa6) and run with MUJOCO_GL=osmesa, "
+                           "or MUJOCO_GL=egl on a GPU") from None
+
+    def pose(self, qpos: np.ndarray) -> mujoco.MjData:
+        d = self.data
+        d.qpos[:] = qpos
+        mujoco.mj_kinematics(self.model, d)
+        mujoco.mj_comPos(self.model, d)
+        mujoco.mj_camlight(self.model, d)   # lights are placed here, not in mj_kinematics
+        return d
+
+    def render(self, camera: CameraView | PinholeCamera) -> tuple[np.ndarray, PinholeCamera]:
+        pinhole = camera if isinstance(camera, PinholeCamera) else None
+        if pinhole is not None and (pinhole.width_px, pinhole.height_px) != (self.width, self.height):
+            raise SimError(f"a {pinhole.width_px}x{pinhole.height_px} camera cannot render a "
+                           f"{self.width}x{self.height} frame", "render at the camera's own size")
+        self.renderer.update_scene(self.data, camera=(free_camera_at(pinhole) if pinhole else camera).mjv_camera())
+        if pinhole is not None:
+            set_scene_pinhole(self.renderer.scene, pinhole)
+        self.renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+        self.renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = int(self.shadows)
+        cam = pinhole_from_scene(self.renderer.scene, self.width, self.height)
+        return self.renderer.render(), cam
+
+    def close(self) -> None:
+        if getattr(self, "renderer", None) is not None:
+            self.renderer.close()
+            self.renderer = None
 
 
 # -- one clip: frames, truth rows, sidecars ------------------------------------------
@@ -90,8 +151,8 @@ class _TruthRow:
 class ClipRecorder:
     """Renders frames from model states into a temporary MP4, collecting the truth.
 
-    ``add_frame(qpos, t_s)`` poses a private ``MjData`` (positions only; the physics' own
-    data is never touched), renders, projects the markers and appends the frame;
+    ``add_frame(qpos, t_s)`` poses and renders the model (:class:`PoseRenderer`), projects
+    the markers and appends the frame;
     ``finish()`` writes the sidecars and moves the video into place; ``abort()`` leaves
     nothing behind.
     """
@@ -110,17 +171,10 @@ class ClipRecorder:
 
     def __post_init__(self) -> None:
         m = self.model
-        m.vis.global_.offwidth = max(int(m.vis.global_.offwidth), self.width)
-        m.vis.global_.offheight = max(int(m.vis.global_.offheight), self.height)
-        self.data = mujoco.MjData(m)
         self.marker_ids = {n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, f"marker_{n}") for n in MARKERS}
         self.chassis_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
-        try:
-            self.renderer = mujoco.Renderer(m, height=self.height, width=self.width)
-        except Exception as exc:
-            raise SimError(f"cannot open an offscreen OpenGL context ({type(exc).__name__}: {exc})",
-                           "install OSMesa (apt-get install libosmesa6) and run with MUJOCO_GL=osmesa, "
-                           "or MUJOCO_GL=egl on a GPU") from None
+        self.poser = PoseRenderer(m, self.width, self.height, self.shadows)
+        self.data = self.poser.data
         fd, self.tmp_path = temp_beside(self.path, suffix=".mp4")
         os.close(fd)
         self.writer = cv2.VideoWriter(self.tmp_path, cv2.VideoWriter_fourcc(*"mp4v"), float(self.fps),
@@ -135,19 +189,9 @@ class ClipRecorder:
         return len(self.rows)
 
     def add_frame(self, qpos: np.ndarray, t_s: float) -> None:
-        d = self.data
-        d.qpos[:] = qpos
-        mujoco.mj_kinematics(self.model, d)
-        mujoco.mj_comPos(self.model, d)
-        mujoco.mj_camlight(self.model, d)   # lights are placed here, not in mj_kinematics
+        d = self.poser.pose(qpos)
         view = self.view.at_x(float(d.xpos[self.chassis_id][0])) if self.camera == "track" else self.view
-        self.renderer.update_scene(d, camera=view.mjv_camera())
-        # No floor reflections: a mirrored marker is a second blob of the marker's colour,
-        # which a matte table does not show and which would merge with a foot on the floor.
-        self.renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
-        self.renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = int(self.shadows)
-        cam = pinhole_from_scene(self.renderer.scene, self.width, self.height)
-        rgb = self.renderer.render()
+        rgb, cam = self.poser.render(view)
         self.writer.write(cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
         world = {n: self._marker_face_m(g) for n, g in self.marker_ids.items()}
         px = {n: tuple(float(v) for v in cam.project(world[n])[0]) for n in MARKERS}
@@ -230,7 +274,7 @@ class ClipRecorder:
     def finish(self) -> VideoInfo:
         try:
             self.writer.release()
-            self.renderer.close()
+            self.poser.close()
             if not self.rows:
                 raise SimError(f"no frames to write to {self.path}", "simulate for at least one frame period")
             truth_path, camera_path = sidecar_paths(self.path)
@@ -246,8 +290,8 @@ class ClipRecorder:
     def abort(self) -> None:
         if getattr(self, "writer", None) is not None:
             self.writer.release()
-        if getattr(self, "renderer", None) is not None:
-            self.renderer.close()
+        if getattr(self, "poser", None) is not None:
+            self.poser.close()
         try:
             os.unlink(self.tmp_path)
         except (FileNotFoundError, AttributeError):
@@ -319,5 +363,5 @@ def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = Non
     return rec.finish()
 
 
-__all__ = ["MARKERS", "VISIBLE_FRAC", "ClipRecorder", "VideoInfo", "check_video_path", "frame_times_s",
+__all__ = ["MARKERS", "VISIBLE_FRAC", "ClipRecorder", "PoseRenderer", "VideoInfo", "check_video_path", "frame_times_s",
            "render_video", "sidecar_paths", "validate_size"]

@@ -6,15 +6,17 @@ import math
 from pathlib import Path
 
 import click
+import numpy as np
 
 from ..errors import TrackError
 from ..fileio import atomic_write_json
 from ..progress import progress
 from . import calib, camera, export, overlay, trk
 from .aruco import DEFAULT_DICTIONARY, side_px_in_video
+from .importing import ImportOptions, import_options, import_tracks, span_warnings
 from .runner import track_video
 from .spec import ModelOptions, parse_markers
-from .tracks_csv import tracks_csv_beside
+from .tracks_csv import tracks_csv_beside, write_tracks_csv
 from .video import Clip, probe
 
 
@@ -88,8 +90,13 @@ def _base_path(out: Path | None, source: Path) -> Path:
               help="Convert the point tracks of a Tracker project (.trk or .trz) instead of tracking a video.")
 @click.option("--track", "trk_names", multiple=True, metavar="NAME",
               help="With --from-trk: only these Tracker tracks (repeatable). Default: all point masses.")
+@click.option("--import", "import_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="Convert a track file instead of tracking a video: a Tracker text export, a t,x,y CSV or a "
+                   "tracks CSV, in --units, with --rename and --mirror, into a tracks CSV in metres.")
+@import_options
 def track(video, markers, color_tol, search_px, template_radius, accept, evolve, scale, scale_aruco, aruco_dict,
-          camera_json, origin, angle, start, end, step, fps, out, fmt, overlay_kind, force, from_trk, trk_names):
+          camera_json, origin, angle, start, end, step, fps, out, fmt, overlay_kind, force, from_trk, trk_names,
+          import_path, imports):
     """Extract marker tracks (nose, foot) from VIDEO, as Tracker's autotracker would, in batch.
 
     \b
@@ -105,13 +112,24 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
       locust track toss.mp4 --marker ball=template:131.28,207.86@2
       locust track slowmo.mp4 --fps 240 --start 30 --end 400
       locust track --from-trk experiment.trz --format tracker
+      locust track --import tracker.txt --units cm --rename A=nose --out hop.tracks.csv
     """
+    if import_path is not None:
+        if video is not None or from_trk is not None:
+            raise TrackError("give one of VIDEO, --from-trk and --import", "one input per run")
+        if fmt != "csv":
+            raise TrackError("--import writes a tracks CSV only", "leave out --format, or use --format csv")
+        return _import(import_path, imports, out, force)
+    if not imports.identity:
+        raise TrackError("--units, --rename and --mirror go with --import",
+                         "locust track --import FILE --units cm --rename A=nose --out tracks.csv")
     if from_trk is not None:
         if video is not None:
             raise TrackError("give either VIDEO or --from-trk, not both", "track a video, or convert a Tracker project")
         return _convert_trk(from_trk, list(trk_names), out, fmt, force)
     if video is None:
-        raise TrackError("no video given", "usage: locust track VIDEO [--marker NAME=SPEC ...]; see --help")
+        raise TrackError("no video given",
+                         "usage: locust track VIDEO [--marker NAME=SPEC ...] or --import FILE; see --help")
 
     info = probe(video)
     clip = Clip(start, end, step, fps).resolved(info)
@@ -172,6 +190,27 @@ def _convert_trk(path: Path, names: list[str], out, fmt: str, force: bool) -> No
     paths = _outputs(_base_path(out, path), fmt, "none")
     _refuse_overwrite(paths, force)
     _report(result, _write(result, paths, fmt))
+
+
+def _import(path: Path, imports: ImportOptions, out: Path | None, force: bool) -> None:
+    tracks = import_tracks(path, options=imports)
+    target = out if out is not None and not out.is_dir() else tracks_csv_beside(out / path.name if out else path)
+    if target.exists() and target.resolve() == path.resolve():
+        raise TrackError(f"--out {target} is the file being imported", "write the tracks CSV to another --out")
+    _refuse_overwrite({"tracks": target}, force)
+    for warning in span_warnings(tracks, imports):
+        click.echo(f"warning: {warning}", err=True)
+    write_tracks_csv(target, tracks)
+    click.echo(f"{path.name}: {tracks.n_rows} rows, {imports.describe()}")
+    for name in tracks.markers_with_positions():
+        x, y = tracks.positions(name)
+        ok = np.isfinite(x) & np.isfinite(y)
+        if ok.any():
+            click.echo(f"  {name}: {int(ok.sum())} rows with a position; x {x[ok].min():.6g} .. {x[ok].max():.6g} m, "
+                       f"y {y[ok].min():.6g} .. {y[ok].max():.6g} m")
+        else:
+            click.echo(f"  {name}: no position")
+    click.echo(f"wrote {target}")
 
 
 def _report(result, written: list[Path]) -> None:

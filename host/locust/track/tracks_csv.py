@@ -1,9 +1,10 @@
 """The tracks CSV (``<video>.tracks.csv``): its one writer, its one reader, its typed object.
 
 ``locust track`` writes it; the report and the calibration layer read it back through
-:func:`read_tracks_csv` (or :func:`read_track_file`, which also takes Tracker's text
-export). Layout: ``#`` comment lines (the file's own notes, e.g. ``# synthetic: ...``),
-then one header line and one row per frame::
+:func:`.importing.import_tracks` (which also takes Tracker's text export and a
+``t,x,y`` CSV, in any unit, renamed or mirrored), built on :func:`read_tracks_csv`.
+Layout: ``#`` comment lines (the file's own notes, e.g. ``# synthetic: ...``), then one
+header line and one row per frame::
 
     frame,t_s,<m>_px,<m>_py,<m>_x_m,<m>_y_m,<m>_ok        (the last five once per marker)
 

@@ -1,0 +1,37 @@
+"""``locust repl``: mpremote's interactive REPL on the robot's serial port.
+
+The firmware's command loop owns the console until Ctrl-C stops it (while no hop runs): the
+servos go to rest and the console is MicroPython's REPL. Ctrl-D at the ``>>>`` prompt is a
+soft reset, which runs ``main.py`` and so the command loop again; leaving mpremote (Ctrl-]
+or Ctrl-X) leaves the board as it is.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from ..errors import DeviceError
+
+
+def mpremote_command(device: str, *args: str) -> list[str]:
+    """``mpremote connect DEVICE ARGS...`` run by this Python (the pinned mpremote beside locust)."""
+    return [sys.executable, "-m", "mpremote", "connect", device, *args]
+
+
+def require_terminal() -> None:
+    """mpremote's REPL puts its standard input in raw mode: it needs a terminal."""
+    if not sys.stdin.isatty():
+        raise DeviceError("`locust repl` needs a terminal (its standard input is not one)",
+                          'run it in a terminal; to script the board, `mpremote connect PORT exec "CODE"` '
+                          "gets past the idle command loop with its own Ctrl-C")
+
+
+def run_repl(device: str) -> None:
+    """Run mpremote's REPL on ``device`` in this terminal until the user leaves it."""
+    require_terminal()
+    code = subprocess.call(mpremote_command(device, "repl"))  # interrupted: mpremote is killed
+    if code != 0:
+        raise DeviceError(f"mpremote's REPL on {device} ended with status {code}",
+                          "check the port (`locust ports`) and that no other program holds it "
+                          "(`locust hop`, a serial monitor, another mpremote)")

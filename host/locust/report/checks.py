@@ -1,0 +1,138 @@
+"""What a report warns about: inputs that look wrong, and where its "measured" trials come from.
+
+Every notice is a warning, printed to stderr (``warning: ...``), listed at the top of
+``report.html`` and kept in ``report.json``; none stops the report:
+
+- ``configuration-guessed``: a trial's leg set came from its folder's name
+  (:func:`.configs.name_from_path`), not from ``--measured NAME=PATH``;
+- ``virtual-robot``: its run record was made on the virtual robot (``locust hop --port sim``:
+  the record's port is ``sim`` or a pseudo-terminal, ``/dev/pts/N``, or its firmware fields
+  say so), so the trial measures the simulation, not the physical robot;
+- ``mirrored``: the tracked marker travels the other way from the prediction (or, with no
+  prediction, backwards): a hop filmed right-to-left, for ``--mirror``;
+- ``units``: hops or jumps far beyond this robot's (hundreds of metres a hop: a track in mm
+  read as metres), with the ``--units`` that would make them plausible.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from ..device.record import RunRecord
+from ..track.importing import units_hint
+from .compare import Comparison, MeasuredTrial
+from .measured import CONFIG_GIVEN, Trial, span_hint
+
+ROBOT = "robot"
+VIRTUAL = "virtual robot"
+SYNTHETIC = "synthetic"
+_PTY = re.compile(r"^/dev/(pts/\d+|ttys\d+)$")             # Linux and macOS pseudo-terminals
+_VIRTUAL_WORDS = re.compile(r"\b(virtual|sim|simulated|simulation)\b", re.IGNORECASE)
+SIM_PORT = "sim"
+
+MAX_HOP_M = 2.0          # a desk robot's hop; the seed hops about 0.25 m
+MAX_JUMP_M = 1.0
+TYPICAL_HOP_M = 0.25
+TYPICAL_JUMP_M = 0.08
+MIN_TRAVEL_M = 0.002     # travel below this has no direction worth a warning (camera noise: ~0.5 mm)
+END_SAMPLES = 5          # the last samples of a track, averaged as where it ended
+
+
+@dataclass(frozen=True)
+class Notice:
+    kind: str            # configuration-guessed | virtual-robot | mirrored | units
+    config: str
+    trial: str
+    message: str
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+
+def recorded_on(record: RunRecord | None) -> tuple[str | None, str]:
+    """Where a trial's run was recorded (robot, virtual robot, synthetic; None without a
+    run record) and why that is known."""
+    if record is None:
+        return None, "no run record"
+    port = record.port.strip()
+    if port == SIM_PORT:
+        return VIRTUAL, f"its run record's port is {port!r}"
+    if _PTY.match(port):
+        return VIRTUAL, f"its run record's port {port} is a pseudo-terminal, as the virtual robot's (--port sim)"
+    for what, text in (("firmware status", record.firmware_status), ("firmware version", record.firmware_version),
+                       ("record's message", record.message)):
+        if text and _VIRTUAL_WORDS.search(text):
+            return VIRTUAL, f"its {what} says {text!r}"
+    if SYNTHETIC in (port, record.firmware_version):
+        return SYNTHETIC, "its run record is labelled synthetic"
+    return ROBOT, f"port {port or '?'}"
+
+
+def notices(comps: list[Comparison]) -> list[Notice]:
+    """Every warning about the comparisons' inputs, configuration by configuration."""
+    out: list[Notice] = []
+    for c in comps:
+        for t in c.all_trials:
+            out += _trial_notices(t)
+        predicted = c.prediction.result.distance_m if c.prediction.valid else math.nan
+        for m in c.trials:
+            out += _track_notices(c, m, predicted)
+    return out
+
+
+def _trial_notices(t: Trial) -> list[Notice]:
+    out = []
+    if t.config_from != CONFIG_GIVEN:
+        where = t.run_path.parent if t.run_path else t.track.path if t.track else t.label
+        out.append(Notice("configuration-guessed", t.config, t.label,
+                          f"{t.label}: leg set {t.config!r} was guessed from the {t.config_from} ({where}), not "
+                          f"given: say which leg set was filmed with --measured {t.config}=PATH"))
+    where, why = recorded_on(t.record)
+    if where == VIRTUAL:
+        out.append(Notice("virtual-robot", t.config, t.label,
+                          f"{t.label}: the 'measured' trial comes from the virtual robot ({why}): it measures the "
+                          "simulated robot, not the physical one"))
+    return out
+
+
+def _track_notices(c: Comparison, m: MeasuredTrial, predicted_m: float) -> list[Notice]:
+    out = []
+    track, label = m.trial.track, m.trial.label
+    travel = float(np.median(m.trace.x_m[-END_SAMPLES:]))           # from where it stood to where it ended
+    marker = f"tracked {track.marker}"
+    if math.isfinite(predicted_m) and abs(predicted_m) >= MIN_TRAVEL_M and abs(travel) >= MIN_TRAVEL_M \
+            and (travel > 0) != (predicted_m > 0):
+        advice = ("the track was mirrored with --mirror: try without it" if track.mirrored else
+                  "the camera likely saw the hop mirrored (filmed right-to-left): give --mirror")
+        out.append(Notice("mirrored", c.config, label,
+                          f"{label}: the {marker} travels {_length(travel)} overall where the model predicts "
+                          f"{_length(predicted_m)}: {advice}"))
+    elif not math.isfinite(predicted_m) and travel <= -MIN_TRAVEL_M and not track.mirrored:
+        out.append(Notice("mirrored", c.config, label,
+                          f"{label}: the {marker} moves backwards overall ({_length(travel)}): if the hop was "
+                          "filmed right-to-left (the camera saw it mirrored), give --mirror"))
+    hops = [abs(h.distance_m) for h in m.hops if math.isfinite(h.distance_m)]
+    jumps = [h.apex_m for h in m.hops if math.isfinite(h.apex_m)]
+    # the typical sizes are a desk robot's, not the prediction's: a model can be off by more than a unit
+    if hops and max(hops) > MAX_HOP_M:
+        size = max(hops)
+        out.append(Notice("units", c.config, label,
+                          f"{label}: {size:.3g} m in one hop is not this robot's (at most {MAX_HOP_M:g} m): "
+                          + units_hint(size, 1e-3, MAX_HOP_M, TYPICAL_HOP_M, track.units)))
+    elif jumps and max(jumps) > MAX_JUMP_M:
+        size = max(jumps)
+        out.append(Notice("units", c.config, label,
+                          f"{label}: a {size:.3g} m jump is not this robot's (at most {MAX_JUMP_M:g} m): "
+                          + units_hint(size, 1e-3, MAX_JUMP_M, TYPICAL_JUMP_M, track.units)))
+    elif hint := span_hint(track):
+        out.append(Notice("units", c.config, label, f"{label}: {hint}"))
+    return out
+
+
+def _length(value_m: float) -> str:
+    """``+0.9 cm``, ``-600 m``: a signed travel in the unit that reads best."""
+    return f"{value_m * 100:+.1f} cm" if abs(value_m) < 1 else f"{value_m:+.4g} m"
