@@ -200,7 +200,7 @@ def write_side_by_side(plan: Plan, folder: Path, say: Callable[[str], None] | No
             encode_video(path, _frames(job), float(job.video.file_fps), (2 * job.video.width_px, job.video.height_px))
         except TrackError as exc:
             raise ReportError(exc.message, exc.hint) from None
-        frames = _count_frames(path)
+        frames = probe(path).frame_count
         out.append(SideBySide(job.comparison.config, job.label, job.video.path, path,
                               "camera.json" if job.camera else OWN_CAMERA, job.camera_note, frames,
                               float(job.video.file_fps), 2 * job.video.width_px, job.video.height_px, job.t_s(0)))
@@ -279,14 +279,6 @@ def _caption(image: np.ndarray, text: str) -> np.ndarray:
     cv2.rectangle(image, (0, 0), (tw + 2 * pad, th + base + 2 * pad), (0, 0, 0), -1)
     cv2.putText(image, text, (pad, pad + th), FONT, scale, (255, 255, 255), thick, cv2.LINE_AA)
     return image
-
-
-def _count_frames(path: Path) -> int:
-    cap = cv2.VideoCapture(str(path))
-    try:
-        return int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
-    finally:
-        cap.release()
 
 
 __all__ = ["SUFFIX", "Job", "Plan", "SideBySide", "find_video", "frame_clock", "plan_side_by_side",

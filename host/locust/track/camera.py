@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import TrackError
 from ..fileio import atomic_write_json
+from .tracks_csv import same_array
 
 CAMERA_JSON_SUFFIX = ".camera.json"
 CAMERA_NOTE = ("simulated camera (MuJoCo free camera); OpenCV pinhole convention: camera x right, "
@@ -74,11 +75,11 @@ class CameraFile:
         if not isinstance(other, CameraFile):
             return NotImplemented
         arrays = ("K", "rotation", "positions_m", "frame_t_s")
-        return (all(_same(getattr(self, a), getattr(other, a)) for a in arrays)
+        return (all(same_array(getattr(self, a), getattr(other, a)) for a in arrays)
                 and all(getattr(self, f) == getattr(other, f) for f in ("camera", "width_px", "height_px", "fps",
                                                                        "frames", "view"))
                 and self.marker_planes.keys() == other.marker_planes.keys()
-                and all(_same(np.array([p.plane_y_m, p.max_off_plane_m]),
+                and all(same_array(np.array([p.plane_y_m, p.max_off_plane_m]),
                               np.array([other.marker_planes[n].plane_y_m, other.marker_planes[n].max_off_plane_m]))
                         for n, p in self.marker_planes.items()))
 
@@ -265,9 +266,3 @@ def _mapping(doc: dict, key: str) -> dict | None:
     if value is not None and not isinstance(value, dict):
         raise ValueError(key)
     return value
-
-
-def _same(a: np.ndarray | None, b: np.ndarray | None) -> bool:
-    if a is None or b is None:
-        return a is None and b is None
-    return a.shape == b.shape and bool(np.array_equal(a, b, equal_nan=True))

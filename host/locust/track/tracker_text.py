@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import TrackError
 from ..fileio import atomic_write_text
 from .delimited import DelimitedText, check_names, read_text, split_text
-from .tracks_csv import missing_time, no_marker
+from .tracks_csv import missing_time, no_marker, same_array
 
 DEFAULT_TRACK = "track"   # the name of columns no title or names row claims
 
@@ -53,9 +53,9 @@ class TrackerTrack:
         if not isinstance(other, TrackerTrack):
             return NotImplemented
         return (self.name == other.name
-                and all(_same(getattr(self, c), getattr(other, c)) for c in ("t_s", "x_m", "y_m"))
+                and all(same_array(getattr(self, c), getattr(other, c)) for c in ("t_s", "x_m", "y_m"))
                 and self.other.keys() == other.other.keys()
-                and all(_same(v, other.other[k]) for k, v in self.other.items()))
+                and all(same_array(v, other.other[k]) for k, v in self.other.items()))
 
     __hash__ = None  # type: ignore[assignment]
 
@@ -208,9 +208,3 @@ def parse_tracker_export(text: str, path: str | Path) -> TrackerExport:
 def read_tracker_export(path: str | Path) -> TrackerExport:
     """Read a Tracker text export; a :class:`~locust.errors.TrackError` names the file and line of any fault."""
     return parse_tracker_export(read_text(path), path)
-
-
-def _same(a: np.ndarray | None, b: np.ndarray | None) -> bool:
-    if a is None or b is None:
-        return a is None and b is None
-    return a.shape == b.shape and bool(np.array_equal(a, b, equal_nan=True))

@@ -61,7 +61,7 @@ class MarkerColumns:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, MarkerColumns):
             return NotImplemented
-        return self.name == other.name and all(_same(getattr(self, c), getattr(other, c)) for c in MARKER_COLUMNS)
+        return self.name == other.name and all(same_array(getattr(self, c), getattr(other, c)) for c in MARKER_COLUMNS)
 
     __hash__ = None  # type: ignore[assignment]
 
@@ -84,9 +84,10 @@ class TracksCsv:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, TracksCsv):
             return NotImplemented
-        return (_same(self.frame, other.frame) and _same(self.t_s, other.t_s) and self.markers == other.markers
-                and self.comments == other.comments and self.other.keys() == other.other.keys()
-                and all(_same(v, other.other[k]) for k, v in self.other.items()))
+        return (same_array(self.frame, other.frame) and same_array(self.t_s, other.t_s)
+                and self.markers == other.markers and self.comments == other.comments
+                and self.other.keys() == other.other.keys()
+                and all(same_array(v, other.other[k]) for k, v in self.other.items()))
 
     __hash__ = None  # type: ignore[assignment]
 
@@ -240,7 +241,11 @@ def _marker_column(name: str) -> tuple[str, str] | None:
     return None
 
 
-def _same(a: np.ndarray, b: np.ndarray) -> bool:
+def same_array(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    """Equal arrays, NaN equal to NaN (and None equal to None): how the track formats' typed
+    objects compare their columns."""
+    if a is None or b is None:
+        return a is None and b is None
     a, b = np.asarray(a), np.asarray(b)
     if a.dtype.kind in "fc" or b.dtype.kind in "fc":
         return a.shape == b.shape and bool(np.array_equal(a, b, equal_nan=True))
