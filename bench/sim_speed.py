@@ -59,7 +59,8 @@ def timed(fn, repeat: int):
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=int, default=5,
+                    help="best of this many runs of each route (the machine is shared and noisy)")
     args = ap.parse_args()
 
     default = preset("seed")
