@@ -67,6 +67,20 @@ def test_seed_six_hops_valid_converged_and_closed():
     assert r.loop_residual_max_m < 2e-5                      # the near-rigid loop: anchors within 20 um
 
 
+def test_explicit_floor_pairs_equal_mujocos_automatic_contacts(monkeypatch):
+    """The floor pairs carry the parameters MuJoCo would mix itself: the record is identical."""
+    from locust.sim import model as sim_model
+    from locust.sim.rollout import simulate
+
+    seed = preset("seed").with_values({"contact.foot_friction": 0.7, "contact.floor_friction": 0.9})
+    paired = simulate(seed, cycles=1)
+    assert paired.built.model.npair == 7                    # the plate and three links a side
+    monkeypatch.setattr(sim_model, "_floor_pairs", lambda spec: None)
+    automatic = simulate(seed, cycles=1)
+    assert automatic.built.model.npair == 0
+    assert abs(paired.sensordata - automatic.sensordata).max() < 1e-12
+
+
 def test_run_keeps_the_rollout_it_was_computed_from():
     seed = preset("seed")
     plain, kept = run(seed, cycles=1), run(seed, cycles=1, keep_states=True)

@@ -94,7 +94,9 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     spec.option.iterations = int(sol.iterations)
     spec.option.tolerance = sol.tolerance
     spec.option.gravity = [0.0, 0.0, -GRAVITY_M_PER_S2]
-    spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
+    # no mjENBL_ENERGY: the energy sensors compute it on demand, once per step for the state
+    # the other sensors see (the flag would also compute it in every rk4 stage, and leave the
+    # kinetic energy of the last stage in the record)
     # MuJoCo's autoreset would silently restart a diverged run: the audit must see it.
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
     # one robot is one constraint island: discovering islands costs a tenth of a step and
@@ -179,8 +181,41 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
         act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
         act.ctrlrange = [-math.radians(s.travel_deg), math.radians(s.travel_deg)]
 
+    if not k.self_collision:
+        _floor_pairs(spec)
     _add_sensors(spec)
     return spec, asm
+
+
+def _floor_pairs(spec: mujoco.MjSpec) -> None:
+    """Turn the floor's automatic contacts into explicit ``pair``s with the same parameters.
+
+    With only the floor to touch, MuJoCo's broad phase (every collidable geom against every
+    other, each of the 4 evaluations of an rk4 step) is a tenth of the step spent finding the
+    7 pairs that can touch at all. Listed explicitly, the pairs carry the contact parameters
+    MuJoCo's automatic mechanism would mix for them (no part has a priority: the larger condim,
+    friction and margin, solref and solimp weighted by solmix), so the result is identical
+    (bench/sim_speed.py, tests/test_sim.py).
+    """
+    floor = spec.geom("floor")
+    colliders = [g for g in spec.geoms if g is not floor and (
+        g.contype & floor.conaffinity or g.conaffinity & floor.contype)]
+    for i, geom in enumerate(colliders):
+        if not geom.name:
+            geom.name = f"floor_contact_{i}"
+        w1, w2 = floor.solmix, geom.solmix
+        w = 0.5 if w1 + w2 < mujoco.mjMINVAL else w1 / (w1 + w2)
+        ref1, ref2 = np.asarray(floor.solref), np.asarray(geom.solref)
+        solref = w * ref1 + (1 - w) * ref2 if ref1[0] > 0 and ref2[0] > 0 else np.minimum(ref1, ref2)
+        friction = np.maximum(np.asarray(floor.friction), np.asarray(geom.friction))
+        spec.add_pair(name=f"floor_{geom.name}", geomname1=floor.name, geomname2=geom.name,
+                      condim=max(floor.condim, geom.condim),
+                      friction=[friction[0], friction[0], friction[1], friction[2], friction[2]],
+                      solref=list(solref),
+                      solimp=list(w * np.asarray(floor.solimp) + (1 - w) * np.asarray(geom.solimp)),
+                      margin=max(floor.margin, geom.margin), gap=max(floor.gap, geom.gap))
+    for geom in [floor, *colliders]:
+        geom.contype = geom.conaffinity = 0
 
 
 def _hinge(body, name: str, c) -> None:

@@ -20,7 +20,11 @@ from .schedule import ControlPlan, control_plan
 
 @dataclass
 class Trajectory:
-    """What one simulation recorded, one row per physics step (after the step)."""
+    """What one simulation recorded, one row per physics step.
+
+    Sensor row i is evaluated in step i's forward pass, at t = i·dt before that step
+    integrates (as ``mujoco.rollout`` records it); state row i is the state after step i.
+    """
 
     built: BuiltModel
     plan: ControlPlan
