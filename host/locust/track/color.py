@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import TrackError
 from .detection import Detection, window
-from .predict import MotionHistory
+from .predict import Trajectory
 
 LUMA_BGR = np.array([0.114, 0.587, 0.299], dtype=np.float32)
 
@@ -48,34 +48,104 @@ class ColorMarker:
     search_half_px: int = 40
     min_area_px: int = 4
     partial_fraction: float = 0.6  # below this share of the usual area: partly hidden
-    history: MotionHistory = field(default_factory=MotionHistory)
+    start_px: tuple[float, float] | None = None
+    hue_tol_deg: float = 16.0
+    track: Trajectory = field(default_factory=Trajectory)
     _areas: deque = field(default_factory=lambda: deque(maxlen=15))
-    _usual_area: float = 0.0       # median of _areas, kept up to date as areas arrive
+    _widths: deque = field(default_factory=lambda: deque(maxlen=15))
+    _usual_area: float = 0.0       # median of _areas (round, whole blobs), kept up to date
+    _usual_width: float = 0.0      # median of _widths: the sticker's diameter in pixels
+    _speed: float = 0.0            # predicted motion over this frame (px), for the blur allowance
+    _tries: int = 0                # frames searched before the first sighting
+    _lost: int = 0                 # frames since the last sighting
+    _velocity: tuple[float, float] = (0.0, 0.0)   # predicted motion over this frame (px)
+    _distractors: list = field(default_factory=list)  # other blobs of the colour seen at the start: (x, y, size)
 
     def __post_init__(self) -> None:
         self._lo = np.array([max(c - self.tolerance, 0) for c in self.bgr], dtype=np.uint8)
         self._hi = np.array([min(c + self.tolerance, 255) for c in self.bgr], dtype=np.uint8)
+        h, s, v = (int(c) for c in cv2.cvtColor(np.uint8([[self.bgr]]), cv2.COLOR_BGR2HSV)[0, 0])
+        # hue is only a colour's identity when the colour has one: grey stickers match by RGB alone
+        self._hsv = (h, s, v) if s >= 80 and v >= 60 else None
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
-        centre = self.history.search_centre()
-        det = None
-        if centre is not None and self._areas:
+        det = self._find(frame, image_bgr) or Detection.missing(0.0)
+        if det.ok and self.track.last_frame is None:
+            self._note_distractors(image_bgr, det)
+        self.track.add(frame, det.point())
+        return det
+
+    def _note_distractors(self, image: np.ndarray, marker: Detection) -> None:
+        """Remember every other blob of the marker's colour on the first sighting (a pen cap
+        lying in the scene): a lost marker is never re-acquired on one of them."""
+        *_, core = self._cores(image)   # the widest test: every pixel that could be taken for it
+        n, _, stats, cents = cv2.connectedComponentsWithStats(core, connectivity=8)
+        for k in range(1, n):
+            x, y = cents[k]
+            size = max(stats[k, cv2.CC_STAT_WIDTH], stats[k, cv2.CC_STAT_HEIGHT])
+            if stats[k, cv2.CC_STAT_AREA] >= self.min_area_px and math.hypot(x - marker.px, y - marker.py) > size:
+                self._distractors.append((float(x), float(y), float(size)))
+
+    def _find(self, frame: int, image: np.ndarray) -> Detection | None:
+        whole = (0, 0, image.shape[1], image.shape[0])
+        if not self._areas:   # not seen yet: around the start point, or anywhere
+            self._tries += 1
+            if self.start_px is None:
+                return self._locate_in(image, whole, None)
+            return self._locate_in(image, window(self.start_px, 2 * self.search_half_px * self._tries, image.shape),
+                                   self.start_px)
+        centre = self.track.predict(frame)
+        before = self.track.predict(frame - 1)
+        self._velocity = (centre[0] - before[0], centre[1] - before[1])
+        lost = self._lost = self.track.frames_lost(frame)
+        self._speed = self.track.speed_px(frame) if lost == 0 else max(self.track.speed_px(frame),
+                                                                       self.track.max_speed_px)
+        if lost == 0:
             # a tight window first (three radii around the prediction): cheap, and the
             # blob must lie wholly inside it; otherwise the full search window
             radius = math.sqrt(self._usual_area / math.pi)
-            det = self._locate_in(image_bgr, window(centre, int(3 * radius) + 6, image_bgr.shape), centre, True)
-        if det is None and centre is not None:
-            det = self._locate_in(image_bgr, window(centre, self.search_half_px, image_bgr.shape), centre)
-        if det is None:  # first frame, or lost: search the whole image
-            det = self._locate_in(image_bgr, (0, 0, image_bgr.shape[1], image_bgr.shape[0]), None)
-        det = det or Detection.missing(0.0)
-        self.history.add(det.point())
-        return det
+            det = self._locate_in(image, window(centre, int(3 * radius + self._speed) + 6, image.shape), centre, True)
+            if det is not None:
+                return det
+        # lost: the window grows by its own size each frame, around the extrapolated path
+        half = self.search_half_px * (1 + lost)
+        h, w = image.shape[:2]
+        box = window((min(max(centre[0], 0), w - 1), min(max(centre[1], 0), h - 1)), half, image.shape)
+        return self._locate_in(image, box, centre)
+
+    def _cores(self, roi: np.ndarray):
+        """Pixels of the marker's colour: first those within ``tolerance`` in RGB (exact on a
+        well-lit sticker); if no blob of those fits, also those of its hue with enough
+        saturation at any brightness above the noise (a shadow darkens, it does not change hue)."""
+        core = cv2.inRange(roi, self._lo, self._hi)
+        yield core
+        if self._hsv is None:
+            return
+        h, s, _ = self._hsv
+        hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
+        tol = int(round(self.hue_tol_deg / 2))      # OpenCV's 8-bit hue is degrees / 2
+        s_min = max(int(0.45 * s), 50)
+        lo, hi = h - tol, h + tol
+        core |= cv2.inRange(hsv, (max(lo, 0), s_min, 30), (min(hi, 179), 255, 255))
+        if lo < 0:
+            core |= cv2.inRange(hsv, (180 + lo, s_min, 30), (179, 255, 255))
+        if hi > 179:
+            core |= cv2.inRange(hsv, (0, s_min, 30), (hi - 180, 255, 255))
+        yield core
 
     def _locate_in(self, image, box, centre, whole_inside: bool = False) -> Detection | None:
         x0, y0, x1, y1 = box
+        if x1 <= x0 or y1 <= y0:           # the prediction lies off the picture
+            return None
         roi = image[y0:y1, x0:x1]          # a view: nothing outside the window is converted
-        core = cv2.inRange(roi, self._lo, self._hi)
+        for core in self._cores(roi):
+            det = self._locate_core(image, roi, core, box, centre, whole_inside)
+            if det is not None:
+                return det
+        return None
+
+    def _locate_core(self, image, roi, core, box, centre, whole_inside: bool) -> Detection | None:
+        x0, y0 = box[:2]
         if not cv2.hasNonZero(core):   # labelling an empty frame costs milliseconds: a hidden marker
             return None
         n, labels = cv2.connectedComponents(core, connectivity=8)
@@ -83,42 +153,113 @@ class ColorMarker:
             return None
         if n == 2:   # one blob (the usual case): its statistics cost less than OpenCV's general ones
             stats = np.array([[0, 0, 0, 0, 0], [*cv2.boundingRect(core), cv2.countNonZero(core)]])
-            cents = None
+            order = np.array([1])
         else:
             n, labels, stats, cents = cv2.connectedComponentsWithStats(core, connectivity=8)
-        areas = stats[1:, cv2.CC_STAT_AREA]
-        candidates = np.flatnonzero(areas >= self.min_area_px) + 1
-        if candidates.size == 0:
-            return None
-        if candidates.size == 1:
-            best = int(candidates[0])
-        elif centre is None:
-            best = candidates[np.argmax(stats[candidates, cv2.CC_STAT_AREA])]
-        else:
-            d = np.hypot(cents[candidates, 0] + x0 - centre[0], cents[candidates, 1] + y0 - centre[1])
-            best = candidates[np.argmin(d)]
-        if _touches_edge(stats[best], roi.shape, box, image.shape):
-            if whole_inside:
-                return None
-            # the window cut the blob (the prediction was off): look again around what it saw
-            bx, by, bw, bh = (int(v) for v in stats[best, :4])
-            seen_at = (x0 + bx + bw / 2, y0 + by + bh / 2)
-            radius = math.sqrt(self._usual_area / math.pi) if self._areas else max(bw, bh)
-            return self._locate_in(image, window(seen_at, int(3 * radius) + 6, image.shape), seen_at, True)
-        area = float(stats[best, cv2.CC_STAT_AREA])
-        usual = self._usual_area if self._areas else area
-        score = area / usual
-        if self._areas and score < self.partial_fraction:
-            return Detection.missing(score)
-        self._areas.append(area)
-        self._usual_area = statistics.median(self._areas)
+            order = np.arange(1, n)
+            if centre is None:   # largest first
+                order = order[np.argsort(-stats[order, cv2.CC_STAT_AREA], kind="stable")]
+            else:                # nearest the prediction first
+                order = order[np.argsort(np.hypot(cents[order, 0] + x0 - centre[0], cents[order, 1] + y0 - centre[1]),
+                                         kind="stable")]
+        order = order[stats[order, cv2.CC_STAT_AREA] >= self.min_area_px]
+        for best in order:
+            best = int(best)
+            if _touches_edge(stats[best], roi.shape, box, image.shape):
+                if whole_inside:
+                    return None
+                # the window cut the blob (the prediction was off): look again around what it saw
+                bx, by, bw, bh = (int(v) for v in stats[best, :4])
+                seen_at = (x0 + bx + bw / 2, y0 + by + bh / 2)
+                radius = math.sqrt(self._usual_area / math.pi) if self._areas else max(bw, bh)
+                half = int(3 * radius + max(bw, bh) / 2) + 6
+                return self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
+            if _on_image_border(stats[best], box, image.shape):
+                continue   # cut by the picture's edge: its centroid is not the marker's
+            shape = _blob_shape(labels, stats[best], best)
+            at = (x0 + stats[best, 0] + stats[best, 2] / 2, y0 + stats[best, 1] + stats[best, 3] / 2)
+            if not self._fits(shape, at):
+                continue
+            if self._lost > 0 and self._near_distractor(*at):
+                continue
+            return self._measure(roi, labels, stats[best], best, shape, x0, y0)
+        return None
+
+    def _near_distractor(self, x: float, y: float) -> bool:
+        return any(math.hypot(x - dx, y - dy) <= size for dx, dy, size in self._distractors)
+
+    def _fits(self, shape: BlobShape, at: tuple[float, float]) -> bool:
+        """Size and shape of the marker: learned from the round, whole sightings so far; the
+        first sighting must be round. Motion blur may stretch it by up to the distance it moves
+        in a frame, along its motion: the predicted one, or the way it went since it was last
+        seen (a launch from rest is not predicted)."""
+        if not self._areas:
+            return shape.minor_px >= 0.6 * shape.major_px
+        if shape.area_px < self.partial_fraction * self._usual_area:
+            return False
+        d = self._usual_width
+        last = self.track.predict(self.track.last_frame)
+        moved = ((at[0] - last[0]) / (self._lost + 1), (at[1] - last[1]) / (self._lost + 1))
+        streak = 1.2 * max(self._speed, math.hypot(*moved)) + 2.0
+        if shape.area_px > 1.6 * self._usual_area + d * streak:
+            return False
+        if d < 5.0:   # a few pixels across: too small to judge its shape
+            return True
+        if not (0.6 * d <= shape.minor_px <= 1.5 * d and shape.major_px <= 1.5 * d + streak):
+            return False
+        if shape.major_px > 1.4 * shape.minor_px:   # a blur streak lies along the motion
+            return _along(shape.angle_rad, self._velocity, d) or _along(shape.angle_rad, moved, d)
+        return True
+
+    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int) -> Detection:
+        area = float(shape.area_px)
+        score = area / self._usual_area if self._areas else 1.0
+        if shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn the marker's size from it
+            self._areas.append(area)
+            self._widths.append(shape.minor_px)
+            self._usual_area = statistics.median(self._areas)
+            self._usual_width = statistics.median(self._widths)
         # the centroid needs the blob and four pixels around it (two dilations of 5x5)
-        bx, by, bw, bh = (int(v) for v in stats[best, :4])
+        bx, by, bw, bh = (int(v) for v in stat[:4])
         cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
         cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
         blob = labels[cy0:cy1, cx0:cx1] == best
         px, py = _coverage_centroid(roi[cy0:cy1, cx0:cx1], blob)
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
+
+
+def _along(angle_rad: float, velocity: tuple[float, float], diameter_px: float) -> bool:
+    """True if a streak at ``angle_rad`` lies within 30 degrees of a motion of ``velocity``
+    px/frame, fast enough to smear a marker of ``diameter_px`` visibly."""
+    vx, vy = velocity
+    speed = math.hypot(vx, vy)
+    if speed < 0.3 * diameter_px:
+        return False
+    return abs(vx * math.cos(angle_rad) + vy * math.sin(angle_rad)) / speed >= math.cos(math.radians(30))
+
+
+@dataclass(frozen=True)
+class BlobShape:
+    area_px: float
+    major_px: float     # full lengths of the equivalent ellipse (4 sigma): a disc's diameter
+    minor_px: float
+    angle_rad: float = 0.0   # direction of the major axis (image x right, y down)
+
+
+def _blob_shape(labels: np.ndarray, stat: np.ndarray, label: int) -> BlobShape:
+    x, y, w, h, area = (int(v) for v in stat[:5])
+    m = cv2.moments((labels[y:y + h, x:x + w] == label).view(np.uint8), binaryImage=True)
+    a, b, c = m["mu20"] / m["m00"], m["mu11"] / m["m00"], m["mu02"] / m["m00"]
+    root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
+    # + 1/12 per axis: a pixel is a square, not a point
+    lam1, lam2 = (a + c) / 2 + root + 1 / 12, (a + c) / 2 - root + 1 / 12
+    return BlobShape(float(area), 4 * math.sqrt(lam1), 4 * math.sqrt(max(lam2, 0.0)), 0.5 * math.atan2(2 * b, a - c))
+
+
+def _on_image_border(stat: np.ndarray, box, image_shape) -> bool:
+    x, y, w, h = (int(v) for v in stat[:4])
+    x0, y0 = box[0] + x, box[1] + y
+    return x0 <= 0 or y0 <= 0 or x0 + w >= image_shape[1] or y0 + h >= image_shape[0]
 
 
 RING_PX = 4
