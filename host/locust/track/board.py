@@ -19,6 +19,7 @@ print it at 100 % ("actual size", no "fit to page"), then measure one marker wit
 
 from __future__ import annotations
 
+import io
 import math
 import re
 from dataclasses import dataclass, field
@@ -28,11 +29,13 @@ import cv2
 import numpy as np
 
 from ..errors import TrackError
+from ..fileio import atomic_write_bytes
 from .calib import NUM
 from .video import read_frames
 
 BOARD_DPI = 300
 BOARD_MARGIN_MM = 10.0
+DEFAULT_BOARD = "aruco:4X4_50:5x4:40:10"   # 240 x 190 mm: fits an A4 sheet
 DETECT_FRAMES = 30       # frames searched for the board at the start of the clip
 MIN_BOARD_MARKERS = 2    # 8 corners: enough for a homography, with some redundancy
 
@@ -63,10 +66,19 @@ class BoardSpec:
         return cv2.aruco.GridBoard((self.cols, self.rows), self.marker_mm / 1000.0, self.gap_mm / 1000.0, d)
 
     def image(self, px_per_mm: float, margin_mm: float = BOARD_MARGIN_MM) -> np.ndarray:
-        """The board drawn at ``px_per_mm``, with a white margin (grey levels, uint8)."""
-        margin = int(round(margin_mm * px_per_mm))
-        size = (int(round(self.width_mm * px_per_mm)) + 2 * margin, int(round(self.height_mm * px_per_mm)) + 2 * margin)
-        return self.board().generateImage(size, marginSize=margin, borderBits=1)
+        """The board drawn at ``px_per_mm``, with a white margin (grey levels, uint8): marker k
+        at column k % cols, row k // cols from the top, as ``cv2.aruco.GridBoard`` numbers them."""
+        d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
+        to_px = lambda mm: int(round(mm * px_per_mm))   # noqa: E731
+        img = np.full((to_px(self.height_mm + 2 * margin_mm), to_px(self.width_mm + 2 * margin_mm)), 255, np.uint8)
+        for k in range(self.cols * self.rows):
+            x0 = to_px(margin_mm + (k % self.cols) * (self.marker_mm + self.gap_mm))
+            y0 = to_px(margin_mm + (k // self.cols) * (self.marker_mm + self.gap_mm))
+            x1 = to_px(margin_mm + (k % self.cols) * (self.marker_mm + self.gap_mm) + self.marker_mm)
+            y1 = to_px(margin_mm + (k // self.cols) * (self.marker_mm + self.gap_mm) + self.marker_mm)
+            side = max(x1 - x0, y1 - y0)
+            img[y0:y0 + side, x0:x0 + side] = cv2.aruco.generateImageMarker(d, k, side, borderBits=1)
+        return img
 
 
 def parse_board(text: str) -> BoardSpec:
@@ -95,12 +107,9 @@ def write_board_png(path: Path, spec: BoardSpec, dpi: int = BOARD_DPI) -> Path:
     """Write the board at ``dpi`` (recorded in the PNG) for printing at 100 %."""
     from PIL import Image
 
-    img = spec.image(dpi / 25.4)
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    Image.fromarray(img).save(tmp, format="PNG", dpi=(dpi, dpi))
-    tmp.replace(path)
-    return path
+    buf = io.BytesIO()
+    Image.fromarray(spec.image(dpi / 25.4)).save(buf, format="PNG", dpi=(dpi, dpi))
+    return atomic_write_bytes(path, buf.getvalue())
 
 
 @dataclass(frozen=True)
