@@ -107,30 +107,36 @@ class ColorMarker:
             det = self._locate_in(image, window(centre, int(3 * radius + self._speed) + 6, image.shape), centre, True)
             if det is not None:
                 return det
-        # lost: the window grows by its own size each frame, around the extrapolated path
-        half = self.search_half_px * (1 + lost)
+        # the search window: at least five marker diameters (a hop starts from rest within a
+        # frame); lost, it grows by its own size each frame around the extrapolated path
+        half = int(max(self.search_half_px, 5 * self._usual_width)) * (1 + lost)
         h, w = image.shape[:2]
         box = window((min(max(centre[0], 0), w - 1), min(max(centre[1], 0), h - 1)), half, image.shape)
         return self._locate_in(image, box, centre)
 
     def _cores(self, roi: np.ndarray):
         """Pixels of the marker's colour: first those within ``tolerance`` in RGB (exact on a
-        well-lit sticker); if no blob of those fits, also those of its hue with enough
-        saturation at any brightness above the noise (a shadow darkens, it does not change hue)."""
+        well-lit sticker); if no blob of those fits, also those of its hue, somewhat paler or much
+        darker (a shadow darkens, it does not change hue)."""
         core = cv2.inRange(roi, self._lo, self._hi)
         yield core
         if self._hsv is None:
             return
-        h, s, _ = self._hsv
+        # --color-tol (default 80 of 255) also sets how far the hue may turn (16 degrees at 80),
+        # how much paler (to 0.45 of the saturation) and how much darker (to 0.3 of the
+        # brightness: a deep shadow) a pixel may be and still count
+        h, s, v = self._hsv
+        share = min(self.tolerance / 80.0, 1.5)
         hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
-        tol = int(round(self.hue_tol_deg / 2))      # OpenCV's 8-bit hue is degrees / 2
-        s_min = max(int(0.45 * s), 50)
+        tol = max(int(round(self.hue_tol_deg * share / 2)), 1)      # OpenCV's 8-bit hue is degrees / 2
+        s_min = max(int(s * (1 - 0.55 * share)), 50)
+        v_min = max(int(v * (1 - 0.7 * share)), 30)
         lo, hi = h - tol, h + tol
-        core |= cv2.inRange(hsv, (max(lo, 0), s_min, 30), (min(hi, 179), 255, 255))
+        core |= cv2.inRange(hsv, (max(lo, 0), s_min, v_min), (min(hi, 179), 255, 255))
         if lo < 0:
-            core |= cv2.inRange(hsv, (180 + lo, s_min, 30), (179, 255, 255))
+            core |= cv2.inRange(hsv, (180 + lo, s_min, v_min), (179, 255, 255))
         if hi > 179:
-            core |= cv2.inRange(hsv, (0, s_min, 30), (hi - 180, 255, 255))
+            core |= cv2.inRange(hsv, (0, s_min, v_min), (hi - 180, 255, 255))
         yield core
 
     def _locate_in(self, image, box, centre, whole_inside: bool = False) -> Detection | None:
