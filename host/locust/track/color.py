@@ -115,29 +115,35 @@ class ColorMarker:
         return self._locate_in(image, box, centre)
 
     def _cores(self, roi: np.ndarray):
-        """Pixels of the marker's colour: first those within ``tolerance`` in RGB (exact on a
-        well-lit sticker); if no blob of those fits, also those of its hue, somewhat paler or much
-        darker (a shadow darkens, it does not change hue)."""
-        core = cv2.inRange(roi, self._lo, self._hi)
-        yield core
+        """Pixels of the marker's colour: first those within ``tolerance`` in RGB and of its hue
+        (exact on a well-lit sticker); if no blob of those fits, all those of its hue, somewhat
+        paler or much darker (a shadow darkens, it does not change hue). A grey marker (no hue
+        to speak of) is matched in RGB alone."""
+        box = cv2.inRange(roi, self._lo, self._hi)
         if self._hsv is None:
+            yield box
             return
+        hue = self._hue_mask(roi)
+        yield box & hue
+        yield hue
+
+    def _hue_mask(self, roi: np.ndarray) -> np.ndarray:
         # --color-tol (default 80 of 255) also sets how far the hue may turn (16 degrees at 80),
-        # how much paler (to 0.45 of the saturation) and how much darker (to 0.3 of the
-        # brightness: a deep shadow) a pixel may be and still count
+        # how much paler (to 0.3 of the saturation: blur mixes in the background) and how much
+        # darker (to 0.3 of the brightness: a deep shadow) a pixel may be and still count
         h, s, v = self._hsv
         share = min(self.tolerance / 80.0, 1.5)
         hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
         tol = max(int(round(self.hue_tol_deg * share / 2)), 1)      # OpenCV's 8-bit hue is degrees / 2
-        s_min = max(int(s * (1 - 0.55 * share)), 50)
+        s_min = max(int(s * (1 - 0.7 * share)), 40)
         v_min = max(int(v * (1 - 0.7 * share)), 30)
         lo, hi = h - tol, h + tol
-        core |= cv2.inRange(hsv, (max(lo, 0), s_min, v_min), (min(hi, 179), 255, 255))
+        mask = cv2.inRange(hsv, (max(lo, 0), s_min, v_min), (min(hi, 179), 255, 255))
         if lo < 0:
-            core |= cv2.inRange(hsv, (180 + lo, s_min, v_min), (179, 255, 255))
+            mask |= cv2.inRange(hsv, (180 + lo, s_min, v_min), (179, 255, 255))
         if hi > 179:
-            core |= cv2.inRange(hsv, (0, s_min, v_min), (hi - 180, 255, 255))
-        yield core
+            mask |= cv2.inRange(hsv, (0, s_min, v_min), (hi - 180, 255, 255))
+        return mask
 
     def _locate_in(self, image, box, centre, whole_inside: bool = False) -> Detection | None:
         x0, y0, x1, y1 = box

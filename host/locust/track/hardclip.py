@@ -31,8 +31,7 @@ from .color import parse_hex
 from .synth import SUPERSAMPLE, camera, dot_coverage, write_video
 
 HARD_BOARD = BoardSpec("DICT_4X4_50", 5, 3, 40.0, 10.0)   # 240 x 140 mm
-STICKER_HEX = "#e8308c"          # a pink sticker ...
-DISTRACTOR_HEX = STICKER_HEX     # ... and a pen cap of the very same colour
+STICKER_HEX = "#e8308c"          # a pink sticker, and a pen cap of the very same colour
 STICKER_DIAMETER_M = 0.020
 GRAVITY_M_S2 = 9.81
 
@@ -141,8 +140,11 @@ def _shadow(width: int, height: int, i: int, n: int) -> np.ndarray:
 
 def make_hard_video(path: str | os.PathLike, width: int = 1920, height: int = 1080, n_frames: int = 120,
                     fps: float = 60.0, exposure_frames: float = 0.3, seed: int = 0,
-                    fourcc: str = "mp4v") -> HardTruth:
-    """Write a SYNTHETIC hard clip and ``<stem>.truth.csv`` beside it; return the truth."""
+                    fourcc: str = "mp4v", sticker_hex: str = STICKER_HEX) -> HardTruth:
+    """Write a SYNTHETIC hard clip and ``<stem>.truth.csv`` beside it; return the truth.
+
+    The sticker and the pen cap are both ``sticker_hex``; the exposure is ``exposure_frames``
+    of the frame time (0.3: a phone in daylight at 60 fps; 1.0: indoors)."""
     path = Path(path)
     rng = np.random.default_rng(seed)
     H = plane_to_image(width, height)
@@ -153,11 +155,11 @@ def make_hard_video(path: str | os.PathLike, width: int = 1920, height: int = 10
     radius = 11.0 * scale
     in_pic = (cx >= -0.5) & (cx <= width - 0.5) & (cy >= -0.5) & (cy <= height - 0.5)
     whole = (cx >= radius) & (cx <= width - 1 - radius) & (cy >= radius) & (cy <= height - 1 - radius)
-    sticker = np.float32(parse_hex(STICKER_HEX))
+    sticker = np.float32(parse_hex(sticker_hex))
     base = _background(width, height, H, HARD_BOARD, rng)
     # the pen cap lies still, right of the landing spot
     cap_x, cap_y = _project(H, np.array([0.90]), np.array([0.08]))
-    _pen_cap(base, (float(cap_x[0]), float(cap_y[0])), 70 * scale, 11 * scale, parse_hex(DISTRACTOR_HEX))
+    _pen_cap(base, (float(cap_x[0]), float(cap_y[0])), 70 * scale, 11 * scale, parse_hex(sticker_hex))
     # blur samples: positions over the exposure, centred on the frame time
     k = 9
     offsets = (np.arange(k) / (k - 1) - 0.5) * exposure_frames / fps
@@ -174,7 +176,7 @@ def make_hard_video(path: str | os.PathLike, width: int = 1920, height: int = 10
 
     write_video(path, frames(), fps, (width, height), fourcc)
     truth = HardTruth(np.arange(n_frames), fps, np.where(in_pic, cx, np.nan), np.where(in_pic, cy, np.nan),
-                      whole, xm, ym, radius, HARD_BOARD, H)
+                      whole, xm, ym, radius, HARD_BOARD, H, sticker_hex)
     truth.write_csv(path.with_suffix(".truth.csv"))
     return truth
 
