@@ -67,6 +67,9 @@ class ColorMarker:
         h, s, v = (int(c) for c in cv2.cvtColor(np.uint8([[self.bgr]]), cv2.COLOR_BGR2HSV)[0, 0])
         # hue is only a colour's identity when the colour has one: grey stickers match by RGB alone
         self._hsv = (h, s, v) if s >= 80 and v >= 60 else None
+        # a box reaching near the grey diagonal (R = G = B) takes grey pixels for the marker:
+        # then a blob of the box is also checked for the marker's hue
+        self._box_holds_grey = int(self._lo.max()) <= int(self._hi.min()) + 30
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
         det = self._find(frame, image_bgr) or Detection.missing(0.0)
@@ -78,13 +81,13 @@ class ColorMarker:
     def _note_distractors(self, image: np.ndarray, marker: Detection) -> None:
         """Remember every other blob of the marker's colour on the first sighting (a pen cap
         lying in the scene): a lost marker is never re-acquired on one of them."""
-        *_, core = self._cores(image)   # the widest test: every pixel that could be taken for it
-        n, _, stats, cents = cv2.connectedComponentsWithStats(core, connectivity=8)
-        for k in range(1, n):
-            x, y = cents[k]
-            size = max(stats[k, cv2.CC_STAT_WIDTH], stats[k, cv2.CC_STAT_HEIGHT])
-            if stats[k, cv2.CC_STAT_AREA] >= self.min_area_px and math.hypot(x - marker.px, y - marker.py) > size:
-                self._distractors.append((float(x), float(y), float(size)))
+        *_, (core, _) = self._cores(image)   # the widest test: every pixel that could be taken for it
+        contours, _ = cv2.findContours(core, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+        for c in contours:
+            x, y, w, h = cv2.boundingRect(c)
+            cx, cy, size = x + (w - 1) / 2, y + (h - 1) / 2, max(w, h)
+            if w * h >= self.min_area_px and math.hypot(cx - marker.px, cy - marker.py) > size:
+                self._distractors.append((cx, cy, float(size)))
 
     def _find(self, frame: int, image: np.ndarray) -> Detection | None:
         whole = (0, 0, image.shape[1], image.shape[0])
@@ -98,13 +101,15 @@ class ColorMarker:
         before = self.track.predict(frame - 1)
         self._velocity = (centre[0] - before[0], centre[1] - before[1])
         lost = self._lost = self.track.frames_lost(frame)
-        self._speed = self.track.speed_px(frame) if lost == 0 else max(self.track.speed_px(frame),
-                                                                       self.track.max_speed_px)
+        self._speed = math.hypot(*self._velocity)
+        if lost:
+            self._speed = max(self._speed, self.track.max_speed_px)
         if lost == 0:
             # a tight window first (three radii around the prediction): cheap, and the
             # blob must lie wholly inside it; otherwise the full search window
             radius = math.sqrt(self._usual_area / math.pi)
-            det = self._locate_in(image, window(centre, int(3 * radius + self._speed) + 6, image.shape), centre, True)
+            tight = window(centre, int(3 * radius + 0.5 * self._speed) + 6, image.shape)
+            det = self._locate_in(image, tight, centre, True)
             if det is not None:
                 return det
         # the search window: at least five marker diameters (a hop starts from rest within a
@@ -115,28 +120,33 @@ class ColorMarker:
         return self._locate_in(image, box, centre)
 
     def _cores(self, roi: np.ndarray):
-        """Pixels of the marker's colour: first those within ``tolerance`` in RGB and of its hue
-        (exact on a well-lit sticker); if no blob of those fits, all those of its hue, somewhat
-        paler or much darker (a shadow darkens, it does not change hue). A grey marker (no hue
-        to speak of) is matched in RGB alone."""
+        """Pixels of the marker's colour, with whether their hue is already checked: first those
+        within ``tolerance`` in RGB (exact on a well-lit sticker; a blob of them is then taken
+        only if its mean colour has the marker's hue); if no blob of those fits, all those of
+        its hue, somewhat paler or much darker (a shadow darkens, it does not change hue). A
+        grey marker (no hue to speak of) is matched in RGB alone."""
         box = cv2.inRange(roi, self._lo, self._hi)
         if self._hsv is None:
-            yield box
+            yield box, True
             return
-        hue = self._hue_mask(roi)
-        yield box & hue
-        yield hue
+        yield box, not self._box_holds_grey
+        yield self._hue_mask(roi), True
+
+    def _hue_bounds(self) -> tuple[int, int, int]:
+        """Hue half-window (OpenCV's 8-bit hue: degrees / 2), least saturation, least brightness.
+
+        --color-tol (default 80 of 255) scales them: the hue may turn 16 degrees at 80, a pixel
+        may be paler down to 0.3 of the saturation (blur mixes in the background) and darker
+        down to 0.3 of the brightness (a deep shadow)."""
+        _, s, v = self._hsv
+        share = min(self.tolerance / 80.0, 1.5)
+        return (max(int(round(self.hue_tol_deg * share / 2)), 1), max(int(s * (1 - 0.7 * share)), 40),
+                max(int(v * (1 - 0.7 * share)), 30))
 
     def _hue_mask(self, roi: np.ndarray) -> np.ndarray:
-        # --color-tol (default 80 of 255) also sets how far the hue may turn (16 degrees at 80),
-        # how much paler (to 0.3 of the saturation: blur mixes in the background) and how much
-        # darker (to 0.3 of the brightness: a deep shadow) a pixel may be and still count
-        h, s, v = self._hsv
-        share = min(self.tolerance / 80.0, 1.5)
+        h = self._hsv[0]
+        tol, s_min, v_min = self._hue_bounds()
         hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
-        tol = max(int(round(self.hue_tol_deg * share / 2)), 1)      # OpenCV's 8-bit hue is degrees / 2
-        s_min = max(int(s * (1 - 0.7 * share)), 40)
-        v_min = max(int(v * (1 - 0.7 * share)), 30)
         lo, hi = h - tol, h + tol
         mask = cv2.inRange(hsv, (max(lo, 0), s_min, v_min), (min(hi, 179), 255, 255))
         if lo < 0:
@@ -145,18 +155,26 @@ class ColorMarker:
             mask |= cv2.inRange(hsv, (0, s_min, v_min), (hi - 180, 255, 255))
         return mask
 
+    def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
+        """True if the mean colour of ``blob`` (a mask at x, y in ``roi``) has the marker's hue."""
+        h, w = blob.shape
+        mean = cv2.mean(roi[y:y + h, x:x + w], blob)[:3]
+        bh, bs, _ = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
+        tol, s_min, _ = self._hue_bounds()
+        return min(abs(bh - self._hsv[0]), 180 - abs(bh - self._hsv[0])) <= tol and bs >= s_min
+
     def _locate_in(self, image, box, centre, whole_inside: bool = False) -> Detection | None:
         x0, y0, x1, y1 = box
         if x1 <= x0 or y1 <= y0:           # the prediction lies off the picture
             return None
         roi = image[y0:y1, x0:x1]          # a view: nothing outside the window is converted
-        for core in self._cores(roi):
-            det = self._locate_core(image, roi, core, box, centre, whole_inside)
+        for core, hue_checked in self._cores(roi):
+            det = self._locate_core(image, roi, core, box, centre, whole_inside, hue_checked)
             if det is not None:
                 return det
         return None
 
-    def _locate_core(self, image, roi, core, box, centre, whole_inside: bool) -> Detection | None:
+    def _locate_core(self, image, roi, core, box, centre, whole_inside: bool, hue_checked: bool) -> Detection | None:
         x0, y0 = box[:2]
         if not cv2.hasNonZero(core):   # labelling an empty frame costs milliseconds: a hidden marker
             return None
@@ -167,7 +185,7 @@ class ColorMarker:
             stats = np.array([[0, 0, 0, 0, 0], [*cv2.boundingRect(core), cv2.countNonZero(core)]])
             order = np.array([1])
         else:
-            n, labels, stats, cents = cv2.connectedComponentsWithStats(core, connectivity=8)
+            stats, cents = _component_stats(core, labels, n)
             order = np.arange(1, n)
             if centre is None:   # largest first
                 order = order[np.argsort(-stats[order, cv2.CC_STAT_AREA], kind="stable")]
@@ -175,26 +193,26 @@ class ColorMarker:
                 order = order[np.argsort(np.hypot(cents[order, 0] + x0 - centre[0], cents[order, 1] + y0 - centre[1]),
                                          kind="stable")]
         order = order[stats[order, cv2.CC_STAT_AREA] >= self.min_area_px]
-        for best in order:
-            best = int(best)
-            if _touches_edge(stats[best], roi.shape, box, image.shape):
+        for best in order.tolist():
+            bx, by, bw, bh, area = stat = stats[best].tolist()
+            if _touches_edge(stat, roi.shape, box, image.shape):
                 if whole_inside:
                     return None
                 # the window cut the blob (the prediction was off): look again around what it saw
-                bx, by, bw, bh = (int(v) for v in stats[best, :4])
                 seen_at = (x0 + bx + bw / 2, y0 + by + bh / 2)
                 radius = math.sqrt(self._usual_area / math.pi) if self._areas else max(bw, bh)
                 half = int(3 * radius + max(bw, bh) / 2) + 6
                 return self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
-            if _on_image_border(stats[best], box, image.shape):
+            if _on_image_border(stat, box, image.shape):
                 continue   # cut by the picture's edge: its centroid is not the marker's
-            shape = _blob_shape(labels, stats[best], best)
-            at = (x0 + stats[best, 0] + stats[best, 2] / 2, y0 + stats[best, 1] + stats[best, 3] / 2)
-            if not self._fits(shape, at):
+            blob = (labels[by:by + bh, bx:bx + bw] == best).view(np.uint8)
+            shape = _blob_shape(blob, area)
+            at = (x0 + bx + bw / 2, y0 + by + bh / 2)
+            if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
                 continue
             if self._lost > 0 and self._near_distractor(*at):
                 continue
-            return self._measure(roi, labels, stats[best], best, shape, x0, y0)
+            return self._measure(roi, labels, stat, best, shape, x0, y0)
         return None
 
     def _near_distractor(self, x: float, y: float) -> bool:
@@ -210,7 +228,7 @@ class ColorMarker:
         if shape.area_px < self.partial_fraction * self._usual_area:
             return False
         d = self._usual_width
-        last = self.track.predict(self.track.last_frame)
+        last = self.track.last_point
         moved = ((at[0] - last[0]) / (self._lost + 1), (at[1] - last[1]) / (self._lost + 1))
         streak = 1.2 * max(self._speed, math.hypot(*moved)) + 2.0
         if shape.area_px > 1.6 * self._usual_area + d * streak:
@@ -232,12 +250,31 @@ class ColorMarker:
             self._usual_area = statistics.median(self._areas)
             self._usual_width = statistics.median(self._widths)
         # the centroid needs the blob and four pixels around it (two dilations of 5x5)
-        bx, by, bw, bh = (int(v) for v in stat[:4])
+        bx, by, bw, bh = stat[:4]
         cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
         cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
         blob = labels[cy0:cy1, cx0:cx1] == best
         px, py = _coverage_centroid(roi[cy0:cy1, cx0:cx1], blob)
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
+
+
+def _component_stats(core: np.ndarray, labels: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``cv2.connectedComponentsWithStats``'s stats and centroids from the labels, computed
+    over the set pixels only (OpenCV's pass over a whole sparse 720p image costs ~8 ms)."""
+    pts = cv2.findNonZero(core).reshape(-1, 2)
+    xs, ys = pts[:, 0], pts[:, 1]
+    lab = labels[ys, xs]
+    area = np.bincount(lab, minlength=n)
+    x0, y0 = np.full(n, labels.shape[1]), np.full(n, labels.shape[0])
+    x1, y1 = np.full(n, -1), np.full(n, -1)
+    np.minimum.at(x0, lab, xs)
+    np.minimum.at(y0, lab, ys)
+    np.maximum.at(x1, lab, xs)
+    np.maximum.at(y1, lab, ys)
+    stats = np.stack([x0, y0, x1 - x0 + 1, y1 - y0 + 1, area], axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cents = np.stack([np.bincount(lab, xs, n) / area, np.bincount(lab, ys, n) / area], axis=1)
+    return stats, cents
 
 
 def _along(angle_rad: float, velocity: tuple[float, float], diameter_px: float) -> bool:
@@ -258,9 +295,9 @@ class BlobShape:
     angle_rad: float = 0.0   # direction of the major axis (image x right, y down)
 
 
-def _blob_shape(labels: np.ndarray, stat: np.ndarray, label: int) -> BlobShape:
-    x, y, w, h, area = (int(v) for v in stat[:5])
-    m = cv2.moments((labels[y:y + h, x:x + w] == label).view(np.uint8), binaryImage=True)
+def _blob_shape(blob: np.ndarray, area: int) -> BlobShape:
+    """Area and equivalent ellipse of a blob given as a 0/1 mask of its bounding box."""
+    m = cv2.moments(blob, binaryImage=True)
     a, b, c = m["mu20"] / m["m00"], m["mu11"] / m["m00"], m["mu02"] / m["m00"]
     root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
     # + 1/12 per axis: a pixel is a square, not a point
@@ -268,8 +305,8 @@ def _blob_shape(labels: np.ndarray, stat: np.ndarray, label: int) -> BlobShape:
     return BlobShape(float(area), 4 * math.sqrt(lam1), 4 * math.sqrt(max(lam2, 0.0)), 0.5 * math.atan2(2 * b, a - c))
 
 
-def _on_image_border(stat: np.ndarray, box, image_shape) -> bool:
-    x, y, w, h = (int(v) for v in stat[:4])
+def _on_image_border(stat: list[int], box, image_shape) -> bool:
+    x, y, w, h = stat[:4]
     x0, y0 = box[0] + x, box[1] + y
     return x0 <= 0 or y0 <= 0 or x0 + w >= image_shape[1] or y0 + h >= image_shape[0]
 
@@ -310,9 +347,9 @@ def _median(values: np.ndarray) -> np.floating:
     return (part[k - 1] + part[k]) / np.float32(2)
 
 
-def _touches_edge(stat: np.ndarray, roi_shape, box, image_shape) -> bool:
+def _touches_edge(stat: list[int], roi_shape, box, image_shape) -> bool:
     """True if a blob reaches a window edge that is not also the image edge."""
-    x, y, w, h = (int(v) for v in stat[:4])
+    x, y, w, h = stat[:4]
     x0, y0, x1, y1 = box
     margin = 3  # the coverage ring needs room too
     return ((x < margin and x0 > 0) or (y < margin and y0 > 0)
