@@ -57,7 +57,7 @@ class ColorMarker:
     _usual_width: float = 0.0      # median of _widths: the sticker's diameter in pixels
     _speed: float = 0.0            # predicted motion over this frame (px), for the blur allowance
     _tries: int = 0                # frames searched before the first sighting
-    _lost: int = 0                 # frames since the last sighting
+    _frame: int = 0                # the frame being searched
     _velocity: tuple[float, float] = (0.0, 0.0)   # predicted motion over this frame (px)
     _distractors: list = field(default_factory=list)  # other blobs of the colour seen at the start: (x, y, size)
 
@@ -90,6 +90,7 @@ class ColorMarker:
                 self._distractors.append((cx, cy, float(size)))
 
     def _find(self, frame: int, image: np.ndarray) -> Detection | None:
+        self._frame = frame
         whole = (0, 0, image.shape[1], image.shape[0])
         if not self._areas:   # not seen yet: around the start point, or anywhere
             self._tries += 1
@@ -100,7 +101,7 @@ class ColorMarker:
         centre = self.track.predict(frame)
         before = self.track.predict(frame - 1)
         self._velocity = (centre[0] - before[0], centre[1] - before[1])
-        lost = self._lost = self.track.frames_lost(frame)
+        lost = self.track.frames_lost(frame)
         self._speed = math.hypot(*self._velocity)
         if lost:
             self._speed = max(self._speed, self.track.max_speed_px)
@@ -109,7 +110,7 @@ class ColorMarker:
             # blob must lie wholly inside it; otherwise the full search window
             radius = math.sqrt(self._usual_area / math.pi)
             tight = window(centre, int(3 * radius + 0.5 * self._speed) + 6, image.shape)
-            det = self._locate_in(image, tight, centre, True)
+            det = self._locate_in(image, tight, centre, True, tight=True)
             if det is not None:
                 return det
         # the search window: at least five marker diameters (a hop starts from rest within a
@@ -163,18 +164,21 @@ class ColorMarker:
         tol, s_min, _ = self._hue_bounds()
         return min(abs(bh - self._hsv[0]), 180 - abs(bh - self._hsv[0])) <= tol and bs >= s_min
 
-    def _locate_in(self, image, box, centre, whole_inside: bool = False) -> Detection | None:
+    def _locate_in(self, image, box, centre, whole_inside: bool = False, tight: bool = False) -> Detection | None:
+        """The marker in ``box``; ``whole_inside``: a blob cut by the box is refused; ``tight``:
+        the box is a few radii around the prediction, where a look-alike cannot be told apart."""
         x0, y0, x1, y1 = box
         if x1 <= x0 or y1 <= y0:           # the prediction lies off the picture
             return None
         roi = image[y0:y1, x0:x1]          # a view: nothing outside the window is converted
         for core, hue_checked in self._cores(roi):
-            det = self._locate_core(image, roi, core, box, centre, whole_inside, hue_checked)
+            det = self._locate_core(image, roi, core, box, centre, whole_inside, hue_checked, tight)
             if det is not None:
                 return det
         return None
 
-    def _locate_core(self, image, roi, core, box, centre, whole_inside: bool, hue_checked: bool) -> Detection | None:
+    def _locate_core(self, image, roi, core, box, centre, whole_inside: bool, hue_checked: bool,
+                     tight: bool) -> Detection | None:
         x0, y0 = box[:2]
         if not cv2.hasNonZero(core):   # labelling an empty frame costs milliseconds: a hidden marker
             return None
@@ -210,8 +214,8 @@ class ColorMarker:
             at = (x0 + bx + bw / 2, y0 + by + bh / 2)
             if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
                 continue
-            if self._lost > 0 and self._near_distractor(*at):
-                continue
+            if not tight and self._near_distractor(*at):
+                continue   # beyond a few radii of the prediction, a look-alike seen at the start is not taken
             return self._measure(roi, labels, stat, best, shape, x0, y0)
         return None
 
@@ -229,7 +233,8 @@ class ColorMarker:
             return False
         d = self._usual_width
         last = self.track.last_point
-        moved = ((at[0] - last[0]) / (self._lost + 1), (at[1] - last[1]) / (self._lost + 1))
+        gap = self.track.frames_lost(self._frame) + 1
+        moved = ((at[0] - last[0]) / gap, (at[1] - last[1]) / gap)
         streak = 1.2 * max(self._speed, math.hypot(*moved)) + 2.0
         if shape.area_px > 1.6 * self._usual_area + d * streak:
             return False
