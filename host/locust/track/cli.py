@@ -54,9 +54,12 @@ def _base_path(out: Path | None, source: Path) -> Path:
                    "frame), template:X,Y@FRAME or aruco:ID[@DICT]. "
                    "Default: the robot's nose (#ff00ff) and foot (#00ffff) colours.")
 @click.option("--color-tol", default=80, show_default=True, type=click.IntRange(1, 255),
-              help="Colour markers: largest per-channel difference (0-255) still counted as the marker.")
+              help="Colour markers: largest per-channel difference (0-255) still counted as the marker; "
+                   "at 80 a pixel of the marker's hue (+-16 deg) also counts down to 0.3 of its saturation and "
+                   "brightness (shadow, blur), and the bounds scale with it.")
 @click.option("--search", "search_px", default=40, show_default=True, type=click.IntRange(4, 2000),
-              help="Half-size (px) of the search window around each predicted position.")
+              help="Half-size (px) of the search window around each predicted position "
+                   "(colour markers: at least five marker diameters, growing while the marker is lost).")
 @click.option("--template-radius", default=8, show_default=True, type=click.IntRange(2, 200),
               help="Template markers: radius (px) of the circular template (Tracker's mask is 16 px across).")
 @click.option("--accept", default=4.0, show_default=True, type=float,

@@ -55,11 +55,13 @@ class ColorMarker:
     _widths: deque = field(default_factory=lambda: deque(maxlen=15))
     _usual_area: float = 0.0       # median of _areas (round, whole blobs), kept up to date
     _usual_width: float = 0.0      # median of _widths: the sticker's diameter in pixels
+    _masses: deque = field(default_factory=lambda: deque(maxlen=15))
+    _usual_mass: float = 0.0       # median of _masses: contrast mass (see _coverage_centroid)
     _speed: float = 0.0            # predicted motion over this frame (px), for the blur allowance
     _tries: int = 0                # frames searched before the first sighting
     _frame: int = 0                # the frame being searched
     _velocity: tuple[float, float] = (0.0, 0.0)   # predicted motion over this frame (px)
-    _distractors: list = field(default_factory=list)  # other blobs of the colour seen at the start: (x, y, size)
+    _distractors: list = field(default_factory=list)  # other blobs of the colour seen at the start: (x, y, w, h)
 
     def __post_init__(self) -> None:
         self._lo = np.array([max(c - self.tolerance, 0) for c in self.bgr], dtype=np.uint8)
@@ -85,9 +87,8 @@ class ColorMarker:
         contours, _ = cv2.findContours(core, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
         for c in contours:
             x, y, w, h = cv2.boundingRect(c)
-            cx, cy, size = x + (w - 1) / 2, y + (h - 1) / 2, max(w, h)
-            if w * h >= self.min_area_px and math.hypot(cx - marker.px, cy - marker.py) > size:
-                self._distractors.append((cx, cy, float(size)))
+            if w * h >= self.min_area_px and not (x - 1 <= marker.px <= x + w and y - 1 <= marker.py <= y + h):
+                self._distractors.append((x, y, w, h))
 
     def _find(self, frame: int, image: np.ndarray) -> Detection | None:
         self._frame = frame
@@ -114,8 +115,11 @@ class ColorMarker:
             if det is not None:
                 return det
         # the search window: at least five marker diameters (a hop starts from rest within a
-        # frame); lost, it grows by its own size each frame around the extrapolated path
-        half = int(max(self.search_half_px, 5 * self._usual_width)) * (1 + lost)
+        # frame); lost, it doubles each frame around the extrapolated path (a toss outruns a
+        # window that grows by a fixed step), until it holds the picture
+        half = int(max(self.search_half_px, 5 * self._usual_width)) << min(lost, 16)
+        if self.track.sightings == 1:   # no velocity yet: twice as far, as Tracker does
+            half *= 2
         h, w = image.shape[:2]
         box = window((min(max(centre[0], 0), w - 1), min(max(centre[1], 0), h - 1)), half, image.shape)
         return self._locate_in(image, box, centre)
@@ -214,13 +218,17 @@ class ColorMarker:
             at = (x0 + bx + bw / 2, y0 + by + bh / 2)
             if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
                 continue
-            if not tight and self._near_distractor(*at):
-                continue   # beyond a few radii of the prediction, a look-alike seen at the start is not taken
-            return self._measure(roi, labels, stat, best, shape, x0, y0)
+            if self._near_distractor(*at):
+                continue   # a look-alike seen at the start is never taken
+            det = self._measure(roi, labels, stat, best, shape, x0, y0)
+            if det is not None:
+                return det
         return None
 
     def _near_distractor(self, x: float, y: float) -> bool:
-        return any(math.hypot(x - dx, y - dy) <= size for dx, dy, size in self._distractors)
+        """True if (x, y) lies on a look-alike's bounding box, grown by a marker radius."""
+        r = 0.5 * self._usual_width + 1.0
+        return any(bx - r <= x <= bx + bw + r and by - r <= y <= by + bh + r for bx, by, bw, bh in self._distractors)
 
     def _fits(self, shape: BlobShape, at: tuple[float, float]) -> bool:
         """Size and shape of the marker: learned from the round, whole sightings so far; the
@@ -246,7 +254,16 @@ class ColorMarker:
             return _along(shape.angle_rad, self._velocity, d) or _along(shape.angle_rad, moved, d)
         return True
 
-    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int) -> Detection:
+    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int) -> Detection | None:
+        """The blob's coverage centroid, or None if its contrast mass is not the marker's."""
+        # the centroid needs the blob and four pixels around it (two dilations of 5x5)
+        bx, by, bw, bh = stat[:4]
+        cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
+        cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
+        blob = labels[cy0:cy1, cx0:cx1] == best
+        px, py, mass = _coverage_centroid(roi[cy0:cy1, cx0:cx1], blob)
+        if self._masses and math.isfinite(mass) and not 0.5 <= mass / self._usual_mass <= 1.6:
+            return None
         area = float(shape.area_px)
         score = area / self._usual_area if self._areas else 1.0
         if shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn the marker's size from it
@@ -254,12 +271,9 @@ class ColorMarker:
             self._widths.append(shape.minor_px)
             self._usual_area = statistics.median(self._areas)
             self._usual_width = statistics.median(self._widths)
-        # the centroid needs the blob and four pixels around it (two dilations of 5x5)
-        bx, by, bw, bh = stat[:4]
-        cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
-        cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
-        blob = labels[cy0:cy1, cx0:cx1] == best
-        px, py = _coverage_centroid(roi[cy0:cy1, cx0:cx1], blob)
+            if math.isfinite(mass):
+                self._masses.append(mass)
+                self._usual_mass = statistics.median(self._masses)
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
 
 
@@ -321,8 +335,13 @@ _KERNEL_5 = np.ones((5, 5), np.uint8)
 _KERNEL_3 = np.ones((3, 3), np.uint8)
 
 
-def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]:
-    """Centroid of per-pixel coverage over ``blob`` grown by two pixels.
+def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float, float]:
+    """Centroid of per-pixel coverage over ``blob`` grown by two pixels, and the blob's
+    *contrast mass*: the sum over it of (luma - background) / background, nan when the
+    sticker is as bright as its surround. The mass is the sticker's area times its contrast
+    with the surface behind it: a shadow leaves it unchanged (it scales both lumas) and so
+    does motion blur (it spreads the same sticker over more pixels), while a longer
+    look-alike of the same colour has more of it.
 
     ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
     """
@@ -334,12 +353,14 @@ def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]
     level = float(_median(luma[inner])) if inner.any() else float(_median(luma[blob]))
     ring_b = ring.view(bool)
     background = float(_median(luma[ring_b])) if ring_b.any() else 0.0
+    mass = math.nan
     if abs(level - background) >= 20:
         cover = np.clip((luma - background) / (level - background), 0.0, 1.0)
+        mass = float(np.sum((luma - background) * grown)) / max(background, 10.0)
     else:  # sticker as bright as its surround: fall back to the colour core alone
         cover = blob.astype(np.float32)
     m = cv2.moments(cover * grown)
-    return m["m10"] / m["m00"], m["m01"] / m["m00"]
+    return m["m10"] / m["m00"], m["m01"] / m["m00"], mass
 
 
 def _median(values: np.ndarray) -> np.floating:

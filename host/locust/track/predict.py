@@ -107,6 +107,11 @@ class Trajectory:
         self._coef = None
 
     @property
+    def sightings(self) -> int:
+        """Positions held (at most ``keep``)."""
+        return len(self._found)
+
+    @property
     def last_frame(self) -> int | None:
         return self._found[-1][0] if self._found else None
 
