@@ -14,7 +14,7 @@ from locust.cli import cli
 from locust.errors import TrackError
 from locust.track.board import BoardSpec, board_points, parse_board, parse_plane_points
 from locust.track.export import track_events
-from locust.track.hardclip import STICKER_HEX, make_hard_video
+from locust.track.hardclip import STICKER_HEX, make_hard_video, read_truth_csv
 from locust.track.predict import Trajectory
 from locust.track.spec import parse_marker
 
@@ -54,6 +54,16 @@ def test_hard_clip_acceptance(hard, tmp_path, start):
     metric = np.sqrt(np.mean(e_mm[ok] ** 2))
     assert metric <= 2.0, f"metric RMS {metric:.2f} mm"      # acceptance 2 mm; measured 1.29
     assert "1 gap(s), longest 25 frames, 1 re-acquisition(s), 0 jump(s)" in res.output
+
+
+def test_truth_csv_reads_back(hard):
+    path, truth = hard
+    back = read_truth_csv(path.with_suffix(".truth.csv"))
+    assert back.board == truth.board and back.sticker_hex == truth.sticker_hex and back.fps == truth.fps
+    assert np.array_equal(back.in_picture, truth.in_picture) and np.array_equal(back.whole, truth.whole)
+    ok = truth.in_picture
+    assert np.abs(back.px[ok] - truth.px[ok]).max() <= 5e-6 and np.abs(back.x_m - truth.x_m).max() <= 5e-7
+    assert np.allclose(back.plane_to_image, truth.plane_to_image, rtol=1e-12)
 
 
 def test_preview_lists_sticker_and_pen_cap(hard, tmp_path):

@@ -18,6 +18,7 @@ the sticker's centre at mid-exposure, which is the centre of its blur streak.
 
 from __future__ import annotations
 
+import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +26,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from ..errors import TrackError
 from ..fileio import atomic_write_text
 from .board import BoardSpec
 from .color import parse_hex
@@ -34,6 +36,7 @@ HARD_BOARD = BoardSpec("DICT_4X4_50", 5, 3, 40.0, 10.0)   # 240 x 140 mm
 STICKER_HEX = "#e8308c"          # a pink sticker, and a pen cap of the very same colour
 STICKER_DIAMETER_M = 0.020
 GRAVITY_M_S2 = 9.81
+TRUTH_HEADER = "frame,t_s,px,py,in_picture,whole_in_picture,x_m,y_m"
 
 
 @dataclass
@@ -55,13 +58,33 @@ class HardTruth:
         return np.isfinite(self.px)
 
     def write_csv(self, path: Path) -> Path:
+        """``<stem>.truth.csv``; :func:`read_truth_csv` reads it back."""
+        meta = {"fps": self.fps, "radius_px": self.radius_px, "board": self.board.text(),
+                "plane_to_image": self.plane_to_image.tolist(), "sticker_hex": self.sticker_hex}
         lines = ["# synthetic: locust.track.hardclip; sticker centre in pixels (OpenCV convention, nan out of "
                  f"the picture) and in the plane of board {self.board.text()} (m, origin bottom-left, y up)",
-                 "frame,t_s,px,py,in_picture,whole_in_picture,x_m,y_m"]
+                 f"# meta {json.dumps(meta)}",
+                 TRUTH_HEADER]
         for i, f in enumerate(self.frames):
             lines.append(f"{int(f)},{f / self.fps:.6f},{self.px[i]:.5f},{self.py[i]:.5f},{int(self.in_picture[i])},"
                          f"{int(self.whole[i])},{self.x_m[i]:.6f},{self.y_m[i]:.6f}")
         return atomic_write_text(path, "\n".join(lines) + "\n")
+
+
+def read_truth_csv(path: str | os.PathLike) -> HardTruth:
+    """A hard clip's ``<stem>.truth.csv`` as written by :meth:`HardTruth.write_csv`."""
+    from .board import parse_board
+
+    lines = Path(path).read_text().splitlines()
+    meta = json.loads(next(ln for ln in lines if ln.startswith("# meta "))[len("# meta "):])
+    table = [ln for ln in lines if ln and not ln.startswith("#")]
+    if table[0] != TRUTH_HEADER:
+        raise TrackError(f"{path}: not a hard-clip truth file (header {table[0]!r})",
+                         "read the .truth.csv written beside a locust.track.hardclip video")
+    rows = np.array([[float(v) for v in ln.split(",")] for ln in table[1:]])
+    return HardTruth(rows[:, 0].astype(int), float(meta["fps"]), rows[:, 2], rows[:, 3], rows[:, 5].astype(bool),
+                     rows[:, 6], rows[:, 7], float(meta["radius_px"]), parse_board(meta["board"]),
+                     np.array(meta["plane_to_image"]), meta["sticker_hex"])
 
 
 def plane_to_image(width: int, height: int) -> np.ndarray:
