@@ -115,9 +115,8 @@ class ColorMarker:
             if det is not None:
                 return det
         # the search window: at least five marker diameters (a hop starts from rest within a
-        # frame); lost, it doubles each frame around the extrapolated path (a toss outruns a
-        # window that grows by a fixed step), until it holds the picture
-        half = int(max(self.search_half_px, 5 * self._usual_width)) << min(lost, 16)
+        # frame); lost, it grows by its own size each frame around the extrapolated path
+        half = int(max(self.search_half_px, 5 * self._usual_width)) * (1 + lost)
         if self.track.sightings == 1:   # no velocity yet: twice as far, as Tracker does
             half *= 2
         h, w = image.shape[:2]
