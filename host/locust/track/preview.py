@@ -48,14 +48,21 @@ def saturated_blobs(image_bgr: np.ndarray, count: int = 10, min_area_px: int = 6
     return blobs
 
 
+def _label(image: np.ndarray, text: str, at: tuple[int, int], colour=(255, 255, 255), scale: float = 0.4) -> None:
+    """Text with a dark outline: readable on any background."""
+    cv2.putText(image, text, at, cv2.FONT_HERSHEY_SIMPLEX, scale, (0, 0, 0), 3, cv2.LINE_AA)
+    cv2.putText(image, text, at, cv2.FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv2.LINE_AA)
+
+
 def draw_grid(image: np.ndarray, step_px: int) -> None:
+    """Grid lines every ``step_px`` (inverted pixels: visible on any background), labelled."""
     h, w = image.shape[:2]
-    for x in range(0, w, step_px):
-        cv2.line(image, (x, 0), (x, h - 1), (255, 255, 255) if x % (5 * step_px) == 0 else (150, 150, 150), 1)
-        cv2.putText(image, str(x), (x + 2, 12), cv2.FONT_HERSHEY_SIMPLEX, 0.35, (255, 255, 255), 1, cv2.LINE_AA)
-    for y in range(0, h, step_px):
-        cv2.line(image, (0, y), (w - 1, y), (255, 255, 255) if y % (5 * step_px) == 0 else (150, 150, 150), 1)
-        cv2.putText(image, str(y), (2, y - 2), cv2.FONT_HERSHEY_SIMPLEX, 0.35, (255, 255, 255), 1, cv2.LINE_AA)
+    image[:, ::step_px] = 255 - image[:, ::step_px]
+    image[::step_px, :] = 255 - image[::step_px, :]
+    for x in range(step_px, w, step_px):
+        _label(image, str(x), (x + 2, 12))
+    for y in range(step_px, h, step_px):
+        _label(image, str(y), (2, y - 3))
 
 
 def preview(info, frame: int, models: list, path: Path) -> tuple[list[Blob], dict[str, tuple[float, float] | None]]:
@@ -76,14 +83,14 @@ def preview(info, frame: int, models: list, path: Path) -> tuple[list[Blob], dic
     draw_grid(out, 50 if max(image.shape[:2]) <= 1000 else 100)
     for k, b in enumerate(blobs, 1):
         r = int(max(8, np.sqrt(b.area_px / np.pi) + 6))
+        cv2.circle(out, (int(round(b.px)), int(round(b.py))), r, (0, 0, 0), 3, cv2.LINE_AA)
         cv2.circle(out, (int(round(b.px)), int(round(b.py))), r, (255, 255, 255), 1, cv2.LINE_AA)
-        cv2.putText(out, str(k), (int(b.px) + r, int(b.py) - r), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1,
-                    cv2.LINE_AA)
+        _label(out, str(k), (int(b.px) + r, int(b.py) - r), scale=0.5)
     for name, p in found.items():
         if p is not None:
             x, y = int(round(p[0])), int(round(p[1]))
             cv2.drawMarker(out, (x, y), (0, 255, 0), cv2.MARKER_CROSS, 20, 2)
-            cv2.putText(out, name, (x + 8, y + 16), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 255, 0), 1, cv2.LINE_AA)
+            _label(out, name, (x + 8, y + 16), (0, 255, 0), 0.5)
     ok, png = cv2.imencode(".png", out)
     atomic_write_bytes(path, png.tobytes())
     return blobs, found
