@@ -55,8 +55,6 @@ class ColorMarker:
     _widths: deque = field(default_factory=lambda: deque(maxlen=15))
     _usual_area: float = 0.0       # median of _areas (round, whole blobs), kept up to date
     _usual_width: float = 0.0      # median of _widths: the sticker's diameter in pixels
-    _masses: deque = field(default_factory=lambda: deque(maxlen=15))
-    _usual_mass: float = 0.0       # median of _masses: contrast mass (see _coverage_centroid)
     _speed: float = 0.0            # predicted motion over this frame (px), for the blur allowance
     _tries: int = 0                # frames searched before the first sighting
     _frame: int = 0                # the frame being searched
@@ -219,9 +217,7 @@ class ColorMarker:
                 continue
             if self._near_distractor(*at):
                 continue   # a look-alike seen at the start is never taken
-            det = self._measure(roi, labels, stat, best, shape, x0, y0)
-            if det is not None:
-                return det
+            return self._measure(roi, labels, stat, best, shape, x0, y0)
         return None
 
     def _near_distractor(self, x: float, y: float) -> bool:
@@ -253,16 +249,14 @@ class ColorMarker:
             return _along(shape.angle_rad, self._velocity, d) or _along(shape.angle_rad, moved, d)
         return True
 
-    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int) -> Detection | None:
-        """The blob's coverage centroid, or None if its contrast mass is not the marker's."""
+    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int) -> Detection:
+        """The blob's coverage centroid; a round, whole blob also teaches the marker's size."""
         # the centroid needs the blob and four pixels around it (two dilations of 5x5)
         bx, by, bw, bh = stat[:4]
         cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
         cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
         blob = labels[cy0:cy1, cx0:cx1] == best
-        px, py, mass = _coverage_centroid(roi[cy0:cy1, cx0:cx1], blob)
-        if self._masses and math.isfinite(mass) and not 0.5 <= mass / self._usual_mass <= 1.6:
-            return None
+        px, py = _coverage_centroid(roi[cy0:cy1, cx0:cx1], blob)
         area = float(shape.area_px)
         score = area / self._usual_area if self._areas else 1.0
         if shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn the marker's size from it
@@ -270,9 +264,6 @@ class ColorMarker:
             self._widths.append(shape.minor_px)
             self._usual_area = statistics.median(self._areas)
             self._usual_width = statistics.median(self._widths)
-            if math.isfinite(mass):
-                self._masses.append(mass)
-                self._usual_mass = statistics.median(self._masses)
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
 
 
@@ -334,13 +325,8 @@ _KERNEL_5 = np.ones((5, 5), np.uint8)
 _KERNEL_3 = np.ones((3, 3), np.uint8)
 
 
-def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float, float]:
-    """Centroid of per-pixel coverage over ``blob`` grown by two pixels, and the blob's
-    *contrast mass*: the sum over it of (luma - background) / background, nan when the
-    sticker is as bright as its surround. The mass is the sticker's area times its contrast
-    with the surface behind it: a shadow leaves it unchanged (it scales both lumas) and so
-    does motion blur (it spreads the same sticker over more pixels), while a longer
-    look-alike of the same colour has more of it.
+def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]:
+    """Centroid of per-pixel coverage over ``blob`` grown by two pixels.
 
     ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
     """
@@ -352,14 +338,12 @@ def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float,
     level = float(_median(luma[inner])) if inner.any() else float(_median(luma[blob]))
     ring_b = ring.view(bool)
     background = float(_median(luma[ring_b])) if ring_b.any() else 0.0
-    mass = math.nan
     if abs(level - background) >= 20:
         cover = np.clip((luma - background) / (level - background), 0.0, 1.0)
-        mass = float(np.sum((luma - background) * grown)) / max(background, 10.0)
     else:  # sticker as bright as its surround: fall back to the colour core alone
         cover = blob.astype(np.float32)
     m = cv2.moments(cover * grown)
-    return m["m10"] / m["m00"], m["m01"] / m["m00"], mass
+    return m["m10"] / m["m00"], m["m01"] / m["m00"]
 
 
 def _median(values: np.ndarray) -> np.floating:
