@@ -13,6 +13,8 @@ Modules, one job each:
 - :mod:`.aruco`     ArUco markers (``cv2.aruco``) with sub-pixel corners
 - :mod:`.spec`      ``--marker NAME=SPEC`` parsing and the default marker set
 - :mod:`.calib`     pixel -> metre calibration (stick or ArUco size), origin, axes
+- :mod:`.board`     pixel -> plane metres through a homography: ArUco grid board or four points
+- :mod:`.preview`   one frame with a pixel grid and the saturated blobs, for picking colours
 - :mod:`.runner`    the frame loop that ties video, markers and calibration together
 - :mod:`.export`    a result as the tracks CSV + JSON sidecar
 - :mod:`.trk`       Tracker's .trk/.trz reader; a result in its text-export layout
@@ -20,6 +22,7 @@ Modules, one job each:
                     ``track --import``, ``calibrate`` and ``report`` read tracks through
 - :mod:`.overlay`   PNG / video of the tracks drawn on the footage
 - :mod:`.synth`     synthetic videos with known sub-pixel truth
+- :mod:`.hardclip`  synthetic phone-like clips: look-alike, shadow, blur, exit, tilted board
 
 The files, each owned by one module (writer, reader and typed object side by side):
 

@@ -11,8 +11,9 @@ import numpy as np
 from ..errors import TrackError
 from ..fileio import atomic_write_json
 from ..progress import progress
-from . import calib, camera, export, overlay, trk
+from . import board, calib, camera, export, overlay, preview, trk
 from .aruco import DEFAULT_DICTIONARY, side_px_in_video
+from .board import DEFAULT_BOARD
 from .importing import ImportOptions, import_options, import_tracks, span_warnings
 from .runner import track_video
 from .spec import ModelOptions, parse_markers
@@ -49,12 +50,16 @@ def _base_path(out: Path | None, source: Path) -> Path:
 @click.command(context_settings={"max_content_width": 100})
 @click.argument("video", required=False, type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--marker", "markers", multiple=True, metavar="NAME=SPEC",
-              help="A marker to track; repeatable. SPEC is color:#RRGGBB, template:X,Y@FRAME or aruco:ID[@DICT]. "
+              help="A marker to track; repeatable. SPEC is color:#RRGGBB[@X,Y] (X,Y: where it is on the first "
+                   "frame), template:X,Y@FRAME or aruco:ID[@DICT]. "
                    "Default: the robot's nose (#ff00ff) and foot (#00ffff) colours.")
 @click.option("--color-tol", default=80, show_default=True, type=click.IntRange(1, 255),
-              help="Colour markers: largest per-channel difference (0-255) still counted as the marker.")
+              help="Colour markers: largest per-channel difference (0-255) still counted as the marker; "
+                   "at 80 a pixel of the marker's hue (+-16 deg) also counts down to 0.3 of its saturation and "
+                   "brightness (shadow, blur), and the bounds scale with it.")
 @click.option("--search", "search_px", default=40, show_default=True, type=click.IntRange(4, 2000),
-              help="Half-size (px) of the search window around each predicted position.")
+              help="Half-size (px) of the search window around each predicted position "
+                   "(colour markers: at least five marker diameters, growing while the marker is lost).")
 @click.option("--template-radius", default=8, show_default=True, type=click.IntRange(2, 200),
               help="Template markers: radius (px) of the circular template (Tracker's mask is 16 px across).")
 @click.option("--accept", default=4.0, show_default=True, type=float,
@@ -67,6 +72,17 @@ def _base_path(out: Path | None, source: Path) -> Path:
               help="Calibrate from an ArUco marker's printed side length (m), measured where it first appears.")
 @click.option("--aruco-dict", default=DEFAULT_DICTIONARY, show_default=True,
               help="ArUco dictionary for --scale-aruco.")
+@click.option("--board", "board_text", metavar="aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM",
+              help="An ArUco grid board lying in the plane of motion (see --make-board): world x_m/y_m in that plane, "
+                   "origin at the board's bottom-left corner, y up, with perspective corrected. "
+                   "E.g. aruco:4X4_50:5x4:40:10.")
+@click.option("--plane-points", metavar="PX,PY=X_M,Y_M;...",
+              help="Instead of a board: four or more pixels with their measured plane coordinates (m, y up).")
+@click.option("--make-board", type=click.Path(dir_okay=False, path_type=Path),
+              help=f"Write the --board (default {DEFAULT_BOARD}) as a PNG at 300 DPI to print at 100 %, and stop.")
+@click.option("--preview", "preview_frame", type=int, metavar="FRAME",
+              help="Write FRAME with a pixel grid, the most saturated blobs listed (colour, position) and what the "
+                   "--marker specs find there, to <out>.preview.png, and stop.")
 @click.option("--camera-json", type=click.Path(dir_okay=False, path_type=Path),
               help="Pinhole camera of a simulated video (world metres through each marker's plane). "
                    "Default: <video>.camera.json beside the video, "
@@ -95,7 +111,8 @@ def _base_path(out: Path | None, source: Path) -> Path:
                    "tracks CSV, in --units, with --rename and --mirror, into a tracks CSV in metres.")
 @import_options
 def track(video, markers, color_tol, search_px, template_radius, accept, evolve, scale, scale_aruco, aruco_dict,
-          camera_json, origin, angle, start, end, step, fps, out, fmt, overlay_kind, force, from_trk, trk_names,
+          board_text, plane_points, make_board, preview_frame, camera_json, origin, angle, start, end, step, fps, out,
+          fmt, overlay_kind, force, from_trk, trk_names,
           import_path, imports):
     """Extract marker tracks (nose, foot) from VIDEO, as Tracker's autotracker would, in batch.
 
@@ -111,9 +128,20 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
       locust track hop.mp4 --scale 100,400,500,400=0.30 --origin 100,400
       locust track toss.mp4 --marker ball=template:131.28,207.86@2
       locust track slowmo.mp4 --fps 240 --start 30 --end 400
+      locust track --make-board board.png                   print at 100 %, lay it in the plane of the hop
+      locust track phone.mp4 --preview 0                    pick colours and start points from phone.preview.png
+      locust track phone.mp4 --marker nose=color:#e8308c@412,630 --board aruco:4X4_50:5x4:40:10
       locust track --from-trk experiment.trz --format tracker
       locust track --import tracker.txt --units cm --rename A=nose --out hop.tracks.csv
     """
+    if make_board is not None:
+        spec = board.parse_board(board_text or DEFAULT_BOARD)
+        _refuse_overwrite({"board": make_board}, force)
+        board.write_board_png(make_board, spec)
+        click.echo(f"wrote {make_board}: board {spec.text()}, {spec.width_mm:g} x {spec.height_mm:g} mm of markers "
+                   f"at {board.BOARD_DPI} DPI; print at 100 % (no fit to page), check one marker is "
+                   f"{spec.marker_mm:g} mm, lay it flat in the plane of motion")
+        return
     if import_path is not None:
         if video is not None or from_trk is not None:
             raise TrackError("give one of VIDEO, --from-trk and --import", "one input per run")
@@ -135,7 +163,18 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
     clip = Clip(start, end, step, fps).resolved(info)
     options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0)
     models = parse_markers(list(markers), options)
-    calibration = _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, camera_json)
+    if preview_frame is not None:
+        return _preview(info, preview_frame, models, _base_path(out, video), force)
+    if board_text or plane_points:
+        if scale or scale_aruco or origin or camera_json:
+            raise TrackError("give --board/--plane-points or --scale/--scale-aruco/--origin/--camera-json, not both",
+                             "one calibration per run")
+        if board_text and plane_points:
+            raise TrackError("give --board or --plane-points, not both", "one calibration per run")
+        calibration = (board.parse_plane_points(plane_points) if plane_points
+                       else board.board_homography(info, clip, board.parse_board(board_text)))
+    else:
+        calibration = _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, camera_json)
     paths = _outputs(_base_path(out, video), fmt, overlay_kind)
     _refuse_overwrite(paths, force)
 
@@ -150,6 +189,20 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
             with progress(length=n, label="overlay video") as bar:
                 written.append(overlay.write_video(result, paths["overlay"], bar.update))
     _report(result, written)
+
+
+def _preview(info, frame: int, models: list, base: Path, force: bool) -> None:
+    path = base.with_name(base.name + ".preview.png")
+    _refuse_overwrite({"preview": path}, force)
+    blobs, found = preview.preview(info, frame, models, path)
+    click.echo(f"frame {frame} of {info.path.name} ({info.width_px}x{info.height_px}): most saturated blobs")
+    for k, b in enumerate(blobs, 1):
+        click.echo(b.line(k))
+    if not blobs:
+        click.echo("  none (no strongly coloured patch in this frame)")
+    for name, p in found.items():
+        click.echo(f"  marker {name}: " + (f"found at {p[0]:.1f},{p[1]:.1f}" if p else "not found"))
+    click.echo(f"wrote {path}")
 
 
 def _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, camera_json=None):

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import TrackError
 from .detection import Detection, window
-from .predict import MotionHistory
+from .predict import Trajectory
 
 LUMA_BGR = np.array([0.114, 0.587, 0.299], dtype=np.float32)
 
@@ -48,34 +48,139 @@ class ColorMarker:
     search_half_px: int = 40
     min_area_px: int = 4
     partial_fraction: float = 0.6  # below this share of the usual area: partly hidden
-    history: MotionHistory = field(default_factory=MotionHistory)
+    start_px: tuple[float, float] | None = None
+    hue_tol_deg: float = 16.0
+    track: Trajectory = field(default_factory=Trajectory)
     _areas: deque = field(default_factory=lambda: deque(maxlen=15))
-    _usual_area: float = 0.0       # median of _areas, kept up to date as areas arrive
+    _widths: deque = field(default_factory=lambda: deque(maxlen=15))
+    _usual_area: float = 0.0       # median of _areas (round, whole blobs), kept up to date
+    _usual_width: float = 0.0      # median of _widths: the sticker's diameter in pixels
+    _speed: float = 0.0            # predicted motion over this frame (px), for the blur allowance
+    _tries: int = 0                # frames searched before the first sighting
+    _frame: int = 0                # the frame being searched
+    _velocity: tuple[float, float] = (0.0, 0.0)   # predicted motion over this frame (px)
+    _distractors: list = field(default_factory=list)  # other blobs of the colour seen at the start: (x, y, w, h)
 
     def __post_init__(self) -> None:
         self._lo = np.array([max(c - self.tolerance, 0) for c in self.bgr], dtype=np.uint8)
         self._hi = np.array([min(c + self.tolerance, 255) for c in self.bgr], dtype=np.uint8)
+        h, s, v = (int(c) for c in cv2.cvtColor(np.uint8([[self.bgr]]), cv2.COLOR_BGR2HSV)[0, 0])
+        # hue is only a colour's identity when the colour has one: grey stickers match by RGB alone
+        self._hsv = (h, s, v) if s >= 80 and v >= 60 else None
+        # a box reaching near the grey diagonal (R = G = B) takes grey pixels for the marker:
+        # then a blob of the box is also checked for the marker's hue
+        self._box_holds_grey = int(self._lo.max()) <= int(self._hi.min()) + 30
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
-        centre = self.history.search_centre()
-        det = None
-        if centre is not None and self._areas:
+        det = self._find(frame, image_bgr) or Detection.missing(0.0)
+        if det.ok and self.track.last_frame is None:
+            self._note_distractors(image_bgr, det)
+        self.track.add(frame, det.point())
+        return det
+
+    def _note_distractors(self, image: np.ndarray, marker: Detection) -> None:
+        """Remember every other blob of the marker's colour on the first sighting (a pen cap
+        lying in the scene): a lost marker is never re-acquired on one of them."""
+        *_, (core, _) = self._cores(image)   # the widest test: every pixel that could be taken for it
+        contours, _ = cv2.findContours(core, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+        for c in contours:
+            x, y, w, h = cv2.boundingRect(c)
+            if w * h >= self.min_area_px and not (x - 1 <= marker.px <= x + w and y - 1 <= marker.py <= y + h):
+                self._distractors.append((x, y, w, h))
+
+    def _find(self, frame: int, image: np.ndarray) -> Detection | None:
+        self._frame = frame
+        whole = (0, 0, image.shape[1], image.shape[0])
+        if not self._areas:   # not seen yet: around the start point, or anywhere
+            self._tries += 1
+            if self.start_px is None:
+                return self._locate_in(image, whole, None)
+            return self._locate_in(image, window(self.start_px, 2 * self.search_half_px * self._tries, image.shape),
+                                   self.start_px)
+        centre = self.track.predict(frame)
+        before = self.track.predict(frame - 1)
+        self._velocity = (centre[0] - before[0], centre[1] - before[1])
+        lost = self.track.frames_lost(frame)
+        self._speed = math.hypot(*self._velocity)
+        if lost:
+            self._speed = max(self._speed, self.track.max_speed_px)
+        if lost == 0:
             # a tight window first (three radii around the prediction): cheap, and the
             # blob must lie wholly inside it; otherwise the full search window
             radius = math.sqrt(self._usual_area / math.pi)
-            det = self._locate_in(image_bgr, window(centre, int(3 * radius) + 6, image_bgr.shape), centre, True)
-        if det is None and centre is not None:
-            det = self._locate_in(image_bgr, window(centre, self.search_half_px, image_bgr.shape), centre)
-        if det is None:  # first frame, or lost: search the whole image
-            det = self._locate_in(image_bgr, (0, 0, image_bgr.shape[1], image_bgr.shape[0]), None)
-        det = det or Detection.missing(0.0)
-        self.history.add(det.point())
-        return det
+            tight = window(centre, int(3 * radius + 0.5 * self._speed) + 6, image.shape)
+            det = self._locate_in(image, tight, centre, True, tight=True)
+            if det is not None:
+                return det
+        # the search window: at least five marker diameters (a hop starts from rest within a
+        # frame); lost, it grows by its own size each frame around the extrapolated path
+        half = int(max(self.search_half_px, 5 * self._usual_width)) * (1 + lost)
+        if self.track.sightings == 1:   # no velocity yet: twice as far, as Tracker does
+            half *= 2
+        h, w = image.shape[:2]
+        box = window((min(max(centre[0], 0), w - 1), min(max(centre[1], 0), h - 1)), half, image.shape)
+        return self._locate_in(image, box, centre)
 
-    def _locate_in(self, image, box, centre, whole_inside: bool = False) -> Detection | None:
+    def _cores(self, roi: np.ndarray):
+        """Pixels of the marker's colour, with whether their hue is already checked: first those
+        within ``tolerance`` in RGB (exact on a well-lit sticker; a blob of them is then taken
+        only if its mean colour has the marker's hue); if no blob of those fits, all those of
+        its hue, somewhat paler or much darker (a shadow darkens, it does not change hue). A
+        grey marker (no hue to speak of) is matched in RGB alone."""
+        box = cv2.inRange(roi, self._lo, self._hi)
+        if self._hsv is None:
+            yield box, True
+            return
+        yield box, not self._box_holds_grey
+        yield self._hue_mask(roi), True
+
+    def _hue_bounds(self) -> tuple[int, int, int]:
+        """Hue half-window (OpenCV's 8-bit hue: degrees / 2), least saturation, least brightness.
+
+        --color-tol (default 80 of 255) scales them: the hue may turn 16 degrees at 80, a pixel
+        may be paler down to 0.3 of the saturation (blur mixes in the background) and darker
+        down to 0.3 of the brightness (a deep shadow)."""
+        _, s, v = self._hsv
+        share = min(self.tolerance / 80.0, 1.5)
+        return (max(int(round(self.hue_tol_deg * share / 2)), 1), max(int(s * (1 - 0.7 * share)), 40),
+                max(int(v * (1 - 0.7 * share)), 30))
+
+    def _hue_mask(self, roi: np.ndarray) -> np.ndarray:
+        h = self._hsv[0]
+        tol, s_min, v_min = self._hue_bounds()
+        hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
+        lo, hi = h - tol, h + tol
+        mask = cv2.inRange(hsv, (max(lo, 0), s_min, v_min), (min(hi, 179), 255, 255))
+        if lo < 0:
+            mask |= cv2.inRange(hsv, (180 + lo, s_min, v_min), (179, 255, 255))
+        if hi > 179:
+            mask |= cv2.inRange(hsv, (0, s_min, v_min), (hi - 180, 255, 255))
+        return mask
+
+    def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
+        """True if the mean colour of ``blob`` (a mask at x, y in ``roi``) has the marker's hue."""
+        h, w = blob.shape
+        mean = cv2.mean(roi[y:y + h, x:x + w], blob)[:3]
+        bh, bs, _ = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
+        tol, s_min, _ = self._hue_bounds()
+        return min(abs(bh - self._hsv[0]), 180 - abs(bh - self._hsv[0])) <= tol and bs >= s_min
+
+    def _locate_in(self, image, box, centre, whole_inside: bool = False, tight: bool = False) -> Detection | None:
+        """The marker in ``box``; ``whole_inside``: a blob cut by the box is refused; ``tight``:
+        the box is a few radii around the prediction, where a look-alike cannot be told apart."""
         x0, y0, x1, y1 = box
+        if x1 <= x0 or y1 <= y0:           # the prediction lies off the picture
+            return None
         roi = image[y0:y1, x0:x1]          # a view: nothing outside the window is converted
-        core = cv2.inRange(roi, self._lo, self._hi)
+        for core, hue_checked in self._cores(roi):
+            det = self._locate_core(image, roi, core, box, centre, whole_inside, hue_checked, tight)
+            if det is not None:
+                return det
+        return None
+
+    def _locate_core(self, image, roi, core, box, centre, whole_inside: bool, hue_checked: bool,
+                     tight: bool) -> Detection | None:
+        x0, y0 = box[:2]
         if not cv2.hasNonZero(core):   # labelling an empty frame costs milliseconds: a hidden marker
             return None
         n, labels = cv2.connectedComponents(core, connectivity=8)
@@ -83,42 +188,136 @@ class ColorMarker:
             return None
         if n == 2:   # one blob (the usual case): its statistics cost less than OpenCV's general ones
             stats = np.array([[0, 0, 0, 0, 0], [*cv2.boundingRect(core), cv2.countNonZero(core)]])
-            cents = None
+            order = np.array([1])
         else:
-            n, labels, stats, cents = cv2.connectedComponentsWithStats(core, connectivity=8)
-        areas = stats[1:, cv2.CC_STAT_AREA]
-        candidates = np.flatnonzero(areas >= self.min_area_px) + 1
-        if candidates.size == 0:
-            return None
-        if candidates.size == 1:
-            best = int(candidates[0])
-        elif centre is None:
-            best = candidates[np.argmax(stats[candidates, cv2.CC_STAT_AREA])]
-        else:
-            d = np.hypot(cents[candidates, 0] + x0 - centre[0], cents[candidates, 1] + y0 - centre[1])
-            best = candidates[np.argmin(d)]
-        if _touches_edge(stats[best], roi.shape, box, image.shape):
-            if whole_inside:
-                return None
-            # the window cut the blob (the prediction was off): look again around what it saw
-            bx, by, bw, bh = (int(v) for v in stats[best, :4])
-            seen_at = (x0 + bx + bw / 2, y0 + by + bh / 2)
-            radius = math.sqrt(self._usual_area / math.pi) if self._areas else max(bw, bh)
-            return self._locate_in(image, window(seen_at, int(3 * radius) + 6, image.shape), seen_at, True)
-        area = float(stats[best, cv2.CC_STAT_AREA])
-        usual = self._usual_area if self._areas else area
-        score = area / usual
-        if self._areas and score < self.partial_fraction:
-            return Detection.missing(score)
-        self._areas.append(area)
-        self._usual_area = statistics.median(self._areas)
+            stats, cents = _component_stats(core, labels, n)
+            order = np.arange(1, n)
+            if centre is None:   # largest first
+                order = order[np.argsort(-stats[order, cv2.CC_STAT_AREA], kind="stable")]
+            else:                # nearest the prediction first
+                order = order[np.argsort(np.hypot(cents[order, 0] + x0 - centre[0], cents[order, 1] + y0 - centre[1]),
+                                         kind="stable")]
+        order = order[stats[order, cv2.CC_STAT_AREA] >= self.min_area_px]
+        for best in order.tolist():
+            bx, by, bw, bh, area = stat = stats[best].tolist()
+            if _touches_edge(stat, roi.shape, box, image.shape):
+                if whole_inside:
+                    return None
+                # the window cut the blob (the prediction was off): look again around what it saw
+                seen_at = (x0 + bx + bw / 2, y0 + by + bh / 2)
+                radius = math.sqrt(self._usual_area / math.pi) if self._areas else max(bw, bh)
+                half = int(3 * radius + max(bw, bh) / 2) + 6
+                return self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
+            if _on_image_border(stat, box, image.shape):
+                continue   # cut by the picture's edge: its centroid is not the marker's
+            blob = (labels[by:by + bh, bx:bx + bw] == best).view(np.uint8)
+            shape = _blob_shape(blob, area)
+            at = (x0 + bx + bw / 2, y0 + by + bh / 2)
+            if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
+                continue
+            if self._near_distractor(*at):
+                continue   # a look-alike seen at the start is never taken
+            return self._measure(roi, labels, stat, best, shape, x0, y0)
+        return None
+
+    def _near_distractor(self, x: float, y: float) -> bool:
+        """True if (x, y) lies on a look-alike's bounding box, grown by a marker radius."""
+        r = 0.5 * self._usual_width + 1.0
+        return any(bx - r <= x <= bx + bw + r and by - r <= y <= by + bh + r for bx, by, bw, bh in self._distractors)
+
+    def _fits(self, shape: BlobShape, at: tuple[float, float]) -> bool:
+        """Size and shape of the marker: learned from the round, whole sightings so far; the
+        first sighting must be round. Motion blur may stretch it by up to the distance it moves
+        in a frame, along its motion: the predicted one, or the way it went since it was last
+        seen (a launch from rest is not predicted)."""
+        if not self._areas:
+            return shape.minor_px >= 0.6 * shape.major_px
+        if shape.area_px < self.partial_fraction * self._usual_area:
+            return False
+        d = self._usual_width
+        last = self.track.last_point
+        gap = self.track.frames_lost(self._frame) + 1
+        moved = ((at[0] - last[0]) / gap, (at[1] - last[1]) / gap)
+        streak = 1.2 * max(self._speed, math.hypot(*moved)) + 2.0
+        if shape.area_px > 1.6 * self._usual_area + d * streak:
+            return False
+        if d < 5.0:   # a few pixels across: too small to judge its shape
+            return True
+        if not (0.6 * d <= shape.minor_px <= 1.5 * d and shape.major_px <= 1.5 * d + streak):
+            return False
+        if shape.major_px > 1.4 * shape.minor_px:   # a blur streak lies along the motion
+            return _along(shape.angle_rad, self._velocity, d) or _along(shape.angle_rad, moved, d)
+        return True
+
+    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int) -> Detection:
+        """The blob's coverage centroid; a round, whole blob also teaches the marker's size."""
         # the centroid needs the blob and four pixels around it (two dilations of 5x5)
-        bx, by, bw, bh = (int(v) for v in stats[best, :4])
+        bx, by, bw, bh = stat[:4]
         cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
         cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
         blob = labels[cy0:cy1, cx0:cx1] == best
         px, py = _coverage_centroid(roi[cy0:cy1, cx0:cx1], blob)
+        area = float(shape.area_px)
+        score = area / self._usual_area if self._areas else 1.0
+        if shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn the marker's size from it
+            self._areas.append(area)
+            self._widths.append(shape.minor_px)
+            self._usual_area = statistics.median(self._areas)
+            self._usual_width = statistics.median(self._widths)
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
+
+
+def _component_stats(core: np.ndarray, labels: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``cv2.connectedComponentsWithStats``'s stats and centroids from the labels, computed
+    over the set pixels only (OpenCV's pass over a whole sparse 720p image costs ~8 ms)."""
+    pts = cv2.findNonZero(core).reshape(-1, 2)
+    xs, ys = pts[:, 0], pts[:, 1]
+    lab = labels[ys, xs]
+    area = np.bincount(lab, minlength=n)
+    x0, y0 = np.full(n, labels.shape[1]), np.full(n, labels.shape[0])
+    x1, y1 = np.full(n, -1), np.full(n, -1)
+    np.minimum.at(x0, lab, xs)
+    np.minimum.at(y0, lab, ys)
+    np.maximum.at(x1, lab, xs)
+    np.maximum.at(y1, lab, ys)
+    stats = np.stack([x0, y0, x1 - x0 + 1, y1 - y0 + 1, area], axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cents = np.stack([np.bincount(lab, xs, n) / area, np.bincount(lab, ys, n) / area], axis=1)
+    return stats, cents
+
+
+def _along(angle_rad: float, velocity: tuple[float, float], diameter_px: float) -> bool:
+    """True if a streak at ``angle_rad`` lies within 30 degrees of a motion of ``velocity``
+    px/frame, fast enough to smear a marker of ``diameter_px`` visibly."""
+    vx, vy = velocity
+    speed = math.hypot(vx, vy)
+    if speed < 0.3 * diameter_px:
+        return False
+    return abs(vx * math.cos(angle_rad) + vy * math.sin(angle_rad)) / speed >= math.cos(math.radians(30))
+
+
+@dataclass(frozen=True)
+class BlobShape:
+    area_px: float
+    major_px: float     # full lengths of the equivalent ellipse (4 sigma): a disc's diameter
+    minor_px: float
+    angle_rad: float = 0.0   # direction of the major axis (image x right, y down)
+
+
+def _blob_shape(blob: np.ndarray, area: int) -> BlobShape:
+    """Area and equivalent ellipse of a blob given as a 0/1 mask of its bounding box."""
+    m = cv2.moments(blob, binaryImage=True)
+    a, b, c = m["mu20"] / m["m00"], m["mu11"] / m["m00"], m["mu02"] / m["m00"]
+    root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
+    # + 1/12 per axis: a pixel is a square, not a point
+    lam1, lam2 = (a + c) / 2 + root + 1 / 12, (a + c) / 2 - root + 1 / 12
+    return BlobShape(float(area), 4 * math.sqrt(lam1), 4 * math.sqrt(max(lam2, 0.0)), 0.5 * math.atan2(2 * b, a - c))
+
+
+def _on_image_border(stat: list[int], box, image_shape) -> bool:
+    x, y, w, h = stat[:4]
+    x0, y0 = box[0] + x, box[1] + y
+    return x0 <= 0 or y0 <= 0 or x0 + w >= image_shape[1] or y0 + h >= image_shape[0]
 
 
 RING_PX = 4
@@ -157,9 +356,9 @@ def _median(values: np.ndarray) -> np.floating:
     return (part[k - 1] + part[k]) / np.float32(2)
 
 
-def _touches_edge(stat: np.ndarray, roi_shape, box, image_shape) -> bool:
+def _touches_edge(stat: list[int], roi_shape, box, image_shape) -> bool:
     """True if a blob reaches a window edge that is not also the image edge."""
-    x, y, w, h = (int(v) for v in stat[:4])
+    x, y, w, h = stat[:4]
     x0, y0, x1, y1 = box
     margin = 3  # the coverage ring needs room too
     return ((x < margin and x0 > 0) or (y < margin and y0 > 0)

@@ -9,6 +9,7 @@ marker not found is ``nan`` with ok 0). This module turns a
 
 from __future__ import annotations
 
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -52,6 +53,7 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
                  "time": "t_s = (frame - start) / fps"},
         "calibration": result.calibration.as_dict(),
         "markers": [{"name": t.name, "spec": t.spec, "frames": len(t.ok), "found": t.found(),
+                     **asdict(track_events(t.px, t.py, t.ok)),
                      "missing_frames": [int(f) for f in result.frames[~t.ok]]} for t in result.markers],
         "scores": {"frame": [int(f) for f in result.frames],
                    **{t.name: [float(s) for s in t.score] for t in result.markers}},
@@ -66,6 +68,33 @@ def write_tracks(result: TrackResult, csv_path: Path) -> tuple[Path, Path]:
     return csv_path, json_path
 
 
+JUMP_MIN_PX = 50.0
+
+
+@dataclass(frozen=True)
+class TrackEvents:
+    """How a marker's track holds together: a tracker that jumps to a look-alike shows here."""
+
+    gaps: int              # runs of frames not found, after the first sighting
+    longest_gap: int       # frames
+    reacquired: int        # sightings after a gap
+    jumps: int             # frame-to-frame steps larger than 50 px and 5 times the median step
+
+
+def track_events(px: np.ndarray, py: np.ndarray, ok: np.ndarray) -> TrackEvents:
+    idx = np.flatnonzero(ok)
+    if idx.size == 0:
+        return TrackEvents(0, 0, 0, 0)
+    apart = np.diff(idx)
+    missing = apart[apart > 1] - 1
+    steps = np.hypot(np.diff(px[idx]), np.diff(py[idx]))[apart == 1]
+    typical = float(np.median(steps)) if steps.size else 0.0
+    jumps = int(np.sum((steps > JUMP_MIN_PX) & (steps > 5 * typical)))
+    tail = len(ok) - 1 - idx[-1]
+    return TrackEvents(int(missing.size + (tail > 0)), int(max(missing.max(initial=0), tail)), int(missing.size),
+                       jumps)
+
+
 def summary_lines(result: TrackResult) -> list[str]:
     lines = []
     n = len(result.frames)
@@ -78,6 +107,9 @@ def summary_lines(result: TrackResult) -> list[str]:
         if missing.size:
             shown = ", ".join(str(int(f)) for f in missing[:8]) + (" ..." if missing.size > 8 else "")
             line += f"; missing frames {shown}"
+        ev = track_events(t.px, t.py, t.ok)
+        line += (f"; {ev.gaps} gap(s), longest {ev.longest_gap} frames, {ev.reacquired} re-acquisition(s), "
+                 f"{ev.jumps} jump(s)")
         lines.append(line)
     lines.append(result.calibration.summary())
     return lines

@@ -13,6 +13,8 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Iterable
 
+import numpy as np
+
 Point = tuple[float, float]
 
 LOOKBACK = 4  # Tracker's predictionLookback
@@ -69,3 +71,83 @@ class MotionHistory:
     def search_centre(self) -> Point | None:
         """The look-ahead prediction, or the last position seen when there is none."""
         return predict_next(self._points) or self.last_found
+
+
+def _quadratic_fit_matrix(n: int) -> np.ndarray:
+    """Least-squares quadratic through frames -n+1 .. 0: coefficients = matrix @ positions."""
+    f = np.arange(1 - n, 1, dtype=float)
+    return np.linalg.pinv(np.vander(f, 3))
+
+
+_CONSECUTIVE_FIT = {n: _quadratic_fit_matrix(n).tolist() for n in range(3, 9)}
+
+
+class Trajectory:
+    """Where a marker should be on a given frame, also across frames it was not seen.
+
+    A least-squares constant-acceleration fit (per axis, over the frame number) to the last
+    ``keep`` positions found; with two positions constant velocity, with one the position
+    itself. While the marker is lost the fit is extrapolated, so a sticker that leaves the
+    picture on a ballistic arc is looked for where it comes back.
+    """
+
+    def __init__(self, keep: int = 5) -> None:  # 3 <= keep <= 8
+        self._found: deque[tuple[int, float, float]] = deque(maxlen=keep)
+        self.max_speed_px: float = 0.0
+        self._coef: list[tuple[float, float]] | None = None
+
+    def add(self, frame: int, point: Point | None) -> None:
+        if point is None:
+            return
+        if self._found:
+            f, x, y = self._found[-1]
+            if frame - f == 1:
+                self.max_speed_px = max(self.max_speed_px, ((point[0] - x) ** 2 + (point[1] - y) ** 2) ** 0.5)
+        self._found.append((frame, point[0], point[1]))
+        self._coef = None
+
+    @property
+    def sightings(self) -> int:
+        """Positions held (at most ``keep``)."""
+        return len(self._found)
+
+    @property
+    def last_frame(self) -> int | None:
+        return self._found[-1][0] if self._found else None
+
+    def frames_lost(self, frame: int) -> int:
+        """Frames since the last one found, not counting ``frame`` itself (0: found just before)."""
+        return frame - self._found[-1][0] - 1 if self._found else 0
+
+    def _fit(self) -> list[tuple[float, float]] | None:
+        """Polynomial coefficients (highest power first; columns x, y) in frames since the last
+        sighting, computed once per sighting."""
+        if self._coef is None and self._found:
+            n = len(self._found)
+            if n == self._found.maxlen and self._found[-1][0] - self._found[0][0] == n - 1:
+                # consecutive sightings, the usual case: a fixed matrix, in plain Python (fast)
+                self._coef = [(sum(m * p[1] for m, p in zip(row, self._found)),
+                               sum(m * p[2] for m, p in zip(row, self._found))) for row in _CONSECUTIVE_FIT[n]]
+                return self._coef
+            f = np.array([p[0] for p in self._found], float)
+            xy = np.array([p[1:] for p in self._found], float)
+            recent = f >= f[-1] - 2 * len(f)        # a fit only over one stretch of sightings
+            f, xy = f[recent] - f[-1], xy[recent]
+            degree = min(len(f) - 1, 2)
+            coef = xy[-1:] if degree == 0 else np.polyfit(f, xy, degree)
+            self._coef = [(float(cx), float(cy)) for cx, cy in coef]
+        return self._coef
+
+    def predict(self, frame: int) -> Point | None:
+        c = self._fit()
+        if c is None:
+            return None
+        dt = frame - self._found[-1][0]
+        x = y = 0.0
+        for cx, cy in c:
+            x, y = x * dt + cx, y * dt + cy
+        return x, y
+
+    @property
+    def last_point(self) -> Point | None:
+        return (self._found[-1][1], self._found[-1][2]) if self._found else None

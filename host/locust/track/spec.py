@@ -2,7 +2,7 @@
 
 Specs::
 
-    color:#RRGGBB          a coloured sticker (tolerance: --color-tol)
+    color:#RRGGBB[@X,Y]    a coloured sticker (tolerance: --color-tol), first looked for near (X, Y)
     template:X,Y@FRAME     Tracker's autotracker, template around (X, Y) on FRAME
     aruco:ID[@DICT]        an ArUco marker (default dictionary DICT_4X4_50)
 
@@ -51,8 +51,17 @@ def parse_marker(text: str, options: ModelOptions = ModelOptions()):
     kind, _, arg = spec.partition(":")
     kind = kind.lower()
     if kind in ("color", "colour"):
-        return ColorMarker(name, spec, parse_hex(arg), tolerance=options.color_tol,
-                           search_half_px=options.search_half_px)
+        colour, at, start = arg.partition("@")
+        start_px = None
+        if at:
+            m = re.fullmatch(rf"\s*({NUM})\s*,\s*({NUM})\s*", start)
+            if not m:
+                raise TrackError(f"--marker {text!r}: colour spec must be color:#RRGGBB or color:#RRGGBB@X,Y",
+                                 "give the sticker's pixel position on the first frame, e.g. color:#e8308c@412,630 "
+                                 "(locust track VIDEO --preview 0 shows the positions)")
+            start_px = (float(m.group(1)), float(m.group(2)))
+        return ColorMarker(name, spec, parse_hex(colour), tolerance=options.color_tol,
+                           search_half_px=options.search_half_px, start_px=start_px)
     if kind == "template":
         m = re.fullmatch(rf"\s*({NUM})\s*,\s*({NUM})\s*@\s*(\d+)\s*", arg)
         if not m:
@@ -68,7 +77,7 @@ def parse_marker(text: str, options: ModelOptions = ModelOptions()):
                              "give the marker's id number, e.g. aruco:7")
         return ArucoMarker(name, spec, int(m.group(1)), m.group(2) or DEFAULT_DICTIONARY)
     raise TrackError(f"--marker {text!r}: unknown marker kind {kind!r}",
-                     "use color:#RRGGBB, template:X,Y@FRAME or aruco:ID")
+                     "use color:#RRGGBB[@X,Y], template:X,Y@FRAME or aruco:ID")
 
 
 def parse_markers(texts: list[str] | tuple[str, ...], options: ModelOptions = ModelOptions()) -> list:

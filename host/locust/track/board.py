@@ -1,0 +1,220 @@
+"""Metres from the picture: a plane homography from an ArUco grid board, or four points.
+
+``--board aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM`` names an OpenCV grid board
+(``cv2.aruco.GridBoard``; DICT as OpenCV names it without ``DICT_``, e.g. ``4X4_50``)
+lying in the plane the markers move in. It is detected in the first frames of the clip
+(``cv2.aruco.ArucoDetector``, sub-pixel corners), every detected corner is matched to its
+place on the board (``GridBoard.matchImagePoints``) and ``cv2.findHomography`` fits the
+image -> plane map. ``--plane-points`` gives the same map from four (or more) pixels whose
+plane coordinates were measured by hand.
+
+Plane coordinates: metres, origin at the board's bottom-left corner (the outer corner of
+the bottom-left marker), x along the board's bottom edge, y up the board. A homography is
+exact for points *in* the plane; a marker in front of it (a sticker on a robot 2 cm
+nearer the camera) reads a little off, by its distance over the camera's distance.
+
+``locust track --make-board FILE.png`` writes the board at 300 DPI (the PNG records it):
+print it at 100 % ("actual size", no "fit to page"), then measure one marker with a ruler.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ..errors import TrackError
+from ..fileio import atomic_write_bytes
+from .calib import NUM
+from .video import read_frames
+
+BOARD_DPI = 300
+BOARD_MARGIN_MM = 10.0
+DEFAULT_BOARD = "aruco:4X4_50:5x4:40:10"   # 240 x 190 mm: fits an A4 sheet
+DETECT_FRAMES = 30       # frames searched for the board at the start of the clip
+MIN_BOARD_MARKERS = 2    # 8 corners: enough for a homography, with some redundancy
+
+
+@dataclass(frozen=True)
+class BoardSpec:
+    """An ArUco grid board, as printed."""
+
+    dictionary: str          # cv2.aruco name, e.g. DICT_4X4_50
+    cols: int
+    rows: int
+    marker_mm: float
+    gap_mm: float
+
+    @property
+    def width_mm(self) -> float:
+        return self.cols * self.marker_mm + (self.cols - 1) * self.gap_mm
+
+    @property
+    def height_mm(self) -> float:
+        return self.rows * self.marker_mm + (self.rows - 1) * self.gap_mm
+
+    def text(self) -> str:
+        return f"aruco:{self.dictionary[5:]}:{self.cols}x{self.rows}:{self.marker_mm:g}:{self.gap_mm:g}"
+
+    def board(self) -> cv2.aruco.GridBoard:
+        d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
+        return cv2.aruco.GridBoard((self.cols, self.rows), self.marker_mm / 1000.0, self.gap_mm / 1000.0, d)
+
+    def image(self, px_per_mm: float, margin_mm: float = BOARD_MARGIN_MM) -> np.ndarray:
+        """The board drawn at ``px_per_mm``, with a white margin (grey levels, uint8): marker k
+        at column k % cols, row k // cols from the top, as ``cv2.aruco.GridBoard`` numbers them."""
+        d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
+        to_px = lambda mm: int(round(mm * px_per_mm))   # noqa: E731
+        img = np.full((to_px(self.height_mm + 2 * margin_mm), to_px(self.width_mm + 2 * margin_mm)), 255, np.uint8)
+        for k in range(self.cols * self.rows):
+            x0 = to_px(margin_mm + (k % self.cols) * (self.marker_mm + self.gap_mm))
+            y0 = to_px(margin_mm + (k // self.cols) * (self.marker_mm + self.gap_mm))
+            x1 = to_px(margin_mm + (k % self.cols) * (self.marker_mm + self.gap_mm) + self.marker_mm)
+            y1 = to_px(margin_mm + (k // self.cols) * (self.marker_mm + self.gap_mm) + self.marker_mm)
+            side = max(x1 - x0, y1 - y0)
+            img[y0:y0 + side, x0:x0 + side] = cv2.aruco.generateImageMarker(d, k, side, borderBits=1)
+        return img
+
+
+def parse_board(text: str) -> BoardSpec:
+    """``aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM`` -> :class:`BoardSpec`."""
+    m = re.fullmatch(rf"\s*aruco:(\w+):(\d+)[xX](\d+):({NUM}):({NUM})\s*", text)
+    hint = "e.g. --board aruco:4X4_50:5x4:40:10 (5 x 4 markers of 40 mm, 10 mm apart)"
+    if not m:
+        raise TrackError(f"--board {text!r}: expected aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM", hint)
+    name = m.group(1).upper()
+    dictionary = name if name.startswith("DICT_") else f"DICT_{name}"
+    if not hasattr(cv2.aruco, dictionary):
+        raise TrackError(f"--board {text!r}: unknown ArUco dictionary {m.group(1)!r}",
+                         "use OpenCV's name without DICT_, e.g. 4X4_50, 5X5_100, 6X6_250")
+    cols, rows, marker_mm, gap_mm = int(m.group(2)), int(m.group(3)), float(m.group(4)), float(m.group(5))
+    if cols < 1 or rows < 1 or cols * rows < MIN_BOARD_MARKERS or not marker_mm > 0 or gap_mm < 0:
+        raise TrackError(f"--board {text!r}: needs at least {MIN_BOARD_MARKERS} markers of positive size", hint)
+    spec = BoardSpec(dictionary, cols, rows, marker_mm, gap_mm)
+    n_ids = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, dictionary)).bytesList.shape[0]
+    if cols * rows > n_ids:
+        raise TrackError(f"--board {text!r}: {cols * rows} markers, but {dictionary} holds {n_ids}",
+                         "use a larger dictionary or fewer markers")
+    return spec
+
+
+def write_board_png(path: Path, spec: BoardSpec, dpi: int = BOARD_DPI) -> Path:
+    """Write the board at ``dpi`` (recorded in the PNG) for printing at 100 %."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(spec.image(dpi / 25.4)).save(buf, format="PNG", dpi=(dpi, dpi))
+    return atomic_write_bytes(path, buf.getvalue())
+
+
+@dataclass(frozen=True)
+class PlaneHomography:
+    """Image pixels -> plane metres (x along the board, y up), through a 3x3 homography."""
+
+    H: np.ndarray                      # image (px, py, 1) -> plane (x_m, y_m, 1)
+    source: str
+    residual_mm: float = math.nan      # RMS of the fitted points in the plane
+    n_points: int = 0
+    frame: int | None = None
+    H_inv: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "H_inv", np.linalg.inv(self.H))
+
+    @property
+    def m_per_px(self) -> float:
+        """Scale near the plane origin (a guide only: it varies across a tilted plane)."""
+        o = self.H_inv @ np.array([0.0, 0.0, 1.0])
+        o = o[:2] / o[2]
+        x, _ = self.to_world(np.array([o[0], o[0] + 1.0]), np.array([o[1], o[1]]))
+        y, _ = self.to_world(np.array([o[0], o[0]]), np.array([o[1], o[1] + 1.0]))
+        return float(math.hypot(x[1] - x[0], y[1] - y[0]))
+
+    def to_world(self, px: np.ndarray, py: np.ndarray, marker: str | None = None,
+                 frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        px, py = np.asarray(px, float), np.asarray(py, float)
+        v = np.stack([px, py, np.ones_like(px)], axis=-1) @ self.H.T
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return v[..., 0] / v[..., 2], v[..., 1] / v[..., 2]
+
+    def to_image(self, x_m: np.ndarray, y_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        v = np.stack([np.asarray(x_m, float), np.asarray(y_m, float), np.ones(np.shape(x_m))], axis=-1) @ self.H_inv.T
+        return v[..., 0] / v[..., 2], v[..., 1] / v[..., 2]
+
+    def axes_px(self):
+        o = self.to_image(np.array([0.0, 0.01, 0.0]), np.array([0.0, 0.0, 0.01]))
+        uv = np.stack(o, axis=-1)
+        dirs = [(uv[k] - uv[0]) / np.linalg.norm(uv[k] - uv[0]) for k in (1, 2)]
+        return tuple(uv[0]), tuple(dirs[0]), tuple(dirs[1])
+
+    def summary(self) -> str:
+        where = f" on frame {self.frame}" if self.frame is not None else ""
+        return (f"plane from {self.source}{where}: {self.n_points} points, fit residual {self.residual_mm:.2f} mm; "
+                f"x_m/y_m in the plane, origin at its corner, y up (about {self.m_per_px * 1000:.3g} mm/px there)")
+
+    def as_dict(self) -> dict:
+        return {"source": self.source, "model": "plane homography, image px -> plane m (y up)",
+                "H_image_to_plane": self.H.tolist(), "fit_residual_mm": self.residual_mm,
+                "points": self.n_points, "frame": self.frame}
+
+
+def _fit(image_pts: np.ndarray, plane_pts: np.ndarray, source: str, frame: int | None = None) -> PlaneHomography:
+    H, _ = cv2.findHomography(image_pts.astype(np.float64), plane_pts.astype(np.float64), 0)
+    if H is None:
+        raise TrackError(f"{source}: no homography fits these points",
+                         "the points must not lie on one line; spread them over the plane")
+    v = np.c_[image_pts, np.ones(len(image_pts))] @ H.T
+    resid = np.hypot(*(v[:, :2] / v[:, 2:] - plane_pts).T)
+    return PlaneHomography(H, source, float(np.sqrt(np.mean(resid ** 2)) * 1000.0), len(image_pts), frame)
+
+
+def board_points(spec: BoardSpec, image_bgr: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """Detected board corners in ``image_bgr`` (px) and their plane positions (m, y up), or None."""
+    from .aruco import make_detector
+
+    gray = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2GRAY) if image_bgr.ndim == 3 else image_bgr
+    corners, ids, _ = make_detector(spec.dictionary).detectMarkers(gray)
+    if ids is None or len(ids) < MIN_BOARD_MARKERS:
+        return None
+    obj, img = spec.board().matchImagePoints(corners, ids)
+    if obj is None or len(obj) < 4 * MIN_BOARD_MARKERS:
+        return None
+    obj = obj.reshape(-1, 3)
+    plane = np.c_[obj[:, 0], spec.height_mm / 1000.0 - obj[:, 1]]   # OpenCV's board: y down from the top
+    return img.reshape(-1, 2).astype(np.float64), plane
+
+
+def board_homography(info, clip, spec: BoardSpec, frames: int = DETECT_FRAMES) -> PlaneHomography:
+    """Fit the plane to the board's corners in every one of the clip's first ``frames`` frames
+    that shows it (a still camera: the corners' noise averages out over the frames)."""
+    image_pts, plane_pts, first = [], [], None
+    for k, (frame, image) in enumerate(read_frames(info, clip)):
+        if k >= frames:
+            break
+        found = board_points(spec, image)
+        if found is not None:
+            image_pts.append(found[0])
+            plane_pts.append(found[1])
+            first = frame if first is None else first
+    if not image_pts:
+        raise TrackError(f"board {spec.text()} not found in the first {frames} frames of {info.path.name}",
+                         "check the dictionary, the marker count and that the board is in view and sharp; "
+                         "or give --plane-points")
+    return _fit(np.vstack(image_pts), np.vstack(plane_pts), f"board {spec.text()} ({len(image_pts)} frames)", first)
+
+
+def parse_plane_points(text: str) -> PlaneHomography:
+    """``PX,PY=X_M,Y_M;...`` (four or more) -> the homography through them."""
+    pairs = [p for p in re.split(r"[;\s]+", text.strip()) if p]
+    rx = re.compile(rf"({NUM}),({NUM})=({NUM}),({NUM})")
+    rows = [rx.fullmatch(p) for p in pairs]
+    if len(rows) < 4 or not all(rows):
+        raise TrackError(f"--plane-points {text!r}: expected four or more PX,PY=X_M,Y_M separated by ';'",
+                         "e.g. --plane-points '102,880=0,0;1650,870=1.2,0;1600,240=1.2,0.5;150,250=0,0.5'")
+    v = np.array([[float(x) for x in m.groups()] for m in rows])
+    return _fit(v[:, :2], v[:, 2:], "plane points")

@@ -1,0 +1,96 @@
+"""``locust track VIDEO --preview FRAME``: choose colours and start points without a GUI.
+
+The frame is written as a PNG with a labelled pixel grid, the most saturated blobs circled
+and numbered (their colour and position listed, ready for ``--marker
+NAME=color:#RRGGBB@X,Y``), and what each current marker spec finds on that frame marked
+with a cross and its name.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ..errors import TrackError
+from ..fileio import atomic_write_bytes
+from .video import Clip, read_frames
+
+MIN_SATURATION = 110   # OpenCV 8-bit saturation: a sticker, not a tinted wall
+MIN_VALUE = 50
+
+
+@dataclass(frozen=True)
+class Blob:
+    px: float
+    py: float
+    area_px: int
+    hex: str          # median colour, #RRGGBB
+
+    def line(self, k: int) -> str:
+        return f"  {k:2d}  {self.hex}  at {self.px:.0f},{self.py:.0f}  ({self.area_px} px)"
+
+
+def saturated_blobs(image_bgr: np.ndarray, count: int = 10, min_area_px: int = 6) -> list[Blob]:
+    """The ``count`` largest blobs of strongly saturated colour, largest first."""
+    hsv = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2HSV)
+    mask = cv2.inRange(hsv, (0, MIN_SATURATION, MIN_VALUE), (179, 255, 255))
+    n, labels, stats, cents = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    order = [k for k in np.argsort(-stats[:, cv2.CC_STAT_AREA]) if k != 0 and stats[k, 4] >= min_area_px][:count]
+    blobs = []
+    for k in order:
+        x, y, w, h = stats[k, :4]
+        pix = image_bgr[y:y + h, x:x + w][labels[y:y + h, x:x + w] == k]
+        b, g, r = (int(v) for v in np.median(pix, axis=0))
+        blobs.append(Blob(float(cents[k, 0]), float(cents[k, 1]), int(stats[k, 4]), f"#{r:02x}{g:02x}{b:02x}"))
+    return blobs
+
+
+def _label(image: np.ndarray, text: str, at: tuple[int, int], colour=(255, 255, 255), scale: float = 0.4) -> None:
+    """Text with a dark outline: readable on any background."""
+    cv2.putText(image, text, at, cv2.FONT_HERSHEY_SIMPLEX, scale, (0, 0, 0), 3, cv2.LINE_AA)
+    cv2.putText(image, text, at, cv2.FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv2.LINE_AA)
+
+
+def draw_grid(image: np.ndarray, step_px: int) -> None:
+    """Grid lines every ``step_px`` (inverted pixels: visible on any background), labelled."""
+    h, w = image.shape[:2]
+    image[:, ::step_px] = 255 - image[:, ::step_px]
+    image[::step_px, :] = 255 - image[::step_px, :]
+    for x in range(step_px, w, step_px):
+        _label(image, str(x), (x + 2, 12))
+    for y in range(step_px, h, step_px):
+        _label(image, str(y), (2, y - 3))
+
+
+def preview(info, frame: int, models: list, path: Path) -> tuple[list[Blob], dict[str, tuple[float, float] | None]]:
+    """Write the annotated ``frame`` of the video to ``path``; return the blobs and what each
+    marker model finds there (None: nothing)."""
+    if not 0 <= frame < info.frame_count:
+        raise TrackError(f"--preview {frame}: the video has frames 0..{info.frame_count - 1}", "pick a frame in it")
+    image = next(img for _, img in read_frames(info, Clip(frame, frame).resolved(info)))
+    blobs = saturated_blobs(image)
+    found = {}
+    for m in models:
+        if getattr(m, "key_frame", frame) != frame:
+            found[m.name] = None   # a template is cut on its own key frame
+            continue
+        det = m.locate(frame, image)
+        found[m.name] = det.point()
+    out = image.copy()
+    draw_grid(out, 50 if max(image.shape[:2]) <= 1000 else 100)
+    for k, b in enumerate(blobs, 1):
+        r = int(max(8, np.sqrt(b.area_px / np.pi) + 6))
+        cv2.circle(out, (int(round(b.px)), int(round(b.py))), r, (0, 0, 0), 3, cv2.LINE_AA)
+        cv2.circle(out, (int(round(b.px)), int(round(b.py))), r, (255, 255, 255), 1, cv2.LINE_AA)
+        _label(out, str(k), (int(b.px) + r, int(b.py) - r), scale=0.5)
+    for name, p in found.items():
+        if p is not None:
+            x, y = int(round(p[0])), int(round(p[1]))
+            cv2.drawMarker(out, (x, y), (0, 255, 0), cv2.MARKER_CROSS, 20, 2)
+            _label(out, name, (x + 8, y + 16), (0, 255, 0), 0.5)
+    ok, png = cv2.imencode(".png", out)
+    atomic_write_bytes(path, png.tobytes())
+    return blobs, found
