@@ -218,7 +218,8 @@ def aligned_residual(run: HopRun, sim: dict[str, np.ndarray] | None) -> tuple[np
     for m, tr in run.tracks.items():
         ts, xs, ys = sim[m]
         t = tr.t_s - shift
-        parts += [tr.x_m - np.interp(t, ts, xs), tr.y_m - np.interp(t, ts, ys)]
+        # before the simulation's kept lead the robot stands: at 0, from where it stood
+        parts += [tr.x_m - np.interp(t, ts, xs, left=0.0), tr.y_m - np.interp(t, ts, ys, left=0.0)]
     return np.concatenate(parts), shift
 
 
@@ -249,8 +250,9 @@ def check_keys(keys: list[str], runs: list[HopRun]) -> None:
 
 
 def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEYS, *, max_iter: int = 30,
-             progress: Callable[[int], None] | None = None) -> HopFit:
-    """Fit ``keys`` (shared by all runs) to the tracked markers; see the module docstring."""
+             grid_stages: int = GRID_STAGES, progress: Callable[[int], None] | None = None) -> HopFit:
+    """Fit ``keys`` (shared by all runs) to the tracked markers; see the module docstring.
+    ``grid_stages``: stages of the starting grid (0: start at the robot's values)."""
     t_start = time.perf_counter()
     keys = tuple(keys)
     if not runs:
@@ -281,7 +283,7 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
         if progress:
             progress(1)
 
-    x0 = grid_start(residual, len(keys))
+    x0 = grid_start(residual, len(keys), grid_stages)
     x, trace = minimize.least_squares(x0, residual, bounds=bounds, eps=FD_STEP,
                                       max_iter=max_iter, verbose=0, iter_callback=on_iter, xtol=1e-6, gtol=1e-8)
     x = np.asarray(x, dtype=float).ravel()
@@ -323,7 +325,7 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
                   simulations=counter["sims"], wall_s=time.perf_counter() - t_start)
 
 
-def grid_start(residual, n: int) -> np.ndarray:
+def grid_start(residual, n: int, stages: int = GRID_STAGES) -> np.ndarray:
     """The best point of a coarse-to-fine grid of factors about the start, each stage's grid
     simulated in one batch about the best point so far, its span halved (in log) each time:
     a hop sits near thresholds (a foot slipping or not, a crank tip touching the floor), so
@@ -333,7 +335,7 @@ def grid_start(residual, n: int) -> np.ndarray:
     best, best_cost = np.zeros(n), math.inf
     if levels is None:
         return best
-    for stage in range(GRID_STAGES):
+    for stage in range(stages):
         half = math.log(GRID_FACTOR) / 2 ** stage
         axis = np.linspace(-half, half, levels)
         xs = best[:, None] + np.array(np.meshgrid(*[axis] * n, indexing="ij")).reshape(n, -1)
