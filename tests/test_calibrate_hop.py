@@ -80,7 +80,7 @@ def test_fit_residual_is_the_noise_it_was_given(small_fit):
 
 
 def test_measured_phase_times_drive_the_command():
-    run = synthetic_run("small", TRUTH)
+    run = synthetic_run("small", TRUTH, cycles=1)
     late = H.HopRun(**{**run.__dict__, "phase_s": np.array([0.0, 0.4])})   # a push measured 100 ms long
     dt = run.robot.solver.timestep_s
     plan, plan_late = H.control_plan(run, run.robot), H.control_plan(late, run.robot)
@@ -91,7 +91,7 @@ def test_measured_phase_times_drive_the_command():
 
 
 def test_keys_that_cannot_be_fitted_are_refused():
-    run = synthetic_run("small", TRUTH)
+    run = synthetic_run("small", TRUTH, cycles=1)
     with pytest.raises(CalibrationError, match="real-valued"):
         H.check_keys(["schedule.cycles"], [run])
     with pytest.raises(CalibrationError, match="unknown robot parameter"):
@@ -113,3 +113,16 @@ def test_samples_spread_comes_from_the_uncertainties():
         bare = bare.with_provenance(key, Provenance(source="test"))
     none = S.sample(bare, 3, cycles=2)
     assert none.uncertain == {} and none.distance_m_sd == 0.0
+
+
+def test_sweep_ranks_designs_by_the_mean_over_draws():
+    from locust.sweep.design import evaluate
+
+    base = preset("seed")
+    plain = evaluate(base, {"scale": 0.0}, 1)
+    mean = evaluate(base, {"scale": 0.0}, 1, samples=4)
+    spread = S.sample(base, 4, cycles=1)
+    assert mean["distance_m"] == pytest.approx(spread.distance_m_mean, abs=1e-12)
+    assert mean["max_nose_height_m"] == pytest.approx(spread.max_nose_height_m_mean, abs=1e-12)
+    # the mean of the draws is not the nominal run's (the seed's servo values are uncertain)
+    assert abs(mean["distance_m"] - plain["distance_m"]) > 1e-6
