@@ -126,3 +126,13 @@ def test_sweep_ranks_designs_by_the_mean_over_draws():
     assert mean["max_nose_height_m"] == pytest.approx(spread.max_nose_height_m_mean, abs=1e-12)
     # the mean of the draws is not the nominal run's (the seed's servo values are uncertain)
     assert abs(mean["distance_m"] - plain["distance_m"]) > 1e-6
+
+
+def test_a_foot_friction_below_the_floors_is_called_inert():
+    # MuJoCo uses the larger friction of two geoms: the seed's floor is 1.6
+    notes: list[str] = []
+    H._friction_notes({"contact.foot_friction": 1.2}, preset("seed"), notes)
+    assert len(notes) == 1 and "changes nothing" in notes[0]
+    notes.clear()
+    H._friction_notes({"contact.foot_friction": 2.0}, preset("seed"), notes)
+    assert notes == []
