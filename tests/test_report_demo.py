@@ -43,10 +43,10 @@ def demo(tmp_path_factory):
 
 def test_demo_finishes_within_ten_minutes_with_progress(demo):
     assert demo["wall_s"] < 600
-    for n in range(1, 7):
-        assert f"[{n}/6]" in demo["stderr"]
+    for n in range(1, 8):
+        assert f"[{n}/7]" in demo["stderr"]
     timings = json.loads((demo["folder"] / "timings.json").read_text())
-    assert len(timings["stages"]) == 6 and timings["total_s"] < 600
+    assert len(timings["stages"]) == 7 and timings["total_s"] < 600
 
 
 def test_demo_keeps_what_it_used(demo):
@@ -99,7 +99,8 @@ def test_measured_hops_match_the_virtual_robots_own(demo):
             label = trial["label"]
             hops = [h for h in cfg["hops"] if h["trial"] == label]
             assert len(hops) == CYCLES
-            log = next(p for p in (demo["folder"] / "logs").glob("*-hop.log") if f"/{label}/" in p.read_text())
+            log = next(p for p in (demo["folder"] / "logs").glob("*-hop.log")
+                       if p.name.split("-", 1)[1] == "hop.log" and f"/{label}/" in p.read_text())
             plant_m = float(re.search(r"distance_m=(-?[\d.e-]+)", log.read_text()).group(1))
             measured_m = sum(h["measured_distance_m"] for h in hops)
             assert measured_m == pytest.approx(plant_m, abs=0.0003), (label, measured_m, plant_m)
@@ -109,3 +110,20 @@ def test_measured_hops_match_the_virtual_robots_own(demo):
             assert max(h["measured_apex_m"] for h in hops) == pytest.approx(true_jump, abs=0.0001)
             checked += 1
     assert checked == len(LEG_SETS) * TRIALS
+
+
+def test_demo_closes_the_loop(demo):
+    """The values hidden in the virtual robot (unlike the presets and the bench recordings)
+    are found from its filmed hops, and the report draws the prediction before the fit."""
+    hidden = json.loads((demo["folder"] / "virtual" / "truth.json").read_text())["hidden_for_hop_fit"]
+    assert hidden
+    fitted = load_robot(demo["folder"] / "calibration" / "robot.toml")
+    bench = load_robot(demo["folder"] / "calibration" / "robot-bench.toml")
+    for key, true in hidden.items():
+        assert fitted.source_of(key).source == "fit:hops", key
+        assert fitted.get(key) == pytest.approx(true, rel=0.10), key
+        assert abs(bench.get(key) - true) > 0.10 * true, key     # the bench alone could not have known
+    doc = json.loads((demo["report"].parent / "report.json").read_text())
+    for cfg in doc["configurations"]:
+        assert cfg["predicted_before_fit"]["valid"]
+        assert cfg["predicted_spread"]["n_valid"] >= 2

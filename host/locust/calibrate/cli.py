@@ -8,11 +8,12 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..errors import CalibrationError
+from ..errors import CalibrationError, ReportError
 from ..fileio import json_text
 from ..progress import progress
 from ..track.importing import ImportOptions, import_options
 from . import beam as B
+from . import hop as H
 from . import ramp as R
 from . import servo as S
 from .fitstats import Estimate
@@ -43,6 +44,7 @@ def calibrate() -> None:
     beam   cardstock cantilever, dropped tip mass  -> hinge stiffness, damping
     servo  servo steps carrying a battery         -> no-load speed, armature, kp
     ramp   ramp tilted until the robot slides      -> static friction mu
+    hop    filmed hops of one or more leg sets     -> any parameters, jointly
 
     Each prints the fitted values with 95% confidence intervals, draws a fit plot, and with
     --write updates robot.toml (only the fitted values, each with source fit:<file>, its
@@ -186,6 +188,87 @@ def ramp(data, ramp_markers, robot_marker, into, imports, write_path, as_json, p
             warnings=warnings)
 
 
+@calibrate.command()
+@click.argument("runs", nargs=-1, required=True)
+@click.option("--fit", "fit_keys", default=",".join(H.DEFAULT_KEYS), show_default=True, metavar="KEY[,KEY...]",
+              help="Robot parameters to fit, shared by every run (any real-valued key of `locust params`).")
+@click.option("--config", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Robot to start from [default: the --write file if it exists, else the seed preset].")
+@click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help="Override a starting value (repeatable).")
+@click.option("--max-iter", type=click.IntRange(1, 200), default=30, show_default=True, help="Solver iterations.")
+@click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
+@click.option("--no-plot", is_flag=True, help="Do not draw the fit plots.")
+@click.option("--write", "write_path", type=click.Path(dir_okay=False, path_type=Path),
+              is_flag=False, flag_value=str(DEFAULT_ROBOT_TOML), default=None,
+              help="Update this robot.toml with the identifiable fitted values only, source fit:hops "
+                   f"[bare --write: {DEFAULT_ROBOT_TOML}].")
+def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
+    """Fit the model to filmed hops: friction, hinge stiffness, servo speed on the robot.
+
+    Each RUN is a `locust hop --out` folder holding its run.json and the track of its video
+    (`locust track`), as NAME=FOLDER or a folder named after its leg set (small-1/, large/).
+    Runs of different leg sets are fitted together: their geometry differs, the fitted
+    physics is shared. The firmware's measured phase times drive each simulation; the
+    tracked nose and foot are compared with the simulated markers, both aligned on the first
+    push. Prints each value with its 95% interval and the RMS residual per run, and draws
+    <run>/hops-fit.png (tracked against the fitted simulation).
+
+    \b
+    Example:
+      locust calibrate hop small=runs/s1 large=runs/l1 --write calibration/robot.toml
+    """
+    from ..params import resolve_robot
+    from ..report.configs import name_from_path
+
+    keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
+    start_from = config or (write_path if write_path and Path(write_path).exists() else None)
+    base = resolve_robot(None, start_from, sets)
+    loaded = []
+    for item in runs:
+        name, sep, rest = item.partition("=")
+        if sep and name and "/" not in name and not Path(item).exists():
+            path, leg_set = Path(rest), name
+        else:
+            path = Path(item)
+            try:
+                leg_set = name_from_path(path)
+            except ReportError:
+                raise CalibrationError(f"{path}: cannot tell which leg set this run is from its folder's name",
+                                       "name it: small=PATH") from None
+        loaded.append(H.load_run(path, leg_set, base))
+    with progress(length=max_iter, label="fitting hops") as bar:
+        fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=bar.update)
+    out = fit.summary()
+    if not no_plot:
+        out["plots"] = []
+        for run in fit.runs:
+            if run.curves:
+                plot = Path(run.source) / "hops-fit.png"
+                out["plots"].append(str(H.plot_run(run, plot, f"RMS {1000 * run.rms_m:.2f} mm")))
+    if write_path:
+        values = {k: fit.estimates[k] for k in fit.keys if fit.identifiable[k]}
+        if values:
+            note = "filmed hops " + ", ".join(f"{r.config}:{Path(r.source).name}" for r in fit.runs)
+            write_fitted(write_path, values, H.PROVENANCE_NAME, note=note)
+        out["written"] = {"path": str(write_path), "keys": list(values)}
+    if as_json:
+        click.echo(json_text(out), nl=False)
+        return
+    click.echo(f"# hops: {len(fit.runs)} runs, {fit.simulations} simulations, {fit.wall_s:.1f} s")
+    for key, val in out["parameters"].items():
+        _print_text_value(key, val)
+    for run in fit.runs:
+        click.echo(f"{run.config:8s} {run.source}: RMS residual {1000 * run.rms_m:.3f} mm")
+    for note in fit.notes:
+        click.echo(f"note: {note}")
+    for plot in out.get("plots", []):
+        click.echo(f"plot: {plot}")
+    if "written" in out:
+        keys = out["written"]["keys"]
+        click.echo(f"wrote {', '.join(keys)} to {out['written']['path']}" if keys
+                   else f"nothing written to {out['written']['path']}: no value was identifiable")
+
+
 # -- helpers ------------------------------------------------------------------------
 def _servo_series(data: Path, pivot: str | None, step: str | None, marker: str | None,
                   imports: ImportOptions):
@@ -257,15 +340,7 @@ def _print_text(out: dict) -> None:
         if key in ("experiment", "source", "notes", "warnings", "written", "plot", "angles_deg"):
             continue
         if isinstance(val, dict) and "value" in val:
-            flag = "" if val.get("identifiable", True) else "   NOT IDENTIFIABLE"
-            if val.get("given"):
-                click.echo(f"{key:30s} {val['value']:<12.6g} (given)")
-            elif val["std"] is None or not math.isfinite(val["std"]):
-                click.echo(f"{key:30s} {val['value']:<12.6g} (undetermined){flag}")
-            else:
-                lo, hi = val["ci95"]
-                click.echo(f"{key:30s} {val['value']:<12.6g} ± {val['std']:.3g} (1σ)  "
-                           f"95% CI [{lo:.6g}, {hi:.6g}]{flag}")
+            _print_text_value(key, val)
         elif isinstance(val, list) and all(isinstance(v, float) for v in val):
             click.echo(f"{key:30s} {', '.join(format(v, '.6g') for v in val)}")
         elif val is not None:
@@ -278,3 +353,15 @@ def _print_text(out: dict) -> None:
         keys = out["written"]["keys"]
         click.echo(f"wrote {', '.join(keys)} to {out['written']['path']}" if keys
                    else f"nothing written to {out['written']['path']}: no value was identifiable")
+
+
+def _print_text_value(key: str, val: dict) -> None:
+    flag = "" if val.get("identifiable", True) else "   NOT IDENTIFIABLE"
+    if val.get("given"):
+        click.echo(f"{key:30s} {val['value']:<12.6g} (given)")
+    elif val["std"] is None or not math.isfinite(val["std"]):
+        click.echo(f"{key:30s} {val['value']:<12.6g} (undetermined){flag}")
+    else:
+        lo, hi = val["ci95"]
+        click.echo(f"{key:30s} {val['value']:<12.6g} ± {val['std']:.3g} (1σ)  "
+                   f"95% CI [{lo:.6g}, {hi:.6g}]{flag}")

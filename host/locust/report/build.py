@@ -26,6 +26,7 @@ from .landscape import Landscape, read_landscape
 from .measured import Trial
 from .predict import predict
 from .sidebyside import plan_side_by_side, write_side_by_side
+from .spread import spread
 
 REPORT_NAME = "report.html"
 DASHBOARD_NAME = "dashboard.png"
@@ -88,7 +89,9 @@ def parameter_rows(robot: Robot) -> list[dict]:
 def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, robot_source: str,
                  cycles: int | None = None, sweep: Path | None = None, added: dict[str, float] | None = None,
                  marker: str = "nose", progress: Callable[[str], None] | None = None,
-                 side_by_side: bool = False) -> ReportResult:
+                 side_by_side: bool = False, samples: int = 0, before: Robot | None = None) -> ReportResult:
+    """``samples``: draws of the robot's uncertain values per configuration (bands and error
+    bars on the predictions); ``before``: the robot before a fit, its predictions drawn too."""
     progress = progress or (lambda msg: None)
     added = added or {}
     unknown = sorted(set(added) - set(measured))
@@ -100,6 +103,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
 
     configs: dict[str, Configuration] = {}
     comps: list[Comparison] = []
+    spreads, befores = {}, {}
     for name, trials in measured.items():
         cfg = configuration(base, name, added.get(name))
         sched = run_schedule(name, trials)
@@ -110,6 +114,12 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
         progress(f"simulating {cfg.label} ({n_cycles} cycles)")
         pred = predict(name, cfg.robot, n_cycles, marker, keep_states=side_by_side)
         comps.append(compare(pred, trials, n_cycles, period))
+        if samples and pred.valid:
+            progress(f"simulating {samples} draws of {cfg.label}'s uncertain values")
+            spreads[name] = spread(cfg.robot, n_cycles, marker, samples)
+        if before is not None:
+            old = configuration(before, name, added.get(name))
+            befores[name] = predict(name, with_run_schedule(old.robot, sched), n_cycles, marker)
 
     progress("drawing figures")
     labels = {name: cfg.label for name, cfg in configs.items()}
@@ -117,15 +127,18 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     figs = [
         H.Figure("overlay", f"Displacement and height vs time: {names_text}",
                  "Nose forward travel and height above standing, every measured trial (solid) and the audited "
-                 "simulation (dashed), on the schedule's clock (t = 0 at the first push; grey lines: cycle starts).",
-                 F.overlay_figure(comps)),
+                 "simulation (dashed), on the schedule's clock (t = 0 at the first push; grey lines: cycle starts)."
+                 + (" Grey band: mean ± 1 sd of the simulation at draws of the robot file's uncertain values."
+                    if spreads else "")
+                 + (" Dotted red: the simulation on the robot before the fit." if befores else ""),
+                 F.overlay_figure(comps, spreads, befores)),
         H.Figure("jump", f"Jump height, measured against predicted: {names_text}",
                  "Highest nose point above standing; measured bars show the mean over trials with ±1 sd "
                  "error bars where repeated trials exist; hatched bars are the simulation's.",
                  F.bars_figure(comps, "jump")),
         H.Figure("hops", f"Each hop, measured against predicted: {names_text}",
                  "Per-hop distance and nose apex of every trial (dots) and the simulation (dashed).",
-                 F.hops_figure(comps)),
+                 F.hops_figure(comps, spreads)),
     ]
     if land is not None:
         figs.append(H.Figure("landscape", f"Sweep landscape with {names_text} marked",
@@ -141,6 +154,10 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     warnings = notices(comps)
     html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings)
     doc = report_json(base, robot_source, comps, configs, timing, land, marker, warnings)
+    for entry in doc["configurations"]:
+        sp, old = spreads.get(entry["name"]), befores.get(entry["name"])
+        entry["predicted_spread"] = sp.to_json() if sp is not None else None
+        entry["predicted_before_fit"] = old.result.to_json() if old is not None else None
 
     sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from ..params import resolve_robot
+from ..params import load_robot, resolve_robot
 from ..params_cli import robot_options
 from ..track.importing import import_options
 
@@ -35,8 +35,14 @@ def _stage(msg: str) -> None:
 @click.option("--side-by-side", "side_by_side", is_flag=True,
               help="Also write <trial>.side_by_side.mp4 for each trial with a video: the filmed hop beside the "
                    "simulation from the same camera (its camera.json), on the schedule's clock.")
+@click.option("--samples", type=click.IntRange(2, 256), default=None, metavar="N",
+              help="Draw the robot file's uncertain values N times per configuration: bands on the predicted "
+                   "curves, error bars on the predicted hops.")
+@click.option("--before", "before_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="The robot.toml before a fit (e.g. `locust calibrate hop`): its predictions are drawn too.")
 @import_options
-def report(measured, config, preset, sets, added, sweep, cycles, marker, out, side_by_side, imports):
+def report(measured, config, preset, sets, added, sweep, cycles, marker, out, side_by_side, samples, before_path,
+           imports):
     """Compare simulation and measurement for each configuration in one self-contained HTML page.
 
     Each configuration (Small/Medium/Large: the --config/--preset robot with +0/+1/+2 cm on
@@ -62,7 +68,8 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
     if sets:
         source += " with " + ", ".join(sets)
     result = build_report(robot, groups, out, robot_source=source, cycles=cycles, sweep=sweep,
-                          added=parse_added(added), marker=marker, progress=_stage, side_by_side=side_by_side)
+                          added=parse_added(added), marker=marker, progress=_stage, side_by_side=side_by_side,
+                          samples=samples or 0, before=load_robot(before_path) if before_path else None)
     for c in result.comparisons:
         r = c.prediction.result
         pred = f"predicted {r.distance_m * 100:.2f} cm" if r.valid else "simulation INVALID"

@@ -37,13 +37,22 @@ def _invalid_note(ax, c: Comparison) -> None:
             wrap=True)
 
 
-def draw_traces(ax, c: Comparison, names: list[str], which: str) -> None:
-    """Nose forward travel (``which='x'``) or height (``'y'``) against time, one configuration."""
+def draw_traces(ax, c: Comparison, names: list[str], which: str, spread=None, before=None) -> None:
+    """Nose forward travel (``which='x'``) or height (``'y'``) against time, one configuration;
+    with a :class:`.spread.Spread` the draws' mean +- 1 sd as a band, with ``before`` (a
+    :class:`.predict.Prediction` on the robot before a fit) its trace dotted."""
     col = colour(c.config, names)
     for i, m in enumerate(c.trials):
         ax.plot(m.trace.t_s, getattr(m.trace, f"{which}_m") * CM, color=col, lw=1.4, alpha=0.85,
                 label="measured" if i == 0 else None)
     p = c.prediction
+    if spread is not None:
+        mean, sd = getattr(spread, f"{which}_mean_m"), getattr(spread, f"{which}_sd_m")
+        ax.fill_between(spread.t_s, (mean - sd) * CM, (mean + sd) * CM, color="0.55", alpha=0.35, lw=0,
+                        label=f"predicted ±1 sd ({spread.n_valid} draws)")
+    if before is not None and before.trace is not None:
+        ax.plot(before.trace.t_s, getattr(before.trace, f"{which}_m") * CM, ":", color="#b00020", lw=1.2,
+                label="predicted before the fit")
     if p.trace is not None:
         ax.plot(p.trace.t_s, getattr(p.trace, f"{which}_m") * CM, "--", color="black", lw=1.2, label="predicted")
     else:
@@ -53,13 +62,14 @@ def draw_traces(ax, c: Comparison, names: list[str], which: str) -> None:
     ax.grid(True, ls=":", alpha=0.5)
 
 
-def overlay_figure(comps: list[Comparison]) -> bytes:
+def overlay_figure(comps: list[Comparison], spreads: dict | None = None, befores: dict | None = None) -> bytes:
     plt = pyplot()
     names = [c.config for c in comps]
+    spreads, befores = spreads or {}, befores or {}
     fig, axes = plt.subplots(2, len(comps), figsize=(4.2 * len(comps), 6.2), squeeze=False, sharex="col")
     for j, c in enumerate(comps):
-        draw_traces(axes[0, j], c, names, "x")
-        draw_traces(axes[1, j], c, names, "y")
+        for row, which in enumerate("xy"):
+            draw_traces(axes[row, j], c, names, which, spreads.get(c.config), befores.get(c.config))
         axes[0, j].set_title(f"{_label(c)}: nose displacement", loc="left", fontsize=10)
         axes[1, j].set_title(f"{_label(c)}: nose height", loc="left", fontsize=10)
         axes[1, j].set_xlabel("time since first push (s)")
@@ -116,10 +126,12 @@ def bars_figure(comps: list[Comparison], what: str) -> bytes:
     return png_bytes(fig)
 
 
-def hops_figure(comps: list[Comparison]) -> bytes:
-    """Per-hop distance and apex, every trial, against the prediction."""
+def hops_figure(comps: list[Comparison], spreads: dict | None = None) -> bytes:
+    """Per-hop distance and apex, every trial, against the prediction (with ±1 sd error bars
+    over the draws of a :class:`.spread.Spread`)."""
     plt = pyplot()
     names = [c.config for c in comps]
+    spreads = spreads or {}
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
     for c in comps:
         col = colour(c.config, names)
@@ -133,7 +145,10 @@ def hops_figure(comps: list[Comparison]) -> bytes:
                     pv = [h.distance_m for h in c.prediction.result.hops]
                 else:                   # the simulated marker's apex
                     px, pv = [h.hop for h in c.prediction.hops], [h.apex_m for h in c.prediction.hops]
-                ax.plot(px, [v * CM for v in pv], "--", color=col, lw=1.2, label=f"{_label(c)} predicted")
+                sp = spreads.get(c.config)
+                err = None if sp is None else [v * CM for v in getattr(sp, f"hop_{key}_sd_m")][:len(pv)]
+                ax.errorbar(px, [v * CM for v in pv], yerr=err, fmt="--", color=col, lw=1.2, capsize=3,
+                            label=f"{_label(c)} predicted" + (" ±1 sd" if err else ""))
     axes[0].set_title("Distance of each hop", loc="left", fontsize=10)
     axes[1].set_title("Nose apex of each hop", loc="left", fontsize=10)
     for ax, unit in zip(axes, ("distance (cm)", "apex above standing (cm)")):

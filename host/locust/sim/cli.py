@@ -24,7 +24,11 @@ from ..params_cli import robot_options
               help="For --video: follow the robot, or hold still (for measuring with `locust track`).")
 @click.option("--check-convergence", is_flag=True,
               help="Rerun at half the time step and report the relative change.")
-def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence):
+@click.option("--samples", type=click.IntRange(2, 4096), default=None, metavar="N",
+              help="Also simulate N draws of the values that carry an uncertainty in the robot file "
+                   "(one batched rollout) and report distance_m_sd and max_nose_height_m_sd.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed of --samples.")
+def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence, samples, seed):
     """Settle the robot on the floor, then run the bang-bang hop schedule.
 
     Every run is audited (non-finite state, loop closure, energy, MuJoCo warnings). A run
@@ -35,6 +39,7 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence)
       locust sim --preset seed --json
       locust sim --preset seed-notebook --json          # the notebook's Part 2 figures
       locust sim --preset large --set servo.stall_torque_nm=0.18 --video large.mp4
+      locust sim --config calibration/robot.toml --samples 16   # with its spread
     """
     from .run import check_convergence as converge
     from .run import invalid_result, run
@@ -60,10 +65,23 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence)
         info = render_video(robot, video, cycles=cycles, camera=camera, trajectory=result.trajectory)
         result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
 
+    spread = None
+    if samples and result.valid:
+        from .samples import sample
+
+        spread = sample(robot, samples, cycles=cycles, seed=seed)
     if as_json:
-        click.echo(json_text(result.to_json()), nl=False)
+        out = result.to_json()
+        if spread is not None:
+            out.update(distance_m_sd=spread.distance_m_sd, max_nose_height_m_sd=spread.max_nose_height_m_sd,
+                       samples=spread.to_json())
+        click.echo(json_text(out), nl=False)
         return
     _print_human(result)
+    if spread is not None:
+        click.echo(f"  {spread.n} draws of {len(spread.uncertain)} uncertain values ({spread.n_valid} valid): "
+                   f"distance sd {spread.distance_m_sd * 100:.3f} cm, "
+                   f"max nose height sd {spread.max_nose_height_m_sd * 100:.3f} cm")
     if not result.valid:
         sys.exit(1)
 

@@ -36,14 +36,25 @@ def marker_positions(traj: Trajectory, marker: str, rows: np.ndarray) -> np.ndar
     gid = _marker_geom(model, marker)
     if gid < 0:
         raise SimError(f"the model carries no {marker!r} marker", "use a marker the model has: nose or foot")
+    return geom_positions(model, traj.states, [gid], rows)[:, 0]
+
+
+def marker_geoms(model: mujoco.MjModel, markers) -> list[int]:
+    """Geom ids of the ``marker_<name>`` discs (-1 where the model has none)."""
+    return [_marker_geom(model, m) for m in markers]
+
+
+def geom_positions(model: mujoco.MjModel, states: np.ndarray, geoms, rows: np.ndarray) -> np.ndarray:
+    """World positions (len(rows), len(geoms), 3), metres, of geom centres at FULLPHYSICS state rows."""
     data = mujoco.MjData(model)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    pos = np.empty((len(rows), 3))
+    geoms = list(geoms)
+    pos = np.empty((len(rows), len(geoms), 3))
     for i, r in enumerate(rows):
-        mujoco.mj_setState(model, data, traj.states[r], spec)
+        mujoco.mj_setState(model, data, states[r], spec)
         mujoco.mj_kinematics(model, data)
-        pos[i] = data.geom_xpos[gid]
+        pos[i] = data.geom_xpos[geoms]
     return pos
 
 
-__all__ = ["carries_marker", "marker_positions"]
+__all__ = ["carries_marker", "geom_positions", "marker_geoms", "marker_positions"]

@@ -64,21 +64,33 @@ def simulate(robot: Robot, cycles: int | None = None, timestep_s: float | None =
 
 
 def simulate_built(built: BuiltModel, plan: ControlPlan, keep_states: bool = False) -> Trajectory:
-    model = built.model
-    state0, sensor0 = initial_state(built)
-    control = np.zeros((1, plan.nstep, model.nu))
-    for act in built.servo_actuators:
-        control[0, :, act] = plan.ctrl_rad
-    data = mujoco.MjData(model)
+    return simulate_batch([built], plan, keep_states=keep_states)[0]
+
+
+def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: bool = False,
+                   threads: int = 1) -> list[Trajectory]:
+    """Several models of one structure (a fit's candidates, draws of the uncertain values) on
+    one plan, in one ``mujoco.rollout`` call on ``threads`` threads. MuJoCo's warnings are
+    counted per thread, so they are attributed to a model only when there is one."""
+    models = [b.model for b in builts]
+    starts = [initial_state(b) for b in builts]
+    control = np.zeros((len(models), plan.nstep, models[0].nu))
+    for act in builts[0].servo_actuators:
+        control[:, :, act] = plan.ctrl_rad
+    datas = [mujoco.MjData(models[0]) for _ in range(max(1, min(threads, len(models))))]
     t0 = time.perf_counter()
-    state, sensordata = mj_rollout.rollout(model, data, state0[None, :], control)
+    state, sensordata = mj_rollout.rollout(models if len(models) > 1 else models[0],
+                                           datas if len(datas) > 1 else datas[0],
+                                           np.array([s for s, _ in starts]), control)
     wall = time.perf_counter() - t0
-    nq = model.nq
-    final_qpos = state[0, -1, 1:1 + nq].copy()  # FULLPHYSICS state starts with time, then qpos
-    warnings = {
-        mujoco.mjtWarning(i).name: int(data.warning[i].number)
-        for i in range(len(data.warning)) if data.warning[i].number
-    }
-    return Trajectory(built=built, plan=plan, initial_sensordata=sensor0,
-                      sensordata=sensordata[0], final_qpos=final_qpos, warnings=warnings, wall_s=wall,
-                      states=state[0] if keep_states else None)
+    nq = models[0].nq
+    warnings = {}
+    if len(models) == 1:
+        data = datas[0]
+        warnings = {mujoco.mjtWarning(i).name: int(data.warning[i].number)
+                    for i in range(len(data.warning)) if data.warning[i].number}
+    # FULLPHYSICS state starts with time, then qpos
+    return [Trajectory(built=b, plan=plan, initial_sensordata=sensor0, sensordata=sensordata[k],
+                       final_qpos=state[k, -1, 1:1 + nq].copy(), warnings=dict(warnings), wall_s=wall,
+                       states=state[k] if keep_states else None)
+            for k, (b, (_, sensor0)) in enumerate(zip(builts, starts))]

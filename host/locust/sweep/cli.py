@@ -33,7 +33,10 @@ def _describe(row: dict, names: list[str]) -> str:
 @click.option("--scheduler", default="local", show_default=True, metavar="local|dask-local|tcp://HOST:PORT",
               help="local: a process per core; dask-local: a Dask LocalCluster; tcp://...: a Dask cluster.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
-def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json):
+@click.option("--samples", type=click.IntRange(2, 256), default=None, metavar="N",
+              help="Rank designs by their mean over N draws of the robot file's uncertain values: "
+                   "distance_m and max_nose_height_m are those means.")
+def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, samples):
     """Simulate a grid of designs and report the best valid one.
 
     Each design is checked before simulation (the four-bar assembles and stays closed over the
@@ -60,7 +63,8 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json):
     total = len(grid(axes))
     with progress(length=total, label=f"sweep ({scheduler})", show_pos=True, show_eta=True) as bar:
         try:
-            summary = run_sweep(base, axes, cycles, out, scheduler=scheduler, jobs=jobs, progress=bar.update)
+            summary = run_sweep(base, axes, cycles, out, scheduler=scheduler, jobs=jobs, progress=bar.update,
+                                samples=samples or 0)
         except KeyboardInterrupt:
             click.echo(f"\ninterrupted: finished designs are in {out}/results.csv; "
                        "rerun the same command to resume", err=True)

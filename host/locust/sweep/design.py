@@ -148,10 +148,13 @@ def invalid_row(reason: str, grashof: str = "", transmission_deg: float = math.n
             "transmission_deg": transmission_deg}
 
 
-def evaluate(base: Robot, values: dict[str, float], cycles: int) -> dict[str, Any]:
+def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 0) -> dict[str, Any]:
     """Check, simulate and audit one design -> the result fields of its row.
 
     A pure function of its arguments: whichever process or machine runs it, the row is the same.
+    With ``samples``, ``distance_m`` and ``max_nose_height_m`` are the means over that many
+    draws of the robot file's uncertain values (:mod:`locust.sim.samples`, seed 0), so designs
+    are ranked by what they do on average over what is not known about the robot.
     """
     from ..sim.run import run
 
@@ -169,9 +172,18 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int) -> dict[str, An
     if not result.valid:
         return invalid_row("; ".join(result.reasons), result.grashof, result.transmission_deg)
     hops = result.hops
+    distance_m, nose_m = result.distance_m, result.max_nose_height_m
+    if samples:
+        from ..sim.samples import sample
+
+        spread = sample(robot, samples, cycles=cycles)
+        if not math.isfinite(spread.distance_m_mean):
+            return invalid_row(f"fewer than two of {samples} draws of the uncertain values are valid",
+                               result.grashof, result.transmission_deg)
+        distance_m, nose_m = spread.distance_m_mean, spread.max_nose_height_m_mean
     return {
-        "valid": True, "reason": "", "distance_m": result.distance_m,
-        "max_nose_height_m": result.max_nose_height_m,
+        "valid": True, "reason": "", "distance_m": distance_m,
+        "max_nose_height_m": nose_m,
         "nose_apex_max_m": max(h.nose_apex_m for h in hops),
         "com_apex_max_m": max(h.com_apex_m for h in hops),
         "hops": sum(1 for h in hops if h.flight_s > 0),

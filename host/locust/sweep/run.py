@@ -32,11 +32,12 @@ class Task:
     design: int
     values: tuple[tuple[str, float], ...]
     cycles: int
+    samples: int = 0
 
 
 def run_task(task: Task) -> dict[str, Any]:
     row: dict[str, Any] = {"design": task.design, **dict(task.values)}
-    row.update(evaluate(task.base, dict(task.values), task.cycles))
+    row.update(evaluate(task.base, dict(task.values), task.cycles, task.samples))
     return row
 
 
@@ -52,8 +53,11 @@ def best_row(rows: list[dict[str, Any]]) -> dict[str, Any] | None:
     return max(valid, key=lambda r: (r["distance_m"], -r["design"])) if valid else None
 
 
-def request(base: Robot, axes: list[Axis], cycles: int) -> dict[str, Any]:
-    return {"base": base.name, "parameters": base.flat(), "vary": [a.to_dict() for a in axes], "cycles": cycles}
+def request(base: Robot, axes: list[Axis], cycles: int, samples: int = 0) -> dict[str, Any]:
+    out = {"base": base.name, "parameters": base.flat(), "vary": [a.to_dict() for a in axes], "cycles": cycles}
+    if samples:    # only when asked: the folders of plain sweeps keep their request as it was
+        out["samples"] = samples
+    return out
 
 
 @dataclass
@@ -74,7 +78,7 @@ class SweepSummary:
 
 def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: str = "local",
               jobs: int | None = None, progress: Callable[[int], None] | None = None,
-              plots: bool = True) -> SweepSummary:
+              plots: bool = True, samples: int = 0) -> SweepSummary:
     """Run (or resume) the sweep into ``out``. ``progress(n)`` is called as each design finishes.
 
     An interrupt (Ctrl-C) leaves every finished row on disk and re-raises.
@@ -82,10 +86,11 @@ def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: 
     jobs = jobs or default_jobs()
     designs = grid(axes)
     names = [a.name for a in axes]
-    meta = {"request": request(base, axes, cycles), "designs": len(designs), "scheduler": scheduler, "jobs": jobs}
+    meta = {"request": request(base, axes, cycles, samples), "designs": len(designs), "scheduler": scheduler,
+            "jobs": jobs}
     store = SweepStore.open(out, meta, names)
     resumed = len(store.done)
-    todo = [Task(base, i, tuple(v.items()), cycles) for i, v in enumerate(designs) if i not in store.done]
+    todo = [Task(base, i, tuple(v.items()), cycles, samples) for i, v in enumerate(designs) if i not in store.done]
     t0 = time.perf_counter()
     finished = False
     try:

@@ -1,0 +1,384 @@
+"""Filmed hops -> the physics no bench experiment reaches: friction under impact, the folded
+hinges in the real linkage, the servo's speed on the robot's own battery.
+
+Each run is a ``locust hop --out`` folder: its ``run.json`` (the firmware's measured phase
+times) and the track of its video (nose, and foot where it was tracked). The simulation of a
+run is driven by those measured phase times (settled on the floor first, as ``locust sim``
+does), on the run's leg set built on the robot being fitted, so runs of different leg sets
+are fitted together: their geometry differs, the physics named by ``--fit`` is shared.
+
+Residual: the tracked markers against the same markers of the simulation, both from where
+they stood, both put on the schedule's clock by the same rule the report uses
+(:mod:`locust.report.measure`: the first nose motion of more than 3 mm, the track's start
+placed where the simulation's is relative to its first push). Every candidate of a solver
+iteration, the finite-difference columns included, is simulated in one batched
+``mujoco.rollout`` per run; the solver is ``mujoco.minimize.least_squares`` on the
+logarithm of each positive parameter (a factor is what a friction or a stiffness is known
+to). Standard errors come from the residual Jacobian at the optimum (:mod:`.fitstats`); a
+value is *identifiable* when its 95% interval is within about +-50% and it did not run to the
+edge of its range (a factor ``BOUND_FACTOR`` either side of where it started).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from mujoco import minimize
+
+from ..errors import CalibrationError, GeometryError, ParamsError, ReportError, SimError
+from ..params import SECTIONS, Robot
+from ..report.configs import configuration
+from ..report.measure import onset_time
+from ..report.measured import load_trial, read_track
+from ..sim.kinematics import geom_positions, marker_geoms
+from ..sim.model import build
+from ..sim.rollout import simulate_batch
+from ..sim.schedule import ControlPlan
+from .fitstats import Estimate, covariance
+
+DEFAULT_KEYS = ("contact.foot_friction", "compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s")
+MARKERS = ("nose", "foot")
+PROVENANCE_NAME = "hops"       # written as source fit:hops
+TRACE_HZ = 240.0               # simulated marker samples kept per second (at least)
+LEAD_S = 0.3                   # simulated standing time kept before the first push
+TAIL_S = 0.5                   # simulated past the track's last frame (the alignment moves it)
+BOUND_FACTOR = 5.0             # each value is searched within this factor of its start
+FD_STEP = 1e-2                 # finite-difference step of the log values (1 %: over the contacts' jaggedness)
+MAX_RELATIVE_STD = 0.25        # identifiable: 95% interval within about +-50%
+FAILED_M = 0.1                 # residual of a candidate whose simulation failed (metres)
+THREADS = 2
+GRID_FACTOR = 1.6              # the starting grid spans this factor either side of the start ...
+GRID_LEVELS = {1: 9, 2: 7, 3: 5, 4: 3, 5: 3}   # ... in this many levels per fitted value
+GRID_STAGES = 3                # ... refined about its best point this many times
+
+
+@dataclass(frozen=True)
+class MarkerTrack:
+    """One tracked marker, from where it stood (median before the first nose motion), metres."""
+
+    t_s: np.ndarray          # camera clock
+    x_m: np.ndarray
+    y_m: np.ndarray
+
+
+@dataclass(frozen=True)
+class HopRun:
+    """One filmed run: what drives its simulation and what it is compared with."""
+
+    source: Path
+    config: str                  # leg set (small, medium, large, ...)
+    robot: Robot                 # the leg set on the robot being fitted, the run's push angle
+    phase_s: np.ndarray          # measured start of each phase, seconds from the first push
+    pushing: np.ndarray          # per phase: a push (True) or a wait
+    onset_s: float               # first nose motion on the camera clock
+    tracks: dict[str, MarkerTrack]
+
+    @property
+    def end_s(self) -> float:
+        """The last frame, seconds after the first nose motion."""
+        return max(float(tr.t_s[-1]) for tr in self.tracks.values()) - self.onset_s
+
+
+@dataclass(frozen=True)
+class RunFit:
+    source: str
+    config: str
+    rms_m: float                         # all tracked coordinates of the run
+    rms_by_marker_m: dict[str, float]
+    samples: int
+    curves: dict = field(repr=False)     # marker -> (t aligned, tracked x, y, sim t, sim x, sim y)
+
+
+@dataclass(frozen=True)
+class HopFit:
+    keys: tuple[str, ...]
+    start: dict[str, float]
+    estimates: dict[str, Estimate]
+    identifiable: dict[str, bool]
+    runs: list[RunFit]
+    notes: list[str]
+    rms_m: float
+    iterations: int
+    simulations: int
+    wall_s: float
+
+    def summary(self) -> dict:
+        params = {k: {**self.estimates[k].as_dict(), "identifiable": self.identifiable[k], "start": self.start[k]}
+                  for k in self.keys}
+        return {"experiment": "hops", "source": "+".join(r.source for r in self.runs),
+                "parameters": params,
+                "runs": [{"source": r.source, "config": r.config, "rms_residual_m": r.rms_m,
+                          "rms_residual_by_marker_m": r.rms_by_marker_m, "samples": r.samples} for r in self.runs],
+                "rms_residual_m": self.rms_m, "iterations": self.iterations, "simulations": self.simulations,
+                "wall_s": round(self.wall_s, 2), "notes": self.notes}
+
+
+# -- reading runs ------------------------------------------------------------------------
+def load_run(path: Path, config: str, base: Robot) -> HopRun:
+    """A ``locust hop --out`` folder (its run.json and tracks) as a :class:`HopRun` of ``config``."""
+    try:
+        trial = load_trial(Path(path), config, "nose")
+    except ReportError as exc:
+        raise CalibrationError(exc.message, exc.hint) from None
+    if trial.record is None or trial.track is None:
+        raise CalibrationError(f"{path}: a hop fit needs the run's run.json and the track of its video",
+                               "give the folder `locust hop --out` wrote, after `locust track` on its video")
+    record = trial.record
+    phases = sorted(record.phases, key=lambda p: p.measured_us)
+    pushes = [p for p in phases if p.phase == "push"]
+    if not pushes:
+        raise CalibrationError(f"{trial.run_path}: the record holds no push phase",
+                               "a hop fit needs a run that pushed at least once; rerun the hop")
+    t0_us = pushes[0].measured_us
+    phases = [p for p in phases if p.measured_us >= t0_us]
+    try:
+        onset, x0, y0 = onset_time(trial.track.t_s, trial.track.x_m, trial.track.y_m, where=str(trial.track.path))
+    except ReportError as exc:
+        raise CalibrationError(exc.message, exc.hint) from None
+    tracks = {"nose": MarkerTrack(trial.track.t_s, trial.track.x_m - x0, trial.track.y_m - y0)}
+    try:
+        foot = read_track(trial.track.path, "foot")
+    except ReportError:
+        foot = None          # a track of the nose alone is fitted on the nose alone
+    if foot is not None and (foot.t_s < onset).sum() >= 2:
+        before = foot.t_s < onset
+        tracks["foot"] = MarkerTrack(foot.t_s, foot.x_m - float(np.median(foot.x_m[before])),
+                                     foot.y_m - float(np.median(foot.y_m[before])))
+    robot = configuration(base, config).robot
+    if not math.isclose(robot.schedule.push_deg, record.schedule.push_deg):
+        robot = robot.with_values({"schedule.push_deg": record.schedule.push_deg}, f"run:{trial.run_path}")
+    return HopRun(source=Path(path), config=config, robot=robot,
+                  phase_s=np.array([(p.measured_us - t0_us) * 1e-6 for p in phases]),
+                  pushing=np.array([p.phase == "push" for p in phases]), onset_s=float(onset), tracks=tracks)
+
+
+# -- simulating a run ------------------------------------------------------------------
+def control_plan(run: HopRun, robot: Robot) -> ControlPlan:
+    """Servo command per physics step: at rest while settling, then each phase from its
+    measured start (held until the next), up to the track's end and ``TAIL_S`` more."""
+    dt, settle_s = robot.solver.timestep_s, robot.solver.settle_s
+    settle = int(round(settle_s / dt))
+    nstep = settle + int(math.ceil((run.end_s + TAIL_S) / dt))
+    t = (np.arange(nstep) - settle) * dt
+    idx = np.searchsorted(run.phase_s, t + 1e-9, side="right") - 1
+    push = (idx >= 0) & run.pushing[np.clip(idx, 0, None)]
+    ctrl = np.where(push, math.radians(robot.schedule.push_deg), 0.0)
+    starts = np.append(settle + np.rint(run.phase_s[run.pushing] / dt).astype(int), nstep)
+    return ControlPlan(ctrl_rad=ctrl, timestep_s=dt, steps_per_tick=1, settle_steps=settle,
+                       cycle_start_steps=starts)
+
+
+def simulate_markers(run: HopRun, robots: list[Robot]) -> list[dict[str, np.ndarray] | None]:
+    """Each robot's simulated markers on the schedule's clock (one batched rollout): marker ->
+    (3, n) rows t, x, y from where it stood; ``t`` = 0 at the first push. None: it failed."""
+    builts = [build(r) for r in robots]
+    plan = control_plan(run, robots[0])
+    trajs = simulate_batch(builts, plan, keep_states=True, threads=THREADS)
+    dt, settle = plan.timestep_s, plan.settle_steps
+    stride = max(1, int(1.0 / (TRACE_HZ * dt)))
+    stand = max(settle - 1, 0)
+    rows = np.unique(np.concatenate(([stand], np.arange(max(0, settle - int(round(LEAD_S / dt))),
+                                                         plan.nstep, stride))))
+    t = (rows + 1 - settle) * dt
+    names = list(run.tracks)
+    geoms = marker_geoms(builts[0].model, names)
+    if min(geoms) < 0:
+        raise CalibrationError(f"the model carries no {names[geoms.index(-1)]!r} marker",
+                               "track the markers the model has: nose and foot")
+    out: list[dict[str, np.ndarray] | None] = []
+    for traj in trajs:
+        if not np.all(np.isfinite(traj.states)):
+            out.append(None)
+            continue
+        pos = geom_positions(traj.built.model, traj.states, geoms, rows)
+        ref = pos[rows == stand][0]
+        out.append({m: np.stack([t, pos[:, i, 0] - ref[i, 0], pos[:, i, 2] - ref[i, 2]]) for i, m in enumerate(names)})
+    return out
+
+
+def aligned_residual(run: HopRun, sim: dict[str, np.ndarray] | None) -> tuple[np.ndarray, float]:
+    """Tracked minus simulated, every tracked coordinate of the run (x then y, marker by
+    marker), and the track's shift onto the schedule's clock (nan when the simulation failed)."""
+    n = sum(2 * len(tr.t_s) for tr in run.tracks.values())
+    if sim is None:
+        return np.full(n, FAILED_M), math.nan
+    nose = sim["nose"]
+    try:
+        latency, _, _ = onset_time(nose[0], nose[1], nose[2], where="simulation")
+    except ReportError:
+        return np.full(n, FAILED_M), math.nan
+    shift = run.onset_s - latency             # camera time of the first push
+    parts = []
+    for m, tr in run.tracks.items():
+        ts, xs, ys = sim[m]
+        t = tr.t_s - shift
+        # before the simulation's kept lead the robot stands: at 0, from where it stood
+        parts += [tr.x_m - np.interp(t, ts, xs, left=0.0), tr.y_m - np.interp(t, ts, ys, left=0.0)]
+    return np.concatenate(parts), shift
+
+
+# -- the fit ----------------------------------------------------------------------------
+def check_keys(keys: list[str], runs: list[HopRun]) -> None:
+    """Fitted keys are real-valued robot parameters, the same in every run's robot."""
+    if not keys:
+        raise CalibrationError("no parameter to fit", f"e.g. --fit {','.join(DEFAULT_KEYS)}")
+    if len(set(keys)) != len(keys):
+        raise CalibrationError(f"--fit names a parameter twice ({','.join(keys)})", "name each once")
+    for key in keys:
+        try:
+            runs[0].robot.get(key)
+        except ParamsError as exc:
+            raise CalibrationError(f"--fit: {exc.message}", exc.hint) from None
+        section, _, name = key.partition(".")
+        if {f.name: f.type for f in dataclasses.fields(SECTIONS[section])}[name] not in ("float", float):
+            raise CalibrationError(f"--fit {key}: only real-valued parameters can be fitted",
+                                   "run `locust params` to list them")
+        values = {run.robot.get(key) for run in runs}
+        if len(values) > 1:
+            raise CalibrationError(f"--fit {key}: the runs' leg sets differ in it ({sorted(values)})",
+                                   "fit the physics the leg sets share; their geometry is set by the leg set")
+        value = values.pop()
+        if not (math.isfinite(value) and value > 0):
+            raise CalibrationError(f"--fit {key}: its starting value {value} is not a positive number",
+                                   "the fit works on factors of a positive value; set a start with --set")
+
+
+def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEYS, *, max_iter: int = 30,
+             grid_stages: int = GRID_STAGES, progress: Callable[[int], None] | None = None) -> HopFit:
+    """Fit ``keys`` (shared by all runs) to the tracked markers; see the module docstring.
+    ``grid_stages``: stages of the starting grid (0: start at the robot's values)."""
+    t_start = time.perf_counter()
+    keys = tuple(keys)
+    if not runs:
+        raise CalibrationError("no run given", "give the folders `locust hop --out` wrote")
+    check_keys(list(keys), runs)
+    start = np.array([runs[0].robot.get(k) for k in keys], dtype=float)
+    counter = {"sims": 0}
+
+    def robots_at(run: HopRun, xs: np.ndarray) -> list[Robot]:
+        return [run.robot.with_values(dict(zip(keys, (start * np.exp(x)).tolist())), "fit") for x in xs]
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        xs = np.atleast_2d(np.asarray(x, dtype=float).T).reshape(-1, len(keys))
+        cols = []
+        for run in runs:
+            try:
+                sims = simulate_markers(run, robots_at(run, xs))
+            except (GeometryError, SimError):
+                sims = [None] * len(xs)
+            counter["sims"] += len(xs)
+            cols.append(np.stack([aligned_residual(run, s)[0] for s in sims], axis=1))
+        return np.concatenate(cols, axis=0)
+
+    bound = math.log(BOUND_FACTOR)
+    bounds = [np.full(len(keys), -bound), np.full(len(keys), bound)]
+
+    def on_iter(trace):
+        if progress:
+            progress(1)
+
+    x0 = grid_start(residual, len(keys), grid_stages)
+    x, trace = minimize.least_squares(x0, residual, bounds=bounds, eps=FD_STEP,
+                                      max_iter=max_iter, verbose=0, iter_callback=on_iter, xtol=1e-6, gtol=1e-8)
+    x = np.asarray(x, dtype=float).ravel()
+    r = residual(x.reshape(-1, 1)).ravel()
+    jac, _ = minimize.jacobian_fd(residual, x.reshape(-1, 1), r.reshape(-1, 1), np.float64(FD_STEP), 0,
+                                  [b.reshape(-1, 1) for b in bounds])
+    values = start * np.exp(x)
+    cov = covariance(jac / values[None, :], r)     # d r / d p = d r / d x / p, with p = start * exp(x)
+    estimates, identifiable, notes = {}, {}, []
+    for i, key in enumerate(keys):
+        est = cov.parameter(values, i)
+        estimates[key] = est
+        ok = bool(np.isfinite(est.std) and est.relative_std <= MAX_RELATIVE_STD)
+        if bound - abs(x[i]) < 1e-3:
+            ok = False
+            notes.append(f"{key} ran to the edge of its range ({est.value:.4g}, a factor {BOUND_FACTOR:g} from "
+                         f"{start[i]:.4g}): the hops do not bound it")
+        elif not ok:
+            notes.append(f"{key} is not identifiable from these hops (its 95% interval is wider than "
+                         f"about +-{200 * MAX_RELATIVE_STD:.0f}%)")
+        identifiable[key] = ok
+    _friction_notes(dict(zip(keys, values.tolist())), runs[0].robot, notes)
+    run_fits, k0 = [], 0
+    for run in runs:
+        sim = simulate_markers(run, robots_at(run, x[None, :]))[0]
+        res, shift = aligned_residual(run, sim)
+        k0 += len(res)
+        by_marker, j = {}, 0
+        curves = {}
+        for m, tr in run.tracks.items():
+            n = len(tr.t_s)
+            by_marker[m] = float(np.sqrt(np.mean(res[j:j + 2 * n] ** 2)))
+            j += 2 * n
+            if sim is not None:
+                curves[m] = (tr.t_s - shift, tr.x_m, tr.y_m, *sim[m])
+        run_fits.append(RunFit(source=str(run.source), config=run.config, rms_m=float(np.sqrt(np.mean(res**2))),
+                               rms_by_marker_m=by_marker, samples=len(res), curves=curves))
+    return HopFit(keys=keys, start=dict(zip(keys, start.tolist())), estimates=estimates, identifiable=identifiable,
+                  runs=run_fits, notes=notes, rms_m=float(np.sqrt(np.mean(r**2))), iterations=len(trace),
+                  simulations=counter["sims"], wall_s=time.perf_counter() - t_start)
+
+
+def grid_start(residual, n: int, stages: int = GRID_STAGES) -> np.ndarray:
+    """The best point of a coarse-to-fine grid of factors about the start, each stage's grid
+    simulated in one batch about the best point so far, its span halved (in log) each time:
+    a hop sits near thresholds (a foot slipping or not, a crank tip touching the floor), so
+    the fit's landscape has local minima that a solver started at the robot file's values,
+    or at a coarse grid's best point, stops in."""
+    levels = GRID_LEVELS.get(n)
+    best, best_cost = np.zeros(n), math.inf
+    if levels is None:
+        return best
+    for stage in range(stages):
+        half = math.log(GRID_FACTOR) / 2 ** stage
+        axis = np.linspace(-half, half, levels)
+        xs = best[:, None] + np.array(np.meshgrid(*[axis] * n, indexing="ij")).reshape(n, -1)
+        cost = np.sum(residual(xs) ** 2, axis=0)
+        k = int(np.argmin(cost))
+        if cost[k] < best_cost:
+            best, best_cost = xs[:, k].copy(), float(cost[k])
+    return best
+
+
+def _friction_notes(fitted: dict[str, float], robot: Robot, notes: list[str]) -> None:
+    """MuJoCo takes the larger friction of two touching geoms: a fitted friction below the
+    other side's acts on nothing."""
+    pairs = (("contact.foot_friction", "contact.floor_friction"), ("contact.floor_friction", "contact.foot_friction"))
+    for key, other in pairs:
+        if key in fitted and other not in fitted and fitted[key] <= robot.get(other):
+            notes.append(f"{key} = {fitted[key]:.4g} is below {other} = {robot.get(other):.4g}: MuJoCo takes the "
+                         f"larger of the two, so {key} changes nothing in these hops")
+
+
+# -- the plot ---------------------------------------------------------------------------
+def plot_run(fit: RunFit, path: Path, subtitle: str = "") -> Path:
+    """Tracked markers against the fitted simulation, x and y of each, on the schedule's clock."""
+    from ..plotting import pyplot, save_png
+
+    plt = pyplot()
+    markers = list(fit.curves)
+    fig, axes = plt.subplots(2, max(len(markers), 1), figsize=(5.2 * max(len(markers), 1), 5.5), squeeze=False,
+                             sharex=True)
+    for col, m in enumerate(markers):
+        t, x, y, ts, xs, ys = fit.curves[m]
+        lo, hi = float(t[0]), float(t[-1])
+        keep = (ts >= lo) & (ts <= hi)
+        for row, (data, model, label) in enumerate(((x, xs, "x forward"), (y, ys, "y up"))):
+            ax = axes[row, col]
+            ax.plot(t, 1000 * data, ".", ms=3, color="#1f77b4", label="tracked")
+            ax.plot(ts[keep], 1000 * model[keep], "-", lw=1.2, color="#d62728", label="fitted simulation")
+            ax.set_ylabel(f"{m} {label} [mm]")
+            ax.grid(alpha=0.3)
+        axes[0, col].set_title(f"{m}: RMS {1000 * fit.rms_by_marker_m[m]:.2f} mm", fontsize=10)
+        axes[1, col].set_xlabel("t from the first push [s]")
+    axes[0, 0].legend(loc="best", fontsize=8)
+    fig.suptitle(f"{fit.config}: {Path(fit.source).name}" + (f"\n{subtitle}" if subtitle else ""), fontsize=10)
+    fig.tight_layout()
+    return save_png(fig, path, dpi=110)

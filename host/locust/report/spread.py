@@ -1,0 +1,69 @@
+"""How sure a prediction is: the marker trace and the hops at draws of the uncertain values.
+
+The robot's values that carry an uncertainty are drawn as ``locust sim --samples`` draws
+them (:func:`locust.sim.samples.draw`), all draws of a configuration are simulated in one
+batched rollout, and each valid draw's marker trace is taken like the prediction's own
+(:func:`.predict.marker_trace`, the same rows, so the draws share one clock). The band is
+the draws' mean +- one standard deviation at every instant; each hop's distance (chassis
+travel, as ``run()`` gives it) and marker apex get their standard deviation over the draws.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..params import Robot
+from ..sim.audit import audit
+from ..sim.hops import summarise
+from ..sim.model import build
+from ..sim.rollout import simulate_batch
+from ..sim.samples import THREADS, draw
+from ..sim.schedule import control_plan
+from .measure import measure_hops
+from .predict import marker_trace
+
+
+@dataclass(frozen=True)
+class Spread:
+    n: int                         # draws
+    n_valid: int
+    t_s: np.ndarray                # the schedule's clock
+    x_mean_m: np.ndarray
+    x_sd_m: np.ndarray
+    y_mean_m: np.ndarray
+    y_sd_m: np.ndarray
+    hop_distance_sd_m: list[float]     # per hop (nan with fewer than two valid draws)
+    hop_apex_sd_m: list[float]
+
+    def to_json(self) -> dict:
+        return {"n": self.n, "n_valid": self.n_valid, "hop_distance_sd_m": self.hop_distance_sd_m,
+                "hop_apex_sd_m": self.hop_apex_sd_m}
+
+
+def spread(robot: Robot, cycles: int, marker: str, n: int, seed: int = 0) -> Spread | None:
+    """``n`` draws of ``robot`` over ``cycles``; None when fewer than two are valid."""
+    plan = control_plan(robot.schedule, robot.solver, cycles)
+    trajs = simulate_batch([build(r) for r in draw(robot, n, seed)], plan, keep_states=True, threads=THREADS)
+    period = robot.schedule.push_s + robot.schedule.wait_s
+    traces, dist, apex = [], [], []
+    for traj in trajs:
+        if not audit(traj).valid:
+            continue
+        trace = marker_trace(traj, marker)
+        traces.append(trace)
+        dist.append([h.distance_m for h in summarise(traj).hops])
+        apex.append([h.apex_m for h in measure_hops(trace, period, cycles)])
+    if len(traces) < 2:
+        return None
+    xs = np.array([t.x_m for t in traces])
+    ys = np.array([t.y_m for t in traces])
+
+    def sd(rows: list[list[float]]) -> list[float]:
+        a = np.array(rows, dtype=float)
+        return [float(v) if math.isfinite(v) else math.nan for v in np.std(a, axis=0, ddof=1)]
+
+    return Spread(n=n, n_valid=len(traces), t_s=traces[0].t_s, x_mean_m=xs.mean(0), x_sd_m=xs.std(0, ddof=1),
+                  y_mean_m=ys.mean(0), y_sd_m=ys.std(0, ddof=1), hop_distance_sd_m=sd(dist), hop_apex_sd_m=sd(apex))

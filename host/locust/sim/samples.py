@@ -1,0 +1,94 @@
+"""A prediction's spread: the robot simulated at draws of its uncertain values.
+
+Every value of the robot file that carries an uncertainty (one standard deviation, written
+by ``locust calibrate`` beside the value) is drawn from a normal distribution about it,
+independently; a positive value stays positive (draws below a tenth of it are put there).
+All draws are simulated in one batched ``mujoco.rollout`` and each is audited and summarised
+like ``locust sim``'s own run; the spread of the valid ones is the prediction's uncertainty.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..params import SECTIONS, Provenance, Robot
+from .audit import audit
+from .hops import summarise
+from .model import build
+from .rollout import simulate_batch
+from .schedule import control_plan
+
+THREADS = 2
+MIN_FRACTION = 0.1      # a positive value's draws are kept above this fraction of it
+
+
+@dataclass(frozen=True)
+class Samples:
+    """The spread of ``n`` draws; figures over the valid ones (nan when fewer than two)."""
+
+    n: int
+    n_valid: int
+    seed: int
+    uncertain: dict[str, float]          # key -> one standard deviation drawn from
+    distance_m: list[float]              # per draw (nan: failed its audit)
+    max_nose_height_m: list[float]
+    distance_m_mean: float
+    distance_m_sd: float
+    max_nose_height_m_mean: float
+    max_nose_height_m_sd: float
+
+    def to_json(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+def uncertain_values(robot: Robot) -> dict[str, float]:
+    """Real-valued keys whose provenance gives a positive, finite uncertainty -> that uncertainty."""
+    out = {}
+    for section, cls in SECTIONS.items():
+        for f in dataclasses.fields(cls):
+            key = f"{section}.{f.name}"
+            sd = robot.source_of(key).uncertainty
+            if f.type in ("float", float) and sd and math.isfinite(sd) and math.isfinite(robot.get(key)):
+                out[key] = float(sd)
+    return out
+
+
+def draw(robot: Robot, n: int, seed: int = 0) -> list[Robot]:
+    """``n`` robots with every uncertain value drawn about its own (see the module docstring)."""
+    sds = uncertain_values(robot)
+    rng = np.random.default_rng(seed)
+    keys = list(sds)
+    centre = np.array([robot.get(k) for k in keys], dtype=float)
+    values = centre + rng.standard_normal((n, len(keys))) * np.array([sds[k] for k in keys])
+    values = np.where(centre > 0, np.maximum(values, MIN_FRACTION * centre), values)
+    prov = Provenance(source="sample", note=f"drawn from the uncertainties, seed {seed}")
+    return [robot.with_values(dict(zip(keys, row.tolist())), prov) for row in values]
+
+
+def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0) -> Samples:
+    """Simulate ``n`` draws of ``robot`` in one batch; their distances and nose heights."""
+    robots = draw(robot, n, seed)
+    plan = control_plan(robot.schedule, robot.solver, cycles)
+    trajs = simulate_batch([build(r) for r in robots], plan, threads=THREADS)
+    dist, nose = [], []
+    for traj in trajs:
+        ok = audit(traj).valid
+        summary = summarise(traj) if ok else None
+        dist.append(summary.distance_m if summary else math.nan)
+        nose.append(summary.max_nose_height_m if summary else math.nan)
+    d, h = np.array(dist), np.array(nose)
+    valid = np.isfinite(d) & np.isfinite(h)
+
+    def stats(a: np.ndarray) -> tuple[float, float]:
+        if valid.sum() < 2:
+            return math.nan, math.nan
+        return float(np.mean(a[valid])), float(np.std(a[valid], ddof=1))
+
+    (dm, ds), (hm, hs) = stats(d), stats(h)
+    return Samples(n=n, n_valid=int(valid.sum()), seed=seed, uncertain=uncertain_values(robot), distance_m=dist,
+                   max_nose_height_m=nose, distance_m_mean=dm, distance_m_sd=ds, max_nose_height_m_mean=hm,
+                   max_nose_height_m_sd=hs)
