@@ -65,6 +65,12 @@ class LazyGroup(click.Group):
             if exc.hint:
                 click.echo(f"  hint: {exc.hint}", err=True)
             ctx.exit(exc.exit_code)
+        except OSError as exc:  # a file or folder the job's own checks did not foresee
+            where = f"{exc.filename}: " if exc.filename else ""
+            click.secho(f"error: {where}{exc.strerror or exc}", fg="red", err=True)
+            click.echo("  hint: check that the path exists and is readable, that the output folder is "
+                       "writable and that the disk has space", err=True)
+            ctx.exit(2)
 
 
 def _available(name: str) -> bool:
