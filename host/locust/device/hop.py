@@ -84,10 +84,11 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             _fetch_report(link, rec)
     except KeyboardInterrupt:
         _stop_quietly(link)
-        rec.status, rec.message = R.INCOMPLETE, "interrupted (Ctrl-C); the robot was sent to rest"
+        rec.status, rec.message = R.INCOMPLETE, "interrupted (Ctrl-C or a kill); the robot was sent to rest"
         R.write(rec, directory)
         raise DeviceError(f"hop interrupted after {len(rec.phases)} of {schedule.phases} phases; "
-                          f"partial record in {directory / R.RECORD_NAME}") from None
+                          f"partial record in {directory / R.RECORD_NAME}",
+                          "the robot is at rest; run the hop again when ready") from None
     except DeviceError as exc:
         _stop_quietly(link)
         if rec.status != R.ERROR:
