@@ -18,12 +18,23 @@ from .summary import summary, summary_text
 
 def _robot(spec: str):
     from .. import params
+    from ..errors import GeometryError
+    from ..sim.fourbar import assemble
 
     if spec in params.PRESETS:
-        return params.preset(spec)
-    path = Path(spec)
-    if path.suffix.lower() == ".toml" or path.exists():
-        return params.load_robot(path)
+        robot = params.preset(spec)
+    elif Path(spec).suffix.lower() == ".toml" or Path(spec).exists():
+        robot = params.load_robot(Path(spec))
+    else:
+        robot = None
+    if robot is not None:
+        g = robot.geometry
+        try:
+            assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, g.crank_start_deg)
+        except GeometryError as exc:
+            raise FabError(f"--from-robot {spec}: the linkage cannot close, so its flat pattern would fold into "
+                           f"nothing: {exc.message}", exc.hint or "check geometry.*_m in the robot.toml") from None
+        return robot
     raise FabError(f"--from-robot {spec!r}: neither a preset nor a robot.toml",
                    f"give one of {', '.join(params.PRESETS)} or the path of a robot.toml")
 
@@ -118,9 +129,11 @@ def fab(dxf, from_robot, out, as_json, layers, units, gap_tol_mm, recover, hinge
                                jig_diameter_mm=jig_diameter_mm, jig_spacing_mm=jig_spacing_mm)
     lam = laminate.build(design, specs, process)
 
-    files: dict[str, bytes] = {}
-    if out is not None:
-        files = export.cut_files(lam)
+    # the cut files are made with or without --out: a kerf that cannot be applied is refused either way
+    files: dict[str, bytes] = export.cut_files(lam)
+    if out is None:
+        files = {}
+    else:
         if fp is not None:
             files["flat_pattern.dxf"] = flat_pattern.drawing_bytes(fp)
         if not no_preview:
