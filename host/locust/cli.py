@@ -60,6 +60,11 @@ class LazyGroup(click.Group):
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
+        except click.UsageError as exc:   # a bad option value, a missing argument: the same two lines
+            sub = exc.ctx.command_path if exc.ctx else "locust"
+            click.secho(f"error: {exc.format_message()}", fg="red", err=True)
+            click.echo(f"  hint: see `{sub} --help`", err=True)
+            ctx.exit(exc.exit_code)
         except LocustError as exc:
             click.secho(f"error: {exc.message}", fg="red", err=True)
             if exc.hint:
