@@ -138,7 +138,7 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
     robot = robot.with_values({"schedule.cycles": schedule.cycles, "schedule.push_deg": schedule.push_deg,
                                "schedule.push_s": schedule.push_ms / 1000, "schedule.wait_s": schedule.wait_ms / 1000},
                               "locust hop options")
-    made = out is None or not Path(out).exists()
+    made = _first_missing(Path(out)) if out is not None else None
     directory = R.run_dir(out)
     # a kill (SIGTERM) or a closed terminal (SIGHUP) ends the hop as Ctrl-C does: the robot to
     # rest, the record says so, a --port sim virtual robot stops
@@ -151,9 +151,8 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
                                   on_phase=lambda p: (bar.update(1),
                                                       setattr(bar, "label", f"cycle {p.cycle} {p.phase}")))
     except BaseException:
-        if made:
-            _remove_if_empty(directory)   # a hop that never started leaves no empty folder behind
-        raise
+        _remove_empty(directory, made if out is not None else directory)   # a hop that never started
+        raise                                                              # leaves no empty folder
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
@@ -257,11 +256,28 @@ def _interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
-def _remove_if_empty(directory: Path) -> None:
-    try:
-        directory.rmdir()   # only an empty folder goes
-    except OSError:
-        pass
+def _first_missing(path: Path) -> Path | None:
+    """The outermost folder of ``path`` that does not exist yet (what making it would create)."""
+    missing = None
+    for p in (path, *path.parents):
+        if p.exists():
+            break
+        missing = p
+    return missing
+
+
+def _remove_empty(directory: Path, top: Path | None) -> None:
+    """Remove ``directory`` and its parents up to ``top`` while they are empty (none if ``top``
+    is None: the folder was there before)."""
+    if top is None:
+        return
+    for p in (directory, *directory.parents):
+        try:
+            p.rmdir()   # only an empty folder goes
+        except OSError:
+            return
+        if p == top:
+            return
 
 
 @click.command()
