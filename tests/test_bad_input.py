@@ -399,3 +399,46 @@ def test_a_killed_hop_leaves_no_interpreter_running(env, tmp_path, sig):
     if sig == signal.SIGTERM:
         assert proc.returncode == 2 and "Traceback" not in stderr and "hint:" in stderr
         assert rec["status"] == "incomplete" and "interrupted" in rec["message"]
+
+
+# -- load -----------------------------------------------------------------------------
+def test_the_heartbeat_keeps_its_clock_beside_a_busy_thread():
+    """Pings from the heartbeat's own thread stay on time while another thread of the host
+    computes in Python (holding the GIL whenever it can): no gap near the firmware's timeout."""
+    import pty
+    import select
+    import threading
+
+    from locust.device.link import Link
+    from locust.firmware import protocol as P
+
+    master, slave = pty.openpty()
+    interval_s = P.COMMANDS["hop"]["heartbeat_ms"][3] / 8000.0
+    stop = threading.Event()
+
+    def busy():
+        x = 0
+        while not stop.is_set():
+            x = (x * 31 + 7) % 1_000_003
+
+    arrivals = []
+    link = Link(os.ttyname(slave))
+    worker = threading.Thread(target=busy, daemon=True)
+    try:
+        worker.start()
+        link.start_heartbeat(interval_s)
+        t_end = time.monotonic() + 2.0
+        while time.monotonic() < t_end:
+            ready, _, _ = select.select([master], [], [], 0.05)
+            if ready:
+                data = os.read(master, 4096)
+                arrivals += [time.monotonic()] * data.count(b'"cmd":"ping"')
+    finally:
+        stop.set()
+        link.close()
+        os.close(master)
+        os.close(slave)
+    gaps = [b - a for a, b in zip(arrivals, arrivals[1:])]
+    assert len(arrivals) >= 0.8 * 2.0 / interval_s
+    # a beat may be late by a few scheduler slices, never by a good part of the timeout
+    assert max(gaps) < 2 * interval_s, gaps

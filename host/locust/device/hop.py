@@ -47,7 +47,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             link.call("stop")
         while not link.events.empty():  # a boot event from before we connected is old news
             link.events.get_nowait()
-        link.start_heartbeat(schedule.heartbeat_ms / 4000.0)
+        link.start_heartbeat(schedule.heartbeat_ms / 8000.0)  # 8 beats in each timeout
         reply = link.request("hop", cycles=schedule.cycles, push_deg=schedule.push_deg,
                              push_ms=schedule.push_ms, wait_ms=schedule.wait_ms,
                              heartbeat_ms=schedule.heartbeat_ms)

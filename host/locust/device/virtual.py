@@ -305,6 +305,10 @@ class VirtualRobot:
     def _bridge(self) -> None:
         import select
 
+        from .link import raise_thread_priority
+
+        raise_thread_priority()   # the host's heartbeat passes through here
+
         while not self._stopping.is_set():
             ready, _, _ = select.select([self._ma, self._mb], [], [], 0.2)
             if self._ma in ready:
