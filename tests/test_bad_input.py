@@ -41,6 +41,8 @@ def tree(folder: Path) -> dict[str, tuple[bytes, int]]:
             out[rel] = (p.read_bytes(), stat.S_IMODE(p.stat().st_mode))
         elif p.is_dir():
             out[rel + "/"] = (b"", stat.S_IMODE(p.stat().st_mode))
+        else:   # a pipe, a device: its type and mode
+            out[rel + "|"] = (b"", p.stat().st_mode)
     return out
 
 
@@ -164,7 +166,9 @@ CASES = [
     # writes never destroy
     ("write-read-only-file", lambda d: ["params", "--write", readonly(d), "--force"], ["read-only"]),
     ("write-existing-file", lambda d: ["params", "--write", robot_toml(d, "# mine\n")], ["exists"]),
-    ("write-device", lambda d: ["params", "--write", "/dev/null", "--force"], ["not a regular file"]),
+    # (a pipe stands in for a device: a regression must not replace the machine's /dev/null)
+    ("write-pipe", lambda d: ["params", "--write", os.mkfifo(d / "pipe") or d / "pipe", "--force"],
+     ["not a regular file"]),
     ("write-onto-folder", lambda d: ["params", "--write", (d / "folder").mkdir() or d / "folder", "--force"],
      ["directory"]),
     # sweeps and optimisation
@@ -442,3 +446,27 @@ def test_the_heartbeat_keeps_its_clock_beside_a_busy_thread():
     assert len(arrivals) >= 0.8 * 2.0 / interval_s
     # a beat may be late by a few scheduler slices, never by a good part of the timeout
     assert max(gaps) < 2 * interval_s, gaps
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc (Linux)")
+def test_ctrl_c_during_a_filmed_hop_finishes_the_video_and_says_so(env, tmp_path):
+    proc = subprocess.Popen(LOCUST + ["hop", "--port", "sim", "--cycles", "4", "--video", "hop.mp4", "--out", "run"],
+                            cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    run = tmp_path / "run" / "run.json"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        if run.exists() and '"phase"' in run.read_text():
+            break
+        time.sleep(0.1)
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGINT)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 2 and "interrupted" in stderr and "hint:" in stderr and "Traceback" not in stderr
+    rec = json.loads(run.read_text())
+    assert rec["status"] == "incomplete" and "interrupted" in rec["message"] and 1 <= len(rec["phases"]) < 8
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert names == ["hop.camera.json", "hop.mp4", "hop.truth.csv", "run"]   # no hidden temporary file
+    from locust.track.video import probe
+
+    assert probe(tmp_path / "hop.mp4").frame_count >= 10   # a playable video of what was filmed
