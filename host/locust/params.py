@@ -324,7 +324,7 @@ def problems(robot: Robot, cycles: int | None = None) -> list[str]:
     """Every reason ``robot`` cannot be simulated or run as given (empty: it can)."""
     out = [p for key in LIMITS if (p := _outside(key, robot.get(key)))]
     s, sol, sch = robot.servo, robot.solver, robot.schedule
-    if abs(sch.push_deg) > s.travel_deg:
+    if abs(sch.push_deg) > s.travel_deg and not _outside("schedule.push_deg", sch.push_deg):
         out.append(f"schedule.push_deg = {sch.push_deg:g} is beyond the servo travel of "
                    f"+-{s.travel_deg:g} deg (servo.travel_deg)")
     if s.pulse_min_us >= s.pulse_max_us:
