@@ -67,7 +67,9 @@ COMMANDS = {
         "push_deg": ("num", -90, 90, -30.0),
         "push_ms": ("int", 20, 10000, 300),
         "wait_ms": ("int", 20, 60000, 1000),
-        "heartbeat_ms": ("int", 100, 10000, 500),
+        # 750 ms: a host on a busy machine may be late by a scheduler hiccup, beating each
+        # heartbeat_ms / 8; a silent host still has the servos at rest within a second
+        "heartbeat_ms": ("int", 100, 10000, 750),
     },
     "pose": {
         "left_deg": ("num", -90, 90, None),

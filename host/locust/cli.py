@@ -60,11 +60,22 @@ class LazyGroup(click.Group):
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
+        except click.UsageError as exc:   # a bad option value, a missing argument: the same two lines
+            sub = exc.ctx.command_path if exc.ctx else "locust"
+            click.secho(f"error: {exc.format_message()}", fg="red", err=True)
+            click.echo(f"  hint: see `{sub} --help`", err=True)
+            ctx.exit(exc.exit_code)
         except LocustError as exc:
             click.secho(f"error: {exc.message}", fg="red", err=True)
             if exc.hint:
                 click.echo(f"  hint: {exc.hint}", err=True)
             ctx.exit(exc.exit_code)
+        except OSError as exc:  # a file or folder the job's own checks did not foresee
+            where = f"{exc.filename}: " if exc.filename else ""
+            click.secho(f"error: {where}{exc.strerror or exc}", fg="red", err=True)
+            click.echo("  hint: check that the path exists and is readable, that the output folder is "
+                       "writable and that the disk has space", err=True)
+            ctx.exit(2)
 
 
 def _available(name: str) -> bool:

@@ -55,3 +55,7 @@ class FabError(LocustError):
 
 class ReportError(LocustError):
     """Building comparison reports."""
+
+
+class WriteError(LocustError):
+    """Writing a result: a read-only or non-regular target, a read-only folder, a full disk."""

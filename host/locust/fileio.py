@@ -4,32 +4,70 @@ from __future__ import annotations
 
 import json
 import os
+import stat
 import tempfile
 from pathlib import Path
 from typing import Any
 
+from .errors import WriteError
+
+DISK_HINT = "check that the folder exists and is writable and that the disk has space, or write elsewhere"
+
+
+def write_target(path: str | os.PathLike) -> Path:
+    """The file a write to ``path`` lands on: a symlink's target (the link is kept), else ``path``.
+
+    Refuses (:class:`WriteError`) what a write must never replace: a device, a folder, a pipe or
+    any other non-regular file, and a file its owner made read-only.
+    """
+    path = Path(path)
+    if path.is_symlink():
+        path = Path(os.path.realpath(path))
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        return path
+    except OSError as exc:
+        raise WriteError(f"{path}: cannot inspect it ({exc.strerror})", DISK_HINT) from None
+    if not stat.S_ISREG(st.st_mode):
+        raise WriteError(f"{path} is not a regular file (a device, folder or pipe); refusing to replace it",
+                         "write to a new file path")
+    if not os.access(path, os.W_OK) or not st.st_mode & 0o222:  # (root may write anything: ask the mode)
+        raise WriteError(f"{path} is read-only; refusing to replace it",
+                         "write to another path, or make it writable (chmod u+w) if you mean to replace it")
+    return path
+
 
 def temp_beside(path: str | os.PathLike, suffix: str = ".tmp") -> tuple[int, str]:
-    """A new temporary file in ``path``'s folder (open fd, name), with ordinary permissions.
+    """A new temporary file in ``path``'s folder (open fd, name), with ordinary permissions
+    (an existing file's own mode, when it is replaced).
 
     Write it, then ``os.replace`` it onto ``path``: the rename is what makes a write atomic.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.fchmod(fd, 0o666 & ~umask)  # mkstemp makes 0600
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    except OSError as exc:
+        raise WriteError(f"cannot write in {path.parent} ({exc.strerror})", DISK_HINT) from None
+    try:
+        mode = stat.S_IMODE(os.stat(path).st_mode)
+    except OSError:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    os.fchmod(fd, mode)  # mkstemp makes 0600
     return fd, tmp
 
 
 def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> Path:
     """Write ``data`` to ``path`` through a temporary file and a rename.
 
-    A reader never sees a half-written file, and an interrupted write leaves the old
-    file (if any) untouched.
+    A reader never sees a half-written file, and an interrupted or failed write (a full disk)
+    leaves the old file (if any) untouched and no temporary file behind. A symlink is followed
+    (its target is updated); what :func:`write_target` refuses is never replaced.
     """
-    path = Path(path)
+    path = write_target(path)
     fd, tmp = temp_beside(path)
     try:
         with os.fdopen(fd, "wb") as fh:
@@ -37,11 +75,13 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> Path:
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         try:
             os.unlink(tmp)
         except FileNotFoundError:
             pass
+        if isinstance(exc, OSError):
+            raise WriteError(f"{path}: cannot write it ({exc.strerror or exc})", DISK_HINT) from None
         raise
     return path
 
@@ -90,12 +130,15 @@ def unique_dir(parent: str | os.PathLike, stem: str) -> Path:
     Never returns a directory that already existed: results are never overwritten.
     """
     parent = Path(parent)
-    parent.mkdir(parents=True, exist_ok=True)
-    for n in range(1, 10_000):
-        candidate = parent / (stem if n == 1 else f"{stem}-{n}")
-        try:
-            candidate.mkdir()
-            return candidate
-        except FileExistsError:
-            continue
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        for n in range(1, 10_000):
+            candidate = parent / (stem if n == 1 else f"{stem}-{n}")
+            try:
+                candidate.mkdir()
+                return candidate
+            except FileExistsError:
+                continue
+    except OSError as exc:
+        raise WriteError(f"cannot make a folder in {parent} ({exc.strerror})", DISK_HINT) from None
     raise FileExistsError(f"no free directory name for {stem!r} in {parent}")

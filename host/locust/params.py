@@ -30,6 +30,7 @@ from typing import Any
 
 from .errors import ParamsError
 from .fileio import atomic_write_text
+from .firmware import protocol
 
 # Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
 GRAVITY_M_PER_S2 = 9.81
@@ -258,6 +259,98 @@ def parse_set_options(items: tuple[str, ...] | list[str]) -> dict[str, str]:
     return out
 
 
+# -- limits -------------------------------------------------------------------------
+# What the model can simulate and the robot can run: (lowest, highest, lowest allowed?,
+# highest allowed?). A value outside is refused with its limit before anything is built, so
+# nothing unsimulatable reaches MuJoCo and nothing absurd is simulated as valid. The schedule's
+# limits are the firmware's own (firmware/protocol.py, the ``hop`` command).
+_OPEN, _SHUT = False, True
+_HOP = protocol.COMMANDS["hop"]   # argument -> (kind, lowest, highest, default)
+LENGTH_LIMIT_M = 10.0
+LIMITS: dict[str, tuple[float, float, bool, bool]] = {
+    **{f"geometry.{n}": (0.0, LENGTH_LIMIT_M, _OPEN, _SHUT) for n in (
+        "ground_m", "crank_m", "coupler_m", "leg_m", "body_length_m", "body_width_m",
+        "body_thickness_m", "link_width_m", "link_thickness_m")},
+    "geometry.body_mass_kg": (0.0, 100.0, _OPEN, _SHUT),
+    "geometry.link_density_kg_per_m3": (0.0, 50000.0, _OPEN, _SHUT),
+    "geometry.drop_height_m": (0.0, LENGTH_LIMIT_M, _SHUT, _SHUT),
+    "geometry.crank_start_deg": (-360.0, 360.0, _SHUT, _SHUT),
+    "geometry.body_pitch_deg": (-180.0, 180.0, _SHUT, _SHUT),
+    "compliance.hinge_stiffness_nm_per_rad": (0.0, math.inf, _SHUT, _OPEN),
+    "compliance.hinge_damping_nms_per_rad": (0.0, math.inf, _SHUT, _OPEN),
+    "servo.kp_nm_per_rad": (0.0, math.inf, _OPEN, _OPEN),
+    "servo.stall_torque_nm": (0.0, math.inf, _OPEN, _OPEN),
+    "servo.noload_speed_rad_per_s": (0.0, math.inf, _OPEN, _SHUT),
+    "servo.armature_kgm2": (0.0, math.inf, _SHUT, _OPEN),
+    "servo.kv_nms_per_rad": (0.0, math.inf, _SHUT, _OPEN),
+    "servo.travel_deg": (0.0, 90.0, _OPEN, _SHUT),
+    "servo.pulse_min_us": (0.0, 20000.0, _OPEN, _OPEN),
+    "servo.pulse_max_us": (0.0, 20000.0, _OPEN, _OPEN),
+    "servo.range_deg": (0.0, 360.0, _OPEN, _SHUT),
+    "contact.foot_friction": (0.0, math.inf, _SHUT, _OPEN),
+    "contact.floor_friction": (0.0, math.inf, _SHUT, _OPEN),
+    "contact.torsional_friction": (0.0, math.inf, _SHUT, _OPEN),
+    "contact.rolling_friction": (0.0, math.inf, _SHUT, _OPEN),
+    "schedule.push_deg": (_HOP["push_deg"][1], _HOP["push_deg"][2], _SHUT, _SHUT),
+    "schedule.push_s": (_HOP["push_ms"][1] / 1000.0, _HOP["push_ms"][2] / 1000.0, _SHUT, _SHUT),
+    "schedule.wait_s": (_HOP["wait_ms"][1] / 1000.0, _HOP["wait_ms"][2] / 1000.0, _SHUT, _SHUT),
+    "schedule.cycles": (_HOP["cycles"][1], _HOP["cycles"][2], _SHUT, _SHUT),
+    "solver.timestep_s": (0.0, 0.01, _OPEN, _SHUT),
+    "solver.iterations": (1, 10000, _SHUT, _SHUT),
+    "solver.tolerance": (0.0, 1.0, _SHUT, _OPEN),
+    "solver.control_hz": (0.0, math.inf, _OPEN, _OPEN),
+    "solver.settle_s": (0.0, 60.0, _SHUT, _SHUT),
+    "solver.loop_timeconst_s": (0.0, 10.0, _OPEN, _SHUT),
+    "solver.loop_dmin": (0.0, 1.0, _OPEN, _OPEN),
+    "solver.loop_dmax": (0.0, 1.0, _OPEN, _OPEN),
+}
+# the most physics steps one simulation may take: its record is kept in memory, about
+# 1.5 kB a step (half a million steps is 1300 s of the seed at 2.5 ms)
+MAX_SIM_STEPS = 2_000_000
+
+
+def _outside(key: str, value: float) -> str | None:
+    low, high, low_ok, high_ok = LIMITS[key]
+    if (value > low or (low_ok and value == low)) and (value < high or (high_ok and value == high)):
+        return None
+    lo = f"{'>=' if low_ok else '>'} {low:g}"
+    hi = f"{'<=' if high_ok else '<'} {high:g}"
+    if high == math.inf:
+        return f"{key} = {value:g} must be {lo}"
+    return f"{key} = {value:g} must be {lo} and {hi}"
+
+
+def problems(robot: Robot, cycles: int | None = None) -> list[str]:
+    """Every reason ``robot`` cannot be simulated or run as given (empty: it can)."""
+    out = [p for key in LIMITS if (p := _outside(key, robot.get(key)))]
+    s, sol, sch = robot.servo, robot.solver, robot.schedule
+    if abs(sch.push_deg) > s.travel_deg and not _outside("schedule.push_deg", sch.push_deg):
+        out.append(f"schedule.push_deg = {sch.push_deg:g} is beyond the servo travel of "
+                   f"+-{s.travel_deg:g} deg (servo.travel_deg)")
+    if s.pulse_min_us >= s.pulse_max_us:
+        out.append(f"servo.pulse_min_us = {s.pulse_min_us:g} must be below servo.pulse_max_us = {s.pulse_max_us:g}")
+    if sol.timestep_s > 0 and sol.control_hz * sol.timestep_s > 1.0 + 1e-9:
+        out.append(f"solver.control_hz = {sol.control_hz:g} is faster than one command per physics step "
+                   f"(1/solver.timestep_s = {1.0 / sol.timestep_s:g} Hz)")
+    if not out:
+        n = sch.cycles if cycles is None else cycles
+        steps = (sol.settle_s + n * (sch.push_s + sch.wait_s)) / sol.timestep_s
+        if steps > MAX_SIM_STEPS:
+            out.append(f"{n} cycles of {sch.push_s + sch.wait_s:g} s at a {sol.timestep_s:g} s step are "
+                       f"{steps:.3g} physics steps, over the limit of {MAX_SIM_STEPS:g}")
+    return out
+
+
+def check_robot(robot: Robot, cycles: int | None = None) -> Robot:
+    """``robot`` if it can be simulated and run; else :class:`ParamsError` naming every problem."""
+    found = problems(robot, cycles)
+    if found:
+        raise ParamsError("; ".join(found),
+                          "change the value(s) with --set KEY=VALUE or in the robot.toml "
+                          "(`locust params` lists every value)")
+    return robot
+
+
 # -- presets ------------------------------------------------------------------------
 _SEED_SOURCE = Provenance(source="seed", note="notebook Part 2")
 # The SG90 as identified by `locust calibrate servo sg90_aa_battery_step.csv --inertia-kgm2 3.3e-6
@@ -457,7 +550,7 @@ def resolve_robot(preset_name: str | None = None, config: str | Path | None = No
     """The robot a command runs on: ``--config`` file, else ``--preset``, then ``--set``."""
     robot = load_robot(config) if config else preset(preset_name or "seed")
     overrides = parse_set_options(sets)
-    return robot.with_values(overrides, "override") if overrides else robot
+    return check_robot(robot.with_values(overrides, "override") if overrides else robot)
 
 
 def as_dict(robot: Robot) -> dict[str, Any]:

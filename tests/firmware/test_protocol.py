@@ -60,7 +60,7 @@ def _check(obj):
 def test_request_checks():
     req_id, cmd, args = P.check_request({"id": 3, "cmd": "hop"})
     assert (req_id, cmd) == (3, "hop")
-    assert args == {"cycles": 6, "push_deg": -30.0, "push_ms": 300, "wait_ms": 1000, "heartbeat_ms": 500}
+    assert args == {"cycles": 6, "push_deg": -30.0, "push_ms": 300, "wait_ms": 1000, "heartbeat_ms": 750}
     assert _check({"cmd": "ping"}) == P.E_REQUEST
     assert _check({"id": -1, "cmd": "ping"}) == P.E_REQUEST
     assert _check({"id": True, "cmd": "ping"}) == P.E_REQUEST

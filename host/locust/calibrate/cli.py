@@ -10,6 +10,7 @@ import numpy as np
 
 from ..errors import CalibrationError, ReportError
 from ..fileio import json_text
+from ..options import FINITE, POSITIVE
 from ..progress import progress
 from ..track.importing import ImportOptions, import_options
 from . import beam as B
@@ -19,7 +20,7 @@ from . import servo as S
 from .fitstats import Estimate
 from .plots import plot_fit
 from .recordings import clean_samples, read_table
-from .write import DEFAULT_ROBOT_TOML, write_fitted
+from .write import DEFAULT_ROBOT_TOML, check_plausible, implausible, write_fitted
 
 
 def output_options(func):
@@ -54,15 +55,15 @@ def calibrate() -> None:
 
 @calibrate.command()
 @click.argument("tracks", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--mass-kg", type=float, required=True, help="Dropped tip mass [kg].")
+@click.option("--mass-kg", type=POSITIVE, required=True, help="Dropped tip mass [kg].")
 @click.option("--marker", default=None, help="Marker of the beam tip in the track [default: the only one].")
-@click.option("--length-m", type=float, default=None,
+@click.option("--length-m", type=POSITIVE, default=None,
               help="Free length of the beam, clamp to mass [m]; needed for the hinge values (k*L^2, b*L^2).")
-@click.option("--beam-mass-kg", type=float, default=0.0, show_default=True,
+@click.option("--beam-mass-kg", type=FINITE, default=0.0, show_default=True,
               help="The beam's own mass [kg]; 33/140 of it is added to the oscillating mass.")
-@click.option("--start-s", type=float, default=None,
+@click.option("--start-s", type=FINITE, default=None,
               help="Fit from this time [default: the first swing after the drop].")
-@click.option("--end-s", type=float, default=None, help="Fit up to this time [default: end of the track].")
+@click.option("--end-s", type=FINITE, default=None, help="Fit up to this time [default: end of the track].")
 @import_options
 @output_options
 def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, imports, write_path, as_json, plot_path,
@@ -94,12 +95,12 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, import
 
 @calibrate.command()
 @click.argument("data", nargs=-1, required=True, type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--inertia-kgm2", type=float, multiple=True, required=True,
+@click.option("--inertia-kgm2", type=POSITIVE, multiple=True, required=True,
               help="Load inertia about the servo axis [kg*m^2]; once, or once per DATA in the same order.")
-@click.option("--stall-torque-nm", type=float, default=None,
+@click.option("--stall-torque-nm", type=POSITIVE, default=None,
               help="Stall torque [N*m] from a stall test or the datasheet (SG90: about 0.15). It splits the "
                    "ratios one load gives; leave it out when DATA holds two loads or a load held against gravity.")
-@click.option("--gravity-moment-nm", type=float, multiple=True,
+@click.option("--gravity-moment-nm", type=FINITE, multiple=True,
               help="Moment of the load's weight with the horn horizontal (angle 0) [N*m]; once, or once per DATA "
                    "[default: 0, a horizontal rig].")
 @click.option("--pivot", default=None, metavar="X,Y",
@@ -318,12 +319,19 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
             warnings: list[str] | None = None) -> None:
     recording_name = recording_name or recording
     out = fit.summary()
-    out["warnings"] = list(warnings or [])
+    odd = implausible(values)
+    out["warnings"] = list(warnings or []) + odd
     for warning in out["warnings"]:
         click.echo(f"warning: {warning}", err=True)
     if not no_plot:
         plot_path = plot_path or recording.with_name(f"{Path(recording_name).stem}-fit.png")
         out["plot"] = str(plot_fit(fit.curves, plot_path, subtitle))
+    if write_path and odd:   # show the fit, then refuse to write it
+        if as_json:
+            click.echo(json_text(out), nl=False)
+        else:
+            _print_text(out)
+        check_plausible(values)
     if write_path:
         if values:
             write_fitted(write_path, values, source_name or recording.name, note=note)

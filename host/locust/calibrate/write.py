@@ -8,17 +8,53 @@ atomically (a reader never sees half of it; a failed write leaves the old one).
 from __future__ import annotations
 
 import datetime as _dt
+import math
 from pathlib import Path
 
+from ..errors import CalibrationError
 from ..params import Provenance, load_robot, preset, save_robot
 from .fitstats import Estimate
 
 DEFAULT_ROBOT_TOML = Path("calibration") / "robot.toml"
 
+# what a desk hopper's fitted values can be (the seed's within a few decades): a fit outside
+# came from a recording read in the wrong unit, and is not written
+PLAUSIBLE = {
+    "compliance.hinge_stiffness_nm_per_rad": (1e-5, 10.0),      # seed 0.056
+    "compliance.hinge_damping_nms_per_rad": (1e-8, 1.0),        # seed 5.6e-4
+    "servo.kp_nm_per_rad": (1e-3, 100.0),                       # SG90 0.26
+    "servo.stall_torque_nm": (1e-3, 10.0),                      # SG90 0.15
+    "servo.noload_speed_rad_per_s": (0.5, 200.0),               # SG90 10.2
+    "servo.armature_kgm2": (1e-9, 0.1),                         # SG90 3.1e-4
+    "servo.kv_nms_per_rad": (0.0, 10.0),
+    "contact.foot_friction": (0.05, 5.0),                       # seed 1.7
+    "contact.floor_friction": (0.05, 5.0),
+}
+UNIT_HINT = ("check the recording's units: times in seconds (not ms), angles in degrees (not radians), "
+             "tracks in metres (or --units cm|mm); the fit is shown but not written")
+
+
+def implausible(values: dict[str, Estimate]) -> list[str]:
+    """Fitted values no desk hopper has (a unit slipped), one message each."""
+    out = []
+    for key, est in values.items():
+        low, high = PLAUSIBLE.get(key, (-math.inf, math.inf))
+        if not (math.isfinite(est.value) and low <= est.value <= high):
+            out.append(f"fitted {key} = {est.value:.4g} is outside the plausible {low:g} .. {high:g}")
+    return out
+
+
+def check_plausible(values: dict[str, Estimate]) -> None:
+    """Refuse (:class:`CalibrationError`) to write implausible fitted values."""
+    found = implausible(values)
+    if found:
+        raise CalibrationError("; ".join(found) + "; not written", UNIT_HINT)
+
 
 def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str | Path, *,
                  note: str = "", date: str | None = None) -> Path:
     """Set each dotted key in ``values`` to its fitted value, with ``fit:<recording>``."""
+    check_plausible(values)
     path = Path(path)
     robot = load_robot(path) if path.exists() else preset("seed").renamed("calibrated")
     date = date or _dt.date.today().isoformat()

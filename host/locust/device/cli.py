@@ -133,16 +133,29 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
     schedule = R.HopSchedule(cycles=cycles or s.cycles, push_deg=s.push_deg if push_deg is None else push_deg,
                              push_ms=push_ms or round(s.push_s * 1000), wait_ms=wait_ms or round(s.wait_s * 1000),
                              heartbeat_ms=heartbeat_ms)
-    directory = R.run_dir(out)
     # the virtual robot's fixed video camera is framed on this schedule's planned run
+    # (the options are in the firmware's limits; the robot itself judges its servo travel)
     robot = robot.with_values({"schedule.cycles": schedule.cycles, "schedule.push_deg": schedule.push_deg,
                                "schedule.push_s": schedule.push_ms / 1000, "schedule.wait_s": schedule.wait_ms / 1000},
                               "locust hop options")
-    with open_port(port, plant=plant, video=video, robot=robot, info=_info) as device:
-        with Link(device) as link:
-            with progress(length=schedule.phases, label="hop") as bar:
-                rec = run_hop(link, schedule, directory,
-                              on_phase=lambda p: (bar.update(1), setattr(bar, "label", f"cycle {p.cycle} {p.phase}")))
+    made = _first_missing(Path(out)) if out is not None else None
+    directory = R.run_dir(out)
+    # a kill (SIGTERM) or a closed terminal (SIGHUP) ends the hop as Ctrl-C does: the robot to
+    # rest, the record says so, a --port sim virtual robot stops
+    previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        with open_port(port, plant=plant, video=video, robot=robot, info=_info) as device:
+            with Link(device) as link:
+                with progress(length=schedule.phases, label="hop") as bar:
+                    rec = run_hop(link, schedule, directory,
+                                  on_phase=lambda p: (bar.update(1),
+                                                      setattr(bar, "label", f"cycle {p.cycle} {p.phase}")))
+    except BaseException:
+        _remove_empty(directory, made if out is not None else directory)   # a hop that never started
+        raise                                                              # leaves no empty folder
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     path = directory / R.RECORD_NAME
     if as_json:
         click.echo(json_text(rec.to_dict()), nl=False)
@@ -241,6 +254,30 @@ def repl(port):
 
 def _interrupt(signum, frame):
     raise KeyboardInterrupt
+
+
+def _first_missing(path: Path) -> Path | None:
+    """The outermost folder of ``path`` that does not exist yet (what making it would create)."""
+    missing = None
+    for p in (path, *path.parents):
+        if p.exists():
+            break
+        missing = p
+    return missing
+
+
+def _remove_empty(directory: Path, top: Path | None) -> None:
+    """Remove ``directory`` and its parents up to ``top`` while they are empty (none if ``top``
+    is None: the folder was there before)."""
+    if top is None:
+        return
+    for p in (directory, *directory.parents):
+        try:
+            p.rmdir()   # only an empty folder goes
+        except OSError:
+            return
+        if p == top:
+            return
 
 
 @click.command()

@@ -47,7 +47,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             link.call("stop")
         while not link.events.empty():  # a boot event from before we connected is old news
             link.events.get_nowait()
-        link.start_heartbeat(schedule.heartbeat_ms / 4000.0)
+        link.start_heartbeat(schedule.heartbeat_ms / 8000.0)  # 8 beats in each timeout
         reply = link.request("hop", cycles=schedule.cycles, push_deg=schedule.push_deg,
                              push_ms=schedule.push_ms, wait_ms=schedule.wait_ms,
                              heartbeat_ms=schedule.heartbeat_ms)
@@ -84,10 +84,11 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             _fetch_report(link, rec)
     except KeyboardInterrupt:
         _stop_quietly(link)
-        rec.status, rec.message = R.INCOMPLETE, "interrupted (Ctrl-C); the robot was sent to rest"
+        rec.status, rec.message = R.INCOMPLETE, "interrupted (Ctrl-C or a kill); the robot was sent to rest"
         R.write(rec, directory)
         raise DeviceError(f"hop interrupted after {len(rec.phases)} of {schedule.phases} phases; "
-                          f"partial record in {directory / R.RECORD_NAME}") from None
+                          f"partial record in {directory / R.RECORD_NAME}",
+                          "the robot is at rest; run the hop again when ready") from None
     except DeviceError as exc:
         _stop_quietly(link)
         if rec.status != R.ERROR:

@@ -10,6 +10,7 @@ and dropped.
 from __future__ import annotations
 
 import collections
+import os
 import queue
 import threading
 import time
@@ -22,6 +23,15 @@ from ..firmware import protocol as P
 CLOSED = {"ev": "link_closed"}  # put on the event queue when the port goes away
 REPL_PROMPT = b">>> "           # the friendly REPL echoing a frame: `>>> ${"id":...`
 RAW_REPL = b"raw REPL; CTRL-B to exit"
+
+
+def raise_thread_priority(nice: int = -10) -> None:
+    """Best effort: this thread ahead of the machine's other work (Linux threads have their own
+    nice value; without the privilege, it stays as it is)."""
+    try:
+        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), nice)
+    except (OSError, AttributeError):
+        pass
 
 
 class Link:
@@ -174,15 +184,26 @@ class Link:
         return msg
 
     def start_heartbeat(self, interval_s: float) -> None:
-        """Ping every ``interval_s`` until stop_heartbeat(): the robot's proof the host is alive."""
+        """Ping every ``interval_s`` until stop_heartbeat(): the robot's proof the host is alive.
+
+        The pings come from a thread of their own, on a fixed clock (a late beat does not push
+        the next one later), at a raised priority where the system allows it, so that a busy
+        machine or a busy main thread does not silence the host."""
         self.stop_heartbeat()
         stop = threading.Event()
         self._heartbeat_stop = stop
+        frame = P.encode({"id": 0, "cmd": "ping"})
 
         def beat() -> None:
-            while not stop.wait(interval_s) and self.error is None:
+            raise_thread_priority()
+            due = time.monotonic()
+            while self.error is None:
+                due += interval_s
+                if stop.wait(max(0.0, due - time.monotonic())):
+                    return
+                due = max(due, time.monotonic() - interval_s)   # after a long stall, beat on from now
                 try:
-                    self.write(P.encode({"id": 0, "cmd": "ping"}))
+                    self.write(frame)
                 except DeviceError:
                     return
 

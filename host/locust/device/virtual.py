@@ -107,7 +107,29 @@ def _read_pty(fd: int) -> bytes:
         raise
 
 
-def _raise_priority() -> None:  # runs in the child before exec
+def _libc_prctl():
+    try:
+        import ctypes
+
+        return ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):  # not Linux
+        return None
+
+
+_PRCTL = _libc_prctl()   # looked up here: the child between fork and exec only calls it
+
+
+def _child_setup() -> None:  # runs in the child before exec
+    """Die with the host (PR_SET_PDEATHSIG: even a kill -9 of the host takes the interpreter
+    with it), then ask for real-time scheduling."""
+    if _PRCTL is not None:
+        _PRCTL(1, signal.SIGKILL, 0, 0, 0)
+        if os.getppid() == 1:   # the host died before the line above
+            os._exit(1)
+    _raise_priority()
+
+
+def _raise_priority() -> None:
     try:
         os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(10))
         return
@@ -187,7 +209,7 @@ class VirtualRobot:
         with self._proc_lock:
             self._proc = subprocess.Popen(args, stdin=self._sa, stdout=self._sa, stderr=self._sa,
                                           cwd=self.flash_dir, env=env, start_new_session=True,
-                                          preexec_fn=_raise_priority)
+                                          preexec_fn=_child_setup)
             try:
                 policy = os.sched_getscheduler(self._proc.pid)
                 self.scheduling = "realtime" if policy == os.SCHED_FIFO else "normal"
@@ -282,6 +304,10 @@ class VirtualRobot:
 
     def _bridge(self) -> None:
         import select
+
+        from .link import raise_thread_priority
+
+        raise_thread_priority()   # the host's heartbeat passes through here
 
         while not self._stopping.is_set():
             ready, _, _ = select.select([self._ma, self._mb], [], [], 0.2)

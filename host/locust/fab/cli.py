@@ -10,6 +10,7 @@ import click
 
 from ..errors import FabError
 from ..fileio import json_text
+from ..options import FINITE
 from . import export, flat_pattern, laminate, preview
 from .design import LayerMap, design_from_drawing, parse_layer_options
 from .dxf_read import UNIT_BY_NAME, read_drawing
@@ -18,12 +19,23 @@ from .summary import summary, summary_text
 
 def _robot(spec: str):
     from .. import params
+    from ..errors import GeometryError
+    from ..sim.fourbar import assemble
 
     if spec in params.PRESETS:
-        return params.preset(spec)
-    path = Path(spec)
-    if path.suffix.lower() == ".toml" or path.exists():
-        return params.load_robot(path)
+        robot = params.preset(spec)
+    elif Path(spec).suffix.lower() == ".toml" or Path(spec).exists():
+        robot = params.load_robot(Path(spec))
+    else:
+        robot = None
+    if robot is not None:
+        g = robot.geometry
+        try:
+            assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, g.crank_start_deg)
+        except GeometryError as exc:
+            raise FabError(f"--from-robot {spec}: the linkage cannot close, so its flat pattern would fold into "
+                           f"nothing: {exc.message}", exc.hint or "check geometry.*_m in the robot.toml") from None
+        return robot
     raise FabError(f"--from-robot {spec!r}: neither a preset nor a robot.toml",
                    f"give one of {', '.join(params.PRESETS)} or the path of a robot.toml")
 
@@ -55,25 +67,25 @@ def _cad_check(out: Path, names: list[str]) -> dict:
                    "Replaces that role's defaults; repeatable.")
 @click.option("--units", type=click.Choice(list(UNIT_BY_NAME)), default=None,
               help="Drawing units, overriding $INSUNITS (a unitless drawing is read as mm).")
-@click.option("--gap-tol-mm", type=float, default=0.01, show_default=True,
+@click.option("--gap-tol-mm", type=FINITE, default=0.01, show_default=True,
               help="Join open outline pieces whose ends are this close.")
 @click.option("--recover", is_flag=True, help="Read a damaged DXF with ezdxf's recover mode.")
-@click.option("--hinge-width-mm", type=float, default=1.0, show_default=True,
+@click.option("--hinge-width-mm", type=FINITE, default=1.0, show_default=True,
               help="Width of the cut-out made from a fold line on a hinge layer.")
 @click.option("--stack", default=",".join(laminate.SEED_STACK), show_default=True,
               help="Layer materials, top to bottom (rigid, adhesive, flexible).")
 @click.option("--mirror", multiple=True, metavar="LAYER",
               help="Mirror this layer's cut files (e.g. adhesive_bottom, cut liner side up). Repeatable.")
-@click.option("--kerf-mm", type=float, default=0.05, show_default=True, help="Laser kerf (cut width).")
-@click.option("--support-width-mm", type=float, default=2.0, show_default=True,
+@click.option("--kerf-mm", type=FINITE, default=0.05, show_default=True, help="Laser kerf (cut width).")
+@click.option("--support-width-mm", type=FINITE, default=2.0, show_default=True,
               help="Support web: release cut this far outside the outline.")
-@click.option("--jig-diameter-mm", type=float, default=5.0, show_default=True, help="Alignment hole diameter.")
-@click.option("--jig-spacing-mm", type=float, default=10.0, show_default=True,
+@click.option("--jig-diameter-mm", type=FINITE, default=5.0, show_default=True, help="Alignment hole diameter.")
+@click.option("--jig-spacing-mm", type=FINITE, default=10.0, show_default=True,
               help="Alignment holes this far out from the body's corners.")
-@click.option("--glue-tab-mm", type=float, default=20.0, show_default=True, help="With --from-robot: glue tab length.")
-@click.option("--slot-width-mm", type=float, default=1.0, show_default=True,
+@click.option("--glue-tab-mm", type=FINITE, default=20.0, show_default=True, help="With --from-robot: glue tab length.")
+@click.option("--slot-width-mm", type=FINITE, default=1.0, show_default=True,
               help="With --from-robot: hinge slot width.")
-@click.option("--slot-length-mm", type=float, default=13.0, show_default=True,
+@click.option("--slot-length-mm", type=FINITE, default=13.0, show_default=True,
               help="With --from-robot: hinge slot length.")
 @click.option("--no-preview", is_flag=True, help="Skip the PNG previews.")
 @click.option("--cad-check", is_flag=True, help="Open every written DXF in LibreCAD (headless) and check it draws.")
@@ -118,9 +130,11 @@ def fab(dxf, from_robot, out, as_json, layers, units, gap_tol_mm, recover, hinge
                                jig_diameter_mm=jig_diameter_mm, jig_spacing_mm=jig_spacing_mm)
     lam = laminate.build(design, specs, process)
 
-    files: dict[str, bytes] = {}
-    if out is not None:
-        files = export.cut_files(lam)
+    # the cut files are made with or without --out: a kerf that cannot be applied is refused either way
+    files: dict[str, bytes] = export.cut_files(lam)
+    if out is None:
+        files = {}
+    else:
         if fp is not None:
             files["flat_pattern.dxf"] = flat_pattern.drawing_bytes(fp)
         if not no_preview:

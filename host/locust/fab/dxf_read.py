@@ -199,5 +199,9 @@ def read_drawing(path: str | Path, *, units: str | None = None, gap_tol_mm: floa
     for layer in sorted(by_layer):
         contours += layer_contours(by_layer[layer], layer, mm_per_unit=mm_per_unit,
                                    gap_tol_mm=gap_tol_mm, sagitta_mm=sagitta_mm)
+    for c in contours:
+        if not np.isfinite(c.points_mm).all():
+            raise FabError(f"{path}: layer {c.layer!r}: {', '.join(c.entities)} has a vertex that is not a "
+                           "finite number (NaN or inf)", "fix the drawing in the CAD program, or redraw that entity")
     return Drawing(Path(path), unit_name, mm_per_unit, units_from, tuple(contours),
                    dict(skipped), fixed)

@@ -22,6 +22,7 @@ symmetrically about it, so they register either way.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from shapely import affinity, unary_union
@@ -40,6 +41,37 @@ class LayerSpec:
     mirror: bool = False
 
 
+# the smallest and largest part a laser cutter can make: below 0.01 mm is a drawing in the wrong
+# unit or a stray point, above 10 m no sheet holds it
+PART_LIMITS_MM = (0.01, 10_000.0)
+# process setting -> (lowest, lowest allowed?, highest), mm
+PROCESS_LIMITS_MM = {"kerf_mm": (0.0, True, 10.0), "support_width_mm": (0.0, True, 1000.0),
+                     "jig_diameter_mm": (0.0, False, 1000.0), "jig_spacing_mm": (0.0, False, 10_000.0)}
+
+
+def check_design(design) -> None:
+    """Refuse a part no cutter can make (size, non-finite vertices) and cut-outs that are not in it."""
+    bounds = design.body.bounds
+    if design.body.is_empty or not all(math.isfinite(v) for v in bounds):
+        raise FabError(f"{design.source or 'the part'}: its outline has no finite vertices (NaN or inf)",
+                       "check the drawing's coordinates, or redraw the outline")
+    x0, y0, x1, y1 = bounds
+    low, high = PART_LIMITS_MM
+    size = max(x1 - x0, y1 - y0)
+    if size > high or min(x1 - x0, y1 - y0) < low:
+        raise FabError(f"{design.source or 'the part'}: {x1 - x0:.4g} x {y1 - y0:.4g} mm is outside the "
+                       f"{low:g} mm to {high / 1000:g} m a cutter can make",
+                       "check the drawing units (--units) or the robot's lengths (metres in robot.toml)")
+    inside = design.body.buffer(1e-6)
+    cuts = [("hole", h) for h in design.holes] + [("slit", s) for s in design.slits] + \
+        [(f"hinge {h.layer}", h.polygon) for h in design.hinges]
+    for what, geom in cuts:
+        if geom.is_empty or not all(math.isfinite(v) for v in geom.bounds) or not geom.intersects(inside):
+            gx0, gy0, gx1, gy1 = geom.bounds if not geom.is_empty else (math.nan,) * 4
+            raise FabError(f"{what} at ({(gx0 + gx1) / 2:.3f}, {(gy0 + gy1) / 2:.3f}) mm lies outside the body",
+                           "move it inside the outline, or put it on another layer")
+
+
 @dataclass(frozen=True)
 class Process:
     """Cutting parameters (the seed's Config, in millimetres)."""
@@ -50,10 +82,11 @@ class Process:
     jig_spacing_mm: float = 10.0
 
     def check(self) -> None:
-        for name in ("kerf_mm", "support_width_mm", "jig_diameter_mm", "jig_spacing_mm"):
-            if not getattr(self, name) >= 0:
-                raise FabError(f"process: {name} = {getattr(self, name)!r} must be >= 0",
-                               f"give --{name.replace('_', '-')} >= 0")
+        for name, (low, low_ok, high) in PROCESS_LIMITS_MM.items():
+            value = getattr(self, name)
+            if not (value > low or (low_ok and value == low)) or not value <= high:
+                raise FabError(f"process: {name} = {value!r} must be {'>=' if low_ok else '>'} {low:g} "
+                               f"and <= {high:g} mm", f"give --{name.replace('_', '-')} in that range")
         if self.jig_diameter_mm / 2 >= self.jig_spacing_mm:
             raise FabError(
                 f"process: alignment holes ({self.jig_diameter_mm:g} mm) would cut into the body "
@@ -137,6 +170,7 @@ def build(design: Design, stack: tuple[LayerSpec, ...] | None = None, process: P
     stack = stack or stack_from_materials(SEED_STACK)
     process = process or Process()
     process.check()
+    check_design(design)
     layers = tuple(LaminateLayer(spec, part_geometry(design, spec.material)) for spec in stack)
     for layer in layers:
         if layer.part.is_empty:

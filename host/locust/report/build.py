@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from .. import __version__
+from ..device.record import ERROR as REFUSED
 from ..errors import ReportError
 from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, unique_dir
 from ..params import Provenance, Robot
@@ -51,6 +52,10 @@ def run_schedule(name: str, trials: list[Trial]) -> dict | None:
     for t in trials:
         if t.record is None:
             continue
+        if t.record.status == REFUSED:   # the robot refused the hop: nothing moved
+            raise ReportError(f"configuration {name}: run {t.label} was refused by the robot "
+                              f"({t.record.message}); there is no hop to compare with a prediction",
+                              "leave that run out of --measured")
         s = t.record.schedule
         key = (float(s.push_deg), float(s.push_ms), float(s.wait_ms))
         seen.setdefault(key, []).append(t)
@@ -109,6 +114,9 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
         sched = run_schedule(name, trials)
         cfg = Configuration(cfg.name, cfg.added_m, with_run_schedule(cfg.robot, sched))
         configs[name] = cfg
+        if cycles and sched and cycles > sched["cycles"]:
+            raise ReportError(f"--cycles {cycles}: the runs of {name} recorded only {sched['cycles']} cycles",
+                              f"give --cycles {sched['cycles']} or fewer, or leave it out")
         n_cycles = cycles or (sched["cycles"] if sched else cfg.robot.schedule.cycles)
         period = cfg.robot.schedule.push_s + cfg.robot.schedule.wait_s
         progress(f"simulating {cfg.label} ({n_cycles} cycles)")

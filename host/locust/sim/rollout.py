@@ -13,7 +13,7 @@ import mujoco
 import numpy as np
 from mujoco import rollout as mj_rollout
 
-from ..params import Robot
+from ..params import Robot, check_robot
 from .model import BuiltModel, build
 from .schedule import ControlPlan, control_plan
 
@@ -58,6 +58,7 @@ def simulate(robot: Robot, cycles: int | None = None, timestep_s: float | None =
     """Simulate settle + ``cycles`` hop cycles; the model is built unless given."""
     if timestep_s is not None:
         robot = robot.with_values({"solver.timestep_s": timestep_s})
+    check_robot(robot, cycles)  # before any allocation
     built = built or build(robot)
     plan = control_plan(robot.schedule, robot.solver, cycles)
     return simulate_built(built, plan, keep_states=keep_states)

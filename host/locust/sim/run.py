@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import GeometryError
-from ..params import Robot
+from ..params import Robot, check_robot
 from .audit import audit
 from .fourbar import GOOD_TRANSMISSION_DEG
 from .hops import Hop, summarise
@@ -73,6 +73,7 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
     """
     if timestep_s is not None:
         robot = robot.with_values({"solver.timestep_s": timestep_s})
+    check_robot(robot, cycles)  # nothing unsimulatable reaches MuJoCo
     built = build(robot)
     traj = simulate(robot, cycles=cycles, built=built, keep_states=keep_states)
     verdict = audit(traj)

@@ -52,7 +52,7 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
     """
     from .design import parse_axis
     from .execute import check_scheduler
-    from .run import grid, run_sweep
+    from .run import grid_size, run_sweep
 
     base = resolve_robot(preset, config, sets)
     axes = [parse_axis(v, base) for v in varies]
@@ -60,7 +60,7 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
     if len(set(names)) != len(names):
         raise SweepError(f"--vary names a parameter twice: {', '.join(names)}", "give each parameter one --vary")
     check_scheduler(scheduler)
-    total = len(grid(axes))
+    total = grid_size(axes)
     with progress(length=total, label=f"sweep ({scheduler})", show_pos=True, show_eta=True) as bar:
         try:
             summary = run_sweep(base, axes, cycles, out, scheduler=scheduler, jobs=jobs, progress=bar.update,

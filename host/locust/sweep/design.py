@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import GeometryError, LocustError, SweepError
-from ..params import Provenance, Robot, all_keys, with_added_length
+from ..params import Provenance, Robot, all_keys, problems, with_added_length
 from ..sim.fourbar import assemble
 
 SCALE = "scale"
@@ -162,7 +162,7 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 
         robot = design_robot(base, values)
     except LocustError as exc:
         return invalid_row(str(exc))
-    reason = precheck(robot)
+    reason = "; ".join(problems(robot, cycles)) or precheck(robot)
     if reason:
         return invalid_row(reason)
     try:

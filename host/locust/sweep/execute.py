@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from contextlib import contextmanager
@@ -40,9 +41,24 @@ def _serial(fn: Callable, items: Sequence) -> Iterator[Any]:
         yield fn(item)
 
 
+def die_with_parent(parent_pid: int) -> None:
+    """In a worker: be killed when the process that started it dies, however it dies (kill -9,
+    out of memory), so no worker outlives its sweep (Linux; elsewhere the pool's own shutdown)."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL, 0, 0, 0)   # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        return
+    if os.getppid() != parent_pid:   # the parent died before the line above
+        os._exit(1)
+
+
 def _pool(fn: Callable, items: Sequence, jobs: int) -> Iterator[Any]:
     ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx)
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=die_with_parent,
+                               initargs=(os.getpid(),))
     pending: set[Future] = set()
     queue = list(items)[::-1]
     try:

@@ -18,9 +18,39 @@ from typing import Any
 from ..errors import SweepError
 from ..fileio import atomic_write_json, atomic_write_text
 from ..params import Robot
-from .design import Bound, evaluate
+from .design import SCALE, Bound, evaluate
 
 RDB_PREFIXES = ("sqlite:", "postgresql", "mysql", "oracle", "mssql")
+# what run_optimize writes in its folder; anything else there is someone else's
+OWN_FILES = frozenset({"trials.csv", "optimize.json", "history.png", "study.journal", "study.journal.lock"})
+
+
+def check_folder(folder: Path) -> None:
+    """Refuse a folder holding files this command did not write (a user's ``trials.csv``
+    included: a folder of ours always has ``optimize.json`` or the study's journal beside it)."""
+    if not folder.exists():
+        return
+    if not folder.is_dir():
+        raise SweepError(f"--out {folder} is a file", "give a folder (new, or one `locust optimize` made)")
+    names = {p.name for p in folder.iterdir() if not p.name.startswith(".")}
+    foreign = sorted(names - OWN_FILES)
+    ours = bool(names & {"optimize.json", "study.journal"})
+    if foreign or (names and not ours):
+        shown = ", ".join((foreign or sorted(names))[:5])
+        raise SweepError(f"{folder} holds files `locust optimize` did not write ({shown}); refusing to write there",
+                         "choose a new or empty --out folder")
+
+
+def check_storage(url: str | None) -> None:
+    if url is None or url.startswith(RDB_PREFIXES):
+        return
+    path = url.removeprefix("journal:")
+    if "://" in path or not path.strip():
+        raise SweepError(f"--storage {url}: not a journal file path nor a database URL Optuna knows",
+                         "give a file path (e.g. opt/study.journal) or sqlite:///study.db, postgresql://..., mysql://...")
+    parent = Path(path).parent
+    if not parent.is_dir():
+        raise SweepError(f"--storage {url}: the folder {parent} does not exist", "create it, or give another path")
 
 
 def open_storage(url: str | None, folder: Path):
@@ -40,6 +70,14 @@ def open_storage(url: str | None, folder: Path):
     return JournalStorage(JournalFileBackend(path))
 
 
+def is_integer(base: Robot, name: str) -> bool:
+    """Whether the parameter ``name`` holds whole numbers (schedule.cycles, solver.iterations)."""
+    if name == SCALE:
+        return False
+    value = base.get(name)
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
 @dataclass
 class OptimizeSummary:
     study_name: str
@@ -56,13 +94,33 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
+    check_folder(folder)
+    check_storage(storage)
+    integers = {b.name for b in bounds if is_integer(base, b.name)}
+    for b in bounds:
+        if b.name in integers and math.floor(b.high) < math.ceil(b.low):
+            raise SweepError(f"--vary {b.name}={b.low:g}:{b.high:g} holds no whole number, and {b.name} is one",
+                             f"give a range with at least one integer, e.g. {b.name}={math.floor(b.low)}:"
+                             f"{math.floor(b.low) + 2}")
     folder.mkdir(parents=True, exist_ok=True)
-    study = optuna.create_study(study_name=study_name, storage=open_storage(storage, folder),
+    storage_obj = open_storage(storage, folder)
+    # a resumed study must not draw its first samples again: the sampler's seed moves on with
+    # the number of trials the study already holds
+    try:
+        done_before = len(optuna.load_study(study_name=study_name, storage=storage_obj).trials)
+    except KeyError:
+        done_before = 0
+    study = optuna.create_study(study_name=study_name, storage=storage_obj,
                                 direction="maximize", load_if_exists=True,
-                                sampler=optuna.samplers.TPESampler(seed=seed))
+                                sampler=optuna.samplers.TPESampler(seed=seed + done_before))
+
+    def suggest(trial: optuna.Trial, b: Bound) -> float | int:
+        if b.name in integers:
+            return trial.suggest_int(b.name, math.ceil(b.low), math.floor(b.high))
+        return trial.suggest_float(b.name, b.low, b.high)
 
     def objective(trial: optuna.Trial) -> float:
-        values = {b.name: trial.suggest_float(b.name, b.low, b.high) for b in bounds}
+        values = {b.name: suggest(trial, b) for b in bounds}
         row = evaluate(base, values, cycles)
         for key in ("max_nose_height_m", "nose_apex_max_m", "com_apex_max_m"):
             if math.isfinite(row[key]):

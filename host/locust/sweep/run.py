@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..errors import SweepError
 from ..params import Robot
 from .design import Axis, evaluate
 from .execute import default_jobs, mapper
@@ -41,8 +42,24 @@ def run_task(task: Task) -> dict[str, Any]:
     return row
 
 
+# the most designs one sweep may hold: its rows are kept in memory, and at a few tenths of a
+# second a design it is already hours on a laptop
+MAX_DESIGNS = 100_000
+
+
+def grid_size(axes: list[Axis]) -> int:
+    """How many designs the grid holds, refused (:class:`SweepError`) over MAX_DESIGNS."""
+    size = math.prod(a.n for a in axes)
+    if size > MAX_DESIGNS:
+        raise SweepError(f"the grid holds {size:,} designs ({' x '.join(str(a.n) for a in axes)}), "
+                         f"over the limit of {MAX_DESIGNS:,}",
+                         "use fewer values per --vary (N), or `locust optimize` to search a large space")
+    return size
+
+
 def grid(axes: list[Axis]) -> list[dict[str, float]]:
     """Every combination, the last axis varying fastest; design ``i`` is the i-th."""
+    grid_size(axes)
     names = [a.name for a in axes]
     return [dict(zip(names, combo)) for combo in itertools.product(*(a.values() for a in axes))]
 

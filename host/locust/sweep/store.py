@@ -174,6 +174,17 @@ class SweepStore:
             raise SweepError(f"another sweep is running in {self.folder}",
                              "wait for it to finish (or stop it), or use another --out folder") from None
         self._lock_fd = fd
+        # a worker forked from here must not hold the lock: when this process dies (kill -9),
+        # the lock goes with it, and rerunning resumes
+        os.register_at_fork(after_in_child=self._forget_lock)
+
+    def _forget_lock(self) -> None:
+        if self._lock_fd is not None:
+            try:
+                os.close(self._lock_fd)
+            except OSError:
+                pass
+            self._lock_fd = None
 
     def _read_rows(self) -> dict[int, dict[str, Any]]:
         """Rows already finished (a last line cut short by an interrupt is dropped)."""

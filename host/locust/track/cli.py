@@ -38,6 +38,18 @@ def _refuse_overwrite(paths: dict[str, Path], force: bool) -> None:
         raise TrackError(f"output exists: {', '.join(taken)}", "choose another --out, or add --force to replace it")
 
 
+def _refuse_inputs(paths: dict[str, Path], inputs: list[Path]) -> None:
+    """No output may land on an input: the video, a Tracker project, or a sidecar beside them
+    (``<video>.camera.json``, ``<video>.truth.csv``), ``--force`` or not."""
+    guarded = set()
+    for p in inputs:
+        guarded |= {p.resolve(), camera.camera_json_beside(p).resolve(), p.with_name(p.stem + ".truth.csv").resolve()}
+    clash = [str(p) for p in paths.values() if p.resolve() in guarded]
+    if clash:
+        raise TrackError(f"--out would overwrite an input or its sidecar: {', '.join(clash)}",
+                         "choose another --out (the default, <video>.tracks.csv, is always safe)")
+
+
 def _base_path(out: Path | None, source: Path) -> Path:
     default_stem = tracks_csv_beside(source).with_suffix("").name   # hop.tracks (.csv, .json, .png)
     if out is None:
@@ -134,6 +146,11 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
       locust track --from-trk experiment.trz --format tracker
       locust track --import tracker.txt --units cm --rename A=nose --out hop.tracks.csv
     """
+    for name, value in (("--angle", angle), ("--accept", accept), ("--fps", fps)):
+        if value is not None and not math.isfinite(value):
+            raise TrackError(f"{name} {value}: not a finite number", f"give {name} as a plain number, see --help")
+    if fps is not None and fps <= 0:
+        raise TrackError(f"--fps {fps:g}: a frame rate must be above 0", "e.g. --fps 240 for slow-motion footage")
     if make_board is not None:
         spec = board.parse_board(board_text or DEFAULT_BOARD)
         _refuse_overwrite({"board": make_board}, force)
@@ -176,6 +193,7 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
     else:
         calibration = _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, camera_json)
     paths = _outputs(_base_path(out, video), fmt, overlay_kind)
+    _refuse_inputs(paths, [p for p in (video, camera_json) if p is not None])
     _refuse_overwrite(paths, force)
 
     n = len(clip.frames())
@@ -241,6 +259,7 @@ def _convert_trk(path: Path, names: list[str], out, fmt: str, force: bool) -> No
     project = trk.read_project(path)
     result = trk.project_result(project, names or None)
     paths = _outputs(_base_path(out, path), fmt, "none")
+    _refuse_inputs(paths, [path])
     _refuse_overwrite(paths, force)
     _report(result, _write(result, paths, fmt))
 

@@ -1,0 +1,472 @@
+"""Bad input, faults and load, as a hostile new user tries them: every case is a clear
+``error:`` with a ``hint:``, exit 2, no traceback, and no file changed (bytes and mode) or
+left behind.
+
+One parametrised case per probe class; the commands run in this process through the
+``locust`` click group (as the console script does), in a fresh folder each. Faults that
+need a process of their own (a full disk, kill -9, a killed hop) run in subprocesses.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import resource
+import signal
+import stat
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from locust.cli import cli
+from locust.device import record as R
+from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
+
+LOCUST = [sys.executable, "-m", "locust.cli"]
+
+
+def tree(folder: Path) -> dict[str, tuple[bytes, int]]:
+    """Every file under ``folder``: its bytes and mode (symlinks by their target's name)."""
+    out = {}
+    for p in sorted(folder.rglob("*")):
+        rel = str(p.relative_to(folder))
+        if p.is_symlink():
+            out[rel] = (os.readlink(p).encode(), 0)
+        elif p.is_file():
+            out[rel] = (p.read_bytes(), stat.S_IMODE(p.stat().st_mode))
+        elif p.is_dir():
+            out[rel + "/"] = (b"", stat.S_IMODE(p.stat().st_mode))
+        else:   # a pipe, a device: its type and mode
+            out[rel + "|"] = (b"", p.stat().st_mode)
+    return out
+
+
+def invoke(args: list[str]):
+    return CliRunner().invoke(cli, [str(a) for a in args], catch_exceptions=True)
+
+
+def assert_clear_error(res, *words: str) -> None:
+    traceback = "".join(__import__("traceback").format_exception(res.exception)) if res.exception else ""
+    assert not isinstance(res.exception, Exception) or isinstance(res.exception, SystemExit), traceback
+    assert res.exit_code == 2, res.output
+    assert "Traceback" not in res.output
+    assert "error:" in res.stderr and "hint:" in res.stderr, res.stderr
+    for w in words:
+        assert w in res.stderr, (w, res.stderr)
+
+
+# -- inputs the cases use ------------------------------------------------------------
+def robot_toml(d: Path, text: str, name: str = "robot.toml") -> Path:
+    p = d / name
+    p.write_text(text)
+    return p
+
+
+def dxf(d: Path, name: str, body, holes=(), slits=()) -> Path:
+    import ezdxf
+
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4   # mm
+    msp = doc.modelspace()
+    msp.add_lwpolyline(body, close=True, dxfattribs={"layer": "plate"})
+    for centre, r in holes:
+        msp.add_circle(centre, r, dxfattribs={"layer": "holes"})
+    for a, b in slits:
+        msp.add_line(a, b, dxfattribs={"layer": "cuts"})
+    doc.saveas(d / name)
+    return d / name
+
+
+RECT = [(0, 0), (50, 0), (50, 30), (0, 30)]
+SERVO_CSV = Path(__file__).resolve().parents[1] / "calibration" / "recordings" / "synthetic_servo.csv"
+BEAM_CSV = Path(__file__).resolve().parents[1] / "calibration" / "recordings" / "synthetic_beam.csv"
+
+
+def trial(d: Path, status: str = R.COMPLETE, cycles: int = 2) -> Path:
+    """A measured trial: a staircase nose track (synthetic) and its run record."""
+    folder = d / "small-1"
+    folder.mkdir()
+    rows = ["frame,t_s,nose_x_m,nose_y_m"]
+    for i in range(90):
+        t = i / 30
+        rows.append(f"{i},{t:.6f},{0.1 + 0.02 * min(int(t / 1.3), cycles):.6f},0.05")
+    (folder / "hop.tracks.csv").write_text("\n".join(rows) + "\n")
+    sched = R.HopSchedule(cycles=cycles, push_deg=-30.0, push_ms=300, wait_ms=1000)
+    rec = R.RunRecord(schedule=sched, port="/dev/ttyUSB0", status=status,
+                      message="out_of_range: push_deg" if status == R.ERROR else None)
+    R.write(rec, folder)
+    return folder
+
+
+def copy_servo(d: Path) -> Path:
+    p = d / "servo.csv"
+    p.write_bytes(SERVO_CSV.read_bytes())
+    return p
+
+
+def copy_beam(d: Path) -> Path:
+    p = d / "beam.csv"
+    p.write_bytes(BEAM_CSV.read_bytes())
+    return p
+
+
+def readonly(d: Path, name: str = "robot.toml") -> Path:
+    p = d / name
+    p.write_text("# mine\n")
+    p.chmod(0o444)
+    return p
+
+
+def user_trials(d: Path) -> Path:
+    (d / "opt").mkdir()
+    (d / "opt" / "trials.csv").write_text("trial,score\n1,0.5\n")
+    return d / "opt"
+
+
+# (id, setup(d) -> args, words the error must hold)
+S = "--set"
+CASES = [
+    # parameter edges: nothing unsimulatable reaches MuJoCo, nothing absurd is simulated as valid
+    ("timestep-0", lambda d: ["sim", S, "solver.timestep_s=0"], ["solver.timestep_s"]),
+    ("timestep-negative", lambda d: ["sim", S, "solver.timestep_s=-1e-3"], ["solver.timestep_s"]),
+    ("timestep-huge", lambda d: ["sim", S, "solver.timestep_s=1"], ["solver.timestep_s"]),
+    ("timestep-nan", lambda d: ["sim", S, "solver.timestep_s=nan"], ["solver.timestep_s"]),
+    ("control-hz-0", lambda d: ["sim", S, "solver.control_hz=0"], ["solver.control_hz"]),
+    ("control-hz-beyond-step", lambda d: ["sim", S, "solver.control_hz=1e6"], ["faster than one command"]),
+    ("wait-negative", lambda d: ["sim", S, "schedule.wait_s=-1"], ["schedule.wait_s"]),
+    ("settle-negative", lambda d: ["sim", S, "solver.settle_s=-1"], ["solver.settle_s"]),
+    ("cycles-0", lambda d: ["sim", S, "schedule.cycles=0"], ["schedule.cycles"]),
+    ("cycles-fraction", lambda d: ["sim", S, "schedule.cycles=1.5"], ["schedule.cycles"]),
+    ("push-s-1e9", lambda d: ["sim", S, "schedule.push_s=1e9"], ["schedule.push_s"]),
+    ("push-deg-beyond-firmware", lambda d: ["sim", S, "schedule.push_deg=-120"], ["schedule.push_deg", "-90"]),
+    ("push-deg-beyond-travel", lambda d: ["sim", S, "schedule.push_deg=-60"], ["servo travel"]),
+    ("foot-friction-negative", lambda d: ["sim", S, "contact.foot_friction=-1"], ["contact.foot_friction"]),
+    ("floor-friction-negative", lambda d: ["sim", S, "contact.floor_friction=-0.1"], ["contact.floor_friction"]),
+    ("kp-negative", lambda d: ["sim", S, "servo.kp_nm_per_rad=-1"], ["servo.kp_nm_per_rad"]),
+    ("kv-negative", lambda d: ["sim", S, "servo.kv_nms_per_rad=-1"], ["servo.kv_nms_per_rad"]),
+    ("stall-torque-0", lambda d: ["sim", S, "servo.stall_torque_nm=0"], ["servo.stall_torque_nm"]),
+    ("iterations-0", lambda d: ["sim", S, "solver.iterations=0"], ["solver.iterations"]),
+    ("leg-length-0", lambda d: ["sim", S, "geometry.leg_m=0"], ["geometry.leg_m"]),
+    ("body-mass-negative", lambda d: ["sim", S, "geometry.body_mass_kg=-0.05"], ["geometry.body_mass_kg"]),
+    ("loop-impedance-1", lambda d: ["sim", S, "solver.loop_dmin=1"], ["solver.loop_dmin"]),
+    ("pulses-swapped", lambda d: ["sim", S, "servo.pulse_min_us=2600"], ["pulse_min_us"]),
+    ("step-budget", lambda d: ["sim", S, "schedule.wait_s=60", "--cycles", "1000"], ["physics steps"]),
+    ("config-file-bad-value", lambda d: ["sim", "--config", robot_toml(d, "[schedule]\nwait_s = -1\n")],
+     ["schedule.wait_s"]),
+    ("sweep-base-bad", lambda d: ["sweep", S, "schedule.push_s=1e9", "--vary", "scale=0:0.01:2", "--out", d / "sw"],
+     ["schedule.push_s"]),
+    ("params-write-refuses-what-sim-refuses",
+     lambda d: ["params", S, "solver.timestep_s=0", "--write", d / "new.toml"], ["solver.timestep_s"]),
+    ("params-unknown-key", lambda d: ["params", S, "solver.timestep=0.001"], ["unknown robot parameter"]),
+    # writes never destroy
+    ("write-read-only-file", lambda d: ["params", "--write", readonly(d), "--force"], ["read-only"]),
+    ("write-existing-file", lambda d: ["params", "--write", robot_toml(d, "# mine\n")], ["exists"]),
+    # (a pipe stands in for a device: a regression must not replace the machine's /dev/null)
+    ("write-pipe", lambda d: ["params", "--write", os.mkfifo(d / "pipe") or d / "pipe", "--force"],
+     ["not a regular file"]),
+    ("write-onto-folder", lambda d: ["params", "--write", (d / "folder").mkdir() or d / "folder", "--force"],
+     ["directory"]),
+    # sweeps and optimisation
+    ("sweep-grid-too-large",
+     lambda d: ["sweep", "--vary", "scale=0:0.05:1000000", "--vary", "geometry.leg_m=0.05:0.09:1000000",
+                "--out", d / "sw"], ["1,000,000,000,000 designs"]),
+    ("sweep-n-0", lambda d: ["sweep", "--vary", "scale=0:0.05:0", "--out", d / "sw"], ["N = 0"]),
+    ("sweep-not-a-number", lambda d: ["sweep", "--vary", "scale=0:x:3", "--out", d / "sw"], ["not a number"]),
+    ("sweep-foreign-folder", lambda d: ["sweep", "--vary", "scale=0:0.01:2", "--out", user_trials(d)],
+     ["not a sweep folder"]),
+    ("optimize-user-trials-csv", lambda d: ["optimize", "--vary", "geometry.leg_m=0.05:0.07", "--trials", "1",
+                                            "--out", user_trials(d)], ["did not write", "trials.csv"]),
+    ("optimize-bogus-storage", lambda d: ["optimize", "--vary", "geometry.leg_m=0.05:0.07", "--trials", "1",
+                                          "--out", d / "o", "--storage", "bogus://x"], ["bogus://x"]),
+    ("optimize-integer-without-integer", lambda d: ["optimize", "--vary", "schedule.cycles=1.2:1.8", "--trials", "1",
+                                                    "--out", d / "o"], ["no whole number"]),
+    # fabrication
+    ("fab-jig-diameter-0", lambda d: ["fab", "--from-robot", "seed", "--jig-diameter-mm", "0"], ["jig_diameter_mm"]),
+    ("fab-jig-spacing-inf", lambda d: ["fab", "--from-robot", "seed", "--jig-spacing-mm", "inf"], ["finite"]),
+    ("fab-kerf-nan", lambda d: ["fab", "--from-robot", "seed", "--kerf-mm", "nan"], ["finite"]),
+    ("fab-kerf-negative", lambda d: ["fab", "--from-robot", "seed", "--kerf-mm", "-1"], ["kerf_mm"]),
+    ("fab-kerf-wide-no-out", lambda d: ["fab", "--from-robot", "seed", "--kerf-mm", "5"], ["kerf"]),
+    ("fab-kerf-wide-out", lambda d: ["fab", "--from-robot", "seed", "--kerf-mm", "5", "--out", d / "cut"], ["kerf"]),
+    ("fab-unclosable-robot", lambda d: ["fab", "--from-robot", robot_toml(d, "[geometry]\ncoupler_m = 0.5\n")],
+     ["cannot close"]),
+    ("fab-part-over-10m", lambda d: ["fab", "--from-robot", robot_toml(
+        d, "[geometry]\nground_m = 4\ncrank_m = 4\ncoupler_m = 3\nleg_m = 4\n")], ["10 m"]),
+    ("fab-part-under-0.01mm", lambda d: ["fab", dxf(d, "tiny.dxf", [(0, 0), (0.001, 0), (0.001, 0.001), (0, 0.001)])],
+     ["0.01 mm"]),
+    ("fab-drawing-over-10m", lambda d: ["fab", dxf(d, "huge.dxf", [(0, 0), (20000, 0), (20000, 30), (0, 30)])],
+     ["10 m"]),
+    ("fab-nan-vertex", lambda d: ["fab", dxf(d, "nan.dxf", [(0, 0), (50, 0), (math.nan, 30), (0, 30)])],
+     ["not a finite number"]),
+    ("fab-hole-outside-body", lambda d: ["fab", dxf(d, "hole.dxf", RECT, holes=[((200, 200), 2)])],
+     ["outside the body"]),
+    ("fab-slit-outside-body", lambda d: ["fab", dxf(d, "slit.dxf", RECT, slits=[((100, 100), (120, 100))])],
+     ["outside the body"]),
+    # tracking options
+    ("track-angle-nan", lambda d: ["track", d / "v.mp4", "--angle", "nan"], ["--angle"]),
+    ("track-accept-nan", lambda d: ["track", d / "v.mp4", "--accept", "nan"], ["--accept"]),
+    ("track-fps-0", lambda d: ["track", d / "v.mp4", "--fps", "0"], ["--fps"]),
+    # calibration: bad numbers, and fits off by a unit are not written
+    ("servo-gravity-moment-inf", lambda d: ["calibrate", "servo", copy_servo(d), "--inertia-kgm2", "1.5e-5",
+                                            "--gravity-moment-nm", "inf", "--no-plot"], ["finite"]),
+    ("servo-inertia-nan", lambda d: ["calibrate", "servo", copy_servo(d), "--inertia-kgm2", "nan", "--no-plot"],
+     ["finite"]),
+    ("servo-inertia-0", lambda d: ["calibrate", "servo", copy_servo(d), "--inertia-kgm2", "0", "--no-plot"],
+     ["above 0"]),
+    ("beam-mass-negative", lambda d: ["calibrate", "beam", copy_beam(d), "--mass-kg", "-0.01", "--no-plot"],
+     ["above 0"]),
+    ("beam-length-in-mm", lambda d: ["calibrate", "beam", copy_beam(d), "--mass-kg", "0.01", "--length-m", "50",
+                                     "--write", d / "cal.toml", "--no-plot"], ["plausible", "not written"]),
+    ("ramp-angles-in-radians", lambda d: ["calibrate", "ramp", robot_toml(d, "trial,angle_deg\n1,1.04\n2,1.05\n",
+                                                                          "ramp.csv"),
+                                          "--write", d / "cal.toml", "--no-plot"], ["contact.foot_friction"]),
+    # report
+    ("report-cycles-beyond-record", lambda d: ["report", "--measured", f"small={trial(d)}", "--cycles", "5",
+                                               "--out", d / "rep"], ["recorded only 2 cycles"]),
+    ("report-refused-hop", lambda d: ["report", "--measured", f"small={trial(d, R.ERROR)}", "--out", d / "rep"],
+     ["refused by the robot"]),
+    # the robot's command line
+    ("hop-heartbeat-0", lambda d: ["hop", "--port", "sim", "--heartbeat-ms", "0", "--out", d / "run"],
+     ["--heartbeat-ms"]),
+    ("hop-push-ms-5", lambda d: ["hop", "--port", "sim", "--push-ms", "5", "--out", d / "run"], ["--push-ms"]),
+    ("hop-no-such-port", lambda d: ["hop", "--port", d / "ttyNONE", "--out", d / "runs" / "one"],
+     ["cannot open serial port"]),
+    ("pose-nan", lambda d: ["pose", "nan", "0", "--port", "sim"], ["error"]),
+    ("unknown-option", lambda d: ["sim", "--bogus"], ["--bogus"]),
+]
+
+
+@pytest.mark.parametrize("setup, words", [pytest.param(s, w, id=i) for i, s, w in CASES])
+def test_bad_input_is_a_clear_error_and_nothing_changes(tmp_path, monkeypatch, setup, words):
+    monkeypatch.chdir(tmp_path)
+    args = setup(tmp_path)
+    before = tree(tmp_path)
+    res = invoke(args)
+    assert_clear_error(res, *words)
+    assert tree(tmp_path) == before   # no input changed, nothing lost, nothing half-written left
+
+
+def test_there_are_enough_probe_classes():
+    assert len(CASES) >= 60
+
+
+# -- the parameter edge, in one place -------------------------------------------------
+def test_every_preset_is_within_the_limits():
+    from locust.params import PRESETS
+
+    for name in PRESETS:
+        assert problems(preset(name)) == [], name
+
+
+def test_schedule_limits_are_the_firmwares():
+    from locust.firmware.protocol import COMMANDS
+
+    hop = COMMANDS["hop"]
+    assert LIMITS["schedule.push_s"][:2] == (hop["push_ms"][1] / 1000, hop["push_ms"][2] / 1000)
+    assert LIMITS["schedule.wait_s"][:2] == (hop["wait_ms"][1] / 1000, hop["wait_ms"][2] / 1000)
+    assert LIMITS["schedule.push_deg"][:2] == (hop["push_deg"][1], hop["push_deg"][2])
+    assert LIMITS["schedule.cycles"][:2] == (hop["cycles"][1], hop["cycles"][2])
+
+
+def test_step_budget_is_checked_before_any_allocation():
+    # 1000 cycles of 70 s at 0.1 ms would be 7e8 steps; refused by arithmetic, not by a MemoryError
+    robot = preset("seed").with_values({"schedule.push_s": 10, "schedule.wait_s": 60, "solver.timestep_s": 1e-4})
+    found = problems(robot, cycles=1000)
+    assert len(found) == 1 and f"{(0.5 + 1000 * 70) / 1e-4:.3g}" in found[0] and f"{MAX_SIM_STEPS:g}" in found[0]
+    check_robot(robot, cycles=2)   # 2 cycles are 1.405e6 steps: within the budget
+
+
+def test_an_unsimulatable_design_is_an_invalid_row_of_the_sweep(tmp_path):
+    from locust.sweep.design import parse_axis
+    from locust.sweep.run import run_sweep
+
+    base = preset("seed")
+    axes = [parse_axis("schedule.wait_s=-1:1:2", base)]
+    s = run_sweep(base, axes, cycles=1, out=tmp_path / "sw", jobs=1, plots=False)
+    assert [r["valid"] for r in s.rows] == [False, True]
+    assert "schedule.wait_s = -1 must be >= 0.02" in s.rows[0]["reason"]
+    assert s.best["design"] == 1
+
+
+# -- writes ---------------------------------------------------------------------------
+def test_write_onto_a_symlink_updates_its_target_and_keeps_the_link(tmp_path):
+    target = tmp_path / "real.toml"
+    target.write_text("# old\n")
+    target.chmod(0o640)
+    link = tmp_path / "link.toml"
+    link.symlink_to("real.toml")
+    res = invoke(["params", "--write", link, "--force"])
+    assert res.exit_code == 0, res.output
+    assert link.is_symlink() and os.readlink(link) == "real.toml"
+    assert target.read_text().startswith("# locust robot parameters")
+    assert stat.S_IMODE(target.stat().st_mode) == 0o640   # the mode is the file's own
+
+
+def test_a_full_disk_is_an_error_and_leaves_nothing_behind(tmp_path):
+    """A file-size limit stands in for a full disk: the write fails part way (EFBIG, as ENOSPC)."""
+    def limit():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (1000, 1000))
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+
+    proc = subprocess.run(LOCUST + ["params", "--write", "robot.toml"], cwd=tmp_path, preexec_fn=limit,
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 2, proc.stderr
+    assert "error:" in proc.stderr and "hint:" in proc.stderr and "Traceback" not in proc.stderr
+    assert list(tmp_path.iterdir()) == []   # no robot.toml, no temporary file
+
+
+def test_track_out_never_lands_on_the_videos_sidecars(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    res = invoke(["sim", "--cycles", "1", "--video", "hop.mp4", "--camera", "fixed",
+                  S, "solver.settle_s=0.1", S, "schedule.wait_s=0.2"])
+    assert res.exit_code == 0, res.output
+    before = tree(tmp_path)
+    for out in ("hop.camera.csv", "hop.camera", "hop.truth.csv"):
+        for force in ([], ["--force"]):
+            res = invoke(["track", "hop.mp4", "--out", out, "--overlay", "none", *force])
+            assert_clear_error(res, "sidecar")
+    assert tree(tmp_path) == before
+
+
+# -- processes ------------------------------------------------------------------------
+def _children(pid: int) -> list[int]:
+    out = []
+    for status in Path("/proc").glob("[0-9]*/status"):
+        try:
+            text = status.read_text()
+        except OSError:
+            continue
+        if f"\nPPid:\t{pid}\n" in text:
+            out.append(int(status.parent.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        text = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    return "\nState:\tZ" not in text
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc (Linux)")
+def test_kill_9_of_a_sweep_leaves_no_worker_and_no_lock_and_resumes(tmp_path):
+    args = LOCUST + ["sweep", "--vary", "scale=0:0.03:40", "--cycles", "1", "--jobs", "2", "--out", "sw"]
+    proc = subprocess.Popen(args, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    results = tmp_path / "sw" / "results.csv"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        if results.exists() and len(results.read_text().splitlines()) >= 3:
+            break
+        time.sleep(0.1)
+    workers = _children(proc.pid)
+    assert workers, "the sweep had no worker processes"
+    proc.kill()
+    proc.wait()
+    time.sleep(1.0)
+    assert not [w for w in workers if _alive(w)], "workers outlived the sweep"
+    done = len(results.read_text().splitlines()) - 1
+    assert 2 <= done < 40
+    again = subprocess.run(args, cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert again.returncode == 0, again.stderr
+    rows = results.read_text().splitlines()[1:]
+    assert len(rows) == 40 and [int(r.split(",")[0]) for r in rows] == list(range(40))
+    assert json.loads((tmp_path / "sw" / "sweep.json").read_text())["finished"] is True
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc (Linux)")
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
+def test_a_killed_hop_leaves_no_interpreter_running(env, tmp_path, sig):
+    proc = subprocess.Popen(LOCUST + ["hop", "--port", "sim", "--plant", "record", "--cycles", "20",
+                                      "--out", str(tmp_path / "run")],
+                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    run = tmp_path / "run" / "run.json"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        if run.exists() and '"phase"' in run.read_text():
+            break
+        time.sleep(0.1)
+    interpreters = [c for c in _children(proc.pid) if "micropython" in Path(f"/proc/{c}/comm").read_text()]
+    assert len(interpreters) == 1
+    proc.send_signal(sig)
+    _, stderr = proc.communicate(timeout=30)
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline and _alive(interpreters[0]):
+        time.sleep(0.1)
+    assert not _alive(interpreters[0]), "the MicroPython interpreter outlived the host"
+    rec = json.loads(run.read_text())
+    assert rec["status"] in ("incomplete", "running")
+    if sig == signal.SIGTERM:
+        assert proc.returncode == 2 and "Traceback" not in stderr and "hint:" in stderr
+        assert rec["status"] == "incomplete" and "interrupted" in rec["message"]
+
+
+# -- load -----------------------------------------------------------------------------
+def test_the_heartbeat_keeps_its_clock_beside_a_busy_thread():
+    """Pings from the heartbeat's own thread stay on time while another thread of the host
+    computes in Python (holding the GIL whenever it can): no gap near the firmware's timeout."""
+    import pty
+    import select
+    import threading
+
+    from locust.device.link import Link
+    from locust.firmware import protocol as P
+
+    master, slave = pty.openpty()
+    interval_s = P.COMMANDS["hop"]["heartbeat_ms"][3] / 8000.0
+    stop = threading.Event()
+
+    def busy():
+        x = 0
+        while not stop.is_set():
+            x = (x * 31 + 7) % 1_000_003
+
+    arrivals = []
+    link = Link(os.ttyname(slave))
+    worker = threading.Thread(target=busy, daemon=True)
+    try:
+        worker.start()
+        link.start_heartbeat(interval_s)
+        t_end = time.monotonic() + 2.0
+        while time.monotonic() < t_end:
+            ready, _, _ = select.select([master], [], [], 0.05)
+            if ready:
+                data = os.read(master, 4096)
+                arrivals += [time.monotonic()] * data.count(b'"cmd":"ping"')
+    finally:
+        stop.set()
+        link.close()
+        os.close(master)
+        os.close(slave)
+    gaps = [b - a for a, b in zip(arrivals, arrivals[1:])]
+    assert len(arrivals) >= 0.8 * 2.0 / interval_s
+    # a beat may be late by a few scheduler slices, never by a good part of the timeout
+    assert max(gaps) < 2 * interval_s, gaps
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc (Linux)")
+def test_ctrl_c_during_a_filmed_hop_finishes_the_video_and_says_so(env, tmp_path):
+    proc = subprocess.Popen(LOCUST + ["hop", "--port", "sim", "--cycles", "4", "--video", "hop.mp4", "--out", "run"],
+                            cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    run = tmp_path / "run" / "run.json"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        if run.exists() and '"phase"' in run.read_text():
+            break
+        time.sleep(0.1)
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGINT)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 2 and "interrupted" in stderr and "hint:" in stderr and "Traceback" not in stderr
+    rec = json.loads(run.read_text())
+    assert rec["status"] == "incomplete" and "interrupted" in rec["message"] and 1 <= len(rec["phases"]) < 8
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert names == ["hop.camera.json", "hop.mp4", "hop.truth.csv", "run"]   # no hidden temporary file
+    from locust.track.video import probe
+
+    assert probe(tmp_path / "hop.mp4").frame_count >= 10   # a playable video of what was filmed
