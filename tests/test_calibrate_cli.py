@@ -165,3 +165,21 @@ def test_sim_runs_with_the_written_robot(recs):
     assert res.exit_code == 0, res.output
     out = json.loads(res.output[res.output.index("{"):])
     assert out["robot"] == "calibrated" and out["valid"] is True
+
+
+def test_plot_never_lands_in_a_read_only_data_folder(recs, tmp_path, monkeypatch):
+    """Someone else's data folder (mode r-x, as ../shared/data is) gets no file, even as root."""
+    data = recs / "shared"
+    data.mkdir()
+    shutil.copy(recs / "synthetic_ramp.csv", data / "ramp.csv")
+    data.chmod(0o555)
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    try:
+        res = run("calibrate", "ramp", data / "ramp.csv")
+        assert res.exit_code == 0, res.output
+        assert sorted(p.name for p in data.iterdir()) == ["ramp.csv"]
+        assert (work / "ramp-fit.png").stat().st_size > 1000
+    finally:
+        data.chmod(0o755)

@@ -27,7 +27,8 @@ def output_options(func):
     """--write [PATH], --json, --plot PATH / --no-plot: shared by the three experiments."""
     func = click.option("--no-plot", is_flag=True, help="Do not draw the fit plot.")(func)
     func = click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-                        help="Fit plot (data, model, residuals) [default: <recording>-fit.png beside it].")(func)
+                        help="Fit plot (data, model, residuals) [default: <recording>-fit.png beside it, or in the "
+                             "current folder when the recording's folder is read-only].")(func)
     func = click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")(func)
     func = click.option("--write", "write_path", type=click.Path(dir_okay=False, path_type=Path),
                         is_flag=False, flag_value=str(DEFAULT_ROBOT_TOML), default=None,
@@ -313,6 +314,14 @@ def _floats(text: str, n: int, option: str, hint: str) -> list[float]:
     return vals
 
 
+def default_plot_path(recording: Path, recording_name: Path | None = None) -> Path:
+    """``<recording>-fit.png`` beside the recording; in the current folder when the recording's
+    folder is read-only by its mode (someone else's data: nothing is written into it, even as root)."""
+    name = f"{Path(recording_name or recording).stem}-fit.png"
+    folder = recording.resolve().parent
+    return (folder if folder.stat().st_mode & 0o222 else Path.cwd()) / name
+
+
 def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_path: Path | None,
             as_json: bool, plot_path: Path | None, no_plot: bool, *, subtitle: str,
             recording_name: Path | None = None, source_name: str | None = None,
@@ -324,7 +333,7 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
     for warning in out["warnings"]:
         click.echo(f"warning: {warning}", err=True)
     if not no_plot:
-        plot_path = plot_path or recording.with_name(f"{Path(recording_name).stem}-fit.png")
+        plot_path = plot_path or default_plot_path(recording, recording_name)
         out["plot"] = str(plot_fit(fit.curves, plot_path, subtitle))
     if write_path and odd:   # show the fit, then refuse to write it
         if as_json:
