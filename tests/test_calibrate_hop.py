@@ -24,7 +24,7 @@ NOISE_M = 1e-4
 TRUTH = {"compliance.hinge_stiffness_nm_per_rad": 0.045, "servo.noload_speed_rad_per_s": 9.0}
 
 
-def synthetic_run(config: str, truth: dict, cycles: int = 2, seed: int = 0) -> H.HopRun:
+def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0) -> H.HopRun:
     """A run of ``config`` at ``truth``, "filmed" at 30 frames/s from 0.4 s before the first
     push, camera clock 1.234 s ahead, positions with NOISE_M of noise (SYNTHETIC)."""
     robot = preset(config)
@@ -53,7 +53,7 @@ def synthetic_run(config: str, truth: dict, cycles: int = 2, seed: int = 0) -> H
 
 @pytest.fixture(scope="module")
 def small_fit():
-    run = synthetic_run("small", TRUTH)
+    run = synthetic_run("small", TRUTH)      # three hops: a cluster-robust interval on two values needs three
     return run, H.fit_hops([run], list(TRUTH), max_iter=20, grid_stages=2)
 
 
@@ -65,6 +65,19 @@ def test_fit_recovers_the_values_the_traces_were_made_with(small_fit):
         assert fit.identifiable[key]
     # started from the seed's values, 25 % and 13 % away, from a two-stage grid
     assert fit.start["compliance.hinge_stiffness_nm_per_rad"] == pytest.approx(0.056375)
+
+
+def test_fit_intervals_cover_the_truth_and_say_what_they_include(small_fit):
+    _, fit = small_fit
+    for key, truth in TRUTH.items():
+        est = fit.estimates[key]
+        assert est.ci95_low <= truth <= est.ci95_high, (key, est)
+        # honest, yet narrow enough to feed a prediction's spread: within +-20 % (the fit's
+        # 0.13 mm of residual over three hops, t(2), gives about +-8 %)
+        assert (est.ci95_high - est.ci95_low) / 2 < 0.20 * truth, (key, est)
+        assert est.std_numerical is not None and 0 <= est.std_numerical <= est.std
+    assert fit.interval.startswith("cluster-robust over 3 hops (CR1), t(2)")
+    assert fit.summary()["interval"] == fit.interval
 
 
 def test_fit_residual_is_the_noise_it_was_given(small_fit):

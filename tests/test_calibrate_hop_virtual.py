@@ -59,6 +59,10 @@ def test_fit_recovers_the_hidden_values(fitted):
         within = abs(p["value"] - truth) <= 0.10 * truth
         covered = lo is not None and lo <= truth <= hi and (hi - lo) / 2 < 0.20 * truth
         assert within or covered, (key, p)
+        # the intervals include the time step's part (docs/calibrate.md: they do not always
+        # cover the hidden values; the 2.5 ms fit of Large is biased against its 2 ms truth)
+        assert 0 < p["std_numerical"] <= p["std"], (key, p)
+    assert fitted["fit"]["interval"].startswith("cluster-robust over 6 hops (CR1), t(5)")
 
 
 def test_fit_takes_under_ten_minutes_and_leaves_little(fitted):

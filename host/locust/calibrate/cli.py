@@ -257,6 +257,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
         click.echo(json_text(out), nl=False)
         return
     click.echo(f"# hops: {len(fit.runs)} runs, {fit.simulations} simulations, {fit.wall_s:.1f} s")
+    click.echo(f"# 95% intervals: {fit.interval}")
     for key, val in out["parameters"].items():
         _print_text_value(key, val)
     for run in fit.runs:

@@ -1,13 +1,24 @@
 """Confidence intervals of a least-squares fit from its Jacobian.
 
-The covariance of the fitted parameters is ``s^2 (J^T J)^-1`` with ``s^2 = SSR / (n - p)``
-(the residual variance), valid near the optimum when the residuals are independent with
-equal variance. 95% intervals use Student's t with ``n - p`` degrees of freedom; derived
-quantities (stiffness from frequency, ...) get theirs by first-order propagation.
+:func:`covariance`: ``s^2 (J^T J)^-1`` with ``s^2 = SSR / (n - p)`` (the residual variance),
+valid near the optimum when the residuals are independent with equal variance; 95% intervals
+use Student's t with ``n - p`` degrees of freedom.
+
+:func:`cluster_covariance`: when residuals are correlated within groups (the frames of one
+hop), the cluster-robust ("sandwich") covariance ``c B (sum_g J_g^T r_g r_g^T J_g) B`` with
+``B = (J^T J)^-1`` and the small-sample factor ``c = G/(G-1) (n-1)/(n-p)`` (CR1; Cameron &
+Miller, J. Human Resources 50, 2015), with Student's t on ``G - 1`` degrees of freedom for
+``G`` clusters. A systematic shift of the parameters (the fit's own time step: its change
+when the step is halved) may be added as a type-B standard uncertainty: combined in
+quadrature, the t factor then takes the Welch-Satterthwaite effective degrees of freedom
+(GUM, JCGM 100:2008, G.4).
+
+Derived quantities (stiffness from frequency, ...) get theirs by first-order propagation.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +33,7 @@ class Estimate:
     std: float          # one standard deviation, in the value's own unit (inf: not determined)
     ci95_low: float
     ci95_high: float
+    std_numerical: float | None = None   # the part of ``std`` from the numerics (None: not assessed)
 
     @property
     def relative_std(self) -> float:
@@ -30,15 +42,21 @@ class Estimate:
     def as_dict(self) -> dict[str, float | list[float]]:
         """For JSON output: an undetermined std or bound stays ``inf``/``nan`` here and is
         written ``null`` (:func:`locust.fileio.json_text`)."""
-        return {"value": self.value, "std": self.std, "ci95": [self.ci95_low, self.ci95_high]}
+        out = {"value": self.value, "std": self.std, "ci95": [self.ci95_low, self.ci95_high]}
+        if self.std_numerical is not None:
+            out["std_numerical"] = self.std_numerical
+        return out
 
 
 @dataclass(frozen=True)
 class Covariance:
-    """Parameter covariance of a fit and its residual degrees of freedom."""
+    """Parameter covariance of a fit, the degrees of freedom of its t factor and, where
+    assessed, the numerical shift of the parameters (added as a type-B uncertainty)."""
 
     matrix: np.ndarray
     dof: int
+    shift: np.ndarray | None = None     # systematic shift of each parameter (e.g. dt -> dt/2)
+    method: str = "s^2 (J^T J)^-1, t(n-p)"
 
     def estimate(self, value: float, grad: np.ndarray) -> Estimate:
         """A quantity ``f(params)`` with gradient ``grad`` at the optimum."""
@@ -47,8 +65,15 @@ class Covariance:
         sub = self.matrix[np.ix_(used, used)]
         var = float(grad[used] @ sub @ grad[used]) if used.any() else 0.0
         std = float(np.sqrt(max(var, 0.0))) if np.all(np.isfinite(sub)) else float("inf")
-        k = t95(self.dof)
-        return Estimate(float(value), std, float(value - k * std), float(value + k * std))
+        dof, numerical = float(self.dof), None
+        if self.shift is not None:
+            numerical = abs(float(grad[used] @ self.shift[used])) if used.any() else 0.0
+            combined = math.hypot(std, numerical)
+            # Welch-Satterthwaite: a type-B part counts with infinite degrees of freedom
+            dof = dof * (combined / std) ** 4 if 0 < std < math.inf else math.inf
+            std = combined
+        k = t95(dof)
+        return Estimate(float(value), std, float(value - k * std), float(value + k * std), numerical)
 
     def parameter(self, values: np.ndarray, i: int) -> Estimate:
         grad = np.zeros(len(values))
@@ -56,9 +81,11 @@ class Covariance:
         return self.estimate(float(values[i]), grad)
 
 
-def t95(dof: int) -> float:
-    """Two-sided 95% Student-t factor for ``dof`` degrees of freedom."""
-    return float(stats.t.ppf(0.975, max(int(dof), 1)))
+def t95(dof: float) -> float:
+    """Two-sided 95% Student-t factor for ``dof`` degrees of freedom (the normal's when infinite)."""
+    if dof > 1e6:
+        return float(stats.norm.ppf(0.975))
+    return float(stats.t.ppf(0.975, max(float(dof), 1.0)))
 
 
 def covariance(jac: np.ndarray, residual: np.ndarray) -> Covariance:
@@ -71,16 +98,59 @@ def covariance(jac: np.ndarray, residual: np.ndarray) -> Covariance:
     residual = np.asarray(residual, dtype=float).ravel()
     n, p = jac.shape
     dof = max(n - p, 1)
-    s2 = float(residual @ residual) / dof
+    bread, undetermined = _inverse_normal(jac)
+    cov = bread * (float(residual @ residual) / dof)
+    return Covariance(_mark(cov, undetermined), dof)
+
+
+def cluster_covariance(jac: np.ndarray, residual: np.ndarray, clusters: np.ndarray,
+                       shift: np.ndarray | None = None) -> Covariance:
+    """Cluster-robust (CR1) covariance, residuals correlated within each cluster label of
+    ``clusters`` (n,), independent between clusters; ``shift`` (p,): a systematic shift of
+    the parameters, added as a type-B uncertainty. Fewer clusters than one more than the
+    parameters determine nothing: every variance is then infinite."""
+    jac = np.asarray(jac, dtype=float)
+    residual = np.asarray(residual, dtype=float).ravel()
+    clusters = np.asarray(clusters).ravel()
+    n, p = jac.shape
+    labels = np.unique(clusters)
+    g = len(labels)
+    bread, undetermined = _inverse_normal(jac)
+    scores = np.array([jac[clusters == c].T @ residual[clusters == c] for c in labels]).reshape(g, p)
+    factor = g / max(g - 1, 1) * (n - 1) / max(n - p, 1)
+    cov = factor * bread @ (scores.T @ scores) @ bread
+    if g <= p:
+        undetermined = np.ones(p, dtype=bool)
+    return Covariance(_mark(cov, undetermined), max(g - 1, 1), shift,
+                      f"cluster-robust (CR1) over {g} clusters, t({max(g - 1, 1)})")
+
+
+def linear_shift(jac: np.ndarray, delta_residual: np.ndarray) -> np.ndarray:
+    """The parameters' first-order (Gauss-Newton) shift when the residual changes by
+    ``delta_residual`` at fixed parameters: ``-(J^T J)^-1 J^T dr`` (0 where undetermined)."""
+    jac = np.asarray(jac, dtype=float)
+    bread, undetermined = _inverse_normal(jac)
+    shift = -bread @ (jac.T @ np.asarray(delta_residual, dtype=float).ravel())
+    return np.where(undetermined, 0.0, shift)
+
+
+def _inverse_normal(jac: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(J^T J)^-1`` by SVD, and which parameters it leaves undetermined (a zero column, or
+    one that loads on a direction with a vanishing singular value)."""
     # Scale the columns first so parameters of very different size (kp ~ 1, kv ~ 0.01)
-    # do not swamp the condition number; the scaling is undone on the covariance.
+    # do not swamp the condition number; the scaling is undone on the result.
     norms = np.linalg.norm(jac, axis=0)
     safe = np.where(norms > 0, norms, 1.0)
     _, sv, vt = np.linalg.svd(jac / safe, full_matrices=False)
     tiny = sv < 1e-8 * max(float(sv.max(initial=0.0)), 1e-300)
     inv_sv2 = np.where(tiny, 0.0, 1.0 / np.where(tiny, 1.0, sv) ** 2)
-    cov = ((vt.T * inv_sv2) @ vt) * s2 / np.outer(safe, safe)
+    bread = ((vt.T * inv_sv2) @ vt) / np.outer(safe, safe)
     undetermined = (norms == 0) | (np.abs(vt[tiny]).max(axis=0, initial=0.0) > 1e-3)
+    return bread, undetermined
+
+
+def _mark(cov: np.ndarray, undetermined: np.ndarray) -> np.ndarray:
+    cov = cov.copy()
     cov[undetermined, :] = np.inf
     cov[:, undetermined] = np.inf
-    return Covariance(cov, dof)
+    return cov

@@ -14,9 +14,14 @@ placed where the simulation's is relative to its first push). Every candidate of
 iteration, the finite-difference columns included, is simulated in one batched
 ``mujoco.rollout`` per run; the solver is ``mujoco.minimize.least_squares`` on the
 logarithm of each positive parameter (a factor is what a friction or a stiffness is known
-to). Standard errors come from the residual Jacobian at the optimum (:mod:`.fitstats`); a
-value is *identifiable* when its 95% interval is within about +-50% and it did not run to the
-edge of its range (a factor ``BOUND_FACTOR`` either side of where it started).
+to). Uncertainties (:mod:`.fitstats`): the frames of one hop share its errors (tracking,
+and a model that is not the robot: neighbouring residuals are correlated), so the covariance
+is cluster-robust with each hop of each run a cluster, from a central-difference Jacobian
+at the optimum with a step (``FD_STEP``) over the contacts' jaggedness, t on hops - 1 degrees
+of freedom; the fit's own time step adds the parameters' shift when it is halved (to first
+order, one more rollout per run), in quadrature. A value is *identifiable* when its 95%
+interval is within about +-50% and it did not run to the edge of its range (a factor
+``BOUND_FACTOR`` either side of where it started).
 """
 
 from __future__ import annotations
@@ -40,7 +45,7 @@ from ..sim.kinematics import geom_positions, marker_geoms
 from ..sim.model import build
 from ..sim.rollout import simulate_batch
 from ..sim.schedule import ControlPlan
-from .fitstats import Estimate, covariance
+from .fitstats import Estimate, cluster_covariance, linear_shift
 
 DEFAULT_KEYS = ("contact.foot_friction", "compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s")
 MARKERS = ("nose", "foot")
@@ -107,6 +112,7 @@ class HopFit:
     iterations: int
     simulations: int
     wall_s: float
+    interval: str = ""                   # what the intervals include
 
     def summary(self) -> dict:
         params = {k: {**self.estimates[k].as_dict(), "identifiable": self.identifiable[k], "start": self.start[k]}
@@ -115,7 +121,8 @@ class HopFit:
                 "parameters": params,
                 "runs": [{"source": r.source, "config": r.config, "rms_residual_m": r.rms_m,
                           "rms_residual_by_marker_m": r.rms_by_marker_m, "samples": r.samples} for r in self.runs],
-                "rms_residual_m": self.rms_m, "iterations": self.iterations, "simulations": self.simulations,
+                "interval": self.interval, "rms_residual_m": self.rms_m, "iterations": self.iterations,
+                "simulations": self.simulations,
                 "wall_s": round(self.wall_s, 2), "notes": self.notes}
 
 
@@ -261,15 +268,18 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     start = np.array([runs[0].robot.get(k) for k in keys], dtype=float)
     counter = {"sims": 0}
 
-    def robots_at(run: HopRun, xs: np.ndarray) -> list[Robot]:
-        return [run.robot.with_values(dict(zip(keys, (start * np.exp(x)).tolist())), "fit") for x in xs]
+    def robots_at(run: HopRun, xs: np.ndarray, refine: int = 1) -> list[Robot]:
+        robot = run.robot
+        if refine > 1:
+            robot = robot.with_values({"solver.timestep_s": robot.solver.timestep_s / refine}, "fit: time step check")
+        return [robot.with_values(dict(zip(keys, (start * np.exp(x)).tolist())), "fit") for x in xs]
 
-    def residual(x: np.ndarray) -> np.ndarray:
+    def residual(x: np.ndarray, refine: int = 1) -> np.ndarray:
         xs = np.atleast_2d(np.asarray(x, dtype=float).T).reshape(-1, len(keys))
         cols = []
         for run in runs:
             try:
-                sims = simulate_markers(run, robots_at(run, xs))
+                sims = simulate_markers(run, robots_at(run, xs, refine))
             except (GeometryError, SimError):
                 sims = [None] * len(xs)
             counter["sims"] += len(xs)
@@ -287,30 +297,12 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     x, trace = minimize.least_squares(x0, residual, bounds=bounds, eps=FD_STEP,
                                       max_iter=max_iter, verbose=0, iter_callback=on_iter, xtol=1e-6, gtol=1e-8)
     x = np.asarray(x, dtype=float).ravel()
-    r = residual(x.reshape(-1, 1)).ravel()
-    jac, _ = minimize.jacobian_fd(residual, x.reshape(-1, 1), r.reshape(-1, 1), np.float64(FD_STEP), 0,
-                                  [b.reshape(-1, 1) for b in bounds])
     values = start * np.exp(x)
-    cov = covariance(jac / values[None, :], r)     # d r / d p = d r / d x / p, with p = start * exp(x)
-    estimates, identifiable, notes = {}, {}, []
-    for i, key in enumerate(keys):
-        est = cov.parameter(values, i)
-        estimates[key] = est
-        ok = bool(np.isfinite(est.std) and est.relative_std <= MAX_RELATIVE_STD)
-        if bound - abs(x[i]) < 1e-3:
-            ok = False
-            notes.append(f"{key} ran to the edge of its range ({est.value:.4g}, a factor {BOUND_FACTOR:g} from "
-                         f"{start[i]:.4g}): the hops do not bound it")
-        elif not ok:
-            notes.append(f"{key} is not identifiable from these hops (its 95% interval is wider than "
-                         f"about +-{200 * MAX_RELATIVE_STD:.0f}%)")
-        identifiable[key] = ok
-    _friction_notes(dict(zip(keys, values.tolist())), runs[0].robot, notes)
-    run_fits, k0 = [], 0
-    for run in runs:
+    run_fits, clusters = [], []
+    for k, run in enumerate(runs):
         sim = simulate_markers(run, robots_at(run, x[None, :]))[0]
         res, shift = aligned_residual(run, sim)
-        k0 += len(res)
+        clusters.append(k * 10_000 + hop_index(run, shift))
         by_marker, j = {}, 0
         curves = {}
         for m, tr in run.tracks.items():
@@ -321,9 +313,51 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
                 curves[m] = (tr.t_s - shift, tr.x_m, tr.y_m, *sim[m])
         run_fits.append(RunFit(source=str(run.source), config=run.config, rms_m=float(np.sqrt(np.mean(res**2))),
                                rms_by_marker_m=by_marker, samples=len(res), curves=curves))
+    # the optimum and its central differences in one batch per run, then the same at dt/2
+    hi, lo = np.minimum(x + FD_STEP, bound), np.maximum(x - FD_STEP, -bound)
+    points = [x] + [np.where(np.arange(len(x)) == i, edge[i], x) for i in range(len(x)) for edge in (hi, lo)]
+    rs = residual(np.array(points).T)
+    r = rs[:, 0]
+    jac = (rs[:, 1::2] - rs[:, 2::2]) / (hi - lo) / values[None, :]    # d r / d p = d r / d x / p
+    numerical = linear_shift(jac, residual(x.reshape(-1, 1), refine=2)[:, 0] - r)
+    cov = cluster_covariance(jac, r, np.concatenate(clusters), numerical)
+    hops = len(np.unique(np.concatenate(clusters)))
+    interval = (f"cluster-robust over {hops} hops (CR1), t({max(hops - 1, 1)}), with the shift at half the time "
+                "step (std_numerical) in quadrature, Welch-Satterthwaite degrees of freedom")
+    estimates, identifiable, notes = {}, {}, []
+    if hops <= len(keys):
+        notes.append(f"{hops} hops cannot bound {len(keys)} values (a cluster-robust interval needs at least one "
+                     "hop more than the values fitted): film more hops, or fit fewer values")
+    for i, key in enumerate(keys):
+        est = cov.parameter(values, i)
+        estimates[key] = est
+        ok = bool(np.isfinite(est.std) and est.relative_std <= MAX_RELATIVE_STD)
+        if bound - abs(x[i]) < 1e-3:
+            ok = False
+            notes.append(f"{key} ran to the edge of its range ({est.value:.4g}, a factor {BOUND_FACTOR:g} from "
+                         f"{start[i]:.4g}): the hops do not bound it")
+        elif not ok and hops > len(keys):
+            notes.append(f"{key} is not identifiable from these hops (its 95% interval is wider than "
+                         f"about +-{200 * MAX_RELATIVE_STD:.0f}%)")
+        identifiable[key] = ok
+    _friction_notes(dict(zip(keys, values.tolist())), runs[0].robot, notes)
     return HopFit(keys=keys, start=dict(zip(keys, start.tolist())), estimates=estimates, identifiable=identifiable,
                   runs=run_fits, notes=notes, rms_m=float(np.sqrt(np.mean(r**2))), iterations=len(trace),
-                  simulations=counter["sims"], wall_s=time.perf_counter() - t_start)
+                  simulations=counter["sims"], wall_s=time.perf_counter() - t_start, interval=interval)
+
+
+def hop_index(run: HopRun, shift: float) -> np.ndarray:
+    """Per residual entry of :func:`aligned_residual` (x then y, marker by marker): the hop
+    its frame belongs to, counted from the push it follows (frames before the first push go
+    with the first hop); ``shift``: the track's shift onto the schedule's clock."""
+    starts = run.phase_s[run.pushing]
+    if not math.isfinite(shift):
+        shift = run.onset_s
+    parts = []
+    for tr in run.tracks.values():
+        hop = np.clip(np.searchsorted(starts, tr.t_s - shift, side="right") - 1, 0, None)
+        parts += [hop, hop]
+    return np.concatenate(parts)
 
 
 def grid_start(residual, n: int, stages: int = GRID_STAGES) -> np.ndarray:
