@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -155,7 +156,8 @@ class ColorMarker:
         return mask
 
     def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
-        """True if the mean colour of ``blob`` (a mask at x, y in ``roi``) has the marker's hue."""
+        """True if the mean colour of ``blob`` (a mask, nonzero in the blob, at x, y in ``roi``)
+        has the marker's hue."""
         h, w = blob.shape
         mean = cv2.mean(roi[y:y + h, x:x + w], blob)[:3]
         bh, bs, _ = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
@@ -208,7 +210,9 @@ class ColorMarker:
                 return self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
             if _on_image_border(stat, box, image.shape):
                 continue   # cut by the picture's edge: its centroid is not the marker's
-            blob = (mask[by:by + bh, bx:bx + bw] == label).view(np.uint8)
+            blob = mask[by:by + bh, bx:bx + bw]
+            if n > 2:   # with one blob the core is its mask
+                blob = (blob == label).view(np.uint8)
             shape = _blob_shape(blob, area)
             at = (x0 + bx + bw / 2, y0 + by + bh / 2)
             if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
@@ -220,6 +224,8 @@ class ColorMarker:
 
     def _near_distractor(self, x: float, y: float) -> bool:
         """True if (x, y) lies on a look-alike's bounding box, grown by a marker radius."""
+        if not self._distractors:
+            return False
         r = 0.5 * self._usual_width + 1.0
         return any(bx - r <= x <= bx + bw + r and by - r <= y <= by + bh + r for bx, by, bw, bh in self._distractors)
 
@@ -301,8 +307,7 @@ def _along(angle_rad: float, velocity: tuple[float, float], diameter_px: float) 
     return abs(vx * math.cos(angle_rad) + vy * math.sin(angle_rad)) / speed >= math.cos(math.radians(30))
 
 
-@dataclass(frozen=True)
-class BlobShape:
+class BlobShape(NamedTuple):   # a tuple: one is made per blob looked at, every frame
     area_px: float
     major_px: float     # full lengths of the equivalent ellipse (4 sigma): a disc's diameter
     minor_px: float
@@ -310,7 +315,7 @@ class BlobShape:
 
 
 def _blob_shape(blob: np.ndarray, area: int) -> BlobShape:
-    """Area and equivalent ellipse of a blob given as a 0/1 mask of its bounding box."""
+    """Area and equivalent ellipse of a blob given as a mask (nonzero in the blob)."""
     m = cv2.moments(blob, binaryImage=True)
     a, b, c = m["mu20"] / m["m00"], m["mu11"] / m["m00"], m["mu02"] / m["m00"]
     root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
@@ -344,7 +349,9 @@ def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]
     ring = luma[cv2.dilate(blob_u8, _KERNEL_9) > grown]   # the two pixels around the grown blob
     background = float(_median(ring)) if ring.size else 0.0
     if abs(level - background) >= 20:
-        cover = (luma - background) / (level - background)
+        cover = luma   # in place: luma is not needed any more
+        cover -= background
+        cover /= level - background
         np.maximum(cover, 0.0, out=cover)
         np.minimum(cover, 1.0, out=cover)
         cover *= grown

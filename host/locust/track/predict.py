@@ -83,6 +83,9 @@ def _fit_matrix(offsets: tuple[int, ...]) -> list[list[float]]:
     return np.linalg.pinv(np.vander(np.array(offsets, float), min(len(offsets), 3))).tolist()
 
 
+_NO_GAP = {n: tuple(range(1 - n, 1)) for n in range(1, 9)}
+
+
 class Trajectory:
     """Where a marker should be on a given frame, also across frames it was not seen.
 
@@ -124,11 +127,14 @@ class Trajectory:
         """Polynomial coefficients (highest power first; columns x, y) in frames since the last
         sighting, computed once per sighting."""
         if self._coef is None and self._found:
-            last = self._found[-1][0]
-            recent = [p for p in self._found if p[0] >= last - 2 * len(self._found)]   # one stretch of sightings
+            last, n = self._found[-1][0], len(self._found)
+            if last - self._found[0][0] == n - 1:   # no gap, the usual case
+                recent, offsets = self._found, _NO_GAP[n]
+            else:
+                recent = [p for p in self._found if p[0] >= last - 2 * n]   # one stretch of sightings
+                offsets = tuple(p[0] - last for p in recent)
             xs, ys = [p[1] for p in recent], [p[2] for p in recent]
-            self._coef = [(sum(map(mul, row, xs)), sum(map(mul, row, ys)))
-                          for row in _fit_matrix(tuple(p[0] - last for p in recent))]
+            self._coef = [(sum(map(mul, row, xs)), sum(map(mul, row, ys))) for row in _fit_matrix(offsets)]
         return self._coef
 
     def predict(self, frame: int) -> Point | None:
