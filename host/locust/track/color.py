@@ -16,9 +16,9 @@ would be pulled toward the visible part: such frames are reported as not found.
 from __future__ import annotations
 
 import math
-import statistics
 from collections import deque
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -26,8 +26,6 @@ import numpy as np
 from ..errors import TrackError
 from .detection import Detection, window
 from .predict import Trajectory
-
-LUMA_BGR = np.array([0.114, 0.587, 0.299], dtype=np.float32)
 
 
 def parse_hex(colour: str) -> tuple[int, int, int]:
@@ -81,7 +79,8 @@ class ColorMarker:
     def _note_distractors(self, image: np.ndarray, marker: Detection) -> None:
         """Remember every other blob of the marker's colour on the first sighting (a pen cap
         lying in the scene): a lost marker is never re-acquired on one of them."""
-        *_, (core, _) = self._cores(image)   # the widest test: every pixel that could be taken for it
+        # the widest test (the last of _cores): every pixel that could be taken for it
+        core = cv2.inRange(image, self._lo, self._hi) if self._hsv is None else self._hue_mask(image)
         contours, _ = cv2.findContours(core, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
         for c in contours:
             x, y, w, h = cv2.boundingRect(c)
@@ -90,11 +89,10 @@ class ColorMarker:
 
     def _find(self, frame: int, image: np.ndarray) -> Detection | None:
         self._frame = frame
-        whole = (0, 0, image.shape[1], image.shape[0])
         if not self._areas:   # not seen yet: around the start point, or anywhere
             self._tries += 1
             if self.start_px is None:
-                return self._locate_in(image, whole, None)
+                return self._locate_in(image, (0, 0, image.shape[1], image.shape[0]), None)
             return self._locate_in(image, window(self.start_px, 2 * self.search_half_px * self._tries, image.shape),
                                    self.start_px)
         centre = self.track.predict(frame)
@@ -158,7 +156,8 @@ class ColorMarker:
         return mask
 
     def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
-        """True if the mean colour of ``blob`` (a mask at x, y in ``roi``) has the marker's hue."""
+        """True if the mean colour of ``blob`` (a mask, nonzero in the blob, at x, y in ``roi``)
+        has the marker's hue."""
         h, w = blob.shape
         mean = cv2.mean(roi[y:y + h, x:x + w], blob)[:3]
         bh, bs, _ = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
@@ -186,9 +185,8 @@ class ColorMarker:
         n, labels = cv2.connectedComponents(core, connectivity=8)
         if n <= 1:
             return None
-        if n == 2:   # one blob (the usual case): its statistics cost less than OpenCV's general ones
-            stats = np.array([[0, 0, 0, 0, 0], [*cv2.boundingRect(core), cv2.countNonZero(core)]])
-            order = np.array([1])
+        if n == 2:   # one blob (the usual case): the core is its mask; its statistics cost less than OpenCV's
+            blobs = [((*cv2.boundingRect(core), cv2.countNonZero(core)), core, 255)]
         else:
             stats, cents = _component_stats(core, labels, n)
             order = np.arange(1, n)
@@ -197,9 +195,11 @@ class ColorMarker:
             else:                # nearest the prediction first
                 order = order[np.argsort(np.hypot(cents[order, 0] + x0 - centre[0], cents[order, 1] + y0 - centre[1]),
                                          kind="stable")]
-        order = order[stats[order, cv2.CC_STAT_AREA] >= self.min_area_px]
-        for best in order.tolist():
-            bx, by, bw, bh, area = stat = stats[best].tolist()
+            blobs = ((stats[i].tolist(), labels, i) for i in order.tolist())
+        for stat, mask, label in blobs:
+            bx, by, bw, bh, area = stat
+            if area < self.min_area_px:
+                continue
             if _touches_edge(stat, roi.shape, box, image.shape):
                 if whole_inside:
                     return None
@@ -210,18 +210,22 @@ class ColorMarker:
                 return self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
             if _on_image_border(stat, box, image.shape):
                 continue   # cut by the picture's edge: its centroid is not the marker's
-            blob = (labels[by:by + bh, bx:bx + bw] == best).view(np.uint8)
+            blob = mask[by:by + bh, bx:bx + bw]
+            if n > 2:   # with one blob the core is its mask
+                blob = (blob == label).view(np.uint8)
             shape = _blob_shape(blob, area)
             at = (x0 + bx + bw / 2, y0 + by + bh / 2)
             if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
                 continue
             if self._near_distractor(*at):
                 continue   # a look-alike seen at the start is never taken
-            return self._measure(roi, labels, stat, best, shape, x0, y0)
+            return self._measure(roi, mask, stat, label, shape, x0, y0)
         return None
 
     def _near_distractor(self, x: float, y: float) -> bool:
         """True if (x, y) lies on a look-alike's bounding box, grown by a marker radius."""
+        if not self._distractors:
+            return False
         r = 0.5 * self._usual_width + 1.0
         return any(bx - r <= x <= bx + bw + r and by - r <= y <= by + bh + r for bx, by, bw, bh in self._distractors)
 
@@ -262,9 +266,16 @@ class ColorMarker:
         if shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn the marker's size from it
             self._areas.append(area)
             self._widths.append(shape.minor_px)
-            self._usual_area = statistics.median(self._areas)
-            self._usual_width = statistics.median(self._widths)
+            self._usual_area = _median_of(self._areas)
+            self._usual_width = _median_of(self._widths)
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
+
+
+def _median_of(values) -> float:
+    """``statistics.median`` of a few floats, without its type checks."""
+    s = sorted(values)
+    k = len(s) // 2
+    return s[k] if len(s) % 2 else (s[k - 1] + s[k]) / 2
 
 
 def _component_stats(core: np.ndarray, labels: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -296,8 +307,7 @@ def _along(angle_rad: float, velocity: tuple[float, float], diameter_px: float) 
     return abs(vx * math.cos(angle_rad) + vy * math.sin(angle_rad)) / speed >= math.cos(math.radians(30))
 
 
-@dataclass(frozen=True)
-class BlobShape:
+class BlobShape(NamedTuple):   # a tuple: one is made per blob looked at, every frame
     area_px: float
     major_px: float     # full lengths of the equivalent ellipse (4 sigma): a disc's diameter
     minor_px: float
@@ -305,7 +315,7 @@ class BlobShape:
 
 
 def _blob_shape(blob: np.ndarray, area: int) -> BlobShape:
-    """Area and equivalent ellipse of a blob given as a 0/1 mask of its bounding box."""
+    """Area and equivalent ellipse of a blob given as a mask (nonzero in the blob)."""
     m = cv2.moments(blob, binaryImage=True)
     a, b, c = m["mu20"] / m["m00"], m["mu11"] / m["m00"], m["mu02"] / m["m00"]
     root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
@@ -321,39 +331,46 @@ def _on_image_border(stat: list[int], box, image_shape) -> bool:
 
 
 RING_PX = 4
+_KERNEL_9 = np.ones((9, 9), np.uint8)    # two 5x5 dilations in one
 _KERNEL_5 = np.ones((5, 5), np.uint8)
 _KERNEL_3 = np.ones((3, 3), np.uint8)
 
 
 def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]:
-    """Centroid of per-pixel coverage over ``blob`` grown by two pixels.
+    """Centroid of per-pixel coverage over ``blob`` (a boolean mask) grown by two pixels.
 
     ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
     """
     blob_u8 = blob.view(np.uint8)
     grown = cv2.dilate(blob_u8, _KERNEL_5)
-    ring = cv2.dilate(grown, _KERNEL_5) & ~grown & 1
-    luma = roi.astype(np.float32) @ LUMA_BGR
-    inner = cv2.erode(blob_u8, _KERNEL_3).view(bool)
-    level = float(_median(luma[inner])) if inner.any() else float(_median(luma[blob]))
-    ring_b = ring.view(bool)
-    background = float(_median(luma[ring_b])) if ring_b.any() else 0.0
+    luma = cv2.cvtColor(roi.astype(np.float32), cv2.COLOR_BGR2GRAY)   # BT.601: 0.114 B + 0.587 G + 0.299 R
+    inner = luma[cv2.erode(blob_u8, _KERNEL_3).view(bool)]
+    level = float(_median(inner if inner.size else luma[blob]))
+    ring = luma[cv2.dilate(blob_u8, _KERNEL_9) > grown]   # the two pixels around the grown blob
+    background = float(_median(ring)) if ring.size else 0.0
     if abs(level - background) >= 20:
-        cover = np.clip((luma - background) / (level - background), 0.0, 1.0)
+        cover = luma   # in place: luma is not needed any more
+        cover -= background
+        cover /= level - background
+        np.maximum(cover, 0.0, out=cover)
+        np.minimum(cover, 1.0, out=cover)
+        cover *= grown
     else:  # sticker as bright as its surround: fall back to the colour core alone
-        cover = blob.astype(np.float32)
-    m = cv2.moments(cover * grown)
+        cover = blob_u8
+    m = cv2.moments(cover)
     return m["m10"] / m["m00"], m["m01"] / m["m00"]
 
 
 def _median(values: np.ndarray) -> np.floating:
-    """``np.median`` of a 1-D float32 array, without its general-purpose overhead."""
+    """``np.median`` of a 1-D float32 array, without its general-purpose overhead; ``values``
+    is a scratch copy (a masked selection): it is partitioned in place."""
     n = values.size
     k = n // 2
     if n % 2:
-        return np.partition(values, k)[k]
-    part = np.partition(values, (k - 1, k))
-    return (part[k - 1] + part[k]) / np.float32(2)
+        values.partition(k)
+        return values[k]
+    values.partition((k - 1, k))
+    return (values[k - 1] + values[k]) / np.float32(2)
 
 
 def _touches_edge(stat: list[int], roi_shape, box, image_shape) -> bool:

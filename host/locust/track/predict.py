@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Iterable
+from functools import lru_cache
+from operator import mul
 
 import numpy as np
 
@@ -73,13 +75,15 @@ class MotionHistory:
         return predict_next(self._points) or self.last_found
 
 
-def _quadratic_fit_matrix(n: int) -> np.ndarray:
-    """Least-squares quadratic through frames -n+1 .. 0: coefficients = matrix @ positions."""
-    f = np.arange(1 - n, 1, dtype=float)
-    return np.linalg.pinv(np.vander(f, 3))
+@lru_cache(maxsize=1024)
+def _fit_matrix(offsets: tuple[int, ...]) -> list[list[float]]:
+    """Least-squares polynomial through positions at frames ``offsets`` (the last one 0): a
+    quadratic; a line through two, the point itself for one. Coefficients (highest power
+    first) = matrix @ positions; a gap-free run of sightings, the usual case, is always the same."""
+    return np.linalg.pinv(np.vander(np.array(offsets, float), min(len(offsets), 3))).tolist()
 
 
-_CONSECUTIVE_FIT = {n: _quadratic_fit_matrix(n).tolist() for n in range(3, 9)}
+_NO_GAP = {n: tuple(range(1 - n, 1)) for n in range(1, 9)}
 
 
 class Trajectory:
@@ -123,19 +127,14 @@ class Trajectory:
         """Polynomial coefficients (highest power first; columns x, y) in frames since the last
         sighting, computed once per sighting."""
         if self._coef is None and self._found:
-            n = len(self._found)
-            if n == self._found.maxlen and self._found[-1][0] - self._found[0][0] == n - 1:
-                # consecutive sightings, the usual case: a fixed matrix, in plain Python (fast)
-                self._coef = [(sum(m * p[1] for m, p in zip(row, self._found)),
-                               sum(m * p[2] for m, p in zip(row, self._found))) for row in _CONSECUTIVE_FIT[n]]
-                return self._coef
-            f = np.array([p[0] for p in self._found], float)
-            xy = np.array([p[1:] for p in self._found], float)
-            recent = f >= f[-1] - 2 * len(f)        # a fit only over one stretch of sightings
-            f, xy = f[recent] - f[-1], xy[recent]
-            degree = min(len(f) - 1, 2)
-            coef = xy[-1:] if degree == 0 else np.polyfit(f, xy, degree)
-            self._coef = [(float(cx), float(cy)) for cx, cy in coef]
+            last, n = self._found[-1][0], len(self._found)
+            if last - self._found[0][0] == n - 1:   # no gap, the usual case
+                recent, offsets = self._found, _NO_GAP[n]
+            else:
+                recent = [p for p in self._found if p[0] >= last - 2 * n]   # one stretch of sightings
+                offsets = tuple(p[0] - last for p in recent)
+            xs, ys = [p[1] for p in recent], [p[2] for p in recent]
+            self._coef = [(sum(map(mul, row, xs)), sum(map(mul, row, ys))) for row in _fit_matrix(offsets)]
         return self._coef
 
     def predict(self, frame: int) -> Point | None:
