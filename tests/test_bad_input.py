@@ -319,6 +319,25 @@ def test_a_full_disk_is_an_error_and_leaves_nothing_behind(tmp_path):
     assert list(tmp_path.iterdir()) == []   # no robot.toml, no temporary file
 
 
+@pytest.mark.parametrize("args", [
+    ["params", "--write", "ro/robot.toml"],
+    ["sweep", "--vary", "scale=0.5:1:2", "--cycles", "1", "--out", "ro/sweep"],
+], ids=["params-write", "sweep-out"])
+def test_a_read_only_folder_is_an_error_and_gets_nothing(tmp_path, monkeypatch, args):
+    """Refused by the folder's mode, so the check holds even for root (who may write anyway)."""
+    monkeypatch.chdir(tmp_path)
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    (ro / "data.csv").write_text("t_s,x_m\n0,0\n")
+    ro.chmod(0o555)
+    try:
+        before = tree(ro)
+        assert_clear_error(invoke(args), "read-only")
+        assert tree(ro) == before
+    finally:
+        ro.chmod(0o755)
+
+
 def test_track_out_never_lands_on_the_videos_sidecars(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     res = invoke(["sim", "--cycles", "1", "--video", "hop.mp4", "--camera", "fixed",

@@ -38,6 +38,35 @@ def write_target(path: str | os.PathLike) -> Path:
     return path
 
 
+def refuse_read_only_folder(folder: Path) -> None:
+    """:class:`WriteError` when ``folder`` exists and its mode gives no one write access: someone
+    else's data (as root the kernel would allow the write; the mode says what its owner meant)."""
+    try:
+        mode = folder.stat().st_mode
+    except OSError:
+        return   # not there yet: making it reports its own error
+    if not mode & 0o222:
+        raise WriteError(f"cannot write in {folder}: the folder is read-only",
+                         "write somewhere else (--out / a path in a folder of your own)")
+
+
+def make_folder(folder: str | os.PathLike) -> Path:
+    """``mkdir -p`` that says what went wrong (:class:`WriteError`) and writes into no read-only
+    folder: the nearest existing ancestor's mode decides, as for files."""
+    folder = Path(folder)
+    existing = folder
+    while not existing.exists() and existing.parent != existing:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise WriteError(f"cannot make {folder}: {existing} is a file", "choose a folder path")
+    refuse_read_only_folder(existing)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WriteError(f"cannot make the folder {folder} ({exc.strerror})", DISK_HINT) from None
+    return folder
+
+
 def temp_beside(path: str | os.PathLike, suffix: str = ".tmp") -> tuple[int, str]:
     """A new temporary file in ``path``'s folder (open fd, name), with ordinary permissions
     (an existing file's own mode, when it is replaced).
@@ -45,8 +74,8 @@ def temp_beside(path: str | os.PathLike, suffix: str = ".tmp") -> tuple[int, str
     Write it, then ``os.replace`` it onto ``path``: the rename is what makes a write atomic.
     """
     path = Path(path)
+    make_folder(path.parent)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
     except OSError as exc:
         raise WriteError(f"cannot write in {path.parent} ({exc.strerror})", DISK_HINT) from None
@@ -129,9 +158,8 @@ def unique_dir(parent: str | os.PathLike, stem: str) -> Path:
 
     Never returns a directory that already existed: results are never overwritten.
     """
-    parent = Path(parent)
+    parent = make_folder(parent)
     try:
-        parent.mkdir(parents=True, exist_ok=True)
         for n in range(1, 10_000):
             candidate = parent / (stem if n == 1 else f"{stem}-{n}")
             try:

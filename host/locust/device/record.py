@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from ..errors import DeviceError
-from ..fileio import atomic_write_json, unique_dir
+from ..fileio import atomic_write_json, make_folder, unique_dir
 from ..firmware import protocol as P
 
 COMPLETE = "complete"
@@ -170,7 +170,7 @@ def run_dir(out: Path | None, root: Path = Path("data/runs")) -> Path:
                           "pass another --out directory, or leave --out off for a new data/runs/<timestamp>/")
     if out.exists() and not out.is_dir():
         raise DeviceError(f"--out {out} is a file, not a directory", "pass a directory path")
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     return out
 
 

@@ -25,6 +25,7 @@ import tempfile
 from pathlib import Path
 
 from ..errors import FabError
+from ..fileio import make_folder
 from .laminate import Laminate, compensate_cutout, compensate_part, union
 
 DXF_NAMES = ("combined_cut_pattern", "first_pass_cuts", "final_perimeter")
@@ -155,7 +156,7 @@ def publish(out_dir: str | os.PathLike, files: dict[str, bytes]) -> Path:
     renamed into place, so a failure leaves nothing behind. Never writes into a folder
     that already holds files."""
     out = check_out(out_dir)
-    out.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(out.parent)
     stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
     try:
         for name, data in files.items():

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fileio import make_folder
 from ..params import Robot
 
 TRACK_NAME = "synthetic.tracks.csv"
@@ -67,7 +68,7 @@ def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int 
         comments=(f"synthetic: simulated nose of robot {robot.name!r}, {cycles} cycles, {fps:g} frames/s, "
                   f"noise {noise_m * 1000:g} mm sd, seed {seed}",))
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    make_folder(folder)
     track_path = write_tracks_csv(folder / TRACK_NAME, tracks)
 
     s = robot.schedule

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SweepError
-from ..fileio import atomic_write_json, atomic_write_text
+from ..fileio import atomic_write_json, atomic_write_text, make_folder
 from ..params import Robot
 from .design import SCALE, Bound, evaluate
 
@@ -102,7 +102,7 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
             raise SweepError(f"--vary {b.name}={b.low:g}:{b.high:g} holds no whole number, and {b.name} is one",
                              f"give a range with at least one integer, e.g. {b.name}={math.floor(b.low)}:"
                              f"{math.floor(b.low) + 2}")
-    folder.mkdir(parents=True, exist_ok=True)
+    make_folder(folder)
     storage_obj = open_storage(storage, folder)
     # a resumed study must not draw its first samples again: the sampler's seed moves on with
     # the number of trials the study already holds

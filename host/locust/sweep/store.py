@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SweepError
-from ..fileio import atomic_write_json, atomic_write_text
+from ..fileio import atomic_write_json, atomic_write_text, make_folder
 from .design import RESULT_FIELDS
 
 RESULTS = "results.csv"
@@ -158,7 +158,7 @@ class SweepStore:
         elif folder.exists() and any(folder.iterdir()):
             raise SweepError(f"{folder} exists and is not a sweep folder; refusing to write into it",
                              "choose a new or empty --out folder")
-        folder.mkdir(parents=True, exist_ok=True)
+        make_folder(folder)
         store._lock()
         atomic_write_json(meta_path, meta)
         store._rewrite(sorted(store.done))
