@@ -368,6 +368,30 @@ def write_truth(path: Path, truth: Truth, note: str) -> None:
                         f"{truth.streak_px[i]:.2f}", f"{truth.shadow[i]:.3f}", f"{truth.radius_px[i]:.2f}"])
 
 
+def read_frames(clip: Path, indices) -> dict[int, np.ndarray]:
+    """Some frames of the written clip, decoded."""
+    want, got = set(int(i) for i in indices), {}
+    cap = cv2.VideoCapture(str(clip))
+    i = 0
+    while want - got.keys():
+        ok, frame = cap.read()
+        if not ok:
+            break
+        if i in want:
+            got[i] = frame
+        i += 1
+    cap.release()
+    return got
+
+
+def colour_at(frame: np.ndarray, x: float, y: float, radius_px: float) -> str:
+    """Median colour (#RRGGBB) of a frame within radius_px of (x, y)."""
+    yy, xx = np.mgrid[0:frame.shape[0], 0:frame.shape[1]]
+    core = np.hypot(xx - x, yy - y) <= max(1.0, radius_px)
+    b, g, r = np.median(frame[core], axis=0).round().astype(int)
+    return f"#{r:02x}{g:02x}{b:02x}"
+
+
 # --- as a user would: pick the colour, run the CLI -------------------------------------------------------
 def picked_colour(clip: Path, truth: Truth, pick: str = "first") -> tuple[str, int, int]:
     """The sticker's colour (median of its core, as a colour picker would give) and its centre on
@@ -377,16 +401,10 @@ def picked_colour(clip: Path, truth: Truth, pick: str = "first") -> tuple[str, i
     i = 0
     if pick == "lit":
         i = int(np.flatnonzero(truth.full & (truth.streak_px < 0.5) & (truth.shadow > 0.97))[0])
-    cap = cv2.VideoCapture(str(clip))
-    cap.set(cv2.CAP_PROP_POS_FRAMES, i)
-    ok, frame = cap.read()
-    cap.release()
-    if not ok:
-        raise SystemExit(f"cannot read {clip}")
-    yy, xx = np.mgrid[0:frame.shape[0], 0:frame.shape[1]]
-    core = np.hypot(xx - truth.px[i], yy - truth.py[i]) <= 0.5 * truth.radius_px[i]
-    b, g, r = np.median(frame[core], axis=0).round().astype(int)
-    return f"#{r:02x}{g:02x}{b:02x}", round(truth.px[0]), round(truth.py[0])
+    frame = read_frames(clip, [i]).get(i)
+    if frame is None:
+        raise SystemExit(f"cannot read frame {i} of {clip}")
+    return colour_at(frame, truth.px[i], truth.py[i], 0.5 * truth.radius_px[i]), round(truth.px[0]), round(truth.py[0])
 
 
 def run_locust_track(clip: Path, colour: str, x: int, y: int, out: Path) -> tuple[str, Path]:
@@ -417,8 +435,8 @@ class Figures:
 WRONG_PX = 8.0
 
 
-def score(truth: Truth, tracks_path: Path, marker: str = "nose") -> Figures:
-    """Compare the tracks CSV with the truth."""
+def score(truth: Truth, tracks_path: Path, clip: Path | None = None, marker: str = "nose") -> Figures:
+    """Compare the tracks CSV with the truth (``clip``: to say what colour a wrong pick had)."""
     from locust.track.tracks_csv import read_tracks_csv
 
     tracks = read_tracks_csv(tracks_path)
@@ -436,13 +454,24 @@ def score(truth: Truth, tracks_path: Path, marker: str = "nose") -> Figures:
     full, out = truth.full, truth.out
     wrong = ok & ~out & (err > WRONG_PX)
     good = ok & full & ~wrong
+    frames = read_frames(clip, np.flatnonzero(ok & (wrong | out))) if clip else {}
     details = []
     for i in np.flatnonzero(ok & (wrong | out | (truth.visibility == "partial"))):
         near_cap = math.hypot(px[i] - truth.cap_px[0], py[i] - truth.cap_px[1])
         what = ("the pen cap" if near_cap < 3 * truth.radius_px[i] else
                 "the sticker" if err[i] <= 3 * truth.radius_px[i] else "something else")
+        if i in frames:
+            what += f" (colour there {colour_at(frames[i], px[i], py[i], 0.3 * truth.radius_px[i])})"
         details.append(f"frame {i:3d} ({truth.visibility[i]:7s}): found at {px[i]:7.1f},{py[i]:7.1f}, "
                        f"truth {truth.px[i]:7.1f},{truth.py[i]:7.1f}, off {err[i]:6.1f} px -> {what}")
+    missed = np.flatnonzero(full & ~ok)
+    if missed.size:
+        details.append("missed with the sticker whole in the picture: " + ", ".join(
+            f"{i} (light {truth.shadow[i]:.2f}, streak {truth.streak_px[i]:.0f} px)" for i in missed))
+    off = np.flatnonzero(good & (err > 1.5))
+    if off.size:
+        details.append("found but more than 1.5 px off: " + ", ".join(
+            f"{i} ({err[i]:.1f} px, light {truth.shadow[i]:.2f})" for i in off))
 
     def rms(a: np.ndarray, s: np.ndarray) -> float:
         return float(np.sqrt(np.mean(a[s] ** 2))) if s.any() else float("nan")
@@ -469,7 +498,7 @@ def run(folder: Path, width: int, height: int, fps: float, background: str, seed
     write_truth(folder / f"foreign_{width}x{height}.truth.csv", truth, note)
     colour, x, y = picked_colour(clip, truth, pick)
     summary, tracks = run_locust_track(clip, colour, x, y, folder / f"foreign_{width}x{height}.tracks.csv")
-    return truth, score(truth, tracks), summary
+    return truth, score(truth, tracks, clip), summary
 
 
 def main() -> None:
