@@ -60,6 +60,8 @@ class ColorMarker:
     _frame: int = 0                # the frame being searched
     _velocity: tuple[float, float] = (0.0, 0.0)   # predicted motion over this frame (px)
     _distractors: list = field(default_factory=list)  # other blobs of the colour seen at the start: (x, y, w, h)
+    _lost: int = 0                 # frames the marker has been lost before the one searched
+    _colours: deque = field(default_factory=lambda: deque(maxlen=15))  # (hue, saturation) of round sightings
 
     def __post_init__(self) -> None:
         self._lo = np.array([max(c - self.tolerance, 0) for c in self.bgr], dtype=np.uint8)
@@ -80,13 +82,15 @@ class ColorMarker:
 
     def _note_distractors(self, image: np.ndarray, marker: Detection) -> None:
         """Remember every other blob of the marker's colour on the first sighting (a pen cap
-        lying in the scene): a lost marker is never re-acquired on one of them."""
+        lying in the scene): a lost marker is never re-acquired on one of them. A blob whose
+        look-alike zone holds the marker itself is a piece of the marker (its edge, split off by
+        a shadow), not a look-alike: it would blind the marker where it was first seen."""
         *_, (core, _) = self._cores(image)   # the widest test: every pixel that could be taken for it
         contours, _ = cv2.findContours(core, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
         for c in contours:
-            x, y, w, h = cv2.boundingRect(c)
-            if w * h >= self.min_area_px and not (x - 1 <= marker.px <= x + w and y - 1 <= marker.py <= y + h):
-                self._distractors.append((x, y, w, h))
+            box = cv2.boundingRect(c)
+            if box[2] * box[3] >= self.min_area_px and not self._in_zone(box, marker.px, marker.py):
+                self._distractors.append(box)
 
     def _find(self, frame: int, image: np.ndarray) -> Detection | None:
         self._frame = frame
@@ -100,7 +104,7 @@ class ColorMarker:
         centre = self.track.predict(frame)
         before = self.track.predict(frame - 1)
         self._velocity = (centre[0] - before[0], centre[1] - before[1])
-        lost = self.track.frames_lost(frame)
+        lost = self._lost = self.track.frames_lost(frame)
         self._speed = math.hypot(*self._velocity)
         if lost:
             self._speed = max(self._speed, self.track.max_speed_px)
@@ -157,11 +161,30 @@ class ColorMarker:
             mask |= cv2.inRange(hsv, (0, s_min, v_min), (hi - 180, 255, 255))
         return mask
 
-    def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
-        """True if the mean colour of ``blob`` (a mask at x, y in ``roi``) has the marker's hue."""
+    def _blob_hs(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> tuple[int, int]:
+        """Hue (OpenCV's 0-179) and saturation (0-255) of the mean colour of ``blob`` at x, y in ``roi``."""
         h, w = blob.shape
         mean = cv2.mean(roi[y:y + h, x:x + w], blob)[:3]
         bh, bs, _ = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
+        return bh, bs
+
+    def _has_own_colour(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
+        """True if the mean colour of ``blob`` is the one the marker has shown (its round
+        sightings, in this light): hue within the hue window of theirs, and at least half their
+        saturation -- mostly sticker, as a blur streak the marker is found on still is. A pick
+        in shadow (dark, any hue passes its loose bounds) thus refuses grey-brown hair or skin."""
+        if self._hsv is None or not self._colours:
+            return True
+        bh, bs = self._blob_hs(roi, blob, x, y)
+        angles = [math.radians(2 * h) for h, _ in self._colours]
+        hue = math.degrees(math.atan2(sum(map(math.sin, angles)), sum(map(math.cos, angles)))) / 2 % 180
+        tol = self._hue_bounds()[0]
+        turn = abs(bh - hue) % 180
+        return min(turn, 180 - turn) <= tol and bs >= 0.5 * _median_of([s for _, s in self._colours])
+
+    def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
+        """True if the mean colour of ``blob`` (a mask at x, y in ``roi``) has the marker's hue."""
+        bh, bs = self._blob_hs(roi, blob, x, y)
         tol, s_min, _ = self._hue_bounds()
         return min(abs(bh - self._hsv[0]), 180 - abs(bh - self._hsv[0])) <= tol and bs >= s_min
 
@@ -215,6 +238,8 @@ class ColorMarker:
             at = (x0 + bx + bw / 2, y0 + by + bh / 2)
             if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
                 continue
+            if self._lost and not self._has_own_colour(roi, blob, bx, by):
+                continue   # lost: re-acquired only on a blob of the colour it had
             if self._near_distractor(*at):
                 continue   # a look-alike seen at the start is never taken
             return self._measure(roi, labels, stat, best, shape, x0, y0)
@@ -222,8 +247,13 @@ class ColorMarker:
 
     def _near_distractor(self, x: float, y: float) -> bool:
         """True if (x, y) lies on a look-alike's bounding box, grown by a marker radius."""
+        return any(self._in_zone(box, x, y) for box in self._distractors)
+
+    def _in_zone(self, box: tuple[int, int, int, int], x: float, y: float) -> bool:
+        """True if (x, y) lies on ``box`` (x, y, w, h) grown by a marker radius."""
+        bx, by, bw, bh = box
         r = 0.5 * self._usual_width + 1.0
-        return any(bx - r <= x <= bx + bw + r and by - r <= y <= by + bh + r for bx, by, bw, bh in self._distractors)
+        return bx - r <= x <= bx + bw + r and by - r <= y <= by + bh + r
 
     def _fits(self, shape: BlobShape, at: tuple[float, float]) -> bool:
         """Size and shape of the marker: learned from the round, whole sightings so far; the
@@ -256,7 +286,8 @@ class ColorMarker:
         cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
         cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
         blob = labels[cy0:cy1, cx0:cx1] == best
-        px, py = _coverage_centroid(roi[cy0:cy1, cx0:cx1], blob)
+        near = roi[cy0:cy1, cx0:cx1]
+        px, py = _chroma_centroid(near, blob) or _coverage_centroid(near, blob)
         area = float(shape.area_px)
         score = area / self._usual_area if self._areas else 1.0
         if shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn the marker's size from it
@@ -264,7 +295,17 @@ class ColorMarker:
             self._widths.append(shape.minor_px)
             self._usual_area = statistics.median(self._areas)
             self._usual_width = statistics.median(self._widths)
+            if self._hsv is not None:
+                whole = (labels[by:by + bh, bx:bx + bw] == best).view(np.uint8)
+                self._colours.append(self._blob_hs(roi, whole, bx, by))
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
+
+
+def _median_of(values) -> float:
+    """``statistics.median`` of a few floats, without its type checks."""
+    s = sorted(values)
+    k = len(s) // 2
+    return s[k] if len(s) % 2 else (s[k - 1] + s[k]) / 2
 
 
 def _component_stats(core: np.ndarray, labels: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -343,6 +384,38 @@ def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]
     else:  # sticker as bright as its surround: fall back to the colour core alone
         cover = blob.astype(np.float32)
     m = cv2.moments(cover * grown)
+    return m["m10"] / m["m00"], m["m01"] / m["m00"]
+
+
+CHROMA_CONTRAST = 40.0   # least sticker-to-background chroma difference (0-255 scale) to weigh by colour
+
+
+def _chroma_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float] | None:
+    """Centroid of per-pixel coverage estimated from colour, not brightness: each pixel's
+    chroma (its colour less its grey level) is projected on the line from the local
+    background's chroma to the sticker's. A textured grey surround (a ruler's marks, a
+    picture frame's edge) then weighs nothing, however bright or dark, where luma coverage
+    takes its dark or bright pixels for part of the sticker. ``None`` when the sticker's
+    chroma differs too little from its surround's (a pale sticker): then luma decides.
+
+    ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
+    """
+    blob_u8 = blob.view(np.uint8)
+    grown = cv2.dilate(blob_u8, _KERNEL_5)
+    ring = (cv2.dilate(grown, _KERNEL_5) & ~grown & 1).view(bool)
+    inner = cv2.erode(blob_u8, _KERNEL_3).view(bool)
+    if not ring.any():
+        return None
+    pixels = roi.astype(np.float32)
+    chroma = pixels - pixels.mean(axis=2, keepdims=True)
+    sticker = np.median(chroma[inner if inner.any() else blob], axis=0)
+    background = np.median(chroma[ring], axis=0)
+    axis = sticker - background
+    contrast = float(np.linalg.norm(axis))
+    if contrast < CHROMA_CONTRAST:
+        return None
+    cover = np.clip((chroma - background) @ (axis / contrast ** 2), 0.0, 1.0) * grown
+    m = cv2.moments(cover)
     return m["m10"] / m["m00"], m["m01"] / m["m00"]
 
 
