@@ -61,7 +61,7 @@ class ColorMarker:
     _velocity: tuple[float, float] = (0.0, 0.0)   # predicted motion over this frame (px)
     _distractors: list = field(default_factory=list)  # other blobs of the colour seen at the start: (x, y, w, h)
     _lost: int = 0                 # frames the marker has been lost before the one searched
-    _colours: deque = field(default_factory=lambda: deque(maxlen=15))  # (hue, saturation) of round sightings
+    _colours: deque = field(default_factory=lambda: deque(maxlen=15))  # (hue, saturation, chroma) of round sightings
 
     def __post_init__(self) -> None:
         self._lo = np.array([max(c - self.tolerance, 0) for c in self.bgr], dtype=np.uint8)
@@ -82,14 +82,17 @@ class ColorMarker:
 
     def _note_distractors(self, image: np.ndarray, marker: Detection) -> None:
         """Remember every other blob of the marker's colour on the first sighting (a pen cap
-        lying in the scene): a lost marker is never re-acquired on one of them. A blob whose
+        lying in the scene): a lost marker is never re-acquired on one of them. A look-alike has
+        the marker's own colour (a loose colour test passes a shadowed brown wall, which is no
+        look-alike: the marker is refused there by its colour when lost). A blob whose
         look-alike zone holds the marker itself is a piece of the marker (its edge, split off by
         a shadow), not a look-alike: it would blind the marker where it was first seen."""
         *_, (core, _) = self._cores(image)   # the widest test: every pixel that could be taken for it
         contours, _ = cv2.findContours(core, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
         for c in contours:
             box = cv2.boundingRect(c)
-            if box[2] * box[3] >= self.min_area_px and not self._in_zone(box, marker.px, marker.py):
+            if box[2] * box[3] >= self.min_area_px and not self._in_zone(box, marker.px, marker.py) \
+                    and self._has_own_colour(image, _filled(c, box), box[0], box[1]):
                 self._distractors.append(box)
 
     def _find(self, frame: int, image: np.ndarray) -> Detection | None:
@@ -130,13 +133,38 @@ class ColorMarker:
         within ``tolerance`` in RGB (exact on a well-lit sticker; a blob of them is then taken
         only if its mean colour has the marker's hue); if no blob of those fits, all those of
         its hue, somewhat paler or much darker (a shadow darkens, it does not change hue). A
-        grey marker (no hue to speak of) is matched in RGB alone."""
+        grey marker (no hue to speak of) is matched in RGB alone. Once the marker has been seen,
+        its own colour comes between the two: where a deep shadow makes the surround dark enough
+        for the loose bounds, the sticker still stands out by its chroma."""
         box = cv2.inRange(roi, self._lo, self._hi)
         if self._hsv is None:
             yield box, True
             return
         yield box, not self._box_holds_grey
-        yield self._hue_mask(roi), True
+        hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
+        if self._colours:
+            yield self._own_mask(roi, hsv), True
+        yield self._hue_mask(roi, hsv), True
+
+    def _own_colour(self) -> tuple[float, float, float]:
+        """Hue (circular mean), saturation and chroma (medians) of the marker's round sightings."""
+        angles = [math.radians(2 * h) for h, _, _ in self._colours]
+        hue = math.degrees(math.atan2(sum(map(math.sin, angles)), sum(map(math.cos, angles)))) / 2 % 180
+        return hue, _median_of([c[1] for c in self._colours]), _median_of([c[2] for c in self._colours])
+
+    def _own_mask(self, roi: np.ndarray, hsv: np.ndarray) -> np.ndarray:
+        """Pixels of the hue the marker has shown whose chroma (largest less smallest channel) is
+        at least the share of its chroma that the brightness may drop to in a shadow (0.3 at the
+        default tolerance): a shadow scales chroma with brightness, a dark grey-brown surround
+        has little of it however its hue reads."""
+        hue, _, chroma = self._own_colour()
+        tol, _, _ = self._hue_bounds()
+        share = min(self.tolerance / 80.0, 1.5)
+        turn = cv2.absdiff(hsv[:, :, 0], int(round(hue)) % 180)
+        hue_ok = cv2.min(turn, cv2.subtract(180, turn)) <= tol
+        b, g, r = cv2.split(roi)
+        spread = cv2.subtract(cv2.max(cv2.max(b, g), r), cv2.min(cv2.min(b, g), r))
+        return (hue_ok & (spread >= chroma * (1 - 0.7 * share))).view(np.uint8) * np.uint8(255)
 
     def _hue_bounds(self) -> tuple[int, int, int]:
         """Hue half-window (OpenCV's 8-bit hue: degrees / 2), least saturation, least brightness.
@@ -149,10 +177,10 @@ class ColorMarker:
         return (max(int(round(self.hue_tol_deg * share / 2)), 1), max(int(s * (1 - 0.7 * share)), 40),
                 max(int(v * (1 - 0.7 * share)), 30))
 
-    def _hue_mask(self, roi: np.ndarray) -> np.ndarray:
+    def _hue_mask(self, roi: np.ndarray, hsv: np.ndarray | None = None) -> np.ndarray:
         h = self._hsv[0]
         tol, s_min, v_min = self._hue_bounds()
-        hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
+        hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV) if hsv is None else hsv
         lo, hi = h - tol, h + tol
         mask = cv2.inRange(hsv, (max(lo, 0), s_min, v_min), (min(hi, 179), 255, 255))
         if lo < 0:
@@ -161,12 +189,13 @@ class ColorMarker:
             mask |= cv2.inRange(hsv, (0, s_min, v_min), (hi - 180, 255, 255))
         return mask
 
-    def _blob_hs(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> tuple[int, int]:
-        """Hue (OpenCV's 0-179) and saturation (0-255) of the mean colour of ``blob`` at x, y in ``roi``."""
+    def _blob_hs(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> tuple[int, int, int]:
+        """Hue (OpenCV's 0-179), saturation and chroma (0-255) of the mean colour of ``blob`` at
+        x, y in ``roi``."""
         h, w = blob.shape
         mean = cv2.mean(roi[y:y + h, x:x + w], blob)[:3]
-        bh, bs, _ = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
-        return bh, bs
+        bh, bs, bv = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
+        return bh, bs, bs * bv // 255
 
     def _has_own_colour(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
         """True if the mean colour of ``blob`` is the one the marker has shown (its round
@@ -175,16 +204,14 @@ class ColorMarker:
         in shadow (dark, any hue passes its loose bounds) thus refuses grey-brown hair or skin."""
         if self._hsv is None or not self._colours:
             return True
-        bh, bs = self._blob_hs(roi, blob, x, y)
-        angles = [math.radians(2 * h) for h, _ in self._colours]
-        hue = math.degrees(math.atan2(sum(map(math.sin, angles)), sum(map(math.cos, angles)))) / 2 % 180
-        tol = self._hue_bounds()[0]
+        bh, bs, _ = self._blob_hs(roi, blob, x, y)
+        hue, saturation, _ = self._own_colour()
         turn = abs(bh - hue) % 180
-        return min(turn, 180 - turn) <= tol and bs >= 0.5 * _median_of([s for _, s in self._colours])
+        return min(turn, 180 - turn) <= self._hue_bounds()[0] and bs >= 0.5 * saturation
 
     def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
         """True if the mean colour of ``blob`` (a mask at x, y in ``roi``) has the marker's hue."""
-        bh, bs = self._blob_hs(roi, blob, x, y)
+        bh, bs, _ = self._blob_hs(roi, blob, x, y)
         tol, s_min, _ = self._hue_bounds()
         return min(abs(bh - self._hsv[0]), 180 - abs(bh - self._hsv[0])) <= tol and bs >= s_min
 
@@ -226,11 +253,15 @@ class ColorMarker:
             if _touches_edge(stat, roi.shape, box, image.shape):
                 if whole_inside:
                     return None
-                # the window cut the blob (the prediction was off): look again around what it saw
+                # the window cut the blob (the prediction was off): look again around what it saw;
+                # if that is not the marker, the other blobs in the window still may be
                 seen_at = (x0 + bx + bw / 2, y0 + by + bh / 2)
                 radius = math.sqrt(self._usual_area / math.pi) if self._areas else max(bw, bh)
                 half = int(3 * radius + max(bw, bh) / 2) + 6
-                return self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
+                det = self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
+                if det is not None:
+                    return det
+                continue
             if _on_image_border(stat, box, image.shape):
                 continue   # cut by the picture's edge: its centroid is not the marker's
             blob = (labels[by:by + bh, bx:bx + bw] == best).view(np.uint8)
@@ -276,6 +307,10 @@ class ColorMarker:
         if not (0.6 * d <= shape.minor_px <= 1.5 * d and shape.major_px <= 1.5 * d + streak):
             return False
         if shape.major_px > 1.4 * shape.minor_px:   # a blur streak lies along the motion
+            if self._lost > self.track.sightings:
+                # lost for longer than the fit's own span: its extrapolated direction is a guess
+                # (a few pixels of error in the curvature turn it by tens of degrees)
+                return self._speed >= 0.3 * d
             return _along(shape.angle_rad, self._velocity, d) or _along(shape.angle_rad, moved, d)
         return True
 
@@ -299,6 +334,14 @@ class ColorMarker:
                 whole = (labels[by:by + bh, bx:bx + bw] == best).view(np.uint8)
                 self._colours.append(self._blob_hs(roi, whole, bx, by))
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
+
+
+def _filled(contour: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
+    """0/1 mask of the blob ``contour`` outlines, over its bounding ``box`` (x, y, w, h)."""
+    x, y, w, h = box
+    mask = np.zeros((h, w), np.uint8)
+    cv2.drawContours(mask, [contour], -1, 1, cv2.FILLED, offset=(-x, -y))
+    return mask
 
 
 def _median_of(values) -> float:
