@@ -122,7 +122,7 @@ class ColorMarker:
         # the search window: at least five marker diameters (a hop starts from rest within a
         # frame); lost, it grows by its own size each frame around the extrapolated path
         half = int(max(self.search_half_px, 5 * self._usual_width)) * (1 + lost)
-        if self.track.sightings == 1:   # no velocity yet: twice as far, as Tracker does
+        if self.track.stretch == 1:   # no velocity yet (first sighting, or re-acquired): twice as far, as Tracker does
             half *= 2
         h, w = image.shape[:2]
         box = window((min(max(centre[0], 0), w - 1), min(max(centre[1], 0), h - 1)), half, image.shape)
@@ -147,10 +147,11 @@ class ColorMarker:
         yield self._hue_mask(roi, hsv), True
 
     def _own_colour(self) -> tuple[float, float, float]:
-        """Hue (circular mean), saturation and chroma (medians) of the marker's round sightings."""
+        """Hue (circular mean), saturation (median) and chroma (the largest: in the best light it
+        has been seen in; a shadow only takes from it) of the marker's round sightings."""
         angles = [math.radians(2 * h) for h, _, _ in self._colours]
         hue = math.degrees(math.atan2(sum(map(math.sin, angles)), sum(map(math.cos, angles)))) / 2 % 180
-        return hue, _median_of([c[1] for c in self._colours]), _median_of([c[2] for c in self._colours])
+        return hue, _median_of([c[1] for c in self._colours]), max(c[2] for c in self._colours)
 
     def _own_mask(self, roi: np.ndarray, hsv: np.ndarray) -> np.ndarray:
         """Pixels of the hue the marker has shown whose chroma (largest less smallest channel) is
@@ -159,12 +160,11 @@ class ColorMarker:
         has little of it however its hue reads."""
         hue, _, chroma = self._own_colour()
         tol, _, _ = self._hue_bounds()
-        share = min(self.tolerance / 80.0, 1.5)
         turn = cv2.absdiff(hsv[:, :, 0], int(round(hue)) % 180)
         hue_ok = cv2.min(turn, cv2.subtract(180, turn)) <= tol
         b, g, r = cv2.split(roi)
         spread = cv2.subtract(cv2.max(cv2.max(b, g), r), cv2.min(cv2.min(b, g), r))
-        return (hue_ok & (spread >= chroma * (1 - 0.7 * share))).view(np.uint8) * np.uint8(255)
+        return (hue_ok & (spread >= chroma * self._shadow_share())).view(np.uint8) * np.uint8(255)
 
     def _hue_bounds(self) -> tuple[int, int, int]:
         """Hue half-window (OpenCV's 8-bit hue: degrees / 2), least saturation, least brightness.
@@ -199,15 +199,22 @@ class ColorMarker:
 
     def _has_own_colour(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
         """True if the mean colour of ``blob`` is the one the marker has shown (its round
-        sightings, in this light): hue within the hue window of theirs, and at least half their
-        saturation -- mostly sticker, as a blur streak the marker is found on still is. A pick
-        in shadow (dark, any hue passes its loose bounds) thus refuses grey-brown hair or skin."""
+        sightings): hue within the hue window of theirs, at least half their saturation (mostly
+        sticker, as a blur streak the marker is found on still is) and at least the chroma a
+        shadow leaves of theirs. A pick in shadow (dark: a brown hue passes its loose bounds)
+        thus refuses grey-brown hair or skin."""
         if self._hsv is None or not self._colours:
             return True
-        bh, bs, _ = self._blob_hs(roi, blob, x, y)
-        hue, saturation, _ = self._own_colour()
+        bh, bs, bc = self._blob_hs(roi, blob, x, y)
+        hue, saturation, chroma = self._own_colour()
         turn = abs(bh - hue) % 180
-        return min(turn, 180 - turn) <= self._hue_bounds()[0] and bs >= 0.5 * saturation
+        return (min(turn, 180 - turn) <= self._hue_bounds()[0] and bs >= 0.5 * saturation
+                and bc >= self._shadow_share() * chroma)
+
+    def _shadow_share(self) -> float:
+        """The least share of its brightness (and so of its chroma) a shadow leaves the marker:
+        0.3 at the default --color-tol."""
+        return 1 - 0.7 * min(self.tolerance / 80.0, 1.5)
 
     def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
         """True if the mean colour of ``blob`` (a mask at x, y in ``roi``) has the marker's hue."""
@@ -269,8 +276,8 @@ class ColorMarker:
             at = (x0 + bx + bw / 2, y0 + by + bh / 2)
             if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
                 continue
-            if self._lost and not self._has_own_colour(roi, blob, bx, by):
-                continue   # lost: re-acquired only on a blob of the colour it had
+            if not self._has_own_colour(roi, blob, bx, by):
+                continue   # taken only on a blob of the colour it has shown
             if self._near_distractor(*at):
                 continue   # a look-alike seen at the start is never taken
             return self._measure(roi, labels, stat, best, shape, x0, y0)
@@ -307,7 +314,7 @@ class ColorMarker:
         if not (0.6 * d <= shape.minor_px <= 1.5 * d and shape.major_px <= 1.5 * d + streak):
             return False
         if shape.major_px > 1.4 * shape.minor_px:   # a blur streak lies along the motion
-            if self._lost > self.track.sightings:
+            if self._lost > self.track.stretch:
                 # lost for longer than the fit's own span: its extrapolated direction is a guess
                 # (a few pixels of error in the curvature turn it by tens of degrees)
                 return self._speed >= 0.3 * d
