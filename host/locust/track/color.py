@@ -133,16 +133,17 @@ class ColorMarker:
         within ``tolerance`` in RGB (exact on a well-lit sticker; a blob of them is then taken
         only if its mean colour has the marker's hue); if no blob of those fits, all those of
         its hue, somewhat paler or much darker (a shadow darkens, it does not change hue). A
-        grey marker (no hue to speak of) is matched in RGB alone. Once the marker has been seen,
+        grey marker (no hue to speak of) is matched in RGB alone. While the marker is followed,
         its own colour comes between the two: where a deep shadow makes the surround dark enough
-        for the loose bounds, the sticker still stands out by its chroma."""
+        for the loose bounds, the sticker still stands out by its chroma. Not while it is lost:
+        far from any prediction, skin stands out by it as well."""
         box = cv2.inRange(roi, self._lo, self._hi)
         if self._hsv is None:
             yield box, True
             return
         yield box, not self._box_holds_grey
         hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
-        if self._colours:
+        if self._colours and not self._lost:
             yield self._own_mask(roi, hsv), True
         yield self._hue_mask(roi, hsv), True
 
