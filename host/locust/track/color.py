@@ -1,13 +1,15 @@
 """Coloured stickers: ``--marker nose=color:#ff00ff``.
 
-Colour picks the marker, brightness locates it. Pixels within ``tolerance`` of the
-marker colour (largest channel difference, 0-255) form the core; the marker is the
-connected core blob nearest the predicted position (the largest one when there is no
-prediction). Its centre is the centroid of each pixel's *coverage* -- the fraction of
-the pixel the sticker covers, estimated from luma between the local background and the
-sticker's own level -- over the blob grown by two pixels, so anti-aliased edge pixels
-count by the share they hold. Luma is used for the weights because video codecs keep it
-at full resolution while they halve the colour planes (4:2:0).
+Colour picks the marker and locates it. Pixels within ``tolerance`` of the marker colour
+(largest channel difference, 0-255) form the core; the marker is the connected core blob
+nearest the predicted position (the largest one when there is no prediction). Its centre
+is the centroid of each pixel's *coverage* -- the fraction of the pixel the sticker
+covers -- over the blob grown by two pixels, so anti-aliased edge pixels count by the
+share they hold. Coverage is estimated from chroma (the pixel's colour less its grey
+level) between the local background's and the sticker's: a textured grey surround (a
+ruler's marks) then weighs nothing. A sticker whose chroma differs little from its
+surround's falls back to luma, which codecs keep at full resolution (4:2:0 halves the
+colour planes).
 
 A blob much smaller than the marker's usual area is partly hidden, and its centroid
 would be pulled toward the visible part: such frames are reported as not found.
@@ -124,6 +126,8 @@ class ColorMarker:
         half = int(max(self.search_half_px, 5 * self._usual_width)) * (1 + lost)
         if self.track.stretch == 1:   # no velocity yet (first sighting, or re-acquired): twice as far, as Tracker does
             half *= 2
+        if not lost:   # it may stop dead (a landing) as it starts from rest: reach back to where it was
+            half = max(half, int(math.dist(centre, self.track.last_point) + self._usual_width))
         h, w = image.shape[:2]
         box = window((min(max(centre[0], 0), w - 1), min(max(centre[1], 0), h - 1)), half, image.shape)
         return self._locate_in(image, box, centre)
