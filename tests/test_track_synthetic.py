@@ -35,7 +35,7 @@ def test_colour_markers_subpixel_and_occlusion(hop, tmp_path):
         vis = truth.visible[name]
         err = np.hypot(df[f"{name}_px"] - truth.px[name], df[f"{name}_py"] - truth.py[name])[vis]
         rms = float(np.sqrt(np.mean(err ** 2)))
-        assert rms <= 0.15, f"{name}: RMS {rms:.3f} px"  # measured 0.05 (nose), 0.09 (foot)
+        assert rms <= 0.15, f"{name}: RMS {rms:.3f} px"  # measured 0.11 (nose), 0.08 (foot)
         assert df[f"{name}_ok"][vis].all()
         assert df[f"{name}_px"][~vis].isna().all() and not df[f"{name}_ok"][~vis].any()
     assert (~truth.visible["foot"]).sum() == OCCLUDED[1] - OCCLUDED[0] + 1

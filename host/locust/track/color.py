@@ -1,13 +1,15 @@
 """Coloured stickers: ``--marker nose=color:#ff00ff``.
 
-Colour picks the marker, brightness locates it. Pixels within ``tolerance`` of the
-marker colour (largest channel difference, 0-255) form the core; the marker is the
-connected core blob nearest the predicted position (the largest one when there is no
-prediction). Its centre is the centroid of each pixel's *coverage* -- the fraction of
-the pixel the sticker covers, estimated from luma between the local background and the
-sticker's own level -- over the blob grown by two pixels, so anti-aliased edge pixels
-count by the share they hold. Luma is used for the weights because video codecs keep it
-at full resolution while they halve the colour planes (4:2:0).
+Colour picks the marker and locates it. Pixels within ``tolerance`` of the marker colour
+(largest channel difference, 0-255) form the core; the marker is the connected core blob
+nearest the predicted position (the largest one when there is no prediction). Its centre
+is the centroid of each pixel's *coverage* -- the fraction of the pixel the sticker
+covers -- over the blob grown by two pixels, so anti-aliased edge pixels count by the
+share they hold. Coverage is estimated from chroma (the pixel's colour less its grey
+level) between the local background's and the sticker's: a textured grey surround (a
+ruler's marks) then weighs nothing. A sticker whose chroma differs little from its
+surround's falls back to luma, which codecs keep at full resolution (4:2:0 halves the
+colour planes).
 
 A blob much smaller than the marker's usual area is partly hidden, and its centroid
 would be pulled toward the visible part: such frames are reported as not found.
@@ -58,6 +60,8 @@ class ColorMarker:
     _frame: int = 0                # the frame being searched
     _velocity: tuple[float, float] = (0.0, 0.0)   # predicted motion over this frame (px)
     _distractors: list = field(default_factory=list)  # other blobs of the colour seen at the start: (x, y, w, h)
+    _lost: int = 0                 # frames the marker has been lost before the one searched
+    _colours: deque = field(default_factory=lambda: deque(maxlen=15))  # (hue, saturation, chroma) of round sightings
 
     def __post_init__(self) -> None:
         self._lo = np.array([max(c - self.tolerance, 0) for c in self.bgr], dtype=np.uint8)
@@ -78,14 +82,19 @@ class ColorMarker:
 
     def _note_distractors(self, image: np.ndarray, marker: Detection) -> None:
         """Remember every other blob of the marker's colour on the first sighting (a pen cap
-        lying in the scene): a lost marker is never re-acquired on one of them."""
+        lying in the scene): a lost marker is never re-acquired on one of them. A look-alike has
+        the marker's own colour (a loose colour test passes a shadowed brown wall, which is no
+        look-alike: the marker is refused there by its colour when lost). A blob whose
+        look-alike zone holds the marker itself is a piece of the marker (its edge, split off by
+        a shadow), not a look-alike: it would blind the marker where it was first seen."""
         # the widest test (the last of _cores): every pixel that could be taken for it
         core = cv2.inRange(image, self._lo, self._hi) if self._hsv is None else self._hue_mask(image)
         contours, _ = cv2.findContours(core, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
         for c in contours:
-            x, y, w, h = cv2.boundingRect(c)
-            if w * h >= self.min_area_px and not (x - 1 <= marker.px <= x + w and y - 1 <= marker.py <= y + h):
-                self._distractors.append((x, y, w, h))
+            box = cv2.boundingRect(c)
+            if box[2] * box[3] >= self.min_area_px and not self._in_zone(box, marker.px, marker.py) \
+                    and self._has_own_colour(image, _filled(c, box), box[0], box[1]):
+                self._distractors.append(box)
 
     def _find(self, frame: int, image: np.ndarray) -> Detection | None:
         self._frame = frame
@@ -98,7 +107,7 @@ class ColorMarker:
         centre = self.track.predict(frame)
         before = self.track.predict(frame - 1)
         self._velocity = (centre[0] - before[0], centre[1] - before[1])
-        lost = self.track.frames_lost(frame)
+        lost = self._lost = self.track.frames_lost(frame)
         self._speed = math.hypot(*self._velocity)
         if lost:
             self._speed = max(self._speed, self.track.max_speed_px)
@@ -113,8 +122,10 @@ class ColorMarker:
         # the search window: at least five marker diameters (a hop starts from rest within a
         # frame); lost, it grows by its own size each frame around the extrapolated path
         half = int(max(self.search_half_px, 5 * self._usual_width)) * (1 + lost)
-        if self.track.sightings == 1:   # no velocity yet: twice as far, as Tracker does
+        if self.track.stretch == 1:   # no velocity yet (first sighting, or re-acquired): twice as far, as Tracker does
             half *= 2
+        if not lost:   # it may stop dead (a landing) as it starts from rest: reach back to where it was
+            half = max(half, int(math.dist(centre, self.track.last_point) + self._usual_width))
         h, w = image.shape[:2]
         box = window((min(max(centre[0], 0), w - 1), min(max(centre[1], 0), h - 1)), half, image.shape)
         return self._locate_in(image, box, centre)
@@ -124,13 +135,39 @@ class ColorMarker:
         within ``tolerance`` in RGB (exact on a well-lit sticker; a blob of them is then taken
         only if its mean colour has the marker's hue); if no blob of those fits, all those of
         its hue, somewhat paler or much darker (a shadow darkens, it does not change hue). A
-        grey marker (no hue to speak of) is matched in RGB alone."""
+        grey marker (no hue to speak of) is matched in RGB alone. While the marker is followed,
+        its own colour comes between the two: where a deep shadow makes the surround dark enough
+        for the loose bounds, the sticker still stands out by its chroma. Not while it is lost:
+        far from any prediction, skin stands out by it as well."""
         box = cv2.inRange(roi, self._lo, self._hi)
         if self._hsv is None:
             yield box, True
             return
         yield box, not self._box_holds_grey
-        yield self._hue_mask(roi), True
+        hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
+        if self._colours and not self._lost:
+            yield self._own_mask(roi, hsv), True
+        yield self._hue_mask(roi, hsv), True
+
+    def _own_colour(self) -> tuple[float, float, float]:
+        """Hue (circular mean), saturation (median) and chroma (the largest: in the best light it
+        has been seen in; a shadow only takes from it) of the marker's round sightings."""
+        angles = [math.radians(2 * h) for h, _, _ in self._colours]
+        hue = math.degrees(math.atan2(sum(map(math.sin, angles)), sum(map(math.cos, angles)))) / 2 % 180
+        return hue, _median_of([c[1] for c in self._colours]), max(c[2] for c in self._colours)
+
+    def _own_mask(self, roi: np.ndarray, hsv: np.ndarray) -> np.ndarray:
+        """Pixels of the hue the marker has shown whose chroma (largest less smallest channel) is
+        at least the share of its chroma that the brightness may drop to in a shadow (0.3 at the
+        default tolerance): a shadow scales chroma with brightness, a dark grey-brown surround
+        has little of it however its hue reads."""
+        hue, _, chroma = self._own_colour()
+        tol, _, _ = self._hue_bounds()
+        turn = cv2.absdiff(hsv[:, :, 0], int(round(hue)) % 180)
+        hue_ok = cv2.min(turn, cv2.subtract(180, turn)) <= tol
+        b, g, r = cv2.split(roi)
+        spread = cv2.subtract(cv2.max(cv2.max(b, g), r), cv2.min(cv2.min(b, g), r))
+        return (hue_ok & (spread >= chroma * self._shadow_share())).view(np.uint8) * np.uint8(255)
 
     def _hue_bounds(self) -> tuple[int, int, int]:
         """Hue half-window (OpenCV's 8-bit hue: degrees / 2), least saturation, least brightness.
@@ -143,10 +180,10 @@ class ColorMarker:
         return (max(int(round(self.hue_tol_deg * share / 2)), 1), max(int(s * (1 - 0.7 * share)), 40),
                 max(int(v * (1 - 0.7 * share)), 30))
 
-    def _hue_mask(self, roi: np.ndarray) -> np.ndarray:
+    def _hue_mask(self, roi: np.ndarray, hsv: np.ndarray | None = None) -> np.ndarray:
         h = self._hsv[0]
         tol, s_min, v_min = self._hue_bounds()
-        hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
+        hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV) if hsv is None else hsv
         lo, hi = h - tol, h + tol
         mask = cv2.inRange(hsv, (max(lo, 0), s_min, v_min), (min(hi, 179), 255, 255))
         if lo < 0:
@@ -155,12 +192,37 @@ class ColorMarker:
             mask |= cv2.inRange(hsv, (0, s_min, v_min), (hi - 180, 255, 255))
         return mask
 
+    def _blob_hs(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> tuple[int, int, int]:
+        """Hue (OpenCV's 0-179), saturation and chroma (0-255) of the mean colour of ``blob`` at
+        x, y in ``roi``."""
+        h, w = blob.shape
+        mean = cv2.mean(roi[y:y + h, x:x + w], blob)[:3]
+        bh, bs, bv = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
+        return bh, bs, bs * bv // 255
+
+    def _has_own_colour(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
+        """True if the mean colour of ``blob`` is the one the marker has shown (its round
+        sightings): hue within the hue window of theirs, at least half their saturation (mostly
+        sticker, as a blur streak the marker is found on still is) and at least the chroma a
+        shadow leaves of theirs. A pick in shadow (dark: a brown hue passes its loose bounds)
+        thus refuses grey-brown hair or skin."""
+        if self._hsv is None or not self._colours:
+            return True
+        bh, bs, bc = self._blob_hs(roi, blob, x, y)
+        hue, saturation, chroma = self._own_colour()
+        turn = abs(bh - hue) % 180
+        return (min(turn, 180 - turn) <= self._hue_bounds()[0] and bs >= 0.5 * saturation
+                and bc >= self._shadow_share() * chroma)
+
+    def _shadow_share(self) -> float:
+        """The least share of its brightness (and so of its chroma) a shadow leaves the marker:
+        0.3 at the default --color-tol."""
+        return 1 - 0.7 * min(self.tolerance / 80.0, 1.5)
+
     def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
         """True if the mean colour of ``blob`` (a mask, nonzero in the blob, at x, y in ``roi``)
         has the marker's hue."""
-        h, w = blob.shape
-        mean = cv2.mean(roi[y:y + h, x:x + w], blob)[:3]
-        bh, bs, _ = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
+        bh, bs, _ = self._blob_hs(roi, blob, x, y)
         tol, s_min, _ = self._hue_bounds()
         return min(abs(bh - self._hsv[0]), 180 - abs(bh - self._hsv[0])) <= tol and bs >= s_min
 
@@ -203,11 +265,15 @@ class ColorMarker:
             if _touches_edge(stat, roi.shape, box, image.shape):
                 if whole_inside:
                     return None
-                # the window cut the blob (the prediction was off): look again around what it saw
+                # the window cut the blob (the prediction was off): look again around what it saw;
+                # if that is not the marker, the other blobs in the window still may be
                 seen_at = (x0 + bx + bw / 2, y0 + by + bh / 2)
                 radius = math.sqrt(self._usual_area / math.pi) if self._areas else max(bw, bh)
                 half = int(3 * radius + max(bw, bh) / 2) + 6
-                return self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
+                det = self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
+                if det is not None:
+                    return det
+                continue
             if _on_image_border(stat, box, image.shape):
                 continue   # cut by the picture's edge: its centroid is not the marker's
             blob = mask[by:by + bh, bx:bx + bw]
@@ -217,6 +283,8 @@ class ColorMarker:
             at = (x0 + bx + bw / 2, y0 + by + bh / 2)
             if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
                 continue
+            if not self._has_own_colour(roi, blob, bx, by):
+                continue   # taken only on a blob of the colour it has shown
             if self._near_distractor(*at):
                 continue   # a look-alike seen at the start is never taken
             return self._measure(roi, mask, stat, label, shape, x0, y0)
@@ -226,8 +294,13 @@ class ColorMarker:
         """True if (x, y) lies on a look-alike's bounding box, grown by a marker radius."""
         if not self._distractors:
             return False
+        return any(self._in_zone(box, x, y) for box in self._distractors)
+
+    def _in_zone(self, box: tuple[int, int, int, int], x: float, y: float) -> bool:
+        """True if (x, y) lies on ``box`` (x, y, w, h) grown by a marker radius."""
+        bx, by, bw, bh = box
         r = 0.5 * self._usual_width + 1.0
-        return any(bx - r <= x <= bx + bw + r and by - r <= y <= by + bh + r for bx, by, bw, bh in self._distractors)
+        return bx - r <= x <= bx + bw + r and by - r <= y <= by + bh + r
 
     def _fits(self, shape: BlobShape, at: tuple[float, float]) -> bool:
         """Size and shape of the marker: learned from the round, whole sightings so far; the
@@ -250,6 +323,10 @@ class ColorMarker:
         if not (0.6 * d <= shape.minor_px <= 1.5 * d and shape.major_px <= 1.5 * d + streak):
             return False
         if shape.major_px > 1.4 * shape.minor_px:   # a blur streak lies along the motion
+            if self._lost > self.track.stretch:
+                # lost for longer than the fit's own span: its extrapolated direction is a guess
+                # (a few pixels of error in the curvature turn it by tens of degrees)
+                return self._speed >= 0.3 * d
             return _along(shape.angle_rad, self._velocity, d) or _along(shape.angle_rad, moved, d)
         return True
 
@@ -260,7 +337,8 @@ class ColorMarker:
         cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
         cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
         blob = labels[cy0:cy1, cx0:cx1] == best
-        px, py = _coverage_centroid(roi[cy0:cy1, cx0:cx1], blob)
+        near = roi[cy0:cy1, cx0:cx1]
+        px, py = _chroma_centroid(near, blob) or _coverage_centroid(near, blob)
         area = float(shape.area_px)
         score = area / self._usual_area if self._areas else 1.0
         if shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn the marker's size from it
@@ -268,7 +346,18 @@ class ColorMarker:
             self._widths.append(shape.minor_px)
             self._usual_area = _median_of(self._areas)
             self._usual_width = _median_of(self._widths)
+            if self._hsv is not None:
+                whole = (labels[by:by + bh, bx:bx + bw] == best).view(np.uint8)
+                self._colours.append(self._blob_hs(roi, whole, bx, by))
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
+
+
+def _filled(contour: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
+    """0/1 mask of the blob ``contour`` outlines, over its bounding ``box`` (x, y, w, h)."""
+    x, y, w, h = box
+    mask = np.zeros((h, w), np.uint8)
+    cv2.drawContours(mask, [contour], -1, 1, cv2.FILLED, offset=(-x, -y))
+    return mask
 
 
 def _median_of(values) -> float:
@@ -357,6 +446,38 @@ def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]
         cover *= grown
     else:  # sticker as bright as its surround: fall back to the colour core alone
         cover = blob_u8
+    m = cv2.moments(cover)
+    return m["m10"] / m["m00"], m["m01"] / m["m00"]
+
+
+CHROMA_CONTRAST = 40.0   # least sticker-to-background chroma difference (0-255 scale) to weigh by colour
+
+
+def _chroma_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float] | None:
+    """Centroid of per-pixel coverage estimated from colour, not brightness: each pixel's
+    chroma (its colour less its grey level) is projected on the line from the local
+    background's chroma to the sticker's. A textured grey surround (a ruler's marks, a
+    picture frame's edge) then weighs nothing, however bright or dark, where luma coverage
+    takes its dark or bright pixels for part of the sticker. ``None`` when the sticker's
+    chroma differs too little from its surround's (a pale sticker): then luma decides.
+
+    ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
+    """
+    blob_u8 = blob.view(np.uint8)
+    grown = cv2.dilate(blob_u8, _KERNEL_5)
+    ring = (cv2.dilate(grown, _KERNEL_5) & ~grown & 1).view(bool)
+    inner = cv2.erode(blob_u8, _KERNEL_3).view(bool)
+    if not ring.any():
+        return None
+    pixels = roi.astype(np.float32)
+    chroma = pixels - pixels.mean(axis=2, keepdims=True)
+    sticker = np.median(chroma[inner if inner.any() else blob], axis=0)
+    background = np.median(chroma[ring], axis=0)
+    axis = sticker - background
+    contrast = float(np.linalg.norm(axis))
+    if contrast < CHROMA_CONTRAST:
+        return None
+    cover = np.clip((chroma - background) @ (axis / contrast ** 2), 0.0, 1.0) * grown
     m = cv2.moments(cover)
     return m["m10"] / m["m00"], m["m01"] / m["m00"]
 

@@ -150,3 +150,12 @@ class Trajectory:
     @property
     def last_point(self) -> Point | None:
         return (self._found[-1][1], self._found[-1][2]) if self._found else None
+
+    @property
+    def stretch(self) -> int:
+        """Sightings the fit is made over: the last stretch of them (none older than twice their
+        count before the last); 1 right after a re-acquisition, when there is no velocity yet."""
+        if not self._found:
+            return 0
+        last = self._found[-1][0]
+        return sum(1 for p in self._found if p[0] >= last - 2 * len(self._found))
