@@ -338,7 +338,7 @@ class ColorMarker:
         cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
         blob = labels[cy0:cy1, cx0:cx1] == best
         near = roi[cy0:cy1, cx0:cx1]
-        px, py = _chroma_centroid(near, blob) or _coverage_centroid(near, blob)
+        px, py = _coverage_centroid(near, blob)
         area = float(shape.area_px)
         score = area / self._usual_area if self._areas else 1.0
         if shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn the marker's size from it
@@ -425,61 +425,78 @@ _KERNEL_5 = np.ones((5, 5), np.uint8)
 _KERNEL_3 = np.ones((3, 3), np.uint8)
 
 
+UNIFORM_SHARE = 0.1      # a surround varying by less than this share of the sticker's luma contrast is uniform
+CHROMA_CONTRAST = 40.0   # least sticker-to-background chroma difference (0-255 scale) to weigh by colour
+
+
 def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]:
     """Centroid of per-pixel coverage over ``blob`` (a boolean mask) grown by two pixels.
+
+    Coverage comes from luma (full resolution under 4:2:0, so the least noisy) when the
+    surround is uniform: the luma of the two-pixel ring around the grown blob varies (standard
+    deviation) by less than ``UNIFORM_SHARE`` of the sticker-to-surround luma contrast, so no
+    surround pixel passes for more than a tenth of sticker. A textured surround (a ruler's
+    marks, a checker floor's edges) would: then coverage comes from chroma
+    (``_chroma_centroid``), where grey texture weighs nothing. A pale sticker (too little
+    chroma contrast) stays with luma; a sticker as bright as its surround with the colour core.
 
     ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
     """
     blob_u8 = blob.view(np.uint8)
     grown = cv2.dilate(blob_u8, _KERNEL_5)
     luma = cv2.cvtColor(roi.astype(np.float32), cv2.COLOR_BGR2GRAY)   # BT.601: 0.114 B + 0.587 G + 0.299 R
-    inner = luma[cv2.erode(blob_u8, _KERNEL_3).view(bool)]
+    inner_u8 = cv2.erode(blob_u8, _KERNEL_3)
+    inner = luma[inner_u8.view(bool)]
     level = float(_median(inner if inner.size else luma[blob]))
-    ring = luma[cv2.dilate(blob_u8, _KERNEL_9) > grown]   # the two pixels around the grown blob
-    background = float(_median(ring)) if ring.size else 0.0
-    if abs(level - background) >= 20:
-        cover = luma   # in place: luma is not needed any more
-        cover -= background
-        cover /= level - background
-        np.maximum(cover, 0.0, out=cover)
-        np.minimum(cover, 1.0, out=cover)
-        cover *= grown
-    else:  # sticker as bright as its surround: fall back to the colour core alone
-        cover = blob_u8
-    m = cv2.moments(cover)
+    ring_u8 = (cv2.dilate(blob_u8, _KERNEL_9) > grown).view(np.uint8)   # the two pixels around the grown blob
+    ring = luma[ring_u8.view(bool)]
+    if not ring.size:
+        return _moments_centroid(blob_u8)
+    background = float(_median(ring))
+    contrast = abs(level - background)
+    if contrast < 20 or float(ring.std()) >= UNIFORM_SHARE * contrast:
+        at = _chroma_centroid(roi, blob_u8, grown, ring_u8, inner_u8)
+        if at is not None:
+            return at
+    if contrast < 20:   # sticker as bright as its surround: the colour core alone
+        return _moments_centroid(blob_u8)
+    cover = luma   # in place: luma is not needed any more
+    cover -= background
+    cover /= level - background
+    np.maximum(cover, 0.0, out=cover)
+    np.minimum(cover, 1.0, out=cover)
+    cover *= grown
+    return _moments_centroid(cover)
+
+
+def _moments_centroid(weights: np.ndarray) -> tuple[float, float]:
+    m = cv2.moments(weights)
     return m["m10"] / m["m00"], m["m01"] / m["m00"]
 
 
-CHROMA_CONTRAST = 40.0   # least sticker-to-background chroma difference (0-255 scale) to weigh by colour
-
-
-def _chroma_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float] | None:
+def _chroma_centroid(roi: np.ndarray, blob_u8: np.ndarray, grown: np.ndarray, ring_u8: np.ndarray,
+                     inner_u8: np.ndarray) -> tuple[float, float] | None:
     """Centroid of per-pixel coverage estimated from colour, not brightness: each pixel's
     chroma (its colour less its grey level) is projected on the line from the local
     background's chroma to the sticker's. A textured grey surround (a ruler's marks, a
     picture frame's edge) then weighs nothing, however bright or dark, where luma coverage
     takes its dark or bright pixels for part of the sticker. ``None`` when the sticker's
     chroma differs too little from its surround's (a pale sticker): then luma decides.
-
-    ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
     """
-    blob_u8 = blob.view(np.uint8)
-    grown = cv2.dilate(blob_u8, _KERNEL_5)
-    ring = (cv2.dilate(grown, _KERNEL_5) & ~grown & 1).view(bool)
-    inner = cv2.erode(blob_u8, _KERNEL_3).view(bool)
-    if not ring.any():
-        return None
     pixels = roi.astype(np.float32)
     chroma = pixels - pixels.mean(axis=2, keepdims=True)
-    sticker = np.median(chroma[inner if inner.any() else blob], axis=0)
-    background = np.median(chroma[ring], axis=0)
+    core = inner_u8 if inner_u8.any() else blob_u8
+    sticker = np.median(chroma[core.view(bool)], axis=0)
+    background = np.median(chroma[ring_u8.view(bool)], axis=0)
     axis = sticker - background
     contrast = float(np.linalg.norm(axis))
     if contrast < CHROMA_CONTRAST:
         return None
-    cover = np.clip((chroma - background) @ (axis / contrast ** 2), 0.0, 1.0) * grown
-    m = cv2.moments(cover)
-    return m["m10"] / m["m00"], m["m01"] / m["m00"]
+    w = axis / contrast ** 2
+    cover = cv2.transform(chroma, w.reshape(1, 3)) - float(background @ w)
+    np.clip(cover, 0.0, 1.0, out=cover)
+    cover *= grown
+    return _moments_centroid(cover)
 
 
 def _median(values: np.ndarray) -> np.floating:
