@@ -39,6 +39,22 @@ def parse_hex(colour: str) -> tuple[int, int, int]:
     return b, g, r
 
 
+class FrameHSV:
+    """The HSV picture of the frame being tracked, converted once for every colour marker that
+    asks for it (the runner hands one to all of them). Held for one frame index and one image
+    object: another frame, or another array, is converted afresh."""
+
+    def __init__(self) -> None:
+        self._frame: int | None = None
+        self._image: np.ndarray | None = None
+        self._hsv: np.ndarray | None = None
+
+    def of(self, frame: int, image: np.ndarray) -> np.ndarray:
+        if frame != self._frame or image is not self._image:
+            self._frame, self._image, self._hsv = frame, image, cv2.cvtColor(image, cv2.COLOR_BGR2HSV)
+        return self._hsv
+
+
 @dataclass
 class ColorMarker:
     name: str
@@ -62,6 +78,8 @@ class ColorMarker:
     _distractors: list = field(default_factory=list)  # other blobs of the colour seen at the start: (x, y, w, h)
     _lost: int = 0                 # frames the marker has been lost before the one searched
     _colours: deque = field(default_factory=lambda: deque(maxlen=15))  # (hue, saturation, chroma) of round sightings
+    _own: tuple | None = None      # _own_colour() of _colours, None when it must be computed again
+    frame_hsv: FrameHSV = field(default_factory=FrameHSV)   # shared by the markers of one run
 
     def __post_init__(self) -> None:
         self._lo = np.array([max(c - self.tolerance, 0) for c in self.bgr], dtype=np.uint8)
@@ -72,6 +90,7 @@ class ColorMarker:
         # a box reaching near the grey diagonal (R = G = B) takes grey pixels for the marker:
         # then a blob of the box is also checked for the marker's hue
         self._box_holds_grey = int(self._lo.max()) <= int(self._hi.min()) + 30
+        self._bounds = self._hue_bounds() if self._hsv is not None else None
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
         det = self._find(frame, image_bgr) or Detection.missing(0.0)
@@ -88,12 +107,13 @@ class ColorMarker:
         look-alike zone holds the marker itself is a piece of the marker (its edge, split off by
         a shadow), not a look-alike: it would blind the marker where it was first seen."""
         # the widest test (the last of _cores): every pixel that could be taken for it
-        core = cv2.inRange(image, self._lo, self._hi) if self._hsv is None else self._hue_mask(image)
+        core = cv2.inRange(image, self._lo, self._hi) if self._hsv is None \
+            else self._hue_mask(image, self.frame_hsv.of(self._frame, image))
         contours, _ = cv2.findContours(core, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
         for c in contours:
             box = cv2.boundingRect(c)
             if box[2] * box[3] >= self.min_area_px and not self._in_zone(box, marker.px, marker.py) \
-                    and self._has_own_colour(image, _filled(c, box), box[0], box[1]):
+                    and self._has_own_colour(self._blob_hs(image, _filled(c, box), box[0], box[1])):
                 self._distractors.append(box)
 
     def _find(self, frame: int, image: np.ndarray) -> Detection | None:
@@ -151,7 +171,13 @@ class ColorMarker:
 
     def _own_colour(self) -> tuple[float, float, float]:
         """Hue (circular mean), saturation (median) and chroma (the largest: in the best light it
-        has been seen in; a shadow only takes from it) of the marker's round sightings."""
+        has been seen in; a shadow only takes from it) of the marker's round sightings; computed
+        once per sighting added."""
+        if self._own is None:
+            self._own = self._colours_mean()
+        return self._own
+
+    def _colours_mean(self) -> tuple[float, float, float]:
         angles = [math.radians(2 * h) for h, _, _ in self._colours]
         hue = math.degrees(math.atan2(sum(map(math.sin, angles)), sum(map(math.cos, angles)))) / 2 % 180
         return hue, _median_of([c[1] for c in self._colours]), max(c[2] for c in self._colours)
@@ -162,7 +188,7 @@ class ColorMarker:
         default tolerance): a shadow scales chroma with brightness, a dark grey-brown surround
         has little of it however its hue reads."""
         hue, _, chroma = self._own_colour()
-        tol, _, _ = self._hue_bounds()
+        tol = self._bounds[0]
         turn = cv2.absdiff(hsv[:, :, 0], int(round(hue)) % 180)
         hue_ok = cv2.min(turn, cv2.subtract(180, turn)) <= tol
         b, g, r = cv2.split(roi)
@@ -182,7 +208,7 @@ class ColorMarker:
 
     def _hue_mask(self, roi: np.ndarray, hsv: np.ndarray | None = None) -> np.ndarray:
         h = self._hsv[0]
-        tol, s_min, v_min = self._hue_bounds()
+        tol, s_min, v_min = self._bounds
         hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV) if hsv is None else hsv
         lo, hi = h - tol, h + tol
         mask = cv2.inRange(hsv, (max(lo, 0), s_min, v_min), (min(hi, 179), 255, 255))
@@ -200,18 +226,18 @@ class ColorMarker:
         bh, bs, bv = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
         return bh, bs, bs * bv // 255
 
-    def _has_own_colour(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
-        """True if the mean colour of ``blob`` is the one the marker has shown (its round
+    def _has_own_colour(self, hs: tuple[int, int, int]) -> bool:
+        """True if a blob's mean colour ``hs`` (``_blob_hs``) is the one the marker has shown (its round
         sightings): hue within the hue window of theirs, at least half their saturation (mostly
         sticker, as a blur streak the marker is found on still is) and at least the chroma a
         shadow leaves of theirs. A pick in shadow (dark: a brown hue passes its loose bounds)
         thus refuses grey-brown hair or skin."""
         if self._hsv is None or not self._colours:
             return True
-        bh, bs, bc = self._blob_hs(roi, blob, x, y)
+        bh, bs, bc = hs
         hue, saturation, chroma = self._own_colour()
         turn = abs(bh - hue) % 180
-        return (min(turn, 180 - turn) <= self._hue_bounds()[0] and bs >= 0.5 * saturation
+        return (min(turn, 180 - turn) <= self._bounds[0] and bs >= 0.5 * saturation
                 and bc >= self._shadow_share() * chroma)
 
     def _shadow_share(self) -> float:
@@ -219,11 +245,10 @@ class ColorMarker:
         0.3 at the default --color-tol."""
         return 1 - 0.7 * min(self.tolerance / 80.0, 1.5)
 
-    def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
-        """True if the mean colour of ``blob`` (a mask, nonzero in the blob, at x, y in ``roi``)
-        has the marker's hue."""
-        bh, bs, _ = self._blob_hs(roi, blob, x, y)
-        tol, s_min, _ = self._hue_bounds()
+    def _has_hue(self, hs: tuple[int, int, int]) -> bool:
+        """True if a blob's mean colour ``hs`` (``_blob_hs``) has the marker's hue."""
+        bh, bs, _ = hs
+        tol, s_min, _ = self._bounds
         return min(abs(bh - self._hsv[0]), 180 - abs(bh - self._hsv[0])) <= tol and bs >= s_min
 
     def _locate_in(self, image, box, centre, whole_inside: bool = False, tight: bool = False) -> Detection | None:
@@ -281,13 +306,17 @@ class ColorMarker:
                 blob = (blob == label).view(np.uint8)
             shape = _blob_shape(blob, area)
             at = (x0 + bx + bw / 2, y0 + by + bh / 2)
-            if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
+            if not self._fits(shape, at):
                 continue
-            if not self._has_own_colour(roi, blob, bx, by):
+            # the blob's mean colour (hue, saturation, chroma), for the checks and to learn from
+            hs = self._blob_hs(roi, blob, bx, by) if self._hsv is not None else None
+            if not (hue_checked or self._has_hue(hs)):
+                continue
+            if not self._has_own_colour(hs):
                 continue   # taken only on a blob of the colour it has shown
             if self._near_distractor(*at):
                 continue   # a look-alike seen at the start is never taken
-            return self._measure(roi, mask, stat, label, shape, x0, y0)
+            return self._measure(roi, mask, stat, label, shape, x0, y0, hs)
         return None
 
     def _near_distractor(self, x: float, y: float) -> bool:
@@ -330,7 +359,7 @@ class ColorMarker:
             return _along(shape.angle_rad, self._velocity, d) or _along(shape.angle_rad, moved, d)
         return True
 
-    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int) -> Detection:
+    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int, hs) -> Detection:
         """The blob's coverage centroid; a round, whole blob also teaches the marker's size."""
         # the centroid needs the blob and four pixels around it (two dilations of 5x5)
         bx, by, bw, bh = stat[:4]
@@ -346,9 +375,9 @@ class ColorMarker:
             self._widths.append(shape.minor_px)
             self._usual_area = _median_of(self._areas)
             self._usual_width = _median_of(self._widths)
-            if self._hsv is not None:
-                whole = (labels[by:by + bh, bx:bx + bw] == best).view(np.uint8)
-                self._colours.append(self._blob_hs(roi, whole, bx, by))
+            if hs is not None:   # the blob's mean colour
+                self._colours.append(hs)
+                self._own = None
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
 
 
@@ -454,7 +483,7 @@ def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]
         return _moments_centroid(blob_u8)
     background = float(_median(ring))
     contrast = abs(level - background)
-    if contrast < 20 or float(ring.std()) >= UNIFORM_SHARE * contrast:
+    if contrast < 20 or float(cv2.meanStdDev(luma, mask=ring_u8)[1][0, 0]) >= UNIFORM_SHARE * contrast:
         at = _chroma_centroid(roi, blob_u8, grown, ring_u8, inner_u8)
         if at is not None:
             return at
