@@ -150,6 +150,21 @@ class ColorMarker:
         box = window((min(max(centre[0], 0), w - 1), min(max(centre[1], 0), h - 1)), half, image.shape)
         return self._locate_in(image, box, centre)
 
+    def _may_hold(self, roi: np.ndarray) -> bool:
+        """False if no blob the marker could be taken for lies in ``roi``, judged from every
+        ``step``-th pixel of every ``step``-th row: a blob is taken only if its least width is
+        at least 0.6 of the marker's (``_fits``), so it holds a square of 0.6 / sqrt(2) of its
+        width, which a grid of 0.3 of it cannot miss. While the marker is hidden its window
+        grows by its size every frame; this keeps the colour tests, the HSV conversion above
+        all, to a sixteenth of it (the step is at most 4)."""
+        step = min(int(0.3 * self._usual_width), 4)
+        if step < 2 or self._usual_width < 5.0:   # a few pixels across: its shape is not judged
+            return True
+        sub = np.ascontiguousarray(roi[step // 2::step, step // 2::step])
+        if cv2.hasNonZero(cv2.inRange(sub, self._lo, self._hi)):
+            return True
+        return self._hsv is not None and cv2.hasNonZero(self._hue_mask(sub))
+
     def _cores(self, roi: np.ndarray):
         """Pixels of the marker's colour, with whether their hue is already checked: first those
         within ``tolerance`` in RGB (exact on a well-lit sticker; a blob of them is then taken
@@ -258,6 +273,8 @@ class ColorMarker:
         if x1 <= x0 or y1 <= y0:           # the prediction lies off the picture
             return None
         roi = image[y0:y1, x0:x1]          # a view: nothing outside the window is converted
+        if self._lost and not self._may_hold(roi):
+            return None
         for core, hue_checked in self._cores(roi):
             det = self._locate_core(image, roi, core, box, centre, whole_inside, hue_checked, tight)
             if det is not None:
@@ -267,15 +284,26 @@ class ColorMarker:
     def _locate_core(self, image, roi, core, box, centre, whole_inside: bool, hue_checked: bool,
                      tight: bool) -> Detection | None:
         x0, y0 = box[:2]
-        if not cv2.hasNonZero(core):   # labelling an empty frame costs milliseconds: a hidden marker
+        # only the box of the set pixels is labelled (the same components, at an offset): an
+        # empty frame (a hidden marker) is not labelled at all, a window or the whole picture
+        # holding one sticker costs the sticker's box
+        rect = cv2.boundingRect(core)
+        lx, ly, lw, lh = rect
+        if lw == 0:
             return None
-        n, labels = cv2.connectedComponents(core, connectivity=8)
+        part = core[ly:ly + lh, lx:lx + lw]
+        n, labels = cv2.connectedComponents(part, connectivity=8)
         if n <= 1:
             return None
         if n == 2:   # one blob (the usual case): the core is its mask; its statistics cost less than OpenCV's
-            blobs = [((*cv2.boundingRect(core), cv2.countNonZero(core)), core, 255)]
+            blobs = [((*rect, cv2.countNonZero(part)), core, 255)]
         else:
-            stats, cents = _component_stats(core, labels, n)
+            stats, cents = _component_stats(part, labels, n)
+            stats[:, 0] += lx
+            stats[:, 1] += ly
+            cents += (lx, ly)
+            labels = cv2.copyMakeBorder(labels, ly, core.shape[0] - ly - lh, lx, core.shape[1] - lx - lw,
+                                        cv2.BORDER_CONSTANT, value=0)
             order = np.arange(1, n)
             if centre is None:   # largest first
                 order = order[np.argsort(-stats[order, cv2.CC_STAT_AREA], kind="stable")]
