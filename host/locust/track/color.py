@@ -47,12 +47,15 @@ class FrameHSV:
     def __init__(self) -> None:
         self._frame: int | None = None
         self._image: np.ndarray | None = None
-        self._hsv: np.ndarray | None = None
+        self._hsv: dict[int, np.ndarray] = {}
 
-    def of(self, frame: int, image: np.ndarray) -> np.ndarray:
+    def of(self, frame: int, image: np.ndarray, step: int = 1) -> np.ndarray:
+        """HSV of every ``step``-th pixel of every ``step``-th row of ``image``."""
         if frame != self._frame or image is not self._image:
-            self._frame, self._image, self._hsv = frame, image, cv2.cvtColor(image, cv2.COLOR_BGR2HSV)
-        return self._hsv
+            self._frame, self._image, self._hsv = frame, image, {}
+        if step not in self._hsv:
+            self._hsv[step] = cv2.cvtColor(np.ascontiguousarray(image[::step, ::step]), cv2.COLOR_BGR2HSV)
+        return self._hsv[step]
 
 
 @dataclass
@@ -106,15 +109,31 @@ class ColorMarker:
         look-alike: the marker is refused there by its colour when lost). A blob whose
         look-alike zone holds the marker itself is a piece of the marker (its edge, split off by
         a shadow), not a look-alike: it would blind the marker where it was first seen."""
-        # the widest test (the last of _cores): every pixel that could be taken for it
-        core = cv2.inRange(image, self._lo, self._hi) if self._hsv is None \
-            else self._hue_mask(image, self.frame_hsv.of(self._frame, image))
-        contours, _ = cv2.findContours(core, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
-        for c in contours:
-            box = cv2.boundingRect(c)
-            if box[2] * box[3] >= self.min_area_px and not self._in_zone(box, marker.px, marker.py) \
-                    and self._has_own_colour(self._blob_hs(image, _filled(c, box), box[0], box[1])):
-                self._distractors.append(box)
+        # The widest test (the last of _cores) finds every pixel that could be taken for it: on
+        # every second pixel of every second row first (a quarter of the picture to convert; any
+        # blob holding a 2x2 square has one there), then in full around what that found.
+        h, w = image.shape[:2]
+        seen = set()
+        for c in _contours(self._widest(image[::2, ::2], self.frame_hsv.of(self._frame, image, 2))):
+            x, y, bw, bh = cv2.boundingRect(c)
+            x0, y0, x1, y1 = max(2 * x - 2, 0), max(2 * y - 2, 0), min(2 * (x + bw) + 2, w), min(2 * (y + bh) + 2, h)
+            roi = image[y0:y1, x0:x1]
+            for piece in _contours(self._widest(roi)):
+                bx, by, bw, bh = cv2.boundingRect(piece)
+                box = (bx + x0, by + y0, bw, bh)
+                if box in seen:
+                    continue
+                seen.add(box)
+                if bw * bh >= self.min_area_px and not self._in_zone(box, marker.px, marker.py) \
+                        and self._has_own_colour(self._blob_hs(roi, _filled(piece, (bx, by, bw, bh)), bx, by)):
+                    self._distractors.append(box)
+
+    def _widest(self, roi: np.ndarray, hsv: np.ndarray | None = None) -> np.ndarray:
+        """The widest colour test (the last of ``_cores``): every pixel that could be taken for
+        the marker; ``hsv``: ``roi`` converted, if it is at hand."""
+        if self._hsv is None:
+            return cv2.inRange(np.ascontiguousarray(roi), self._lo, self._hi)
+        return self._hue_mask(roi, hsv)
 
     def _find(self, frame: int, image: np.ndarray) -> Detection | None:
         self._frame = frame
@@ -287,10 +306,10 @@ class ColorMarker:
         # only the box of the set pixels is labelled (the same components, at an offset): an
         # empty frame (a hidden marker) is not labelled at all, a window or the whole picture
         # holding one sticker costs the sticker's box
+        if not cv2.hasNonZero(core):   # a hidden marker: nothing to label (a scan that stops at the first pixel set)
+            return None
         rect = cv2.boundingRect(core)
         lx, ly, lw, lh = rect
-        if lw == 0:
-            return None
         part = core[ly:ly + lh, lx:lx + lw]
         n, labels = cv2.connectedComponents(part, connectivity=8)
         if n <= 1:
@@ -409,6 +428,11 @@ class ColorMarker:
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
 
 
+def _contours(mask: np.ndarray) -> list:
+    """Outer contours of the blobs of ``mask``."""
+    return cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)[0]
+
+
 def _filled(contour: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
     """0/1 mask of the blob ``contour`` outlines, over its bounding ``box`` (x, y, w, h)."""
     x, y, w, h = box
@@ -462,7 +486,7 @@ class BlobShape(NamedTuple):   # a tuple: one is made per blob looked at, every 
 
 def _blob_shape(blob: np.ndarray, area: int) -> BlobShape:
     """Area and equivalent ellipse of a blob given as a mask (nonzero in the blob)."""
-    m = cv2.moments(blob, binaryImage=True)
+    m = cv2.moments(blob)   # 0/1 or 0/255: the same shape
     a, b, c = m["mu20"] / m["m00"], m["mu11"] / m["m00"], m["mu02"] / m["m00"]
     root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
     # + 1/12 per axis: a pixel is a square, not a point
@@ -511,7 +535,8 @@ def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]
         return _moments_centroid(blob_u8)
     background = float(_median(ring))
     contrast = abs(level - background)
-    if contrast < 20 or float(cv2.meanStdDev(luma, mask=ring_u8)[1][0, 0]) >= UNIFORM_SHARE * contrast:
+    ring -= background
+    if contrast < 20 or float(np.dot(ring, ring)) >= (UNIFORM_SHARE * contrast) ** 2 * ring.size:
         at = _chroma_centroid(roi, blob_u8, grown, ring_u8, inner_u8)
         if at is not None:
             return at
