@@ -5,11 +5,10 @@ Colour picks the marker and locates it. Pixels within ``tolerance`` of the marke
 nearest the predicted position (the largest one when there is no prediction). Its centre
 is the centroid of each pixel's *coverage* -- the fraction of the pixel the sticker
 covers -- over the blob grown by two pixels, so anti-aliased edge pixels count by the
-share they hold. Coverage is estimated from chroma (the pixel's colour less its grey
-level) between the local background's and the sticker's: a textured grey surround (a
-ruler's marks) then weighs nothing. A sticker whose chroma differs little from its
-surround's falls back to luma, which codecs keep at full resolution (4:2:0 halves the
-colour planes).
+share they hold. Coverage is estimated from luma, which codecs keep at full resolution
+(4:2:0 halves the colour planes), where the surround is uniform; around a textured surround
+(a ruler's marks) from chroma (the pixel's colour less its grey level) between the local
+background's and the sticker's, so the texture weighs nothing.
 
 A blob much smaller than the marker's usual area is partly hidden, and its centroid
 would be pulled toward the visible part: such frames are reported as not found.
