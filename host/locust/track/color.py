@@ -5,11 +5,10 @@ Colour picks the marker and locates it. Pixels within ``tolerance`` of the marke
 nearest the predicted position (the largest one when there is no prediction). Its centre
 is the centroid of each pixel's *coverage* -- the fraction of the pixel the sticker
 covers -- over the blob grown by two pixels, so anti-aliased edge pixels count by the
-share they hold. Coverage is estimated from chroma (the pixel's colour less its grey
-level) between the local background's and the sticker's: a textured grey surround (a
-ruler's marks) then weighs nothing. A sticker whose chroma differs little from its
-surround's falls back to luma, which codecs keep at full resolution (4:2:0 halves the
-colour planes).
+share they hold. Coverage is estimated from luma, which codecs keep at full resolution
+(4:2:0 halves the colour planes), where the surround is uniform; around a textured surround
+(a ruler's marks) from chroma (the pixel's colour less its grey level) between the local
+background's and the sticker's, so the texture weighs nothing.
 
 A blob much smaller than the marker's usual area is partly hidden, and its centroid
 would be pulled toward the visible part: such frames are reported as not found.
@@ -39,6 +38,25 @@ def parse_hex(colour: str) -> tuple[int, int, int]:
     return b, g, r
 
 
+class FrameHSV:
+    """The HSV picture of the frame being tracked, converted once for every colour marker that
+    asks for it (the runner hands one to all of them). Held for one frame index and one image
+    object: another frame, or another array, is converted afresh."""
+
+    def __init__(self) -> None:
+        self._frame: int | None = None
+        self._image: np.ndarray | None = None
+        self._hsv: dict[int, np.ndarray] = {}
+
+    def of(self, frame: int, image: np.ndarray, step: int = 1) -> np.ndarray:
+        """HSV of every ``step``-th pixel of every ``step``-th row of ``image``."""
+        if frame != self._frame or image is not self._image:
+            self._frame, self._image, self._hsv = frame, image, {}
+        if step not in self._hsv:
+            self._hsv[step] = cv2.cvtColor(np.ascontiguousarray(image[::step, ::step]), cv2.COLOR_BGR2HSV)
+        return self._hsv[step]
+
+
 @dataclass
 class ColorMarker:
     name: str
@@ -62,6 +80,8 @@ class ColorMarker:
     _distractors: list = field(default_factory=list)  # other blobs of the colour seen at the start: (x, y, w, h)
     _lost: int = 0                 # frames the marker has been lost before the one searched
     _colours: deque = field(default_factory=lambda: deque(maxlen=15))  # (hue, saturation, chroma) of round sightings
+    _own: tuple | None = None      # _own_colour() of _colours, None when it must be computed again
+    frame_hsv: FrameHSV = field(default_factory=FrameHSV)   # shared by the markers of one run
 
     def __post_init__(self) -> None:
         self._lo = np.array([max(c - self.tolerance, 0) for c in self.bgr], dtype=np.uint8)
@@ -72,6 +92,7 @@ class ColorMarker:
         # a box reaching near the grey diagonal (R = G = B) takes grey pixels for the marker:
         # then a blob of the box is also checked for the marker's hue
         self._box_holds_grey = int(self._lo.max()) <= int(self._hi.min()) + 30
+        self._bounds = self._hue_bounds() if self._hsv is not None else None
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
         det = self._find(frame, image_bgr) or Detection.missing(0.0)
@@ -87,14 +108,31 @@ class ColorMarker:
         look-alike: the marker is refused there by its colour when lost). A blob whose
         look-alike zone holds the marker itself is a piece of the marker (its edge, split off by
         a shadow), not a look-alike: it would blind the marker where it was first seen."""
-        # the widest test (the last of _cores): every pixel that could be taken for it
-        core = cv2.inRange(image, self._lo, self._hi) if self._hsv is None else self._hue_mask(image)
-        contours, _ = cv2.findContours(core, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
-        for c in contours:
-            box = cv2.boundingRect(c)
-            if box[2] * box[3] >= self.min_area_px and not self._in_zone(box, marker.px, marker.py) \
-                    and self._has_own_colour(image, _filled(c, box), box[0], box[1]):
-                self._distractors.append(box)
+        # The widest test (the last of _cores) finds every pixel that could be taken for it: on
+        # every second pixel of every second row first (a quarter of the picture to convert; any
+        # blob holding a 2x2 square has one there), then in full around what that found.
+        h, w = image.shape[:2]
+        seen = set()
+        for c in _contours(self._widest(image[::2, ::2], self.frame_hsv.of(self._frame, image, 2))):
+            x, y, bw, bh = cv2.boundingRect(c)
+            x0, y0, x1, y1 = max(2 * x - 2, 0), max(2 * y - 2, 0), min(2 * (x + bw) + 2, w), min(2 * (y + bh) + 2, h)
+            roi = image[y0:y1, x0:x1]
+            for piece in _contours(self._widest(roi)):
+                bx, by, bw, bh = cv2.boundingRect(piece)
+                box = (bx + x0, by + y0, bw, bh)
+                if box in seen:
+                    continue
+                seen.add(box)
+                if bw * bh >= self.min_area_px and not self._in_zone(box, marker.px, marker.py) \
+                        and self._has_own_colour(self._blob_hs(roi, _filled(piece, (bx, by, bw, bh)), bx, by)):
+                    self._distractors.append(box)
+
+    def _widest(self, roi: np.ndarray, hsv: np.ndarray | None = None) -> np.ndarray:
+        """The widest colour test (the last of ``_cores``): every pixel that could be taken for
+        the marker; ``hsv``: ``roi`` converted, if it is at hand."""
+        if self._hsv is None:
+            return cv2.inRange(np.ascontiguousarray(roi), self._lo, self._hi)
+        return self._hue_mask(roi, hsv)
 
     def _find(self, frame: int, image: np.ndarray) -> Detection | None:
         self._frame = frame
@@ -130,6 +168,21 @@ class ColorMarker:
         box = window((min(max(centre[0], 0), w - 1), min(max(centre[1], 0), h - 1)), half, image.shape)
         return self._locate_in(image, box, centre)
 
+    def _may_hold(self, roi: np.ndarray) -> bool:
+        """False if no blob the marker could be taken for lies in ``roi``, judged from every
+        ``step``-th pixel of every ``step``-th row: a blob is taken only if its least width is
+        at least 0.6 of the marker's (``_fits``), so it holds a square of 0.6 / sqrt(2) of its
+        width, which a grid of 0.3 of it cannot miss. While the marker is hidden its window
+        grows by its size every frame; this keeps the colour tests, the HSV conversion above
+        all, to a sixteenth of it (the step is at most 4)."""
+        step = min(int(0.3 * self._usual_width), 4)
+        if step < 2 or self._usual_width < 5.0:   # a few pixels across: its shape is not judged
+            return True
+        sub = np.ascontiguousarray(roi[step // 2::step, step // 2::step])
+        if cv2.hasNonZero(cv2.inRange(sub, self._lo, self._hi)):
+            return True
+        return self._hsv is not None and cv2.hasNonZero(self._hue_mask(sub))
+
     def _cores(self, roi: np.ndarray):
         """Pixels of the marker's colour, with whether their hue is already checked: first those
         within ``tolerance`` in RGB (exact on a well-lit sticker; a blob of them is then taken
@@ -151,7 +204,13 @@ class ColorMarker:
 
     def _own_colour(self) -> tuple[float, float, float]:
         """Hue (circular mean), saturation (median) and chroma (the largest: in the best light it
-        has been seen in; a shadow only takes from it) of the marker's round sightings."""
+        has been seen in; a shadow only takes from it) of the marker's round sightings; computed
+        once per sighting added."""
+        if self._own is None:
+            self._own = self._colours_mean()
+        return self._own
+
+    def _colours_mean(self) -> tuple[float, float, float]:
         angles = [math.radians(2 * h) for h, _, _ in self._colours]
         hue = math.degrees(math.atan2(sum(map(math.sin, angles)), sum(map(math.cos, angles)))) / 2 % 180
         return hue, _median_of([c[1] for c in self._colours]), max(c[2] for c in self._colours)
@@ -162,7 +221,7 @@ class ColorMarker:
         default tolerance): a shadow scales chroma with brightness, a dark grey-brown surround
         has little of it however its hue reads."""
         hue, _, chroma = self._own_colour()
-        tol, _, _ = self._hue_bounds()
+        tol = self._bounds[0]
         turn = cv2.absdiff(hsv[:, :, 0], int(round(hue)) % 180)
         hue_ok = cv2.min(turn, cv2.subtract(180, turn)) <= tol
         b, g, r = cv2.split(roi)
@@ -182,7 +241,7 @@ class ColorMarker:
 
     def _hue_mask(self, roi: np.ndarray, hsv: np.ndarray | None = None) -> np.ndarray:
         h = self._hsv[0]
-        tol, s_min, v_min = self._hue_bounds()
+        tol, s_min, v_min = self._bounds
         hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV) if hsv is None else hsv
         lo, hi = h - tol, h + tol
         mask = cv2.inRange(hsv, (max(lo, 0), s_min, v_min), (min(hi, 179), 255, 255))
@@ -200,18 +259,18 @@ class ColorMarker:
         bh, bs, bv = (int(c) for c in cv2.cvtColor(np.uint8([[mean]]), cv2.COLOR_BGR2HSV)[0, 0])
         return bh, bs, bs * bv // 255
 
-    def _has_own_colour(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
-        """True if the mean colour of ``blob`` is the one the marker has shown (its round
+    def _has_own_colour(self, hs: tuple[int, int, int]) -> bool:
+        """True if a blob's mean colour ``hs`` (``_blob_hs``) is the one the marker has shown (its round
         sightings): hue within the hue window of theirs, at least half their saturation (mostly
         sticker, as a blur streak the marker is found on still is) and at least the chroma a
         shadow leaves of theirs. A pick in shadow (dark: a brown hue passes its loose bounds)
         thus refuses grey-brown hair or skin."""
         if self._hsv is None or not self._colours:
             return True
-        bh, bs, bc = self._blob_hs(roi, blob, x, y)
+        bh, bs, bc = hs
         hue, saturation, chroma = self._own_colour()
         turn = abs(bh - hue) % 180
-        return (min(turn, 180 - turn) <= self._hue_bounds()[0] and bs >= 0.5 * saturation
+        return (min(turn, 180 - turn) <= self._bounds[0] and bs >= 0.5 * saturation
                 and bc >= self._shadow_share() * chroma)
 
     def _shadow_share(self) -> float:
@@ -219,11 +278,10 @@ class ColorMarker:
         0.3 at the default --color-tol."""
         return 1 - 0.7 * min(self.tolerance / 80.0, 1.5)
 
-    def _has_hue(self, roi: np.ndarray, blob: np.ndarray, x: int, y: int) -> bool:
-        """True if the mean colour of ``blob`` (a mask, nonzero in the blob, at x, y in ``roi``)
-        has the marker's hue."""
-        bh, bs, _ = self._blob_hs(roi, blob, x, y)
-        tol, s_min, _ = self._hue_bounds()
+    def _has_hue(self, hs: tuple[int, int, int]) -> bool:
+        """True if a blob's mean colour ``hs`` (``_blob_hs``) has the marker's hue."""
+        bh, bs, _ = hs
+        tol, s_min, _ = self._bounds
         return min(abs(bh - self._hsv[0]), 180 - abs(bh - self._hsv[0])) <= tol and bs >= s_min
 
     def _locate_in(self, image, box, centre, whole_inside: bool = False, tight: bool = False) -> Detection | None:
@@ -233,6 +291,8 @@ class ColorMarker:
         if x1 <= x0 or y1 <= y0:           # the prediction lies off the picture
             return None
         roi = image[y0:y1, x0:x1]          # a view: nothing outside the window is converted
+        if self._lost and not self._may_hold(roi):
+            return None
         for core, hue_checked in self._cores(roi):
             det = self._locate_core(image, roi, core, box, centre, whole_inside, hue_checked, tight)
             if det is not None:
@@ -242,15 +302,26 @@ class ColorMarker:
     def _locate_core(self, image, roi, core, box, centre, whole_inside: bool, hue_checked: bool,
                      tight: bool) -> Detection | None:
         x0, y0 = box[:2]
-        if not cv2.hasNonZero(core):   # labelling an empty frame costs milliseconds: a hidden marker
+        # only the box of the set pixels is labelled (the same components, at an offset): an
+        # empty frame (a hidden marker) is not labelled at all, a window or the whole picture
+        # holding one sticker costs the sticker's box
+        if not cv2.hasNonZero(core):   # a hidden marker: nothing to label (a scan that stops at the first pixel set)
             return None
-        n, labels = cv2.connectedComponents(core, connectivity=8)
+        rect = cv2.boundingRect(core)
+        lx, ly, lw, lh = rect
+        part = core[ly:ly + lh, lx:lx + lw]
+        n, labels = cv2.connectedComponents(part, connectivity=8)
         if n <= 1:
             return None
         if n == 2:   # one blob (the usual case): the core is its mask; its statistics cost less than OpenCV's
-            blobs = [((*cv2.boundingRect(core), cv2.countNonZero(core)), core, 255)]
+            blobs = [((*rect, cv2.countNonZero(part)), core, 255)]
         else:
-            stats, cents = _component_stats(core, labels, n)
+            stats, cents = _component_stats(part, labels, n)
+            stats[:, 0] += lx
+            stats[:, 1] += ly
+            cents += (lx, ly)
+            labels = cv2.copyMakeBorder(labels, ly, core.shape[0] - ly - lh, lx, core.shape[1] - lx - lw,
+                                        cv2.BORDER_CONSTANT, value=0)
             order = np.arange(1, n)
             if centre is None:   # largest first
                 order = order[np.argsort(-stats[order, cv2.CC_STAT_AREA], kind="stable")]
@@ -281,13 +352,17 @@ class ColorMarker:
                 blob = (blob == label).view(np.uint8)
             shape = _blob_shape(blob, area)
             at = (x0 + bx + bw / 2, y0 + by + bh / 2)
-            if not self._fits(shape, at) or not (hue_checked or self._has_hue(roi, blob, bx, by)):
+            if not self._fits(shape, at):
                 continue
-            if not self._has_own_colour(roi, blob, bx, by):
+            # the blob's mean colour (hue, saturation, chroma), for the checks and to learn from
+            hs = self._blob_hs(roi, blob, bx, by) if self._hsv is not None else None
+            if not (hue_checked or self._has_hue(hs)):
+                continue
+            if not self._has_own_colour(hs):
                 continue   # taken only on a blob of the colour it has shown
             if self._near_distractor(*at):
                 continue   # a look-alike seen at the start is never taken
-            return self._measure(roi, mask, stat, label, shape, x0, y0)
+            return self._measure(roi, mask, stat, label, shape, x0, y0, hs)
         return None
 
     def _near_distractor(self, x: float, y: float) -> bool:
@@ -330,7 +405,7 @@ class ColorMarker:
             return _along(shape.angle_rad, self._velocity, d) or _along(shape.angle_rad, moved, d)
         return True
 
-    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int) -> Detection:
+    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int, hs) -> Detection:
         """The blob's coverage centroid; a round, whole blob also teaches the marker's size."""
         # the centroid needs the blob and four pixels around it (two dilations of 5x5)
         bx, by, bw, bh = stat[:4]
@@ -338,7 +413,7 @@ class ColorMarker:
         cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
         blob = labels[cy0:cy1, cx0:cx1] == best
         near = roi[cy0:cy1, cx0:cx1]
-        px, py = _chroma_centroid(near, blob) or _coverage_centroid(near, blob)
+        px, py = _coverage_centroid(near, blob)
         area = float(shape.area_px)
         score = area / self._usual_area if self._areas else 1.0
         if shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn the marker's size from it
@@ -346,10 +421,15 @@ class ColorMarker:
             self._widths.append(shape.minor_px)
             self._usual_area = _median_of(self._areas)
             self._usual_width = _median_of(self._widths)
-            if self._hsv is not None:
-                whole = (labels[by:by + bh, bx:bx + bw] == best).view(np.uint8)
-                self._colours.append(self._blob_hs(roi, whole, bx, by))
+            if hs is not None:   # the blob's mean colour
+                self._colours.append(hs)
+                self._own = None
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
+
+
+def _contours(mask: np.ndarray) -> list:
+    """Outer contours of the blobs of ``mask``."""
+    return cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)[0]
 
 
 def _filled(contour: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
@@ -405,7 +485,7 @@ class BlobShape(NamedTuple):   # a tuple: one is made per blob looked at, every 
 
 def _blob_shape(blob: np.ndarray, area: int) -> BlobShape:
     """Area and equivalent ellipse of a blob given as a mask (nonzero in the blob)."""
-    m = cv2.moments(blob, binaryImage=True)
+    m = cv2.moments(blob)   # 0/1 or 0/255: the same shape
     a, b, c = m["mu20"] / m["m00"], m["mu11"] / m["m00"], m["mu02"] / m["m00"]
     root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
     # + 1/12 per axis: a pixel is a square, not a point
@@ -425,61 +505,79 @@ _KERNEL_5 = np.ones((5, 5), np.uint8)
 _KERNEL_3 = np.ones((3, 3), np.uint8)
 
 
+UNIFORM_SHARE = 0.1      # a surround varying by less than this share of the sticker's luma contrast is uniform
+CHROMA_CONTRAST = 40.0   # least sticker-to-background chroma difference (0-255 scale) to weigh by colour
+
+
 def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]:
     """Centroid of per-pixel coverage over ``blob`` (a boolean mask) grown by two pixels.
+
+    Coverage comes from luma (full resolution under 4:2:0, so the least noisy) when the
+    surround is uniform: the luma of the two-pixel ring around the grown blob varies (standard
+    deviation) by less than ``UNIFORM_SHARE`` of the sticker-to-surround luma contrast, so no
+    surround pixel passes for more than a tenth of sticker. A textured surround (a ruler's
+    marks, a checker floor's edges) would: then coverage comes from chroma
+    (``_chroma_centroid``), where grey texture weighs nothing. A pale sticker (too little
+    chroma contrast) stays with luma; a sticker as bright as its surround with the colour core.
 
     ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
     """
     blob_u8 = blob.view(np.uint8)
     grown = cv2.dilate(blob_u8, _KERNEL_5)
     luma = cv2.cvtColor(roi.astype(np.float32), cv2.COLOR_BGR2GRAY)   # BT.601: 0.114 B + 0.587 G + 0.299 R
-    inner = luma[cv2.erode(blob_u8, _KERNEL_3).view(bool)]
+    inner_u8 = cv2.erode(blob_u8, _KERNEL_3)
+    inner = luma[inner_u8.view(bool)]
     level = float(_median(inner if inner.size else luma[blob]))
-    ring = luma[cv2.dilate(blob_u8, _KERNEL_9) > grown]   # the two pixels around the grown blob
-    background = float(_median(ring)) if ring.size else 0.0
-    if abs(level - background) >= 20:
-        cover = luma   # in place: luma is not needed any more
-        cover -= background
-        cover /= level - background
-        np.maximum(cover, 0.0, out=cover)
-        np.minimum(cover, 1.0, out=cover)
-        cover *= grown
-    else:  # sticker as bright as its surround: fall back to the colour core alone
-        cover = blob_u8
-    m = cv2.moments(cover)
+    ring_u8 = (cv2.dilate(blob_u8, _KERNEL_9) > grown).view(np.uint8)   # the two pixels around the grown blob
+    ring = luma[ring_u8.view(bool)]
+    if not ring.size:
+        return _moments_centroid(blob_u8)
+    background = float(_median(ring))
+    contrast = abs(level - background)
+    ring -= background
+    if contrast < 20 or float(np.dot(ring, ring)) >= (UNIFORM_SHARE * contrast) ** 2 * ring.size:
+        at = _chroma_centroid(roi, blob_u8, grown, ring_u8, inner_u8)
+        if at is not None:
+            return at
+    if contrast < 20:   # sticker as bright as its surround: the colour core alone
+        return _moments_centroid(blob_u8)
+    cover = luma   # in place: luma is not needed any more
+    cover -= background
+    cover /= level - background
+    np.maximum(cover, 0.0, out=cover)
+    np.minimum(cover, 1.0, out=cover)
+    cover *= grown
+    return _moments_centroid(cover)
+
+
+def _moments_centroid(weights: np.ndarray) -> tuple[float, float]:
+    m = cv2.moments(weights)
     return m["m10"] / m["m00"], m["m01"] / m["m00"]
 
 
-CHROMA_CONTRAST = 40.0   # least sticker-to-background chroma difference (0-255 scale) to weigh by colour
-
-
-def _chroma_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float] | None:
+def _chroma_centroid(roi: np.ndarray, blob_u8: np.ndarray, grown: np.ndarray, ring_u8: np.ndarray,
+                     inner_u8: np.ndarray) -> tuple[float, float] | None:
     """Centroid of per-pixel coverage estimated from colour, not brightness: each pixel's
     chroma (its colour less its grey level) is projected on the line from the local
     background's chroma to the sticker's. A textured grey surround (a ruler's marks, a
     picture frame's edge) then weighs nothing, however bright or dark, where luma coverage
     takes its dark or bright pixels for part of the sticker. ``None`` when the sticker's
     chroma differs too little from its surround's (a pale sticker): then luma decides.
-
-    ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
     """
-    blob_u8 = blob.view(np.uint8)
-    grown = cv2.dilate(blob_u8, _KERNEL_5)
-    ring = (cv2.dilate(grown, _KERNEL_5) & ~grown & 1).view(bool)
-    inner = cv2.erode(blob_u8, _KERNEL_3).view(bool)
-    if not ring.any():
-        return None
     pixels = roi.astype(np.float32)
     chroma = pixels - pixels.mean(axis=2, keepdims=True)
-    sticker = np.median(chroma[inner if inner.any() else blob], axis=0)
-    background = np.median(chroma[ring], axis=0)
+    core = inner_u8 if inner_u8.any() else blob_u8
+    sticker = np.median(chroma[core.view(bool)], axis=0)
+    background = np.median(chroma[ring_u8.view(bool)], axis=0)
     axis = sticker - background
     contrast = float(np.linalg.norm(axis))
     if contrast < CHROMA_CONTRAST:
         return None
-    cover = np.clip((chroma - background) @ (axis / contrast ** 2), 0.0, 1.0) * grown
-    m = cv2.moments(cover)
-    return m["m10"] / m["m00"], m["m01"] / m["m00"]
+    w = axis / contrast ** 2
+    cover = cv2.transform(chroma, w.reshape(1, 3)) - float(background @ w)
+    np.clip(cover, 0.0, 1.0, out=cover)
+    cover *= grown
+    return _moments_centroid(cover)
 
 
 def _median(values: np.ndarray) -> np.floating:

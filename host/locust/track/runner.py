@@ -10,6 +10,7 @@ import numpy as np
 from ..errors import TrackError
 from .calib import Calibration
 from .camera import PlaneCalibration
+from .color import FrameHSV
 from .video import Clip, VideoInfo, read_frames
 
 
@@ -57,6 +58,10 @@ def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibrat
             raise TrackError(f"marker {model.name}: key frame {key} is not in the clip "
                              f"(frames {clip.start}..{clip.end} step {clip.step})",
                              f"start the clip at or before frame {key} with a step that reaches it")
+    frame_hsv = FrameHSV()   # colour markers share each frame's HSV picture
+    for model in models:
+        if hasattr(model, "frame_hsv"):
+            model.frame_hsv = frame_hsv
     cols = {m.name: (np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan), np.zeros(n, bool)) for m in models}
     for i, (frame, image) in enumerate(read_frames(info, clip)):
         for model in models:
