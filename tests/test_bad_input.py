@@ -397,18 +397,23 @@ def test_kill_9_of_a_sweep_leaves_no_worker_and_no_lock_and_resumes(tmp_path):
     assert json.loads((tmp_path / "sw" / "sweep.json").read_text())["finished"] is True
 
 
+def _wait_for_the_first_phase(run: Path, timeout_s: float = 60.0) -> Path:
+    """``run`` (a run.json) once it records a phase: the hop is under way."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if run.exists() and '"phase"' in run.read_text():
+            break
+        time.sleep(0.1)
+    return run
+
+
 @pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc (Linux)")
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
 def test_a_killed_hop_leaves_no_interpreter_running(env, tmp_path, sig):
     proc = subprocess.Popen(LOCUST + ["hop", "--port", "sim", "--plant", "record", "--cycles", "20",
                                       "--out", str(tmp_path / "run")],
                             env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    run = tmp_path / "run" / "run.json"
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        if run.exists() and '"phase"' in run.read_text():
-            break
-        time.sleep(0.1)
+    run = _wait_for_the_first_phase(tmp_path / "run" / "run.json")
     interpreters = [c for c in _children(proc.pid) if "micropython" in Path(f"/proc/{c}/comm").read_text()]
     assert len(interpreters) == 1
     proc.send_signal(sig)
@@ -472,12 +477,7 @@ def test_ctrl_c_during_a_filmed_hop_finishes_the_video_and_says_so(env, tmp_path
     proc = subprocess.Popen(LOCUST + ["hop", "--port", "sim", "--cycles", "4", "--video", "hop.mp4", "--out", "run"],
                             cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    run = tmp_path / "run" / "run.json"
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        if run.exists() and '"phase"' in run.read_text():
-            break
-        time.sleep(0.1)
+    run = _wait_for_the_first_phase(tmp_path / "run" / "run.json")
     time.sleep(0.5)
     proc.send_signal(signal.SIGINT)
     _, stderr = proc.communicate(timeout=120)
