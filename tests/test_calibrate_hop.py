@@ -149,3 +149,16 @@ def test_a_foot_friction_below_the_floors_is_called_inert():
     notes.clear()
     H._friction_notes({"contact.foot_friction": 2.0}, preset("seed"), notes)
     assert notes == []
+
+
+def test_draws_outside_the_limits_are_invalid_not_simulated():
+    """A push drawn beyond the servo's 45 deg travel is refused as `locust sim` would refuse it."""
+    robot = preset("small").with_provenance("schedule.push_deg", Provenance(source="test", uncertainty=20.0))
+    drawn = [r.get("schedule.push_deg") for r in S.draw(robot, 12, seed=3)]
+    outside = [abs(v) > robot.get("servo.travel_deg") for v in drawn]
+    assert 0 < sum(outside) < 12                               # the seed gives some of each
+    trajs = S.simulate_draws(robot, 12, cycles=1, seed=3)
+    assert [t is None for t in trajs] == outside
+    spread = S.sample(robot, 12, cycles=1, seed=3)
+    assert spread.n_valid == 12 - sum(outside)
+    assert [math.isnan(d) for d in spread.distance_m] == outside

@@ -28,6 +28,7 @@ from __future__ import annotations
 import collections
 import errno
 import fcntl
+import functools
 import math
 import os
 import queue
@@ -45,6 +46,7 @@ from pathlib import Path
 
 from ..errors import DeviceError
 from ..firmware import config as fw_config
+from ..orphans import die_with_parent
 from .plant import Plant, RecordingPlant
 
 SHIM_DIR = Path(__file__).resolve().parent / "machine_shim"
@@ -107,25 +109,10 @@ def _read_pty(fd: int) -> bytes:
         raise
 
 
-def _libc_prctl():
-    try:
-        import ctypes
-
-        return ctypes.CDLL(None, use_errno=True).prctl
-    except (OSError, AttributeError):  # not Linux
-        return None
-
-
-_PRCTL = _libc_prctl()   # looked up here: the child between fork and exec only calls it
-
-
-def _child_setup() -> None:  # runs in the child before exec
+def _child_setup(host_pid: int) -> None:  # runs in the child before exec
     """Die with the host (PR_SET_PDEATHSIG: even a kill -9 of the host takes the interpreter
     with it), then ask for real-time scheduling."""
-    if _PRCTL is not None:
-        _PRCTL(1, signal.SIGKILL, 0, 0, 0)
-        if os.getppid() == 1:   # the host died before the line above
-            os._exit(1)
+    die_with_parent(host_pid)
     _raise_priority()
 
 
@@ -209,7 +196,7 @@ class VirtualRobot:
         with self._proc_lock:
             self._proc = subprocess.Popen(args, stdin=self._sa, stdout=self._sa, stderr=self._sa,
                                           cwd=self.flash_dir, env=env, start_new_session=True,
-                                          preexec_fn=_child_setup)
+                                          preexec_fn=functools.partial(_child_setup, os.getpid()))
             try:
                 policy = os.sched_getscheduler(self._proc.pid)
                 self.scheduling = "realtime" if policy == os.SCHED_FIFO else "normal"

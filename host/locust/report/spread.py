@@ -16,12 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..params import Robot
-from ..sim.audit import audit
 from ..sim.hops import summarise
-from ..sim.model import build
-from ..sim.rollout import simulate_batch
-from ..sim.samples import THREADS, draw
-from ..sim.schedule import control_plan
+from ..sim.samples import simulate_draws
 from .measure import measure_hops
 from .predict import marker_trace
 
@@ -45,12 +41,10 @@ class Spread:
 
 def spread(robot: Robot, cycles: int, marker: str, n: int, seed: int = 0) -> Spread | None:
     """``n`` draws of ``robot`` over ``cycles``; None when fewer than two are valid."""
-    plan = control_plan(robot.schedule, robot.solver, cycles)
-    trajs = simulate_batch([build(r) for r in draw(robot, n, seed)], plan, keep_states=True, threads=THREADS)
     period = robot.schedule.push_s + robot.schedule.wait_s
     traces, dist, apex = [], [], []
-    for traj in trajs:
-        if not audit(traj).valid:
+    for traj in simulate_draws(robot, n, cycles, seed, keep_states=True):
+        if traj is None:
             continue
         trace = marker_trace(traj, marker)
         traces.append(trace)

@@ -71,8 +71,9 @@ def simulate_built(built: BuiltModel, plan: ControlPlan, keep_states: bool = Fal
 def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: bool = False,
                    threads: int = 1) -> list[Trajectory]:
     """Several models of one structure (a fit's candidates, draws of the uncertain values) on
-    one plan, in one ``mujoco.rollout`` call on ``threads`` threads. MuJoCo's warnings are
-    counted per thread, so they are attributed to a model only when there is one."""
+    one plan, in one ``mujoco.rollout`` call on ``threads`` threads. MuJoCo counts its warnings
+    per thread, not per model: when a batch raised any, each model is run again alone, so that
+    every trajectory carries its own warnings for the audit."""
     models = [b.model for b in builts]
     starts = [initial_state(b) for b in builts]
     control = np.zeros((len(models), plan.nstep, models[0].nu))
@@ -85,11 +86,11 @@ def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: boo
                                            np.array([s for s, _ in starts]), control)
     wall = time.perf_counter() - t0
     nq = models[0].nq
-    warnings = {}
-    if len(models) == 1:
-        data = datas[0]
-        warnings = {mujoco.mjtWarning(i).name: int(data.warning[i].number)
-                    for i in range(len(data.warning)) if data.warning[i].number}
+    if len(models) > 1 and any(d.warning[i].number for d in datas for i in range(len(d.warning))):
+        return [simulate_batch([b], plan, keep_states=keep_states)[0] for b in builts]
+    data = datas[0]
+    warnings = {mujoco.mjtWarning(i).name: int(data.warning[i].number)
+                for i in range(len(data.warning)) if data.warning[i].number}
     # FULLPHYSICS state starts with time, then qpos
     return [Trajectory(built=b, plan=plan, initial_sensordata=sensor0, sensordata=sensordata[k],
                        final_qpos=state[k, -1, 1:1 + nq].copy(), warnings=dict(warnings), wall_s=wall,

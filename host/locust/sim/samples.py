@@ -15,11 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..params import SECTIONS, Provenance, Robot
+from ..errors import GeometryError
+from ..params import SECTIONS, Provenance, Robot, problems
 from .audit import audit
 from .hops import summarise
 from .model import build
-from .rollout import simulate_batch
+from .rollout import Trajectory, simulate_batch
 from .schedule import control_plan
 
 THREADS = 2
@@ -69,15 +70,32 @@ def draw(robot: Robot, n: int, seed: int = 0) -> list[Robot]:
     return [robot.with_values(dict(zip(keys, row.tolist())), prov) for row in values]
 
 
+def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 0,
+                   keep_states: bool = False) -> list[Trajectory | None]:
+    """``n`` draws of ``robot`` simulated in one batch, each audited: a draw's trajectory, or
+    None for a draw outside the parameter limits, whose linkage cannot close, or that fails
+    its audit (as a sweep's design would be an invalid row)."""
+    plan = control_plan(robot.schedule, robot.solver, cycles)
+    builts = []
+    for r in draw(robot, n, seed):
+        try:
+            builts.append(None if problems(r, cycles) else build(r))
+        except GeometryError:
+            builts.append(None)
+    ok = [b for b in builts if b is not None]
+    trajs = iter(simulate_batch(ok, plan, keep_states=keep_states, threads=THREADS) if ok else [])
+    out: list[Trajectory | None] = []
+    for b in builts:
+        traj = next(trajs) if b is not None else None
+        out.append(traj if traj is not None and audit(traj).valid else None)
+    return out
+
+
 def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0) -> Samples:
     """Simulate ``n`` draws of ``robot`` in one batch; their distances and nose heights."""
-    robots = draw(robot, n, seed)
-    plan = control_plan(robot.schedule, robot.solver, cycles)
-    trajs = simulate_batch([build(r) for r in robots], plan, threads=THREADS)
     dist, nose = [], []
-    for traj in trajs:
-        ok = audit(traj).valid
-        summary = summarise(traj) if ok else None
+    for traj in simulate_draws(robot, n, cycles, seed):
+        summary = summarise(traj) if traj is not None else None
         dist.append(summary.distance_m if summary else math.nan)
         nose.append(summary.max_nose_height_m if summary else math.nan)
     d, h = np.array(dist), np.array(nose)

@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import multiprocessing
 import os
-import signal
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from contextlib import contextmanager
 from typing import Any
 
 from ..errors import SweepError
+from ..orphans import die_with_parent
 
 
 def default_jobs() -> int:
@@ -39,20 +39,6 @@ def check_scheduler(scheduler: str) -> str:
 def _serial(fn: Callable, items: Sequence) -> Iterator[Any]:
     for item in items:
         yield fn(item)
-
-
-def die_with_parent(parent_pid: int) -> None:
-    """In a worker: be killed when the process that started it dies, however it dies (kill -9,
-    out of memory), so no worker outlives its sweep (Linux; elsewhere the pool's own shutdown)."""
-    try:
-        import ctypes
-
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(1, signal.SIGKILL, 0, 0, 0)   # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        return
-    if os.getppid() != parent_pid:   # the parent died before the line above
-        os._exit(1)
 
 
 def _pool(fn: Callable, items: Sequence, jobs: int) -> Iterator[Any]:
