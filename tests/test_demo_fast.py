@@ -3,18 +3,17 @@ virtual robot (real firmware under MicroPython, MuJoCo plant, rendered video), t
 from the bundled SYNTHETIC recordings, a 2-design sweep, the report (about 40 s).
 
 Known truth at every stage: the virtual robot's hidden values (virtual/truth.json) for the
-calibration, the plant's own audited distance (printed by `locust hop`) and the nose marker's
-true height in the video's frames (hop.truth.csv) for the tracking, run() on the calibrated
-robot for the predictions. The full-size demo is tests/test_report_demo.py (slow).
+calibration, the nose marker's true position in the video's frames (hop.truth.csv) for the
+tracking, run() on the calibrated robot for the predictions. The full-size demo is tests/test_report_demo.py (slow).
 """
 
 from __future__ import annotations
 
 import json
-import re
 import subprocess
 import sys
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -48,18 +47,27 @@ def test_calibration_recovers_the_virtual_robots_hidden_values(demo):
         assert robot.get(key) == pytest.approx(true, rel=0.04), key
 
 
-def test_tracked_hops_match_the_plant_and_the_truth_frames(demo):
-    """Measured from the video against the plant's own numbers: within 0.1 mm (the chain
-    reached 0.02 mm: 640x360 frames, about 2.5 mm per pixel, sub-pixel marker centroids)."""
+def test_tracked_hops_match_the_truth_frames(demo):
+    """Measured from the video against the nose marker's true positions in the rendered
+    frames: within 0.1 mm (the chain reached 0.04 mm: 640x360 frames, about 2.5 mm per pixel,
+    sub-pixel marker centroids).
+
+    The truth is the nose's travel, the quantity the report measures. The plant's own figure
+    in the hop log is the chassis' travel: it agrees with the nose's to about 1 um when the
+    legs come to rest as they started, and was 0.10 mm apart once on Medium (nose and foot
+    1.151 mm, chassis 1.2535 mm), where a foot on the edge of slipping can come to rest with
+    the hinges holding a different bend.
+    """
     folder, doc = demo["folder"], demo["doc"]
     assert [c["name"] for c in doc["configurations"]] == list(LEG_SETS)
     for cfg in doc["configurations"]:
         (hop,) = cfg["hops"]
         label = hop["trial"]
-        log = next(p for p in (folder / "logs").glob("*-hop.log") if f"/{label}/" in p.read_text())
-        plant_m = float(re.search(r"distance_m=(-?[\d.e-]+)", log.read_text()).group(1))
-        assert hop["measured_distance_m"] == pytest.approx(plant_m, abs=1e-4), label
-        z = pd.read_csv(folder / "hops" / label / "hop.truth.csv", comment="#")["nose_z_m"].to_numpy()
+        truth = pd.read_csv(folder / "hops" / label / "hop.truth.csv", comment="#")
+        x, z = truth["nose_x_m"].to_numpy(), truth["nose_z_m"].to_numpy()
+        settled = truth["t_s"].to_numpy() >= truth["t_s"].iloc[-1] - 0.3
+        assert np.ptp(x[settled]) < 1e-6, label          # at rest over the clip's end: the measure's window
+        assert hop["measured_distance_m"] == pytest.approx(float(x[-1] - x[0]), abs=1e-4), label
         assert hop["measured_apex_m"] == pytest.approx(float(z.max() - z[0]), abs=1e-4), label
 
 
