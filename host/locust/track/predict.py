@@ -147,6 +147,18 @@ class Trajectory:
             x, y = x * dt + cx, y * dt + cy
         return x, y
 
+    def predict_motion(self, frame: int) -> tuple[Point, Point] | None:
+        """``predict(frame)`` and the motion into it, ``predict(frame) - predict(frame - 1)``."""
+        c = self._fit()
+        if c is None:
+            return None
+        dt = frame - self._found[-1][0]
+        x = y = x1 = y1 = 0.0
+        for cx, cy in c:
+            x, y = x * dt + cx, y * dt + cy
+            x1, y1 = x1 * (dt - 1) + cx, y1 * (dt - 1) + cy
+        return (x, y), (x - x1, y - y1)
+
     @property
     def last_point(self) -> Point | None:
         return (self._found[-1][1], self._found[-1][2]) if self._found else None
