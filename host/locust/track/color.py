@@ -12,6 +12,10 @@ background's and the sticker's, so the texture weighs nothing.
 
 A blob much smaller than the marker's usual area is partly hidden, and its centroid
 would be pulled toward the visible part: such frames are reported as not found.
+
+A blob's shape and mean colour are judged against what the marker has shown (a look-alike,
+a blur streak, a shadow); a blob alone in the tight window around the prediction, at the
+marker's usual size, is judged only every ``JUDGE_EVERY``-th frame.
 """
 
 from __future__ import annotations
@@ -82,6 +86,7 @@ class ColorMarker:
     # (hue, saturation, chroma, cos and sin of the hue angle) of the round sightings
     _colours: deque = field(default_factory=lambda: deque(maxlen=15))
     _own: tuple | None = None      # _own_colour() of _colours, None when it must be computed again
+    _unjudged: int = 0             # frames in a row found as usual without judging shape and colour
     frame_hsv: FrameHSV = field(default_factory=FrameHSV)   # shared by the markers of one run
 
     def __post_init__(self) -> None:
@@ -292,7 +297,8 @@ class ColorMarker:
 
     def _locate_in(self, image, box, centre, whole_inside: bool = False, tight: bool = False) -> Detection | None:
         """The marker in ``box``; ``whole_inside``: a blob cut by the box is refused; ``tight``:
-        the box is a few radii around the prediction, where a look-alike cannot be told apart."""
+        the box is a few radii around the prediction, where a lone blob as usual is the marker
+        (``_as_usual``)."""
         x0, y0, x1, y1 = box
         if x1 <= x0 or y1 <= y0:           # the prediction lies off the picture
             return None
@@ -311,10 +317,10 @@ class ColorMarker:
         # only the box of the set pixels is labelled (the same components, at an offset): an
         # empty frame (a hidden marker) is not labelled at all, a window or the whole picture
         # holding one sticker costs the sticker's box
-        if not cv2.hasNonZero(core):   # a hidden marker: nothing to label (a scan that stops at the first pixel set)
-            return None
         rect = cv2.boundingRect(core)
         lx, ly, lw, lh = rect
+        if lw == 0:   # a hidden marker: nothing to label
+            return None
         part = core[ly:ly + lh, lx:lx + lw]
         n, labels = cv2.connectedComponents(part, connectivity=8)
         if n <= 1:
@@ -353,11 +359,16 @@ class ColorMarker:
                 continue
             if _on_image_border(stat, box, image.shape):
                 continue   # cut by the picture's edge: its centroid is not the marker's
+            at = (x0 + bx + bw / 2, y0 + by + bh / 2)
+            if tight and n == 2 and hue_checked and self._as_usual(area, bw, bh):
+                if self._near_distractor(*at):
+                    return None
+                self._unjudged += 1
+                return self._measure(roi, mask, stat, label, None, x0, y0, None)
             blob = mask[by:by + bh, bx:bx + bw]
             if n > 2:   # with one blob the core is its mask
                 blob = (blob == label).view(np.uint8)
             shape = _blob_shape(blob, area)
-            at = (x0 + bx + bw / 2, y0 + by + bh / 2)
             if not self._fits(shape, at):
                 continue
             # the blob's mean colour (hue, saturation, chroma), for the checks and to learn from
@@ -368,8 +379,22 @@ class ColorMarker:
                 continue   # taken only on a blob of the colour it has shown
             if self._near_distractor(*at):
                 continue   # a look-alike seen at the start is never taken
+            self._unjudged = 0
             return self._measure(roi, mask, stat, label, shape, x0, y0, hs)
         return None
+
+    def _as_usual(self, area: int, width: int, height: int) -> bool:
+        """True if a blob, alone in the tight window around the prediction and in the marker's
+        colour, is the marker just as it has been seen: within 20 % of its usual area, its box
+        within 20 % (and a pixel) of its usual width both ways. Its shape and colour are then
+        not judged again, which costs three OpenCV calls a frame; they are every
+        ``JUDGE_EVERY``-th frame, so that what the marker looks like is still learned as the
+        light and its distance change."""
+        if self._unjudged >= JUDGE_EVERY - 1 or self._usual_width < 5.0:
+            return False
+        a, d = self._usual_area, self._usual_width
+        slack = 0.2 * d + 1.0
+        return 0.8 * a <= area <= 1.25 * a and abs(width - d) <= slack and abs(height - d) <= slack
 
     def _near_distractor(self, x: float, y: float) -> bool:
         """True if (x, y) lies on a look-alike's bounding box, grown by a marker radius."""
@@ -411,18 +436,22 @@ class ColorMarker:
             return _along(shape.angle_rad, self._velocity, d) or _along(shape.angle_rad, moved, d)
         return True
 
-    def _measure(self, roi, labels, stat, best: int, shape: BlobShape, x0: int, y0: int, hs) -> Detection:
-        """The blob's coverage centroid; a round, whole blob also teaches the marker's size."""
+    def _measure(self, roi, labels, stat, best: int, shape: BlobShape | None, x0: int, y0: int,
+                 hs) -> Detection:
+        """The blob's coverage centroid; a round, whole blob also teaches the marker's size
+        (``shape``: None when it was not judged)."""
         # the centroid needs the blob and four pixels around it (two dilations of 5x5)
         bx, by, bw, bh = stat[:4]
         cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
         cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
-        blob = labels[cy0:cy1, cx0:cx1] == best
+        blob = labels[cy0:cy1, cx0:cx1]
+        # the colour mask itself (0/255) when the window held one blob, else OpenCV's labels
+        blob = blob.astype(bool) if blob.dtype == np.uint8 else blob == best
         near = roi[cy0:cy1, cx0:cx1]
         px, py = _coverage_centroid(near, blob)
-        area = float(shape.area_px)
+        area = float(stat[4])
         score = area / self._usual_area if self._areas else 1.0
-        if shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn the marker's size from it
+        if shape is not None and shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn its size
             self._areas.append(area)
             self._widths.append(shape.minor_px)
             self._usual_area = _median_of(self._areas)
@@ -528,6 +557,7 @@ def _on_image_border(stat: list[int], box, image_shape) -> bool:
 
 
 RING_PX = 4
+JUDGE_EVERY = 4   # a marker found as usual has its shape and colour judged every this many frames
 _KERNEL_9 = np.ones((9, 9), np.uint8)    # two 5x5 dilations in one
 _KERNEL_5 = np.ones((5, 5), np.uint8)
 _KERNEL_3 = np.ones((3, 3), np.uint8)
