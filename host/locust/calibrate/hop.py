@@ -41,7 +41,7 @@ from ..params import SECTIONS, Robot
 from ..report.configs import configuration
 from ..report.measure import onset_time
 from ..report.measured import load_trial, read_track
-from ..sim.kinematics import geom_positions, marker_geoms
+from ..sim.kinematics import geom_positions, marker_geoms, trace_rows
 from ..sim.model import build
 from ..sim.rollout import simulate_batch
 from ..sim.schedule import ControlPlan
@@ -50,8 +50,6 @@ from .fitstats import Estimate, cluster_covariance, linear_shift
 DEFAULT_KEYS = ("contact.foot_friction", "compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s")
 MARKERS = ("nose", "foot")
 PROVENANCE_NAME = "hops"       # written as source fit:hops
-TRACE_HZ = 240.0               # simulated marker samples kept per second (at least)
-LEAD_S = 0.3                   # simulated standing time kept before the first push
 TAIL_S = 0.5                   # simulated past the track's last frame (the alignment moves it)
 BOUND_FACTOR = 5.0             # each value is searched within this factor of its start
 FD_STEP = 1e-2                 # finite-difference step of the log values (1 %: over the contacts' jaggedness)
@@ -188,10 +186,7 @@ def simulate_markers(run: HopRun, robots: list[Robot]) -> list[dict[str, np.ndar
     plan = control_plan(run, robots[0])
     trajs = simulate_batch(builts, plan, keep_states=True, threads=THREADS)
     dt, settle = plan.timestep_s, plan.settle_steps
-    stride = max(1, int(1.0 / (TRACE_HZ * dt)))
-    stand = max(settle - 1, 0)
-    rows = np.unique(np.concatenate(([stand], np.arange(max(0, settle - int(round(LEAD_S / dt))),
-                                                         plan.nstep, stride))))
+    rows, stand = trace_rows(dt, settle, plan.nstep)
     t = (rows + 1 - settle) * dt
     names = list(run.tracks)
     geoms = marker_geoms(builts[0].model, names)

@@ -6,7 +6,7 @@ pipeline's own. The camera follows a marker (the ``marker_<name>`` disc the mode
 where the sticker goes, e.g. on the chassis' side, up and back from the nose edge), not the
 model's ``nose`` site, and a point on a pitching body rises by its own amount: so the
 predicted trace and apexes are those of the same marker, from the very rollout the result
-comes from (``run(..., keep_states=True)``, thinned to ``TRACE_HZ``; the marker is posed by
+comes from (``run(..., keep_states=True)``, thinned to ``sim.kinematics.TRACE_HZ``; the marker is posed by
 :func:`locust.sim.kinematics.marker_positions`), measured with the same functions as the
 track. A run that fails its audit is kept as invalid, with its reasons, and has no trace.
 """
@@ -16,14 +16,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from ..errors import GeometryError, ReportError
 from ..params import Robot
 from .measure import Aligned, MeasuredHop, measure_hops, onset_time
-
-TRACE_HZ = 240.0
-LEAD_S = 0.3             # standing time kept before the first push
 
 
 @dataclass
@@ -65,16 +60,13 @@ def predict(config: str, robot: Robot, cycles: int, marker: str = "nose", keep_s
 def marker_trace(traj, marker: str) -> Aligned:
     """The ``marker_<marker>`` disc's centre, t = 0 at the first push, from where it stood
     at the end of the settle phase; x forward, y up. ``traj`` must have kept its states."""
-    from ..sim.kinematics import carries_marker, marker_positions
+    from ..sim.kinematics import carries_marker, marker_positions, trace_rows
 
     if not carries_marker(traj, marker):
         raise ReportError(f"the model carries no {marker!r} marker to compare the track with",
                           "track a marker the model has: nose or foot (--marker)")
     dt, settle = traj.timestep_s, traj.plan.settle_steps
-    stride = max(1, int(round(1.0 / (TRACE_HZ * dt))))
-    stand = max(settle - 1, 0)
-    first = max(0, settle - int(round(LEAD_S / dt)))
-    rows = np.unique(np.concatenate(([stand], np.arange(first, len(traj.states), stride))))
+    rows, stand = trace_rows(dt, settle, len(traj.states))
     pos = marker_positions(traj, marker, rows)
     x0, z0 = pos[rows == stand][0, [0, 2]]
     return Aligned(t_s=(rows + 1 - settle) * dt, x_m=pos[:, 0] - x0, y_m=pos[:, 2] - z0,

@@ -14,6 +14,23 @@ import numpy as np
 from ..errors import SimError
 from .rollout import Trajectory
 
+TRACE_HZ = 240.0   # marker samples a trace keeps per second, at least (a phone films at up to 240)
+TRACE_LEAD_S = 0.3  # standing time a trace keeps before the schedule starts
+
+
+def trace_rows(timestep_s: float, settle_steps: int, nstep: int) -> tuple[np.ndarray, int]:
+    """State rows a marker trace is taken at, and the standing row among them.
+
+    Every ``stride``-th row from ``TRACE_LEAD_S`` before the end of the settle phase to the
+    last, the stride the largest that keeps at least ``TRACE_HZ`` samples a second, plus the
+    last row of the settle phase (where the robot stood). The trace's times are
+    ``(rows + 1 - settle_steps) * timestep_s``: row i is the state after step i + 1.
+    """
+    stride = max(1, int(1.0 / (TRACE_HZ * timestep_s)))
+    stand = max(settle_steps - 1, 0)
+    first = max(0, settle_steps - int(round(TRACE_LEAD_S / timestep_s)))
+    return np.unique(np.concatenate(([stand], np.arange(first, nstep, stride)))), stand
+
 
 def _marker_geom(model: mujoco.MjModel, marker: str) -> int:
     return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"marker_{marker}")
