@@ -217,11 +217,23 @@ def _split_key(key: str) -> tuple[str, str]:
     return section, name
 
 
-def _coerce(key: str, raw: Any) -> Any:
+def value_type(key: str) -> str:
+    """The type of a dotted key's value: ``"float"``, ``"int"``, ``"bool"`` or ``"str"``
+    (ParamsError for an unknown key)."""
     section, name = _split_key(key)
     ftype = {f.name: f.type for f in fields(SECTIONS[section])}[name]
+    return ftype if isinstance(ftype, str) else ftype.__name__
+
+
+def real_keys() -> list[str]:
+    """Every real-valued key (the ones a fit or a draw can move), in file order."""
+    return [key for key in all_keys() if value_type(key) == "float"]
+
+
+def _coerce(key: str, raw: Any) -> Any:
+    ftype = value_type(key)
     try:
-        if ftype in ("bool", bool):
+        if ftype == "bool":
             if isinstance(raw, bool):
                 return raw
             text = str(raw).strip().lower()
@@ -230,14 +242,14 @@ def _coerce(key: str, raw: Any) -> Any:
             if text in ("0", "false", "no", "off"):
                 return False
             raise ValueError("not true/false")
-        if ftype in ("float", float):
+        if ftype == "float":
             value = float(raw)
             if key in UNBOUNDED_KEYS and value == math.inf:
                 return value
             if not math.isfinite(value):
                 raise ValueError("not finite")
             return value
-        if ftype in ("int", int):
+        if ftype == "int":
             value = float(raw)
             if value != int(value):
                 raise ValueError("not a whole number")

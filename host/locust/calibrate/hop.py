@@ -26,7 +26,6 @@ interval is within about +-50% and it did not run to the edge of its range (a fa
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -37,7 +36,7 @@ import numpy as np
 from mujoco import minimize
 
 from ..errors import CalibrationError, GeometryError, ParamsError, ReportError, SimError
-from ..params import SECTIONS, Robot
+from ..params import Robot, value_type
 from ..report.configs import configuration
 from ..report.measure import onset_time
 from ..report.measured import load_trial, read_track
@@ -237,8 +236,7 @@ def check_keys(keys: list[str], runs: list[HopRun]) -> None:
             runs[0].robot.get(key)
         except ParamsError as exc:
             raise CalibrationError(f"--fit: {exc.message}", exc.hint) from None
-        section, _, name = key.partition(".")
-        if {f.name: f.type for f in dataclasses.fields(SECTIONS[section])}[name] not in ("float", float):
+        if value_type(key) != "float":
             raise CalibrationError(f"--fit {key}: only real-valued parameters can be fitted",
                                    "run `locust params` to list them")
         values = {run.robot.get(key) for run in runs}

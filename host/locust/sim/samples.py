@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import GeometryError
-from ..params import SECTIONS, Provenance, Robot, problems
+from ..params import Provenance, Robot, problems, real_keys
 from .audit import audit
 from .hops import summarise
 from .model import build
@@ -49,12 +49,10 @@ class Samples:
 def uncertain_values(robot: Robot) -> dict[str, float]:
     """Real-valued keys whose provenance gives a positive, finite uncertainty -> that uncertainty."""
     out = {}
-    for section, cls in SECTIONS.items():
-        for f in dataclasses.fields(cls):
-            key = f"{section}.{f.name}"
-            sd = robot.source_of(key).uncertainty
-            if f.type in ("float", float) and sd and math.isfinite(sd) and math.isfinite(robot.get(key)):
-                out[key] = float(sd)
+    for key in real_keys():
+        sd = robot.source_of(key).uncertainty
+        if sd and math.isfinite(sd) and math.isfinite(robot.get(key)):
+            out[key] = float(sd)
     return out
 
 
