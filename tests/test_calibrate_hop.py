@@ -96,7 +96,7 @@ def test_measured_phase_times_drive_the_command():
     run = synthetic_run("small", TRUTH, cycles=1)
     late = H.HopRun(**{**run.__dict__, "phase_s": np.array([0.0, 0.4])})   # a push measured 100 ms long
     dt = run.robot.solver.timestep_s
-    plan, plan_late = H.control_plan(run, run.robot), H.control_plan(late, run.robot)
+    plan, plan_late = H.measured_plan(run, run.robot), H.measured_plan(late, run.robot)
     push = math.radians(run.robot.schedule.push_deg)
     assert np.sum(plan.ctrl_rad == push) * dt == pytest.approx(0.3, abs=dt)
     assert np.sum(plan_late.ctrl_rad == push) * dt == pytest.approx(0.4, abs=dt)

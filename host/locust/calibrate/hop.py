@@ -163,7 +163,7 @@ def load_run(path: Path, config: str, base: Robot) -> HopRun:
 
 
 # -- simulating a run ------------------------------------------------------------------
-def control_plan(run: HopRun, robot: Robot) -> ControlPlan:
+def measured_plan(run: HopRun, robot: Robot) -> ControlPlan:
     """Servo command per physics step: at rest while settling, then each phase from its
     measured start (held until the next), up to the track's end and ``TAIL_S`` more."""
     dt, settle_s = robot.solver.timestep_s, robot.solver.settle_s
@@ -182,7 +182,7 @@ def simulate_markers(run: HopRun, robots: list[Robot]) -> list[dict[str, np.ndar
     """Each robot's simulated markers on the schedule's clock (one batched rollout): marker ->
     (3, n) rows t, x, y from where it stood; ``t`` = 0 at the first push. None: it failed."""
     builts = [build(r) for r in robots]
-    plan = control_plan(run, robots[0])
+    plan = measured_plan(run, robots[0])
     trajs = simulate_batch(builts, plan, keep_states=True, threads=THREADS)
     dt, settle = plan.timestep_s, plan.settle_steps
     rows, stand = trace_rows(dt, settle, plan.nstep)
