@@ -13,7 +13,7 @@ from click.testing import CliRunner
 
 from locust.calibrate.recordings import read_table
 from locust.cli import cli
-from locust.params import load_robot, preset
+from locust.params import load_robot, preset, to_toml
 
 ROOT = Path(__file__).resolve().parents[1]
 RECORDINGS = ROOT / "calibration" / "recordings"
@@ -146,6 +146,19 @@ def test_bad_input_names_the_file(tmp_path, content, args, message):
         assert "bad.csv" in res.output
     assert "Traceback" not in res.output
     assert not toml.exists()        # nothing half-written
+
+
+def test_write_onto_a_robot_that_cannot_be_simulated_is_refused(recs):
+    """The fit is shown, the file is left as it was (bytes), and the problem is named."""
+    toml = recs / "robot.toml"
+    text = to_toml(preset("seed").renamed("calibrated"))
+    assert "timestep_s = { value = 0.0025," in text
+    toml.write_text(text.replace("timestep_s = { value = 0.0025,", "timestep_s = { value = 0.5,"))
+    before = toml.read_bytes()
+    res = run("calibrate", "ramp", recs / "synthetic_ramp.csv", "--write", toml, "--no-plot")
+    assert res.exit_code == 2, res.output
+    assert "solver.timestep_s = 0.5 must be > 0 and <= 0.01" in res.output and "hint:" in res.output
+    assert toml.read_bytes() == before
 
 
 def test_missing_file_and_write_without_length(recs):

@@ -12,7 +12,7 @@ import math
 from pathlib import Path
 
 from ..errors import CalibrationError
-from ..params import Provenance, load_robot, preset, save_robot
+from ..params import Provenance, load_robot, preset, problems, save_robot
 from .fitstats import Estimate
 
 DEFAULT_ROBOT_TOML = Path("calibration") / "robot.toml"
@@ -53,7 +53,8 @@ def check_plausible(values: dict[str, Estimate]) -> None:
 
 def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str | Path, *,
                  note: str = "", date: str | None = None) -> Path:
-    """Set each dotted key in ``values`` to its fitted value, with ``fit:<recording>``."""
+    """Set each dotted key in ``values`` to its fitted value, with ``fit:<recording>``; refused
+    (nothing written) when a value is implausible or the robot could then not be simulated."""
     check_plausible(values)
     path = Path(path)
     robot = load_robot(path) if path.exists() else preset("seed").renamed("calibrated")
@@ -63,4 +64,9 @@ def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str |
         prov = Provenance(source=f"fit:{Path(recording).name}", uncertainty=float(est.std), date=date,
                           note=f"{ci}; {note}" if note else ci)
         robot = robot.with_values({key: est.value}, prov)
+    found = problems(robot)
+    if found:   # a calibration file is what sim and hop run: it must be one they can
+        raise CalibrationError(f"{path}: with the fitted values the robot cannot be simulated: "
+                               + "; ".join(found) + "; not written",
+                               "fix the value(s) in the robot file first (`locust params --config FILE` lists them)")
     return save_robot(robot, path)
