@@ -66,7 +66,7 @@ def test_tracked_hops_match_the_truth_frames(demo):
         truth = pd.read_csv(folder / "hops" / label / "hop.truth.csv", comment="#")
         x, z = truth["nose_x_m"].to_numpy(), truth["nose_z_m"].to_numpy()
         settled = truth["t_s"].to_numpy() >= truth["t_s"].iloc[-1] - 0.3
-        assert np.ptp(x[settled]) < 1e-6, label          # at rest over the clip's end: the measure's window
+        assert np.ptp(x[settled]) <= 2e-6, label         # at rest over the clip's end (6 decimals written)
         assert hop["measured_distance_m"] == pytest.approx(float(x[-1] - x[0]), abs=1e-4), label
         assert hop["measured_apex_m"] == pytest.approx(float(z.max() - z[0]), abs=1e-4), label
 

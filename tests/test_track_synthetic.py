@@ -101,8 +101,9 @@ def test_aruco_centre_and_scale(tmp_path):
 def test_marker_found_as_usual_is_judged_every_few_frames(hop, monkeypatch):
     """A marker alone in its tight window at its usual size and colour is not judged again on
     every frame (color.JUDGE_EVERY): the SYNTHETIC hop gives the same positions (to 1e-9 px)
-    as judging shape and colour on every frame, with the shape measured on at most a
-    third of the frames (measured: 23 of 96 marker-frames, 91 when every frame is judged)."""
+    as judging shape and colour on every frame, with the shape measured on at most half
+    of the marker-frames (measured: 45 of 96, every frame judged until 15 sightings are
+    learned; 91 when every frame is judged)."""
     from locust.track import color
     from locust.track.calib import build
     from locust.track.runner import track_video
@@ -132,4 +133,4 @@ def test_marker_found_as_usual_is_judged_every_few_frames(hop, monkeypatch):
     assert np.array_equal(np.isnan(every_few), np.isnan(every_frame))
     frames = 2 * info.frame_count
     assert judged_all >= frames - 2 * (OCCLUDED[1] - OCCLUDED[0] + 1)
-    assert judged <= frames / 3, (judged, frames)
+    assert judged <= frames // 2, (judged, frames)

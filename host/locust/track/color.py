@@ -297,16 +297,16 @@ class ColorMarker:
 
     def _locate_in(self, image, box, centre, whole_inside: bool = False, tight: bool = False) -> Detection | None:
         """The marker in ``box``; ``whole_inside``: a blob cut by the box is refused; ``tight``:
-        the box is a few radii around the prediction, where a lone blob as usual is the marker
-        (``_as_usual``)."""
+        the box is a few radii around the prediction, where a lone blob of the RGB box, as
+        usual, is the marker (``_as_usual``; a blob of the looser colour tests is judged)."""
         x0, y0, x1, y1 = box
         if x1 <= x0 or y1 <= y0:           # the prediction lies off the picture
             return None
         roi = image[y0:y1, x0:x1]          # a view: nothing outside the window is converted
         if self._lost and not self._may_hold(roi):
             return None
-        for core, hue_checked in self._cores(roi):
-            det = self._locate_core(image, roi, core, box, centre, whole_inside, hue_checked, tight)
+        for layer, (core, hue_checked) in enumerate(self._cores(roi)):
+            det = self._locate_core(image, roi, core, box, centre, whole_inside, hue_checked, tight and layer == 0)
             if det is not None:
                 return det
         return None
@@ -364,7 +364,7 @@ class ColorMarker:
                 if self._near_distractor(*at):
                     return None
                 self._unjudged += 1
-                return self._measure(roi, mask, stat, label, None, x0, y0, None)
+                return self._measure(roi, mask, stat, label, None, x0, y0, None, n == 2)
             blob = mask[by:by + bh, bx:bx + bw]
             if n > 2:   # with one blob the core is its mask
                 blob = (blob == label).view(np.uint8)
@@ -380,21 +380,25 @@ class ColorMarker:
             if self._near_distractor(*at):
                 continue   # a look-alike seen at the start is never taken
             self._unjudged = 0
-            return self._measure(roi, mask, stat, label, shape, x0, y0, hs)
+            return self._measure(roi, mask, stat, label, shape, x0, y0, hs, n == 2)
         return None
 
     def _as_usual(self, area: int, width: int, height: int) -> bool:
-        """True if a blob, alone in the tight window around the prediction and in the marker's
-        colour, is the marker just as it has been seen: within 20 % of its usual area, its box
-        within 20 % (and a pixel) of its usual width both ways. Its shape and colour are then
-        not judged again, which costs three OpenCV calls a frame; they are every
-        ``JUDGE_EVERY``-th frame, so that what the marker looks like is still learned as the
-        light and its distance change."""
-        if self._unjudged >= JUDGE_EVERY - 1 or self._usual_width < 5.0:
+        """True if a blob, alone in the tight window around the prediction and within the RGB
+        box of the marker's colour, is the marker just as it has been seen: 0.8 to 1.25 of its
+        usual area, its box within 20 % (and a pixel) of its usual width both ways and filled
+        as a disc fills its box (a streak lying diagonally fills half of it). Its shape and
+        colour are then not judged again, which costs three OpenCV calls a frame; they are
+        every ``JUDGE_EVERY``-th frame, so that what the marker looks like is still learned as
+        the light and its distance change, and on every frame until as many sightings are
+        learned as are kept (the shortcut must not slow the learning where it starts)."""
+        if (self._unjudged >= JUDGE_EVERY - 1 or self._usual_width < 5.0
+                or len(self._areas) < self._areas.maxlen):
             return False
         a, d = self._usual_area, self._usual_width
         slack = 0.2 * d + 1.0
-        return 0.8 * a <= area <= 1.25 * a and abs(width - d) <= slack and abs(height - d) <= slack
+        return (0.8 * a <= area <= 1.25 * a and abs(width - d) <= slack and abs(height - d) <= slack
+                and area >= DISC_FILL * width * height)
 
     def _near_distractor(self, x: float, y: float) -> bool:
         """True if (x, y) lies on a look-alike's bounding box, grown by a marker radius."""
@@ -437,16 +441,16 @@ class ColorMarker:
         return True
 
     def _measure(self, roi, labels, stat, best: int, shape: BlobShape | None, x0: int, y0: int,
-                 hs) -> Detection:
+                 hs, alone: bool) -> Detection:
         """The blob's coverage centroid; a round, whole blob also teaches the marker's size
-        (``shape``: None when it was not judged)."""
+        (``shape``: None when it was not judged). ``alone``: ``labels`` is the colour mask
+        itself (0/255, one blob in it), else OpenCV's labels with the blob as ``best``."""
         # the centroid needs the blob and four pixels around it (two dilations of 5x5)
         bx, by, bw, bh = stat[:4]
         cx0, cy0 = max(bx - RING_PX, 0), max(by - RING_PX, 0)
         cx1, cy1 = min(bx + bw + RING_PX, roi.shape[1]), min(by + bh + RING_PX, roi.shape[0])
         blob = labels[cy0:cy1, cx0:cx1]
-        # the colour mask itself (0/255) when the window held one blob, else OpenCV's labels
-        blob = blob.astype(bool) if blob.dtype == np.uint8 else blob == best
+        blob = blob.astype(bool) if alone else blob == best
         near = roi[cy0:cy1, cx0:cx1]
         px, py = _coverage_centroid(near, blob)
         area = float(stat[4])
@@ -473,6 +477,7 @@ def every(image: np.ndarray, step: int) -> np.ndarray:
     if step == 1 or hq == 0 or wq == 0:
         return np.ascontiguousarray(image[::step, ::step])
     main = cv2.resize(image[:hq * step, :wq * step], (wq, hq), interpolation=cv2.INTER_NEAREST)
+    main = main.reshape((hq, wq) + image.shape[2:])   # OpenCV drops a single channel's axis
     if h == hq * step and w == wq * step:
         return main
     out = np.empty((-(-h // step), -(-w // step)) + image.shape[2:], image.dtype)
@@ -558,6 +563,7 @@ def _on_image_border(stat: list[int], box, image_shape) -> bool:
 
 RING_PX = 4
 JUDGE_EVERY = 4   # a marker found as usual has its shape and colour judged every this many frames
+DISC_FILL = 0.65  # least share of its box a blob taken as usual fills (a disc: pi/4, 0.79)
 _KERNEL_9 = np.ones((9, 9), np.uint8)    # two 5x5 dilations in one
 _KERNEL_5 = np.ones((5, 5), np.uint8)
 _KERNEL_3 = np.ones((3, 3), np.uint8)
