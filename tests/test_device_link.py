@@ -7,6 +7,7 @@ MicroPython interpreter; only the servos are virtual (a recording plant).
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 import pty
 import time
@@ -58,6 +59,17 @@ def test_hop_phases_on_time_and_servos_follow(robot, tmp_path):
     writes = [w for w in vr.pwm_writes if w.t_written_s > t_start and w.servo]
     for w in writes:  # each duty change lands at the next 20 ms PWM period
         assert 0 <= w.t_effect_s - w.t_written_s <= PWM_PERIOD_S + 1e-9
+    # one timer for both servos: the periods start together, so the left and right writes of
+    # one command take effect at the same instant unless a period starts between the two
+    starts = [w.t_effect_s for w in writes]
+    periods = [(t - starts[0]) / PWM_PERIOD_S for t in starts]
+    assert all(abs(k - round(k)) < 1e-6 for k in periods)     # one grid of period starts
+    pairs = [(a, b) for a, b in zip(writes, writes[1:]) if (a.servo, b.servo) == ("left", "right")]
+    assert len(pairs) >= 4
+    for a, b in pairs:
+        apart = math.ceil((b.t_written_s - starts[0]) / PWM_PERIOD_S - 1e-9) != \
+            math.ceil((a.t_written_s - starts[0]) / PWM_PERIOD_S - 1e-9)
+        assert b.t_effect_s - a.t_effect_s == pytest.approx(PWM_PERIOD_S if apart else 0.0, abs=1e-9)
 
 
 def test_silent_host_leaves_servos_at_rest_within_heartbeat(robot):

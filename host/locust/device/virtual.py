@@ -12,7 +12,9 @@ What runs where:
 - a ``machine`` shim on the interpreter's path writes every PWM change into a FIFO; here
   each pulse is turned back into a horn angle with the firmware's own ``config.py`` and
   ``config.json`` (pins, pulse range, trim, direction) and handed to the plant at the start of
-  the next 20 ms PWM period, as the ESP32's PWM hardware does;
+  the next 20 ms PWM period, as the ESP32's PWM hardware does. Both servos share the period
+  (one timer, as on the board): the firmware's two writes of one command reach the legs at
+  the same instant, a period apart only if a period starts between them;
 - when the interpreter exits (Ctrl-D soft reset, ``machine.reset()``) it is started again and
   ``soft reboot`` is printed, as a board reboots without dropping its USB port. Like a board,
   a soft reset from the raw REPL (mpremote's ``exec``, ``run``, ``fs``...) comes back in the
@@ -146,7 +148,9 @@ class VirtualRobot:
         self._plant_queue: queue.Queue = queue.Queue()
         self._t0 = time.monotonic()
         self._config_cache: tuple[float, dict] | None = None
-        self._period_anchor: dict[int, float] = {}
+        # one PWM timer for both servos (they run at the same 50 Hz: MicroPython's ESP32 PWM
+        # gives channels of one frequency one LEDC timer), so their periods start together
+        self._period_anchor_s: float | None = None
         self._last_angle = {"left": 0.0, "right": 0.0}
         self._log = None
         self._raw_repl = False         # the console is in the raw REPL (read off its output)
@@ -192,7 +196,7 @@ class VirtualRobot:
         env = dict(os.environ, MICROPYPATH=f"{SHIM_DIR}:.frozen:{self.flash_dir / 'lib'}",
                    LOCUST_PWM_FIFO=self._fifo_path)
         env.pop("PYTHONPATH", None)
-        self._period_anchor.clear()
+        self._period_anchor_s = None
         with self._proc_lock:
             self._proc = subprocess.Popen(args, stdin=self._sa, stdout=self._sa, stderr=self._sa,
                                           cwd=self.flash_dir, env=env, start_new_session=True,
@@ -378,7 +382,9 @@ class VirtualRobot:
             if item is None:
                 break
             t_s, pin, pulse_us = item
-            anchor = self._period_anchor.setdefault(pin, t_s)
+            if self._period_anchor_s is None:
+                self._period_anchor_s = t_s
+            anchor = self._period_anchor_s
             t_effect = anchor + math.ceil((t_s - anchor) / PWM_PERIOD_S - 1e-9) * PWM_PERIOD_S
             cfg = self._config()
             servo = next((name for name in fw_config.SERVOS if cfg[name]["pin"] == pin), None)
