@@ -26,8 +26,12 @@ TRUTH = {"compliance.hinge_stiffness_nm_per_rad": 0.045, "servo.noload_speed_rad
 
 def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0) -> H.HopRun:
     """A run of ``config`` at ``truth``, "filmed" at 30 frames/s from 0.4 s before the first
-    push, camera clock 1.234 s ahead, positions with NOISE_M of noise (SYNTHETIC)."""
+    push, camera clock 1.234 s ahead, positions with NOISE_M of noise (SYNTHETIC). The values
+    not in ``truth`` are the preset's exactly, so here they carry no uncertainty."""
     robot = preset(config)
+    for key in S.uncertain_values(robot):
+        if key not in truth:
+            robot = robot.with_provenance(key, Provenance(source="synthetic: exact"))
     period = robot.schedule.push_s + robot.schedule.wait_s
     phase_s = np.array([k * period + d for k in range(cycles) for d in (0.0, robot.schedule.push_s)])
     pushing = np.array([True, False] * cycles)
@@ -76,6 +80,7 @@ def test_fit_intervals_cover_the_truth_and_say_what_they_include(small_fit):
         # 0.13 mm of residual over three hops, t(2), gives about +-8 %)
         assert (est.ci95_high - est.ci95_low) / 2 < 0.20 * truth, (key, est)
         assert est.std_numerical is not None and 0 <= est.std_numerical <= est.std
+        assert est.std_fixed is None          # nothing held fixed carries an uncertainty here
     assert fit.interval.startswith("cluster-robust over 3 hops (CR1), t(2)")
     assert fit.summary()["interval"] == fit.interval
 

@@ -62,7 +62,11 @@ def test_fit_recovers_the_hidden_values(fitted):
         # the intervals include the time step's part (docs/calibrate.md: they do not always
         # cover the hidden values; the 2.5 ms fit of Large is biased against its 2 ms truth)
         assert 0 < p["std_numerical"] <= p["std"], (key, p)
-    assert fitted["fit"]["interval"].startswith("cluster-robust over 6 hops (CR1), t(5)")
+        # and the uncertainties of the values held fixed (the preset's SG90 fit, its stall torque)
+        assert 0 < p["std_fixed"] <= p["std"], (key, p)
+    interval = fitted["fit"]["interval"]
+    assert interval.startswith("cluster-robust over 6 hops (CR1), t(5)")
+    assert "values held fixed" in interval and "servo.stall_torque_nm" in interval
 
 
 def test_fit_takes_under_ten_minutes_and_leaves_little(fitted):

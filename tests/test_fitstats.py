@@ -58,3 +58,30 @@ def test_a_numerical_shift_adds_in_quadrature_with_welch_satterthwaite_dof():
     # the shift as a linear change of the data: the Gauss-Newton step of a line fit
     jac = -np.column_stack([np.ones(5), np.arange(5.0)])
     assert F.linear_shift(jac, np.full(5, 0.1)) == pytest.approx([0.1, 0.0])
+
+
+def test_values_held_fixed_carry_their_uncertainty_into_the_fit():
+    """A line y = a x + b z fitted for a with b held at its calibrated value (sd 0.2): the
+    fitted a moves by -(x.z / x.x) per unit of b, so its std_fixed is |x.z / x.x| 0.2, exactly
+    what refitting a at b +- 0.2 gives; it adds in quadrature with the fit's own."""
+    rng = np.random.default_rng(5)
+    x, z = rng.normal(size=40), rng.normal(size=40)
+    a_true, b_held, sd_b = 1.5, 0.7, 0.2
+    y = a_true * x + b_held * z + rng.normal(scale=0.05, size=40)
+
+    def fit_a(b):
+        return float(x @ (y - b * z) / (x @ x))
+
+    a = fit_a(b_held)
+    r = y - a * x - b_held * z
+    jac, jac_b = -x[:, None], -z[:, None]             # d residual / d a, d residual / d b
+    fixed = F.fixed_covariance(jac, jac_b, np.array([sd_b]))
+    moved = (fit_a(b_held + sd_b) - fit_a(b_held - sd_b)) / 2
+    assert np.sqrt(fixed[0, 0]) == pytest.approx(abs(moved), rel=1e-12)
+    assert np.sqrt(fixed[0, 0]) == pytest.approx(abs(x @ z / (x @ x)) * sd_b, rel=1e-12)
+    clusters = np.arange(40) // 4
+    plain = F.cluster_covariance(jac, r, clusters).parameter(np.array([a]), 0)
+    est = F.cluster_covariance(jac, r, clusters, fixed=fixed).parameter(np.array([a]), 0)
+    assert est.std_fixed == pytest.approx(np.sqrt(fixed[0, 0]), rel=1e-12)
+    assert est.std == pytest.approx(np.hypot(plain.std, est.std_fixed), rel=1e-12)
+    assert est.std_numerical is None and "std_fixed" in est.as_dict()

@@ -11,7 +11,8 @@ Miller, J. Human Resources 50, 2015), with Student's t on ``G - 1`` degrees of f
 ``G`` clusters. A systematic shift of the parameters (the fit's own time step: its change
 when the step is halved) may be added as a type-B standard uncertainty: combined in
 quadrature, the t factor then takes the Welch-Satterthwaite effective degrees of freedom
-(GUM, JCGM 100:2008, G.4).
+(GUM, JCGM 100:2008, G.4). So may the uncertainties of values the fit holds fixed
+(:func:`fixed_covariance`: taken from earlier calibrations, they are not exact).
 
 Derived quantities (stiffness from frequency, ...) get theirs by first-order propagation.
 """
@@ -34,6 +35,7 @@ class Estimate:
     ci95_low: float
     ci95_high: float
     std_numerical: float | None = None   # the part of ``std`` from the numerics (None: not assessed)
+    std_fixed: float | None = None       # the part from the uncertainties of values held fixed (None: none)
 
     @property
     def relative_std(self) -> float:
@@ -45,6 +47,8 @@ class Estimate:
         out = {"value": self.value, "std": self.std, "ci95": [self.ci95_low, self.ci95_high]}
         if self.std_numerical is not None:
             out["std_numerical"] = self.std_numerical
+        if self.std_fixed is not None:
+            out["std_fixed"] = self.std_fixed
         return out
 
 
@@ -57,6 +61,7 @@ class Covariance:
     dof: int
     shift: np.ndarray | None = None     # systematic shift of each parameter (e.g. dt -> dt/2)
     method: str = "s^2 (J^T J)^-1, t(n-p)"
+    fixed: np.ndarray | None = None     # covariance carried in from values held fixed (fixed_covariance)
 
     def estimate(self, value: float, grad: np.ndarray) -> Estimate:
         """A quantity ``f(params)`` with gradient ``grad`` at the optimum."""
@@ -65,15 +70,19 @@ class Covariance:
         sub = self.matrix[np.ix_(used, used)]
         var = float(grad[used] @ sub @ grad[used]) if used.any() else 0.0
         std = float(np.sqrt(max(var, 0.0))) if np.all(np.isfinite(sub)) else float("inf")
-        dof, numerical = float(self.dof), None
+        dof, numerical, fixed = float(self.dof), None, None
         if self.shift is not None:
             numerical = abs(float(grad[used] @ self.shift[used])) if used.any() else 0.0
-            combined = math.hypot(std, numerical)
+        if self.fixed is not None:
+            part = self.fixed[np.ix_(used, used)]
+            fixed = float(np.sqrt(max(float(grad[used] @ part @ grad[used]), 0.0))) if used.any() else 0.0
+        if numerical is not None or fixed is not None:
+            combined = math.sqrt(std ** 2 + (numerical or 0.0) ** 2 + (fixed or 0.0) ** 2)
             # Welch-Satterthwaite: a type-B part counts with infinite degrees of freedom
             dof = dof * (combined / std) ** 4 if 0 < std < math.inf else math.inf
             std = combined
         k = t95(dof)
-        return Estimate(float(value), std, float(value - k * std), float(value + k * std), numerical)
+        return Estimate(float(value), std, float(value - k * std), float(value + k * std), numerical, fixed)
 
     def parameter(self, values: np.ndarray, i: int) -> Estimate:
         grad = np.zeros(len(values))
@@ -104,11 +113,12 @@ def covariance(jac: np.ndarray, residual: np.ndarray) -> Covariance:
 
 
 def cluster_covariance(jac: np.ndarray, residual: np.ndarray, clusters: np.ndarray,
-                       shift: np.ndarray | None = None) -> Covariance:
+                       shift: np.ndarray | None = None, fixed: np.ndarray | None = None) -> Covariance:
     """Cluster-robust (CR1) covariance, residuals correlated within each cluster label of
     ``clusters`` (n,), independent between clusters; ``shift`` (p,): a systematic shift of
-    the parameters, added as a type-B uncertainty. Fewer clusters than one more than the
-    parameters determine nothing: every variance is then infinite."""
+    the parameters, and ``fixed`` (p, p): the covariance carried in from values held fixed
+    (:func:`fixed_covariance`), both added as type-B uncertainties. Fewer clusters than one
+    more than the parameters determine nothing: every variance is then infinite."""
     jac = np.asarray(jac, dtype=float)
     residual = np.asarray(residual, dtype=float).ravel()
     clusters = np.asarray(clusters).ravel()
@@ -122,7 +132,23 @@ def cluster_covariance(jac: np.ndarray, residual: np.ndarray, clusters: np.ndarr
     if g <= p:
         undetermined = np.ones(p, dtype=bool)
     return Covariance(_mark(cov, undetermined), max(g - 1, 1), shift,
-                      f"cluster-robust (CR1) over {g} clusters, t({max(g - 1, 1)})")
+                      f"cluster-robust (CR1) over {g} clusters, t({max(g - 1, 1)})", fixed)
+
+
+def fixed_covariance(jac: np.ndarray, jac_fixed: np.ndarray, std_fixed: np.ndarray) -> np.ndarray:
+    """What the uncertainties of values held fixed in a fit do to the fitted ones (p, p).
+
+    A held value ``q`` off by ``dq`` moves the optimum, to first order, by
+    ``G dq`` with ``G = -(J^T J)^-1 J^T J_q`` (``jac_fixed`` (n, q): the residual's
+    derivative in each held value, ``std_fixed`` (q,): their standard uncertainties, taken
+    as independent): the fitted values' covariance from them is ``G diag(std^2) G^T``. A
+    fit that takes its other values from earlier calibrations carries their uncertainty in
+    this way instead of treating them as exact (GUM, JCGM 100:2008, 5.1)."""
+    jac = np.asarray(jac, dtype=float)
+    bread, undetermined = _inverse_normal(jac)
+    gain = -bread @ (jac.T @ np.asarray(jac_fixed, dtype=float))
+    gain[undetermined] = 0.0
+    return (gain * np.asarray(std_fixed, dtype=float) ** 2) @ gain.T
 
 
 def linear_shift(jac: np.ndarray, delta_residual: np.ndarray) -> np.ndarray:

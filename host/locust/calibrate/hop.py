@@ -19,7 +19,10 @@ and a model that is not the robot: neighbouring residuals are correlated), so th
 is cluster-robust with each hop of each run a cluster, from a central-difference Jacobian
 at the optimum with a step (``FD_STEP``) over the contacts' jaggedness, t on hops - 1 degrees
 of freedom; the fit's own time step adds the parameters' shift when it is halved (to first
-order, one more rollout per run), in quadrature. A value is *identifiable* when its 95%
+order, one more rollout per run), and so do the uncertainties of the values the fit holds
+fixed (from the bench calibrations: the hinge damping, the servo's armature, kp and stall
+torque), each carried through the fit's sensitivity to it (one batch per run, each held value
+one standard uncertainty either side), in quadrature. A value is *identifiable* when its 95%
 interval is within about +-50% and it did not run to the edge of its range (a factor
 ``BOUND_FACTOR`` either side of where it started).
 """
@@ -43,8 +46,9 @@ from ..report.measured import load_trial, read_track
 from ..sim.kinematics import geom_positions, marker_geoms, trace_rows
 from ..sim.model import build
 from ..sim.rollout import simulate_batch
+from ..sim.samples import uncertain_values
 from ..sim.schedule import ControlPlan
-from .fitstats import Estimate, cluster_covariance, linear_shift
+from .fitstats import Estimate, cluster_covariance, fixed_covariance, linear_shift
 
 DEFAULT_KEYS = ("contact.foot_friction", "compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s")
 MARKERS = ("nose", "foot")
@@ -313,10 +317,28 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     r = rs[:, 0]
     jac = (rs[:, 1::2] - rs[:, 2::2]) / (hi - lo) / values[None, :]    # d r / d p = d r / d x / p
     numerical = linear_shift(jac, residual(x.reshape(-1, 1), refine=2)[:, 0] - r)
-    cov = cluster_covariance(jac, r, np.concatenate(clusters), numerical)
+    held = held_uncertainties(runs, keys)
+    fixed = None
+    if held:   # each held value one standard uncertainty either side, at the optimum: one batch per run
+        sds = np.array(list(held.values()))
+        changes = [{key: runs[0].robot.get(key) + sign * sd} for key, sd in held.items() for sign in (1, -1)]
+        cols = []
+        for run in runs:
+            at_x = robots_at(run, x[None, :])[0]
+            try:
+                sims = simulate_markers(run, [at_x.with_values(c, "fit: held value's uncertainty") for c in changes])
+            except (GeometryError, SimError):
+                sims = [None] * len(changes)
+            counter["sims"] += len(changes)
+            cols.append(np.stack([aligned_residual(run, s_)[0] for s_ in sims], axis=1))
+        rq = np.concatenate(cols, axis=0)
+        fixed = fixed_covariance(jac, (rq[:, 0::2] - rq[:, 1::2]) / (2 * sds), sds)
+    cov = cluster_covariance(jac, r, np.concatenate(clusters), numerical, fixed)
     hops = len(np.unique(np.concatenate(clusters)))
     interval = (f"cluster-robust over {hops} hops (CR1), t({max(hops - 1, 1)}), with the shift at half the time "
-                "step (std_numerical) in quadrature, Welch-Satterthwaite degrees of freedom")
+                "step (std_numerical)" + (f" and the uncertainties of the {len(held)} values held fixed "
+                                          f"({', '.join(held)}: std_fixed)" if held else "")
+                + " in quadrature, Welch-Satterthwaite degrees of freedom")
     estimates, identifiable, notes = {}, {}, []
     if hops <= len(keys):
         notes.append(f"{hops} hops cannot bound {len(keys)} values (a cluster-robust interval needs at least one "
@@ -337,6 +359,19 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     return HopFit(keys=keys, start=dict(zip(keys, start.tolist())), estimates=estimates, identifiable=identifiable,
                   runs=run_fits, notes=notes, rms_m=float(np.sqrt(np.mean(r**2))), iterations=len(trace),
                   simulations=counter["sims"], wall_s=time.perf_counter() - t_start, interval=interval)
+
+
+def held_uncertainties(runs: list[HopRun], keys: tuple[str, ...]) -> dict[str, float]:
+    """Values the fit holds fixed that carry an uncertainty (from earlier calibrations),
+    the same in every run's robot -> that standard uncertainty."""
+    held = {}
+    for key, sd in uncertain_values(runs[0].robot).items():
+        if key in keys:
+            continue
+        if all(run.robot.get(key) == runs[0].robot.get(key) and run.robot.source_of(key).uncertainty == sd
+               for run in runs):
+            held[key] = sd
+    return held
 
 
 def hop_index(run: HopRun, shift: float) -> np.ndarray:
