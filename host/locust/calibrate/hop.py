@@ -271,17 +271,22 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
             robot = robot.with_values({"solver.timestep_s": robot.solver.timestep_s / refine}, "fit: time step check")
         return [robot.with_values(dict(zip(keys, (start * np.exp(x)).tolist())), "fit") for x in xs]
 
-    def residual(x: np.ndarray, refine: int = 1) -> np.ndarray:
-        xs = np.atleast_2d(np.asarray(x, dtype=float).T).reshape(-1, len(keys))
+    def residuals_of(robots: Callable[[HopRun], list[Robot]]) -> np.ndarray:
+        """One residual column per robot ``robots(run)`` gives (one batch per run), runs stacked."""
         cols = []
         for run in runs:
+            batch = robots(run)
             try:
-                sims = simulate_markers(run, robots_at(run, xs, refine))
+                sims = simulate_markers(run, batch)
             except (GeometryError, SimError):
-                sims = [None] * len(xs)
-            counter["sims"] += len(xs)
+                sims = [None] * len(batch)
+            counter["sims"] += len(batch)
             cols.append(np.stack([aligned_residual(run, s)[0] for s in sims], axis=1))
         return np.concatenate(cols, axis=0)
+
+    def residual(x: np.ndarray, refine: int = 1) -> np.ndarray:
+        xs = np.atleast_2d(np.asarray(x, dtype=float).T).reshape(-1, len(keys))
+        return residuals_of(lambda run: robots_at(run, xs, refine))
 
     bound = math.log(BOUND_FACTOR)
     bounds = [np.full(len(keys), -bound), np.full(len(keys), bound)]
@@ -322,16 +327,8 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     if held:   # each held value one standard uncertainty either side, at the optimum: one batch per run
         sds = np.array(list(held.values()))
         changes = [{key: runs[0].robot.get(key) + sign * sd} for key, sd in held.items() for sign in (1, -1)]
-        cols = []
-        for run in runs:
-            at_x = robots_at(run, x[None, :])[0]
-            try:
-                sims = simulate_markers(run, [at_x.with_values(c, "fit: held value's uncertainty") for c in changes])
-            except (GeometryError, SimError):
-                sims = [None] * len(changes)
-            counter["sims"] += len(changes)
-            cols.append(np.stack([aligned_residual(run, s_)[0] for s_ in sims], axis=1))
-        rq = np.concatenate(cols, axis=0)
+        rq = residuals_of(lambda run: [robots_at(run, x[None, :])[0].with_values(c, "fit: held value's uncertainty")
+                                       for c in changes])
         fixed = fixed_covariance(jac, (rq[:, 0::2] - rq[:, 1::2]) / (2 * sds), sds)
     cov = cluster_covariance(jac, r, np.concatenate(clusters), numerical, fixed)
     hops = len(np.unique(np.concatenate(clusters)))
