@@ -6,7 +6,9 @@ The tip moves as a damped linear oscillator after the mass is dropped on it::
     wd = wn*sqrt(1 - zeta^2)
 
 fitted by least squares to the tip's displacement along the direction it moves most
-(the first principal axis of the track, so the camera need not be level). Then, with the
+(the first principal axis of the track, so the camera need not be level), started from the
+best points of a grid over frequency and damping (:func:`_start_values`), with intervals
+widened for residuals correlated from frame to frame (``fitstats.serial_covariance``). Then, with the
 oscillating mass m (tip mass plus 33/140 of the beam's own mass, Rayleigh's cantilever
 result):
 
