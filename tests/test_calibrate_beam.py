@@ -125,3 +125,15 @@ def test_beam_intervals_hold_with_correlated_tracking_noise():
         fitted_rho.append(fit.residual_autocorrelation)
     assert np.median(fitted_rho) == pytest.approx(rho, abs=0.05)
     assert covered >= 44
+
+
+def test_creeping_tip_is_refused():
+    """A mass lowered by hand: the tip creeps 5.3 mm to its new rest over ~3 s, no ringing
+    (the shape of the real deflection test in ../shared/data/hinge); SYNTHETIC. Refused,
+    not fitted as a 0.5 Hz 'oscillation' at the damping bound."""
+    rng = np.random.default_rng(11)
+    t = np.arange(200) / 60.0
+    y = 0.0053 * (1 - np.exp(-np.clip(t - 0.5, 0, None) / 0.8)) + rng.normal(0, 1e-4, len(t))
+    with pytest.raises(CalibrationError, match="no ring-down") as err:
+        B.fit_beam(t, y, 0.095, length_m=0.048)
+    assert "static deflection" in err.value.hint

@@ -170,10 +170,15 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
             "drop the mass from higher, or track the tip more closely (see calibration/protocols/beam.md)",
         )
     fn, zeta = float(p[3]), float(p[4])
+    creep = ("a tip that creeps to its new rest without ringing (a mass lowered by hand) has no oscillation "
+             "to fit: read its static deflection, k = m*g/deflection")
+    if zeta >= 0.999 * ZETA_BOUNDS[1]:
+        raise CalibrationError(f"{source}: no ring-down, the fitted damping ratio is at its bound {ZETA_BOUNDS[1]} "
+                               f"({fn:.3g} Hz)", creep)
     cycles = (t[-1] - t[0]) * fn
     if cycles < MIN_CYCLES:
         raise CalibrationError(f"{source}: the fit window covers {cycles:.2g} oscillations (need {MIN_CYCLES})",
-                               "record longer after the drop")
+                               "record longer after the drop; " + creep)
     if fs_hz < MIN_FRAMES_PER_CYCLE * fn:
         raise CalibrationError(f"{source}: {fs_hz:.3g} frames/s for a {fn:.3g} Hz oscillation "
                                f"(need {MIN_FRAMES_PER_CYCLE:g} frames a cycle)",
@@ -207,21 +212,18 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
 
 
 def _window(t_s: np.ndarray, d: np.ndarray, start_s: float | None, end_s: float | None) -> np.ndarray:
-    """Samples to fit: from the first big swing after the drop (or ``start_s``) to ``end_s``.
+    """Samples to fit: from the drop (or ``start_s``) to ``end_s``.
 
-    Before the drop the tip is at rest and the impact itself is not a free oscillation, so
-    the fit starts at the largest excursion from the final rest position in the first half
-    of what follows the drop: the first swing after the impact. The drop is where the tip
-    first leaves its starting level by a quarter of its whole range (a heavy mass rests
-    lower than its first swing reaches, so the rest before the drop is excluded).
+    Before the drop the tip rests at its starting level; the drop is the first sample at
+    which the tip has left that level by a quarter of its whole range, a few milliseconds
+    after the mass landed. From then on the tip and the mass stuck to it move freely, and
+    the fit takes the whole first swing: the fastest part of a heavily damped ring-down,
+    where most of what fixes its frequency is.
     """
     end = t_s[-1] if end_s is None else end_s
     if start_s is None:
-        rest = np.median(d[len(d) * 4 // 5:])
         level = np.median(d[:max(len(d) // 20, 3)])
-        drop = int(np.argmax(np.abs(d - level) > 0.25 * np.ptp(d)))
-        after = d[drop:drop + max((len(d) - drop) // 2, 1)]
-        start_s = t_s[drop + int(np.argmax(np.abs(after - rest)))]
+        start_s = t_s[int(np.argmax(np.abs(d - level) > 0.25 * np.ptp(d)))]
     return (t_s >= start_s) & (t_s <= end)
 
 
