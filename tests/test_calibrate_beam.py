@@ -105,8 +105,11 @@ def test_beam_intervals_cover_truth_over_seeds(zeta):
         # a 3 % error is never excluded where the frequency is pinned to 1 % (a 3-sigma miss)
         if est.std < 0.01 * fn_true and abs(est.value / fn_true - 1) > 0.03:
             assert est.ci95_low <= fn_true <= est.ci95_high, (truth, est)
-    for name, n in covered.items():
-        assert n >= 0.88 * len(runs), (name, n, len(runs))
+    # 95 % intervals: fn's held the truth in 93.5 %, zeta's in 92 % of 200 such ring-downs at
+    # zeta 0.10 (the spectral start's: 24 % at 0.24); 50 draws of a 92 % coverage fall to 42
+    # about one time in 40, hence zeta's looser floor
+    assert covered["natural_frequency_hz"] >= 0.88 * len(runs), covered
+    assert covered["damping_ratio"] >= 0.84 * len(runs), covered
 
 
 def test_beam_intervals_hold_with_correlated_tracking_noise():
