@@ -6,6 +6,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from scipy import signal
 
 from locust.calibrate import beam as B
 from locust.calibrate import synthetic as S
@@ -62,3 +63,80 @@ def test_too_few_beam_samples_are_refused():
     t, x, y = S.beam_tip_track(truth, np.random.default_rng(0))
     with pytest.raises(CalibrationError, match="samples in the fit window"):
         B.fit_beam(t, B.principal_displacement(x, y), 0.01, start_s=0.2, end_s=0.25)
+
+
+# Interval coverage over many ring-downs: damping ratios from a lightly damped strip to a
+# heavily damped one with a single visible cycle, the frame rates of phones (30-240 frames/s)
+# and tracking noise of half a pixel to a pixel (0.3 and 0.6 mm), all SYNTHETIC. At 30
+# frames/s the tip mass is 40 g (3.8 Hz, 8 frames a cycle; 10 g rings at 7.6 Hz, 4 frames).
+COVERAGE_SEEDS = 50
+COVERAGE_FPS = (30.0, 60.0, 120.0, 240.0)
+COVERAGE_MASS_KG = {30.0: 0.04}
+COVERAGE_NOISE_M = (0.0003, 0.0006)
+
+
+def _coverage_runs(zeta: float) -> list[tuple[S.BeamTruth, B.BeamFit]]:
+    """(truth, fit) of ``COVERAGE_SEEDS`` ring-downs at damping ratio ``zeta``."""
+    runs = []
+    for seed in range(COVERAGE_SEEDS):
+        fps = COVERAGE_FPS[seed % len(COVERAGE_FPS)]
+        noise = COVERAGE_NOISE_M[seed // len(COVERAGE_FPS) % len(COVERAGE_NOISE_M)]
+        truth = dataclasses.replace(S.BeamTruth(), damping_ratio=zeta, fps=fps, noise_m=noise,
+                                    mass_kg=COVERAGE_MASS_KG.get(fps, S.BeamTruth.mass_kg))
+        t, x, y = S.beam_tip_track(truth, np.random.default_rng(9000 + seed))
+        runs.append((truth, B.fit_beam(t, B.principal_displacement(x, y), truth.mass_kg)))
+    return runs
+
+
+@pytest.mark.parametrize("zeta", [0.02, 0.03, 0.10, 0.24, 0.40])
+def test_beam_intervals_cover_truth_over_seeds(zeta):
+    runs = _coverage_runs(zeta)
+    covered = {"natural_frequency_hz": 0, "damping_ratio": 0}
+    for truth, fit in runs:
+        fn_true = truth.natural_frequency_hz
+        for name, true in (("natural_frequency_hz", fn_true), ("damping_ratio", zeta)):
+            est = getattr(fit, name)
+            inside = est.ci95_low <= true <= est.ci95_high
+            covered[name] += inside
+            # never a confident wrong answer: a miss is within 4 of its own standard errors
+            # (the spectral start's fits were 60-250 % off, tens of standard errors)
+            assert inside or abs(est.value - true) < 4 * est.std, (name, truth, est)
+        est = fit.natural_frequency_hz
+        # a 3 % error is never excluded where the frequency is pinned to 1 % (a 3-sigma miss)
+        if est.std < 0.01 * fn_true and abs(est.value / fn_true - 1) > 0.03:
+            assert est.ci95_low <= fn_true <= est.ci95_high, (truth, est)
+    # 95 % intervals: fn's held the truth in 93.5 %, zeta's in 92 % of 200 such ring-downs at
+    # zeta 0.10 (the spectral start's: 24 % at 0.24); 50 draws of a 92 % coverage fall to 42
+    # about one time in 40, hence zeta's looser floor
+    assert covered["natural_frequency_hz"] >= 0.88 * len(runs), covered
+    assert covered["damping_ratio"] >= 0.84 * len(runs), covered
+
+
+def test_beam_intervals_hold_with_correlated_tracking_noise():
+    """A tracker whose error wanders from frame to frame (AR(1), lag-1 correlation 0.8, 0.3 mm):
+    the residuals' autocorrelation widens the intervals (s^2 (J^T J)^-1 alone covered the
+    truth in 32 of these 50 ring-downs); SYNTHETIC."""
+    truth = dataclasses.replace(S.BeamTruth(), damping_ratio=0.1, noise_m=0.0)
+    rho, covered, fitted_rho = 0.8, 0, []
+    for seed in range(50):
+        rng = np.random.default_rng(300 + seed)
+        t, x, y = S.beam_tip_track(truth, rng)
+        noise = signal.lfilter([1.0], [1.0, -rho], rng.normal(0, 3e-4 * np.sqrt(1 - rho**2), len(t) + 200))[200:]
+        fit = B.fit_beam(t, B.principal_displacement(x, y) + noise, truth.mass_kg)
+        est = fit.natural_frequency_hz
+        covered += est.ci95_low <= truth.natural_frequency_hz <= est.ci95_high
+        fitted_rho.append(fit.residual_autocorrelation)
+    assert np.median(fitted_rho) == pytest.approx(rho, abs=0.05)
+    assert covered >= 44
+
+
+def test_creeping_tip_is_refused():
+    """A mass lowered by hand: the tip creeps 5.3 mm to its new rest over ~3 s, no ringing
+    (the shape of the real deflection test in ../shared/data/hinge); SYNTHETIC. Refused,
+    not fitted as a 0.5 Hz 'oscillation' at the damping bound."""
+    rng = np.random.default_rng(11)
+    t = np.arange(200) / 60.0
+    y = 0.0053 * (1 - np.exp(-np.clip(t - 0.5, 0, None) / 0.8)) + rng.normal(0, 1e-4, len(t))
+    with pytest.raises(CalibrationError, match="no ring-down") as err:
+        B.fit_beam(t, y, 0.095, length_m=0.048)
+    assert "static deflection" in err.value.hint

@@ -6,7 +6,9 @@ The tip moves as a damped linear oscillator after the mass is dropped on it::
     wd = wn*sqrt(1 - zeta^2)
 
 fitted by least squares to the tip's displacement along the direction it moves most
-(the first principal axis of the track, so the camera need not be level). Then, with the
+(the first principal axis of the track, so the camera need not be level), started from the
+best points of a grid over frequency and damping (:func:`_start_values`), with intervals
+widened for residuals correlated from frame to frame (``fitstats.serial_covariance``). Then, with the
 oscillating mass m (tip mass plus 33/140 of the beam's own mass, Rayleigh's cantilever
 result):
 
@@ -34,17 +36,23 @@ from scipy import optimize
 from ..errors import CalibrationError
 from ..track.importing import units_hint
 from .curves import Curves
-from .fitstats import Estimate, covariance
+from .fitstats import Estimate, serial_covariance
 
 RAYLEIGH_TIP_FRACTION = 33.0 / 140.0  # share of a cantilever's own mass moving with its tip
 MAPPING = ("k_rot = k*L^2, b_rot = b*L^2: rigid bar of length L on a torsional spring at the clamp, "
            "mass at the tip, small angles, viscous damping")
 MIN_SAMPLES = 20
 MIN_CYCLES = 1.5
+MIN_FRAMES_PER_CYCLE = 4.0   # samples per period the fit needs (Nyquist is 2)
 # plausible peak-to-peak swing of the tip: a 1-3 cm drop (calibration/protocols/beam.md), less than
 # the beam is long; without --length-m, that of a desk-sized beam
 SWING_OF_LENGTH = (1 / 500, 1.0, 0.1)       # (least, most, typical) swing as a share of L
 SWING_M = (1e-4, 0.25, 0.01)                # (least, most, typical) without L
+ZETA_BOUNDS = (1e-4, 0.95)                  # damping ratios the fit allows
+LOWEST_CYCLES = 0.5                         # lowest frequency the fit allows: cycles over the fit window
+START_FN_STEP = 0.01                        # relative step of the start grid's frequencies
+START_ZETAS = (0.005, 0.02, 0.05, 0.1, 0.2, 0.35, 0.6)   # the start grid's damping ratios
+START_COUNT = 3                             # starts refined by least squares: the grid's best local minima
 
 
 @dataclass(frozen=True)
@@ -62,6 +70,7 @@ class BeamFit:
     hinge_damping_nms_per_rad: Estimate | None
     amplitude_m: float
     rms_residual_m: float
+    residual_autocorrelation: float     # lag-1; above 2/sqrt(n) the intervals are widened for it
     n_samples: int
     fit_start_s: float
     fit_end_s: float
@@ -76,7 +85,8 @@ class BeamFit:
             est = getattr(self, name)
             out[name] = None if est is None else est.as_dict()
         out.update(damped_frequency_hz=self.damped_frequency_hz, amplitude_m=self.amplitude_m,
-                   rms_residual_m=self.rms_residual_m, n_samples=self.n_samples,
+                   rms_residual_m=self.rms_residual_m, residual_autocorrelation=self.residual_autocorrelation,
+                   n_samples=self.n_samples,
                    fit_window_s=[self.fit_start_s, self.fit_end_s], mapping=self.mapping)
         return out
 
@@ -139,19 +149,18 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
                                "or widen --start-s/--end-s")
     t0 = float(t[0])
     fs_hz = 1.0 / float(np.median(np.diff(t)))
-    fn0 = _dominant_frequency_hz(t, y - np.median(y[len(y) * 3 // 4:]))
+    lo = [-np.inf, -np.inf, -np.inf, LOWEST_CYCLES / (t[-1] - t0), ZETA_BOUNDS[0]]
+    hi = [np.inf, np.inf, np.inf, fs_hz / 2, ZETA_BOUNDS[1]]
     best = None
-    for zeta0 in (0.02, 0.1, 0.3):
-        p0 = np.array([np.median(y[len(y) * 3 // 4:]), y[0] - np.median(y[len(y) * 3 // 4:]), 0.0, fn0, zeta0])
-        lo = [-np.inf, -np.inf, -np.inf, fn0 * 0.3, 1e-4]
-        hi = [np.inf, np.inf, np.inf, min(fn0 * 3.0, fs_hz / 2), 0.95]
-        p0[3] = np.clip(p0[3], lo[3] * 1.0001, hi[3] * 0.9999)
+    for fn0, zeta0 in _start_values(t, y, lo[3], hi[3]):
+        c0, a0, b0 = _linear_part(t - t0, y, fn0, zeta0)
+        p0 = np.clip([c0, a0, b0, fn0, zeta0], np.nextafter(lo, np.inf), np.nextafter(hi, -np.inf))
         res = optimize.least_squares(lambda p: damped_oscillation(t, p, t0) - y, p0, bounds=(lo, hi),
                                      x_scale="jac", method="trf")
         if best is None or res.cost < best.cost:
             best = res
     p, r = best.x, best.fun
-    cov = covariance(best.jac, r)
+    cov, rho = serial_covariance(best.jac, r)
     rms = float(np.sqrt(np.mean(r**2)))
     amp = float(np.hypot(p[1], p[2]))
     if amp < 5 * rms:
@@ -161,12 +170,18 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
             "drop the mass from higher, or track the tip more closely (see calibration/protocols/beam.md)",
         )
     fn, zeta = float(p[3]), float(p[4])
+    creep = ("a tip that creeps to its new rest without ringing (a mass lowered by hand) has no oscillation "
+             "to fit: read its static deflection, k = m*g/deflection")
+    if zeta >= 0.999 * ZETA_BOUNDS[1]:
+        raise CalibrationError(f"{source}: no ring-down, the fitted damping ratio is at its bound {ZETA_BOUNDS[1]} "
+                               f"({fn:.3g} Hz)", creep)
     cycles = (t[-1] - t[0]) * fn
     if cycles < MIN_CYCLES:
         raise CalibrationError(f"{source}: the fit window covers {cycles:.2g} oscillations (need {MIN_CYCLES})",
-                               "record longer after the drop")
-    if fs_hz < 8 * fn:
-        raise CalibrationError(f"{source}: {fs_hz:.3g} frames/s for a {fn:.3g} Hz oscillation (need 8 frames a cycle)",
+                               "record longer after the drop; " + creep)
+    if fs_hz < MIN_FRAMES_PER_CYCLE * fn:
+        raise CalibrationError(f"{source}: {fs_hz:.3g} frames/s for a {fn:.3g} Hz oscillation "
+                               f"(need {MIN_FRAMES_PER_CYCLE:g} frames a cycle)",
                                "film in slow motion (see calibration/protocols/beam.md)")
     m = mass_kg + RAYLEIGH_TIP_FRACTION * beam_mass_kg
     wn = 2 * np.pi * fn
@@ -190,33 +205,68 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
         damped_frequency_hz=fn * float(np.sqrt(1 - zeta**2)),
         stiffness_n_per_m=cov.estimate(k, grad_k), damping_ns_per_m=cov.estimate(b, grad_b),
         hinge_stiffness_nm_per_rad=hinge_k, hinge_damping_nms_per_rad=hinge_b, amplitude_m=amp,
-        rms_residual_m=rms, n_samples=len(t), fit_start_s=float(t[0]), fit_end_s=float(t[-1]),
+        rms_residual_m=rms, residual_autocorrelation=rho, n_samples=len(t), fit_start_s=float(t[0]),
+        fit_end_s=float(t[-1]),
         mapping=MAPPING, curves=curves,
     )
 
 
 def _window(t_s: np.ndarray, d: np.ndarray, start_s: float | None, end_s: float | None) -> np.ndarray:
-    """Samples to fit: from the first big swing after the drop (or ``start_s``) to ``end_s``.
+    """Samples to fit: from the drop (or ``start_s``) to ``end_s``.
 
-    Before the drop the tip is at rest and the impact itself is not a free oscillation, so
-    the fit starts at the largest excursion from the final rest position in the first half
-    of the record: the first swing after the impact.
+    Before the drop the tip rests at its starting level; the drop is the first sample at
+    which the tip has left that level by a quarter of its whole range, a few milliseconds
+    after the mass landed. From then on the tip and the mass stuck to it move freely, and
+    the fit takes the whole first swing: the fastest part of a heavily damped ring-down,
+    where most of what fixes its frequency is.
     """
     end = t_s[-1] if end_s is None else end_s
     if start_s is None:
-        rest = np.median(d[len(d) * 4 // 5:])
-        half = max(len(d) // 2, 1)
-        start_s = t_s[int(np.argmax(np.abs(d[:half] - rest)))]
+        level = np.median(d[:max(len(d) // 20, 3)])
+        start_s = t_s[int(np.argmax(np.abs(d - level) > 0.25 * np.ptp(d)))]
     return (t_s >= start_s) & (t_s <= end)
 
 
-def _dominant_frequency_hz(t: np.ndarray, u: np.ndarray) -> float:
-    """Peak of the zero-padded spectrum, resampled to a uniform grid first."""
-    n = len(t)
-    tu = np.linspace(t[0], t[-1], n)
-    uu = np.interp(tu, t, u) * np.hanning(n)
-    nfft = 16 * int(2 ** np.ceil(np.log2(n)))
-    spec = np.abs(np.fft.rfft(uu - uu.mean(), nfft))
-    freqs = np.fft.rfftfreq(nfft, tu[1] - tu[0])
-    spec[freqs < 1.0 / (t[-1] - t[0])] = 0  # not the record's own length
-    return float(freqs[int(np.argmax(spec))])
+def _start_values(t: np.ndarray, y: np.ndarray, fn_low_hz: float, fn_high_hz: float) -> list[tuple[float, float]]:
+    """Starts (fn [Hz], zeta) for the least-squares fit: the best few of a grid.
+
+    For each (fn, zeta) of a grid (fn log-spaced ``START_FN_STEP`` apart over the band the
+    fit allows, zeta in ``START_ZETAS``) the offset and the two amplitudes, linear in the
+    model, are solved exactly; the grid points of least residual that are local minima
+    along fn are the starts. Every frequency is tried on the whole ring-down, heavily damped
+    (one or two visible cycles) or not, so the start cannot lock onto the record's length
+    or a noise peak the way a spectrum's highest peak can.
+    """
+    tau = t - t[0]
+    fns = np.exp(np.arange(np.log(fn_low_hz), np.log(fn_high_hz), np.log1p(START_FN_STEP)))
+    zetas = np.asarray(START_ZETAS)
+    wn = 2 * np.pi * fns[:, None]
+    pole = (-zetas * wn + 1j * wn * np.sqrt(1 - zetas**2)).astype(np.complex128)
+    e = np.exp(pole[..., None] * tau)                # env*cos + i env*sin, (fn, zeta, samples)
+    s1, s2, sa = e.sum(-1), (e * e).sum(-1), (e.real**2 + e.imag**2).sum(-1)
+    gram = np.empty(e.shape[:2] + (3, 3))
+    gram[..., 0, 0] = len(tau)
+    gram[..., 0, 1] = gram[..., 1, 0] = s1.real
+    gram[..., 0, 2] = gram[..., 2, 0] = s1.imag
+    gram[..., 1, 1] = (sa + s2.real) / 2
+    gram[..., 2, 2] = (sa - s2.real) / 2
+    gram[..., 1, 2] = gram[..., 2, 1] = s2.imag / 2
+    ey = e @ y
+    rhs = np.stack([np.full(ey.shape, y.sum()), ey.real, ey.imag], axis=-1)
+    coef = np.linalg.solve(gram + 1e-12 * np.eye(3) * np.trace(gram, axis1=-2, axis2=-1)[..., None, None],
+                           rhs[..., None])[..., 0]
+    ssr = float(y @ y) - np.einsum("fzi,fzi->fz", coef, rhs)
+    profile = ssr.min(axis=1)                    # best zeta at each frequency
+    inner = np.r_[True, profile[1:] <= profile[:-1]] & np.r_[profile[:-1] <= profile[1:], True]
+    minima = np.flatnonzero(inner)
+    minima = minima[np.argsort(profile[minima])][:START_COUNT]
+    return [(float(fns[i]), float(zetas[int(np.argmin(ssr[i]))])) for i in minima]
+
+
+def _linear_part(tau: np.ndarray, y: np.ndarray, fn_hz: float, zeta: float) -> np.ndarray:
+    """Offset c and amplitudes A, B of the model at given fn and zeta (linear least squares)."""
+    wn = 2 * np.pi * fn_hz
+    env = np.exp(-zeta * wn * tau)
+    phase = wn * np.sqrt(1 - zeta**2) * tau
+    basis = np.column_stack([np.ones_like(tau), env * np.cos(phase), env * np.sin(phase)])
+    return np.linalg.lstsq(basis, y, rcond=None)[0]

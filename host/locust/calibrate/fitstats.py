@@ -14,6 +14,11 @@ quadrature, the t factor then takes the Welch-Satterthwaite effective degrees of
 (GUM, JCGM 100:2008, G.4). So may the uncertainties of values the fit holds fixed
 (:func:`fixed_covariance`: taken from earlier calibrations, they are not exact).
 
+:func:`serial_covariance`: for residuals in time order, the same inflated by the AR(1)
+factor ``(1 + rho)/(1 - rho)`` of their lag-1 autocorrelation ``rho`` when that is above
+what independent residuals give (effective sample size; e.g. Wilks, Statistical Methods in
+the Atmospheric Sciences, 5.2.4).
+
 Derived quantities (stiffness from frequency, ...) get theirs by first-order propagation.
 """
 
@@ -110,6 +115,32 @@ def covariance(jac: np.ndarray, residual: np.ndarray) -> Covariance:
     bread, undetermined = _inverse_normal(jac)
     cov = bread * (float(residual @ residual) / dof)
     return Covariance(_mark(cov, undetermined), dof)
+
+
+def serial_covariance(jac: np.ndarray, residual: np.ndarray) -> tuple[Covariance, float]:
+    """:func:`covariance` for residuals in time order that may be serially correlated (a
+    track's jitter, a model that misses a slow drift), and their lag-1 autocorrelation rho.
+
+    Correlated residuals carry less information than as many independent ones: for a
+    first-order autoregressive residual the variance of a slowly varying fit grows by
+    ``(1 + rho)/(1 - rho)`` and the effective number of samples falls by the same factor.
+    Where rho is above what independent residuals give (``2/sqrt(n)``, about the one-sided
+    97.7 % point) the covariance is multiplied by that factor and the t factor takes
+    ``n_eff - p`` degrees of freedom; otherwise it is :func:`covariance`'s.
+    """
+    base = covariance(jac, residual)
+    r = np.asarray(residual, dtype=float).ravel()
+    r = r - r.mean()
+    power = float(r @ r)
+    rho = float(r[1:] @ r[:-1]) / power if power > 0 else 0.0
+    n, p = np.shape(jac)
+    if rho <= 2 / math.sqrt(n):
+        return base, rho
+    rho = min(rho, 0.99)
+    factor = (1 + rho) / (1 - rho)
+    dof = max(int(n / factor) - p, 1)
+    method = f"s^2 (J^T J)^-1 x (1+rho)/(1-rho), residual autocorrelation rho={rho:.3g}, t(n_eff-p)"
+    return Covariance(base.matrix * factor, dof, method=method), rho
 
 
 def cluster_covariance(jac: np.ndarray, residual: np.ndarray, clusters: np.ndarray,
