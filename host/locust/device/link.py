@@ -52,10 +52,14 @@ class Link:
         ser.port = port
         ser.baudrate = baud
         ser.timeout = 0.05
-        # DTR and RTS drive EN and GPIO0 through the ESP32 boards' auto-reset circuit:
-        # keep both released, or opening the port can reset the board mid-hop.
-        ser.dtr = False
-        ser.rts = False
+        # DTR and RTS drive EN and GPIO0 through a DevKit's auto-reset circuit (EN is pulled low
+        # while RTS is asserted and DTR is not), and a C3/S3's USB-Serial-JTAG resets the chip on
+        # the same combination. The kernel asserts both lines when the port opens; pyserial then
+        # applies its own dtr/rts settings one at a time, DTR first. Clearing them (dtr=False,
+        # rts=False) passes through DTR=0/RTS=1 and resets the board at every open, and on S2/S3
+        # MicroPython sends nothing (or drops bursts) while DTR is low. So keep pyserial's
+        # default, both asserted, as mpremote does on POSIX: open() re-asserts what the kernel
+        # already asserted (TIOCMBIS only) and the lines never move.
         try:
             ser.open()
         except (serial.SerialException, OSError) as exc:
@@ -216,6 +220,14 @@ class Link:
 
     def close(self) -> None:
         self.stop_heartbeat()
+        try:
+            # Release RTS before DTR (as mpremote does): DTR=1/RTS=0 only holds GPIO0 low, which a
+            # running chip ignores; DTR first would pass through DTR=0/RTS=1, a reset. Closing then
+            # drops the last line.
+            self.serial.rts = False
+            self.serial.dtr = False
+        except (serial.SerialException, OSError):
+            pass  # a pseudo-terminal (the virtual robot) has no modem lines
         try:
             self.serial.close()
         except (serial.SerialException, OSError):
