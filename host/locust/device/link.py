@@ -23,6 +23,10 @@ from ..firmware import protocol as P
 CLOSED = {"ev": "link_closed"}  # put on the event queue when the port goes away
 REPL_PROMPT = b">>> "           # the friendly REPL echoing a frame: `>>> ${"id":...`
 RAW_REPL = b"raw REPL; CTRL-B to exit"
+MIN_MICROPYTHON = (1, 26)  # older ESP32 ports start a PWM at 50 % duty (a 10 ms pulse) before duty_ns applies
+OLD_MICROPYTHON_HINT = ("install MicroPython 1.26 or newer (docs/hardware.md, \"Installing MicroPython\"): older "
+                        "ESP32 releases start each servo's PWM at 50 % duty, a 10 ms pulse that throws the leg "
+                        "to its end stop at every boot")
 
 
 def raise_thread_priority(nice: int = -10) -> None:
@@ -181,6 +185,10 @@ class Link:
         if not msg.get("ok") or msg.get("name") != P.NAME:
             raise DeviceError(f"{self.port} answered but is not the locust firmware: {msg}",
                               f"flash it with `locust flash --port {self.port}`")
+        version = msg.get("micropython")
+        if version is not None and tuple(version[:2]) < MIN_MICROPYTHON:  # older firmware does not say
+            shown = ".".join(str(v) for v in version)
+            raise DeviceError(f"the robot runs MicroPython {shown}; locust needs 1.26 or newer", OLD_MICROPYTHON_HINT)
         if msg.get("protocol") != P.PROTOCOL:
             raise DeviceError(f"firmware {msg.get('version')} speaks protocol {msg.get('protocol')}, "
                               f"this host speaks {P.PROTOCOL}",
