@@ -40,6 +40,22 @@ def test_flash_then_hop_six_cycles_on_time(env, tmp_path):
     assert json.loads((tmp_path / "run" / "run.json").read_text()) == rec
 
 
+def test_flash_refuses_a_pin_the_chip_cannot_drive_and_writes_nothing(env, tmp_path):
+    """GPIO6 of a classic ESP32 is its SPI flash: refused with the usable pins as the hint, before
+    any file is written; the firmware on the board is untouched and still hops."""
+    flash_dir = Path(env["LOCUST_VIRTUAL_DIR"]) / "flash"
+    before = {p.name: (p.stat().st_mtime_ns, p.read_bytes()) for p in flash_dir.iterdir()}
+    proc = _run(["flash", "--port", "sim", "--servo", "left.pin=6"], env)
+    assert proc.returncode == 2, proc.stderr
+    assert "error: --servo left.pin=6 refused for the ESP32" in proc.stderr and "SPI flash" in proc.stderr
+    assert "hint: the ESP32's pins that can drive a servo: 4, 13, 14, 18, 19" in proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert {p.name: (p.stat().st_mtime_ns, p.read_bytes()) for p in flash_dir.iterdir()} == before
+    hop = _run(["hop", "--port", "sim", "--cycles", "1", "--push-ms", "50", "--wait-ms", "50", "--plant", "record",
+                "--out", str(tmp_path / "run")], env)
+    assert hop.returncode == 0, hop.stderr
+
+
 def test_ctrl_c_keeps_an_incomplete_record(env, tmp_path):
     out = tmp_path / "D"
     proc = subprocess.Popen(LOCUST + ["hop", "--port", "sim", "--cycles", "6", "--plant", "record", "--out", str(out)],

@@ -10,6 +10,8 @@ import hashlib
 import math
 import os
 import pty
+import subprocess
+import sys
 import time
 
 import pytest
@@ -19,7 +21,7 @@ from locust.device.flash import firmware_files, flash
 from locust.device.hop import run_hop
 from locust.device.link import Link
 from locust.device.plant import RecordingPlant
-from locust.device.virtual import PWM_PERIOD_S, VirtualRobot
+from locust.device.virtual import PWM_PERIOD_S, TICKS_LEAD_S, VirtualRobot
 from locust.errors import DeviceError
 from locust.firmware import protocol as P
 
@@ -109,6 +111,57 @@ def test_errors_over_the_wire_and_busy(robot):
         bad_id = link.request("pose", left_deg=10, right_deg=-10)
         assert bad_id["ok"] and (bad_id["left_deg"], bad_id["right_deg"]) == (10, -10)
         assert link.call("rest")["ok"]
+
+
+def _reboot_into_firmware(link):
+    """Soft-reset the robot (the firmware's `repl`, then Ctrl-D): its ticks start anew, 5 s before a wrap."""
+    link.call("repl")
+    link.write(b"\x04")
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:
+        if link.events.get(timeout=deadline - time.monotonic()).get("ev") == P.EV_BOOT:
+            return
+    raise AssertionError("no boot event")
+
+
+def test_hop_across_a_ticks_wrap_stays_on_time(robot, tmp_path):
+    """A board's ticks_us wraps at 2**30 us; the virtual robot's do so TICKS_LEAD_S after each
+    boot, so a 6.5 s hop started right after one crosses the wrap. Phase times are the firmware's
+    own (its clock), as on a board."""
+    vr, _, _ = robot
+    with Link(vr.device_path) as link:
+        _reboot_into_firmware(link)
+        before = link.call("ping")["t_us"]
+        assert (1 << 30) - before < TICKS_LEAD_S * 1e6  # the wrap is ahead
+        rec = run_hop(link, R.HopSchedule(cycles=5, push_ms=300, wait_ms=1000), tmp_path)
+        after = link.call("ping")["t_us"]
+    assert after < before  # wrapped during the hop
+    assert rec.status == R.COMPLETE and len(rec.phases) == 10
+    assert [p.commanded_us for p in rec.phases][-1] == 4 * 1_300_000 + 300_000
+    for p in rec.phases:
+        assert 0 <= p.error_us <= 2000, p
+
+
+def test_idle_robot_has_a_boards_ticks_and_soft_reset_leaves_servos_limp(robot):
+    """mpremote exec on the idle robot: Ctrl-C stops the firmware (servos to rest), the raw
+    REPL's soft reset stops every PWM output (a zero pulse on both servo pins), and the
+    ticks are a board's 30-bit ones."""
+    vr, _, _ = robot
+    mpremote = [sys.executable, "-m", "mpremote", "connect", vr.device_path]
+    n = len(vr.pwm_writes)
+    proc = subprocess.run(mpremote + ["exec", "import time; print(time.ticks_add(0, -1))"],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.stdout.strip() == "1073741823", proc.stdout + proc.stderr
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline and not any(w.pulse_us == 0 for w in list(vr.pwm_writes)[n:]):
+        time.sleep(0.02)
+    new = list(vr.pwm_writes)[n:]
+    rest = [w for w in new if w.servo and w.pulse_us > 0]
+    assert rest and all(abs(w.horn_deg) < 1e-6 for w in rest)  # Ctrl-C: to rest first
+    assert {w.pin for w in new if w.pulse_us == 0} == {18, 19}  # then no pulse at all
+    subprocess.run(mpremote + ["reset"], capture_output=True, timeout=60)  # main.py again
+    with Link(vr.device_path) as link:
+        assert link.hello(wait_s=8.0)["chip"] == "esp32"
 
 
 def test_flash_on_a_port_without_micropython_names_the_installer():

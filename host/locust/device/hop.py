@@ -19,6 +19,8 @@ from ..firmware import protocol as P
 from . import record as R
 from .link import CLOSED, Link
 
+RECORD_EVERY_S = 0.25  # run.json is rewritten at most this often during a hop
+
 
 def _phase(ev: dict) -> R.Phase:
     return R.Phase(int(ev["cycle"]), str(ev["phase"]), int(ev["commanded_us"]), int(ev["measured_us"]))
@@ -57,6 +59,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             raise DeviceError(f"the robot refused the hop: {rec.message}",
                               "see `locust hop --help` and docs/protocol.md for the limits")
         hop_id = reply["id"]
+        last_write = 0.0
         deadline = time.monotonic() + schedule.duration_s + 3.0
         while True:
             try:
@@ -74,7 +77,12 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             if ev.get("ev") == P.EV_PHASE:
                 phase = _phase(ev)
                 rec.add_phase(phase)
-                R.write(rec, directory)
+                # rewriting the whole record at each of 2000 phases costs more than the phases
+                # last: a host that falls behind stops reading, the board's output blocks and its
+                # phases start late. So at most every RECORD_EVERY_S while phases stream in.
+                if time.monotonic() - last_write >= RECORD_EVERY_S:
+                    R.write(rec, directory)
+                    last_write = time.monotonic()
                 on_phase(phase)
             elif ev.get("ev") == P.EV_DONE:
                 rec.firmware_status = ev.get("status")

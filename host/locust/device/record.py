@@ -1,7 +1,7 @@
 """The run record of a hop: what was commanded, what the firmware measured, how it ended.
 
 ``data/runs/<timestamp>/run.json`` (or ``--out DIR``): written when the hop starts and again
-as every phase arrives, atomically, so an interrupted run still leaves a readable record of
+as phases arrive (at most every 0.25 s), atomically, so an interrupted run still leaves a readable record of
 what happened. A record is never overwritten by another run.
 
 This module owns the format both ways: :func:`write` puts a :class:`RunRecord` on disk and
