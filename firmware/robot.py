@@ -120,6 +120,20 @@ class NoServos:
         pass
 
 
+RESET_CAUSES = {1: "power_on", 2: "hard", 3: "watchdog", 4: "deepsleep", 5: "soft"}
+
+
+def reset_cause():
+    """machine.reset_cause() by name. On the ESP32 MicroPython reports a brown-out (the supply
+    sagging under the servos' stall current) as PWRON_RESET: "power_on" while the board's power
+    stayed plugged in means a brown-out."""
+    try:
+        import machine
+        return RESET_CAUSES.get(machine.reset_cause(), "unknown")
+    except Exception:
+        return "unknown"
+
+
 def machine_name():
     """os.uname().machine ("<board> with ESP32S3"): the only place a board names its chip."""
     try:
@@ -348,7 +362,8 @@ class Controller:
             self.run_hop(req_id, args)
 
     def run(self):
-        self.send(P.event(P.EV_BOOT, name=P.NAME, version=P.VERSION, protocol=P.PROTOCOL))
+        self.send(P.event(P.EV_BOOT, name=P.NAME, version=P.VERSION, protocol=P.PROTOCOL,
+                          reset=reset_cause()))
         while not self.quit:
             try:
                 self.step()

@@ -9,6 +9,7 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
 import serial
 
 from locust.firmware import protocol as P
@@ -164,3 +165,15 @@ def test_fuzzed_virtual_robot_survives_and_then_hops(env, tmp_path):
     angles = [float(r[5]) for r in rows if r[5]]
     assert len(angles) > 2 * moved
     assert max(abs(a) for a in angles) <= 45.0 + 1e-3  # never outside the servo travel
+
+
+@pytest.mark.slow
+def test_thousand_cycle_hop_runs_in_a_boards_heap(env, tmp_path):
+    """1000 cycles (2000 phases, 40 s) on the virtual robot's 224 kB heap: the phases are
+    computed when due, not listed up front (the two lists of 2000 tuples alone do not fit)."""
+    proc = _run(["hop", "--port", "sim", "--cycles", "1000", "--push-ms", "20", "--wait-ms", "20", "--json",
+                 "--plant", "record", "--out", str(tmp_path / "run")], env, timeout=300)
+    assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr[-3000:]
+    rec = json.loads(proc.stdout)
+    assert rec["status"] == "complete" and len(rec["phases"]) == 2000
+    assert rec["phases"][-1]["commanded_ms"] == 999 * 40 + 20

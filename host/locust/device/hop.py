@@ -70,7 +70,10 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             if ev is CLOSED:
                 raise link.lost_error()
             if ev.get("ev") == P.EV_BOOT:
-                raise DeviceError("the robot rebooted mid-hop (brown-out or reset?)",
+                cause = ev.get("reset", "unknown")
+                what = ("a brown-out (MicroPython reports it as a power-on reset)" if cause == "power_on"
+                        else f"a {cause} reset")
+                raise DeviceError(f"the robot rebooted mid-hop: {what}",
                                   "check the servo power supply: two servos pushing can sag the ESP32's supply")
             if ev.get("hop") != hop_id:
                 continue

@@ -72,6 +72,7 @@ CHIPS = tuple(fw_config.CHIPS)
 MACHINES = {"esp32": "Generic ESP32 module with ESP32", "s2": "Generic ESP32S2 module with ESP32S2",
             "s3": "Generic ESP32S3 module with ESP32S3", "c3": "ESP32C3 module with ESP32C3"}
 SIGINT_BIT = 1 << (signal.SIGINT - 1)
+RESET_POWER_ON, RESET_HARD, RESET_SOFT = 1, 2, 5  # machine.PWRON_RESET, HARD_RESET, SOFT_RESET
 RAW_REPL_BANNER = b"raw REPL; CTRL-B to exit\r\n"
 FRIENDLY_PROMPT = b"\n>>> "
 CTRL_A = b"\x01"
@@ -179,6 +180,7 @@ class VirtualRobot:
             raise DeviceError(f"unknown chip {chip!r} for the virtual robot", f"choose one of {', '.join(CHIPS)}")
         self.chip = chip
         self._ticks_offset_us = 0
+        self._next_reset_cause = RESET_POWER_ON  # machine.reset_cause() of the next boot
         self._active_pins: set[int] = set()
         self._sigint_at = 0.0
         self.flash_dir = Path(flash_dir) if flash_dir else default_flash_dir()
@@ -246,6 +248,7 @@ class VirtualRobot:
         self._ticks_offset_us = (TICKS_PERIOD - int(TICKS_LEAD_S * 1e6) - int(time.monotonic() * 1e6)) % TICKS_PERIOD
         env = dict(os.environ, MICROPYPATH=f"{SHIM_DIR}:.frozen:{self.flash_dir / 'lib'}",
                    LOCUST_PWM_FIFO=self._fifo_path, LOCUST_TICKS_OFFSET_US=str(self._ticks_offset_us),
+                   LOCUST_RESET_CAUSE=str(self._next_reset_cause),
                    **chip_env(self.chip))
         env.pop("PYTHONPATH", None)
         self._period_anchor_s = None
@@ -259,6 +262,7 @@ class VirtualRobot:
             except OSError:
                 pass
         self.boots += 1
+        self._next_reset_cause = RESET_SOFT  # until machine.reset() says otherwise
 
     def stop(self) -> dict:
         """Stop the interpreter and the threads; close the plant; returns its summary."""
@@ -430,6 +434,7 @@ class VirtualRobot:
                 parts = line.split()
                 if parts[:1] == [b"R"]:
                     self._raw_repl = False  # a hard reset boots into main.py
+                    self._next_reset_cause = RESET_HARD
                     with self._proc_lock:
                         if self._proc and self._proc.poll() is None:
                             self._proc.kill()  # machine.reset(): the supervisor reboots it

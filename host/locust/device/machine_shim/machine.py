@@ -116,6 +116,17 @@ class PWM:
             _emit("P %d 0 %d\n" % (self.pin, time.ticks_us()))
 
 
+PWRON_RESET = 1
+HARD_RESET = 2
+WDT_RESET = 3
+DEEPSLEEP_RESET = 4
+SOFT_RESET = 5
+
+
+def reset_cause():
+    return int(os.getenv("LOCUST_RESET_CAUSE") or PWRON_RESET)  # the host tells how it rebooted
+
+
 def reset():
     _emit("R\n")
     time.sleep(1)
