@@ -201,7 +201,8 @@ class Controller:
         return P.reply(req_id, name=P.NAME, version=P.VERSION, protocol=P.PROTOCOL,
                        platform=sys.platform, mpy=getattr(sys.implementation, "_mpy", 0),
                        micropython=list(sys.implementation.version[:3]), machine=machine_name(),
-                       chip=self.chip, config_problems=self.cfg_problems, hopping=self.hop is not None)
+                       chip=self.chip, reset=reset_cause(), config_problems=self.cfg_problems,
+                       hopping=self.hop is not None)
 
     def do_ping(self, req_id, args):
         return P.reply(req_id, t_us=ticks_us())
