@@ -302,7 +302,9 @@ class Controller:
             if left <= 0:
                 return None
             if left > SPIN_US:
-                wait = min(left - SPIN_US, heartbeat_us - silent) // 1000
+                # the heartbeat's deadline gets the same 12 ms margin as a phase: within it
+                # the loop polls without sleeping (poll(0)), still reading the host's pings
+                wait = (min(left, heartbeat_us - silent) - SPIN_US) // 1000
                 self.poll(max(0, min(wait, MAX_POLL_MS)))
 
     def run_hop(self, req_id, args):
@@ -320,7 +322,7 @@ class Controller:
         self.ctrl_c(False)  # a stray 0x03 on the line must not stop the legs mid-hop
         gc.collect()  # collect now, not in the middle of a phase's timing
         clock = Elapsed()
-        self.last_rx = clock.start()
+        self.last_rx = t0_ticks = clock.start()
         try:
             for i in range(n + 1):
                 if i < n:
@@ -351,8 +353,10 @@ class Controller:
                 self.ctrl_c(True)
         self.errors = self.errors[:done]
         self.status = status
-        self.send(P.event(P.EV_DONE, hop=req_id, status=status, phases=done,
-                          total=n, max_err_us=worst, rest_us=clock.now()))
+        rest_us = clock.now()
+        # the raw ticks_us at the start and the end: a wrap crossed if the end is the smaller
+        self.send(P.event(P.EV_DONE, hop=req_id, status=status, phases=done, total=n, max_err_us=worst,
+                          rest_us=rest_us, ticks_us=[t0_ticks, clock.last]))
 
     # -- main loop -----------------------------------------------------------------
     def step(self, timeout_ms=100):

@@ -136,6 +136,8 @@ def test_hop_across_a_ticks_wrap_stays_on_time(robot, tmp_path):
         rec = run_hop(link, R.HopSchedule(cycles=5, push_ms=300, wait_ms=1000), tmp_path)
         after = link.call("ping")["t_us"]
     assert after < before  # wrapped during the hop
+    start, end = rec.firmware_ticks_us
+    assert before < start < (1 << 30) and end < after and rec.to_dict()["ticks_wrapped"]
     assert rec.status == R.COMPLETE and len(rec.phases) == 10
     assert [p.commanded_us for p in rec.phases][-1] == 4 * 1_300_000 + 300_000
     for p in rec.phases:
@@ -162,6 +164,18 @@ def test_idle_robot_has_a_boards_ticks_and_soft_reset_leaves_servos_limp(robot):
     subprocess.run(mpremote + ["reset"], capture_output=True, timeout=60)  # main.py again
     with Link(vr.device_path) as link:
         assert link.hello(wait_s=8.0)["chip"] == "esp32"
+
+
+def test_flash_stops_a_running_hop_instead_of_calling_the_board_blank(robot):
+    """A hop ignores Ctrl-C and answers `repl` with busy: flash stops it and gets in, rather than
+    telling the user the board has no MicroPython."""
+    vr, _, _ = robot
+    with Link(vr.device_path) as link:
+        link.hello()
+        link.call("hop", cycles=20, push_ms=300, wait_ms=1000, heartbeat_ms=10000)
+    # the hop runs on, silent host or not, for 10 s: past the 3 s the raw REPL is given
+    result = flash(vr.device_path, repl_timeout_s=3.0)
+    assert result.firmware_version == P.VERSION
 
 
 def test_flash_on_a_port_without_micropython_names_the_installer():

@@ -89,6 +89,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
                 on_phase(phase)
             elif ev.get("ev") == P.EV_DONE:
                 rec.firmware_status = ev.get("status")
+                rec.firmware_ticks_us = ev.get("ticks_us")
                 break
         link.stop_heartbeat()
         if len(rec.phases) < schedule.phases:
