@@ -114,7 +114,7 @@ def test_errors_over_the_wire_and_busy(robot):
 
 
 def _reboot_into_firmware(link):
-    """Soft-reset the robot (the firmware's `repl`, then Ctrl-D): its ticks start anew, 5 s before a wrap."""
+    """Soft-reset the robot (the firmware's `repl`, then Ctrl-D): its ticks start anew, TICKS_LEAD_S before a wrap."""
     link.call("repl")
     link.write(b"\x04")
     deadline = time.monotonic() + 10
@@ -125,21 +125,21 @@ def _reboot_into_firmware(link):
 
 
 def test_hop_across_a_ticks_wrap_stays_on_time(robot, tmp_path):
-    """A board's ticks_us wraps at 2**30 us; the virtual robot's do so TICKS_LEAD_S after each
-    boot, so a 6.5 s hop started right after one crosses the wrap. Phase times are the firmware's
-    own (its clock), as on a board."""
+    """A board's ticks_us wraps at 2**30 us; the virtual robot's do so TICKS_LEAD_S (7 s) after
+    each boot, so a 7.8 s hop started right after one crosses the wrap. Phase times are the
+    firmware's own (its clock), as on a board."""
     vr, _, _ = robot
     with Link(vr.device_path) as link:
         _reboot_into_firmware(link)
         before = link.call("ping")["t_us"]
         assert (1 << 30) - before < TICKS_LEAD_S * 1e6  # the wrap is ahead
-        rec = run_hop(link, R.HopSchedule(cycles=5, push_ms=300, wait_ms=1000), tmp_path)
+        rec = run_hop(link, R.HopSchedule(cycles=6, push_ms=300, wait_ms=1000), tmp_path)
         after = link.call("ping")["t_us"]
     assert after < before  # wrapped during the hop
     start, end = rec.firmware_ticks_us
     assert before < start < (1 << 30) and end < after and rec.to_dict()["ticks_wrapped"]
-    assert rec.status == R.COMPLETE and len(rec.phases) == 10
-    assert [p.commanded_us for p in rec.phases][-1] == 4 * 1_300_000 + 300_000
+    assert rec.status == R.COMPLETE and len(rec.phases) == 12
+    assert [p.commanded_us for p in rec.phases][-1] == 5 * 1_300_000 + 300_000
     for p in rec.phases:
         assert 0 <= p.error_us <= 2000, p
 

@@ -64,7 +64,7 @@ SHIM_DIR = Path(__file__).resolve().parent / "machine_shim"
 PWM_PERIOD_S = 0.020
 PLANT_CLOSE_TIMEOUT_S = 600.0  # the simulation may still be rendering its video when the hop ends
 TICKS_PERIOD = 1 << 30  # an ESP32's ticks_us() wraps at 2**30 us
-TICKS_LEAD_S = 5.0      # each boot's ticks start this long before a wrap
+TICKS_LEAD_S = 7.0      # each boot's ticks start this long before a wrap (a 7.8 s hop started within 7 s crosses it)
 # A board without PSRAM gives MicroPython about 110 kB of heap; the unix port's objects are
 # twice as large (64-bit words), so twice that here makes the same program fit or fail alike.
 HEAP_BYTES = 224 * 1024
