@@ -7,6 +7,7 @@ MicroPython interpreter; only the servos are virtual (a recording plant).
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 import os
 import pty
@@ -164,6 +165,36 @@ def test_idle_robot_has_a_boards_ticks_and_soft_reset_leaves_servos_limp(robot):
     subprocess.run(mpremote + ["reset"], capture_output=True, timeout=60)  # main.py again
     with Link(vr.device_path) as link:
         assert link.hello(wait_s=8.0)["chip"] == "esp32"
+
+
+def test_bad_saved_pins_fall_back_and_the_boot_escape_skips_the_firmware(robot):
+    """A config.json with the flash pin 6 (written by hand) does not crash-loop the board: the
+    firmware boots on the chip's default pins and says why; a `noboot` file leaves the REPL."""
+    vr, _, _ = robot
+    cfg_path = vr.flash_dir / "config.json"
+    good = cfg_path.read_text()
+    bad = json.loads(good)
+    bad["left"]["pin"] = 6
+    cfg_path.write_text(json.dumps(bad))
+    try:
+        with Link(vr.device_path) as link:
+            _reboot_into_firmware(link)
+            hello = link.hello()
+            assert any("GPIO6" in p for p in hello["config_problems"]), hello
+            assert link.call("config")["config"]["left"]["pin"] == 18
+            assert link.call("pose", left_deg=-10, right_deg=-10)["ok"]
+        (vr.flash_dir / "noboot").write_text("")
+        with Link(vr.device_path) as link:
+            link.call("repl")
+            link.write(b"\x04")
+            with pytest.raises(DeviceError, match="at the MicroPython REPL"):
+                link.hello(wait_s=2.0)
+    finally:
+        cfg_path.write_text(good)
+        (vr.flash_dir / "noboot").unlink(missing_ok=True)
+    with Link(vr.device_path) as link:
+        link.write(b"\x04")  # the friendly REPL's soft reset: main.py again
+        assert link.hello(wait_s=8.0)["config_problems"] == []
 
 
 def test_flash_stops_a_running_hop_instead_of_calling_the_board_blank(robot):

@@ -29,7 +29,7 @@ from ..errors import DeviceError
 from ..firmware import config as fw_config
 from ..firmware import protocol as P
 from ..params import Servo
-from .link import MIN_MICROPYTHON, OLD_MICROPYTHON_HINT, Link
+from .link import MIN_MICROPYTHON, OLD_MICROPYTHON_HINT, REPLY_LIMIT, Link
 
 FIRMWARE_DIR = Path(P.__file__).resolve().parent
 NOT_FLASHED = ("__init__.py",)
@@ -119,7 +119,7 @@ def _release_console(transport, tries: int = 3) -> bool:
 
     A firmware in the middle of a hop answers ``busy`` (and ignores Ctrl-C): it is told to stop
     first, so that a running hop is not mistaken for a board without MicroPython."""
-    reader = P.LineReader(limit=4096)
+    reader = P.LineReader(limit=REPLY_LIMIT)
     for attempt in range(tries):
         transport.serial.write(P.encode({"id": 900 + attempt, "cmd": "repl"}))
         deadline = time.monotonic() + 0.6
@@ -130,7 +130,7 @@ def _release_console(transport, tries: int = 3) -> bool:
                 time.sleep(0.01)
             for line in reader.feed(data):
                 try:
-                    msg = P.decode(line) if line else None
+                    msg = P.decode(line, REPLY_LIMIT) if line else None
                 except P.ProtocolError:
                     continue
                 if msg and msg.get("id") == 900 + attempt and msg.get("ok"):

@@ -20,6 +20,7 @@ import serial
 from ..errors import DeviceError
 from ..firmware import protocol as P
 
+REPLY_LIMIT = 64 * 1024         # longest reply or event line read (requests are held to P.MAX_FRAME)
 CLOSED = {"ev": "link_closed"}  # put on the event queue when the port goes away
 REPL_PROMPT = b">>> "           # the friendly REPL echoing a frame: `>>> ${"id":...`
 RAW_REPL = b"raw REPL; CTRL-B to exit"
@@ -77,7 +78,7 @@ class Link:
 
     # -- reading ---------------------------------------------------------------------
     def _read_loop(self) -> None:
-        lines = P.LineReader(limit=64 * 1024)
+        lines = P.LineReader(limit=REPLY_LIMIT)
         while self.error is None:
             try:
                 data = self.serial.read(max(1, self.serial.in_waiting))
@@ -94,7 +95,7 @@ class Link:
 
     def _dispatch(self, line: bytes | None) -> None:
         try:
-            msg = P.decode(line) if line is not None else None
+            msg = P.decode(line, REPLY_LIMIT) if line is not None else None
         except P.ProtocolError:
             msg = None
         if msg is None or ("ev" not in msg and "ok" not in msg):  # noise, or a REPL echoing our request

@@ -455,7 +455,7 @@ class VirtualRobot:
         except OSError:
             mtime = -1.0
         if self._config_cache is None or self._config_cache[0] != mtime:
-            cfg, _ = fw_config.load(str(path))
+            cfg, _ = fw_config.load(str(path), self.chip)  # as the firmware reads it on this chip
             self._config_cache = (mtime, cfg)
         return self._config_cache[1]
 
