@@ -440,7 +440,10 @@ def main():
         interrupted = True
     finally:
         console.ctrl_c(False)  # a second Ctrl-C (some tools send two) must not cut the rest short
-        ctl.servos.rest()
+        try:
+            ctl.servos.rest()
+        except Exception:  # Ctrl-C can land anywhere on a board, e.g. between a config's deinit and its new servos
+            pass
         console.ctrl_c(True)  # the REPL's own Ctrl-C
     if interrupted:
         console.write(STOPPED)

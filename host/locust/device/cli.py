@@ -195,7 +195,8 @@ def pose(left_deg, right_deg, rest, port):
     by default). Negative angles can be typed directly or after `--` (`locust pose -- -20 -20`).
 
     The pose holds after the command ends, until the robot is told otherwise: another pose, or
-    a hop, a servo config change, Ctrl-C into the REPL or a reset, which all leave it at rest.
+    a hop, a servo config change or Ctrl-C into the REPL, which leave it at rest, or a reset,
+    which stops the pulses (the servos go limp) until the firmware starts and sets them to rest.
     With --port sim the virtual robot lives only as long as the command: use `locust virtual`
     and its /dev/pts/N to watch a pose there.
     """
