@@ -16,6 +16,7 @@ import sys
 import time
 
 import pytest
+import serial
 
 from locust.device import record as R
 from locust.device.flash import firmware_files, flash
@@ -195,6 +196,35 @@ def test_bad_saved_pins_fall_back_and_the_boot_escape_skips_the_firmware(robot):
     with Link(vr.device_path) as link:
         link.write(b"\x04")  # the friendly REPL's soft reset: main.py again
         assert link.hello(wait_s=8.0)["config_problems"] == []
+
+
+def test_ctrl_c_interrupts_running_code_and_cancels_a_line_at_the_prompt(robot):
+    """As on a board: Ctrl-C raises KeyboardInterrupt inside running code (here a sleep, not a
+    read of the console), while at the >>> prompt it cancels the line being typed."""
+    vr, _, _ = robot
+    with Link(vr.device_path) as link:
+        link.call("repl")
+    port = serial.Serial(vr.device_path, timeout=0.2)
+    try:
+        def until(marker: bytes, data: bytes = b"") -> bytes:
+            port.write(data)
+            seen = b""
+            deadline = time.monotonic() + 5
+            while marker not in seen and time.monotonic() < deadline:
+                seen += port.read(256)
+            return seen
+        until(b">>> ", b"\r")
+        assert b"\n42\n" not in until(b">>> ", b"12\x03")          # the line "12" is dropped...
+        assert b"\n42\n" in until(b">>> ", b"6*7\r")               # ...so this is 6*7, not 126*7
+        until(b"... ", b"import time\rwhile True: time.sleep_ms(5)\r")
+        port.write(b"\r")  # runs the loop: no prompt until it is interrupted
+        time.sleep(0.3)
+        assert b"KeyboardInterrupt" in until(b">>> ", b"\x03")
+        port.write(b"\x04")  # soft reset: the firmware again
+    finally:
+        port.close()
+    with Link(vr.device_path) as link:
+        assert link.hello(wait_s=8.0)["name"] == "locust"
 
 
 def test_flash_stops_a_running_hop_instead_of_calling_the_board_blank(robot):

@@ -162,6 +162,21 @@ def _catches_sigint(pid: int) -> bool:
     return False
 
 
+READ_SYSCALL = {"x86_64": 0, "aarch64": 63}.get(os.uname().machine)  # read(2)'s number here
+
+
+def _in_readline(pid: int) -> bool:
+    """Whether the process is blocked in read(2): the unix port's REPL waiting for a line (the
+    firmware waits in poll(2)). A board's REPL takes Ctrl-C there as a character (it cancels
+    the line); the unix port keeps its SIGINT handler installed at its prompt."""
+    try:
+        with open(f"/proc/{pid}/syscall") as fh:
+            first = fh.read().split()[:1]
+    except OSError:
+        return True   # cannot tell: pass the byte on, as the pseudo-terminal would
+    return READ_SYSCALL is None or first == [str(READ_SYSCALL)]
+
+
 def chip_env(chip: str) -> dict[str, str]:
     """The environment that tells the machine/os shims which chip they are."""
     exists = fw_config.CHIPS[chip][0]
@@ -388,7 +403,7 @@ class VirtualRobot:
             return data
         with self._proc_lock:
             proc = self._proc
-        if proc is None or proc.poll() is not None or not _catches_sigint(proc.pid):
+        if proc is None or proc.poll() is not None or not _catches_sigint(proc.pid) or _in_readline(proc.pid):
             return data
         # one SIGINT per burst: the unix port exits on a second SIGINT before the first is handled
         if time.monotonic() - self._sigint_at > 0.1:
