@@ -8,6 +8,11 @@
 # there, a soft reset, runs main.py again). While a hop runs Ctrl-C is switched off, so a
 # stray 0x03 is just a byte of a bad frame and cannot stop the legs half-way. The `repl`
 # command also hands the console back to the REPL (`locust flash` uses it).
+#
+# There is no watchdog: MicroPython's ESP32 machine.WDT cannot be stopped once started, so it
+# would reset a board left at the REPL. A silent host is covered by the heartbeat, and the
+# console's writes do not block for ever on any chip (the UART drains by itself; USB CDC and
+# USB-Serial-JTAG give up after a timeout when no host reads).
 
 import gc
 import sys
@@ -38,9 +43,13 @@ class Console:
 
     ``ctrl_c(on)`` says whether Ctrl-C stops the command loop (KeyboardInterrupt). On the
     ESP32 the console driver raises it itself (``micropython.kbd_intr(3)``) and the byte never
-    reaches stdin; where the console hands 0x03 over as a byte (the unix port behind the
-    virtual robot's raw pseudo-terminal), read() raises it, leaving the bytes after it unread
-    for the REPL. Switched off, 0x03 is an ordinary byte on both.
+    reaches stdin (the virtual robot does the same with a SIGINT); where a console hands 0x03
+    over as a byte (the unix port on a raw terminal), read() raises it, leaving the bytes after
+    it unread for the REPL. Switched off, 0x03 is an ordinary byte on both.
+
+    Input is read a byte per poll(0): a board's stdin has no non-blocking read of "what is
+    there", and read(n) would block for n bytes. That costs tens of microseconds a byte on
+    the chip, so it happens only outside the spin before a phase.
     """
 
     def __init__(self):
