@@ -118,9 +118,12 @@ def encode(obj):
     return b"$" + body + b"*" + crc_hex(body).encode() + b"\n"
 
 
-def decode(line):
-    """One frame without its newline -> the message dict; raises ProtocolError."""
-    if len(line) > MAX_FRAME:
+def decode(line, limit=MAX_FRAME):
+    """One frame without its newline -> the message dict; raises ProtocolError.
+
+    ``limit`` bounds a request (the board's buffer); the host reads replies and events, which
+    may be longer (a hello with config problems), with a limit of its own."""
+    if len(line) > limit:
         raise ProtocolError(E_TOO_LONG, "frame longer than %d bytes" % MAX_FRAME)
     if not line or line[0] != START:
         raise ProtocolError(E_FRAME, "frame does not start with '$'")

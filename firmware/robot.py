@@ -8,10 +8,16 @@
 # there, a soft reset, runs main.py again). While a hop runs Ctrl-C is switched off, so a
 # stray 0x03 is just a byte of a bad frame and cannot stop the legs half-way. The `repl`
 # command also hands the console back to the REPL (`locust flash` uses it).
+#
+# There is no watchdog: MicroPython's ESP32 machine.WDT cannot be stopped once started, so it
+# would reset a board left at the REPL. A silent host is covered by the heartbeat, and the
+# console's writes do not block for ever on any chip (the UART drains by itself; USB CDC and
+# USB-Serial-JTAG give up after a timeout when no host reads).
 
 import gc
 import sys
 import time
+from array import array
 
 import config
 import protocol as P
@@ -20,9 +26,12 @@ import schedule
 ticks_us = time.ticks_us
 ticks_diff = time.ticks_diff
 
-# Busy-wait the last few milliseconds before a phase starts: a sleeping wait (poll) can
-# wake late on a busy system, the spin cannot. Input is serviced outside this window.
-SPIN_US = 4000
+# Busy-wait the last 12 ms before a phase starts. On the ESP32 select.poll() with a timeout
+# sleeps in FreeRTOS ticks (ulTaskNotifyTake(.., 1) in MicroPython's poll loop, 10 ms ticks
+# at CONFIG_FREERTOS_HZ=100): it returns on the first tick after its timeout, up to 10 ms
+# late. Sleeping only until 12 ms before the phase keeps that overshoot out of the phase
+# start; the spin cannot be late. Input is serviced outside this window (poll(0) only).
+SPIN_US = 12000
 MAX_POLL_MS = 50
 
 
@@ -34,9 +43,13 @@ class Console:
 
     ``ctrl_c(on)`` says whether Ctrl-C stops the command loop (KeyboardInterrupt). On the
     ESP32 the console driver raises it itself (``micropython.kbd_intr(3)``) and the byte never
-    reaches stdin; where the console hands 0x03 over as a byte (the unix port behind the
-    virtual robot's raw pseudo-terminal), read() raises it, leaving the bytes after it unread
-    for the REPL. Switched off, 0x03 is an ordinary byte on both.
+    reaches stdin (the virtual robot does the same with a SIGINT); where a console hands 0x03
+    over as a byte (the unix port on a raw terminal), read() raises it, leaving the bytes after
+    it unread for the REPL. Switched off, 0x03 is an ordinary byte on both.
+
+    Input is read a byte per poll(0): a board's stdin has no non-blocking read of "what is
+    there", and read(n) would block for n bytes. That costs tens of microseconds a byte on
+    the chip, so it happens only outside the spin before a phase.
     """
 
     def __init__(self):
@@ -80,19 +93,81 @@ class Console:
         self._out.write(data)
 
 
+class Elapsed:
+    """Microseconds since start(), valid however long a hop runs.
+
+    ticks_us() wraps at 2**30 us (17.9 min) on a 32-bit board, and ticks_diff() is only right
+    for differences under 2**29 us (8.9 min); a hop may last 1000 x 70 s. So the elapsed time
+    is summed from the differences between consecutive readings, each far below 2**29 us
+    (the hop loop reads the clock at least every MAX_POLL_MS). Past 2**30 us the sum is a
+    long integer on the board, as it should be.
+    """
+
+    def start(self):
+        self.last = ticks_us()
+        self.total = 0
+        return self.last
+
+    def now(self):
+        t = ticks_us()
+        self.total += ticks_diff(t, self.last)
+        self.last = t
+        return self.total
+
+
+class NoServos:
+    """Stands in when no servo could be created at boot (bad pins): the loop still answers,
+    so the host can read config_problems and write a config that works."""
+
+    def set(self, left_deg, right_deg):
+        raise ValueError("no servos: fix the config (locust flash --servo left.pin=...)")
+
+    def rest(self):
+        return 0.0, 0.0
+
+    def deinit(self):
+        pass
+
+
+RESET_CAUSES = {1: "power_on", 2: "hard", 3: "watchdog", 4: "deepsleep", 5: "soft"}
+
+
+def reset_cause():
+    """machine.reset_cause() by name. On the ESP32 MicroPython reports a brown-out (the supply
+    sagging under the servos' stall current) as PWRON_RESET: "power_on" while the board's power
+    stayed plugged in means a brown-out."""
+    try:
+        import machine
+        return RESET_CAUSES.get(machine.reset_cause(), "unknown")
+    except Exception:
+        return "unknown"
+
+
+def machine_name():
+    """os.uname().machine ("<board> with ESP32S3"): the only place a board names its chip."""
+    try:
+        import os
+        return os.uname().machine
+    except Exception:  # a port without os.uname (the unix port without the virtual robot's shim)
+        return ""
+
+
 class Controller:
-    def __init__(self, port, make_servos, cfg, cfg_problems=(), cfg_path=config.FILE):
+    def __init__(self, port, make_servos, cfg, cfg_problems=(), cfg_path=config.FILE, chip=None,
+                 servos=None):
         self.port = port
         self.make_servos = make_servos
         self.cfg = cfg
         self.cfg_problems = list(cfg_problems)
         self.cfg_path = cfg_path
-        self.servos = make_servos(cfg)
+        self.chip = chip
+        self.servos = servos if servos is not None else make_servos(cfg)
         self.reader = P.LineReader()
         self.last_rx = ticks_us()
         self.hop = None            # {"id", "stop"} while a hop runs
         self.pending_hop = None    # (id, args) accepted, to start from the main loop
-        self.phases = []           # [(cycle, phase, commanded_us, measured_us)] of the last hop
+        self.hop_args = None       # the last hop's arguments: its phases follow from them
+        self.errors = array("i")   # measured - commanded start of each phase of the last hop, us
         self.status = None         # status of the last hop
         self.quit = False
 
@@ -134,7 +209,9 @@ class Controller:
     def do_hello(self, req_id, args):
         return P.reply(req_id, name=P.NAME, version=P.VERSION, protocol=P.PROTOCOL,
                        platform=sys.platform, mpy=getattr(sys.implementation, "_mpy", 0),
-                       config_problems=self.cfg_problems, hopping=self.hop is not None)
+                       micropython=list(sys.implementation.version[:3]), machine=machine_name(),
+                       chip=self.chip, reset=reset_cause(), config_problems=self.cfg_problems,
+                       hopping=self.hop is not None)
 
     def do_ping(self, req_id, args):
         return P.reply(req_id, t_us=ticks_us())
@@ -169,22 +246,23 @@ class Controller:
 
     def do_report(self, req_id, args):
         start = args["start"]
-        page = [list(p) for p in self.phases[start:start + P.REPORT_PAGE]]
-        return P.reply(req_id, status=self.status, total=len(self.phases), start=start, phases=page)
+        page = []
+        a = self.hop_args
+        for i in range(start, min(start + P.REPORT_PAGE, len(self.errors))):
+            cycle, name, start_us, _ = schedule.phase(i, a["push_deg"], a["push_ms"], a["wait_ms"])
+            page.append([cycle, name, start_us, start_us + self.errors[i]])
+        return P.reply(req_id, status=self.status, total=len(self.errors), start=start, phases=page)
 
     def do_config(self, req_id, args):
         key = args["key"]
         if args["write"]:
             try:
-                new = config.with_value(self.cfg, key, args["value"])
-                config.save(new, self.cfg_path)
+                # the chip's pin rules as well as the limits: a pin the chip refuses must never
+                # reach config.json, where it would be tried at every boot
+                new = config.with_value(self.cfg, key, args["value"], self.chip)
             except ValueError as e:
-                raise P.ProtocolError(P.E_RANGE, str(e)[:120], req_id)
-            self.servos.rest()
-            self.servos.deinit()
-            self.cfg = new
-            self.cfg_problems = []
-            self.servos = self.make_servos(new)
+                raise P.ProtocolError(P.E_RANGE, str(e)[:160], req_id)
+            self._apply(req_id, new)
         if not key:
             return P.reply(req_id, config=self.cfg)
         parts = key.split(".")
@@ -192,65 +270,102 @@ class Controller:
             raise P.ProtocolError(P.E_RANGE, "unknown config key " + key, req_id)
         return P.reply(req_id, key=key, value=self.cfg[parts[0]][parts[1]])
 
+    def _apply(self, req_id, new):
+        """Drive the servos from ``new``, then save it; on any failure the old config and its
+        servos come back and nothing is saved. Saving first (as before) could store a config
+        whose pins fail, and main.py would then fail on it at every boot."""
+        self.servos.rest()
+        self.servos.deinit()
+        try:
+            servos = self.make_servos(new)
+        except Exception as e:  # e.g. ValueError("invalid pin") from machine.Pin
+            self.servos = self.make_servos(self.cfg)  # the old pins worked: they still do
+            raise P.ProtocolError(P.E_RANGE, ("the board refused the new config: " + repr(e))[:160], req_id)
+        try:
+            config.save(new, self.cfg_path, self.chip)
+        except Exception as e:  # a full or failing filesystem
+            servos.rest()
+            servos.deinit()
+            self.servos = self.make_servos(self.cfg)
+            raise P.ProtocolError(P.E_INTERNAL, ("config.json not saved: " + repr(e))[:160], req_id)
+        self.servos = servos
+        self.cfg = new
+        self.cfg_problems = []
+
     def do_repl(self, req_id, args):
         self.servos.rest()
         self.quit = True
         return P.reply(req_id)
 
     # -- the hop -------------------------------------------------------------------
-    def _wait_until(self, t0, target_us, heartbeat_us):
-        """None once target_us (from t0) is reached, or the reason to abort."""
+    def _wait_until(self, clock, target_us, heartbeat_us):
+        """None once target_us (from the hop's start) is reached, or the reason to abort."""
         while True:
             if self.hop["stop"]:
                 return P.HOP_STOPPED
-            now = ticks_us()
-            silent = ticks_diff(now, self.last_rx)
+            left = target_us - clock.now()
+            # the heartbeat's silence is short (<= 10 s): one ticks_diff is exact for it
+            silent = ticks_diff(clock.last, self.last_rx)
             if silent > heartbeat_us:
                 return P.HOP_HEARTBEAT
-            left = target_us - ticks_diff(now, t0)
             if left <= 0:
                 return None
             if left > SPIN_US:
-                wait = min(left - SPIN_US, heartbeat_us - silent) // 1000
+                # the heartbeat's deadline gets the same 12 ms margin as a phase: within it
+                # the loop polls without sleeping (poll(0)), still reading the host's pings
+                wait = (min(left, heartbeat_us - silent) - SPIN_US) // 1000
                 self.poll(max(0, min(wait, MAX_POLL_MS)))
 
     def run_hop(self, req_id, args):
-        plan = schedule.phases(args["cycles"], args["push_deg"], args["push_ms"], args["wait_ms"])
+        n = schedule.count(args["cycles"])
         end_us = schedule.total_us(args["cycles"], args["push_ms"], args["wait_ms"])
         heartbeat_us = args["heartbeat_ms"] * 1000
-        self.phases = []
+        self.hop_args = args
+        self.errors = array("i")  # let the last hop's go before the new one is allocated
+        self.errors = array("i", bytearray(4 * n))  # one allocation: 8 kB for 1000 cycles
+        done = 0
+        worst = 0
         self.status = None
         self.hop = {"id": req_id, "stop": False}
         status = P.HOP_COMPLETE
         self.ctrl_c(False)  # a stray 0x03 on the line must not stop the legs mid-hop
         gc.collect()  # collect now, not in the middle of a phase's timing
-        t0 = ticks_us()
-        self.last_rx = t0
+        clock = Elapsed()
+        self.last_rx = t0_ticks = clock.start()
         try:
-            for i in range(len(plan) + 1):
-                target = plan[i][2] if i < len(plan) else end_us
-                abort = self._wait_until(t0, target, heartbeat_us)
+            for i in range(n + 1):
+                if i < n:
+                    cycle, name, start_us, angle = schedule.phase(i, args["push_deg"], args["push_ms"], args["wait_ms"])
+                else:
+                    start_us = end_us
+                abort = self._wait_until(clock, start_us, heartbeat_us)
                 if abort:
                     status = abort
                     break
-                if i == len(plan):
+                if i == n:
                     break
-                cycle, name, start_us, angle = plan[i]
                 self.servos.set(angle, angle)
-                measured = ticks_diff(ticks_us(), t0)
-                self.phases.append((cycle, name, start_us, measured))
+                measured = clock.now()
+                self.errors[i] = measured - start_us
+                done = i + 1
+                worst = max(worst, abs(measured - start_us))
                 self.send(P.event(P.EV_PHASE, hop=req_id, i=i, cycle=cycle, phase=name,
                                   commanded_us=start_us, measured_us=measured))
                 gc.collect()  # every phase lasts >= 20 ms: room for it before the next one
         finally:
-            self.servos.rest()
+            # whatever failed above (even rest() itself), the loop must come back idle with
+            # Ctrl-C on: a hop left "running" answers busy to everything but stop
             self.hop = None
-            self.ctrl_c(True)
+            try:
+                self.servos.rest()
+            finally:
+                self.ctrl_c(True)
+        self.errors = self.errors[:done]
         self.status = status
-        late = [abs(p[3] - p[2]) for p in self.phases]
-        self.send(P.event(P.EV_DONE, hop=req_id, status=status, phases=len(self.phases),
-                          total=len(plan), max_err_us=max(late) if late else 0,
-                          rest_us=ticks_diff(ticks_us(), t0)))
+        rest_us = clock.now()
+        # the raw ticks_us at the start and the end: a wrap crossed if the end is the smaller
+        self.send(P.event(P.EV_DONE, hop=req_id, status=status, phases=done, total=n, max_err_us=worst,
+                          rest_us=rest_us, ticks_us=[t0_ticks, clock.last]))
 
     # -- main loop -----------------------------------------------------------------
     def step(self, timeout_ms=100):
@@ -261,7 +376,8 @@ class Controller:
             self.run_hop(req_id, args)
 
     def run(self):
-        self.send(P.event(P.EV_BOOT, name=P.NAME, version=P.VERSION, protocol=P.PROTOCOL))
+        self.send(P.event(P.EV_BOOT, name=P.NAME, version=P.VERSION, protocol=P.PROTOCOL,
+                          reset=reset_cause()))
         while not self.quit:
             try:
                 self.step()
@@ -276,13 +392,56 @@ class Controller:
 STOPPED = b"\r\nlocust: Ctrl-C stopped the command loop, servos at rest; Ctrl-D restarts it\r\n"
 
 
+ESCAPE_FILE = "noboot"
+
+
+def escape(chip):
+    """True to skip the firmware at boot and leave the board at the REPL: a file named
+    ``noboot`` on the board, or the BOOT button held down while it boots. However the
+    firmware or its config fails, a board can always be reached this way."""
+    try:
+        import os
+        os.stat(ESCAPE_FILE)
+        return True
+    except OSError:
+        pass
+    button = config.BOOT_BUTTON.get(chip)
+    if button is None:
+        return False
+    try:
+        from machine import Pin
+        return Pin(button, Pin.IN, Pin.PULL_UP).value() == 0
+    except Exception:
+        return False
+
+
+def boot_servos(cfg, bad, chip, make):
+    """(config, problems, servos) for boot: the saved config if its servos start, else the
+    chip's default config, else none at all; never an exception (a crash here would
+    repeat at every boot)."""
+    try:
+        return cfg, bad, make(cfg)
+    except Exception as e:
+        bad = bad + ["servos on the saved config failed: " + repr(e)[:80]]
+    fallback = config.default(chip)
+    try:
+        return fallback, bad + ["using the default config"], make(fallback)
+    except Exception as e:
+        return fallback, bad + ["servos on the default config failed: " + repr(e)[:80]], NoServos()
+
+
 def main():
     from machine import PWM, Pin
     from servo import Servos
 
-    cfg, bad = config.load()
+    chip = config.chip_of(machine_name())
+    if escape(chip):
+        print("locust: boot escape (noboot file or BOOT button): firmware not started")
+        return
+    make = lambda c: Servos(c, PWM, Pin)  # noqa: E731
+    cfg, bad, servos = boot_servos(*config.load(config.FILE, chip), chip, make)
     console = Console()
-    ctl = Controller(console, lambda c: Servos(c, PWM, Pin), cfg, bad)
+    ctl = Controller(console, make, cfg, bad, config.FILE, chip, servos)
     interrupted = False
     try:
         ctl.run()
@@ -290,7 +449,10 @@ def main():
         interrupted = True
     finally:
         console.ctrl_c(False)  # a second Ctrl-C (some tools send two) must not cut the rest short
-        ctl.servos.rest()
+        try:
+            ctl.servos.rest()
+        except Exception:  # Ctrl-C can land anywhere on a board, e.g. between a config's deinit and its new servos
+            pass
         console.ctrl_c(True)  # the REPL's own Ctrl-C
     if interrupted:
         console.write(STOPPED)

@@ -14,10 +14,17 @@ class Servos:
         self.cfg = cfg
         self.pwm = {}
         self.horn_deg = {}
-        for name in config.SERVOS:
-            pulse, _ = config.horn_to_pulse_us(cfg[name], 0.0)
-            self.pwm[name] = pwm_cls(pin_cls(cfg[name]["pin"]), freq=PERIOD_HZ, duty_ns=int(pulse * 1000))
-            self.horn_deg[name] = 0.0
+        try:
+            for name in config.SERVOS:
+                pulse, _ = config.horn_to_pulse_us(cfg[name], 0.0)
+                # freq and duty_ns in the constructor: from MicroPython 1.26 the channel starts
+                # with this duty. Older ESP32 ports start it at 50 % (a 10 ms pulse, the servo
+                # lunges to its end stop) until duty_ns applies; locust flash refuses them.
+                self.pwm[name] = pwm_cls(pin_cls(cfg[name]["pin"]), freq=PERIOD_HZ, duty_ns=int(pulse * 1000))
+                self.horn_deg[name] = 0.0
+        except Exception:
+            self.deinit()  # the left servo's channel must not stay on when the right one fails
+            raise
 
     def set(self, left_deg, right_deg):
         """Command both horns; returns the (clamped) angles actually commanded."""
@@ -31,5 +38,5 @@ class Servos:
         return self.set(0.0, 0.0)
 
     def deinit(self):
-        for name in config.SERVOS:
-            self.pwm[name].deinit()
+        for name in list(self.pwm):
+            self.pwm.pop(name).deinit()

@@ -9,6 +9,7 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
 import serial
 
 from locust.firmware import protocol as P
@@ -37,7 +38,24 @@ def test_flash_then_hop_six_cycles_on_time(env, tmp_path):
         assert abs(p["measured_ms"] - p["commanded_ms"]) <= 2.0, p
     assert rec["phases"][-1]["commanded_ms"] == 5 * 1300 + 300
     assert rec["jitter"]["max_abs_ms"] <= 2.0
+    assert rec["ticks_wrapped"]  # the virtual robot's 30-bit ticks wrap 7 s after its boot
     assert json.loads((tmp_path / "run" / "run.json").read_text()) == rec
+
+
+def test_flash_refuses_a_pin_the_chip_cannot_drive_and_writes_nothing(env, tmp_path):
+    """GPIO6 of a classic ESP32 is its SPI flash: refused with the usable pins as the hint, before
+    any file is written; the firmware on the board is untouched and still hops."""
+    flash_dir = Path(env["LOCUST_VIRTUAL_DIR"]) / "flash"
+    before = {p.name: (p.stat().st_mtime_ns, p.read_bytes()) for p in flash_dir.iterdir()}
+    proc = _run(["flash", "--port", "sim", "--servo", "left.pin=6"], env)
+    assert proc.returncode == 2, proc.stderr
+    assert "error: --servo left.pin=6 refused for the ESP32" in proc.stderr and "SPI flash" in proc.stderr
+    assert "hint: the ESP32's pins that can drive a servo: 4, 13, 14, 18, 19" in proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert {p.name: (p.stat().st_mtime_ns, p.read_bytes()) for p in flash_dir.iterdir()} == before
+    hop = _run(["hop", "--port", "sim", "--cycles", "1", "--push-ms", "50", "--wait-ms", "50", "--plant", "record",
+                "--out", str(tmp_path / "run")], env)
+    assert hop.returncode == 0, hop.stderr
 
 
 def test_ctrl_c_keeps_an_incomplete_record(env, tmp_path):
@@ -148,3 +166,15 @@ def test_fuzzed_virtual_robot_survives_and_then_hops(env, tmp_path):
     angles = [float(r[5]) for r in rows if r[5]]
     assert len(angles) > 2 * moved
     assert max(abs(a) for a in angles) <= 45.0 + 1e-3  # never outside the servo travel
+
+
+@pytest.mark.slow
+def test_thousand_cycle_hop_runs_in_a_boards_heap(env, tmp_path):
+    """1000 cycles (2000 phases, 40 s) on the virtual robot's 224 kB heap: the phases are
+    computed when due, not listed up front (the two lists of 2000 tuples alone do not fit)."""
+    proc = _run(["hop", "--port", "sim", "--cycles", "1000", "--push-ms", "20", "--wait-ms", "20", "--json",
+                 "--plant", "record", "--out", str(tmp_path / "run")], env, timeout=300)
+    assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr[-3000:]
+    rec = json.loads(proc.stdout)
+    assert rec["status"] == "complete" and len(rec["phases"]) == 2000
+    assert rec["phases"][-1]["commanded_ms"] == 999 * 40 + 20

@@ -112,3 +112,69 @@ print(port.calls, port.during, events)
 """
     # the reply goes out before the hop starts, the phase events with Ctrl-C off, `done` once it is back on
     assert _micropython(script) == "[False, True] [None, False, False, True] [None, 'phase', 'phase', 'done']"
+
+
+def _board(script: str, chip: str, stdin: bytes = b"") -> str:
+    """Run a script under the unix port with the virtual robot's shims for ``chip``."""
+    from locust.device.virtual import chip_env
+
+    env = dict(os.environ, MICROPYPATH=str(SHIM_DIR), **chip_env(chip))
+    proc = subprocess.run([micropython_executable(), "-c", script], input=stdin, capture_output=True,
+                          timeout=60, env=env)
+    assert proc.returncode == 0, (proc.stdout + proc.stderr).decode(errors="replace")[-3000:]
+    return proc.stdout.decode().strip().splitlines()[-1]
+
+
+PIN_PROBE = """
+import machine, os
+out = [os.uname().machine]
+for pin in PINS:
+    try:
+        p = machine.PWM(machine.Pin(pin), freq=50, duty_ns=1500000)
+        out.append("ok")
+    except ValueError as e:
+        out.append(str(e))
+p.deinit()
+try:
+    p.duty_ns(1000000)
+except RuntimeError as e:
+    out.append(str(e))
+print(out)
+"""
+
+
+def test_virtual_pins_refuse_what_the_chip_refuses():
+    """As the ESP32 port's machine.Pin/PWM: a GPIO the chip lacks is "invalid pin", an input-only
+    one cannot be a PWM, and a PWM used after deinit() raises."""
+    esp32 = _board("PINS = (20, 34, 18)\n" + PIN_PROBE, "esp32")
+    assert esp32 == ("['Generic ESP32 module with ESP32', 'invalid pin', 'pin can only be input', 'ok', "
+                     "'PWM is inactive']")
+    c3 = _board("PINS = (18, 19, 4)\n" + PIN_PROBE, "c3")  # the C3's USB-Serial-JTAG lines
+    assert c3 == "['ESP32C3 module with ESP32C3', 'invalid pin', 'invalid pin', 'ok', 'PWM is inactive']"
+
+
+def test_virtual_poll_timeout_ends_on_a_10_ms_tick():
+    """select.poll(3) on a board sleeps to the next FreeRTOS tick: it never returns before the
+    first 10 ms boundary after its timeout (a lower bound: no race on the machine's load)."""
+    script = """
+import select, sys, time, utime
+p = select.poll()
+p.register(sys.stdin, select.POLLIN)
+short = []
+for timeout in (1, 3, 7, 12):
+    start = utime.ticks_ms()
+    p.poll(timeout)
+    end = utime.ticks_ms()
+    grid = start + timeout + (-(start + timeout)) % 10
+    short.append(end < grid)
+print(short)
+"""
+    r, w = os.pipe()  # an open, silent stdin
+    try:
+        env = dict(os.environ, MICROPYPATH=str(SHIM_DIR))
+        proc = subprocess.run([micropython_executable(), "-c", script], stdin=r, capture_output=True,
+                              timeout=60, env=env)
+    finally:
+        os.close(r)
+        os.close(w)
+    assert proc.stdout.decode().strip() == "[False, False, False, False]", proc.stderr

@@ -7,19 +7,23 @@ MicroPython interpreter; only the servos are virtual (a recording plant).
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 import os
 import pty
+import subprocess
+import sys
 import time
 
 import pytest
+import serial
 
 from locust.device import record as R
 from locust.device.flash import firmware_files, flash
 from locust.device.hop import run_hop
 from locust.device.link import Link
 from locust.device.plant import RecordingPlant
-from locust.device.virtual import PWM_PERIOD_S, VirtualRobot
+from locust.device.virtual import PWM_PERIOD_S, TICKS_LEAD_S, VirtualRobot
 from locust.errors import DeviceError
 from locust.firmware import protocol as P
 
@@ -109,6 +113,130 @@ def test_errors_over_the_wire_and_busy(robot):
         bad_id = link.request("pose", left_deg=10, right_deg=-10)
         assert bad_id["ok"] and (bad_id["left_deg"], bad_id["right_deg"]) == (10, -10)
         assert link.call("rest")["ok"]
+
+
+def _reboot_into_firmware(link):
+    """Soft-reset the robot (the firmware's `repl`, then Ctrl-D): its ticks start anew, TICKS_LEAD_S before a wrap."""
+    link.call("repl")
+    link.write(b"\x04")
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:
+        if link.events.get(timeout=deadline - time.monotonic()).get("ev") == P.EV_BOOT:
+            return
+    raise AssertionError("no boot event")
+
+
+def test_hop_across_a_ticks_wrap_stays_on_time(robot, tmp_path):
+    """A board's ticks_us wraps at 2**30 us; the virtual robot's do so TICKS_LEAD_S (7 s) after
+    each boot, so a 7.8 s hop started right after one crosses the wrap. Phase times are the
+    firmware's own (its clock), as on a board."""
+    vr, _, _ = robot
+    with Link(vr.device_path) as link:
+        _reboot_into_firmware(link)
+        before = link.call("ping")["t_us"]
+        assert (1 << 30) - before < TICKS_LEAD_S * 1e6  # the wrap is ahead
+        rec = run_hop(link, R.HopSchedule(cycles=6, push_ms=300, wait_ms=1000), tmp_path)
+        after = link.call("ping")["t_us"]
+    assert after < before  # wrapped during the hop
+    start, end = rec.firmware_ticks_us
+    assert before < start < (1 << 30) and end < after and rec.to_dict()["ticks_wrapped"]
+    assert rec.status == R.COMPLETE and len(rec.phases) == 12
+    assert [p.commanded_us for p in rec.phases][-1] == 5 * 1_300_000 + 300_000
+    for p in rec.phases:
+        assert 0 <= p.error_us <= 2000, p
+
+
+def test_idle_robot_has_a_boards_ticks_and_soft_reset_leaves_servos_limp(robot):
+    """mpremote exec on the idle robot: Ctrl-C stops the firmware (servos to rest), the raw
+    REPL's soft reset stops every PWM output (a zero pulse on both servo pins), and the
+    ticks are a board's 30-bit ones."""
+    vr, _, _ = robot
+    mpremote = [sys.executable, "-m", "mpremote", "connect", vr.device_path]
+    n = len(vr.pwm_writes)
+    proc = subprocess.run(mpremote + ["exec", "import time; print(time.ticks_add(0, -1))"],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.stdout.strip() == "1073741823", proc.stdout + proc.stderr
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline and not any(w.pulse_us == 0 for w in list(vr.pwm_writes)[n:]):
+        time.sleep(0.02)
+    new = list(vr.pwm_writes)[n:]
+    rest = [w for w in new if w.servo and w.pulse_us > 0]
+    assert rest and all(abs(w.horn_deg) < 1e-6 for w in rest)  # Ctrl-C: to rest first
+    assert {w.pin for w in new if w.pulse_us == 0} == {18, 19}  # then no pulse at all
+    subprocess.run(mpremote + ["reset"], capture_output=True, timeout=60)  # main.py again
+    with Link(vr.device_path) as link:
+        assert link.hello(wait_s=8.0)["chip"] == "esp32"
+
+
+def test_bad_saved_pins_fall_back_and_the_boot_escape_skips_the_firmware(robot):
+    """A config.json with the flash pin 6 (written by hand) does not crash-loop the board: the
+    firmware boots on the chip's default pins and says why; a `noboot` file leaves the REPL."""
+    vr, _, _ = robot
+    cfg_path = vr.flash_dir / "config.json"
+    good = cfg_path.read_text()
+    bad = json.loads(good)
+    bad["left"]["pin"] = 6
+    cfg_path.write_text(json.dumps(bad))
+    try:
+        with Link(vr.device_path) as link:
+            _reboot_into_firmware(link)
+            hello = link.hello()
+            assert any("GPIO6" in p for p in hello["config_problems"]), hello
+            assert link.call("config")["config"]["left"]["pin"] == 18
+            assert link.call("pose", left_deg=-10, right_deg=-10)["ok"]
+        (vr.flash_dir / "noboot").write_text("")
+        with Link(vr.device_path) as link:
+            link.call("repl")
+            link.write(b"\x04")
+            with pytest.raises(DeviceError, match="at the MicroPython REPL"):
+                link.hello(wait_s=2.0)
+    finally:
+        cfg_path.write_text(good)
+        (vr.flash_dir / "noboot").unlink(missing_ok=True)
+    with Link(vr.device_path) as link:
+        link.write(b"\x04")  # the friendly REPL's soft reset: main.py again
+        assert link.hello(wait_s=8.0)["config_problems"] == []
+
+
+def test_ctrl_c_interrupts_running_code_and_cancels_a_line_at_the_prompt(robot):
+    """As on a board: Ctrl-C raises KeyboardInterrupt inside running code (here a sleep, not a
+    read of the console), while at the >>> prompt it cancels the line being typed."""
+    vr, _, _ = robot
+    with Link(vr.device_path) as link:
+        link.call("repl")
+    port = serial.Serial(vr.device_path, timeout=0.2)
+    try:
+        def until(marker: bytes, data: bytes = b"") -> bytes:
+            port.write(data)
+            seen = b""
+            deadline = time.monotonic() + 5
+            while marker not in seen and time.monotonic() < deadline:
+                seen += port.read(256)
+            return seen
+        until(b">>> ", b"\r")
+        assert b"\n42\n" not in until(b">>> ", b"12\x03")          # the line "12" is dropped...
+        assert b"\n42\n" in until(b">>> ", b"6*7\r")               # ...so this is 6*7, not 126*7
+        until(b"... ", b"import time\rwhile True: time.sleep_ms(5)\r")
+        port.write(b"\r")  # runs the loop: no prompt until it is interrupted
+        time.sleep(0.3)
+        assert b"KeyboardInterrupt" in until(b">>> ", b"\x03")
+        port.write(b"\x04")  # soft reset: the firmware again
+    finally:
+        port.close()
+    with Link(vr.device_path) as link:
+        assert link.hello(wait_s=8.0)["name"] == "locust"
+
+
+def test_flash_stops_a_running_hop_instead_of_calling_the_board_blank(robot):
+    """A hop ignores Ctrl-C and answers `repl` with busy: flash stops it and gets in, rather than
+    telling the user the board has no MicroPython."""
+    vr, _, _ = robot
+    with Link(vr.device_path) as link:
+        link.hello()
+        link.call("hop", cycles=20, push_ms=300, wait_ms=1000, heartbeat_ms=10000)
+    # the hop runs on, silent host or not, for 10 s: past the 3 s the raw REPL is given
+    result = flash(vr.device_path, repl_timeout_s=3.0)
+    assert result.firmware_version == P.VERSION
 
 
 def test_flash_on_a_port_without_micropython_names_the_installer():

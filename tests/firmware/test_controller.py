@@ -161,3 +161,92 @@ def test_fuzz_never_raises_or_leaves_travel():
     assert not internal, internal[:3]
     for _, left, right in ctl.servos.log:
         assert abs(left) <= 45 and abs(right) <= 45
+
+
+class PickyServos(RecordingServos):
+    """Servos that fail on pin 4 (as machine.Pin may on a board) and count live instances."""
+
+    live = 0
+
+    def __init__(self, cfg):
+        if cfg["left"]["pin"] == 4:
+            raise ValueError("invalid pin")
+        super().__init__(cfg)
+        PickyServos.live += 1
+
+    def deinit(self):
+        PickyServos.live -= 1
+
+
+def test_config_that_fails_is_rolled_back_and_not_saved():
+    path = "/tmp/locust_fw_rollback.json"
+    config.save(config.default(), path)
+    PickyServos.live = 0
+    port = ScriptedPort()
+    ctl = robot.Controller(port, PickyServos, config.default(), (), path, "esp32")
+    ctl.handle_line(_req(1, "config", key="left.pin", value=4, write=1)[:-1])   # rules allow, board refuses
+    ctl.handle_line(_req(2, "config", key="left.pin", value=34, write=1)[:-1])  # the chip's rules refuse
+    ctl.handle_line(_req(3, "pose", left_deg=10, right_deg=10)[:-1])
+    m1, m2, m3 = port.messages()
+    assert m1["error"] == P.E_RANGE and "invalid pin" in m1["detail"]
+    assert m2["error"] == P.E_RANGE and "GPIO34" in m2["detail"]
+    assert m3["ok"] and ctl.servos.log[-1][1:] == (10, 10)  # the old servos drive the legs again
+    assert ctl.cfg["left"]["pin"] == 18 and PickyServos.live == 1
+    assert config.load(path) == (config.default(), [])  # nothing saved
+
+
+def test_boot_falls_back_without_raising():
+    bad = config.with_value(config.default(), "left.pin", 4)
+    cfg, problems, servos = robot.boot_servos(bad, [], "esp32", PickyServos)
+    assert cfg == config.default("esp32") and len(problems) == 2 and isinstance(servos, PickyServos)
+    cfg, problems, servos = robot.boot_servos(bad, [], "esp32", lambda c: PickyServos(bad))
+    assert isinstance(servos, robot.NoServos) and len(problems) == 2
+
+
+class FailingRest(RecordingServos):
+    def rest(self):
+        raise OSError("PWM failed")
+
+
+def test_hop_ends_idle_even_if_rest_fails():
+    port = ScriptedPort()
+    ctl = robot.Controller(port, FailingRest, config.default(), (), "/tmp/locust_fw_ctl.json")
+    ctl.handle_line(_req(1, "hop", cycles=1, push_ms=20, wait_ms=20, heartbeat_ms=5000)[:-1])
+    try:
+        ctl.step(0)
+    except OSError:
+        pass
+    assert ctl.hop is None  # not left "busy": the next command is served
+    ctl.handle_line(_req(2, "ping")[:-1])
+    assert port.messages()[-1]["ok"]
+
+
+def test_elapsed_sums_across_ticks_wraps():
+    """ticks_us wraps at 2**30 on a board and ticks_diff is valid to 2**29: the hop clock sums
+    the steps between readings, so 8 steps of 2**28 us (2**31 us, 36 min) read exactly."""
+    real = robot.ticks_us
+    seq = [(1 << 30) - 10 + k * (1 << 28) & ((1 << 30) - 1) for k in range(9)]
+    robot.ticks_us = lambda: seq.pop(0)
+    try:
+        clock = robot.Elapsed()
+        clock.start()
+        totals = [clock.now() for _ in range(8)]
+    finally:
+        robot.ticks_us = real
+    assert totals == [k * (1 << 28) for k in range(1, 9)]
+
+
+def test_report_rebuilds_each_phase_from_the_schedule():
+    ctl, port = _controller()
+    ctl.handle_line(_req(7, "hop", cycles=5, push_deg=-20, push_ms=20, wait_ms=30, heartbeat_ms=5000)[:-1])
+    ctl.step(0)
+    events = [[m["cycle"], m["phase"], m["commanded_us"], m["measured_us"]] for m in port.messages()
+              if m.get("ev") == P.EV_PHASE]
+    pages = []
+    for start in (0, 8):
+        ctl.handle_line(_req(8 + start, "report", start=start)[:-1])
+        last = bytes(port.out).split(b"\n")[-2]
+        reply = json.loads(last[1:-9])  # a report page is longer than a request may be
+        assert reply["total"] == 10 and reply["status"] == P.HOP_COMPLETE
+        pages += reply["phases"]
+    assert pages == events and len(events) == 10

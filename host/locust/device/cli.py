@@ -10,11 +10,14 @@ import click
 
 from ..errors import DeviceError
 from ..fileio import json_text
+from ..firmware import config as fw_config
 from ..params import Schedule, resolve_robot
 from ..params_cli import robot_options
 from ..progress import progress
 from . import record as R
 from .plant import PLANTS
+
+CHIPS = tuple(fw_config.CHIPS)  # the chips whose pin rules the firmware knows, and the virtual robot models
 
 PORT_HELP = "Serial port (e.g. /dev/ttyUSB0), or 'sim' for the virtual robot. Default: the one likely ESP32."
 ROBOT_SCHEDULE = Schedule()   # the robot parameters' default schedule, named in the hop options' help
@@ -71,14 +74,15 @@ def flash(port, compile_mpy, reset_config, servo_sets, preset, config, sets):
     ($LOCUST_VIRTUAL_DIR/flash, default ~/.cache/locust/virtual/flash).
     """
     from .flash import flash as do_flash
-    from .flash import servo_config
     from .link import Link
     from .session import open_port
 
     edits = [_parse_servo_set(s) for s in servo_sets]
-    servo_cfg = servo_config(resolve_robot(preset, config, sets).servo) if reset_config else None
+    servo = resolve_robot(preset, config, sets).servo if reset_config else None
     with open_port(port, plant="record", info=_info) as device:
-        result = do_flash(device, compile_mpy=compile_mpy, config=servo_cfg, progress=lambda s: _info(f"  {s}"))
+        # the edits are checked against the board's chip before any file is written
+        result = do_flash(device, compile_mpy=compile_mpy, servo=servo, edits=edits,
+                          progress=lambda s: _info(f"  {s}"))
         if edits:
             with Link(device) as link:
                 link.hello()
@@ -191,7 +195,8 @@ def pose(left_deg, right_deg, rest, port):
     by default). Negative angles can be typed directly or after `--` (`locust pose -- -20 -20`).
 
     The pose holds after the command ends, until the robot is told otherwise: another pose, or
-    a hop, a servo config change, Ctrl-C into the REPL or a reset, which all leave it at rest.
+    a hop, a servo config change or Ctrl-C into the REPL, which leave it at rest, or a reset,
+    which stops the pulses (the servos go limp) until the firmware starts and sets them to rest.
     With --port sim the virtual robot lives only as long as the command: use `locust virtual`
     and its /dev/pts/N to watch a pose there.
     """
@@ -286,14 +291,20 @@ def _remove_empty(directory: Path, top: Path | None) -> None:
                    "Default: $LOCUST_VIRTUAL_DIR/flash or ~/.cache/locust/virtual/flash.")
 @click.option("--pwm-log", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Write every PWM change (and the horn angle it means) to this CSV file (must not exist).")
+@click.option("--chip", type=click.Choice(CHIPS), default="esp32", show_default=True,
+              help="The chip whose limits the virtual robot has: its pins (os.uname().machine names it).")
 @_plant_options
 @robot_options
-def virtual(flash_dir, pwm_log, plant, video, preset, config, sets):
+def virtual(flash_dir, pwm_log, chip, plant, video, preset, config, sets):
     """Start a virtual robot in the foreground; print its device path (/dev/pts/N) first.
 
     The firmware in the flash folder runs on the real MicroPython interpreter (unix port)
     behind that pseudo-terminal; any serial tool, mpremote or `locust hop --port /dev/pts/N`
     can talk to it. Fill the flash with `locust flash --port /dev/pts/N`. Ctrl-C stops it.
+
+    It has a board's limits (docs/device.md): 30-bit ticks that wrap a few seconds after each
+    boot, poll timeouts on a 10 ms tick, the chip's pin rules, a heap like a board without
+    PSRAM, servos limp after a soft reset, Ctrl-C that interrupts anywhere while idle.
     """
     from .plant import make_plant
     from .virtual import VirtualRobot
@@ -301,10 +312,10 @@ def virtual(flash_dir, pwm_log, plant, video, preset, config, sets):
     if pwm_log is not None and pwm_log.exists():
         raise DeviceError(f"{pwm_log} exists; a log is never overwritten", "choose another --pwm-log path")
     robot = resolve_robot(preset, config, sets)
-    vr = VirtualRobot(flash_dir, make_plant(plant, robot, video), log_path=pwm_log).start()
+    vr = VirtualRobot(flash_dir, make_plant(plant, robot, video), log_path=pwm_log, chip=chip).start()
     click.echo(vr.device_path)
     sys.stdout.flush()
-    _info(f"virtual robot: flash {vr.flash_dir}, {vr.scheduling} scheduling, "
+    _info(f"virtual robot ({vr.chip}): flash {vr.flash_dir}, {vr.scheduling} scheduling, "
           f"plant {type(vr.plant).__name__}; Ctrl-C to stop")
     signal.signal(signal.SIGTERM, _interrupt)
     try:

@@ -29,7 +29,7 @@ from ..errors import DeviceError
 from ..firmware import config as fw_config
 from ..firmware import protocol as P
 from ..params import Servo
-from .link import Link
+from .link import MIN_MICROPYTHON, OLD_MICROPYTHON_HINT, REPLY_LIMIT, Link
 
 FIRMWARE_DIR = Path(P.__file__).resolve().parent
 NOT_FLASHED = ("__init__.py",)
@@ -44,11 +44,11 @@ NO_MICROPYTHON_HINT = (
 )
 
 
-def servo_config(servo: Servo) -> dict:
-    """The board's ``config.json`` for ``servo``: its pulse range and travel, the firmware's pins,
-    trims and directions. The firmware keeps its own copy of the default pulse range (it cannot
-    import the host); the host always writes these from :class:`locust.params.Servo`."""
-    cfg = fw_config.default()
+def servo_config(servo: Servo, chip: str = "esp32") -> dict:
+    """The board's ``config.json`` for ``servo``: its pulse range and travel, the firmware's pins
+    for ``chip``, trims and directions. The firmware keeps its own copy of the default pulse
+    range (it cannot import the host); the host always writes these from :class:`locust.params.Servo`."""
+    cfg = fw_config.default(chip)
     for name in fw_config.SERVOS:
         cfg[name].update(pulse_min_us=servo.pulse_min_us, pulse_max_us=servo.pulse_max_us,
                          range_deg=servo.range_deg, travel_deg=servo.travel_deg)
@@ -115,8 +115,11 @@ def _transport(port: str):
 
 
 def _release_console(transport, tries: int = 3) -> bool:
-    """Ask a running locust firmware for the REPL; False if nothing answered (plain REPL, or none)."""
-    reader = P.LineReader(limit=4096)
+    """Ask a running locust firmware for the REPL; False if nothing answered (plain REPL, or none).
+
+    A firmware in the middle of a hop answers ``busy`` (and ignores Ctrl-C): it is told to stop
+    first, so that a running hop is not mistaken for a board without MicroPython."""
+    reader = P.LineReader(limit=REPLY_LIMIT)
     for attempt in range(tries):
         transport.serial.write(P.encode({"id": 900 + attempt, "cmd": "repl"}))
         deadline = time.monotonic() + 0.6
@@ -127,17 +130,51 @@ def _release_console(transport, tries: int = 3) -> bool:
                 time.sleep(0.01)
             for line in reader.feed(data):
                 try:
-                    msg = P.decode(line) if line else None
+                    msg = P.decode(line, REPLY_LIMIT) if line else None
                 except P.ProtocolError:
                     continue
                 if msg and msg.get("id") == 900 + attempt and msg.get("ok"):
                     time.sleep(0.1)  # let main.py end and the REPL print its prompt
                     return True
+                if msg and msg.get("id") == 900 + attempt and msg.get("error") == P.E_BUSY:
+                    transport.serial.write(P.encode({"id": 899, "cmd": "stop"}))
+                    time.sleep(0.2)  # the hop ends at its next check; then ask again
+                    deadline = 0.0
     return False
 
 
+def board_chip(transport) -> tuple[str, str | None]:
+    """(os.uname().machine, chip) of the board at the raw REPL; chip None if locust has no
+    pin rules for it. sys.platform is "esp32" on every chip: only the machine string tells."""
+    transport.exec("import os\ntry:\n _m = os.uname().machine\nexcept Exception:\n _m = ''")
+    machine = transport.eval("_m")
+    return machine, fw_config.chip_of(machine)
+
+
+def planned_config(board: dict | None, written: dict | None, edits: list[tuple[str, float]],
+                   chip: str) -> dict:
+    """The config the board will run after flashing with ``edits``, checked against ``chip``'s pin
+    rules before anything is written; DeviceError naming the bad value and the usable pins."""
+    cfg = written or (board if board is not None and not fw_config.problems(board, chip) else None) \
+        or servo_config(Servo(), chip)
+    for key, value in edits:
+        try:
+            cfg = fw_config.with_value(cfg, key, value, chip)
+        except ValueError as exc:
+            pins = ", ".join(str(p) for p in fw_config.usable_pins(chip))
+            raise DeviceError(f"--servo {key}={value:g} refused for the {fw_config.chip_name(chip)}: {exc}",
+                              f"the {fw_config.chip_name(chip)}'s pins that can drive a servo: {pins}; "
+                              "nothing was written to the board") from None
+    return cfg
+
+
 def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
-          progress: Callable[[str], None] = lambda s: None, repl_timeout_s: float = 10.0) -> FlashResult:
+          progress: Callable[[str], None] = lambda s: None, repl_timeout_s: float = 10.0,
+          edits: list[tuple[str, float]] = (), servo: Servo | None = None) -> FlashResult:
+    """Flash the firmware; ``config`` (a whole config.json, or with ``servo`` one made from those
+    servo parameters and the chip's pins) and ``edits`` ("left.pin", 4) are
+    checked against the board's chip before any file is written (the edits themselves are
+    applied afterwards through the firmware, which checks them again)."""
     from mpremote.transport import TransportError
 
     if config is not None and fw_config.problems(config):
@@ -145,6 +182,7 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
                           "see docs/device.md for the keys and their limits")
     t_start = time.monotonic()
     transport = _transport(port)
+    in_raw_repl = False
     try:
         progress("connecting")
         _release_console(transport)
@@ -154,12 +192,35 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
             transport.enter_raw_repl(soft_reset=False, timeout_overall=repl_timeout_s)
         except TransportError:
             raise DeviceError(f"no MicroPython REPL answered on {port}", NO_MICROPYTHON_HINT) from None
+        in_raw_repl = True
         transport.serial.timeout = None
         transport.exec("import sys")
-        impl, board_mpy, platform = transport.eval(
-            "(sys.implementation.name, getattr(sys.implementation, '_mpy', 0), sys.platform)")
+        impl, board_mpy, platform, version = transport.eval(
+            "(sys.implementation.name, getattr(sys.implementation, '_mpy', 0), sys.platform, "
+            "sys.implementation.version[:2])")
         if impl != "micropython":
             raise DeviceError(f"{port} runs {impl}, not MicroPython", NO_MICROPYTHON_HINT)
+        if tuple(version) < MIN_MICROPYTHON:
+            raise DeviceError(f"{port} runs MicroPython {version[0]}.{version[1]}; locust needs "
+                              f"{MIN_MICROPYTHON[0]}.{MIN_MICROPYTHON[1]} or newer", OLD_MICROPYTHON_HINT)
+        machine, chip = board_chip(transport)
+        if chip is None:
+            raise DeviceError(f"{port} is a {machine or 'board that does not name its chip'}: locust knows the "
+                              "pins of the ESP32, ESP32-S2, ESP32-S3 and ESP32-C3 only",
+                              "use one of those chips (docs/hardware.md)")
+        if servo is not None and config is None:
+            config = servo_config(servo, chip)
+        if config is not None and fw_config.problems(config, chip):
+            raise DeviceError(f"bad servo config for the {fw_config.chip_name(chip)}: "
+                              + "; ".join(fw_config.problems(config, chip)),
+                              f"usable pins: {', '.join(str(p) for p in fw_config.usable_pins(chip))}")
+        board_cfg = None
+        if edits and config is None and transport.fs_exists(fw_config.FILE):
+            try:
+                board_cfg = json.loads(transport.fs_readfile(fw_config.FILE))
+            except ValueError:
+                board_cfg = None
+        planned_config(board_cfg, config, list(edits), chip)  # raises before anything is written
         with tempfile.TemporaryDirectory(prefix="locust-flash-") as tmp:
             files = build(compile_mpy, Path(tmp))
         if compile_mpy:
@@ -168,7 +229,7 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
             if ours != theirs:
                 raise DeviceError(f"the board reads .mpy v{theirs}, mpy-cross writes v{ours}",
                                   "flash without --compile, or install the mpy-cross matching the board's MicroPython")
-        result = FlashResult(port=port, compiled=compile_mpy, firmware_version="", board=platform,
+        result = FlashResult(port=port, compiled=compile_mpy, firmware_version="", board=machine or platform,
                              config_written=False)
         for name, data in files:
             progress(f"copying {name}")
@@ -186,14 +247,21 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
             result.files.append(FlashedFile(name, len(data), digest))
         if config is not None or not transport.fs_exists(fw_config.FILE):
             progress(f"writing {fw_config.FILE}")
-            transport.fs_writefile(fw_config.FILE, json.dumps(config or servo_config(Servo())).encode())
+            transport.fs_writefile(fw_config.FILE, json.dumps(config or servo_config(Servo(), chip)).encode())
             result.config_written = True
         progress("resetting")
         transport.exit_raw_repl()
+        in_raw_repl = False
         transport.serial.write(b"\x04")  # soft reset from the friendly REPL: runs main.py
     except TransportError as exc:
         raise DeviceError(f"mpremote failed on {port}: {exc}", "reset the board and run `locust flash` again") from None
     finally:
+        if in_raw_repl:  # refused before writing: give the board its firmware back
+            try:
+                transport.exit_raw_repl()
+                transport.serial.write(b"\x04")
+            except (TransportError, OSError):
+                pass
         transport.close()
     progress("handshake")
     with Link(port) as link:

@@ -19,6 +19,8 @@ from ..firmware import protocol as P
 from . import record as R
 from .link import CLOSED, Link
 
+RECORD_EVERY_S = 0.25  # run.json is rewritten at most this often during a hop
+
 
 def _phase(ev: dict) -> R.Phase:
     return R.Phase(int(ev["cycle"]), str(ev["phase"]), int(ev["commanded_us"]), int(ev["measured_us"]))
@@ -57,6 +59,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             raise DeviceError(f"the robot refused the hop: {rec.message}",
                               "see `locust hop --help` and docs/protocol.md for the limits")
         hop_id = reply["id"]
+        last_write = 0.0
         deadline = time.monotonic() + schedule.duration_s + 3.0
         while True:
             try:
@@ -67,17 +70,26 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             if ev is CLOSED:
                 raise link.lost_error()
             if ev.get("ev") == P.EV_BOOT:
-                raise DeviceError("the robot rebooted mid-hop (brown-out or reset?)",
+                cause = ev.get("reset", "unknown")
+                what = ("a brown-out (MicroPython reports it as a power-on reset)" if cause == "power_on"
+                        else f"a {cause} reset")
+                raise DeviceError(f"the robot rebooted mid-hop: {what}",
                                   "check the servo power supply: two servos pushing can sag the ESP32's supply")
             if ev.get("hop") != hop_id:
                 continue
             if ev.get("ev") == P.EV_PHASE:
                 phase = _phase(ev)
                 rec.add_phase(phase)
-                R.write(rec, directory)
+                # rewriting the whole record at each of 2000 phases costs more than the phases
+                # last: a host that falls behind stops reading, the board's output blocks and its
+                # phases start late. So at most every RECORD_EVERY_S while phases stream in.
+                if time.monotonic() - last_write >= RECORD_EVERY_S:
+                    R.write(rec, directory)
+                    last_write = time.monotonic()
                 on_phase(phase)
             elif ev.get("ev") == P.EV_DONE:
                 rec.firmware_status = ev.get("status")
+                rec.firmware_ticks_us = ev.get("ticks_us")
                 break
         link.stop_heartbeat()
         if len(rec.phases) < schedule.phases:

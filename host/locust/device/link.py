@@ -20,9 +20,14 @@ import serial
 from ..errors import DeviceError
 from ..firmware import protocol as P
 
+REPLY_LIMIT = 64 * 1024         # longest reply or event line read (requests are held to P.MAX_FRAME)
 CLOSED = {"ev": "link_closed"}  # put on the event queue when the port goes away
 REPL_PROMPT = b">>> "           # the friendly REPL echoing a frame: `>>> ${"id":...`
 RAW_REPL = b"raw REPL; CTRL-B to exit"
+MIN_MICROPYTHON = (1, 26)  # older ESP32 ports start a PWM at 50 % duty (a 10 ms pulse) before duty_ns applies
+OLD_MICROPYTHON_HINT = ("install MicroPython 1.26 or newer (docs/hardware.md, \"Installing MicroPython\"): older "
+                        "ESP32 releases start each servo's PWM at 50 % duty, a 10 ms pulse that throws the leg "
+                        "to its end stop at every boot")
 
 
 def raise_thread_priority(nice: int = -10) -> None:
@@ -52,10 +57,14 @@ class Link:
         ser.port = port
         ser.baudrate = baud
         ser.timeout = 0.05
-        # DTR and RTS drive EN and GPIO0 through the ESP32 boards' auto-reset circuit:
-        # keep both released, or opening the port can reset the board mid-hop.
-        ser.dtr = False
-        ser.rts = False
+        # DTR and RTS drive EN and GPIO0 through a DevKit's auto-reset circuit (EN is pulled low
+        # while RTS is asserted and DTR is not), and a C3/S3's USB-Serial-JTAG resets the chip on
+        # the same combination. The kernel asserts both lines when the port opens; pyserial then
+        # applies its own dtr/rts settings one at a time, DTR first. Clearing them (dtr=False,
+        # rts=False) passes through DTR=0/RTS=1 and resets the board at every open, and on S2/S3
+        # MicroPython sends nothing (or drops bursts) while DTR is low. So keep pyserial's
+        # default, both asserted, as mpremote does on POSIX: open() re-asserts what the kernel
+        # already asserted (TIOCMBIS only) and the lines never move.
         try:
             ser.open()
         except (serial.SerialException, OSError) as exc:
@@ -69,7 +78,7 @@ class Link:
 
     # -- reading ---------------------------------------------------------------------
     def _read_loop(self) -> None:
-        lines = P.LineReader(limit=64 * 1024)
+        lines = P.LineReader(limit=REPLY_LIMIT)
         while self.error is None:
             try:
                 data = self.serial.read(max(1, self.serial.in_waiting))
@@ -86,7 +95,7 @@ class Link:
 
     def _dispatch(self, line: bytes | None) -> None:
         try:
-            msg = P.decode(line) if line is not None else None
+            msg = P.decode(line, REPLY_LIMIT) if line is not None else None
         except P.ProtocolError:
             msg = None
         if msg is None or ("ev" not in msg and "ok" not in msg):  # noise, or a REPL echoing our request
@@ -177,6 +186,10 @@ class Link:
         if not msg.get("ok") or msg.get("name") != P.NAME:
             raise DeviceError(f"{self.port} answered but is not the locust firmware: {msg}",
                               f"flash it with `locust flash --port {self.port}`")
+        version = msg.get("micropython")
+        if version is not None and tuple(version[:2]) < MIN_MICROPYTHON:  # older firmware does not say
+            shown = ".".join(str(v) for v in version)
+            raise DeviceError(f"the robot runs MicroPython {shown}; locust needs 1.26 or newer", OLD_MICROPYTHON_HINT)
         if msg.get("protocol") != P.PROTOCOL:
             raise DeviceError(f"firmware {msg.get('version')} speaks protocol {msg.get('protocol')}, "
                               f"this host speaks {P.PROTOCOL}",
@@ -216,6 +229,14 @@ class Link:
 
     def close(self) -> None:
         self.stop_heartbeat()
+        try:
+            # Release RTS before DTR (as mpremote does): DTR=1/RTS=0 only holds GPIO0 low, which a
+            # running chip ignores; DTR first would pass through DTR=0/RTS=1, a reset. Closing then
+            # drops the last line.
+            self.serial.rts = False
+            self.serial.dtr = False
+        except (serial.SerialException, OSError):
+            pass  # a pseudo-terminal (the virtual robot) has no modem lines
         try:
             self.serial.close()
         except (serial.SerialException, OSError):

@@ -1,7 +1,7 @@
 """The run record of a hop: what was commanded, what the firmware measured, how it ended.
 
 ``data/runs/<timestamp>/run.json`` (or ``--out DIR``): written when the hop starts and again
-as every phase arrives, atomically, so an interrupted run still leaves a readable record of
+as phases arrive (at most every 0.25 s), atomically, so an interrupted run still leaves a readable record of
 what happened. A record is never overwritten by another run.
 
 This module owns the format both ways: :func:`write` puts a :class:`RunRecord` on disk and
@@ -138,6 +138,8 @@ class RunRecord:
     message: str | None = None           # why it is not complete
     started_at: str = field(default_factory=lambda: time.strftime("%Y-%m-%dT%H:%M:%S%z"))
     phases: list[Phase] = field(default_factory=list)
+    # the board's raw ticks_us at the hop's start and end (30-bit: wrapped if end < start)
+    firmware_ticks_us: list[int] | None = None
 
     def add_phase(self, phase: Phase) -> None:
         if all((p.cycle, p.phase) != (phase.cycle, phase.phase) for p in self.phases):
@@ -157,6 +159,9 @@ class RunRecord:
             "phases_expected": self.schedule.phases,
             "phases": [p.to_dict() for p in self.phases],
             "jitter": asdict(j) if j else None,
+            "firmware_ticks_us": self.firmware_ticks_us,
+            "ticks_wrapped": (None if not self.firmware_ticks_us
+                              else self.firmware_ticks_us[1] < self.firmware_ticks_us[0]),
         }
 
 
@@ -220,7 +225,12 @@ def read_run_record(path: Path) -> RunRecord:
         schedule=HopSchedule(**values), port=str(doc.get("port") or ""), status=str(doc.get("status") or INCOMPLETE),
         firmware_version=_text(doc.get("firmware_version")), firmware_status=_text(doc.get("firmware_status")),
         message=_text(doc.get("message")), started_at=str(doc.get("started_at") or ""), phases=phases,
+        firmware_ticks_us=_ticks(doc.get("firmware_ticks_us")),
     )
+
+
+def _ticks(value) -> list[int] | None:
+    return list(value) if isinstance(value, list) and len(value) == 2 and all(_is_int(v) for v in value) else None
 
 
 def _is_number(value) -> bool:

@@ -23,6 +23,15 @@ What runs where:
 
 The interpreter runs with real-time scheduling when the host allows it (otherwise at a raised
 or normal priority): an MCU does not share its core with a compiler and a browser.
+
+It has a board's limits, by default those of a classic ESP32 without PSRAM (``chip`` picks
+esp32, s2, s3 or c3): ``time``'s ticks are 30-bit and start ``TICKS_LEAD_S`` before a wrap at
+every boot; ``select.poll`` timeouts end on a 10 ms FreeRTOS tick; ``os.uname().machine``
+names the chip; ``machine.Pin``/``PWM`` refuse the pins that chip refuses (and a flash pin
+crashes it), and a PWM raises after ``deinit()`` (the ``machine_shim`` modules); the heap is
+``HEAP_BYTES``; a soft reset stops every PWM output (a zero pulse: the servos go limp), as
+MicroPython's ``machine_pwm_deinit_all()`` does; and Ctrl-C raises KeyboardInterrupt wherever
+the program is while it has Ctrl-C on (``micropython.kbd_intr(3)``), not only in a read.
 """
 
 from __future__ import annotations
@@ -54,10 +63,20 @@ from .plant import Plant, RecordingPlant
 SHIM_DIR = Path(__file__).resolve().parent / "machine_shim"
 PWM_PERIOD_S = 0.020
 PLANT_CLOSE_TIMEOUT_S = 600.0  # the simulation may still be rendering its video when the hop ends
-TICKS_PERIOD = 1 << 30  # MicroPython's ticks wrap at least this often
+TICKS_PERIOD = 1 << 30  # an ESP32's ticks_us() wraps at 2**30 us
+TICKS_LEAD_S = 7.0      # each boot's ticks start this long before a wrap (a 7.8 s hop started within 7 s crosses it)
+# A board without PSRAM gives MicroPython about 110 kB of heap; the unix port's objects are
+# twice as large (64-bit words), so twice that here makes the same program fit or fail alike.
+HEAP_BYTES = 224 * 1024
+CHIPS = tuple(fw_config.CHIPS)
+MACHINES = {"esp32": "Generic ESP32 module with ESP32", "s2": "Generic ESP32S2 module with ESP32S2",
+            "s3": "Generic ESP32S3 module with ESP32S3", "c3": "ESP32C3 module with ESP32C3"}
+SIGINT_BIT = 1 << (signal.SIGINT - 1)
+RESET_POWER_ON, RESET_HARD, RESET_SOFT = 1, 2, 5  # machine.PWRON_RESET, HARD_RESET, SOFT_RESET
 RAW_REPL_BANNER = b"raw REPL; CTRL-B to exit\r\n"
 FRIENDLY_PROMPT = b"\n>>> "
 CTRL_A = b"\x01"
+CTRL_C = b"\x03"
 
 
 def virtual_home() -> Path:
@@ -130,8 +149,55 @@ def _raise_priority() -> None:
         pass
 
 
+def _catches_sigint(pid: int) -> bool:
+    """Whether the process has a SIGINT handler: the unix port installs one exactly while
+    Ctrl-C is on (``micropython.kbd_intr(3)``, and while the REPL runs code)."""
+    try:
+        with open(f"/proc/{pid}/status") as fh:
+            for line in fh:
+                if line.startswith("SigCgt:"):
+                    return bool(int(line.split()[1], 16) & SIGINT_BIT)
+    except OSError:
+        pass
+    return False
+
+
+READ_SYSCALL = {"x86_64": 0, "aarch64": 63}.get(os.uname().machine)  # read(2)'s number here
+
+
+def _in_readline(pid: int) -> bool:
+    """Whether the process is blocked in read(2): the unix port's REPL waiting for a line (the
+    firmware waits in poll(2)). A board's REPL takes Ctrl-C there as a character (it cancels
+    the line); the unix port keeps its SIGINT handler installed at its prompt."""
+    try:
+        with open(f"/proc/{pid}/syscall") as fh:
+            first = fh.read().split()[:1]
+    except OSError:
+        return True   # cannot tell: pass the byte on, as the pseudo-terminal would
+    return READ_SYSCALL is None or first == [str(READ_SYSCALL)]
+
+
+def chip_env(chip: str) -> dict[str, str]:
+    """The environment that tells the machine/os shims which chip they are."""
+    exists = fw_config.CHIPS[chip][0]
+    flash = fw_config.pins_of_kind(chip, "flash")
+    return {"LOCUST_MACHINE": MACHINES[chip],
+            "LOCUST_PINS_INVALID": ",".join(str(p) for p in range(0, 64) if p not in exists),
+            "LOCUST_PINS_INPUT": ",".join(str(p) for p in fw_config.pins_of_kind(chip, "input")),
+            # the pins that are a Pin but wired to the flash or PSRAM
+            "LOCUST_PINS_FLASH": ",".join(str(p) for p in flash if p in exists)}
+
+
 class VirtualRobot:
-    def __init__(self, flash_dir: Path | None = None, plant: Plant | None = None, log_path: Path | None = None):
+    def __init__(self, flash_dir: Path | None = None, plant: Plant | None = None, log_path: Path | None = None,
+                 chip: str = "esp32"):
+        if chip not in CHIPS:
+            raise DeviceError(f"unknown chip {chip!r} for the virtual robot", f"choose one of {', '.join(CHIPS)}")
+        self.chip = chip
+        self._ticks_offset_us = 0
+        self._next_reset_cause = RESET_POWER_ON  # machine.reset_cause() of the next boot
+        self._active_pins: set[int] = set()
+        self._sigint_at = 0.0
         self.flash_dir = Path(flash_dir) if flash_dir else default_flash_dir()
         self.flash_dir.mkdir(parents=True, exist_ok=True)
         self.plant = plant if plant is not None else RecordingPlant()
@@ -191,10 +257,14 @@ class VirtualRobot:
         # a board runs main.py after boot, then its REPL; without main.py, only the REPL.
         # A soft reset from the raw REPL skips main.py and stays in the raw REPL.
         run_main = not raw_repl and (self.flash_dir / "main.py").exists()
-        args = [self._mp, "-i", "main.py"] if run_main else [self._mp]
+        args = [self._mp, "-X", f"heapsize={HEAP_BYTES}"] + (["-i", "main.py"] if run_main else [])
         self._raw_boot_pending = raw_repl
+        # the ticks start TICKS_LEAD_S before a wrap (the unix port's ticks_us is CLOCK_MONOTONIC)
+        self._ticks_offset_us = (TICKS_PERIOD - int(TICKS_LEAD_S * 1e6) - int(time.monotonic() * 1e6)) % TICKS_PERIOD
         env = dict(os.environ, MICROPYPATH=f"{SHIM_DIR}:.frozen:{self.flash_dir / 'lib'}",
-                   LOCUST_PWM_FIFO=self._fifo_path)
+                   LOCUST_PWM_FIFO=self._fifo_path, LOCUST_TICKS_OFFSET_US=str(self._ticks_offset_us),
+                   LOCUST_RESET_CAUSE=str(self._next_reset_cause),
+                   **chip_env(self.chip))
         env.pop("PYTHONPATH", None)
         self._period_anchor_s = None
         with self._proc_lock:
@@ -207,6 +277,7 @@ class VirtualRobot:
             except OSError:
                 pass
         self.boots += 1
+        self._next_reset_cause = RESET_SOFT  # until machine.reset() says otherwise
 
     def stop(self) -> dict:
         """Stop the interpreter and the threads; close the plant; returns its summary."""
@@ -271,6 +342,13 @@ class VirtualRobot:
             if self._stopping.is_set():
                 break
             self._settle_console()  # its last words (the REPL mode) before the reboot's
+            self._drain_pwm()
+            # MicroPython's soft reset runs machine_pwm_deinit_all(): every PWM output stops,
+            # the servos get no pulse and go limp (they do not hold the rest position)
+            t_s = self.now_s()
+            for pin in sorted(self._active_pins):
+                self._plant_queue.put((t_s, pin, 0.0))
+            self._active_pins.clear()
             self._to_client(b"\r\nMPY: soft reboot\r\n")
             time.sleep(0.05)
             self._boot(raw_repl=self._raw_repl)
@@ -311,10 +389,27 @@ class VirtualRobot:
             if self._mb in ready:
                 data = _read_pty(self._mb)
                 if data:
+                    data = self._ctrl_c(data)
                     try:
                         os.write(self._ma, data)
                     except (BlockingIOError, OSError):
                         pass  # the interpreter is not reading: input overrun
+
+    def _ctrl_c(self, data: bytes) -> bytes:
+        """Ctrl-C as a board's console driver treats it: while the program has Ctrl-C on, the
+        0x03 never reaches stdin; it raises KeyboardInterrupt wherever the program is (here: a
+        SIGINT, which the unix port turns into that). With Ctrl-C off it is an ordinary byte."""
+        if CTRL_C not in data:
+            return data
+        with self._proc_lock:
+            proc = self._proc
+        if proc is None or proc.poll() is not None or not _catches_sigint(proc.pid) or _in_readline(proc.pid):
+            return data
+        # one SIGINT per burst: the unix port exits on a second SIGINT before the first is handled
+        if time.monotonic() - self._sigint_at > 0.1:
+            self._sigint_at = time.monotonic()
+            proc.send_signal(signal.SIGINT)
+        return data.replace(CTRL_C, b"")
 
     def _watch_console(self, data: bytes) -> None:
         """Follow the console's REPL mode in the interpreter's output (the last marker wins)."""
@@ -354,6 +449,7 @@ class VirtualRobot:
                 parts = line.split()
                 if parts[:1] == [b"R"]:
                     self._raw_repl = False  # a hard reset boots into main.py
+                    self._next_reset_cause = RESET_HARD
                     with self._proc_lock:
                         if self._proc and self._proc.poll() is None:
                             self._proc.kill()  # machine.reset(): the supervisor reboots it
@@ -362,7 +458,9 @@ class VirtualRobot:
                         pin, duty_ns, ticks = (int(p) for p in parts[1:])
                     except ValueError:
                         continue
-                    t_us = now_us - ((now_us - ticks) % TICKS_PERIOD)
+                    # the write's time: the latest host instant whose 30-bit ticks match
+                    t_us = now_us - ((now_us + self._ticks_offset_us - ticks) % TICKS_PERIOD)
+                    (self._active_pins.add if duty_ns > 0 else self._active_pins.discard)(pin)
                     self._plant_queue.put((t_us / 1e6 - self._t0, pin, duty_ns / 1000.0))
 
     def _config(self) -> dict:
@@ -372,7 +470,7 @@ class VirtualRobot:
         except OSError:
             mtime = -1.0
         if self._config_cache is None or self._config_cache[0] != mtime:
-            cfg, _ = fw_config.load(str(path))
+            cfg, _ = fw_config.load(str(path), self.chip)  # as the firmware reads it on this chip
             self._config_cache = (mtime, cfg)
         return self._config_cache[1]
 
