@@ -2,8 +2,10 @@
 
 Every number the toolkit uses about the robot lives here, with its unit in its name and
 its provenance beside it: ``default`` (a reasonable value nobody measured), ``seed`` (the
-team's notebook, Part 2), ``preset:<name>``, ``override`` (``--set`` on the command line)
-or ``fit:<recording>`` (identified by ``locust calibrate``, with an uncertainty and a date).
+team's notebook, Part 2), ``photo:<file>``, ``cut_file:<file>``, ``datasheet:<part>``,
+``data:<recording>`` or ``estimate:<what>`` (the robot as built), ``preset:<name>``,
+``override`` (``--set`` on the command line) or ``fit:<recording>`` (identified by
+``locust calibrate``, with an uncertainty and a date).
 
 Presets:
 
@@ -12,8 +14,9 @@ Presets:
   near-rigid loop closure, rounded link edges on the floor, links that collide with the floor
   but not with their own chassis (a flexure hinge does not collide with the plate it is folded
   from), a time step at which the hop has converged (docs/servo.md), audited.
-- ``small`` / ``medium`` / ``large``: the physical leg sets of Part 3, +0 / +1 / +2 cm on
-  every link of the seed design.
+- ``small`` / ``medium`` / ``large``: the seed team's robot as built (``AS_BUILT``: its
+  photos, cut file and the SG90's datasheet, each value with its source) with the leg sets
+  of Part 3, +0 / +1 / +2 cm on every link of the cut file's strip.
 - ``seed-notebook``: the notebook's Part 2 simulation exactly (dropped from 8 cm with the
   schedule already running, 60 Hz control frames of ``int(1/60/dt)`` steps, Euler at
   dt = 1e-4 s, 50 solver iterations, tolerance 1e-8), for reproducing its figures.
@@ -475,6 +478,7 @@ AS_BUILT: dict[str, tuple[Any, Provenance]] = {
         note="the ground link lies along the servo's side, parallel to the plate")),
     "geometry.body_length_m": (0.12, Provenance(_TOP, uncertainty=0.01, note="about 12 cm against the servo's 23 mm")),
     "geometry.body_width_m": (0.12, Provenance(_TOP, uncertainty=0.01, note="about 12 cm against the servo's 23 mm")),
+    "geometry.nose_x_m": (-0.06, Provenance(_TOP, uncertainty=0.005, note="the plate's edge away from the legs")),
     "geometry.body_mass_kg": (0.004, Provenance("datasheet:cardstock", uncertainty=0.001,
         note="the plate alone: 12 x 12 cm of black cardstock at about 270 g/m^2; weigh yours")),
     "geometry.link_density_kg_per_m3": (700.0, Provenance("datasheet:cardstock", uncertainty=150.0,
@@ -650,7 +654,8 @@ def _toml_value(value: Any) -> str:
 def to_toml(robot: Robot) -> str:
     lines = [
         "# locust robot parameters. Each value: {value, source, uncertainty (1 sigma), date, note}.",
-        "# source: default | seed | preset:<name> | override | fit:<recording>.",
+        "# source: default | seed | photo:, cut_file:, datasheet:, data:, estimate:<what> | preset:<name>",
+        "# | override | fit:<recording>.",
         f"name = {_toml_value(robot.name)}",
         "",
     ]
