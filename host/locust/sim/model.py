@@ -1,10 +1,12 @@
 """Build the hopper's MuJoCo model from a :class:`~locust.params.Robot` with ``MjSpec``.
 
-The chassis is a free body (a thin plate); each leg is a planar four-bar hung from it:
-ground link (fixed to the chassis) -> crank (servo joint) -> coupler (knee hinge) ->
+The chassis is a free body (a thin plate) carrying the two servo bodies; each leg is a
+planar four-bar hung from it: ground link (fixed to the chassis at the servo axis, at
+``geometry.ground_angle_deg`` to the plate) -> crank (servo joint) -> coupler (knee hinge) ->
 leg (ankle hinge) -> loop closed back onto the ground link's front pivot by a ``connect``
-equality. Every body is placed in the assembled pose from :mod:`.fourbar`, so the loop is
-closed before the first step (``connect`` anchors are defined in the assembled pose).
+equality. The floor's contacts are explicit pairs, each with its part's friction. Every body
+is placed in the assembled pose from :mod:`.fourbar`, so the loop is closed before the first
+step (``connect`` anchors are defined in the assembled pose).
 
 Numbers come from the robot parameters only; each one's provenance is in ``robot.toml``.
 The structure follows the notebook's Part 2 model so that the ``seed-notebook`` preset
