@@ -44,8 +44,9 @@ class Geometry:
     """Linkage and chassis geometry, each value a length, angle or mass a student can measure
     with a ruler, a protractor and a scale (docs/hardware.md, "Measure your robot").
 
-    Chassis frame: x along the plate from its nose (-x) to its leg end (+x), y to the robot's
-    left, z out of the plate's top face (the legs and servos hang under it, at -z).
+    Chassis frame: x along the plate from its nose (-x) to its leg end (+x), z toward the side
+    the servos and legs hang from (down when the robot stands: the notebook's chassis is
+    turned over, euler 180/pitch/180).
     """
 
     ground_m: float = 0.04          # blue link: glued to the servo, servo axis to front pivot
@@ -60,7 +61,7 @@ class Geometry:
     servo_axis_x_m: float = 0.02    # servo shaft axis along the plate, from the plate's centre
     leg_mount_y_m: float = 0.045    # lateral offset of each leg loop's middle (left +, right -)
     servo_axis_below_plate_m: float = 0.0  # servo shaft axis under the plate's mid-plane
-    ground_angle_deg: float = 0.0   # ground link against the plate, about the servo axis
+    ground_angle_deg: float = 0.0   # ground link against the plate (+: its front pivot nearer the plate)
     servo_mass_kg: float = 0.0      # each servo body (the notebook's model: none)
     servo_length_m: float = 0.023   # servo body along the plate (x)
     servo_width_m: float = 0.012    # servo body across the plate (z)
