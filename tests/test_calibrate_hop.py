@@ -16,7 +16,7 @@ import pytest
 
 from locust.calibrate import hop as H
 from locust.errors import CalibrationError
-from locust.params import Provenance, preset
+from locust.params import Provenance, leg_set, preset
 from locust.sim import samples as S
 
 CAMERA_HZ = 30.0
@@ -24,11 +24,18 @@ NOISE_M = 1e-4
 TRUTH = {"compliance.hinge_stiffness_nm_per_rad": 0.045, "servo.noload_speed_rad_per_s": 9.0}
 
 
+def seed_leg(config: str):
+    """A leg set of the seed robot (the notebook's plate mass and hinge stiffness): the fit's
+    machinery is tested on the model the figures here were measured on, not on the as-built
+    presets, whose hinges are 280 times softer than this truth."""
+    return leg_set(preset("seed"), config)
+
+
 def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0) -> H.HopRun:
     """A run of ``config`` at ``truth``, "filmed" at 30 frames/s from 0.4 s before the first
     push, camera clock 1.234 s ahead, positions with NOISE_M of noise (SYNTHETIC). The values
     not in ``truth`` are the preset's exactly, so here they carry no uncertainty."""
-    robot = preset(config)
+    robot = seed_leg(config)
     for key in S.uncertain_values(robot):
         if key not in truth:
             robot = robot.with_provenance(key, Provenance(source="synthetic: exact"))
@@ -114,13 +121,13 @@ def test_keys_that_cannot_be_fitted_are_refused():
         H.check_keys(["schedule.cycles"], [run])
     with pytest.raises(CalibrationError, match="unknown robot parameter"):
         H.check_keys(["contact.foot_frict"], [run])
-    large = H.HopRun(**{**run.__dict__, "robot": preset("large")})
+    large = H.HopRun(**{**run.__dict__, "robot": seed_leg("large")})
     with pytest.raises(CalibrationError, match="leg sets differ"):
         H.check_keys(["geometry.leg_m"], [run, large])
 
 
 def test_samples_spread_comes_from_the_uncertainties():
-    robot = preset("small")
+    robot = seed_leg("small")
     spread = S.sample(robot, 8, cycles=2)
     # the seed's servo values carry the SG90 fit's uncertainties
     assert "servo.noload_speed_rad_per_s" in spread.uncertain
@@ -130,14 +137,16 @@ def test_samples_spread_comes_from_the_uncertainties():
     for key in spread.uncertain:
         bare = bare.with_provenance(key, Provenance(source="test"))
     none = S.sample(bare, 3, cycles=2)
-    assert none.uncertain == {} and none.distance_m_sd == 0.0
+    # (the draws share each thread's MjData, so the constraint solver's warm start differs: the
+    # same run to within a few 1e-18 m)
+    assert none.uncertain == {} and none.distance_m_sd < 1e-12
 
 
 def test_draws_follow_the_written_uncertainties():
     """Each uncertain value is drawn about its own with the written standard deviation (one
     sigma, not a variance or a 95 % half-width) and independently of the others: 4000 draws
     give the mean within 4 standard errors, the SD within 5 %, correlations below 0.06."""
-    robot = (preset("small")
+    robot = (seed_leg("small")
              .with_provenance("contact.foot_friction", Provenance(source="test", uncertainty=0.05))
              .with_provenance("compliance.hinge_stiffness_nm_per_rad", Provenance(source="test", uncertainty=0.004)))
     keys = ["contact.foot_friction", "compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s"]
@@ -165,19 +174,9 @@ def test_sweep_ranks_designs_by_the_mean_over_draws():
     assert abs(mean["distance_m"] - plain["distance_m"]) > 1e-6
 
 
-def test_a_foot_friction_below_the_floors_is_called_inert():
-    # MuJoCo uses the larger friction of two geoms: the seed's floor is 1.6
-    notes: list[str] = []
-    H._friction_notes({"contact.foot_friction": 1.2}, preset("seed"), notes)
-    assert len(notes) == 1 and "changes nothing" in notes[0]
-    notes.clear()
-    H._friction_notes({"contact.foot_friction": 2.0}, preset("seed"), notes)
-    assert notes == []
-
-
 def test_draws_outside_the_limits_are_invalid_not_simulated():
     """A push drawn beyond the servo's 45 deg travel is refused as `locust sim` would refuse it."""
-    robot = preset("small").with_provenance("schedule.push_deg", Provenance(source="test", uncertainty=20.0))
+    robot = seed_leg("small").with_provenance("schedule.push_deg", Provenance(source="test", uncertainty=20.0))
     drawn = [r.get("schedule.push_deg") for r in S.draw(robot, 12, seed=3)]
     outside = [abs(v) > robot.get("servo.travel_deg") for v in drawn]
     assert 0 < sum(outside) < 12                               # the seed gives some of each

@@ -67,15 +67,25 @@ def test_seed_six_hops_valid_converged_and_closed():
     assert r.loop_residual_max_m < 2e-5                      # the near-rigid loop: anchors within 20 um
 
 
-def test_explicit_floor_pairs_equal_mujocos_automatic_contacts(monkeypatch):
-    """The floor pairs carry the parameters MuJoCo would mix itself: the record is identical."""
+def test_floor_pairs_carry_each_friction_exactly(monkeypatch):
+    """Each floor pair acts with its own part's friction, even below 1 (MuJoCo's automatic
+    contacts would take the larger of the two geoms' values); where that larger value is the
+    part's own (the seed: 1.6 and 1.7 against the floor's default 1), the record is MuJoCo's."""
+    import mujoco
+
     from locust.sim import model as sim_model
     from locust.sim.rollout import simulate
 
-    seed = preset("seed").with_values({"contact.foot_friction": 0.7, "contact.floor_friction": 0.9})
+    low = simulate(preset("seed").with_values({"contact.foot_friction": 0.7, "contact.nose_friction": 0.3}),
+                   cycles=1).built.model
+    assert low.npair == 7                                   # the plate and three links a side
+    mu = {mujoco.mj_id2name(low, mujoco.mjtObj.mjOBJ_PAIR, i): low.pair_friction[i, 0] for i in range(low.npair)}
+    assert mu.pop("floor_plate") == pytest.approx(0.3, abs=1e-12)
+    assert list(mu.values()) == pytest.approx([0.7] * 6, abs=1e-12)
+
+    seed = preset("seed")
     paired = simulate(seed, cycles=1)
-    assert paired.built.model.npair == 7                    # the plate and three links a side
-    monkeypatch.setattr(sim_model, "_floor_pairs", lambda spec: None)
+    monkeypatch.setattr(sim_model, "_floor_pairs", lambda spec, contact: None)
     automatic = simulate(seed, cycles=1)
     assert automatic.built.model.npair == 0
     assert abs(paired.sensordata - automatic.sensordata).max() < 1e-12

@@ -4,8 +4,9 @@ Each stage runs the real command (``python -m locust.cli ...``, one child proces
 the demo exercises the same code paths a user does:
 
 1. ``locust flash --port sim``: the firmware into the demo's own virtual flash folder;
-2. ``locust hop --port sim --preset P --video``: Small, Medium and Large hop on the virtual
-   robot (the firmware under MicroPython driving the MuJoCo model), filmed;
+2. ``locust hop --port sim --preset seed --set ... --video``: Small, Medium and Large (the seed
+   robot with each leg set's links) hop on the virtual robot (the firmware under MicroPython
+   driving the MuJoCo model), filmed;
 3. ``locust track``: nose and foot tracks from those videos;
 4. ``locust calibrate``: beam, servo and ramp fits from the bundled synthetic
    recordings into the demo's ``robot.toml``;
@@ -38,6 +39,20 @@ from .fileio import atomic_write_json, atomic_write_text, unique_dir
 from .progress import progress
 
 LEG_SETS = ("small", "medium", "large")
+# The virtual robot is the seed robot with each leg set's links (what the demo's calibration
+# models: its robot.toml's base is the seed), at the step each converges at on that robot
+# (0.1 mm per hop at dt/2); the small/medium/large presets are the robot as built instead.
+SEED_LEG_SET_STEP_S = {"small": 2.5e-3, "medium": 2.5e-4, "large": 2e-3}
+
+
+def seed_leg_set_options(name: str) -> list[str]:
+    """``--preset seed --set ...`` for the seed robot with leg set ``name``'s links."""
+    from .params import leg_set, preset
+
+    robot = leg_set(preset("seed"), name)
+    keys = ("geometry.ground_m", "geometry.crank_m", "geometry.coupler_m", "geometry.leg_m")
+    values = {**{key: robot.get(key) for key in keys}, "solver.timestep_s": SEED_LEG_SET_STEP_S[name]}
+    return ["--preset", "seed", *[arg for key, value in values.items() for arg in ("--set", f"{key}={value!r}")]]
 RECORDINGS = Path(__file__).resolve().parents[2] / "calibration" / "recordings"
 # (subcommand, recording, its options); the servo recording is the preset SG90 on a light
 # load, split with the datasheet's stall torque (no-load speed, armature and kp are written).
@@ -64,9 +79,7 @@ TRUTH_KEYS = {
 
 # What the bench experiments cannot reach, hidden in the virtual robot (unlike any preset and
 # unlike the recordings): friction under impact above the ramp's, the folded linkage's hinges
-# softer than the beam's, the servo slower on the robot's battery than on the bench. MuJoCo
-# takes the larger friction of two touching geoms, so a hidden foot friction must be above the
-# floor's 1.6 to act at all (docs/calibrate.md).
+# softer than the beam's, the servo slower on the robot's battery than on the bench.
 HOP_TRUTH = {"contact.foot_friction": 2.0, "compliance.hinge_stiffness_nm_per_rad": 0.045,
              "servo.noload_speed_rad_per_s": 9.0}
 HOP_FIT_SETS = ("small", "large")   # Medium sits on a friction threshold at a 0.25 ms step: slow and touchy
@@ -194,7 +207,7 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     with d.stage(2, total, f"hop Small, Medium, Large x {trials} on the virtual robot, {cycles} cycles, filmed"):
         with d.bar(trials_dirs, "hops") as bar:
             for name, trial in bar:
-                d.call(["hop", "--port", "sim", "--preset", name, *truth_sets, "--cycles", str(cycles),
+                d.call(["hop", "--port", "sim", *seed_leg_set_options(name), *truth_sets, "--cycles", str(cycles),
                         "--video", str(trial / "hop.mp4"), "--out", str(trial)])
                 d.expect(trial / "hop.mp4", trial / "run.json")
     with d.stage(3, total, "track nose and foot in the videos"):

@@ -2,8 +2,10 @@
 
 Every number the toolkit uses about the robot lives here, with its unit in its name and
 its provenance beside it: ``default`` (a reasonable value nobody measured), ``seed`` (the
-team's notebook, Part 2), ``preset:<name>``, ``override`` (``--set`` on the command line)
-or ``fit:<recording>`` (identified by ``locust calibrate``, with an uncertainty and a date).
+team's notebook, Part 2), ``photo:<file>``, ``cut_file:<file>``, ``datasheet:<part>``,
+``data:<recording>`` or ``estimate:<what>`` (the robot as built), ``preset:<name>``,
+``override`` (``--set`` on the command line) or ``fit:<recording>`` (identified by
+``locust calibrate``, with an uncertainty and a date).
 
 Presets:
 
@@ -12,8 +14,9 @@ Presets:
   near-rigid loop closure, rounded link edges on the floor, links that collide with the floor
   but not with their own chassis (a flexure hinge does not collide with the plate it is folded
   from), a time step at which the hop has converged (docs/servo.md), audited.
-- ``small`` / ``medium`` / ``large``: the physical leg sets of Part 3, +0 / +1 / +2 cm on
-  every link of the seed design.
+- ``small`` / ``medium`` / ``large``: the seed team's robot as built (``AS_BUILT``: its
+  photos, cut file and the SG90's datasheet, each value with its source) with the leg sets
+  of Part 3, +0 / +1 / +2 cm on every link of the cut file's strip.
 - ``seed-notebook``: the notebook's Part 2 simulation exactly (dropped from 8 cm with the
   schedule already running, 60 Hz control frames of ``int(1/60/dt)`` steps, Euler at
   dt = 1e-4 s, 50 solver iterations, tolerance 1e-8), for reproducing its figures.
@@ -38,19 +41,33 @@ GRAVITY_M_PER_S2 = 9.81
 
 @dataclass(frozen=True)
 class Geometry:
-    """Linkage and chassis geometry (the notebook's Part 1-2 values)."""
+    """Linkage and chassis geometry, each value a length, angle or mass a student can measure
+    with a ruler, a protractor and a scale (docs/hardware.md, "Measure your robot").
 
-    ground_m: float = 0.04          # blue link: chassis, between the two fixed pivots
-    crank_m: float = 0.04           # yellow link: servo horn
+    Chassis frame: x along the plate from its nose (-x) to its leg end (+x), z toward the side
+    the servos and legs hang from (down when the robot stands: the notebook's chassis is
+    turned over, euler 180/pitch/180).
+    """
+
+    ground_m: float = 0.04          # blue link: glued to the servo, servo axis to front pivot
+    crank_m: float = 0.04           # yellow link: on the servo horn
     coupler_m: float = 0.02         # green link
     leg_m: float = 0.06             # red link: the leg, foot at its far end
-    crank_start_deg: float = -90.0  # crank angle in the assembled pose (0 = along the ground link)
+    crank_start_deg: float = -90.0  # crank angle at the 0 deg command (0 = along the ground link)
     body_length_m: float = 0.12
     body_width_m: float = 0.12
     body_thickness_m: float = 0.001
-    body_mass_kg: float = 0.05
-    leg_mount_x_m: float = 0.04     # centre of each ground link in the chassis frame
-    leg_mount_y_m: float = 0.045    # lateral offset of each leg (left +, right -)
+    body_mass_kg: float = 0.05      # the plate (the notebook's 0.05: everything that hops)
+    servo_axis_x_m: float = 0.02    # servo shaft axis along the plate, from the plate's centre
+    leg_mount_y_m: float = 0.045    # lateral offset of each leg loop's middle (left +, right -)
+    servo_axis_below_plate_m: float = 0.0  # servo shaft axis under the plate's mid-plane
+    ground_angle_deg: float = 0.0   # ground link against the plate (+: its front pivot nearer the plate)
+    servo_mass_kg: float = 0.0      # each servo body (the notebook's model: none)
+    servo_length_m: float = 0.023   # servo body along the plate (x)
+    servo_width_m: float = 0.012    # servo body across the plate (z)
+    servo_height_m: float = 0.029   # servo body along its shaft (y)
+    servo_body_x_m: float = 0.0055  # servo body's centre from its shaft axis, along x
+    servo_body_y_m: float = 0.0145  # servo body's centre from the plate's centre line, along y
     link_width_m: float = 0.03
     link_thickness_m: float = 0.001
     link_density_kg_per_m3: float = 1000.0
@@ -61,7 +78,10 @@ class Geometry:
 
 @dataclass(frozen=True)
 class Compliance:
-    """Hinge compliance of the folded cardstock (cantilever-beam experiment)."""
+    """The folded linkage's flexure hinges (four a leg, the one at the servo axis in parallel
+    with the servo). A film hinge's stiffness, not a cardstock beam's: the links between the
+    hinges carry their loads along their length and are rigid in the model (docs/servo.md,
+    "Hinges and links" has the beam test's numbers for bending and buckling)."""
 
     hinge_stiffness_nm_per_rad: float = 0.056375
     hinge_damping_nms_per_rad: float = 0.00056375
@@ -85,20 +105,39 @@ class Servo:
     pulse_min_us: float = 500.0      # pulse at -range_deg/2
     pulse_max_us: float = 2500.0     # pulse at +range_deg/2
     range_deg: float = 180.0         # angle swept by pulse_min..pulse_max
+    # the DC motor behind the figures above: they hold at reference_voltage_v at the servo's
+    # terminals; the winding resistance sets how far the supply's resistance sags them
+    reference_voltage_v: float = 5.0
+    winding_resistance_ohm: float = 10.0
 
 
 @dataclass(frozen=True)
 class Contact:
-    """Friction (ramp critical-angle experiment: mu = tan(theta))."""
+    """The floor's contacts, one explicit pair per robot part: each friction acts exactly as
+    given (docs/servo.md, "Contact and loop")."""
 
-    foot_friction: float = 1.7
-    floor_friction: float = 1.6
+    foot_friction: float = 1.7       # the leg's links on the floor (ramp: mu = tan(theta))
+    nose_friction: float = 1.6       # the plate (its nose edge) on the floor
     torsional_friction: float = 0.006
     rolling_friction: float = 0.00005
+    # contact softness as a drop test sees it: the impact's time constant (MuJoCo's solref
+    # timeconst) and the coefficient of restitution (0: no bounce), on every floor pair
+    timeconst_s: float = 0.02
+    restitution: float = 0.0
     self_collision: bool = False     # links collide with the chassis and each other (notebook: yes)
     # a link's edge on the floor is a rounded line (a capsule of the laminate's thickness);
     # False: sharp box corners, the notebook's model (docs/servo.md, "Contact and loop")
     rounded_edges: bool = True
+
+
+@dataclass(frozen=True)
+class Power:
+    """The servos' supply: both servos draw through one source resistance (USB cable, board,
+    breadboard), so the voltage at the servos sags under their current (docs/servo.md,
+    "Power")."""
+
+    supply_voltage_v: float = 5.0
+    source_resistance_ohm: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -135,6 +174,7 @@ SECTIONS: dict[str, type] = {
     "compliance": Compliance,
     "servo": Servo,
     "contact": Contact,
+    "power": Power,
     "schedule": Schedule,
     "solver": Solver,
 }
@@ -159,6 +199,7 @@ class Robot:
     compliance: Compliance = field(default_factory=Compliance)
     servo: Servo = field(default_factory=Servo)
     contact: Contact = field(default_factory=Contact)
+    power: Power = field(default_factory=Power)
     schedule: Schedule = field(default_factory=Schedule)
     solver: Solver = field(default_factory=Solver)
     provenance: dict[str, Provenance] = field(default_factory=dict, compare=False)
@@ -282,8 +323,14 @@ LENGTH_LIMIT_M = 10.0
 LIMITS: dict[str, tuple[float, float, bool, bool]] = {
     **{f"geometry.{n}": (0.0, LENGTH_LIMIT_M, _OPEN, _SHUT) for n in (
         "ground_m", "crank_m", "coupler_m", "leg_m", "body_length_m", "body_width_m",
-        "body_thickness_m", "link_width_m", "link_thickness_m")},
+        "body_thickness_m", "link_width_m", "link_thickness_m", "servo_length_m", "servo_width_m",
+        "servo_height_m")},
+    **{f"geometry.{n}": (-LENGTH_LIMIT_M, LENGTH_LIMIT_M, _SHUT, _SHUT) for n in (
+        "servo_axis_x_m", "leg_mount_y_m", "servo_axis_below_plate_m", "servo_body_x_m",
+        "servo_body_y_m", "nose_x_m")},
     "geometry.body_mass_kg": (0.0, 100.0, _OPEN, _SHUT),
+    "geometry.servo_mass_kg": (0.0, 100.0, _SHUT, _SHUT),
+    "geometry.ground_angle_deg": (-180.0, 180.0, _SHUT, _SHUT),
     "geometry.link_density_kg_per_m3": (0.0, 50000.0, _OPEN, _SHUT),
     "geometry.drop_height_m": (0.0, LENGTH_LIMIT_M, _SHUT, _SHUT),
     "geometry.crank_start_deg": (-360.0, 360.0, _SHUT, _SHUT),
@@ -299,10 +346,16 @@ LIMITS: dict[str, tuple[float, float, bool, bool]] = {
     "servo.pulse_min_us": (0.0, 20000.0, _OPEN, _OPEN),
     "servo.pulse_max_us": (0.0, 20000.0, _OPEN, _OPEN),
     "servo.range_deg": (0.0, 360.0, _OPEN, _SHUT),
+    "servo.reference_voltage_v": (0.0, 100.0, _OPEN, _SHUT),
+    "servo.winding_resistance_ohm": (0.0, math.inf, _OPEN, _OPEN),
     "contact.foot_friction": (0.0, math.inf, _SHUT, _OPEN),
-    "contact.floor_friction": (0.0, math.inf, _SHUT, _OPEN),
+    "contact.nose_friction": (0.0, math.inf, _SHUT, _OPEN),
     "contact.torsional_friction": (0.0, math.inf, _SHUT, _OPEN),
     "contact.rolling_friction": (0.0, math.inf, _SHUT, _OPEN),
+    "contact.timeconst_s": (0.0, 10.0, _OPEN, _SHUT),
+    "contact.restitution": (0.0, 1.0, _SHUT, _OPEN),
+    "power.supply_voltage_v": (0.0, 100.0, _OPEN, _SHUT),
+    "power.source_resistance_ohm": (0.0, math.inf, _SHUT, _OPEN),
     "schedule.push_deg": (_HOP["push_deg"][1], _HOP["push_deg"][2], _SHUT, _SHUT),
     "schedule.push_s": (_HOP["push_ms"][1] / 1000.0, _HOP["push_ms"][2] / 1000.0, _SHUT, _SHUT),
     "schedule.wait_s": (_HOP["wait_ms"][1] / 1000.0, _HOP["wait_ms"][2] / 1000.0, _SHUT, _SHUT),
@@ -387,17 +440,87 @@ def _seed() -> Robot:
     measured = [
         "geometry.ground_m", "geometry.crank_m", "geometry.coupler_m", "geometry.leg_m",
         "geometry.crank_start_deg", "geometry.body_length_m", "geometry.body_width_m",
-        "geometry.body_thickness_m", "geometry.body_mass_kg", "geometry.leg_mount_x_m",
+        "geometry.body_thickness_m", "geometry.body_mass_kg", "geometry.servo_axis_x_m",
         "geometry.leg_mount_y_m", "geometry.link_width_m", "geometry.link_thickness_m",
         "geometry.nose_x_m", "geometry.body_pitch_deg", "geometry.drop_height_m",
         "compliance.hinge_stiffness_nm_per_rad", "compliance.hinge_damping_nms_per_rad",
-        "servo.stall_torque_nm", "servo.travel_deg", "contact.foot_friction", "contact.floor_friction",
+        "servo.stall_torque_nm", "servo.travel_deg", "contact.foot_friction", "contact.nose_friction",
         "contact.torsional_friction", "contact.rolling_friction", "schedule.push_deg",
         "schedule.push_s", "schedule.wait_s", "schedule.cycles",
     ]
     provenance = {k: _SEED_SOURCE for k in measured}
+    provenance["contact.nose_friction"] = Provenance(
+        source="seed", note="notebook Part 2: its floor's 1.6, which MuJoCo's mixing gave the plate's contact")
     provenance.update(SG90_SOURCE)
     return Robot(name="seed", provenance=provenance)
+
+
+# -- the robot as built ----------------------------------------------------------------
+# The seed team's robot (../shared/data/robot/: the top view, the folded loop, the flat strip,
+# the cut files), each value a length, angle or mass with where it was read; docs/hardware.md,
+# "Measure your robot", says how to measure yours. What the photos do not show is a datasheet
+# figure or the notebook's, named as such.
+_TOP = "photo:assembled_top_view.png"
+_LOOP = "photo:folded_leg_loop.png"
+_SG90 = "datasheet:SG90"
+_CUT = "cut_file:zz.dxf"
+_HINGE = "data:hinge/Damping_test (team's fit, pending locust calibrate hinge)"
+AS_BUILT: dict[str, tuple[Any, Provenance]] = {
+    "geometry.ground_m": (0.04, Provenance(_CUT, note="hinge slots at 4, 8, 10, 16 cm of the 18 x 3 cm strip: "
+                                                      "links 4, 4, 2, 6 cm, the last 2 cm glued over the first")),
+    "geometry.crank_m": (0.04, Provenance(_CUT, note="strip 4-8 cm, on the servo horn")),
+    "geometry.coupler_m": (0.02, Provenance(_CUT, note="strip 8-10 cm")),
+    "geometry.leg_m": (0.06, Provenance(_CUT, note="strip 10-16 cm")),
+    "geometry.link_width_m": (0.03, Provenance(_CUT, note="the strip is 3 cm wide")),
+    "geometry.crank_start_deg": (-100.0, Provenance(_LOOP, uncertainty=10.0,
+        note="the folded loop at rest: 100 deg between the ground link and the crank (63, 97, 99 deg at the "
+             "other corners), the horn fitted with the loop unstressed")),
+    "geometry.ground_angle_deg": (0.0, Provenance(_TOP, uncertainty=15.0,
+        note="the ground link lies along the servo's side, parallel to the plate")),
+    "geometry.body_length_m": (0.12, Provenance(_TOP, uncertainty=0.01, note="about 12 cm against the servo's 23 mm")),
+    "geometry.body_width_m": (0.12, Provenance(_TOP, uncertainty=0.01, note="about 12 cm against the servo's 23 mm")),
+    "geometry.nose_x_m": (-0.06, Provenance(_TOP, uncertainty=0.005, note="the plate's edge away from the legs")),
+    "geometry.body_mass_kg": (0.004, Provenance("datasheet:cardstock", uncertainty=0.001,
+        note="the plate alone: 12 x 12 cm of black cardstock at about 270 g/m^2; weigh yours")),
+    "geometry.link_density_kg_per_m3": (700.0, Provenance("datasheet:cardstock", uncertainty=150.0,
+        note="two 270 g/m^2 cardstock layers, 0.05 mm PET film, two adhesive layers: about 0.7 kg/m^2 "
+             "over the 1 mm laminate (a Small strip 3.8 g); weigh a strip")),
+    "geometry.servo_axis_x_m": (0.02, Provenance(_TOP, uncertainty=0.005,
+        note="the horns 4 cm in from the plate's leg-end edge (the loops reach past it)")),
+    "geometry.leg_mount_y_m": (0.045, Provenance(_TOP, uncertainty=0.003,
+        note="servos back to back on the centre line: 29 mm of servo, then half the 3 cm loop")),
+    "geometry.servo_axis_below_plate_m": (0.0065, Provenance(_SG90, uncertainty=0.002,
+        note="the servo on its side under the plate, the shaft at mid-width of its 12 mm")),
+    "geometry.servo_mass_kg": (0.009, Provenance(_SG90, uncertainty=0.0005)),
+    "geometry.servo_length_m": (0.023, Provenance(_SG90)),
+    "geometry.servo_width_m": (0.012, Provenance(_SG90)),
+    "geometry.servo_height_m": (0.029, Provenance(_SG90)),
+    "geometry.servo_body_x_m": (0.0055, Provenance(_SG90, uncertainty=0.001,
+        note="the shaft 6 mm from one end of the 23 mm body; the body toward the plate's leg end (photo)")),
+    "geometry.servo_body_y_m": (0.0145, Provenance(_TOP, uncertainty=0.002,
+        note="back to back on the centre line: half the servo's 29 mm")),
+    "compliance.hinge_stiffness_nm_per_rad": (1.6e-4, Provenance(_HINGE,
+        note="a folded film hinge (the course's damping test); the seed's 0.056 was the cardstock beam's")),
+    "compliance.hinge_damping_nms_per_rad": (2.14e-6, Provenance(_HINGE)),
+    "servo.reference_voltage_v": (5.0, Provenance("data:servo/sg90_aa_battery_step.csv",
+        note="the recording's 5 V supply: the identified stall torque, speed and gain hold there")),
+    "servo.winding_resistance_ohm": (10.0, Provenance(_SG90, uncertainty=1.5,
+        note="stall current about 0.6 A at 6 V")),
+    "power.supply_voltage_v": (5.0, Provenance(_TOP, uncertainty=0.25,
+        note="the servos on the USB-powered ESP32's 5 V, through the breadboard")),
+    "power.source_resistance_ohm": (0.5, Provenance("estimate:USB", uncertainty=0.3,
+        note="USB cable (about 0.2 ohm a conductor) and breadboard contacts; measure the servo plug's "
+             "voltage with both servos held stalled")),
+}
+
+
+def _built() -> Robot:
+    """The seed team's robot as built: the seed's values where nothing better was measured,
+    every value the photos, cut files and datasheets give replaced (AS_BUILT)."""
+    robot = _seed()
+    for key, (value, prov) in AS_BUILT.items():
+        robot = robot.with_values({key: value}, prov)
+    return robot
 
 
 def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
@@ -423,7 +546,7 @@ def leg_set(base: Robot, name: str) -> Robot:
         added = LEG_SETS_M[name]
     except KeyError:
         raise ParamsError(f"unknown leg set {name!r}", f"choose one of {', '.join(LEG_SETS_M)}") from None
-    note = f"notebook Part 3 leg set: +{added * 100:g} cm on every link"
+    note = f"the cut file's link + {added * 100:g} cm (notebook Part 3 leg set)"
     return with_added_length(base, added, source=f"preset:{name}", note=note).renamed(name)
 
 
@@ -444,16 +567,14 @@ def _seed_notebook() -> Robot:
 
 PRESETS = {
     "seed": _seed,
-    "small": lambda: leg_set(_seed(), "small"),
-    # Medium sits near a threshold (its crank tips and couplers touch the floor): at 2 ms and
-    # 0.5 ms it lands on the other side of it, 0.12 mm per hop away; 0.25 ms is within
-    # 0.01 mm per hop of 0.125 ms (docs/servo.md)
-    "medium": lambda: leg_set(_seed(), "medium").with_values(
-        {"solver.timestep_s": 2.5e-4}, Provenance(source="preset:medium", note="converged step, docs/servo.md")),
-    # Large's hops are about half a millimetre: at 2.5 ms its dt/2 change is 0.1 mm per hop,
-    # at 2 ms 0.01 mm (docs/servo.md)
-    "large": lambda: leg_set(_seed(), "large").with_values(
-        {"solver.timestep_s": 2e-3}, Provenance(source="preset:large", note="converged step, docs/servo.md")),
+    # the filmed leg sets of the robot as built (AS_BUILT); each at its converged step
+    # (docs/servo.md, "Time step")
+    "small": lambda: leg_set(_built(), "small").with_values(
+        {"solver.timestep_s": 1e-3}, Provenance(source="preset:small", note="converged step, docs/servo.md")),
+    "medium": lambda: leg_set(_built(), "medium").with_values(
+        {"solver.timestep_s": 1e-3}, Provenance(source="preset:medium", note="converged step, docs/servo.md")),
+    "large": lambda: leg_set(_built(), "large").with_values(
+        {"solver.timestep_s": 2.5e-4}, Provenance(source="preset:large", note="converged step, docs/servo.md")),
     "seed-notebook": _seed_notebook,
 }
 
@@ -534,7 +655,8 @@ def _toml_value(value: Any) -> str:
 def to_toml(robot: Robot) -> str:
     lines = [
         "# locust robot parameters. Each value: {value, source, uncertainty (1 sigma), date, note}.",
-        "# source: default | seed | preset:<name> | override | fit:<recording>.",
+        "# source: default | seed | photo:, cut_file:, datasheet:, data:, estimate:<what> | preset:<name>",
+        "# | override | fit:<recording>.",
         f"name = {_toml_value(robot.name)}",
         "",
     ]

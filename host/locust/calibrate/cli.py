@@ -161,8 +161,8 @@ def _per_recording(values: tuple[float, ...], n: int, option: str) -> list[float
 @click.option("--ramp-markers", default="ramp_a,ramp_b", show_default=True, metavar="A,B",
               help="For a ramp video track: markers at the two ends of the board.")
 @click.option("--robot-marker", default="robot", show_default=True, help="For a ramp video track: the robot's marker.")
-@click.option("--into", type=click.Choice(["foot", "floor"]), default="foot", show_default=True,
-              help="Which friction the result is written to (contact.foot_friction or contact.floor_friction).")
+@click.option("--into", type=click.Choice(["foot", "nose"]), default="foot", show_default=True,
+              help="Which friction the result is written to (contact.foot_friction or contact.nose_friction).")
 @import_options
 @output_options
 def ramp(data, ramp_markers, robot_marker, into, imports, write_path, as_json, plot_path, no_plot):

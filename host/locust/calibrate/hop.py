@@ -352,7 +352,6 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
             notes.append(f"{key} is not identifiable from these hops (its 95% interval is wider than "
                          f"about +-{200 * MAX_RELATIVE_STD:.0f}%)")
         identifiable[key] = ok
-    _friction_notes(dict(zip(keys, values.tolist())), runs[0].robot, notes)
     return HopFit(keys=keys, start=dict(zip(keys, start.tolist())), estimates=estimates, identifiable=identifiable,
                   runs=run_fits, notes=notes, rms_m=float(np.sqrt(np.mean(r**2))), iterations=len(trace),
                   simulations=counter["sims"], wall_s=time.perf_counter() - t_start, interval=interval)
@@ -404,16 +403,6 @@ def grid_start(residual, n: int, stages: int = GRID_STAGES) -> np.ndarray:
         if cost[k] < best_cost:
             best, best_cost = xs[:, k].copy(), float(cost[k])
     return best
-
-
-def _friction_notes(fitted: dict[str, float], robot: Robot, notes: list[str]) -> None:
-    """MuJoCo takes the larger friction of two touching geoms: a fitted friction below the
-    other side's acts on nothing."""
-    pairs = (("contact.foot_friction", "contact.floor_friction"), ("contact.floor_friction", "contact.foot_friction"))
-    for key, other in pairs:
-        if key in fitted and other not in fitted and fitted[key] <= robot.get(other):
-            notes.append(f"{key} = {fitted[key]:.4g} is below {other} = {robot.get(other):.4g}: MuJoCo takes the "
-                         f"larger of the two, so {key} changes nothing in these hops")
 
 
 # -- the plot ---------------------------------------------------------------------------

@@ -28,7 +28,7 @@ PLAUSIBLE = {
     "servo.armature_kgm2": (1e-9, 0.1),                         # SG90 3.1e-4
     "servo.kv_nms_per_rad": (0.0, 10.0),
     "contact.foot_friction": (0.05, 5.0),                       # seed 1.7
-    "contact.floor_friction": (0.05, 5.0),
+    "contact.nose_friction": (0.05, 5.0),
 }
 UNIT_HINT = ("check the recording's units: times in seconds (not ms), angles in degrees (not radians), "
              "tracks in metres (or --units cm|mm); the fit is shown but not written")

@@ -1,10 +1,12 @@
 """Build the hopper's MuJoCo model from a :class:`~locust.params.Robot` with ``MjSpec``.
 
-The chassis is a free body (a thin plate); each leg is a planar four-bar hung from it:
-ground link (fixed to the chassis) -> crank (servo joint) -> coupler (knee hinge) ->
+The chassis is a free body (a thin plate) carrying the two servo bodies; each leg is a
+planar four-bar hung from it: ground link (fixed to the chassis at the servo axis, at
+``geometry.ground_angle_deg`` to the plate) -> crank (servo joint) -> coupler (knee hinge) ->
 leg (ankle hinge) -> loop closed back onto the ground link's front pivot by a ``connect``
-equality. Every body is placed in the assembled pose from :mod:`.fourbar`, so the loop is
-closed before the first step (``connect`` anchors are defined in the assembled pose).
+equality. The floor's contacts are explicit pairs, each with its part's friction. Every body
+is placed in the assembled pose from :mod:`.fourbar`, so the loop is closed before the first
+step (``connect`` anchors are defined in the assembled pose).
 
 Numbers come from the robot parameters only; each one's provenance is in ``robot.toml``.
 The structure follows the notebook's Part 2 model so that the ``seed-notebook`` preset
@@ -23,6 +25,7 @@ from ..errors import SimError
 from ..markers import MARKER_COLOURS, hex_to_rgb01
 from ..params import GRAVITY_M_PER_S2, Robot
 from .fourbar import Assembly, assemble
+from .servo import at_supply
 from .servo import configure as configure_servo
 
 SIDES = ("L", "R")  # left leg at +y (faces the default camera), right leg at -y
@@ -80,7 +83,8 @@ def _quat_euler_deg(x: float, y: float, z: float) -> np.ndarray:
 
 def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     """The model as an ``MjSpec`` (raises ``GeometryError`` for a linkage that cannot close)."""
-    g, c, s, k, sol = robot.geometry, robot.compliance, robot.servo, robot.contact, robot.solver
+    g, c, k, sol = robot.geometry, robot.compliance, robot.contact, robot.solver
+    s = at_supply(robot.servo, robot.power)   # the servo on this supply (docs/servo.md, "Power")
     asm = assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, g.crank_start_deg)
     if sol.integrator not in INTEGRATORS:
         raise SimError(f"solver.integrator = {sol.integrator!r} is not known",
@@ -120,8 +124,7 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     world.add_light(pos=[-2, -5, 5], dir=[0.5, 0.5, -1], castshadow=True)
     world.add_light(pos=[5, 5, 8], dir=[-0.5, -0.5, -1], castshadow=True)
     world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[10, 5, 0.1],
-                   material="floor", friction=[k.floor_friction, k.torsional_friction, k.rolling_friction],
-                   contype=FLOOR_BITS[0], conaffinity=FLOOR_BITS[1])
+                   material="floor", contype=FLOOR_BITS[0], conaffinity=FLOOR_BITS[1])
 
     chassis = world.add_body(name="chassis", pos=[0, 0, g.drop_height_m],
                              quat=_quat_euler_deg(180.0, g.body_pitch_deg, 180.0))
@@ -129,6 +132,7 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     chassis.add_geom(name="plate", type=mujoco.mjtGeom.mjGEOM_BOX,
                      size=[g.body_length_m / 2, g.body_width_m / 2, g.body_thickness_m / 2],
                      rgba=[0.1, 0.1, 0.1, 1], mass=g.body_mass_kg,
+                     friction=[k.nose_friction, k.torsional_friction, k.rolling_friction],
                      contype=ROBOT_BITS[bool(k.self_collision)][0], conaffinity=ROBOT_BITS[bool(k.self_collision)][1])
     chassis.add_site(name="nose", pos=[g.nose_x_m, 0, 0], size=[0.005, 0, 0], rgba=[1, 0, 0, 1])
     # nose dot: on the chassis' camera-facing side, up and back from the nose edge (which
@@ -141,7 +145,17 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     rho, selfc, rounded = g.link_density_kg_per_m3, bool(k.self_collision), bool(k.rounded_edges)
     for side in SIDES:
         y = g.leg_mount_y_m if side == "L" else -g.leg_mount_y_m
-        ground = chassis.add_body(name=f"{side}_ground", pos=[g.leg_mount_x_m, y, 0])
+        # the servo under the plate (chassis +z is the legs' side): its body carries its mass,
+        # drawn and massive but not colliding (the leg loops reach the floor first)
+        chassis.add_geom(name=f"{side}_servo_body", type=mujoco.mjtGeom.mjGEOM_BOX,
+                         pos=[g.servo_axis_x_m + g.servo_body_x_m, math.copysign(g.servo_body_y_m, y),
+                              g.servo_axis_below_plate_m],
+                         size=[g.servo_length_m / 2, g.servo_height_m / 2, g.servo_width_m / 2],
+                         mass=g.servo_mass_kg, rgba=[0.25, 0.35, 0.9, 0.8], contype=0, conaffinity=0)
+        # the ground link from the servo axis to the front pivot, at ground_angle_deg to the plate
+        mount = chassis.add_body(name=f"{side}_mount", pos=[g.servo_axis_x_m, y, g.servo_axis_below_plate_m],
+                                 quat=_quat_euler_deg(0, g.ground_angle_deg, 0))
+        ground = mount.add_body(name=f"{side}_ground", pos=[g.ground_m / 2, 0, 0])
         _ghost_box(ground, g.ground_m, half_w, half_t, LINK_RGBA["ground"], rho)
         ground.add_site(name=f"{side}_loop_a", pos=[g.ground_m / 2, 0, 0])
         # Joint angles about +y turn +x toward -z, the mirror of the fourbar frame's
@@ -181,41 +195,49 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
         act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
         act.ctrlrange = [-math.radians(s.travel_deg), math.radians(s.travel_deg)]
 
-    if not k.self_collision:
-        _floor_pairs(spec)
+    _floor_pairs(spec, k)
     _add_sensors(spec)
     return spec, asm
 
 
-def _floor_pairs(spec: mujoco.MjSpec) -> None:
-    """Turn the floor's automatic contacts into explicit ``pair``s with the same parameters.
+def contact_solref(contact) -> list[float]:
+    """MuJoCo's ``solref`` (time constant, damping ratio) for a contact of ``timeconst_s`` whose
+    bounce has the coefficient of restitution ``restitution``: a damped spring loses
+    ``exp(-zeta*pi/sqrt(1 - zeta^2))`` of its speed in one half-cycle, solved for zeta
+    (restitution 0: critical damping, MuJoCo's default (0.02 s, 1))."""
+    e = contact.restitution
+    if e <= 0.0:
+        return [contact.timeconst_s, 1.0]
+    log_e = math.log(e)
+    return [contact.timeconst_s, -log_e / math.sqrt(math.pi**2 + log_e**2)]
 
-    With only the floor to touch, MuJoCo's broad phase (every collidable geom against every
-    other, each of the 4 evaluations of an rk4 step) is a tenth of the step spent finding the
-    7 pairs that can touch at all. Listed explicitly, the pairs carry the contact parameters
-    MuJoCo's automatic mechanism would mix for them (no part has a priority: the larger condim,
-    friction and margin, solref and solimp weighted by solmix), so the result is identical
-    (bench/sim_speed.py, tests/test_sim.py).
+
+def _floor_pairs(spec: mujoco.MjSpec, contact) -> None:
+    """Every robot part that can touch the floor gets an explicit ``pair`` with the floor that
+    carries its own friction exactly: the plate ``contact.nose_friction``, the leg's links
+    ``contact.foot_friction`` (MuJoCo's automatic contacts would take the larger of the two
+    geoms' frictions). The softness is the drop test's (:func:`contact_solref`). The floor then
+    takes no automatic contacts; with ``contact.self_collision`` the parts still collide with
+    each other automatically.
+
+    Listing the pairs also saves MuJoCo's broad phase (every collidable geom against every
+    other, in each of the 4 evaluations of an rk4 step): a tenth of the step.
     """
     floor = spec.geom("floor")
     colliders = [g for g in spec.geoms if g is not floor and (
         g.contype & floor.conaffinity or g.conaffinity & floor.contype)]
+    solref = contact_solref(contact)
     for i, geom in enumerate(colliders):
         if not geom.name:
             geom.name = f"floor_contact_{i}"
-        w1, w2 = floor.solmix, geom.solmix
-        w = 0.5 if w1 + w2 < mujoco.mjMINVAL else w1 / (w1 + w2)
-        ref1, ref2 = np.asarray(floor.solref), np.asarray(geom.solref)
-        solref = w * ref1 + (1 - w) * ref2 if ref1[0] > 0 and ref2[0] > 0 else np.minimum(ref1, ref2)
-        friction = np.maximum(np.asarray(floor.friction), np.asarray(geom.friction))
+        mu = contact.nose_friction if geom.name == "plate" else contact.foot_friction
         spec.add_pair(name=f"floor_{geom.name}", geomname1=floor.name, geomname2=geom.name,
                       condim=max(floor.condim, geom.condim),
-                      friction=[friction[0], friction[0], friction[1], friction[2], friction[2]],
-                      solref=list(solref),
-                      solimp=list(w * np.asarray(floor.solimp) + (1 - w) * np.asarray(geom.solimp)),
+                      friction=[mu, mu, contact.torsional_friction, contact.rolling_friction,
+                                contact.rolling_friction],
+                      solref=solref, solimp=list(floor.solimp),
                       margin=max(floor.margin, geom.margin), gap=max(floor.gap, geom.gap))
-    for geom in [floor, *colliders]:
-        geom.contype = geom.conaffinity = 0
+    floor.contype = floor.conaffinity = 0
 
 
 def _hinge(body, name: str, c) -> None:

@@ -15,16 +15,50 @@ controller; the joint's ``damping`` is ``b`` and its ``armature`` the reflected 
 inertia, both integrated implicitly by the ``implicitfast`` and ``implicit`` integrators.
 ``kv`` (velocity feedback inside the clamp) is 0 for a hobby servo; the notebook's model,
 which had neither ``b`` nor armature, used it.
+
+The supply (:func:`at_supply`): the drive is a DC motor, ``torque = eta*K*(u*V - K*w)/R`` at
+the output shaft for a duty ``u`` in [-1, 1], terminal voltage ``V``, winding resistance
+``R``, output-referred constant ``K`` and gearbox efficiency ``eta``: stall torque
+``eta*K*V/R`` and no-load speed ``V/K`` both grow in proportion to ``V``, and the back-EMF
+damping ``eta*K^2/R`` is their ratio. Two servos on one supply of resistance ``R_s`` drawing
+the same current (the legs get the same command) see ``V = V_s - 2*R_s*I``: each acts as a
+motor on the full supply voltage behind ``R + 2*R_s``. So the servo's identified figures
+(at ``reference_voltage_v`` on its terminals) become, on the supply::
+
+    stall  = stall_ref * (V_s / V_ref) * R / (R + 2 R_s)
+    noload = noload_ref * (V_s / V_ref)
+    kp     = kp_ref * stall / stall_ref          (the controller's duty gain is fixed)
+
+which are still a clamped position actuator plus joint damping: exact for the symmetric hop
+and integrated by MuJoCo itself (rollouts included), no per-step callback.
 """
 
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 
 import mujoco
 
-from ..params import Servo
+from ..params import Power, Servo
+
+SERVOS_ON_SUPPLY = 2   # both legs' servos share the supply (and its resistance)
+
+
+def at_supply(servo: Servo, power: Power) -> Servo:
+    """``servo`` as it acts on ``power``'s supply: stall torque, no-load speed and holding
+    gain scaled from its reference voltage to the voltage its terminals see (module docstring)."""
+    volts = power.supply_voltage_v / servo.reference_voltage_v
+    sag = servo.winding_resistance_ohm / (servo.winding_resistance_ohm
+                                          + SERVOS_ON_SUPPLY * power.source_resistance_ohm)
+    torque = volts * sag
+    if volts == 1.0 and sag == 1.0:   # the servo as identified: its figures unchanged
+        return servo
+    return dataclasses.replace(servo, stall_torque_nm=servo.stall_torque_nm * torque,
+                               noload_speed_rad_per_s=servo.noload_speed_rad_per_s * volts,
+                               kp_nm_per_rad=servo.kp_nm_per_rad * torque,
+                               kv_nms_per_rad=servo.kv_nms_per_rad * torque)
 
 
 def back_emf_damping_nms_per_rad(servo: Servo) -> float:

@@ -1,0 +1,76 @@
+"""The seed team's robot as built (params.AS_BUILT): sources, the supply's DC-motor physics,
+the contact softness, and the leg sets against the filmed range the data README publishes."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from locust import params as P
+from locust.sim import servo as SV
+from locust.sim.model import build, contact_solref
+from locust.sim.run import run
+
+
+def test_every_as_built_value_names_a_measurement_and_none_a_hop_fit():
+    for name in ("small", "medium", "large"):
+        robot = P.preset(name)
+        for key in P.AS_BUILT:
+            source = robot.source_of(key).source
+            assert source.split(":")[0] in {"photo", "cut_file", "datasheet", "data", "estimate", "preset"}, key
+        assert not [k for k in P.all_keys() if "hop" in robot.source_of(k).source], name
+    # the leg sets' lengths are the cut file's plus the notebook's added centimetres
+    assert P.preset("large").link_lengths_m() == pytest.approx((0.06, 0.06, 0.04, 0.08), abs=1e-12)
+
+
+def test_the_supply_scales_the_servo_as_a_dc_motor():
+    """4.2 V through 0.5 ohm to two servos of 10 ohm: stall torque 0.15 * 4.2/5 * 10/11, no-load
+    speed 10.2 * 4.2/5 (no current at no load, no sag), the holding gain with the torque."""
+    robot = P.preset("medium").with_values({"power.supply_voltage_v": 4.2, "power.source_resistance_ohm": 0.5})
+    s = SV.at_supply(robot.servo, robot.power)
+    torque = 4.2 / 5.0 * 10.0 / 11.0
+    assert s.stall_torque_nm == pytest.approx(0.15 * torque, rel=1e-12)
+    assert s.noload_speed_rad_per_s == pytest.approx(10.2 * 4.2 / 5.0, rel=1e-12)
+    assert s.kp_nm_per_rad == pytest.approx(0.26 * torque, rel=1e-12)
+    # and that is what MuJoCo runs: the actuator's clamp and gain, the crank's back-EMF damping
+    model = build(robot).model
+    act = model.actuator("L_servo")
+    assert act.forcerange[1] == pytest.approx(0.15 * torque, rel=1e-12)
+    assert act.gainprm[0] == pytest.approx(0.26 * torque, rel=1e-12)
+    dof = model.joint("L_servo").dofadr[0]
+    back_emf = (0.15 * torque) / (10.2 * 4.2 / 5.0)
+    assert model.dof_damping[dof] == pytest.approx(2.14e-6 + back_emf, rel=1e-12)
+    # on the voltage it was identified at, with no source resistance, the servo is unchanged
+    bare = P.preset("medium").with_values({"power.source_resistance_ohm": 0.0})
+    assert SV.at_supply(bare.servo, bare.power) is bare.servo
+
+
+@pytest.mark.parametrize("restitution", [0.0, 0.2, 0.5, 0.9])
+def test_contact_softness_gives_the_drop_tests_restitution(restitution):
+    contact = P.Contact(timeconst_s=0.01, restitution=restitution)
+    timeconst, zeta = contact_solref(contact)
+    assert timeconst == 0.01
+    bounce = 0.0 if zeta >= 1.0 else math.exp(-zeta * math.pi / math.sqrt(1.0 - zeta**2))
+    assert bounce == pytest.approx(restitution, abs=1e-12)
+    # restitution 0 is MuJoCo's default contact (critically damped)
+    assert contact_solref(P.Contact()) == [0.02, 1.0]
+
+
+@pytest.fixture(scope="module")
+def leg_sets():
+    return {name: run(P.preset(name), cycles=6) for name in ("small", "medium", "large")}
+
+
+def test_leg_sets_raise_the_nose_by_the_filmed_centimetres(leg_sets):
+    """The data README: the filmed nose rose between about 6 and 12 cm per hop across the three
+    leg sets, Medium highest, Large farthest. The model, built from the photos and datasheets
+    (docs/servo.md has its figures: 10.6 / 11.8 / 7.9 cm), lands in that range."""
+    rise = {name: max(h.nose_apex_m for h in r.hops) for name, r in leg_sets.items()}
+    for name, r in leg_sets.items():
+        assert r.valid, (name, r.reasons)
+        assert 0.06 <= rise[name] <= 0.12, (name, rise[name])
+    assert rise["medium"] > rise["small"] > rise["large"]
+    # Large is the one that keeps hopping forward; Small and Medium rear onto the plate's
+    # edge and stay there, sliding back once (docs/servo.md)
+    assert leg_sets["large"].distance_m > 0 > leg_sets["small"].distance_m > leg_sets["medium"].distance_m
