@@ -119,10 +119,11 @@ def test_hinge_fit_is_accurate_and_its_intervals_cover_over_seeds(case, tmp_path
         coulomb_fitted += fit.coulomb_friction_nm is not None
         # the marker follows the model to the tracking noise (0.1 / 0.05 mm a coordinate, in 2D)
         assert fit.rms_residual_m < 1.3 * math.sqrt(2) * truth.noise_m, (case, seed, fit.rms_residual_m)
-        assert fit.pivot_source == "circle fit"
+        assert fit.pivot_source == "fitted"
         assert math.hypot(fit.pivot_m[0] - truth.pivot_m[0], fit.pivot_m[1] - truth.pivot_m[1]) < 0.05 * truth.radius_m
-    # 95 % intervals: at least 17 of 20 cover (a binomial(20, 0.95) gives 16 or fewer 1.6 % of the time)
-    assert covered["k"] >= 17 and covered["b"] >= 17, (case, covered)
+    # 95 % intervals: at least 16 of 20 cover (a binomial(20, 0.95) gives 15 or fewer 0.3 % of the
+    # time; intervals half as wide as they should be cover about 67 %: 13 of 20)
+    assert covered["k"] >= 16 and covered["b"] >= 16, (case, covered)
     assert coulomb_fitted <= 1, (case, coulomb_fitted)   # no friction in the truth: rarely claimed
 
 
@@ -173,7 +174,7 @@ def test_cli_hinge_json_write_and_trk_note(tmp_path):
     out = json.loads(res.stdout)
     k = out["hinge_stiffness_nm_per_rad"]
     assert k["ci95"][0] <= truth.hinge_stiffness_nm_per_rad <= k["ci95"][1]
-    assert out["pivot"] == "circle fit" and out["rms_residual_m"] < 2e-4
+    assert out["pivot"] == "fitted" and out["rms_residual_m"] < 2e-4
     assert "7200 px/m" in out["input"] and "Tracker project" in out["input"]
     text = robot.read_text()
     assert "fit:swing.trk" in text and "I=8.5e-07 kg*m^2" in text
@@ -198,7 +199,7 @@ def test_cli_hinge_refuses_what_it_cannot_fit(tmp_path):
     flat = write_txy(tmp_path / "flat.csv", t, np.full_like(t, 0.02), np.zeros_like(t))
     res = run("calibrate", "hinge", flat, "--inertia-kgm2", 4.2e-7, "--gravity", "out-of-plane",
               "--pivot", "0,0", "--no-plot")
-    assert res.exit_code == 2 and "crosses its rest angle" in res.output
+    assert res.exit_code == 2 and "flat signal" in res.output
 
 
 def test_beam_reads_a_tracker_project(tmp_path):

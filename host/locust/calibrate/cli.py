@@ -114,7 +114,8 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, import
                    "fitted to the marker's arc].")
 @click.option("--marker", default=None, help="Marker on the swinging link [default: the only one].")
 @click.option("--start-s", type=FINITE, default=None,
-              help="Fit from this time [s] [default: the release, the last moment at the largest excursion].")
+              help="Fit from this time [s] [default: the first turning point after the release, the end of "
+                   "the first free swing].")
 @click.option("--end-s", type=FINITE, default=None, help="Fit up to this time [s] [default: end of the track].")
 @click.option("--coulomb", type=click.Choice(["auto", "off", "on"]), default="auto", show_default=True,
               help="Coulomb friction torque [N*m]: auto fits it only when the swing shows it (score test "

@@ -16,11 +16,12 @@ plane), the swing obeys, at any angle::
 - ``tau_c`` [N*m] Coulomb friction, fitted only when the data show it: kept when it lowers
   the residual beyond chance (F test, p < 0.001) and its 95 % interval excludes zero.
 
-The angle comes from the marker's x, y about the pivot (``--pivot``, or the centre of the
-circle fitted to the marker's arc). The swing is integrated (LSODA, relative tolerance
-1e-10) from the release, its initial angle and rate fitted with ``k``, ``b``, ``theta0``;
-the residual is the marker's arc length, ``R*(theta_model - theta_measured)`` with ``R``
-the marker's median distance from the pivot. Intervals come from the residual Jacobian
+The swing is integrated (LSODA, relative tolerance 1e-10) from the start of the fit window,
+its initial angle and rate fitted with ``k``, ``b``, ``theta0``. The residual is the
+marker's position, x and y [m], against ``pivot + R*(cos theta, sin theta)``: the distance
+``R`` from the hinge to the marker is fitted too, and so is the pivot unless ``--pivot``
+gives it (its start: the centre of the circle fitted to the marker's arc), so its
+uncertainty is in the intervals of ``k`` and ``b``. Intervals come from the residual Jacobian
 (:mod:`.fitstats`). Start values come from the swing itself: the period from its zero
 crossings, the decay from its successive peaks (never a spectral peak, which can lock onto
 the record length).
@@ -78,7 +79,7 @@ class HingeFit:
     damping_ratio: float
     rest_angle_deg: float
     pivot_m: tuple[float, float]
-    pivot_source: str                        # given | circle fit
+    pivot_source: str                        # given | fitted (started at the circle fit)
     radius_m: float
     release_angle_deg: float
     rms_residual_m: float
@@ -163,7 +164,7 @@ def swing_shape(t_s: np.ndarray, theta: np.ndarray, source: str) -> SwingShape:
     """From the zero crossings (about the final rest) and the peaks between them."""
     rest = float(np.median(theta[len(theta) * 4 // 5:]))
     u = theta - rest
-    noise = float(np.std(np.diff(u, 2))) / math.sqrt(6)          # white noise seen through a 2nd difference
+    noise = angle_noise_rad(theta)
     amp = float(np.max(np.abs(u)))
     band = max(3 * noise, 0.02 * amp)                             # hysteresis: noise at rest is no crossing
     crossings, peaks, side, last = [], [], 0, 0
@@ -209,23 +210,52 @@ def start_values(t_s: np.ndarray, theta: np.ndarray, rig: HingeRig, shape: Swing
     return np.array([k0, b0, th0, float(theta[0]), rate])
 
 
+def angle_noise_rad(theta: np.ndarray) -> float:
+    """The angle's tracking noise: from its second differences where the link is quietest (the
+    first or the last fifth of the record: held before the release, or at rest after it)."""
+    fifth = max(len(theta) // 5, 4)
+    parts = [np.diff(theta[:fifth], 2), np.diff(theta[-fifth:], 2)]
+    return min(float(np.std(p)) for p in parts if len(p)) / math.sqrt(6)
+
+
 def release_window(t_s: np.ndarray, theta: np.ndarray, start_s: float | None, end_s: float | None) -> np.ndarray:
-    """Samples to fit: from the release (or ``start_s``) to ``end_s``.
+    """Samples to fit: the free swing from the first turning point after the release (or from
+    ``start_s``) to ``end_s``.
 
     The release is the last moment the link is held at its largest excursion from the final
-    rest in the first half of the record: from there on it swings freely.
+    rest in the first half of the record: the last sample, before the link has swung a tenth
+    of the way back, within three noise deviations of the level it was held at. A hand lets
+    go over a few hundredths of a second, which is no free swing: the fit starts at the far
+    end of that first swing, where the link turns (a drop's impact is skipped alike in
+    :mod:`.beam`).
     """
     end = t_s[-1] if end_s is None else end_s
     if start_s is None:
         rest = np.median(theta[len(theta) * 4 // 5:])
-        u = np.abs(theta - rest)
-        half = max(len(u) // 2, 1)
-        i = int(np.argmax(u[:half]))
-        tol = max(0.02 * u[i], 3 * float(np.std(np.diff(theta, 2))) / math.sqrt(6))
-        while i + 1 < len(u) and abs(u[i + 1] - u[i]) < tol and u[i + 1] > u[i] - tol:
-            i += 1
-        start_s = t_s[i]
+        signed = theta - rest
+        u = np.abs(signed)
+        noise = angle_noise_rad(theta)
+        i = int(np.argmax(u[:max(len(u) // 2, 1)]))
+        leaving = np.nonzero(u[i:] < u[i] - max(0.1 * u[i], 6 * noise))[0]
+        j = i + (int(leaving[0]) if len(leaving) else len(u) - i)
+        level = float(np.median(u[i:j]))
+        release = i + int(np.nonzero(u[i:j] >= level - 3 * noise)[0][-1])
+        start_s = t_s[_first_turn(signed, release, max(3 * noise, 0.02 * u[i]))]
     return (t_s >= start_s) & (t_s <= end)
+
+
+def _first_turn(u: np.ndarray, release: int, band: float) -> int:
+    """The far extreme of the first swing after ``release`` (``release`` itself without one)."""
+    side = np.sign(u[release])
+    over = np.nonzero(u[release:] * -side > band)[0]
+    if not len(over):
+        return release
+    c1 = release + int(over[0])
+    back = np.nonzero(u[c1:] * side > band)[0]
+    if not len(back):
+        return release
+    c2 = c1 + int(back[0])
+    return c1 + int(np.argmax(np.abs(u[c1:c2])))
 
 
 # -- the fit ------------------------------------------------------------------------
@@ -238,37 +268,31 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
     _check_rig(rig)
     t_s, x_m, y_m = (np.asarray(a, dtype=float) for a in (t_s, x_m, y_m))
     notes = []
-    if pivot is None:
-        cx, cy, _ = circle_fit(x_m, y_m)
-        pivot, pivot_source = (cx, cy), "circle fit"
-    else:
-        pivot_source = "given"
-    theta_all, radius_all = swing_angle(x_m, y_m, pivot)
+    centre = pivot if pivot is not None else circle_fit(x_m, y_m)[:2]
+    theta_all, radius_all = swing_angle(x_m, y_m, centre)
+    swing_deg = math.degrees(float(np.ptp(theta_all)))
+    if swing_deg < 30 * math.degrees(angle_noise_rad(theta_all)) or swing_deg < 1.0:
+        raise CalibrationError(f"{source}: flat signal, the marker turns {swing_deg:.3g} deg about the pivot",
+                               "check the marker (is it on the swinging link?), --pivot, and that the link was "
+                               "released (calibration/protocols/hinge.md)")
     window = release_window(t_s, theta_all, start_s, end_s)
-    t, theta, radius = t_s[window], theta_all[window], radius_all[window]
+    t, theta, x, y = t_s[window], theta_all[window], x_m[window], y_m[window]
     if len(t) < MIN_SAMPLES:
         raise CalibrationError(f"{source}: only {len(t)} samples in the fit window (need {MIN_SAMPLES})",
                                "widen --start-s/--end-s, or film longer")
     arc_deg = math.degrees(float(np.ptp(theta)))
-    if pivot_source == "circle fit" and arc_deg < SMALL_ARC_DEG:
-        notes.append(f"the swing covers {arc_deg:.3g} deg: the circle fit places the pivot poorly; give --pivot")
-    r_m = float(np.median(radius))
+    if pivot is None and arc_deg < SMALL_ARC_DEG:
+        notes.append(f"the swing covers {arc_deg:.3g} deg: the fitted pivot is poorly placed; give --pivot")
     shape = swing_shape(t, theta, source)
     p0 = start_values(t, theta, rig, shape)
-    width = 0.002 * max(shape.amplitude_rad, 1e-3) * shape.damped_omega_rad_per_s   # sign(rate), smoothed
-    tau_ref = 0.05 * p0[1] * shape.amplitude_rad * shape.damped_omega_rad_per_s
-    scale = np.array([p0[0], p0[1], 1.0, 1.0, max(shape.damped_omega_rad_per_s, 1e-3), tau_ref])
-
-    def residual(q):       # the solver works on values of order one: q = p / scale
-        return r_m * (simulate(t, q * scale[:len(q)], rig, width) - theta)
-
-    base = _solve(residual, p0 / scale[:5])
+    problem = _Swing(t, x, y, rig, p0, shape, float(np.median(radius_all[window])), centre, fit_pivot=pivot is None)
+    base = problem.solve(problem.start())
     chosen, coulomb_note = base, "not fitted (--coulomb off)"
     if coulomb != "off":
-        p_value = _coulomb_score_p(residual, base)
+        p_value = problem.coulomb_score_p(base)
         if coulomb == "on" or p_value < COULOMB_P_VALUE:
-            with_c = _solve(residual, np.append(base.x, 1.0))
-            tau = covariance(with_c.jac, with_c.fun).estimate(with_c.x[5] * tau_ref, _unit(6, 5, tau_ref))
+            with_c = problem.solve(np.append(base.x, 1.0))
+            tau = problem.estimates(with_c)["coulomb_friction_nm"]
             if coulomb == "on" or tau.ci95_low > 0:
                 chosen = with_c
                 coulomb_note = (f"fitted: significant (score test p = {p_value:.2g})" if p_value < COULOMB_P_VALUE
@@ -278,35 +302,133 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
                                 f"{tau.ci95_high:.3g}] holds zero; left out")
         else:
             coulomb_note = f"not significant (score test p = {p_value:.2g}): left out"
-    q, r = chosen.x, chosen.fun
-    npar = len(q)
-    p = q * scale[:npar]
-    cov = covariance(chosen.jac, r)
-    model_theta = theta + r / r_m
-    mx, my = pivot[0] + r_m * np.cos(model_theta), pivot[1] + r_m * np.sin(model_theta)
-    rms_m = float(np.sqrt(np.mean((mx - x_m[window]) ** 2 + (my - y_m[window]) ** 2)))
+    est = problem.estimates(chosen)
+    p, radius, (px, py) = problem.split(chosen.x)
+    model = simulate(t, p, rig, problem.width)
     k, b = float(p[0]), float(p[1])
     rest = _rest_angle(p, rig)
     stiff_total = k - rig.gravity_moment_nm * math.sin(rest)
     wn = math.sqrt(max(stiff_total, 0.0) / rig.inertia_kgm2)
     zeta = b / (2 * math.sqrt(max(stiff_total, 1e-300) * rig.inertia_kgm2))
+    measured = np.unwrap(np.arctan2(y - py, x - px))
+    measured += 2 * math.pi * np.round((model[0] - measured[0]) / (2 * math.pi))
     fine_t = np.linspace(t[0], t[-1], max(10 * len(t), 2000))
-    fine = simulate(fine_t, p, rig, width)
-    curves = Curves(x=t, data=np.degrees(theta), model=np.degrees(model_theta), x_label="t [s]",
+    curves = Curves(x=t, data=np.degrees(measured), model=np.degrees(model), x_label="t [s]",
                     y_label="link angle about the hinge [deg]", title=f"hinge: {Path(source).name}",
-                    model_x=fine_t, model_fine=np.degrees(fine))
+                    model_x=fine_t, model_fine=np.degrees(simulate(fine_t, p, rig, problem.width)))
+    rx, ry = np.split(chosen.fun, 2)
     return HingeFit(
-        source=source, rig=rig, hinge_stiffness_nm_per_rad=cov.estimate(k, _unit(npar, 0, scale[0])),
-        hinge_damping_nms_per_rad=cov.estimate(b, _unit(npar, 1, scale[1])),
-        neutral_angle_deg=cov.estimate(math.degrees(p[2]), _unit(npar, 2, math.degrees(1.0))),
-        coulomb_friction_nm=cov.estimate(float(p[5]), _unit(npar, 5, scale[5])) if npar > 5 else None,
-        coulomb_note=coulomb_note,
+        source=source, rig=rig, hinge_stiffness_nm_per_rad=est["hinge_stiffness_nm_per_rad"],
+        hinge_damping_nms_per_rad=est["hinge_damping_nms_per_rad"], neutral_angle_deg=est["neutral_angle_deg"],
+        coulomb_friction_nm=est.get("coulomb_friction_nm"), coulomb_note=coulomb_note,
         natural_frequency_hz=wn / (2 * math.pi), damping_ratio=zeta, rest_angle_deg=math.degrees(rest),
-        pivot_m=(float(pivot[0]), float(pivot[1])), pivot_source=pivot_source, radius_m=r_m,
-        release_angle_deg=math.degrees(float(theta[0])), rms_residual_m=rms_m,
-        rms_residual_deg=math.degrees(float(np.sqrt(np.mean(r**2))) / r_m), n_samples=len(t),
+        pivot_m=(px, py), pivot_source="given" if pivot is not None else "fitted",
+        radius_m=radius, release_angle_deg=math.degrees(float(theta[0])),
+        rms_residual_m=float(np.sqrt(np.mean(rx**2 + ry**2))),
+        rms_residual_deg=math.degrees(float(np.sqrt(np.mean((measured - model) ** 2)))), n_samples=len(t),
         fit_start_s=float(t[0]), fit_end_s=float(t[-1]), fit_time_s=time.perf_counter() - clock,
         curves=curves, notes=notes)
+
+
+class _Swing:
+    """The least-squares problem: the marker's x and y residuals [m] of a swing.
+
+    Its values, scaled to order one: k/k0, b/b0, theta0, the start angle, the start rate in
+    units of the damped angular frequency, the radius R/R0, then (when the pivot is fitted)
+    its offsets from the circle fit in units of R0, then (when fitted) tau_c in units of a
+    friction that would stop a tenth of the first swing's decay.
+    """
+
+    DYNAMIC = 5
+
+    def __init__(self, t, x, y, rig: HingeRig, p0: np.ndarray, shape: SwingShape, radius_m: float,
+                 centre, *, fit_pivot: bool):
+        self.t, self.x, self.y, self.rig = t, x, y, rig
+        self.p0, self.radius0, self.fit_pivot = p0, radius_m, fit_pivot
+        self.centre = (float(centre[0]), float(centre[1]))
+        self.width = 0.002 * max(shape.amplitude_rad, 1e-3) * shape.damped_omega_rad_per_s   # sign(rate), smoothed
+        self.tau_ref = 0.05 * p0[1] * shape.amplitude_rad * shape.damped_omega_rad_per_s
+        self.dyn_scale = np.array([p0[0], p0[1], 1.0, 1.0, max(shape.damped_omega_rad_per_s, 1e-3)])
+        self.n_geo = 3 if fit_pivot else 1
+
+    def start(self) -> np.ndarray:
+        return np.concatenate([self.p0 / self.dyn_scale, [1.0], np.zeros(self.n_geo - 1)])
+
+    def split(self, q: np.ndarray):
+        """(simulate's params, radius [m], pivot [m]) of the scaled values ``q``."""
+        n = self.DYNAMIC + self.n_geo
+        p = q[:self.DYNAMIC] * self.dyn_scale
+        if len(q) > n:
+            p = np.append(p, q[n] * self.tau_ref)
+        radius = q[self.DYNAMIC] * self.radius0
+        off = q[self.DYNAMIC + 1:n] * self.radius0 if self.fit_pivot else np.zeros(2)
+        return p, float(radius), (self.centre[0] + float(off[0]), self.centre[1] + float(off[1]))
+
+    def angle(self, q: np.ndarray) -> np.ndarray:
+        return simulate(self.t, self.split(q)[0], self.rig, self.width)
+
+    def residual(self, q: np.ndarray, theta: np.ndarray | None = None) -> np.ndarray:
+        _, radius, (px, py) = self.split(q)
+        th = self.angle(q) if theta is None else theta
+        return np.concatenate([px + radius * np.cos(th) - self.x, py + radius * np.sin(th) - self.y])
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """The dynamic columns by forward differences of 3e-5 (far above the integrator's
+        relative tolerance of 1e-10), the radius and pivot columns exactly."""
+        _, radius, _ = self.split(q)
+        th = self.angle(q)
+        cos, sin = np.cos(th), np.sin(th)
+        n = len(th)
+        jac = np.zeros((2 * n, len(q)))
+        dynamic = list(range(self.DYNAMIC)) + ([len(q) - 1] if len(q) > self.DYNAMIC + self.n_geo else [])
+        for i in dynamic:
+            h = 3e-5 * max(1.0, abs(q[i]))
+            step = q.copy()
+            step[i] += h
+            dth = (self.angle(step) - th) / h
+            jac[:n, i], jac[n:, i] = -radius * sin * dth, radius * cos * dth
+        jac[:n, self.DYNAMIC], jac[n:, self.DYNAMIC] = self.radius0 * cos, self.radius0 * sin
+        if self.fit_pivot:
+            jac[:n, self.DYNAMIC + 1] = self.radius0
+            jac[n:, self.DYNAMIC + 2] = self.radius0
+        return jac
+
+    def solve(self, q0: np.ndarray) -> optimize.OptimizeResult:
+        """Least squares, k, b, the radius and tau_c kept positive."""
+        lo = np.full(len(q0), -np.inf)
+        positive = [0, 1, self.DYNAMIC] + ([len(q0) - 1] if len(q0) > self.DYNAMIC + self.n_geo else [])
+        lo[positive] = 0.0
+        q0 = np.where(np.isfinite(lo), np.maximum(q0, 1e-9), q0)
+        return optimize.least_squares(self.residual, q0, jac=self.jacobian, bounds=(lo, np.inf), method="trf",
+                                      xtol=1e-10, ftol=1e-10, max_nfev=200)
+
+    def estimates(self, result: optimize.OptimizeResult) -> dict[str, Estimate]:
+        cov = covariance(result.jac, result.fun)
+        q, n = result.x, len(result.x)
+        p, _, _ = self.split(q)
+        out = {"hinge_stiffness_nm_per_rad": cov.estimate(float(p[0]), _unit(n, 0, self.dyn_scale[0])),
+               "hinge_damping_nms_per_rad": cov.estimate(float(p[1]), _unit(n, 1, self.dyn_scale[1])),
+               "neutral_angle_deg": cov.estimate(math.degrees(p[2]), _unit(n, 2, math.degrees(1.0)))}
+        if len(p) > self.DYNAMIC:
+            out["coulomb_friction_nm"] = cov.estimate(float(p[-1]), _unit(n, n - 1, self.tau_ref))
+        return out
+
+    def coulomb_score_p(self, base: optimize.OptimizeResult) -> float:
+        """p-value of adding Coulomb friction to the viscous fit ``base``: the residual's share
+        along the friction's own direction (its Jacobian column at zero friction, the fitted
+        columns projected out), against the residual variance (a score test, F(1, n-p-1))."""
+        h = 1e-3
+        col = (self.residual(np.append(base.x, h)) - base.fun) / h
+        jac = base.jac
+        coef, *_ = np.linalg.lstsq(jac, col, rcond=None)
+        own = col - jac @ coef
+        n, p = len(base.fun), len(base.x) + 1
+        if not float(own @ own) > 0:
+            return 1.0
+        drop = float(own @ base.fun) ** 2 / float(own @ own)
+        ssr = float(base.fun @ base.fun) - drop
+        f_stat = drop / max(ssr / (n - p), 1e-300)
+        return float(stats.f.sf(f_stat, 1, n - p))
 
 
 def _unit(n: int, i: int, factor: float) -> np.ndarray:
@@ -314,37 +436,6 @@ def _unit(n: int, i: int, factor: float) -> np.ndarray:
     grad = np.zeros(n)
     grad[i] = factor
     return grad
-
-
-def _coulomb_score_p(residual, base: optimize.OptimizeResult) -> float:
-    """p-value of adding Coulomb friction to the viscous fit ``base``: the residual's share
-    along the friction's own direction (its Jacobian column at zero friction, the fitted
-    columns projected out), against the residual variance (a score test, F(1, n-p-1))."""
-    h = 1e-3
-    col = (residual(np.append(base.x, h)) - base.fun) / h
-    jac = base.jac
-    coef, *_ = np.linalg.lstsq(jac, col, rcond=None)
-    own = col - jac @ coef
-    n, p = len(base.fun), len(base.x) + 1
-    if not float(own @ own) > 0:
-        return 1.0
-    drop = float(own @ base.fun) ** 2 / float(own @ own)
-    ssr = float(base.fun @ base.fun) - drop
-    f_stat = drop / max(ssr / (n - p), 1e-300)
-    return float(stats.f.sf(f_stat, 1, n - p))
-
-
-def _solve(residual, q0: np.ndarray) -> optimize.OptimizeResult:
-    """Least squares on the scaled values (k, b and tau_c kept non-negative); central
-    differences of 3e-5 on values of order one stay far above the integrator's error (its
-    relative tolerance 1e-10): a step of 1e-6 left the solver 0.3 % above the least cost."""
-    lo = np.full(len(q0), -np.inf)
-    lo[[0, 1]] = 0.0
-    if len(q0) > 5:
-        lo[5] = 0.0
-    q0 = np.maximum(q0, np.where(np.isfinite(lo), 1e-9, -np.inf))
-    return optimize.least_squares(residual, q0, bounds=(lo, np.inf), method="trf", jac="2-point", diff_step=3e-5,
-                                  xtol=1e-10, ftol=1e-10, max_nfev=200)
 
 
 def _rest_angle(p: np.ndarray, rig: HingeRig) -> float:
