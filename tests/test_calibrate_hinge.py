@@ -240,3 +240,24 @@ def test_damping_test_trk_rings_at_its_recorded_frequency(shared_data):
     k_ring = 8.5e-7 * (2 * math.pi * fd) ** 2 / (1 - zeta**2)
     assert out["hinge_stiffness_nm_per_rad"]["value"] == pytest.approx(k_ring, rel=0.05)
     assert out["rms_residual_m"] < 1e-3
+
+
+def test_times_printed_to_three_digits_are_rebuilt_from_the_rows(tmp_path):
+    """A Tracker export with 3 significant digits repeats its times from 10 s on (10.5, 10.5,
+    10.5, 10.6 at 30 frames/s): the rows give them back, and the fit is the one of the full
+    times; a time that truly steps back stays an error."""
+    truth = dataclasses.replace(OUT_OF_PLANE, fps=30.0, duration_s=16.0, hold_s=9.0)
+    t, x, y = S.hinge_swing_track(truth, np.random.default_rng(5))
+    ref = fit_file(write_txy(tmp_path / "full.csv", t, x, y), truth)
+    coarse = np.array([float(f"{v:.3g}") for v in t])
+    path = write_txy(tmp_path / "coarse.csv", coarse, x, y)
+    table = read_table(path)
+    assert "times rebuilt from the row order at 30" in table.input_note
+    assert np.max(np.abs(table.time_s() - t)) < 1e-4       # a line through 480 rounded times: 0.3 % of a frame
+    fit = fit_file(path, truth)
+    assert fit.hinge_stiffness_nm_per_rad.value == pytest.approx(ref.hinge_stiffness_nm_per_rad.value, rel=1e-4)
+    back = coarse.copy()
+    back[200] = back[199] - 0.5
+    res = run("calibrate", "hinge", write_txy(tmp_path / "back.csv", back, x, y), "--inertia-kgm2", 8.5e-7,
+              "--gravity", "out-of-plane", "--no-plot")
+    assert res.exit_code == 2 and "time does not increase" in res.output

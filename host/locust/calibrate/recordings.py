@@ -26,7 +26,8 @@ naming the file, and the line or column, with a hint.
 Slow motion: a clip filmed at 240 frames/s and exported (or played) at 30 has times 8 times
 too long. :class:`TimeOptions` (``--time-scale S``: real time = file time * S, or
 ``--clip-fps F``: the rate the clip was filmed at, the file's own rate read from its median
-time step) puts every recording back on real time, tracks and plain CSVs alike.
+time step) puts every recording back on real time, tracks and plain CSVs alike. Times
+printed to too few digits (they repeat) are rebuilt from the row order (:func:`regular_time`).
 """
 
 from __future__ import annotations
@@ -172,7 +173,31 @@ def read_table(path: str | Path, imports: ImportOptions = AS_IS, timing: TimeOpt
             table = parse_table(read_text(path), path, imports)
     except TrackError as exc:
         raise CalibrationError(exc.message, exc.hint) from None
-    return rescale_time(table, timing)
+    return rescale_time(regular_time(table), timing)
+
+
+def regular_time(table: Table) -> Table:
+    """A recording whose times repeat because they were printed to too few digits (Tracker with
+    3 significant digits: 10.5, 10.5, 10.5, 10.6 at 30 frames/s) gets them back from the row
+    order, one frame a row, when a line through (row, time) stays within half the printed step
+    plus half a frame of every time; the note says so. Other recordings are returned as they are
+    (a real step back in time is :func:`clean_samples`' error)."""
+    if "t_s" not in table.columns:
+        return table
+    t = table.columns["t_s"]
+    rows = np.nonzero(np.isfinite(t))[0]
+    steps = np.diff(t[rows])
+    if len(rows) < 3 or np.all(steps > 0) or np.any(steps < 0):
+        return table
+    slope, offset = np.polyfit(rows, t[rows], 1)
+    printed = float(steps.max())
+    if not slope > 0 or np.max(np.abs(t[rows] - (offset + slope * rows))) > 0.5 * printed + 0.5 * slope:
+        return table
+    rebuilt = np.where(np.isfinite(t), offset + slope * np.arange(len(t)), np.nan)
+    note = (f"times rebuilt from the row order at {1 / slope:.5g} frames/s: the file's repeat "
+            f"({int(np.sum(steps == 0))} repeated, printed to {printed:g} s)")
+    tracks = None if table.tracks is None else replace(table.tracks, t_s=rebuilt)
+    return replace(table, columns={**table.columns, "t_s": rebuilt}, tracks=tracks, time_note=note)
 
 
 def rescale_time(table: Table, timing: TimeOptions) -> Table:
@@ -184,7 +209,7 @@ def rescale_time(table: Table, timing: TimeOptions) -> Table:
         return table
     columns = {**table.columns, "t_s": table.columns["t_s"] * factor}
     tracks = None if table.tracks is None else replace(table.tracks, t_s=table.tracks.t_s * factor)
-    return replace(table, columns=columns, tracks=tracks, time_note=note)
+    return replace(table, columns=columns, tracks=tracks, time_note="; ".join(filter(None, (table.time_note, note))))
 
 
 def parse_table(text: str, path: Path, imports: ImportOptions = AS_IS) -> Table:
