@@ -110,8 +110,8 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, import
               help="With --gravity in-plane: hinge to the link's centre of mass [m], taken on the line from the "
                    "hinge to the marker.")
 @click.option("--pivot", default=None, metavar="X,Y",
-              help="The hinge's position in the track [m, after --units] [default: the centre of the circle "
-                   "fitted to the marker's arc].")
+              help="The hinge's position in the track [m, after --units], held fixed [default: fitted with the "
+                   "swing, from the centre of the circle through the marker's arc].")
 @click.option("--marker", default=None, help="Marker on the swinging link [default: the only one].")
 @click.option("--start-s", type=FINITE, default=None,
               help="Fit from this time [s] [default: the first turning point after the release, the end of "

@@ -81,7 +81,7 @@ class HingeFit:
     pivot_m: tuple[float, float]
     pivot_source: str                        # given | fitted (started at the circle fit)
     radius_m: float
-    release_angle_deg: float
+    start_angle_deg: float                  # where the fit window starts (the first turning point after the release)
     rms_residual_m: float
     rms_residual_deg: float
     n_samples: int
@@ -101,7 +101,7 @@ class HingeFit:
         out.update(coulomb_friction=self.coulomb_note, natural_frequency_hz=self.natural_frequency_hz,
                    damping_ratio=self.damping_ratio, rest_angle_deg=self.rest_angle_deg,
                    pivot_m=list(self.pivot_m), pivot=self.pivot_source, radius_m=self.radius_m,
-                   release_angle_deg=self.release_angle_deg, rms_residual_m=self.rms_residual_m,
+                   start_angle_deg=self.start_angle_deg, rms_residual_m=self.rms_residual_m,
                    rms_residual_deg=self.rms_residual_deg, n_samples=self.n_samples,
                    fit_window_s=[self.fit_start_s, self.fit_end_s], fit_time_s=self.fit_time_s, model=MODEL,
                    notes=list(self.notes))
@@ -323,7 +323,7 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
         coulomb_friction_nm=est.get("coulomb_friction_nm"), coulomb_note=coulomb_note,
         natural_frequency_hz=wn / (2 * math.pi), damping_ratio=zeta, rest_angle_deg=math.degrees(rest),
         pivot_m=(px, py), pivot_source="given" if pivot is not None else "fitted",
-        radius_m=radius, release_angle_deg=math.degrees(float(theta[0])),
+        radius_m=radius, start_angle_deg=math.degrees(float(theta[0])),
         rms_residual_m=float(np.sqrt(np.mean(rx**2 + ry**2))),
         rms_residual_deg=math.degrees(float(np.sqrt(np.mean((measured - model) ** 2)))), n_samples=len(t),
         fit_start_s=float(t[0]), fit_end_s=float(t[-1]), fit_time_s=time.perf_counter() - clock,
