@@ -261,3 +261,17 @@ def test_times_printed_to_three_digits_are_rebuilt_from_the_rows(tmp_path):
     res = run("calibrate", "hinge", write_txy(tmp_path / "back.csv", back, x, y), "--inertia-kgm2", 8.5e-7,
               "--gravity", "out-of-plane", "--no-plot")
     assert res.exit_code == 2 and "time does not increase" in res.output
+
+
+def test_track_import_reads_a_tracker_project(tmp_path):
+    """`locust track --import` goes through the same reader: a .trk's metres, renamed."""
+    t, x, y = S.hinge_swing_track(dataclasses.replace(OUT_OF_PLANE, duration_s=2.0), np.random.default_rng(1))
+    trk = write_trk(tmp_path / "swing.trk", t, x, y)
+    res = run("track", "--import", trk, "--rename", "mass_A=tip", "--out", tmp_path / "swing.tracks.csv")
+    assert res.exit_code == 0, res.output
+    table = read_table(tmp_path / "swing.tracks.csv")
+    tx, ty = table.marker("tip")
+    # the tracks CSV prints metres to the micrometre, seconds to the microsecond
+    assert np.max(np.abs(tx - x)) <= 5.1e-7 and np.max(np.abs(ty - y)) <= 5.1e-7
+    assert np.max(np.abs(table.time_s() - t)) <= 5.1e-7
+    assert "7200 px/m" in " ".join(table.comments)

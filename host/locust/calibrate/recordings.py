@@ -107,7 +107,7 @@ class Table:
         """How the file was read: its layout's conversion note (scale, units), and the time scale."""
         notes = [c.strip() for c in (self.tracks.comments if self.tracks is not None else ())
                  if c.strip().startswith(("imported from", "converted from"))]
-        return "; ".join(notes[-1:] + ([self.time_note] if self.time_note else []))
+        return "; ".join(notes + ([self.time_note] if self.time_note else []))
 
 
 @dataclass(frozen=True)

@@ -188,7 +188,7 @@ def import_project(path: str | Path, options: ImportOptions = AS_IS) -> TracksCs
                          "set the clip's frame rate in Tracker, or export its data (File > Export > Data)")
     note = (f"imported from {path.name} (Tracker project): scale {1 / cal.m_per_px:.6g} px/m, origin "
             f"({cal.origin_x_px + 0.5:.6g}, {cal.origin_y_px + 0.5:.6g}) px, x axis {cal.angle_deg:g} deg, "
-            f"{clip.fps:.6g} frames/s, {options.describe()}")
+            f"{clip.fps:.6g} frames/s")
     tracks = replace(tracks_of(result), comments=(note,), path=path)
     return tracks if options.identity else _convert_tracks_csv(tracks, options)
 
