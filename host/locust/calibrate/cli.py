@@ -14,12 +14,13 @@ from ..options import FINITE, POSITIVE
 from ..progress import progress
 from ..track.importing import ImportOptions, import_options
 from . import beam as B
+from . import hinge as HG
 from . import hop as H
 from . import ramp as R
 from . import servo as S
 from .fitstats import Estimate
 from .plots import plot_fit
-from .recordings import clean_samples, read_table
+from .recordings import REAL_TIME, TimeOptions, clean_samples, read_table, time_options
 from .write import DEFAULT_ROBOT_TOML, check_plausible, implausible, write_fitted
 
 
@@ -44,6 +45,7 @@ def calibrate() -> None:
 
     \b
     beam   cardstock cantilever, dropped tip mass  -> hinge stiffness, damping
+    hinge  a link swinging on a flexure hinge     -> hinge stiffness, damping (large angles)
     servo  servo steps carrying a battery         -> no-load speed, armature, kp
     ramp   ramp tilted until the robot slides      -> static friction mu
     hop    filmed hops of one or more leg sets     -> any parameters, jointly
@@ -66,15 +68,16 @@ def calibrate() -> None:
               help="Fit from this time [default: the first swing after the drop].")
 @click.option("--end-s", type=FINITE, default=None, help="Fit up to this time [default: end of the track].")
 @import_options
+@time_options
 @output_options
-def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, imports, write_path, as_json, plot_path,
-         no_plot):
+def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, imports, timing, write_path, as_json,
+         plot_path, no_plot):
     """Fit the beam tip's damped oscillation: stiffness, damping, and the model's hinge values.
 
-    TRACKS is a `locust track` CSV, a Tracker text export or a t,x,y CSV of the beam tip
-    (metres, or --units cm|mm).
+    TRACKS is a `locust track` CSV, a Tracker project (.trk, .trz) or text export, or a
+    t,x,y CSV of the beam tip (metres, or --units cm|mm).
     """
-    table = read_table(tracks, imports)
+    table = read_table(tracks, imports, timing)
     x, y = table.marker(marker)
     t, x, y = clean_samples(tracks, "the beam tip", table.time_s(), x, y, min_samples=B.MIN_SAMPLES)
     displacement = B.principal_displacement(x, y)
@@ -91,7 +94,73 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, import
     note = f"beam L={length_m} m, m={mass_kg} kg; {B.MAPPING}"
     _finish(fit, tracks, values, note, write_path, as_json, plot_path, no_plot,
             subtitle=f"fn {fit.natural_frequency_hz.value:.4g} Hz, zeta {fit.damping_ratio.value:.3g}",
-            warnings=[warning] if warning else [])
+            warnings=[warning] if warning else [], input_note=table.input_note)
+
+
+@calibrate.command()
+@click.argument("tracks", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--inertia-kgm2", type=POSITIVE, required=True,
+              help="The swinging link's moment of inertia about the hinge axis [kg*m^2], marker included "
+                   "(calibration/protocols/hinge.md: a bar of mass m and length L hinged at one end: m*L^2/3).")
+@click.option("--gravity", type=click.Choice(HG.GRAVITY_CHOICES), required=True,
+              help="in-plane: the link swings in a vertical plane (its weight pulls it down, -M*g*D*cos(angle), "
+                   "straight down being the track's -y); out-of-plane: the hinge axis is vertical (no moment).")
+@click.option("--mass-kg", type=POSITIVE, default=None, help="With --gravity in-plane: the swinging link's mass [kg].")
+@click.option("--com-m", type=POSITIVE, default=None,
+              help="With --gravity in-plane: hinge to the link's centre of mass [m], taken on the line from the "
+                   "hinge to the marker.")
+@click.option("--pivot", default=None, metavar="X,Y",
+              help="The hinge's position in the track [m, after --units], held fixed [default: fitted with the "
+                   "swing, from the centre of the circle through the marker's arc].")
+@click.option("--marker", default=None, help="Marker on the swinging link [default: the only one].")
+@click.option("--start-s", type=FINITE, default=None,
+              help="Fit from this time [s] [default: the first turning point after the release, the end of "
+                   "the first free swing].")
+@click.option("--end-s", type=FINITE, default=None, help="Fit up to this time [s] [default: end of the track].")
+@click.option("--coulomb", type=click.Choice(["auto", "off", "on"]), default="auto", show_default=True,
+              help="Coulomb friction torque [N*m]: auto fits it only when the swing shows it (score test "
+                   "p < 0.001, and its 95% interval excludes zero).")
+@import_options
+@time_options
+@output_options
+def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s, end_s, coulomb, imports, timing,
+          write_path, as_json, plot_path, no_plot):
+    """Fit a link's free swing on a flexure hinge: stiffness, damping, neutral angle.
+
+    TRACKS is a track of one marker on the swinging link: a Tracker project (.trk, .trz;
+    its own calibration gives metres), a Tracker text export (a title line such as mass_A
+    accepted), a `locust track` CSV or a t,x,y CSV (--units for cm or mm). The angle about
+    the hinge is taken from the marker's x, y, at any size of swing; the model is
+    I*theta'' = -k*(theta - theta0) - b*theta' [- M*g*D*cos(theta)] [- tau_c*sign(theta')].
+    Prints k [N*m/rad], b [N*m*s/rad] with 95% intervals, the RMS residual of the marker
+    position [m]; --write sets compliance.hinge_stiffness_nm_per_rad and
+    compliance.hinge_damping_nms_per_rad.
+
+    \b
+    Example (the course's film hinge, the link clamped with its hinge axis vertical):
+      locust calibrate hinge Damping_test.trk --inertia-kgm2 8.5e-7 --gravity out-of-plane
+    """
+    if gravity == "out-of-plane" and (mass_kg or com_m):
+        raise CalibrationError("--mass-kg and --com-m act with --gravity in-plane only",
+                               "leave them out, or give --gravity in-plane if the link swings in a vertical plane")
+    rig = HG.HingeRig(inertia_kgm2, gravity, mass_kg or 0.0, com_m or 0.0)
+    table = read_table(tracks, imports, timing)
+    x, y = table.marker(marker)
+    t, x, y = clean_samples(tracks, "the link's marker", table.time_s(), x, y, min_samples=HG.MIN_SAMPLES)
+    centre = tuple(_floats(pivot, 2, "--pivot", "X,Y in metres, e.g. --pivot 0.0,0.0")) if pivot else None
+    with progress(length=1, label="fitting hinge swing") as bar:
+        fit = HG.fit_hinge(t, x, y, rig, pivot=centre, start_s=start_s, end_s=end_s, coulomb=coulomb,
+                           source=str(tracks))
+        bar.update(1)
+    values = {"compliance.hinge_stiffness_nm_per_rad": fit.hinge_stiffness_nm_per_rad,
+              "compliance.hinge_damping_nms_per_rad": fit.hinge_damping_nms_per_rad}
+    note = (f"hinge swing, I={inertia_kgm2:g} kg*m^2, gravity {gravity}"
+            + (f", M={mass_kg:g} kg, D={com_m:g} m" if gravity == "in-plane" else "")
+            + f", pivot {fit.pivot_source}; Coulomb friction {fit.coulomb_note}")
+    _finish(fit, tracks, values, note, write_path, as_json, plot_path, no_plot,
+            subtitle=(f"fn {fit.natural_frequency_hz:.4g} Hz, zeta {fit.damping_ratio:.3g}, "
+                      f"RMS {1000 * fit.rms_residual_m:.3g} mm"),
+            input_note=table.input_note)
 
 
 @calibrate.command()
@@ -110,9 +179,10 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, import
               help="With --pivot: the commanded step, degrees from the horizontal, and when it was sent [s].")
 @click.option("--marker", default=None, help="With --pivot: marker of the horn tip [default: the only one].")
 @import_options
+@time_options
 @output_options
-def servo(data, inertia_kgm2, stall_torque_nm, gravity_moment_nm, pivot, step, marker, imports, write_path, as_json,
-          plot_path, no_plot):
+def servo(data, inertia_kgm2, stall_torque_nm, gravity_moment_nm, pivot, step, marker, imports, timing, write_path,
+          as_json, plot_path, no_plot):
     """Identify the hobby servo (no-load speed, armature, kp) from step responses.
 
     DATA is a CSV with t_s, angle_deg, command_deg (degrees from the horizontal; several
@@ -135,7 +205,7 @@ def servo(data, inertia_kgm2, stall_torque_nm, gravity_moment_nm, pivot, step, m
                                "leave them out for t_s,angle_deg,command_deg recordings")
     recordings = []
     for path, inertia, moment in zip(data, inertias, moments):
-        t, angle, command = _servo_series(path, pivot, step, marker, imports)
+        t, angle, command = _servo_series(path, pivot, step, marker, imports, timing)
         recordings.append(S.StepRecording(t, angle, command, S.ServoRig(inertia, moment), source=str(path)))
     with progress(length=3 * 60, label="fitting servo") as bar:
         fit = S.fit_servo(recordings, stall_torque_nm, progress=bar.update)
@@ -164,8 +234,9 @@ def _per_recording(values: tuple[float, ...], n: int, option: str) -> list[float
 @click.option("--into", type=click.Choice(["foot", "nose"]), default="foot", show_default=True,
               help="Which friction the result is written to (contact.foot_friction or contact.nose_friction).")
 @import_options
+@time_options
 @output_options
-def ramp(data, ramp_markers, robot_marker, into, imports, write_path, as_json, plot_path, no_plot):
+def ramp(data, ramp_markers, robot_marker, into, imports, timing, write_path, as_json, plot_path, no_plot):
     """Static friction from critical ramp angles: mu = tan(mean angle), with a 95% interval.
 
     DATA: CSVs with an angle_deg column (one trial a row, degrees), and/or side-view
@@ -173,7 +244,7 @@ def ramp(data, ramp_markers, robot_marker, into, imports, write_path, as_json, p
     """
     angles, warnings, tracks = [], [], 0
     for path in data:
-        found, warning, is_track = _ramp_angles(path, ramp_markers, robot_marker, imports)
+        found, warning, is_track = _ramp_angles(path, ramp_markers, robot_marker, imports, timing)
         angles.extend(found)
         warnings += [warning] if warning else []
         tracks += is_track
@@ -274,8 +345,8 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
 
 # -- helpers ------------------------------------------------------------------------
 def _servo_series(data: Path, pivot: str | None, step: str | None, marker: str | None,
-                  imports: ImportOptions):
-    table = read_table(data, imports)
+                  imports: ImportOptions, timing: TimeOptions = REAL_TIME):
+    table = read_table(data, imports, timing)
     if pivot is None:
         t, angle, command = table.require("t_s", "angle_deg", "command_deg", purpose="a servo step")
         return clean_samples(data, "the servo angle", t, angle, command, min_samples=S.MIN_SAMPLES)
@@ -289,10 +360,10 @@ def _servo_series(data: Path, pivot: str | None, step: str | None, marker: str |
     return t, S.horn_angle_deg(x, y, px, py), np.where(t < at_s, a_from, a_to)
 
 
-def _ramp_angles(path: Path, ramp_markers: str, robot_marker: str,
-                 imports: ImportOptions) -> tuple[list[float], str | None, bool]:
+def _ramp_angles(path: Path, ramp_markers: str, robot_marker: str, imports: ImportOptions,
+                 timing: TimeOptions = REAL_TIME) -> tuple[list[float], str | None, bool]:
     """The trials' angles in ``path``, a plausibility warning, and whether it was a track."""
-    table = read_table(path, imports)
+    table = read_table(path, imports, timing)
     if table.has("angle_deg"):
         return [float(a) for a in table.columns["angle_deg"] if np.isfinite(a)], None, table.tracks is not None
     names = [n.strip() for n in ramp_markers.split(",")]
@@ -326,9 +397,11 @@ def default_plot_path(recording: Path, recording_name: Path | None = None) -> Pa
 def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_path: Path | None,
             as_json: bool, plot_path: Path | None, no_plot: bool, *, subtitle: str,
             recording_name: Path | None = None, source_name: str | None = None,
-            warnings: list[str] | None = None) -> None:
+            warnings: list[str] | None = None, input_note: str = "") -> None:
     recording_name = recording_name or recording
     out = fit.summary()
+    if input_note:
+        out["input"] = input_note
     odd = implausible(values)
     out["warnings"] = list(warnings or []) + odd
     for warning in out["warnings"]:

@@ -1,6 +1,6 @@
-"""Read calibration recordings: plain CSV, ``locust track`` CSV, or Tracker's text export.
+"""Read calibration recordings: plain CSV, ``locust track`` CSV, Tracker's text export or project.
 
-All three become one :class:`Table` of numeric columns, with marker positions under the
+All four become one :class:`Table` of numeric columns, with marker positions under the
 ``locust track`` names (``<marker>_x_m``, ``<marker>_y_m``) and time as ``t_s``:
 
 - plain CSV (``t_s,angle_deg,command_deg`` or ``angle_deg``), ``#`` lines are comments:
@@ -14,23 +14,34 @@ All three become one :class:`Table` of numeric columns, with marker positions un
   separated, possibly with decimal commas; or a plain ``t,x,y`` CSV of one marker (``nose``).
   Tracker writes positions in its calibration unit: ``--units cm`` for a Tracker in cm.
 
-Every track (the last two) goes through :func:`locust.track.importing.import_tracks`'s
+- a Tracker project (``.trk``, or a ``.trz`` zip holding one), read by
+  :mod:`locust.track.trk`: its point tracks in metres through the project's own calibration.
+
+Every track (the last three) goes through :func:`locust.track.importing.import_tracks`'s
 conversion, so ``--units``, ``--rename`` and ``--mirror`` act here as in ``locust track
 --import``; a plain CSV has no positions and is read as it is. The three share one tokenizer
 (:mod:`locust.track.delimited`). Every problem is a :class:`~locust.errors.CalibrationError`
 naming the file, and the line or column, with a hint.
+
+Slow motion: a clip filmed at 240 frames/s and exported (or played) at 30 has times 8 times
+too long. :class:`TimeOptions` (``--time-scale S``: real time = file time * S, or
+``--clip-fps F``: the rate the clip was filmed at, the file's own rate read from its median
+time step) puts every recording back on real time, tracks and plain CSVs alike. Times
+printed to too few digits (they repeat) are rebuilt from the row order (:func:`regular_time`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import functools
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import click
 import numpy as np
 
 from ..errors import CalibrationError, TrackError
 from ..track.delimited import check_names, read_text, split_text
-from ..track.importing import AS_IS, ImportOptions, track_layout, tracks_from_delimited
+from ..track.importing import AS_IS, ImportOptions, import_project, is_project, track_layout, tracks_from_delimited
 from ..track.tracks_csv import TracksCsv
 
 
@@ -44,6 +55,7 @@ class Table:
     comments: tuple[str, ...] = field(default=())
     tracks: TracksCsv | None = field(default=None, compare=False, repr=False)   # marker files, in metres
     units: str = "m"                         # the unit the file's positions were in (--units)
+    time_note: str = ""                      # how the times were rescaled (slow motion), if they were
 
     @property
     def n_rows(self) -> int:
@@ -90,15 +102,114 @@ class Table:
         return t
 
 
-def read_table(path: str | Path, imports: ImportOptions = AS_IS) -> Table:
+    @property
+    def input_note(self) -> str:
+        """How the file was read: its layout's conversion note (scale, units), and the time scale."""
+        notes = [c.strip() for c in (self.tracks.comments if self.tracks is not None else ())
+                 if c.strip().startswith(("imported from", "converted from"))]
+        return "; ".join(notes + ([self.time_note] if self.time_note else []))
+
+
+@dataclass(frozen=True)
+class TimeOptions:
+    """``--time-scale`` / ``--clip-fps``: a slow-motion recording back on real time."""
+
+    time_scale: float | None = None     # real time = file time * time_scale
+    clip_fps: float | None = None       # the rate the clip was filmed at [frames/s]
+
+    def factor(self, t_s: np.ndarray, path: Path) -> tuple[float, str]:
+        """The factor on the file's times, and what to say about it ('' when 1)."""
+        if self.time_scale is not None and self.clip_fps is not None:
+            raise CalibrationError("give --time-scale or --clip-fps, not both",
+                                   "--clip-fps F: the clip was filmed at F frames/s; --time-scale S: t_real = t*S")
+        if self.time_scale is not None:
+            if not self.time_scale > 0:
+                raise CalibrationError(f"--time-scale must be positive (got {self.time_scale})",
+                                       "e.g. --time-scale 0.125 for a 240 frames/s clip exported at 30")
+            return self.time_scale, f"times x {self.time_scale:g} (--time-scale)"
+        if self.clip_fps is not None:
+            steps = np.diff(np.asarray(t_s, dtype=float)[np.isfinite(t_s)])
+            steps = steps[steps > 0]
+            if not self.clip_fps > 0 or len(steps) == 0:
+                raise CalibrationError(f"{path}: --clip-fps {self.clip_fps:g} needs a positive rate and a time column "
+                                       "that advances", "the rate the clip was filmed at, e.g. --clip-fps 240")
+            file_fps = 1.0 / float(np.median(steps))
+            return file_fps / self.clip_fps, (f"times x {file_fps / self.clip_fps:.6g}: the file's "
+                                              f"{file_fps:.5g} frames/s made the clip's {self.clip_fps:g}")
+        return 1.0, ""
+
+
+REAL_TIME = TimeOptions()
+
+
+def time_options(func):
+    """``--time-scale``, ``--clip-fps`` on a click command, given to it as one :class:`TimeOptions`, ``timing``."""
+
+    @functools.wraps(func)
+    def wrapper(*args, time_scale, clip_fps, **kwargs):
+        return func(*args, timing=TimeOptions(time_scale, clip_fps), **kwargs)
+
+    wrapper = click.option("--clip-fps", type=float, default=None, metavar="FPS",
+                           help="Slow motion: the rate the clip was filmed at [frames/s]; the file's own rate "
+                                "(its median time step) is rescaled to it, e.g. a 240 frames/s clip exported "
+                                "at 30: --clip-fps 240.")(wrapper)
+    wrapper = click.option("--time-scale", type=float, default=None, metavar="S",
+                           help="Slow motion: real time = the file's time * S [-], e.g. 0.125 for a 240 "
+                                "frames/s clip exported at 30 [default: 1, times as they are].")(wrapper)
+    return wrapper
+
+
+def read_table(path: str | Path, imports: ImportOptions = AS_IS, timing: TimeOptions = REAL_TIME) -> Table:
     """Read a recording; see the module docstring for the formats understood. ``imports``
-    (``--units``, ``--rename``, ``--mirror``) converts a track; a plain CSV is read as it is."""
+    (``--units``, ``--rename``, ``--mirror``) converts a track; a plain CSV is read as it is;
+    ``timing`` rescales a slow-motion recording's times."""
     path = Path(path)
     try:
-        text = read_text(path)
+        if is_project(path):
+            tracks = import_project(path, imports)
+            table = Table(path=path, columns={n: tracks.column(n) for n in tracks.columns}, kind="tracker",
+                          comments=tracks.comments, tracks=tracks)
+        else:
+            table = parse_table(read_text(path), path, imports)
     except TrackError as exc:
         raise CalibrationError(exc.message, exc.hint) from None
-    return parse_table(text, path, imports)
+    return rescale_time(regular_time(table), timing)
+
+
+def regular_time(table: Table) -> Table:
+    """A recording whose times repeat because they were printed to too few digits (Tracker with
+    3 significant digits: 10.5, 10.5, 10.5, 10.6 at 30 frames/s) gets them back from the row
+    order, one frame a row, when a line through (row, time) stays within half the printed step
+    plus half a frame of every time; the note says so. Other recordings are returned as they are
+    (a real step back in time is :func:`clean_samples`' error)."""
+    if "t_s" not in table.columns:
+        return table
+    t = table.columns["t_s"]
+    rows = np.nonzero(np.isfinite(t))[0]
+    steps = np.diff(t[rows])
+    if len(rows) < 3 or np.all(steps > 0) or np.any(steps < 0):
+        return table
+    slope, offset = np.polyfit(rows, t[rows], 1)
+    printed = float(steps.max())
+    if not slope > 0 or np.max(np.abs(t[rows] - (offset + slope * rows))) > 0.5 * printed + 0.5 * slope:
+        return table
+    rebuilt = np.where(np.isfinite(t), offset + slope * np.arange(len(t)), np.nan)
+    note = (f"times rebuilt from the row order at {1 / slope:.5g} frames/s: the file's repeat "
+            f"({int(np.sum(steps == 0))} repeated, printed to {printed:g} s)")
+    tracks = None if table.tracks is None else replace(table.tracks, t_s=rebuilt)
+    return replace(table, columns={**table.columns, "t_s": rebuilt}, tracks=tracks, time_note=note)
+
+
+def rescale_time(table: Table, timing: TimeOptions) -> Table:
+    """``table`` with its times (``t_s``, and its tracks') multiplied as ``timing`` says."""
+    if "t_s" not in table.columns:
+        return table
+    factor, note = timing.factor(table.columns["t_s"], table.path)
+    if factor == 1.0:
+        return table
+    columns = {**table.columns, "t_s": table.columns["t_s"] * factor}
+    tracks = None if table.tracks is None else replace(table.tracks, t_s=table.tracks.t_s * factor)
+    return replace(table, columns=columns, tracks=tracks, time_note="; ".join(filter(None, (table.time_note, note))))
 
 
 def parse_table(text: str, path: Path, imports: ImportOptions = AS_IS) -> Table:

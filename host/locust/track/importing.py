@@ -11,7 +11,7 @@ The one conversion every track input goes through (:func:`import_tracks`):
   (``"cup 3=nose"``); NEW is a plain name (letters, digits, ``_``);
 - ``--mirror``: x becomes -x, so a hop filmed right-to-left reads left-to-right (y stays up).
 
-Three layouts are read (the tokenizer is :mod:`.delimited`):
+Three text layouts are read (the tokenizer is :mod:`.delimited`), and Tracker's projects:
 
 - locust's tracks CSV (:mod:`.tracks_csv`): ``<m>_x_m`` / ``<m>_y_m`` hold the file's unit;
   pixel columns are kept as they are;
@@ -19,6 +19,11 @@ Three layouts are read (the tokenizer is :mod:`.delimited`):
   marker; its other columns (``v``, ``vx`` ...) are dropped (their units are Tracker's);
 - a plain CSV of one marker: ``t,x,y`` (or ``t_s``/``time`` for ``t``). Like an export
   without a title line, its track has no name: it is ``nose`` (``--rename nose=NEW``).
+
+- a Tracker project, ``.trk`` or a ``.trz`` zip holding one (:mod:`.trk`): its point tracks
+  through the project's own calibration (scale, origin, axes, length unit), in metres; its
+  times from the clip's frame rate. ``--units`` does not apply (the project says its unit),
+  ``--rename`` and ``--mirror`` do; a project without a scale is refused.
 
 Time stays in seconds (Tracker's ``t``), positions become metres, y up. A file of none of
 these layouts, an unknown unit, or a rename of a marker the file does not have, is a
@@ -149,7 +154,43 @@ def import_tracks(path: str | Path, units: str = "m", rename: Iterable[str] | Ma
     ``units``, ``rename`` and ``mirror`` as on the command line (``rename``: ``["A=nose"]`` or
     ``{"A": "nose"}``), or ``options`` already parsed."""
     options = options or ImportOptions.parse(units, rename, mirror)
+    if is_project(path):
+        return import_project(path, options)
     return tracks_from_delimited(split_text(read_text(path), path), options)
+
+
+PROJECT_SUFFIXES = (".trk", ".trz")
+
+
+def is_project(path: str | Path) -> bool:
+    """Whether ``path`` names a Tracker project (``.trk``, or a ``.trz`` zip holding one)."""
+    return Path(path).suffix.lower() in PROJECT_SUFFIXES
+
+
+def import_project(path: str | Path, options: ImportOptions = AS_IS) -> TracksCsv:
+    """A Tracker project's point tracks in metres through its own calibration (:mod:`.trk`),
+    renamed and mirrored by ``options``; a comment says which scale, origin and rate were used."""
+    from .export import tracks_of  # the project reader pulls in the video layer: only when needed
+    from .trk import project_result, read_project
+
+    path = Path(path)
+    if options.units != "m":
+        raise TrackError(f"{path}: --units {options.units} does not apply to a Tracker project",
+                         "the project's own calibration gives metres: leave --units out")
+    project = read_project(path)
+    result = project_result(project)
+    cal, clip = project.calibration, project.clip
+    if not math.isfinite(cal.m_per_px):
+        raise TrackError(f"{path}: the Tracker project has no scale (no calibration stick or tape)",
+                         "calibrate it in Tracker, or export its data in pixels and convert them")
+    if not math.isfinite(clip.fps):
+        raise TrackError(f"{path}: the Tracker project has no frame rate (clip control delta_t)",
+                         "set the clip's frame rate in Tracker, or export its data (File > Export > Data)")
+    note = (f"imported from {path.name} (Tracker project): scale {1 / cal.m_per_px:.6g} px/m, origin "
+            f"({cal.origin_x_px + 0.5:.6g}, {cal.origin_y_px + 0.5:.6g}) px, x axis {cal.angle_deg:g} deg, "
+            f"{clip.fps:.6g} frames/s")
+    tracks = replace(tracks_of(result), comments=(note,), path=path)
+    return tracks if options.identity else _convert_tracks_csv(tracks, options)
 
 
 def track_layout(doc: DelimitedText) -> str | None:

@@ -1,0 +1,463 @@
+"""A link swinging on a flexure hinge: its free ring-down -> hinge stiffness and damping.
+
+The link turns about the hinge by theta (rad, counter-clockwise from the track's +x axis,
+y up). With the link's inertia ``I`` about the hinge (given), its mass ``M`` and the
+distance ``D`` of its centre of mass from the hinge (given, for gravity in the swing's
+plane), the swing obeys, at any angle::
+
+    I*theta'' = -k*(theta - theta0) - b*theta' [- M*g*D*cos(theta)] [- tau_c*sign(theta')]
+
+- ``k`` [N*m/rad] the hinge's stiffness and ``theta0`` its neutral angle (fitted: a folded
+  flexure rarely rests where it was cut);
+- ``b`` [N*m*s/rad] its viscous damping;
+- gravity in the swing's plane (a link swinging in a vertical plane): the weight's moment
+  with the centre of mass on the line from the hinge to the marker, straight down being
+  -90 deg (the track's y up); out of the plane (the hinge axis vertical): no moment;
+- ``tau_c`` [N*m] Coulomb friction, fitted only when the data show it: kept when it lowers
+  the residual beyond chance (F test, p < 0.001) and its 95 % interval excludes zero.
+
+The swing is integrated (LSODA, relative tolerance 1e-10) from the start of the fit window,
+its initial angle and rate fitted with ``k``, ``b``, ``theta0``. The residual is the
+marker's position, x and y [m], against ``pivot + R*(cos theta, sin theta)``: the distance
+``R`` from the hinge to the marker is fitted too, and so is the pivot unless ``--pivot``
+gives it (its start: the centre of the circle fitted to the marker's arc), so its
+uncertainty is in the intervals of ``k`` and ``b``. Intervals come from the residual Jacobian
+(:mod:`.fitstats`). Start values come from the swing itself: the period from its zero
+crossings, the decay from its successive peaks (never a spectral peak, which can lock onto
+the record length).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy import integrate, optimize, stats
+
+from ..errors import CalibrationError
+from ..params import GRAVITY_M_PER_S2
+from .curves import Curves
+from .fitstats import Estimate, covariance
+
+GRAVITY_CHOICES = ("in-plane", "out-of-plane")
+MIN_SAMPLES = 20
+MIN_HALF_SWINGS = 3              # zero crossings needed for a period
+COULOMB_P_VALUE = 1e-3
+SMALL_ARC_DEG = 20.0             # a circle fit over less arc than this places the pivot poorly
+MODEL = ("I*theta'' = -k*(theta - theta0) - b*theta' - M*g*D*cos(theta) [gravity in plane] "
+         "- tau_c*sign(theta') [Coulomb, when significant]")
+
+
+@dataclass(frozen=True)
+class HingeRig:
+    """The swinging link: inertia about the hinge, and where its weight acts."""
+
+    inertia_kgm2: float
+    gravity: str = "out-of-plane"          # in-plane | out-of-plane
+    mass_kg: float = 0.0
+    com_m: float = 0.0                     # hinge to centre of mass [m], along the hinge-marker line
+
+    @property
+    def gravity_moment_nm(self) -> float:
+        """M*g*D: the weight's largest moment about the hinge (0 out of plane)."""
+        return self.mass_kg * GRAVITY_M_PER_S2 * self.com_m if self.gravity == "in-plane" else 0.0
+
+
+@dataclass(frozen=True)
+class HingeFit:
+    source: str
+    rig: HingeRig
+    hinge_stiffness_nm_per_rad: Estimate
+    hinge_damping_nms_per_rad: Estimate
+    neutral_angle_deg: Estimate
+    coulomb_friction_nm: Estimate | None
+    coulomb_note: str
+    natural_frequency_hz: float              # small swings about rest, gravity included
+    damping_ratio: float
+    rest_angle_deg: float
+    pivot_m: tuple[float, float]
+    pivot_source: str                        # given | fitted (started at the circle fit)
+    radius_m: float
+    start_angle_deg: float                  # where the fit window starts (the first turning point after the release)
+    rms_residual_m: float
+    rms_residual_deg: float
+    n_samples: int
+    fit_start_s: float
+    fit_end_s: float
+    fit_time_s: float
+    curves: Curves
+    notes: list[str] = field(default_factory=list)
+
+    def summary(self) -> dict:
+        out = {"experiment": "hinge", "source": self.source, "inertia_kgm2": self.rig.inertia_kgm2,
+               "gravity": self.rig.gravity, "mass_kg": self.rig.mass_kg or None, "com_m": self.rig.com_m or None}
+        for name in ("hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad", "neutral_angle_deg",
+                     "coulomb_friction_nm"):
+            est = getattr(self, name)
+            out[name] = None if est is None else est.as_dict()
+        out.update(coulomb_friction=self.coulomb_note, natural_frequency_hz=self.natural_frequency_hz,
+                   damping_ratio=self.damping_ratio, rest_angle_deg=self.rest_angle_deg,
+                   pivot_m=list(self.pivot_m), pivot=self.pivot_source, radius_m=self.radius_m,
+                   start_angle_deg=self.start_angle_deg, rms_residual_m=self.rms_residual_m,
+                   rms_residual_deg=self.rms_residual_deg, n_samples=self.n_samples,
+                   fit_window_s=[self.fit_start_s, self.fit_end_s], fit_time_s=self.fit_time_s, model=MODEL,
+                   notes=list(self.notes))
+        return out
+
+
+# -- geometry -----------------------------------------------------------------------
+def circle_fit(x_m: np.ndarray, y_m: np.ndarray) -> tuple[float, float, float]:
+    """Centre (x, y) and radius of the circle nearest the points: the algebraic (Kasa) fit,
+    refined by Gauss-Newton on the geometric distances."""
+    x, y = np.asarray(x_m, float), np.asarray(y_m, float)
+    a = np.column_stack([x, y, np.ones_like(x)])
+    sol, *_ = np.linalg.lstsq(a, x**2 + y**2, rcond=None)
+    cx, cy = sol[0] / 2, sol[1] / 2
+    r = math.sqrt(max(sol[2] + cx**2 + cy**2, 0.0))
+    res = optimize.least_squares(lambda p: np.hypot(x - p[0], y - p[1]) - p[2], [cx, cy, r], method="lm")
+    cx, cy, r = res.x
+    return float(cx), float(cy), float(abs(r))
+
+
+def swing_angle(x_m: np.ndarray, y_m: np.ndarray, pivot: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """The marker's angle about the pivot (rad, unwrapped, from +x, counter-clockwise) and its distance [m]."""
+    dx, dy = np.asarray(x_m) - pivot[0], np.asarray(y_m) - pivot[1]
+    return np.unwrap(np.arctan2(dy, dx)), np.hypot(dx, dy)
+
+
+# -- the model ----------------------------------------------------------------------
+def simulate(t_s: np.ndarray, params: np.ndarray, rig: HingeRig, coulomb_width_rad_per_s: float = 0.0) -> np.ndarray:
+    """theta(t) [rad] from ``params`` = (k, b, theta0, theta_start, rate_start[, tau_c]), t from t_s[0]."""
+    k, b, th0, th_start, w_start = (float(v) for v in params[:5])
+    tau_c = float(params[5]) if len(params) > 5 else 0.0
+    inv_i, mgd = 1.0 / rig.inertia_kgm2, rig.gravity_moment_nm
+    eps = coulomb_width_rad_per_s
+
+    def rhs(_t, s):
+        th, w = s
+        torque = -k * (th - th0) - b * w - mgd * math.cos(th)
+        if tau_c:
+            torque -= tau_c * math.tanh(w / eps)
+        return [w, torque * inv_i]
+
+    sol = integrate.odeint(rhs, [th_start, w_start], np.asarray(t_s) - t_s[0], tfirst=True, rtol=1e-10,
+                           atol=1e-12, mxstep=50000)
+    return sol[:, 0]
+
+
+# -- start values --------------------------------------------------------------------
+@dataclass(frozen=True)
+class SwingShape:
+    """What the swing shows before any fit: rest angle, damped period, decay rate, amplitude."""
+
+    rest_rad: float
+    damped_omega_rad_per_s: float
+    decay_per_s: float
+    amplitude_rad: float
+    crossings: int
+
+
+def swing_shape(t_s: np.ndarray, theta: np.ndarray, source: str) -> SwingShape:
+    """From the zero crossings (about the final rest) and the peaks between them."""
+    rest = float(np.median(theta[len(theta) * 4 // 5:]))
+    u = theta - rest
+    noise = angle_noise_rad(theta)
+    amp = float(np.max(np.abs(u)))
+    band = max(3 * noise, 0.02 * amp)                             # hysteresis: noise at rest is no crossing
+    crossings, peaks, side, last = [], [], 0, 0
+    for i, v in enumerate(u):
+        s = 1 if v > band else -1 if v < -band else 0
+        if s == 0:
+            continue
+        if side and s != side:
+            j = max(k for k in range(last, i) if np.sign(u[k]) == side)   # the last sample on the old side
+            tc = t_s[j] + (t_s[j + 1] - t_s[j]) * u[j] / (u[j] - u[j + 1]) if u[j] != u[j + 1] else t_s[j]
+            crossings.append(float(tc))
+            seg = np.abs(u[last:i])
+            peaks.append((float(t_s[last + int(np.argmax(seg))]), float(seg.max())))
+        if s != side:
+            last = i
+        side = s
+    if len(crossings) < MIN_HALF_SWINGS:
+        raise CalibrationError(f"{source}: the link crosses its rest angle {len(crossings)} times in the fit window "
+                               f"(need {MIN_HALF_SWINGS})",
+                               "film until the swing has died out, or widen --start-s/--end-s; "
+                               "see calibration/protocols/hinge.md")
+    half = float(np.median(np.diff(crossings)))
+    wd = math.pi / half
+    decay = 0.0
+    big = [(tp, a) for tp, a in peaks if a > 3 * band]
+    if len(big) >= 2:
+        slope = np.polyfit([p[0] for p in big], np.log([p[1] for p in big]), 1)[0]
+        decay = max(-float(slope), 0.0)
+    return SwingShape(rest, wd, decay, amp, len(crossings))
+
+
+def start_values(t_s: np.ndarray, theta: np.ndarray, rig: HingeRig, shape: SwingShape) -> np.ndarray:
+    """(k, b, theta0, theta_start, rate_start) from the linearised swing about its rest."""
+    wn = math.hypot(shape.damped_omega_rad_per_s, shape.decay_per_s)
+    stiff_total = rig.inertia_kgm2 * wn**2
+    mgd = rig.gravity_moment_nm
+    k0 = stiff_total + mgd * math.sin(shape.rest_rad)
+    k0 = max(k0, 0.05 * stiff_total)
+    b0 = max(2 * shape.decay_per_s * rig.inertia_kgm2, 1e-3 * 2 * rig.inertia_kgm2 * wn)
+    th0 = shape.rest_rad + mgd * math.cos(shape.rest_rad) / k0
+    n = min(5, len(t_s))
+    rate = float(np.polyfit(t_s[:n] - t_s[0], theta[:n], 2)[1]) if n >= 3 else 0.0
+    return np.array([k0, b0, th0, float(theta[0]), rate])
+
+
+def angle_noise_rad(theta: np.ndarray) -> float:
+    """The angle's tracking noise: from its second differences where the link is quietest (the
+    first or the last fifth of the record: held before the release, or at rest after it)."""
+    fifth = max(len(theta) // 5, 4)
+    parts = [np.diff(theta[:fifth], 2), np.diff(theta[-fifth:], 2)]
+    return min(float(np.std(p)) for p in parts if len(p)) / math.sqrt(6)
+
+
+def release_window(t_s: np.ndarray, theta: np.ndarray, start_s: float | None, end_s: float | None) -> np.ndarray:
+    """Samples to fit: the free swing from the first turning point after the release (or from
+    ``start_s``) to ``end_s``.
+
+    The release is the last moment the link is held at its largest excursion from the final
+    rest in the first half of the record: the last sample, before the link has swung a tenth
+    of the way back, within three noise deviations of the level it was held at. A hand lets
+    go over a few hundredths of a second, which is no free swing: the fit starts at the far
+    end of that first swing, where the link turns (a drop's impact is skipped alike in
+    :mod:`.beam`).
+    """
+    end = t_s[-1] if end_s is None else end_s
+    if start_s is None:
+        rest = np.median(theta[len(theta) * 4 // 5:])
+        signed = theta - rest
+        u = np.abs(signed)
+        noise = angle_noise_rad(theta)
+        i = int(np.argmax(u[:max(len(u) // 2, 1)]))
+        leaving = np.nonzero(u[i:] < u[i] - max(0.1 * u[i], 6 * noise))[0]
+        j = i + (int(leaving[0]) if len(leaving) else len(u) - i)
+        level = float(np.median(u[i:j]))
+        release = i + int(np.nonzero(u[i:j] >= level - 3 * noise)[0][-1])
+        start_s = t_s[_first_turn(signed, release, max(3 * noise, 0.02 * u[i]))]
+    return (t_s >= start_s) & (t_s <= end)
+
+
+def _first_turn(u: np.ndarray, release: int, band: float) -> int:
+    """The far extreme of the first swing after ``release`` (``release`` itself without one)."""
+    side = np.sign(u[release])
+    over = np.nonzero(u[release:] * -side > band)[0]
+    if not len(over):
+        return release
+    c1 = release + int(over[0])
+    back = np.nonzero(u[c1:] * side > band)[0]
+    if not len(back):
+        return release
+    c2 = c1 + int(back[0])
+    return c1 + int(np.argmax(np.abs(u[c1:c2])))
+
+
+# -- the fit ------------------------------------------------------------------------
+def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, *,
+              pivot: tuple[float, float] | None = None, start_s: float | None = None, end_s: float | None = None,
+              coulomb: str = "auto", source: str = "hinge") -> HingeFit:
+    """Fit the swing of the marker at (x_m, y_m); see the module docstring. ``coulomb``:
+    auto (fit it when significant), off, on."""
+    clock = time.perf_counter()
+    _check_rig(rig)
+    t_s, x_m, y_m = (np.asarray(a, dtype=float) for a in (t_s, x_m, y_m))
+    notes = []
+    centre = pivot if pivot is not None else circle_fit(x_m, y_m)[:2]
+    theta_all, radius_all = swing_angle(x_m, y_m, centre)
+    swing_deg = math.degrees(float(np.ptp(theta_all)))
+    if swing_deg < 30 * math.degrees(angle_noise_rad(theta_all)) or swing_deg < 1.0:
+        raise CalibrationError(f"{source}: flat signal, the marker turns {swing_deg:.3g} deg about the pivot",
+                               "check the marker (is it on the swinging link?), --pivot, and that the link was "
+                               "released (calibration/protocols/hinge.md)")
+    window = release_window(t_s, theta_all, start_s, end_s)
+    t, theta, x, y = t_s[window], theta_all[window], x_m[window], y_m[window]
+    if len(t) < MIN_SAMPLES:
+        raise CalibrationError(f"{source}: only {len(t)} samples in the fit window (need {MIN_SAMPLES})",
+                               "widen --start-s/--end-s, or film longer")
+    arc_deg = math.degrees(float(np.ptp(theta)))
+    if pivot is None and arc_deg < SMALL_ARC_DEG:
+        notes.append(f"the swing covers {arc_deg:.3g} deg: the fitted pivot is poorly placed; give --pivot")
+    shape = swing_shape(t, theta, source)
+    p0 = start_values(t, theta, rig, shape)
+    problem = _Swing(t, x, y, rig, p0, shape, float(np.median(radius_all[window])), centre, fit_pivot=pivot is None)
+    base = problem.solve(problem.start())
+    chosen, coulomb_note = base, "not fitted (--coulomb off)"
+    if coulomb != "off":
+        p_value = problem.coulomb_score_p(base)
+        if coulomb == "on" or p_value < COULOMB_P_VALUE:
+            with_c = problem.solve(np.append(base.x, 1.0))
+            tau = problem.estimates(with_c)["coulomb_friction_nm"]
+            if coulomb == "on" or tau.ci95_low > 0:
+                chosen = with_c
+                coulomb_note = (f"fitted: significant (score test p = {p_value:.2g})" if p_value < COULOMB_P_VALUE
+                                else f"fitted (--coulomb on), not significant (score test p = {p_value:.2g})")
+            else:
+                coulomb_note = (f"not significant: {tau.value:.3g} N*m, 95% CI [{tau.ci95_low:.3g}, "
+                                f"{tau.ci95_high:.3g}] holds zero; left out")
+        else:
+            coulomb_note = f"not significant (score test p = {p_value:.2g}): left out"
+    est = problem.estimates(chosen)
+    p, radius, (px, py) = problem.split(chosen.x)
+    model = simulate(t, p, rig, problem.width)
+    k, b = float(p[0]), float(p[1])
+    rest = _rest_angle(p, rig)
+    stiff_total = k - rig.gravity_moment_nm * math.sin(rest)
+    wn = math.sqrt(max(stiff_total, 0.0) / rig.inertia_kgm2)
+    zeta = b / (2 * math.sqrt(max(stiff_total, 1e-300) * rig.inertia_kgm2))
+    measured = np.unwrap(np.arctan2(y - py, x - px))
+    measured += 2 * math.pi * np.round((model[0] - measured[0]) / (2 * math.pi))
+    fine_t = np.linspace(t[0], t[-1], max(10 * len(t), 2000))
+    curves = Curves(x=t, data=np.degrees(measured), model=np.degrees(model), x_label="t [s]",
+                    y_label="link angle about the hinge [deg]", title=f"hinge: {Path(source).name}",
+                    model_x=fine_t, model_fine=np.degrees(simulate(fine_t, p, rig, problem.width)))
+    rx, ry = np.split(chosen.fun, 2)
+    return HingeFit(
+        source=source, rig=rig, hinge_stiffness_nm_per_rad=est["hinge_stiffness_nm_per_rad"],
+        hinge_damping_nms_per_rad=est["hinge_damping_nms_per_rad"], neutral_angle_deg=est["neutral_angle_deg"],
+        coulomb_friction_nm=est.get("coulomb_friction_nm"), coulomb_note=coulomb_note,
+        natural_frequency_hz=wn / (2 * math.pi), damping_ratio=zeta, rest_angle_deg=math.degrees(rest),
+        pivot_m=(px, py), pivot_source="given" if pivot is not None else "fitted",
+        radius_m=radius, start_angle_deg=math.degrees(float(theta[0])),
+        rms_residual_m=float(np.sqrt(np.mean(rx**2 + ry**2))),
+        rms_residual_deg=math.degrees(float(np.sqrt(np.mean((measured - model) ** 2)))), n_samples=len(t),
+        fit_start_s=float(t[0]), fit_end_s=float(t[-1]), fit_time_s=time.perf_counter() - clock,
+        curves=curves, notes=notes)
+
+
+class _Swing:
+    """The least-squares problem: the marker's x and y residuals [m] of a swing.
+
+    Its values, scaled to order one: k/k0, b/b0, theta0, the start angle, the start rate in
+    units of the damped angular frequency, the radius R/R0, then (when the pivot is fitted)
+    its offsets from the circle fit in units of R0, then (when fitted) tau_c in units of a
+    friction that would stop a tenth of the first swing's decay.
+    """
+
+    DYNAMIC = 5
+
+    def __init__(self, t, x, y, rig: HingeRig, p0: np.ndarray, shape: SwingShape, radius_m: float,
+                 centre, *, fit_pivot: bool):
+        self.t, self.x, self.y, self.rig = t, x, y, rig
+        self.p0, self.radius0, self.fit_pivot = p0, radius_m, fit_pivot
+        self.centre = (float(centre[0]), float(centre[1]))
+        self.width = 0.002 * max(shape.amplitude_rad, 1e-3) * shape.damped_omega_rad_per_s   # sign(rate), smoothed
+        self.tau_ref = 0.05 * p0[1] * shape.amplitude_rad * shape.damped_omega_rad_per_s
+        self.dyn_scale = np.array([p0[0], p0[1], 1.0, 1.0, max(shape.damped_omega_rad_per_s, 1e-3)])
+        self.n_geo = 3 if fit_pivot else 1
+
+    def start(self) -> np.ndarray:
+        return np.concatenate([self.p0 / self.dyn_scale, [1.0], np.zeros(self.n_geo - 1)])
+
+    def split(self, q: np.ndarray):
+        """(simulate's params, radius [m], pivot [m]) of the scaled values ``q``."""
+        n = self.DYNAMIC + self.n_geo
+        p = q[:self.DYNAMIC] * self.dyn_scale
+        if len(q) > n:
+            p = np.append(p, q[n] * self.tau_ref)
+        radius = q[self.DYNAMIC] * self.radius0
+        off = q[self.DYNAMIC + 1:n] * self.radius0 if self.fit_pivot else np.zeros(2)
+        return p, float(radius), (self.centre[0] + float(off[0]), self.centre[1] + float(off[1]))
+
+    def angle(self, q: np.ndarray) -> np.ndarray:
+        return simulate(self.t, self.split(q)[0], self.rig, self.width)
+
+    def residual(self, q: np.ndarray, theta: np.ndarray | None = None) -> np.ndarray:
+        _, radius, (px, py) = self.split(q)
+        th = self.angle(q) if theta is None else theta
+        return np.concatenate([px + radius * np.cos(th) - self.x, py + radius * np.sin(th) - self.y])
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """The dynamic columns by forward differences of 3e-5 (far above the integrator's
+        relative tolerance of 1e-10), the radius and pivot columns exactly."""
+        _, radius, _ = self.split(q)
+        th = self.angle(q)
+        cos, sin = np.cos(th), np.sin(th)
+        n = len(th)
+        jac = np.zeros((2 * n, len(q)))
+        dynamic = list(range(self.DYNAMIC)) + ([len(q) - 1] if len(q) > self.DYNAMIC + self.n_geo else [])
+        for i in dynamic:
+            h = 3e-5 * max(1.0, abs(q[i]))
+            step = q.copy()
+            step[i] += h
+            dth = (self.angle(step) - th) / h
+            jac[:n, i], jac[n:, i] = -radius * sin * dth, radius * cos * dth
+        jac[:n, self.DYNAMIC], jac[n:, self.DYNAMIC] = self.radius0 * cos, self.radius0 * sin
+        if self.fit_pivot:
+            jac[:n, self.DYNAMIC + 1] = self.radius0
+            jac[n:, self.DYNAMIC + 2] = self.radius0
+        return jac
+
+    def solve(self, q0: np.ndarray) -> optimize.OptimizeResult:
+        """Least squares, k, b, the radius and tau_c kept positive."""
+        lo = np.full(len(q0), -np.inf)
+        positive = [0, 1, self.DYNAMIC] + ([len(q0) - 1] if len(q0) > self.DYNAMIC + self.n_geo else [])
+        lo[positive] = 0.0
+        q0 = np.where(np.isfinite(lo), np.maximum(q0, 1e-9), q0)
+        return optimize.least_squares(self.residual, q0, jac=self.jacobian, bounds=(lo, np.inf), method="trf",
+                                      xtol=1e-10, ftol=1e-10, max_nfev=200)
+
+    def estimates(self, result: optimize.OptimizeResult) -> dict[str, Estimate]:
+        cov = covariance(result.jac, result.fun)
+        q, n = result.x, len(result.x)
+        p, _, _ = self.split(q)
+        out = {"hinge_stiffness_nm_per_rad": cov.estimate(float(p[0]), _unit(n, 0, self.dyn_scale[0])),
+               "hinge_damping_nms_per_rad": cov.estimate(float(p[1]), _unit(n, 1, self.dyn_scale[1])),
+               "neutral_angle_deg": cov.estimate(math.degrees(p[2]), _unit(n, 2, math.degrees(1.0)))}
+        if len(p) > self.DYNAMIC:
+            out["coulomb_friction_nm"] = cov.estimate(float(p[-1]), _unit(n, n - 1, self.tau_ref))
+        return out
+
+    def coulomb_score_p(self, base: optimize.OptimizeResult) -> float:
+        """p-value of adding Coulomb friction to the viscous fit ``base``: the residual's share
+        along the friction's own direction (its Jacobian column at zero friction, the fitted
+        columns projected out), against the residual variance (a score test, F(1, n-p-1))."""
+        h = 1e-3
+        col = (self.residual(np.append(base.x, h)) - base.fun) / h
+        jac = base.jac
+        coef, *_ = np.linalg.lstsq(jac, col, rcond=None)
+        own = col - jac @ coef
+        n, p = len(base.fun), len(base.x) + 1
+        if not float(own @ own) > 0:
+            return 1.0
+        drop = float(own @ base.fun) ** 2 / float(own @ own)
+        ssr = float(base.fun @ base.fun) - drop
+        f_stat = drop / max(ssr / (n - p), 1e-300)
+        return float(stats.f.sf(f_stat, 1, n - p))
+
+
+def _unit(n: int, i: int, factor: float) -> np.ndarray:
+    """Gradient of ``factor * q[i]`` in the solver's values ``q``."""
+    grad = np.zeros(n)
+    grad[i] = factor
+    return grad
+
+
+def _rest_angle(p: np.ndarray, rig: HingeRig) -> float:
+    """Where spring and weight balance: k*(theta - theta0) + M*g*D*cos(theta) = 0, nearest theta0."""
+    k, th0, mgd = float(p[0]), float(p[2]), rig.gravity_moment_nm
+    if mgd == 0 or k <= 0:
+        return th0
+    root = optimize.least_squares(lambda th: k * (th - th0) + mgd * np.cos(th), [th0]).x[0]
+    return float(root)
+
+
+def _check_rig(rig: HingeRig) -> None:
+    if not rig.inertia_kgm2 > 0:
+        raise CalibrationError(f"--inertia-kgm2 must be positive (got {rig.inertia_kgm2})",
+                               "the link's moment of inertia about the hinge, in kg*m^2 "
+                               "(calibration/protocols/hinge.md)")
+    if rig.gravity not in GRAVITY_CHOICES:
+        raise CalibrationError(f"--gravity {rig.gravity!r}: expected in-plane or out-of-plane",
+                               "in-plane: the link swings in a vertical plane; "
+                               "out-of-plane: the hinge axis is vertical")
+    if rig.gravity == "in-plane" and not (rig.mass_kg > 0 and rig.com_m > 0):
+        raise CalibrationError("--gravity in-plane needs --mass-kg and --com-m (the weight's moment M*g*D)",
+                               "weigh the link and measure the hinge-to-centre-of-mass distance "
+                               "(calibration/protocols/hinge.md)")
+
