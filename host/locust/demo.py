@@ -39,7 +39,7 @@ from .progress import progress
 
 LEG_SETS = ("small", "medium", "large")
 RECORDINGS = Path(__file__).resolve().parents[2] / "calibration" / "recordings"
-# (subcommand, recording, its options); the servo recording is the preset SG90 on a light
+# (subcommand, recording, its options); the servo recording is the AA swing's SG90 on a light
 # load, split with the datasheet's stall torque (no-load speed, armature and kp are written).
 CALIBRATIONS = (
     ("beam", "synthetic_beam.csv", ["--mass-kg", "0.01", "--length-m", "0.05"]),
