@@ -185,7 +185,7 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
         extra["validation"] = [v.summary() for v in validations]
         if not no_plot:
             target = plot_path.with_name(plot_path.stem + "-validate.png") if plot_path else \
-                default_plot_path(validate[0], Path(validate[0].stem + "-validate"))
+                default_plot_path(validate[0]).with_name(f"{validate[0].stem}-validate.png")
             extra["validation_plot"] = str(plot_fit([v.curves for v in validations], target,
                                                     "predicted by the fitted servo (not fitted to it)"))
     subtitle = ", ".join(f"{Path(r.source).name} RMS {rms:.3g} {'deg' if r.kind == 'angle' else 'rad/s'}"
