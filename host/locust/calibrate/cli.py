@@ -103,7 +103,8 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, import
               help="Load inertia about the servo axis [kg*m^2]; once, or once per DATA in the same order.")
 @click.option("--stall-torque-nm", type=POSITIVE, default=None,
               help="Stall torque [N*m] from a stall test or the datasheet (SG90: about 0.15). It splits the "
-                   "ratios one load gives; leave it out when DATA holds two loads or a load held against gravity.")
+                   "ratios one load gives; leave it out when DATA holds loads of very different inertia (beside the "
+                   "armature: a few 1e-4 kg*m^2 for an SG90) or a load held against gravity.")
 @click.option("--kv-nms-per-rad", type=FINITE, default=0.0, show_default=True,
               help="Velocity feedback inside the drive's clamp [N*m*s/rad], held at this value: the SG90's real "
                    "recordings do not ask for it (docs/servo.md).")
