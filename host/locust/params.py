@@ -370,7 +370,7 @@ _SEED_SOURCE = Provenance(source="seed", note="notebook Part 2")
 # sg90_unloaded_gyro_steps.txt --inertia-kgm2 3.3e-6 --inertia-kgm2 1e-6 --stall-torque-nm 0.15`
 # (a real SG90 swinging an AA battery, filmed at 30 frames/s, the course's servo experiment;
 # and a real SG90 with a gyro on its horn stepped 0 -> A -> 0, A = 10 ... 130 deg). kv held at
-# 0: fitted, it is 0.002 +- 0.002 and changes neither RMS. Uncertainties: the fit's 1 sigma
+# 0: fitted, it is 0.002 +- 0.0015 and changes neither RMS. Uncertainties: the fit's 1 sigma
 # (cluster-robust over the 33 steps); docs/servo.md has the figures.
 _SG90_FIT = "fit:sg90_aa_battery_step.csv+sg90_unloaded_gyro_steps.txt"
 _SG90_DATE = "2026-11-24"
@@ -387,7 +387,7 @@ SG90_SOURCE = {
                                       note="95% CI [0.349, 0.405]; pinned by the gyro's small steps; scales with "
                                            "the stall torque 0.15 N*m"),
     "servo.kv_nms_per_rad": Provenance(source="model", note="a hobby servo has no velocity feedback; fitted to "
-                                                            "both recordings 0.002 +- 0.002, RMS unchanged"),
+                                                            "both recordings 0.002 +- 0.0015, RMS unchanged"),
 }
 
 
