@@ -92,7 +92,7 @@ def beam(out: Path) -> None:
 def servo(out: Path) -> None:
     heavy = dataclasses.replace(S.ServoTruth(), inertia_kgm2=1e-3, half_period_s=1.2)
     for name, truth, seed, what in (
-        ("synthetic_servo.csv", S.ServoTruth(), 6002, "the preset SG90, a 1.5e-5 kg*m^2 load"),
+        ("synthetic_servo.csv", S.ServoTruth(), 6002, "the SG90 of the AA swing alone, a 1.5e-5 kg*m^2 load"),
         ("synthetic_servo_heavy.csv", heavy, 6006, "the same SG90, a 1e-3 kg*m^2 load"),
         ("synthetic_servo_stall.csv", S.STALL_SERVO, 6003, "the same SG90, a load too heavy: the horn stalls"),
     ):

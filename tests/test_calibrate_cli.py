@@ -59,7 +59,7 @@ def test_beam_json_and_write_then_ramp_and_servo(recs):
     # everything not fitted is the seed's, with the seed's provenance
     seed = preset("seed")
     assert robot.get("servo.kp_nm_per_rad") == seed.get("servo.kp_nm_per_rad")
-    assert robot.source_of("servo.kp_nm_per_rad").source == "fit:sg90_aa_battery_step.csv"
+    assert robot.source_of("servo.kp_nm_per_rad").source == "fit:sg90_aa_battery_step.csv+sg90_unloaded_gyro_steps.txt"
 
     res = run("calibrate", "ramp", recs / "synthetic_ramp.csv", "--write", toml, "--no-plot")
     assert res.exit_code == 0, res.output
@@ -72,7 +72,7 @@ def test_beam_json_and_write_then_ramp_and_servo(recs):
               "--stall-torque-nm", 0.15, "--write", toml, "--no-plot")
     assert res.exit_code == 0, res.output
     robot = load_robot(toml)
-    # header truth: the preset SG90 (noload 10.2 rad/s, armature 3.1e-4 kg*m^2, kp 0.26 N*m/rad)
+    # header truth: the AA swing's SG90 (noload 10.2 rad/s, armature 3.1e-4 kg*m^2, kp 0.26 N*m/rad)
     assert robot.get("servo.noload_speed_rad_per_s") == pytest.approx(10.2, rel=0.01)
     assert robot.get("servo.armature_kgm2") == pytest.approx(3.1e-4, rel=0.05)
     assert robot.get("servo.kp_nm_per_rad") == pytest.approx(0.26, rel=0.05)
@@ -91,7 +91,7 @@ def test_servo_two_loads_json(recs):
     assert out["noload_speed_rad_per_s"]["value"] == pytest.approx(10.2, rel=0.01)
     assert out["command_delay_s"] == pytest.approx([0.012, 0.012], abs=0.002)
     assert out["command_clock_ratio"] == pytest.approx([1.002, 1.002], abs=3e-4)
-    assert len(out["rms_per_recording_deg"]) == 2
+    assert len(out["rms_per_recording"]) == 2 and out["rms_unit"] == ["deg", "deg"]
 
     res = run("calibrate", "servo", recs / "synthetic_servo.csv", "--inertia-kgm2", 1.5e-5, "--no-plot")
     assert res.exit_code != 0 and "stall torque is needed" in res.output

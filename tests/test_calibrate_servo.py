@@ -1,11 +1,12 @@
-"""Servo steps: no-load speed, armature and kp of the hobby-servo model, identified with the
-MuJoCo rig model, mujoco.rollout and mujoco.minimize; on SYNTHETIC steps (known truth) and on
-the real SG90 recording in ../shared/data/servo."""
+"""Servo steps: no-load speed, armature, kp and kv of the hobby-servo model, identified with
+the MuJoCo rig model, mujoco.rollout and mujoco.minimize from angle recordings and gyro logs;
+on SYNTHETIC steps (known truth) and on the real SG90 recordings in ../shared/data/servo."""
 
 from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -13,11 +14,13 @@ import pytest
 
 from locust.calibrate import servo as SV
 from locust.calibrate import synthetic as S
+from locust.calibrate.gyro_log import looks_like_gyro_log, parse_gyro_log, read_gyro_log
 from locust.calibrate.recordings import read_table
 from locust.errors import CalibrationError
 from locust.params import Servo
 
-SG90 = Servo()   # the preset SG90
+SG90 = S.ServoTruth().servo   # the synthetic recordings' SG90 (the AA swing's fit alone)
+PRESET = Servo()              # the presets' SG90: the AA swing and the gyro steps together
 
 
 def recording(truth: S.ServoTruth, seed: int) -> SV.StepRecording:
@@ -77,7 +80,7 @@ def test_synthetic_step_other_load_and_frame_rate_is_recovered():
     recording: 1.5e-5 at 60, the real one 3.3e-6 at 30), stall torque given."""
     truth = dataclasses.replace(S.ServoTruth(), inertia_kgm2=6e-5, fps=120.0, edges=4, target_deg=90.0,
                                 delay_s=0.02, clock_ratio=0.998)
-    fit = SV.fit_servo([recording(truth, 11)], stall_torque_nm=0.15)
+    fit = SV.fit_servo([recording(truth, 11)], stall_torque_nm=0.15, kv_nms_per_rad=0.0)
     est = fit.estimates
     assert est["noload_speed_rad_per_s"].value == pytest.approx(SG90.noload_speed_rad_per_s, rel=0.05)
     assert est["armature_kgm2"].value == pytest.approx(SG90.armature_kgm2, rel=0.15)
@@ -86,16 +89,16 @@ def test_synthetic_step_other_load_and_frame_rate_is_recovered():
     assert fit.rms_residual_deg == pytest.approx(truth.noise_deg, rel=0.15)
     assert fit.timings[0].delay_s == pytest.approx(0.02, abs=0.002)
     assert fit.timings[0].clock_ratio == pytest.approx(0.998, abs=5e-4)
-    assert fit.rms_half_step_deg == pytest.approx(fit.rms_residual_deg, rel=0.02)   # converged in dt
+    assert fit.rms_half_step[0] == pytest.approx(fit.rms_residual_deg, rel=0.02)   # converged in dt
 
 
 def test_two_loads_give_the_stall_torque():
     """SYNTHETIC: the same SG90 on two loads; no stall torque given, all four identified."""
     light = S.ServoTruth()
     heavy = dataclasses.replace(light, inertia_kgm2=1e-3, half_period_s=1.2)
-    fit = SV.fit_servo([recording(light, 4), recording(heavy, 5)])
+    fit = SV.fit_servo([recording(light, 4), recording(heavy, 5)], kv_nms_per_rad=0.0)
     assert all(fit.identifiable.values()), fit.notes
-    for name in SV.PARAMS:
+    for name in ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "stall_torque_nm"):
         true = getattr(SG90, name)
         est = fit.estimates[name]
         assert est.value == pytest.approx(true, rel=0.05), name
@@ -105,7 +108,7 @@ def test_two_loads_give_the_stall_torque():
 def test_stalled_servo_gives_stall_torque_not_kp():
     """SYNTHETIC: a weight too heavy to lift: the horn stalls where M*cos(angle) = stall."""
     truth = S.STALL_SERVO
-    fit = SV.fit_servo([recording(truth, 12)])
+    fit = SV.fit_servo([recording(truth, 12)], kv_nms_per_rad=0.0)
     assert fit.estimates["stall_torque_nm"].value == pytest.approx(0.15, rel=0.01)
     assert fit.identifiable["stall_torque_nm"] and not fit.identifiable["kp_nm_per_rad"]
     assert any("kp_nm_per_rad is not identifiable" in n for n in fit.notes)
@@ -116,20 +119,31 @@ def test_one_load_without_stall_torque_is_refused():
         SV.fit_servo([recording(S.ServoTruth(), 1)])
 
 
+def aa_recording(shared_data) -> SV.StepRecording:
+    c = read_table(shared_data / "servo" / "sg90_aa_battery_step.csv").columns
+    return SV.StepRecording(c["t_s"], c["angle_deg"], c["command_deg"], SV.ServoRig(3.3e-6),
+                            source="sg90_aa_battery_step.csv")
+
+
+def gyro_recording(path, source: str | None = None) -> SV.RateRecording:
+    log = read_gyro_log(path)
+    return SV.RateRecording(log.t_s, log.rate_units, log.command_deg, SV.ServoRig(1e-6), source=source or str(path))
+
+
 def test_real_sg90_recording_is_followed(shared_data):
     """REAL: an SG90 swinging an AA battery (3.3e-6 kg*m^2) 0 <-> 180 deg at 30 frames/s.
-    Datasheet: no-load 0.1 s/60 deg = 10.5 rad/s; a reflected rotor inertia of a few 1e-4."""
-    table = read_table(shared_data / "servo" / "sg90_aa_battery_step.csv")
-    c = table.columns
-    rec = SV.StepRecording(c["t_s"], c["angle_deg"], c["command_deg"], SV.ServoRig(3.3e-6), source="sg90")
-    fit = SV.fit_servo([rec], stall_torque_nm=0.15)
+    Datasheet: no-load 0.1 s/60 deg = 10.5 rad/s; a reflected rotor inertia of a few 1e-4.
+    kv held at 0: one large swing cannot tell kp from kv (the gyro steps can)."""
+    fit = SV.fit_servo([aa_recording(shared_data)], stall_torque_nm=0.15, kv_nms_per_rad=0.0)
     assert fit.rms_residual_deg <= 2.5
     assert 8.0 <= fit.estimates["noload_speed_rad_per_s"].value <= 13.0
     assert 5e-5 <= fit.estimates["armature_kgm2"].value <= 2e-3
     assert all(fit.identifiable.values()), fit.notes
-    # the preset SG90 is this fit (params.SG90_SOURCE), to its stated uncertainty
+    # the synthetic recordings' SG90 is this fit, to its stated uncertainty
     for name in ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad"):
         assert fit.estimates[name].value == pytest.approx(getattr(SG90, name), abs=2 * fit.estimates[name].std), name
+    # the presets' top speed (both recordings) agrees with the swing's alone
+    assert fit.estimates["noload_speed_rad_per_s"].value == pytest.approx(PRESET.noload_speed_rad_per_s, rel=0.03)
 
 
 def test_horn_angle_from_track():
@@ -144,3 +158,169 @@ def test_flat_servo_signal_is_refused():
     rec = SV.StepRecording(t, np.random.default_rng(0).normal(0, 0.3, len(t)), command, SV.ServoRig(4e-4))
     with pytest.raises(CalibrationError, match="flat signal"):
         SV.fit_servo([rec], stall_torque_nm=0.15)
+
+
+# -- gyro logs (rate recordings) ----------------------------------------------------------
+GYRO_TEXT = "0,0,0\n13,0,0\n26,30,0\n39,30,12\n# a comment\n52,30,40\n"
+
+
+def test_gyro_log_is_read_as_typed_columns(tmp_path):
+    path = tmp_path / "log.txt"
+    path.write_text(GYRO_TEXT)
+    assert looks_like_gyro_log(GYRO_TEXT)
+    assert not looks_like_gyro_log("t_s,angle_deg,command_deg\n0,0,0\n")
+    log = read_gyro_log(path)
+    assert log.t_s == pytest.approx([0, 0.013, 0.026, 0.039, 0.052])
+    assert list(log.command_deg) == [0, 0, 30, 30, 30]
+    assert list(log.rate_units) == [0, 0, 0, 12, 40]
+    assert log.comments == ("# a comment",)
+
+
+@pytest.mark.parametrize("text, match", [
+    ("0,0,0\n13,0\n", "line 2: expected three numbers"),
+    ("0,0,0\n13,0,x\n", "line 2: expected three numbers"),
+    ("0,0,0\n13,0,0\n13,0,0\n", "line 3: time does not increase"),
+])
+def test_bad_gyro_log_is_refused(text, match):
+    with pytest.raises(CalibrationError, match=match):
+        parse_gyro_log(text, "log.txt")
+
+
+def gyro_synthetic(truth: S.GyroTruth, seed: int) -> SV.RateRecording:
+    t, command, rate = S.gyro_steps(truth, np.random.default_rng(seed))
+    return SV.RateRecording(t, rate, command, SV.ServoRig(truth.inertia_kgm2), source=f"synthetic gyro {seed}")
+
+
+def test_validation_of_the_true_servo_reports_each_step():
+    """SYNTHETIC: the true servo predicting its own gyro log: each step's signed size, peak
+    speeds measured and predicted alike (the gyro's noise is 0.5 of 8 units per rad/s)."""
+    truth = S.GyroTruth()
+    v = SV.validate(truth.servo, gyro_synthetic(truth, 3), gain=truth.gain_units_per_rad_per_s)
+    assert [p.step_deg for p in v.steps] == [15.0, -15.0, 45.0, -45.0, 100.0, -100.0]
+    for p in v.steps:
+        assert p.peak_speed_predicted_rad_per_s == pytest.approx(p.peak_speed_measured_rad_per_s, abs=0.15)
+    assert v.steps[0].peak_speed_measured_rad_per_s < 0.6 * v.steps[-1].peak_speed_measured_rad_per_s
+    assert v.timing.delay_s == pytest.approx(truth.delay_s, abs=0.002)
+    assert v.rms == pytest.approx(math.hypot(0.5, 1 / math.sqrt(12)) / 8, rel=0.25)  # noise and rounding
+
+
+def write_gyro_log(path, truth: S.GyroTruth, seed: int) -> None:
+    t, command, rate = S.gyro_steps(truth, np.random.default_rng(seed))
+    path.write_text("".join(f"{round(1000 * ti)},{c:g},{g:g}\n" for ti, c, g in zip(t, command, rate)))
+
+
+def test_cli_fits_angle_and_gyro_together_and_validates(tmp_path):
+    """SYNTHETIC: `locust calibrate servo` on an angle CSV and a gyro log (its kind told by its
+    layout) of one known servo, each with its own inertia, and --validate on a gyro log of
+    other step sizes: the servo and the gyro's gain recovered, the unseen peaks predicted."""
+    import json
+
+    from click.testing import CliRunner
+
+    from locust.calibrate.cli import calibrate
+
+    true = dataclasses.replace(PRESET, kp_nm_per_rad=0.5, kv_nms_per_rad=0.004)
+    angle = dataclasses.replace(S.ServoTruth(), servo=true)
+    t, a, c = S.servo_step(angle, np.random.default_rng(21))
+    (tmp_path / "angle.csv").write_text("t_s,angle_deg,command_deg\n"
+                                        + "".join(f"{ti},{ai},{ci}\n" for ti, ai, ci in zip(t, a, c)))
+    gyro = S.GyroTruth(servo=true, steps_deg=(10.0, 30.0, 90.0))
+    write_gyro_log(tmp_path / "gyro.txt", gyro, 22)
+    write_gyro_log(tmp_path / "unseen.txt", dataclasses.replace(gyro, steps_deg=(20.0, 60.0)), 23)
+    result = CliRunner().invoke(calibrate, [
+        "servo", str(tmp_path / "angle.csv"), str(tmp_path / "gyro.txt"), "--inertia-kgm2", str(angle.inertia_kgm2),
+        "--inertia-kgm2", "1e-6", "--stall-torque-nm", "0.15", "--validate", str(tmp_path / "unseen.txt"),
+        "--fit-kv", "--json", "--plot", str(tmp_path / "fit.png")])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.output[result.output.index("{"):])
+    assert out["kind"] == ["angle", "rate"]
+    for name in ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "kv_nms_per_rad"):
+        est = out[name]
+        assert est["identifiable"], (name, out["notes"])
+        assert est["ci95"][0] <= getattr(true, name) <= est["ci95"][1], name
+    gain = out["gyro_gain_units_per_rad_per_s"][1]
+    assert gain["ci95"][0] <= gyro.gain_units_per_rad_per_s <= gain["ci95"][1]
+    (val,) = out["validation"]
+    assert val["source"].endswith("unseen.txt") and val["rms_unit"] == "rad/s"
+    assert [s["step_deg"] for s in val["steps"]] == [20.0, -20.0, 60.0, -60.0]
+    for step in val["steps"]:
+        assert step["peak_speed_predicted_rad_per_s"] == pytest.approx(step["peak_speed_measured_rad_per_s"],
+                                                                       rel=0.05)
+    assert (tmp_path / "fit.png").is_file() and (tmp_path / "fit-validate.png").is_file()
+
+
+@pytest.mark.slow
+def test_joint_fit_intervals_cover_the_truth():
+    """SYNTHETIC, 10 seeds: an angle recording and a gyro log of one servo (kv held at 0, the
+    presets' structure); the 95% intervals of no-load speed, armature, kp and the gyro gain
+    (40 in all) cover the truth at least 36 times (binomial at 95%: 36 or more 95% of the time)."""
+    covered, total = 0, 0
+    for seed in range(10):
+        rng = np.random.default_rng(100 + seed)
+        angle = dataclasses.replace(S.ServoTruth(), servo=PRESET)
+        t, a, c = S.servo_step(angle, rng)
+        gyro = S.GyroTruth(servo=PRESET)
+        tg, cg, g = S.gyro_steps(gyro, rng)
+        fit = SV.fit_servo([SV.StepRecording(t, a, c, SV.ServoRig(angle.inertia_kgm2)),
+                            SV.RateRecording(tg, g, cg, SV.ServoRig(gyro.inertia_kgm2))],
+                           stall_torque_nm=0.15, kv_nms_per_rad=0.0)
+        checks = [(fit.estimates[n], getattr(PRESET, n)) for n in ("noload_speed_rad_per_s", "armature_kgm2",
+                                                                  "kp_nm_per_rad")]
+        checks.append((fit.gains[1], gyro.gain_units_per_rad_per_s))
+        for est, true in checks:
+            assert est.value == pytest.approx(true, rel=0.05)
+            covered += est.ci95_low <= true <= est.ci95_high
+            total += 1
+    assert covered >= 36, f"{covered}/{total}"
+
+
+# -- the two real SG90 recordings together --------------------------------------------
+def split_gyro_log(source, folder, amplitudes) -> Path:
+    """The rows of the excursions 0 -> A -> 0 of the given A of a gyro log, written to
+    ``folder`` (a temporary folder, never the project)."""
+    rows = [line for line in source.read_text().splitlines() if line.strip()]
+    command = np.array([float(r.split(",")[1]) for r in rows])
+    change = np.flatnonzero(np.diff(command) != 0) + 1
+    up = [i for i in change if command[i] != 0]
+    down = [i for i in change if command[i] == 0]
+    cuts = [0] + [(d + u) // 2 for d, u in zip(down[:-1], up[1:])] + [len(rows)]
+    keep = [i for k, u in enumerate(up) if command[u] in amplitudes for i in range(cuts[k], cuts[k + 1])]
+    path = folder / f"gyro_{'_'.join(str(int(a)) for a in sorted(amplitudes))}.txt"
+    path.write_text("\n".join(rows[i] for i in keep) + "\n")
+    return path
+
+
+@pytest.mark.slow
+def test_real_sg90s_predict_step_sizes_they_never_saw(shared_data, tmp_path):
+    """REAL, cross-validated: fitted on the AA swing and the gyro log's steps of 10, 30, ...,
+    130 deg, the servo predicts the peak speeds of the 20, 40, ..., 120 deg steps, and the
+    reverse: every one within 20 %, the median within 8 % (the issue's acceptance on its
+    withheld 15-135 deg steps)."""
+    log = shared_data / "servo" / "sg90_unloaded_gyro_steps.txt"
+    odd = split_gyro_log(log, tmp_path, set(range(10, 140, 20)))
+    even = split_gyro_log(log, tmp_path, set(range(20, 130, 20)))
+    errors = []
+    for fitted, unseen in ((odd, even), (even, odd)):
+        fit = SV.fit_servo([aa_recording(shared_data), gyro_recording(fitted)], stall_torque_nm=0.15,
+                           kv_nms_per_rad=PRESET.kv_nms_per_rad)
+        v = SV.validate(fit.servo, gyro_recording(unseen), gain=fit.rate_gain)
+        assert len(v.steps) == 2 * (6 if unseen is even else 7)
+        errors += [abs(p.error) for p in v.steps]
+    assert max(errors) <= 0.20, errors
+    assert float(np.median(errors)) <= 0.08, errors
+
+
+@pytest.mark.slow
+def test_real_sg90s_together_are_the_preset(shared_data):
+    """REAL: the AA swing and the gyro steps fitted together (kv held at 0): kp is identified,
+    and the preset SG90 (params.SG90_SOURCE) is this fit."""
+    fit = SV.fit_servo([aa_recording(shared_data),
+                        gyro_recording(shared_data / "servo" / "sg90_unloaded_gyro_steps.txt")],
+                       stall_torque_nm=0.15, kv_nms_per_rad=0.0)
+    assert all(fit.identifiable.values()), fit.notes
+    assert fit.rms_per_recording[0] <= 2.5 and fit.rms_per_recording[1] <= 0.7
+    for name in ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad"):
+        est = fit.estimates[name]
+        assert est.value == pytest.approx(getattr(PRESET, name), abs=0.5 * est.std), name
+    # the data README's integral: 0.148 units*s per commanded degree, i.e. 8.48 units per rad/s
+    assert fit.rate_gain == pytest.approx(math.degrees(0.148), rel=0.10)

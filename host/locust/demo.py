@@ -54,7 +54,7 @@ def seed_leg_set_options(name: str) -> list[str]:
     values = {**{key: robot.get(key) for key in keys}, "solver.timestep_s": SEED_LEG_SET_STEP_S[name]}
     return ["--preset", "seed", *[arg for key, value in values.items() for arg in ("--set", f"{key}={value!r}")]]
 RECORDINGS = Path(__file__).resolve().parents[2] / "calibration" / "recordings"
-# (subcommand, recording, its options); the servo recording is the preset SG90 on a light
+# (subcommand, recording, its options); the servo recording is the AA swing's SG90 on a light
 # load, split with the datasheet's stall torque (no-load speed, armature and kp are written).
 CALIBRATIONS = (
     ("beam", "synthetic_beam.csv", ["--mass-kg", "0.01", "--length-m", "0.05"]),

@@ -92,14 +92,15 @@ class Servo:
     """Hobby servo (docs/servo.md): torque = clip(kp*(cmd-q) - kv*qdot, +-stall) - (stall/noload)*qdot,
     with the gearbox's reflected rotor inertia (armature) on the servo joint.
 
-    Defaults: an SG90 identified from a real step response (the course's AA-battery recording,
-    fitted by ``locust calibrate servo``) with the datasheet's stall torque; see SG90_SOURCE.
+    Defaults: an SG90 identified from two real recordings fitted together by ``locust
+    calibrate servo`` (the course's AA-battery swing and a gyro on an unloaded horn stepped
+    10-130 deg) with the datasheet's stall torque; see SG90_SOURCE.
     """
 
-    kp_nm_per_rad: float = 0.26            # proportional gain inside the torque clamp
+    kp_nm_per_rad: float = 0.377           # proportional gain inside the torque clamp
     stall_torque_nm: float = 0.15          # datasheet: 1.5-1.8 kg*cm
-    noload_speed_rad_per_s: float = 10.2   # inf: no speed limit (the notebook's model)
-    armature_kgm2: float = 3.1e-4          # rotor inertia x gear ratio^2, at the output shaft
+    noload_speed_rad_per_s: float = 10.31  # inf: no speed limit (the notebook's model)
+    armature_kgm2: float = 4.65e-4         # rotor inertia x gear ratio^2, at the output shaft
     kv_nms_per_rad: float = 0.0            # velocity feedback inside the clamp (notebook: 0.0069)
     travel_deg: float = 45.0         # mechanical travel either side of rest
     pulse_min_us: float = 500.0      # pulse at -range_deg/2
@@ -418,21 +419,28 @@ def check_robot(robot: Robot, cycles: int | None = None) -> Robot:
 
 # -- presets ------------------------------------------------------------------------
 _SEED_SOURCE = Provenance(source="seed", note="notebook Part 2")
-# The SG90 as identified by `locust calibrate servo sg90_aa_battery_step.csv --inertia-kgm2 3.3e-6
-# --stall-torque-nm 0.15` (a real SG90 swinging an AA battery, filmed at 30 frames/s; the
-# course's servo experiment). Uncertainties: the fit's 1 sigma (docs/servo.md has the figures).
-_SG90_FIT = "fit:sg90_aa_battery_step.csv"
-_SG90_DATE = "2026-11-23"
+# The SG90 as identified by `locust calibrate servo sg90_aa_battery_step.csv
+# sg90_unloaded_gyro_steps.txt --inertia-kgm2 3.3e-6 --inertia-kgm2 1e-6 --stall-torque-nm 0.15`
+# (a real SG90 swinging an AA battery, filmed at 30 frames/s, the course's servo experiment;
+# and a real SG90 with a gyro on its horn stepped 0 -> A -> 0, A = 10 ... 130 deg). kv held at
+# 0: fitted, it is 0.002 +- 0.0015 and changes neither RMS. Uncertainties: the fit's 1 sigma
+# (cluster-robust over the 33 steps); docs/servo.md has the figures.
+_SG90_FIT = "fit:sg90_aa_battery_step.csv+sg90_unloaded_gyro_steps.txt"
+_SG90_DATE = "2026-11-24"
 SG90_SOURCE = {
     "servo.stall_torque_nm": Provenance(source="datasheet:SG90", uncertainty=0.015,
                                         note="1.5-1.8 kg*cm at 4.8-6 V; the fit's split of the ratios"),
-    "servo.noload_speed_rad_per_s": Provenance(source=_SG90_FIT, uncertainty=0.06, date=_SG90_DATE,
-                                               note="datasheet: 0.1 s/60 deg = 10.5 rad/s at 4.8 V"),
-    "servo.armature_kgm2": Provenance(source=_SG90_FIT, uncertainty=3.3e-5, date=_SG90_DATE,
-                                      note="reflected rotor inertia; scales with the stall torque 0.15 N*m"),
-    "servo.kp_nm_per_rad": Provenance(source=_SG90_FIT, uncertainty=0.019, date=_SG90_DATE,
-                                      note="scales with the stall torque 0.15 N*m"),
-    "servo.kv_nms_per_rad": Provenance(source="model", note="a hobby servo has no velocity feedback"),
+    "servo.noload_speed_rad_per_s": Provenance(source=_SG90_FIT, uncertainty=0.11, date=_SG90_DATE,
+                                               note="95% CI [10.08, 10.53]; datasheet: 0.1 s/60 deg = "
+                                                    "10.5 rad/s at 4.8 V"),
+    "servo.armature_kgm2": Provenance(source=_SG90_FIT, uncertainty=2.5e-5, date=_SG90_DATE,
+                                      note="95% CI [4.14e-4, 5.15e-4]; reflected rotor inertia; scales with the "
+                                           "stall torque 0.15 N*m"),
+    "servo.kp_nm_per_rad": Provenance(source=_SG90_FIT, uncertainty=0.014, date=_SG90_DATE,
+                                      note="95% CI [0.349, 0.405]; pinned by the gyro's small steps; scales with "
+                                           "the stall torque 0.15 N*m"),
+    "servo.kv_nms_per_rad": Provenance(source="model", note="a hobby servo has no velocity feedback; fitted to "
+                                                            "both recordings 0.002 +- 0.0015, RMS unchanged"),
 }
 
 

@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import click
 import numpy as np
 
-from ..errors import CalibrationError, ReportError
+from ..errors import CalibrationError, ReportError, TrackError
 from ..fileio import json_text
 from ..options import FINITE, POSITIVE
 from ..progress import progress
+from ..track.delimited import read_text
 from ..track.importing import ImportOptions, import_options
 from . import beam as B
 from . import hinge as HG
@@ -19,6 +21,7 @@ from . import hop as H
 from . import ramp as R
 from . import servo as S
 from .fitstats import Estimate
+from .gyro_log import looks_like_gyro_log, parse_gyro_log
 from .plots import plot_fit
 from .recordings import REAL_TIME, TimeOptions, clean_samples, read_table, time_options
 from .write import DEFAULT_ROBOT_TOML, check_plausible, implausible, write_fitted
@@ -46,7 +49,7 @@ def calibrate() -> None:
     \b
     beam   cardstock cantilever, dropped tip mass  -> hinge stiffness, damping
     hinge  a link swinging on a flexure hinge     -> hinge stiffness, damping (large angles)
-    servo  servo steps carrying a battery         -> no-load speed, armature, kp
+    servo  servo steps: filmed angle, gyro on the horn -> no-load speed, armature, kp
     ramp   ramp tilted until the robot slides      -> static friction mu
     hop    filmed hops of one or more leg sets     -> any parameters, jointly
 
@@ -169,7 +172,13 @@ def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s,
               help="Load inertia about the servo axis [kg*m^2]; once, or once per DATA in the same order.")
 @click.option("--stall-torque-nm", type=POSITIVE, default=None,
               help="Stall torque [N*m] from a stall test or the datasheet (SG90: about 0.15). It splits the "
-                   "ratios one load gives; leave it out when DATA holds two loads or a load held against gravity.")
+                   "ratios one load gives; leave it out when DATA holds loads of very different inertia (beside the "
+                   "armature: a few 1e-4 kg*m^2 for an SG90) or a load held against gravity.")
+@click.option("--kv-nms-per-rad", type=FINITE, default=0.0, show_default=True,
+              help="Velocity feedback inside the drive's clamp [N*m*s/rad], held at this value: the SG90's real "
+                   "recordings do not ask for it (docs/servo.md).")
+@click.option("--fit-kv", is_flag=True,
+              help="Fit kv too (steps of several sizes, as a gyro log holds, are needed to tell it from kp).")
 @click.option("--gravity-moment-nm", type=FINITE, multiple=True,
               help="Moment of the load's weight with the horn horizontal (angle 0) [N*m]; once, or once per DATA "
                    "[default: 0, a horizontal rig].")
@@ -178,43 +187,99 @@ def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s,
 @click.option("--step", "step", default=None, metavar="FROM,TO,AT_S",
               help="With --pivot: the commanded step, degrees from the horizontal, and when it was sent [s].")
 @click.option("--marker", default=None, help="With --pivot: marker of the horn tip [default: the only one].")
+@click.option("--validate", "validate", multiple=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="A recording not fitted (repeatable): predict it with the fitted servo, report its RMS and "
+                   "each step's peak speed, measured and predicted, and draw it.")
+@click.option("--validate-inertia-kgm2", type=POSITIVE, multiple=True,
+              help="Load inertia of the --validate recordings; once, or once per --validate [default: that of "
+                   "the first fitted recording of the same kind].")
 @import_options
 @time_options
 @output_options
-def servo(data, inertia_kgm2, stall_torque_nm, gravity_moment_nm, pivot, step, marker, imports, timing, write_path,
-          as_json, plot_path, no_plot):
-    """Identify the hobby servo (no-load speed, armature, kp) from step responses.
+def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_moment_nm, pivot, step, marker, validate,
+          validate_inertia_kgm2, imports, timing, write_path, as_json, plot_path, no_plot):
+    """Identify the hobby servo (no-load speed, armature, kp; kv with --fit-kv) from step responses.
 
-    DATA is a CSV with t_s, angle_deg, command_deg (degrees from the horizontal; several
-    steps, as a square-wave command gives, are fitted together), or with --pivot and --step
-    a track of the horn tip. The rig is simulated in MuJoCo with the robot model's servo
-    (docs/servo.md); the firmware-to-camera timing (a delay and, with three or more command
-    edges, the clock ratio) is fitted beside it and reported. Parameters the recordings
-    cannot determine are reported as not identifiable and never written.
+    Each DATA is one of two kinds, told apart by its layout:
 
     \b
-    Example (a real SG90 swinging an AA battery):
+    angle  a CSV with a header t_s,angle_deg,command_deg (degrees from the horizontal;
+           a square-wave command's steps are fitted together), or with --pivot and
+           --step a track of the horn tip;
+    rate   a gyro log on the horn: rows millis,command_deg,gyro with no header (the
+           controller's clock in ms, the command, the gyro in its own unit). The gyro's
+           gain [units per rad/s] is fitted; between steps the horn must rest.
+
+    Recordings of both kinds, each with its own --inertia-kgm2, are fitted together to one
+    servo. The rig is simulated in MuJoCo with the robot model's servo (docs/servo.md); the
+    timing of each recording (a delay and, for an angle recording of three or more command
+    edges, the ratio of camera and firmware clocks) is fitted beside it and reported.
+    Parameters the recordings cannot determine are reported as not identifiable and never
+    written. --validate predicts other recordings with the fitted servo (their own delay,
+    and the fitted gyro gain, are the only things fitted to them).
+
+    \b
+    Examples (real SG90s: an AA battery swung 0 <-> 180 deg; a gyro on an unloaded horn):
       locust calibrate servo sg90_aa_battery_step.csv --inertia-kgm2 3.3e-6 --stall-torque-nm 0.15
+      locust calibrate servo sg90_aa_battery_step.csv sg90_unloaded_gyro_steps.txt \\
+          --inertia-kgm2 3.3e-6 --inertia-kgm2 1e-6 --stall-torque-nm 0.15 --validate other_steps.txt
     """
     inertias = _per_recording(inertia_kgm2, len(data), "--inertia-kgm2")
     moments = _per_recording(gravity_moment_nm or (0.0,), len(data), "--gravity-moment-nm")
     if pivot is not None and len(data) > 1:
         raise CalibrationError("--pivot takes one horn track", "fit tracks one at a time, or give angle CSVs")
+    recordings = [_servo_recording(path, S.ServoRig(inertia, moment), pivot, step, marker, imports, timing)
+                  for path, inertia, moment in zip(data, inertias, moments)]
     if pivot is None and not imports.identity:
         raise CalibrationError("--units, --rename and --mirror apply to a horn track (--pivot), not to angles",
-                               "leave them out for t_s,angle_deg,command_deg recordings")
-    recordings = []
-    for path, inertia, moment in zip(data, inertias, moments):
-        t, angle, command = _servo_series(path, pivot, step, marker, imports, timing)
-        recordings.append(S.StepRecording(t, angle, command, S.ServoRig(inertia, moment), source=str(path)))
+                               "leave them out for t_s,angle_deg,command_deg recordings and gyro logs")
     with progress(length=3 * 60, label="fitting servo") as bar:
-        fit = S.fit_servo(recordings, stall_torque_nm, progress=bar.update)
-    values = {f"servo.{n}": fit.estimates[n] for n in S.PARAMS
-              if fit.identifiable[n] and not (n == "stall_torque_nm" and fit.stall_torque_given)}
-    note = (f"servo steps, J={','.join(map(str, inertias))} kg*m^2, M={','.join(map(str, moments))} N*m"
-            + (f", stall torque {stall_torque_nm} N*m given" if stall_torque_nm else ""))
+        fit = S.fit_servo(recordings, stall_torque_nm, kv_nms_per_rad=None if fit_kv else kv_nms_per_rad,
+                          progress=bar.update)
+    validations = []
+    if validate:
+        v_inertias = _per_recording(validate_inertia_kgm2, len(validate), "--validate-inertia-kgm2") \
+            if validate_inertia_kgm2 else [None] * len(validate)
+        for path, inertia in zip(validate, v_inertias):
+            rec = _servo_recording(path, S.ServoRig(inertias[0]), None, None, None, ImportOptions())
+            if inertia is None:
+                inertia = next((r.rig.inertia_kgm2 for r in recordings if r.kind == rec.kind), inertias[0])
+            rec = replace(rec, rig=S.ServoRig(inertia))
+            validations.append(S.validate(fit.servo, rec, gain=fit.rate_gain))
+    values = {f"servo.{n}": fit.estimates[n] for n in S.PARAMS if fit.identifiable[n] and n not in fit.given}
+    kinds = ",".join(r.kind for r in recordings)
+    note = (f"servo steps ({kinds}), J={','.join(map(str, inertias))} kg*m^2, M={','.join(map(str, moments))} N*m"
+            + (f", stall torque {stall_torque_nm} N*m given" if stall_torque_nm else "")
+            + ("" if fit_kv else f", kv {kv_nms_per_rad} N*m*s/rad held"))
+    extra = {}
+    if validations:
+        extra["validation"] = [v.summary() for v in validations]
+        if not no_plot:
+            target = plot_path.with_name(plot_path.stem + "-validate.png") if plot_path else \
+                default_plot_path(validate[0]).with_name(f"{validate[0].stem}-validate.png")
+            extra["validation_plot"] = str(plot_fit([v.curves for v in validations], target,
+                                                    "predicted by the fitted servo (not fitted to it)"))
+    subtitle = ", ".join(f"{Path(r.source).name} RMS {rms:.3g} {'deg' if r.kind == 'angle' else 'rad/s'}"
+                         for r, rms in zip(recordings, fit.rms_per_recording))
     _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot,
-            subtitle=f"RMS residual {fit.rms_residual_deg:.3g} deg", source_name=Path(fit.source).name)
+            subtitle=subtitle, source_name=Path(fit.source).name, extra=extra)
+
+
+def _servo_recording(path: Path, rig, pivot, step, marker, imports: ImportOptions,
+                     timing: TimeOptions = REAL_TIME):
+    """One servo recording, of the kind its layout says: a gyro log (rate) or an angle table."""
+    try:
+        text = read_text(path)
+    except TrackError as exc:
+        raise CalibrationError(exc.message, exc.hint) from None
+    if looks_like_gyro_log(text):
+        if pivot is not None:
+            raise CalibrationError(f"{path}: --pivot is for a horn track, and this is a gyro log",
+                                   "leave out --pivot and --step for a gyro log")
+        log = parse_gyro_log(text, path)
+        return S.RateRecording(log.t_s, log.rate_units, log.command_deg, rig, source=str(path))
+    t, angle, command = _servo_series(path, pivot, step, marker, imports, timing)
+    return S.StepRecording(t, angle, command, rig, source=str(path))
 
 
 def _per_recording(values: tuple[float, ...], n: int, option: str) -> list[float]:
@@ -397,9 +462,9 @@ def default_plot_path(recording: Path, recording_name: Path | None = None) -> Pa
 def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_path: Path | None,
             as_json: bool, plot_path: Path | None, no_plot: bool, *, subtitle: str,
             recording_name: Path | None = None, source_name: str | None = None,
-            warnings: list[str] | None = None, input_note: str = "") -> None:
+            warnings: list[str] | None = None, extra: dict | None = None, input_note: str = "") -> None:
     recording_name = recording_name or recording
-    out = fit.summary()
+    out = {**fit.summary(), **(extra or {})}
     if input_note:
         out["input"] = input_note
     odd = implausible(values)
@@ -428,7 +493,8 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
 def _print_text(out: dict) -> None:
     click.echo(f"# {out['experiment']}: {out['source']}")
     for key, val in out.items():
-        if key in ("experiment", "source", "notes", "warnings", "written", "plot", "angles_deg"):
+        if key in ("experiment", "source", "notes", "warnings", "written", "plot", "angles_deg", "validation",
+                   "validation_plot", "gyro_gain_units_per_rad_per_s"):
             continue
         if isinstance(val, dict) and "value" in val:
             _print_text_value(key, val)
@@ -436,10 +502,21 @@ def _print_text(out: dict) -> None:
             click.echo(f"{key:30s} {', '.join(format(v, '.6g') for v in val)}")
         elif val is not None:
             click.echo(f"{key:30s} {val if not isinstance(val, float) else format(val, '.6g')}")
+    for k, gain in enumerate(out.get("gyro_gain_units_per_rad_per_s") or []):
+        if gain is not None:
+            _print_text_value(f"gyro_gain_units_per_rad_per_s[{k}]", gain)
     for note in out.get("notes", []):
         click.echo(f"note: {note}")
     if "plot" in out:
         click.echo(f"plot: {out['plot']}")
+    for v in out.get("validation", []):
+        click.echo(f"# validation: {v['source']}: RMS {v['rms']:.3g} {v['rms_unit']} (not fitted to it)")
+        click.echo(f"{'step_deg':>10s} {'peak measured':>15s} {'peak predicted':>15s} {'error':>8s}  [rad/s]")
+        for st in v["steps"]:
+            click.echo(f"{st['step_deg']:10.4g} {st['peak_speed_measured_rad_per_s']:15.3f} "
+                       f"{st['peak_speed_predicted_rad_per_s']:15.3f} {100 * st['error']:+7.1f}%")
+    if "validation_plot" in out:
+        click.echo(f"plot: {out['validation_plot']}")
     if "written" in out:
         keys = out["written"]["keys"]
         click.echo(f"wrote {', '.join(keys)} to {out['written']['path']}" if keys

@@ -1,4 +1,5 @@
-"""Fit plots: data and model above, residuals below, written atomically as PNG."""
+"""Fit plots: data and model above, residuals below (one such pair per recording), written
+atomically as PNG."""
 
 from __future__ import annotations
 
@@ -8,24 +9,29 @@ from ..plotting import pyplot, save_png
 from .curves import Curves
 
 
-def plot_fit(curves: Curves, path: str | Path, subtitle: str = "") -> Path:
+def plot_fit(curves: Curves | list[Curves], path: str | Path, subtitle: str = "") -> Path:
+    """One recording's ``Curves``, or several stacked (each with its residuals below it)."""
+    panels = [curves] if isinstance(curves, Curves) else list(curves)
     plt = pyplot()
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(7.5, 5.5), sharex=True,
-                                      gridspec_kw={"height_ratios": [3, 1.2]})
-    discrete = curves.model_x is None
-    top.plot(curves.x, curves.data, "o" if discrete else ".", ms=4, color="#1f77b4", label="data")
-    if discrete:
-        top.plot(curves.x, curves.model, "-", color="#d62728", label="fit")
-    else:
-        top.plot(curves.model_x, curves.model_fine, "-", lw=1.2, color="#d62728", label="model")
-    top.set_ylabel(curves.y_label)
-    top.set_title(curves.title + (f"\n{subtitle}" if subtitle else ""), fontsize=10)
-    top.legend(loc="best", fontsize=8)
-    top.grid(alpha=0.3)
-    bottom.axhline(0, color="0.5", lw=0.8)
-    bottom.plot(curves.x, curves.residual, "o" if discrete else ".", ms=3, color="#2ca02c")
-    bottom.set_ylabel("residual")
-    bottom.set_xlabel(curves.x_label)
-    bottom.grid(alpha=0.3)
+    fig, axes = plt.subplots(2 * len(panels), 1, figsize=(7.5, 5.5 * len(panels)), squeeze=False,
+                             gridspec_kw={"height_ratios": [3, 1.2] * len(panels)})
+    for k, c in enumerate(panels):
+        top, bottom = axes[2 * k, 0], axes[2 * k + 1, 0]
+        bottom.sharex(top)
+        discrete = c.model_x is None
+        top.plot(c.x, c.data, "o" if discrete else ".", ms=4, color="#1f77b4", label="data")
+        if discrete:
+            top.plot(c.x, c.model, "-", color="#d62728", label="fit")
+        else:
+            top.plot(c.model_x, c.model_fine, "-", lw=1.2, color="#d62728", label="model")
+        top.set_ylabel(c.y_label)
+        top.set_title(c.title + (f"\n{subtitle}" if subtitle and k == 0 else ""), fontsize=10)
+        top.legend(loc="best", fontsize=8)
+        top.grid(alpha=0.3)
+        bottom.axhline(0, color="0.5", lw=0.8)
+        bottom.plot(c.x, c.residual, "o" if discrete else ".", ms=3, color="#2ca02c")
+        bottom.set_ylabel("residual")
+        bottom.set_xlabel(c.x_label)
+        bottom.grid(alpha=0.3)
     fig.tight_layout()
     return save_png(fig, path, dpi=110)

@@ -1,27 +1,36 @@
-"""Servo step responses -> no-load speed, armature and kp of the hobby-servo model.
+"""Servo step responses -> no-load speed, armature, kp and kv of the hobby-servo model.
 
-The test rig, as a one-joint MuJoCo model: the servo horn carries a load (the battery) of
-inertia ``J`` about the servo axis; optionally the load's weight gives a moment
-``-M*cos(angle)`` (angle from the horizontal, positive lifting the load), where ``M`` is the
-moment with the horn horizontal. The servo is the robot model's (:mod:`locust.sim.servo`)::
+The test rig, as a one-joint MuJoCo model: the servo horn carries a load (the battery, a
+gyro board) of inertia ``J`` about the servo axis; optionally the load's weight gives a
+moment ``-M*cos(angle)`` (angle from the horizontal, positive lifting the load), where ``M``
+is the moment with the horn horizontal. The servo is the robot model's
+(:mod:`locust.sim.servo`)::
 
-    (J + armature) * acc = clip(kp*(command(t) - angle), +-stall) - (stall/noload)*velocity - M*cos(angle)
+    (J + armature) * acc = clip(kp*(command(t) - angle) - kv*velocity, +-stall)
+                           - (stall/noload)*velocity - M*cos(angle)
 
 Dividing by ``stall`` shows what one recording can tell: ``noload``, ``(J + armature)/stall``
-and ``kp/stall``. The stall torque (a stall test, the datasheet: ``--stall-torque-nm``)
+and ``kp/stall`` (and ``kv/stall``, which one large swing cannot tell from ``kp``: steps of
+several sizes can). The stall torque (a stall test, the datasheet: ``--stall-torque-nm``)
 splits the ratios; so does a second recording with another load, or a load whose weight the
 servo must hold (``gravity_moment_nm``), and the stall torque is then fitted too.
 
-The recording's command column is the firmware's command, on the firmware's clock, while
-the angle is on the camera's; each recording gets two timing parameters: a delay (the
-servo's latency, plus any offset of the reconstructed command edges) and, when it holds
-three or more command edges, the ratio of the two clocks. Both are fitted and reported;
-neither is a property of the servo, and neither is written to ``robot.toml``.
+Two kinds of recording are fitted, together if given together: an angle recording
+(:class:`StepRecording`: a filmed horn) and a rate recording (:class:`RateRecording`: a gyro
+on the horn, read by :mod:`.gyro_log`, its gain in its own unknown unit fitted too).
+
+An angle recording's command column is the firmware's command, on the firmware's clock,
+while the angle is on the camera's; it gets two timing parameters: a delay (the servo's
+latency, plus any offset of the reconstructed command edges) and, when it holds three or
+more command edges, the ratio of the two clocks. A gyro log has one clock: a delay only.
+Both are fitted and reported; neither is a property of the servo, and neither is written
+to ``robot.toml``.
 
 All candidates of a solver iteration are simulated at once (``mujoco.rollout``, one model
-per candidate) and the angle error is minimised with MuJoCo's own least-squares solver
-(``mujoco.minimize.least_squares``) from the best few points of a batched grid. Standard
-errors come from the residual Jacobian at the optimum; a parameter is reported *not
+per candidate) and the error, each recording's divided by its own RMS, is minimised with
+MuJoCo's own least-squares solver (``mujoco.minimize.least_squares``) from the best few
+points of a batched grid. Standard errors come from the residual Jacobian at the optimum
+(cluster-robust over the steps when there are enough of them); a parameter is reported *not
 identifiable* when its 95% interval is wider than about +-50%, when it ran to the edge of
 its range, or when halving and doubling it changes the fit by less than the noise.
 """
@@ -42,12 +51,14 @@ from ..errors import CalibrationError
 from ..params import GRAVITY_M_PER_S2, Servo
 from ..sim.servo import configure, with_servo
 from .curves import Curves
-from .fitstats import Estimate, covariance
+from .fitstats import Estimate, cluster_covariance, covariance, linear_shift
 
-PARAMS = ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "stall_torque_nm")
+PARAMS = ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "kv_nms_per_rad", "stall_torque_nm")
 # search box of the physical parameters (wide: an SG90 sits well inside it)
-LOWER = {"noload_speed_rad_per_s": 0.5, "armature_kgm2": 1e-8, "kp_nm_per_rad": 1e-3, "stall_torque_nm": 1e-3}
-UPPER = {"noload_speed_rad_per_s": 200.0, "armature_kgm2": 1e-1, "kp_nm_per_rad": 1e3, "stall_torque_nm": 50.0}
+LOWER = {"noload_speed_rad_per_s": 0.5, "armature_kgm2": 1e-8, "kp_nm_per_rad": 1e-3, "kv_nms_per_rad": 1e-6,
+         "stall_torque_nm": 1e-3}
+UPPER = {"noload_speed_rad_per_s": 200.0, "armature_kgm2": 1e-1, "kp_nm_per_rad": 1e3, "kv_nms_per_rad": 10.0,
+         "stall_torque_nm": 50.0}
 DELAY_SCALE_S = 0.01          # the solver works in delay / 10 ms and (clock ratio - 1) / 1e-3
 CLOCK_SCALE = 1e-3
 MAX_DELAY_S = 0.2
@@ -56,6 +67,12 @@ MAX_RELATIVE_STD = 0.25   # identifiable: 95% interval within about +-50% of the
 MIN_SAMPLES = 20
 MIN_STEP_DEG = 5.0
 MIN_EDGES_FOR_CLOCK = 3
+RATE_WINDOW_S = 0.8       # a rate recording's step is fitted this long after its edge (an SG90 settles in 0.5 s)
+RATE_PRE_SAMPLES = 2      # ... and from this many samples before it (at rest)
+# The samples of one step share their errors (the model is not the servo, the command's
+# PWM period moves each edge): with enough steps the covariance is cluster-robust, each
+# step a cluster (fitstats.cluster_covariance); with fewer, s^2 (J^T J)^-1.
+CLUSTERS_PER_PARAMETER = 2
 STARTS = 2                # solver runs from the best points of the grid (distinct armatures)
 FD_STEP = 1e-6
 
@@ -69,15 +86,11 @@ class ServoRig:
     timestep_s: float = 1e-3     # converged: docs/servo.md compares 5e-4
 
 
-@dataclass(frozen=True)
-class StepRecording:
-    """One recording: sample times, horn angle and the firmware's command (degrees)."""
+class _Commanded:
+    """What every recording has: sample times and the command [deg]."""
 
     t_s: np.ndarray
-    angle_deg: np.ndarray
     command_deg: np.ndarray
-    rig: ServoRig
-    source: str = "servo"
 
     @property
     def edges(self) -> np.ndarray:
@@ -89,6 +102,77 @@ class StepRecording:
         """Mean time of the command edges: the origin of :class:`Timing`'s clock ratio."""
         edges = self.edges
         return float(np.mean(self.t_s[edges])) if len(edges) else float(self.t_s[0])
+
+
+@dataclass(frozen=True)
+class StepRecording(_Commanded):
+    """An angle recording: sample times, horn angle and the firmware's command (degrees)."""
+
+    t_s: np.ndarray
+    angle_deg: np.ndarray
+    command_deg: np.ndarray
+    rig: ServoRig
+    source: str = "servo"
+    kind = "angle"
+
+
+@dataclass(frozen=True)
+class RateRecording(_Commanded):
+    """A rate recording: a gyro on the horn, logged with the command on one clock. The gyro's
+    unit is unknown (``rate_units``): its gain [units per rad/s] is fitted with the servo.
+    Between steps the horn is at rest at the command (a level held for RATE_WINDOW_S or more);
+    each step is simulated from rest and fitted over RATE_WINDOW_S after its edge."""
+
+    t_s: np.ndarray
+    rate_units: np.ndarray
+    command_deg: np.ndarray
+    rig: ServoRig
+    source: str = "gyro"
+    kind = "rate"
+
+    def windows(self) -> list[tuple[int, int, int]]:
+        """(edge, first, end) sample indices of each step's fitted window."""
+        edges = list(self.edges)
+        sample_s = float(np.median(np.diff(self.t_s)))
+        out = []
+        for k, e in enumerate(edges):
+            nxt = edges[k + 1] if k + 1 < len(edges) else len(self.t_s)
+            end = min(nxt, int(np.searchsorted(self.t_s, self.t_s[e] + RATE_WINDOW_S)))
+            first = max(e - RATE_PRE_SAMPLES, edges[k - 1] if k else 0,   # at rest, not across a gap in time
+                        int(np.searchsorted(self.t_s, self.t_s[e] - (RATE_PRE_SAMPLES + 0.5) * sample_s)))
+            out.append((e, first, end))
+        return out
+
+    def sample_weights(self) -> np.ndarray:
+        """Weight of each fitted sample: each step's samples by the inverse of its peak reading
+        (relative to the mean peak), so that every step counts by its relative error."""
+        peaks = [max(float(np.max(np.abs(self.rate_units[e:end]))), 1.0) for e, _, end in self.windows()]
+        mean = float(np.mean(peaks))
+        return np.concatenate([np.full(end - first, mean / p) for (e, first, end), p in zip(self.windows(), peaks)])
+
+    def samples(self) -> np.ndarray:
+        """Indices of the fitted samples (every window, in order)."""
+        return np.concatenate([np.arange(first, end) for _, first, end in self.windows()])
+
+    @property
+    def gain_sign(self) -> float:
+        """+1 when the gyro reads positive as the angle rises, -1 otherwise (from the data)."""
+        u = self.command_deg
+        total = sum(float(np.sum(self.rate_units[e:end])) * math.copysign(1, u[e] - u[e - 1])
+                    for e, _, end in self.windows())
+        return 1.0 if total >= 0 else -1.0
+
+    def gain_guess(self) -> float:
+        """|gain| [units per rad/s] from the data alone: the gyro's integral over each step
+        against the step (the horn settles at the command)."""
+        area, step = 0.0, 0.0
+        for e, _, end in self.windows():
+            area += abs(float(np.trapezoid(self.rate_units[e - 1:end], self.t_s[e - 1:end])))
+            step += abs(math.radians(self.command_deg[e] - self.command_deg[e - 1]))
+        return area / step if step > 0 else 1.0
+
+
+Recording = StepRecording | RateRecording
 
 
 @dataclass(frozen=True)
@@ -104,44 +188,62 @@ class Timing:
 @dataclass(frozen=True)
 class ServoFit:
     source: str
-    recordings: list[StepRecording] = field(repr=False)
-    estimates: dict[str, Estimate]           # PARAMS -> value; a given stall torque has std 0
-    stall_torque_given: bool
+    recordings: list[Recording] = field(repr=False)
+    estimates: dict[str, Estimate]           # PARAMS -> value; a held one (given) has std 0
+    given: tuple[str, ...]                   # the PARAMS held at a given value, not fitted
     timings: list[Timing]
     timing_std: list[tuple[float, float]]
+    gains: list[Estimate | None]             # per recording: the gyro gain [units per rad/s] of a rate recording
     identifiable: dict[str, bool]
     notes: list[str]
-    rms_residual_deg: float
-    rms_per_recording_deg: list[float]
+    rms_residual_deg: float | None           # over the angle recordings (None: there are none)
+    rms_per_recording: list[float]           # in each recording's unit: deg (angle), rad/s (rate)
     timestep_s: float
-    rms_half_step_deg: float                 # the same fit simulated at half the step: convergence
+    rms_half_step: list[float]               # the same at half the step: convergence
     n_samples: int
     iterations: int
     wall_s: float
-    curves: Curves = field(repr=False)
+    interval: str = "s^2 (J^T J)^-1, t(n-p)"
+    curves: list[Curves] = field(default_factory=list, repr=False)
 
     @property
     def servo(self) -> Servo:
         """The fitted servo (other fields at their defaults)."""
         return Servo(**{name: self.estimates[name].value for name in PARAMS})
 
+    @property
+    def rms_residual_rad_per_s(self) -> float | None:
+        rates = [r for rec, r in zip(self.recordings, self.rms_per_recording) if rec.kind == "rate"]
+        return float(np.sqrt(np.mean(np.square(rates)))) if rates else None
+
+    @property
+    def rate_gain(self) -> float | None:
+        """The gyro's gain of the fitted rate recordings (their mean; None without one)."""
+        gains = [g.value for g in self.gains if g is not None]
+        return float(np.mean(gains)) if gains else None
+
     def summary(self) -> dict:
         out = {"experiment": "servo", "source": self.source,
+               "kind": [r.kind for r in self.recordings],
                "inertia_kgm2": [r.rig.inertia_kgm2 for r in self.recordings],
                "gravity_moment_nm": [r.rig.gravity_moment_nm for r in self.recordings]}
         for name in PARAMS:
             est = self.estimates[name]
             entry = {**est.as_dict(), "identifiable": self.identifiable[name]}
-            if name == "stall_torque_nm" and self.stall_torque_given:
+            if name in self.given:
                 entry = {"value": est.value, "std": None, "ci95": [None, None], "identifiable": True,
                          "given": True}
             out[name] = entry
+        out["interval"] = self.interval
         out["command_delay_s"] = [round(t.delay_s, 5) for t in self.timings]
         out["command_delay_std_s"] = [round(s[0], 5) for s in self.timing_std]
         out["command_clock_ratio"] = [round(t.clock_ratio, 6) for t in self.timings]
         out["command_clock_ratio_std"] = [round(s[1], 6) for s in self.timing_std]
-        out.update(rms_residual_deg=self.rms_residual_deg, rms_per_recording_deg=self.rms_per_recording_deg,
-                   timestep_s=self.timestep_s, rms_half_step_deg=self.rms_half_step_deg,
+        out["gyro_gain_units_per_rad_per_s"] = [g.as_dict() if g is not None else None for g in self.gains]
+        out.update(rms_residual_deg=self.rms_residual_deg, rms_residual_rad_per_s=self.rms_residual_rad_per_s,
+                   rms_per_recording=self.rms_per_recording,
+                   rms_unit=["deg" if r.kind == "angle" else "rad/s" for r in self.recordings],
+                   timestep_s=self.timestep_s, rms_half_step=self.rms_half_step,
                    n_samples=self.n_samples, iterations=self.iterations, wall_s=round(self.wall_s, 2),
                    notes=self.notes)
         return out
@@ -221,55 +323,136 @@ def simulate_deg(model: mujoco.MjModel, servos: list[Servo], timings: list[Timin
     return np.degrees(np.array([np.interp(rt, grid, qi) for rt, qi in zip(read_t, q)]))
 
 
+def simulate_rate(model: mujoco.MjModel, servos: list[Servo], delays_s: list[float], rec: RateRecording,
+                  t_out: np.ndarray | None = None) -> np.ndarray:
+    """Horn speed [rad/s] at the fitted samples of a rate recording (``t_out``: other times,
+    given per window as times after each edge, shape (windows, m)) for each candidate.
+
+    Each step is simulated from rest at the previous command, the new command held from the
+    moment it reaches the servo (the edge's time plus the delay): the speed is read at the
+    samples' times after that moment, so it moves continuously with the delay."""
+    dt = model.opt.timestep
+    wins = rec.windows()
+    t, u = rec.t_s, rec.command_deg
+    after = ([t[first:end] - t[e] for e, first, end in wins] if t_out is None
+             else [np.asarray(row, dtype=float) for row in t_out])
+    span = max(float(a.max()) for a in after) - min(0.0, min(delays_s))
+    nstep = math.ceil(span / dt) + 2
+    nwin, ncand = len(wins), len(servos)
+    data = mujoco.MjData(model)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    size = mujoco.mj_stateSize(model, spec)
+    state0 = np.zeros((nwin, size))
+    for w, (e, _, _) in enumerate(wins):
+        data.qpos[0], data.qvel[0] = math.radians(u[e - 1]), 0.0
+        mujoco.mj_getState(model, data, state0[w], spec)
+    ctrl = np.repeat(np.radians([u[e] for e, _, _ in wins])[:, None, None], nstep, axis=1)
+    models = [m for s in servos for m in [with_servo(model, s)] * nwin]
+    state, _ = rollout.rollout(models, data, np.tile(state0, (ncand, 1)), np.tile(ctrl, (ncand, 1, 1)))
+    qvel_col = 1 + model.nq
+    v = np.concatenate([np.zeros((ncand * nwin, 1)), state[:, :, qvel_col]], axis=1).reshape(ncand, nwin, -1)
+    grid = dt * np.arange(nstep + 1)
+    out = []
+    for c, delay in enumerate(delays_s):
+        parts = [np.where(a > delay, np.interp(a - delay, grid, v[c, w]), 0.0) for w, a in enumerate(after)]
+        out.append(np.concatenate(parts))
+    return np.array(out)
+
+
 # -- the fit ----------------------------------------------------------------------------
 @dataclass(frozen=True)
 class _Layout:
     """Which solver variables there are: log of each fitted physical parameter, then per
-    recording the scaled delay and (if it has enough edges) the scaled clock error."""
+    recording the scaled delay, (if it has enough edges and two clocks) the scaled clock
+    error and (a rate recording) the log of its gyro gain."""
 
     fitted: tuple[str, ...]
     clock: tuple[bool, ...]
+    gain: tuple[bool, ...]
     stall_given: float | None
+    signs: tuple[float, ...] = ()
+    kv_given: float | None = None
 
     @property
     def size(self) -> int:
-        return len(self.fitted) + len(self.clock) + sum(self.clock)
+        return len(self.fitted) + len(self.clock) + sum(self.clock) + sum(self.gain)
 
-    def unpack(self, x: np.ndarray) -> tuple[Servo, list[Timing]]:
+    def unpack(self, x: np.ndarray) -> tuple[Servo, list[Timing], list[float | None]]:
         values = dict(zip(self.fitted, np.exp(x[:len(self.fitted)])))
         if self.stall_given is not None:
             values["stall_torque_nm"] = self.stall_given
-        timings, i = [], len(self.fitted)
-        for has_clock in self.clock:
+        if self.kv_given is not None:
+            values["kv_nms_per_rad"] = self.kv_given
+        timings, gains, i = [], [], len(self.fitted)
+        for k, (has_clock, has_gain) in enumerate(zip(self.clock, self.gain)):
             delay = float(x[i]) * DELAY_SCALE_S
             i += 1
             ratio = 1.0
             if has_clock:
                 ratio = 1.0 + float(x[i]) * CLOCK_SCALE
                 i += 1
+            gain = None
+            if has_gain:
+                gain = self.signs[k] * math.exp(float(x[i]))
+                i += 1
             timings.append(Timing(delay, ratio))
-        return Servo(**{k: float(v) for k, v in values.items()}), timings
+            gains.append(gain)
+        return Servo(**{k: float(v) for k, v in values.items()}), timings, gains
 
-    def timing_scales(self) -> list[float]:
-        """Physical size of one solver unit of each timing variable, in order."""
-        return [s for has_clock in self.clock
-                for s in ((DELAY_SCALE_S, CLOCK_SCALE) if has_clock else (DELAY_SCALE_S,))]
+    def nuisance(self) -> list[tuple[int, str]]:
+        """(recording, what) of each variable after the physical ones, in order."""
+        out = []
+        for k, (has_clock, has_gain) in enumerate(zip(self.clock, self.gain)):
+            out.append((k, "delay"))
+            if has_clock:
+                out.append((k, "clock"))
+            if has_gain:
+                out.append((k, "gain"))
+        return out
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         lo = [math.log(LOWER[n]) for n in self.fitted]
         hi = [math.log(UPPER[n]) for n in self.fitted]
-        for has_clock in self.clock:
-            lo.append(-MAX_DELAY_S / DELAY_SCALE_S)
-            hi.append(MAX_DELAY_S / DELAY_SCALE_S)
-            if has_clock:
+        for _, what in self.nuisance():
+            if what == "delay":
+                lo.append(-MAX_DELAY_S / DELAY_SCALE_S)
+                hi.append(MAX_DELAY_S / DELAY_SCALE_S)
+            elif what == "clock":
                 lo.append(-MAX_CLOCK_ERROR / CLOCK_SCALE)
                 hi.append(MAX_CLOCK_ERROR / CLOCK_SCALE)
+            else:
+                lo.append(math.log(1e-9))
+                hi.append(math.log(1e9))
         return np.array(lo), np.array(hi)
 
 
-def fit_servo(recordings: list[StepRecording], stall_torque_nm: float | None = None, *, max_iter: int = 60,
+def _residual_parts(recs: list[Recording], models: list[mujoco.MjModel],
+                    cands: list[tuple[Servo, list[Timing], list[float | None]]]) -> list[np.ndarray]:
+    """Per recording, (candidates, samples) residuals in its own unit: rad (angle), gyro units (rate)."""
+    parts = []
+    for k, (rec, model) in enumerate(zip(recs, models)):
+        servos = [c[0] for c in cands]
+        if rec.kind == "angle":
+            sim = simulate_deg(model, servos, [c[1][k] for c in cands], rec, float(rec.angle_deg[0]))
+            parts.append(np.radians(sim - rec.angle_deg[None, :]))
+        else:
+            sim = simulate_rate(model, servos, [c[1][k].delay_s for c in cands], rec)
+            gains = np.array([c[2][k] for c in cands])[:, None]
+            parts.append((gains * sim - rec.rate_units[rec.samples()][None, :]) * rec.sample_weights()[None, :])
+    return parts
+
+
+def _rms_in_unit(rec: Recording, part: np.ndarray, gain: float | None) -> float:
+    """RMS of one recording's residual in deg (angle) or rad/s (rate)."""
+    rms = float(np.sqrt(np.mean(part ** 2)))
+    return math.degrees(rms) if rec.kind == "angle" else rms / abs(gain)
+
+
+def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None, *,
+              kv_nms_per_rad: float | None = None, max_iter: int = 60,
               progress: Callable[[int], None] | None = None) -> ServoFit:
-    """Identify the servo from one or more step recordings; see the module docstring."""
+    """Identify the servo from one or more recordings (angle or rate); see the module docstring.
+    ``stall_torque_nm`` and ``kv_nms_per_rad``, when given, are held at that value."""
     import time
 
     t_start = time.perf_counter()
@@ -285,28 +468,33 @@ def fit_servo(recordings: list[StepRecording], stall_torque_nm: float | None = N
             "one load gives only ratios (speed, armature/stall, kp/stall): the stall torque is needed to split them",
             "give --stall-torque-nm (stall test or datasheet: about 0.15 N*m for an SG90), or a second recording "
             "with another load")
-    fitted = tuple(n for n in PARAMS if not (n == "stall_torque_nm" and stall_torque_nm is not None))
-    layout = _Layout(fitted, tuple(len(r.edges) >= MIN_EDGES_FOR_CLOCK for r in recs), stall_torque_nm)
+    if kv_nms_per_rad is not None and not (kv_nms_per_rad >= 0 and math.isfinite(kv_nms_per_rad)):
+        raise CalibrationError(f"--kv-nms-per-rad must be 0 or more (got {kv_nms_per_rad})",
+                               "0 holds the servo without velocity feedback inside its drive")
+    held = {"stall_torque_nm": stall_torque_nm, "kv_nms_per_rad": kv_nms_per_rad}
+    fitted = tuple(n for n in PARAMS if held.get(n) is None)
+    layout = _Layout(fitted, tuple(r.kind == "angle" and len(r.edges) >= MIN_EDGES_FOR_CLOCK for r in recs),
+                     tuple(r.kind == "rate" for r in recs), stall_torque_nm,
+                     tuple(r.gain_sign if r.kind == "rate" else 1.0 for r in recs), kv_nms_per_rad)
     models = [rig_model(r.rig) for r in recs]
-    angle0 = [float(r.angle_deg[0]) for r in recs]
+    # each recording's residual in units of its noise, so that recordings of different kinds
+    # weigh by their information: a first guess (1 deg; a gyro unit), then each one's own RMS
+    scales = [math.radians(1.0) if r.kind == "angle" else 1.0 for r in recs]
 
-    def residual(x: np.ndarray) -> np.ndarray:
+    def residual(x: np.ndarray, on: list[mujoco.MjModel] | None = None) -> np.ndarray:
         xs = np.atleast_2d(np.asarray(x).T).reshape(-1, layout.size)
-        cands = [layout.unpack(row) for row in xs]
-        parts = []
-        for k, (rec, model) in enumerate(zip(recs, models)):
-            sim = simulate_deg(model, [c[0] for c in cands], [c[1][k] for c in cands], rec, angle0[k])
-            parts.append(np.radians(sim - rec.angle_deg[None, :]))
-        r = np.concatenate(parts, axis=1).T
+        parts = _residual_parts(recs, on or models, [layout.unpack(row) for row in xs])
+        r = np.concatenate([p / sc for p, sc in zip(parts, scales)], axis=1).T
         return np.where(np.isfinite(r), r, 1e3)
+
+    def on_iter(trace):
+        if progress:
+            progress(1)
 
     bounds = layout.bounds()
     starts = _grid_starts(recs, layout, residual, bounds)
     best, best_cost, iterations = None, math.inf, 0
     for x0 in starts:
-        def on_iter(trace):
-            if progress:
-                progress(1)
         x, trace = minimize.least_squares(x0, residual, bounds=bounds, max_iter=max_iter, verbose=0,
                                           iter_callback=on_iter, eps=FD_STEP, xtol=1e-8, gtol=1e-10)
         x = np.asarray(x).ravel()
@@ -315,72 +503,125 @@ def fit_servo(recordings: list[StepRecording], stall_torque_nm: float | None = N
         if cost < best_cost:
             best, best_cost = x, cost
     x = best
+    if len(recs) > 1:   # weigh each recording by its own noise, and polish
+        parts = _residual_parts(recs, models, [layout.unpack(x)])
+        scales = [max(float(np.sqrt(np.mean(p ** 2))), 1e-12) for p in parts]
+        x, trace = minimize.least_squares(x, residual, bounds=bounds, max_iter=max_iter, verbose=0,
+                                          iter_callback=on_iter, eps=FD_STEP, xtol=1e-8, gtol=1e-10)
+        x = np.asarray(x).ravel()
+        iterations += len(trace)
     r = residual(x.reshape(-1, 1)).ravel()
     jac, _ = minimize.jacobian_fd(residual, x.reshape(-1, 1), r.reshape(-1, 1), np.float64(1e-6), 0,
                                   [b.reshape(-1, 1) for b in bounds])
     nphys = len(fitted)
     phys = np.exp(x[:nphys])
-    scale = np.concatenate([phys, layout.timing_scales()])
-    # d r / d p = d r / d x / (d p / d x): p = exp(x) for the physical ones, p = scale*x for timing
-    cov = covariance(jac / scale[None, :], r)
-    servo, timings = layout.unpack(x)
+    servo, timings, gains = layout.unpack(x)
+    nuis = layout.nuisance()
+    nvals, nscale = [], []
+    for k, what in nuis:
+        if what == "delay":
+            nvals.append(timings[k].delay_s)
+            nscale.append(DELAY_SCALE_S)
+        elif what == "clock":
+            nvals.append(timings[k].clock_ratio)
+            nscale.append(CLOCK_SCALE)
+        else:
+            nvals.append(gains[k])
+            nscale.append(gains[k])          # gain = sign*exp(x): d gain / d x = gain
+    scale = np.concatenate([phys, nscale])
+    # d r / d p = d r / d x / (d p / d x): p = exp(x) for the physical ones (and the gains), p = scale*x for timing
+    clusters = np.concatenate([_step_clusters(rec) + 10_000 * k for k, rec in enumerate(recs)])
+    jac_p = jac / scale[None, :]
+    # the fit's time step: implicitfast is first order, so the values' distance to the dt -> 0
+    # limit is about twice their shift when the step is halved (Richardson); a type-B part
+    half = [rig_model(replace(rec.rig, timestep_s=rec.rig.timestep_s / 2)) for rec in recs]
+    shift = 2.0 * linear_shift(jac_p, residual(x.reshape(-1, 1), half).ravel() - r)
+    if len(np.unique(clusters)) > CLUSTERS_PER_PARAMETER * layout.size:
+        cov = cluster_covariance(jac_p, r, clusters, shift=shift)
+    else:
+        cov = replace(covariance(jac_p, r), shift=shift)
+    values = np.concatenate([phys, nvals])
     estimates, identifiable = {}, {}
     for i, name in enumerate(fitted):
-        estimates[name] = cov.parameter(phys, i)
-    if stall_torque_nm is not None:
-        estimates["stall_torque_nm"] = Estimate(stall_torque_nm, 0.0, stall_torque_nm, stall_torque_nm)
-        identifiable["stall_torque_nm"] = True
-    tvals = np.concatenate([[t.delay_s] + ([t.clock_ratio] if c else []) for t, c in zip(timings, layout.clock)])
-    stds = iter([cov.parameter(np.concatenate([phys, tvals]), nphys + j).std for j in range(len(tvals))])
-    timing_std = [(next(stds), next(stds) if has_clock else 0.0) for has_clock in layout.clock]
+        estimates[name] = cov.parameter(values, i)
+    for name, value in held.items():
+        if value is not None:
+            estimates[name] = Estimate(value, 0.0, value, value)
+            identifiable[name] = True
+    timing_std = [[0.0, 0.0] for _ in recs]
+    gain_est: list[Estimate | None] = [None] * len(recs)
+    for j, (k, what) in enumerate(nuis):
+        est = cov.parameter(values, nphys + j)
+        if what == "gain":
+            gain_est[k] = est
+        else:
+            timing_std[k][0 if what == "delay" else 1] = est.std
 
-    rms_deg = float(np.degrees(np.sqrt(np.mean(r**2))))
-    per_rec, k0 = [], 0
-    for rec in recs:
-        n = len(rec.t_s)
-        per_rec.append(float(np.degrees(np.sqrt(np.mean(r[k0:k0 + n] ** 2)))))
-        k0 += n
+    parts = _residual_parts(recs, models, [(servo, timings, gains)])
+    per_rec = [_rms_in_unit(rec, p[0], g) for rec, p, g in zip(recs, parts, gains)]
+    angle_rms = [(rms, len(rec.t_s)) for rec, rms in zip(recs, per_rec) if rec.kind == "angle"]
+    rms_deg = (math.sqrt(sum(rms ** 2 * n for rms, n in angle_rms) / sum(n for _, n in angle_rms))
+               if angle_rms else None)
     notes: list[str] = []
     profile = _profile_ok(residual, x, r, nphys)
     for i, name in enumerate(fitted):
         ok = bool(np.isfinite(estimates[name].std) and estimates[name].relative_std <= MAX_RELATIVE_STD)
         if min(x[i] - bounds[0][i], bounds[1][i] - x[i]) < 1e-3:
             ok = False
-            notes.append(f"{name} ran to the edge of its range ({estimates[name].value:.3g}): the recording does "
+            notes.append(f"{name} ran to the edge of its range ({estimates[name].value:.3g}): the recordings do "
                          "not bound it")
         elif ok and not profile[i]:
             ok = False
-            notes.append(f"{name} is not identifiable from this recording: halving or doubling it changes the "
+            notes.append(f"{name} is not identifiable from these recordings: halving or doubling it changes the "
                          "fit by less than the noise")
         elif not ok:
-            notes.append(f"{name} is not identifiable from this recording (its 95% interval is wider than "
+            notes.append(f"{name} is not identifiable from these recordings (its 95% interval is wider than "
                          f"about +-{200 * MAX_RELATIVE_STD:.0f}%)")
         identifiable[name] = ok
     _physics_notes(servo, recs, notes)
-    steps = [abs(float(np.ptp(rec.command_deg))) for rec in recs]
-    if rms_deg > max(3.0, 0.05 * max(steps)):
-        identifiable = dict.fromkeys(identifiable, False)
-        notes.insert(0, f"the model does not follow the recording (RMS {rms_deg:.3g} deg): no value is "
-                        "trustworthy; check --inertia-kgm2, --gravity-moment-nm and the command column")
-    rms_half = _rms_half_step(recs, servo, timings, angle0)
-    if abs(rms_half - rms_deg) > 0.05 * rms_deg:
-        notes.append(f"not converged in the time step: the fit's RMS is {rms_deg:.3g} deg at "
-                     f"{recs[0].rig.timestep_s:g} s and {rms_half:.3g} deg at half of it")
-    curves = _curves(models[0], servo, timings[0], recs[0], angle0[0])
+    for rec, rms, g in zip(recs, per_rec, gains):
+        if rec.kind == "angle":
+            bad = rms > max(3.0, 0.05 * float(np.ptp(rec.command_deg)))
+        else:
+            bad = rms > 0.15 * float(np.max(np.abs(rec.rate_units))) / abs(g)
+        if bad:
+            identifiable = dict.fromkeys(identifiable, False)
+            unit = "deg" if rec.kind == "angle" else "rad/s"
+            notes.insert(0, f"the model does not follow {Path(rec.source).name} (RMS {rms:.3g} {unit}): no value "
+                            "is trustworthy; check --inertia-kgm2, --gravity-moment-nm and the command column")
+    rms_half = _rms_half_step(recs, servo, timings, gains)
+    for rec, full, half in zip(recs, per_rec, rms_half):
+        if abs(half - full) > 0.05 * full:
+            notes.append(f"not converged in the time step: {Path(rec.source).name}'s RMS is {full:.3g} at "
+                         f"{rec.rig.timestep_s:g} s and {half:.3g} at half of it")
+    curves = [recording_curves(model, servo, timing, gain, rec)
+              for model, rec, timing, gain in zip(models, recs, timings, gains)]
     source = recs[0].source if len(recs) == 1 else "+".join(Path(rec.source).name for rec in recs)
-    return ServoFit(source=source, recordings=recs, estimates=estimates, stall_torque_given=stall_torque_nm is not None,
-                    timings=timings, timing_std=timing_std, identifiable=identifiable, notes=notes,
-                    rms_residual_deg=rms_deg, rms_per_recording_deg=per_rec,
-                    timestep_s=recs[0].rig.timestep_s, rms_half_step_deg=rms_half,
-                    n_samples=int(sum(len(rec.t_s) for rec in recs)), iterations=iterations,
-                    wall_s=time.perf_counter() - t_start, curves=curves)
+    given = tuple(n for n, v in held.items() if v is not None)
+    return ServoFit(source=source, recordings=recs, estimates=estimates, given=given,
+                    timings=timings, timing_std=[tuple(ts) for ts in timing_std], gains=gain_est,
+                    identifiable=identifiable, notes=notes, rms_residual_deg=rms_deg, rms_per_recording=per_rec,
+                    timestep_s=recs[0].rig.timestep_s, rms_half_step=rms_half,
+                    n_samples=int(sum(p.shape[1] for p in parts)), iterations=iterations,
+                    wall_s=time.perf_counter() - t_start, interval=cov.method, curves=curves)
 
 
-def _checked(rec: StepRecording) -> StepRecording:
+def _step_clusters(rec: Recording) -> np.ndarray:
+    """The step each fitted sample belongs to (0, 1, ...; samples before the first edge: 0)."""
+    if rec.kind == "rate":
+        return np.concatenate([np.full(end - first, k) for k, (_, first, end) in enumerate(rec.windows())])
+    return np.maximum(np.searchsorted(rec.edges, np.arange(len(rec.t_s)), side="right") - 1, 0)
+
+
+def _checked(rec: Recording) -> Recording:
     t = np.asarray(rec.t_s, dtype=float)
-    q = np.asarray(rec.angle_deg, dtype=float)
     u = np.asarray(rec.command_deg, dtype=float)
-    rec = replace(rec, t_s=t, angle_deg=q, command_deg=u)
+    if rec.kind == "angle":
+        rec = replace(rec, t_s=t, angle_deg=np.asarray(rec.angle_deg, dtype=float), command_deg=u)
+        moved = float(np.ptp(rec.angle_deg))
+    else:
+        rec = replace(rec, t_s=t, rate_units=np.asarray(rec.rate_units, dtype=float), command_deg=u)
+    step_deg = float(np.max(np.abs(np.diff(u)))) if len(u) > 1 else 0.0
     if len(t) < MIN_SAMPLES:
         raise CalibrationError(f"{rec.source}: only {len(t)} samples (need {MIN_SAMPLES})",
                                "film at 30 frames/s or more and keep recording until the horn is still")
@@ -388,10 +629,13 @@ def _checked(rec: StepRecording) -> StepRecording:
     if len(edges) == 0:
         raise CalibrationError(f"{rec.source}: the command never changes, so there is no step to fit",
                                "the command_deg column must hold the command sent, before and after the step")
-    step_deg = float(np.max(np.abs(np.diff(u))))
-    if np.ptp(q) < 0.2 * max(step_deg, MIN_STEP_DEG):
+    if rec.kind == "rate":
+        if edges[0] < 1 or not np.any(rec.rate_units[edges[0]:]):
+            raise CalibrationError(f"{rec.source}: flat signal, the gyro reads nothing after the steps",
+                                   "check that the gyro's axis is the servo's and that its column is logged")
+    elif moved < 0.2 * max(step_deg, MIN_STEP_DEG):
         raise CalibrationError(
-            f"{rec.source}: flat signal, the horn moved {np.ptp(q):.3g} deg for a {step_deg:.3g} deg step",
+            f"{rec.source}: flat signal, the horn moved {moved:.3g} deg for a {step_deg:.3g} deg step",
             "check that the angle column follows the horn (or the --pivot of the horn track)")
     if len(t) - edges[0] < MIN_SAMPLES:
         raise CalibrationError(f"{rec.source}: only {len(t) - edges[0]} samples after the step (need {MIN_SAMPLES})",
@@ -399,20 +643,23 @@ def _checked(rec: StepRecording) -> StepRecording:
     return rec
 
 
-def _speed_guess(rec: StepRecording) -> float:
+def _speed_guess(rec: Recording) -> float:
     """No-load speed from the data: a high percentile of the angular speed between samples."""
-    speed = np.abs(np.diff(np.radians(rec.angle_deg)) / np.diff(rec.t_s))
+    if rec.kind == "rate":
+        speed = np.abs(rec.rate_units) / rec.gain_guess()
+    else:
+        speed = np.abs(np.diff(np.radians(rec.angle_deg)) / np.diff(rec.t_s))
     moving = speed[speed > 0.2 * speed.max()]
     return float(np.percentile(moving, 75)) if moving.size else float(speed.max())
 
 
 def _grid_starts(recs, layout: _Layout, residual, bounds) -> list[np.ndarray]:
     """Starting points: a grid of no-load speed (at and above the fastest speed seen: a load
-    slows the servo), armature, linear range (stall/kp) and delay, simulated in one batch;
+    slows the servo), armature, linear range (stall/kp), kv and delay, simulated in one batch;
     the best few with distinct speed and armature."""
     stall = layout.stall_given or 0.15
     seen_speed = max(_speed_guess(rec) for rec in recs) * 1.02
-    frame_s = float(np.median(np.diff(recs[0].t_s)))
+    frame_s = [float(np.median(np.diff(rec.t_s))) for rec in recs]
     j = recs[0].rig.inertia_kgm2
     cands = []
     for noload in (seen_speed, 1.5 * seen_speed, 2.5 * seen_speed):
@@ -420,15 +667,23 @@ def _grid_starts(recs, layout: _Layout, residual, bounds) -> list[np.ndarray]:
         for tau_s in (0.002, 0.01, 0.03):                        # mechanical time constant (J+Ja)/b
             armature = max(tau_s * stall / noload - j, LOWER["armature_kgm2"] * 10)
             for linear_deg in (3.0, 10.0, 25.0):
-                for delay_frames in (-1.0, -0.5, 0.0, 0.5):
-                    x = [math.log(noload), math.log(armature), math.log(stall / math.radians(linear_deg))]
-                    if "stall_torque_nm" in layout.fitted:
-                        x.append(math.log(stall))
-                    for has_clock, (delay_s, ratio) in zip(layout.clock, timing):
-                        x.append((delay_s - tau_s + delay_frames * frame_s) / DELAY_SCALE_S)
-                        if has_clock:
-                            x.append((ratio - 1.0) / CLOCK_SCALE)
-                    cands.append(x)
+                kv_shares = (0.01, 0.3, 1.0) if "kv_nms_per_rad" in layout.fitted else (None,)
+                for kv_share in kv_shares:                       # kv against the back-EMF's stall/noload
+                    for delay_frames in (-1.0, -0.5, 0.0, 0.5):
+                        phys = {"noload_speed_rad_per_s": noload, "armature_kgm2": armature,
+                                "kp_nm_per_rad": stall / math.radians(linear_deg), "stall_torque_nm": stall,
+                                "kv_nms_per_rad": (kv_share or 0.0) * stall / noload}
+                        x = [math.log(phys[n]) for n in layout.fitted]
+                        for k, what in layout.nuisance():
+                            delay_s, ratio = timing[k]
+                            if what == "delay":
+                                lag = tau_s if recs[k].kind == "angle" else 0.0
+                                x.append((delay_s - lag + delay_frames * frame_s[k]) / DELAY_SCALE_S)
+                            elif what == "clock":
+                                x.append((ratio - 1.0) / CLOCK_SCALE)
+                            else:
+                                x.append(math.log(recs[k].gain_guess()))
+                        cands.append(x)
     lo, hi = bounds
     xs = np.clip(np.array(cands), lo + 1e-6, hi - 1e-6)
     cost = np.sum(residual(xs.T) ** 2, axis=0)
@@ -443,10 +698,21 @@ def _grid_starts(recs, layout: _Layout, residual, bounds) -> list[np.ndarray]:
     return picked
 
 
-def _timing_guess(rec: StepRecording, noload: float) -> tuple[float, float]:
-    """(delay, clock ratio) from when the horn passes the middle of each step: a straight
-    line through (edge time, crossing time); at top speed the middle comes half a step late."""
-    t, q, u = rec.t_s, rec.angle_deg, rec.command_deg
+def _timing_guess(rec: Recording, noload: float) -> tuple[float, float]:
+    """(delay, clock ratio). An angle recording: from when the horn passes the middle of each
+    step, a straight line through (edge time, crossing time); at top speed the middle comes
+    half a step late. A rate recording (one clock): when the speed first reaches a fifth of
+    its peak after each edge, less a sample."""
+    t, u = rec.t_s, rec.command_deg
+    if rec.kind == "rate":
+        lags = []
+        for e, _, end in rec.windows():
+            speed = np.abs(rec.rate_units[e:end])
+            if speed.size and speed.max() > 0:
+                lags.append(t[e + int(np.argmax(speed >= 0.2 * speed.max()))] - t[e])
+        step_s = float(np.median(np.diff(t)))
+        return float(np.clip(np.median(lags) - step_s if lags else 0.0, -MAX_DELAY_S, MAX_DELAY_S)), 1.0
+    q = rec.angle_deg
     edge_t, cross_t = [], []
     edges = list(rec.edges) + [len(t)]
     for i, end in itertools.pairwise(edges):
@@ -489,31 +755,159 @@ def _profile_ok(residual, x: np.ndarray, r: np.ndarray, nphys: int) -> list[bool
     return [bool(min(rise[2 * i], rise[2 * i + 1]) > 4.0 * s2) for i in range(nphys)]
 
 
-def _physics_notes(servo: Servo, recs: list[StepRecording], notes: list[str]) -> None:
+def _physics_notes(servo: Servo, recs: list[Recording], notes: list[str]) -> None:
     """Plain-language facts about the fitted servo that a user should check."""
     linear_deg = math.degrees(servo.stall_torque_nm / servo.kp_nm_per_rad)
     j = recs[0].rig.inertia_kgm2
     tau_ms = 1000 * (j + servo.armature_kgm2) * servo.noload_speed_rad_per_s / servo.stall_torque_nm
+    zeta = ((servo.kv_nms_per_rad + servo.stall_torque_nm / servo.noload_speed_rad_per_s)
+            / (2 * math.sqrt(servo.kp_nm_per_rad * (j + servo.armature_kgm2))))
     notes.append(f"top speed {servo.noload_speed_rad_per_s:.3g} rad/s, reached with a time constant of "
-                 f"{tau_ms:.3g} ms on this load; full torque until {linear_deg:.3g} deg from the command")
+                 f"{tau_ms:.3g} ms on this load; full torque until {linear_deg:.3g} deg from the command; "
+                 f"damping ratio {zeta:.2g} inside that range")
 
 
-def _rms_half_step(recs: list[StepRecording], servo: Servo, timings: list[Timing], angle0: list[float]) -> float:
-    """RMS residual [deg] of the fitted servo simulated at half the fit's time step."""
-    sq, n = 0.0, 0
-    for rec, timing, a0 in zip(recs, timings, angle0):
-        model = rig_model(replace(rec.rig, timestep_s=rec.rig.timestep_s / 2))
-        err = simulate_deg(model, [servo], [timing], rec, a0)[0] - rec.angle_deg
-        sq, n = sq + float(err @ err), n + len(err)
-    return math.sqrt(sq / n)
+def _rms_half_step(recs: list[Recording], servo: Servo, timings: list[Timing],
+                   gains: list[float | None]) -> list[float]:
+    """Each recording's RMS residual (its unit) with the fitted servo simulated at half the step."""
+    models = [rig_model(replace(rec.rig, timestep_s=rec.rig.timestep_s / 2)) for rec in recs]
+    parts = _residual_parts(recs, models, [(servo, timings, gains)])
+    return [_rms_in_unit(rec, p[0], g) for rec, p, g in zip(recs, parts, gains)]
 
 
-def _curves(model, servo: Servo, timing: Timing, rec: StepRecording, angle0: float) -> Curves:
-    sim = simulate_deg(model, [servo], [timing], rec, angle0)[0]
-    fine_t = np.linspace(rec.t_s[0], rec.t_s[-1], 3000)
-    fine = simulate_deg(model, [servo], [timing], rec, angle0, t_out=fine_t)[0]
-    return Curves(x=rec.t_s, data=rec.angle_deg, model=sim, x_label="t [s]", y_label="horn angle [deg]",
-                  title=f"servo: {Path(rec.source).name}", model_x=fine_t, model_fine=fine)
+def recording_curves(model, servo: Servo, timing: Timing, gain: float | None, rec: Recording,
+                     label: str = "") -> Curves:
+    """The recording against the model: the angle [deg] over time, or the speed [rad/s] over
+    each step's window, the windows laid end to end."""
+    name = f"{label}{Path(rec.source).name}"
+    if rec.kind == "angle":
+        sim = simulate_deg(model, [servo], [timing], rec, float(rec.angle_deg[0]))[0]
+        fine_t = np.linspace(rec.t_s[0], rec.t_s[-1], 3000)
+        fine = simulate_deg(model, [servo], [timing], rec, float(rec.angle_deg[0]), t_out=fine_t)[0]
+        return Curves(x=rec.t_s, data=rec.angle_deg, model=sim, x_label="t [s]", y_label="horn angle [deg]",
+                      title=f"servo: {name}", model_x=fine_t, model_fine=fine)
+    wins = rec.windows()
+    offsets = np.arange(len(wins)) * RATE_WINDOW_S * 1.25
+    x = np.concatenate([rec.t_s[first:end] - rec.t_s[e] + off for (e, first, end), off in zip(wins, offsets)])
+    fine_after = [np.linspace(rec.t_s[first] - rec.t_s[e], rec.t_s[end - 1] - rec.t_s[e], 120)
+                  for e, first, end in wins]
+    sim = simulate_rate(model, [servo], [timing.delay_s], rec)[0]
+    fine = simulate_rate(model, [servo], [timing.delay_s], rec, t_out=fine_after)[0]
+    fine_x = np.concatenate([a + off for a, off in zip(fine_after, offsets)])
+    return Curves(x=x, data=rec.rate_units[rec.samples()] / gain, model=sim,
+                  x_label="t after each command step [s] (steps laid end to end)",
+                  y_label="horn speed [rad/s]", title=f"servo: {name}", model_x=fine_x, model_fine=fine)
+
+
+# -- validation: predicting recordings the fit never saw ---------------------------------
+@dataclass(frozen=True)
+class StepPeak:
+    step_deg: float                            # the signed command change
+    peak_speed_measured_rad_per_s: float
+    peak_speed_predicted_rad_per_s: float      # sampled at the recording's own sample times
+
+    @property
+    def error(self) -> float:
+        return self.peak_speed_predicted_rad_per_s / self.peak_speed_measured_rad_per_s - 1.0
+
+
+@dataclass(frozen=True)
+class Validation:
+    """A fitted servo predicting a recording it was not fitted to; only the recording's own
+    timing (delay; clock ratio for an angle recording of three edges or more) is fitted to it,
+    and a rate recording's gyro gain is the fitted recordings' (the same gyro) or, without
+    one, its own integral over each step against the step."""
+
+    source: str
+    kind: str
+    rms: float                                 # deg (angle) or rad/s (rate)
+    timing: Timing
+    gain: float | None
+    steps: list[StepPeak]
+    curves: Curves = field(repr=False)
+
+    def summary(self) -> dict:
+        return {"source": self.source, "kind": self.kind, "rms": self.rms,
+                "rms_unit": "deg" if self.kind == "angle" else "rad/s",
+                "command_delay_s": round(self.timing.delay_s, 5),
+                "command_clock_ratio": round(self.timing.clock_ratio, 6),
+                "gyro_gain_units_per_rad_per_s": self.gain,
+                "steps": [{"step_deg": p.step_deg,
+                           "peak_speed_measured_rad_per_s": p.peak_speed_measured_rad_per_s,
+                           "peak_speed_predicted_rad_per_s": p.peak_speed_predicted_rad_per_s,
+                           "error": p.error} for p in self.steps]}
+
+
+def step_windows(rec: Recording) -> list[tuple[int, int]]:
+    """(edge, end) sample indices of each step: to the next edge, at most RATE_WINDOW_S."""
+    if rec.kind == "rate":
+        return [(e, end) for e, _, end in rec.windows()]
+    edges = list(rec.edges) + [len(rec.t_s)]
+    return [(e, min(nxt, int(np.searchsorted(rec.t_s, rec.t_s[e] + RATE_WINDOW_S))))
+            for e, nxt in itertools.pairwise(edges)]
+
+
+def peak_speeds(rec: Recording, predicted: np.ndarray, gain: float | None) -> list[StepPeak]:
+    """Each step's peak speed, measured and predicted (``predicted``: the model's angle [deg]
+    at every sample of an angle recording, its speed [rad/s] at the fitted samples of a rate
+    recording). An angle's speed is its change between samples over their interval."""
+    out = []
+    if rec.kind == "rate":
+        measured = rec.rate_units[rec.samples()] / gain
+        k0 = 0
+        for e, first, end in rec.windows():
+            n = end - first
+            sl = slice(k0 + (e - first), k0 + n)
+            out.append(StepPeak(float(rec.command_deg[e] - rec.command_deg[e - 1]),
+                                float(np.max(np.abs(measured[sl]))), float(np.max(np.abs(predicted[sl])))))
+            k0 += n
+        return out
+    dt = np.diff(rec.t_s)
+    meas = np.radians(np.diff(rec.angle_deg)) / dt
+    pred = np.radians(np.diff(predicted)) / dt
+    for e, end in step_windows(rec):
+        sl = slice(e - 1, end - 1)
+        out.append(StepPeak(float(rec.command_deg[e] - rec.command_deg[e - 1]),
+                            float(np.max(np.abs(meas[sl]))), float(np.max(np.abs(pred[sl])))))
+    return out
+
+
+def validate(servo: Servo, rec: Recording, gain: float | None = None) -> Validation:
+    """Predict ``rec`` with ``servo``; see :class:`Validation`."""
+    rec = _checked(rec)
+    if rec.kind == "rate" and gain is None:
+        gain = rec.gain_sign * rec.gain_guess()
+    elif rec.kind == "rate":
+        gain = rec.gain_sign * abs(gain)
+    has_clock = rec.kind == "angle" and len(rec.edges) >= MIN_EDGES_FOR_CLOCK
+    layout = _Layout((), (has_clock,), (False,), servo.stall_torque_nm)
+    model = rig_model(rec.rig)
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        xs = np.atleast_2d(np.asarray(x).T).reshape(-1, layout.size)
+        cands = [(servo, layout.unpack(row)[1], [gain]) for row in xs]
+        r = _residual_parts([rec], [model], cands)[0].T
+        return np.where(np.isfinite(r), r, 1e3)
+
+    noload = servo.noload_speed_rad_per_s if math.isfinite(servo.noload_speed_rad_per_s) else 10.0
+    delay_s, ratio = _timing_guess(rec, noload)
+    frame_s = float(np.median(np.diff(rec.t_s)))
+    starts = [[(delay_s + f * frame_s) / DELAY_SCALE_S] + ([(ratio - 1.0) / CLOCK_SCALE] if has_clock else [])
+              for f in (-1.5, -1.0, -0.5, 0.0, 0.5)]
+    bounds = layout.bounds()
+    lo, hi = bounds
+    xs = np.clip(np.array(starts), lo + 1e-6, hi - 1e-6)
+    x0 = xs[int(np.argmin(np.sum(residual(xs.T) ** 2, axis=0)))]
+    x, _ = minimize.least_squares(x0, residual, bounds=bounds, max_iter=40, verbose=0, eps=FD_STEP)
+    timing = layout.unpack(np.asarray(x).ravel())[1][0]
+    if rec.kind == "angle":
+        predicted = simulate_deg(model, [servo], [timing], rec, float(rec.angle_deg[0]))[0]
+        rms = float(np.sqrt(np.mean((predicted - rec.angle_deg) ** 2)))
+    else:
+        predicted = simulate_rate(model, [servo], [timing.delay_s], rec)[0]
+        rms = float(np.sqrt(np.mean((predicted - rec.rate_units[rec.samples()] / gain) ** 2)))
+    return Validation(rec.source, rec.kind, rms, timing, gain, peak_speeds(rec, predicted, gain),
+                      recording_curves(model, servo, timing, gain, rec, label="predicted: "))
 
 
 def horn_angle_deg(x_m: np.ndarray, y_m: np.ndarray, pivot_x_m: float, pivot_y_m: float) -> np.ndarray:

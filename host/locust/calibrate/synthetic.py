@@ -17,7 +17,7 @@ import numpy as np
 from scipy import integrate
 
 from ..params import GRAVITY_M_PER_S2, Servo
-from .servo import ServoRig, StepRecording, Timing, rig_model, simulate_deg
+from .servo import RateRecording, ServoRig, StepRecording, Timing, rig_model, simulate_deg, simulate_rate
 
 
 @dataclass(frozen=True)
@@ -72,13 +72,19 @@ def beam_tip_track(truth: BeamTruth, rng: np.random.Generator, tilt_deg: float =
     return t, x_m, y_m
 
 
+SG90_AA_SWING = Servo(kp_nm_per_rad=0.26, stall_torque_nm=0.15, noload_speed_rad_per_s=10.2, armature_kgm2=3.1e-4,
+                      kv_nms_per_rad=0.0)
+"""The SG90 fitted to the course's AA-battery swing alone (kv held at 0): the servo of the
+demo recordings ``calibration/recordings/synthetic_servo*.csv``."""
+
+
 @dataclass(frozen=True)
 class ServoTruth:
     """A servo rig filmed through a square-wave command: the servo (locust.params.Servo), the
-    load, the camera and the firmware-to-camera timing. Default: the preset SG90 swinging a
-    load five times the course's AA battery, filmed at 60 frames/s."""
+    load, the camera and the firmware-to-camera timing. Default: the AA swing's SG90
+    (SG90_AA_SWING) swinging a load five times the course's AA battery, filmed at 60 frames/s."""
 
-    servo: Servo = field(default_factory=Servo)
+    servo: Servo = field(default_factory=lambda: SG90_AA_SWING)
     inertia_kgm2: float = 1.5e-5        # a 20 g weight 2.7 cm from the axis
     gravity_moment_nm: float = 0.0      # 0: horizontal rig
     start_deg: float = 0.0
@@ -107,6 +113,43 @@ STALL_SERVO = ServoTruth(inertia_kgm2=4e-4, gravity_moment_nm=0.2, start_deg=-90
 straight down the horn rises until 0.2*cos(angle) = 0.15 N*m and stalls there, 131 deg short
 of the command, torque-limited for the whole step. With the gravity moment given the stall
 torque is identifiable; kp is not (any kp that saturates the drive fits alike)."""
+
+
+@dataclass(frozen=True)
+class GyroTruth:
+    """A servo stepped 0 -> A -> 0 for each A, each level held ``level_s``, logged with a rate
+    gyro on the horn (the layout of ``../shared/data/servo/sg90_unloaded_gyro_steps.txt``):
+    readings ``gain * speed + noise``, rounded to whole units as an IMU's raw counts are."""
+
+    servo: Servo = field(default_factory=Servo)
+    inertia_kgm2: float = 1e-6              # the gyro board on the horn
+    steps_deg: tuple[float, ...] = (15.0, 45.0, 100.0)
+    level_s: float = 1.0
+    sample_s: float = 0.013                 # about 75 samples/s
+    first_edge_s: float = 0.2
+    gain_units_per_rad_per_s: float = 8.0
+    delay_s: float = 0.025
+    noise_units: float = 0.5
+    timestep_s: float = 2.5e-4              # finer than the fit's
+
+    @property
+    def rig(self) -> ServoRig:
+        return ServoRig(self.inertia_kgm2, timestep_s=self.timestep_s)
+
+
+def gyro_steps(truth: GyroTruth, rng: np.random.Generator):
+    """(t_s, command_deg, rate_units): the rig model's speed at the samples, the horn at rest
+    between steps, plus noise, rounded."""
+    duration = truth.first_edge_s + 2 * len(truth.steps_deg) * truth.level_s
+    t = np.arange(int(duration / truth.sample_s)) * truth.sample_s
+    level = np.floor((t - truth.first_edge_s) / truth.level_s).astype(int)
+    command = np.where((level >= 0) & (level % 2 == 0),
+                       np.array(truth.steps_deg)[np.clip(level // 2, 0, len(truth.steps_deg) - 1)], 0.0)
+    rec = RateRecording(t, np.zeros_like(t), command, truth.rig, source="synthetic")
+    speed = np.zeros_like(t)
+    speed[rec.samples()] = simulate_rate(rig_model(truth.rig), [truth.servo], [truth.delay_s], rec)[0]
+    rate = truth.gain_units_per_rad_per_s * speed + rng.normal(0, truth.noise_units, len(t))
+    return t, command, np.round(rate)
 
 
 def _rest_deg(truth: ServoTruth) -> float:
