@@ -155,8 +155,9 @@ class Schedule:
 class Solver:
     """How the simulation is run (not a property of the robot, but of the result)."""
 
-    # rk4 at 2.5 ms: the seed design within 0.1 mm per hop of dt/2 (docs/servo.md has the table)
-    timestep_s: float = 2.5e-3
+    # rk4 at 1 ms: the seed design within 0.1 mm per hop of dt/2 with the SG90 of both servo
+    # recordings (0.066 mm at 1 ms, 0.29 mm at 2 ms; docs/servo.md, "Time step")
+    timestep_s: float = 1e-3
     integrator: str = "rk4"          # euler | implicitfast | implicit | rk4
     iterations: int = 10
     tolerance: float = 1e-6
