@@ -74,8 +74,12 @@ def _base_path(out: Path | None, source: Path) -> Path:
                    "(colour markers: at least five marker diameters, growing while the marker is lost).")
 @click.option("--template-radius", default=8, show_default=True, type=click.IntRange(2, 200),
               help="Template markers: radius (px) of the circular template (Tracker's mask is 16 px across).")
-@click.option("--accept", default=4.0, show_default=True, type=float,
-              help="Template markers: least peak height (Tracker's 'automark' level) to accept a match.")
+@click.option("--accept", default=0.5, show_default=True, type=float,
+              help="Template markers: least peak height (mean / best square difference - 1 over the search "
+                   "window) to accept a match; it must also look like the template (--likeness) and follow the "
+                   "motion its track predicts.")
+@click.option("--likeness", default=0.5, show_default=True, type=click.FloatRange(-1, 1),
+              help="Template markers: least correlation (zero-mean, normalised) of a match with the template.")
 @click.option("--evolve", default=20.0, show_default=True, type=click.FloatRange(0, 100),
               help="Template markers: percent of each accepted match blended into the template.")
 @click.option("--scale", metavar="X1,Y1,X2,Y2=LENGTH_M",
@@ -122,10 +126,9 @@ def _base_path(out: Path | None, source: Path) -> Path:
               help="Convert a track file instead of tracking a video: a Tracker text export, a t,x,y CSV or a "
                    "tracks CSV, in --units, with --rename and --mirror, into a tracks CSV in metres.")
 @import_options
-def track(video, markers, color_tol, search_px, template_radius, accept, evolve, scale, scale_aruco, aruco_dict,
-          board_text, plane_points, make_board, preview_frame, camera_json, origin, angle, start, end, step, fps, out,
-          fmt, overlay_kind, force, from_trk, trk_names,
-          import_path, imports):
+def track(video, markers, color_tol, search_px, template_radius, accept, likeness, evolve, scale, scale_aruco,
+          aruco_dict, board_text, plane_points, make_board, preview_frame, camera_json, origin, angle, start, end,
+          step, fps, out, fmt, overlay_kind, force, from_trk, trk_names, import_path, imports):
     """Extract marker tracks (nose, foot) from VIDEO, as Tracker's autotracker would, in batch.
 
     \b
@@ -178,7 +181,7 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
 
     info = probe(video)
     clip = Clip(start, end, step, fps).resolved(info)
-    options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0)
+    options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0, likeness)
     models = parse_markers(list(markers), options)
     if preview_frame is not None:
         return _preview(info, preview_frame, models, _base_path(out, video), force)
@@ -288,5 +291,10 @@ def _import(path: Path, imports: ImportOptions, out: Path | None, force: bool) -
 def _report(result, written: list[Path]) -> None:
     for line in export.summary_lines(result):
         click.echo(line)
+    lost = [t.name for t in result.markers if t.spec.startswith("template:") and not t.ok.all()]
+    if lost:
+        click.echo(f"hint: {', '.join(lost)}: lost (nan) where the match looked unlike the template (--likeness, "
+                   "--accept) or left the path its track predicts, e.g. out of view; check the overlay, and pick "
+                   "a point with texture that stays in view, or a --template-radius about the feature's size")
     for p in written:
         click.echo(f"wrote {p}")

@@ -5,19 +5,35 @@ The same steps as Tracker's ``TemplateMatcher`` / ``AutoTracker`` (Open Source P
 1. On the key frame, the template is the circle of radius ``radius_px`` (Tracker's
    default mask is 16 px across) around (X, Y).
 2. On each later frame, the search window (+-``search_half_px``, Tracker's 40) is
-   centred on the constant-acceleration look-ahead of the recent positions
-   (:mod:`.predict`). Until two positions give a velocity the window is twice as
-   large: Tracker's own BallToss ball moves 70 px between its first two steps.
+   centred on where the track's motion puts the marker: a constant-acceleration fit to
+   its last positions (:class:`.predict.Trajectory`), extrapolated across frames where it
+   was lost. Until two positions give a velocity the window is twice as large: Tracker's
+   own BallToss ball moves 70 px between its first two steps.
 3. The match is the position of least RGB square difference (masked) in the window.
    Its score is Tracker's *peak height*: mean difference / best difference - 1.
 4. Sub-pixel: a Gaussian through the peak heights of the best position and its two
    neighbours, per axis (a three-point fit, exact, done in closed form).
-5. A match is accepted when the peak height exceeds ``accept`` (Tracker's "automark",
-   default 4); the template then evolves toward the matched image by ``evolve``
-   (Tracker's default rate 20 %).
+5. A match is accepted when the peak height exceeds ``accept`` (Tracker's "automark");
+   the template then evolves toward the matched image by ``evolve`` (Tracker's
+   evolution rate, default 20 %), so it follows a marker whose look changes.
 
-The reported point is the key point plus the measured displacement, so it follows the
-exact spot picked on the key frame. Frames before the key frame are not searched.
+Three rules keep it off still things, which Tracker leaves to the user's eye:
+
+- *Ambiguity*: where several places match almost as well as the best (within
+  ``AMBIGUITY`` of its square difference: a row of look-alike cups, a textured desk), the
+  one nearest the predicted position is taken, not the best by a hair.
+- *Motion gate*: a match farther from the prediction than ``GATE_MIN_PX`` or
+  ``GATE_STEP_FRACTION`` of the predicted step (whichever is larger) does not follow the
+  motion its track predicts: the marker is lost there.
+- *Likeness*: the matched patch must correlate with the template (zero-mean normalised
+  correlation over the mask, all three channels) at ``min_likeness`` or more; an empty
+  background where the marker was, after it left the picture, does not.
+
+A lost marker is ``nan`` (never a guess); it is looked for again on every later frame,
+in a window that grows while it stays lost, and re-acquired once a match passes all
+three rules. The reported point is the key point plus the measured displacement, so it
+follows the exact spot picked on the key frame. Frames before the key frame are not
+searched.
 """
 
 from __future__ import annotations
@@ -30,7 +46,13 @@ import numpy as np
 
 from ..errors import TrackError
 from .detection import Detection, window
-from .predict import MotionHistory
+from .predict import Trajectory
+
+AMBIGUITY = 1.5            # matches within this factor of the best square difference are look-alikes
+GATE_MIN_PX = 8.0          # a match may always land this far from the prediction
+GATE_STEP_FRACTION = 0.5   # ... or this fraction of the predicted step, whichever is larger
+LOST_GROWTH = 0.5          # window and gate grow by this fraction per frame lost ...
+LOST_GROWTH_MAX = 3.0      # ... up to this many times their size
 
 
 @dataclass
@@ -42,9 +64,10 @@ class TemplateMarker:
     key_frame: int
     radius_px: int = 8
     search_half_px: int = 40
-    accept: float = 4.0
+    accept: float = 0.5
     evolve: float = 0.2
-    history: MotionHistory = field(default_factory=MotionHistory)
+    min_likeness: float = 0.5
+    trajectory: Trajectory = field(default_factory=Trajectory)
     _template: np.ndarray | None = None
     _mask: np.ndarray | None = None
     _offset: tuple[float, float] = (0.0, 0.0)  # key point minus template centre pixel
@@ -56,12 +79,12 @@ class TemplateMarker:
             if frame != self.key_frame:
                 raise TrackError(f"marker {self.name}: key frame {self.key_frame} was not in the clip",
                                  f"start the clip at or before frame {self.key_frame} with a step that reaches it")
-            return self._start(image_bgr)
-        det = self._match(image_bgr)
-        self.history.add(det.point())
+            return self._start(frame, image_bgr)
+        det = self._match(frame, image_bgr)
+        self.trajectory.add(frame, det.point())
         return det
 
-    def _start(self, image: np.ndarray) -> Detection:
+    def _start(self, frame: int, image: np.ndarray) -> Detection:
         cx, cy, r = int(round(self.key_x_px)), int(round(self.key_y_px)), self.radius_px
         h, w = image.shape[:2]
         if not (r <= cx < w - r and r <= cy < h - r):
@@ -73,22 +96,33 @@ class TemplateMarker:
         cv2.circle(self._mask, (r, r), r, 1, -1)
         self._mask = np.repeat(self._mask[:, :, None], 3, axis=2).astype(np.float32)
         self._offset = (self.key_x_px - cx, self.key_y_px - cy)
-        self.history.add((self.key_x_px, self.key_y_px))
+        self.trajectory.add(frame, (self.key_x_px, self.key_y_px))
         return Detection(self.key_x_px, self.key_y_px, math.inf, True)
 
-    def _match(self, image: np.ndarray) -> Detection:
+    def _prediction(self, frame: int) -> tuple[tuple[float, float], float, float]:
+        """Predicted point, search half-size and gate radius (px) for ``frame``."""
+        traj = self.trajectory
+        lost = traj.frames_lost(frame)
+        growth = min(1.0 + LOST_GROWTH * lost, LOST_GROWTH_MAX)
+        if traj.stretch < 2:   # no velocity yet: look twice as far, anywhere in the window
+            half = 2 * self.search_half_px * growth
+            return traj.last_point, half, math.inf
+        point, motion = traj.predict_motion(frame)
+        step = math.hypot(*motion)
+        gate = max(GATE_MIN_PX, GATE_STEP_FRACTION * step) * growth
+        return point, self.search_half_px * growth, gate
+
+    def _match(self, frame: int, image: np.ndarray) -> Detection:
         r = self.radius_px
-        cx, cy = self.history.search_centre()
-        # until two positions give a velocity there is no look-ahead: search twice as far
-        half = self.search_half_px * (1 if self.history.has_velocity() else 2)
+        (px, py), half, gate = self._prediction(frame)
+        ox, oy = self._offset
         # the window holds every template *centre* within +-half of the prediction
-        x0, y0, x1, y1 = window((cx - self._offset[0], cy - self._offset[1]), half + r, image.shape)
+        x0, y0, x1, y1 = window((px - ox, py - oy), int(math.ceil(half)) + r, image.shape)
         roi = image[y0:y1, x0:x1].astype(np.float32)
         if roi.shape[0] < 2 * r + 3 or roi.shape[1] < 2 * r + 3:
             return Detection.missing()
-        diff = cv2.matchTemplate(roi, self._template, cv2.TM_SQDIFF, mask=self._mask)
-        diff = np.maximum(diff, 0.0)
-        iy, ix = np.unravel_index(int(np.argmin(diff)), diff.shape)
+        diff = np.maximum(cv2.matchTemplate(roi, self._template, cv2.TM_SQDIFF, mask=self._mask), 0.0)
+        iy, ix = self._nearest_lookalike(diff, px - ox - x0 - r, py - oy - y0 - r)
         best = float(diff[iy, ix])
         mean = float(diff.mean())
         if best <= 0.0:
@@ -97,9 +131,38 @@ class TemplateMarker:
         height = peak(best)
         if not height > self.accept:
             return Detection.missing(height)
+        if math.hypot(x0 + ix + r + ox - px, y0 + iy + r + oy - py) > gate:
+            return Detection.missing(height)
+        if self._likeness(image, x0 + ix + r, y0 + iy + r) < self.min_likeness:
+            return Detection.missing(height)
         dx = _gaussian_peak(*(peak(diff[iy, ix + k]) if 0 <= ix + k < diff.shape[1] else math.nan for k in (-1, 0, 1)))
         dy = _gaussian_peak(*(peak(diff[iy + k, ix]) if 0 <= iy + k < diff.shape[0] else math.nan for k in (-1, 0, 1)))
         return self._accept(image, x0 + ix + r, y0 + iy + r, dx, dy, height)
+
+    @staticmethod
+    def _nearest_lookalike(diff: np.ndarray, pred_x: float, pred_y: float) -> tuple[int, int]:
+        """Of the local minima of ``diff`` within ``AMBIGUITY`` of the best, the one nearest the
+        predicted position (``pred_x``, ``pred_y``: in ``diff``'s own indices)."""
+        best = float(diff.min())
+        minima = (diff <= AMBIGUITY * best) & (diff <= cv2.erode(diff, np.ones((3, 3), np.uint8)))
+        ys, xs = np.nonzero(minima)
+        if ys.size == 0:
+            iy, ix = np.unravel_index(int(np.argmin(diff)), diff.shape)
+            return int(iy), int(ix)
+        k = int(np.argmin((xs - pred_x) ** 2 + (ys - pred_y) ** 2))
+        return int(ys[k]), int(xs[k])
+
+    def _likeness(self, image: np.ndarray, ix: int, iy: int) -> float:
+        """Zero-mean normalised correlation of the template and the patch centred on (ix, iy)."""
+        r = self.radius_px
+        patch = image[iy - r:iy + r + 1, ix - r:ix + r + 1].astype(np.float32)
+        if patch.shape != self._template.shape:
+            return -1.0
+        inside = self._mask > 0
+        a = patch[inside] - patch[inside].mean()
+        b = self._template[inside] - self._template[inside].mean()
+        norm = math.sqrt(float(a @ a) * float(b @ b))
+        return float(a @ b) / norm if norm > 0 else -1.0
 
     def _accept(self, image, ix: int, iy: int, dx: float, dy: float, height: float) -> Detection:
         r = self.radius_px
