@@ -98,7 +98,7 @@ def test_calibration_from_trk_gives_trackers_metres(balltoss, tmp_path):
     assert ok[2:].all() and not ok[:2].any()                       # Tracker's steps: frames 2..12
     assert np.abs(df["t_s"] - theirs.t_s).max() < 1e-9             # the project's 66 ms frame interval
     err_mm = 1000 * np.hypot(df["ball_x_m"] - x, df["ball_y_m"] - y)[ok]
-    assert err_mm.max() <= 5.0, err_mm                              # acceptance 5 mm; measured 3.9
+    assert err_mm.max() <= 5.0, err_mm                              # acceptance 5 mm; measured 3.6, mean 2.7
     written = trk.read_project(tmp_path / "ball.trk")
     assert written.calibration.m_per_px == pytest.approx(theirs.calibration.m_per_px, rel=1e-12)
     assert written.calibration.angle_deg == pytest.approx(theirs.calibration.angle_deg, abs=1e-12)
