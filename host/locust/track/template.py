@@ -31,7 +31,12 @@ Three rules keep it off still things, which Tracker leaves to the user's eye:
 
 A lost marker is ``nan`` (never a guess); it is looked for again on every later frame,
 in a window that grows while it stays lost, and re-acquired once a match passes all
-three rules. The reported point is the key point plus the measured displacement, so it
+three rules; while it is lost the gate is measured from its predicted path (the gate grown)
+or from where it was last seen (not grown), whichever passes: a hand-held camera jerks, and
+the jerk is no path to extrapolate. A lost marker also comes back anywhere in its window
+when the match is unmistakable: peak height ``REACQUIRE_PEAK`` and likeness
+``REACQUIRE_LIKENESS`` (a textured patch on a hand-held clip; a small cup among look-alike
+cups peaks near 10 and stays lost). The reported point is the key point plus the measured displacement, so it
 follows the exact spot picked on the key frame. Frames before the key frame are not
 searched.
 """
@@ -53,6 +58,10 @@ GATE_MIN_PX = 8.0          # a match may always land this far from the predictio
 GATE_STEP_FRACTION = 0.5   # ... or this fraction of the predicted step, whichever is larger
 LOST_GROWTH = 0.5          # window and gate grow by this fraction per frame lost ...
 LOST_GROWTH_MAX = 3.0      # ... up to this many times their size
+REACQUIRE_PEAK = 50.0            # a lost marker comes back with a peak height this high ...
+REACQUIRE_OFF_PATH_PEAK = 100.0  # ... off its path, this high
+SPREAD_RADII = 2.0         # a match whose near-equals reach this many template radii has no position
+EXTRAPOLATE_FRAMES = 5     # a lost marker is looked for along its path this many frames on, then there
 
 
 @dataclass
@@ -104,10 +113,15 @@ class TemplateMarker:
         traj = self.trajectory
         lost = traj.frames_lost(frame)
         growth = min(1.0 + LOST_GROWTH * lost, LOST_GROWTH_MAX)
-        if traj.stretch < 2:   # no velocity yet: look twice as far, anywhere in the window
+        if traj.stretch < 2:
             half = 2 * self.search_half_px * growth
-            return traj.last_point, half, math.inf
-        point, motion = traj.predict_motion(frame)
+            if traj.max_speed_px == 0.0:   # the key frame alone: no velocity yet, anywhere in the window
+                return traj.last_point, half, math.inf
+            # just re-acquired: no velocity yet, but no faster than the marker has been seen to move
+            return traj.last_point, half, max(GATE_MIN_PX, traj.max_speed_px) * growth
+        # lost for long, the fit is not extrapolated further: where it led after EXTRAPOLATE_FRAMES
+        ahead = min(frame, traj.last_frame + 1 + EXTRAPOLATE_FRAMES)
+        point, motion = traj.predict_motion(ahead)
         step = math.hypot(*motion)
         gate = max(GATE_MIN_PX, GATE_STEP_FRACTION * step) * growth
         return point, self.search_half_px * growth, gate
@@ -129,11 +143,27 @@ class TemplateMarker:
             return self._accept(image, x0 + ix + r, y0 + iy + r, 0.0, 0.0, math.inf)
         peak = lambda d: mean / max(d, 1e-12) - 1.0  # noqa: E731 - Tracker's peak height
         height = peak(best)
+        spread = _valley_extent(diff, iy, ix)
+        mx, my = x0 + ix + r + ox, y0 + iy + r + oy
+        off = math.hypot(mx - px, my - py) / gate
+        lost = self.trajectory.frames_lost(frame)
+        if lost > 0:   # lost: where it was last seen is as good a guess, the gate not grown
+            growth = min(1.0 + LOST_GROWTH * lost, LOST_GROWTH_MAX)
+            lx, ly = self.trajectory.last_point
+            off = min(off, math.hypot(mx - lx, my - ly) * growth / gate)
+        like = self._likeness(image, x0 + ix + r, y0 + iy + r)
+        self.last_check = (height, off, gate, like, spread)
         if not height > self.accept:
             return Detection.missing(height)
-        if math.hypot(x0 + ix + r + ox - px, y0 + iy + r + oy - py) > gate:
+        # off its path: lost -- unless it is lost already and this match is unmistakable (a
+        # hand-held camera panned while it was lost: the path knows nothing of that)
+        if spread > SPREAD_RADII * r:   # the match slides along an edge or over a plain patch: no position
             return Detection.missing(height)
-        if self._likeness(image, x0 + ix + r, y0 + iy + r) < self.min_likeness:
+        if lost > 0 and height < REACQUIRE_PEAK:
+            return Detection.missing(height)   # coming back takes a match that stands out in its window
+        if off > 1.0 and not (lost > 0 and height >= REACQUIRE_OFF_PATH_PEAK):
+            return Detection.missing(height)
+        if like < self.min_likeness:
             return Detection.missing(height)
         dx = _gaussian_peak(*(peak(diff[iy, ix + k]) if 0 <= ix + k < diff.shape[1] else math.nan for k in (-1, 0, 1)))
         dy = _gaussian_peak(*(peak(diff[iy + k, ix]) if 0 <= iy + k < diff.shape[0] else math.nan for k in (-1, 0, 1)))
@@ -152,15 +182,17 @@ class TemplateMarker:
         k = int(np.argmin((xs - pred_x) ** 2 + (ys - pred_y) ** 2))
         return int(ys[k]), int(xs[k])
 
-    def _likeness(self, image: np.ndarray, ix: int, iy: int) -> float:
-        """Zero-mean normalised correlation of the template and the patch centred on (ix, iy)."""
+    def _likeness(self, image: np.ndarray, ix: int, iy: int, template: np.ndarray | None = None) -> float:
+        """Zero-mean normalised correlation of ``template`` (default: the evolved one) and the
+        patch centred on (ix, iy)."""
         r = self.radius_px
+        template = self._template if template is None else template
         patch = image[iy - r:iy + r + 1, ix - r:ix + r + 1].astype(np.float32)
-        if patch.shape != self._template.shape:
+        if patch.shape != template.shape:
             return -1.0
         inside = self._mask > 0
         a = patch[inside] - patch[inside].mean()
-        b = self._template[inside] - self._template[inside].mean()
+        b = template[inside] - template[inside].mean()
         norm = math.sqrt(float(a @ a) * float(b @ b))
         return float(a @ b) / norm if norm > 0 else -1.0
 
@@ -170,6 +202,16 @@ class TemplateMarker:
         if patch.shape == self._template.shape:
             self._template = (1.0 - self.evolve) * self._template + self.evolve * patch
         return Detection(ix + dx + self._offset[0], iy + dy + self._offset[1], height, True)
+
+
+def _valley_extent(diff: np.ndarray, iy: int, ix: int) -> float:
+    """How far (px) the places matching within ``AMBIGUITY`` of the match at (iy, ix) reach from
+    it, connected to it: a few pixels on a textured spot, long along a straight edge (the
+    match slides along it) or over a plain area."""
+    low = (diff <= AMBIGUITY * diff[iy, ix]).astype(np.uint8)
+    _, labels = cv2.connectedComponents(low, connectivity=8)
+    ys, xs = np.nonzero(labels == labels[iy, ix])
+    return float(np.sqrt(((ys - iy) ** 2 + (xs - ix) ** 2).max()))
 
 
 def _gaussian_peak(left: float, centre: float, right: float) -> float:
