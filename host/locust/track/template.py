@@ -17,7 +17,7 @@ The same steps as Tracker's ``TemplateMatcher`` / ``AutoTracker`` (Open Source P
    the template then evolves toward the matched image by ``evolve`` (Tracker's
    evolution rate, default 20 %), so it follows a marker whose look changes.
 
-Three rules keep it off still things, which Tracker leaves to the user's eye:
+Rules keep it off still things, which Tracker leaves to the user's eye:
 
 - *Ambiguity*: where several places match almost as well as the best (within
   ``AMBIGUITY`` of its square difference: a row of look-alike cups, a textured desk), the
@@ -30,15 +30,20 @@ Three rules keep it off still things, which Tracker leaves to the user's eye:
   background where the marker was, after it left the picture, does not.
 
 A lost marker is ``nan`` (never a guess); it is looked for again on every later frame,
-in a window that grows while it stays lost, and re-acquired once a match passes all
-three rules; while it is lost the gate is measured from its predicted path (the gate grown)
-or from where it was last seen (not grown), whichever passes: a hand-held camera jerks, and
-the jerk is no path to extrapolate. A lost marker also comes back anywhere in its window
-when the match is unmistakable: peak height ``REACQUIRE_PEAK`` and likeness
-``REACQUIRE_LIKENESS`` (a textured patch on a hand-held clip; a small cup among look-alike
-cups peaks near 10 and stays lost). The reported point is the key point plus the measured displacement, so it
-follows the exact spot picked on the key frame. Frames before the key frame are not
-searched.
+around its path (extrapolated at most ``EXTRAPOLATE_FRAMES``) in a window and gate that grow
+while it stays lost, or within the ungrown gate of where it was last seen (a hand-held camera
+jerks, and a jerk is no path to extrapolate). It comes back only where its match stands out
+and looks like it: Tracker's peak height ``REACQUIRE_PEAK`` and likeness
+``REACQUIRE_LIKENESS`` (a small cup among look-alike cups peaks near 10 and stays lost). A
+marker that reappears far from both stays lost: a black blob matches any dark patch of the
+background just as well.
+
+A fourth rule, *position*: when the places matching within ``AMBIGUITY`` of the match reach
+more than ``SPREAD_RADII`` template radii from it (the template slides along a straight
+edge, or sits on a plain patch), the frame has no position.
+
+The reported point is the key point plus the measured displacement, so it follows the exact
+spot picked on the key frame. Frames before the key frame are not searched.
 """
 
 from __future__ import annotations
@@ -58,8 +63,8 @@ GATE_MIN_PX = 8.0          # a match may always land this far from the predictio
 GATE_STEP_FRACTION = 0.5   # ... or this fraction of the predicted step, whichever is larger
 LOST_GROWTH = 0.5          # window and gate grow by this fraction per frame lost ...
 LOST_GROWTH_MAX = 3.0      # ... up to this many times their size
-REACQUIRE_PEAK = 50.0            # a lost marker comes back with a peak height this high ...
-REACQUIRE_OFF_PATH_PEAK = 100.0  # ... off its path, this high
+REACQUIRE_PEAK = 50.0      # a lost marker comes back only with a peak height this high ...
+REACQUIRE_LIKENESS = 0.7   # ... and this likeness
 SPREAD_RADII = 2.0         # a match whose near-equals reach this many template radii has no position
 EXTRAPOLATE_FRAMES = 5     # a lost marker is looked for along its path this many frames on, then there
 
@@ -118,7 +123,7 @@ class TemplateMarker:
             if traj.max_speed_px == 0.0:   # the key frame alone: no velocity yet, anywhere in the window
                 return traj.last_point, half, math.inf
             # just re-acquired: no velocity yet, but no faster than the marker has been seen to move
-            return traj.last_point, half, max(GATE_MIN_PX, traj.max_speed_px) * growth
+            return traj.last_point, half, max(GATE_MIN_PX, GATE_STEP_FRACTION * traj.max_speed_px) * growth
         # lost for long, the fit is not extrapolated further: where it led after EXTRAPOLATE_FRAMES
         ahead = min(frame, traj.last_frame + 1 + EXTRAPOLATE_FRAMES)
         point, motion = traj.predict_motion(ahead)
@@ -159,9 +164,9 @@ class TemplateMarker:
         # hand-held camera panned while it was lost: the path knows nothing of that)
         if spread > SPREAD_RADII * r:   # the match slides along an edge or over a plain patch: no position
             return Detection.missing(height)
-        if lost > 0 and height < REACQUIRE_PEAK:
+        if lost > 0 and (height < REACQUIRE_PEAK or like < REACQUIRE_LIKENESS):
             return Detection.missing(height)   # coming back takes a match that stands out in its window
-        if off > 1.0 and not (lost > 0 and height >= REACQUIRE_OFF_PATH_PEAK):
+        if off > 1.0:   # off its path
             return Detection.missing(height)
         if like < self.min_likeness:
             return Detection.missing(height)
