@@ -37,7 +37,7 @@ def test_servo_label_followed_or_lost(shared_data, tmp_path):
     df = _track(shared_data / "video" / "fourbar_robot_walk_oblique_1.mp4", tmp_path, 299,
                 "servo=template:425,272@0")
     ok = df["servo_ok"].astype(bool)
-    assert ok.sum() >= 200                                  # measured 225 of 300
+    assert ok.sum() >= 200                                  # measured 226 of 300
     assert not ok[11:15].any()                              # motion blur on frames 11-14: lost, not guessed
     seen = df[ok]
     # on the servo in every frame checked by eye: its label stays inside this box over frames 0-299

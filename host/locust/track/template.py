@@ -23,8 +23,9 @@ Rules keep it off still things, which Tracker leaves to the user's eye:
   ``AMBIGUITY`` of its square difference: a row of look-alike cups, a textured desk), the
   one nearest the predicted position is taken, not the best by a hair.
 - *Motion gate*: a match farther from the prediction than ``GATE_MIN_PX`` or
-  ``GATE_STEP_FRACTION`` of the predicted step (whichever is larger) does not follow the
-  motion its track predicts: the marker is lost there.
+  ``GATE_STEP_FRACTION`` of the predicted step (whichever is larger) along the predicted
+  motion, or ``GATE_MIN_PX`` across it, does not follow the motion its track predicts: the
+  marker is lost there (two cups falling side by side, 12 px apart).
 - *Likeness*: the matched patch must correlate with the template (zero-mean normalised
   correlation over the mask, all three channels) at ``min_likeness`` or more; an empty
   background where the marker was, after it left the picture, does not.
@@ -59,6 +60,7 @@ from .detection import Detection, window
 from .predict import Trajectory
 
 AMBIGUITY = 1.5            # matches within this factor of the best square difference are look-alikes
+AMBIGUITY_IN_GATE = 3.0    # ... and within this factor, inside the motion gate
 GATE_MIN_PX = 8.0          # a match may always land this far from the prediction
 GATE_STEP_FRACTION = 0.5   # ... or this fraction of the predicted step, whichever is larger
 LOST_GROWTH = 0.5          # window and gate grow by this fraction per frame lost ...
@@ -67,6 +69,24 @@ REACQUIRE_PEAK = 50.0      # a lost marker comes back only with a peak height th
 REACQUIRE_LIKENESS = 0.7   # ... and this likeness
 SPREAD_RADII = 2.0         # a match whose near-equals reach this many template radii has no position
 EXTRAPOLATE_FRAMES = 5     # a lost marker is looked for along its path this many frames on, then there
+
+
+@dataclass(frozen=True)
+class Gate:
+    """Where a match may land around the prediction: an ellipse, ``along_px`` along the
+    predicted motion (unit vector ``ux``, ``uy``) and ``across_px`` across it (a constant-
+    acceleration prediction errs along the path, hardly across it); a circle without motion."""
+
+    along_px: float
+    across_px: float
+    ux: float = 1.0
+    uy: float = 0.0
+
+    def ratio(self, dx, dy):
+        """Distance of the offset (dx, dy) from the prediction in gate sizes (<= 1: inside)."""
+        along = dx * self.ux + dy * self.uy
+        across = -dx * self.uy + dy * self.ux
+        return np.hypot(along / self.along_px, across / self.across_px)
 
 
 @dataclass
@@ -113,23 +133,27 @@ class TemplateMarker:
         self.trajectory.add(frame, (self.key_x_px, self.key_y_px))
         return Detection(self.key_x_px, self.key_y_px, math.inf, True)
 
-    def _prediction(self, frame: int) -> tuple[tuple[float, float], float, float]:
-        """Predicted point, search half-size and gate radius (px) for ``frame``."""
+    def _prediction(self, frame: int) -> tuple[tuple[float, float], float, Gate]:
+        """Predicted point, search half-size (px) and gate for ``frame``."""
         traj = self.trajectory
         lost = traj.frames_lost(frame)
         growth = min(1.0 + LOST_GROWTH * lost, LOST_GROWTH_MAX)
         if traj.stretch < 2:
             half = 2 * self.search_half_px * growth
             if traj.max_speed_px == 0.0:   # the key frame alone: no velocity yet, anywhere in the window
-                return traj.last_point, half, math.inf
+                return traj.last_point, half, Gate(math.inf, math.inf)
             # just re-acquired: no velocity yet, but no faster than the marker has been seen to move
-            return traj.last_point, half, max(GATE_MIN_PX, GATE_STEP_FRACTION * traj.max_speed_px) * growth
+            radius = max(GATE_MIN_PX, GATE_STEP_FRACTION * traj.max_speed_px) * growth
+            return traj.last_point, half, Gate(radius, radius)
         # lost for long, the fit is not extrapolated further: where it led after EXTRAPOLATE_FRAMES
         ahead = min(frame, traj.last_frame + 1 + EXTRAPOLATE_FRAMES)
         point, motion = traj.predict_motion(ahead)
         step = math.hypot(*motion)
-        gate = max(GATE_MIN_PX, GATE_STEP_FRACTION * step) * growth
-        return point, self.search_half_px * growth, gate
+        along = max(GATE_MIN_PX, GATE_STEP_FRACTION * step) * growth
+        ux, uy = (motion[0] / step, motion[1] / step) if step > 0 else (1.0, 0.0)
+        # with two positions the look-ahead is a straight line: it may err across the path too
+        across = GATE_MIN_PX * growth if traj.stretch >= 3 else along
+        return point, self.search_half_px * growth, Gate(along, across, ux, uy)
 
     def _match(self, frame: int, image: np.ndarray) -> Detection:
         r = self.radius_px
@@ -141,7 +165,9 @@ class TemplateMarker:
         if roi.shape[0] < 2 * r + 3 or roi.shape[1] < 2 * r + 3:
             return Detection.missing()
         diff = np.maximum(cv2.matchTemplate(roi, self._template, cv2.TM_SQDIFF, mask=self._mask), 0.0)
-        iy, ix = self._nearest_lookalike(diff, px - ox - x0 - r, py - oy - y0 - r)
+        lost = self.trajectory.frames_lost(frame)
+        iy, ix = _nearest_lookalike(diff, px - ox - x0 - r, py - oy - y0 - r,
+                                    gate if lost == 0 else Gate(math.inf, math.inf))
         best = float(diff[iy, ix])
         mean = float(diff.mean())
         if best <= 0.0:
@@ -150,18 +176,15 @@ class TemplateMarker:
         height = peak(best)
         spread = _valley_extent(diff, iy, ix)
         mx, my = x0 + ix + r + ox, y0 + iy + r + oy
-        off = math.hypot(mx - px, my - py) / gate
-        lost = self.trajectory.frames_lost(frame)
+        off = float(gate.ratio(mx - px, my - py))
         if lost > 0:   # lost: where it was last seen is as good a guess, the gate not grown
             growth = min(1.0 + LOST_GROWTH * lost, LOST_GROWTH_MAX)
             lx, ly = self.trajectory.last_point
-            off = min(off, math.hypot(mx - lx, my - ly) * growth / gate)
+            off = min(off, math.hypot(mx - lx, my - ly) * growth / gate.along_px)
         like = self._likeness(image, x0 + ix + r, y0 + iy + r)
-        self.last_check = (height, off, gate, like, spread)
+        self.last_check = (height, off, gate.along_px, like, spread)
         if not height > self.accept:
             return Detection.missing(height)
-        # off its path: lost -- unless it is lost already and this match is unmistakable (a
-        # hand-held camera panned while it was lost: the path knows nothing of that)
         if spread > SPREAD_RADII * r:   # the match slides along an edge or over a plain patch: no position
             return Detection.missing(height)
         if lost > 0 and (height < REACQUIRE_PEAK or like < REACQUIRE_LIKENESS):
@@ -173,19 +196,6 @@ class TemplateMarker:
         dx = _gaussian_peak(*(peak(diff[iy, ix + k]) if 0 <= ix + k < diff.shape[1] else math.nan for k in (-1, 0, 1)))
         dy = _gaussian_peak(*(peak(diff[iy + k, ix]) if 0 <= iy + k < diff.shape[0] else math.nan for k in (-1, 0, 1)))
         return self._accept(image, x0 + ix + r, y0 + iy + r, dx, dy, height)
-
-    @staticmethod
-    def _nearest_lookalike(diff: np.ndarray, pred_x: float, pred_y: float) -> tuple[int, int]:
-        """Of the local minima of ``diff`` within ``AMBIGUITY`` of the best, the one nearest the
-        predicted position (``pred_x``, ``pred_y``: in ``diff``'s own indices)."""
-        best = float(diff.min())
-        minima = (diff <= AMBIGUITY * best) & (diff <= cv2.erode(diff, np.ones((3, 3), np.uint8)))
-        ys, xs = np.nonzero(minima)
-        if ys.size == 0:
-            iy, ix = np.unravel_index(int(np.argmin(diff)), diff.shape)
-            return int(iy), int(ix)
-        k = int(np.argmin((xs - pred_x) ** 2 + (ys - pred_y) ** 2))
-        return int(ys[k]), int(xs[k])
 
     def _likeness(self, image: np.ndarray, ix: int, iy: int, template: np.ndarray | None = None) -> float:
         """Zero-mean normalised correlation of ``template`` (default: the evolved one) and the
@@ -207,6 +217,30 @@ class TemplateMarker:
         if patch.shape == self._template.shape:
             self._template = (1.0 - self.evolve) * self._template + self.evolve * patch
         return Detection(ix + dx + self._offset[0], iy + dy + self._offset[1], height, True)
+
+
+def _nearest_lookalike(diff: np.ndarray, pred_x: float, pred_y: float, gate: Gate) -> tuple[int, int]:
+    """The match in ``diff`` (indices iy, ix) given the predicted position (``pred_x``,
+    ``pred_y``, in ``diff``'s own indices): of the local minima within ``AMBIGUITY`` of the
+    best, the one nearest the prediction; when that one lies outside ``gate``, the
+    lowest local minimum within the gate if it is within ``AMBIGUITY_IN_GATE`` of the best
+    (a look-alike outside the path matched the evolved template a little better)."""
+    best = float(diff.min())
+    minima = diff <= cv2.erode(diff, np.ones((3, 3), np.uint8))
+    ys, xs = np.nonzero(minima & (diff <= AMBIGUITY * best))
+    if ys.size == 0:
+        iy, ix = np.unravel_index(int(np.argmin(diff)), diff.shape)
+        return int(iy), int(ix)
+    k = int(np.argmin((xs - pred_x) ** 2 + (ys - pred_y) ** 2))
+    if gate.ratio(xs[k] - pred_x, ys[k] - pred_y) <= 1.0:
+        return int(ys[k]), int(xs[k])
+    ys, xs = np.nonzero(minima & (diff <= AMBIGUITY_IN_GATE * best))
+    inside = gate.ratio(xs - pred_x, ys - pred_y) <= 1.0
+    if not inside.any():
+        return int(ys[k]), int(xs[k])
+    ys, xs = ys[inside], xs[inside]
+    k = int(np.argmin(diff[ys, xs]))
+    return int(ys[k]), int(xs[k])
 
 
 def _valley_extent(diff: np.ndarray, iy: int, ix: int) -> float:
