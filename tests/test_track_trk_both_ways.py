@@ -124,3 +124,19 @@ def test_image_sequence_needs_a_frame_rate(cups):
                                    "--marker", "c=template:203.4,34.5@0", "--out", str(cups / "nofps.csv")])
     assert res.exit_code == 2
     assert "no frame rate" in res.output and "--fps" in res.output
+
+
+def test_a_folder_is_the_same_sequence_and_a_lone_image_is_refused(cups, cups_run, tmp_path):
+    _, df, _ = cups_run
+    project = trk.read_project(cups / "CupsClips_CupsClips.trk")
+    c3 = project.points["cup 3"][0]
+    res = CliRunner().invoke(cli, ["track", str(cups / "videos"), "--fps", "10.1", "--overlay", "none",
+                                   "--marker", f"cup3=template:{c3[0]:.2f},{c3[1]:.2f}@0",
+                                   "--out", str(tmp_path / "folder.csv")])
+    assert res.exit_code == 0, res.output
+    folder = pd.read_csv(tmp_path / "folder.csv")
+    assert np.array_equal(folder["cup3_px"].to_numpy(), df["cup3_px"].to_numpy(), equal_nan=True)
+    lone = tmp_path / "shot.jpg"
+    lone.write_bytes((cups / "videos" / "CupsClips_CupsClips00.jpg").read_bytes())
+    res = CliRunner().invoke(cli, ["track", str(lone), "--fps", "10", "--marker", "c=template:203.4,34.5@0"])
+    assert res.exit_code == 2 and "a single image" in res.output

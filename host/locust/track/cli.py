@@ -60,7 +60,7 @@ def _base_path(out: Path | None, source: Path) -> Path:
 
 
 @click.command(context_settings={"max_content_width": 100})
-@click.argument("video", required=False, type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("video", required=False, type=click.Path(path_type=Path))
 @click.option("--marker", "markers", multiple=True, metavar="NAME=SPEC",
               help="A marker to track; repeatable. SPEC is color:#RRGGBB[@X,Y] (X,Y: where it is on the first "
                    "frame), template:X,Y@FRAME or aruco:ID[@DICT]. "
