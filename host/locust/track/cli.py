@@ -250,6 +250,8 @@ def _track(video: Path, named: Path, project, markers, settings, board_text, pla
     n = len(clip.frames())
     with progress(length=n, label=f"tracking {video.name}") as bar:
         result = track_video(info, clip, models, calibration, progress=bar.update)
+    if named != video:   # a Tracker project's video, unpacked from it for this run
+        result.source = f"locust track of the video in {named}"
     written = _write(result, paths, fmt)
     if trk_out is not None:
         media = trk.media_in_zip(project, trk_out) if project is not None and trk.is_project(named) else None
