@@ -182,7 +182,6 @@ class TemplateMarker:
             lx, ly = self.trajectory.last_point
             off = min(off, math.hypot(mx - lx, my - ly) * growth / gate.along_px)
         like = self._likeness(image, x0 + ix + r, y0 + iy + r)
-        self.last_check = (height, off, gate.along_px, like, spread)
         if not height > self.accept:
             return Detection.missing(height)
         if spread > SPREAD_RADII * r:   # the match slides along an edge or over a plain patch: no position
