@@ -18,7 +18,7 @@ from . import record as R
 from .plant import PLANTS
 
 CHIPS = tuple(fw_config.CHIPS)  # the chips whose pin rules the firmware knows, and the virtual robot models
-
+VIDEO_FPS = 60                # the virtual robot's camera, as docs/hardware.md asks of a real one
 PORT_HELP = "Serial port (e.g. /dev/ttyUSB0), or 'sim' for the virtual robot. Default: the one likely ESP32."
 ROBOT_SCHEDULE = Schedule()   # the robot parameters' default schedule, named in the hop options' help
 
@@ -32,6 +32,9 @@ def _plant_options(func):
                         help="With the virtual robot: render the simulated robot to this video "
                              "(fixed camera framed on the planned hops, "
                              "with .truth.csv and .camera.json beside it for `locust track`).")(func)
+    func = click.option("--fps", "video_fps", type=click.IntRange(1, 1000), default=VIDEO_FPS, show_default=True,
+                        help="With --video: frames per second of the rendered video (docs/hardware.md asks "
+                             "60 or more of a real camera: a hop's flight lasts a few frames at 30).")(func)
     func = click.option("--plant", type=click.Choice(PLANTS), default="auto", show_default=True,
                         help="With the virtual robot: what the servos drive (mujoco: the live model; "
                              "record: only record the commands; auto: mujoco when installed).")(func)
@@ -121,7 +124,8 @@ def _parse_servo_set(item: str) -> tuple[str, float]:
 @click.option("--json", "as_json", is_flag=True, help="Print the run record as JSON.")
 @_plant_options
 @robot_options
-def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, plant, video, preset, config, sets):
+def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, plant, video, video_fps, preset, config,
+        sets):
     """Run the bang-bang hop schedule (push, wait; N cycles) and save the run record.
 
     Phases are timed on the robot (ticks_us); run.json gets the commanded and measured start
@@ -148,7 +152,7 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
     # rest, the record says so, a --port sim virtual robot stops
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
     try:
-        with open_port(port, plant=plant, video=video, robot=robot, info=_info) as device:
+        with open_port(port, plant=plant, video=video, robot=robot, info=_info, video_fps=video_fps) as device:
             with Link(device) as link:
                 with progress(length=schedule.phases, label="hop") as bar:
                     rec = run_hop(link, schedule, directory,
@@ -295,7 +299,7 @@ def _remove_empty(directory: Path, top: Path | None) -> None:
               help="The chip whose limits the virtual robot has: its pins (os.uname().machine names it).")
 @_plant_options
 @robot_options
-def virtual(flash_dir, pwm_log, chip, plant, video, preset, config, sets):
+def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, sets):
     """Start a virtual robot in the foreground; print its device path (/dev/pts/N) first.
 
     The firmware in the flash folder runs on the real MicroPython interpreter (unix port)
@@ -312,7 +316,7 @@ def virtual(flash_dir, pwm_log, chip, plant, video, preset, config, sets):
     if pwm_log is not None and pwm_log.exists():
         raise DeviceError(f"{pwm_log} exists; a log is never overwritten", "choose another --pwm-log path")
     robot = resolve_robot(preset, config, sets)
-    vr = VirtualRobot(flash_dir, make_plant(plant, robot, video), log_path=pwm_log, chip=chip).start()
+    vr = VirtualRobot(flash_dir, make_plant(plant, robot, video, video_fps), log_path=pwm_log, chip=chip).start()
     click.echo(vr.device_path)
     sys.stdout.flush()
     _info(f"virtual robot ({vr.chip}): flash {vr.flash_dir}, {vr.scheduling} scheduling, "

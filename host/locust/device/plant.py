@@ -52,13 +52,13 @@ class RecordingPlant:
 class MujocoPlant:
     """The live MuJoCo model, stepped up to each command's time."""
 
-    def __init__(self, robot, video_path: Path | None = None):
+    def __init__(self, robot, video_path: Path | None = None, video_fps: int = 60):
         try:
             from ..sim.live import LiveSim
         except ImportError as exc:
             raise DeviceError(f"the live MuJoCo model is not available ({exc})",
                               "use --plant record, or install the simulation part of locust") from None
-        self.sim = LiveSim(robot, video_path=str(video_path) if video_path else None)
+        self.sim = LiveSim(robot, video_path=str(video_path) if video_path else None, fps=video_fps)
 
     def command(self, t_s: float, left_deg: float, right_deg: float) -> None:
         self.sim.advance_to(t_s)
@@ -78,7 +78,7 @@ def mujoco_available() -> bool:
         return False
 
 
-def make_plant(kind: str, robot=None, video_path: Path | None = None) -> Plant:
+def make_plant(kind: str, robot=None, video_path: Path | None = None, video_fps: int = 60) -> Plant:
     """``auto`` is the MuJoCo model when it is installed (or a video is asked for), else a recorder."""
     if kind == "auto":
         kind = "mujoco" if (video_path is not None or mujoco_available()) else "record"
@@ -86,7 +86,7 @@ def make_plant(kind: str, robot=None, video_path: Path | None = None) -> Plant:
         if robot is None:
             from ..params import preset
             robot = preset("seed")
-        return MujocoPlant(robot, video_path)
+        return MujocoPlant(robot, video_path, video_fps)
     if kind == "record":
         return RecordingPlant()
     raise DeviceError(f"unknown plant {kind!r}", f"choose one of {', '.join(PLANTS)}")

@@ -12,12 +12,12 @@ from .ports import SIM, autodetect, list_serial_ports
 
 @contextlib.contextmanager
 def open_port(port: str | None, plant: str = "auto", video: Path | None = None, robot=None,
-              info=None) -> Iterator[str]:
+              info=None, video_fps: int = 60) -> Iterator[str]:
     """Yields the device path to open. ``sim`` runs a virtual robot for the ``with`` block."""
     if port == SIM:
         from .virtual import VirtualRobot
 
-        vr = VirtualRobot(plant=make_plant(plant, robot, video)).start()
+        vr = VirtualRobot(plant=make_plant(plant, robot, video, video_fps)).start()
         try:
             if info:
                 info(f"virtual robot on {vr.device_path} (flash {vr.flash_dir}, {vr.scheduling} scheduling)")

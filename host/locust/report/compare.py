@@ -90,6 +90,13 @@ class Comparison:
         return self.prediction.result.distance_m
 
     @property
+    def resolution_m(self) -> float:
+        """One pixel of the coarsest track, in metres: a difference below it is not measured
+        (nan when no track has pixel columns)."""
+        px = [m.trial.track.m_per_px for m in self.trials if math.isfinite(m.trial.track.m_per_px)]
+        return max(px) if px else math.nan
+
+    @property
     def predicted_hop_distance_m(self) -> float:
         return self.predicted_distance_m / self.cycles
 

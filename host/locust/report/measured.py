@@ -18,6 +18,7 @@ a tracks CSV, a Tracker text export or a ``t,x,y`` CSV, with ``--units``, ``--re
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -47,6 +48,7 @@ class Track:
     frames: int          # rows in the file, lost ones included
     units: str = "m"     # the unit the file's positions were in (--units)
     mirrored: bool = False
+    m_per_px: float = math.nan   # tracking resolution: one pixel at the marker, in metres (nan: no pixels)
 
 
 @dataclass(frozen=True)
@@ -150,7 +152,19 @@ def read_track(path: Path, marker: str = "nose", imports: ImportOptions = AS_IS)
         raise ReportError(f"{path}: repeated time stamps in t_s",
                           "export the track again; each frame needs its own time")
     return Track(path=path, marker=marker, t_s=tt, x_m=x[ok][order], y_m=y[ok][order], frames=tracks.n_rows,
-                 units=imports.units, mirrored=imports.mirror)
+                 units=imports.units, mirrored=imports.mirror, m_per_px=metres_per_pixel(tracks, marker))
+
+
+def metres_per_pixel(tracks, marker: str) -> float:
+    """The track's own resolution: the median of (step in metres) / (step in pixels) over the
+    frame-to-frame steps of at least a pixel; nan for a track without pixel columns."""
+    columns = getattr(tracks, "markers", {}).get(marker)
+    if columns is None or not hasattr(columns, "px"):
+        return math.nan
+    step_px = np.hypot(np.diff(columns.px), np.diff(columns.py))
+    step_m = np.hypot(np.diff(columns.x_m), np.diff(columns.y_m))
+    use = np.isfinite(step_px) & np.isfinite(step_m) & (step_px >= 1.0)
+    return float(np.median(step_m[use] / step_px[use])) if use.any() else math.nan
 
 
 def read_run(path: Path) -> RunRecord:

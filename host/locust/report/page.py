@@ -51,9 +51,13 @@ def cm_pm(mean: float, std: float | None) -> str:
     return cm(mean) + (f" ± {std * 100:.2f}" if std is not None else "")
 
 
-def pct(err: float, ref: float) -> str:
+def pct(err: float, ref: float, resolution_m: float = math.nan) -> str:
+    """The error in percent of ``ref``; "within 1 px" when it is smaller than the tracking
+    resolution (one pixel, in metres), which no percentage of a small jump can beat."""
     if not (math.isfinite(err) and math.isfinite(ref)) or ref == 0:
         return "—"
+    if math.isfinite(resolution_m) and abs(err) < resolution_m:
+        return f"within 1 px ({resolution_m * 100:.2f} cm)"
     return f"{100 * err / abs(ref):+.1f} %"
 
 
@@ -84,12 +88,12 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
             td(labels[name], left=True), td(f"+{added[name] * 100:g}"), td(str(c.distance.n), name, "trials"),
             td(cm(c.predicted_distance_m), name, "predicted_distance_cm"),
             td(cm_pm(c.distance.mean, c.distance.std), name, "measured_distance_cm"),
-            td(cm(dist_err), name, "distance_error_cm"), td(pct(dist_err, c.predicted_distance_m)),
+            td(cm(dist_err), name, "distance_error_cm"), td(pct(dist_err, c.predicted_distance_m, c.resolution_m)),
             td(cm(c.predicted_hop_distance_m), name, "predicted_hop_distance_cm"),
             td(cm_pm(c.hop_distance.mean, c.hop_distance.std), name, "measured_hop_distance_cm"),
             td(cm(c.predicted_jump_m), name, "predicted_jump_cm"),
             td(cm_pm(c.jump.mean, c.jump.std), name, "measured_jump_cm"),
-            td(cm(jump_err), name, "jump_error_cm"), td(pct(jump_err, c.predicted_jump_m)),
+            td(cm(jump_err), name, "jump_error_cm"), td(pct(jump_err, c.predicted_jump_m, c.resolution_m)),
             td("valid" if valid else "INVALID: " + "; ".join(c.prediction.result.reasons), name, "sim_status",
                left=True),
         ]
@@ -97,7 +101,11 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
     headers = ["configuration", "added (cm)", "trials", "predicted distance (cm)", "measured distance (cm)",
                "error (cm)", "error", "predicted per hop (cm)", "measured per hop (cm)",
                "predicted jump (cm)", "measured jump (cm)", "error (cm)", "error", "simulation"]
-    return table(headers, rows, id_="summary")
+    known = [(labels[c.config], c.resolution_m) for c in comps if math.isfinite(c.resolution_m)]
+    note = ("" if not known else '<p class="note">Tracking resolution (one pixel at the marker): '
+            + ", ".join(f"{esc(label)} {res * 100:.3g} cm" for label, res in known)
+            + '; an error smaller than that is not measured and reads "within 1 px".</p>')
+    return table(headers, rows, id_="summary") + note
 
 
 def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
@@ -109,10 +117,10 @@ def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
                 td(labels[c.config], left=True), td(r.trial, left=True), td(str(r.hop)),
                 td(cm(r.measured_distance_m), c.config, f"hop_measured_distance_cm:{key}"),
                 td(cm(r.predicted_distance_m), c.config, f"hop_predicted_distance_cm:{key}"),
-                td(cm(r.distance_error_m)), td(pct(r.distance_error_m, r.predicted_distance_m)),
+                td(cm(r.distance_error_m)), td(pct(r.distance_error_m, r.predicted_distance_m, c.resolution_m)),
                 td(cm(r.measured_apex_m), c.config, f"hop_measured_apex_cm:{key}"),
                 td(cm(r.predicted_apex_m), c.config, f"hop_predicted_apex_cm:{key}"),
-                td(cm(r.apex_error_m)), td(pct(r.apex_error_m, r.predicted_apex_m)),
+                td(cm(r.apex_error_m)), td(pct(r.apex_error_m, r.predicted_apex_m, c.resolution_m)),
             ]) + "</tr>")
     if not rows:
         return '<p class="note">No tracks were given: nothing measured to compare hop by hop.</p>'

@@ -60,7 +60,7 @@ def _base_path(out: Path | None, source: Path) -> Path:
 
 
 @click.command(context_settings={"max_content_width": 100})
-@click.argument("video", required=False, type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("video", required=False, type=click.Path(path_type=Path))
 @click.option("--marker", "markers", multiple=True, metavar="NAME=SPEC",
               help="A marker to track; repeatable. SPEC is color:#RRGGBB[@X,Y] (X,Y: where it is on the first "
                    "frame), template:X,Y@FRAME or aruco:ID[@DICT]. "
@@ -74,8 +74,12 @@ def _base_path(out: Path | None, source: Path) -> Path:
                    "(colour markers: at least five marker diameters, growing while the marker is lost).")
 @click.option("--template-radius", default=8, show_default=True, type=click.IntRange(2, 200),
               help="Template markers: radius (px) of the circular template (Tracker's mask is 16 px across).")
-@click.option("--accept", default=4.0, show_default=True, type=float,
-              help="Template markers: least peak height (Tracker's 'automark' level) to accept a match.")
+@click.option("--accept", default=0.5, show_default=True, type=float,
+              help="Template markers: least peak height (mean / best square difference - 1 over the search "
+                   "window) to accept a match; it must also look like the template (--likeness) and follow the "
+                   "motion its track predicts.")
+@click.option("--likeness", default=0.5, show_default=True, type=click.FloatRange(-1, 1),
+              help="Template markers: least correlation (zero-mean, normalised) of a match with the template.")
 @click.option("--evolve", default=20.0, show_default=True, type=click.FloatRange(0, 100),
               help="Template markers: percent of each accepted match blended into the template.")
 @click.option("--scale", metavar="X1,Y1,X2,Y2=LENGTH_M",
@@ -114,6 +118,12 @@ def _base_path(out: Path | None, source: Path) -> Path:
 @click.option("--overlay", "overlay_kind", type=click.Choice(["png", "video", "none"]), default="png",
               show_default=True, help="Draw the tracks on the last frame (png) or on the whole clip (video).")
 @click.option("--force", is_flag=True, help="Replace existing output files.")
+@click.option("--trk", "trk_out", type=click.Path(dir_okay=False, path_type=Path),
+              help="Also write the tracks as a Tracker project (.trk) that opens the video or image sequence with "
+                   "the clip's timing and calibration, one point mass per marker: correct frames by hand in Tracker.")
+@click.option("--calibration-from", type=click.Path(dir_okay=False, path_type=Path),
+              help="Track in the coordinates of a Tracker project (.trk or .trz): its scale, origin and axes, and "
+                   "its frame interval unless --fps is given. VIDEO may also be the project itself.")
 @click.option("--from-trk", type=click.Path(dir_okay=False, path_type=Path),
               help="Convert the point tracks of a Tracker project (.trk or .trz) instead of tracking a video.")
 @click.option("--track", "trk_names", multiple=True, metavar="NAME",
@@ -122,10 +132,10 @@ def _base_path(out: Path | None, source: Path) -> Path:
               help="Convert a track file instead of tracking a video: a Tracker text export, a t,x,y CSV or a "
                    "tracks CSV, in --units, with --rename and --mirror, into a tracks CSV in metres.")
 @import_options
-def track(video, markers, color_tol, search_px, template_radius, accept, evolve, scale, scale_aruco, aruco_dict,
-          board_text, plane_points, make_board, preview_frame, camera_json, origin, angle, start, end, step, fps, out,
-          fmt, overlay_kind, force, from_trk, trk_names,
-          import_path, imports):
+def track(video, markers, color_tol, search_px, template_radius, accept, likeness, evolve, scale, scale_aruco,
+          aruco_dict, board_text, plane_points, make_board, preview_frame, camera_json, origin, angle, start, end,
+          step, fps, out, fmt, overlay_kind, force, trk_out, calibration_from, from_trk, trk_names, import_path,
+          imports):
     """Extract marker tracks (nose, foot) from VIDEO, as Tracker's autotracker would, in batch.
 
     \b
@@ -139,6 +149,9 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
       locust track hop.mp4                                  nose + foot by colour (metres from hop.camera.json)
       locust track hop.mp4 --scale 100,400,500,400=0.30 --origin 100,400
       locust track toss.mp4 --marker ball=template:131.28,207.86@2
+      locust track toss.mp4 --marker ball=template:131.28,207.86@2 --calibration-from toss.trk
+      locust track BallToss.trz --marker ball=template:131.28,207.86@2 --trk redo.trk
+      locust track frames/shot00.jpg --fps 10 --marker cup=template:203.4,34.5@0   an image sequence
       locust track slowmo.mp4 --fps 240 --start 30 --end 400
       locust track --make-board board.png                   print at 100 %, lay it in the plane of the hop
       locust track phone.mp4 --preview 0                    pick colours and start points from phone.preview.png
@@ -162,6 +175,11 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
     if import_path is not None:
         if video is not None or from_trk is not None:
             raise TrackError("give one of VIDEO, --from-trk and --import", "one input per run")
+        if trk.is_project(import_path):   # a Tracker project carries its own units and names
+            if not imports.identity:
+                raise TrackError(f"{import_path.name} is a Tracker project: its units and track names are its own",
+                                 "leave out --units, --rename and --mirror (use --track NAME to pick tracks)")
+            return _convert_trk(import_path, list(trk_names), out, fmt, force)
         if fmt != "csv":
             raise TrackError("--import writes a tracks CSV only", "leave out --format, or use --format csv")
         return _import(import_path, imports, out, force)
@@ -175,13 +193,42 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
     if video is None:
         raise TrackError("no video given",
                          "usage: locust track VIDEO [--marker NAME=SPEC ...] or --import FILE; see --help")
+    if trk_out is not None and trk_out.suffix.lower() != ".trk":
+        raise TrackError(f"--trk {trk_out}: a Tracker project is written as a .trk file", "e.g. --trk redo.trk")
+    project = None
+    if trk.is_project(video):
+        if calibration_from is not None:
+            raise TrackError("VIDEO is a Tracker project: its calibration is used, leave out --calibration-from",
+                             "or give the video itself as VIDEO")
+        project = trk.read_project(video)
+    elif calibration_from is not None:
+        project = trk.read_project(calibration_from)
+    if project is not None and (scale or scale_aruco or origin or camera_json or board_text or plane_points):
+        raise TrackError("a Tracker project's calibration, or --scale/--scale-aruco/--origin/--camera-json/--board, "
+                         "not both", "one calibration per run")
+    if project is not None and fps is None and math.isfinite(project.clip.fps):
+        fps = project.clip.fps
+    if project is not None and trk.is_project(video):
+        with trk.project_media(project) as media:
+            return _track(media, video, project, markers, (color_tol, search_px, template_radius, accept, likeness,
+                                                           evolve), board_text, plane_points, preview_frame,
+                          camera_json, scale, scale_aruco, aruco_dict, origin, angle, Clip(start, end, step, fps),
+                          out, fmt, overlay_kind, force, trk_out)
+    return _track(video, video, project, markers, (color_tol, search_px, template_radius, accept, likeness, evolve),
+                  board_text, plane_points, preview_frame, camera_json, scale, scale_aruco, aruco_dict, origin, angle,
+                  Clip(start, end, step, fps), out, fmt, overlay_kind, force, trk_out)
 
+
+def _track(video: Path, named: Path, project, markers, settings, board_text, plane_points, preview_frame, camera_json,
+           scale, scale_aruco, aruco_dict, origin, angle, clip: Clip, out, fmt, overlay_kind, force, trk_out) -> None:
+    """Track ``video`` (``named`` on the command line: the video, or a Tracker project that opens it)."""
+    color_tol, search_px, template_radius, accept, likeness, evolve = settings
     info = probe(video)
-    clip = Clip(start, end, step, fps).resolved(info)
-    options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0)
+    clip = clip.resolved(info)
+    options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0, likeness)
     models = parse_markers(list(markers), options)
     if preview_frame is not None:
-        return _preview(info, preview_frame, models, _base_path(out, video), force)
+        return _preview(info, preview_frame, models, _base_path(out, named), force)
     if board_text or plane_points:
         if scale or scale_aruco or origin or camera_json:
             raise TrackError("give --board/--plane-points or --scale/--scale-aruco/--origin/--camera-json, not both",
@@ -190,16 +237,25 @@ def track(video, markers, color_tol, search_px, template_radius, accept, evolve,
             raise TrackError("give --board or --plane-points, not both", "one calibration per run")
         calibration = (board.parse_plane_points(plane_points) if plane_points
                        else board.board_homography(info, clip, board.parse_board(board_text)))
+    elif project is not None:
+        calibration = project.calibration
     else:
         calibration = _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, camera_json)
-    paths = _outputs(_base_path(out, video), fmt, overlay_kind)
-    _refuse_inputs(paths, [p for p in (video, camera_json) if p is not None])
+    paths = _outputs(_base_path(out, named), fmt, overlay_kind)
+    if trk_out is not None:
+        paths["trk"] = trk_out
+    _refuse_inputs(paths, [p for p in (video, named, camera_json, project and project.path) if p])
     _refuse_overwrite(paths, force)
 
     n = len(clip.frames())
     with progress(length=n, label=f"tracking {video.name}") as bar:
         result = track_video(info, clip, models, calibration, progress=bar.update)
+    if named != video:   # a Tracker project's video, unpacked from it for this run
+        result.source = f"locust track of the video in {named}"
     written = _write(result, paths, fmt)
+    if trk_out is not None:
+        media = trk.media_in_zip(project, trk_out) if project is not None and trk.is_project(named) else None
+        written.append(trk.write_project(result, trk_out, media))
     if "overlay" in paths:
         if overlay_kind == "png":
             written.append(overlay.write_png(result, paths["overlay"]))
@@ -288,5 +344,11 @@ def _import(path: Path, imports: ImportOptions, out: Path | None, force: bool) -
 def _report(result, written: list[Path]) -> None:
     for line in export.summary_lines(result):
         click.echo(line)
+    lost = [t.name for t in result.markers
+            if t.spec.startswith("template:") and t.ok.any() and not t.ok[int(np.argmax(t.ok)):].all()]
+    if lost:
+        click.echo(f"hint: {', '.join(lost)}: lost (nan) where the match looked unlike the template (--likeness, "
+                   "--accept) or left the path its track predicts, e.g. out of view; check the overlay, and pick "
+                   "a point with texture that stays in view, or a --template-radius about the feature's size")
     for p in written:
         click.echo(f"wrote {p}")

@@ -23,15 +23,23 @@ def _colour(track: MarkerTrack, k: int) -> tuple[int, int, int]:
     return PALETTE_BGR[k % len(PALETTE_BGR)]
 
 
-def draw_tracks(image: np.ndarray, result: TrackResult, upto: int | None = None) -> np.ndarray:
-    """Draw each marker's path (and its latest point) on a copy of ``image``."""
+TRAIL_FRAMES = 15   # the video overlay's trail, as Tracker's default trail length
+
+
+def draw_tracks(image: np.ndarray, result: TrackResult, upto: int | None = None,
+                trail: int | None = None) -> np.ndarray:
+    """Draw each marker's path (and its latest point) on a copy of ``image``: the whole path,
+    or with ``upto`` (a frame of a video) the last ``trail`` frames of it, the point found in
+    that frame ringed, and a marker lost there named as lost in the top-left corner."""
     out = image.copy()
     n = len(result.frames) if upto is None else upto + 1
+    first = 0 if trail is None else max(n - trail, 0)
     shift = 4  # sub-pixel drawing: coordinates in 1/16 px
     for k, tr in enumerate(result.markers):
         colour = _colour(tr, k)
         pts = np.stack([tr.px[:n], tr.py[:n]], axis=1)
-        good = tr.ok[:n]
+        good = tr.ok[:n].copy()
+        good[:first] = False
         # break the path where the marker was missing
         for seg in np.split(np.arange(n), np.flatnonzero(~good) + 1):
             seg = seg[good[seg]] if seg.size else seg
@@ -41,9 +49,16 @@ def draw_tracks(image: np.ndarray, result: TrackResult, upto: int | None = None)
         for i in np.flatnonzero(good):
             c = tuple(int(v) for v in np.round(pts[i] * (1 << shift)))
             cv2.circle(out, c, 3 << shift, colour, 1, cv2.LINE_AA, shift)
+        if upto is not None and not good[n - 1]:
+            cv2.putText(out, f"{tr.name}: lost", (8, 20 + 18 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1,
+                        cv2.LINE_AA)
+            continue
         last = np.flatnonzero(good)
         if last.size:
             x, y = pts[last[-1]]
+            if upto is not None:
+                c = tuple(int(v) for v in np.round(pts[n - 1] * (1 << shift)))
+                cv2.circle(out, c, 8 << shift, colour, 2, cv2.LINE_AA, shift)
             cv2.putText(out, tr.name, (int(x) + 8, int(y) - 8), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv2.LINE_AA)
     origin, x_dir, y_dir = result.calibration.axes_px()
     o = (int(round(origin[0])), int(round(origin[1])))
@@ -62,12 +77,13 @@ def write_png(result: TrackResult, path: Path) -> Path:
 
 
 def write_video(result: TrackResult, path: Path, progress: Callable[[int], None] | None = None) -> Path:
-    """The whole clip with the tracks growing frame by frame (MPEG-4, at the clip's rate)."""
+    """The whole clip, each frame with the last ``TRAIL_FRAMES`` of every track and the point
+    found in it, or the marker named as lost (MPEG-4, at the clip's rate)."""
     v = result.video
 
     def drawn():
         for i, (_, image) in enumerate(read_frames(v, result.clip)):
-            yield draw_tracks(image, result, upto=i)
+            yield draw_tracks(image, result, upto=i, trail=TRAIL_FRAMES)
             if progress:
                 progress(1)
 

@@ -33,8 +33,9 @@ class ModelOptions:
     color_tol: int = 80
     search_half_px: int = 40
     template_radius_px: int = 8
-    accept: float = 4.0
+    accept: float = 0.5
     evolve: float = 0.2
+    likeness: float = 0.5
 
 
 def default_specs() -> list[str]:
@@ -69,7 +70,8 @@ def parse_marker(text: str, options: ModelOptions = ModelOptions()):
                              "give the pixel position of the feature on a frame, e.g. template:131.28,207.86@2")
         return TemplateMarker(name, spec, float(m.group(1)), float(m.group(2)), int(m.group(3)),
                               radius_px=options.template_radius_px, search_half_px=options.search_half_px,
-                              accept=options.accept, evolve=options.evolve)
+                              accept=options.accept, evolve=options.evolve,
+                              min_likeness=options.likeness)
     if kind == "aruco":
         m = re.fullmatch(r"\s*(\d+)\s*(?:@\s*(DICT_\w+)\s*)?", arg)
         if not m:

@@ -1,4 +1,5 @@
-"""Tracker (Open Source Physics) files: read ``.trk``/``.trz`` projects, write its text export.
+"""Tracker (Open Source Physics) files: read ``.trk``/``.trz`` projects, write ``.trk`` projects
+and its text export.
 
 The text export's layout, reader and typed object are :mod:`.tracker_text`'s; this module
 turns a :class:`~.runner.TrackResult` into one.
@@ -19,14 +20,20 @@ from __future__ import annotations
 
 import io
 import math
+import os
+import tempfile
 import xml.etree.ElementTree as ET
 import zipfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
-from pathlib import Path
+from pathlib import Path, PurePosixPath
+from xml.sax.saxutils import escape
 
 import numpy as np
 
 from ..errors import TrackError
+from ..fileio import atomic_write_text
 from .calib import Calibration
 from .runner import MarkerTrack, TrackResult
 from .tracker_text import TrackerExport, TrackerTrack, tracker_export_text, write_tracker_export
@@ -192,3 +199,149 @@ def tracker_text(result: TrackResult) -> str:
 def write_tracker_text(result: TrackResult, path: Path) -> Path:
     """Write ``result`` in Tracker's text export layout, atomically."""
     return write_tracker_export(path, tracker_export(result))
+
+
+# --- Writing a Tracker project ---------------------------------------------------------
+
+TRACKER_VERSION = "6.0.6"  # the schema written: that of the .trk files Tracker 6.0.6 saves
+_CORE = "org.opensourcephysics.media.core"
+_TRACKER = "org.opensourcephysics.cabrillo.tracker"
+_TRACK_RGB = [(255, 0, 255), (0, 255, 255), (255, 255, 0), (255, 128, 0), (0, 128, 255), (0, 255, 128)]
+
+
+def _p(name: str, kind: str, value, indent: int) -> str:
+    text = repr(float(value)) if kind == "double" else (str(value).lower() if kind == "boolean" else str(value))
+    return f'{" " * indent}<property name="{name}" type="{kind}">{escape(text)}</property>\n'
+
+
+def _colour(rgb: tuple[int, int, int], indent: int) -> str:
+    pad = " " * indent
+    body = "".join(_p(c, "int", v, indent + 8) for c, v in zip(("red", "green", "blue", "alpha"), (*rgb, 255)))
+    return (f'{pad}<property name="color" type="object">\n{pad}<object class="java.awt.Color">\n{body}'
+            f"{pad}</object>\n{pad}</property>\n")
+
+
+def project_xml(result: TrackResult, trk_path: Path, media: str | None = None) -> str:
+    """``result`` as a Tracker 6 project (``.trk`` XML) saved at ``trk_path``: the video (or the
+    image sequence's first file) by its path relative to the project, the clip's frames and
+    frame interval, the calibration (scale, origin, axes) and one point mass per marker, with a
+    step on every frame where the marker was found (pixels in Tracker's convention). ``media``
+    overrides the video's path as written (a video inside a ``.trz``: ``project.trz!/videos/a.mp4``)."""
+    info = result.video
+    if info is None:
+        raise TrackError("these tracks have no video to open in Tracker", "track a video to write a .trk")
+    clip = result.clip
+    rel = media or Path(os.path.relpath((info.images[0] if info.images else info.path).resolve(),
+                                        trk_path.resolve().parent)).as_posix()
+    dt_ms = 1000.0 / clip.fps
+    if info.images:
+        video = (f'        <object class="{_CORE}.ImageVideo">\n' + _p("path", "string", rel, 12)
+                 + _p("delta_t", "double", dt_ms, 12) + "        </object>\n")
+    else:
+        video = ('        <object class="org.opensourcephysics.media.xuggle.XuggleVideo">\n'
+                 + _p("path", "string", rel, 12) + "        </object>\n")
+    count = len(result.frames)
+    out = ['<?xml version="1.0" encoding="UTF-8"?>\n', f'<object class="{_TRACKER}.TrackerPanel">\n',
+           _p("semantic_version", "string", TRACKER_VERSION, 4), _p("width", "double", info.width_px, 4),
+           _p("height", "double", info.height_px, 4),
+           f'    <property name="videoclip" type="object">\n    <object class="{_CORE}.VideoClip">\n',
+           f'        <property name="video" type="object">\n{video}        </property>\n',
+           _p("video_framecount", "int", info.frame_count, 8), _p("startframe", "int", clip.start, 8),
+           _p("stepsize", "int", clip.step, 8), _p("stepcount", "int", count, 8), _p("starttime", "double", 0.0, 8),
+           _p("readout", "string", "frame", 8), _p("playallsteps", "boolean", True, 8),
+           "    </object>\n    </property>\n",
+           f'    <property name="clipcontrol" type="object">\n    <object class="{_CORE}.StepperClipControl">\n',
+           _p("rate", "double", 1.0, 8), _p("delta_t", "double", dt_ms, 8), _p("frame", "int", clip.start, 8),
+           "    </object>\n    </property>\n"]
+    cal = result.calibration
+    if isinstance(cal, Calibration) and math.isfinite(cal.m_per_px):
+        frame_data = "".join((_p("xorigin", "double", cal.origin_x_px - TRACKER_TO_OPENCV_PX, 16),
+                              _p("yorigin", "double", cal.origin_y_px - TRACKER_TO_OPENCV_PX, 16),
+                              _p("angle", "double", cal.angle_deg, 16), _p("xscale", "double", 1.0 / cal.m_per_px, 16),
+                              _p("yscale", "double", 1.0 / cal.m_per_px, 16)))
+        out += [f'    <property name="coords" type="object">\n    <object class="{_CORE}.ImageCoordSystem">\n',
+                _p("fixedorigin", "boolean", True, 8), _p("fixedangle", "boolean", True, 8),
+                _p("fixedscale", "boolean", True, 8), _p("locked", "boolean", False, 8),
+                f'        <property name="framedata" type="array" class="[L{_CORE}.ImageCoordSystem$FrameData;">\n'
+                f'            <property name="[0]" type="object">\n'
+                f'            <object class="{_CORE}.ImageCoordSystem$FrameData">\n{frame_data}'
+                "            </object>\n            </property>\n        </property>\n    </object>\n    </property>\n",
+                _p("length_unit", "string", "m", 4)]
+    out.append('    <property name="tracks" type="collection" class="java.util.ArrayList">\n')
+    for k, tr in enumerate(result.markers):
+        steps = "".join(
+            f'                <property name="[{int(f)}]" type="object">\n'
+            f'                <object class="{_TRACKER}.PointMass$FrameData">\n'
+            + _p("x", "double", float(x) - TRACKER_TO_OPENCV_PX, 20)
+            + _p("y", "double", float(y) - TRACKER_TO_OPENCV_PX, 20)
+            + "                </object>\n                </property>\n"
+            for f, x, y, ok in zip(result.frames, tr.px, tr.py, tr.ok) if ok)
+        out += ['        <property name="item" type="object">\n', f'        <object class="{_TRACKER}.PointMass">\n',
+                _p("mass", "double", 1.0, 12), _p("name", "string", tr.name, 12),
+                _p("description", "string", f"locust track: {tr.spec}", 12),
+                _colour(_TRACK_RGB[k % len(_TRACK_RGB)], 12), _p("footprint", "string", "Footprint.Diamond", 12),
+                _p("visible", "boolean", True, 12), _p("trail", "boolean", True, 12),
+                f'            <property name="framedata" type="array" class="[L{_TRACKER}.PointMass$FrameData;">\n',
+                steps, "            </property>\n        </object>\n        </property>\n"]
+    out += ["    </property>\n", "</object>\n"]
+    return "".join(out)
+
+
+def write_project(result: TrackResult, path: Path, media: str | None = None) -> Path:
+    """Write ``result`` as a Tracker project ``path`` (see :func:`project_xml`), atomically."""
+    return atomic_write_text(path, project_xml(result, Path(path), media))
+
+
+def media_in_zip(project: TrackerProject, trk_path: Path) -> str | None:
+    """How a project written at ``trk_path`` names the video inside ``project``'s ``.trz``
+    (OSP's ``zip!/entry`` path); None for a plain ``.trk``, whose video is a file of its own."""
+    if not zipfile.is_zipfile(project.path) or not project.video_path:
+        return None
+    with zipfile.ZipFile(project.path) as z:
+        trk_name = next(n for n in sorted(z.namelist()) if n.lower().endswith(".trk"))
+    entry = (PurePosixPath(trk_name).parent / project.video_path.replace("\\", "/")).as_posix()
+    zip_rel = Path(os.path.relpath(project.path.resolve(), Path(trk_path).resolve().parent)).as_posix()
+    return f"{zip_rel}!/{entry}"
+
+
+PROJECT_SUFFIXES = (".trk", ".trz")
+
+
+def is_project(path: Path) -> bool:
+    """True for a path named like a Tracker project (``.trk``, or a ``.trz`` zip)."""
+    return Path(path).suffix.lower() in PROJECT_SUFFIXES
+
+
+@contextmanager
+def project_media(project: TrackerProject) -> Iterator[Path]:
+    """The video (or the image sequence's first file) a project opens, as a local path for the
+    duration of the ``with``: beside the ``.trk``, or unpacked from the ``.trz`` into a
+    temporary folder removed afterwards."""
+    if not project.video_path:
+        raise TrackError(f"{project.path}: the project names no video", "give the video itself as VIDEO")
+    rel = Path(project.video_path.replace("\\", "/"))
+    if not zipfile.is_zipfile(project.path):
+        media = rel if rel.is_absolute() else project.path.parent / rel
+        if not media.is_file():
+            raise TrackError(f"{project.path.name} opens {project.video_path}, which is not at {media}",
+                             "put the video where the project expects it, or give the video as VIDEO "
+                             f"with --calibration-from {project.path.name}")
+        yield media
+        return
+    with tempfile.TemporaryDirectory(prefix="locust-trz-") as tmp:
+        with zipfile.ZipFile(project.path) as z:
+            trk_dirs = {PurePosixPath(n).parent for n in z.namelist() if n.lower().endswith(".trk")}
+            wanted = [n for n in z.namelist() if not n.endswith("/")
+                      and any(PurePosixPath(n).parent == (d / rel).parent for d in trk_dirs)]
+            for name in wanted:
+                target = Path(tmp, *PurePosixPath(name).parts)
+                if ".." in PurePosixPath(name).parts:
+                    continue
+                target.parent.mkdir(parents=True, exist_ok=True)
+                target.write_bytes(z.read(name))
+        candidates = [Path(tmp, *d.parts) / rel for d in sorted(trk_dirs)]
+        media = next((c for c in candidates if c.is_file()), None)
+        if media is None:
+            raise TrackError(f"{project.path.name} opens {project.video_path}, which is not inside it",
+                             "give the video itself as VIDEO, with --calibration-from the project")
+        yield media

@@ -4,12 +4,18 @@ Decoding goes through OpenCV's FFmpeg backend. Bad input is caught here, once, a
 turned into a :class:`~locust.errors.TrackError` naming the file and frame: a file that
 is not a video, a still image, and a video that ends before its header says it should
 (truncated by a copy or a full card).
+
+An image sequence is a video too, as Tracker and ffmpeg take it: a folder of images
+(sorted by name), or the first file of a numbered run (``shot00.jpg``, ``shot01.jpg``, ...:
+the same name with the number counting up by one, as many as follow without a gap).
+It has no frame rate of its own: give ``--fps`` (or the ``.trk``'s frame interval).
 """
 
 from __future__ import annotations
 
 import os
 import queue
+import re
 import threading
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -33,6 +39,7 @@ class VideoInfo:
     height_px: int
     frame_count: int
     file_fps: float
+    images: tuple[Path, ...] = ()  # an image sequence's files, in frame order; () for a video file
 
 
 @dataclass(frozen=True)
@@ -62,6 +69,10 @@ class Clip:
         if not self.start <= end <= last:
             raise TrackError(f"--end {end} is outside frames {self.start}..{last} of {info.path.name}",
                              f"choose an end frame between {self.start} and {last}")
+        if info.images and self.fps is None:
+            raise TrackError(f"{info.path.name}: an image sequence has no frame rate",
+                             "give it with --fps (e.g. --fps 10.1 for frames 99 ms apart), or use "
+                             "--calibration-from the Tracker project that opens it")
         if not (fps and np.isfinite(fps) and fps > 0):
             raise TrackError(f"{info.path.name} has no usable frame rate ({fps!r})",
                              "give the real frame rate with --fps, e.g. --fps 240")
@@ -76,9 +87,52 @@ class Clip:
         return (frame - self.start) / self.fps
 
 
+IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".gif")
+
+
+def image_sequence(path: Path) -> tuple[Path, ...]:
+    """The files of the image sequence ``path`` names (a folder, or the first file of a
+    numbered run), in frame order; ``()`` when ``path`` is not an image sequence."""
+    if path.is_dir():
+        return tuple(sorted(p for p in path.iterdir() if p.is_file() and p.suffix.lower() in IMAGE_SUFFIXES))
+    if path.suffix.lower() not in IMAGE_SUFFIXES:
+        return ()
+    m = re.fullmatch(r"(.*?)(\d+)", path.stem)
+    if not m:
+        return (path,)
+    head, digits = m.groups()
+    files, number = [], int(digits)
+    while True:
+        name = f"{head}{number:0{len(digits)}d}{path.suffix}"
+        candidate = path.with_name(name)
+        if not candidate.is_file():
+            break
+        files.append(candidate)
+        number += 1
+    return tuple(files)
+
+
+def _probe_images(path: Path, files: tuple[Path, ...]) -> VideoInfo:
+    if len(files) < 2:
+        raise TrackError(f"{path}: a single image, not a video or an image sequence",
+                         "give a video file, a folder of frames, or the first file of a numbered run "
+                         "(shot00.jpg, shot01.jpg, ...)")
+    first = cv2.imread(str(files[0]), cv2.IMREAD_COLOR)
+    if first is None:
+        raise TrackError(f"{files[0]}: not a readable image", "check the file opens in an image viewer")
+    h, w = first.shape[:2]
+    return VideoInfo(path, w, h, len(files), 0.0, files)
+
+
 def probe(path: str | os.PathLike) -> VideoInfo:
-    """Open ``path`` and read its size, frame count and rate, or raise TrackError."""
+    """Open ``path`` (a video file, or an image sequence: see the module doc) and read its
+    size, frame count and rate (0 for an image sequence), or raise TrackError."""
     path = Path(path)
+    files = image_sequence(path) if path.exists() else ()
+    if files or path.is_dir():
+        if not files:
+            raise TrackError(f"{path}: a folder without images", "give a folder of numbered frames, or a video file")
+        return _probe_images(path, files)
     if not path.is_file():
         raise TrackError(f"{path}: no such file", "check the path of the video")
     if path.stat().st_size == 0:
@@ -120,7 +174,19 @@ def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8) -> Iterator[tupl
                 continue
         return False
 
+    def decode_images() -> None:
+        for frame in clip.frames():
+            image = cv2.imread(str(info.images[frame]), cv2.IMREAD_COLOR) if frame < len(info.images) else None
+            if image is None or image.shape[:2] != (info.height_px, info.width_px):
+                put(_EndedEarly(frame))
+                return
+            if not put((frame, image)):
+                return
+        put(None)
+
     def decode() -> None:
+        if info.images:
+            return decode_images()
         cap = cv2.VideoCapture(str(info.path))
         try:
             index = 0
@@ -169,6 +235,10 @@ def read_frame(info: VideoInfo, frame: int) -> np.ndarray:
 
 
 def _ended_early(info: VideoInfo, index: int) -> None:
+    if info.images:
+        raise TrackError(f"{info.images[index]}: not readable, or not {info.width_px}x{info.height_px} "
+                         "like the first image of the sequence",
+                         f"replace that frame, or track the frames before it with --end {max(index - 1, 0)}")
     raise TrackError(f"{info.path}: decoding stopped at frame {index}, but the file says it has "
                      f"{info.frame_count} frames: the video is truncated or damaged",
                      f"re-copy the file, or track the readable part with --end {max(index - 1, 0)}")

@@ -1,0 +1,142 @@
+"""`locust track` with Tracker's own examples (../shared/data/tracker): an image sequence
+(CupsClips), a .trk written and read back, a project's calibration on its video, a .trz as input."""
+
+from __future__ import annotations
+
+import zipfile
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from locust.cli import cli
+from locust.track import trk
+
+
+@pytest.fixture(scope="module")
+def cups(shared_data, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("cups")
+    with zipfile.ZipFile(shared_data / "tracker" / "CupsClips.zip") as z:
+        z.extractall(folder)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def balltoss(shared_data, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("balltoss")
+    with zipfile.ZipFile(shared_data / "tracker" / "BallToss.trz") as z:
+        z.extractall(folder)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def cups_run(cups):
+    """Both cups tracked from the points Tracker's user clicked on frame 0, with a .trk out."""
+    project = trk.read_project(cups / "CupsClips_CupsClips.trk")
+    c3, c7 = project.points["cup 3"][0], project.points["cup 7"][0]
+    res = CliRunner().invoke(cli, ["track", str(cups / "videos" / "CupsClips_CupsClips00.jpg"), "--fps", "10.1",
+                                   "--marker", f"cup3=template:{c3[0]:.2f},{c3[1]:.2f}@0",
+                                   "--marker", f"cup7=template:{c7[0]:.2f},{c7[1]:.2f}@0",
+                                   "--out", str(cups / "cups.csv"), "--trk", str(cups / "cups_out.trk")])
+    assert res.exit_code == 0, res.output
+    return project, pd.read_csv(cups / "cups.csv"), res.output
+
+
+@pytest.mark.parametrize("name, theirs", [("cup3", "cup 3"), ("cup7", "cup 7")])
+def test_image_sequence_cups_follow_trackers_points(cups_run, name, theirs):
+    project, df, _ = cups_run
+    assert len(df) == 17                                           # the whole numbered run, frames 0..16
+    assert df["t_s"].iloc[-1] == pytest.approx(16 / 10.1)
+    ref = project.points[theirs]                                   # Tracker's steps: frames 0..8
+    got = df.set_index("frame").loc[sorted(ref)]
+    ok = got[f"{name}_ok"].astype(bool).to_numpy()
+    err = np.hypot(got[f"{name}_px"] - [ref[f][0] for f in sorted(ref)],
+                   got[f"{name}_py"] - [ref[f][1] for f in sorted(ref)]).to_numpy()
+    assert (~ok).sum() <= 2                                        # acceptance 2; measured 0
+    assert err[ok].max() <= 3.0, err                               # acceptance 10 px; measured 0.8 / 0.9
+    assert err[ok].mean() <= 1.0, err                              # acceptance 3 px; measured 0.50 / 0.56
+
+
+def test_cup_out_of_view_is_lost_not_stuck(cups_run):
+    """Cup 7 leaves the picture after frame 8 (Tracker's last step at y = 211 px of 240, falling
+    30 px a frame): it is reported lost there, never found on a still look-alike."""
+    _, df, output = cups_run
+    after = df[df["frame"] >= 10]
+    assert not after["cup7_ok"].any()
+    assert after["cup7_px"].isna().all()
+    assert "hint: cup3, cup7: lost" in output
+
+
+def test_trk_out_reads_back_to_the_same_points(cups, cups_run):
+    _, df, _ = cups_run
+    res = CliRunner().invoke(cli, ["track", "--from-trk", str(cups / "cups_out.trk"), "--out", str(cups / "back.csv")])
+    assert res.exit_code == 0, res.output
+    back = pd.read_csv(cups / "back.csv")
+    assert list(back.columns) == list(df.columns)
+    assert (back["frame"] == df["frame"]).all()
+    assert np.abs(back["t_s"] - df["t_s"]).max() < 1e-9
+    for name in ("cup3", "cup7"):
+        assert (back[f"{name}_ok"] == df[f"{name}_ok"]).all()
+        for axis in ("px", "py"):
+            assert np.nanmax(np.abs(back[f"{name}_{axis}"] - df[f"{name}_{axis}"])) <= 0.01
+    project = trk.read_project(cups / "cups_out.trk")
+    assert project.video_path == "videos/CupsClips_CupsClips00.jpg"     # relative to the .trk, as Tracker saves
+    assert project.clip.fps == pytest.approx(10.1)
+
+
+def test_calibration_from_trk_gives_trackers_metres(balltoss, tmp_path):
+    res = CliRunner().invoke(cli, ["track", str(balltoss / "videos" / "BallToss_new_BallToss.mp4"),
+                                   "--marker", "ball=template:131.28,207.86@2",
+                                   "--calibration-from", str(balltoss / "BallToss_BallToss.trk"),
+                                   "--out", str(tmp_path / "ball.csv"), "--trk", str(tmp_path / "ball.trk")])
+    assert res.exit_code == 0, res.output
+    df = pd.read_csv(tmp_path / "ball.csv")
+    theirs = trk.project_result(trk.read_project(balltoss / "BallToss_BallToss.trk"))
+    x, y = theirs.world(theirs.markers[0])
+    ok = df["ball_ok"].astype(bool).to_numpy()
+    assert ok[2:].all() and not ok[:2].any()                       # Tracker's steps: frames 2..12
+    assert np.abs(df["t_s"] - theirs.t_s).max() < 1e-9             # the project's 66 ms frame interval
+    err_mm = 1000 * np.hypot(df["ball_x_m"] - x, df["ball_y_m"] - y)[ok]
+    assert err_mm.max() <= 5.0, err_mm                              # acceptance 5 mm; measured 3.6, mean 2.7
+    written = trk.read_project(tmp_path / "ball.trk")
+    assert written.calibration.m_per_px == pytest.approx(theirs.calibration.m_per_px, rel=1e-12)
+    assert written.calibration.angle_deg == pytest.approx(theirs.calibration.angle_deg, abs=1e-12)
+    assert written.calibration.origin_x_px == pytest.approx(theirs.calibration.origin_x_px, abs=1e-9)
+
+
+def test_trz_is_a_video_and_an_import(shared_data, tmp_path):
+    trz = shared_data / "tracker" / "BallToss.trz"
+    res = CliRunner().invoke(cli, ["track", str(trz), "--marker", "ball=template:131.28,207.86@2",
+                                   "--out", str(tmp_path / "t.csv"), "--trk", str(tmp_path / "t.trk")])
+    assert res.exit_code == 0, res.output
+    assert pd.read_csv(tmp_path / "t.csv")["ball_ok"].sum() == 11
+    assert trk.read_project(tmp_path / "t.trk").video_path.endswith("BallToss.trz!/videos/BallToss_new_BallToss.mp4")
+    res = CliRunner().invoke(cli, ["track", "--import", str(trz), "--out", str(tmp_path / "i.csv")])
+    assert res.exit_code == 0, res.output
+    imported = pd.read_csv(tmp_path / "i.csv")
+    assert imported["ball_ok"].sum() == 11                         # Tracker's steps, frames 2..12
+    assert imported["ball_x_m"].iloc[2] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_image_sequence_needs_a_frame_rate(cups):
+    res = CliRunner().invoke(cli, ["track", str(cups / "videos" / "CupsClips_CupsClips00.jpg"),
+                                   "--marker", "c=template:203.4,34.5@0", "--out", str(cups / "nofps.csv")])
+    assert res.exit_code == 2
+    assert "no frame rate" in res.output and "--fps" in res.output
+
+
+def test_a_folder_is_the_same_sequence_and_a_lone_image_is_refused(cups, cups_run, tmp_path):
+    _, df, _ = cups_run
+    project = trk.read_project(cups / "CupsClips_CupsClips.trk")
+    c3 = project.points["cup 3"][0]
+    res = CliRunner().invoke(cli, ["track", str(cups / "videos"), "--fps", "10.1", "--overlay", "none",
+                                   "--marker", f"cup3=template:{c3[0]:.2f},{c3[1]:.2f}@0",
+                                   "--out", str(tmp_path / "folder.csv")])
+    assert res.exit_code == 0, res.output
+    folder = pd.read_csv(tmp_path / "folder.csv")
+    assert np.array_equal(folder["cup3_px"].to_numpy(), df["cup3_px"].to_numpy(), equal_nan=True)
+    lone = tmp_path / "shot.jpg"
+    lone.write_bytes((cups / "videos" / "CupsClips_CupsClips00.jpg").read_bytes())
+    res = CliRunner().invoke(cli, ["track", str(lone), "--fps", "10", "--marker", "c=template:203.4,34.5@0"])
+    assert res.exit_code == 2 and "a single image" in res.output
