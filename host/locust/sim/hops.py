@@ -30,6 +30,7 @@ class HopSummary:
     max_nose_height_m: float     # highest nose point during the run (the notebook's metric)
     standing_nose_m: float
     standing_com_m: float
+    end_nose_rise_m: float       # nose height at the end of the run above its standing height
 
 
 def _longest_run(mask: np.ndarray) -> int:
@@ -67,4 +68,5 @@ def summarise(traj: Trajectory) -> HopSummary:
     if plan.settle_steps == 0:  # the notebook counts the drop too
         run_nose = np.concatenate(([traj.initial_sensordata[s.nose_pos][2]], nose_z))
     return HopSummary(hops=hops, distance_m=float(x[-1] - x_start), max_nose_height_m=float(run_nose.max()),
-                      standing_nose_m=standing_nose, standing_com_m=standing_com)
+                      standing_nose_m=standing_nose, standing_com_m=standing_com,
+                      end_nose_rise_m=float(nose_z[-1] - standing_nose))

@@ -63,6 +63,11 @@ def invalid_result(robot: Robot, reason: str, cycles: int | None = None) -> SimR
                      servo_work_j=nan)
 
 
+# a robot whose nose ends the run this far above its standing height did not come back down
+# from a push (a robot that hops and lands again stands within a few millimetres of its start)
+STAYED_UP_M = 0.01
+
+
 def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None,
         keep_states: bool = False) -> SimResult:
     """Simulate and audit. An impossible linkage raises :class:`GeometryError`.
@@ -82,6 +87,10 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
     notes = list(verdict.notes)
     asm = built.assembly
     lo, hi = GOOD_TRANSMISSION_DEG
+    if summary and summary.end_nose_rise_m > STAYED_UP_M:
+        notes.append(f"did not come back down: the nose ends {summary.end_nose_rise_m * 100:.1f} cm above its "
+                     "standing height (the robot rears and stays), so a hop's nose rise after the one that "
+                     "reared is its resting height, not a hop")
     if not lo <= asm.transmission_deg <= hi:
         notes.append(f"poor transmission angle {asm.transmission_deg:.0f} deg at the start (outside {lo:g}-{hi:g})")
     return SimResult(
