@@ -175,11 +175,13 @@ def track(video, markers, color_tol, search_px, template_radius, accept, likenes
     if import_path is not None:
         if video is not None or from_trk is not None:
             raise TrackError("give one of VIDEO, --from-trk and --import", "one input per run")
-        if trk.is_project(import_path):   # a Tracker project carries its own units and names
-            if not imports.identity:
-                raise TrackError(f"{import_path.name} is a Tracker project: its units and track names are its own",
-                                 "leave out --units, --rename and --mirror (use --track NAME to pick tracks)")
+        # a Tracker project carries its own units: converted as --from-trk does, or, renamed or
+        # mirrored, through the import layer (which refuses --units for it)
+        if trk.is_project(import_path) and imports.identity:
             return _convert_trk(import_path, list(trk_names), out, fmt, force)
+        if trk_names:
+            raise TrackError("--track picks the tracks of a Tracker project converted as it is",
+                             "leave out --rename and --mirror, or leave out --track")
         if fmt != "csv":
             raise TrackError("--import writes a tracks CSV only", "leave out --format, or use --format csv")
         return _import(import_path, imports, out, force)
