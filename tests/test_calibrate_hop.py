@@ -249,7 +249,7 @@ def test_intervals_cover_hidden_truths_over_leg_set_pairs():
                 cover = est.ci95_low <= value <= est.ci95_high
                 covered += cover
                 rows.append((pair, key, value, est.value, est.ci95_low, est.ci95_high, fit.wall_s))
+                print(rows[-1], flush=True)
                 near = abs(est.value - value) <= 0.05 * value
                 assert near or (cover and est.ci95_high - est.ci95_low < 0.4 * value), rows[-1]
-    print("\n".join(str(r) for r in rows))
     assert covered >= 24, rows

@@ -12,9 +12,11 @@ Before the fit each run's step is checked at the start values: halved (at most
 ``STEP_TOLERANCE_M`` (RMS over the tracked frames), so the fitted model is the converged one.
 
 Residual: the tracked markers against the same markers of the simulation, both from where
-they stood, both put on the schedule's clock by the same rule the report uses
-(:mod:`locust.report.measure`: the first nose motion of more than 3 mm, the track's start
-placed where the simulation's is relative to its first push). Every candidate of a solver
+they stood by the track's rule (the median of its frames before the first nose motion),
+put on the schedule's clock by the rule the report uses (:mod:`locust.report.measure`: the
+first nose motion of more than 3 mm, the track's start placed where the simulation's is
+relative to its first push) and then each run's clock offset fitted about it, for every
+candidate (:func:`aligned_residual`). Every candidate of a solver
 iteration, the finite-difference columns included, is simulated in one batched
 ``mujoco.rollout`` per run; the solver is ``mujoco.minimize.least_squares`` on the
 logarithm of each positive parameter (a factor is what a friction or a stiffness is known
