@@ -1,10 +1,12 @@
 """The hop fit and the prediction's spread, on SYNTHETIC traces of known truth.
 
 The "filmed" runs here are the simulation itself at known values (friction, hinge
-stiffness, servo speed unlike the presets), sampled like a 30 frames/s video on a camera
-clock of its own, with 0.1 mm of seeded Gaussian noise: the fit must recover the values it
-was made with. The system test on the virtual robot's own videos is in
-test_calibrate_hop_virtual.py (slow).
+stiffness, servo speed unlike the presets), on the leg set's preset (the virtual robot's
+plant) at half its converged step (nearer the continuous robot than the fit's model),
+sampled like a 30 frames/s video on a camera clock of its own, with 0.1 mm of seeded
+Gaussian noise; the fit's runs are built from the seed the way a filmed run is loaded
+(``report.configs.configuration``): the fit must recover the values it was made with. The
+system test on the virtual robot's own videos is in test_calibrate_hop_virtual.py (slow).
 """
 
 from __future__ import annotations
@@ -16,7 +18,8 @@ import pytest
 
 from locust.calibrate import hop as H
 from locust.errors import CalibrationError
-from locust.params import Provenance, leg_set, preset
+from locust.params import LEG_SETS, Provenance, leg_set, preset
+from locust.report.configs import configuration
 from locust.sim import samples as S
 
 CAMERA_HZ = 30.0
@@ -33,12 +36,15 @@ def seed_leg(config: str):
 
 def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0) -> H.HopRun:
     """A run of ``config`` at ``truth``, "filmed" at 30 frames/s from 0.4 s before the first
-    push, camera clock 1.234 s ahead, positions with NOISE_M of noise (SYNTHETIC). The values
-    not in ``truth`` are the preset's exactly, so here they carry no uncertainty."""
-    robot = seed_leg(config)
-    for key in S.uncertain_values(robot):
+    push, camera clock 1.234 s ahead, positions with NOISE_M of noise (SYNTHETIC): leg set
+    ``config`` of the seed at ``truth`` and half its step. The run's robot (the fit's model and
+    start) is the same leg set, whose values not in ``truth`` are exact here."""
+    seed_robot = preset("seed")
+    for key in S.uncertain_values(seed_robot):
         if key not in truth:
-            robot = robot.with_provenance(key, Provenance(source="synthetic: exact"))
+            seed_robot = seed_robot.with_provenance(key, Provenance(source="synthetic: exact"))
+    robot = configuration(seed_robot, config).robot
+    plant = seed_leg(config).with_values({**truth, "solver.timestep_s": seed_leg(config).solver.timestep_s / 2})
     period = robot.schedule.push_s + robot.schedule.wait_s
     phase_s = np.array([k * period + d for k in range(cycles) for d in (0.0, robot.schedule.push_s)])
     pushing = np.array([True, False] * cycles)
@@ -47,13 +53,15 @@ def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0) -> H
     blank = H.MarkerTrack(t_cam, np.zeros_like(t_cam), np.zeros_like(t_cam))
     template = H.HopRun(source=H.Path(f"synthetic-{config}"), config=config, robot=robot, phase_s=phase_s,
                         pushing=pushing, onset_s=clock_s, tracks={"nose": blank, "foot": blank})
-    sim = H.simulate_markers(template, [robot.with_values(truth)])[0]
+    sim = H.simulate_markers(template, [plant])[0]
     rng = np.random.default_rng(seed)
     tracks = {}
     for m in ("nose", "foot"):
         t, x, y = sim[m]
-        tracks[m] = H.MarkerTrack(t_cam, np.interp(t_cam - clock_s, t, x) + rng.normal(0, NOISE_M, t_cam.size),
-                                  np.interp(t_cam - clock_s, t, y) + rng.normal(0, NOISE_M, t_cam.size))
+        # standing where it stood before the simulation's kept lead, as the fit takes it
+        at = t_cam - clock_s
+        tracks[m] = H.MarkerTrack(t_cam, np.interp(at, t, x, left=0.0) + rng.normal(0, NOISE_M, t_cam.size),
+                                  np.interp(at, t, y, left=0.0) + rng.normal(0, NOISE_M, t_cam.size))
     nose = tracks["nose"]
     onset, x0, y0 = H.onset_time(nose.t_s, nose.x_m, nose.y_m)
     tracks = {m: H.MarkerTrack(tr.t_s, tr.x_m - np.median(tr.x_m[tr.t_s < onset]),
@@ -72,7 +80,10 @@ def test_fit_recovers_the_values_the_traces_were_made_with(small_fit):
     _, fit = small_fit
     for key, truth in TRUTH.items():
         est = fit.estimates[key]
-        assert est.value == pytest.approx(truth, rel=0.02), key
+        # on three Small hops the two trade along a valley whose floor is within the noise
+        # (0.104-0.111 mm RMS from 0.042 / 8.4 to 0.047 / 9.6, jagged on the 1 % scale): the
+        # estimate lands in it, its interval (next test) spans it
+        assert est.value == pytest.approx(truth, rel=0.10), key
         assert fit.identifiable[key]
     # started from the seed's values, 25 % and 13 % away, from a two-stage grid
     assert fit.start["compliance.hinge_stiffness_nm_per_rad"] == pytest.approx(0.056375)
@@ -185,3 +196,57 @@ def test_draws_outside_the_limits_are_invalid_not_simulated():
     spread = S.sample(robot, 12, cycles=1, seed=3)
     assert spread.n_valid == 12 - sum(outside)
     assert [math.isnan(d) for d in spread.distance_m] == outside
+
+
+def test_one_leg_set_rule_for_presets_reports_and_the_fit():
+    """Each leg set runs at its own converged step wherever it is built (docs/servo.md): the
+    fit of a filmed Medium at the seed's 2.5 ms missed its 0.25 ms robot's no-load speed by 10 %."""
+    seed = preset("seed")
+    for name, spec in LEG_SETS.items():
+        robot = preset(name)                               # the robot as built with these links
+        built = configuration(seed, name).robot            # the report's and the hop fit's
+        assert built == leg_set(seed, name)
+        assert built.solver.timestep_s == robot.solver.timestep_s == min(spec.timestep_s, seed.solver.timestep_s)
+        assert built.link_lengths_m() == pytest.approx(tuple(v + spec.added_m for v in seed.link_lengths_m()))
+        assert robot.link_lengths_m() == pytest.approx(built.link_lengths_m())   # the cut file's are the seed's
+    # a base finer than the leg set's step keeps its own
+    fine = seed.with_values({"solver.timestep_s": 1e-4})
+    assert leg_set(fine, "large").solver.timestep_s == 1e-4
+
+
+def test_the_fit_halves_a_step_that_has_not_converged():
+    """Small at 5 ms: halving the step moves its markers by more than the fit's tolerance at the
+    seed's values (0.1 mm RMS), so the fit refines it; at its own step (LEG_SETS) it is kept."""
+    run = synthetic_run("small", {}, cycles=1)
+    coarse = H.HopRun(**{**run.__dict__, "robot": run.robot.with_values({"solver.timestep_s": 5e-3})})
+    refined, change = H.converged_step(coarse)
+    assert refined.robot.solver.timestep_s < 5e-3 and change <= H.STEP_TOLERANCE_M
+    assert refined.robot.source_of("solver.timestep_s").source == "fit: time step check"
+    kept, change = H.converged_step(run)
+    assert kept.robot.solver.timestep_s == LEG_SETS["small"].timestep_s and change <= H.STEP_TOLERANCE_M
+
+
+# hidden values unlike any preset, friction above the floor's 1.6 (below it acts on nothing)
+KEYS = ("contact.foot_friction", "compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s")
+COVERAGE_TRUTHS = tuple(dict(zip(KEYS, v)) for v in ((2.2, 0.040, 8.5), (1.9, 0.070, 11.0), (2.5, 0.033, 9.6)))
+COVERAGE_PAIRS = (("small", "medium"), ("medium", "large"), ("small", "large"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("pair", COVERAGE_PAIRS, ids="+".join)
+@pytest.mark.parametrize("i", range(len(COVERAGE_TRUTHS)))
+def test_hidden_truths_over_leg_set_pairs(i, pair):
+    """Three hidden truths x three leg-set pairs (Medium in two), each run two cycles of its own
+    noise (SYNTHETIC filmings), three values fitted (one fit per test: 50-310 s each). Every
+    value within 5 % of the truth, or its interval covers it and is narrower than +-20 %
+    (issue 24's acceptance). The intervals here carry no held values' part (the seed's values
+    are exact): on truth 0, 6 of the 9 cover, the misses 0.01-2.2 % off (docs/calibrate.md)."""
+    truth = COVERAGE_TRUTHS[i]
+    j = COVERAGE_PAIRS.index(pair)
+    runs = [synthetic_run(name, truth, cycles=2, seed=10 * i + 3 * j + k) for k, name in enumerate(pair)]
+    fit = H.fit_hops(runs, list(truth), max_iter=20, grid_stages=2)
+    for key, value in truth.items():
+        est = fit.estimates[key]
+        cover = est.ci95_low <= value <= est.ci95_high
+        near = abs(est.value - value) <= 0.05 * value
+        assert near or (cover and est.ci95_high - est.ci95_low < 0.4 * value), (key, value, est)

@@ -126,7 +126,8 @@ def test_predictions_are_the_pipelines_own(world):
         assert float(cells[(name, "predicted_jump_cm")]) == pytest.approx(max(apexes) * 100, abs=0.02)
         for k, a in enumerate(apexes, start=1):
             assert float(cells[(name, f"hop_predicted_apex_cm:{name}-1#{k}")]) == pytest.approx(a * 100, abs=0.02)
-    # the sweep's design at scale 0 / 0.01 is the same robot as Small / Medium: same number
+    # the sweep's designs at scale 0 and 0.01 are Small and Medium: every leg set converges at the
+    # seed's own 1 ms (params.LEG_SETS), so the sweep's rows and the report's figures are one number
     rows = {round(r["scale"], 6): r for r in world["sweep"].rows}
     assert cells[("small", "predicted_distance_cm")] == cm(rows[0.0]["distance_m"])
     assert cells[("medium", "predicted_distance_cm")] == cm(rows[0.01]["distance_m"])
@@ -145,12 +146,12 @@ def test_measured_hops_match_the_synthetic_truth(world):
             assert d == pytest.approx(d_true, abs=0.0015), (label, k)
             assert a == pytest.approx(a_true, abs=0.005), (label, k)
             assert a <= a_true + 0.0015
-    # the true robot (softer hinges) hops 3.2 mm farther than the model over the two hops: the
+    # the true robot (softer hinges) hops 2.8 mm farther than the model over the two hops: the
     # report shows that error, to the measurement's resolution
     err = float(cells[("small", "distance_error_cm")])
     true_total = world["truth"]["small-1"].distance_m
     model_total = run(leg_set(preset("seed"), "small"), cycles=CYCLES).distance_m
-    assert (true_total - model_total) * 100 == pytest.approx(0.32, abs=0.03)
+    assert (true_total - model_total) * 100 == pytest.approx(0.276, abs=0.03)
     assert err == pytest.approx((true_total - model_total) * 100, abs=0.06)
 
 

@@ -40,19 +40,19 @@ from .progress import progress
 
 LEG_SETS = ("small", "medium", "large")
 # The virtual robot is the seed robot with each leg set's links (what the demo's calibration
-# models: its robot.toml's base is the seed), at the step each converges at on that robot
-# (0.1 mm per hop at dt/2); the small/medium/large presets are the robot as built instead.
-SEED_LEG_SET_STEP_S = {"small": 2.5e-3, "medium": 2.5e-4, "large": 2e-3}
+# models: its robot.toml's base is the seed), at that leg set's converged step (params.LEG_SETS);
+# the small/medium/large presets are the robot as built instead.
 
 
 def seed_leg_set_options(name: str) -> list[str]:
-    """``--preset seed --set ...`` for the seed robot with leg set ``name``'s links."""
+    """``--preset seed --set ...`` for the seed robot with leg set ``name``'s links and step."""
     from .params import leg_set, preset
 
     robot = leg_set(preset("seed"), name)
-    keys = ("geometry.ground_m", "geometry.crank_m", "geometry.coupler_m", "geometry.leg_m")
-    values = {**{key: robot.get(key) for key in keys}, "solver.timestep_s": SEED_LEG_SET_STEP_S[name]}
-    return ["--preset", "seed", *[arg for key, value in values.items() for arg in ("--set", f"{key}={value!r}")]]
+    keys = ("geometry.ground_m", "geometry.crank_m", "geometry.coupler_m", "geometry.leg_m", "solver.timestep_s")
+    return ["--preset", "seed", *[arg for key in keys for arg in ("--set", f"{key}={robot.get(key)!r}")]]
+
+
 RECORDINGS = Path(__file__).resolve().parents[2] / "calibration" / "recordings"
 # (subcommand, recording, its options); the servo recording is the AA swing's SG90 on a light
 # load, split with the datasheet's stall torque (no-load speed, armature and kp are written).

@@ -16,7 +16,9 @@ Presets:
   from), a time step at which the hop has converged (docs/servo.md), audited.
 - ``small`` / ``medium`` / ``large``: the seed team's robot as built (``AS_BUILT``: its
   photos, cut file and the SG90's datasheet, each value with its source) with the leg sets
-  of Part 3, +0 / +1 / +2 cm on every link of the cut file's strip.
+  of Part 3, +0 / +1 / +2 cm on every link of the cut file's strip, each at the time step
+  its hop needs (``LEG_SETS``, the one table that presets, reports and the hop fit build a
+  leg set from).
 - ``seed-notebook``: the notebook's Part 2 simulation exactly (dropped from 8 cm with the
   schedule already running, 60 Hz control frames of ``int(1/60/dt)`` steps, Euler at
   dt = 1e-4 s, 50 solver iterations, tolerance 1e-8), for reproducing its figures.
@@ -551,17 +553,42 @@ def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
     return base.with_values(values, Provenance(source=source, note=note))
 
 
-LEG_SETS_M = {"small": 0.0, "medium": 0.01, "large": 0.02}   # notebook Part 3: added to every link
+@dataclass(frozen=True)
+class LegSet:
+    """A physical leg set: what it adds to the seed design and the step its hop needs."""
+
+    added_m: float          # length added to every link (notebook Part 3)
+    timestep_s: float       # the step at which its hop has converged (rk4; docs/servo.md)
+    step_note: str          # why that step
 
 
-def leg_set(base: Robot, name: str) -> Robot:
-    """The physical leg set ``name`` (small/medium/large) built on ``base``'s parameters."""
+# The one table of leg sets: presets, reports and the hop fit all build a leg set from it
+LEG_SETS = {
+    # rk4 at 1 ms keeps every leg set within 0.1 mm per hop of dt/2, on the seed design and on the
+    # robot as built alike (docs/servo.md, "Time step"): seed design 0.066 / 0.056 / 0.070 mm,
+    # as built 0.006 / 0.006 / 0.027 mm (nose 0.14 mm of 13.6 cm) for Small / Medium / Large
+    "small": LegSet(0.0, 1e-3, "within 0.07 mm per hop of dt/2"),
+    "medium": LegSet(0.01, 1e-3, "within 0.06 mm per hop of dt/2"),
+    "large": LegSet(0.02, 1e-3, "within 0.07 mm per hop of dt/2"),
+}
+
+
+def leg_set(base: Robot, name: str, source: str | None = None) -> Robot:
+    """The physical leg set ``name`` (small/medium/large) built on ``base``'s parameters: its
+    links, and its converged time step where ``base``'s is coarser (a finer one is kept);
+    ``source``: the provenance of what it changes (``preset:<name>``)."""
     try:
-        added = LEG_SETS_M[name]
+        spec = LEG_SETS[name]
     except KeyError:
-        raise ParamsError(f"unknown leg set {name!r}", f"choose one of {', '.join(LEG_SETS_M)}") from None
-    note = f"the cut file's link + {added * 100:g} cm (notebook Part 3 leg set)"
-    return with_added_length(base, added, source=f"preset:{name}", note=note).renamed(name)
+        raise ParamsError(f"unknown leg set {name!r}", f"choose one of {', '.join(LEG_SETS)}") from None
+    source = source or f"preset:{name}"
+    note = f"notebook Part 3 leg set: +{spec.added_m * 100:g} cm on every link"
+    robot = with_added_length(base, spec.added_m, source=source, note=note).renamed(name)
+    if spec.timestep_s < base.solver.timestep_s:
+        robot = robot.with_values({"solver.timestep_s": spec.timestep_s},
+                                  Provenance(source=source,
+                                             note=f"converged step of this leg set, {spec.step_note} (docs/servo.md)"))
+    return robot
 
 
 def _seed_notebook() -> Robot:
@@ -581,14 +608,10 @@ def _seed_notebook() -> Robot:
 
 PRESETS = {
     "seed": _seed,
-    # the filmed leg sets of the robot as built (AS_BUILT); each at its converged step
-    # (docs/servo.md, "Time step")
-    "small": lambda: leg_set(_built(), "small").with_values(
-        {"solver.timestep_s": 1e-3}, Provenance(source="preset:small", note="converged step, docs/servo.md")),
-    "medium": lambda: leg_set(_built(), "medium").with_values(
-        {"solver.timestep_s": 1e-3}, Provenance(source="preset:medium", note="converged step, docs/servo.md")),
-    "large": lambda: leg_set(_built(), "large").with_values(
-        {"solver.timestep_s": 2.5e-4}, Provenance(source="preset:large", note="converged step, docs/servo.md")),
+    # the filmed leg sets of the robot as built (AS_BUILT), each at its converged step
+    "small": lambda: leg_set(_built(), "small"),
+    "medium": lambda: leg_set(_built(), "medium"),
+    "large": lambda: leg_set(_built(), "large"),
     "seed-notebook": _seed_notebook,
 }
 

@@ -4,13 +4,19 @@ hinges in the real linkage, the servo's speed on the robot's own battery.
 Each run is a ``locust hop --out`` folder: its ``run.json`` (the firmware's measured phase
 times) and the track of its video (nose, and foot where it was tracked). The simulation of a
 run is driven by those measured phase times (settled on the floor first, as ``locust sim``
-does), on the run's leg set built on the robot being fitted, so runs of different leg sets
+does), on the run's leg set built on the robot being fitted (:func:`locust.params.leg_set`,
+the presets' rule: its links and its converged time step), so runs of different leg sets
 are fitted together: their geometry differs, the physics named by ``--fit`` is shared.
+Before the fit each run's step is checked at the start values: halved (at most
+``MAX_HALVINGS`` times) while halving it moves the run's markers by more than
+``STEP_TOLERANCE_M`` (RMS over the tracked frames), so the fitted model is the converged one.
 
 Residual: the tracked markers against the same markers of the simulation, both from where
-they stood, both put on the schedule's clock by the same rule the report uses
-(:mod:`locust.report.measure`: the first nose motion of more than 3 mm, the track's start
-placed where the simulation's is relative to its first push). Every candidate of a solver
+they stood by the track's rule (the median of its frames before the first nose motion),
+put on the schedule's clock by the rule the report uses (:mod:`locust.report.measure`: the
+first nose motion of more than 3 mm, the track's start placed where the simulation's is
+relative to its first push) and then each run's clock offset fitted about it, for every
+candidate (:func:`aligned_residual`). Every candidate of a solver
 iteration, the finite-difference columns included, is simulated in one batched
 ``mujoco.rollout`` per run; the solver is ``mujoco.minimize.least_squares`` on the
 logarithm of each positive parameter (a factor is what a friction or a stiffness is known
@@ -32,14 +38,15 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 from mujoco import minimize
+from scipy import optimize
 
 from ..errors import CalibrationError, GeometryError, ParamsError, ReportError, SimError
-from ..params import Robot, value_type
+from ..params import Provenance, Robot, value_type
 from ..report.configs import configuration
 from ..report.measure import onset_time
 from ..report.measured import load_trial, read_track
@@ -59,6 +66,10 @@ FD_STEP = 1e-2                 # finite-difference step of the log values (1 %: 
 MAX_RELATIVE_STD = 0.25        # identifiable: 95% interval within about +-50%
 FAILED_M = 0.1                 # residual of a candidate whose simulation failed (metres)
 THREADS = 2
+STEP_TOLERANCE_M = 1e-4        # a run's step is converged when dt/2 moves its markers less (RMS) ...
+MAX_HALVINGS = 3               # ... halved up to this many times until it is
+SHIFT_SEARCH_S = 0.05          # each run's clock offset is fitted within this of the onset rule's ...
+SHIFT_LEVELS = 101             # ... from the best of this many offsets, refined
 GRID_FACTOR = 1.6              # the starting grid spans this factor either side of the start ...
 GRID_LEVELS = {1: 9, 2: 7, 3: 5, 4: 3, 5: 3}   # ... in this many levels per fitted value
 GRID_STAGES = 3                # ... refined about its best point this many times
@@ -99,6 +110,8 @@ class RunFit:
     rms_by_marker_m: dict[str, float]
     samples: int
     curves: dict = field(repr=False)     # marker -> (t aligned, tracked x, y, sim t, sim x, sim y)
+    timestep_s: float = math.nan         # the step the run was fitted at
+    step_change_m: float = math.nan      # RMS move of its markers at dt/2, at the start values
 
 
 @dataclass(frozen=True)
@@ -121,7 +134,9 @@ class HopFit:
         return {"experiment": "hops", "source": "+".join(r.source for r in self.runs),
                 "parameters": params,
                 "runs": [{"source": r.source, "config": r.config, "rms_residual_m": r.rms_m,
-                          "rms_residual_by_marker_m": r.rms_by_marker_m, "samples": r.samples} for r in self.runs],
+                          "rms_residual_by_marker_m": r.rms_by_marker_m, "samples": r.samples,
+                          "timestep_s": r.timestep_s, "step_change_at_half_m": r.step_change_m}
+                         for r in self.runs],
                 "interval": self.interval, "rms_residual_m": self.rms_m, "iterations": self.iterations,
                 "simulations": self.simulations,
                 "wall_s": round(self.wall_s, 2), "notes": self.notes}
@@ -209,7 +224,13 @@ def simulate_markers(run: HopRun, robots: list[Robot]) -> list[dict[str, np.ndar
 
 def aligned_residual(run: HopRun, sim: dict[str, np.ndarray] | None) -> tuple[np.ndarray, float]:
     """Tracked minus simulated, every tracked coordinate of the run (x then y, marker by
-    marker), and the track's shift onto the schedule's clock (nan when the simulation failed)."""
+    marker), both from where they stood by the track's rule (:func:`load_run`: the median of
+    the frames before the first nose motion), and the track's shift onto the schedule's clock
+    (nan when the simulation failed):
+    the report's rule (the first nose motion of 3 mm in both) places it, then the shift that
+    fits the run best within ``SHIFT_SEARCH_S`` of it (a clock offset fitted per run and
+    candidate: the rule on a 30 frames/s track is off by up to a few milliseconds, which the
+    fitted values would otherwise bend to make up for)."""
     n = sum(2 * len(tr.t_s) for tr in run.tracks.values())
     if sim is None:
         return np.full(n, FAILED_M), math.nan
@@ -218,14 +239,58 @@ def aligned_residual(run: HopRun, sim: dict[str, np.ndarray] | None) -> tuple[np
         latency, _, _ = onset_time(nose[0], nose[1], nose[2], where="simulation")
     except ReportError:
         return np.full(n, FAILED_M), math.nan
-    shift = run.onset_s - latency             # camera time of the first push
-    parts = []
-    for m, tr in run.tracks.items():
-        ts, xs, ys = sim[m]
-        t = tr.t_s - shift
-        # before the simulation's kept lead the robot stands: at 0, from where it stood
-        parts += [tr.x_m - np.interp(t, ts, xs, left=0.0), tr.y_m - np.interp(t, ts, ys, left=0.0)]
-    return np.concatenate(parts), shift
+
+    def residual_at(shift: float) -> np.ndarray:       # shift: camera time of the first push
+        parts = []
+        for m, tr in run.tracks.items():
+            ts, xs, ys = sim[m]
+            t = tr.t_s - shift
+            # before the simulation's kept lead the robot stands: at 0, from where it stood
+            x, y = np.interp(t, ts, xs, left=0.0), np.interp(t, ts, ys, left=0.0)
+            # from where it stood by the track's own rule: the median of its frames before the
+            # first nose motion (they include the push's first millimetres)
+            before = tr.t_s < run.onset_s
+            parts += [tr.x_m - (x - np.median(x[before])), tr.y_m - (y - np.median(y[before]))]
+        return np.concatenate(parts)
+
+    rule = run.onset_s - latency
+    grid = rule + np.linspace(-SHIFT_SEARCH_S, SHIFT_SEARCH_S, SHIFT_LEVELS)
+    cost = [float(np.sum(residual_at(s) ** 2)) for s in grid]
+    k = int(np.argmin(cost))
+    half = grid[1] - grid[0]
+    best = optimize.minimize_scalar(lambda s: float(np.sum(residual_at(s) ** 2)), method="bounded",
+                                    bounds=(grid[k] - half, grid[k] + half), options={"xatol": 1e-6}).x
+    shift = float(best) if np.sum(residual_at(best) ** 2) <= cost[k] else float(grid[k])
+    return residual_at(shift), shift
+
+
+def converged_step(run: HopRun, robot: Robot | None = None) -> tuple[HopRun, float]:
+    """``run`` at a step where halving it moves its markers by at most ``STEP_TOLERANCE_M``
+    (RMS over the tracked frames, each simulation on the clock by its own onset) at ``robot``'s
+    values (the run's own when None), halved at most ``MAX_HALVINGS`` times; and that last
+    move (nan: a simulation failed, the step is kept)."""
+    at = robot or run.robot
+    step = run.robot.solver.timestep_s
+    change = math.nan
+    for halvings in range(MAX_HALVINGS + 1):
+        pair = []
+        for dt in (step, step / 2):
+            try:
+                robot_dt = at.with_values({"solver.timestep_s": dt}, "fit: time step check")
+                pair.append(simulate_markers(run, [robot_dt])[0])
+            except (GeometryError, SimError):
+                pair.append(None)
+        if any(sim is None for sim in pair):
+            return run, math.nan
+        change = float(np.sqrt(np.mean((aligned_residual(run, pair[0])[0] - aligned_residual(run, pair[1])[0]) ** 2)))
+        if change <= STEP_TOLERANCE_M or halvings == MAX_HALVINGS:
+            break
+        step /= 2
+    if step != run.robot.solver.timestep_s:
+        note = f"halved until dt/2 moved the markers by at most {STEP_TOLERANCE_M * 1e3:g} mm (hop fit's check)"
+        run = replace(run, robot=run.robot.with_values({"solver.timestep_s": step}, Provenance("fit: time step check",
+                                                                                                note=note)))
+    return run, change
 
 
 # -- the fit ----------------------------------------------------------------------------
@@ -264,6 +329,20 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     check_keys(list(keys), runs)
     start = np.array([runs[0].robot.get(k) for k in keys], dtype=float)
     counter = {"sims": 0}
+    runs, step_notes, step_changes = list(runs), [], []
+    for k, run in enumerate(runs):
+        given = run.robot.solver.timestep_s
+        runs[k], change = converged_step(run)
+        step_changes.append(change)
+        dt = runs[k].robot.solver.timestep_s
+        if not change <= STEP_TOLERANCE_M:
+            step_notes.append(f"{run.config} ({run.source.name}): at {dt * 1e3:g} ms, halving the step still moves the "
+                              f"markers by {change * 1e3:.3g} mm RMS at the start values: the fit is not converged "
+                              "in its step (std_numerical carries part of it)")
+        elif dt != given:
+            step_notes.append(f"{run.config} ({run.source.name}): fitted at {dt * 1e3:g} ms, not its leg set's "
+                              f"{given * 1e3:g} ms (there halving the step moved the markers by more than "
+                              f"{STEP_TOLERANCE_M * 1e3:g} mm RMS at the start values)")
 
     def robots_at(run: HopRun, xs: np.ndarray, refine: int = 1) -> list[Robot]:
         robot = run.robot
@@ -314,7 +393,8 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
             if sim is not None:
                 curves[m] = (tr.t_s - shift, tr.x_m, tr.y_m, *sim[m])
         run_fits.append(RunFit(source=str(run.source), config=run.config, rms_m=float(np.sqrt(np.mean(res**2))),
-                               rms_by_marker_m=by_marker, samples=len(res), curves=curves))
+                               rms_by_marker_m=by_marker, samples=len(res), curves=curves,
+                               timestep_s=run.robot.solver.timestep_s, step_change_m=step_changes[k]))
     # the optimum and its central differences in one batch per run, then the same at dt/2
     hi, lo = np.minimum(x + FD_STEP, bound), np.maximum(x - FD_STEP, -bound)
     points = [x] + [np.where(np.arange(len(x)) == i, edge[i], x) for i in range(len(x)) for edge in (hi, lo)]
@@ -336,7 +416,7 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
                 "step (std_numerical)" + (f" and the uncertainties of the {len(held)} values held fixed "
                                           f"({', '.join(held)}: std_fixed)" if held else "")
                 + " in quadrature, Welch-Satterthwaite degrees of freedom")
-    estimates, identifiable, notes = {}, {}, []
+    estimates, identifiable, notes = {}, {}, step_notes
     if hops <= len(keys):
         notes.append(f"{hops} hops cannot bound {len(keys)} values (a cluster-robust interval needs at least one "
                      "hop more than the values fitted): film more hops, or fit fewer values")

@@ -2,8 +2,9 @@
 
 A configuration is the base robot (``--config robot.toml`` or ``--preset``) with the same
 length added to all four links: ``small`` / ``medium`` / ``large`` are the notebook's
-physical leg sets (+0 / +1 / +2 cm), any other name is the base as it is unless
-``--added NAME=METRES`` gives its added length.
+physical leg sets (:data:`locust.params.LEG_SETS`: +0 / +1 / +2 cm, each at its own
+converged time step, as its preset), any other name is the base as it is unless
+``--added NAME=METRES`` gives its added length (at the base's step).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ReportError
-from ..params import LEG_SETS_M, Robot, with_added_length
+from ..params import LEG_SETS, Robot, leg_set, with_added_length
 
 _TRIAL_SUFFIX = re.compile(r"(?:[-_.]|^)(?:(?:trial|run|take)[-_.]?)?\d+$", re.IGNORECASE)
 _NAME_OK = re.compile(r"^[A-Za-z][A-Za-z0-9_+-]*$")
@@ -34,8 +35,9 @@ class Configuration:
 def configuration(base: Robot, name: str, added_m: float | None = None) -> Configuration:
     """The configuration ``name`` on ``base``: a known leg set, or ``base`` plus ``added_m``."""
     key = check_name(name)
-    if added_m is None:
-        added_m = LEG_SETS_M.get(key, 0.0)
+    if key in LEG_SETS and (added_m is None or added_m == LEG_SETS[key].added_m):
+        return Configuration(name=key, added_m=LEG_SETS[key].added_m, robot=leg_set(base, key, source=f"leg-set:{key}"))
+    added_m = added_m or 0.0
     note = f"report configuration {key}: +{added_m * 100:g} cm on every link"
     robot = with_added_length(base, added_m, source=f"leg-set:{key}", note=note) if added_m else base
     return Configuration(name=key, added_m=float(added_m), robot=robot.renamed(key))
@@ -65,7 +67,7 @@ def name_from_path(path: Path) -> str:
 
 def sort_key(name: str) -> tuple[int, str]:
     """Known leg sets in size order first, then the rest by name."""
-    order = list(LEG_SETS_M)
+    order = list(LEG_SETS)
     return (order.index(name), "") if name in order else (len(order), name)
 
 

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ..params import LEG_SETS_M, Robot, preset
+from ..params import LEG_SETS, Robot, preset
 from ..plotting import pyplot, save_png
 from .design import SCALE, Axis
 
@@ -21,7 +21,8 @@ def _leg_set_marks(axis: Axis, base: Robot) -> list[tuple[str, float]]:
     if axis.name != SCALE or base.link_lengths_m() != preset("seed").link_lengths_m():
         return []
     lo, hi = sorted((axis.start, axis.stop))
-    return [(name.capitalize(), v) for name, v in LEG_SETS_M.items() if lo - 1e-12 <= v <= hi + 1e-12]
+    return [(name.capitalize(), leg.added_m) for name, leg in LEG_SETS.items()
+            if lo - 1e-12 <= leg.added_m <= hi + 1e-12]
 
 
 def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robot, path: Path) -> Path:
