@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -20,6 +21,22 @@ def shared_data() -> Path:
     if not SHARED_DATA.is_dir():
         pytest.skip(f"reference data not found at {SHARED_DATA} (clone with ../shared beside it)")
     return SHARED_DATA
+
+
+@pytest.fixture(scope="session")
+def tracker_example(shared_data, tmp_path_factory):
+    """``tracker_example("BallToss.trz")``: one of Tracker's example zips, unpacked once a session
+    into a temporary folder (returned); the files in it are not to be changed."""
+    folders: dict[str, Path] = {}
+
+    def unpacked(name: str) -> Path:
+        if name not in folders:
+            folders[name] = tmp_path_factory.mktemp(Path(name).stem)
+            with zipfile.ZipFile(shared_data / "tracker" / name) as z:
+                z.extractall(folders[name])
+        return folders[name]
+
+    return unpacked
 
 
 @pytest.fixture(scope="module")

@@ -15,11 +15,8 @@ from locust.track.tracker_text import read_tracker_export
 
 
 @pytest.fixture(scope="module")
-def balltoss(shared_data, tmp_path_factory):
-    folder = tmp_path_factory.mktemp("balltoss")
-    with zipfile.ZipFile(shared_data / "tracker" / "BallToss.trz") as z:
-        z.extractall(folder)
-    return folder
+def balltoss(tracker_example):
+    return tracker_example("BallToss.trz")
 
 
 def _tracker_points(folder) -> dict[int, tuple[float, float]]:

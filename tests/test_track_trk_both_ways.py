@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-import zipfile
-
 import numpy as np
 import pandas as pd
 import pytest
@@ -15,19 +13,13 @@ from locust.track import trk
 
 
 @pytest.fixture(scope="module")
-def cups(shared_data, tmp_path_factory):
-    folder = tmp_path_factory.mktemp("cups")
-    with zipfile.ZipFile(shared_data / "tracker" / "CupsClips.zip") as z:
-        z.extractall(folder)
-    return folder
+def cups(tracker_example):
+    return tracker_example("CupsClips.zip")
 
 
 @pytest.fixture(scope="module")
-def balltoss(shared_data, tmp_path_factory):
-    folder = tmp_path_factory.mktemp("balltoss")
-    with zipfile.ZipFile(shared_data / "tracker" / "BallToss.trz") as z:
-        z.extractall(folder)
-    return folder
+def balltoss(tracker_example):
+    return tracker_example("BallToss.trz")
 
 
 @pytest.fixture(scope="module")
