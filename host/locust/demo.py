@@ -82,7 +82,7 @@ TRUTH_KEYS = {
 # softer than the beam's, the servo slower on the robot's battery than on the bench.
 HOP_TRUTH = {"contact.foot_friction": 2.0, "compliance.hinge_stiffness_nm_per_rad": 0.045,
              "servo.noload_speed_rad_per_s": 9.0}
-HOP_FIT_SETS = ("small", "large")   # Medium sits on a friction threshold at a 0.25 ms step: slow and touchy
+HOP_FIT_SETS = ("small", "large")   # the two leg sets farthest apart (Small + Medium: test_calibrate_hop_virtual)
 REPORT_SAMPLES = 8
 
 
