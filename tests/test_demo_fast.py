@@ -49,8 +49,10 @@ def test_calibration_recovers_the_virtual_robots_hidden_values(demo):
 
 def test_tracked_hops_match_the_truth_frames(demo):
     """Measured from the video against the nose marker's true positions in the rendered
-    frames: within 0.1 mm (the chain reached 0.04 mm: 640x360 frames, about 2.5 mm per pixel,
-    sub-pixel marker centroids).
+    frames: within a quarter pixel at the marker (640x360 frames at 60 frames/s, about 0.66 mm
+    a pixel: 0.16 mm). The colour marker's centre is good to about 0.1 px RMS (docs/track.md),
+    and one frame decides an apex: at the top of Large's hop the nose moves 1.5 mm between
+    frames, so a clock or frame slip would be off by far more than that.
 
     The truth is the nose's travel, the quantity the report measures. The plant's own figure
     in the hop log is the chassis' travel: it agrees with the nose's to about 1 um when the
@@ -67,8 +69,12 @@ def test_tracked_hops_match_the_truth_frames(demo):
         x, z = truth["nose_x_m"].to_numpy(), truth["nose_z_m"].to_numpy()
         settled = truth["t_s"].to_numpy() >= truth["t_s"].iloc[-1] - 0.3
         assert np.ptp(x[settled]) <= 2e-6, label         # at rest over the clip's end (6 decimals written)
-        assert hop["measured_distance_m"] == pytest.approx(float(x[-1] - x[0]), abs=1e-4), label
-        assert hop["measured_apex_m"] == pytest.approx(float(z.max() - z[0]), abs=1e-4), label
+        tracks = pd.read_csv(folder / "hops" / label / "hop.tracks.csv", comment="#")
+        seen = tracks[["nose_y_m", "nose_py"]].dropna()
+        px_per_m = abs(np.polyfit(seen["nose_y_m"], seen["nose_py"], 1)[0])
+        quarter_px_m = 0.25 / px_per_m
+        assert hop["measured_distance_m"] == pytest.approx(float(x[-1] - x[0]), abs=quarter_px_m), label
+        assert hop["measured_apex_m"] == pytest.approx(float(z.max() - z[0]), abs=quarter_px_m), label
 
 
 def test_predictions_are_run_on_the_calibrated_robot(demo):
