@@ -310,7 +310,7 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
     stiff_total = k - rig.gravity_moment_nm * math.sin(rest)
     wn = math.sqrt(max(stiff_total, 0.0) / rig.inertia_kgm2)
     zeta = b / (2 * math.sqrt(max(stiff_total, 1e-300) * rig.inertia_kgm2))
-    measured = np.unwrap(np.arctan2(y - py, x - px))
+    measured = swing_angle(x, y, (px, py))[0]
     measured += 2 * math.pi * np.round((model[0] - measured[0]) / (2 * math.pi))
     fine_t = np.linspace(t[0], t[-1], max(10 * len(t), 2000))
     curves = Curves(x=t, data=np.degrees(measured), model=np.degrees(model), x_label="t [s]",

@@ -14,7 +14,7 @@ from ..progress import progress
 from . import board, calib, camera, export, overlay, preview, trk
 from .aruco import DEFAULT_DICTIONARY, side_px_in_video
 from .board import DEFAULT_BOARD
-from .importing import ImportOptions, import_options, import_tracks, span_warnings
+from .importing import ImportOptions, import_options, import_tracks, is_project, span_warnings
 from .runner import track_video
 from .spec import ModelOptions, parse_markers
 from .tracks_csv import tracks_csv_beside, write_tracks_csv
@@ -177,7 +177,7 @@ def track(video, markers, color_tol, search_px, template_radius, accept, likenes
             raise TrackError("give one of VIDEO, --from-trk and --import", "one input per run")
         # a Tracker project carries its own units: converted as --from-trk does, or, renamed or
         # mirrored, through the import layer (which refuses --units for it)
-        if trk.is_project(import_path) and imports.identity:
+        if is_project(import_path) and imports.identity:
             return _convert_trk(import_path, list(trk_names), out, fmt, force)
         if trk_names:
             raise TrackError("--track picks the tracks of a Tracker project converted as it is",
@@ -198,7 +198,7 @@ def track(video, markers, color_tol, search_px, template_radius, accept, likenes
     if trk_out is not None and trk_out.suffix.lower() != ".trk":
         raise TrackError(f"--trk {trk_out}: a Tracker project is written as a .trk file", "e.g. --trk redo.trk")
     project = None
-    if trk.is_project(video):
+    if is_project(video):
         if calibration_from is not None:
             raise TrackError("VIDEO is a Tracker project: its calibration is used, leave out --calibration-from",
                              "or give the video itself as VIDEO")
@@ -210,7 +210,7 @@ def track(video, markers, color_tol, search_px, template_radius, accept, likenes
                          "not both", "one calibration per run")
     if project is not None and fps is None and math.isfinite(project.clip.fps):
         fps = project.clip.fps
-    if project is not None and trk.is_project(video):
+    if project is not None and is_project(video):
         with trk.project_media(project) as media:
             return _track(media, video, project, markers, (color_tol, search_px, template_radius, accept, likeness,
                                                            evolve), board_text, plane_points, preview_frame,
@@ -256,7 +256,7 @@ def _track(video: Path, named: Path, project, markers, settings, board_text, pla
         result.source = f"locust track of the video in {named}"
     written = _write(result, paths, fmt)
     if trk_out is not None:
-        media = trk.media_in_zip(project, trk_out) if project is not None and trk.is_project(named) else None
+        media = trk.media_in_zip(project, trk_out) if project is not None and is_project(named) else None
         written.append(trk.write_project(result, trk_out, media))
     if "overlay" in paths:
         if overlay_kind == "png":

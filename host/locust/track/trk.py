@@ -304,14 +304,6 @@ def media_in_zip(project: TrackerProject, trk_path: Path) -> str | None:
     return f"{zip_rel}!/{entry}"
 
 
-PROJECT_SUFFIXES = (".trk", ".trz")
-
-
-def is_project(path: Path) -> bool:
-    """True for a path named like a Tracker project (``.trk``, or a ``.trz`` zip)."""
-    return Path(path).suffix.lower() in PROJECT_SUFFIXES
-
-
 @contextmanager
 def project_media(project: TrackerProject) -> Iterator[Path]:
     """The video (or the image sequence's first file) a project opens, as a local path for the
