@@ -241,7 +241,7 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
         v_inertias = _per_recording(validate_inertia_kgm2, len(validate), "--validate-inertia-kgm2") \
             if validate_inertia_kgm2 else [None] * len(validate)
         for path, inertia in zip(validate, v_inertias):
-            rec = _servo_recording(path, S.ServoRig(inertias[0]), None, None, None, ImportOptions())
+            rec = _servo_recording(path, S.ServoRig(inertias[0]), None, None, None, ImportOptions(), timing)
             if inertia is None:
                 inertia = next((r.rig.inertia_kgm2 for r in recordings if r.kind == rec.kind), inertias[0])
             rec = replace(rec, rig=S.ServoRig(inertia))
