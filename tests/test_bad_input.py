@@ -21,43 +21,12 @@ import time
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
-from locust.cli import cli
 from locust.device import record as R
 from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
+from probing import assert_clear_error, invoke, tree
 
 LOCUST = [sys.executable, "-m", "locust.cli"]
-
-
-def tree(folder: Path) -> dict[str, tuple[bytes, int]]:
-    """Every file under ``folder``: its bytes and mode (symlinks by their target's name)."""
-    out = {}
-    for p in sorted(folder.rglob("*")):
-        rel = str(p.relative_to(folder))
-        if p.is_symlink():
-            out[rel] = (os.readlink(p).encode(), 0)
-        elif p.is_file():
-            out[rel] = (p.read_bytes(), stat.S_IMODE(p.stat().st_mode))
-        elif p.is_dir():
-            out[rel + "/"] = (b"", stat.S_IMODE(p.stat().st_mode))
-        else:   # a pipe, a device: its type and mode
-            out[rel + "|"] = (b"", p.stat().st_mode)
-    return out
-
-
-def invoke(args: list[str]):
-    return CliRunner().invoke(cli, [str(a) for a in args], catch_exceptions=True)
-
-
-def assert_clear_error(res, *words: str) -> None:
-    traceback = "".join(__import__("traceback").format_exception(res.exception)) if res.exception else ""
-    assert not isinstance(res.exception, Exception) or isinstance(res.exception, SystemExit), traceback
-    assert res.exit_code == 2, res.output
-    assert "Traceback" not in res.output
-    assert "error:" in res.stderr and "hint:" in res.stderr, res.stderr
-    for w in words:
-        assert w in res.stderr, (w, res.stderr)
 
 
 # -- inputs the cases use ------------------------------------------------------------
