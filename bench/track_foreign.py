@@ -437,7 +437,7 @@ WRONG_PX = 8.0
 
 def score(truth: Truth, tracks_path: Path, clip: Path | None = None, marker: str = "nose") -> Figures:
     """Compare the tracks CSV with the truth (``clip``: to say what colour a wrong pick had)."""
-    from locust.track.tracks_csv import read_tracks_csv
+    from locust.io.tracks_csv import read_tracks_csv
 
     tracks = read_tracks_csv(tracks_path)
     m = tracks.markers[marker]

@@ -1,10 +1,10 @@
 """The track layer's files, each through its one owner: write -> read back -> equal.
 
-- the tracks CSV (locust.track.tracks_csv), lost frames (NaN, ok 0) included, and what
+- the tracks CSV (locust.io.tracks_csv), lost frames (NaN, ok 0) included, and what
   other programs make of it (true/false, semicolons and decimal commas);
-- Tracker's text export (locust.track.tracker_text): steps a track does not have, a frame
+- Tracker's text export (locust.io.tracker_text): steps a track does not have, a frame
   no track has, Tracker 6's shared time column, per-track time columns;
-- camera.json (locust.track.camera): a fixed and a following camera, a plane without its
+- camera.json (locust.io.camera_json): a fixed and a following camera, a plane without its
   stray distance (null in JSON, NaN here).
 
 Numbers here are SYNTHETIC (chosen to survive the files' decimals exactly).
@@ -20,9 +20,10 @@ import pytest
 
 from locust.calibrate.recordings import read_table
 from locust.errors import TrackError
-from locust.track import camera as cam
-from locust.track import tracker_text as tt
-from locust.track import tracks_csv as tc
+from locust.io import camera_json as cam
+from locust.io import tracker_text as tt
+from locust.io import tracks_csv as tc
+from locust.track import camera as track_camera
 
 NAN = math.nan
 
@@ -142,7 +143,7 @@ def test_calibration_tables_come_from_the_owners(tmp_path):
     assert isinstance(table.tracks, tc.TracksCsv) and table.kind == "csv" and table.markers() == ["nose", "foot"]
     assert np.isnan(table.marker("nose")[0][2])                          # ok 0 is never a position
     table = read_table(txt_path)
-    # a Tracker export comes through the track layer's one import (locust.track.importing), as tracks
+    # a Tracker export comes through the track layer's one import (locust.io.importing), as tracks
     assert isinstance(table.tracks, tc.TracksCsv) and table.kind == "tracker"
     for marker in ("ball", "cup_3"):
         for got, want in zip(table.marker(marker), _export().positions(marker)):
@@ -171,11 +172,11 @@ def test_camera_json_round_trip(tmp_path, kind):
     assert ("m_per_px" in doc) == (kind == "fixed")
     back = cam.read_camera_json(path)
     assert back == camera and math.isnan(back.marker_planes["foot"].max_off_plane_m)
-    cal = cam.load(path, 320, 180)
+    cal = track_camera.load(path, 320, 180)
     assert cal.planes_y_m == {"nose": 0.0602, "foot": -0.02} and cal.camera == kind
     np.testing.assert_array_equal(cal.positions_m, camera.positions_m)
     with pytest.raises(TrackError, match="describes a 320x180 camera"):
-        cam.load(path, 640, 360)
+        track_camera.load(path, 640, 360)
 
 
 @pytest.mark.slow

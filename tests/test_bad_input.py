@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from locust.device import record as R
+from locust.io import run_record as R
 from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
 from probing import assert_clear_error, invoke, tree
 

@@ -21,7 +21,7 @@ from locust.calibrate import hinge as H
 from locust.calibrate import synthetic as S
 from locust.calibrate.recordings import REAL_TIME, TimeOptions, clean_samples, read_table
 from locust.cli import cli
-from locust.track.importing import ImportOptions
+from locust.io.importing import ImportOptions
 
 POINT = "org.opensourcephysics.cabrillo.tracker.PointMass"
 FRAME = "org.opensourcephysics.media.core.ImageCoordSystem$FrameData"

@@ -19,8 +19,8 @@ import pytest
 from locust.calibrate import hop as H
 from locust.errors import CalibrationError
 from locust.params import LEG_SETS, Provenance, leg_set, preset
-from locust.report.configs import configuration
 from locust.sim import samples as S
+from locust.trials.configs import configuration
 
 CAMERA_HZ = 30.0
 NOISE_M = 1e-4

@@ -14,12 +14,12 @@ from click.testing import CliRunner
 
 from locust.cli import cli
 from locust.errors import ReportError
+from locust.io.sweep_store import columns as sweep_columns
 from locust.params import preset
-from locust.report.configs import configuration, name_from_path, parse_added
 from locust.report.landscape import design_value, read_landscape
-from locust.report.measure import align, measure_hops, onset_time
-from locust.report.measured import parse_measured
-from locust.sweep.store import columns as sweep_columns
+from locust.trials.configs import configuration, name_from_path, parse_added
+from locust.trials.measure import align, measure_hops, onset_time
+from locust.trials.measured import parse_measured
 
 
 def staircase(fps=30.0, lead_s=0.4, period_s=1.3, hops=(0.20, 0.25, 0.15), apex=(0.05, 0.08, 0.03), noise=0.0, seed=0):

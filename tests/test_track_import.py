@@ -1,5 +1,5 @@
 """`locust track --import`: Tracker text exports, t,x,y CSVs and tracks CSVs in any unit, renamed
-and mirrored, through the one conversion (locust.track.importing.import_tracks).
+and mirrored, through the one conversion (locust.io.importing.import_tracks).
 
 The small exports written here are SYNTHETIC (labelled so in their first line; numbers chosen
 to survive the files' decimals exactly); the real ones are Tracker's own example projects
@@ -18,10 +18,11 @@ from click.testing import CliRunner
 
 from locust.cli import cli
 from locust.errors import TrackError
-from locust.track import tracker_text as tt
-from locust.track import tracks_csv as tc
+from locust.io import tracker_text as tt
+from locust.io import tracks_csv as tc
+from locust.io import trk as trk_io
+from locust.io.importing import ImportOptions, import_tracks, likely_units, span_warnings, units_hint
 from locust.track import trk
-from locust.track.importing import ImportOptions, import_tracks, likely_units, span_warnings, units_hint
 
 # SYNTHETIC: a Tracker export calibrated in cm, one track named "A" (title line), one step missing
 CM_EXPORT = ("# SYNTHETIC Tracker export in cm (written by tests/test_track_import.py)\n"
@@ -214,7 +215,7 @@ def test_real_balltoss_exported_in_cm_gives_trackers_metres_and_g(shared_data, t
     """BallToss (Tracker's example): the ball's steps exported in cm under Tracker's name come
     back as the nose in metres, Tracker's own numbers to the export's 6 digits, and the
     parabola through them gives the published g of about 10.3 m/s^2."""
-    project = trk.read_project(shared_data / "tracker" / "BallToss.trz")
+    project = trk_io.read_project(shared_data / "tracker" / "BallToss.trz")
     export, result = _real_export_in_cm(project, {"ball": "ball"})
     src = tt.write_tracker_export(tmp_path / "balltoss_cm.txt", export)
     out = tmp_path / "balltoss.tracks.csv"
@@ -239,7 +240,7 @@ def test_real_cupsclips_renamed_by_trackers_own_names(shared_data, tmp_path):
     with zipfile.ZipFile(shared_data / "tracker" / "CupsClips.zip") as z:
         name = next(n for n in z.namelist() if n.lower().endswith(".trk"))
         z.extract(name, tmp_path)
-    project = trk.read_project(tmp_path / name)
+    project = trk_io.read_project(tmp_path / name)
     export, result = _real_export_in_cm(project, {"cup_3": "cup 3", "cup_7": "cup 7"})
     src = tt.write_tracker_export(tmp_path / "cups_cm.txt", export)
     assert src.read_text().splitlines()[0].split("\t")[0] == "cup 3"     # Tracker's name, with its space

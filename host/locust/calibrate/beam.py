@@ -34,7 +34,7 @@ import numpy as np
 from scipy import optimize
 
 from ..errors import CalibrationError
-from ..track.importing import units_hint
+from ..io.importing import units_hint
 from .curves import Curves
 from .fitstats import Estimate, serial_covariance
 

@@ -11,10 +11,10 @@ import numpy as np
 
 from ..errors import CalibrationError, ReportError, TrackError
 from ..fileio import json_text
+from ..io.delimited import read_text
+from ..io.importing import ImportOptions, import_options
 from ..options import FINITE, POSITIVE
 from ..progress import progress
-from ..track.delimited import read_text
-from ..track.importing import ImportOptions, import_options
 from . import beam as B
 from . import hinge as HG
 from . import hop as H
@@ -356,7 +356,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
       locust calibrate hop small=runs/s1 large=runs/l1 --write calibration/robot.toml
     """
     from ..params import resolve_robot
-    from ..report.configs import name_from_path
+    from ..trials.configs import name_from_path
 
     keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
     start_from = config or (write_path if write_path and Path(write_path).exists() else None)

@@ -13,7 +13,7 @@ Before the fit each run's step is checked at the start values: halved (at most
 
 Residual: the tracked markers against the same markers of the simulation, both from where
 they stood by the track's rule (the median of its frames before the first nose motion),
-put on the schedule's clock by the rule the report uses (:mod:`locust.report.measure`: the
+put on the schedule's clock by the rule the report uses (:mod:`locust.trials.measure`: the
 first nose motion of more than 3 mm, the track's start placed where the simulation's is
 relative to its first push) and then each run's clock offset fitted about it, for every
 candidate (:func:`aligned_residual`). Every candidate of a solver
@@ -47,14 +47,14 @@ from scipy import optimize
 
 from ..errors import CalibrationError, GeometryError, ParamsError, ReportError, SimError
 from ..params import Provenance, Robot, value_type
-from ..report.configs import configuration
-from ..report.measure import onset_time
-from ..report.measured import load_trial, read_track
 from ..sim.kinematics import geom_positions, marker_geoms, trace_rows
 from ..sim.model import build
 from ..sim.rollout import simulate_batch
 from ..sim.samples import uncertain_values
 from ..sim.schedule import ControlPlan
+from ..trials.configs import configuration
+from ..trials.measure import onset_time
+from ..trials.measured import load_trial, read_track
 from .fitstats import Estimate, cluster_covariance, fixed_covariance, linear_shift
 
 DEFAULT_KEYS = ("contact.foot_friction", "compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s")

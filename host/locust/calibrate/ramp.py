@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import CalibrationError
-from ..track.importing import units_hint
+from ..io.importing import units_hint
 from .curves import Curves
 from .fitstats import Estimate, t95
 

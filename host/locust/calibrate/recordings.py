@@ -6,21 +6,21 @@ All four become one :class:`Table` of numeric columns, with marker positions und
 - plain CSV (``t_s,angle_deg,command_deg`` or ``angle_deg``), ``#`` lines are comments:
   this module's own format;
 - ``locust track`` CSV (``frame,t_s,<m>_px,<m>_py,<m>_x_m,<m>_y_m,<m>_ok``: any header
-  naming marker columns), read by :mod:`locust.track.tracks_csv`; a row whose ``<m>_ok``
+  naming marker columns), read by :mod:`locust.io.tracks_csv`; a row whose ``<m>_ok``
   is false counts as *not found* (NaN), never as a position;
 - Tracker (Open Source Physics) *File > Export > Data*, read by
-  :mod:`locust.track.tracker_text`: an optional title line (the track name) or Tracker 6's
+  :mod:`locust.io.tracker_text`: an optional title line (the track name) or Tracker 6's
   ``#multi:`` line followed by a row of track names, then a header (``t x y ...``), tab
   separated, possibly with decimal commas; or a plain ``t,x,y`` CSV of one marker (``nose``).
   Tracker writes positions in its calibration unit: ``--units cm`` for a Tracker in cm.
 
 - a Tracker project (``.trk``, or a ``.trz`` zip holding one), read by
-  :mod:`locust.track.trk`: its point tracks in metres through the project's own calibration.
+  :mod:`locust.io.trk`: its point tracks in metres through the project's own calibration.
 
-Every track (the last three) goes through :func:`locust.track.importing.import_tracks`'s
+Every track (the last three) goes through :func:`locust.io.importing.import_tracks`'s
 conversion, so ``--units``, ``--rename`` and ``--mirror`` act here as in ``locust track
 --import``; a plain CSV has no positions and is read as it is. The three share one tokenizer
-(:mod:`locust.track.delimited`). Every problem is a :class:`~locust.errors.CalibrationError`
+(:mod:`locust.io.delimited`). Every problem is a :class:`~locust.errors.CalibrationError`
 naming the file, and the line or column, with a hint.
 
 Slow motion: a clip filmed at 240 frames/s and exported (or played) at 30 has times 8 times
@@ -40,9 +40,9 @@ import click
 import numpy as np
 
 from ..errors import CalibrationError, TrackError
-from ..track.delimited import check_names, read_text, split_text
-from ..track.importing import AS_IS, ImportOptions, import_project, is_project, track_layout, tracks_from_delimited
-from ..track.tracks_csv import TracksCsv
+from ..io.delimited import check_names, read_text, split_text
+from ..io.importing import AS_IS, ImportOptions, import_project, is_project, track_layout, tracks_from_delimited
+from ..io.tracks_csv import TracksCsv
 
 
 @dataclass(frozen=True)

@@ -11,10 +11,10 @@ import click
 from ..errors import DeviceError
 from ..fileio import json_text
 from ..firmware import config as fw_config
+from ..io import run_record as R
 from ..params import Schedule, resolve_robot
 from ..params_cli import robot_options
 from ..progress import progress
-from . import record as R
 from .plant import PLANTS
 
 CHIPS = tuple(fw_config.CHIPS)  # the chips whose pin rules the firmware knows, and the virtual robot models

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ..errors import DeviceError
 from ..firmware import protocol as P
-from . import record as R
+from ..io import run_record as R
 from .link import CLOSED, Link
 
 RECORD_EVERY_S = 0.25  # run.json is rewritten at most this often during a hop

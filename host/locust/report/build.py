@@ -14,17 +14,17 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from .. import __version__
-from ..device.record import ERROR as REFUSED
 from ..errors import ReportError
 from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, unique_dir
+from ..io.run_record import ERROR as REFUSED
 from ..params import Provenance, Robot
+from ..trials.configs import Configuration, configuration
+from ..trials.measured import Trial
 from . import figures as F
 from . import page as H
 from .checks import VIRTUAL, Notice, notices, recorded_on
 from .compare import Comparison, compare, timing_rows
-from .configs import Configuration, configuration
 from .landscape import Landscape, read_landscape
-from .measured import Trial
 from .predict import predict
 from .sidebyside import plan_side_by_side, write_side_by_side
 from .spread import spread

@@ -22,10 +22,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..device.record import RunRecord
-from ..track.importing import units_hint
+from ..io.importing import units_hint
+from ..io.run_record import RunRecord
+from ..trials.measured import CONFIG_GIVEN, Trial, span_hint
 from .compare import Comparison, MeasuredTrial
-from .measured import CONFIG_GIVEN, Trial, span_hint
 
 ROBOT = "robot"
 VIRTUAL = "virtual robot"

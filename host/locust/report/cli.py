@@ -7,9 +7,9 @@ from pathlib import Path
 
 import click
 
+from ..io.importing import import_options
 from ..params import load_robot, resolve_robot
 from ..params_cli import robot_options
-from ..track.importing import import_options
 
 
 def _stage(msg: str) -> None:
@@ -58,9 +58,9 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
                     --config calibration/robot.toml
       locust report --measured medium=a.tracks.csv,b.tracks.csv --preset seed --sweep sweep/ --cycles 6
     """
+    from ..trials.configs import parse_added
+    from ..trials.measured import parse_measured
     from .build import build_report
-    from .configs import parse_added
-    from .measured import parse_measured
 
     robot = resolve_robot(preset, config, sets)
     groups = parse_measured(list(measured), marker=marker, imports=imports)

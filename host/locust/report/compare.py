@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..device.record import Jitter, jitter
 from ..errors import ReportError
-from .measure import Aligned, MeasuredHop, align, measure_hops
-from .measured import Trial, span_hint
+from ..io.run_record import Jitter, jitter
+from ..trials.measure import Aligned, MeasuredHop, align, measure_hops
+from ..trials.measured import Trial, span_hint
 from .predict import Prediction
 
 

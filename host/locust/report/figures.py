@@ -11,8 +11,8 @@ import numpy as np
 
 from ..plotting import png_bytes, pyplot
 from ..sweep.design import SCALE
+from ..trials.configs import Configuration
 from .compare import Comparison
-from .configs import Configuration
 from .landscape import Landscape, design_value
 
 COLOURS = {"small": "#1f77b4", "medium": "#ff7f0e", "large": "#2ca02c"}   # the seed dashboard's

@@ -20,8 +20,6 @@ from ..params import Provenance, Robot, all_keys, problems, with_added_length
 from ..sim.fourbar import assemble
 
 SCALE = "scale"
-RESULT_FIELDS = ("valid", "reason", "distance_m", "max_nose_height_m", "nose_apex_max_m",
-                 "com_apex_max_m", "hops", "grashof", "transmission_deg")
 CRANK_CHECK_STEP_DEG = 1.0
 
 

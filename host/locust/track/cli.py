@@ -10,14 +10,16 @@ import numpy as np
 
 from ..errors import TrackError
 from ..fileio import atomic_write_json
+from ..io import trk as trk_io
+from ..io.camera_json import camera_json_beside
+from ..io.importing import ImportOptions, import_options, import_tracks, is_project, span_warnings
+from ..io.tracks_csv import tracks_csv_beside, write_tracks_csv
 from ..progress import progress
 from . import board, calib, camera, export, overlay, preview, trk
 from .aruco import DEFAULT_DICTIONARY, side_px_in_video
 from .board import DEFAULT_BOARD
-from .importing import ImportOptions, import_options, import_tracks, is_project, span_warnings
 from .runner import track_video
 from .spec import ModelOptions, parse_markers
-from .tracks_csv import tracks_csv_beside, write_tracks_csv
 from .video import Clip, probe
 
 
@@ -43,7 +45,7 @@ def _refuse_inputs(paths: dict[str, Path], inputs: list[Path]) -> None:
     (``<video>.camera.json``, ``<video>.truth.csv``), ``--force`` or not."""
     guarded = set()
     for p in inputs:
-        guarded |= {p.resolve(), camera.camera_json_beside(p).resolve(), p.with_name(p.stem + ".truth.csv").resolve()}
+        guarded |= {p.resolve(), camera_json_beside(p).resolve(), p.with_name(p.stem + ".truth.csv").resolve()}
     clash = [str(p) for p in paths.values() if p.resolve() in guarded]
     if clash:
         raise TrackError(f"--out would overwrite an input or its sidecar: {', '.join(clash)}",
@@ -202,16 +204,16 @@ def track(video, markers, color_tol, search_px, template_radius, accept, likenes
         if calibration_from is not None:
             raise TrackError("VIDEO is a Tracker project: its calibration is used, leave out --calibration-from",
                              "or give the video itself as VIDEO")
-        project = trk.read_project(video)
+        project = trk_io.read_project(video)
     elif calibration_from is not None:
-        project = trk.read_project(calibration_from)
+        project = trk_io.read_project(calibration_from)
     if project is not None and (scale or scale_aruco or origin or camera_json or board_text or plane_points):
         raise TrackError("a Tracker project's calibration, or --scale/--scale-aruco/--origin/--camera-json/--board, "
                          "not both", "one calibration per run")
     if project is not None and fps is None and math.isfinite(project.clip.fps):
         fps = project.clip.fps
     if project is not None and is_project(video):
-        with trk.project_media(project) as media:
+        with trk_io.project_media(project) as media:
             return _track(media, video, project, markers, (color_tol, search_px, template_radius, accept, likeness,
                                                            evolve), board_text, plane_points, preview_frame,
                           camera_json, scale, scale_aruco, aruco_dict, origin, angle, Clip(start, end, step, fps),
@@ -256,7 +258,7 @@ def _track(video: Path, named: Path, project, markers, settings, board_text, pla
         result.source = f"locust track of the video in {named}"
     written = _write(result, paths, fmt)
     if trk_out is not None:
-        media = trk.media_in_zip(project, trk_out) if project is not None and is_project(named) else None
+        media = trk_io.media_in_zip(project, trk_out) if project is not None and is_project(named) else None
         written.append(trk.write_project(result, trk_out, media))
     if "overlay" in paths:
         if overlay_kind == "png":
@@ -290,7 +292,7 @@ def _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, came
             raise TrackError("give --camera-json or --scale/--scale-aruco/--origin, not both",
                              "one calibration per run")
         return camera.load(camera_json, info.width_px, info.height_px)
-    beside = camera.camera_json_beside(info.path)
+    beside = camera_json_beside(info.path)
     if not by_hand and beside.is_file():
         return camera.load(beside, info.width_px, info.height_px)
     m_per_px, source = math.nan, "none"
@@ -314,7 +316,7 @@ def _write(result, paths: dict[str, Path], fmt: str) -> list[Path]:
 
 
 def _convert_trk(path: Path, names: list[str], out, fmt: str, force: bool) -> None:
-    project = trk.read_project(path)
+    project = trk_io.read_project(path)
     result = trk.project_result(project, names or None)
     paths = _outputs(_base_path(out, path), fmt, "none")
     _refuse_inputs(paths, [path])

@@ -16,8 +16,8 @@ import numpy as np
 
 from .. import __version__
 from ..fileio import atomic_write_json
+from ..io.tracks_csv import MarkerColumns, TracksCsv, tracks_csv_text, write_tracks_csv
 from .runner import TrackResult
-from .tracks_csv import MarkerColumns, TracksCsv, tracks_csv_text, write_tracks_csv
 
 PIXEL_CONVENTION = "OpenCV: origin at the centre of the top-left pixel, x right, y down"
 

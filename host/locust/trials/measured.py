@@ -4,14 +4,14 @@
 
 - a folder holding a track (``*.tracks.csv``, or one CSV/Tracker export with marker columns)
   and/or a ``run.json`` (the record ``locust hop`` wrote, read with
-  :func:`locust.device.record.read_run_record`);
+  :func:`locust.io.run_record.read_run_record`);
 - a track file (``locust track`` CSV or Tracker text export); a ``run.json`` beside it is
   its run record;
 - a ``run.json``; a single ``*.tracks.csv`` beside it is its track.
 
 A plain path's configuration comes from its folder's name (see
 :func:`.configs.name_from_path`); the trial remembers that it was guessed (``config_from``).
-Tracks are read by the track layer's one import (:func:`locust.track.importing.import_tracks`:
+Tracks are read by the track layer's one import (:func:`locust.io.importing.import_tracks`:
 a tracks CSV, a Tracker text export or a ``t,x,y`` CSV, with ``--units``, ``--rename`` and
 ``--mirror``), so the formats and conversions are the same everywhere.
 """
@@ -24,11 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..device.record import RECORD_NAME as RUN_NAME
-from ..device.record import RunRecord, read_run_record
 from ..errors import DeviceError, ReportError, TrackError
-from ..track.importing import AS_IS, DESK_SPAN_M, TYPICAL_SPAN_M, ImportOptions, import_tracks, units_hint
-from ..track.tracks_csv import TRACKS_CSV_SUFFIX
+from ..io.importing import AS_IS, DESK_SPAN_M, TYPICAL_SPAN_M, ImportOptions, import_tracks, units_hint
+from ..io.run_record import RECORD_NAME as RUN_NAME
+from ..io.run_record import RunRecord, read_run_record
+from ..io.tracks_csv import TRACKS_CSV_SUFFIX
 from .configs import check_name, name_from_path, sort_key
 
 TRACK_GLOB = f"*{TRACKS_CSV_SUFFIX}"

@@ -170,15 +170,13 @@ def is_project(path: str | Path) -> bool:
 def import_project(path: str | Path, options: ImportOptions = AS_IS) -> TracksCsv:
     """A Tracker project's point tracks in metres through its own calibration (:mod:`.trk`),
     renamed and mirrored by ``options``; a comment says which scale, origin and rate were used."""
-    from .export import tracks_of  # the project reader pulls in the video layer: only when needed
-    from .trk import project_result, read_project
+    from .trk import project_tracks, read_project
 
     path = Path(path)
     if options.units != "m":
         raise TrackError(f"{path}: --units {options.units} does not apply to a Tracker project",
                          "the project's own calibration gives metres: leave --units out")
     project = read_project(path)
-    result = project_result(project)
     cal, clip = project.calibration, project.clip
     if not math.isfinite(cal.m_per_px):
         raise TrackError(f"{path}: the Tracker project has no scale (no calibration stick or tape)",
@@ -189,7 +187,7 @@ def import_project(path: str | Path, options: ImportOptions = AS_IS) -> TracksCs
     note = (f"imported from {path.name} (Tracker project): scale {1 / cal.m_per_px:.6g} px/m, origin "
             f"({cal.origin_x_px + 0.5:.6g}, {cal.origin_y_px + 0.5:.6g}) px, x axis {cal.angle_deg:g} deg, "
             f"{clip.fps:.6g} frames/s")
-    tracks = replace(tracks_of(result), comments=(note,), path=path)
+    tracks = replace(project_tracks(project), comments=(note,), path=path)
     return tracks if options.identity else _convert_tracks_csv(tracks, options)
 
 
