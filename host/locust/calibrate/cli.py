@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..errors import CalibrationError, ReportError, TrackError
+from ..errors import CalibrationError, TrackError
 from ..fileio import json_text
 from ..io.delimited import read_text
 from ..io.importing import ImportOptions, import_options
@@ -368,11 +368,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
             path, leg_set = Path(rest), name
         else:
             path = Path(item)
-            try:
-                leg_set = name_from_path(path)
-            except ReportError:
-                raise CalibrationError(f"{path}: cannot tell which leg set this run is from its folder's name",
-                                       "name it: small=PATH") from None
+            leg_set = name_from_path(path)
         loaded.append(H.load_run(path, leg_set, base))
     with progress(length=max_iter, label="fitting hops") as bar:
         fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=bar.update)

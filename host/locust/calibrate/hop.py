@@ -45,7 +45,7 @@ import numpy as np
 from mujoco import minimize
 from scipy import optimize
 
-from ..errors import CalibrationError, GeometryError, ParamsError, ReportError, SimError
+from ..errors import CalibrationError, GeometryError, ParamsError, SimError, TrialError
 from ..params import Provenance, Robot, value_type
 from ..sim.kinematics import geom_positions, marker_geoms, trace_rows
 from ..sim.model import build
@@ -145,10 +145,7 @@ class HopFit:
 # -- reading runs ------------------------------------------------------------------------
 def load_run(path: Path, config: str, base: Robot) -> HopRun:
     """A ``locust hop --out`` folder (its run.json and tracks) as a :class:`HopRun` of ``config``."""
-    try:
-        trial = load_trial(Path(path), config, "nose")
-    except ReportError as exc:
-        raise CalibrationError(exc.message, exc.hint) from None
+    trial = load_trial(Path(path), config, "nose")
     if trial.record is None or trial.track is None:
         raise CalibrationError(f"{path}: a hop fit needs the run's run.json and the track of its video",
                                "give the folder `locust hop --out` wrote, after `locust track` on its video")
@@ -160,14 +157,11 @@ def load_run(path: Path, config: str, base: Robot) -> HopRun:
                                "a hop fit needs a run that pushed at least once; rerun the hop")
     t0_us = pushes[0].measured_us
     phases = [p for p in phases if p.measured_us >= t0_us]
-    try:
-        onset, x0, y0 = onset_time(trial.track.t_s, trial.track.x_m, trial.track.y_m, where=str(trial.track.path))
-    except ReportError as exc:
-        raise CalibrationError(exc.message, exc.hint) from None
+    onset, x0, y0 = onset_time(trial.track.t_s, trial.track.x_m, trial.track.y_m, where=str(trial.track.path))
     tracks = {"nose": MarkerTrack(trial.track.t_s, trial.track.x_m - x0, trial.track.y_m - y0)}
     try:
         foot = read_track(trial.track.path, "foot")
-    except ReportError:
+    except TrialError:
         foot = None          # a track of the nose alone is fitted on the nose alone
     if foot is not None and (foot.t_s < onset).sum() >= 2:
         before = foot.t_s < onset
@@ -237,7 +231,7 @@ def aligned_residual(run: HopRun, sim: dict[str, np.ndarray] | None) -> tuple[np
     nose = sim["nose"]
     try:
         latency, _, _ = onset_time(nose[0], nose[1], nose[2], where="simulation")
-    except ReportError:
+    except TrialError:
         return np.full(n, FAILED_M), math.nan
 
     def residual_at(shift: float) -> np.ndarray:       # shift: camera time of the first push

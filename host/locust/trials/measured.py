@@ -1,4 +1,4 @@
-"""Measured inputs of a report: marker tracks and run records, grouped by configuration.
+"""Measured inputs of a report or a hop fit: marker tracks and run records, grouped by configuration.
 
 ``--measured`` takes ``NAME=PATH[,PATH...]`` or plain paths. Each path is one trial:
 
@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DeviceError, ReportError, TrackError
+from ..errors import DeviceError, TrackError, TrialError
 from ..io.importing import AS_IS, DESK_SPAN_M, TYPICAL_SPAN_M, ImportOptions, import_tracks, units_hint
 from ..io.run_record import RECORD_NAME as RUN_NAME
 from ..io.run_record import RunRecord, read_run_record
@@ -66,7 +66,7 @@ def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose",
     """``--measured`` values -> trials per configuration, in leg-set order; ``imports``
     (``--units``, ``--rename``, ``--mirror``) converts every track."""
     if not items:
-        raise ReportError("no measured inputs", "give --measured small=runs/small-1,runs/small-2 (or plain paths)")
+        raise TrialError("no measured inputs", "give --measured small=runs/small-1,runs/small-2 (or plain paths)")
     groups: dict[str, list[Trial]] = {}
     for item in items:
         name, paths = _split_item(item)
@@ -82,7 +82,7 @@ def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose",
         for t in trials:
             key = (t.track.path.resolve() if t.track else None, t.run_path.resolve() if t.run_path else None)
             if key in seen:
-                raise ReportError(f"configuration {name}: the trial {t.label} is given twice",
+                raise TrialError(f"configuration {name}: the trial {t.label} is given twice",
                                   "list each trial once")
             seen.add(key)
     return {k: groups[k] for k in sorted(groups, key=sort_key)}
@@ -93,7 +93,7 @@ def _split_item(item: str) -> tuple[str | None, list[str]]:
     if sep and name and "/" not in name and not Path(item).exists():
         paths = [p for p in rest.split(",") if p.strip()]
         if not paths:
-            raise ReportError(f"--measured {item!r} names no path", "e.g. --measured small=runs/s1,runs/s2")
+            raise TrialError(f"--measured {item!r} names no path", "e.g. --measured small=runs/s1,runs/s2")
         return check_name(name), [p.strip() for p in paths]
     return None, [item]
 
@@ -101,7 +101,7 @@ def _split_item(item: str) -> tuple[str | None, list[str]]:
 def load_trial(path: Path, config: str, marker: str = "nose", imports: ImportOptions = AS_IS,
                config_from: str = CONFIG_GIVEN) -> Trial:
     if not path.exists():
-        raise ReportError(f"{path}: no such file or folder", "check the --measured path")
+        raise TrialError(f"{path}: no such file or folder", "check the --measured path")
     if path.is_dir():
         run_path = path / RUN_NAME if (path / RUN_NAME).is_file() else None
         track_path = _one_track(path, required=run_path is None)
@@ -119,12 +119,12 @@ def load_trial(path: Path, config: str, marker: str = "nose", imports: ImportOpt
 def _one_track(folder: Path, required: bool) -> Path | None:
     found = sorted(folder.glob(TRACK_GLOB))
     if len(found) > 1:
-        raise ReportError(f"{folder}: several tracks ({', '.join(p.name for p in found)})",
+        raise TrialError(f"{folder}: several tracks ({', '.join(p.name for p in found)})",
                           "give the track file itself as the --measured path")
     if found:
         return found[0]
     if required:
-        raise ReportError(f"{folder}: no track (*.tracks.csv) and no run.json",
+        raise TrialError(f"{folder}: no track (*.tracks.csv) and no run.json",
                           "run `locust track VIDEO` there, or give the track file's path")
     return None
 
@@ -136,20 +136,20 @@ def read_track(path: Path, marker: str = "nose", imports: ImportOptions = AS_IS)
         t = tracks.time_s()
         x, y = tracks.positions(marker)
     except TrackError as exc:
-        raise ReportError(exc.message, exc.hint) from None
+        raise TrialError(exc.message, exc.hint) from None
     ok = np.isfinite(t) & np.isfinite(x) & np.isfinite(y)
     if not ok.any():
         scaled = tracks.has_pixels(marker)
         hint = ("the track has pixels but no metres: run `locust track` with --scale or --scale-aruco"
                 if scaled else f"the {marker} marker was never found: check the video and the marker colour")
-        raise ReportError(f"{path}: no {marker} position in metres in any frame", hint)
+        raise TrialError(f"{path}: no {marker} position in metres in any frame", hint)
     if ok.sum() < 10:
-        raise ReportError(f"{path}: only {int(ok.sum())} frames with a {marker} position",
+        raise TrialError(f"{path}: only {int(ok.sum())} frames with a {marker} position",
                           "a report needs the whole hop: track the full clip")
     order = np.argsort(t[ok], kind="stable")
     tt = t[ok][order]
     if np.any(np.diff(tt) <= 0):
-        raise ReportError(f"{path}: repeated time stamps in t_s",
+        raise TrialError(f"{path}: repeated time stamps in t_s",
                           "export the track again; each frame needs its own time")
     return Track(path=path, marker=marker, t_s=tt, x_m=x[ok][order], y_m=y[ok][order], frames=tracks.n_rows,
                  units=imports.units, mirrored=imports.mirror, m_per_px=metres_per_pixel(tracks, marker))
@@ -172,7 +172,7 @@ def read_run(path: Path) -> RunRecord:
     try:
         return read_run_record(path)
     except DeviceError as exc:
-        raise ReportError(exc.message, exc.hint) from None
+        raise TrialError(exc.message, exc.hint) from None
 
 
 def span_hint(track: Track) -> str | None:
