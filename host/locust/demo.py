@@ -36,18 +36,16 @@ import click
 
 from .errors import ReportError
 from .fileio import atomic_write_json, atomic_write_text, unique_dir
+from .params import LEG_SETS, leg_set, preset
 from .progress import progress
 
-LEG_SETS = ("small", "medium", "large")
-# The virtual robot is the seed robot with each leg set's links (what the demo's calibration
-# models: its robot.toml's base is the seed), at that leg set's converged step (params.LEG_SETS);
-# the small/medium/large presets are the robot as built instead.
+# The virtual robot is the seed robot with each leg set of params.LEG_SETS (the one definition:
+# its links and its converged step; what the demo's calibration models: its robot.toml's base is
+# the seed); the small/medium/large presets are the robot as built instead.
 
 
 def seed_leg_set_options(name: str) -> list[str]:
     """``--preset seed --set ...`` for the seed robot with leg set ``name``'s links and step."""
-    from .params import leg_set, preset
-
     robot = leg_set(preset("seed"), name)
     keys = ("geometry.ground_m", "geometry.crank_m", "geometry.coupler_m", "geometry.leg_m", "solver.timestep_s")
     return ["--preset", "seed", *[arg for key in keys for arg in ("--set", f"{key}={robot.get(key)!r}")]]
