@@ -5,7 +5,9 @@
 - Tracker's text export (locust.io.tracker_text): steps a track does not have, a frame
   no track has, Tracker 6's shared time column, per-track time columns;
 - camera.json (locust.io.camera_json): a fixed and a following camera, a plane without its
-  stray distance (null in JSON, NaN here).
+  stray distance (null in JSON, NaN here);
+- a Tracker project (.trk) written from a tracking result (locust.track.trk) and read back by
+  its reader (locust.io.trk): steps, clip, calibration, and the tracks in metres.
 
 Numbers here are SYNTHETIC (chosen to survive the files' decimals exactly).
 """
@@ -23,7 +25,12 @@ from locust.errors import TrackError
 from locust.io import camera_json as cam
 from locust.io import tracker_text as tt
 from locust.io import tracks_csv as tc
+from locust.io import trk as trk_io
 from locust.track import camera as track_camera
+from locust.track import trk
+from locust.track.export import tracks_of
+from locust.track.runner import MarkerTrack, TrackResult
+from locust.track.video import Clip, VideoInfo
 
 NAN = math.nan
 
@@ -190,3 +197,33 @@ def test_simulations_camera_json_reads_back_to_the_same_bytes(tmp_path, kind):
     assert info.camera_path == cam.camera_json_beside(info.video_path)
     again = cam.write_camera_json(tmp_path / "again.json", cam.read_camera_json(info.camera_path))
     assert again.read_text() == info.camera_path.read_text()
+
+
+def test_tracker_project_round_trip(tmp_path):
+    """A result written as a .trk reads back with the same steps (Tracker's pixel convention
+    undone), clip, calibration and, through that calibration, the same metres."""
+    frames = np.arange(2, 8)
+    ok = np.array([True, True, False, True, True, True])
+    px = np.where(ok, 100.0 + 4.25 * (frames - 2), NAN)
+    py = np.where(ok, 300.0 - 2.5 * (frames - 2), NAN)
+    nose = MarkerTrack("nose", "colour:pink", px, py, np.where(ok, 1.0, NAN), ok)
+    cal = trk_io.Calibration(m_per_px=1 / 2048, origin_x_px=12.5, origin_y_px=350.25, angle_deg=2.5, source="stick")
+    clip = Clip(2, 7, 1, 30.0)
+    video = VideoInfo(tmp_path / "hop.mp4", 640, 360, 12, 30.0)
+    result = TrackResult(video, clip, frames, (frames - 2) / 30.0, [nose], cal)
+    path = trk.write_project(result, tmp_path / "hop.trk")
+
+    back = trk_io.read_project(path)
+    assert back.video_path == "hop.mp4"
+    assert back.points["nose"] == {int(f): (x, y) for f, x, y, k in zip(frames, px, py, ok) if k}
+    assert (back.clip.start, back.clip.end, back.clip.step) == (2, 7, 1)
+    assert back.clip.fps == pytest.approx(30.0, rel=1e-12)
+    c = back.calibration
+    assert (c.origin_x_px, c.origin_y_px, c.angle_deg) == (12.5, 350.25, 2.5)
+    assert c.m_per_px == pytest.approx(1 / 2048, rel=1e-12)
+    mine, theirs = tracks_of(result), trk_io.project_tracks(back)
+    np.testing.assert_array_equal(theirs.frame, mine.frame)
+    np.testing.assert_allclose(theirs.t_s, mine.t_s, rtol=1e-12)
+    for col in ("px", "py", "x_m", "y_m", "ok"):
+        np.testing.assert_allclose(getattr(theirs.markers["nose"], col), getattr(mine.markers["nose"], col),
+                                   rtol=1e-12, atol=0)

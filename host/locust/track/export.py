@@ -1,6 +1,6 @@
 """Tracks to files: the CSV everyone reads, and a JSON sidecar with how they were made.
 
-The CSV's layout, writer and reader are :mod:`.tracks_csv`'s (columns ``frame``, ``t_s``,
+The CSV's layout, writer and reader are :mod:`locust.io.tracks_csv`'s (columns ``frame``, ``t_s``,
 then per marker ``<name>_px``, ``<name>_py`` in pixels, OpenCV convention, ``<name>_x_m``,
 ``<name>_y_m`` in world metres, y up, ``nan`` without a scale, and ``<name>_ok`` 1/0; a
 marker not found is ``nan`` with ok 0). This module turns a

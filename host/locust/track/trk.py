@@ -34,7 +34,7 @@ def project_result(project: TrackerProject, names: list[str] | None = None) -> T
                        source=f"tracker project {project.path}")
 
 
-# --- Tracker's text export (the format itself: :mod:`.tracker_text`) ------------------
+# --- Tracker's text export (the format itself: :mod:`locust.io.tracker_text`) --------
 
 def tracker_export(result: TrackResult) -> TrackerExport:
     """Tracks as Tracker exports them: per track ``t``, ``x``, ``y`` in world units (m, s),
