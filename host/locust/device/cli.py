@@ -14,6 +14,7 @@ from ..firmware import config as fw_config
 from ..params import Schedule, resolve_robot
 from ..params_cli import robot_options
 from ..progress import progress
+from ..tables import plant_lines
 from . import record as R
 from .plant import PLANTS
 
@@ -329,4 +330,6 @@ def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, s
         pass
     finally:
         summary = vr.stop()
-        _info(f"virtual robot stopped after {vr.boots} boot(s); " + ", ".join(f"{k}={v}" for k, v in summary.items()))
+        _info(f"virtual robot stopped after {vr.boots} boot(s)")
+        for line in plant_lines(summary):
+            _info(line)
