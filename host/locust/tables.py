@@ -37,15 +37,25 @@ def sim_lines(r) -> list[str]:
     if not r.valid:
         return lines
     lines.append(f"{INDENT}linkage: {r.grashof}, transmission angle {r.transmission_deg:.0f} deg")
-    rows = [[str(h.cycle), mm(h.distance_m), mm(h.nose_apex_m), mm(h.com_apex_m), f"{h.flight_s * 1000:.1f}"]
-            for h in r.hops]
-    lines += table(["hop", "distance mm", "nose rise mm", "CoM rise mm", "flight ms"], rows)
-    lines.append(f"{INDENT}total distance {mm(r.distance_m)} mm; highest nose {mm(r.max_nose_height_m)} mm "
-                 f"above the floor")
+    lines += hop_table([vars(h) for h in r.hops])
+    lines.append(totals_line(r.distance_m, r.max_nose_height_m))
     if r.convergence:
         lines.append(INDENT + convergence_line(r.convergence))
     lines += [f"{INDENT}note: {note}" for note in r.notes]
     return lines
+
+
+def hop_table(hops: list[dict]) -> list[str]:
+    """One row per hop (the fields of :class:`locust.sim.hops.Hop`, as a dict): distance, nose
+    and centre-of-mass rise above standing in mm, flight in ms."""
+    rows = [[str(h["cycle"]), mm(h["distance_m"]), mm(h["nose_apex_m"]), mm(h["com_apex_m"]),
+             f"{h['flight_s'] * 1000:.1f}"] for h in hops]
+    return table(["hop", "distance mm", "nose rise mm", "CoM rise mm", "flight ms"], rows)
+
+
+def totals_line(distance_m: float, max_nose_height_m: float) -> str:
+    """The run's whole distance and its highest nose point, in mm."""
+    return f"{INDENT}total distance {mm(distance_m)} mm; highest nose {mm(max_nose_height_m)} mm above the floor"
 
 
 def convergence_line(c: dict) -> str:
@@ -65,7 +75,8 @@ def spread_line(spread) -> str:
 
 def plant_lines(summary: dict) -> list[str]:
     """``locust hop --port sim`` and ``locust virtual``: what the virtual robot's plant did
-    (the dict its ``close()`` returns: the live MuJoCo model's audited run, or the recorder's count)."""
+    (the dict its ``close()`` returns: the live MuJoCo model's audited run, one row per push,
+    or the recorder's count)."""
     if summary.get("plant") != "mujoco":
         return [f"servo commands recorded: {summary.get('commands', 0)}"]
     rtf = summary["realtime_factor"]
@@ -73,8 +84,10 @@ def plant_lines(summary: dict) -> list[str]:
              f"{rtf:.1f}x real time)" if math.isfinite(rtf) else
              f"simulated robot: {verdict(summary['valid'])} ({summary['sim_time_s']:.3f} s simulated)"]
     lines += [f"{INDENT}reason: {reason}" for reason in summary["reasons"]]
-    lines += table(["distance mm", "highest nose mm"],
-                   [[mm(summary["distance_m"]), mm(summary["max_nose_height_m"])]])
+    if summary["valid"]:
+        if summary.get("hops"):
+            lines += hop_table(summary["hops"])
+        lines.append(totals_line(summary["distance_m"], summary["max_nose_height_m"]))
     if summary.get("video_path"):
         lines.append(f"{INDENT}video: {summary['video_path']} ({summary['frames']} frames)")
     return lines
