@@ -31,7 +31,8 @@ def verdict(valid: bool) -> str:
 def sim_lines(r) -> list[str]:
     """``locust sim``: a :class:`locust.sim.run.SimResult` as the verdict, one row per hop,
     the totals, the convergence check and the notes."""
-    lines = [f"{r.robot}: {verdict(r.valid)} ({r.cycles} cycles, time step {r.timestep_s:g} s, "
+    lines = [f"{r.robot}: {verdict(r.valid)} ({r.cycles} cycle{'' if r.cycles == 1 else 's'}, "
+             f"time step {r.timestep_s:g} s, "
              f"{r.wall_s:.1f} s wall)"]
     lines += [f"{INDENT}reason: {reason}" for reason in r.reasons]
     if not r.valid:
