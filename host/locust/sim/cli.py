@@ -27,7 +27,8 @@ from ..tables import sim_lines, spread_line
               help="Rerun at half the time step and report the relative change.")
 @click.option("--samples", type=click.IntRange(2, 4096), default=None, metavar="N",
               help="Also simulate N draws of the values that carry an uncertainty in the robot file "
-                   "(one batched rollout) and report distance_m_sd and max_nose_height_m_sd.")
+                   "(one batched rollout) and report the sd of distance and highest nose "
+                   "(--json: distance_m_sd, max_nose_height_m_sd).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of --samples.")
 def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence, samples, seed):
     """Settle the robot on the floor, then run the bang-bang hop schedule.
