@@ -45,6 +45,8 @@ def test_live_two_cycles_match_the_rollout(seed):
     # the same model, the same steps, the same commands at the same steps: bit for bit
     assert live["distance_m"] == ref.distance_m
     assert live["max_nose_height_m"] == ref.max_nose_height_m
+    # cut where each push starts, the live run's hops are the rollout's cycles, bit for bit
+    assert live["hops"] == [vars(hop) for hop in ref.hops] and len(live["hops"]) == 2
     assert sim.close() == live           # closing twice gives the same answer
 
 

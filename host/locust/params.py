@@ -310,7 +310,7 @@ def parse_set_options(items: tuple[str, ...] | list[str]) -> dict[str, str]:
     for item in items:
         key, sep, value = item.partition("=")
         if not sep or not key.strip() or not value.strip():
-            raise ParamsError(f"--set {item!r} is not KEY=VALUE", "e.g. --set servo.kp_nm_per_rad=25")
+            raise ParamsError(f"--set {item!r} is not KEY=VALUE", "e.g. --set servo.kp_nm_per_rad=0.4")
         _split_key(key.strip())
         out[key.strip()] = value.strip()
     return out

@@ -15,6 +15,7 @@ from ..io import run_record as R
 from ..params import Schedule, resolve_robot
 from ..params_cli import robot_options
 from ..progress import progress
+from ..tables import plant_lines
 from .plant import PLANTS
 
 CHIPS = tuple(fw_config.CHIPS)  # the chips whose pin rules the firmware knows, and the virtual robot models
@@ -329,4 +330,6 @@ def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, s
         pass
     finally:
         summary = vr.stop()
-        _info(f"virtual robot stopped after {vr.boots} boot(s); " + ", ".join(f"{k}={v}" for k, v in summary.items()))
+        _info(f"virtual robot stopped after {vr.boots} boot(s)")
+        for line in plant_lines(summary):
+            _info(line)

@@ -106,18 +106,47 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     land = read_landscape(sweep) if sweep is not None else None   # fail early on a bad sweep folder
     t0 = time.perf_counter()
 
+    configs, comps, spreads, befores = _simulate(base, measured, added, cycles, marker, progress, side_by_side,
+                                                 samples, before)
+
+    progress("drawing figures")
+    figs = _figures(comps, configs, land, spreads, befores)
+    dash = F.dashboard(comps, land, configs)
+
+    timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
+    warnings = notices(comps)
+    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings)
+    doc = report_json(base, robot_source, comps, configs, timing, land, marker, warnings)
+    for entry in doc["configurations"]:
+        sp, old = spreads.get(entry["name"]), befores.get(entry["name"])
+        entry["predicted_spread"] = sp.to_json() if sp is not None else None
+        entry["predicted_before_fit"] = old.result.to_json() if old is not None else None
+
+    sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
+
+    folder = unique_dir(out, "report")
+    html_path = atomic_write_text(folder / REPORT_NAME, html_text)
+    dash_path = atomic_write_bytes(folder / DASHBOARD_NAME, dash)
+    videos = write_side_by_side(sbs_plan, folder, progress) if sbs_plan is not None else []
+    if sbs_plan is not None:
+        doc["side_by_side"] = [v.to_json() for v in videos]
+    json_path = atomic_write_json(folder / JSON_NAME, {**doc, "wall_s": round(time.perf_counter() - t0, 2)})
+    return ReportResult(folder, html_path, dash_path, json_path, comps, [f.key for f in figs],
+                        warnings=warnings, side_by_side=videos)
+
+
+def _simulate(base: Robot, measured: dict[str, list[Trial]], added: dict[str, float], cycles: int | None,
+              marker: str, progress: Callable[[str], None], side_by_side: bool, samples: int,
+              before: Robot | None) -> tuple[dict[str, Configuration], list[Comparison], dict, dict]:
+    """Each configuration simulated on its runs' schedule and compared with its trials; with
+    ``samples``, its spread over the uncertain values; with ``before``, the robot before the
+    fit predicted too. Returns (configs, comparisons, spreads, befores)."""
     configs: dict[str, Configuration] = {}
     comps: list[Comparison] = []
     spreads, befores = {}, {}
     for name, trials in measured.items():
-        cfg = configuration(base, name, added.get(name))
-        sched = run_schedule(name, trials)
-        cfg = Configuration(cfg.name, cfg.added_m, with_run_schedule(cfg.robot, sched))
+        cfg, sched, n_cycles = _run_configuration(base, name, trials, added.get(name), cycles)
         configs[name] = cfg
-        if cycles and sched and cycles > sched["cycles"]:
-            raise ReportError(f"--cycles {cycles}: the runs of {name} recorded only {sched['cycles']} cycles",
-                              f"give --cycles {sched['cycles']} or fewer, or leave it out")
-        n_cycles = cycles or (sched["cycles"] if sched else cfg.robot.schedule.cycles)
         period = cfg.robot.schedule.push_s + cfg.robot.schedule.wait_s
         progress(f"simulating {cfg.label} ({n_cycles} cycles)")
         pred = predict(name, cfg.robot, n_cycles, marker, keep_states=side_by_side)
@@ -128,8 +157,27 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
         if before is not None:
             old = configuration(before, name, added.get(name))
             befores[name] = predict(name, with_run_schedule(old.robot, sched), n_cycles, marker)
+    return configs, comps, spreads, befores
 
-    progress("drawing figures")
+
+def _run_configuration(base: Robot, name: str, trials: list[Trial], added_m: float | None,
+                       cycles: int | None) -> tuple[Configuration, dict | None, int]:
+    """Configuration ``name`` on the schedule its trials ran, that schedule, and the cycles to
+    simulate (``cycles``, else the runs', else the robot's; never more than the runs recorded)."""
+    cfg = configuration(base, name, added_m)
+    sched = run_schedule(name, trials)
+    cfg = Configuration(cfg.name, cfg.added_m, with_run_schedule(cfg.robot, sched))
+    if cycles and sched and cycles > sched["cycles"]:
+        raise ReportError(f"--cycles {cycles}: the runs of {name} recorded only {sched['cycles']} cycles",
+                          f"give --cycles {sched['cycles']} or fewer, or leave it out")
+    n_cycles = cycles or (sched["cycles"] if sched else cfg.robot.schedule.cycles)
+    return cfg, sched, n_cycles
+
+
+def _figures(comps: list[Comparison], configs: dict[str, Configuration], land: Landscape | None,
+             spreads: dict, befores: dict) -> list[H.Figure]:
+    """The page's figures with their captions: overlay, jump, hops, the sweep landscape (with
+    a sweep) and the firmware timing."""
     labels = {name: cfg.label for name, cfg in configs.items()}
     names_text = ", ".join(labels.values())
     figs = [
@@ -156,28 +204,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     figs.append(H.Figure("timing", f"Firmware timing of the runs: {names_text}",
                          "Start of every phase as the firmware measured it, minus the commanded start.",
                          F.timing_figure(comps)))
-    dash = F.dashboard(comps, land, configs)
-
-    timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
-    warnings = notices(comps)
-    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings)
-    doc = report_json(base, robot_source, comps, configs, timing, land, marker, warnings)
-    for entry in doc["configurations"]:
-        sp, old = spreads.get(entry["name"]), befores.get(entry["name"])
-        entry["predicted_spread"] = sp.to_json() if sp is not None else None
-        entry["predicted_before_fit"] = old.result.to_json() if old is not None else None
-
-    sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
-
-    folder = unique_dir(out, "report")
-    html_path = atomic_write_text(folder / REPORT_NAME, html_text)
-    dash_path = atomic_write_bytes(folder / DASHBOARD_NAME, dash)
-    videos = write_side_by_side(sbs_plan, folder, progress) if sbs_plan is not None else []
-    if sbs_plan is not None:
-        doc["side_by_side"] = [v.to_json() for v in videos]
-    json_path = atomic_write_json(folder / JSON_NAME, {**doc, "wall_s": round(time.perf_counter() - t0, 2)})
-    return ReportResult(folder, html_path, dash_path, json_path, comps, [f.key for f in figs],
-                        warnings=warnings, side_by_side=videos)
+    return figs
 
 
 def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker: str) -> str:
