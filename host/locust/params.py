@@ -438,12 +438,6 @@ def problems(robot: Robot, cycles: int | None = None) -> list[str]:
     if sol.timestep_s > 0 and sol.control_hz * sol.timestep_s > 1.0 + 1e-9:
         out.append(f"solver.control_hz = {sol.control_hz:g} is faster than one command per physics step "
                    f"(1/solver.timestep_s = {1.0 / sol.timestep_s:g} Hz)")
-    fall_s = math.sqrt(2.0 * max(robot.geometry.drop_height_m, 0.0) / GRAVITY_M_PER_S2)
-    if sol.settle_s > 0 and fall_s > sol.settle_s / 2 and not _outside("geometry.drop_height_m",
-                                                                      robot.geometry.drop_height_m):
-        out.append(f"geometry.drop_height_m = {robot.geometry.drop_height_m:g} takes {fall_s:.3g} s to fall, over "
-                   f"half the {sol.settle_s:g} s on the floor before the schedule (solver.settle_s): the robot "
-                   "would still be falling or bouncing at the first push")
     if not out:
         n = sch.cycles if cycles is None else cycles
         steps = (sol.settle_s + n * (sch.push_s + sch.wait_s)) / sol.timestep_s
