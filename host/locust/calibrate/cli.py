@@ -12,8 +12,8 @@ import numpy as np
 
 from ..errors import CalibrationError, ReportError, TrackError
 from ..fileio import check_distinct, json_text
-from ..plotting import check_figure_path
 from ..options import FINITE, POSITIVE
+from ..plotting import check_figure_path
 from ..progress import progress
 from ..track.delimited import read_text
 from ..track.importing import ImportOptions, import_options
