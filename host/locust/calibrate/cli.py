@@ -10,12 +10,11 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..errors import CalibrationError, ReportError, TrackError
+from ..errors import CalibrationError, ReportError
 from ..fileio import check_distinct, json_text
 from ..options import FINITE, POSITIVE
 from ..plotting import check_figure_path
 from ..progress import progress
-from ..track.delimited import read_text
 from ..track.importing import ImportOptions, import_options
 from . import beam as B
 from . import hinge as HG
@@ -25,7 +24,7 @@ from . import servo as S
 from .fitstats import Estimate
 from .gyro_log import looks_like_gyro_log, parse_gyro_log
 from .plots import plot_fit
-from .recordings import REAL_TIME, TimeOptions, clean_samples, read_table, time_options
+from .recordings import REAL_TIME, TimeOptions, clean_samples, read_recording_text, read_table, time_options
 from .write import DEFAULT_ROBOT_TOML, check_plausible, implausible, write_fitted
 
 
@@ -317,10 +316,7 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
 def _servo_recording(path: Path, rig, pivot, step, marker, imports: ImportOptions,
                      timing: TimeOptions = REAL_TIME):
     """One servo recording, of the kind its layout says: a gyro log (rate) or an angle table."""
-    try:
-        text = read_text(path)
-    except TrackError as exc:
-        raise CalibrationError(exc.message, exc.hint) from None
+    text = read_recording_text(path)
     if looks_like_gyro_log(text):
         if pivot is not None:
             raise CalibrationError(f"{path}: --pivot is for a horn track, and this is a gyro log",
