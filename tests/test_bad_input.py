@@ -152,8 +152,8 @@ CASES = [
                                             "--out", user_trials(d)], ["did not write", "trials.csv"]),
     ("optimize-bogus-storage", lambda d: ["optimize", "--vary", "geometry.leg_m=0.05:0.07", "--trials", "1",
                                           "--out", d / "o", "--storage", "bogus://x"], ["bogus://x"]),
-    ("optimize-integer-without-integer", lambda d: ["optimize", "--vary", "schedule.cycles=1.2:1.8", "--trials", "1",
-                                                    "--out", d / "o"], ["no whole number"]),
+    ("optimize-integer-without-integer", lambda d: ["optimize", "--vary", "solver.iterations=1.2:1.8", "--trials",
+                                                    "1", "--out", d / "o"], ["no whole number"]),
     # fabrication
     ("fab-jig-diameter-0", lambda d: ["fab", "--from-robot", "seed", "--jig-diameter-mm", "0"], ["jig_diameter_mm"]),
     ("fab-jig-spacing-inf", lambda d: ["fab", "--from-robot", "seed", "--jig-spacing-mm", "inf"], ["finite"]),
@@ -253,11 +253,12 @@ def test_an_unsimulatable_design_is_an_invalid_row_of_the_sweep(tmp_path):
     from locust.sweep.design import parse_axis
     from locust.sweep.run import run_sweep
 
+    # each value within its limits, the push beyond the servo's travel together: a row, not a run
     base = preset("seed")
-    axes = [parse_axis("schedule.wait_s=-1:1:2", base)]
+    axes = [parse_axis("schedule.push_deg=-60:-30:2", base)]
     s = run_sweep(base, axes, cycles=1, out=tmp_path / "sw", jobs=1, plots=False)
     assert [r["valid"] for r in s.rows] == [False, True]
-    assert "schedule.wait_s = -1 must be >= 0.02" in s.rows[0]["reason"]
+    assert "schedule.push_deg = -60 is beyond the servo travel of +-45 deg" in s.rows[0]["reason"]
     assert s.best["design"] == 1
 
 
@@ -290,7 +291,7 @@ def test_a_full_disk_is_an_error_and_leaves_nothing_behind(tmp_path):
 
 @pytest.mark.parametrize("args", [
     ["params", "--write", "ro/robot.toml"],
-    ["sweep", "--vary", "scale=0.5:1:2", "--cycles", "1", "--out", "ro/sweep"],
+    ["sweep", "--vary", "scale=0.3:0.4:2", "--cycles", "1", "--out", "ro/sweep"],
 ], ids=["params-write", "sweep-out"])
 def test_a_read_only_folder_is_an_error_and_gets_nothing(tmp_path, monkeypatch, args):
     """Refused by the folder's mode, so the check holds even for root (who may write anyway)."""

@@ -275,6 +275,16 @@ def real_keys() -> list[str]:
     return [key for key in all_keys() if value_type(key) == "float"]
 
 
+# what the robot is (a fit may identify these), against what it is told to do (schedule) and
+# how it is simulated (solver)
+PHYSICAL_SECTIONS = ("geometry", "compliance", "servo", "contact", "power")
+
+
+def fittable_keys() -> list[str]:
+    """The real-valued physical keys: the only ones a fit may move."""
+    return [key for key in real_keys() if key.partition(".")[0] in PHYSICAL_SECTIONS]
+
+
 def _coerce(key: str, raw: Any) -> Any:
     ftype = value_type(key)
     try:
@@ -415,7 +425,8 @@ LIMITS: dict[str, Limit] = {
 MAX_SIM_STEPS = 2_000_000
 
 
-def _outside(key: str, value: float) -> str | None:
+def outside_limits(key: str, value: float) -> str | None:
+    """Why ``value`` is outside ``key``'s limits (with the limit and its reason), or None."""
     low, high, low_ok, high_ok, reason = LIMITS[key]
     if (value > low or (low_ok and value == low)) and (value < high or (high_ok and value == high)):
         return None
@@ -428,9 +439,9 @@ def _outside(key: str, value: float) -> str | None:
 
 def problems(robot: Robot, cycles: int | None = None) -> list[str]:
     """Every reason ``robot`` cannot be simulated or run as given (empty: it can)."""
-    out = [p for key in LIMITS if (p := _outside(key, robot.get(key)))]
+    out = [p for key in LIMITS if (p := outside_limits(key, robot.get(key)))]
     s, sol, sch = robot.servo, robot.solver, robot.schedule
-    if abs(sch.push_deg) > s.travel_deg and not _outside("schedule.push_deg", sch.push_deg):
+    if abs(sch.push_deg) > s.travel_deg and not outside_limits("schedule.push_deg", sch.push_deg):
         out.append(f"schedule.push_deg = {sch.push_deg:g} is beyond the servo travel of "
                    f"+-{s.travel_deg:g} deg (servo.travel_deg)")
     if s.pulse_min_us >= s.pulse_max_us:

@@ -343,11 +343,14 @@ def _per_recording(values: tuple[float, ...], n: int, option: str) -> list[float
 @click.option("--robot-marker", default="robot", show_default=True, help="For a ramp video track: the robot's marker.")
 @click.option("--into", type=click.Choice(["foot", "nose"]), default="foot", show_default=True,
               help="Which friction the result is written to (contact.foot_friction or contact.nose_friction).")
+@click.option("--resolution-deg", type=FINITE, default=R.READING_RESOLUTION_DEG, show_default=True,
+              help="How finely each angle was read [deg] (a protractor's graduation); the trials' spread is "
+                   "taken as at least resolution/sqrt(12), so trials read alike give an interval, not a point.")
 @import_options
 @time_options
 @output_options
-def ramp(data, ramp_markers, robot_marker, into, imports, timing, write_path, as_json, plot_path, no_plot,
-         force):
+def ramp(data, ramp_markers, robot_marker, into, resolution_deg, imports, timing, write_path, as_json, plot_path,
+         no_plot, force):
     """Static friction from critical ramp angles: mu = tan(mean angle), with a 95% interval.
 
     DATA: CSVs with an angle_deg column (one trial a row, degrees), and/or side-view
@@ -363,7 +366,7 @@ def ramp(data, ramp_markers, robot_marker, into, imports, timing, write_path, as
         raise CalibrationError("--units, --rename and --mirror apply to ramp tracks; these are angle tables",
                                "leave them out for angle_deg recordings")
     source = str(data[0]) if len(data) == 1 else "+".join(p.name for p in data)
-    fit = R.fit_ramp(np.array(angles), source=source)
+    fit = R.fit_ramp(np.array(angles), source=source, resolution_deg=resolution_deg)
     values = {f"contact.{into}_friction": fit.mu_static}
     note = f"ramp, {fit.n_trials} trials, mean angle {fit.mean_angle_deg:.4g} deg"
     _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot, force,
@@ -418,6 +421,9 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
             except ReportError:
                 raise CalibrationError(f"{path}: cannot tell which leg set this run is from its folder's name",
                                        "name it: small=PATH") from None
+        if path.resolve() in (Path(run.source).resolve() for run in loaded):
+            raise CalibrationError(f"{item}: the run {path} is given twice; each run counts once in the fit",
+                                   "give each run folder once (a repeat is another filmed hop, another folder)")
         loaded.append(H.load_run(path, leg_set, base))
     with progress(length=max_iter, label="fitting hops") as bar:
         fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=bar.update)

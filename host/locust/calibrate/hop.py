@@ -46,7 +46,7 @@ from mujoco import minimize
 from scipy import optimize
 
 from ..errors import CalibrationError, GeometryError, ParamsError, ReportError, SimError
-from ..params import Provenance, Robot, value_type
+from ..params import Provenance, Robot, fittable_keys
 from ..report.configs import configuration
 from ..report.measure import onset_time
 from ..report.measured import load_trial, read_track
@@ -305,9 +305,10 @@ def check_keys(keys: list[str], runs: list[HopRun]) -> None:
             runs[0].robot.get(key)
         except ParamsError as exc:
             raise CalibrationError(f"--fit: {exc.message}", exc.hint) from None
-        if value_type(key) != "float":
-            raise CalibrationError(f"--fit {key}: only real-valued parameters can be fitted",
-                                   "run `locust params` to list them")
+        if key not in fittable_keys():
+            raise CalibrationError(f"--fit {key}: only the robot's real-valued physical parameters can be fitted "
+                                   "(not the schedule it is given, nor how it is simulated)",
+                                   "fit any of " + ", ".join(fittable_keys()))
         values = {run.robot.get(key) for run in runs}
         if len(values) > 1:
             raise CalibrationError(f"--fit {key}: the runs' leg sets differ in it ({sorted(values)})",
