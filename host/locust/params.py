@@ -308,7 +308,7 @@ def _coerce(key: str, raw: Any) -> Any:
             return value
         if ftype == "int":
             value = float(raw)
-            if value != int(value):
+            if not math.isfinite(value) or value != int(value):
                 raise ValueError("not a whole number")
             return int(value)
         return str(raw)

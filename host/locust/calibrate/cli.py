@@ -406,10 +406,11 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
     from ..report.configs import name_from_path
 
     keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
+    H.check_fittable(keys)
     write_path = write_target(write_path)
     start_from = config or (write_path if write_path and Path(write_path).exists() else None)
     base = resolve_robot(None, start_from, sets)
-    loaded = []
+    named = []
     for item in runs:
         name, sep, rest = item.partition("=")
         if sep and name and "/" not in name and not Path(item).exists():
@@ -421,10 +422,11 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
             except ReportError:
                 raise CalibrationError(f"{path}: cannot tell which leg set this run is from its folder's name",
                                        "name it: small=PATH") from None
-        if path.resolve() in (Path(run.source).resolve() for run in loaded):
+        if path.resolve() in (p.resolve() for p, _ in named):
             raise CalibrationError(f"{item}: the run {path} is given twice; each run counts once in the fit",
                                    "give each run folder once (a repeat is another filmed hop, another folder)")
-        loaded.append(H.load_run(path, leg_set, base))
+        named.append((path, leg_set))
+    loaded = [H.load_run(path, leg_set, base) for path, leg_set in named]
     with progress(length=max_iter, label="fitting hops") as bar:
         fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=bar.update)
     out = fit.summary()
