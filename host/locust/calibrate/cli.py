@@ -343,7 +343,7 @@ def _per_recording(values: tuple[float, ...], n: int, option: str) -> list[float
 @click.option("--robot-marker", default="robot", show_default=True, help="For a ramp video track: the robot's marker.")
 @click.option("--into", type=click.Choice(["foot", "nose"]), default="foot", show_default=True,
               help="Which friction the result is written to (contact.foot_friction or contact.nose_friction).")
-@click.option("--resolution-deg", type=FINITE, default=R.READING_RESOLUTION_DEG, show_default=True,
+@click.option("--resolution-deg", type=POSITIVE, default=R.READING_RESOLUTION_DEG, show_default=True,
               help="How finely each angle was read [deg] (a protractor's graduation); the trials' spread is "
                    "taken as at least resolution/sqrt(12), so trials read alike give an interval, not a point.")
 @import_options

@@ -55,8 +55,8 @@ def fit_ramp(angles_deg: np.ndarray, source: str = "ramp",
              resolution_deg: float = READING_RESOLUTION_DEG) -> RampFit:
     """``resolution_deg``: how finely each angle was read; the trials' spread is taken as at
     least ``resolution_deg / sqrt(12)`` (see the module docstring)."""
-    if not (math.isfinite(resolution_deg) and resolution_deg >= 0):
-        raise CalibrationError(f"--resolution-deg {resolution_deg:g} must be a finite number >= 0",
+    if not (math.isfinite(resolution_deg) and resolution_deg > 0):
+        raise CalibrationError(f"--resolution-deg {resolution_deg:g} must be a finite number above 0",
                                "the angle's reading resolution, e.g. 1 for a protractor read to the degree")
     a = np.asarray(angles_deg, dtype=float)
     a = a[np.isfinite(a)]
