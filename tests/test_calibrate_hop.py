@@ -5,7 +5,7 @@ stiffness, servo speed unlike the presets), on the leg set's preset (the virtual
 plant) at half its converged step (nearer the continuous robot than the fit's model),
 sampled like a 30 frames/s video on a camera clock of its own, with 0.1 mm of seeded
 Gaussian noise; the fit's runs are built from the seed the way a filmed run is loaded
-(``report.configs.configuration``): the fit must recover the values it was made with. The
+(``trials.configs.configuration``): the fit must recover the values it was made with. The
 system test on the virtual robot's own videos is in test_calibrate_hop_virtual.py (slow).
 """
 

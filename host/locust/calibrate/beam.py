@@ -53,6 +53,7 @@ LOWEST_CYCLES = 0.5                         # lowest frequency the fit allows: c
 START_FN_STEP = 0.01                        # relative step of the start grid's frequencies
 START_ZETAS = (0.005, 0.02, 0.05, 0.1, 0.2, 0.35, 0.6)   # the start grid's damping ratios
 START_COUNT = 3                             # starts refined by least squares: the grid's best local minima
+START_SAMPLES = 2048                        # the start grid looks at the window's first samples (the ring-down)
 
 
 @dataclass(frozen=True)
@@ -259,8 +260,11 @@ def _start_values(t: np.ndarray, y: np.ndarray, fn_low_hz: float, fn_high_hz: fl
     model, are solved exactly; the grid points of least residual that are local minima
     along fn are the starts. Every frequency is tried on the whole ring-down, heavily damped
     (one or two visible cycles) or not, so the start cannot lock onto the record's length
-    or a noise peak the way a spectrum's highest peak can.
+    or a noise peak the way a spectrum's highest peak can. Only the first ``START_SAMPLES``
+    samples are looked at (8.5 s at 240 frames/s: the ring-down after the drop), so the grid's
+    memory and time stay bounded on a long recording; the fit itself takes the whole window.
     """
+    t, y = t[:START_SAMPLES], y[:START_SAMPLES]
     tau = t - t[0]
     fns = np.exp(np.arange(np.log(fn_low_hz), np.log(fn_high_hz), np.log1p(START_FN_STEP)))
     zetas = np.asarray(START_ZETAS)

@@ -46,7 +46,7 @@ from mujoco import minimize
 from scipy import optimize
 
 from ..errors import CalibrationError, GeometryError, ParamsError, SimError, TrialError
-from ..params import Provenance, Robot, value_type
+from ..params import Provenance, Robot, fittable_keys, value_type
 from ..sim.kinematics import geom_positions, marker_geoms, trace_rows
 from ..sim.model import build
 from ..sim.rollout import simulate_batch
@@ -288,20 +288,28 @@ def converged_step(run: HopRun, robot: Robot | None = None) -> tuple[HopRun, flo
 
 
 # -- the fit ----------------------------------------------------------------------------
-def check_keys(keys: list[str], runs: list[HopRun]) -> None:
-    """Fitted keys are real-valued robot parameters, the same in every run's robot."""
+def check_fittable(keys: list[str]) -> None:
+    """Fitted keys are named once each, and each is a real-valued physical robot parameter
+    (:func:`locust.params.fittable_keys`): never the schedule or the solver."""
     if not keys:
         raise CalibrationError("no parameter to fit", f"e.g. --fit {','.join(DEFAULT_KEYS)}")
     if len(set(keys)) != len(keys):
         raise CalibrationError(f"--fit names a parameter twice ({','.join(keys)})", "name each once")
     for key in keys:
         try:
-            runs[0].robot.get(key)
+            value_type(key)
         except ParamsError as exc:
             raise CalibrationError(f"--fit: {exc.message}", exc.hint) from None
-        if value_type(key) != "float":
-            raise CalibrationError(f"--fit {key}: only real-valued parameters can be fitted",
-                                   "run `locust params` to list them")
+        if key not in fittable_keys():
+            raise CalibrationError(f"--fit {key}: only the robot's real-valued physical parameters can be fitted "
+                                   "(not the schedule it is given, nor how it is simulated)",
+                                   "fit any of " + ", ".join(fittable_keys()))
+
+
+def check_keys(keys: list[str], runs: list[HopRun]) -> None:
+    """Fitted keys are fittable (:func:`check_fittable`) and the same in every run's robot."""
+    check_fittable(keys)
+    for key in keys:
         values = {run.robot.get(key) for run in runs}
         if len(values) > 1:
             raise CalibrationError(f"--fit {key}: the runs' leg sets differ in it ({sorted(values)})",
