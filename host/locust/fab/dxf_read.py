@@ -13,6 +13,7 @@ is a unit converted.
 
 from __future__ import annotations
 
+import contextlib
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +33,13 @@ INSUNITS: dict[int, tuple[str, float]] = {
 UNIT_BY_NAME: dict[str, tuple[int, float]] = {name: (code, mm) for code, (name, mm) in INSUNITS.items()}
 
 CURVES = {"LINE", "ARC", "LWPOLYLINE", "POLYLINE", "CIRCLE", "ELLIPSE", "SPLINE"}
+
+# Block references are expanded this many levels deep, into at most this many entities: an
+# outline for a laser is thousands of curves (50,000 circles read in about 9 s), and nested
+# blocks multiply (8 levels of 10 references each are 10^8 copies, hours of expansion), so
+# they are counted before any is expanded.
+MAX_INSERT_DEPTH = 8
+MAX_EXPANDED_ENTITIES = 50_000
 
 
 @dataclass(frozen=True)
@@ -61,6 +69,7 @@ class Drawing:
     contours: tuple[Contour, ...]
     skipped: dict[str, int] = field(default_factory=dict)   # entity type -> count, not curves
     recovered: int = 0             # problems fixed by ezdxf's recover mode
+    points: tuple[Contour, ...] = ()   # pieces shorter than the gap tolerance: one point each
 
     def layers(self) -> list[str]:
         return sorted({c.layer for c in self.contours})
@@ -114,6 +123,45 @@ def drawing_units(doc, override: str | None) -> tuple[str, float, str]:
     return "mm", 1.0, "assumed (no $INSUNITS)"
 
 
+def _copies(entity) -> int:
+    """How many times an INSERT places its block (a MINSERT is rows x columns)."""
+    rows = max(int(entity.dxf.get("row_count", 1) or 1), 1)
+    cols = max(int(entity.dxf.get("column_count", 1) or 1), 1)
+    return rows * cols
+
+
+def expanded_count(doc, entities, depth: int = 0, memo: dict | None = None) -> int:
+    """How many entities ``entities`` become once their block references are expanded (as
+    ``_entities_by_layer`` expands them), counted from the block definitions without expanding."""
+    memo = {} if memo is None else memo
+    total = 0
+    for entity in entities:
+        total += 1
+        if entity.dxftype() != "INSERT" or depth >= MAX_INSERT_DEPTH:
+            continue
+        name = entity.dxf.get("name")
+        key = (name, depth + 1)
+        if key not in memo:
+            block = doc.blocks.get(name) if name else None
+            memo[key] = 0 if block is None else expanded_count(doc, block, depth + 1, memo)
+        total += _copies(entity) * memo[key]
+        if total > MAX_EXPANDED_ENTITIES:
+            return total
+    return total
+
+
+def check_expansion(doc, path) -> None:
+    """Refuse a drawing whose block references expand into more than MAX_EXPANDED_ENTITIES."""
+    n = expanded_count(doc, doc.modelspace())
+    if n > MAX_EXPANDED_ENTITIES:
+        raise FabError(
+            f"{path}: its block references expand into more than {MAX_EXPANDED_ENTITIES:,} entities "
+            f"(blocks nested in blocks multiply; counted before expanding)",
+            "explode the blocks in the CAD program and keep only the outline for the laser, "
+            "or remove the repeated blocks",
+        )
+
+
 def _entities_by_layer(msp) -> tuple[dict[str, list], Counter]:
     """Model-space curves grouped by layer; block references are expanded in place."""
     by_layer: dict[str, list] = defaultdict(list)
@@ -124,7 +172,7 @@ def _entities_by_layer(msp) -> tuple[dict[str, list], Counter]:
         layer = entity.dxf.get("layer", "0")
         if inherited is not None and layer == "0":
             layer = inherited                     # DXF rule: layer 0 in a block takes the insert's
-        if kind == "INSERT" and depth < 8:
+        if kind == "INSERT" and depth < MAX_INSERT_DEPTH:
             for sub in entity.virtual_entities():
                 visit(sub, layer, depth + 1)
         elif kind in CURVES:
@@ -164,8 +212,11 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
     def emit(pts: np.ndarray, closed: bool, labels: tuple[str, ...]) -> None:
         if closed and len(pts) > 2 and np.hypot(*(pts[0] - pts[-1])) <= gap:
             pts = pts[:-1]
+        closed = closed and len(pts) >= 3     # a "loop" of two points is a line there and back
         if len(pts) >= 2:
             out.append(Contour(layer, pts * mm_per_unit, closed, labels))
+        elif len(pts):                    # collapsed to a point: kept so the caller can name it
+            out.append(Contour(layer, pts[:1] * mm_per_unit, False, labels))
 
     open_pieces = []
     for entity in entities:
@@ -178,7 +229,14 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
         else:
             open_pieces.append(entity)
 
-    edges = [e for e in (es.make_edge_2d(ent, gap_tol=gap) for ent in open_pieces) if e is not None]
+    edges = []
+    for ent in open_pieces:
+        edge = es.make_edge_2d(ent, gap_tol=gap)
+        if edge is not None:
+            edges.append(edge)
+        else:                             # shorter than the gap tolerance
+            with contextlib.suppress(Exception):
+                emit(_flat(ezpath.make_path(ent), sag)[:1], False, (_label(ent),))
     if not edges:
         return out
     deposit = em.Deposit(edges, gap_tol=gap)
@@ -194,6 +252,7 @@ def read_drawing(path: str | Path, *, units: str | None = None, gap_tol_mm: floa
     """Read every curve of ``path`` into contours in millimetres (see the module doc)."""
     doc, fixed = open_document(path, recover=recover)
     unit_name, mm_per_unit, units_from = drawing_units(doc, units)
+    check_expansion(doc, path)
     by_layer, skipped = _entities_by_layer(doc.modelspace())
     contours: list[Contour] = []
     for layer in sorted(by_layer):
@@ -203,5 +262,6 @@ def read_drawing(path: str | Path, *, units: str | None = None, gap_tol_mm: floa
         if not np.isfinite(c.points_mm).all():
             raise FabError(f"{path}: layer {c.layer!r}: {', '.join(c.entities)} has a vertex that is not a "
                            "finite number (NaN or inf)", "fix the drawing in the CAD program, or redraw that entity")
-    return Drawing(Path(path), unit_name, mm_per_unit, units_from, tuple(contours),
-                   dict(skipped), fixed)
+    return Drawing(Path(path), unit_name, mm_per_unit, units_from,
+                   tuple(c for c in contours if len(c.points_mm) >= 2), dict(skipped), fixed,
+                   tuple(c for c in contours if len(c.points_mm) < 2))
