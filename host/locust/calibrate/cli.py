@@ -356,7 +356,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
       locust calibrate hop small=runs/s1 large=runs/l1 --write calibration/robot.toml
     """
     from ..params import resolve_robot
-    from ..report.configs import name_from_path
+    from ..report.measured import config_of
 
     keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
     start_from = config or (write_path if write_path and Path(write_path).exists() else None)
@@ -369,10 +369,9 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
         else:
             path = Path(item)
             try:
-                leg_set = name_from_path(path)
-            except ReportError:
-                raise CalibrationError(f"{path}: cannot tell which leg set this run is from its folder's name",
-                                       "name it: small=PATH") from None
+                leg_set, _ = config_of(path)     # the leg set its run.json names, else its folder's
+            except ReportError as exc:   # no such path, a damaged run.json, or no name anywhere
+                raise CalibrationError(exc.message, (exc.hint or "").replace("--measured ", "")) from None
         loaded.append(H.load_run(path, leg_set, base))
     with progress(length=max_iter, label="fitting hops") as bar:
         fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=bar.update)

@@ -25,7 +25,7 @@ import numpy as np
 from ..device.record import RunRecord
 from ..track.importing import units_hint
 from .compare import Comparison, MeasuredTrial
-from .measured import CONFIG_GIVEN, Trial, span_hint
+from .measured import CONFIG_FROM_RECORD, CONFIG_GIVEN, Trial, span_hint
 
 ROBOT = "robot"
 VIRTUAL = "virtual robot"
@@ -86,7 +86,7 @@ def notices(comps: list[Comparison]) -> list[Notice]:
 
 def _trial_notices(t: Trial) -> list[Notice]:
     out = []
-    if t.config_from != CONFIG_GIVEN:
+    if t.config_from not in (CONFIG_GIVEN, CONFIG_FROM_RECORD):
         where = t.run_path.parent if t.run_path else t.track.path if t.track else t.label
         out.append(Notice("configuration-guessed", t.config, t.label,
                           f"{t.label}: leg set {t.config!r} was guessed from the {t.config_from} ({where}), not "
