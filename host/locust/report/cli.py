@@ -59,6 +59,7 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
       locust report --measured medium=a.tracks.csv,b.tracks.csv --preset seed --sweep sweep/ --cycles 6
     """
     from .build import build_report
+    from .checks import collapsed
     from .configs import parse_added
     from .measured import parse_measured
 
@@ -76,7 +77,7 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
         meas = (f"measured {c.distance.mean * 100:.2f} cm over {c.distance.n} trial(s)" if c.distance.n
                 else "no track")
         click.echo(f"{c.config:8s} {pred}, {meas}", err=True)
-    for warning in result.warnings:
+    for warning in collapsed(result.warnings):     # one line for what several trials share
         click.echo(f"warning: {warning.message}", err=True)
     click.echo(f"dashboard: {result.dashboard_path}", err=True)
     for v in result.side_by_side:
