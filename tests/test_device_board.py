@@ -107,6 +107,10 @@ def test_a_corrupt_board_config_is_recorded_and_never_complete(env, flash_config
     assert rec.status == R.DEFAULT_CONFIG and len(rec.phases) == 2
     assert rec.board.problems == ("config.json is not valid JSON; using defaults",)
 
+    reflashed = _run(["flash", "--port", "sim"], env)        # keeps the board's config.json, and says it is unused
+    assert reflashed.returncode == 0, reflashed.stderr
+    assert "warning: the board runs on its default config: config.json is not valid JSON" in reflashed.stderr
+    assert "fix: write a valid config: `locust config --port PORT --set" in reflashed.stderr
     shown = _run(["config", "--port", "sim"], env)
     assert shown.returncode == 0 and "NOT in use" in shown.stdout and "not valid JSON" in shown.stderr
     fixed = _run(["config", "--port", "sim", "--set", "left.trim_deg=0"], env)
@@ -134,3 +138,30 @@ def test_robot_and_board_read_back_equal_and_a_damaged_board_entry_is_named(tmp_
     del doc["board"], doc["robot"]                # a record from before they were recorded
     path.write_text(json.dumps(doc))
     assert R.read_run_record(path).robot == R.RobotSource() and R.read_run_record(path).board is None
+
+
+def test_every_torn_or_out_of_limits_config_is_reported_and_never_used(tmp_path):
+    """The firmware's own loader (the host imports the same file): every prefix of a valid
+    config.json (a write torn at any byte), every key pushed past its limit either way and
+    every key given a boolean or a string is refused with a reason naming it, and the board
+    runs on the chip's default config; the valid file itself is used as it is."""
+    path = tmp_path / fw_config.FILE
+    good = dict(fw_config.default("esp32"), left=dict(fw_config.default("esp32")["left"], trim_deg=2.5))
+    text = json.dumps(good)
+    path.write_text(text)
+    assert fw_config.load(str(path), "esp32") == (good, [])
+    for cut in range(len(text)):
+        path.write_text(text[:cut])
+        cfg, problems = fw_config.load(str(path), "esp32")
+        assert cfg == fw_config.default("esp32") and problems, cut
+    cases = 0
+    for name in fw_config.SERVOS:
+        for key, (lo, hi, whole) in fw_config.LIMITS.items():
+            step = 1 if whole else 0.5
+            for bad in (lo - step, hi + step, True, "1"):
+                path.write_text(json.dumps(dict(good, **{name: dict(good[name], **{key: bad})})))
+                cfg, problems = fw_config.load(str(path), "esp32")
+                assert cfg == fw_config.default("esp32"), (name, key, bad)
+                assert any(f"{name}.{key}" in p for p in problems), (name, key, bad, problems)
+                cases += 1
+    assert cases == 2 * len(fw_config.LIMITS) * 4

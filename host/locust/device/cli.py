@@ -95,6 +95,9 @@ def flash(port, compile_mpy, reset_config, servo_sets, preset, config, sets):
     click.echo(f"flashed locust firmware {result.firmware_version} to {port or device} ({result.board}): "
                f"{len(result.files)} files verified by SHA-256 ({names})"
                f"{'; wrote config.json' if result.config_written else ''} in {result.elapsed_s:.1f} s")
+    if result.config_problems and not edits:   # a --servo edit saved a whole valid config
+        _info("warning: the board runs on its default config: " + "; ".join(result.config_problems))
+        _info(f"  fix: {R.CONFIG_FIX_HINT}")
 
 
 def _parse_servo_set(item: str, option: str = "--servo") -> tuple[str, float]:
