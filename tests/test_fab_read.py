@@ -207,6 +207,8 @@ def test_a_hinge_outside_the_body_or_of_no_length_is_refused_with_its_position(t
                                  "does not cross the body", "x 0.000 to 100.000")
     point = _plate_with(tmp_path, lambda m: m.add_line((40, 10), (40, 10), dxfattribs={"layer": "hinge_1"}))
     assert_refused_and_unchanged(tmp_path, ["fab", point], "(40.000, 10.000) mm", "has no length")
+    dot = _plate_with(tmp_path, lambda m: m.add_circle((60, 20), 0, dxfattribs={"layer": "hinge_1"}))
+    assert_refused_and_unchanged(tmp_path, ["fab", dot], "CIRCLE #", "(60.000, 20.000) mm", "has no length")
     # a closed hinge "loop" of two vertices is a fold line there and back, used as one
     design = design_from_drawing(read_drawing(_plate_with(
         tmp_path, lambda m: m.add_lwpolyline([(40, -5), (40, 35)], close=True, dxfattribs={"layer": "hinge_1"}))))

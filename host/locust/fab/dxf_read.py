@@ -198,6 +198,18 @@ def _flat(path, sagitta: float) -> np.ndarray:
     return pts
 
 
+def _anchor(entity) -> np.ndarray | None:
+    """Where a degenerate entity (no length, zero radius) lies: its centre, start or first vertex."""
+    for attr in ("center", "start"):
+        value = entity.dxf.get(attr)
+        if value is not None:
+            return np.array([[value[0], value[1]]], dtype=float)
+    with contextlib.suppress(Exception):
+        first = next(iter(entity.vertices()))
+        return np.array([[first[0], first[1]]], dtype=float)
+    return None
+
+
 def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm: float,
                    sagitta_mm: float) -> list[Contour]:
     """The loops and open paths of one layer's curves."""
@@ -234,9 +246,10 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
         edge = es.make_edge_2d(ent, gap_tol=gap)
         if edge is not None:
             edges.append(edge)
-        else:                             # shorter than the gap tolerance
-            with contextlib.suppress(Exception):
-                emit(_flat(ezpath.make_path(ent), sag)[:1], False, (_label(ent),))
+        else:                             # shorter than the gap tolerance (or of zero radius)
+            point = _anchor(ent)
+            if point is not None:
+                emit(point, False, (_label(ent),))
     if not edges:
         return out
     deposit = em.Deposit(edges, gap_tol=gap)
