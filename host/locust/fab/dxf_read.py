@@ -201,7 +201,7 @@ def _flat(path, sagitta: float) -> np.ndarray:
 def _anchor(entity) -> np.ndarray | None:
     """Where a degenerate entity (no length, zero radius) lies: its centre, start or first vertex."""
     for attr in ("center", "start"):
-        value = entity.dxf.get(attr)
+        value = entity.dxf.get(attr) if entity.dxf.is_supported(attr) else None
         if value is not None:
             return np.array([[value[0], value[1]]], dtype=float)
     with contextlib.suppress(Exception):
