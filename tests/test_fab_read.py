@@ -230,3 +230,21 @@ def test_overlapping_outlines_are_joined_and_said_so_a_hole_in_the_overlap_stays
         in design.joined[0]
     res = invoke(["fab", tmp_path / "o.dxf"])
     assert res.exit_code == 0 and "overlapping outlines joined (union)" in res.output
+
+
+def test_an_outline_drawn_many_times_over_itself_is_cut_once(tmp_path):
+    """200 copies of one 50 mm square of LINEs, stacked (a block inserted 200 times at one
+    place, as a careless copy leaves it), and a circle of two half ARCs with the same ends: the
+    square is one loop of 2500 mm2, the arcs are not taken for copies of each other."""
+    doc, msp = _doc()
+    blk = doc.blocks.new("SQ")
+    _square_of_lines(blk, 0, 0, 50, layer="0")
+    for _ in range(200):
+        msp.add_blockref("SQ", (0, 0), dxfattribs={"layer": "plate"})
+    msp.add_arc((100, 25), 10, 0, 180, dxfattribs={"layer": "plate"})
+    msp.add_arc((100, 25), 10, 180, 360, dxfattribs={"layer": "plate"})
+    doc.saveas(tmp_path / "stack.dxf")
+    drawing = read_drawing(tmp_path / "stack.dxf")
+    assert len(drawing.contours) == 2
+    areas = sorted(p.area for p in design_from_drawing(drawing).body.geoms)
+    assert areas == pytest.approx([math.pi * 100, 2500.0], rel=2e-4)

@@ -198,6 +198,22 @@ def _flat(path, sagitta: float) -> np.ndarray:
     return pts
 
 
+def _trace_key(entity, edge, gap: float) -> tuple:
+    """Where an open piece runs, to ``gap``: its two ends (either way round) and its middle."""
+    from ezdxf import path as ezpath
+
+    def q(v) -> tuple[int, int]:
+        return round(v[0] / gap), round(v[1] / gap)
+
+    try:
+        pts = list(ezpath.make_path(entity).flattening(distance=gap))
+        middle = q(pts[len(pts) // 2]) if len(pts) > 2 else None
+    except Exception:  # a path ezdxf cannot make: keep the piece (an entity key of its own)
+        middle = id(entity)
+    ends = tuple(sorted((q(edge.start), q(edge.end))))
+    return ends, middle
+
+
 def _anchor(entity) -> np.ndarray | None:
     """Where a degenerate entity (no length, zero radius) lies: its centre, start or first vertex."""
     for attr in ("center", "start"):
@@ -242,10 +258,16 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
             open_pieces.append(entity)
 
     edges = []
+    seen: set = set()
     for ent in open_pieces:
         edge = es.make_edge_2d(ent, gap_tol=gap)
         if edge is not None:
-            edges.append(edge)
+            # an entity drawn twice over itself (same ends, same middle) is one cut: chaining every
+            # copy multiplies the chains the edge miner tries (10,000 stacked lines ran for minutes)
+            key = _trace_key(ent, edge, gap)
+            if key not in seen:
+                seen.add(key)
+                edges.append(edge)
         else:                             # shorter than the gap tolerance (or of zero radius)
             point = _anchor(ent)
             if point is not None:
