@@ -219,7 +219,7 @@ def board_config(port, servo_sets, as_json):
     """Read the board's servo config back (chip, pins, trims, pulse ranges), or change it.
 
     
-      locust config --port /dev/ttyUSB0                         what the firmware runs on
+      locust config --port /dev/ttyUSB0                           what the firmware runs on
       locust config --port /dev/ttyUSB0 --set left.trim_deg=2.5   trim without reflashing
 
     The board checks each value against its limits and its chip's pins and saves the whole
@@ -263,7 +263,7 @@ def pose(left_deg, right_deg, rest, port):
     then push each horn onto its spline as close to its rest position as the splines allow.
     Trimming the rest of the error:
       locust pose 0 0               look at the legs at rest
-      locust flash --servo left.trim_deg=2.5   (shaft deg; reversed on the mirrored right leg)
+      locust config --set left.trim_deg=2.5   (shaft deg; reversed on the mirrored right leg)
     Checking the travel and the direction of each leg:
       locust pose -20 10            left horn -20 deg, right horn +10 deg
 
