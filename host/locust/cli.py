@@ -25,6 +25,7 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
     "ports": ("locust.device.cli", "ports", "List serial ports and mark the likely ESP32."),
     "flash": ("locust.device.cli", "flash", "Copy the MicroPython firmware to the board (mpremote)."),
     "hop": ("locust.device.cli", "hop", "Run the bang-bang hop schedule on the robot; save a run record."),
+    "config": ("locust.device.cli", "board_config", "Read the board's servo config back, or set a trim (no flashing)."),
     "pose": ("locust.device.cli", "pose", "Move the servos to an angle and hold it (centring, trim)."),
     "repl": ("locust.device.cli", "repl", "Open MicroPython's REPL on the robot (mpremote)."),
     "virtual": ("locust.device.cli", "virtual", "Start a virtual robot on a pseudo-terminal."),

@@ -403,7 +403,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
       locust calibrate hop small=runs/s1 large=runs/l1 --write calibration/robot.toml
     """
     from ..params import resolve_robot
-    from ..trials.configs import name_from_path
+    from ..trials.measured import config_of
 
     keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
     H.check_fittable(keys)
@@ -417,7 +417,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
             path, leg_set = Path(rest), name
         else:
             path = Path(item)
-            leg_set = name_from_path(path)
+            leg_set, _ = config_of(path)     # the leg set its run.json names, else its folder's
         if path.resolve() in (p.resolve() for p, _ in named):
             raise CalibrationError(f"{item}: the run {path} is given twice; each run counts once in the fit",
                                    "give each run folder once (a repeat is another filmed hop, another folder)")

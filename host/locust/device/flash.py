@@ -71,6 +71,7 @@ class FlashResult:
     config_written: bool
     files: list[FlashedFile] = field(default_factory=list)
     elapsed_s: float = 0.0
+    config_problems: list[str] = field(default_factory=list)   # why the board runs on its defaults
 
 
 def firmware_files() -> list[Path]:
@@ -225,6 +226,7 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
         raise DeviceError(f"the board reports firmware {hello.get('version')} after flashing {P.VERSION}",
                           "reset the board (a stale .py/.mpy may shadow the new files) and flash again")
     result.firmware_version = hello["version"]
+    result.config_problems = list(hello.get("config_problems") or [])
     result.elapsed_s = time.monotonic() - t_start
     return result
 

@@ -22,7 +22,7 @@ from ..trials.configs import Configuration, configuration
 from ..trials.measured import Trial
 from . import figures as F
 from . import page as H
-from .checks import VIRTUAL, Notice, notices, recorded_on
+from .checks import VIRTUAL, Notice, collapsed, notices, recorded_on
 from .compare import Comparison, compare, timing_rows
 from .landscape import Landscape, read_landscape
 from .predict import predict
@@ -198,9 +198,7 @@ def _figures(comps: list[Comparison], configs: dict[str, Configuration], land: L
     ]
     if land is not None:
         figs.append(H.Figure("landscape", f"Sweep landscape with {names_text} marked",
-                             f"Simulated distance per hop over the sweep in {land.folder} (invalid designs as red "
-                             "crosses at zero), with each physical design's prediction (open circle) and "
-                             "measurement (filled square, ±1 sd).", F.landscape_figure(land, comps, configs)))
+                             F.landscape_caption(land, comps), F.landscape_figure(land, comps, configs)))
     figs.append(H.Figure("timing", f"Firmware timing of the runs: {names_text}",
                          "Start of every phase as the firmware measured it, minus the commanded start.",
                          F.timing_figure(comps)))
@@ -263,7 +261,7 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
                           + H.td(t.config_from, c.config, f"config_from:{t.label}", left=True)
                           + H.td(where or "—", c.config, f"recorded_on:{t.label}", left=True)
                           + H.td(_track_reading(t), left=True) + "</tr>")
-    sections = [("Warnings", H.warnings_list(warnings))] if warnings else []
+    sections = [("Warnings", H.warnings_list(collapsed(warnings)))] if warnings else []
     sections += [
         ("Summary", H.summary_table(comps, labels, added)),
         ("Figures", "".join(H.figure_html(f) for f in figs)),

@@ -61,6 +61,7 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
     from ..trials.configs import parse_added
     from ..trials.measured import parse_measured
     from .build import build_report
+    from .checks import collapsed
 
     robot = resolve_robot(preset, config, sets)
     groups = parse_measured(list(measured), marker=marker, imports=imports)
@@ -76,7 +77,7 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
         meas = (f"measured {c.distance.mean * 100:.2f} cm over {c.distance.n} trial(s)" if c.distance.n
                 else "no track")
         click.echo(f"{c.config:8s} {pred}, {meas}", err=True)
-    for warning in result.warnings:
+    for warning in collapsed(result.warnings):     # one line for what several trials share
         click.echo(f"warning: {warning.message}", err=True)
     click.echo(f"dashboard: {result.dashboard_path}", err=True)
     for v in result.side_by_side:

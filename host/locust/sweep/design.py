@@ -21,6 +21,15 @@ from ..sim.fourbar import assemble
 
 SCALE = "scale"
 CRANK_CHECK_STEP_DEG = 1.0
+CM_PER_M = 100.0   # every figure draws lengths in centimetres, and says so on its axis
+
+
+def axis_scale(name: str) -> tuple[float, str]:
+    """(factor, axis label) to draw the sweep axis ``name``: a length (``scale``, ``*_m``) in
+    cm, anything else in its own unit, as its name says."""
+    if name == SCALE:
+        return CM_PER_M, "added length on every link (cm)"
+    return (CM_PER_M, f"{name} (cm)") if name.endswith("_m") else (1.0, name)
 
 
 @dataclass(frozen=True)

@@ -9,8 +9,9 @@
   its run record;
 - a ``run.json``; a single ``*.tracks.csv`` beside it is its track.
 
-A plain path's configuration comes from its folder's name (see
-:func:`.configs.name_from_path`); the trial remembers that it was guessed (``config_from``).
+A plain path's configuration is the leg set its run record names (``locust hop --leg-set``,
+or a leg-set ``--preset``), else its folder's name (see :func:`.configs.name_from_path`);
+the trial remembers which (``config_from``).
 Tracks are read by the track layer's one import (:func:`locust.io.importing.import_tracks`:
 a tracks CSV, a Tracker text export or a ``t,x,y`` CSV, with ``--units``, ``--rename`` and
 ``--mirror``), so the formats and conversions are the same everywhere.
@@ -34,6 +35,7 @@ from .configs import check_name, name_from_path, sort_key
 TRACK_GLOB = f"*{TRACKS_CSV_SUFFIX}"
 CONFIG_GIVEN = "given"                   # --measured NAME=PATH
 CONFIG_FROM_FOLDER = "folder name"       # guessed by name_from_path
+CONFIG_FROM_RECORD = "run record"        # the leg set run.json names
 
 
 @dataclass(frozen=True)
@@ -58,7 +60,7 @@ class Trial:
     track: Track | None
     run_path: Path | None
     record: RunRecord | None = field(default=None, compare=False)
-    config_from: str = CONFIG_GIVEN      # how its configuration was known: given, or guessed from its folder
+    config_from: str = CONFIG_GIVEN      # how its configuration was known: given, its run record, or its folder
 
 
 def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose",
@@ -75,7 +77,8 @@ def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose",
             if name:
                 trial = load_trial(path, name, marker, imports)
             else:
-                trial = load_trial(path, name_from_path(path), marker, imports, config_from=CONFIG_FROM_FOLDER)
+                name, known_from = config_of(path)
+                trial = load_trial(path, name, marker, imports, config_from=known_from)
             groups.setdefault(trial.config, []).append(trial)
     for name, trials in groups.items():
         seen: set[tuple] = set()
@@ -98,19 +101,43 @@ def _split_item(item: str) -> tuple[str | None, list[str]]:
     return None, [item]
 
 
-def load_trial(path: Path, config: str, marker: str = "nose", imports: ImportOptions = AS_IS,
-               config_from: str = CONFIG_GIVEN) -> Trial:
+def _must_exist(path: Path) -> None:
     if not path.exists():
         raise TrialError(f"{path}: no such file or folder", "check the --measured path")
+
+
+def _run_path(path: Path) -> Path | None:
+    """The run record of the trial at ``path``: the run.json itself, the one in the folder, or
+    the one beside the track."""
     if path.is_dir():
-        run_path = path / RUN_NAME if (path / RUN_NAME).is_file() else None
+        return path / RUN_NAME if (path / RUN_NAME).is_file() else None
+    if path.name.endswith(".json"):
+        return path
+    return path.parent / RUN_NAME if (path.parent / RUN_NAME).is_file() else None
+
+
+def config_of(path: Path) -> tuple[str, str]:
+    """(configuration, how it is known) of the trial at ``path`` given without a name: the leg
+    set its run record names, else its folder's name."""
+    _must_exist(path)
+    run_path = _run_path(path)
+    leg_set = read_run(run_path).robot.leg_set if run_path else None
+    if leg_set:
+        return check_name(leg_set), CONFIG_FROM_RECORD
+    return name_from_path(path), CONFIG_FROM_FOLDER
+
+
+def load_trial(path: Path, config: str, marker: str = "nose", imports: ImportOptions = AS_IS,
+               config_from: str = CONFIG_GIVEN) -> Trial:
+    _must_exist(path)
+    run_path = _run_path(path)
+    if path.is_dir():
         track_path = _one_track(path, required=run_path is None)
         label = path.name
     elif path.name.endswith(".json"):
-        run_path, track_path, label = path, _one_track(path.parent, required=False), path.parent.name
+        track_path, label = _one_track(path.parent, required=False), path.parent.name
     else:
-        beside = path.parent / RUN_NAME
-        run_path, track_path, label = (beside if beside.is_file() else None), path, path.parent.name or path.stem
+        track_path, label = path, path.parent.name or path.stem
     record = read_run(run_path) if run_path else None
     track = read_track(track_path, marker, imports) if track_path else None
     return Trial(config=config, label=label, track=track, run_path=run_path, record=record, config_from=config_from)
