@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from locust.io import run_record as R
 from locust.firmware import config as fw_config
-from locust.report.measured import config_of
+from locust.io import run_record as R
+from locust.trials.measured import config_of
 from probing import assert_refused_and_unchanged, tree
 
 LOCUST = [sys.executable, "-m", "locust.cli"]
