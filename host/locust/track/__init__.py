@@ -19,7 +19,7 @@ Modules, one job each:
 - :mod:`.export`    a result as the tracks CSV + JSON sidecar
 - :mod:`.trk`       Tracker's .trk/.trz reader; a result in its text-export layout
 - :mod:`.importing` any track file in any unit, renamed, mirrored: the one conversion that
-                    ``track --import``, ``calibrate`` and ``report`` read tracks through
+                    ``track import``, ``calibrate`` and ``report`` read tracks through
 - :mod:`.overlay`   PNG / video of the tracks drawn on the footage
 - :mod:`.synth`     synthetic videos with known sub-pixel truth
 - :mod:`.hardclip`  synthetic phone-like clips: look-alike, shadow, blur, exit, tilted board

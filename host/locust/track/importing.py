@@ -1,7 +1,7 @@
 """Imports: any track file, in any length unit, with its markers renamed and x mirrored.
 
 The one conversion every track input goes through (:func:`import_tracks`):
-``locust track --import``, ``locust calibrate`` (beam, servo ``--pivot``, ramp tracks) and
+``locust track import``, ``locust calibrate`` (beam, servo ``--pivot``, ramp tracks) and
 ``locust report`` (``--measured`` tracks) all read their tracks here, with the same options:
 
 - ``--units m|cm|mm``: the unit of the file's positions; they are divided by 1, 100 or 1000
