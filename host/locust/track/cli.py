@@ -24,7 +24,7 @@ from .importing import ImportOptions, import_options, import_tracks, is_project,
 from .runner import track_video
 from .spec import ModelOptions, parse_markers
 from .tracks_csv import tracks_csv_beside, write_tracks_csv
-from .video import Clip, probe
+from .video import Clip, check_fps, probe
 
 SUBCOMMANDS = ("video", "import", "from-trk", "board", "preview")
 # the options of the one-command `locust track` that became subcommands, and their new form
@@ -121,7 +121,7 @@ CLIP = [
     click.option("--start", default=0, show_default=True, type=int, help="First frame of the clip."),
     click.option("--end", default=None, type=int, help="Last frame of the clip (inclusive). Default: the last frame."),
     click.option("--step", default=1, show_default=True, type=int, help="Track every STEP-th frame."),
-    click.option("--fps", default=None, type=float,
+    click.option("--fps", default=None, type=float, callback=lambda ctx, param, value: check_fps(value),
                  help="True frame rate (1 to 10000 frames/s), for slow-motion footage whose file rate is wrong. "
                       "Default: the file's rate."),
 ]

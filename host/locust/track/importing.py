@@ -215,12 +215,14 @@ def tracks_from_delimited(doc: DelimitedText, options: ImportOptions = AS_IS) ->
                          f"(columns: {', '.join(doc.header)})", FORMATS_HINT)
     if layout == "tracks":
         tracks = TracksCsv.from_delimited(doc)
+        check_times(doc, tracks.t_s)
         return tracks if options.identity else _convert_tracks_csv(tracks, options)
     columns, dropped = _tracker_markers(doc) if layout == "tracker" else _txy_markers(doc)
     if not columns:
         raise TrackError(f"{doc.path}: no track with x and y columns (columns: {', '.join(doc.header)})",
                          FORMATS_HINT)
     t_s = columns.pop(0)
+    check_times(doc, t_s)
     markers = _apply(doc.path, columns, options)
     plain = layout == "txy" or (doc.delimiter == "," and doc.names_row is None and not doc.multi)
     note = f"imported from {doc.path.name} ({LAYOUT_NAMES['txy' if plain else layout]}): {options.describe()}"
@@ -228,6 +230,24 @@ def tracks_from_delimited(doc: DelimitedText, options: ImportOptions = AS_IS) ->
         note += f"; not imported: {', '.join(dropped)}"
     return TracksCsv(frame=np.arange(len(t_s)), t_s=t_s, markers=markers, comments=(*doc.comments, note),
                      path=doc.path)
+
+
+def check_times(doc: DelimitedText, t_s) -> None:
+    """Refuse rows whose time repeats the row before or goes back (rows without a time are
+    skipped): velocities, onsets and fits all divide by the step. Names the file's lines."""
+    t = np.asarray(t_s, dtype=float)
+    rows = np.flatnonzero(np.isfinite(t))
+    step = np.diff(t[rows])
+    bad = rows[1:][step <= 0]
+    if not bad.size:
+        return
+    repeats, back = int((step == 0).sum()), int((step < 0).sum())
+    lines = [doc.rows[k][0] for k in bad]
+    where = ", ".join(str(n) for n in lines[:6]) + (f" and {len(lines) - 6} more" if len(lines) > 6 else "")
+    raise TrackError(f"{doc.path}: time does not increase on {len(bad)} of {len(rows)} rows ({repeats} repeat the "
+                     f"time before, {back} go back), line {where}; first at t = {t[bad[0]]:g} s",
+                     "sort the rows by time and remove duplicate frames; times that repeat only after rounding "
+                     "(e.g. 3 significant digits) need an export with more digits")
 
 
 # -- the layouts -------------------------------------------------------------------

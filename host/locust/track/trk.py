@@ -37,7 +37,7 @@ from ..fileio import atomic_write_text
 from .calib import Calibration
 from .runner import MarkerTrack, TrackResult
 from .tracker_text import TrackerExport, TrackerTrack, tracker_export_text, write_tracker_export
-from .video import Clip
+from .video import FPS_MAX, FPS_MIN, Clip
 
 TRACKER_TO_OPENCV_PX = -0.5
 POINT_CLASSES = ("PointMass",)  # Tracker's point tracks; vectors, tapes, axes are not tracks of a marker
@@ -146,6 +146,11 @@ def _project(path: Path, root: ET.Element) -> TrackerProject:
     if not points:
         raise TrackError(f"{path}: no point-mass tracks in this Tracker file", "mark a point mass in Tracker first")
     end = start + step * (count - 1) if count else max(max(p) for p in points.values() if p)
+    if dt_ms is not None and not 1000.0 / FPS_MAX <= dt_ms <= 1000.0 / FPS_MIN:
+        raise TrackError(f"{path}: the clip's frame interval (clip control delta_t) is {dt_ms:g} ms; a camera's is "
+                         f"{1000.0 / FPS_MAX:g} to {1000.0 / FPS_MIN:g} ms ({FPS_MIN:g} to {FPS_MAX:g} frames/s), "
+                         "and times are frame x delta_t",
+                         "set the clip's frame rate in Tracker (Video > Clip Settings) and save the project again")
     fps = 1000.0 / dt_ms if dt_ms else math.nan
     return TrackerProject(path, video_path, Clip(start, end, step, fps), calibration, points)
 
