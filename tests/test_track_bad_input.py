@@ -14,7 +14,7 @@ import pytest
 
 from locust.track.calib import build
 from locust.track.runner import MarkerTrack, TrackResult
-from locust.track.synth import make_hop_video
+from locust.track.synth import make_hop_video, paint_dot
 from locust.track.trk import project_xml
 from locust.track.video import Clip, VideoInfo, encode_video, probe
 from probing import assert_refused_and_unchanged, invoke
@@ -179,3 +179,47 @@ def test_real_footage_without_stickers_is_refused(shared_data, tmp_path, name):
     assert res.exit_code == 2 and "never found" in res.stderr, res.output
     assert "nose (color:#ff00ff), foot (color:#00ffff)" in res.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+# -- an upside-down video: heights inverted ------------------------------------------------
+def _rest_hop_rest(seed: int, upside_down: bool, w: int = 320, h: int = 180, fps: float = 60.0):
+    """SYNTHETIC: a magenta sticker resting on the floor, one ballistic hop, resting again
+    (the heights a filmed hop has), drawn right way up or turned over (the phone upside down)."""
+    rng = np.random.default_rng(seed)
+    rest_before, rest_after = rng.integers(8, 20), rng.integers(8, 20)
+    rise_px = rng.uniform(30, 120)
+    flight = int(round(2 * math.sqrt(2 * rise_px * 0.002 / 9.81) * fps)) + 2    # 2 mm a pixel
+    u = np.linspace(0, 1, flight)
+    y = np.r_[np.zeros(rest_before), 4 * rise_px * u * (1 - u), np.zeros(rest_after)]
+    x = rng.uniform(40, 80) + np.r_[np.zeros(rest_before), u * rng.uniform(60, 160), np.full(rest_after, 0.0)]
+    x[rest_before + flight:] = x[rest_before + flight - 1]
+    floor_py = h - rng.uniform(20, 40)
+    noise = np.random.default_rng(seed + 1000)
+    for px, height in zip(x, y):
+        img = np.full((h, w, 3), 90.0, np.float32)
+        cv2.line(img, (0, int(floor_py) + 8), (w, int(floor_py) + 8), (40, 40, 40), 2)
+        paint_dot(img, px, floor_py - height, 6.0, (255, 0, 255))
+        frame = np.clip(np.rint(img + noise.normal(0, 1.5, img.shape)), 0, 255).astype(np.uint8)
+        yield cv2.flip(frame, -1) if upside_down else frame
+
+
+def _hop_clip(folder, seed, upside_down):
+    path = folder / f"hop{seed}{'_flipped' if upside_down else ''}.avi"
+    encode_video(path, _rest_hop_rest(seed, upside_down), 60.0, (320, 180), "MJPG")
+    return path
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_an_upside_down_hop_is_flagged_and_an_upright_one_is_not(tmp_path, seed):
+    args = ["--marker", "nose=color:#ff00ff", "--scale", "0,0,500,0=1.0", "--overlay", "none"]
+    upright = invoke(["track", _hop_clip(tmp_path, seed, False), *args])
+    assert upright.exit_code == 0 and "upside down" not in upright.stderr, upright.output
+    flipped = invoke(["track", _hop_clip(tmp_path, seed, True), *args])
+    assert flipped.exit_code == 0, flipped.output
+    share = re.search(r"nose stands still at the top of its heights \(\d+ still frames at y = \S+ m, (\d+)% ",
+                      flipped.stderr)
+    assert share and int(share.group(1)) >= 90, flipped.stderr    # at rest on the floor: 0 % upright
+    assert "--angle 180" in flipped.stderr
+    turned = invoke(["track", tmp_path / f"hop{seed}_flipped.avi", *args, "--angle", "180", "--out",
+                     tmp_path / "turned.csv"])
+    assert turned.exit_code == 0 and "upside down" not in turned.stderr, turned.output

@@ -24,6 +24,7 @@ from .importing import ImportOptions, import_options, import_tracks, is_project,
 from .runner import track_video
 from .spec import ModelOptions, parse_markers
 from .tracks_csv import tracks_csv_beside, write_tracks_csv
+from .upright import upside_down_warnings
 from .video import Clip, check_fps, probe
 
 SUBCOMMANDS = ("video", "import", "from-trk", "board", "preview")
@@ -400,6 +401,8 @@ def _track(video: Path, named: Path, project, models: list, cal: dict, clip: Cli
         result = track_video(info, clip, models, calibration, progress=bar.update)
     if named != video:   # a Tracker project's video, unpacked from it for this run
         result.source = f"locust track of the video in {named}"
+    for warning in upside_down_warnings(result):
+        click.echo(f"warning: {warning}", err=True)
     written = _write(result, paths, fmt)
     if trk_out is not None:
         media = trk.media_in_zip(project, trk_out) if project is not None and is_project(named) else None
