@@ -263,7 +263,7 @@ def from_trk_command(project, trk_names, out, force, fmt):
     \b
     Examples:
       locust track from-trk experiment.trz
-      locust track from-trk BallToss.trz --track "mass A" --format tracker --out toss.txt
+      locust track from-trk BallToss.trz --track ball --format tracker --out toss.txt
     """
     _convert_trk(project, list(trk_names), out, fmt, force)
 
@@ -291,7 +291,7 @@ def board_command(png, board_text, force):
                f"{spec.marker_mm:g} mm, lay it flat in the plane of motion")
 
 
-@track.command("preview", short_help="One frame with a pixel grid and its coloured blobs, to pick markers.")
+@track.command("preview", short_help="One frame with a pixel grid, its coloured blobs listed.")
 @click.argument("video", type=click.Path(path_type=Path))
 @click.option("--frame", default=0, show_default=True, type=int, help="The frame to show.")
 @marker_options
