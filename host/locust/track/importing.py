@@ -156,7 +156,10 @@ def import_tracks(path: str | Path, units: str = "m", rename: Iterable[str] | Ma
     options = options or ImportOptions.parse(units, rename, mirror)
     if is_project(path):
         return import_project(path, options)
-    return tracks_from_delimited(split_text(read_text(path), path), options)
+    doc = split_text(read_text(path), path)
+    tracks = tracks_from_delimited(doc, options)
+    check_times(doc, tracks.t_s)
+    return tracks
 
 
 PROJECT_SUFFIXES = (".trk", ".trz")
@@ -215,14 +218,12 @@ def tracks_from_delimited(doc: DelimitedText, options: ImportOptions = AS_IS) ->
                          f"(columns: {', '.join(doc.header)})", FORMATS_HINT)
     if layout == "tracks":
         tracks = TracksCsv.from_delimited(doc)
-        check_times(doc, tracks.t_s)
         return tracks if options.identity else _convert_tracks_csv(tracks, options)
     columns, dropped = _tracker_markers(doc) if layout == "tracker" else _txy_markers(doc)
     if not columns:
         raise TrackError(f"{doc.path}: no track with x and y columns (columns: {', '.join(doc.header)})",
                          FORMATS_HINT)
     t_s = columns.pop(0)
-    check_times(doc, t_s)
     markers = _apply(doc.path, columns, options)
     plain = layout == "txy" or (doc.delimiter == "," and doc.names_row is None and not doc.multi)
     note = f"imported from {doc.path.name} ({LAYOUT_NAMES['txy' if plain else layout]}): {options.describe()}"
@@ -234,7 +235,10 @@ def tracks_from_delimited(doc: DelimitedText, options: ImportOptions = AS_IS) ->
 
 def check_times(doc: DelimitedText, t_s) -> None:
     """Refuse rows whose time repeats the row before or goes back (rows without a time are
-    skipped): velocities, onsets and fits all divide by the step. Names the file's lines."""
+    skipped): velocities, onsets and fits all divide by the step. Names the file's lines.
+    :func:`import_tracks` applies it; the calibration layer reads through
+    :func:`tracks_from_delimited` and rebuilds times rounded to repeating values from the row
+    order itself (``locust.calibrate.recordings.regular_time``)."""
     t = np.asarray(t_s, dtype=float)
     rows = np.flatnonzero(np.isfinite(t))
     step = np.diff(t[rows])
