@@ -223,3 +223,22 @@ def test_an_upside_down_hop_is_flagged_and_an_upright_one_is_not(tmp_path, seed)
     turned = invoke(["track", tmp_path / f"hop{seed}_flipped.avi", *args, "--angle", "180", "--out",
                      tmp_path / "turned.csv"])
     assert turned.exit_code == 0 and "upside down" not in turned.stderr, turned.output
+
+
+# -- the one-command form's options that are subcommands now ---------------------------------
+@pytest.mark.parametrize("args, new", [
+    (["--import", "x.txt"], "locust track import FILE"),
+    (["--from-trk", "x.trz"], "locust track from-trk PROJECT"),
+    (["--make-board", "b.png"], "locust track board BOARD.png"),
+    (["hop.mp4", "--preview", "0"], "locust track preview VIDEO --frame N"),
+    (["hop.mp4", "--preview=0"], "locust track preview VIDEO --frame N"),
+])
+def test_the_old_options_name_their_subcommand(hop, args, new):
+    assert_refused_and_unchanged(hop, ["track", *args], "a subcommand of its own", new)
+
+
+def test_track_video_is_the_default_subcommand(hop, tmp_path):
+    short = invoke(["track", hop / "hop.mp4", "--overlay", "none", "--out", tmp_path / "a.csv"])
+    full = invoke(["track", "video", hop / "hop.mp4", "--overlay", "none", "--out", tmp_path / "b.csv"])
+    assert short.exit_code == 0 and full.exit_code == 0, short.output + full.output
+    assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
