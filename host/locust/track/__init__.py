@@ -17,6 +17,8 @@ Modules, one job each:
 - :mod:`.preview`   one frame with a pixel grid and the saturated blobs, for picking colours
 - :mod:`.runner`    the frame loop that ties video, markers and calibration together
 - :mod:`.export`    a result as the tracks CSV + JSON sidecar
+- :mod:`.upright`   whether the heights are the right way up (a robot rests on the floor)
+- :mod:`.options`   the subcommands' click options, each defined once (:mod:`.cli`)
 - :mod:`.trk`       Tracker's .trk/.trz reader; a result in its text-export layout
 - :mod:`.importing` any track file in any unit, renamed, mirrored: the one conversion that
                     ``track import``, ``calibrate`` and ``report`` read tracks through

@@ -7,7 +7,6 @@ with only its options; ``locust track VIDEO ...`` is short for ``locust track vi
 from __future__ import annotations
 
 import contextlib
-import functools
 import math
 from pathlib import Path
 
@@ -18,14 +17,14 @@ from ..errors import TrackError
 from ..fileio import atomic_write_json
 from ..progress import progress
 from . import board, calib, camera, export, overlay, preview, trk
-from .aruco import DEFAULT_DICTIONARY, side_px_in_video
+from .aruco import side_px_in_video
 from .board import DEFAULT_BOARD
 from .importing import ImportOptions, import_options, import_tracks, is_project, span_warnings
+from .options import CALIBRATION, CLIP, FORMAT, OUTPUT, marker_options, stacked
 from .runner import track_video
-from .spec import ModelOptions, parse_markers
 from .tracks_csv import tracks_csv_beside, write_tracks_csv
 from .upright import upside_down_warnings
-from .video import Clip, check_fps, probe
+from .video import Clip, probe
 
 SUBCOMMANDS = ("video", "import", "from-trk", "board", "preview")
 # the options of the one-command `locust track` that became subcommands, and their new form
@@ -44,88 +43,6 @@ class TrackGroup(click.Group):
         if args and args[0] not in SUBCOMMANDS and args[0] not in ctx.help_option_names:
             args = ["video", *args]
         return super().parse_args(ctx, args)
-
-
-def _stack(func, options: list):
-    for option in reversed(options):
-        func = option(func)
-    return func
-
-
-OUTPUT = [click.option("--out", type=click.Path(path_type=Path),
-                       help="Output file (or folder). Default: beside the input, <input>.tracks.csv (with .json)."),
-          click.option("--force", is_flag=True, help="Replace existing output files.")]
-FORMAT = [click.option("--format", "fmt", type=click.Choice(["csv", "tracker"]), default="csv", show_default=True,
-                       help="csv: frame, t_s, <name>_px/_py/_x_m/_y_m/_ok. tracker: Tracker's text export layout.")]
-
-
-def marker_options(func):
-    """``--marker`` and the matching settings; the command gets them as ``models``."""
-
-    @functools.wraps(func)
-    def wrapper(*args, markers, color_tol, search_px, template_radius, accept, likeness, evolve, **kwargs):
-        if not math.isfinite(accept):
-            raise TrackError(f"--accept {accept}: not a finite number", "give --accept as a plain number, see --help")
-        options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0, likeness)
-        return func(*args, models=parse_markers(list(markers), options), **kwargs)
-
-    return _stack(wrapper, [
-        click.option("--marker", "markers", multiple=True, metavar="NAME=SPEC",
-                     help="A marker to track; repeatable. SPEC is color:#RRGGBB[@X,Y] (X,Y: where it is on the "
-                          "first frame), template:X,Y@FRAME or aruco:ID[@DICT]. "
-                          "Default: the robot's nose (#ff00ff) and foot (#00ffff) colours."),
-        click.option("--color-tol", default=80, show_default=True, type=click.IntRange(1, 255),
-                     help="Colour markers: largest per-channel difference (0-255) still counted as the marker; "
-                          "at 80 a pixel of the marker's hue (+-16 deg) also counts down to 0.3 of its saturation "
-                          "and brightness (shadow, blur), and the bounds scale with it."),
-        click.option("--search", "search_px", default=40, show_default=True, type=click.IntRange(4, 2000),
-                     help="Half-size (px) of the search window around each predicted position "
-                          "(colour markers: at least five marker diameters, growing while the marker is lost)."),
-        click.option("--template-radius", default=8, show_default=True, type=click.IntRange(2, 200),
-                     help="Template markers: radius (px) of the circular template (Tracker's mask is 16 px across)."),
-        click.option("--accept", default=0.5, show_default=True, type=float,
-                     help="Template markers: least peak height (mean / best square difference - 1 over the search "
-                          "window) to accept a match; it must also look like the template (--likeness) and follow "
-                          "the motion its track predicts."),
-        click.option("--likeness", default=0.5, show_default=True, type=click.FloatRange(-1, 1),
-                     help="Template markers: least correlation (zero-mean, normalised) of a match with the template."),
-        click.option("--evolve", default=20.0, show_default=True, type=click.FloatRange(0, 100),
-                     help="Template markers: percent of each accepted match blended into the template."),
-    ])
-
-
-CALIBRATION = [
-    click.option("--scale", metavar="X1,Y1,X2,Y2=LENGTH_M",
-                 help="Calibration stick: two pixel points and the distance between them in metres."),
-    click.option("--scale-aruco", metavar="ID=SIDE_M",
-                 help="Calibrate from an ArUco marker's printed side length (m), measured where it first appears."),
-    click.option("--aruco-dict", default=DEFAULT_DICTIONARY, show_default=True,
-                 help="ArUco dictionary for --scale-aruco."),
-    click.option("--board", "board_text", metavar="aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM",
-                 help="An ArUco grid board lying in the plane of motion (see `locust track board`): world x_m/y_m "
-                      "in that plane, origin at the board's bottom-left corner, y up, with perspective corrected. "
-                      "E.g. aruco:4X4_50:5x4:40:10."),
-    click.option("--plane-points", metavar="PX,PY=X_M,Y_M;...",
-                 help="Instead of a board: four or more pixels with their measured plane coordinates (m, y up)."),
-    click.option("--camera-json", type=click.Path(dir_okay=False, path_type=Path),
-                 help="Pinhole camera of a simulated video (world metres through each marker's plane). "
-                      "Default: <video>.camera.json beside the video, "
-                      "used when no --scale/--scale-aruco/--origin is given."),
-    click.option("--origin", metavar="X,Y", help="World origin in pixels. Default: centre of the bottom-left pixel."),
-    click.option("--angle", default=0.0, show_default=True, type=float,
-                 help="Direction of the world x axis, degrees counter-clockwise from the image x axis (as Tracker)."),
-    click.option("--calibration-from", type=click.Path(dir_okay=False, path_type=Path),
-                 help="Track in the coordinates of a Tracker project (.trk or .trz): its scale, origin and axes, and "
-                      "its frame interval unless --fps is given. VIDEO may also be the project itself."),
-]
-CLIP = [
-    click.option("--start", default=0, show_default=True, type=int, help="First frame of the clip."),
-    click.option("--end", default=None, type=int, help="Last frame of the clip (inclusive). Default: the last frame."),
-    click.option("--step", default=1, show_default=True, type=int, help="Track every STEP-th frame."),
-    click.option("--fps", default=None, type=float, callback=lambda ctx, param, value: check_fps(value),
-                 help="True frame rate (1 to 10000 frames/s), for slow-motion footage whose file rate is wrong. "
-                      "Default: the file's rate."),
-]
 
 
 @click.group(cls=TrackGroup, context_settings={"max_content_width": 100})
@@ -152,7 +69,7 @@ def track():
 @track.command("video", short_help="Track the markers of a video or image sequence.")
 @click.argument("video", type=click.Path(path_type=Path))
 @marker_options
-@functools.partial(_stack, options=CALIBRATION + CLIP + OUTPUT + FORMAT)
+@stacked(*CALIBRATION, *CLIP, *OUTPUT, *FORMAT)
 @click.option("--overlay", "overlay_kind", type=click.Choice(["png", "video", "none"]), default="png",
               show_default=True, help="Draw the tracks on the last frame (png) or on the whole clip (video).")
 @click.option("--trk", "trk_out", type=click.Path(dir_okay=False, path_type=Path),
@@ -207,7 +124,7 @@ def video_command(video, models, start, end, step, fps, out, force, fmt, overlay
 @import_options
 @click.option("--track", "trk_names", multiple=True, metavar="NAME",
               help="A Tracker project converted as it is: only these of its tracks (repeatable).")
-@functools.partial(_stack, options=OUTPUT)
+@stacked(*OUTPUT)
 def import_command(file, imports: ImportOptions, trk_names, out, force):
     """Convert FILE, another program's tracks, into a tracks CSV in metres: a Tracker text
     export, a t,x,y CSV (one marker, the nose), a tracks CSV, or a Tracker project
@@ -254,7 +171,7 @@ def import_command(file, imports: ImportOptions, trk_names, out, force):
 @click.argument("project", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--track", "trk_names", multiple=True, metavar="NAME",
               help="Only these Tracker tracks (repeatable). Default: all point masses.")
-@functools.partial(_stack, options=OUTPUT + FORMAT)
+@stacked(*OUTPUT, *FORMAT)
 def from_trk_command(project, trk_names, out, force, fmt):
     """Convert the point tracks of a Tracker PROJECT (.trk, or a .trz zip holding one) into a
     tracks CSV (or Tracker's text layout), in metres through the project's own calibration
@@ -295,7 +212,7 @@ def board_command(png, board_text, force):
 @click.argument("video", type=click.Path(path_type=Path))
 @click.option("--frame", default=0, show_default=True, type=int, help="The frame to show.")
 @marker_options
-@functools.partial(_stack, options=OUTPUT)
+@stacked(*OUTPUT)
 def preview_command(video, frame, models, out, force):
     """Write one FRAME of VIDEO with a pixel grid, the most saturated blobs listed (colour,
     position) and what the --marker specs find there, to <out>.preview.png: pick colours
