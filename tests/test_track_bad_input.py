@@ -242,3 +242,38 @@ def test_track_video_is_the_default_subcommand(hop, tmp_path):
     full = invoke(["track", "video", hop / "hop.mp4", "--overlay", "none", "--out", tmp_path / "b.csv"])
     assert short.exit_code == 0 and full.exit_code == 0, short.output + full.output
     assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
+
+
+def _dim_sticker_frames(chroma_share: float, radius_px: float, n: int = 16, w: int = 160, h: int = 120):
+    """SYNTHETIC: one magenta sticker of ``chroma_share`` of #ff00ff's chroma (saturation and
+    brightness both sqrt of it), drifting 1.5 px a frame on a grey floor; its true centres."""
+    level = 255 * math.sqrt(chroma_share)
+    bgr = cv2.cvtColor(np.uint8([[[150, round(level), round(level)]]]), cv2.COLOR_HSV2BGR)[0, 0].tolist()
+    centres = [(50.3 + 1.5 * i, 60.7 - 0.5 * i) for i in range(n)]
+    frames = []
+    for cx, cy in centres:
+        img = np.full((h, w, 3), 40.0, np.float32)
+        paint_dot(img, cx, cy, radius_px, bgr)
+        frames.append(np.rint(img).astype(np.uint8))
+    return frames, np.array(centres)
+
+
+@pytest.mark.parametrize("radius_px", [2.0, 3.0, 6.0])
+@pytest.mark.parametrize("chroma_share", [0.35, 0.5, 1.0])
+def test_a_sticker_in_shadow_or_small_is_still_taken(tmp_path, chroma_share, radius_px):
+    """The first-sighting bounds (0.3 of the colour's chroma, 3 px across) keep real stickers:
+    dim to 0.35 of the chroma, 4 px across, every frame found within 0.25 px of the truth."""
+    frames, truth = _dim_sticker_frames(chroma_share, radius_px)
+    encode_video(tmp_path / "dim.avi", frames, 30.0, (160, 120), "FFV1")
+    res = invoke(["track", tmp_path / "dim.avi", "--marker", "nose=color:#ff00ff", "--overlay", "none"])
+    assert res.exit_code == 0, res.output
+    got = np.loadtxt(tmp_path / "dim.tracks.csv", delimiter=",", skiprows=1, usecols=(2, 3), comments="#")
+    assert np.hypot(*(got - truth).T).max() <= 0.25
+
+
+@pytest.mark.parametrize("chroma_share, radius_px", [(0.2, 6.0), (0.25, 6.0), (1.0, 1.0)])
+def test_a_dim_patch_or_a_speck_is_never_taken(tmp_path, chroma_share, radius_px):
+    frames, _ = _dim_sticker_frames(chroma_share, radius_px)
+    encode_video(tmp_path / "dim.avi", frames, 30.0, (160, 120), "FFV1")
+    assert_refused_and_unchanged(tmp_path, ["track", tmp_path / "dim.avi", "--marker", "nose=color:#ff00ff"],
+                                 "never found", "nose (color:#ff00ff)")
