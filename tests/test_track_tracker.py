@@ -67,7 +67,7 @@ def test_trk_reader_reproduces_trackers_world_data(shared_data):
 
 def test_from_trk_cli_writes_trackers_text_layout(shared_data, tmp_path):
     out = tmp_path / "balltoss.txt"
-    res = CliRunner().invoke(cli, ["track", "--from-trk", str(shared_data / "tracker" / "BallToss.trz"),
+    res = CliRunner().invoke(cli, ["track", "from-trk", str(shared_data / "tracker" / "BallToss.trz"),
                                    "--format", "tracker", "--out", str(out)])
     assert res.exit_code == 0, res.output
     table = read_tracker_export(out).tracks["ball"]
@@ -89,7 +89,7 @@ def test_from_trk_reads_cupsclips_tracks(shared_data, tmp_path):
         z.extract(names[0], tmp_path)
     project = trk_io.read_project(tmp_path / names[0])
     assert {"cup 3", "cup 7"} <= set(project.points)
-    res = CliRunner().invoke(cli, ["track", "--from-trk", str(tmp_path / names[0]),
+    res = CliRunner().invoke(cli, ["track", "from-trk", str(tmp_path / names[0]),
                                    "--out", str(tmp_path / "cups.csv")])
     assert res.exit_code == 0, res.output
     df = pd.read_csv(tmp_path / "cups.csv")

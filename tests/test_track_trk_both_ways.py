@@ -63,7 +63,7 @@ def test_cup_out_of_view_is_lost_not_stuck(cups_run):
 
 def test_trk_out_reads_back_to_the_same_points(cups, cups_run):
     _, df, _ = cups_run
-    res = CliRunner().invoke(cli, ["track", "--from-trk", str(cups / "cups_out.trk"), "--out", str(cups / "back.csv")])
+    res = CliRunner().invoke(cli, ["track", "from-trk", str(cups / "cups_out.trk"), "--out", str(cups / "back.csv")])
     assert res.exit_code == 0, res.output
     back = pd.read_csv(cups / "back.csv")
     assert list(back.columns) == list(df.columns)
@@ -105,7 +105,7 @@ def test_trz_is_a_video_and_an_import(shared_data, tmp_path):
     assert res.exit_code == 0, res.output
     assert pd.read_csv(tmp_path / "t.csv")["ball_ok"].sum() == 11
     assert trk_io.read_project(tmp_path / "t.trk").video_path.endswith("BallToss.trz!/videos/BallToss_new_BallToss.mp4")
-    res = CliRunner().invoke(cli, ["track", "--import", str(trz), "--out", str(tmp_path / "i.csv")])
+    res = CliRunner().invoke(cli, ["track", "import", str(trz), "--out", str(tmp_path / "i.csv")])
     assert res.exit_code == 0, res.output
     imported = pd.read_csv(tmp_path / "i.csv")
     assert imported["ball_ok"].sum() == 11                         # Tracker's steps, frames 2..12

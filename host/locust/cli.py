@@ -29,7 +29,7 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
     "pose": ("locust.device.cli", "pose", "Move the servos to an angle and hold it (centring, trim)."),
     "repl": ("locust.device.cli", "repl", "Open MicroPython's REPL on the robot (mpremote)."),
     "virtual": ("locust.device.cli", "virtual", "Start a virtual robot on a pseudo-terminal."),
-    "track": ("locust.track.cli", "track", "Extract marker tracks (nose, foot) from video."),
+    "track": ("locust.track.cli", "track", "Marker tracks from video, or converted from Tracker (5 subcommands)."),
     "calibrate": ("locust.calibrate.cli", "calibrate", "Fit stiffness, damping, servo gains, friction."),
     "report": ("locust.report.cli", "report", "Compare simulation and measurement in an HTML report."),
     "demo": ("locust.demo", "demo", "Run the whole toolkit end to end on the virtual robot."),

@@ -19,7 +19,7 @@ All four become one :class:`Table` of numeric columns, with marker positions und
 
 Every track (the last three) goes through :func:`locust.io.importing.import_tracks`'s
 conversion, so ``--units``, ``--rename`` and ``--mirror`` act here as in ``locust track
---import``; a plain CSV has no positions and is read as it is. The three share one tokenizer
+import``; a plain CSV has no positions and is read as it is. The three share one tokenizer
 (:mod:`locust.io.delimited`). Every problem is a :class:`~locust.errors.CalibrationError`
 naming the file, and the line or column, with a hint.
 

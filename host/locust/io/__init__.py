@@ -9,7 +9,7 @@ robot all read and write files through it without importing one another.
 - :mod:`.tracker_text` Tracker's text export (*File > Export > Data*)
 - :mod:`.trk`          Tracker projects (``.trk``, ``.trz``) and their calibration
 - :mod:`.importing`    any track file in any unit, renamed, mirrored: the one conversion that
-                       ``track --import``, ``calibrate`` and ``report`` read tracks through
+                       ``track import``, ``calibrate`` and ``report`` read tracks through
 - :mod:`.camera_json`  ``<video>.camera.json``, the pinhole camera of a simulated video
 - :mod:`.run_record`   ``run.json``, a hop's run record
 - :mod:`.sweep_store`  a sweep's folder: ``sweep.json`` and ``results.csv``

@@ -1,7 +1,7 @@
 """Imports: any track file, in any length unit, with its markers renamed and x mirrored.
 
 The one conversion every track input goes through (:func:`import_tracks`):
-``locust track --import``, ``locust calibrate`` (beam, servo ``--pivot``, ramp tracks) and
+``locust track import``, ``locust calibrate`` (beam, servo ``--pivot``, ramp tracks) and
 ``locust report`` (``--measured`` tracks) all read their tracks here, with the same options:
 
 - ``--units m|cm|mm``: the unit of the file's positions; they are divided by 1, 100 or 1000
@@ -156,7 +156,10 @@ def import_tracks(path: str | Path, units: str = "m", rename: Iterable[str] | Ma
     options = options or ImportOptions.parse(units, rename, mirror)
     if is_project(path):
         return import_project(path, options)
-    return tracks_from_delimited(split_text(read_text(path), path), options)
+    doc = split_text(read_text(path), path)
+    tracks = tracks_from_delimited(doc, options)
+    check_times(doc, tracks.t_s)
+    return tracks
 
 
 PROJECT_SUFFIXES = (".trk", ".trz")
@@ -226,6 +229,27 @@ def tracks_from_delimited(doc: DelimitedText, options: ImportOptions = AS_IS) ->
         note += f"; not imported: {', '.join(dropped)}"
     return TracksCsv(frame=np.arange(len(t_s)), t_s=t_s, markers=markers, comments=(*doc.comments, note),
                      path=doc.path)
+
+
+def check_times(doc: DelimitedText, t_s) -> None:
+    """Refuse rows whose time repeats the row before or goes back (rows without a time are
+    skipped): velocities, onsets and fits all divide by the step. Names the file's lines.
+    :func:`import_tracks` applies it; the calibration layer reads through
+    :func:`tracks_from_delimited` and rebuilds times rounded to repeating values from the row
+    order itself (``locust.calibrate.recordings.regular_time``)."""
+    t = np.asarray(t_s, dtype=float)
+    rows = np.flatnonzero(np.isfinite(t))
+    step = np.diff(t[rows])
+    bad = rows[1:][step <= 0]
+    if not bad.size:
+        return
+    repeats, back = int((step == 0).sum()), int((step < 0).sum())
+    lines = [doc.rows[k][0] for k in bad]
+    where = ", ".join(str(n) for n in lines[:6]) + (f" and {len(lines) - 6} more" if len(lines) > 6 else "")
+    raise TrackError(f"{doc.path}: time does not increase on {len(bad)} of {len(rows)} rows ({repeats} repeat the "
+                     f"time before, {back} go back), line {where}; first at t = {t[bad[0]]:g} s",
+                     "sort the rows by time and remove duplicate frames; times that repeat only after rounding "
+                     "(e.g. 3 significant digits) need an export with more digits")
 
 
 # -- the layouts -------------------------------------------------------------------

@@ -37,6 +37,7 @@ from .tracks_csv import MarkerColumns, TracksCsv
 
 TRACKER_TO_OPENCV_PX = -0.5
 POINT_CLASSES = ("PointMass",)  # Tracker's point tracks; vectors, tapes, axes are not tracks of a marker
+FPS_MIN, FPS_MAX = 1.0, 10000.0   # frames/s a camera films: a time-lapse at 1/s to a high-speed camera's 10 000/s
 LENGTH_UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "km": 1000.0, "in": 0.0254, "ft": 0.3048}
 
 
@@ -191,6 +192,11 @@ def _project(path: Path, root: ET.Element) -> TrackerProject:
     if not points:
         raise TrackError(f"{path}: no point-mass tracks in this Tracker file", "mark a point mass in Tracker first")
     end = start + step * (count - 1) if count else max(max(p) for p in points.values() if p)
+    if dt_ms is not None and not 1000.0 / FPS_MAX <= dt_ms <= 1000.0 / FPS_MIN:
+        raise TrackError(f"{path}: the clip's frame interval (clip control delta_t) is {dt_ms:g} ms; a camera's is "
+                         f"{1000.0 / FPS_MAX:g} to {1000.0 / FPS_MIN:g} ms ({FPS_MIN:g} to {FPS_MAX:g} frames/s), "
+                         "and times are frame x delta_t",
+                         "set the clip's frame rate in Tracker (Video > Clip Settings) and save the project again")
     fps = 1000.0 / dt_ms if dt_ms else math.nan
     return TrackerProject(path, video_path, TrackerClip(start, end, step, fps), calibration, points)
 

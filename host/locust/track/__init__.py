@@ -18,6 +18,8 @@ Modules, one job each:
 - :mod:`.preview`   one frame with a pixel grid and the saturated blobs, for picking colours
 - :mod:`.runner`    the frame loop that ties video, markers and calibration together
 - :mod:`.export`    a result as the tracks CSV + JSON sidecar
+- :mod:`.upright`   whether the heights are the right way up (a robot rests on the floor)
+- :mod:`.options`   the subcommands' click options, each defined once (:mod:`.cli`)
 - :mod:`.trk`       a result as a Tracker project (.trk) or in Tracker's text-export layout; a
                     Tracker project as a result
 - :mod:`.overlay`   PNG / video of the tracks drawn on the footage
