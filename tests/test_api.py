@@ -159,3 +159,17 @@ def test_readme_python_api_runs_as_shown(tmp_path, monkeypatch, capsys):
     assert len(scope["swept"].to_dataframe()) == 6
     assert scope["calibrated"].contact.foot_friction == scope["fit"].parameters["contact.foot_friction"].value
     assert f"{scope['result'].distance_m * 1000:.2f} mm" in capsys.readouterr().out
+
+
+def test_calibrate_hop_takes_its_runs_through_the_api(tmp_path, monkeypatch):
+    """`locust calibrate hop` loads its runs through locust.calibrate_hops: an empty run folder is
+    refused there, before any fit, and nothing is written."""
+    from probing import assert_refused_and_unchanged
+
+    (tmp_path / "small-1").mkdir()
+    monkeypatch.chdir(tmp_path)
+    assert_refused_and_unchanged(tmp_path, ["calibrate", "hop", "small=small-1", "--write", "robot.toml"],
+                                 "small-1", "no run.json")
+    with pytest.raises(LocustError, match="no run.json") as exc:
+        locust.calibrate_hops(locust.robot("seed"), {"small": tmp_path / "small-1"})
+    assert exc.value.hint

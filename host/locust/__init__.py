@@ -18,7 +18,7 @@ import types as _types
 __version__ = "0.1.0"
 
 __all__ = ["robot", "simulate", "SimResult", "sweep", "SweepResults", "track", "read_tracks", "Tracks",
-           "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "Fit", "report",
+           "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "calibrate_hops", "Fit", "report",
            "Robot", "LocustError"]
 
 

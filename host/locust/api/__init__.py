@@ -27,7 +27,7 @@ EXPORTS = {
     "sweep": "sweeps", "SweepResults": "sweeps",
     "track": "tracking", "read_tracks": "tracking", "Tracks": "tracking",
     "calibrate_beam": "calibration", "calibrate_hinge": "calibration", "calibrate_ramp": "calibration",
-    "calibrate_servo": "calibration", "Fit": "calibration",
+    "calibrate_servo": "calibration", "calibrate_hops": "calibration", "Fit": "calibration",
     "report": "reports",
 }
 

@@ -4,7 +4,7 @@ and the robot with them applied)."""
 from __future__ import annotations
 
 import html
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -56,13 +56,19 @@ class Fit:
         """Everything the fit found, as ``locust calibrate --json`` prints it."""
         return self.result.summary()
 
-    def plot(self):
-        """Data and model above, residuals below (per recording).
+    def plot(self, run: int = 0):
+        """Data and model above, residuals below (per recording); for a hop fit, run ``run``'s
+        tracked markers against the fitted simulation.
 
         Returns
         -------
         matplotlib.figure.Figure
         """
+        if self.experiment == "hops":
+            from ..calibrate.hop import run_figure
+
+            fit = self.result.runs[run]
+            return run_figure(fit, f"RMS {1000 * fit.rms_m:.2f} mm")
         from ..calibrate.plots import fit_figure
 
         return fit_figure(self.result.curves, self.subtitle)
@@ -308,8 +314,60 @@ def calibrate_ramp(data: PathLike | Sequence[PathLike] | np.ndarray, *, into: st
                subtitle=f"mu {fit.mu_static.value:.4g} from {fit.n_trials} trials", warnings=warnings)
 
 
+def calibrate_hops(robot: Robot, runs: Mapping[str, PathLike] | Sequence[PathLike | object],
+                   keys: Sequence[str] | None = None, *, max_iter: int = 30, progress=None) -> Fit:
+    """Fit the model to filmed hops of one or more leg sets at once (the physics is shared).
+
+    Parameters
+    ----------
+    robot : Robot
+        The starting values (e.g. the bench-calibrated robot); each run's leg set is built on it.
+    runs : dict or list
+        Leg set -> a ``locust hop --out`` folder (its ``run.json`` and the track of its video),
+        or the command line's ``["small=runs/s1", "runs/large-1", ...]`` (a folder named after
+        its leg set), or runs already loaded (``locust.calibrate.hop.HopRun``).
+    keys : list of str, optional
+        The robot values fitted (default: foot friction, hinge stiffness, servo no-load speed).
+    max_iter : int, default 30
+        Solver iterations.
+
+    Returns
+    -------
+    Fit
+        The identifiable values; ``.plot(run)`` the tracked markers against the fitted simulation.
+    """
+    from ..calibrate import hop as H
+
+    keys = tuple(keys or H.DEFAULT_KEYS)
+    if isinstance(runs, Mapping):
+        runs = [f"{name}={path}" for name, path in runs.items()]
+    loaded = [item if isinstance(item, H.HopRun) else H.load_run(*_run_folder(str(item)), robot) for item in runs]
+    fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=progress)
+    values = {k: fit.estimates[k] for k in fit.keys if fit.identifiable[k]}
+    note = "filmed hops " + ", ".join(f"{r.config}:{Path(r.source).name}" for r in fit.runs)
+    return Fit("hops", H.PROVENANCE_NAME, values, fit, note=note,
+               subtitle=f"{len(fit.runs)} runs, RMS {1000 * fit.rms_m:.2f} mm", warnings=[])
+
+
+def _run_folder(item: str) -> tuple[Path, str]:
+    """``NAME=FOLDER``, or a folder named after its leg set (small-1/, large/)."""
+    from ..errors import ReportError
+    from ..report.configs import name_from_path
+
+    name, sep, rest = item.partition("=")
+    if sep and name and "/" not in name and not Path(item).exists():
+        return Path(rest), name
+    path = Path(item)
+    try:
+        return path, name_from_path(path)
+    except ReportError:
+        raise CalibrationError(f"{path}: cannot tell which leg set this run is from its folder's name",
+                               "name it: small=PATH") from None
+
+
 def _tuple(value) -> tuple[float, ...]:
     return tuple(float(v) for v in value) if isinstance(value, Sequence) else (float(value),)
 
 
-__all__ = ["Fit", "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "fit_servo_recordings"]
+__all__ = ["Fit", "calibrate_beam", "calibrate_hinge", "calibrate_hops", "calibrate_ramp", "calibrate_servo",
+           "fit_servo_recordings"]

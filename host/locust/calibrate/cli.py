@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..errors import CalibrationError, ReportError, TrackError
+from ..errors import CalibrationError, TrackError
 from ..fileio import json_text
 from ..options import FINITE, POSITIVE
 from ..progress import progress
@@ -321,27 +321,15 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
     Example:
       locust calibrate hop small=runs/s1 large=runs/l1 --write calibration/robot.toml
     """
+    from ..api.calibration import calibrate_hops
     from ..params import resolve_robot
-    from ..report.configs import name_from_path
 
     keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
     start_from = config or (write_path if write_path and Path(write_path).exists() else None)
     base = resolve_robot(None, start_from, sets)
-    loaded = []
-    for item in runs:
-        name, sep, rest = item.partition("=")
-        if sep and name and "/" not in name and not Path(item).exists():
-            path, leg_set = Path(rest), name
-        else:
-            path = Path(item)
-            try:
-                leg_set = name_from_path(path)
-            except ReportError:
-                raise CalibrationError(f"{path}: cannot tell which leg set this run is from its folder's name",
-                                       "name it: small=PATH") from None
-        loaded.append(H.load_run(path, leg_set, base))
     with progress(length=max_iter, label="fitting hops") as bar:
-        fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=bar.update)
+        facade_fit = calibrate_hops(base, list(runs), keys, max_iter=max_iter, progress=bar.update)
+    fit = facade_fit.result
     out = fit.summary()
     if not no_plot:
         out["plots"] = []
@@ -350,10 +338,9 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
                 plot = Path(run.source) / "hops-fit.png"
                 out["plots"].append(str(H.plot_run(run, plot, f"RMS {1000 * run.rms_m:.2f} mm")))
     if write_path:
-        values = {k: fit.estimates[k] for k in fit.keys if fit.identifiable[k]}
+        values = facade_fit.parameters
         if values:
-            note = "filmed hops " + ", ".join(f"{r.config}:{Path(r.source).name}" for r in fit.runs)
-            write_fitted(write_path, values, H.PROVENANCE_NAME, note=note)
+            write_fitted(write_path, values, H.PROVENANCE_NAME, note=facade_fit.note)
         out["written"] = {"path": str(write_path), "keys": list(values)}
     if as_json:
         click.echo(json_text(out), nl=False)
