@@ -173,3 +173,12 @@ def test_calibrate_hop_takes_its_runs_through_the_api(tmp_path, monkeypatch):
     with pytest.raises(LocustError, match="no run.json") as exc:
         locust.calibrate_hops(locust.robot("seed"), {"small": tmp_path / "small-1"})
     assert exc.value.hint
+
+
+def test_a_result_without_states_says_how_to_keep_them():
+    r = locust.simulate(locust.robot("seed"), cycles=1, keep_states=False)
+    assert r.trajectory is None
+    assert r.distance_m == locust.simulate(locust.robot("seed"), cycles=1).distance_m
+    with pytest.raises(SimError, match="kept no rollout") as exc:
+        r.trace()
+    assert "keep_states=True" in exc.value.hint

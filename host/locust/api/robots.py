@@ -14,9 +14,10 @@ def robot(preset_or_path: str | Path = "seed", **overrides: Any) -> Robot:
 
     Parameters
     ----------
-    preset_or_path : str or path-like, default "seed"
-        A preset name (``seed``, ``small``, ``medium``, ``large``, ``seed-notebook``) or the
-        path of a robot TOML (``calibration/robot.toml``, ``locust params --write``).
+    preset_or_path : str, path-like or Robot, default "seed"
+        A preset name (``seed``, ``small``, ``medium``, ``large``, ``seed-notebook``), the
+        path of a robot TOML (``calibration/robot.toml``, ``locust params --write``), or a
+        robot to change.
     **overrides
         Values to change, by dotted name with the unit in it (``locust params`` lists them);
         since a dotted name is not a Python keyword, pass them as ``**{"servo.kp_nm_per_rad":

@@ -168,7 +168,7 @@ class SimResult(_run.SimResult):
     def _trajectory(self):
         if self.trajectory is None or self.trajectory.states is None:
             raise SimError("this result kept no rollout to trace or render",
-                           "make it with locust.simulate(robot), which keeps it")
+                           "simulate it with locust.simulate(robot, keep_states=True)")
         return self.trajectory
 
     # -- display ---------------------------------------------------------------------
@@ -213,7 +213,8 @@ class SimResult(_run.SimResult):
         return "".join(out)
 
 
-def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: int = 0) -> SimResult:
+def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: int = 0,
+             keep_states: bool = True) -> SimResult:
     """Settle the robot on the floor, run its hop schedule, audit the run and measure the hops.
 
     Parameters
@@ -228,6 +229,9 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
         ``max_nose_height_m_sd``, ...).
     seed : int, default 0
         Random seed of the draws.
+    keep_states : bool, default True
+        Keep every step's state for ``trace()`` and ``video()`` (False: the figures only, for
+        runs of many cycles).
 
     Returns
     -------
@@ -252,7 +256,7 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
     >>> r.trace().columns[:3].tolist()
     ['t_s', 'nose_x_m', 'nose_z_m']
     """
-    base = _run.run(robot, cycles=cycles, keep_states=True)
+    base = _run.run(robot, cycles=cycles, keep_states=keep_states)
     result = SimResult(**{f.name: getattr(base, f.name) for f in dataclasses.fields(base)}, params=robot)
     if samples and result.valid:
         from ..sim.samples import sample

@@ -51,7 +51,8 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
 
         check_video_path(video)  # fail before simulating, not after
     try:
-        result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed)  # the video reuses the rollout
+        result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed,
+                          keep_states=video is not None)  # the video reuses the rollout
     except GeometryError as exc:
         if not as_json:
             raise
