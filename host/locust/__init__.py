@@ -12,7 +12,6 @@ Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
 """
 
 import importlib as _importlib
-import inspect as _inspect
 import types as _types
 
 __version__ = "0.1.0"
@@ -34,7 +33,9 @@ class _CallablePackage(_types.ModuleType):
 
     @property
     def __signature__(self):
-        return _inspect.signature(self._function())
+        import inspect
+
+        return inspect.signature(self._function())
 
     @property
     def __doc__(self):
