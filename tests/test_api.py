@@ -182,3 +182,22 @@ def test_a_result_without_states_says_how_to_keep_them():
     with pytest.raises(SimError, match="kept no rollout") as exc:
         r.trace()
     assert "keep_states=True" in exc.value.hint
+
+
+def test_hop_fit_is_a_fit():
+    """locust.calibrate_hops wraps calibrate.hop.fit_hops: its values, their provenance and the
+    run's figure (a two-cycle SYNTHETIC run of Small, as tests/test_calibrate_hop.py makes them;
+    coverage over seeds is that file's)."""
+    from test_calibrate_hop import synthetic_run
+
+    key = "servo.noload_speed_rad_per_s"
+    run = synthetic_run("small", {key: 9.0}, cycles=2)
+    fit = locust.calibrate_hops(run.robot, [run], [key], max_iter=3)
+    assert fit.parameters == {key: fit.result.estimates[key]} and fit.result.identifiable[key]
+    assert abs(fit.parameters[key].value - 9.0) < 1.0          # 9.30 here, from 9.0
+    robot = fit.apply(locust.robot("seed"))
+    prov = robot.source_of(key)
+    assert (robot.get(key), prov.source, prov.uncertainty) == (fit.parameters[key].value, "fit:hops",
+                                                               fit.parameters[key].std)
+    assert "small:synthetic-small" in prov.note
+    assert len(fit.plot().axes) == 4                             # nose and foot, x and y
