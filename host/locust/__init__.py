@@ -1,3 +1,66 @@
-"""locust: firmware-plus-host toolkit for a foldable four-bar hopping robot."""
+"""locust: firmware-plus-host toolkit for a foldable four-bar hopping robot.
+
+The Python API (:mod:`locust.api`), for notebooks and scripts::
+
+    import locust
+    r = locust.simulate(locust.robot("small", **{"servo.kp_nm_per_rad": 0.4}), cycles=3)
+    r.trace()                          # pandas.DataFrame, one row per physics step
+    r.video("hop.mp4", overwrite=True)
+    locust.sweep(locust.robot("seed"), vary={"scale": (0.0, 0.05, 30)}, cycles=3).to_dataframe()
+
+Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
+"""
+
+import importlib as _importlib
+import types as _types
 
 __version__ = "0.1.0"
+
+__all__ = ["robot", "simulate", "SimResult", "sweep", "SweepResults", "track", "read_tracks", "Tracks",
+           "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "calibrate_hops", "Fit", "report",
+           "Robot", "LocustError"]
+
+
+class _CallablePackage(_types.ModuleType):
+    """A subpackage that is also the API function of its name: ``locust.sweep(...)`` calls
+    :func:`locust.api.sweeps.sweep`, while ``locust.sweep.run`` stays the module."""
+
+    def _function(self):
+        return getattr(_importlib.import_module("locust.api"), self.__name__.rpartition(".")[2])
+
+    def __call__(self, *args, **kwargs):
+        return self._function()(*args, **kwargs)
+
+    @property
+    def __signature__(self):
+        import inspect
+
+        return inspect.signature(self._function())
+
+    @property
+    def __doc__(self):
+        return (self._function().__doc__ or "") + "\n\nThe package:\n\n" + (self.__dict__.get("__doc__") or "")
+
+
+from . import report, sweep, track  # noqa: E402  (the packages' __init__ hold no code)
+
+report.__class__ = sweep.__class__ = track.__class__ = _CallablePackage
+
+
+def __getattr__(name: str):
+    """The API's names, imported on first use (``import locust`` stays quick for the command line)."""
+    if name == "Robot":
+        from .params import Robot
+
+        return Robot
+    if name == "LocustError":
+        from .errors import LocustError
+
+        return LocustError
+    if name in __all__:
+        return getattr(_importlib.import_module("locust.api"), name)
+    raise AttributeError(f"module 'locust' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

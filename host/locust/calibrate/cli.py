@@ -16,7 +16,6 @@ from ..io.importing import ImportOptions, import_options
 from ..options import FINITE, POSITIVE
 from ..plotting import check_figure_path
 from ..progress import progress
-from . import beam as B
 from . import hinge as HG
 from . import hop as H
 from . import ramp as R
@@ -128,24 +127,15 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, import
     TRACKS is a `locust track` CSV, a Tracker project (.trk, .trz) or text export, or a
     t,x,y CSV of the beam tip (metres, or --units cm|mm).
     """
-    table = read_table(tracks, imports, timing)
-    x, y = table.marker(marker)
-    t, x, y = clean_samples(tracks, "the beam tip", table.time_s(), x, y, min_samples=B.MIN_SAMPLES)
-    displacement = B.principal_displacement(x, y)
-    warning = B.tip_swing_warning(float(np.ptp(displacement)), length_m, imports.units, source=str(tracks))
-    fit = B.fit_beam(t, displacement, mass_kg, length_m=length_m, beam_mass_kg=beam_mass_kg,
-                     start_s=start_s, end_s=end_s, source=str(tracks))
-    values = {}
-    if fit.hinge_stiffness_nm_per_rad is not None:
-        values = {"compliance.hinge_stiffness_nm_per_rad": fit.hinge_stiffness_nm_per_rad,
-                  "compliance.hinge_damping_nms_per_rad": fit.hinge_damping_nms_per_rad}
-    elif write_path:
+    from ..api.calibration import calibrate_beam
+
+    fit = calibrate_beam(tracks, mass_kg, length_m=length_m, beam_mass_kg=beam_mass_kg, marker=marker,
+                         start_s=start_s, end_s=end_s, imports=imports, timing=timing)
+    if not fit.parameters and write_path:
         raise CalibrationError("--write needs --length-m: the hinge values are k*L^2 and b*L^2",
                                "measure the beam's free length from the clamp to the mass")
-    note = f"beam L={length_m} m, m={mass_kg} kg; {B.MAPPING}"
-    _finish(fit, tracks, values, note, write_path, as_json, plot_path, no_plot, force,
-            subtitle=f"fn {fit.natural_frequency_hz.value:.4g} Hz, zeta {fit.damping_ratio.value:.3g}",
-            warnings=[warning] if warning else [], input_note=table.input_note)
+    _finish(fit.result, tracks, fit.parameters, fit.note, write_path, as_json, plot_path, no_plot, force,
+            subtitle=fit.subtitle, warnings=fit.warnings, input_note=fit.input_note)
 
 
 @calibrate.command()
@@ -191,27 +181,16 @@ def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s,
     Example (the course's film hinge, the link clamped with its hinge axis vertical):
       locust calibrate hinge Damping_test.trk --inertia-kgm2 8.5e-7 --gravity out-of-plane
     """
-    if gravity == "out-of-plane" and (mass_kg or com_m):
-        raise CalibrationError("--mass-kg and --com-m act with --gravity in-plane only",
-                               "leave them out, or give --gravity in-plane if the link swings in a vertical plane")
-    rig = HG.HingeRig(inertia_kgm2, gravity, mass_kg or 0.0, com_m or 0.0)
-    table = read_table(tracks, imports, timing)
-    x, y = table.marker(marker)
-    t, x, y = clean_samples(tracks, "the link's marker", table.time_s(), x, y, min_samples=HG.MIN_SAMPLES)
+    from ..api.calibration import calibrate_hinge
+
     centre = tuple(_floats(pivot, 2, "--pivot", "X,Y in metres, e.g. --pivot 0.0,0.0")) if pivot else None
     with progress(length=1, label="fitting hinge swing") as bar:
-        fit = HG.fit_hinge(t, x, y, rig, pivot=centre, start_s=start_s, end_s=end_s, coulomb=coulomb,
-                           source=str(tracks))
+        fit = calibrate_hinge(tracks, inertia_kgm2, gravity, mass_kg=mass_kg, com_m=com_m, pivot=centre,
+                              marker=marker, start_s=start_s, end_s=end_s, coulomb=coulomb, imports=imports,
+                              timing=timing)
         bar.update(1)
-    values = {"compliance.hinge_stiffness_nm_per_rad": fit.hinge_stiffness_nm_per_rad,
-              "compliance.hinge_damping_nms_per_rad": fit.hinge_damping_nms_per_rad}
-    note = (f"hinge swing, I={inertia_kgm2:g} kg*m^2, gravity {gravity}"
-            + (f", M={mass_kg:g} kg, D={com_m:g} m" if gravity == "in-plane" else "")
-            + f", pivot {fit.pivot_source}; Coulomb friction {fit.coulomb_note}")
-    _finish(fit, tracks, values, note, write_path, as_json, plot_path, no_plot, force,
-            subtitle=(f"fn {fit.natural_frequency_hz:.4g} Hz, zeta {fit.damping_ratio:.3g}, "
-                      f"RMS {1000 * fit.rms_residual_m:.3g} mm"),
-            input_note=table.input_note)
+    _finish(fit.result, tracks, fit.parameters, fit.note, write_path, as_json, plot_path, no_plot, force,
+            subtitle=fit.subtitle, input_note=fit.input_note)
 
 
 @calibrate.command()
@@ -281,9 +260,12 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
     if pivot is None and not imports.identity:
         raise CalibrationError("--units, --rename and --mirror apply to a horn track (--pivot), not to angles",
                                "leave them out for t_s,angle_deg,command_deg recordings and gyro logs")
+    from ..api.calibration import fit_servo_recordings
+
     with progress(length=3 * 60, label="fitting servo") as bar:
-        fit = S.fit_servo(recordings, stall_torque_nm, kv_nms_per_rad=None if fit_kv else kv_nms_per_rad,
-                          progress=bar.update)
+        facade_fit = fit_servo_recordings(recordings, stall_torque_nm, kv_nms_per_rad=kv_nms_per_rad, fit_kv=fit_kv,
+                                          progress=bar.update)
+    fit = facade_fit.result
     validations = []
     if validate:
         v_inertias = _per_recording(validate_inertia_kgm2, len(validate), "--validate-inertia-kgm2") \
@@ -294,11 +276,7 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
                 inertia = next((r.rig.inertia_kgm2 for r in recordings if r.kind == rec.kind), inertias[0])
             rec = replace(rec, rig=S.ServoRig(inertia))
             validations.append(S.validate(fit.servo, rec, gain=fit.rate_gain))
-    values = {f"servo.{n}": fit.estimates[n] for n in S.PARAMS if fit.identifiable[n] and n not in fit.given}
-    kinds = ",".join(r.kind for r in recordings)
-    note = (f"servo steps ({kinds}), J={','.join(map(str, inertias))} kg*m^2, M={','.join(map(str, moments))} N*m"
-            + (f", stall torque {stall_torque_nm} N*m given" if stall_torque_nm else "")
-            + ("" if fit_kv else f", kv {kv_nms_per_rad} N*m*s/rad held"))
+    values, note = facade_fit.parameters, facade_fit.note
     extra = {}
     if validations:
         extra["validation"] = [v.summary() for v in validations]
@@ -307,10 +285,8 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
                 default_plot_path(validate[0]).with_name(f"{validate[0].stem}-validate.png")
             extra["validation_plot"] = str(plot_fit([v.curves for v in validations], target,
                                                     "predicted by the fitted servo (not fitted to it)", force))
-    subtitle = ", ".join(f"{Path(r.source).name} RMS {rms:.3g} {'deg' if r.kind == 'angle' else 'rad/s'}"
-                         for r, rms in zip(recordings, fit.rms_per_recording))
     _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot, force,
-            subtitle=subtitle, source_name=Path(fit.source).name, extra=extra)
+            subtitle=facade_fit.subtitle, source_name=Path(fit.source).name, extra=extra)
 
 
 def _servo_recording(path: Path, rig, pivot, step, marker, imports: ImportOptions,
@@ -356,23 +332,13 @@ def ramp(data, ramp_markers, robot_marker, into, resolution_deg, imports, timing
     DATA: CSVs with an angle_deg column (one trial a row, degrees), and/or side-view
     tracks of a tilting ramp (one trial each; --units, --rename, --mirror act on them).
     """
-    angles, warnings, tracks = [], [], 0
-    for path in data:
-        found, warning, is_track = _ramp_angles(path, ramp_markers, robot_marker, imports, timing)
-        angles.extend(found)
-        warnings += [warning] if warning else []
-        tracks += is_track
-    if tracks == 0 and not imports.identity:
-        raise CalibrationError("--units, --rename and --mirror apply to ramp tracks; these are angle tables",
-                               "leave them out for angle_deg recordings")
-    source = str(data[0]) if len(data) == 1 else "+".join(p.name for p in data)
-    fit = R.fit_ramp(np.array(angles), source=source, resolution_deg=resolution_deg)
-    values = {f"contact.{into}_friction": fit.mu_static}
-    note = f"ramp, {fit.n_trials} trials, mean angle {fit.mean_angle_deg:.4g} deg"
-    _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot, force,
-            subtitle=f"mu {fit.mu_static.value:.4g} from {fit.n_trials} trials",
-            recording_name=Path(source) if len(data) == 1 else Path("ramp"), source_name=Path(source).name,
-            warnings=warnings)
+    from ..api.calibration import calibrate_ramp
+
+    fit = calibrate_ramp(list(data), into=into, ramp_markers=ramp_markers, robot_marker=robot_marker,
+                         imports=imports, timing=timing, resolution_deg=resolution_deg)
+    _finish(fit.result, data[0], fit.parameters, fit.note, write_path, as_json, plot_path, no_plot, force,
+            subtitle=fit.subtitle, recording_name=Path(fit.source) if len(data) == 1 else Path("ramp"),
+            source_name=Path(fit.source).name, warnings=fit.warnings)
 
 
 @calibrate.command()
@@ -402,29 +368,17 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
     Example:
       locust calibrate hop small=runs/s1 large=runs/l1 --write calibration/robot.toml
     """
+    from ..api.calibration import calibrate_hops
     from ..params import resolve_robot
-    from ..trials.measured import config_of
 
     keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
     H.check_fittable(keys)
     write_path = write_target(write_path)
     start_from = config or (write_path if write_path and Path(write_path).exists() else None)
     base = resolve_robot(None, start_from, sets)
-    named = []
-    for item in runs:
-        name, sep, rest = item.partition("=")
-        if sep and name and "/" not in name and not Path(item).exists():
-            path, leg_set = Path(rest), name
-        else:
-            path = Path(item)
-            leg_set, _ = config_of(path)     # the leg set its run.json names, else its folder's
-        if path.resolve() in (p.resolve() for p, _ in named):
-            raise CalibrationError(f"{item}: the run {path} is given twice; each run counts once in the fit",
-                                   "give each run folder once (a repeat is another filmed hop, another folder)")
-        named.append((path, leg_set))
-    loaded = [H.load_run(path, leg_set, base) for path, leg_set in named]
     with progress(length=max_iter, label="fitting hops") as bar:
-        fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=bar.update)
+        facade_fit = calibrate_hops(base, list(runs), keys, max_iter=max_iter, progress=bar.update)
+    fit = facade_fit.result
     out = fit.summary()
     if not no_plot:
         out["plots"] = []
@@ -433,10 +387,9 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
                 plot = Path(run.source) / "hops-fit.png"
                 out["plots"].append(str(H.plot_run(run, plot, f"RMS {1000 * run.rms_m:.2f} mm")))
     if write_path:
-        values = {k: fit.estimates[k] for k in fit.keys if fit.identifiable[k]}
+        values = facade_fit.parameters
         if values:
-            note = "filmed hops " + ", ".join(f"{r.config}:{Path(r.source).name}" for r in fit.runs)
-            write_fitted(write_path, values, H.PROVENANCE_NAME, note=note)
+            write_fitted(write_path, values, H.PROVENANCE_NAME, note=facade_fit.note)
         out["written"] = {"path": str(Path(write_path).resolve()), "keys": list(values)}
     if as_json:
         click.echo(json_text(out), nl=False)

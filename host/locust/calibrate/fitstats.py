@@ -43,6 +43,11 @@ class Estimate:
     std_fixed: float | None = None       # the part from the uncertainties of values held fixed (None: none)
 
     @property
+    def ci95(self) -> tuple[float, float]:
+        """The 95% interval, (low, high)."""
+        return (self.ci95_low, self.ci95_high)
+
+    @property
     def relative_std(self) -> float:
         return self.std / abs(self.value) if self.value else float("inf")
 

@@ -543,12 +543,18 @@ def grid_start(residual, n: int, stages: int = GRID_STAGES) -> np.ndarray:
 # -- the plot ---------------------------------------------------------------------------
 def plot_run(fit: RunFit, path: Path, subtitle: str = "") -> Path:
     """Tracked markers against the fitted simulation, x and y of each, on the schedule's clock."""
-    from ..plotting import pyplot, save_png
+    from ..plotting import save_png
 
-    plt = pyplot()
+    return save_png(run_figure(fit, subtitle), path, dpi=110)
+
+
+def run_figure(fit: RunFit, subtitle: str = ""):
+    """The figure :func:`plot_run` writes (a ``matplotlib.figure.Figure``, no display needed)."""
+    from matplotlib.figure import Figure
+
     markers = list(fit.curves)
-    fig, axes = plt.subplots(2, max(len(markers), 1), figsize=(5.2 * max(len(markers), 1), 5.5), squeeze=False,
-                             sharex=True)
+    fig = Figure(figsize=(5.2 * max(len(markers), 1), 5.5))
+    axes = fig.subplots(2, max(len(markers), 1), squeeze=False, sharex=True)
     for col, m in enumerate(markers):
         t, x, y, ts, xs, ys = fit.curves[m]
         lo, hi = float(t[0]), float(t[-1])
@@ -564,4 +570,4 @@ def plot_run(fit: RunFit, path: Path, subtitle: str = "") -> Path:
     axes[0, 0].legend(loc="best", fontsize=8)
     fig.suptitle(f"{fit.config}: {Path(fit.source).name}" + (f"\n{subtitle}" if subtitle else ""), fontsize=10)
     fig.tight_layout()
-    return save_png(fig, path, dpi=110)
+    return fig

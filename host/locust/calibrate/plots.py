@@ -5,17 +5,23 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..plotting import pyplot, save_png
+from ..plotting import save_png
 from .curves import Curves
 
 
 def plot_fit(curves: Curves | list[Curves], path: str | Path, subtitle: str = "", force: bool = False) -> Path:
     """One recording's ``Curves``, or several stacked (each with its residuals below it); ``force``:
     replace an existing file that is not one of this toolkit's figures."""
+    return save_png(fit_figure(curves, subtitle), path, dpi=110, force=force, option="--plot")
+
+
+def fit_figure(curves: Curves | list[Curves], subtitle: str = ""):
+    """The figure :func:`plot_fit` writes (a ``matplotlib.figure.Figure``, no display needed)."""
+    from matplotlib.figure import Figure
+
     panels = [curves] if isinstance(curves, Curves) else list(curves)
-    plt = pyplot()
-    fig, axes = plt.subplots(2 * len(panels), 1, figsize=(7.5, 5.5 * len(panels)), squeeze=False,
-                             gridspec_kw={"height_ratios": [3, 1.2] * len(panels)})
+    fig = Figure(figsize=(7.5, 5.5 * len(panels)))
+    axes = fig.subplots(2 * len(panels), 1, squeeze=False, gridspec_kw={"height_ratios": [3, 1.2] * len(panels)})
     for k, c in enumerate(panels):
         top, bottom = axes[2 * k, 0], axes[2 * k + 1, 0]
         bottom.sharex(top)
@@ -35,4 +41,4 @@ def plot_fit(curves: Curves | list[Curves], path: str | Path, subtitle: str = ""
         bottom.set_xlabel(c.x_label)
         bottom.grid(alpha=0.3)
     fig.tight_layout()
-    return save_png(fig, path, dpi=110, force=force, option="--plot")
+    return fig

@@ -12,7 +12,7 @@ import math
 from pathlib import Path
 
 from ..errors import CalibrationError
-from ..params import Provenance, load_robot, preset, problems, save_robot
+from ..params import Provenance, Robot, load_robot, preset, problems, save_robot
 from .fitstats import Estimate
 
 DEFAULT_ROBOT_TOML = Path("calibration") / "robot.toml"
@@ -58,15 +58,23 @@ def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str |
     check_plausible(values)
     path = Path(path)
     robot = load_robot(path) if path.exists() else preset("seed").renamed("calibrated")
-    date = date or _dt.date.today().isoformat()
-    for key, est in values.items():
-        ci = f"95% CI [{est.ci95_low:.6g}, {est.ci95_high:.6g}]"
-        prov = Provenance(source=f"fit:{Path(recording).name}", uncertainty=float(est.std), date=date,
-                          note=f"{ci}; {note}" if note else ci)
-        robot = robot.with_values({key: est.value}, prov)
+    robot = with_fitted(robot, values, recording, note=note, date=date)
     found = problems(robot)
     if found:   # a calibration file is what sim and hop run: it must be one they can
         raise CalibrationError(f"{path}: with the fitted values the robot cannot be simulated: "
                                + "; ".join(found) + "; not written",
                                "fix the value(s) in the robot file first (`locust params --config FILE` lists them)")
     return save_robot(robot, path)
+
+
+def with_fitted(robot: Robot, values: dict[str, Estimate], recording: str | Path, *, note: str = "",
+                date: str | None = None) -> Robot:
+    """``robot`` with each dotted key in ``values`` set to its fitted value, its source
+    ``fit:<recording>``, its uncertainty (1 sigma), the date and the 95% interval in its note."""
+    date = date or _dt.date.today().isoformat()
+    for key, est in values.items():
+        ci = f"95% CI [{est.ci95_low:.6g}, {est.ci95_high:.6g}]"
+        prov = Provenance(source=f"fit:{Path(recording).name}", uncertainty=float(est.std), date=date,
+                          note=f"{ci}; {note}" if note else ci)
+        robot = robot.with_values({key: est.value}, prov)
+    return robot

@@ -58,19 +58,18 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
                     --config calibration/robot.toml
       locust report --measured medium=a.tracks.csv,b.tracks.csv --preset seed --sweep sweep/ --cycles 6
     """
+    from ..api.reports import report as build_report
     from ..trials.configs import parse_added
-    from ..trials.measured import parse_measured
-    from .build import build_report
     from .checks import collapsed
 
     robot = resolve_robot(preset, config, sets)
-    groups = parse_measured(list(measured), marker=marker, imports=imports)
     source = str(config) if config else f"preset {preset}"
     if sets:
         source += " with " + ", ".join(sets)
-    result = build_report(robot, groups, out, robot_source=source, cycles=cycles, sweep=sweep,
+    result = build_report(robot, list(measured), out=out, robot_source=source, cycles=cycles, sweep=sweep,
                           added=parse_added(added), marker=marker, progress=_stage, side_by_side=side_by_side,
-                          samples=samples or 0, before=load_robot(before_path) if before_path else None)
+                          samples=samples or 0, before=load_robot(before_path) if before_path else None,
+                          imports=imports)
     for c in result.comparisons:
         r = c.prediction.result
         pred = f"predicted {r.distance_m * 100:.2f} cm" if r.valid else "simulation INVALID"

@@ -43,8 +43,9 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
       locust sim --preset large --set servo.stall_torque_nm=0.18 --video large.mp4
       locust sim --config calibration/robot.toml --samples 16   # with its spread
     """
+    from ..api.simulation import simulate
     from .run import check_convergence as converge
-    from .run import invalid_result, run
+    from .run import invalid_result
 
     robot = resolve_robot(preset, config, sets)
     if video is not None:
@@ -52,7 +53,8 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
 
         check_video_path(video)  # fail before simulating, not after
     try:
-        result = run(robot, cycles=cycles, keep_states=video is not None)  # the video reuses the rollout
+        result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed,
+                          keep_states=video is not None)  # the video reuses the rollout
     except GeometryError as exc:
         if not as_json:
             raise
@@ -62,16 +64,10 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
     if video is not None:
         if not result.valid:
             raise SimError("not rendering an invalid simulation", "fix the reasons listed above first")
-        from .clip import render_video
-
-        info = render_video(robot, video, cycles=cycles, camera=camera, trajectory=result.trajectory)
+        info = result.video(video, camera=camera)
         result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
 
-    spread = None
-    if samples and result.valid:
-        from .samples import sample
-
-        spread = sample(robot, samples, cycles=cycles, seed=seed)
+    spread = getattr(result, "spread", None)
     if as_json:
         out = result.to_json()
         if spread is not None:

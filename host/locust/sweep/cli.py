@@ -50,20 +50,19 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
       locust sweep --vary geometry.leg_m=0.04:0.1:7 --vary geometry.crank_m=0.03:0.06:4 --out grid
       locust sweep --vary scale=0:0.05:30 --scheduler tcp://10.0.0.5:8786 --out cluster-run
     """
-    from .design import parse_axis
+    from ..api.sweeps import sweep as run_sweep
+    from ..api.sweeps import sweep_axes
     from .execute import check_scheduler
-    from .run import grid_size, run_sweep
+    from .run import grid_size
 
     base = resolve_robot(preset, config, sets)
-    axes = [parse_axis(v, base) for v in varies]
+    axes = sweep_axes(base, list(varies))
     names = [a.name for a in axes]
-    if len(set(names)) != len(names):
-        raise SweepError(f"--vary names a parameter twice: {', '.join(names)}", "give each parameter one --vary")
     check_scheduler(scheduler)
     total = grid_size(axes)
     with progress(length=total, label=f"sweep ({scheduler})", show_pos=True, show_eta=True) as bar:
         try:
-            summary = run_sweep(base, axes, cycles, out, scheduler=scheduler, jobs=jobs, progress=bar.update,
+            summary = run_sweep(base, axes, cycles, out=out, scheduler=scheduler, jobs=jobs, progress=bar.update,
                                 samples=samples or 0)
         except KeyboardInterrupt:
             click.echo(f"\ninterrupted: finished designs are in {out}/results.csv; "

@@ -1,0 +1,45 @@
+"""The Python API: what a notebook calls, each a function over the toolkit's own machinery.
+
+=================  ========================  =====================================================
+function           module                    returns
+=================  ========================  =====================================================
+``robot``          :mod:`.robots`            :class:`locust.params.Robot`
+``simulate``       :mod:`.simulation`        :class:`.simulation.SimResult` (trace, video, plot)
+``sweep``          :mod:`.sweeps`            :class:`.sweeps.SweepResults` (to_dataframe, best)
+``track``          :mod:`.tracking`          :class:`.tracking.Tracks` (to_dataframe)
+``read_tracks``    :mod:`.tracking`          :class:`.tracking.Tracks`
+``calibrate_*``    :mod:`.calibration`       :class:`.calibration.Fit` (parameters, apply, plot)
+``report``         :mod:`.reports`           :class:`locust.report.build.ReportResult`
+=================  ========================  =====================================================
+
+The command line calls the same functions (``locust sim``, ``sweep``, ``report``, ``calibrate
+beam|hinge|servo|ramp``). Every name is also at the package top: ``locust.simulate``.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+# name -> the module of this package that defines it
+EXPORTS = {
+    "robot": "robots",
+    "simulate": "simulation", "SimResult": "simulation",
+    "sweep": "sweeps", "SweepResults": "sweeps",
+    "track": "tracking", "read_tracks": "tracking", "Tracks": "tracking",
+    "calibrate_beam": "calibration", "calibrate_hinge": "calibration", "calibrate_ramp": "calibration",
+    "calibrate_servo": "calibration", "calibrate_hops": "calibration", "Fit": "calibration",
+    "report": "reports",
+}
+
+__all__ = list(EXPORTS)
+
+
+def __getattr__(name: str):
+    """Import a name's module on first use: ``import locust`` stays quick for the command line."""
+    if name not in EXPORTS:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(f"{__name__}.{EXPORTS[name]}"), name)
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -1,0 +1,385 @@
+"""The calibrations as functions: recordings in, a :class:`Fit` out (values with intervals, a plot,
+and the robot with them applied)."""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..calibrate.fitstats import Estimate
+from ..calibrate.ramp import READING_RESOLUTION_DEG
+from ..calibrate.recordings import REAL_TIME, TimeOptions
+from ..errors import CalibrationError
+from ..io.importing import ImportOptions
+from ..params import Robot
+
+PathLike = str | Path
+
+
+@dataclass(frozen=True)
+class Fit:
+    """One calibration's outcome.
+
+    ``parameters``: robot parameter (dotted name) -> :class:`~locust.calibrate.fitstats.Estimate`
+    (``.value``, ``.std`` one standard deviation, ``.ci95`` the 95% interval), only the values
+    the recordings determine; ``result``: the experiment's own fit (every other quantity,
+    ``.summary()``); ``warnings``: what looked wrong in the recording.
+    """
+
+    experiment: str
+    source: str
+    parameters: dict[str, Estimate]
+    result: object = field(repr=False)
+    note: str = ""
+    subtitle: str = ""
+    warnings: list[str] = field(default_factory=list)
+    input_note: str = ""
+
+    def apply(self, robot: Robot) -> Robot:
+        """``robot`` with the fitted values, each with its source ``fit:<recording>``, its
+        uncertainty and the date, as ``locust calibrate --write`` records them.
+
+        Raises
+        ------
+        locust.errors.CalibrationError
+            A fitted value no desk hopper has (a recording read in the wrong unit).
+        """
+        from ..calibrate.write import check_plausible, with_fitted
+
+        check_plausible(self.parameters)
+        return with_fitted(robot, self.parameters, self.source, note=self.note)
+
+    def summary(self) -> dict:
+        """Everything the fit found, as ``locust calibrate --json`` prints it."""
+        return self.result.summary()
+
+    def plot(self, run: int = 0):
+        """Data and model above, residuals below (per recording); for a hop fit, run ``run``'s
+        tracked markers against the fitted simulation.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        if self.experiment == "hops":
+            from ..calibrate.hop import run_figure
+
+            fit = self.result.runs[run]
+            return run_figure(fit, f"RMS {1000 * fit.rms_m:.2f} mm")
+        from ..calibrate.plots import fit_figure
+
+        return fit_figure(self.result.curves, self.subtitle)
+
+    def _rows(self) -> list[tuple[str, str, str, str]]:
+        return [(key, f"{e.value:.6g}", f"{e.std:.3g}", f"[{e.ci95_low:.6g}, {e.ci95_high:.6g}]")
+                for key, e in self.parameters.items()]
+
+    def __repr__(self) -> str:
+        lines = [f"Fit {self.experiment}: {self.source}"]
+        if self.subtitle:
+            lines.append(f"  {self.subtitle}")
+        lines += [f"  {k:40s} {v:>12s} ± {s:<9s} 95% CI {ci}" for k, v, s, ci in self._rows()]
+        if not self.parameters:
+            lines.append("  no robot value determined")
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+    def _repr_html_(self) -> str:
+        esc = html.escape
+        head = "".join(f"<th>{c}</th>" for c in ("parameter", "value", "std (1σ)", "95% interval"))
+        body = "".join("<tr>" + "".join(f"<td>{esc(c)}</td>" for c in row) + "</tr>" for row in self._rows())
+        warn = "".join(f"<p>warning: {esc(w)}</p>" for w in self.warnings)
+        return (f"<b>Fit {esc(self.experiment)}</b>: {esc(self.source)}<br>{esc(self.subtitle)}"
+                f"<table><tr>{head}</tr>{body}</table>{warn}")
+
+
+def _imports(imports: ImportOptions | None, units: str) -> ImportOptions:
+    return imports if imports is not None else ImportOptions.parse(units)
+
+
+def calibrate_beam(tracks: PathLike, mass_kg: float, *, length_m: float | None = None, beam_mass_kg: float = 0.0,
+                   marker: str | None = None, start_s: float | None = None, end_s: float | None = None,
+                   units: str = "m", imports: ImportOptions | None = None,
+                   timing: TimeOptions = REAL_TIME) -> Fit:
+    """Fit a cantilever's damped oscillation after a tip mass is dropped on it.
+
+    Parameters
+    ----------
+    tracks : path-like
+        A track of the beam tip: a ``locust track`` CSV, a Tracker project or export, or t,x,y.
+    mass_kg : float
+        The dropped tip mass.
+    length_m : float, optional
+        The beam's free length, clamp to mass: needed for the hinge values (k L², b L²).
+    beam_mass_kg : float, default 0
+        The beam's own mass (33/140 of it oscillates with the tip).
+    marker : str, optional
+        The tip's marker (default: the only one).
+    start_s, end_s : float, optional
+        The fit window (default: from the first swing after the drop to the end).
+    units : {"m", "cm", "mm"}
+        The track's unit. ``imports`` and ``timing``: the command line's options, parsed.
+
+    Returns
+    -------
+    Fit
+        ``compliance.hinge_stiffness_nm_per_rad`` and ``compliance.hinge_damping_nms_per_rad``
+        (with ``length_m``); ``.result`` has the frequency, damping ratio and stiffness.
+
+    Examples
+    --------
+    >>> fit = locust.calibrate_beam("calibration/recordings/synthetic_beam.csv", 0.01, length_m=0.05)
+    >>> fit.parameters["compliance.hinge_stiffness_nm_per_rad"].ci95   # doctest: +SKIP
+    """
+    from ..calibrate import beam as B
+    from ..calibrate.recordings import clean_samples, read_table
+
+    imports = _imports(imports, units)
+    table = read_table(tracks, imports, timing)
+    x, y = table.marker(marker)
+    t, x, y = clean_samples(tracks, "the beam tip", table.time_s(), x, y, min_samples=B.MIN_SAMPLES)
+    displacement = B.principal_displacement(x, y)
+    warning = B.tip_swing_warning(float(np.ptp(displacement)), length_m, imports.units, source=str(tracks))
+    fit = B.fit_beam(t, displacement, mass_kg, length_m=length_m, beam_mass_kg=beam_mass_kg,
+                     start_s=start_s, end_s=end_s, source=str(tracks))
+    values = {}
+    if fit.hinge_stiffness_nm_per_rad is not None:
+        values = {"compliance.hinge_stiffness_nm_per_rad": fit.hinge_stiffness_nm_per_rad,
+                  "compliance.hinge_damping_nms_per_rad": fit.hinge_damping_nms_per_rad}
+    return Fit("beam", str(tracks), values, fit, note=f"beam L={length_m} m, m={mass_kg} kg; {B.MAPPING}",
+               subtitle=f"fn {fit.natural_frequency_hz.value:.4g} Hz, zeta {fit.damping_ratio.value:.3g}",
+               warnings=[warning] if warning else [], input_note=table.input_note)
+
+
+def calibrate_hinge(tracks: PathLike, inertia_kgm2: float, gravity: str, *, mass_kg: float | None = None,
+                    com_m: float | None = None, pivot: tuple[float, float] | None = None, marker: str | None = None,
+                    start_s: float | None = None, end_s: float | None = None, coulomb: str = "auto",
+                    units: str = "m", imports: ImportOptions | None = None,
+                    timing: TimeOptions = REAL_TIME) -> Fit:
+    """Fit a link's free swing on a flexure hinge: stiffness, damping, neutral angle.
+
+    Parameters
+    ----------
+    tracks : path-like
+        A track of one marker on the swinging link.
+    inertia_kgm2 : float
+        The link's moment of inertia about the hinge axis, marker included.
+    gravity : {"in-plane", "out-of-plane"}
+        Whether the link swings in a vertical plane (its weight pulls it) or about a vertical axis.
+    mass_kg, com_m : float, optional
+        With ``gravity="in-plane"``: the link's mass and hinge-to-centre-of-mass distance.
+    pivot : (x, y), optional
+        The hinge in the track's metres, held fixed (default: fitted).
+    coulomb : {"auto", "off", "on"}
+        Coulomb friction: fitted only when the swing shows it (auto).
+
+    Returns
+    -------
+    Fit
+        ``compliance.hinge_stiffness_nm_per_rad`` and ``compliance.hinge_damping_nms_per_rad``.
+    """
+    from ..calibrate import hinge as HG
+    from ..calibrate.recordings import clean_samples, read_table
+
+    if gravity == "out-of-plane" and (mass_kg or com_m):
+        raise CalibrationError("--mass-kg and --com-m act with --gravity in-plane only",
+                               "leave them out, or give --gravity in-plane if the link swings in a vertical plane")
+    rig = HG.HingeRig(inertia_kgm2, gravity, mass_kg or 0.0, com_m or 0.0)
+    table = read_table(tracks, _imports(imports, units), timing)
+    x, y = table.marker(marker)
+    t, x, y = clean_samples(tracks, "the link's marker", table.time_s(), x, y, min_samples=HG.MIN_SAMPLES)
+    fit = HG.fit_hinge(t, x, y, rig, pivot=pivot, start_s=start_s, end_s=end_s, coulomb=coulomb, source=str(tracks))
+    values = {"compliance.hinge_stiffness_nm_per_rad": fit.hinge_stiffness_nm_per_rad,
+              "compliance.hinge_damping_nms_per_rad": fit.hinge_damping_nms_per_rad}
+    note = (f"hinge swing, I={inertia_kgm2:g} kg*m^2, gravity {gravity}"
+            + (f", M={mass_kg:g} kg, D={com_m:g} m" if gravity == "in-plane" else "")
+            + f", pivot {fit.pivot_source}; Coulomb friction {fit.coulomb_note}")
+    return Fit("hinge", str(tracks), values, fit, note=note,
+               subtitle=(f"fn {fit.natural_frequency_hz:.4g} Hz, zeta {fit.damping_ratio:.3g}, "
+                         f"RMS {1000 * fit.rms_residual_m:.3g} mm"),
+               input_note=table.input_note)
+
+
+def calibrate_servo(recordings: PathLike | Sequence[PathLike], inertia_kgm2: float | Sequence[float], *,
+                    stall_torque_nm: float | None = None, kv_nms_per_rad: float = 0.0, fit_kv: bool = False,
+                    gravity_moment_nm: float | Sequence[float] = 0.0, timing: TimeOptions = REAL_TIME,
+                    progress=None) -> Fit:
+    """Identify the hobby servo (no-load speed, armature, kp) from step responses.
+
+    Parameters
+    ----------
+    recordings : path-like or list of them
+        Angle recordings (CSV ``t_s,angle_deg,command_deg``) and/or gyro logs on the horn
+        (``millis,command_deg,gyro``), fitted together to one servo.
+    inertia_kgm2 : float or list of float
+        The load's inertia about the servo axis: once, or once per recording.
+    stall_torque_nm : float, optional
+        From a stall test or the datasheet (SG90: about 0.15); splits what one load gives.
+    kv_nms_per_rad : float, default 0
+        Velocity feedback held at this value (unless ``fit_kv``).
+    gravity_moment_nm : float or list of float, default 0
+        The load's weight moment with the horn horizontal: once, or once per recording.
+
+    Returns
+    -------
+    Fit
+        The ``servo.*`` values the recordings determine (never those not identifiable).
+
+    Examples
+    --------
+    >>> fit = locust.calibrate_servo("calibration/recordings/synthetic_servo.csv", 1.5e-5,
+    ...                              stall_torque_nm=0.15)            # doctest: +SKIP
+    >>> fit.parameters["servo.noload_speed_rad_per_s"].value          # doctest: +SKIP
+    """
+    from ..calibrate import servo as S
+    from ..calibrate.cli import _per_recording, _servo_recording
+
+    paths = [Path(recordings)] if isinstance(recordings, (str, Path)) else [Path(p) for p in recordings]
+    inertias = _per_recording(_tuple(inertia_kgm2), len(paths), "--inertia-kgm2")
+    moments = _per_recording(_tuple(gravity_moment_nm), len(paths), "--gravity-moment-nm")
+    recs = [_servo_recording(path, S.ServoRig(inertia, moment), None, None, None, ImportOptions(), timing)
+            for path, inertia, moment in zip(paths, inertias, moments)]
+    return fit_servo_recordings(recs, stall_torque_nm, kv_nms_per_rad=kv_nms_per_rad, fit_kv=fit_kv,
+                                progress=progress)
+
+
+def fit_servo_recordings(recs: list, stall_torque_nm: float | None = None, *, kv_nms_per_rad: float = 0.0,
+                         fit_kv: bool = False, progress=None) -> Fit:
+    """:func:`calibrate_servo` on recordings already read (``locust.calibrate.servo.StepRecording``,
+    ``RateRecording``: a horn track through its pivot, as ``locust calibrate servo --pivot`` makes)."""
+    from ..calibrate import servo as S
+
+    inertias = [r.rig.inertia_kgm2 for r in recs]
+    moments = [r.rig.gravity_moment_nm for r in recs]
+    fit = S.fit_servo(recs, stall_torque_nm, kv_nms_per_rad=None if fit_kv else kv_nms_per_rad, progress=progress)
+    values = {f"servo.{n}": fit.estimates[n] for n in S.PARAMS if fit.identifiable[n] and n not in fit.given}
+    kinds = ",".join(r.kind for r in recs)
+    note = (f"servo steps ({kinds}), J={','.join(map(str, inertias))} kg*m^2, M={','.join(map(str, moments))} N*m"
+            + (f", stall torque {stall_torque_nm} N*m given" if stall_torque_nm else "")
+            + ("" if fit_kv else f", kv {kv_nms_per_rad} N*m*s/rad held"))
+    subtitle = ", ".join(f"{Path(r.source).name} RMS {rms:.3g} {'deg' if r.kind == 'angle' else 'rad/s'}"
+                         for r, rms in zip(recs, fit.rms_per_recording))
+    return Fit("servo", fit.source, values, fit, note=note, subtitle=subtitle)
+
+
+def calibrate_ramp(data: PathLike | Sequence[PathLike] | np.ndarray, *, into: str = "foot",
+                   ramp_markers: str = "ramp_a,ramp_b", robot_marker: str = "robot", units: str = "m",
+                   imports: ImportOptions | None = None, timing: TimeOptions = REAL_TIME,
+                   resolution_deg: float = READING_RESOLUTION_DEG) -> Fit:
+    """Static friction from the angles at which the robot starts to slide down a tilted board.
+
+    Parameters
+    ----------
+    data : path-like, list of them, or array of angles in degrees
+        CSVs with an ``angle_deg`` column (one trial a row), side-view tracks of a tilting ramp
+        (markers ``ramp_markers`` on the board's ends and ``robot_marker``), or the angles.
+    into : {"foot", "nose"}
+        Which friction the result is: ``contact.foot_friction`` or ``contact.nose_friction``.
+    resolution_deg : float, default 1.0
+        How finely each angle was read (a protractor's 1 degree graduation): the trials' spread
+        is taken as at least ``resolution_deg / sqrt(12)``, so trials read alike still give an
+        interval.
+
+    Returns
+    -------
+    Fit
+        ``mu = tan(mean angle)`` with its 95% interval.
+
+    Examples
+    --------
+    >>> locust.calibrate_ramp([59.5, 60.1, 58.7]).parameters["contact.foot_friction"].value  # doctest: +SKIP
+    """
+    from ..calibrate import ramp as R
+    from ..calibrate.cli import _ramp_angles
+
+    if into not in ("foot", "nose"):
+        raise CalibrationError(f"into={into!r}: not a friction of the model", "choose foot or nose")
+    warnings: list[str] = []
+    if isinstance(data, (str, Path)):
+        data = [data]
+    if len(data) and all(isinstance(p, (str, Path)) for p in data):
+        paths, angles, imports, tracks = [Path(p) for p in data], [], _imports(imports, units), 0
+        for path in paths:
+            found, warning, is_track = _ramp_angles(path, ramp_markers, robot_marker, imports, timing)
+            angles.extend(found)
+            warnings += [warning] if warning else []
+            tracks += is_track
+        if tracks == 0 and not imports.identity:
+            raise CalibrationError("--units, --rename and --mirror apply to ramp tracks; these are angle tables",
+                                   "leave them out for angle_deg recordings")
+        source = str(paths[0]) if len(paths) == 1 else "+".join(p.name for p in paths)
+    else:
+        angles, source = [float(a) for a in np.asarray(data, dtype=float).ravel()], "ramp"
+    fit = R.fit_ramp(np.array(angles), source=source, resolution_deg=resolution_deg)
+    return Fit("ramp", source, {f"contact.{into}_friction": fit.mu_static}, fit,
+               note=f"ramp, {fit.n_trials} trials, mean angle {fit.mean_angle_deg:.4g} deg",
+               subtitle=f"mu {fit.mu_static.value:.4g} from {fit.n_trials} trials", warnings=warnings)
+
+
+def calibrate_hops(robot: Robot, runs: Mapping[str, PathLike] | Sequence[PathLike | object],
+                   keys: Sequence[str] | None = None, *, max_iter: int = 30, progress=None) -> Fit:
+    """Fit the model to filmed hops of one or more leg sets at once (the physics is shared).
+
+    Parameters
+    ----------
+    robot : Robot
+        The starting values (e.g. the bench-calibrated robot); each run's leg set is built on it.
+    runs : dict or list
+        Leg set -> a ``locust hop --out`` folder (its ``run.json`` and the track of its video),
+        or the command line's ``["small=runs/s1", "runs/large-1", ...]`` (a folder named after
+        its leg set), or runs already loaded (``locust.calibrate.hop.HopRun``).
+    keys : list of str, optional
+        The robot values fitted (default: foot friction, hinge stiffness, servo no-load speed).
+    max_iter : int, default 30
+        Solver iterations.
+
+    Returns
+    -------
+    Fit
+        The identifiable values; ``.plot(run)`` the tracked markers against the fitted simulation.
+    """
+    from ..calibrate import hop as H
+
+    keys = tuple(keys or H.DEFAULT_KEYS)
+    if isinstance(runs, Mapping):
+        runs = [f"{name}={path}" for name, path in runs.items()]
+    named: list[tuple[Path, str]] = []
+    for item in runs:
+        if isinstance(item, H.HopRun):
+            continue
+        path, leg_set = _run_folder(str(item))
+        if path.resolve() in (p.resolve() for p, _ in named):
+            raise CalibrationError(f"{item}: the run {path} is given twice; each run counts once in the fit",
+                                   "give each run folder once (a repeat is another filmed hop, another folder)")
+        named.append((path, leg_set))
+    folders = iter(named)
+    loaded = [item if isinstance(item, H.HopRun) else H.load_run(*next(folders), robot) for item in runs]
+    fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=progress)
+    values = {k: fit.estimates[k] for k in fit.keys if fit.identifiable[k]}
+    note = "filmed hops " + ", ".join(f"{r.config}:{Path(r.source).name}" for r in fit.runs)
+    return Fit("hops", H.PROVENANCE_NAME, values, fit, note=note,
+               subtitle=f"{len(fit.runs)} runs, RMS {1000 * fit.rms_m:.2f} mm", warnings=[])
+
+
+def _run_folder(item: str) -> tuple[Path, str]:
+    """``NAME=FOLDER``, or a folder whose run.json names its leg set, else named after it
+    (small-1/, large/)."""
+    from ..trials.measured import config_of
+
+    name, sep, rest = item.partition("=")
+    if sep and name and "/" not in name and not Path(item).exists():
+        return Path(rest), name
+    path = Path(item)
+    return path, config_of(path)[0]
+
+
+def _tuple(value) -> tuple[float, ...]:
+    return tuple(float(v) for v in value) if isinstance(value, Sequence) else (float(value),)
+
+
+__all__ = ["Fit", "calibrate_beam", "calibrate_hinge", "calibrate_hops", "calibrate_ramp", "calibrate_servo",
+           "fit_servo_recordings"]

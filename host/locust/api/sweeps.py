@@ -1,0 +1,121 @@
+"""``locust.sweep``: a grid of designs, each checked, simulated and audited; the best valid one."""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import SweepError
+from ..params import Robot
+from ..sweep.design import Axis, parse_axis
+from ..sweep.run import SweepSummary, run_sweep
+
+RANGE = tuple[float, float, int]
+
+
+@dataclass
+class SweepResults(SweepSummary):
+    """What :func:`sweep` returns: every design's row (``rows``), the best valid one (``best``,
+    None when none is valid), the varied names (``names``) and, when written to a folder,
+    ``folder`` and the landscape ``plots``.
+    """
+
+    names: tuple[str, ...] = ()
+
+    def to_dataframe(self):
+        """One row per design, in design order.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``design``, the varied values by name, ``valid``, ``reason``, ``distance_m``,
+            ``max_nose_height_m``, ``nose_apex_max_m``, ``com_apex_max_m``, ``hops``,
+            ``grashof``, ``transmission_deg``.
+        """
+        import pandas as pd
+
+        return pd.DataFrame(self.rows)
+
+    def __repr__(self) -> str:
+        valid = sum(1 for r in self.rows if r["valid"])
+        head = f"SweepResults: {len(self.rows)} designs of {', '.join(self.names)}, {valid} valid"
+        if self.best is None:
+            return head + "; no valid design"
+        where = ", ".join(f"{n}={self.best[n]:.6g}" for n in self.names)
+        return (f"{head}\n  best: design {self.best['design']} ({where}): {self.best['distance_m'] * 1000:.2f} mm, "
+                f"highest nose {self.best['max_nose_height_m'] * 1000:.2f} mm")
+
+
+def sweep_axes(base: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis]) -> list[Axis]:
+    """The grid's axes: ``{"scale": (0.0, 0.05, 30)}``, ``{"geometry.leg_m": "0.04:0.1:7"}`` or
+    ``["scale=0:0.05:30", ...]`` (the command line's ``--vary``), each name checked once."""
+    if isinstance(vary, Mapping):
+        items = [v if isinstance(v, str) else ":".join(repr(x) for x in v) for v in vary.values()]
+        vary = [f"{name}={spec}" for name, spec in zip(vary, items)]
+    axes = [v if isinstance(v, Axis) else parse_axis(v, base) for v in vary]
+    names = [a.name for a in axes]
+    if not names:
+        raise SweepError("nothing to vary", 'e.g. vary={"scale": (0.0, 0.05, 30)}')
+    if len(set(names)) != len(names):
+        raise SweepError(f"--vary names a parameter twice: {', '.join(names)}", "give each parameter one --vary")
+    return axes
+
+
+def sweep(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis], cycles: int = 3, *,
+          out: str | Path | None = None, jobs: int | None = None, scheduler: str = "local", samples: int = 0,
+          progress: Callable[[int], None] | None = None) -> SweepResults:
+    """Simulate every combination of the varied values and find the best valid design.
+
+    Each design is checked before it is simulated (the four-bar assembles and stays closed over
+    the commanded crank range) and audited after; one that fails is a row with ``valid`` False
+    and its ``reason``, never the best.
+
+    Parameters
+    ----------
+    robot : Robot
+        The base design (:func:`locust.robot`).
+    vary : dict
+        Name -> ``(start, stop, n)``: n values from start to stop inclusive. A name is a
+        numeric parameter's dotted name or ``scale`` (metres added to all four links, the seed
+        notebook's sweep variable). Several names make a grid.
+    cycles : int, default 3
+        Hop cycles per design.
+    out : path-like, optional
+        A folder for ``results.csv``, ``sweep.json`` and the landscape plots (rerunning into it
+        resumes); default none: nothing is kept on disk.
+    jobs : int, optional
+        Worker processes (default every local core; 1 runs in this process).
+    scheduler : str, default "local"
+        ``local``, ``dask-local`` or ``tcp://HOST:PORT`` of a Dask scheduler.
+    samples : int, default 0
+        Rank designs by their mean over this many draws of the uncertain values.
+    progress : callable, optional
+        Called with 1 as each design finishes.
+
+    Returns
+    -------
+    SweepResults
+        ``.rows``, ``.best``, ``.to_dataframe()``.
+
+    Examples
+    --------
+    >>> import locust
+    >>> res = locust.sweep(locust.robot("seed"), vary={"scale": (0.0, 0.02, 3)}, cycles=1, jobs=1)
+    >>> res.to_dataframe()[["scale", "valid"]].shape
+    (3, 2)
+    """
+    axes = sweep_axes(robot, vary)
+    if out is not None:
+        summary = run_sweep(robot, axes, cycles, Path(out), scheduler=scheduler, jobs=jobs, progress=progress,
+                            samples=samples)
+        return SweepResults(**vars(summary), names=tuple(a.name for a in axes))
+    with tempfile.TemporaryDirectory(prefix="locust-sweep-") as tmp:
+        summary = run_sweep(robot, axes, cycles, Path(tmp), scheduler=scheduler, jobs=jobs, progress=progress,
+                            plots=False, samples=samples)
+    summary.folder = None
+    return SweepResults(**vars(summary), names=tuple(a.name for a in axes))
+
+
+__all__ = ["SweepResults", "sweep", "sweep_axes"]

@@ -1,0 +1,181 @@
+"""``locust.track`` and ``locust.read_tracks``: marker tracks from a video or a track file, as a table."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import TrackError
+from ..io.tracks_csv import TracksCsv
+
+
+@dataclass(frozen=True, eq=False)
+class Tracks:
+    """Marker tracks: per frame its time, per marker pixels and world metres (x forward, y up).
+
+    ``tracks`` is the typed file contents (:class:`locust.io.tracks_csv.TracksCsv`);
+    ``result`` the tracking run behind them (None for tracks read from a file).
+    """
+
+    tracks: TracksCsv
+    result: object | None = None     # locust.track.runner.TrackResult
+
+    @property
+    def markers(self) -> list[str]:
+        return list(self.tracks.markers)
+
+    def positions(self, marker: str) -> tuple[np.ndarray, np.ndarray]:
+        """``marker``'s world x and y (m), NaN where it was not found."""
+        return self.tracks.positions(marker)
+
+    def to_dataframe(self):
+        """One row per frame.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``frame``, ``t_s``, then per marker ``<name>_px``, ``<name>_py`` (pixels, OpenCV
+            convention), ``<name>_x_m``, ``<name>_y_m`` (world metres, NaN without a scale) and
+            ``<name>_ok`` (found in that frame), as in a tracks CSV.
+        """
+        import pandas as pd
+
+        t = self.tracks
+        cols = {name: t.column(name) for name in t.columns}
+        cols["frame"] = t.frame.copy()
+        for name in t.markers:
+            if f"{name}_ok" in cols:
+                cols[f"{name}_ok"] = t.markers[name].ok.copy()
+        return pd.DataFrame(cols)
+
+    def write(self, path: str | Path, overwrite: bool = False) -> Path:
+        """Write the tracks CSV (atomic; an existing file only with ``overwrite``)."""
+        from ..io.tracks_csv import write_tracks_csv
+
+        path = Path(path)
+        if path.exists() and not overwrite:
+            raise TrackError(f"{path} exists already; not overwriting it", "choose another name, or overwrite=True")
+        return write_tracks_csv(path, self.tracks)
+
+    def __repr__(self) -> str:
+        t = self.tracks
+        lines = [f"Tracks: {t.n_rows} frames, markers {', '.join(t.markers) or 'none'}"]
+        for name, m in t.markers.items():
+            lines.append(f"  {name}: found in {int(np.count_nonzero(m.ok))} of {len(m.ok)} frames")
+        return "\n".join(lines)
+
+
+def _marker_specs(markers: Mapping[str, str] | Sequence[str] | None) -> list[str]:
+    from ..track.spec import default_specs
+
+    if markers is None:
+        return default_specs()
+    if isinstance(markers, Mapping):
+        return [f"{name}={spec}" for name, spec in markers.items()]
+    return list(markers)
+
+
+def _calibration(info, scale, origin, angle_deg: float, camera_json):
+    from ..io.camera_json import camera_json_beside
+    from ..track import calib, camera
+
+    if camera_json is not None and (scale or origin):
+        raise TrackError("give camera_json or scale/origin, not both", "one calibration per run")
+    if camera_json is not None:
+        return camera.load(camera_json, info.width_px, info.height_px)
+    beside = camera_json_beside(info.path)
+    if scale is None and origin is None and beside.is_file():
+        return camera.load(beside, info.width_px, info.height_px)
+    m_per_px, source = float("nan"), "none"
+    if scale is not None:
+        x1, y1, x2, y2, length_m = (float(v) for v in scale)
+        m_per_px, source = calib.m_per_px_from_stick(x1, y1, x2, y2, length_m), f"stick {tuple(scale)}"
+    return calib.build(info.height_px, m_per_px, origin, angle_deg, source)
+
+
+def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None = None, *,
+          scale: tuple[float, float, float, float, float] | None = None, origin: tuple[float, float] | None = None,
+          angle_deg: float = 0.0, camera_json: str | Path | None = None, start: int = 0, end: int | None = None,
+          step: int = 1, fps: float | None = None, color_tol: int = 80, search_px: int = 40,
+          progress: Callable[[int], None] | None = None) -> Tracks:
+    """Find markers in every frame of a video (or an image sequence), as Tracker's autotracker would.
+
+    Parameters
+    ----------
+    video : path-like
+        An MP4 (or the first image of a numbered sequence).
+    markers : dict, optional
+        Name -> spec: ``color:#RRGGBB[@X,Y]``, ``template:X,Y@FRAME`` or ``aruco:ID``.
+        Default: the robot's nose (``#ff00ff``) and foot (``#00ffff``) colours.
+    scale : (x1, y1, x2, y2, length_m), optional
+        A calibration stick: two pixels and the distance between them in metres.
+    origin : (x, y), optional
+        The world origin in pixels (default the centre of the bottom-left pixel).
+    angle_deg : float, default 0
+        Direction of the world x axis, degrees counter-clockwise from the image's.
+    camera_json : path-like, optional
+        The pinhole camera of a simulated video; default ``<video>.camera.json`` beside it,
+        used when no scale or origin is given (world metres through each marker's plane).
+    start, end, step : int
+        The frames tracked (``end`` inclusive, default the last).
+    fps : float, optional
+        The true frame rate, for slow-motion footage; default the file's.
+    color_tol, search_px : int
+        Colour tolerance (0-255) and the search window's half size (px).
+
+    Returns
+    -------
+    Tracks
+        ``.to_dataframe()``, ``.positions(marker)``, ``.write(path)``.
+
+    Examples
+    --------
+    >>> hop = locust.simulate(locust.robot("small"), cycles=1)
+    >>> hop.video("hop.mp4", overwrite=True, camera="fixed", width=320, height=240)  # doctest: +SKIP
+    >>> locust.track("hop.mp4").to_dataframe()[["t_s", "nose_x_m", "nose_y_m"]]  # doctest: +SKIP
+    """
+    from ..track.export import tracks_of
+    from ..track.runner import track_video
+    from ..track.spec import ModelOptions, parse_markers
+    from ..track.video import Clip, probe
+
+    info = probe(Path(video))
+    clip = Clip(start, end, step, fps).resolved(info)
+    models = parse_markers(_marker_specs(markers), ModelOptions(color_tol=color_tol, search_half_px=search_px))
+    calibration = _calibration(info, scale, origin, angle_deg, camera_json)
+    result = track_video(info, clip, models, calibration, progress=progress)
+    return Tracks(tracks_of(result), result)
+
+
+def read_tracks(path: str | Path, units: str = "m", rename: Mapping[str, str] | Sequence[str] = (),
+                mirror: bool = False) -> Tracks:
+    """Read a track file: a ``locust track`` CSV, a Tracker project (.trk/.trz) or text export, or a t,x,y CSV.
+
+    Parameters
+    ----------
+    path : path-like
+    units : {"m", "cm", "mm"}, default "m"
+        The unit of a file's positions (a Tracker project carries its own).
+    rename : dict, optional
+        Marker names to change, e.g. ``{"mass A": "nose"}``.
+    mirror : bool, default False
+        Flip x (a hop filmed going left).
+
+    Returns
+    -------
+    Tracks
+
+    Examples
+    --------
+    >>> locust.read_tracks("calibration/recordings/synthetic_beam.csv").markers   # doctest: +SKIP
+    ['tip']
+    """
+    from ..io.importing import import_tracks
+
+    return Tracks(import_tracks(path, units, rename, mirror))
+
+
+__all__ = ["Tracks", "read_tracks", "track"]

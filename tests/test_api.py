@@ -1,0 +1,203 @@
+"""The Python API at the package top (locust.robot, simulate, sweep, track, calibrate_*, report):
+a notebook session with exactly those names, checked against the figures the toolkit computes."""
+
+from __future__ import annotations
+
+import inspect
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import locust
+import locust.sweep.run
+import locust.track.runner
+from locust.errors import LocustError, ParamsError, SimError
+
+ROOT = Path(__file__).resolve().parents[1]
+RECORDINGS = ROOT / "calibration" / "recordings"
+FACADE = ["robot", "simulate", "SimResult", "sweep", "SweepResults", "track", "read_tracks", "Tracks",
+          "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "Fit", "report"]
+
+
+def test_all_lists_the_facade():
+    assert set(FACADE) <= set(locust.__all__)
+    assert set(FACADE) <= set(dir(locust))
+    for name in FACADE:
+        assert callable(getattr(locust, name)), name
+    # sweep, track and report are also the subpackages: both uses work
+    assert locust.sweep.run.run_sweep.__name__ == "run_sweep"
+    assert locust.track.runner.track_video.__name__ == "track_video"
+    assert "vary" in inspect.signature(locust.sweep).parameters
+    assert "Parameters" in locust.sweep.__doc__
+
+
+def test_notebook_session(tmp_path):
+    """The session of the issue: robot, simulate, .trace(), .video(..., overwrite=True) twice,
+    sweep .to_dataframe()."""
+    robot = locust.robot("small", **{"servo.kp_nm_per_rad": 0.4})
+    assert robot.get("servo.kp_nm_per_rad") == 0.4
+    result = locust.simulate(robot, cycles=1)
+    assert result.valid
+    trace = result.trace()
+    assert list(trace.columns[:3]) == ["t_s", "nose_x_m", "nose_z_m"]
+    assert {"foot_x_m", "foot_z_m", "crank_left_deg", "crank_right_deg", "command_deg"} <= set(trace.columns)
+    start = trace[trace.t_s < 0].iloc[-1]
+    assert abs(trace.chassis_x_m.iloc[-1] - start.chassis_x_m - result.distance_m) <= 1e-12
+    assert trace.nose_z_m[trace.t_s >= 0].max() == result.max_nose_height_m
+    # the crank follows its command: at the end of the push it is within a few degrees of it
+    push = trace[(trace.t_s >= 0) & (trace.t_s < robot.schedule.push_s)]
+    assert np.allclose(push.command_deg, robot.schedule.push_deg, rtol=0, atol=1e-9)
+    assert abs(push.crank_left_deg.iloc[-1] - robot.schedule.push_deg) < 1.0   # -29.67 deg
+
+    again = locust.simulate(robot, cycles=1)
+    assert (again.distance_m, again.max_nose_height_m, again.hops) == \
+        (result.distance_m, result.max_nose_height_m, result.hops)
+    pd.testing.assert_frame_equal(again.trace(), trace, check_exact=True)
+
+    video = tmp_path / "hop.mp4"
+    first = result.video(video, overwrite=True, width=160, height=120)
+    inode, truth = video.stat().st_ino, first.truth_path.read_bytes()
+    assert first.frames == round(result.duration_s * 30) and video.stat().st_size > 1000
+    second = result.video(video, overwrite=True, width=160, height=120)
+    assert second.video_path == video and second.frames == first.frames
+    assert video.stat().st_ino != inode                         # rendered again, not left as it was
+    assert second.truth_path.read_bytes() == truth              # the same rollout, the same truth
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["hop.camera.json", "hop.mp4", "hop.truth.csv"]
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    with pytest.raises(SimError, match="exists already") as exc:
+        result.video(video)
+    assert exc.value.hint
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+    table = locust.sweep(locust.robot("seed"), vary={"scale": (0.0, 0.01, 2)}, cycles=1, jobs=1).to_dataframe()
+    assert list(table.scale) == [0.0, 0.01] and table.valid.all()
+    assert table.distance_m[0] == locust.simulate(locust.robot("seed"), cycles=1).distance_m
+
+
+def test_repr_is_a_short_table_in_mm():
+    r = locust.simulate(locust.robot("seed"), cycles=2)
+    text = repr(r)
+    assert f"{r.distance_m * 1000:.2f} mm" in text and f"{r.max_nose_height_m * 1000:.2f} mm" in text
+    assert repr(r.distance_m) not in text and len(text.splitlines()) < 12
+    assert "<table>" in r._repr_html_() and f"{r.hops[0].distance_m * 1000:.2f}" in r._repr_html_()
+    # the CLI's JSON is the simulation's own figures: nothing of the facade in it
+    assert set(r.to_json()) == set(locust.sim.run.SimResult(**{k: v for k, v in vars(r).items()
+                                                               if k not in ("params", "spread")}).to_json())
+
+
+def test_robot_from_a_file_and_bad_names(tmp_path):
+    from locust.params import save_robot
+
+    path = save_robot(locust.robot("medium", **{"geometry.leg_m": 0.075}), tmp_path / "mine.toml")
+    mine = locust.robot(path)
+    assert mine.geometry.leg_m == 0.075 and mine.geometry.crank_m == locust.robot("medium").geometry.crank_m
+    assert locust.robot(str(path), **{"servo.kp_nm_per_rad": 0.3}).get("servo.kp_nm_per_rad") == 0.3
+    for call in (lambda: locust.robot("tiny"), lambda: locust.robot("seed", **{"servo.kp": 1.0}),
+                 lambda: locust.robot(tmp_path / "none.toml"), lambda: locust.robot("seed", **{"geometry.leg_m": -1})):
+        with pytest.raises(ParamsError) as exc:
+            call()
+        assert isinstance(exc.value, LocustError) and exc.value.hint
+
+
+def test_sweep_errors_are_the_library_s_own():
+    with pytest.raises(LocustError, match="no such robot parameter"):
+        locust.sweep(locust.robot("seed"), vary={"geometry.nope_m": (0.0, 1.0, 2)})
+    with pytest.raises(LocustError) as exc:
+        locust.sweep(locust.robot("seed"), vary={})
+    assert exc.value.hint
+
+
+def test_fit_matches_the_command_line_and_applies(tmp_path):
+    data = RECORDINGS / "synthetic_ramp.csv"
+    fit = locust.calibrate_ramp(data)
+    proc = subprocess.run([sys.executable, "-m", "locust.cli", "calibrate", "ramp", str(data), "--json", "--no-plot"],
+                          capture_output=True, text=True, check=True, timeout=120,
+                          env=dict(os.environ, PYTHONPATH=str(ROOT / "host")))
+    cli = json.loads(proc.stdout)["mu_static"]
+    est = fit.parameters["contact.foot_friction"]
+    assert (est.value, est.std, list(est.ci95)) == (cli["value"], cli["std"], cli["ci95"])
+    # the truth the synthetic file was made from (its header): mu 1.7
+    assert est.ci95[0] <= 1.7 <= est.ci95[1]
+    angles = pd.read_csv(data, comment="#").angle_deg.to_numpy()
+    assert locust.calibrate_ramp(angles).parameters["contact.foot_friction"].value == est.value
+
+    robot = fit.apply(locust.robot("seed"))
+    prov = robot.source_of("contact.foot_friction")
+    assert robot.contact.foot_friction == est.value
+    assert (prov.source, prov.uncertainty) == ("fit:synthetic_ramp.csv", est.std)
+    assert "95% CI" in prov.note and "Fit ramp" in repr(fit)
+    fig = fit.plot()
+    assert len(fig.axes) == 2
+
+
+def test_read_tracks_to_dataframe():
+    tracks = locust.read_tracks(RECORDINGS / "synthetic_beam.csv")
+    df = tracks.to_dataframe()
+    assert tracks.markers == ["tip"] and len(df) == 360
+    assert list(df.columns) == ["frame", "t_s", "tip_px", "tip_py", "tip_x_m", "tip_y_m", "tip_ok"]
+    # the file's header: frames 50 and 51 lost
+    assert list(df.frame[~df.tip_ok]) == [50, 51] and df.tip_ok.dtype == bool
+    assert np.isnan(df.tip_x_m[50]) or not df.tip_ok[50]
+    assert df.t_s.iloc[1] == pytest.approx(1 / 240, abs=1e-6)
+
+
+def test_readme_python_api_runs_as_shown(tmp_path, monkeypatch, capsys):
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text.split("## Python API", 1)[1]
+    block = section.split("```python\n", 1)[1].split("```", 1)[0]
+    (tmp_path / "calibration").symlink_to(ROOT / "calibration")   # run "from the repository's root"
+    monkeypatch.chdir(tmp_path)
+    scope: dict = {}
+    exec(compile(block, "README.md", "exec"), scope)
+    assert (tmp_path / "hop.mp4").is_file() and scope["result"].valid
+    assert len(scope["swept"].to_dataframe()) == 6
+    assert scope["calibrated"].contact.foot_friction == scope["fit"].parameters["contact.foot_friction"].value
+    assert f"{scope['result'].distance_m * 1000:.2f} mm" in capsys.readouterr().out
+
+
+def test_calibrate_hop_takes_its_runs_through_the_api(tmp_path, monkeypatch):
+    """`locust calibrate hop` loads its runs through locust.calibrate_hops: an empty run folder is
+    refused there, before any fit, and nothing is written."""
+    from probing import assert_refused_and_unchanged
+
+    (tmp_path / "small-1").mkdir()
+    monkeypatch.chdir(tmp_path)
+    assert_refused_and_unchanged(tmp_path, ["calibrate", "hop", "small=small-1", "--write", "robot.toml"],
+                                 "small-1", "no run.json")
+    with pytest.raises(LocustError, match="no run.json") as exc:
+        locust.calibrate_hops(locust.robot("seed"), {"small": tmp_path / "small-1"})
+    assert exc.value.hint
+
+
+def test_a_result_without_states_says_how_to_keep_them():
+    r = locust.simulate(locust.robot("seed"), cycles=1, keep_states=False)
+    assert r.trajectory is None
+    assert r.distance_m == locust.simulate(locust.robot("seed"), cycles=1).distance_m
+    with pytest.raises(SimError, match="kept no rollout") as exc:
+        r.trace()
+    assert "keep_states=True" in exc.value.hint
+
+
+def test_hop_fit_is_a_fit():
+    """locust.calibrate_hops wraps calibrate.hop.fit_hops: its values, their provenance and the
+    run's figure (a two-cycle SYNTHETIC run of Small, as tests/test_calibrate_hop.py makes them;
+    coverage over seeds is that file's)."""
+    from test_calibrate_hop import synthetic_run
+
+    key = "servo.noload_speed_rad_per_s"
+    run = synthetic_run("small", {key: 9.0}, cycles=2)
+    fit = locust.calibrate_hops(run.robot, [run], [key], max_iter=3)
+    assert fit.parameters == {key: fit.result.estimates[key]} and fit.result.identifiable[key]
+    assert abs(fit.parameters[key].value - 9.0) < 1.0          # 9.30 here, from 9.0
+    robot = fit.apply(locust.robot("seed"))
+    prov = robot.source_of(key)
+    assert (robot.get(key), prov.source, prov.uncertainty) == (fit.parameters[key].value, "fit:hops",
+                                                               fit.parameters[key].std)
+    assert "small:synthetic-small" in prov.note
+    assert len(fit.plot().axes) == 4                             # nose and foot, x and y
