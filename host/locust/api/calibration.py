@@ -236,12 +236,12 @@ def calibrate_servo(recordings: PathLike | Sequence[PathLike], inertia_kgm2: flo
     >>> fit.parameters["servo.noload_speed_rad_per_s"].value          # doctest: +SKIP
     """
     from ..calibrate import servo as S
-    from ..calibrate.cli import _per_recording, _servo_recording
+    from ..calibrate.inputs import per_recording, servo_recording
 
     paths = [Path(recordings)] if isinstance(recordings, (str, Path)) else [Path(p) for p in recordings]
-    inertias = _per_recording(_tuple(inertia_kgm2), len(paths), "--inertia-kgm2")
-    moments = _per_recording(_tuple(gravity_moment_nm), len(paths), "--gravity-moment-nm")
-    recs = [_servo_recording(path, S.ServoRig(inertia, moment), None, None, None, ImportOptions(), timing)
+    inertias = per_recording(_tuple(inertia_kgm2), len(paths), "--inertia-kgm2")
+    moments = per_recording(_tuple(gravity_moment_nm), len(paths), "--gravity-moment-nm")
+    recs = [servo_recording(path, S.ServoRig(inertia, moment), None, None, None, ImportOptions(), timing)
             for path, inertia, moment in zip(paths, inertias, moments)]
     return fit_servo_recordings(recs, stall_torque_nm, kv_nms_per_rad=kv_nms_per_rad, fit_kv=fit_kv,
                                 progress=progress)
@@ -294,7 +294,7 @@ def calibrate_ramp(data: PathLike | Sequence[PathLike] | np.ndarray, *, into: st
     >>> locust.calibrate_ramp([59.5, 60.1, 58.7]).parameters["contact.foot_friction"].value  # doctest: +SKIP
     """
     from ..calibrate import ramp as R
-    from ..calibrate.cli import _ramp_angles
+    from ..calibrate.inputs import ramp_angles
 
     if into not in ("foot", "nose"):
         raise CalibrationError(f"into={into!r}: not a friction of the model", "choose foot or nose")
@@ -304,7 +304,7 @@ def calibrate_ramp(data: PathLike | Sequence[PathLike] | np.ndarray, *, into: st
     if len(data) and all(isinstance(p, (str, Path)) for p in data):
         paths, angles, imports, tracks = [Path(p) for p in data], [], _imports(imports, units), 0
         for path in paths:
-            found, warning, is_track = _ramp_angles(path, ramp_markers, robot_marker, imports, timing)
+            found, warning, is_track = ramp_angles(path, ramp_markers, robot_marker, imports, timing)
             angles.extend(found)
             warnings += [warning] if warning else []
             tracks += is_track

@@ -8,7 +8,6 @@ from dataclasses import replace
 from pathlib import Path
 
 import click
-import numpy as np
 
 from ..errors import CalibrationError
 from ..fileio import check_distinct, json_text
@@ -18,12 +17,12 @@ from ..plotting import check_figure_path
 from ..progress import progress
 from . import hinge as HG
 from . import hop as H
+from . import inputs
 from . import ramp as R
 from . import servo as S
 from .fitstats import Estimate
-from .gyro_log import looks_like_gyro_log, parse_gyro_log
 from .plots import plot_fit
-from .recordings import REAL_TIME, TimeOptions, clean_samples, read_recording_text, read_table, time_options
+from .recordings import time_options
 from .write import DEFAULT_ROBOT_TOML, check_plausible, implausible, write_fitted
 
 
@@ -183,7 +182,7 @@ def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s,
     """
     from ..api.calibration import calibrate_hinge
 
-    centre = tuple(_floats(pivot, 2, "--pivot", "X,Y in metres, e.g. --pivot 0.0,0.0")) if pivot else None
+    centre = tuple(inputs.parse_floats(pivot, 2, "--pivot", "X,Y in metres, e.g. --pivot 0.0,0.0")) if pivot else None
     with progress(length=1, label="fitting hinge swing") as bar:
         fit = calibrate_hinge(tracks, inertia_kgm2, gravity, mass_kg=mass_kg, com_m=com_m, pivot=centre,
                               marker=marker, start_s=start_s, end_s=end_s, coulomb=coulomb, imports=imports,
@@ -251,11 +250,11 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
       locust calibrate servo sg90_aa_battery_step.csv sg90_unloaded_gyro_steps.txt \\
           --inertia-kgm2 3.3e-6 --inertia-kgm2 1e-6 --stall-torque-nm 0.15 --validate other_steps.txt
     """
-    inertias = _per_recording(inertia_kgm2, len(data), "--inertia-kgm2")
-    moments = _per_recording(gravity_moment_nm or (0.0,), len(data), "--gravity-moment-nm")
+    inertias = inputs.per_recording(inertia_kgm2, len(data), "--inertia-kgm2")
+    moments = inputs.per_recording(gravity_moment_nm or (0.0,), len(data), "--gravity-moment-nm")
     if pivot is not None and len(data) > 1:
         raise CalibrationError("--pivot takes one horn track", "fit tracks one at a time, or give angle CSVs")
-    recordings = [_servo_recording(path, S.ServoRig(inertia, moment), pivot, step, marker, imports, timing)
+    recordings = [inputs.servo_recording(path, S.ServoRig(inertia, moment), pivot, step, marker, imports, timing)
                   for path, inertia, moment in zip(data, inertias, moments)]
     if pivot is None and not imports.identity:
         raise CalibrationError("--units, --rename and --mirror apply to a horn track (--pivot), not to angles",
@@ -268,10 +267,10 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
     fit = facade_fit.result
     validations = []
     if validate:
-        v_inertias = _per_recording(validate_inertia_kgm2, len(validate), "--validate-inertia-kgm2") \
+        v_inertias = inputs.per_recording(validate_inertia_kgm2, len(validate), "--validate-inertia-kgm2") \
             if validate_inertia_kgm2 else [None] * len(validate)
         for path, inertia in zip(validate, v_inertias):
-            rec = _servo_recording(path, S.ServoRig(inertias[0]), None, None, None, ImportOptions(), timing)
+            rec = inputs.servo_recording(path, S.ServoRig(inertias[0]), None, None, None, ImportOptions(), timing)
             if inertia is None:
                 inertia = next((r.rig.inertia_kgm2 for r in recordings if r.kind == rec.kind), inertias[0])
             rec = replace(rec, rig=S.ServoRig(inertia))
@@ -287,29 +286,6 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
                                                     "predicted by the fitted servo (not fitted to it)", force))
     _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot, force,
             subtitle=facade_fit.subtitle, source_name=Path(fit.source).name, extra=extra)
-
-
-def _servo_recording(path: Path, rig, pivot, step, marker, imports: ImportOptions,
-                     timing: TimeOptions = REAL_TIME):
-    """One servo recording, of the kind its layout says: a gyro log (rate) or an angle table."""
-    text = read_recording_text(path)
-    if looks_like_gyro_log(text):
-        if pivot is not None:
-            raise CalibrationError(f"{path}: --pivot is for a horn track, and this is a gyro log",
-                                   "leave out --pivot and --step for a gyro log")
-        log = parse_gyro_log(text, path)
-        return S.RateRecording(log.t_s, log.rate_units, log.command_deg, rig, source=str(path))
-    t, angle, command = _servo_series(path, pivot, step, marker, imports, timing)
-    return S.StepRecording(t, angle, command, rig, source=str(path))
-
-
-def _per_recording(values: tuple[float, ...], n: int, option: str) -> list[float]:
-    if len(values) == 1:
-        return list(values) * n
-    if len(values) != n:
-        raise CalibrationError(f"{option} given {len(values)} times for {n} recordings",
-                               f"give {option} once (for every recording) or once per recording, in order")
-    return list(values)
 
 
 @calibrate.command()
@@ -408,49 +384,6 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
         keys = out["written"]["keys"]
         click.echo(f"wrote {', '.join(keys)} to {out['written']['path']}" if keys
                    else f"nothing written to {out['written']['path']}: no value was identifiable")
-
-
-# -- helpers ------------------------------------------------------------------------
-def _servo_series(data: Path, pivot: str | None, step: str | None, marker: str | None,
-                  imports: ImportOptions, timing: TimeOptions = REAL_TIME):
-    table = read_table(data, imports, timing)
-    if pivot is None:
-        t, angle, command = table.require("t_s", "angle_deg", "command_deg", purpose="a servo step")
-        return clean_samples(data, "the servo angle", t, angle, command, min_samples=S.MIN_SAMPLES)
-    px, py = _floats(pivot, 2, "--pivot", "X,Y in metres, e.g. --pivot 0.10,0.05")
-    if step is None:
-        raise CalibrationError("--pivot needs --step FROM,TO,AT_S (the track holds no command)",
-                               "e.g. --step 0,180,0.05 for a 0->180 deg step sent at t = 0.05 s")
-    a_from, a_to, at_s = _floats(step, 3, "--step", "FROM,TO,AT_S, e.g. --step 0,180,0.05")
-    x, y = table.marker(marker)
-    t, x, y = clean_samples(data, "the horn tip", table.time_s(), x, y, min_samples=S.MIN_SAMPLES)
-    return t, S.horn_angle_deg(x, y, px, py), np.where(t < at_s, a_from, a_to)
-
-
-def _ramp_angles(path: Path, ramp_markers: str, robot_marker: str, imports: ImportOptions,
-                 timing: TimeOptions = REAL_TIME) -> tuple[list[float], str | None, bool]:
-    """The trials' angles in ``path``, a plausibility warning, and whether it was a track."""
-    table = read_table(path, imports, timing)
-    if table.has("angle_deg"):
-        return [float(a) for a in table.columns["angle_deg"] if np.isfinite(a)], None, table.tracks is not None
-    names = [n.strip() for n in ramp_markers.split(",")]
-    if len(names) != 2 or not table.markers():
-        table.require("angle_deg", purpose="ramp trials (or a track with ramp and robot markers)")
-    a, b = table.marker(names[0]), table.marker(names[1])
-    onset = R.critical_angle_from_track(table.time_s(), a, b, table.marker(robot_marker), source=str(path))
-    board = np.hypot(b[0] - a[0], b[1] - a[1])
-    board_m = float(np.median(board[np.isfinite(board)])) if np.isfinite(board).any() else float("nan")
-    return [onset.critical_angle_deg], R.board_length_warning(board_m, imports.units, str(path)), True
-
-
-def _floats(text: str, n: int, option: str, hint: str) -> list[float]:
-    try:
-        vals = [float(v) for v in text.split(",")]
-    except ValueError:
-        vals = []
-    if len(vals) != n:
-        raise CalibrationError(f"{option} {text!r}: expected {n} numbers", hint)
-    return vals
 
 
 def default_plot_path(recording: Path, recording_name: Path | None = None) -> Path:
