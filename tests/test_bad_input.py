@@ -311,7 +311,7 @@ def test_a_read_only_folder_is_an_error_and_gets_nothing(tmp_path, monkeypatch, 
 def test_track_out_never_lands_on_the_videos_sidecars(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     res = invoke(["sim", "--cycles", "1", "--video", "hop.mp4", "--camera", "fixed",
-                  S, "solver.settle_s=0.1", S, "schedule.wait_s=0.2"])
+                  S, "solver.settle_s=0.3", S, "schedule.wait_s=0.2"])
     assert res.exit_code == 0, res.output
     before = tree(tmp_path)
     for out in ("hop.camera.csv", "hop.camera", "hop.truth.csv"):

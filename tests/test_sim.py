@@ -126,3 +126,11 @@ def test_cli_refuses_impossible_linkage_with_reason():
     human = _cli("sim", "--preset", "seed", "--set", "geometry.coupler_m=0.2")
     assert human.returncode == 2 and "Traceback" not in human.stderr
     assert "cannot close" in human.stderr
+
+
+@pytest.mark.parametrize("settle_s, valid", [(0.1, False), (0.5, True)])
+def test_a_robot_still_falling_when_the_schedule_starts_is_invalid(settle_s, valid):
+    """The seed drops 8 cm: 0.1 s later it still falls at ~1 m/s (invalid); at 0.5 s it rests."""
+    res = run(preset("seed").with_values({"solver.settle_s": settle_s}), cycles=1)
+    assert res.valid is valid, res.reasons
+    assert any("not at rest when the schedule started" in r for r in res.reasons) is not valid

@@ -10,7 +10,12 @@ Checks, each with a threshold stated here and reported with its measured value:
 - energy: the mechanical energy (kinetic + gravity + springs) may not rise above its start
   plus the work the servos did, beyond a small slack for soft contacts; a blow-up makes
   energy out of nothing;
-- MuJoCo's own warnings (bad acceleration, full constraint buffers, ...).
+- MuJoCo's own warnings (bad acceleration, full constraint buffers, ...);
+- at rest when the schedule starts: after ``solver.settle_s`` the robot's kinetic energy, as
+  the speed of its whole mass, must be under ``SETTLED_SPEED_LIMIT_M_PER_S``. A robot still
+  falling from its drop (a 0.1 s settle after the 8 cm drop: 0.15-1 m/s) would start its
+  first push in the air; a 0.3 s settle leaves under 1.2 mm/s, the default 0.5 s under
+  0.02 mm/s. (A zero settle, the notebook's, starts at rest at the drop height.)
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ ASSEMBLY_RESIDUAL_LIMIT_M = 1e-6     # the model must be built closed
 # Soft constraints and contacts store and return a little energy; a blow-up creates joules.
 ENERGY_SLACK_J = 0.005
 ENERGY_SLACK_OF_WORK = 0.10
+SETTLED_SPEED_LIMIT_M_PER_S = 0.05   # sqrt(2 KE / mass) when the first push is sent
 
 
 @dataclass
@@ -80,6 +86,15 @@ def audit(traj: Trajectory) -> Audit:
     if not surplus <= slack:
         reasons.append(f"energy audit failed: mechanical energy rose {surplus:.4g} J above the start "
                        f"plus servo work (slack {slack:.3g} J): the simulation created energy")
+
+    if traj.plan.settle_steps > 0 and len(sd) >= traj.plan.settle_steps:
+        kinetic_j = float(sd[traj.plan.settle_steps - 1, s.energy_kinetic][0])
+        speed = (2.0 * max(kinetic_j, 0.0) / float(traj.built.model.body_mass.sum())) ** 0.5
+        if not speed <= SETTLED_SPEED_LIMIT_M_PER_S:
+            reasons.append(f"not at rest when the schedule started: the robot moved at {speed * 1000:.0f} mm/s "
+                           f"(limit {SETTLED_SPEED_LIMIT_M_PER_S * 1000:.0f} mm/s) after "
+                           f"{traj.plan.settle_steps * traj.timestep_s:g} s of settling: it was still falling "
+                           "from its drop; raise solver.settle_s or lower geometry.drop_height_m")
 
     if traj.warnings:
         listed = ", ".join(f"{name.removeprefix('mjWARN_')} x{n}" for name, n in traj.warnings.items())
