@@ -144,4 +144,9 @@ def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_n
         where = ", ".join(f"{x.name}={b[x.name]:.6g}" for x in bounds)
         click.echo(f"best: trial {b['trial']} ({where}): {b['distance_m'] * 100:.2f} cm, "
                    f"highest nose {b['max_nose_height_m'] * 100:.2f} cm")
+        click.echo(f"best design as a robot file: {summary.best_robot}")
     click.echo(f"results: {out / 'trials.csv'}, {out / 'optimize.json'}, {out / 'history.png'}")
+    if summary.interrupted:
+        click.echo(f"interrupted: the trial under way was dropped; {summary.complete + summary.pruned} finished "
+                   "trials are kept in the study and the files above; rerun the same command to continue", err=True)
+        sys.exit(130)
