@@ -394,3 +394,138 @@ def test_interrupted_optimize_keeps_finished_trials_without_a_traceback(tmp_path
     rerun = subprocess.run(LOCUST + args, capture_output=True, text=True, timeout=300)
     assert rerun.returncode == 0, rerun.stderr
     assert "6 trials" in rerun.stdout   # 2 before (1 finished, 1 dropped) + 4
+
+
+# -- sweep: workers, schedulers ---------------------------------------------------------
+# A worker kills itself (SIGKILL, as the kernel's out-of-memory killer does) when given design
+# 2; the leader, its other worker and the rows already written are untouched.
+_WORKER_KILLED_AT_DESIGN_2 = """
+import os, signal, sys
+from locust.sweep import run
+run_task = run.run_task
+def run_task_or_die(task):
+    if task.design == 2:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return run_task(task)
+run.run_task = run_task_or_die
+from locust.cli import main
+sys.argv[0] = "locust"
+main()
+"""
+
+
+def test_a_killed_worker_is_a_clear_error_and_the_rerun_resumes(tmp_path):
+    from locust.sweep.execute import default_jobs
+
+    if default_jobs() < 2:
+        pytest.skip("needs two cores: with one, the sweep runs in the leader itself")
+    out = tmp_path / "s"
+    args = ["sweep", "--preset", "seed", "--vary", "geometry.leg_m=0.055:0.07:4", "--cycles", "1",
+            "--jobs", "2", "--out", str(out), "--json"]
+    died = subprocess.run([sys.executable, "-c", _WORKER_KILLED_AT_DESIGN_2, *args], capture_output=True,
+                          text=True, timeout=300)
+    assert died.returncode == 2, died.stderr
+    assert "Traceback" not in died.stderr and "BrokenProcessPool" not in died.stderr
+    assert "error: a worker process died" in died.stderr and "hint:" in died.stderr and "resume" in died.stderr
+    kept = read_rows(out)
+    assert {int(r["design"]) for r in kept} <= {0, 1, 3}
+    rerun = subprocess.run(LOCUST + args, capture_output=True, text=True, timeout=300)
+    assert rerun.returncode == 0, rerun.stderr
+    report = json.loads(rerun.stdout)
+    assert (report["resumed"], report["computed"]) == (len(kept), 4 - len(kept))
+    rows = read_rows(out)
+    assert [int(r["design"]) for r in rows] == [0, 1, 2, 3]
+    for old in kept:
+        assert rows[int(old["design"])] == old
+
+
+def test_jobs_are_capped_at_the_designs_and_the_cores_and_the_sweep_says_so(tmp_path):
+    from locust.sweep.execute import default_jobs
+
+    base = preset("seed")
+    said = []
+    s = run_sweep(base, [parse_axis("geometry.coupler_m=0.205:0.21:2", base)], cycles=1, out=tmp_path / "s",
+                  jobs=1024, plots=False, say=said.append)
+    used = min(2, default_jobs())
+    assert said == [f"--jobs 1024: starting {used} worker{'s' * (used != 1)} (2 designs to run, "
+                    f"{default_jobs()} cores)"]
+    assert json.loads((tmp_path / "s" / "sweep.json").read_text())["last_run"]["jobs"] == used
+    assert len(s.rows) == 2
+
+
+class _Impostor:
+    """A TCP server on 127.0.0.1 that is not a Dask scheduler: it greets every connection with
+    ``greeting`` (None: says nothing) and then closes it."""
+
+    def __init__(self, greeting: bytes | None):
+        import socket
+        import threading
+
+        self.greeting = greeting
+        self.sock = socket.create_server(("127.0.0.1", 0))
+        self.port = self.sock.getsockname()[1]
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self):
+
+        self.sock.settimeout(0.2)
+        while not self.stop.is_set():
+            try:
+                conn, _ = self.sock.accept()
+            except OSError:
+                continue
+            with conn:
+                if self.greeting is None:
+                    self.stop.wait(10)
+                else:
+                    try:
+                        conn.sendall(self.greeting)
+                    except OSError:
+                        pass
+
+    def close(self):
+        self.stop.set()
+        self.thread.join()
+        self.sock.close()
+
+
+def _impostor_greetings() -> dict[str, bytes | None]:
+    rng = random.Random(28)
+    cases: dict[str, bytes | None] = {
+        "http": b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n", "ssh": b"SSH-2.0-OpenSSH_9.6\r\n",
+        "exabytes": (3 << 60).to_bytes(8, "little") + b"\x01" + b"\x00" * 7, "ones": b"\xff" * 64,
+        "short": b"\x3a\x00", "closes": b"",
+        # a Dask-shaped header whose frame lengths do not add up
+        "inconsistent": (58).to_bytes(8, "little") + (1).to_bytes(8, "little") + (99).to_bytes(8, "little")
+        + b"\x00" * 42,
+        "silent": None}
+    for k in range(4):
+        cases[f"random-{k}"] = rng.randbytes(rng.randrange(1, 200))
+    return cases
+
+
+def test_a_scheduler_address_where_no_dask_answers_is_refused_promptly(tmp_path):
+    """Each case returns within the probe's few seconds (a hang would hang the test)."""
+    for name, greeting in _impostor_greetings().items():
+        server = _Impostor(greeting)
+        try:
+            folder = tmp_path / name
+            folder.mkdir()
+            (folder / "notes.txt").write_text("mine")
+            assert_refused_and_unchanged(folder, ["sweep", "--vary", "scale=0:0.01:2", "--cycles", "1",
+                                                  "--scheduler", f"tcp://127.0.0.1:{server.port}",
+                                                  "--out", folder / "s"], "Dask scheduler")
+        finally:
+            server.close()
+
+
+def test_a_real_dask_scheduler_passes_the_probe():
+    from dask.distributed import LocalCluster
+
+    from locust.sweep.execute import probe_dask_scheduler
+
+    with LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
+                      dashboard_address=None) as cluster:
+        probe_dask_scheduler(cluster.scheduler_address)   # raises if refused

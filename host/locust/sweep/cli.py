@@ -64,7 +64,7 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
     with progress(length=total, label=f"sweep ({scheduler})", show_pos=True, show_eta=True) as bar:
         try:
             summary = run_sweep(base, axes, cycles, out, scheduler=scheduler, jobs=jobs, progress=bar.update,
-                                samples=samples or 0)
+                                samples=samples or 0, say=lambda line: click.echo(line, err=True))
         except KeyboardInterrupt:
             click.echo(f"\ninterrupted: finished designs are in {out}/results.csv; "
                        "rerun the same command to resume", err=True)
