@@ -35,6 +35,7 @@ from ..markers import MARKER_COLOURS
 from ..params import Robot
 from ..progress import progress
 from ..track.camera import CameraFile, MarkerPlane, camera_json_beside, write_camera_json
+from ..track.video import check_encoded
 from .audit import audit
 from .camera import (
     CAMERAS,
@@ -277,6 +278,7 @@ class ClipRecorder:
             self.poser.close()
             if not self.rows:
                 raise SimError(f"no frames to write to {self.path}", "simulate for at least one frame period")
+            check_encoded(self.tmp_path, self.frames, self.path)
             truth_path, camera_path = sidecar_paths(self.path)
             atomic_write_text(truth_path, self.truth_csv())
             write_camera_json(camera_path, self.camera_file())

@@ -24,8 +24,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ..errors import TrackError
-from ..fileio import temp_beside
+from ..errors import TrackError, WriteError
+from ..fileio import DISK_HINT, temp_beside
 
 # FFmpeg's own log lines ("moov atom not found" ...) are noise next to our error
 # message; OpenCV reads the level when it opens its first capture, not on import.
@@ -244,6 +244,22 @@ def _ended_early(info: VideoInfo, index: int) -> None:
                      f"re-copy the file, or track the readable part with --end {max(index - 1, 0)}")
 
 
+def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
+    """Raise :class:`WriteError` unless the video just encoded at ``tmp`` (for ``path``) reads
+    back with its ``frames`` frames: OpenCV's writer ignores a failed write (a full disk) and
+    leaves a truncated file no player opens."""
+    if frames == 0:
+        return
+    cap = cv2.VideoCapture(str(tmp))
+    try:
+        count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
+    finally:
+        cap.release()
+    if count != frames:
+        raise WriteError(f"{path}: the video could not be written completely ({count} of {frames} frames read "
+                         "back); the disk may be full", DISK_HINT)
+
+
 def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: str = "mp4v") -> Path:
     """Encode ``frames`` (an iterable of BGR images) to ``path`` atomically."""
     path = Path(path)
@@ -256,9 +272,12 @@ def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: 
         if not writer.isOpened():
             raise TrackError(f"OpenCV cannot encode {fourcc} to {path}",
                              "check the folder is writable and the codec name")
+        written = 0
         for frame in frames:
             writer.write(frame)
+            written += 1
         writer.release()
+        check_encoded(tmp, written, path)
         os.replace(tmp, path)
     except BaseException:
         writer.release()
