@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 import socket
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -54,9 +55,18 @@ def _serial(fn: Callable, items: Sequence) -> Iterator[Any]:
         yield fn(item)
 
 
+def _worker_start(parent_pid: int) -> None:
+    """In a pool worker: die with the leader, and die plainly on SIGTERM (the pool's own way to
+    stop its workers): the leader's handler, inherited by fork, would unwind a worker into
+    sending its SystemExit back through a pipe no one reads any more."""
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_DFL)
+    die_with_parent(parent_pid)
+
+
 def _pool(fn: Callable, items: Sequence, jobs: int) -> Iterator[Any]:
     ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=die_with_parent,
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_start,
                                initargs=(os.getpid(),))
     pending: set[Future] = set()
     queue = list(items)[::-1]
