@@ -324,7 +324,11 @@ def _not_journals(journal: str) -> dict[str, bytes]:
     return cases
 
 
-def test_optimize_refuses_a_storage_file_that_is_not_a_whole_journal_and_leaves_it(tmp_path, journal_text):
+def test_optimize_refuses_a_storage_file_that_is_not_a_whole_journal_and_leaves_it(tmp_path, journal_text,
+                                                                                   monkeypatch):
+    from locust.sweep import optimize
+
+    monkeypatch.setattr(optimize, "JOURNAL_RECHECK_S", (0.0,))   # no other process writes these
     for name, data in _not_journals(journal_text).items():
         folder = tmp_path / name
         folder.mkdir()

@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import math
 import sqlite3
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,6 +35,9 @@ OWN_FILES = frozenset({"trials.csv", "optimize.json", "history.png", "best.toml"
 # the study's user attribute holding what it searches
 SETTINGS_ATTR = "locust"
 SQLITE_MAGIC = b"SQLite format 3\x00"
+# pauses before reading a journal again when its last line is cut short (a process sharing the
+# study may be writing it): 1.7 s in all before it is taken for a damaged one
+JOURNAL_RECHECK_S = (0.0, 0.2, 0.5, 1.0)
 
 
 def check_folder(folder: Path) -> None:
@@ -76,11 +80,15 @@ def check_journal_file(path: Path) -> None:
     hint = "give --storage a new file path (or a new --out folder); this file is left as it is"
     if not path.is_file():
         raise SweepError(f"{path} is not a file; refusing it as an Optuna journal", hint)
-    try:
-        text = path.read_bytes().decode("utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SweepError(f"{path}: not an Optuna journal (not UTF-8 text: {exc})", hint) from None
-    lines = text.split("\n")
+    for wait_s in JOURNAL_RECHECK_S:   # another process sharing the study may be appending a line
+        time.sleep(wait_s)
+        try:
+            text = path.read_bytes().decode("utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise SweepError(f"{path}: not an Optuna journal (not UTF-8 text: {exc})", hint) from None
+        lines = text.split("\n")
+        if not lines[-1]:
+            break
     if lines[-1]:
         raise SweepError(f"{path}: a damaged Optuna journal (its last line is cut short)",
                          "restore the file from a copy, or " + hint)
