@@ -396,7 +396,7 @@ def colour_at(frame: np.ndarray, x: float, y: float, radius_px: float) -> str:
 def picked_colour(clip: Path, truth: Truth, pick: str = "first") -> tuple[str, int, int]:
     """The sticker's colour (median of its core, as a colour picker would give) and its centre on
     the first frame, rounded: what goes into ``--marker``. ``pick="first"``: the colour on the first
-    frame (what ``--preview 0`` shows); ``"lit"``: on the first frame where the sticker is still,
+    frame (what ``locust track preview`` shows); ``"lit"``: on the first frame where the sticker is still,
     whole and out of the shadow."""
     i = 0
     if pick == "lit":
@@ -437,7 +437,7 @@ WRONG_PX = 8.0
 
 def score(truth: Truth, tracks_path: Path, clip: Path | None = None, marker: str = "nose") -> Figures:
     """Compare the tracks CSV with the truth (``clip``: to say what colour a wrong pick had)."""
-    from locust.track.tracks_csv import read_tracks_csv
+    from locust.io.tracks_csv import read_tracks_csv
 
     tracks = read_tracks_csv(tracks_path)
     m = tracks.markers[marker]
@@ -509,7 +509,7 @@ def main() -> None:
     ap.add_argument("--background", choices=("cups", "balltoss"), default="cups")
     ap.add_argument("--seed", type=int, default=7)
     ap.add_argument("--pick", choices=("first", "lit"), default="first",
-                    help="where the marker's colour is picked: the first frame (as --preview 0) or the first "
+                    help="where the marker's colour is picked: the first frame (as locust track preview) or the first "
                          "frame where the sticker is still and out of the shadow")
     ap.add_argument("--keep", type=Path, help="write the clip, truth and tracks to this folder (default: a temp one)")
     args = ap.parse_args()

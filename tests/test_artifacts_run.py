@@ -1,4 +1,4 @@
-"""``run.json`` has one owner: locust.device.record writes it and reads it back, equal."""
+"""``run.json`` has one owner: locust.io.run_record writes it and reads it back, equal."""
 
 from __future__ import annotations
 
@@ -8,11 +8,11 @@ import click
 import pytest
 
 from locust.device import cli as device_cli
-from locust.device import record as R
-from locust.errors import DeviceError, ReportError
+from locust.errors import DeviceError, TrialError
 from locust.firmware import protocol as P
+from locust.io import run_record as R
 from locust.report.compare import timing_rows, trial_cycles
-from locust.report.measured import load_trial
+from locust.trials.measured import load_trial
 
 
 def _record(status: str = R.COMPLETE) -> R.RunRecord:
@@ -101,7 +101,7 @@ def test_the_report_reads_run_json_through_the_record(tmp_path):
     assert row.jitter == R.jitter(rec.phases)
     (tmp_path / "bad").mkdir()
     (tmp_path / "bad" / R.RECORD_NAME).write_text("[]")
-    with pytest.raises(ReportError, match="not a run record"):
+    with pytest.raises(TrialError, match="not a run record"):
         load_trial(tmp_path / "bad", "small")
 
 

@@ -1,11 +1,13 @@
 """The track layer's files, each through its one owner: write -> read back -> equal.
 
-- the tracks CSV (locust.track.tracks_csv), lost frames (NaN, ok 0) included, and what
+- the tracks CSV (locust.io.tracks_csv), lost frames (NaN, ok 0) included, and what
   other programs make of it (true/false, semicolons and decimal commas);
-- Tracker's text export (locust.track.tracker_text): steps a track does not have, a frame
+- Tracker's text export (locust.io.tracker_text): steps a track does not have, a frame
   no track has, Tracker 6's shared time column, per-track time columns;
-- camera.json (locust.track.camera): a fixed and a following camera, a plane without its
-  stray distance (null in JSON, NaN here).
+- camera.json (locust.io.camera_json): a fixed and a following camera, a plane without its
+  stray distance (null in JSON, NaN here);
+- a Tracker project (.trk) written from a tracking result (locust.track.trk) and read back by
+  its reader (locust.io.trk): steps, clip, calibration, and the tracks in metres.
 
 Numbers here are SYNTHETIC (chosen to survive the files' decimals exactly).
 """
@@ -20,9 +22,15 @@ import pytest
 
 from locust.calibrate.recordings import read_table
 from locust.errors import TrackError
-from locust.track import camera as cam
-from locust.track import tracker_text as tt
-from locust.track import tracks_csv as tc
+from locust.io import camera_json as cam
+from locust.io import tracker_text as tt
+from locust.io import tracks_csv as tc
+from locust.io import trk as trk_io
+from locust.track import camera as track_camera
+from locust.track import trk
+from locust.track.export import tracks_of
+from locust.track.runner import MarkerTrack, TrackResult
+from locust.track.video import Clip, VideoInfo
 
 NAN = math.nan
 
@@ -142,7 +150,7 @@ def test_calibration_tables_come_from_the_owners(tmp_path):
     assert isinstance(table.tracks, tc.TracksCsv) and table.kind == "csv" and table.markers() == ["nose", "foot"]
     assert np.isnan(table.marker("nose")[0][2])                          # ok 0 is never a position
     table = read_table(txt_path)
-    # a Tracker export comes through the track layer's one import (locust.track.importing), as tracks
+    # a Tracker export comes through the track layer's one import (locust.io.importing), as tracks
     assert isinstance(table.tracks, tc.TracksCsv) and table.kind == "tracker"
     for marker in ("ball", "cup_3"):
         for got, want in zip(table.marker(marker), _export().positions(marker)):
@@ -171,11 +179,11 @@ def test_camera_json_round_trip(tmp_path, kind):
     assert ("m_per_px" in doc) == (kind == "fixed")
     back = cam.read_camera_json(path)
     assert back == camera and math.isnan(back.marker_planes["foot"].max_off_plane_m)
-    cal = cam.load(path, 320, 180)
+    cal = track_camera.load(path, 320, 180)
     assert cal.planes_y_m == {"nose": 0.0602, "foot": -0.02} and cal.camera == kind
     np.testing.assert_array_equal(cal.positions_m, camera.positions_m)
     with pytest.raises(TrackError, match="describes a 320x180 camera"):
-        cam.load(path, 640, 360)
+        track_camera.load(path, 640, 360)
 
 
 @pytest.mark.slow
@@ -189,3 +197,33 @@ def test_simulations_camera_json_reads_back_to_the_same_bytes(tmp_path, kind):
     assert info.camera_path == cam.camera_json_beside(info.video_path)
     again = cam.write_camera_json(tmp_path / "again.json", cam.read_camera_json(info.camera_path))
     assert again.read_text() == info.camera_path.read_text()
+
+
+def test_tracker_project_round_trip(tmp_path):
+    """A result written as a .trk reads back with the same steps (Tracker's pixel convention
+    undone), clip, calibration and, through that calibration, the same metres."""
+    frames = np.arange(2, 8)
+    ok = np.array([True, True, False, True, True, True])
+    px = np.where(ok, 100.0 + 4.25 * (frames - 2), NAN)
+    py = np.where(ok, 300.0 - 2.5 * (frames - 2), NAN)
+    nose = MarkerTrack("nose", "colour:pink", px, py, np.where(ok, 1.0, NAN), ok)
+    cal = trk_io.Calibration(m_per_px=1 / 2048, origin_x_px=12.5, origin_y_px=350.25, angle_deg=2.5, source="stick")
+    clip = Clip(2, 7, 1, 30.0)
+    video = VideoInfo(tmp_path / "hop.mp4", 640, 360, 12, 30.0)
+    result = TrackResult(video, clip, frames, (frames - 2) / 30.0, [nose], cal)
+    path = trk.write_project(result, tmp_path / "hop.trk")
+
+    back = trk_io.read_project(path)
+    assert back.video_path == "hop.mp4"
+    assert back.points["nose"] == {int(f): (x, y) for f, x, y, k in zip(frames, px, py, ok) if k}
+    assert (back.clip.start, back.clip.end, back.clip.step) == (2, 7, 1)
+    assert back.clip.fps == pytest.approx(30.0, rel=1e-12)
+    c = back.calibration
+    assert (c.origin_x_px, c.origin_y_px, c.angle_deg) == (12.5, 350.25, 2.5)
+    assert c.m_per_px == pytest.approx(1 / 2048, rel=1e-12)
+    mine, theirs = tracks_of(result), trk_io.project_tracks(back)
+    np.testing.assert_array_equal(theirs.frame, mine.frame)
+    np.testing.assert_allclose(theirs.t_s, mine.t_s, rtol=1e-12)
+    for col in ("px", "py", "x_m", "y_m", "ok"):
+        np.testing.assert_allclose(getattr(theirs.markers["nose"], col), getattr(mine.markers["nose"], col),
+                                   rtol=1e-12, atol=0)

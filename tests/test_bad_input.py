@@ -22,9 +22,9 @@ from pathlib import Path
 
 import pytest
 
-from locust.device import record as R
+from locust.io import run_record as R
 from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
-from probing import assert_clear_error, invoke, tree
+from probing import assert_clear_error, assert_refused_and_unchanged, invoke, tree
 
 LOCUST = [sys.executable, "-m", "locust.cli"]
 
@@ -152,8 +152,8 @@ CASES = [
                                             "--out", user_trials(d)], ["did not write", "trials.csv"]),
     ("optimize-bogus-storage", lambda d: ["optimize", "--vary", "geometry.leg_m=0.05:0.07", "--trials", "1",
                                           "--out", d / "o", "--storage", "bogus://x"], ["bogus://x"]),
-    ("optimize-integer-without-integer", lambda d: ["optimize", "--vary", "schedule.cycles=1.2:1.8", "--trials", "1",
-                                                    "--out", d / "o"], ["no whole number"]),
+    ("optimize-integer-without-integer", lambda d: ["optimize", "--vary", "solver.iterations=1.2:1.8", "--trials",
+                                                    "1", "--out", d / "o"], ["no whole number"]),
     # fabrication
     ("fab-jig-diameter-0", lambda d: ["fab", "--from-robot", "seed", "--jig-diameter-mm", "0"], ["jig_diameter_mm"]),
     ("fab-jig-spacing-inf", lambda d: ["fab", "--from-robot", "seed", "--jig-spacing-mm", "inf"], ["finite"]),
@@ -253,11 +253,12 @@ def test_an_unsimulatable_design_is_an_invalid_row_of_the_sweep(tmp_path):
     from locust.sweep.design import parse_axis
     from locust.sweep.run import run_sweep
 
+    # each value within its limits, the push beyond the servo's travel together: a row, not a run
     base = preset("seed")
-    axes = [parse_axis("schedule.wait_s=-1:1:2", base)]
+    axes = [parse_axis("schedule.push_deg=-60:-30:2", base)]
     s = run_sweep(base, axes, cycles=1, out=tmp_path / "sw", jobs=1, plots=False)
     assert [r["valid"] for r in s.rows] == [False, True]
-    assert "schedule.wait_s = -1 must be >= 0.02" in s.rows[0]["reason"]
+    assert "schedule.push_deg = -60 is beyond the servo travel of +-45 deg" in s.rows[0]["reason"]
     assert s.best["design"] == 1
 
 
@@ -290,7 +291,7 @@ def test_a_full_disk_is_an_error_and_leaves_nothing_behind(tmp_path):
 
 @pytest.mark.parametrize("args", [
     ["params", "--write", "ro/robot.toml"],
-    ["sweep", "--vary", "scale=0.5:1:2", "--cycles", "1", "--out", "ro/sweep"],
+    ["sweep", "--vary", "scale=0.3:0.4:2", "--cycles", "1", "--out", "ro/sweep"],
 ], ids=["params-write", "sweep-out"])
 def test_a_read_only_folder_is_an_error_and_gets_nothing(tmp_path, monkeypatch, args):
     """Refused by the folder's mode, so the check holds even for root (who may write anyway)."""
@@ -458,3 +459,280 @@ def test_ctrl_c_during_a_filmed_hop_finishes_the_video_and_says_so(env, tmp_path
     from locust.track.video import probe
 
     assert probe(tmp_path / "hop.mp4").frame_count >= 10   # a playable video of what was filmed
+
+
+# -- the property-style probe: many generated inputs per class ------------------------
+# Each class draws its inputs from a seeded generator (the same cases every run, a new seed
+# a new set): every one must be a clear error (exit 2, error:/hint:, no traceback) that
+# leaves every file as it was and creates none.
+DRAWS = 20
+
+
+def _draws(seed: int, n: int = DRAWS):
+    import random
+
+    rng = random.Random(seed)
+    return [(k, rng) for k in range(n)]
+
+
+def _beyond(key: str, rng) -> str:
+    """A value of ``key`` outside its limits: past either end (the end itself where that end is
+    open), as far as 1e300 past, or not finite."""
+    from locust.params import value_type
+
+    low, high, low_ok, high_ok, _ = LIMITS[key]
+    whole = value_type(key) == "int"
+    sides = [s for s, end in (("low", low), ("high", high)) if math.isfinite(end)]
+    side = rng.choice(sides + ["nan"])
+    if side == "nan":
+        return "nan"
+    end, ok, sign = (low, low_ok, -1) if side == "low" else (high, high_ok, 1)
+    if not ok and rng.random() < 0.3:
+        return repr(end)
+    step = 10 ** rng.uniform(-3, 300 if not whole else 6) * max(abs(end), 1e-3)
+    value = end + sign * step
+    return str(int(math.floor(value) if sign < 0 else math.ceil(value) + (value == math.ceil(value)))) \
+        if whole else repr(value)
+
+
+def _robot_bytes(rng) -> bytes:
+    """A valid robot.toml with a byte that is not UTF-8 somewhere in it."""
+    text = b'name = "mine"\n[geometry]\nleg_m = 0.06\n# measured with a ruler\n[servo]\nkp_nm_per_rad = 0.4\n'
+    at = rng.randrange(len(text))
+    bad = bytes([rng.choice([0x80, 0x9F, 0xC0, 0xC1, 0xF5, 0xFE, 0xFF])])
+    return text[:at] + bad + text[at:]
+
+
+NUMBER_KEYS = sorted(LIMITS)
+
+
+@pytest.mark.parametrize("k, rng", _draws(1))
+def test_probe_out_of_limit_values_are_refused_with_their_reason(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    key = rng.choice(NUMBER_KEYS)
+    value = _beyond(key, rng)
+    (tmp_path / "mine.toml").write_text("# mine\n")
+    section, name = key.split(".")
+    robot = robot_toml(tmp_path, f"[{section}]\n{name} = {value}\n")
+    for args in (["params", S, f"{key}={value}"], ["sim", "--cycles", "1", "--config", robot],
+                 ["params", "--config", robot, "--write", tmp_path / "new.toml"]):
+        before = tree(tmp_path)
+        res = invoke(args)
+        assert_clear_error(res, key)
+        if value != "nan":
+            assert f"({LIMITS[key].reason})" in res.stderr or "takes a" in res.stderr, res.stderr
+        assert tree(tmp_path) == before
+
+
+def test_every_parameter_has_limits_with_a_reason():
+    from locust.params import PRESETS, real_keys
+
+    numbers = [k for k in real_keys()] + ["schedule.cycles", "solver.iterations"]
+    assert sorted(numbers) == sorted(LIMITS)
+    assert all(len(limit.reason) > 10 for limit in LIMITS.values())
+    # the toolkit's robots: a gram to a kilogram, millimetres to tens of centimetres, hobby servos
+    assert LIMITS["geometry.body_mass_kg"][:2] == (0.001, 1.0)
+    assert LIMITS["geometry.leg_m"][:2] == (0.001, 0.5)
+    assert LIMITS["servo.stall_torque_nm"][1] == 5.0
+    for name in PRESETS:
+        assert problems(preset(name)) == [], name
+
+
+@pytest.mark.parametrize("k, rng", _draws(2))
+def test_probe_robot_files_that_are_not_utf8_in_every_reader(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    robot = tmp_path / "robot.toml"
+    robot.write_bytes(_robot_bytes(rng))
+    ramp = robot_toml(tmp_path, "trial,angle_deg\n1,30\n2,31\n3,29\n", "ramp.csv")
+    commands = [["params", "--config", robot], ["sim", "--cycles", "1", "--config", robot],
+                ["hop", "--port", "sim", "--config", robot, "--out", tmp_path / "run"],
+                ["fab", "--from-robot", robot],
+                ["report", "--before", robot, "--measured", f"small={trial(tmp_path)}", "--out", tmp_path / "rep"],
+                ["calibrate", "ramp", ramp, "--write", robot, "--no-plot"]]
+    assert_refused_and_unchanged(tmp_path, commands[k % len(commands)], "robot.toml", "not UTF-8")
+
+
+@pytest.mark.parametrize("k, rng", _draws(3))
+def test_probe_booleans_are_not_numbers_in_a_robot_file(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    key = rng.choice(NUMBER_KEYS)
+    section, name = key.split(".")
+    robot = robot_toml(tmp_path, f"[{section}]\n{name} = {rng.choice(['true', 'false'])}\n")
+    assert_refused_and_unchanged(tmp_path, ["params", "--config", robot], key, "not a number")
+
+
+def _corrupt_cell(path: Path, rng, columns: list[str]) -> None:
+    """One data cell of ``columns`` replaced by a value no recording holds."""
+    lines = path.read_text().splitlines()
+    header = next(i for i, ln in enumerate(lines) if not ln.startswith("#"))
+    names = lines[header].split(",")
+    row = rng.randrange(header + 1, len(lines))
+    cells = lines[row].split(",")
+    cells[names.index(rng.choice(columns))] = rng.choice(["inf", "-inf", "1e308", "-1e305", "Infinity"]) \
+        if rng.random() < 0.6 else repr(rng.choice([-1, 1]) * 10 ** rng.uniform(12, 300))
+    lines[row] = ",".join(cells)
+    path.write_text("\n".join(lines) + "\n")
+
+
+@pytest.mark.parametrize("k, rng", _draws(4))
+def test_probe_non_finite_and_absurd_values_in_recordings(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    if k % 2:
+        rec = copy_beam(tmp_path)
+        _corrupt_cell(rec, rng, ["t_s", "tip_x_m", "tip_y_m"])
+        args = ["calibrate", "beam", rec, "--mass-kg", "0.01", "--no-plot"]
+    else:
+        rec = copy_servo(tmp_path)
+        _corrupt_cell(rec, rng, ["t_s", "angle_deg", "command_deg"])
+        args = ["calibrate", "servo", rec, "--inertia-kgm2", "1.5e-5", "--no-plot"]
+    assert_refused_and_unchanged(tmp_path, args, "data row")
+
+
+@pytest.mark.parametrize("k, rng", _draws(5))
+def test_probe_times_not_in_seconds(tmp_path, monkeypatch, k, rng):
+    """Times of a 60 frames/s recording written in ms (or any unit 100 to 100000 times too
+    long): refused, with --time-scale in the hint, before any simulation."""
+    monkeypatch.chdir(tmp_path)
+    factor = 10 ** rng.uniform(2, 5)
+    lines = SERVO_CSV.read_text().splitlines()
+    out = []
+    for ln in lines:
+        if ln[:1].isdigit() or ln[:1] == "-":
+            t, rest = ln.split(",", 1)
+            ln = f"{float(t) * factor:.6f},{rest}"
+        out.append(ln)
+    rec = robot_toml(tmp_path, "\n".join(out) + "\n", "servo_ms.csv")
+    assert_refused_and_unchanged(tmp_path, ["calibrate", "servo", rec, "--inertia-kgm2", "1.5e-5", "--no-plot"],
+                                 "not in seconds", "--time-scale 0.001")
+
+
+def _plot_collision(d: Path, rng, inputs: list[Path]) -> tuple[list, str]:
+    """--plot / --write paths that would destroy something: (extra args, a word of the error)."""
+    target = rng.choice(inputs)
+    spellings = [target, Path(os.path.relpath(target, d)), d / "." / target.name,
+                 d / "sub" / ".." / target.name]
+    (d / "sub").mkdir(exist_ok=True)
+    choice = rng.randrange(5)
+    if choice == 0:   # an input, spelt some way
+        return ["--plot", rng.choice(spellings)], "an input"
+    if choice == 1:   # an input reached through a link
+        link = d / "link.png"
+        link.symlink_to(target)
+        return ["--plot", link], "an input"
+    if choice == 2:   # a path that is not an image
+        name = rng.choice(["notes.txt", "fit.csv", "robot.toml", "fit", "fit.png.bak"])
+        if rng.random() < 0.5:
+            (d / name).write_text("mine\n")
+        return ["--plot", d / name], "must end in"
+    if choice == 3:   # a user's picture
+        (d / "photo.png").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(rng.randrange(256) for _ in range(64)))
+        return ["--plot", d / "photo.png"], "not a figure this toolkit wrote"
+    same = d / rng.choice(["out.png", "out.toml"])   # two outputs on one file
+    return ["--plot", same, "--write", rng.choice([same, Path(os.path.relpath(same, d))])], "same file"
+
+
+@pytest.mark.parametrize("k, rng", _draws(6, 30))
+def test_probe_plot_paths_never_replace_inputs_or_user_files(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    kind = ["beam", "servo", "ramp", "hinge"][k % 4]
+    if kind == "beam":
+        rec = copy_beam(tmp_path)
+        base = ["calibrate", "beam", rec, "--mass-kg", "0.01", "--length-m", "0.05"]
+    elif kind == "servo":
+        rec = copy_servo(tmp_path)
+        base = ["calibrate", "servo", rec, "--inertia-kgm2", "1.5e-5"]
+    elif kind == "ramp":
+        rec = robot_toml(tmp_path, "trial,angle_deg\n1,30\n2,31\n3,29\n", "ramp.csv")
+        base = ["calibrate", "ramp", rec]
+    else:
+        rec = copy_beam(tmp_path)
+        base = ["calibrate", "hinge", rec, "--inertia-kgm2", "8.5e-7", "--gravity", "out-of-plane"]
+    extra, word = _plot_collision(tmp_path, rng, [rec])
+    assert_refused_and_unchanged(tmp_path, base + extra, word)
+
+
+@pytest.mark.parametrize("k, rng", _draws(7))
+def test_probe_sweep_ranges_beyond_the_limits(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    key = rng.choice(NUMBER_KEYS + ["scale"] * 5)
+    if key == "scale":   # centimetres typed for metres
+        a, b = 0.0, rng.choice([1, 2, 5, 10, 30, 100])
+        words = ["scale", "units"]
+    else:
+        inside = preset("seed").get(key)
+        a, b = sorted([float(inside), float(_beyond(key, rng).replace("nan", "inf"))])
+        if not math.isfinite(a) or not math.isfinite(b):
+            a, b = (inside, LIMITS[key].high * 10 + 1) if math.isfinite(LIMITS[key].high) else \
+                (LIMITS[key].low - 1, inside)
+        words = [key] if key != "schedule.cycles" else ["--cycles"]
+    cmd = rng.choice(["sweep", "optimize"])
+    args = [cmd, "--vary", f"{key}={a!r}:{b!r}" + (":3" if cmd == "sweep" else ""), "--cycles", "1",
+            "--out", tmp_path / "out"]
+    assert_refused_and_unchanged(tmp_path, args, *words)
+
+
+@pytest.mark.parametrize("k, rng", _draws(8))
+def test_probe_hop_fits_take_each_run_once_and_only_physics(tmp_path, monkeypatch, k, rng):
+    from locust.params import all_keys, fittable_keys
+
+    monkeypatch.chdir(tmp_path)
+    run = trial(tmp_path)
+    if k % 2:
+        spelt = rng.choice([run, Path("small-1"), Path("./small-1"), tmp_path / "x" / ".." / "small-1"])
+        (tmp_path / "x").mkdir()
+        args = ["calibrate", "hop", f"small={run}", f"{rng.choice(['small', 'large'])}={spelt}", "--no-plot"]
+        word = "given twice"
+    else:
+        key = rng.choice([key for key in all_keys() if key not in fittable_keys()])
+        args = ["calibrate", "hop", f"small={run}", "--fit", key, "--no-plot"]
+        word = "physical parameters"
+    assert_refused_and_unchanged(tmp_path, args, word)
+
+
+def test_a_bare_write_names_its_file_and_makes_no_calibration_folder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    ramp = robot_toml(tmp_path, "trial,angle_deg\n1,30\n2,31\n3,29\n", "ramp.csv")
+    assert_refused_and_unchanged(tmp_path, ["calibrate", "ramp", ramp, "--write", "--no-plot"],
+                                 str(tmp_path / "calibration"), "--write PATH")
+    (tmp_path / "calibration").mkdir()
+    res = invoke(["calibrate", "ramp", ramp, "--write", "--no-plot"])
+    assert res.exit_code == 0, res.output
+    assert f"to {tmp_path / 'calibration' / 'robot.toml'}" in res.output
+    assert (tmp_path / "calibration" / "robot.toml").is_file()
+
+
+def test_a_plot_replaces_only_its_own_figure(tmp_path, monkeypatch):
+    from locust.plotting import is_own_figure
+
+    monkeypatch.chdir(tmp_path)
+    ramp = robot_toml(tmp_path, "trial,angle_deg\n1,30\n2,31\n3,29\n", "ramp.csv")
+    for suffix in (".png", ".svg", ".pdf"):
+        for _ in range(2):   # the second run replaces the first one's figure
+            res = invoke(["calibrate", "ramp", ramp, "--plot", f"fit{suffix}"])
+            assert res.exit_code == 0, res.output
+        assert is_own_figure(tmp_path / f"fit{suffix}")
+    (tmp_path / "mine.png").write_bytes((tmp_path / "fit.png").read_bytes().replace(b"locust", b"gimp!!"))
+    assert not is_own_figure(tmp_path / "mine.png")
+    assert_refused_and_unchanged(tmp_path, ["calibrate", "ramp", ramp, "--plot", "mine.png"], "--force")
+    assert invoke(["calibrate", "ramp", ramp, "--plot", "mine.png", "--force"]).exit_code == 0
+    assert is_own_figure(tmp_path / "mine.png")
+
+
+def test_an_unstable_simulation_leaves_no_mujoco_log(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    res = invoke(["sim", "--cycles", "1", S, "solver.timestep_s=0.01", S, "solver.integrator=euler",
+                  S, "servo.kp_nm_per_rad=100", S, "servo.armature_kgm2=0",
+                  S, "compliance.hinge_stiffness_nm_per_rad=10", S, "schedule.wait_s=0.2", S, "solver.settle_s=0.1"])
+    assert "INVALID" in res.output and "MuJoCo warnings: BADQACC" in res.output, res.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_two_million_row_recording_is_refused_before_it_is_parsed(tmp_path, monkeypatch):
+    from locust.calibrate.recordings import MAX_ROWS
+
+    monkeypatch.chdir(tmp_path)
+    rec = tmp_path / "long.csv"
+    rows = "\n".join(f"{i / 1000:.3f},{0.1 + 0.01 * math.sin(i / 50):.6f},0.05" for i in range(MAX_ROWS + 1))
+    rec.write_text("t,x,y\n" + rows + "\n")
+    assert_refused_and_unchanged(tmp_path, ["calibrate", "beam", rec, "--mass-kg", "0.01", "--no-plot"],
+                                 f"{MAX_ROWS + 2:,} lines", "cut the recording")

@@ -21,7 +21,7 @@ from locust.calibrate import hinge as H
 from locust.calibrate import synthetic as S
 from locust.calibrate.recordings import REAL_TIME, TimeOptions, clean_samples, read_table
 from locust.cli import cli
-from locust.track.importing import ImportOptions
+from locust.io.importing import ImportOptions
 
 POINT = "org.opensourcephysics.cabrillo.tracker.PointMass"
 FRAME = "org.opensourcephysics.media.core.ImageCoordSystem$FrameData"
@@ -264,10 +264,10 @@ def test_times_printed_to_three_digits_are_rebuilt_from_the_rows(tmp_path):
 
 
 def test_track_import_reads_a_tracker_project(tmp_path):
-    """`locust track --import` goes through the same reader: a .trk's metres, renamed."""
+    """`locust track import` goes through the same reader: a .trk's metres, renamed."""
     t, x, y = S.hinge_swing_track(dataclasses.replace(OUT_OF_PLANE, duration_s=2.0), np.random.default_rng(1))
     trk = write_trk(tmp_path / "swing.trk", t, x, y)
-    res = run("track", "--import", trk, "--rename", "mass_A=tip", "--out", tmp_path / "swing.tracks.csv")
+    res = run("track", "import", trk, "--rename", "mass_A=tip", "--out", tmp_path / "swing.tracks.csv")
     assert res.exit_code == 0, res.output
     table = read_table(tmp_path / "swing.tracks.csv")
     tx, ty = table.marker("tip")

@@ -5,7 +5,7 @@ stiffness, servo speed unlike the presets), on the leg set's preset (the virtual
 plant) at half its converged step (nearer the continuous robot than the fit's model),
 sampled like a 30 frames/s video on a camera clock of its own, with 0.1 mm of seeded
 Gaussian noise; the fit's runs are built from the seed the way a filmed run is loaded
-(``report.configs.configuration``): the fit must recover the values it was made with. The
+(``trials.configs.configuration``): the fit must recover the values it was made with. The
 system test on the virtual robot's own videos is in test_calibrate_hop_virtual.py (slow).
 """
 
@@ -19,8 +19,8 @@ import pytest
 from locust.calibrate import hop as H
 from locust.errors import CalibrationError
 from locust.params import LEG_SETS, Provenance, leg_set, preset
-from locust.report.configs import configuration
 from locust.sim import samples as S
+from locust.trials.configs import configuration
 
 CAMERA_HZ = 30.0
 NOISE_M = 1e-4

@@ -30,6 +30,24 @@ def test_interval_by_hand():
     assert fit.mu_static.std == pytest.approx(math.radians(1 / math.sqrt(3)) / math.cos(math.radians(41)) ** 2)
 
 
+def test_identical_readings_give_the_resolutions_interval_not_a_point():
+    """Three trials read 30 deg on a protractor graduated in degrees: each is 30 +- 0.5 deg, a
+    spread of 1/sqrt(12) = 0.2887 deg (a uniform rounding error), so the interval is
+    tan(30 +- 4.303 * 0.2887 / sqrt(3)) = [0.5608, 0.5942], never [0.5774, 0.5774]."""
+    fit = R.fit_ramp(np.array([30.0, 30.0, 30.0]))
+    half = 4.302653 * (1 / math.sqrt(12)) / math.sqrt(3)
+    assert fit.mu_static.ci95_low == pytest.approx(math.tan(math.radians(30 - half)), rel=1e-6)
+    assert fit.mu_static.ci95_high == pytest.approx(math.tan(math.radians(30 + half)), rel=1e-6)
+    assert fit.mu_static.ci95_low == pytest.approx(0.5608, abs=1e-4)
+    assert fit.std_angle_deg == pytest.approx(0.288675, rel=1e-5) and "reading resolution" in fit.notes[0]
+    # a finer reading (0.1 deg) narrows it tenfold; spread above the floor is the trials' own
+    fine = R.fit_ramp(np.array([30.0, 30.0, 30.0]), resolution_deg=0.1)
+    assert fine.std_angle_deg == pytest.approx(0.0288675, rel=1e-5)
+    assert R.fit_ramp(np.array([40.0, 41.0, 42.0])).notes == []
+    with pytest.raises(CalibrationError, match="resolution"):
+        R.fit_ramp(np.array([30.0, 30.0]), resolution_deg=0.0)
+
+
 def test_critical_angle_from_tilt_track():
     truth = S.RampTruth()
     for seed in (1, 2):

@@ -18,7 +18,6 @@ import time
 import pytest
 import serial
 
-from locust.device import record as R
 from locust.device.flash import firmware_files, flash
 from locust.device.hop import run_hop
 from locust.device.link import Link
@@ -26,6 +25,7 @@ from locust.device.plant import RecordingPlant
 from locust.device.virtual import PWM_PERIOD_S, TICKS_LEAD_S, VirtualRobot
 from locust.errors import DeviceError
 from locust.firmware import protocol as P
+from locust.io import run_record as R
 
 
 @pytest.fixture(scope="module")

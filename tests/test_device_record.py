@@ -7,8 +7,8 @@ import json
 import pytest
 
 from locust.device import ports as PT
-from locust.device import record as R
 from locust.errors import DeviceError
+from locust.io import run_record as R
 
 
 def test_jitter_known_values():

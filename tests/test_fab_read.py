@@ -11,7 +11,8 @@ from ezdxf.math import rational_bspline_from_arc
 
 from locust.errors import FabError
 from locust.fab.design import LayerMap, design_from_drawing, parse_layer_options
-from locust.fab.dxf_read import read_drawing
+from locust.fab.dxf_read import MAX_EXPANDED_ENTITIES, expanded_count, read_drawing
+from probing import assert_refused_and_unchanged, invoke
 
 
 def _doc(units=4):
@@ -171,3 +172,79 @@ def test_self_crossing_outline_is_an_error(tmp_path):
     doc.saveas(tmp_path / "x.dxf")
     with pytest.raises(FabError, match="crosses itself"):
         _area(tmp_path / "x.dxf")
+
+
+def test_nested_block_references_are_counted_and_refused_before_expanding(tmp_path):
+    """8 levels of 10 references to a block of one LINE would be 10^8 lines (the expansion ran
+    for hours); they are counted from the block table first, so the refusal is immediate."""
+    doc, msp = _doc()
+    doc.blocks.new("L0").add_line((0, 0), (1, 0))
+    for level in range(1, 9):
+        blk = doc.blocks.new(f"L{level}")
+        for i in range(10):
+            blk.add_blockref(f"L{level - 1}", (2 * i, 0))
+    msp.add_blockref("L8", (0, 0), dxfattribs={"layer": "plate"})
+    msp.add_blockref("L2", (0, 0), dxfattribs={"layer": "plate"})
+    doc.saveas(tmp_path / "nest.dxf")
+    doc = ezdxf.readfile(tmp_path / "nest.dxf")
+    # L2 alone: itself, 10 L1 references, 100 L0 references, 100 lines = 211 entities
+    assert expanded_count(doc, [e for e in doc.modelspace() if e.dxf.name == "L2"]) == 211
+    assert expanded_count(doc, doc.modelspace()) > MAX_EXPANDED_ENTITIES
+    assert_refused_and_unchanged(tmp_path, ["fab", tmp_path / "nest.dxf"], "more than 50,000 entities")
+
+
+def _plate_with(tmp_path, draw):
+    doc, msp = _doc()
+    msp.add_lwpolyline([(0, 0), (100, 0), (100, 30), (0, 30)], close=True, dxfattribs={"layer": "plate"})
+    draw(msp)
+    doc.saveas(tmp_path / "p.dxf")
+    return tmp_path / "p.dxf"
+
+
+def test_a_hinge_outside_the_body_or_of_no_length_is_refused_with_its_position(tmp_path):
+    outside = _plate_with(tmp_path, lambda m: m.add_line((150, -5), (150, 35), dxfattribs={"layer": "hinge_1"}))
+    assert_refused_and_unchanged(tmp_path, ["fab", outside], "hinge LINE #", "(150.000, -5.000) mm",
+                                 "does not cross the body", "x 0.000 to 100.000")
+    point = _plate_with(tmp_path, lambda m: m.add_line((40, 10), (40, 10), dxfattribs={"layer": "hinge_1"}))
+    assert_refused_and_unchanged(tmp_path, ["fab", point], "(40.000, 10.000) mm", "has no length")
+    dot = _plate_with(tmp_path, lambda m: m.add_circle((60, 20), 0, dxfattribs={"layer": "hinge_1"}))
+    assert_refused_and_unchanged(tmp_path, ["fab", dot], "CIRCLE #", "(60.000, 20.000) mm", "has no length")
+    # a closed hinge "loop" of two vertices is a fold line there and back, used as one
+    design = design_from_drawing(read_drawing(_plate_with(
+        tmp_path, lambda m: m.add_lwpolyline([(40, -5), (40, 35)], close=True, dxfattribs={"layer": "hinge_1"}))))
+    assert [h.kind for h in design.hinges] == ["fold"] and design.hinges[0].area_mm2 == pytest.approx(30.0)
+
+
+def test_overlapping_outlines_are_joined_and_said_so_a_hole_in_the_overlap_stays_a_hole(tmp_path):
+    """Two 100 mm squares overlapping by half, a 30 mm square hole inside the overlap: the
+    material is their union (15000 mm2) less the hole (900 mm2); counted by nesting alone the
+    hole lies inside two outlines and would be material again."""
+    doc, msp = _doc()
+    for x0, y0, side in ((0, 0, 100), (50, 0, 100), (60, 30, 30)):
+        msp.add_lwpolyline([(x0, y0), (x0 + side, y0), (x0 + side, y0 + side), (x0, y0 + side)],
+                           close=True, dxfattribs={"layer": "plate"})
+    doc.saveas(tmp_path / "o.dxf")
+    design = design_from_drawing(read_drawing(tmp_path / "o.dxf"))
+    assert design.body.area == pytest.approx(15000 - 900)
+    assert len(design.joined) == 1 and "overlap by 5000 mm2 at x 50.000 to 100.000, y 0.000 to 100.000" \
+        in design.joined[0]
+    res = invoke(["fab", tmp_path / "o.dxf"])
+    assert res.exit_code == 0 and "overlapping outlines joined (union)" in res.output
+
+
+def test_an_outline_drawn_many_times_over_itself_is_cut_once(tmp_path):
+    """200 copies of one 50 mm square of LINEs, stacked (a block inserted 200 times at one
+    place, as a careless copy leaves it), and a circle of two half ARCs with the same ends: the
+    square is one loop of 2500 mm2, the arcs are not taken for copies of each other."""
+    doc, msp = _doc()
+    blk = doc.blocks.new("SQ")
+    _square_of_lines(blk, 0, 0, 50, layer="0")
+    for _ in range(200):
+        msp.add_blockref("SQ", (0, 0), dxfattribs={"layer": "plate"})
+    msp.add_arc((100, 25), 10, 0, 180, dxfattribs={"layer": "plate"})
+    msp.add_arc((100, 25), 10, 180, 360, dxfattribs={"layer": "plate"})
+    doc.saveas(tmp_path / "stack.dxf")
+    drawing = read_drawing(tmp_path / "stack.dxf")
+    assert len(drawing.contours) == 2
+    areas = sorted(p.area for p in design_from_drawing(drawing).body.geoms)
+    assert areas == pytest.approx([math.pi * 100, 2500.0], rel=2e-4)

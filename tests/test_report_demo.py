@@ -101,7 +101,7 @@ def test_measured_hops_match_the_virtual_robots_own(demo):
             assert len(hops) == CYCLES
             log = next(p for p in (demo["folder"] / "logs").glob("*-hop.log")
                        if p.name.split("-", 1)[1] == "hop.log" and f"/{label}/" in p.read_text())
-            plant_m = float(re.search(r"distance_m=(-?[\d.e-]+)", log.read_text()).group(1))
+            plant_m = float(re.search(r"total distance (-?[\d.]+) mm", log.read_text()).group(1)) / 1000
             measured_m = sum(h["measured_distance_m"] for h in hops)
             assert measured_m == pytest.approx(plant_m, abs=0.0003), (label, measured_m, plant_m)
             truth = pd.read_csv(demo["folder"] / "hops" / label / "hop.truth.csv", comment="#")

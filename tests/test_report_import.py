@@ -18,10 +18,10 @@ import pytest
 from click.testing import CliRunner
 
 from locust.cli import cli
-from locust.device.record import HopSchedule, Phase, RunRecord
-from locust.device.record import write as write_record
+from locust.io.run_record import HopSchedule, Phase, RunRecord
+from locust.io.run_record import write as write_record
+from locust.io.tracks_csv import MarkerColumns, TracksCsv, write_tracks_csv
 from locust.report.checks import ROBOT, SYNTHETIC, VIRTUAL, recorded_on
-from locust.track.tracks_csv import MarkerColumns, TracksCsv, write_tracks_csv
 from test_report import parse
 from test_report_inputs import staircase
 

@@ -13,13 +13,13 @@ import pytest
 from click.testing import CliRunner
 
 from locust.cli import cli
-from locust.errors import ReportError
+from locust.errors import ReportError, TrialError
+from locust.io.sweep_store import columns as sweep_columns
 from locust.params import preset
-from locust.report.configs import configuration, name_from_path, parse_added
 from locust.report.landscape import design_value, read_landscape
-from locust.report.measure import align, measure_hops, onset_time
-from locust.report.measured import parse_measured
-from locust.sweep.store import columns as sweep_columns
+from locust.trials.configs import configuration, name_from_path, parse_added
+from locust.trials.measure import align, measure_hops, onset_time
+from locust.trials.measured import parse_measured
 from probing import assert_clear_error, invoke, tree
 
 
@@ -70,9 +70,9 @@ def test_noise_and_a_short_track():
 
 def test_a_track_that_starts_moving_or_never_moves_is_refused():
     t, x, y = staircase(lead_s=0.0)
-    with pytest.raises(ReportError, match="already moving"):
+    with pytest.raises(TrialError, match="already moving"):
         onset_time(t, x, y)
-    with pytest.raises(ReportError, match="never moves"):
+    with pytest.raises(TrialError, match="never moves"):
         onset_time(t, np.full_like(t, 0.3), np.full_like(t, 0.02))
 
 
@@ -88,10 +88,10 @@ def test_configuration_names_and_added_lengths():
     assert name_from_path(Path("runs/medium-2/run.json")) == "medium"
     assert name_from_path(Path("runs/small/trial-3/x.tracks.csv")) == "small"
     assert name_from_path(Path("runs/v2/x.csv")) == "v2"
-    with pytest.raises(ReportError, match="cannot tell"):
+    with pytest.raises(TrialError, match="cannot tell"):
         name_from_path(Path("data/runs/20260101-120000/run.json"))
     assert parse_added(["v2=0.015"]) == {"v2": 0.015}
-    with pytest.raises(ReportError):
+    with pytest.raises(TrialError):
         parse_added(["v2"])
 
 
@@ -194,7 +194,7 @@ def test_measured_groups_by_name_and_folder(tmp_path):
     groups = parse_measured([str(a), f"Medium={b}"])
     assert list(groups) == ["medium", "large"]            # leg-set order, not argument order
     assert groups["large"][0].label == "large-1" and groups["large"][0].track is None
-    with pytest.raises(ReportError, match="given twice"):
+    with pytest.raises(TrialError, match="given twice"):
         parse_measured([str(a), f"large={a}"])
 
 

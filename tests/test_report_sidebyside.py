@@ -23,13 +23,13 @@ import pytest
 from click.testing import CliRunner
 
 from locust.cli import cli
+from locust.io.camera_json import read_camera_json
 from locust.markers import MARKER_COLOURS
 from locust.params import preset
 from locust.report.sidebyside import OWN_CAMERA
 from locust.sim.camera import CameraView, frame_views
 from locust.sim.clip import ClipRecorder, PoseRenderer
 from locust.sim.run import run
-from locust.track.camera import read_camera_json
 from test_sim_video import _frames, blob_centroid
 
 W, H, FPS = 320, 240, 30

@@ -119,7 +119,7 @@ def test_a_folder_holding_another_sweep_or_other_files_is_refused(tmp_path):
 # that does not depend on how fast the machine is.
 _KILLED_AFTER_TWO_ROWS = """
 import os, signal, sys
-from locust.sweep import store
+from locust.io import sweep_store as store
 append = store.SweepStore.append
 def append_then_die(self, row):
     append(self, row)
@@ -241,7 +241,7 @@ def test_seed_scale_sweep_local_and_dask_local_agree(tmp_path):
 def test_a_second_sweep_into_a_running_sweeps_folder_is_refused(tmp_path):
     import fcntl
 
-    from locust.sweep.store import LOCK
+    from locust.io.sweep_store import LOCK
 
     base = preset("seed")
     axis = parse_axis("geometry.coupler_m=0.205:0.21:2", base)
@@ -257,10 +257,10 @@ def test_a_second_sweep_into_a_running_sweeps_folder_is_refused(tmp_path):
 
 
 def test_results_csv_round_trips_through_its_owner_and_only_a_torn_last_line_is_dropped(tmp_path):
-    """results.csv is written and read back by locust.sweep.store alone: every field comes back
+    """results.csv is written and read back by locust.io.sweep_store alone: every field comes back
     bit for bit (floats by repr, nan, bools, ints); an interrupt's torn last line is dropped on
     reading, a malformed row anywhere else is an error naming its line."""
-    from locust.sweep.store import SweepStore, read_results
+    from locust.io.sweep_store import SweepStore, read_results
 
     rows = [  # SYNTHETIC rows (made-up figures, not simulations)
         {"design": 0, "scale": 0.0, "valid": True, "reason": "", "distance_m": 0.009292704540008771,

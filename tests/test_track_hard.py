@@ -68,7 +68,7 @@ def test_truth_csv_reads_back(hard):
 
 def test_preview_lists_sticker_and_pen_cap(hard, tmp_path):
     path, truth = hard
-    res = _run(path, "--preview", 0, "--marker", f"s=color:{STICKER_HEX}", "--out", tmp_path / "p")
+    res = _run("preview", path, "--frame", 0, "--marker", f"s=color:{STICKER_HEX}", "--out", tmp_path / "p")
     assert res.exit_code == 0, res.output
     assert (tmp_path / "p.preview.png").is_file()
     lines = [ln.split() for ln in res.output.splitlines() if ln.strip().startswith(("1 ", "2 "))]
@@ -85,7 +85,7 @@ def test_preview_lists_sticker_and_pen_cap(hard, tmp_path):
 
 
 def test_make_board_is_to_scale(tmp_path):
-    res = _run("--make-board", tmp_path / "b.png", "--board", "aruco:4X4_50:4x3:30:6")
+    res = _run("board", tmp_path / "b.png", "--board", "aruco:4X4_50:4x3:30:6")
     assert res.exit_code == 0, res.output
     img = Image.open(tmp_path / "b.png")
     assert img.info["dpi"][0] == pytest.approx(300, abs=0.01)

@@ -1,5 +1,5 @@
-"""`locust track --import`: Tracker text exports, t,x,y CSVs and tracks CSVs in any unit, renamed
-and mirrored, through the one conversion (locust.track.importing.import_tracks).
+"""`locust track import`: Tracker text exports, t,x,y CSVs and tracks CSVs in any unit, renamed
+and mirrored, through the one conversion (locust.io.importing.import_tracks).
 
 The small exports written here are SYNTHETIC (labelled so in their first line; numbers chosen
 to survive the files' decimals exactly); the real ones are Tracker's own example projects
@@ -18,10 +18,11 @@ from click.testing import CliRunner
 
 from locust.cli import cli
 from locust.errors import TrackError
-from locust.track import tracker_text as tt
-from locust.track import tracks_csv as tc
+from locust.io import tracker_text as tt
+from locust.io import tracks_csv as tc
+from locust.io import trk as trk_io
+from locust.io.importing import ImportOptions, import_tracks, likely_units, span_warnings, units_hint
 from locust.track import trk
-from locust.track.importing import ImportOptions, import_tracks, likely_units, span_warnings, units_hint
 from probing import assert_clear_error
 
 # SYNTHETIC: a Tracker export calibrated in cm, one track named "A" (title line), one step missing
@@ -48,7 +49,7 @@ def test_tracker_export_in_cm_becomes_metres_with_the_new_name(tmp_path):
     src = tmp_path / "export.txt"
     src.write_text(CM_EXPORT)
     out = tmp_path / "hop.tracks.csv"
-    res = track("--import", src, "--units", "cm", "--rename", "A=nose", "--out", out)
+    res = track("import", src, "--units", "cm", "--rename", "A=nose", "--out", out)
     assert res.exit_code == 0, res.output
     assert f"wrote {out}" in res.output
     text = out.read_text()
@@ -99,7 +100,7 @@ def test_plain_txy_csv_is_the_nose_and_mirror_flips_x(tmp_path):
     assert list(tracks.markers) == ["tip"] and tracks.positions("tip")[0].tolist() == [1.0, 3.0]
     assert tracks.comments[-1].endswith("renamed nose -> tip; not imported: note")
     out = tmp_path / "tip.tracks.csv"
-    res = track("--import", other, "--rename", "nose=tip", "--mirror", "--out", out)
+    res = track("import", other, "--rename", "nose=tip", "--mirror", "--out", out)
     assert res.exit_code == 0, res.output
     assert tc.read_tracks_csv(out).positions("tip")[0].tolist() == [-1.0, -3.0]
 
@@ -109,7 +110,7 @@ def test_tracks_csv_in_mm_keeps_pixels_and_renames_columns(tmp_path):
     src.write_text("# synthetic: two frames in mm\nframe,t_s,A_px,A_py,A_x_m,A_y_m,A_ok\n"
                    "5,0.0,100.5,200.25,125.0,40.0,1\n6,0.5,nan,nan,nan,nan,0\n")
     out = tmp_path / "m.tracks.csv"
-    res = track("--import", src, "--units", "mm", "--rename", "A=nose", "--out", out)
+    res = track("import", src, "--units", "mm", "--rename", "A=nose", "--out", out)
     assert res.exit_code == 0, res.output
     back = tc.read_tracks_csv(out)
     assert back.columns == ("frame", "t_s", "nose_px", "nose_py", "nose_x_m", "nose_y_m", "nose_ok")
@@ -133,23 +134,23 @@ def test_bad_import_options(tmp_path, args, words):
     src = tmp_path / "export.txt"
     src.write_text(CM_EXPORT)
     out = tmp_path / "out.csv"
-    fails(track("--import", src, *args, "--out", out), *words)
+    fails(track("import", src, *args, "--out", out), *words)
     assert not out.exists()
 
 
 def test_a_file_of_neither_format_and_clashing_names(tmp_path):
     angles = tmp_path / "servo.csv"
     angles.write_text("t_s,angle_deg,command_deg\n0,1,0\n0.1,2,0\n")
-    fails(track("--import", angles, "--out", tmp_path / "o.csv"),
+    fails(track("import", angles, "--out", tmp_path / "o.csv"),
           "neither a Tracker text export, a t,x,y CSV nor a tracks CSV (columns: t_s, angle_deg, command_deg)",
           "File > Export > Data")
     notes = tmp_path / "notes.txt"
     notes.write_text("just some words\n")
-    fails(track("--import", notes, "--out", tmp_path / "o.csv"), "no numeric rows")
-    fails(track("--import", tmp_path / "nope.txt"), "nope.txt: no such file")
+    fails(track("import", notes, "--out", tmp_path / "o.csv"), "no numeric rows")
+    fails(track("import", tmp_path / "nope.txt"), "nope.txt: no such file")
     two = tmp_path / "two.txt"
     two.write_text("a\t\t\tb\t\t\nt\tx\ty\tt\tx\ty\n0\t1\t2\t0\t3\t4\n")
-    fails(track("--import", two, "--rename", "a=b"), "two markers would be named 'b' (a, b)")
+    fails(track("import", two, "--rename", "a=b"), "two markers would be named 'b' (a, b)")
     assert not (tmp_path / "o.csv").exists()
     with pytest.raises(TrackError, match="no track with x and y"):
         (tmp_path / "angle.txt").write_text("theta\nt\ttheta\n0\t1\n")
@@ -161,13 +162,14 @@ def test_existing_out_is_never_overwritten(tmp_path):
     src.write_text(CM_EXPORT)
     out = tmp_path / "hop.tracks.csv"
     out.write_text("keep me\n")
-    fails(track("--import", src, "--units", "cm", "--rename", "A=nose", "--out", out), "output exists")
+    fails(track("import", src, "--units", "cm", "--rename", "A=nose", "--out", out), "output exists")
     assert out.read_text() == "keep me\n"
-    fails(track("--import", src, "--out", src), "is the file being imported")
+    fails(track("import", src, "--out", src), "is the file being imported")
     assert src.read_text() == CM_EXPORT
-    # the options belong to --import
-    fails(track("video.mp4", "--units", "cm"), "--units, --rename and --mirror go with --import")
-    fails(track("--import", src, "--format", "tracker"), "--import writes a tracks CSV only")
+    # each subcommand has only its own options; the old one-command form names the new one
+    fails(track("video", "video.mp4", "--units", "cm"), "No such option '--units'")
+    fails(track("import", src, "--format", "tracker"), "No such option '--format'")
+    fails(track("--import", src), "locust track import FILE")
 
 
 def test_units_suggestions_name_the_unit():
@@ -185,12 +187,12 @@ def test_units_suggestions_name_the_unit():
 def test_an_import_spanning_more_than_a_desk_warns(tmp_path):
     src = tmp_path / "hop_cm.csv"       # SYNTHETIC: 30 cm of travel, in cm, read as metres
     src.write_text("t,x,y\n0,0,2\n1,30,2\n")
-    res = track("--import", src, "--out", tmp_path / "a.csv")
+    res = track("import", src, "--out", tmp_path / "a.csv")
     assert res.exit_code == 0
     assert ("warning: hop_cm.csv: marker nose spans 30 m, more than the 5 m of a desk experiment: the track is "
             "likely in cm, not m (0.3 m then): give --units cm") in res.stderr
     assert span_warnings(import_tracks(src, "cm")) == []
-    res = track("--import", src, "--units", "cm", "--out", tmp_path / "b.csv")
+    res = track("import", src, "--units", "cm", "--out", tmp_path / "b.csv")
     assert res.exit_code == 0 and "warning" not in res.stderr
 
 
@@ -210,11 +212,11 @@ def test_real_balltoss_exported_in_cm_gives_trackers_metres_and_g(shared_data, t
     """BallToss (Tracker's example): the ball's steps exported in cm under Tracker's name come
     back as the nose in metres, Tracker's own numbers to the export's 6 digits, and the
     parabola through them gives the published g of about 10.3 m/s^2."""
-    project = trk.read_project(shared_data / "tracker" / "BallToss.trz")
+    project = trk_io.read_project(shared_data / "tracker" / "BallToss.trz")
     export, result = _real_export_in_cm(project, {"ball": "ball"})
     src = tt.write_tracker_export(tmp_path / "balltoss_cm.txt", export)
     out = tmp_path / "balltoss.tracks.csv"
-    res = track("--import", src, "--units", "cm", "--rename", "ball=nose", "--out", out)
+    res = track("import", src, "--units", "cm", "--rename", "ball=nose", "--out", out)
     assert res.exit_code == 0, res.output
     back = tc.read_tracks_csv(out)
     x, y = back.positions("nose")
@@ -235,7 +237,7 @@ def test_real_cupsclips_renamed_by_trackers_own_names(shared_data, tmp_path):
     with zipfile.ZipFile(shared_data / "tracker" / "CupsClips.zip") as z:
         name = next(n for n in z.namelist() if n.lower().endswith(".trk"))
         z.extract(name, tmp_path)
-    project = trk.read_project(tmp_path / name)
+    project = trk_io.read_project(tmp_path / name)
     export, result = _real_export_in_cm(project, {"cup_3": "cup 3", "cup_7": "cup 7"})
     src = tt.write_tracker_export(tmp_path / "cups_cm.txt", export)
     assert src.read_text().splitlines()[0].split("\t")[0] == "cup 3"     # Tracker's name, with its space

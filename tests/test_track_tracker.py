@@ -10,8 +10,9 @@ import pytest
 from click.testing import CliRunner
 
 from locust.cli import cli
+from locust.io import trk as trk_io
+from locust.io.tracker_text import read_tracker_export
 from locust.track import trk
-from locust.track.tracker_text import read_tracker_export
 
 
 @pytest.fixture(scope="module")
@@ -21,8 +22,8 @@ def balltoss(tracker_example):
 
 def _tracker_points(folder) -> dict[int, tuple[float, float]]:
     """Tracker's stored ball steps, in Tracker's own image coordinates (no conversion)."""
-    project = trk.read_project(folder / "BallToss_BallToss.trk")
-    return {f: (x - trk.TRACKER_TO_OPENCV_PX, y - trk.TRACKER_TO_OPENCV_PX)
+    project = trk_io.read_project(folder / "BallToss_BallToss.trk")
+    return {f: (x - trk_io.TRACKER_TO_OPENCV_PX, y - trk_io.TRACKER_TO_OPENCV_PX)
             for f, (x, y) in project.points["ball"].items()}
 
 
@@ -49,7 +50,7 @@ def test_template_tracker_matches_trackers_autotracker(balltoss, monkeypatch):
 
 
 def test_trk_reader_reproduces_trackers_world_data(shared_data):
-    project = trk.read_project(shared_data / "tracker" / "BallToss.trz")
+    project = trk_io.read_project(shared_data / "tracker" / "BallToss.trz")
     assert sorted(project.points["ball"]) == list(range(2, 13))
     assert project.calibration.m_per_px == pytest.approx(1 / 398.70891559670895)
     # Tracker's image origin is the top-left corner; OpenCV's the top-left pixel centre
@@ -66,11 +67,11 @@ def test_trk_reader_reproduces_trackers_world_data(shared_data):
 
 def test_from_trk_cli_writes_trackers_text_layout(shared_data, tmp_path):
     out = tmp_path / "balltoss.txt"
-    res = CliRunner().invoke(cli, ["track", "--from-trk", str(shared_data / "tracker" / "BallToss.trz"),
+    res = CliRunner().invoke(cli, ["track", "from-trk", str(shared_data / "tracker" / "BallToss.trz"),
                                    "--format", "tracker", "--out", str(out)])
     assert res.exit_code == 0, res.output
     table = read_tracker_export(out).tracks["ball"]
-    project = trk.read_project(shared_data / "tracker" / "BallToss.trz")
+    project = trk_io.read_project(shared_data / "tracker" / "BallToss.trz")
     result = trk.project_result(project)
     x, y = result.world(result.markers[0])
     ok = result.markers[0].ok
@@ -86,9 +87,9 @@ def test_from_trk_reads_cupsclips_tracks(shared_data, tmp_path):
     with zipfile.ZipFile(shared_data / "tracker" / "CupsClips.zip") as z:
         names = [n for n in z.namelist() if n.lower().endswith(".trk")]
         z.extract(names[0], tmp_path)
-    project = trk.read_project(tmp_path / names[0])
+    project = trk_io.read_project(tmp_path / names[0])
     assert {"cup 3", "cup 7"} <= set(project.points)
-    res = CliRunner().invoke(cli, ["track", "--from-trk", str(tmp_path / names[0]),
+    res = CliRunner().invoke(cli, ["track", "from-trk", str(tmp_path / names[0]),
                                    "--out", str(tmp_path / "cups.csv")])
     assert res.exit_code == 0, res.output
     df = pd.read_csv(tmp_path / "cups.csv")

@@ -9,6 +9,7 @@ import pytest
 from click.testing import CliRunner
 
 from locust.cli import cli
+from locust.io import trk as trk_io
 from locust.track import trk
 
 
@@ -25,7 +26,7 @@ def balltoss(tracker_example):
 @pytest.fixture(scope="module")
 def cups_run(cups):
     """Both cups tracked from the points Tracker's user clicked on frame 0, with a .trk out."""
-    project = trk.read_project(cups / "CupsClips_CupsClips.trk")
+    project = trk_io.read_project(cups / "CupsClips_CupsClips.trk")
     c3, c7 = project.points["cup 3"][0], project.points["cup 7"][0]
     res = CliRunner().invoke(cli, ["track", str(cups / "videos" / "CupsClips_CupsClips00.jpg"), "--fps", "10.1",
                                    "--marker", f"cup3=template:{c3[0]:.2f},{c3[1]:.2f}@0",
@@ -62,7 +63,7 @@ def test_cup_out_of_view_is_lost_not_stuck(cups_run):
 
 def test_trk_out_reads_back_to_the_same_points(cups, cups_run):
     _, df, _ = cups_run
-    res = CliRunner().invoke(cli, ["track", "--from-trk", str(cups / "cups_out.trk"), "--out", str(cups / "back.csv")])
+    res = CliRunner().invoke(cli, ["track", "from-trk", str(cups / "cups_out.trk"), "--out", str(cups / "back.csv")])
     assert res.exit_code == 0, res.output
     back = pd.read_csv(cups / "back.csv")
     assert list(back.columns) == list(df.columns)
@@ -72,7 +73,7 @@ def test_trk_out_reads_back_to_the_same_points(cups, cups_run):
         assert (back[f"{name}_ok"] == df[f"{name}_ok"]).all()
         for axis in ("px", "py"):
             assert np.nanmax(np.abs(back[f"{name}_{axis}"] - df[f"{name}_{axis}"])) <= 0.01
-    project = trk.read_project(cups / "cups_out.trk")
+    project = trk_io.read_project(cups / "cups_out.trk")
     assert project.video_path == "videos/CupsClips_CupsClips00.jpg"     # relative to the .trk, as Tracker saves
     assert project.clip.fps == pytest.approx(10.1)
 
@@ -84,14 +85,14 @@ def test_calibration_from_trk_gives_trackers_metres(balltoss, tmp_path):
                                    "--out", str(tmp_path / "ball.csv"), "--trk", str(tmp_path / "ball.trk")])
     assert res.exit_code == 0, res.output
     df = pd.read_csv(tmp_path / "ball.csv")
-    theirs = trk.project_result(trk.read_project(balltoss / "BallToss_BallToss.trk"))
+    theirs = trk.project_result(trk_io.read_project(balltoss / "BallToss_BallToss.trk"))
     x, y = theirs.world(theirs.markers[0])
     ok = df["ball_ok"].astype(bool).to_numpy()
     assert ok[2:].all() and not ok[:2].any()                       # Tracker's steps: frames 2..12
     assert np.abs(df["t_s"] - theirs.t_s).max() < 1e-9             # the project's 66 ms frame interval
     err_mm = 1000 * np.hypot(df["ball_x_m"] - x, df["ball_y_m"] - y)[ok]
     assert err_mm.max() <= 5.0, err_mm                              # acceptance 5 mm; measured 3.6, mean 2.7
-    written = trk.read_project(tmp_path / "ball.trk")
+    written = trk_io.read_project(tmp_path / "ball.trk")
     assert written.calibration.m_per_px == pytest.approx(theirs.calibration.m_per_px, rel=1e-12)
     assert written.calibration.angle_deg == pytest.approx(theirs.calibration.angle_deg, abs=1e-12)
     assert written.calibration.origin_x_px == pytest.approx(theirs.calibration.origin_x_px, abs=1e-9)
@@ -103,8 +104,8 @@ def test_trz_is_a_video_and_an_import(shared_data, tmp_path):
                                    "--out", str(tmp_path / "t.csv"), "--trk", str(tmp_path / "t.trk")])
     assert res.exit_code == 0, res.output
     assert pd.read_csv(tmp_path / "t.csv")["ball_ok"].sum() == 11
-    assert trk.read_project(tmp_path / "t.trk").video_path.endswith("BallToss.trz!/videos/BallToss_new_BallToss.mp4")
-    res = CliRunner().invoke(cli, ["track", "--import", str(trz), "--out", str(tmp_path / "i.csv")])
+    assert trk_io.read_project(tmp_path / "t.trk").video_path.endswith("BallToss.trz!/videos/BallToss_new_BallToss.mp4")
+    res = CliRunner().invoke(cli, ["track", "import", str(trz), "--out", str(tmp_path / "i.csv")])
     assert res.exit_code == 0, res.output
     imported = pd.read_csv(tmp_path / "i.csv")
     assert imported["ball_ok"].sum() == 11                         # Tracker's steps, frames 2..12
@@ -120,7 +121,7 @@ def test_image_sequence_needs_a_frame_rate(cups):
 
 def test_a_folder_is_the_same_sequence_and_a_lone_image_is_refused(cups, cups_run, tmp_path):
     _, df, _ = cups_run
-    project = trk.read_project(cups / "CupsClips_CupsClips.trk")
+    project = trk_io.read_project(cups / "CupsClips_CupsClips.trk")
     c3 = project.points["cup 3"][0]
     res = CliRunner().invoke(cli, ["track", str(cups / "videos"), "--fps", "10.1", "--overlay", "none",
                                    "--marker", f"cup3=template:{c3[0]:.2f},{c3[1]:.2f}@0",

@@ -11,12 +11,12 @@ from click.testing import CliRunner
 
 from locust.cli import cli
 from locust.device.plant import make_plant
+from locust.io.tracks_csv import MarkerColumns, TracksCsv
 from locust.params import preset
-from locust.report.measured import metres_per_pixel
 from locust.report.page import pct
 from locust.sim.live import PREROLL_S
-from locust.track.tracks_csv import MarkerColumns, TracksCsv
 from locust.track.video import probe
+from locust.trials.measured import metres_per_pixel
 
 
 def test_hop_video_rate_defaults_to_60_and_is_passed_on(monkeypatch):

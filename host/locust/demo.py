@@ -36,18 +36,16 @@ import click
 
 from .errors import ReportError
 from .fileio import atomic_write_json, atomic_write_text, unique_dir
+from .params import LEG_SETS, leg_set, preset
 from .progress import progress
 
-LEG_SETS = ("small", "medium", "large")
-# The virtual robot is the seed robot with each leg set's links (what the demo's calibration
-# models: its robot.toml's base is the seed), at that leg set's converged step (params.LEG_SETS);
-# the small/medium/large presets are the robot as built instead.
+# The virtual robot is the seed robot with each leg set of params.LEG_SETS (the one definition:
+# its links and its converged step; what the demo's calibration models: its robot.toml's base is
+# the seed); the small/medium/large presets are the robot as built instead.
 
 
 def seed_leg_set_options(name: str) -> list[str]:
     """``--preset seed --set ...`` for the seed robot with leg set ``name``'s links and step."""
-    from .params import leg_set, preset
-
     robot = leg_set(preset("seed"), name)
     keys = ("geometry.ground_m", "geometry.crank_m", "geometry.coupler_m", "geometry.leg_m", "solver.timestep_s")
     return ["--preset", "seed", *[arg for key in keys for arg in ("--set", f"{key}={robot.get(key)!r}")]]
@@ -190,14 +188,7 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     total = 7 if fit_hops else 6
     bench_toml = cal_dir / "robot-bench.toml"
 
-    truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])
-    note = ("the virtual robot's parameters: the values the bundled SYNTHETIC calibration recordings were "
-            "generated with")
-    if fit_hops:
-        truth = {**truth, **HOP_TRUTH}
-        note += f", except {', '.join(HOP_TRUTH)}: hidden, for the hop fit to find"
-    atomic_write_json(folder / "virtual" / "truth.json", {"note": note, "values": truth,
-                                                          "hidden_for_hop_fit": HOP_TRUTH if fit_hops else {}})
+    truth = _virtual_truth(folder, fit_hops)
     truth_sets = [arg for key, value in truth.items() for arg in ("--set", f"{key}={value!r}")]
     d.say("demo: the virtual robot carries the recordings' true values: "
           + ", ".join(f"{k}={v:g}" for k, v in truth.items()))
@@ -235,11 +226,28 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
         printed = d.call(["report", *measured, "--config", str(robot_toml), "--sweep", str(folder / "sweep"),
                           *closing, "--out", str(folder)])
     report_path = Path(printed.strip().splitlines()[-1])
-    wall = time.perf_counter() - t_start
-    atomic_write_json(folder / "timings.json", {"stages": d.stages, "total_s": round(wall, 2),
-                                                "cycles": cycles, "trials": trials, "designs": designs})
+    _timings(d, folder, time.perf_counter() - t_start, {"cycles": cycles, "trials": trials, "designs": designs})
+    click.echo(f"report: {report_path}")
+
+
+def _virtual_truth(folder: Path, fit_hops: bool) -> dict[str, float]:
+    """The virtual robot's values: the bundled recordings' truth (and, for the hop fit, the
+    hidden HOP_TRUTH), written to virtual/truth.json."""
+    truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])
+    note = ("the virtual robot's parameters: the values the bundled SYNTHETIC calibration recordings were "
+            "generated with")
+    if fit_hops:
+        truth = {**truth, **HOP_TRUTH}
+        note += f", except {', '.join(HOP_TRUTH)}: hidden, for the hop fit to find"
+    atomic_write_json(folder / "virtual" / "truth.json", {"note": note, "values": truth,
+                                                          "hidden_for_hop_fit": HOP_TRUTH if fit_hops else {}})
+    return truth
+
+
+def _timings(d: Demo, folder: Path, wall: float, sizes: dict[str, int]) -> None:
+    """timings.json (each stage's wall time, the total, the demo's sizes) and the same printed."""
+    atomic_write_json(folder / "timings.json", {"stages": d.stages, "total_s": round(wall, 2), **sizes})
     d.say("demo: time per stage")
     for s in d.stages:
         d.say(f"  {s['wall_s']:7.1f} s  {s['stage']}")
     d.say(f"  {wall:7.1f} s  total")
-    click.echo(f"report: {report_path}")

@@ -41,6 +41,10 @@ class TrackError(LocustError):
     """Video decoding and marker tracking."""
 
 
+class TrialError(LocustError):
+    """Filmed trials: finding and reading their tracks and run records, their configurations."""
+
+
 class CalibrationError(LocustError):
     """Fitting the calibration experiments."""
 

@@ -141,6 +141,24 @@ def unwind_on_termination() -> None:
             signal.signal(sig, unwind)
 
 
+def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
+    """Raise :class:`WriteError` unless the video just encoded at ``tmp`` (for ``path``) reads
+    back with its ``frames`` frames: OpenCV's writer ignores a failed write (a full disk) and
+    leaves a truncated file no player opens."""
+    if frames == 0:
+        return
+    import cv2
+
+    cap = cv2.VideoCapture(str(tmp))
+    try:
+        count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
+    finally:
+        cap.release()
+    if count != frames:
+        raise WriteError(f"{path}: the video could not be written completely ({count} of {frames} frames read "
+                         "back); the disk may be full", DISK_HINT)
+
+
 def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> Path:
     """Write ``data`` to ``path`` through a temporary file and a rename.
 
@@ -222,3 +240,24 @@ def unique_dir(parent: str | os.PathLike, stem: str) -> Path:
     except OSError as exc:
         raise WriteError(f"cannot make a folder in {parent} ({exc.strerror})", DISK_HINT) from None
     raise FileExistsError(f"no free directory name for {stem!r} in {parent}")
+
+
+def check_distinct(outputs: dict[str, str | os.PathLike | None],
+                   inputs: list[str | os.PathLike] | tuple = ()) -> None:
+    """Before anything is written: every output of one command is its own file, and none is
+    one of its inputs (:class:`WriteError`). ``outputs``: by the option that names each
+    (``--plot``, ``--write``; None: not written). Paths are compared resolved (links followed,
+    ``./`` and ``..`` removed), so two spellings of one file are one file."""
+    read = {os.path.realpath(p): Path(p) for p in inputs}
+    written: dict[str, str] = {}
+    for option, path in outputs.items():
+        if path is None:
+            continue
+        real = os.path.realpath(path)
+        if real in read:
+            raise WriteError(f"{option} {path} is {read[real]}, an input of this command; refusing to write it",
+                             f"give {option} a new path of its own")
+        if real in written:
+            raise WriteError(f"{option} {path} and {written[real]} name the same file; refusing to write either",
+                             "give every output its own path")
+        written[real] = f"{option} {path}"

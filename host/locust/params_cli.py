@@ -15,7 +15,7 @@ def robot_options(func):
     """The shared --preset / --config / --set options of every command that needs a robot."""
     func = click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
                         help="Override any parameter by its dotted name, "
-                             "e.g. --set servo.kp_nm_per_rad=25. Repeatable.")(func)
+                             "e.g. --set servo.kp_nm_per_rad=0.4. Repeatable.")(func)
     func = click.option("--config", type=click.Path(dir_okay=False, path_type=Path), default=None,
                         help="A robot.toml (e.g. calibration/robot.toml); overrides --preset.")(func)
     func = click.option("--preset", type=click.Choice(list(P.PRESETS)), default="seed", show_default=True,

@@ -34,7 +34,7 @@ import numpy as np
 from scipy import optimize
 
 from ..errors import CalibrationError
-from ..track.importing import units_hint
+from ..io.importing import units_hint
 from .curves import Curves
 from .fitstats import Estimate, serial_covariance
 
@@ -53,6 +53,7 @@ LOWEST_CYCLES = 0.5                         # lowest frequency the fit allows: c
 START_FN_STEP = 0.01                        # relative step of the start grid's frequencies
 START_ZETAS = (0.005, 0.02, 0.05, 0.1, 0.2, 0.35, 0.6)   # the start grid's damping ratios
 START_COUNT = 3                             # starts refined by least squares: the grid's best local minima
+START_SAMPLES = 2048                        # the start grid looks at the window's first samples (the ring-down)
 
 
 @dataclass(frozen=True)
@@ -132,57 +133,13 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
              beam_mass_kg: float = 0.0, start_s: float | None = None, end_s: float | None = None,
              source: str = "beam") -> BeamFit:
     """Fit a damped oscillation to the tip displacement; see the module docstring."""
-    if not mass_kg > 0:
-        raise CalibrationError(f"--mass-kg must be positive (got {mass_kg})", "weigh the dropped mass, in kg")
-    if length_m is not None and not length_m > 0:
-        raise CalibrationError(f"--length-m must be positive (got {length_m})", "the beam's free length, in m")
-    t_s = np.asarray(t_s, dtype=float)
-    d = np.asarray(displacement_m, dtype=float)
-    if np.ptp(d) < 1e-9:
-        raise CalibrationError(f"{source}: flat signal, the tip does not move ({np.ptp(d):.3g} m peak to peak)",
-                               "check the marker (is it on the beam tip?) and the scale of the track")
-    window = _window(t_s, d, start_s, end_s)
-    t, y = t_s[window], d[window]
-    if len(t) < MIN_SAMPLES:
-        raise CalibrationError(f"{source}: only {len(t)} samples in the fit window (need {MIN_SAMPLES})",
-                               "film at a higher frame rate (see calibration/protocols/beam.md) "
-                               "or widen --start-s/--end-s")
+    t, y = _checked_window(t_s, displacement_m, mass_kg, length_m, start_s, end_s, source)
     t0 = float(t[0])
     fs_hz = 1.0 / float(np.median(np.diff(t)))
-    lo = [-np.inf, -np.inf, -np.inf, LOWEST_CYCLES / (t[-1] - t0), ZETA_BOUNDS[0]]
-    hi = [np.inf, np.inf, np.inf, fs_hz / 2, ZETA_BOUNDS[1]]
-    best = None
-    for fn0, zeta0 in _start_values(t, y, lo[3], hi[3]):
-        c0, a0, b0 = _linear_part(t - t0, y, fn0, zeta0)
-        p0 = np.clip([c0, a0, b0, fn0, zeta0], np.nextafter(lo, np.inf), np.nextafter(hi, -np.inf))
-        res = optimize.least_squares(lambda p: damped_oscillation(t, p, t0) - y, p0, bounds=(lo, hi),
-                                     x_scale="jac", method="trf")
-        if best is None or res.cost < best.cost:
-            best = res
+    best = _least_squares(t, y, fs_hz)
     p, r = best.x, best.fun
     cov, rho = serial_covariance(best.jac, r)
-    rms = float(np.sqrt(np.mean(r**2)))
-    amp = float(np.hypot(p[1], p[2]))
-    if amp < 5 * rms:
-        raise CalibrationError(
-            f"{source}: flat signal, no oscillation above the noise (amplitude {amp * 1e3:.3g} mm, "
-            f"residual {rms * 1e3:.3g} mm)",
-            "drop the mass from higher, or track the tip more closely (see calibration/protocols/beam.md)",
-        )
-    fn, zeta = float(p[3]), float(p[4])
-    creep = ("a tip that creeps to its new rest without ringing (a mass lowered by hand) has no oscillation "
-             "to fit: read its static deflection, k = m*g/deflection")
-    if zeta >= 0.999 * ZETA_BOUNDS[1]:
-        raise CalibrationError(f"{source}: no ring-down, the fitted damping ratio is at its bound {ZETA_BOUNDS[1]} "
-                               f"({fn:.3g} Hz)", creep)
-    cycles = (t[-1] - t[0]) * fn
-    if cycles < MIN_CYCLES:
-        raise CalibrationError(f"{source}: the fit window covers {cycles:.2g} oscillations (need {MIN_CYCLES})",
-                               "record longer after the drop; " + creep)
-    if fs_hz < MIN_FRAMES_PER_CYCLE * fn:
-        raise CalibrationError(f"{source}: {fs_hz:.3g} frames/s for a {fn:.3g} Hz oscillation "
-                               f"(need {MIN_FRAMES_PER_CYCLE:g} frames a cycle)",
-                               "film in slow motion (see calibration/protocols/beam.md)")
+    rms, amp, fn, zeta = _checked_oscillation(p, r, t, fs_hz, source)
     m = mass_kg + RAYLEIGH_TIP_FRACTION * beam_mass_kg
     wn = 2 * np.pi * fn
     grad_fn = np.array([0, 0, 0, 1.0, 0])
@@ -211,6 +168,74 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
     )
 
 
+def _checked_window(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, length_m: float | None,
+                    start_s: float | None, end_s: float | None, source: str) -> tuple[np.ndarray, np.ndarray]:
+    """The samples (t, displacement) of the fit window, after refusing a mass or length that
+    is not positive, a flat signal and a window of too few samples."""
+    if not mass_kg > 0:
+        raise CalibrationError(f"--mass-kg must be positive (got {mass_kg})", "weigh the dropped mass, in kg")
+    if length_m is not None and not length_m > 0:
+        raise CalibrationError(f"--length-m must be positive (got {length_m})", "the beam's free length, in m")
+    t_s = np.asarray(t_s, dtype=float)
+    d = np.asarray(displacement_m, dtype=float)
+    if np.ptp(d) < 1e-9:
+        raise CalibrationError(f"{source}: flat signal, the tip does not move ({np.ptp(d):.3g} m peak to peak)",
+                               "check the marker (is it on the beam tip?) and the scale of the track")
+    window = _window(t_s, d, start_s, end_s)
+    t, y = t_s[window], d[window]
+    if len(t) < MIN_SAMPLES:
+        raise CalibrationError(f"{source}: only {len(t)} samples in the fit window (need {MIN_SAMPLES})",
+                               "film at a higher frame rate (see calibration/protocols/beam.md) "
+                               "or widen --start-s/--end-s")
+    return t, y
+
+
+def _least_squares(t: np.ndarray, y: np.ndarray, fs_hz: float):
+    """The damped oscillation of least squares from each start of the grid (scipy's result):
+    the frequency between LOWEST_CYCLES over the window and Nyquist."""
+    t0 = float(t[0])
+    lo = [-np.inf, -np.inf, -np.inf, LOWEST_CYCLES / (t[-1] - t0), ZETA_BOUNDS[0]]
+    hi = [np.inf, np.inf, np.inf, fs_hz / 2, ZETA_BOUNDS[1]]
+    best = None
+    for fn0, zeta0 in _start_values(t, y, lo[3], hi[3]):
+        c0, a0, b0 = _linear_part(t - t0, y, fn0, zeta0)
+        p0 = np.clip([c0, a0, b0, fn0, zeta0], np.nextafter(lo, np.inf), np.nextafter(hi, -np.inf))
+        res = optimize.least_squares(lambda p: damped_oscillation(t, p, t0) - y, p0, bounds=(lo, hi),
+                                     x_scale="jac", method="trf")
+        if best is None or res.cost < best.cost:
+            best = res
+    return best
+
+
+def _checked_oscillation(p: np.ndarray, r: np.ndarray, t: np.ndarray, fs_hz: float,
+                         source: str) -> tuple[float, float, float, float]:
+    """(RMS residual, amplitude, natural frequency, damping ratio) of the fit, after refusing an
+    oscillation lost in the noise, one that does not ring, too few cycles or too few frames a cycle."""
+    rms = float(np.sqrt(np.mean(r**2)))
+    amp = float(np.hypot(p[1], p[2]))
+    if amp < 5 * rms:
+        raise CalibrationError(
+            f"{source}: flat signal, no oscillation above the noise (amplitude {amp * 1e3:.3g} mm, "
+            f"residual {rms * 1e3:.3g} mm)",
+            "drop the mass from higher, or track the tip more closely (see calibration/protocols/beam.md)",
+        )
+    fn, zeta = float(p[3]), float(p[4])
+    creep = ("a tip that creeps to its new rest without ringing (a mass lowered by hand) has no oscillation "
+             "to fit: read its static deflection, k = m*g/deflection")
+    if zeta >= 0.999 * ZETA_BOUNDS[1]:
+        raise CalibrationError(f"{source}: no ring-down, the fitted damping ratio is at its bound {ZETA_BOUNDS[1]} "
+                               f"({fn:.3g} Hz)", creep)
+    cycles = (t[-1] - t[0]) * fn
+    if cycles < MIN_CYCLES:
+        raise CalibrationError(f"{source}: the fit window covers {cycles:.2g} oscillations (need {MIN_CYCLES})",
+                               "record longer after the drop; " + creep)
+    if fs_hz < MIN_FRAMES_PER_CYCLE * fn:
+        raise CalibrationError(f"{source}: {fs_hz:.3g} frames/s for a {fn:.3g} Hz oscillation "
+                               f"(need {MIN_FRAMES_PER_CYCLE:g} frames a cycle)",
+                               "film in slow motion (see calibration/protocols/beam.md)")
+    return rms, amp, fn, zeta
+
+
 def _window(t_s: np.ndarray, d: np.ndarray, start_s: float | None, end_s: float | None) -> np.ndarray:
     """Samples to fit: from the drop (or ``start_s``) to ``end_s``.
 
@@ -235,8 +260,11 @@ def _start_values(t: np.ndarray, y: np.ndarray, fn_low_hz: float, fn_high_hz: fl
     model, are solved exactly; the grid points of least residual that are local minima
     along fn are the starts. Every frequency is tried on the whole ring-down, heavily damped
     (one or two visible cycles) or not, so the start cannot lock onto the record's length
-    or a noise peak the way a spectrum's highest peak can.
+    or a noise peak the way a spectrum's highest peak can. Only the first ``START_SAMPLES``
+    samples are looked at (8.5 s at 240 frames/s: the ring-down after the drop), so the grid's
+    memory and time stay bounded on a long recording; the fit itself takes the whole window.
     """
+    t, y = t[:START_SAMPLES], y[:START_SAMPLES]
     tau = t - t[0]
     fns = np.exp(np.arange(np.log(fn_low_hz), np.log(fn_high_hz), np.log1p(START_FN_STEP)))
     zetas = np.asarray(START_ZETAS)

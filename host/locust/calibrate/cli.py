@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import replace
 from pathlib import Path
@@ -9,12 +10,12 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..errors import CalibrationError, ReportError, TrackError
-from ..fileio import json_text
+from ..errors import CalibrationError
+from ..fileio import check_distinct, json_text
+from ..io.importing import ImportOptions, import_options
 from ..options import FINITE, POSITIVE
+from ..plotting import check_figure_path
 from ..progress import progress
-from ..track.delimited import read_text
-from ..track.importing import ImportOptions, import_options
 from . import beam as B
 from . import hinge as HG
 from . import hop as H
@@ -23,23 +24,70 @@ from . import servo as S
 from .fitstats import Estimate
 from .gyro_log import looks_like_gyro_log, parse_gyro_log
 from .plots import plot_fit
-from .recordings import REAL_TIME, TimeOptions, clean_samples, read_table, time_options
+from .recordings import REAL_TIME, TimeOptions, clean_samples, read_recording_text, read_table, time_options
 from .write import DEFAULT_ROBOT_TOML, check_plausible, implausible, write_fitted
 
 
 def output_options(func):
-    """--write [PATH], --json, --plot PATH / --no-plot: shared by the three experiments."""
+    """--write [PATH], --json, --plot PATH / --no-plot, --force: shared by the experiments. Before
+    anything is read or fitted, the outputs are checked: each its own file, none an input
+    (TRACKS, DATA, --validate), the plot an image path that replaces no user file."""
+
+    command = func
+
+    @functools.wraps(command)
+    def wrapper(*args, **kwargs):
+        kwargs["write_path"] = write_target(kwargs["write_path"])
+        inputs = [p for name in ("tracks", "data", "validate") for p in _paths(kwargs.get(name))]
+        plot = None if kwargs["no_plot"] else kwargs["plot_path"]
+        check_distinct({"--plot": plot, "--write": kwargs["write_path"]}, inputs)
+        if plot is not None:
+            check_figure_path(plot, kwargs["force"])
+        return command(*args, **kwargs)
+
+    func = wrapper
+    func = click.option("--force", is_flag=True,
+                        help="Replace an existing file at --plot that is not a figure this toolkit wrote.")(func)
     func = click.option("--no-plot", is_flag=True, help="Do not draw the fit plot.")(func)
     func = click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-                        help="Fit plot (data, model, residuals) [default: <recording>-fit.png beside it, or in the "
-                             "current folder when the recording's folder is read-only].")(func)
+                        help="Fit plot (data, model, residuals; .png, .svg or .pdf) [default: <recording>-fit.png "
+                             "beside it, or in the current folder when the recording's folder is read-only]. An "
+                             "existing file is replaced only when it is a figure this toolkit wrote.")(func)
     func = click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")(func)
-    func = click.option("--write", "write_path", type=click.Path(dir_okay=False, path_type=Path),
-                        is_flag=False, flag_value=str(DEFAULT_ROBOT_TOML), default=None,
-                        help="Update this robot.toml with the fitted values only "
-                             f"[bare --write: {DEFAULT_ROBOT_TOML}]. "
-                             "Other values are kept; a new file starts from the seed preset.")(func)
+    func = write_option(func, "Update this robot.toml with the fitted values only. Other values are kept; a new "
+                              "file starts from the seed preset.")
     return func
+
+
+def write_option(func, help_text: str):
+    """``--write [PATH]``: bare, ``calibration/robot.toml`` under the current folder (see :func:`write_target`)."""
+    return click.option("--write", "write_path", type=click.Path(dir_okay=False, path_type=Path),
+                        is_flag=False, flag_value=_BARE_WRITE, default=None,
+                        help=f"{help_text} [bare --write: {DEFAULT_ROBOT_TOML} in the current folder, which "
+                             "must hold a calibration/ folder].")(func)
+
+
+_BARE_WRITE = ":bare --write:"
+
+
+def write_target(write_path: Path | None) -> Path | None:
+    """The file ``--write`` updates: a bare ``--write`` is ``calibration/robot.toml`` under the
+    current folder, refused when that folder has no ``calibration/`` (a run from elsewhere
+    would make one there unasked); a path given is used as given."""
+    if write_path is None or str(write_path) != _BARE_WRITE:
+        return write_path
+    target = Path.cwd() / DEFAULT_ROBOT_TOML
+    if not target.parent.is_dir():
+        raise CalibrationError(f"a bare --write writes {target}, and {target.parent} does not exist",
+                               f"give the file: --write PATH (e.g. --write robot.toml), or run from the folder "
+                               f"that holds {DEFAULT_ROBOT_TOML.parent}/")
+    return target
+
+
+def _paths(value) -> list[Path]:
+    if value is None:
+        return []
+    return [Path(v) for v in value] if isinstance(value, (tuple, list)) else [Path(value)]
 
 
 @click.group()
@@ -74,7 +122,7 @@ def calibrate() -> None:
 @time_options
 @output_options
 def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, imports, timing, write_path, as_json,
-         plot_path, no_plot):
+         plot_path, no_plot, force):
     """Fit the beam tip's damped oscillation: stiffness, damping, and the model's hinge values.
 
     TRACKS is a `locust track` CSV, a Tracker project (.trk, .trz) or text export, or a
@@ -95,7 +143,7 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, import
         raise CalibrationError("--write needs --length-m: the hinge values are k*L^2 and b*L^2",
                                "measure the beam's free length from the clamp to the mass")
     note = f"beam L={length_m} m, m={mass_kg} kg; {B.MAPPING}"
-    _finish(fit, tracks, values, note, write_path, as_json, plot_path, no_plot,
+    _finish(fit, tracks, values, note, write_path, as_json, plot_path, no_plot, force,
             subtitle=f"fn {fit.natural_frequency_hz.value:.4g} Hz, zeta {fit.damping_ratio.value:.3g}",
             warnings=[warning] if warning else [], input_note=table.input_note)
 
@@ -127,7 +175,7 @@ def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, import
 @time_options
 @output_options
 def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s, end_s, coulomb, imports, timing,
-          write_path, as_json, plot_path, no_plot):
+          write_path, as_json, plot_path, no_plot, force):
     """Fit a link's free swing on a flexure hinge: stiffness, damping, neutral angle.
 
     TRACKS is a track of one marker on the swinging link: a Tracker project (.trk, .trz;
@@ -160,7 +208,7 @@ def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s,
     note = (f"hinge swing, I={inertia_kgm2:g} kg*m^2, gravity {gravity}"
             + (f", M={mass_kg:g} kg, D={com_m:g} m" if gravity == "in-plane" else "")
             + f", pivot {fit.pivot_source}; Coulomb friction {fit.coulomb_note}")
-    _finish(fit, tracks, values, note, write_path, as_json, plot_path, no_plot,
+    _finish(fit, tracks, values, note, write_path, as_json, plot_path, no_plot, force,
             subtitle=(f"fn {fit.natural_frequency_hz:.4g} Hz, zeta {fit.damping_ratio:.3g}, "
                       f"RMS {1000 * fit.rms_residual_m:.3g} mm"),
             input_note=table.input_note)
@@ -197,7 +245,7 @@ def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s,
 @time_options
 @output_options
 def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_moment_nm, pivot, step, marker, validate,
-          validate_inertia_kgm2, imports, timing, write_path, as_json, plot_path, no_plot):
+          validate_inertia_kgm2, imports, timing, write_path, as_json, plot_path, no_plot, force):
     """Identify the hobby servo (no-load speed, armature, kp; kv with --fit-kv) from step responses.
 
     Each DATA is one of two kinds, told apart by its layout:
@@ -258,20 +306,17 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
             target = plot_path.with_name(plot_path.stem + "-validate.png") if plot_path else \
                 default_plot_path(validate[0]).with_name(f"{validate[0].stem}-validate.png")
             extra["validation_plot"] = str(plot_fit([v.curves for v in validations], target,
-                                                    "predicted by the fitted servo (not fitted to it)"))
+                                                    "predicted by the fitted servo (not fitted to it)", force))
     subtitle = ", ".join(f"{Path(r.source).name} RMS {rms:.3g} {'deg' if r.kind == 'angle' else 'rad/s'}"
                          for r, rms in zip(recordings, fit.rms_per_recording))
-    _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot,
+    _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot, force,
             subtitle=subtitle, source_name=Path(fit.source).name, extra=extra)
 
 
 def _servo_recording(path: Path, rig, pivot, step, marker, imports: ImportOptions,
                      timing: TimeOptions = REAL_TIME):
     """One servo recording, of the kind its layout says: a gyro log (rate) or an angle table."""
-    try:
-        text = read_text(path)
-    except TrackError as exc:
-        raise CalibrationError(exc.message, exc.hint) from None
+    text = read_recording_text(path)
     if looks_like_gyro_log(text):
         if pivot is not None:
             raise CalibrationError(f"{path}: --pivot is for a horn track, and this is a gyro log",
@@ -298,10 +343,14 @@ def _per_recording(values: tuple[float, ...], n: int, option: str) -> list[float
 @click.option("--robot-marker", default="robot", show_default=True, help="For a ramp video track: the robot's marker.")
 @click.option("--into", type=click.Choice(["foot", "nose"]), default="foot", show_default=True,
               help="Which friction the result is written to (contact.foot_friction or contact.nose_friction).")
+@click.option("--resolution-deg", type=POSITIVE, default=R.READING_RESOLUTION_DEG, show_default=True,
+              help="How finely each angle was read [deg] (a protractor's graduation); the trials' spread is "
+                   "taken as at least resolution/sqrt(12), so trials read alike give an interval, not a point.")
 @import_options
 @time_options
 @output_options
-def ramp(data, ramp_markers, robot_marker, into, imports, timing, write_path, as_json, plot_path, no_plot):
+def ramp(data, ramp_markers, robot_marker, into, resolution_deg, imports, timing, write_path, as_json, plot_path,
+         no_plot, force):
     """Static friction from critical ramp angles: mu = tan(mean angle), with a 95% interval.
 
     DATA: CSVs with an angle_deg column (one trial a row, degrees), and/or side-view
@@ -317,10 +366,10 @@ def ramp(data, ramp_markers, robot_marker, into, imports, timing, write_path, as
         raise CalibrationError("--units, --rename and --mirror apply to ramp tracks; these are angle tables",
                                "leave them out for angle_deg recordings")
     source = str(data[0]) if len(data) == 1 else "+".join(p.name for p in data)
-    fit = R.fit_ramp(np.array(angles), source=source)
+    fit = R.fit_ramp(np.array(angles), source=source, resolution_deg=resolution_deg)
     values = {f"contact.{into}_friction": fit.mu_static}
     note = f"ramp, {fit.n_trials} trials, mean angle {fit.mean_angle_deg:.4g} deg"
-    _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot,
+    _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot, force,
             subtitle=f"mu {fit.mu_static.value:.4g} from {fit.n_trials} trials",
             recording_name=Path(source) if len(data) == 1 else Path("ramp"), source_name=Path(source).name,
             warnings=warnings)
@@ -336,10 +385,8 @@ def ramp(data, ramp_markers, robot_marker, into, imports, timing, write_path, as
 @click.option("--max-iter", type=click.IntRange(1, 200), default=30, show_default=True, help="Solver iterations.")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
 @click.option("--no-plot", is_flag=True, help="Do not draw the fit plots.")
-@click.option("--write", "write_path", type=click.Path(dir_okay=False, path_type=Path),
-              is_flag=False, flag_value=str(DEFAULT_ROBOT_TOML), default=None,
-              help="Update this robot.toml with the identifiable fitted values only, source fit:hops "
-                   f"[bare --write: {DEFAULT_ROBOT_TOML}].")
+@functools.partial(write_option, help_text="Update this robot.toml with the identifiable fitted values only, "
+                                           "source fit:hops.")
 def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
     """Fit the model to filmed hops: friction, hinge stiffness, servo speed on the robot.
 
@@ -356,24 +403,26 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
       locust calibrate hop small=runs/s1 large=runs/l1 --write calibration/robot.toml
     """
     from ..params import resolve_robot
-    from ..report.configs import name_from_path
+    from ..trials.measured import config_of
 
     keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
+    H.check_fittable(keys)
+    write_path = write_target(write_path)
     start_from = config or (write_path if write_path and Path(write_path).exists() else None)
     base = resolve_robot(None, start_from, sets)
-    loaded = []
+    named = []
     for item in runs:
         name, sep, rest = item.partition("=")
         if sep and name and "/" not in name and not Path(item).exists():
             path, leg_set = Path(rest), name
         else:
             path = Path(item)
-            try:
-                leg_set = name_from_path(path)
-            except ReportError:
-                raise CalibrationError(f"{path}: cannot tell which leg set this run is from its folder's name",
-                                       "name it: small=PATH") from None
-        loaded.append(H.load_run(path, leg_set, base))
+            leg_set, _ = config_of(path)     # the leg set its run.json names, else its folder's
+        if path.resolve() in (p.resolve() for p, _ in named):
+            raise CalibrationError(f"{item}: the run {path} is given twice; each run counts once in the fit",
+                                   "give each run folder once (a repeat is another filmed hop, another folder)")
+        named.append((path, leg_set))
+    loaded = [H.load_run(path, leg_set, base) for path, leg_set in named]
     with progress(length=max_iter, label="fitting hops") as bar:
         fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=bar.update)
     out = fit.summary()
@@ -388,7 +437,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
         if values:
             note = "filmed hops " + ", ".join(f"{r.config}:{Path(r.source).name}" for r in fit.runs)
             write_fitted(write_path, values, H.PROVENANCE_NAME, note=note)
-        out["written"] = {"path": str(write_path), "keys": list(values)}
+        out["written"] = {"path": str(Path(write_path).resolve()), "keys": list(values)}
     if as_json:
         click.echo(json_text(out), nl=False)
         return
@@ -460,7 +509,7 @@ def default_plot_path(recording: Path, recording_name: Path | None = None) -> Pa
 
 
 def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_path: Path | None,
-            as_json: bool, plot_path: Path | None, no_plot: bool, *, subtitle: str,
+            as_json: bool, plot_path: Path | None, no_plot: bool, force: bool, *, subtitle: str,
             recording_name: Path | None = None, source_name: str | None = None,
             warnings: list[str] | None = None, extra: dict | None = None, input_note: str = "") -> None:
     recording_name = recording_name or recording
@@ -473,7 +522,7 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
         click.echo(f"warning: {warning}", err=True)
     if not no_plot:
         plot_path = plot_path or default_plot_path(recording, recording_name)
-        out["plot"] = str(plot_fit(fit.curves, plot_path, subtitle))
+        out["plot"] = str(plot_fit(fit.curves, plot_path, subtitle, force))
     if write_path and odd:   # show the fit, then refuse to write it
         if as_json:
             click.echo(json_text(out), nl=False)
@@ -483,7 +532,7 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
     if write_path:
         if values:
             write_fitted(write_path, values, source_name or recording.name, note=note)
-        out["written"] = {"path": str(write_path), "keys": list(values)}
+        out["written"] = {"path": str(Path(write_path).resolve()), "keys": list(values)}
     if as_json:
         click.echo(json_text(out), nl=False)
         return

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import CalibrationError, TrackError
-from ..track.delimited import read_text
+from ..io.delimited import read_text
 
 _SPLIT = re.compile(r"[,;\t]")
 HINT = "a gyro log has rows millis,command_deg,gyro (three numbers, no header)"

@@ -13,7 +13,7 @@ Before the fit each run's step is checked at the start values: halved (at most
 
 Residual: the tracked markers against the same markers of the simulation, both from where
 they stood by the track's rule (the median of its frames before the first nose motion),
-put on the schedule's clock by the rule the report uses (:mod:`locust.report.measure`: the
+put on the schedule's clock by the rule the report uses (:mod:`locust.trials.measure`: the
 first nose motion of more than 3 mm, the track's start placed where the simulation's is
 relative to its first push) and then each run's clock offset fitted about it, for every
 candidate (:func:`aligned_residual`). Every candidate of a solver
@@ -45,16 +45,16 @@ import numpy as np
 from mujoco import minimize
 from scipy import optimize
 
-from ..errors import CalibrationError, GeometryError, ParamsError, ReportError, SimError
-from ..params import Provenance, Robot, value_type
-from ..report.configs import configuration
-from ..report.measure import onset_time
-from ..report.measured import load_trial, read_track
+from ..errors import CalibrationError, GeometryError, ParamsError, SimError, TrialError
+from ..params import Provenance, Robot, fittable_keys, value_type
 from ..sim.kinematics import geom_positions, marker_geoms, trace_rows
 from ..sim.model import build
 from ..sim.rollout import simulate_batch
 from ..sim.samples import uncertain_values
 from ..sim.schedule import ControlPlan
+from ..trials.configs import configuration
+from ..trials.measure import onset_time
+from ..trials.measured import load_trial, read_track
 from .fitstats import Estimate, cluster_covariance, fixed_covariance, linear_shift
 
 DEFAULT_KEYS = ("contact.foot_friction", "compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s")
@@ -145,10 +145,7 @@ class HopFit:
 # -- reading runs ------------------------------------------------------------------------
 def load_run(path: Path, config: str, base: Robot) -> HopRun:
     """A ``locust hop --out`` folder (its run.json and tracks) as a :class:`HopRun` of ``config``."""
-    try:
-        trial = load_trial(Path(path), config, "nose")
-    except ReportError as exc:
-        raise CalibrationError(exc.message, exc.hint) from None
+    trial = load_trial(Path(path), config, "nose")
     if trial.record is None or trial.track is None:
         raise CalibrationError(f"{path}: a hop fit needs the run's run.json and the track of its video",
                                "give the folder `locust hop --out` wrote, after `locust track` on its video")
@@ -160,14 +157,11 @@ def load_run(path: Path, config: str, base: Robot) -> HopRun:
                                "a hop fit needs a run that pushed at least once; rerun the hop")
     t0_us = pushes[0].measured_us
     phases = [p for p in phases if p.measured_us >= t0_us]
-    try:
-        onset, x0, y0 = onset_time(trial.track.t_s, trial.track.x_m, trial.track.y_m, where=str(trial.track.path))
-    except ReportError as exc:
-        raise CalibrationError(exc.message, exc.hint) from None
+    onset, x0, y0 = onset_time(trial.track.t_s, trial.track.x_m, trial.track.y_m, where=str(trial.track.path))
     tracks = {"nose": MarkerTrack(trial.track.t_s, trial.track.x_m - x0, trial.track.y_m - y0)}
     try:
         foot = read_track(trial.track.path, "foot")
-    except ReportError:
+    except TrialError:
         foot = None          # a track of the nose alone is fitted on the nose alone
     if foot is not None and (foot.t_s < onset).sum() >= 2:
         before = foot.t_s < onset
@@ -237,7 +231,7 @@ def aligned_residual(run: HopRun, sim: dict[str, np.ndarray] | None) -> tuple[np
     nose = sim["nose"]
     try:
         latency, _, _ = onset_time(nose[0], nose[1], nose[2], where="simulation")
-    except ReportError:
+    except TrialError:
         return np.full(n, FAILED_M), math.nan
 
     def residual_at(shift: float) -> np.ndarray:       # shift: camera time of the first push
@@ -294,20 +288,28 @@ def converged_step(run: HopRun, robot: Robot | None = None) -> tuple[HopRun, flo
 
 
 # -- the fit ----------------------------------------------------------------------------
-def check_keys(keys: list[str], runs: list[HopRun]) -> None:
-    """Fitted keys are real-valued robot parameters, the same in every run's robot."""
+def check_fittable(keys: list[str]) -> None:
+    """Fitted keys are named once each, and each is a real-valued physical robot parameter
+    (:func:`locust.params.fittable_keys`): never the schedule or the solver."""
     if not keys:
         raise CalibrationError("no parameter to fit", f"e.g. --fit {','.join(DEFAULT_KEYS)}")
     if len(set(keys)) != len(keys):
         raise CalibrationError(f"--fit names a parameter twice ({','.join(keys)})", "name each once")
     for key in keys:
         try:
-            runs[0].robot.get(key)
+            value_type(key)
         except ParamsError as exc:
             raise CalibrationError(f"--fit: {exc.message}", exc.hint) from None
-        if value_type(key) != "float":
-            raise CalibrationError(f"--fit {key}: only real-valued parameters can be fitted",
-                                   "run `locust params` to list them")
+        if key not in fittable_keys():
+            raise CalibrationError(f"--fit {key}: only the robot's real-valued physical parameters can be fitted "
+                                   "(not the schedule it is given, nor how it is simulated)",
+                                   "fit any of " + ", ".join(fittable_keys()))
+
+
+def check_keys(keys: list[str], runs: list[HopRun]) -> None:
+    """Fitted keys are fittable (:func:`check_fittable`) and the same in every run's robot."""
+    check_fittable(keys)
+    for key in keys:
         values = {run.robot.get(key) for run in runs}
         if len(values) > 1:
             raise CalibrationError(f"--fit {key}: the runs' leg sets differ in it ({sorted(values)})",
@@ -318,17 +320,10 @@ def check_keys(keys: list[str], runs: list[HopRun]) -> None:
                                    "the fit works on factors of a positive value; set a start with --set")
 
 
-def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEYS, *, max_iter: int = 30,
-             grid_stages: int = GRID_STAGES, progress: Callable[[int], None] | None = None) -> HopFit:
-    """Fit ``keys`` (shared by all runs) to the tracked markers; see the module docstring.
-    ``grid_stages``: stages of the starting grid (0: start at the robot's values)."""
-    t_start = time.perf_counter()
-    keys = tuple(keys)
-    if not runs:
-        raise CalibrationError("no run given", "give the folders `locust hop --out` wrote")
-    check_keys(list(keys), runs)
-    start = np.array([runs[0].robot.get(k) for k in keys], dtype=float)
-    counter = {"sims": 0}
+def _converged_steps(runs: list[HopRun]) -> tuple[list[HopRun], list[str], list[float]]:
+    """Each run at the time step its markers converge in (:func:`converged_step`), with a note
+    where that is not its leg set's step or where even the halved step moves them; returns
+    (runs, notes, the RMS change of each run's markers at half its step)."""
     runs, step_notes, step_changes = list(runs), [], []
     for k, run in enumerate(runs):
         given = run.robot.solver.timestep_s
@@ -343,45 +338,48 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
             step_notes.append(f"{run.config} ({run.source.name}): fitted at {dt * 1e3:g} ms, not its leg set's "
                               f"{given * 1e3:g} ms (there halving the step moved the markers by more than "
                               f"{STEP_TOLERANCE_M * 1e3:g} mm RMS at the start values)")
+    return runs, step_notes, step_changes
 
-    def robots_at(run: HopRun, xs: np.ndarray, refine: int = 1) -> list[Robot]:
+
+class _HopResidual:
+    """The markers' residual of every run, stacked, for candidate vectors ``x`` (columns): the
+    fitted values are ``start * exp(x)``; ``sims`` counts the simulations it ran."""
+
+    def __init__(self, runs: list[HopRun], keys: tuple[str, ...], start: np.ndarray):
+        self.runs, self.keys, self.start = runs, keys, start
+        self.sims = 0
+
+    def robots_at(self, run: HopRun, xs: np.ndarray, refine: int = 1) -> list[Robot]:
+        """``run``'s robot at each row of ``xs`` (its step divided by ``refine``)."""
         robot = run.robot
         if refine > 1:
             robot = robot.with_values({"solver.timestep_s": robot.solver.timestep_s / refine}, "fit: time step check")
-        return [robot.with_values(dict(zip(keys, (start * np.exp(x)).tolist())), "fit") for x in xs]
+        return [robot.with_values(dict(zip(self.keys, (self.start * np.exp(x)).tolist())), "fit") for x in xs]
 
-    def residuals_of(robots: Callable[[HopRun], list[Robot]]) -> np.ndarray:
+    def residuals_of(self, robots: Callable[[HopRun], list[Robot]]) -> np.ndarray:
         """One residual column per robot ``robots(run)`` gives (one batch per run), runs stacked."""
         cols = []
-        for run in runs:
+        for run in self.runs:
             batch = robots(run)
             try:
                 sims = simulate_markers(run, batch)
             except (GeometryError, SimError):
                 sims = [None] * len(batch)
-            counter["sims"] += len(batch)
+            self.sims += len(batch)
             cols.append(np.stack([aligned_residual(run, s)[0] for s in sims], axis=1))
         return np.concatenate(cols, axis=0)
 
-    def residual(x: np.ndarray, refine: int = 1) -> np.ndarray:
-        xs = np.atleast_2d(np.asarray(x, dtype=float).T).reshape(-1, len(keys))
-        return residuals_of(lambda run: robots_at(run, xs, refine))
+    def __call__(self, x: np.ndarray, refine: int = 1) -> np.ndarray:
+        xs = np.atleast_2d(np.asarray(x, dtype=float).T).reshape(-1, len(self.keys))
+        return self.residuals_of(lambda run: self.robots_at(run, xs, refine))
 
-    bound = math.log(BOUND_FACTOR)
-    bounds = [np.full(len(keys), -bound), np.full(len(keys), bound)]
 
-    def on_iter(trace):
-        if progress:
-            progress(1)
-
-    x0 = grid_start(residual, len(keys), grid_stages)
-    x, trace = minimize.least_squares(x0, residual, bounds=bounds, eps=FD_STEP,
-                                      max_iter=max_iter, verbose=0, iter_callback=on_iter, xtol=1e-6, gtol=1e-8)
-    x = np.asarray(x, dtype=float).ravel()
-    values = start * np.exp(x)
+def _run_fits(residual: _HopResidual, x: np.ndarray, step_changes: list[float]) -> tuple[list[RunFit], list]:
+    """Each run at the optimum: its RMS (overall and per marker) and curves; and the hop each
+    of its residual samples belongs to (the clusters of the interval)."""
     run_fits, clusters = [], []
-    for k, run in enumerate(runs):
-        sim = simulate_markers(run, robots_at(run, x[None, :]))[0]
+    for k, run in enumerate(residual.runs):
+        sim = simulate_markers(run, residual.robots_at(run, x[None, :]))[0]
         res, shift = aligned_residual(run, sim)
         clusters.append(k * 10_000 + hop_index(run, shift))
         by_marker, j = {}, 0
@@ -395,28 +393,50 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
         run_fits.append(RunFit(source=str(run.source), config=run.config, rms_m=float(np.sqrt(np.mean(res**2))),
                                rms_by_marker_m=by_marker, samples=len(res), curves=curves,
                                timestep_s=run.robot.solver.timestep_s, step_change_m=step_changes[k]))
-    # the optimum and its central differences in one batch per run, then the same at dt/2
+    return run_fits, clusters
+
+
+def _jacobian(residual: _HopResidual, x: np.ndarray, values: np.ndarray,
+              bound: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The residual at the optimum, its Jacobian in the values (central differences, one batch
+    per run) and the values' shift at half the time step: (r, jac, numerical)."""
     hi, lo = np.minimum(x + FD_STEP, bound), np.maximum(x - FD_STEP, -bound)
     points = [x] + [np.where(np.arange(len(x)) == i, edge[i], x) for i in range(len(x)) for edge in (hi, lo)]
     rs = residual(np.array(points).T)
     r = rs[:, 0]
     jac = (rs[:, 1::2] - rs[:, 2::2]) / (hi - lo) / values[None, :]    # d r / d p = d r / d x / p
     numerical = linear_shift(jac, residual(x.reshape(-1, 1), refine=2)[:, 0] - r)
+    return r, jac, numerical
+
+
+def _held_covariance(residual: _HopResidual, x: np.ndarray, jac: np.ndarray) -> tuple[dict[str, float], object]:
+    """The values held fixed that carry an uncertainty, and what it adds to the fitted values'
+    covariance (None when there are none)."""
+    runs, keys = residual.runs, residual.keys
     held = held_uncertainties(runs, keys)
-    fixed = None
-    if held:   # each held value one standard uncertainty either side, at the optimum: one batch per run
-        sds = np.array(list(held.values()))
-        changes = [{key: runs[0].robot.get(key) + sign * sd} for key, sd in held.items() for sign in (1, -1)]
-        rq = residuals_of(lambda run: [robots_at(run, x[None, :])[0].with_values(c, "fit: held value's uncertainty")
-                                       for c in changes])
-        fixed = fixed_covariance(jac, (rq[:, 0::2] - rq[:, 1::2]) / (2 * sds), sds)
-    cov = cluster_covariance(jac, r, np.concatenate(clusters), numerical, fixed)
-    hops = len(np.unique(np.concatenate(clusters)))
-    interval = (f"cluster-robust over {hops} hops (CR1), t({max(hops - 1, 1)}), with the shift at half the time "
-                "step (std_numerical)" + (f" and the uncertainties of the {len(held)} values held fixed "
-                                          f"({', '.join(held)}: std_fixed)" if held else "")
-                + " in quadrature, Welch-Satterthwaite degrees of freedom")
-    estimates, identifiable, notes = {}, {}, step_notes
+    if not held:
+        return held, None
+    # each held value one standard uncertainty either side, at the optimum: one batch per run
+    sds = np.array(list(held.values()))
+    changes = [{key: runs[0].robot.get(key) + sign * sd} for key, sd in held.items() for sign in (1, -1)]
+    rq = residual.residuals_of(lambda run: [residual.robots_at(run, x[None, :])[0].with_values(
+        c, "fit: held value's uncertainty") for c in changes])
+    return held, fixed_covariance(jac, (rq[:, 0::2] - rq[:, 1::2]) / (2 * sds), sds)
+
+
+def _interval_text(hops: int, held: dict[str, float]) -> str:
+    """How the intervals are made, in words."""
+    return (f"cluster-robust over {hops} hops (CR1), t({max(hops - 1, 1)}), with the shift at half the time "
+            "step (std_numerical)" + (f" and the uncertainties of the {len(held)} values held fixed "
+                                      f"({', '.join(held)}: std_fixed)" if held else "")
+            + " in quadrature, Welch-Satterthwaite degrees of freedom")
+
+
+def _hop_estimates(cov, values: np.ndarray, x: np.ndarray, keys: tuple[str, ...], start: np.ndarray,
+                   bound: float, hops: int, notes: list[str]) -> tuple[dict[str, Estimate], dict[str, bool]]:
+    """Each value's estimate and whether the hops bound it, with a note for each that is not
+    (too few hops, the edge of its range, an interval too wide)."""
+    estimates, identifiable = {}, {}
     if hops <= len(keys):
         notes.append(f"{hops} hops cannot bound {len(keys)} values (a cluster-robust interval needs at least one "
                      "hop more than the values fitted): film more hops, or fit fewer values")
@@ -432,9 +452,44 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
             notes.append(f"{key} is not identifiable from these hops (its 95% interval is wider than "
                          f"about +-{200 * MAX_RELATIVE_STD:.0f}%)")
         identifiable[key] = ok
+    return estimates, identifiable
+
+
+def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEYS, *, max_iter: int = 30,
+             grid_stages: int = GRID_STAGES, progress: Callable[[int], None] | None = None) -> HopFit:
+    """Fit ``keys`` (shared by all runs) to the tracked markers; see the module docstring.
+    ``grid_stages``: stages of the starting grid (0: start at the robot's values)."""
+    t_start = time.perf_counter()
+    keys = tuple(keys)
+    if not runs:
+        raise CalibrationError("no run given", "give the folders `locust hop --out` wrote")
+    check_keys(list(keys), runs)
+    start = np.array([runs[0].robot.get(k) for k in keys], dtype=float)
+    runs, notes, step_changes = _converged_steps(runs)
+    residual = _HopResidual(runs, keys, start)
+    bound = math.log(BOUND_FACTOR)
+    bounds = [np.full(len(keys), -bound), np.full(len(keys), bound)]
+
+    def on_iter(trace):
+        if progress:
+            progress(1)
+
+    x0 = grid_start(residual, len(keys), grid_stages)
+    x, trace = minimize.least_squares(x0, residual, bounds=bounds, eps=FD_STEP,
+                                      max_iter=max_iter, verbose=0, iter_callback=on_iter, xtol=1e-6, gtol=1e-8)
+    x = np.asarray(x, dtype=float).ravel()
+    values = start * np.exp(x)
+    run_fits, clusters = _run_fits(residual, x, step_changes)
+    # the optimum and its central differences in one batch per run, then the same at dt/2
+    r, jac, numerical = _jacobian(residual, x, values, bound)
+    held, fixed = _held_covariance(residual, x, jac)
+    cov = cluster_covariance(jac, r, np.concatenate(clusters), numerical, fixed)
+    hops = len(np.unique(np.concatenate(clusters)))
+    estimates, identifiable = _hop_estimates(cov, values, x, keys, start, bound, hops, notes)
     return HopFit(keys=keys, start=dict(zip(keys, start.tolist())), estimates=estimates, identifiable=identifiable,
                   runs=run_fits, notes=notes, rms_m=float(np.sqrt(np.mean(r**2))), iterations=len(trace),
-                  simulations=counter["sims"], wall_s=time.perf_counter() - t_start, interval=interval)
+                  simulations=residual.sims, wall_s=time.perf_counter() - t_start,
+                  interval=_interval_text(hops, held))
 
 
 def held_uncertainties(runs: list[HopRun], keys: tuple[str, ...]) -> dict[str, float]:

@@ -1,5 +1,5 @@
 """Fit plots: data and model above, residuals below (one such pair per recording), written
-atomically as PNG."""
+atomically (PNG, SVG or PDF by the path's suffix)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,9 @@ from ..plotting import pyplot, save_png
 from .curves import Curves
 
 
-def plot_fit(curves: Curves | list[Curves], path: str | Path, subtitle: str = "") -> Path:
-    """One recording's ``Curves``, or several stacked (each with its residuals below it)."""
+def plot_fit(curves: Curves | list[Curves], path: str | Path, subtitle: str = "", force: bool = False) -> Path:
+    """One recording's ``Curves``, or several stacked (each with its residuals below it); ``force``:
+    replace an existing file that is not one of this toolkit's figures."""
     panels = [curves] if isinstance(curves, Curves) else list(curves)
     plt = pyplot()
     fig, axes = plt.subplots(2 * len(panels), 1, figsize=(7.5, 5.5 * len(panels)), squeeze=False,
@@ -34,4 +35,4 @@ def plot_fit(curves: Curves | list[Curves], path: str | Path, subtitle: str = ""
         bottom.set_xlabel(c.x_label)
         bottom.grid(alpha=0.3)
     fig.tight_layout()
-    return save_png(fig, path, dpi=110)
+    return save_png(fig, path, dpi=110, force=force, option="--plot")

@@ -2,7 +2,10 @@
 
 From several trials (one critical angle each) the estimate is ``mu = tan(mean angle)``,
 with the 95% interval ``tan(mean +- t * s / sqrt(n))`` (Student's t on the angles; tan is
-monotonic below 90 deg) and a one-sigma uncertainty ``sec^2(mean) * s / sqrt(n)``.
+monotonic below 90 deg) and a one-sigma uncertainty ``sec^2(mean) * s / sqrt(n)``. The
+trials' spread ``s`` is never taken below what the angle's reading resolution leaves
+unknown, ``resolution / sqrt(12)`` (a protractor's 1 deg graduation: 0.29 deg): trials read
+alike are alike to the graduation, not identical, and give an interval of that width.
 
 A trial can also come from a side-view track of the ramp (markers at both ends of the
 board) and the robot: the ramp angle is that of the board, and the robot starts to slide
@@ -20,11 +23,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import CalibrationError
-from ..track.importing import units_hint
+from ..io.importing import units_hint
 from .curves import Curves
 from .fitstats import Estimate, t95
 
 MIN_TRIALS = 2
+READING_RESOLUTION_DEG = 1.0   # a protractor's graduation: the angle is read to the nearest degree
 BOARD_M = (0.05, 3.0, 0.3)     # (least, most, typical) length between the ramp's two markers
 
 
@@ -37,14 +41,23 @@ class RampFit:
     n_trials: int
     angles_deg: list[float] = field(repr=False)
     curves: Curves = field(repr=False)
+    resolution_deg: float = READING_RESOLUTION_DEG
+    notes: list[str] = field(default_factory=list)
 
     def summary(self) -> dict:
         return {"experiment": "ramp", "source": self.source, "mu_static": self.mu_static.as_dict(),
                 "mean_angle_deg": self.mean_angle_deg, "std_angle_deg": self.std_angle_deg,
-                "n_trials": self.n_trials, "angles_deg": self.angles_deg}
+                "n_trials": self.n_trials, "angles_deg": self.angles_deg, "resolution_deg": self.resolution_deg,
+                "notes": self.notes}
 
 
-def fit_ramp(angles_deg: np.ndarray, source: str = "ramp") -> RampFit:
+def fit_ramp(angles_deg: np.ndarray, source: str = "ramp",
+             resolution_deg: float = READING_RESOLUTION_DEG) -> RampFit:
+    """``resolution_deg``: how finely each angle was read; the trials' spread is taken as at
+    least ``resolution_deg / sqrt(12)`` (see the module docstring)."""
+    if not (math.isfinite(resolution_deg) and resolution_deg > 0):
+        raise CalibrationError(f"--resolution-deg {resolution_deg:g} must be a finite number above 0",
+                               "the angle's reading resolution, e.g. 1 for a protractor read to the degree")
     a = np.asarray(angles_deg, dtype=float)
     a = a[np.isfinite(a)]
     if len(a) < MIN_TRIALS:
@@ -55,6 +68,11 @@ def fit_ramp(angles_deg: np.ndarray, source: str = "ramp") -> RampFit:
         raise CalibrationError(f"{source}: critical angle {bad:g} deg is not between 0 and 90 deg",
                                "angles are in degrees from the horizontal")
     mean, sd, n = float(a.mean()), float(a.std(ddof=1)), len(a)
+    floor, notes = resolution_deg / math.sqrt(12.0), []
+    if sd < floor:
+        notes.append(f"the trials' spread {sd:.3g} deg is below the reading resolution's {floor:.3g} deg "
+                     f"({resolution_deg:g} deg / sqrt(12)): the interval uses {floor:.3g} deg")
+        sd = floor
     se = sd / math.sqrt(n)
     k = t95(n - 1)
     mu = math.tan(math.radians(mean))
@@ -64,7 +82,8 @@ def fit_ramp(angles_deg: np.ndarray, source: str = "ramp") -> RampFit:
     curves = Curves(x=trials, data=np.tan(np.radians(a)), model=np.full(n, mu), x_label="trial",
                     y_label="tan(critical angle)", title=f"ramp: {source}")
     return RampFit(source=source, mu_static=Estimate(mu, std, lo, hi), mean_angle_deg=mean, std_angle_deg=sd,
-                   n_trials=n, angles_deg=[float(x) for x in a], curves=curves)
+                   n_trials=n, angles_deg=[float(x) for x in a], curves=curves, resolution_deg=resolution_deg,
+                   notes=notes)
 
 
 @dataclass(frozen=True)

@@ -6,21 +6,21 @@ All four become one :class:`Table` of numeric columns, with marker positions und
 - plain CSV (``t_s,angle_deg,command_deg`` or ``angle_deg``), ``#`` lines are comments:
   this module's own format;
 - ``locust track`` CSV (``frame,t_s,<m>_px,<m>_py,<m>_x_m,<m>_y_m,<m>_ok``: any header
-  naming marker columns), read by :mod:`locust.track.tracks_csv`; a row whose ``<m>_ok``
+  naming marker columns), read by :mod:`locust.io.tracks_csv`; a row whose ``<m>_ok``
   is false counts as *not found* (NaN), never as a position;
 - Tracker (Open Source Physics) *File > Export > Data*, read by
-  :mod:`locust.track.tracker_text`: an optional title line (the track name) or Tracker 6's
+  :mod:`locust.io.tracker_text`: an optional title line (the track name) or Tracker 6's
   ``#multi:`` line followed by a row of track names, then a header (``t x y ...``), tab
   separated, possibly with decimal commas; or a plain ``t,x,y`` CSV of one marker (``nose``).
   Tracker writes positions in its calibration unit: ``--units cm`` for a Tracker in cm.
 
 - a Tracker project (``.trk``, or a ``.trz`` zip holding one), read by
-  :mod:`locust.track.trk`: its point tracks in metres through the project's own calibration.
+  :mod:`locust.io.trk`: its point tracks in metres through the project's own calibration.
 
-Every track (the last three) goes through :func:`locust.track.importing.import_tracks`'s
+Every track (the last three) goes through :func:`locust.io.importing.import_tracks`'s
 conversion, so ``--units``, ``--rename`` and ``--mirror`` act here as in ``locust track
---import``; a plain CSV has no positions and is read as it is. The three share one tokenizer
-(:mod:`locust.track.delimited`). Every problem is a :class:`~locust.errors.CalibrationError`
+import``; a plain CSV has no positions and is read as it is. The three share one tokenizer
+(:mod:`locust.io.delimited`). Every problem is a :class:`~locust.errors.CalibrationError`
 naming the file, and the line or column, with a hint.
 
 Slow motion: a clip filmed at 240 frames/s and exported (or played) at 30 has times 8 times
@@ -40,9 +40,9 @@ import click
 import numpy as np
 
 from ..errors import CalibrationError, TrackError
-from ..track.delimited import check_names, read_text, split_text
-from ..track.importing import AS_IS, ImportOptions, import_project, is_project, track_layout, tracks_from_delimited
-from ..track.tracks_csv import TracksCsv
+from ..io.delimited import check_names, read_text, split_text
+from ..io.importing import AS_IS, ImportOptions, import_project, is_project, track_layout, tracks_from_delimited
+from ..io.tracks_csv import TracksCsv
 
 
 @dataclass(frozen=True)
@@ -159,6 +159,57 @@ def time_options(func):
     return wrapper
 
 
+# What a calibration recording holds: a few seconds to minutes of video (24-240 frames/s) or of
+# a sensor log. Longer files are refused before they are parsed (a fit's start grid grows with
+# the samples), with what to do.
+MAX_ROWS = 50_000                   # lines: 3.5 minutes at 240 frames/s
+MAX_BYTES = 64 * 2**20
+LONGEST_STEP_S = 1.0                # a camera or a logger samples faster than once a second
+# the largest magnitude a value may have, by its column's unit: positions within a lab
+LARGEST = {"_m": 1e3, "t_s": 1e6}
+LARGEST_OTHER = 1e9
+SIZE_HINT = ("cut the recording to the experiment (a few seconds to minutes), e.g. keep its header and the rows "
+             "you need, or export it again at the rate it was filmed")
+
+
+def read_recording_text(path: str | Path) -> str:
+    """The text of a recording (a CSV, a Tracker export, a gyro log): refused
+    (:class:`CalibrationError`) before parsing when it is larger than a recording can be."""
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+    except OSError:
+        size = 0   # read_text says what is wrong
+    if size > MAX_BYTES:
+        raise CalibrationError(f"{path}: {size / 2**20:.0f} MB, more than a calibration recording holds "
+                               f"({MAX_BYTES / 2**20:.0f} MB and {MAX_ROWS:,} lines at most)", SIZE_HINT)
+    try:
+        text = read_text(path)
+    except TrackError as exc:
+        raise CalibrationError(exc.message, exc.hint) from None
+    lines = text.count("\n")
+    if lines > MAX_ROWS:
+        raise CalibrationError(f"{path}: {lines:,} lines, more than the {MAX_ROWS:,} a calibration recording "
+                               f"holds ({MAX_ROWS / 240 / 60:.1f} minutes at 240 frames/s)", SIZE_HINT)
+    return text
+
+
+def check_values(table: Table) -> Table:
+    """``table`` if every value is a number a recording can hold: NaN (not found) is kept, an
+    infinite or absurdly large one (1e308 in a position in metres) is a :class:`CalibrationError`
+    naming its column and row."""
+    for name, col in table.columns.items():
+        limit = next((v for k, v in LARGEST.items() if name.endswith(k)), LARGEST_OTHER)
+        bad = np.flatnonzero(np.abs(np.nan_to_num(col, nan=0.0)) > limit)
+        if len(bad):
+            row = int(bad[0])
+            raise CalibrationError(
+                f"{table.path}: column {name!r}, data row {row + 1}: {float(col[row])!r} is not a value a recording "
+                f"can hold (|value| <= {limit:g}){f'; {len(bad) - 1} more such rows' if len(bad) > 1 else ''}",
+                "fix or delete that row (an empty cell reads as not found), and check the file's units")
+    return table
+
+
 def read_table(path: str | Path, imports: ImportOptions = AS_IS, timing: TimeOptions = REAL_TIME) -> Table:
     """Read a recording; see the module docstring for the formats understood. ``imports``
     (``--units``, ``--rename``, ``--mirror``) converts a track; a plain CSV is read as it is;
@@ -170,10 +221,10 @@ def read_table(path: str | Path, imports: ImportOptions = AS_IS, timing: TimeOpt
             table = Table(path=path, columns={n: tracks.column(n) for n in tracks.columns}, kind="tracker",
                           comments=tracks.comments, tracks=tracks)
         else:
-            table = parse_table(read_text(path), path, imports)
+            table = parse_table(read_recording_text(path), path, imports)
     except TrackError as exc:
         raise CalibrationError(exc.message, exc.hint) from None
-    return rescale_time(regular_time(table), timing)
+    return rescale_time(regular_time(check_values(table)), timing)
 
 
 def regular_time(table: Table) -> Table:
@@ -249,4 +300,10 @@ def clean_samples(path: Path, what: str, t_s: np.ndarray, *series: np.ndarray,
         bad = int(np.argmax(np.diff(out[0]) <= 0)) + 1
         raise CalibrationError(f"{path}: time does not increase at sample {bad} (t_s = {out[0][bad]:g})",
                                "sort the rows by time and remove duplicate frames")
+    step = float(np.median(np.diff(out[0])))
+    if step > LONGEST_STEP_S:
+        raise CalibrationError(
+            f"{path}: {what}: the samples are {step:g} s apart (median), slower than any camera or logger "
+            f"(24-240 frames/s: 0.004-0.04 s); the times are not in seconds",
+            f"times in milliseconds: add --time-scale 0.001 (real time = file time * {0.001:g})")
     return tuple(out)

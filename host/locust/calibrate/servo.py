@@ -448,14 +448,9 @@ def _rms_in_unit(rec: Recording, part: np.ndarray, gain: float | None) -> float:
     return math.degrees(rms) if rec.kind == "angle" else rms / abs(gain)
 
 
-def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None, *,
-              kv_nms_per_rad: float | None = None, max_iter: int = 60,
-              progress: Callable[[int], None] | None = None) -> ServoFit:
-    """Identify the servo from one or more recordings (angle or rate); see the module docstring.
-    ``stall_torque_nm`` and ``kv_nms_per_rad``, when given, are held at that value."""
-    import time
-
-    t_start = time.perf_counter()
+def _checked_inputs(recordings: list[Recording], stall_torque_nm: float | None,
+                    kv_nms_per_rad: float | None) -> list[Recording]:
+    """The recordings, checked, and the held values refused where they cannot be used."""
     if not recordings:
         raise CalibrationError("no recording given", "give the CSV of a servo step")
     recs = [_checked(r) for r in recordings]
@@ -471,54 +466,63 @@ def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None,
     if kv_nms_per_rad is not None and not (kv_nms_per_rad >= 0 and math.isfinite(kv_nms_per_rad)):
         raise CalibrationError(f"--kv-nms-per-rad must be 0 or more (got {kv_nms_per_rad})",
                                "0 holds the servo without velocity feedback inside its drive")
-    held = {"stall_torque_nm": stall_torque_nm, "kv_nms_per_rad": kv_nms_per_rad}
-    fitted = tuple(n for n in PARAMS if held.get(n) is None)
-    layout = _Layout(fitted, tuple(r.kind == "angle" and len(r.edges) >= MIN_EDGES_FOR_CLOCK for r in recs),
-                     tuple(r.kind == "rate" for r in recs), stall_torque_nm,
-                     tuple(r.gain_sign if r.kind == "rate" else 1.0 for r in recs), kv_nms_per_rad)
-    models = [rig_model(r.rig) for r in recs]
-    # each recording's residual in units of its noise, so that recordings of different kinds
-    # weigh by their information: a first guess (1 deg; a gyro unit), then each one's own RMS
-    scales = [math.radians(1.0) if r.kind == "angle" else 1.0 for r in recs]
+    return recs
 
-    def residual(x: np.ndarray, on: list[mujoco.MjModel] | None = None) -> np.ndarray:
-        xs = np.atleast_2d(np.asarray(x).T).reshape(-1, layout.size)
-        parts = _residual_parts(recs, on or models, [layout.unpack(row) for row in xs])
-        r = np.concatenate([p / sc for p, sc in zip(parts, scales)], axis=1).T
+
+class _Residual:
+    """The fit's residual vector for one or more candidate vectors ``x`` (columns), each
+    recording's part in units of its noise (``scales``), so that recordings of different
+    kinds weigh by their information: a first guess (1 deg; a gyro unit), then each one's
+    own RMS (:meth:`weigh_by_own_noise`)."""
+
+    def __init__(self, recs: list[Recording], layout: _Layout):
+        self.recs, self.layout = recs, layout
+        self.models = [rig_model(r.rig) for r in recs]
+        self.scales = [math.radians(1.0) if r.kind == "angle" else 1.0 for r in recs]
+
+    def __call__(self, x: np.ndarray, on: list[mujoco.MjModel] | None = None) -> np.ndarray:
+        xs = np.atleast_2d(np.asarray(x).T).reshape(-1, self.layout.size)
+        parts = _residual_parts(self.recs, on or self.models, [self.layout.unpack(row) for row in xs])
+        r = np.concatenate([p / sc for p, sc in zip(parts, self.scales)], axis=1).T
         return np.where(np.isfinite(r), r, 1e3)
 
+    def weigh_by_own_noise(self, x: np.ndarray) -> None:
+        parts = _residual_parts(self.recs, self.models, [self.layout.unpack(x)])
+        self.scales = [max(float(np.sqrt(np.mean(p ** 2))), 1e-12) for p in parts]
+
+
+def _solve(residual: _Residual, max_iter: int, progress: Callable[[int], None] | None) -> tuple[np.ndarray, int]:
+    """Least squares from each grid start, the best kept; with several recordings, each then
+    weighed by its own noise and the best polished. Returns (x, iterations)."""
     def on_iter(trace):
         if progress:
             progress(1)
 
-    bounds = layout.bounds()
-    starts = _grid_starts(recs, layout, residual, bounds)
-    best, best_cost, iterations = None, math.inf, 0
-    for x0 in starts:
+    def least_squares(x0):
         x, trace = minimize.least_squares(x0, residual, bounds=bounds, max_iter=max_iter, verbose=0,
                                           iter_callback=on_iter, eps=FD_STEP, xtol=1e-8, gtol=1e-10)
-        x = np.asarray(x).ravel()
-        iterations += len(trace)
+        return np.asarray(x).ravel(), len(trace)
+
+    bounds = residual.layout.bounds()
+    best, best_cost, iterations = None, math.inf, 0
+    for x0 in _grid_starts(residual.recs, residual.layout, residual, bounds):
+        x, n = least_squares(x0)
+        iterations += n
         cost = float(np.sum(residual(x.reshape(-1, 1)) ** 2))
         if cost < best_cost:
             best, best_cost = x, cost
     x = best
-    if len(recs) > 1:   # weigh each recording by its own noise, and polish
-        parts = _residual_parts(recs, models, [layout.unpack(x)])
-        scales = [max(float(np.sqrt(np.mean(p ** 2))), 1e-12) for p in parts]
-        x, trace = minimize.least_squares(x, residual, bounds=bounds, max_iter=max_iter, verbose=0,
-                                          iter_callback=on_iter, eps=FD_STEP, xtol=1e-8, gtol=1e-10)
-        x = np.asarray(x).ravel()
-        iterations += len(trace)
-    r = residual(x.reshape(-1, 1)).ravel()
-    jac, _ = minimize.jacobian_fd(residual, x.reshape(-1, 1), r.reshape(-1, 1), np.float64(1e-6), 0,
-                                  [b.reshape(-1, 1) for b in bounds])
-    nphys = len(fitted)
-    phys = np.exp(x[:nphys])
-    servo, timings, gains = layout.unpack(x)
-    nuis = layout.nuisance()
+    if len(residual.recs) > 1:   # weigh each recording by its own noise, and polish
+        residual.weigh_by_own_noise(x)
+        x, n = least_squares(x)
+        iterations += n
+    return x, iterations
+
+
+def _nuisance_values(layout: _Layout, timings: list[Timing], gains: list[float | None]) -> tuple[list, list]:
+    """The nuisance variables' values and their d value / d x (the scale of each variable)."""
     nvals, nscale = [], []
-    for k, what in nuis:
+    for k, what in layout.nuisance():
         if what == "delay":
             nvals.append(timings[k].delay_s)
             nscale.append(DELAY_SCALE_S)
@@ -528,7 +532,15 @@ def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None,
         else:
             nvals.append(gains[k])
             nscale.append(gains[k])          # gain = sign*exp(x): d gain / d x = gain
-    scale = np.concatenate([phys, nscale])
+    return nvals, nscale
+
+
+def _covariance(residual: _Residual, x: np.ndarray, r: np.ndarray, scale: np.ndarray):
+    """The covariance of the values (physical, then nuisance) at the solution ``x``: clustered
+    by servo step when there are enough steps, with the time step's shift as a type-B part."""
+    recs, layout = residual.recs, residual.layout
+    jac, _ = minimize.jacobian_fd(residual, x.reshape(-1, 1), r.reshape(-1, 1), np.float64(1e-6), 0,
+                                  [b.reshape(-1, 1) for b in layout.bounds()])
     # d r / d p = d r / d x / (d p / d x): p = exp(x) for the physical ones (and the gains), p = scale*x for timing
     clusters = np.concatenate([_step_clusters(rec) + 10_000 * k for k, rec in enumerate(recs)])
     jac_p = jac / scale[None, :]
@@ -537,33 +549,38 @@ def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None,
     half = [rig_model(replace(rec.rig, timestep_s=rec.rig.timestep_s / 2)) for rec in recs]
     shift = 2.0 * linear_shift(jac_p, residual(x.reshape(-1, 1), half).ravel() - r)
     if len(np.unique(clusters)) > CLUSTERS_PER_PARAMETER * layout.size:
-        cov = cluster_covariance(jac_p, r, clusters, shift=shift)
-    else:
-        cov = replace(covariance(jac_p, r), shift=shift)
-    values = np.concatenate([phys, nvals])
+        return cluster_covariance(jac_p, r, clusters, shift=shift)
+    return replace(covariance(jac_p, r), shift=shift)
+
+
+def _estimates(cov, values: np.ndarray, layout: _Layout, held: dict[str, float | None], n_recs: int):
+    """Estimates of the physical values (the held ones exact), the timing std per recording
+    (delay, clock) and the gain estimate of each rate recording."""
     estimates, identifiable = {}, {}
-    for i, name in enumerate(fitted):
+    for i, name in enumerate(layout.fitted):
         estimates[name] = cov.parameter(values, i)
     for name, value in held.items():
         if value is not None:
             estimates[name] = Estimate(value, 0.0, value, value)
             identifiable[name] = True
-    timing_std = [[0.0, 0.0] for _ in recs]
-    gain_est: list[Estimate | None] = [None] * len(recs)
-    for j, (k, what) in enumerate(nuis):
-        est = cov.parameter(values, nphys + j)
+    timing_std = [[0.0, 0.0] for _ in range(n_recs)]
+    gain_est: list[Estimate | None] = [None] * n_recs
+    for j, (k, what) in enumerate(layout.nuisance()):
+        est = cov.parameter(values, len(layout.fitted) + j)
         if what == "gain":
             gain_est[k] = est
         else:
             timing_std[k][0 if what == "delay" else 1] = est.std
+    return estimates, identifiable, timing_std, gain_est
 
-    parts = _residual_parts(recs, models, [(servo, timings, gains)])
-    per_rec = [_rms_in_unit(rec, p[0], g) for rec, p, g in zip(recs, parts, gains)]
-    angle_rms = [(rms, len(rec.t_s)) for rec, rms in zip(recs, per_rec) if rec.kind == "angle"]
-    rms_deg = (math.sqrt(sum(rms ** 2 * n for rms, n in angle_rms) / sum(n for _, n in angle_rms))
-               if angle_rms else None)
-    notes: list[str] = []
-    profile = _profile_ok(residual, x, r, nphys)
+
+def _identifiable(residual: _Residual, x: np.ndarray, r: np.ndarray, estimates: dict[str, Estimate],
+                  identifiable: dict[str, bool], notes: list[str]) -> None:
+    """Mark each fitted value identifiable or not (interval, edge of its range, profile),
+    with a note for each that is not."""
+    fitted = residual.layout.fitted
+    bounds = residual.layout.bounds()
+    profile = _profile_ok(residual, x, r, len(fitted))
     for i, name in enumerate(fitted):
         ok = bool(np.isfinite(estimates[name].std) and estimates[name].relative_std <= MAX_RELATIVE_STD)
         if min(x[i] - bounds[0][i], bounds[1][i] - x[i]) < 1e-3:
@@ -578,7 +595,12 @@ def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None,
             notes.append(f"{name} is not identifiable from these recordings (its 95% interval is wider than "
                          f"about +-{200 * MAX_RELATIVE_STD:.0f}%)")
         identifiable[name] = ok
-    _physics_notes(servo, recs, notes)
+
+
+def _misfit_notes(recs: list[Recording], per_rec: list[float], gains: list[float | None],
+                  identifiable: dict[str, bool], notes: list[str]) -> dict[str, bool]:
+    """A recording the model does not follow makes every value untrustworthy: the
+    identifiable flags then, all False, with the note first."""
     for rec, rms, g in zip(recs, per_rec, gains):
         if rec.kind == "angle":
             bad = rms > max(3.0, 0.05 * float(np.ptp(rec.command_deg)))
@@ -589,13 +611,54 @@ def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None,
             unit = "deg" if rec.kind == "angle" else "rad/s"
             notes.insert(0, f"the model does not follow {Path(rec.source).name} (RMS {rms:.3g} {unit}): no value "
                             "is trustworthy; check --inertia-kgm2, --gravity-moment-nm and the command column")
-    rms_half = _rms_half_step(recs, servo, timings, gains)
+    return identifiable
+
+
+def _convergence_notes(recs: list[Recording], per_rec: list[float], rms_half: list[float], notes: list[str]) -> None:
+    """A note for each recording whose RMS moves by more than 5 % at half the time step."""
     for rec, full, half in zip(recs, per_rec, rms_half):
         if abs(half - full) > 0.05 * full:
             notes.append(f"not converged in the time step: {Path(rec.source).name}'s RMS is {full:.3g} at "
                          f"{rec.rig.timestep_s:g} s and {half:.3g} at half of it")
+
+
+def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None, *,
+              kv_nms_per_rad: float | None = None, max_iter: int = 60,
+              progress: Callable[[int], None] | None = None) -> ServoFit:
+    """Identify the servo from one or more recordings (angle or rate); see the module docstring.
+    ``stall_torque_nm`` and ``kv_nms_per_rad``, when given, are held at that value."""
+    import time
+
+    t_start = time.perf_counter()
+    recs = _checked_inputs(recordings, stall_torque_nm, kv_nms_per_rad)
+    held = {"stall_torque_nm": stall_torque_nm, "kv_nms_per_rad": kv_nms_per_rad}
+    fitted = tuple(n for n in PARAMS if held.get(n) is None)
+    layout = _Layout(fitted, tuple(r.kind == "angle" and len(r.edges) >= MIN_EDGES_FOR_CLOCK for r in recs),
+                     tuple(r.kind == "rate" for r in recs), stall_torque_nm,
+                     tuple(r.gain_sign if r.kind == "rate" else 1.0 for r in recs), kv_nms_per_rad)
+    residual = _Residual(recs, layout)
+    x, iterations = _solve(residual, max_iter, progress)
+    r = residual(x.reshape(-1, 1)).ravel()
+    phys = np.exp(x[:len(fitted)])
+    servo, timings, gains = layout.unpack(x)
+    nvals, nscale = _nuisance_values(layout, timings, gains)
+    cov = _covariance(residual, x, r, np.concatenate([phys, nscale]))
+    estimates, identifiable, timing_std, gain_est = _estimates(cov, np.concatenate([phys, nvals]), layout, held,
+                                                               len(recs))
+
+    parts = _residual_parts(recs, residual.models, [(servo, timings, gains)])
+    per_rec = [_rms_in_unit(rec, p[0], g) for rec, p, g in zip(recs, parts, gains)]
+    angle_rms = [(rms, len(rec.t_s)) for rec, rms in zip(recs, per_rec) if rec.kind == "angle"]
+    rms_deg = (math.sqrt(sum(rms ** 2 * n for rms, n in angle_rms) / sum(n for _, n in angle_rms))
+               if angle_rms else None)
+    notes: list[str] = []
+    _identifiable(residual, x, r, estimates, identifiable, notes)
+    _physics_notes(servo, recs, notes)
+    identifiable = _misfit_notes(recs, per_rec, gains, identifiable, notes)
+    rms_half = _rms_half_step(recs, servo, timings, gains)
+    _convergence_notes(recs, per_rec, rms_half, notes)
     curves = [recording_curves(model, servo, timing, gain, rec)
-              for model, rec, timing, gain in zip(models, recs, timings, gains)]
+              for model, rec, timing, gain in zip(residual.models, recs, timings, gains)]
     source = recs[0].source if len(recs) == 1 else "+".join(Path(rec.source).name for rec in recs)
     given = tuple(n for n, v in held.items() if v is not None)
     return ServoFit(source=source, recordings=recs, estimates=estimates, given=given,

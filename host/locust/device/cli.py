@@ -11,10 +11,11 @@ import click
 from ..errors import DeviceError, LocustError
 from ..fileio import json_text
 from ..firmware import config as fw_config
+from ..io import run_record as R
 from ..params import Schedule, resolve_robot
 from ..params_cli import robot_options
 from ..progress import progress
-from . import record as R
+from ..tables import plant_lines
 from .plant import PLANTS
 
 CHIPS = tuple(fw_config.CHIPS)  # the chips whose pin rules the firmware knows, and the virtual robot models
@@ -76,6 +77,7 @@ def flash(port, compile_mpy, reset_config, servo_sets, preset, config, sets):
     With --port sim the files go to the virtual robot's flash folder
     ($LOCUST_VIRTUAL_DIR/flash, default ~/.cache/locust/virtual/flash).
     """
+    from .board import write_values
     from .flash import flash as do_flash
     from .link import Link
     from .session import open_port
@@ -89,21 +91,22 @@ def flash(port, compile_mpy, reset_config, servo_sets, preset, config, sets):
         if edits:
             with Link(device) as link:
                 link.hello()
-                for key, value in edits:
-                    link.call("config", key=key, value=value, write=1)
-                    _info(f"  set {key} = {value:g}")
+                write_values(link, edits, _info)
     names = ", ".join(f.name for f in result.files)
     click.echo(f"flashed locust firmware {result.firmware_version} to {port or device} ({result.board}): "
                f"{len(result.files)} files verified by SHA-256 ({names})"
                f"{'; wrote config.json' if result.config_written else ''} in {result.elapsed_s:.1f} s")
+    if result.config_problems and not edits:   # a --servo edit saved a whole valid config
+        _info("warning: the board runs on its default config: " + "; ".join(result.config_problems))
+        _info(f"  fix: {R.CONFIG_FIX_HINT}")
 
 
-def _parse_servo_set(item: str) -> tuple[str, float]:
+def _parse_servo_set(item: str, option: str = "--servo") -> tuple[str, float]:
     key, sep, value = item.partition("=")
     try:
         return key.strip(), float(value)
     except ValueError:
-        raise DeviceError(f"--servo {item!r} is not KEY=NUMBER", "e.g. --servo left.trim_deg=-1.5") from None
+        raise DeviceError(f"{option} {item!r} is not KEY=NUMBER", f"e.g. {option} left.trim_deg=-1.5") from None
 
 
 @click.command()
@@ -122,21 +125,28 @@ def _parse_servo_set(item: str) -> tuple[str, float]:
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Directory for run.json (must not hold one). Default: data/runs/<timestamp>/.")
 @click.option("--json", "as_json", is_flag=True, help="Print the run record as JSON.")
+@click.option("--leg-set", "leg_set_name", default=None, metavar="NAME",
+              help="The legs on the robot (small, medium, large, or a name of your own), recorded in "
+                   "run.json for `locust report`. Default: the --preset when it is a leg set. "
+                   "A known leg set is built on the --config robot for the virtual robot.")
 @_plant_options
 @robot_options
-def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, plant, video, video_fps, preset, config,
-        sets):
+def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, leg_set_name, plant, video, video_fps,
+        preset, config, sets):
     """Run the bang-bang hop schedule (push, wait; N cycles) and save the run record.
 
     Phases are timed on the robot (ticks_us); run.json gets the commanded and measured start
-    of every phase and the jitter. Ctrl-C or a lost cable: the robot goes to rest, the
-    record keeps what arrived (status incomplete) and the command exits non-zero.
+    of every phase and the jitter, which robot and leg set were hopped (--preset/--config,
+    --leg-set), and the board's config (chip, pins, trims) read back before the hop. Ctrl-C or
+    a lost cable: the robot goes to rest, the record keeps what arrived (status incomplete)
+    and the command exits non-zero; so does a hop the board ran on its default config because
+    its config.json was unreadable (status default_config).
     """
     from .hop import run_hop
     from .link import Link
     from .session import open_port
 
-    robot = resolve_robot(preset, config, sets)
+    robot, source = _hopped_robot(preset, config, sets, leg_set_name)
     s = robot.schedule
     schedule = R.HopSchedule(cycles=cycles or s.cycles, push_deg=s.push_deg if push_deg is None else push_deg,
                              push_ms=push_ms or round(s.push_s * 1000), wait_ms=wait_ms or round(s.wait_s * 1000),
@@ -158,7 +168,8 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
                 with progress(length=schedule.phases, label="hop") as bar:
                     rec = run_hop(link, schedule, directory,
                                   on_phase=lambda p: (bar.update(1),
-                                                      setattr(bar, "label", f"cycle {p.cycle} {p.phase}")))
+                                                      setattr(bar, "label", f"cycle {p.cycle} {p.phase}")),
+                                  robot=source)
     except BaseException as exc:
         if rec is not None and rec.status == R.COMPLETE and isinstance(exc, LocustError):
             # the hop ran, what ends it failed (the virtual robot's video onto a full disk):
@@ -177,8 +188,72 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, pl
     _info(f"{rec.status}: {len(rec.phases)}/{schedule.phases} phases"
           + (f", start error max {j.max_abs_ms:.3f} ms (mean {j.mean_ms:.3f}, sd {j.std_ms:.3f})" if j else "")
           + f"; record {path}")
+    if rec.status == R.DEFAULT_CONFIG:
+        raise DeviceError(f"every phase ran, but {rec.message}",
+                          f"{R.CONFIG_FIX_HINT}; then hop again (this record, {path}, says {R.DEFAULT_CONFIG})")
     if rec.status != R.COMPLETE:
         raise DeviceError(f"the hop did not complete: {rec.message}", f"the partial record is in {path}")
+
+
+def _hopped_robot(preset, config, sets, leg_set_name):
+    """(robot, what run.json records of it): --config or --preset, the leg set on it, --set."""
+    from ..params import LEG_SETS, check_robot, leg_set, parse_set_options
+
+    preset_set = preset if config is None and preset in LEG_SETS else None
+    if leg_set_name is not None:
+        leg_set_name = R.check_leg_set(leg_set_name)
+        if preset_set and leg_set_name != preset_set:
+            raise DeviceError(f"--leg-set {leg_set_name} contradicts --preset {preset}, which is the {preset} leg set",
+                              f"give --preset {leg_set_name}, or --leg-set with --config robot.toml")
+    robot = resolve_robot(preset, config, ())
+    if leg_set_name in LEG_SETS and not preset_set:
+        robot = leg_set(robot, leg_set_name, source=f"leg-set:{leg_set_name}")
+    overrides = parse_set_options(sets)
+    robot = check_robot(robot.with_values(overrides, "override") if overrides else robot)
+    source = R.RobotSource(preset=None if config else preset, robot_file=str(config) if config else None,
+                           leg_set=leg_set_name or preset_set)
+    return robot, source
+
+
+@click.command("config")
+@click.option("--port", default=None, help=PORT_HELP)
+@click.option("--set", "servo_sets", multiple=True, metavar="KEY=VALUE",
+              help="Set one servo config value on the board and save its config.json, e.g. "
+                   "--set right.trim_deg=2.5 (keys: left./right. pin, trim_deg, direction, pulse_min_us, "
+                   "pulse_max_us, range_deg, travel_deg). Repeatable. Nothing is flashed.")
+@click.option("--json", "as_json", is_flag=True, help="Print the board's config as JSON.")
+def board_config(port, servo_sets, as_json):
+    """Read the board's servo config back (chip, pins, trims, pulse ranges), or change it.
+
+    
+      locust config --port /dev/ttyUSB0                           what the firmware runs on
+      locust config --port /dev/ttyUSB0 --set left.trim_deg=2.5   trim without reflashing
+
+    The board checks each value against its limits and its chip's pins and saves the whole
+    config.json; a config.json it could not read (it then runs on its defaults, and says so
+    here) is replaced by a valid one. `locust hop` records the same config in run.json.
+    """
+    from .board import read_board, table, write_values
+    from .link import Link
+    from .session import open_port
+
+    edits = [_parse_servo_set(s, "--set") for s in servo_sets]
+    with open_port(port, plant="record", info=_info) as device:
+        with Link(device) as link:
+            hello = link.hello()
+            write_values(link, edits, _info)
+            board = read_board(link, None if edits else hello)
+    if as_json:
+        click.echo(json_text(board.to_dict()), nl=False)
+    else:
+        click.echo(f"board on {port or device}: {fw_config.chip_name(board.chip) if board.chip else 'unknown chip'} "
+                   f"({board.machine}), firmware {hello.get('version')}")
+        click.echo(table(board))
+        click.echo("config.json: " + ("NOT in use, the firmware runs on its defaults" if board.on_defaults
+                                      else "in use"))
+    if board.on_defaults:
+        _info("warning: the board runs on its default config: " + "; ".join(board.problems))
+        _info(f"  fix: {R.CONFIG_FIX_HINT}")
 
 
 @click.command(context_settings={"ignore_unknown_options": True})  # `pose -20 10`: -20 is an angle
@@ -195,7 +270,7 @@ def pose(left_deg, right_deg, rest, port):
     then push each horn onto its spline as close to its rest position as the splines allow.
     Trimming the rest of the error:
       locust pose 0 0               look at the legs at rest
-      locust flash --servo left.trim_deg=2.5   (shaft deg; reversed on the mirrored right leg)
+      locust config --set left.trim_deg=2.5   (shaft deg; reversed on the mirrored right leg)
     Checking the travel and the direction of each leg:
       locust pose -20 10            left horn -20 deg, right horn +10 deg
 
@@ -335,4 +410,6 @@ def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, s
         pass
     finally:
         summary = vr.stop()
-        _info(f"virtual robot stopped after {vr.boots} boot(s); " + ", ".join(f"{k}={v}" for k, v in summary.items()))
+        _info(f"virtual robot stopped after {vr.boots} boot(s)")
+        for line in plant_lines(summary):
+            _info(line)

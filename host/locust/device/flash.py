@@ -71,6 +71,7 @@ class FlashResult:
     config_written: bool
     files: list[FlashedFile] = field(default_factory=list)
     elapsed_s: float = 0.0
+    config_problems: list[str] = field(default_factory=list)   # why the board runs on its defaults
 
 
 def firmware_files() -> list[Path]:
@@ -194,57 +195,12 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
             raise DeviceError(f"no MicroPython REPL answered on {port}", NO_MICROPYTHON_HINT) from None
         in_raw_repl = True
         transport.serial.timeout = None
-        transport.exec("import sys")
-        impl, board_mpy, platform, version = transport.eval(
-            "(sys.implementation.name, getattr(sys.implementation, '_mpy', 0), sys.platform, "
-            "sys.implementation.version[:2])")
-        if impl != "micropython":
-            raise DeviceError(f"{port} runs {impl}, not MicroPython", NO_MICROPYTHON_HINT)
-        if tuple(version) < MIN_MICROPYTHON:
-            raise DeviceError(f"{port} runs MicroPython {version[0]}.{version[1]}; locust needs "
-                              f"{MIN_MICROPYTHON[0]}.{MIN_MICROPYTHON[1]} or newer", OLD_MICROPYTHON_HINT)
-        machine, chip = board_chip(transport)
-        if chip is None:
-            raise DeviceError(f"{port} is a {machine or 'board that does not name its chip'}: locust knows the "
-                              "pins of the ESP32, ESP32-S2, ESP32-S3 and ESP32-C3 only",
-                              "use one of those chips (docs/hardware.md)")
-        if servo is not None and config is None:
-            config = servo_config(servo, chip)
-        if config is not None and fw_config.problems(config, chip):
-            raise DeviceError(f"bad servo config for the {fw_config.chip_name(chip)}: "
-                              + "; ".join(fw_config.problems(config, chip)),
-                              f"usable pins: {', '.join(str(p) for p in fw_config.usable_pins(chip))}")
-        board_cfg = None
-        if edits and config is None and transport.fs_exists(fw_config.FILE):
-            try:
-                board_cfg = json.loads(transport.fs_readfile(fw_config.FILE))
-            except ValueError:
-                board_cfg = None
-        planned_config(board_cfg, config, list(edits), chip)  # raises before anything is written
-        with tempfile.TemporaryDirectory(prefix="locust-flash-") as tmp:
-            files = build(compile_mpy, Path(tmp))
-        if compile_mpy:
-            ours = mpy_version(next(data for name, data in files if name.endswith(".mpy")))
-            theirs = board_mpy & 0xFF
-            if ours != theirs:
-                raise DeviceError(f"the board reads .mpy v{theirs}, mpy-cross writes v{ours}",
-                                  "flash without --compile, or install the mpy-cross matching the board's MicroPython")
+        board_mpy, platform, machine, chip = _board_identity(transport, port)
+        config = _checked_config(transport, chip, config, servo, edits)
+        files = _firmware_files(compile_mpy, board_mpy)
         result = FlashResult(port=port, compiled=compile_mpy, firmware_version="", board=machine or platform,
                              config_written=False)
-        for name, data in files:
-            progress(f"copying {name}")
-            transport.fs_writefile(name, data)
-            stem, ext = name.rsplit(".", 1)
-            other = stem + (".py" if ext == "mpy" else ".mpy")
-            if other not in KEEP_SOURCE and transport.fs_exists(other):
-                transport.fs_rmfile(other)  # a stale .py would be imported before the new .mpy
-        for name, data in files:
-            progress(f"verifying {name}")
-            digest = hashlib.sha256(data).hexdigest()
-            if transport.fs_hashfile(name, "sha256").hex() != digest:
-                raise DeviceError(f"{name} on the board does not match the copy sent (SHA-256)",
-                                  "flash again; if it persists, the board's filesystem may be full or failing")
-            result.files.append(FlashedFile(name, len(data), digest))
+        _write_files(transport, files, progress, result)
         if config is not None or not transport.fs_exists(fw_config.FILE):
             progress(f"writing {fw_config.FILE}")
             transport.fs_writefile(fw_config.FILE, json.dumps(config or servo_config(Servo(), chip)).encode())
@@ -270,5 +226,78 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
         raise DeviceError(f"the board reports firmware {hello.get('version')} after flashing {P.VERSION}",
                           "reset the board (a stale .py/.mpy may shadow the new files) and flash again")
     result.firmware_version = hello["version"]
+    result.config_problems = list(hello.get("config_problems") or [])
     result.elapsed_s = time.monotonic() - t_start
     return result
+
+
+def _board_identity(transport, port: str) -> tuple[int, str, str | None, str]:
+    """(.mpy version, sys.platform, machine, chip) of the board in the raw REPL; refuses
+    anything but MicroPython, new enough, on a chip whose pins locust knows."""
+    transport.exec("import sys")
+    impl, board_mpy, platform, version = transport.eval(
+        "(sys.implementation.name, getattr(sys.implementation, '_mpy', 0), sys.platform, "
+        "sys.implementation.version[:2])")
+    if impl != "micropython":
+        raise DeviceError(f"{port} runs {impl}, not MicroPython", NO_MICROPYTHON_HINT)
+    if tuple(version) < MIN_MICROPYTHON:
+        raise DeviceError(f"{port} runs MicroPython {version[0]}.{version[1]}; locust needs "
+                          f"{MIN_MICROPYTHON[0]}.{MIN_MICROPYTHON[1]} or newer", OLD_MICROPYTHON_HINT)
+    machine, chip = board_chip(transport)
+    if chip is None:
+        raise DeviceError(f"{port} is a {machine or 'board that does not name its chip'}: locust knows the "
+                          "pins of the ESP32, ESP32-S2, ESP32-S3 and ESP32-C3 only",
+                          "use one of those chips (docs/hardware.md)")
+    return board_mpy, platform, machine, chip
+
+
+def _checked_config(transport, chip: str, config: dict | None, servo: Servo | None,
+                    edits: list[tuple[str, float]]) -> dict | None:
+    """The config to write (``servo``'s when no whole one is given), checked against the chip,
+    and the ``edits`` checked on it or on the board's own config: raises before anything is written."""
+    if servo is not None and config is None:
+        config = servo_config(servo, chip)
+    if config is not None and fw_config.problems(config, chip):
+        raise DeviceError(f"bad servo config for the {fw_config.chip_name(chip)}: "
+                          + "; ".join(fw_config.problems(config, chip)),
+                          f"usable pins: {', '.join(str(p) for p in fw_config.usable_pins(chip))}")
+    board_cfg = None
+    if edits and config is None and transport.fs_exists(fw_config.FILE):
+        try:
+            board_cfg = json.loads(transport.fs_readfile(fw_config.FILE))
+        except ValueError:
+            board_cfg = None
+    planned_config(board_cfg, config, list(edits), chip)  # raises before anything is written
+    return config
+
+
+def _firmware_files(compile_mpy: bool, board_mpy: int) -> list[tuple[str, bytes]]:
+    """The files to copy (name, bytes); compiled ones only in the .mpy version the board reads."""
+    with tempfile.TemporaryDirectory(prefix="locust-flash-") as tmp:
+        files = build(compile_mpy, Path(tmp))
+    if compile_mpy:
+        ours = mpy_version(next(data for name, data in files if name.endswith(".mpy")))
+        theirs = board_mpy & 0xFF
+        if ours != theirs:
+            raise DeviceError(f"the board reads .mpy v{theirs}, mpy-cross writes v{ours}",
+                              "flash without --compile, or install the mpy-cross matching the board's MicroPython")
+    return files
+
+
+def _write_files(transport, files: list[tuple[str, bytes]], progress: Callable[[str], None],
+                 result: FlashResult) -> None:
+    """Copy each file (removing its stale .py/.mpy twin), then check each by SHA-256 on the board."""
+    for name, data in files:
+        progress(f"copying {name}")
+        transport.fs_writefile(name, data)
+        stem, ext = name.rsplit(".", 1)
+        other = stem + (".py" if ext == "mpy" else ".mpy")
+        if other not in KEEP_SOURCE and transport.fs_exists(other):
+            transport.fs_rmfile(other)  # a stale .py would be imported before the new .mpy
+    for name, data in files:
+        progress(f"verifying {name}")
+        digest = hashlib.sha256(data).hexdigest()
+        if transport.fs_hashfile(name, "sha256").hex() != digest:
+            raise DeviceError(f"{name} on the board does not match the copy sent (SHA-256)",
+                              "flash again; if it persists, the board's filesystem may be full or failing")
+        result.files.append(FlashedFile(name, len(data), digest))

@@ -16,7 +16,8 @@ from pathlib import Path
 
 from ..errors import DeviceError
 from ..firmware import protocol as P
-from . import record as R
+from ..io import run_record as R
+from .board import read_board
 from .link import CLOSED, Link
 
 RECORD_EVERY_S = 0.25  # run.json is rewritten at most this often during a hop
@@ -39,14 +40,17 @@ def _fetch_report(link: Link, rec: R.RunRecord) -> None:
 
 
 def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
-            on_phase: Callable[[R.Phase], None] = lambda p: None) -> R.RunRecord:
-    rec = R.RunRecord(schedule=schedule, port=link.port, message="running")
+            on_phase: Callable[[R.Phase], None] = lambda p: None,
+            robot: R.RobotSource | None = None) -> R.RunRecord:
+    rec = R.RunRecord(schedule=schedule, port=link.port, message="running", robot=robot or R.RobotSource())
     R.write(rec, directory)
     try:
         hello = link.hello()
         rec.firmware_version = hello.get("version")
         if hello.get("hopping"):
             link.call("stop")
+        rec.board = read_board(link, hello)
+        R.write(rec, directory)
         while not link.events.empty():  # a boot event from before we connected is old news
             link.events.get_nowait()
         link.start_heartbeat(schedule.heartbeat_ms / 8000.0)  # 8 beats in each timeout
@@ -113,6 +117,9 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
     complete = rec.firmware_status == P.HOP_COMPLETE and len(rec.phases) == schedule.phases
     rec.status = R.COMPLETE if complete else R.INCOMPLETE
     rec.message = None if complete else f"firmware ended the hop: {rec.firmware_status}"
+    if complete and rec.board is not None and rec.board.on_defaults:
+        rec.status = R.DEFAULT_CONFIG
+        rec.message = "the board ran on its default config, not its config.json: " + "; ".join(rec.board.problems)
     R.write(rec, directory)
     return rec
 

@@ -6,6 +6,7 @@ import contextlib
 from collections.abc import Iterator
 from pathlib import Path
 
+from ..tables import plant_lines
 from .plant import make_plant
 from .ports import SIM, autodetect, list_serial_ports
 
@@ -25,6 +26,7 @@ def open_port(port: str | None, plant: str = "auto", video: Path | None = None, 
         finally:
             summary = vr.stop()
             if info and summary.get("plant") == "mujoco":
-                info("simulated robot: " + ", ".join(f"{k}={v}" for k, v in summary.items() if k != "plant"))
+                for line in plant_lines(summary):
+                    info(line)
         return
     yield port or autodetect(list_serial_ports())

@@ -5,9 +5,12 @@ seed's ``plate`` / ``hinge_N`` and the course files' ``body`` / ``joints`` /
 ``hinge_mountain`` / ``hinge_valley`` / ``holes`` / ``cuts``:
 
 - body: closed outlines; nested loops alternate material and hole (even-odd), touching
-  pieces are joined. An open body outline is an error that names the gap.
+  pieces are joined. An open body outline is an error that names the gap. Outlines that
+  overlap without one holding the other are joined (their union, material once) and the
+  summary names each overlap.
 - hinge: a closed outline is a hinge slot, used as drawn; an open path is a fold line,
-  cut out ``hinge_width_mm`` wide (flat ends) across the body.
+  cut out ``hinge_width_mm`` wide (flat ends) across the body. A fold line that misses the
+  body or has no length is an error that names its position.
 - holes: closed outlines cut through every layer.
 - cuts: closed outlines cut through every layer; open paths are slits (a single pass of
   the beam, zero width as designed).
@@ -19,7 +22,7 @@ import fnmatch
 from dataclasses import dataclass, field
 
 import numpy as np
-from shapely import unary_union
+from shapely import STRtree, unary_union
 from shapely.geometry import LineString, MultiPolygon, Polygon
 from shapely.validation import explain_validity
 
@@ -71,6 +74,7 @@ class Design:
     units_from: str = ""
     layer_roles: dict[str, str] = field(default_factory=dict)    # drawing layer -> role
     ignored_layers: tuple[str, ...] = ()
+    joined: tuple[str, ...] = ()                   # overlapping body outlines joined, and where
 
     @property
     def bounds_mm(self) -> tuple[float, float, float, float]:
@@ -151,6 +155,40 @@ def _polygon(contour: Contour) -> Polygon:
     return poly
 
 
+def join_overlaps(contours: list[Contour], polys: list[Polygon],
+                  tol_mm2: float = 1e-6) -> tuple[list[Polygon], tuple[str, ...]]:
+    """Outlines that overlap without one holding the other are joined into one (their union),
+    before even-odd nesting, so an overlap is material once, never cut out. Returns the
+    outlines and, for each overlap joined, where it is."""
+    parent = list(range(len(polys)))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    notes = []
+    pairs = STRtree(polys).query(polys, predicate="intersects")     # (2, n): candidate pairs
+    for i, j in sorted((int(i), int(j)) for i, j in pairs.T if i < j):
+        p, q = polys[i], polys[j]
+        if p.contains(q) or q.contains(p):
+            continue
+        common = p.intersection(q)
+        if common.area <= tol_mm2:
+            continue                       # touching pieces are joined by the union anyway
+        x0, y0, x1, y1 = common.bounds
+        notes.append(f"layer {contours[i].layer!r}: {', '.join(contours[i].entities[:2])} and "
+                     f"{', '.join(contours[j].entities[:2])} overlap by {common.area:.4g} mm2 at "
+                     f"x {x0:.3f} to {x1:.3f}, y {y0:.3f} to {y1:.3f} mm")
+        parent[root(i)] = root(j)
+    groups: dict[int, list[Polygon]] = {}
+    for i, p in enumerate(polys):
+        groups.setdefault(root(i), []).append(p)
+    joined = [g[0] if len(g) == 1 else unary_union(g) for g in groups.values()]
+    return [g for part in joined for g in getattr(part, "geoms", [part])], tuple(notes)
+
+
 def even_odd(polys: list[Polygon]):
     """Material of nested loops: inside an even number of others is material, odd is a hole."""
     depth = [sum(1 for j, q in enumerate(polys) if j != i and q.contains(p)) for i, p in enumerate(polys)]
@@ -185,19 +223,30 @@ def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
         for layer in dict.fromkeys(c.layer for c in opens):
             raise open_outline_error(layer, [c for c in opens if c.layer == layer], gap_tol_mm)
 
-    body = even_odd([_polygon(c) for c in by_role["body"]])
+    body_polys, joined = join_overlaps(by_role["body"], [_polygon(c) for c in by_role["body"]])
+    body = even_odd(body_polys)
     if body.is_empty or body.area <= 0:
         raise FabError(f"{drawing.path}: the body outline encloses no area", "check the body layer")
 
     hinges: list[HingeCut] = []
+    for c in drawing.points:
+        if layer_map.role_of(c.layer) == "hinge":
+            raise FabError(f"layer {c.layer!r}: hinge {', '.join(c.entities)} at {_fmt(c.start_mm)} has no length "
+                           f"(shorter than --gap-tol-mm {gap_tol_mm:g})",
+                           "draw the fold line across the body, or delete it")
     for c in by_role["hinge"]:
         if c.closed:
             poly = _polygon(c)
             hinges.append(HingeCut(c.layer, "slot", poly))
         else:
             cut = fold_cutout(LineString(c.points_mm), hinge_width_mm, body)
-            if not cut.is_empty:
-                hinges.append(HingeCut(c.layer, "fold", cut))
+            if cut.is_empty or cut.area <= 0:
+                raise FabError(f"layer {c.layer!r}: hinge {', '.join(c.entities[:3])} from {_fmt(c.start_mm)} "
+                               f"to {_fmt(c.end_mm)} does not cross the body "
+                               f"(x {body.bounds[0]:.3f} to {body.bounds[2]:.3f}, "
+                               f"y {body.bounds[1]:.3f} to {body.bounds[3]:.3f} mm)",
+                               "draw the fold line across the body, or put it on another layer")
+            hinges.append(HingeCut(c.layer, "fold", cut))
     hinges.sort(key=lambda h: (round(h.polygon.bounds[0], 6), round(h.polygon.bounds[1], 6)))
 
     holes = tuple(_polygon(c) for c in by_role["holes"] + by_role["cuts"] if c.closed)
@@ -206,5 +255,5 @@ def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
         body=body, hinges=tuple(hinges), holes=holes, slits=slits, source=str(drawing.path),
         units=drawing.units, units_from=drawing.units_from,
         layer_roles={k: v for k, v in roles.items() if v},
-        ignored_layers=tuple(k for k, v in roles.items() if not v),
+        ignored_layers=tuple(k for k, v in roles.items() if not v), joined=joined,
     )

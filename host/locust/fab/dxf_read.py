@@ -13,6 +13,7 @@ is a unit converted.
 
 from __future__ import annotations
 
+import contextlib
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +33,13 @@ INSUNITS: dict[int, tuple[str, float]] = {
 UNIT_BY_NAME: dict[str, tuple[int, float]] = {name: (code, mm) for code, (name, mm) in INSUNITS.items()}
 
 CURVES = {"LINE", "ARC", "LWPOLYLINE", "POLYLINE", "CIRCLE", "ELLIPSE", "SPLINE"}
+
+# Block references are expanded this many levels deep, into at most this many entities: an
+# outline for a laser is thousands of curves (50,000 circles read in about 9 s), and nested
+# blocks multiply (8 levels of 10 references each are 10^8 copies, hours of expansion), so
+# they are counted before any is expanded.
+MAX_INSERT_DEPTH = 8
+MAX_EXPANDED_ENTITIES = 50_000
 
 
 @dataclass(frozen=True)
@@ -61,6 +69,7 @@ class Drawing:
     contours: tuple[Contour, ...]
     skipped: dict[str, int] = field(default_factory=dict)   # entity type -> count, not curves
     recovered: int = 0             # problems fixed by ezdxf's recover mode
+    points: tuple[Contour, ...] = ()   # pieces shorter than the gap tolerance: one point each
 
     def layers(self) -> list[str]:
         return sorted({c.layer for c in self.contours})
@@ -114,6 +123,45 @@ def drawing_units(doc, override: str | None) -> tuple[str, float, str]:
     return "mm", 1.0, "assumed (no $INSUNITS)"
 
 
+def _copies(entity) -> int:
+    """How many times an INSERT places its block (a MINSERT is rows x columns)."""
+    rows = max(int(entity.dxf.get("row_count", 1) or 1), 1)
+    cols = max(int(entity.dxf.get("column_count", 1) or 1), 1)
+    return rows * cols
+
+
+def expanded_count(doc, entities, depth: int = 0, memo: dict | None = None) -> int:
+    """How many entities ``entities`` become once their block references are expanded (as
+    ``_entities_by_layer`` expands them), counted from the block definitions without expanding."""
+    memo = {} if memo is None else memo
+    total = 0
+    for entity in entities:
+        total += 1
+        if entity.dxftype() != "INSERT" or depth >= MAX_INSERT_DEPTH:
+            continue
+        name = entity.dxf.get("name")
+        key = (name, depth + 1)
+        if key not in memo:
+            block = doc.blocks.get(name) if name else None
+            memo[key] = 0 if block is None else expanded_count(doc, block, depth + 1, memo)
+        total += _copies(entity) * memo[key]
+        if total > MAX_EXPANDED_ENTITIES:
+            return total
+    return total
+
+
+def check_expansion(doc, path) -> None:
+    """Refuse a drawing whose block references expand into more than MAX_EXPANDED_ENTITIES."""
+    n = expanded_count(doc, doc.modelspace())
+    if n > MAX_EXPANDED_ENTITIES:
+        raise FabError(
+            f"{path}: its block references expand into more than {MAX_EXPANDED_ENTITIES:,} entities "
+            f"(blocks nested in blocks multiply; counted before expanding)",
+            "explode the blocks in the CAD program and keep only the outline for the laser, "
+            "or remove the repeated blocks",
+        )
+
+
 def _entities_by_layer(msp) -> tuple[dict[str, list], Counter]:
     """Model-space curves grouped by layer; block references are expanded in place."""
     by_layer: dict[str, list] = defaultdict(list)
@@ -124,7 +172,7 @@ def _entities_by_layer(msp) -> tuple[dict[str, list], Counter]:
         layer = entity.dxf.get("layer", "0")
         if inherited is not None and layer == "0":
             layer = inherited                     # DXF rule: layer 0 in a block takes the insert's
-        if kind == "INSERT" and depth < 8:
+        if kind == "INSERT" and depth < MAX_INSERT_DEPTH:
             for sub in entity.virtual_entities():
                 visit(sub, layer, depth + 1)
         elif kind in CURVES:
@@ -150,6 +198,34 @@ def _flat(path, sagitta: float) -> np.ndarray:
     return pts
 
 
+def _trace_key(entity, edge, gap: float) -> tuple:
+    """Where an open piece runs, to ``gap``: its two ends (either way round) and its middle."""
+    from ezdxf import path as ezpath
+
+    def q(v) -> tuple[int, int]:
+        return round(v[0] / gap), round(v[1] / gap)
+
+    try:
+        pts = list(ezpath.make_path(entity).flattening(distance=gap))
+        middle = q(pts[len(pts) // 2]) if len(pts) > 2 else None
+    except Exception:  # a path ezdxf cannot make: keep the piece (an entity key of its own)
+        middle = id(entity)
+    ends = tuple(sorted((q(edge.start), q(edge.end))))
+    return ends, middle
+
+
+def _anchor(entity) -> np.ndarray | None:
+    """Where a degenerate entity (no length, zero radius) lies: its centre, start or first vertex."""
+    for attr in ("center", "start"):
+        value = entity.dxf.get(attr) if entity.dxf.is_supported(attr) else None
+        if value is not None:
+            return np.array([[value[0], value[1]]], dtype=float)
+    with contextlib.suppress(Exception):
+        first = next(iter(entity.vertices()))
+        return np.array([[first[0], first[1]]], dtype=float)
+    return None
+
+
 def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm: float,
                    sagitta_mm: float) -> list[Contour]:
     """The loops and open paths of one layer's curves."""
@@ -164,8 +240,11 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
     def emit(pts: np.ndarray, closed: bool, labels: tuple[str, ...]) -> None:
         if closed and len(pts) > 2 and np.hypot(*(pts[0] - pts[-1])) <= gap:
             pts = pts[:-1]
+        closed = closed and len(pts) >= 3     # a "loop" of two points is a line there and back
         if len(pts) >= 2:
             out.append(Contour(layer, pts * mm_per_unit, closed, labels))
+        elif len(pts):                    # collapsed to a point: kept so the caller can name it
+            out.append(Contour(layer, pts[:1] * mm_per_unit, False, labels))
 
     open_pieces = []
     for entity in entities:
@@ -178,7 +257,21 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
         else:
             open_pieces.append(entity)
 
-    edges = [e for e in (es.make_edge_2d(ent, gap_tol=gap) for ent in open_pieces) if e is not None]
+    edges = []
+    seen: set = set()
+    for ent in open_pieces:
+        edge = es.make_edge_2d(ent, gap_tol=gap)
+        if edge is not None:
+            # an entity drawn twice over itself (same ends, same middle) is one cut: chaining every
+            # copy multiplies the chains the edge miner tries (10,000 stacked lines ran for minutes)
+            key = _trace_key(ent, edge, gap)
+            if key not in seen:
+                seen.add(key)
+                edges.append(edge)
+        else:                             # shorter than the gap tolerance (or of zero radius)
+            point = _anchor(ent)
+            if point is not None:
+                emit(point, False, (_label(ent),))
     if not edges:
         return out
     deposit = em.Deposit(edges, gap_tol=gap)
@@ -194,6 +287,7 @@ def read_drawing(path: str | Path, *, units: str | None = None, gap_tol_mm: floa
     """Read every curve of ``path`` into contours in millimetres (see the module doc)."""
     doc, fixed = open_document(path, recover=recover)
     unit_name, mm_per_unit, units_from = drawing_units(doc, units)
+    check_expansion(doc, path)
     by_layer, skipped = _entities_by_layer(doc.modelspace())
     contours: list[Contour] = []
     for layer in sorted(by_layer):
@@ -203,5 +297,6 @@ def read_drawing(path: str | Path, *, units: str | None = None, gap_tol_mm: floa
         if not np.isfinite(c.points_mm).all():
             raise FabError(f"{path}: layer {c.layer!r}: {', '.join(c.entities)} has a vertex that is not a "
                            "finite number (NaN or inf)", "fix the drawing in the CAD program, or redraw that entity")
-    return Drawing(Path(path), unit_name, mm_per_unit, units_from, tuple(contours),
-                   dict(skipped), fixed)
+    return Drawing(Path(path), unit_name, mm_per_unit, units_from,
+                   tuple(c for c in contours if len(c.points_mm) >= 2), dict(skipped), fixed,
+                   tuple(c for c in contours if len(c.points_mm) < 2))

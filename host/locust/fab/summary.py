@@ -34,6 +34,7 @@ def summary(lam: Laminate, *, hinges_x_mm: tuple[float, ...] | None = None,
         "process": asdict(lam.process),
         "layer_roles": d.layer_roles,
         "ignored_layers": list(d.ignored_layers),
+        "joined_overlaps": list(d.joined),
         "out": out_dir,
         "files": files or [],
     }
@@ -63,6 +64,8 @@ def summary_text(s: dict) -> str:
     lines.append(f"kerf: {p['kerf_mm']:g} mm (outer contours out, holes in, by half)")
     if s["ignored_layers"]:
         lines.append(f"ignored layers (no role): {', '.join(s['ignored_layers'])}")
+    for note in s["joined_overlaps"]:
+        lines.append(f"overlapping outlines joined (union): {note}")
     if s["files"]:
         lines.append(f"wrote {len(s['files'])} files to {s['out']}: {', '.join(s['files'])}")
     return "\n".join(lines)

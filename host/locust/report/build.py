@@ -14,17 +14,17 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from .. import __version__
-from ..device.record import ERROR as REFUSED
 from ..errors import ReportError
 from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, unique_dir
+from ..io.run_record import ERROR as REFUSED
 from ..params import Provenance, Robot
+from ..trials.configs import Configuration, configuration
+from ..trials.measured import Trial
 from . import figures as F
 from . import page as H
-from .checks import VIRTUAL, Notice, notices, recorded_on
+from .checks import VIRTUAL, Notice, collapsed, notices, recorded_on
 from .compare import Comparison, compare, timing_rows
-from .configs import Configuration, configuration
 from .landscape import Landscape, read_landscape
-from .measured import Trial
 from .predict import predict
 from .sidebyside import plan_side_by_side, write_side_by_side
 from .spread import spread
@@ -106,56 +106,11 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     land = read_landscape(sweep) if sweep is not None else None   # fail early on a bad sweep folder
     t0 = time.perf_counter()
 
-    configs: dict[str, Configuration] = {}
-    comps: list[Comparison] = []
-    spreads, befores = {}, {}
-    for name, trials in measured.items():
-        cfg = configuration(base, name, added.get(name))
-        sched = run_schedule(name, trials)
-        cfg = Configuration(cfg.name, cfg.added_m, with_run_schedule(cfg.robot, sched))
-        configs[name] = cfg
-        if cycles and sched and cycles > sched["cycles"]:
-            raise ReportError(f"--cycles {cycles}: the runs of {name} recorded only {sched['cycles']} cycles",
-                              f"give --cycles {sched['cycles']} or fewer, or leave it out")
-        n_cycles = cycles or (sched["cycles"] if sched else cfg.robot.schedule.cycles)
-        period = cfg.robot.schedule.push_s + cfg.robot.schedule.wait_s
-        progress(f"simulating {cfg.label} ({n_cycles} cycles)")
-        pred = predict(name, cfg.robot, n_cycles, marker, keep_states=side_by_side)
-        comps.append(compare(pred, trials, n_cycles, period))
-        if samples and pred.valid:
-            progress(f"simulating {samples} draws of {cfg.label}'s uncertain values")
-            spreads[name] = spread(cfg.robot, n_cycles, marker, samples)
-        if before is not None:
-            old = configuration(before, name, added.get(name))
-            befores[name] = predict(name, with_run_schedule(old.robot, sched), n_cycles, marker)
+    configs, comps, spreads, befores = _simulate(base, measured, added, cycles, marker, progress, side_by_side,
+                                                 samples, before)
 
     progress("drawing figures")
-    labels = {name: cfg.label for name, cfg in configs.items()}
-    names_text = ", ".join(labels.values())
-    figs = [
-        H.Figure("overlay", f"Displacement and height vs time: {names_text}",
-                 "Nose forward travel and height above standing, every measured trial (solid) and the audited "
-                 "simulation (dashed), on the schedule's clock (t = 0 at the first push; grey lines: cycle starts)."
-                 + (" Grey band: mean ± 1 sd of the simulation at draws of the robot file's uncertain values."
-                    if spreads else "")
-                 + (" Dotted red: the simulation on the robot before the fit." if befores else ""),
-                 F.overlay_figure(comps, spreads, befores)),
-        H.Figure("jump", f"Jump height, measured against predicted: {names_text}",
-                 "Highest nose point above standing; measured bars show the mean over trials with ±1 sd "
-                 "error bars where repeated trials exist; hatched bars are the simulation's.",
-                 F.bars_figure(comps, "jump")),
-        H.Figure("hops", f"Each hop, measured against predicted: {names_text}",
-                 "Per-hop distance and nose apex of every trial (dots) and the simulation (dashed).",
-                 F.hops_figure(comps, spreads)),
-    ]
-    if land is not None:
-        figs.append(H.Figure("landscape", f"Sweep landscape with {names_text} marked",
-                             f"Simulated distance per hop over the sweep in {land.folder} (invalid designs as red "
-                             "crosses at zero), with each physical design's prediction (open circle) and "
-                             "measurement (filled square, ±1 sd).", F.landscape_figure(land, comps, configs)))
-    figs.append(H.Figure("timing", f"Firmware timing of the runs: {names_text}",
-                         "Start of every phase as the firmware measured it, minus the commanded start.",
-                         F.timing_figure(comps)))
+    figs = _figures(comps, configs, land, spreads, befores)
     dash = F.dashboard(comps, land, configs)
 
     timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
@@ -178,6 +133,76 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     json_path = atomic_write_json(folder / JSON_NAME, {**doc, "wall_s": round(time.perf_counter() - t0, 2)})
     return ReportResult(folder, html_path, dash_path, json_path, comps, [f.key for f in figs],
                         warnings=warnings, side_by_side=videos)
+
+
+def _simulate(base: Robot, measured: dict[str, list[Trial]], added: dict[str, float], cycles: int | None,
+              marker: str, progress: Callable[[str], None], side_by_side: bool, samples: int,
+              before: Robot | None) -> tuple[dict[str, Configuration], list[Comparison], dict, dict]:
+    """Each configuration simulated on its runs' schedule and compared with its trials; with
+    ``samples``, its spread over the uncertain values; with ``before``, the robot before the
+    fit predicted too. Returns (configs, comparisons, spreads, befores)."""
+    configs: dict[str, Configuration] = {}
+    comps: list[Comparison] = []
+    spreads, befores = {}, {}
+    for name, trials in measured.items():
+        cfg, sched, n_cycles = _run_configuration(base, name, trials, added.get(name), cycles)
+        configs[name] = cfg
+        period = cfg.robot.schedule.push_s + cfg.robot.schedule.wait_s
+        progress(f"simulating {cfg.label} ({n_cycles} cycles)")
+        pred = predict(name, cfg.robot, n_cycles, marker, keep_states=side_by_side)
+        comps.append(compare(pred, trials, n_cycles, period))
+        if samples and pred.valid:
+            progress(f"simulating {samples} draws of {cfg.label}'s uncertain values")
+            spreads[name] = spread(cfg.robot, n_cycles, marker, samples)
+        if before is not None:
+            old = configuration(before, name, added.get(name))
+            befores[name] = predict(name, with_run_schedule(old.robot, sched), n_cycles, marker)
+    return configs, comps, spreads, befores
+
+
+def _run_configuration(base: Robot, name: str, trials: list[Trial], added_m: float | None,
+                       cycles: int | None) -> tuple[Configuration, dict | None, int]:
+    """Configuration ``name`` on the schedule its trials ran, that schedule, and the cycles to
+    simulate (``cycles``, else the runs', else the robot's; never more than the runs recorded)."""
+    cfg = configuration(base, name, added_m)
+    sched = run_schedule(name, trials)
+    cfg = Configuration(cfg.name, cfg.added_m, with_run_schedule(cfg.robot, sched))
+    if cycles and sched and cycles > sched["cycles"]:
+        raise ReportError(f"--cycles {cycles}: the runs of {name} recorded only {sched['cycles']} cycles",
+                          f"give --cycles {sched['cycles']} or fewer, or leave it out")
+    n_cycles = cycles or (sched["cycles"] if sched else cfg.robot.schedule.cycles)
+    return cfg, sched, n_cycles
+
+
+def _figures(comps: list[Comparison], configs: dict[str, Configuration], land: Landscape | None,
+             spreads: dict, befores: dict) -> list[H.Figure]:
+    """The page's figures with their captions: overlay, jump, hops, the sweep landscape (with
+    a sweep) and the firmware timing."""
+    labels = {name: cfg.label for name, cfg in configs.items()}
+    names_text = ", ".join(labels.values())
+    figs = [
+        H.Figure("overlay", f"Displacement and height vs time: {names_text}",
+                 "Nose forward travel and height above standing, every measured trial (solid) and the audited "
+                 "simulation (dashed), on the schedule's clock (t = 0 at the first push; grey lines: cycle starts)."
+                 + (" Grey band: mean ± 1 sd of the simulation at draws of the robot file's uncertain values."
+                    if spreads else "")
+                 + (" Dotted red: the simulation on the robot before the fit." if befores else ""),
+                 F.overlay_figure(comps, spreads, befores)),
+        H.Figure("jump", f"Jump height, measured against predicted: {names_text}",
+                 "Highest nose point above standing; measured bars show the mean over trials with ±1 sd "
+                 "error bars where repeated trials exist; hatched bars are the simulation's.",
+                 F.bars_figure(comps, "jump")),
+        H.Figure("hops", f"Each hop, measured against predicted: {names_text}",
+                 "Per-hop distance and nose apex of every trial (dots) and the simulation (dashed).",
+                 F.hops_figure(comps, spreads)),
+    ]
+    if land is not None:
+        figs.append(H.Figure("landscape", f"Sweep landscape with {names_text} marked",
+                             F.landscape_caption(land, comps), F.landscape_figure(land, comps, configs)))
+    figs.append(H.Figure("timing", f"Firmware timing of the runs: {names_text}",
+                         "Start of every phase as the firmware measured it, minus the commanded start.",
+                         F.timing_figure(comps)))
+    return figs
 
 
 def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker: str) -> str:
@@ -236,7 +261,7 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
                           + H.td(t.config_from, c.config, f"config_from:{t.label}", left=True)
                           + H.td(where or "—", c.config, f"recorded_on:{t.label}", left=True)
                           + H.td(_track_reading(t), left=True) + "</tr>")
-    sections = [("Warnings", H.warnings_list(warnings))] if warnings else []
+    sections = [("Warnings", H.warnings_list(collapsed(warnings)))] if warnings else []
     sections += [
         ("Summary", H.summary_table(comps, labels, added)),
         ("Figures", "".join(H.figure_html(f) for f in figs)),

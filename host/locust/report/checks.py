@@ -22,10 +22,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..device.record import RunRecord
-from ..track.importing import units_hint
+from ..io.importing import units_hint
+from ..io.run_record import RunRecord
+from ..trials.measured import CONFIG_FROM_RECORD, CONFIG_GIVEN, Trial, span_hint
 from .compare import Comparison, MeasuredTrial
-from .measured import CONFIG_GIVEN, Trial, span_hint
 
 ROBOT = "robot"
 VIRTUAL = "virtual robot"
@@ -48,9 +48,28 @@ class Notice:
     config: str
     trial: str
     message: str
+    # the same warning without this trial's details: notices sharing it are shown as one line
+    summary: str = ""
 
     def to_json(self) -> dict:
         return asdict(self)
+
+
+def collapsed(found: list[Notice]) -> list[Notice]:
+    """The notices as they are shown: those that say the same of several trials (one ``kind``
+    and ``summary``) become one notice naming how many trials and which, in first-seen order."""
+    groups: dict[tuple[str, str], list[Notice]] = {}
+    for n in found:
+        groups.setdefault((n.kind, n.summary or n.message), []).append(n)
+    out = []
+    for (kind, text), group in groups.items():
+        if len(group) == 1 or not group[0].summary:
+            out += group
+            continue
+        trials = ", ".join(n.trial for n in group)
+        configs = ", ".join(dict.fromkeys(n.config for n in group))
+        out.append(Notice(kind, configs, trials, f"{len(group)} trials ({trials}): {text}", text))
+    return out
 
 
 def recorded_on(record: RunRecord | None) -> tuple[str | None, str]:
@@ -86,16 +105,20 @@ def notices(comps: list[Comparison]) -> list[Notice]:
 
 def _trial_notices(t: Trial) -> list[Notice]:
     out = []
-    if t.config_from != CONFIG_GIVEN:
+    if t.config_from not in (CONFIG_GIVEN, CONFIG_FROM_RECORD):
         where = t.run_path.parent if t.run_path else t.track.path if t.track else t.label
         out.append(Notice("configuration-guessed", t.config, t.label,
                           f"{t.label}: leg set {t.config!r} was guessed from the {t.config_from} ({where}), not "
-                          f"given: say which leg set was filmed with --measured {t.config}=PATH"))
+                          f"given: say which leg set was filmed with --measured {t.config}=PATH",
+                          f"the leg set was guessed from the {t.config_from}, not given: say which leg set was "
+                          "filmed with --measured NAME=PATH, or record it with `locust hop --leg-set NAME`"))
     where, why = recorded_on(t.record)
     if where == VIRTUAL:
         out.append(Notice("virtual-robot", t.config, t.label,
                           f"{t.label}: the 'measured' trial comes from the virtual robot ({why}): it measures the "
-                          "simulated robot, not the physical one"))
+                          "simulated robot, not the physical one",
+                          "the 'measured' trials come from the virtual robot: they measure the simulated robot, "
+                          "not the physical one"))
     return out
 
 
@@ -110,11 +133,14 @@ def _track_notices(c: Comparison, m: MeasuredTrial, predicted_m: float) -> list[
                   "the camera likely saw the hop mirrored (filmed right-to-left): give --mirror")
         out.append(Notice("mirrored", c.config, label,
                           f"{label}: the {marker} travels {_length(travel)} overall where the model predicts "
-                          f"{_length(predicted_m)}: {advice}"))
+                          f"{_length(predicted_m)}: {advice}",
+                          f"the {marker} travels against the model's prediction: {advice}"))
     elif not math.isfinite(predicted_m) and travel <= -MIN_TRAVEL_M and not track.mirrored:
         out.append(Notice("mirrored", c.config, label,
                           f"{label}: the {marker} moves backwards overall ({_length(travel)}): if the hop was "
-                          "filmed right-to-left (the camera saw it mirrored), give --mirror"))
+                          "filmed right-to-left (the camera saw it mirrored), give --mirror",
+                          f"the {marker} moves backwards overall: if the hop was filmed right-to-left (the camera "
+                          "saw it mirrored), give --mirror"))
     hops = [abs(h.distance_m) for h in m.hops if math.isfinite(h.distance_m)]
     jumps = [h.apex_m for h in m.hops if math.isfinite(h.apex_m)]
     # the typical sizes are a desk robot's, not the prediction's: a model can be off by more than a unit

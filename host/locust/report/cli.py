@@ -7,9 +7,9 @@ from pathlib import Path
 
 import click
 
+from ..io.importing import import_options
 from ..params import load_robot, resolve_robot
 from ..params_cli import robot_options
-from ..track.importing import import_options
 
 
 def _stage(msg: str) -> None:
@@ -58,9 +58,10 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
                     --config calibration/robot.toml
       locust report --measured medium=a.tracks.csv,b.tracks.csv --preset seed --sweep sweep/ --cycles 6
     """
+    from ..trials.configs import parse_added
+    from ..trials.measured import parse_measured
     from .build import build_report
-    from .configs import parse_added
-    from .measured import parse_measured
+    from .checks import collapsed
 
     robot = resolve_robot(preset, config, sets)
     groups = parse_measured(list(measured), marker=marker, imports=imports)
@@ -76,7 +77,7 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
         meas = (f"measured {c.distance.mean * 100:.2f} cm over {c.distance.n} trial(s)" if c.distance.n
                 else "no track")
         click.echo(f"{c.config:8s} {pred}, {meas}", err=True)
-    for warning in result.warnings:
+    for warning in collapsed(result.warnings):     # one line for what several trials share
         click.echo(f"warning: {warning.message}", err=True)
     click.echo(f"dashboard: {result.dashboard_path}", err=True)
     for v in result.side_by_side:

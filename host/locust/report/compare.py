@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..device.record import Jitter, jitter
-from ..errors import ReportError
-from .measure import Aligned, MeasuredHop, align, measure_hops
-from .measured import Trial, span_hint
+from ..errors import ReportError, TrialError
+from ..io.run_record import Jitter, jitter
+from ..trials.measure import Aligned, MeasuredHop, align, measure_hops
+from ..trials.measured import Trial, span_hint
 from .predict import Prediction
 
 
@@ -121,7 +121,7 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
         tr = trial.track
         try:
             trace = align(tr.t_s, tr.x_m, tr.y_m, latency, where=str(tr.path))
-        except ReportError as exc:
+        except TrialError as exc:
             hint = span_hint(tr)        # noise in mm read as metres looks like a robot already moving
             raise ReportError(exc.message, f"{hint}; {exc.hint}" if hint else exc.hint) from None
         measured.append(MeasuredTrial(trial, trace, measure_hops(trace, period_s, trial_cycles(trial, cycles))))

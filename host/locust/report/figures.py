@@ -1,6 +1,7 @@
 """The report's figures (matplotlib, Agg), each drawn on given axes so the HTML page and the
 PNG dashboard share them. Measured: solid, coloured by configuration; predicted: dashed or
-hatched. An invalid simulation is written in its panel, never drawn as a prediction.
+hatched. An invalid simulation is written in its panel, never drawn as a prediction. Lengths
+are in centimetres on every axis; legends stand outside the axes, never over the data.
 """
 
 from __future__ import annotations
@@ -10,9 +11,9 @@ import math
 import numpy as np
 
 from ..plotting import png_bytes, pyplot
-from ..sweep.design import SCALE
+from ..sweep.design import axis_scale
+from ..trials.configs import Configuration
 from .compare import Comparison
-from .configs import Configuration
 from .landscape import Landscape, design_value
 
 COLOURS = {"small": "#1f77b4", "medium": "#ff7f0e", "large": "#2ca02c"}   # the seed dashboard's
@@ -25,6 +26,13 @@ def colour(name: str, names: list[str]) -> str:
         return COLOURS[name]
     others = [n for n in names if n not in COLOURS]
     return OTHER[others.index(name) % len(OTHER)] if name in others else OTHER[0]
+
+
+def legend_outside(ax, below: bool = False, **kw) -> None:
+    """The axes' legend beside them on the right (or ``below`` them), off the data."""
+    place = (dict(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2) if below
+             else dict(loc="upper left", bbox_to_anchor=(1.02, 1.0)))
+    ax.legend(frameon=False, fontsize=kw.pop("fontsize", 7), borderaxespad=0.0, **place, **kw)
 
 
 def _label(c: Comparison) -> str:
@@ -73,7 +81,7 @@ def overlay_figure(comps: list[Comparison], spreads: dict | None = None, befores
         axes[0, j].set_title(f"{_label(c)}: nose displacement", loc="left", fontsize=10)
         axes[1, j].set_title(f"{_label(c)}: nose height", loc="left", fontsize=10)
         axes[1, j].set_xlabel("time since first push (s)")
-        axes[0, j].legend(frameon=False, fontsize=8, loc="upper left")
+        legend_outside(axes[1, j], below=True, fontsize=8)
     axes[0, 0].set_ylabel("forward (cm)")
     axes[1, 0].set_ylabel("above standing (cm)")
     fig.suptitle("Displacement and height vs time: measured (solid) and predicted (dashed)", fontsize=11)
@@ -109,7 +117,7 @@ def draw_bars(ax, comps: list[Comparison], what: str) -> None:
     ax.set_xticks(x, [_label(c) for c in comps])
     ax.axhline(0, color="black", lw=0.6)
     ax.yaxis.grid(True, ls="--", alpha=0.5, zorder=0)
-    ax.legend(frameon=False, fontsize=8)
+    legend_outside(ax, fontsize=8)
 
 
 def bars_figure(comps: list[Comparison], what: str) -> bytes:
@@ -156,21 +164,15 @@ def hops_figure(comps: list[Comparison], spreads: dict | None = None) -> bytes:
         ax.set_ylabel(unit)
         ax.grid(True, ls=":", alpha=0.5)
         ax.xaxis.get_major_locator().set_params(integer=True)
-    axes[1].legend(frameon=False, fontsize=7, loc="best")
+    legend_outside(axes[1])
     fig.tight_layout()
     return png_bytes(fig)
-
-
-def _axis_scale(name: str) -> tuple[float, str]:
-    if name == SCALE:
-        return CM, "added length on every link (cm)"
-    return (CM, f"{name} (cm)") if name.endswith("_m") else (1.0, name)
 
 
 def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[str, Configuration]) -> None:
     names = [c.config for c in comps]
     first = land.names[0]
-    k, xlabel = _axis_scale(first)
+    k, xlabel = axis_scale(first)
     xs = land.values[first] * k
     hop = land.hop_distance_m * CM
     if len(land.names) == 1:
@@ -196,7 +198,7 @@ def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[s
         ax.set_ylabel("distance per hop (cm)")
     else:
         second = land.names[1]
-        k2, ylabel = _axis_scale(second)
+        k2, ylabel = axis_scale(second)
         ys = land.values[second] * k2
         sc = ax.scatter(xs[land.valid], ys[land.valid], c=hop[land.valid], cmap="viridis", s=28)
         ax.figure.colorbar(sc, ax=ax, label="distance per hop (cm)")
@@ -212,7 +214,27 @@ def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[s
     ax.set_title(f"Sweep landscape ({land.designs} designs, {land.cycles} cycles, base {land.base}) "
                  "with the physical designs", loc="left", fontsize=9)
     ax.grid(True, ls=":", alpha=0.5)
-    ax.legend(frameon=False, fontsize=7)
+    legend_outside(ax)
+
+
+def landscape_caption(land: Landscape, comps: list[Comparison]) -> str:
+    """What :func:`draw_landscape` draws, in words: only marks that are drawn are named."""
+    bad = int((~land.valid).sum())
+    if len(land.names) == 1:
+        text = f"Simulated distance per hop over the sweep in {land.folder}"
+        text += (f" ({bad} invalid design{'s' if bad != 1 else ''}, failed audit: red crosses at zero)" if bad
+                 else " (every design valid)")
+        marks = []
+        if any(c.prediction.valid for c in comps):
+            marks.append("its prediction (open circle)")
+        if any(c.hop_distance.n for c in comps):
+            marks.append("its measurement (filled square, ±1 sd)")
+        text += ", with each physical design's position (dotted line)"
+        return text + (", " + " and ".join(marks) if marks else "") + "."
+    text = f"Simulated distance per hop (colour) over the sweep in {land.folder}"
+    text += (f" ({bad} invalid design{'s' if bad != 1 else ''}, failed audit: red crosses)" if bad
+             else " (every design valid)")
+    return text + ", with each physical design marked by a star."
 
 
 def landscape_figure(land: Landscape, comps: list[Comparison], configs: dict[str, Configuration]) -> bytes:
@@ -241,7 +263,7 @@ def draw_timing(ax, comps: list[Comparison]) -> None:
     ax.set_title("Firmware timing: phase start, measured - commanded", loc="left", fontsize=10)
     ax.grid(True, ls=":", alpha=0.5)
     if drawn:
-        ax.legend(frameon=False, fontsize=7, ncol=2)
+        legend_outside(ax)
 
 
 def timing_figure(comps: list[Comparison]) -> bytes:
@@ -270,7 +292,7 @@ def dashboard(comps: list[Comparison], land: Landscape | None, configs: dict[str
     ax.set_xlabel("time since first push (s)")
     ax.set_ylabel("displacement (cm)")
     ax.grid(True, ls=":", alpha=0.5)
-    ax.legend(frameon=False, fontsize=8, loc="upper left")
+    legend_outside(ax, fontsize=8)
     draw_bars(axes[0, 1], comps, "jump")
     axes[0, 1].set_title("Max vertical jump height (nose above standing)", loc="left", fontsize=11)
     axes[0, 1].set_ylabel("height (cm)")

@@ -1,7 +1,7 @@
 """A sweep's landscape (``locust sweep --out DIR``) and where the physical designs sit on it.
 
 ``DIR/sweep.json`` and ``DIR/results.csv`` are read by their owner,
-:func:`locust.sweep.store.read_results`. A configuration's position on a ``scale`` axis is the length it adds
+:func:`locust.io.sweep_store.read_results`. A configuration's position on a ``scale`` axis is the length it adds
 to every link; on a dotted parameter's axis, that parameter's value in its robot.
 """
 
@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import LocustError, ReportError, SweepError
+from ..io.sweep_store import read_results
 from ..sweep.design import SCALE
-from ..sweep.store import read_results
-from .configs import Configuration
+from ..trials.configs import Configuration
 
 
 @dataclass(frozen=True)
@@ -41,7 +41,7 @@ class Landscape:
 
 
 def read_landscape(folder: Path) -> Landscape:
-    """The landscape of a sweep folder, read by its owner (:mod:`locust.sweep.store`)."""
+    """The landscape of a sweep folder, read by its owner (:mod:`locust.io.sweep_store`)."""
     try:
         res = read_results(Path(folder))
     except SweepError as exc:

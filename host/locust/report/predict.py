@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 from ..errors import GeometryError, ReportError
 from ..params import Robot
-from .measure import Aligned, MeasuredHop, measure_hops, onset_time
+from ..trials.measure import Aligned, MeasuredHop, measure_hops, onset_time
 
 
 @dataclass

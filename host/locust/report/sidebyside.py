@@ -41,9 +41,9 @@ import cv2
 import numpy as np
 
 from ..errors import ReportError, TrackError
+from ..io.camera_json import CameraFile, camera_json_beside, read_camera_json
+from ..io.tracks_csv import TRACKS_CSV_SUFFIX, TracksCsv, read_track_file
 from ..progress import progress
-from ..track.camera import CameraFile, camera_json_beside, read_camera_json
-from ..track.tracks_csv import TRACKS_CSV_SUFFIX, TracksCsv, read_track_file
 from ..track.video import Clip, VideoInfo, encode_video, probe, read_frames
 from .compare import Comparison, MeasuredTrial
 

@@ -18,7 +18,7 @@ import numpy as np
 from ..params import Robot
 from ..sim.hops import summarise
 from ..sim.samples import simulate_draws
-from .measure import measure_hops
+from ..trials.measure import measure_hops
 from .predict import marker_trace
 
 

@@ -48,9 +48,9 @@ def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int 
                           noise_m: float = 0.0005, camera_lead_s: float = 0.25, lost_frames: int = 3,
                           truth=None) -> SyntheticTruth:
     """Write one synthetic trial into ``folder``; ``truth`` reuses a :func:`simulated_nose`."""
-    from ..device.record import COMPLETE, HopSchedule, Phase, RunRecord
-    from ..device.record import write as write_record
-    from ..track.tracks_csv import MarkerColumns, TracksCsv, write_tracks_csv
+    from ..io.run_record import COMPLETE, HopSchedule, Phase, RunRecord
+    from ..io.run_record import write as write_record
+    from ..io.tracks_csv import MarkerColumns, TracksCsv, write_tracks_csv
 
     result, trace = truth or simulated_nose(robot, cycles)
     rng = np.random.default_rng(seed)

@@ -11,6 +11,7 @@ from ..errors import GeometryError, SimError
 from ..fileio import json_text
 from ..params import resolve_robot
 from ..params_cli import robot_options
+from ..tables import sim_lines, spread_line
 
 
 @click.command()
@@ -26,7 +27,8 @@ from ..params_cli import robot_options
               help="Rerun at half the time step and report the relative change.")
 @click.option("--samples", type=click.IntRange(2, 4096), default=None, metavar="N",
               help="Also simulate N draws of the values that carry an uncertainty in the robot file "
-                   "(one batched rollout) and report distance_m_sd and max_nose_height_m_sd.")
+                   "(one batched rollout) and report the sd of distance and highest nose "
+                   "(--json: distance_m_sd, max_nose_height_m_sd).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of --samples.")
 def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence, samples, seed):
     """Settle the robot on the floor, then run the bang-bang hop schedule.
@@ -77,36 +79,10 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
                        samples=spread.to_json())
         click.echo(json_text(out), nl=False)
         return
-    _print_human(result)
+    for line in sim_lines(result):
+        click.echo(line)
     if spread is not None:
-        click.echo(f"  {spread.n} draws of {len(spread.uncertain)} uncertain values ({spread.n_valid} valid): "
-                   f"distance sd {spread.distance_m_sd * 100:.3f} cm, "
-                   f"max nose height sd {spread.max_nose_height_m_sd * 100:.3f} cm")
+        click.echo(spread_line(spread))
     if not result.valid:
         sys.exit(1)
 
-
-def _print_human(r) -> None:
-    verdict = click.style("valid", fg="green") if r.valid else click.style("INVALID", fg="red")
-    click.echo(f"{r.robot}: {verdict} ({r.cycles} cycles, dt {r.timestep_s:g} s, {r.wall_s:.1f} s wall)")
-    for reason in r.reasons:
-        click.echo(f"  reason: {reason}")
-    if not r.valid:
-        return
-    click.echo(f"  distance        {r.distance_m * 100:8.2f} cm")
-    click.echo(f"  max nose height {r.max_nose_height_m * 100:8.2f} cm")
-    click.echo(f"  linkage         {r.grashof}, transmission {r.transmission_deg:.0f} deg")
-    click.echo("  hop  distance_cm  nose_apex_cm  com_apex_cm  flight_ms")
-    for h in r.hops:
-        click.echo(f"  {h.cycle:3d}  {h.distance_m * 100:11.2f}  {h.nose_apex_m * 100:12.2f}  "
-                   f"{h.com_apex_m * 100:11.2f}  {h.flight_s * 1000:9.1f}")
-    if r.convergence:
-        c = r.convergence
-        verdict = "converged" if c["converged"] else "NOT converged (within 1 % or 0.1 mm asked)"
-        click.echo(f"  convergence at dt/2 ({c['half_timestep_s']:g} s): distance "
-                   f"{c['distance_change_mm_per_hop']:.3f} mm per hop ({c['distance_rel_change'] * 100:.2f} %), "
-                   f"nose height {c['max_nose_height_change_mm']:.3f} mm "
-                   f"({c['max_nose_height_rel_change'] * 100:.2f} %): "
-                   f"{verdict}")
-    for note in r.notes:
-        click.echo(f"  note: {note}")

@@ -30,12 +30,11 @@ import mujoco
 import numpy as np
 
 from ..errors import SimError
-from ..fileio import atomic_write_text, temp_beside
+from ..fileio import atomic_write_text, check_encoded, temp_beside
+from ..io.camera_json import CameraFile, MarkerPlane, camera_json_beside, write_camera_json
 from ..markers import MARKER_COLOURS
 from ..params import Robot
 from ..progress import progress
-from ..track.camera import CameraFile, MarkerPlane, camera_json_beside, write_camera_json
-from ..track.video import check_encoded
 from .audit import audit
 from .camera import (
     CAMERAS,
@@ -251,7 +250,7 @@ class ClipRecorder:
         return "\n".join(lines) + "\n"
 
     def camera_file(self) -> CameraFile:
-        """The camera this clip was rendered with, as its owner (:mod:`locust.track.camera`) writes it."""
+        """The camera this clip was rendered with, as its owner (:mod:`locust.io.camera_json`) writes it."""
         first = self.cameras[0]
         K = np.array([[first.fx_px, 0.0, first.cx_px], [0.0, first.fy_px, first.cy_px], [0.0, 0.0, 1.0]])
         fixed = self.camera == "fixed"

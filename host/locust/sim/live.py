@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import threading
 import time
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, field, replace
 
 import mujoco
 import numpy as np
@@ -54,6 +54,7 @@ class LiveResult:
     realtime_factor: float       # simulated seconds per wall second spent stepping (and rendering)
     video_path: str | None = None
     frames: int = 0
+    hops: list[dict] = field(default_factory=list)   # per push: Hop's fields (locust.sim.hops.Hop)
 
     def to_dict(self) -> dict:
         return dict(self.__dict__)
@@ -248,7 +249,8 @@ class LiveSim:
             distance, nose = summary.distance_m, summary.max_nose_height_m
         else:  # nothing happened after the settle phase
             distance, nose = 0.0, float(traj.sensordata[-1, self.built.sensors.nose_pos][2])
-        return LiveResult(distance, nose, sim_s, verdict.valid, verdict.reasons, rtf, video_path, frames)
+        hops = _per_push(traj) if verdict.valid and self._steps > self._settle_steps else []
+        return LiveResult(distance, nose, sim_s, verdict.valid, verdict.reasons, rtf, video_path, frames, hops)
 
     def trajectory(self) -> Trajectory:
         """The record so far, in the rollout's form (one row per physics step, settle included)."""
@@ -279,6 +281,19 @@ class LiveSim:
             self.abort()   # a failed run leaves no half-written video
         elif self._result is None:
             self.close()
+
+
+def _per_push(traj: Trajectory) -> list[dict]:
+    """The run cut where each push starts (the left servo's command leaving rest), as the
+    rollout's cycles are: per hop its distance, nose and CoM rise and flight (Hop's fields).
+    The first hop starts at the end of the settle phase."""
+    ctrl, settle = traj.plan.ctrl_rad, traj.plan.settle_steps
+    pushing = ctrl[settle:] != 0.0
+    starts = settle + np.flatnonzero(pushing & ~np.concatenate(([False], pushing[:-1])))
+    if len(starts) == 0:
+        return []
+    cut = replace(traj, plan=replace(traj.plan, cycle_start_steps=np.array([settle, *starts[1:], len(ctrl)])))
+    return [asdict(hop) for hop in summarise(cut).hops]
 
 
 __all__ = ["LiveSim", "LiveResult"]

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import SimError
 from ..markers import MARKER_COLOURS, hex_to_rgb01
-from ..params import GRAVITY_M_PER_S2, Robot
+from ..params import GRAVITY_M_PER_S2, Robot, Servo
 from .fourbar import Assembly, assemble
 from .servo import at_supply
 from .servo import configure as configure_servo
@@ -83,7 +83,7 @@ def _quat_euler_deg(x: float, y: float, z: float) -> np.ndarray:
 
 def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     """The model as an ``MjSpec`` (raises ``GeometryError`` for a linkage that cannot close)."""
-    g, c, k, sol = robot.geometry, robot.compliance, robot.contact, robot.solver
+    g, sol = robot.geometry, robot.solver
     s = at_supply(robot.servo, robot.power)   # the servo on this supply (docs/servo.md, "Power")
     asm = assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, g.crank_start_deg)
     if sol.integrator not in INTEGRATORS:
@@ -91,6 +91,20 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
                        f"choose one of {', '.join(INTEGRATORS)}")
 
     spec = mujoco.MjSpec()
+    _set_options(spec, robot)
+    _add_scene(spec)
+    chassis = _add_chassis(spec, robot)
+    for side in SIDES:
+        _add_leg(spec, chassis, robot, side, asm, s)
+    _floor_pairs(spec, robot.contact)
+    _add_sensors(spec)
+    return spec, asm
+
+
+def _set_options(spec: mujoco.MjSpec, robot: Robot) -> None:
+    """Name, solver options (time step, integrator, gravity, disabled features) and the
+    offscreen rendering settings."""
+    sol = robot.solver
     spec.modelname = f"locust-{robot.name}"
     spec.compiler.degree = False
     spec.option.timestep = sol.timestep_s
@@ -112,6 +126,9 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     spec.visual.map.fogstart = 100
     spec.visual.map.fogend = 1000
 
+
+def _add_scene(spec: mujoco.MjSpec) -> None:
+    """The floor (checker texture, its collision bits), the marker materials and the lights."""
     spec.add_texture(name="grid", type=mujoco.mjtTexture.mjTEXTURE_2D,
                      builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER, width=512, height=512,
                      rgb1=[0.2, 0.2, 0.25], rgb2=[0.15, 0.15, 0.2])
@@ -126,8 +143,12 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[10, 5, 0.1],
                    material="floor", contype=FLOOR_BITS[0], conaffinity=FLOOR_BITS[1])
 
-    chassis = world.add_body(name="chassis", pos=[0, 0, g.drop_height_m],
-                             quat=_quat_euler_deg(180.0, g.body_pitch_deg, 180.0))
+
+def _add_chassis(spec: mujoco.MjSpec, robot: Robot):
+    """The plate on its free joint at the drop height, with the nose site and nose marker."""
+    g, k = robot.geometry, robot.contact
+    chassis = spec.worldbody.add_body(name="chassis", pos=[0, 0, g.drop_height_m],
+                                      quat=_quat_euler_deg(180.0, g.body_pitch_deg, 180.0))
     chassis.add_freejoint(name="free")
     chassis.add_geom(name="plate", type=mujoco.mjtGeom.mjGEOM_BOX,
                      size=[g.body_length_m / 2, g.body_width_m / 2, g.body_thickness_m / 2],
@@ -139,65 +160,67 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     # touches the floor when the robot stands nose-down)
     _marker(chassis, "nose", [g.nose_x_m + MARKER_NOSE_BACK * MARKER_RADIUS_M, g.body_width_m / 2,
                               -MARKER_NOSE_UP * MARKER_RADIUS_M])
+    return chassis
 
+
+def _add_leg(spec: mujoco.MjSpec, chassis, robot: Robot, side: str, asm: Assembly, s: Servo) -> None:
+    """One side's servo body and four-bar leg (ground, crank on the servo joint, coupler and
+    leg on folded hinges), the loop-closing equality and the servo's actuator; ``s`` is the
+    servo on the robot's supply."""
+    g, c, k, sol = robot.geometry, robot.compliance, robot.contact, robot.solver
     half_w, half_t = g.link_width_m / 2, g.link_thickness_m / 2
     foot_material = [k.foot_friction, k.torsional_friction, k.rolling_friction]
     rho, selfc, rounded = g.link_density_kg_per_m3, bool(k.self_collision), bool(k.rounded_edges)
-    for side in SIDES:
-        y = g.leg_mount_y_m if side == "L" else -g.leg_mount_y_m
-        # the servo under the plate (chassis +z is the legs' side): its body carries its mass,
-        # drawn and massive but not colliding (the leg loops reach the floor first)
-        chassis.add_geom(name=f"{side}_servo_body", type=mujoco.mjtGeom.mjGEOM_BOX,
-                         pos=[g.servo_axis_x_m + g.servo_body_x_m, math.copysign(g.servo_body_y_m, y),
-                              g.servo_axis_below_plate_m],
-                         size=[g.servo_length_m / 2, g.servo_height_m / 2, g.servo_width_m / 2],
-                         mass=g.servo_mass_kg, rgba=[0.25, 0.35, 0.9, 0.8], contype=0, conaffinity=0)
-        # the ground link from the servo axis to the front pivot, at ground_angle_deg to the plate
-        mount = chassis.add_body(name=f"{side}_mount", pos=[g.servo_axis_x_m, y, g.servo_axis_below_plate_m],
-                                 quat=_quat_euler_deg(0, g.ground_angle_deg, 0))
-        ground = mount.add_body(name=f"{side}_ground", pos=[g.ground_m / 2, 0, 0])
-        _ghost_box(ground, g.ground_m, half_w, half_t, LINK_RGBA["ground"], rho)
-        ground.add_site(name=f"{side}_loop_a", pos=[g.ground_m / 2, 0, 0])
-        # Joint angles about +y turn +x toward -z, the mirror of the fourbar frame's
-        # counter-clockwise angles: pass the fourbar angles through unchanged and the
-        # chain is the mirror image of the planar solution, closed at the same anchor.
-        crank = ground.add_body(name=f"{side}_crank", pos=[-g.ground_m / 2, 0, 0],
-                                quat=_quat_euler_deg(0, asm.crank_deg, 0))
-        # the crank turns on the servo shaft, in parallel with the laminate's folded hinge
-        servo_joint = crank.add_joint(name=f"{side}_servo", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
-                                      range=[-math.radians(s.travel_deg), math.radians(s.travel_deg)],
-                                      limited=mujoco.mjtLimited.mjLIMITED_TRUE,
-                                      stiffness=c.hinge_stiffness_nm_per_rad)
-        _link_box(crank, g.crank_m, half_w, half_t, LINK_RGBA["crank"], foot_material, rho, selfc, rounded)
-        coupler = crank.add_body(name=f"{side}_coupler", pos=[g.crank_m, 0, 0],
-                                 quat=_quat_euler_deg(0, asm.coupler_rel_deg, 0))
-        _hinge(coupler, f"{side}_knee", c)
-        _link_box(coupler, g.coupler_m, half_w, half_t, LINK_RGBA["coupler"], foot_material, rho, selfc, rounded)
-        leg = coupler.add_body(name=f"{side}_leg", pos=[g.coupler_m, 0, 0],
-                               quat=_quat_euler_deg(0, asm.leg_rel_deg, 0))
-        _hinge(leg, f"{side}_ankle", c)
-        _link_box(leg, g.leg_m, half_w, half_t, LINK_RGBA["leg"], foot_material, rho, selfc, rounded)
-        leg.add_site(name=f"{side}_foot", pos=[0, 0, 0], size=[0.004, 0, 0])
-        if side == "L":   # foot dot: on the leg's camera-facing face, up the leg from the foot
-            _marker(leg, "foot", [MARKER_FOOT_UP * MARKER_RADIUS_M, g.link_width_m / 2, 0])
-        end = leg.add_body(name=f"{side}_end", pos=[g.leg_m, 0, 0])
-        end.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.005, 0, 0], contype=0, conaffinity=0, density=rho,
-                     rgba=list(LINK_RGBA["ground"]))
-        end.add_site(name=f"{side}_loop_b", pos=[0, 0, 0])
-        spec.add_equality(name=f"{side}_loop", type=mujoco.mjtEq.mjEQ_CONNECT,
-                          objtype=mujoco.mjtObj.mjOBJ_BODY, name1=f"{side}_ground", name2=f"{side}_end",
-                          data=[g.ground_m / 2, 0, 0] + [0.0] * 7 + [1.0, 0.0],  # as MJCF fills it
-                          solref=[sol.loop_timeconst_s, 1.0],
-                          solimp=[sol.loop_dmin, sol.loop_dmax, 0.001, 0.5, 2.0])
-        act = spec.add_actuator(name=f"{side}_servo", target=f"{side}_servo",
-                                trntype=mujoco.mjtTrn.mjTRN_JOINT)
-        configure_servo(servo_joint, act, s, joint_damping_nms_per_rad=c.hinge_damping_nms_per_rad)
-        act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
-        act.ctrlrange = [-math.radians(s.travel_deg), math.radians(s.travel_deg)]
-
-    _floor_pairs(spec, k)
-    _add_sensors(spec)
-    return spec, asm
+    y = g.leg_mount_y_m if side == "L" else -g.leg_mount_y_m
+    # the servo under the plate (chassis +z is the legs' side): its body carries its mass,
+    # drawn and massive but not colliding (the leg loops reach the floor first)
+    chassis.add_geom(name=f"{side}_servo_body", type=mujoco.mjtGeom.mjGEOM_BOX,
+                     pos=[g.servo_axis_x_m + g.servo_body_x_m, math.copysign(g.servo_body_y_m, y),
+                          g.servo_axis_below_plate_m],
+                     size=[g.servo_length_m / 2, g.servo_height_m / 2, g.servo_width_m / 2],
+                     mass=g.servo_mass_kg, rgba=[0.25, 0.35, 0.9, 0.8], contype=0, conaffinity=0)
+    # the ground link from the servo axis to the front pivot, at ground_angle_deg to the plate
+    mount = chassis.add_body(name=f"{side}_mount", pos=[g.servo_axis_x_m, y, g.servo_axis_below_plate_m],
+                             quat=_quat_euler_deg(0, g.ground_angle_deg, 0))
+    ground = mount.add_body(name=f"{side}_ground", pos=[g.ground_m / 2, 0, 0])
+    _ghost_box(ground, g.ground_m, half_w, half_t, LINK_RGBA["ground"], rho)
+    ground.add_site(name=f"{side}_loop_a", pos=[g.ground_m / 2, 0, 0])
+    # Joint angles about +y turn +x toward -z, the mirror of the fourbar frame's
+    # counter-clockwise angles: pass the fourbar angles through unchanged and the
+    # chain is the mirror image of the planar solution, closed at the same anchor.
+    crank = ground.add_body(name=f"{side}_crank", pos=[-g.ground_m / 2, 0, 0],
+                            quat=_quat_euler_deg(0, asm.crank_deg, 0))
+    # the crank turns on the servo shaft, in parallel with the laminate's folded hinge
+    servo_joint = crank.add_joint(name=f"{side}_servo", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
+                                  range=[-math.radians(s.travel_deg), math.radians(s.travel_deg)],
+                                  limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+                                  stiffness=c.hinge_stiffness_nm_per_rad)
+    _link_box(crank, g.crank_m, half_w, half_t, LINK_RGBA["crank"], foot_material, rho, selfc, rounded)
+    coupler = crank.add_body(name=f"{side}_coupler", pos=[g.crank_m, 0, 0],
+                             quat=_quat_euler_deg(0, asm.coupler_rel_deg, 0))
+    _hinge(coupler, f"{side}_knee", c)
+    _link_box(coupler, g.coupler_m, half_w, half_t, LINK_RGBA["coupler"], foot_material, rho, selfc, rounded)
+    leg = coupler.add_body(name=f"{side}_leg", pos=[g.coupler_m, 0, 0],
+                           quat=_quat_euler_deg(0, asm.leg_rel_deg, 0))
+    _hinge(leg, f"{side}_ankle", c)
+    _link_box(leg, g.leg_m, half_w, half_t, LINK_RGBA["leg"], foot_material, rho, selfc, rounded)
+    leg.add_site(name=f"{side}_foot", pos=[0, 0, 0], size=[0.004, 0, 0])
+    if side == "L":   # foot dot: on the leg's camera-facing face, up the leg from the foot
+        _marker(leg, "foot", [MARKER_FOOT_UP * MARKER_RADIUS_M, g.link_width_m / 2, 0])
+    end = leg.add_body(name=f"{side}_end", pos=[g.leg_m, 0, 0])
+    end.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.005, 0, 0], contype=0, conaffinity=0, density=rho,
+                 rgba=list(LINK_RGBA["ground"]))
+    end.add_site(name=f"{side}_loop_b", pos=[0, 0, 0])
+    spec.add_equality(name=f"{side}_loop", type=mujoco.mjtEq.mjEQ_CONNECT,
+                      objtype=mujoco.mjtObj.mjOBJ_BODY, name1=f"{side}_ground", name2=f"{side}_end",
+                      data=[g.ground_m / 2, 0, 0] + [0.0] * 7 + [1.0, 0.0],  # as MJCF fills it
+                      solref=[sol.loop_timeconst_s, 1.0],
+                      solimp=[sol.loop_dmin, sol.loop_dmax, 0.001, 0.5, 2.0])
+    act = spec.add_actuator(name=f"{side}_servo", target=f"{side}_servo",
+                            trntype=mujoco.mjtTrn.mjTRN_JOINT)
+    configure_servo(servo_joint, act, s, joint_damping_nms_per_rad=c.hinge_damping_nms_per_rad)
+    act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+    act.ctrlrange = [-math.radians(s.travel_deg), math.radians(s.travel_deg)]
 
 
 def contact_solref(contact) -> list[float]:

@@ -1,3 +1,3 @@
 """Design sweeps and optimisation over the simulation: design (axes, checks, one design's
-evaluation), execute (local processes or Dask), store (results.csv and sweep.json), run
-(the sweep), plot, optimize (Optuna), cli."""
+evaluation), execute (local processes or Dask), run (the sweep, into the folder
+:mod:`locust.io.sweep_store` owns: results.csv and sweep.json), plot, optimize (Optuna), cli."""

@@ -16,13 +16,20 @@ from typing import Any
 import numpy as np
 
 from ..errors import GeometryError, LocustError, SweepError
-from ..params import Provenance, Robot, all_keys, problems, with_added_length
+from ..params import Provenance, Robot, all_keys, outside_limits, problems, with_added_length
 from ..sim.fourbar import assemble
 
 SCALE = "scale"
-RESULT_FIELDS = ("valid", "reason", "distance_m", "max_nose_height_m", "nose_apex_max_m",
-                 "com_apex_max_m", "hops", "grashof", "transmission_deg")
 CRANK_CHECK_STEP_DEG = 1.0
+CM_PER_M = 100.0   # every figure draws lengths in centimetres, and says so on its axis
+
+
+def axis_scale(name: str) -> tuple[float, str]:
+    """(factor, axis label) to draw the sweep axis ``name``: a length (``scale``, ``*_m``) in
+    cm, anything else in its own unit, as its name says."""
+    if name == SCALE:
+        return CM_PER_M, "added length on every link (cm)"
+    return (CM_PER_M, f"{name} (cm)") if name.endswith("_m") else (1.0, name)
 
 
 @dataclass(frozen=True)
@@ -61,6 +68,27 @@ def check_name(name: str, base: Robot) -> None:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise SweepError(f"--vary {name!r}: the parameter is not a number ({value!r})",
                          "vary a numeric parameter, e.g. geometry.leg_m or schedule.push_deg")
+    if name == "schedule.cycles":   # one rule: every design of a run hops as often
+        raise SweepError("--vary schedule.cycles: the hops per design are --cycles, the same for every design",
+                         "give --cycles N instead (one run per number of hops, each with its own --out)")
+
+
+def check_range(item: str, name: str, low: float, high: float, base: Robot) -> None:
+    """Both ends of a --vary range within the limits of what it changes (``scale``: the four
+    links), checked before any design runs: a range outside is a unit slip (centimetres typed
+    for metres), not a sweep of invalid designs."""
+    for end in (low, high):
+        if name == SCALE:
+            g = base.geometry
+            changed = {f"geometry.{k}": getattr(g, k) + end for k in ("ground_m", "crank_m", "coupler_m", "leg_m")}
+        else:
+            changed = {name: end}
+        found = [p for key, value in changed.items() if (p := outside_limits(key, value))]
+        if found:
+            more = f" (and {len(found) - 1} more)" if len(found) > 1 else ""
+            raise SweepError(f"--vary {item!r}: at {end:g}, {found[0]}{more}",
+                             "values are in the units their names end in (m, kg, s, deg; scale in m): "
+                             "5 cm is 0.05, e.g. --vary scale=0:0.05:30")
 
 
 def _numbers(text: str, parts: int, what: str, item: str) -> list[float]:
@@ -94,6 +122,7 @@ def parse_axis(item: str, base: Robot) -> Axis:
                          "e.g. --vary scale=0:0.05:30")
     if int(n) == 1 and start != stop:
         raise SweepError(f"--vary {item!r}: one design cannot span {start:g}..{stop:g}", "use N >= 2")
+    check_range(item, name, start, stop, base)
     return Axis(name, start, stop, int(n))
 
 
@@ -104,6 +133,7 @@ def parse_bound(item: str, base: Robot) -> Bound:
     if not low < high:
         raise SweepError(f"--vary {item!r}: LOW {low:g} must be below HIGH {high:g}",
                          "e.g. --vary geometry.leg_m=0.05:0.09")
+    check_range(item, name, low, high, base)
     return Bound(name, low, high)
 
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..params import LEG_SETS, Robot, preset
 from ..plotting import pyplot, save_png
-from .design import SCALE, Axis
+from .design import SCALE, Axis, axis_scale
 
 METRICS = (("distance_m", "distance (cm)"), ("max_nose_height_m", "highest nose point (cm)"))
 
@@ -27,8 +27,7 @@ def _leg_set_marks(axis: Axis, base: Robot) -> list[tuple[str, float]]:
 
 def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robot, path: Path) -> Path:
     plt = pyplot()
-    x_scale, unit = (100.0, " (cm)") if axis.name == SCALE or axis.name.endswith("_m") else (1.0, "")
-    label = ("added length on every link" if axis.name == SCALE else axis.name) + unit
+    x_scale, label = axis_scale(axis.name)
     fig, panels = plt.subplots(1, 2, figsize=(11, 4.2))
     ok = [r for r in rows if r["valid"]]
     bad = [r for r in rows if not r["valid"]]
@@ -62,6 +61,7 @@ def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robo
 def _heatmap(rows: list[dict[str, Any]], ax_a: Axis, ax_b: Axis, path: Path) -> Path:
     plt = pyplot()
     va, vb = ax_a.values(), ax_b.values()
+    (ka, label_a), (kb, label_b) = axis_scale(ax_a.name), axis_scale(ax_b.name)
     fig, panels = plt.subplots(1, 2, figsize=(12, 4.8))
     for ax, (key, title) in zip(panels, METRICS):
         grid = np.full((len(vb), len(va)), np.nan)
@@ -70,15 +70,15 @@ def _heatmap(rows: list[dict[str, Any]], ax_a: Axis, ax_b: Axis, path: Path) -> 
                 i, j = vb.index(r[ax_b.name]), va.index(r[ax_a.name])
                 grid[i, j] = np.fmax(grid[i, j], r[key] * 100)
         img = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis",
-                        extent=_extent(va) + _extent(vb))
+                        extent=_extent([v * ka for v in va]) + _extent([v * kb for v in vb]))
         fig.colorbar(img, ax=ax, label=title)
         bad = np.isnan(grid)
         if bad.any():
-            jj, ii = np.meshgrid(va, vb)
+            jj, ii = np.meshgrid(np.asarray(va) * ka, np.asarray(vb) * kb)
             ax.plot(jj[bad], ii[bad], "x", color="#d62728", ms=5, label="invalid (no valid design)")
             ax.legend(fontsize=8, loc="upper right")
-        ax.set_xlabel(ax_a.name)
-        ax.set_ylabel(ax_b.name)
+        ax.set_xlabel(label_a)
+        ax.set_ylabel(label_b)
         ax.set_title(title + ("" if len(rows) == grid.size else ", best over the other axes"), fontsize=9)
     return save_png(fig, path)
 

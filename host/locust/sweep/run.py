@@ -19,10 +19,10 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SweepError
+from ..io.sweep_store import SweepStore
 from ..params import Robot
 from .design import Axis, evaluate
 from .execute import default_jobs, mapper, plan_jobs, probe_dask_scheduler
-from .store import SweepStore
 
 
 @dataclass(frozen=True)

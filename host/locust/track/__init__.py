@@ -13,21 +13,19 @@ Modules, one job each:
 - :mod:`.aruco`     ArUco markers (``cv2.aruco``) with sub-pixel corners
 - :mod:`.spec`      ``--marker NAME=SPEC`` parsing and the default marker set
 - :mod:`.calib`     pixel -> metre calibration (stick or ArUco size), origin, axes
+- :mod:`.camera`    pixel -> plane metres through the pinhole camera of a ``camera.json``
 - :mod:`.board`     pixel -> plane metres through a homography: ArUco grid board or four points
 - :mod:`.preview`   one frame with a pixel grid and the saturated blobs, for picking colours
 - :mod:`.runner`    the frame loop that ties video, markers and calibration together
 - :mod:`.export`    a result as the tracks CSV + JSON sidecar
-- :mod:`.trk`       Tracker's .trk/.trz reader; a result in its text-export layout
-- :mod:`.importing` any track file in any unit, renamed, mirrored: the one conversion that
-                    ``track --import``, ``calibrate`` and ``report`` read tracks through
+- :mod:`.upright`   whether the heights are the right way up (a robot rests on the floor)
+- :mod:`.options`   the subcommands' click options, each defined once (:mod:`.cli`)
+- :mod:`.trk`       a result as a Tracker project (.trk) or in Tracker's text-export layout; a
+                    Tracker project as a result
 - :mod:`.overlay`   PNG / video of the tracks drawn on the footage
 - :mod:`.synth`     synthetic videos with known sub-pixel truth
 - :mod:`.hardclip`  synthetic phone-like clips: look-alike, shadow, blur, exit, tilted board
 
-The files, each owned by one module (writer, reader and typed object side by side):
-
-- :mod:`.tracks_csv`   ``<video>.tracks.csv``, the tracks everyone reads
-- :mod:`.tracker_text` Tracker's text export (*File > Export > Data*)
-- :mod:`.camera`       ``<video>.camera.json``, the pinhole camera of a simulated video
-- :mod:`.delimited`    the tokenizer under every table of samples (also the calibration CSVs)
+The files it reads and writes (tracks CSV, Tracker's text export and projects, ``camera.json``,
+imports of foreign tracks) are owned by :mod:`locust.io`.
 """

@@ -13,7 +13,7 @@ the bottom-left marker), x along the board's bottom edge, y up the board. A homo
 exact for points *in* the plane; a marker in front of it (a sticker on a robot 2 cm
 nearer the camera) reads a little off, by its distance over the camera's distance.
 
-``locust track --make-board FILE.png`` writes the board at 300 DPI (the PNG records it):
+``locust track board FILE.png`` writes the board at 300 DPI (the PNG records it):
 print it at 100 % ("actual size", no "fit to page"), then measure one marker with a ruler.
 """
 

@@ -1,4 +1,5 @@
-"""Pixels to metres: scale, origin and axes, as Tracker's calibration stick and axes.
+"""Pixels to metres: scale, origin and axes, as Tracker's calibration stick and axes
+(:class:`~locust.io.trk.Calibration`, the type a Tracker project's calibration is read into).
 
 World coordinates are metres, y up. ``angle_deg`` is the direction of the world x axis
 measured counter-clockwise (as seen on screen) from the image x axis, as in Tracker's
@@ -10,47 +11,11 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import asdict, dataclass
-
-import numpy as np
 
 from ..errors import TrackError
+from ..io.trk import Calibration
 
 NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-
-
-@dataclass(frozen=True)
-class Calibration:
-    m_per_px: float  # NaN: no scale given, world columns stay empty
-    origin_x_px: float
-    origin_y_px: float
-    angle_deg: float = 0.0
-    source: str = "none"
-
-    def to_world(self, px: np.ndarray, py: np.ndarray, marker: str | None = None,
-                 frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Image pixels -> world metres (y up). NaN stays NaN. One scale serves every marker and frame."""
-        a = math.radians(self.angle_deg)
-        dx = np.asarray(px, float) - self.origin_x_px
-        dy = -(np.asarray(py, float) - self.origin_y_px)
-        x = self.m_per_px * (dx * math.cos(a) + dy * math.sin(a))
-        y = self.m_per_px * (-dx * math.sin(a) + dy * math.cos(a))
-        return x, y
-
-    def axes_px(self) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float]]:
-        """World origin in pixels, and the on-screen unit directions of the world x and y axes."""
-        a = math.radians(self.angle_deg)
-        return (self.origin_x_px, self.origin_y_px), (math.cos(a), -math.sin(a)), (-math.sin(a), -math.cos(a))
-
-    def summary(self) -> str:
-        if not math.isfinite(self.m_per_px):
-            return "no scale given (--scale or --scale-aruco): the *_x_m/*_y_m columns are nan"
-        return (f"scale {self.m_per_px * 1000:.5g} mm/px ({self.source}), origin ({self.origin_x_px:.2f}, "
-                f"{self.origin_y_px:.2f}) px, x axis {self.angle_deg:g} deg")
-
-    def as_dict(self) -> dict:
-        """For the JSON sidecar (no scale: ``m_per_px`` nan, written ``null``)."""
-        return asdict(self)
 
 
 def parse_scale(text: str) -> tuple[float, float, float, float, float]:

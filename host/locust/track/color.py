@@ -275,10 +275,15 @@ class ColorMarker:
         sightings): hue within the hue window of theirs, at least half their saturation (mostly
         sticker, as a blur streak the marker is found on still is) and at least the chroma a
         shadow leaves of theirs. A pick in shadow (dark: a brown hue passes its loose bounds)
-        thus refuses grey-brown hair or skin."""
-        if self._hsv is None or not self._colours:
+        thus refuses grey-brown hair or skin. Before the first sighting the blob must have at
+        least the chroma a shadow leaves of the given colour's (0.3 at the default --color-tol;
+        paler *and* darker is a dim patch of that hue: a wire, a screen, not a sticker)."""
+        if self._hsv is None:
             return True
         bh, bs, bc = hs
+        if not self._colours:
+            _, s, v = self._hsv
+            return bc >= self._shadow_share() * (s * v // 255)
         hue, saturation, chroma = self._own_colour()
         turn = abs(bh - hue) % 180
         return (min(turn, 180 - turn) <= self._bounds[0] and bs >= 0.5 * saturation
@@ -414,11 +419,12 @@ class ColorMarker:
 
     def _fits(self, shape: BlobShape, at: tuple[float, float]) -> bool:
         """Size and shape of the marker: learned from the round, whole sightings so far; the
-        first sighting must be round. Motion blur may stretch it by up to the distance it moves
-        in a frame, along its motion: the predicted one, or the way it went since it was last
-        seen (a launch from rest is not predicted)."""
-        if not self._areas:
-            return shape.minor_px >= 0.6 * shape.major_px
+        first sighting must be round and at least ``FIRST_SIGHTING_MIN_PX`` across. Motion blur
+        may stretch it by up to the distance it moves in a frame, along its motion: the
+        predicted one, or the way it went since it was last seen (a launch from rest is not
+        predicted)."""
+        if not self._areas:   # the first sighting: a round patch a sticker's centroid can be measured on
+            return shape.minor_px >= max(0.6 * shape.major_px, FIRST_SIGHTING_MIN_PX)
         if shape.area_px < self.partial_fraction * self._usual_area:
             return False
         d = self._usual_width
@@ -563,6 +569,7 @@ def _on_image_border(stat: list[int], box, image_shape) -> bool:
 
 RING_PX = 4
 JUDGE_EVERY = 4   # a marker found as usual has its shape and colour judged every this many frames
+FIRST_SIGHTING_MIN_PX = 3.0   # least width of a first sighting: a 2 x 2 speck (2.3 px) is noise, not a sticker
 DISC_FILL = 0.65  # least share of its box a blob taken as usual fills (a disc: pi/4, 0.79)
 _KERNEL_9 = np.ones((9, 9), np.uint8)    # two 5x5 dilations in one
 _KERNEL_5 = np.ones((5, 5), np.uint8)

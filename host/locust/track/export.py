@@ -1,6 +1,6 @@
 """Tracks to files: the CSV everyone reads, and a JSON sidecar with how they were made.
 
-The CSV's layout, writer and reader are :mod:`.tracks_csv`'s (columns ``frame``, ``t_s``,
+The CSV's layout, writer and reader are :mod:`locust.io.tracks_csv`'s (columns ``frame``, ``t_s``,
 then per marker ``<name>_px``, ``<name>_py`` in pixels, OpenCV convention, ``<name>_x_m``,
 ``<name>_y_m`` in world metres, y up, ``nan`` without a scale, and ``<name>_ok`` 1/0; a
 marker not found is ``nan`` with ok 0). This module turns a
@@ -16,8 +16,8 @@ import numpy as np
 
 from .. import __version__
 from ..fileio import atomic_write_json
+from ..io.tracks_csv import MarkerColumns, TracksCsv, tracks_csv_text, write_tracks_csv
 from .runner import TrackResult
-from .tracks_csv import MarkerColumns, TracksCsv, tracks_csv_text, write_tracks_csv
 
 PIXEL_CONVENTION = "OpenCV: origin at the centre of the top-left pixel, x right, y down"
 

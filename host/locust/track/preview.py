@@ -1,4 +1,4 @@
-"""``locust track VIDEO --preview FRAME``: choose colours and start points without a GUI.
+"""``locust track preview VIDEO --frame FRAME``: choose colours and start points without a GUI.
 
 The frame is written as a PNG with a labelled pixel grid, the most saturated blobs circled
 and numbered (their colour and position listed, ready for ``--marker
@@ -69,7 +69,7 @@ def preview(info, frame: int, models: list, path: Path) -> tuple[list[Blob], dic
     """Write the annotated ``frame`` of the video to ``path``; return the blobs and what each
     marker model finds there (None: nothing)."""
     if not 0 <= frame < info.frame_count:
-        raise TrackError(f"--preview {frame}: the video has frames 0..{info.frame_count - 1}", "pick a frame in it")
+        raise TrackError(f"--frame {frame}: the video has frames 0..{info.frame_count - 1}", "pick a frame in it")
     image = next(img for _, img in read_frames(info, Clip(frame, frame).resolved(info)))
     blobs = saturated_blobs(image)
     found = {}

@@ -77,7 +77,9 @@ def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibrat
             raise TrackError(
                 f"marker(s) never found in frames {clip.start}..{clip.end} of {info.path.name}: "
                 + ", ".join(f"{t.name} ({t.spec})" for t in lost),
-                "check the colour with --color-tol, the template point and frame, or the ArUco id; "
-                "--marker NAME=SPEC replaces the default nose/foot colours")
+                "a colour marker is first taken on a round patch at least 3 px across with at least 0.3 of its "
+                "colour's chroma (no sticker of that colour in the picture: nothing): `locust track preview VIDEO` "
+                "lists the coloured patches of a frame; else check --color-tol, the template point and frame, or "
+                "the ArUco id; --marker NAME=SPEC replaces the default nose/foot colours")
     t_s = np.array([clip.time_s(int(f)) for f in frames])
     return TrackResult(info, clip, frames, t_s, tracks, calibration)

@@ -59,7 +59,7 @@ def parse_marker(text: str, options: ModelOptions = ModelOptions()):
             if not m:
                 raise TrackError(f"--marker {text!r}: colour spec must be color:#RRGGBB or color:#RRGGBB@X,Y",
                                  "give the sticker's pixel position on the first frame, e.g. color:#e8308c@412,630 "
-                                 "(locust track VIDEO --preview 0 shows the positions)")
+                                 "(locust track preview VIDEO shows the positions)")
             start_px = (float(m.group(1)), float(m.group(2)))
         return ColorMarker(name, spec, parse_hex(colour), tolerance=options.color_tol,
                            search_half_px=options.search_half_px, start_px=start_px)

@@ -24,8 +24,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ..errors import TrackError, WriteError
-from ..fileio import DISK_HINT, temp_beside
+from ..errors import TrackError
+from ..fileio import check_encoded, temp_beside
+from ..io.trk import FPS_MAX, FPS_MIN
 
 # FFmpeg's own log lines ("moov atom not found" ...) are noise next to our error
 # message; OpenCV reads the level when it opens its first capture, not on import.
@@ -40,6 +41,15 @@ class VideoInfo:
     frame_count: int
     file_fps: float
     images: tuple[Path, ...] = ()  # an image sequence's files, in frame order; () for a video file
+
+
+def check_fps(fps: float | None) -> float | None:
+    """``fps`` as given (None: the file's rate), if a camera can film at it."""
+    if fps is not None and not FPS_MIN <= fps <= FPS_MAX:
+        raise TrackError(f"--fps {fps:g}: a camera films {FPS_MIN:g} to {FPS_MAX:g} frames/s (times are "
+                         "frame / fps: a rate outside that makes them all 0, or hours apart)",
+                         "give the true frame rate, e.g. --fps 240 for slow-motion footage")
+    return fps
 
 
 @dataclass(frozen=True)
@@ -73,8 +83,10 @@ class Clip:
             raise TrackError(f"{info.path.name}: an image sequence has no frame rate",
                              "give it with --fps (e.g. --fps 10.1 for frames 99 ms apart), or use "
                              "--calibration-from the Tracker project that opens it")
-        if not (fps and np.isfinite(fps) and fps > 0):
-            raise TrackError(f"{info.path.name} has no usable frame rate ({fps!r})",
+        check_fps(self.fps)
+        if not (fps and np.isfinite(fps) and FPS_MIN <= fps <= FPS_MAX):
+            raise TrackError(f"{info.path.name} has no usable frame rate ({fps!r}; a camera films "
+                             f"{FPS_MIN:g} to {FPS_MAX:g} frames/s)",
                              "give the real frame rate with --fps, e.g. --fps 240")
         return Clip(self.start, end, self.step, float(fps))
 
@@ -242,22 +254,6 @@ def _ended_early(info: VideoInfo, index: int) -> None:
     raise TrackError(f"{info.path}: decoding stopped at frame {index}, but the file says it has "
                      f"{info.frame_count} frames: the video is truncated or damaged",
                      f"re-copy the file, or track the readable part with --end {max(index - 1, 0)}")
-
-
-def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
-    """Raise :class:`WriteError` unless the video just encoded at ``tmp`` (for ``path``) reads
-    back with its ``frames`` frames: OpenCV's writer ignores a failed write (a full disk) and
-    leaves a truncated file no player opens."""
-    if frames == 0:
-        return
-    cap = cv2.VideoCapture(str(tmp))
-    try:
-        count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
-    finally:
-        cap.release()
-    if count != frames:
-        raise WriteError(f"{path}: the video could not be written completely ({count} of {frames} frames read "
-                         "back); the disk may be full", DISK_HINT)
 
 
 def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: str = "mp4v") -> Path:

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ReportError
+from ..errors import TrialError
 
 ONSET_M = 0.003          # nose motion that counts as the first push (camera noise is ~0.5 mm)
 REST_WINDOW_S = 0.2      # end of a cycle averaged as the rest position
@@ -54,11 +54,11 @@ def onset_time(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, threshold_m: f
     dist = np.hypot(x_m - x_m[0], y_m - y_m[0])
     moved = np.flatnonzero(dist > threshold_m)
     if moved.size == 0:
-        raise ReportError(f"{where}: the nose never moves more than {threshold_m * 1000:g} mm",
+        raise TrialError(f"{where}: the nose never moves more than {threshold_m * 1000:g} mm",
                           "is this a hop? check the clip covers the hops and the scale is in metres")
     i = int(moved[0])
     if i < MIN_STANDING_SAMPLES:
-        raise ReportError(f"{where}: the nose is already moving at t = {t_s[i]:.3f} s, the clip's start",
+        raise TrialError(f"{where}: the nose is already moving at t = {t_s[i]:.3f} s, the clip's start",
                           "the report needs the robot standing still before the first push: start the clip earlier")
     x0, y0 = float(np.median(x_m[:i])), float(np.median(y_m[:i]))
     d_prev, d_now = float(np.hypot(x_m[i - 1] - x0, y_m[i - 1] - y0)), float(np.hypot(x_m[i] - x0, y_m[i] - y0))

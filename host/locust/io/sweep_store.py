@@ -21,11 +21,12 @@ from typing import Any
 
 from ..errors import SweepError
 from ..fileio import atomic_write_json, atomic_write_text, make_folder
-from .design import RESULT_FIELDS
 
 RESULTS = "results.csv"
 META = "sweep.json"
 LOCK = ".sweep.lock"
+RESULT_FIELDS = ("valid", "reason", "distance_m", "max_nose_height_m", "nose_apex_max_m",
+                 "com_apex_max_m", "hops", "grashof", "transmission_deg")   # a design's result row
 _FLOATS = {"distance_m", "max_nose_height_m", "nose_apex_max_m", "com_apex_max_m", "transmission_deg"}
 
 

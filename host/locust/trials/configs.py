@@ -1,4 +1,4 @@
-"""The configurations a report compares: named leg sets built on one identified robot.
+"""The configurations trials are filmed in (the report's and the hop fit's): named leg sets on one robot.
 
 A configuration is the base robot (``--config robot.toml`` or ``--preset``) with the same
 length added to all four links: ``small`` / ``medium`` / ``large`` are the notebook's
@@ -13,7 +13,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import ReportError
+from ..errors import TrialError
 from ..params import LEG_SETS, Robot, leg_set, with_added_length
 
 _TRIAL_SUFFIX = re.compile(r"(?:[-_.]|^)(?:(?:trial|run|take)[-_.]?)?\d+$", re.IGNORECASE)
@@ -46,7 +46,7 @@ def configuration(base: Robot, name: str, added_m: float | None = None) -> Confi
 def check_name(name: str) -> str:
     key = name.strip().lower()
     if not _NAME_OK.match(key):
-        raise ReportError(f"configuration name {name!r} is not a plain name",
+        raise TrialError(f"configuration name {name!r} is not a plain name",
                           "use letters, digits, - or _, e.g. small, medium, large, v2")
     return key
 
@@ -61,8 +61,8 @@ def name_from_path(path: Path) -> str:
         stem = _TRIAL_SUFFIX.sub("", part)
         if stem and _NAME_OK.match(stem) and stem.lower() not in ("trial", "run", "runs", "hops", "tracks"):
             return stem.lower()
-    raise ReportError(f"{path}: cannot tell which configuration this trial is",
-                      "name it on the command line: --measured small=PATH")
+    raise TrialError(f"{path}: cannot tell which configuration this trial is",
+                      "name it on the command line: small=PATH (report: --measured small=PATH)")
 
 
 def sort_key(name: str) -> tuple[int, str]:
@@ -81,5 +81,5 @@ def parse_added(items: tuple[str, ...] | list[str]) -> dict[str, float]:
         except ValueError:
             sep = ""
         if not sep:
-            raise ReportError(f"--added {item!r} is not NAME=METRES", "e.g. --added v2=0.015")
+            raise TrialError(f"--added {item!r} is not NAME=METRES", "e.g. --added v2=0.015")
     return out

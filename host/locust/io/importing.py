@@ -1,7 +1,7 @@
 """Imports: any track file, in any length unit, with its markers renamed and x mirrored.
 
 The one conversion every track input goes through (:func:`import_tracks`):
-``locust track --import``, ``locust calibrate`` (beam, servo ``--pivot``, ramp tracks) and
+``locust track import``, ``locust calibrate`` (beam, servo ``--pivot``, ramp tracks) and
 ``locust report`` (``--measured`` tracks) all read their tracks here, with the same options:
 
 - ``--units m|cm|mm``: the unit of the file's positions; they are divided by 1, 100 or 1000
@@ -156,7 +156,10 @@ def import_tracks(path: str | Path, units: str = "m", rename: Iterable[str] | Ma
     options = options or ImportOptions.parse(units, rename, mirror)
     if is_project(path):
         return import_project(path, options)
-    return tracks_from_delimited(split_text(read_text(path), path), options)
+    doc = split_text(read_text(path), path)
+    tracks = tracks_from_delimited(doc, options)
+    check_times(doc, tracks.t_s)
+    return tracks
 
 
 PROJECT_SUFFIXES = (".trk", ".trz")
@@ -170,15 +173,13 @@ def is_project(path: str | Path) -> bool:
 def import_project(path: str | Path, options: ImportOptions = AS_IS) -> TracksCsv:
     """A Tracker project's point tracks in metres through its own calibration (:mod:`.trk`),
     renamed and mirrored by ``options``; a comment says which scale, origin and rate were used."""
-    from .export import tracks_of  # the project reader pulls in the video layer: only when needed
-    from .trk import project_result, read_project
+    from .trk import project_tracks, read_project
 
     path = Path(path)
     if options.units != "m":
         raise TrackError(f"{path}: --units {options.units} does not apply to a Tracker project",
                          "the project's own calibration gives metres: leave --units out")
     project = read_project(path)
-    result = project_result(project)
     cal, clip = project.calibration, project.clip
     if not math.isfinite(cal.m_per_px):
         raise TrackError(f"{path}: the Tracker project has no scale (no calibration stick or tape)",
@@ -189,7 +190,7 @@ def import_project(path: str | Path, options: ImportOptions = AS_IS) -> TracksCs
     note = (f"imported from {path.name} (Tracker project): scale {1 / cal.m_per_px:.6g} px/m, origin "
             f"({cal.origin_x_px + 0.5:.6g}, {cal.origin_y_px + 0.5:.6g}) px, x axis {cal.angle_deg:g} deg, "
             f"{clip.fps:.6g} frames/s")
-    tracks = replace(tracks_of(result), comments=(note,), path=path)
+    tracks = replace(project_tracks(project), comments=(note,), path=path)
     return tracks if options.identity else _convert_tracks_csv(tracks, options)
 
 
@@ -228,6 +229,27 @@ def tracks_from_delimited(doc: DelimitedText, options: ImportOptions = AS_IS) ->
         note += f"; not imported: {', '.join(dropped)}"
     return TracksCsv(frame=np.arange(len(t_s)), t_s=t_s, markers=markers, comments=(*doc.comments, note),
                      path=doc.path)
+
+
+def check_times(doc: DelimitedText, t_s) -> None:
+    """Refuse rows whose time repeats the row before or goes back (rows without a time are
+    skipped): velocities, onsets and fits all divide by the step. Names the file's lines.
+    :func:`import_tracks` applies it; the calibration layer reads through
+    :func:`tracks_from_delimited` and rebuilds times rounded to repeating values from the row
+    order itself (``locust.calibrate.recordings.regular_time``)."""
+    t = np.asarray(t_s, dtype=float)
+    rows = np.flatnonzero(np.isfinite(t))
+    step = np.diff(t[rows])
+    bad = rows[1:][step <= 0]
+    if not bad.size:
+        return
+    repeats, back = int((step == 0).sum()), int((step < 0).sum())
+    lines = [doc.rows[k][0] for k in bad]
+    where = ", ".join(str(n) for n in lines[:6]) + (f" and {len(lines) - 6} more" if len(lines) > 6 else "")
+    raise TrackError(f"{doc.path}: time does not increase on {len(bad)} of {len(rows)} rows ({repeats} repeat the "
+                     f"time before, {back} go back), line {where}; first at t = {t[bad[0]]:g} s",
+                     "sort the rows by time and remove duplicate frames; times that repeat only after rounding "
+                     "(e.g. 3 significant digits) need an export with more digits")
 
 
 # -- the layouts -------------------------------------------------------------------

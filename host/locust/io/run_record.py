@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -26,6 +27,11 @@ from ..firmware import protocol as P
 COMPLETE = "complete"
 INCOMPLETE = "incomplete"
 ERROR = "error"
+# every phase ran, but the board's config.json was unreadable or invalid and the firmware ran
+# on its default config (pins, trims and pulse range that may not be this robot's)
+DEFAULT_CONFIG = "default_config"
+CONFIG_FIX_HINT = ("write a valid config: `locust config --port PORT --set left.trim_deg=0` (any key; the "
+                   "board saves the whole config), or `locust flash --port PORT --reset-config`")
 RECORD_NAME = "run.json"
 READ_HINT = "give the run.json that `locust hop` wrote"
 DAMAGED_HINT = "the record is damaged; rerun the hop"
@@ -126,6 +132,83 @@ def jitter(phases: list[Phase]) -> Jitter | None:
                   max_late_ms=round(max(max(errs), 0.0), 4), max_early_ms=round(max(-min(errs), 0.0), 4))
 
 
+_LEG_SET_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_+-]*$")
+
+
+def check_leg_set(name: str) -> str:
+    """A leg set's name as recorded: a plain name, lower case (``report`` groups trials by it)."""
+    key = str(name).strip().lower()
+    if not _LEG_SET_NAME.match(key):
+        raise DeviceError(f"leg set {name!r} is not a plain name",
+                          "use letters, digits, - or _, e.g. small, medium, large, v2")
+    return key
+
+
+@dataclass(frozen=True)
+class RobotSource:
+    """Which robot was hopped: the parameter set named on the command line and the leg set on it."""
+
+    preset: str | None = None        # --preset, when no robot file was given
+    robot_file: str | None = None    # --config: the robot.toml's path as given
+    leg_set: str | None = None       # small / medium / large, or the user's own name (--leg-set)
+
+
+@dataclass(frozen=True)
+class ServoConfig:
+    """One servo's entry of the board's config.json (``locust.firmware.config``)."""
+
+    pin: int
+    trim_deg: float
+    direction: int
+    pulse_min_us: float
+    pulse_max_us: float
+    range_deg: float
+    travel_deg: float
+
+
+@dataclass(frozen=True)
+class BoardConfig:
+    """The config the firmware was running on, read back from the board at the start of a hop."""
+
+    chip: str | None
+    machine: str | None
+    left: ServoConfig
+    right: ServoConfig
+    problems: tuple[str, ...] = ()   # why the firmware did not use config.json (empty: it did)
+
+    @property
+    def on_defaults(self) -> bool:
+        return bool(self.problems)
+
+    def to_dict(self) -> dict:
+        return {"chip": self.chip, "machine": self.machine, "left": asdict(self.left),
+                "right": asdict(self.right), "config_problems": list(self.problems)}
+
+
+def board_config(doc, where: str = "the board") -> BoardConfig:
+    """A :class:`BoardConfig` from ``{"chip", "machine", "left", "right", "config_problems"}``
+    (the run record's ``board``, or the board's hello and config replies put together)."""
+    if not isinstance(doc, dict):
+        raise DeviceError(f"{where}: the board config is not an object", DAMAGED_HINT)
+    servos = {}
+    for name in ("left", "right"):
+        entry = doc.get(name)
+        if not isinstance(entry, dict):
+            raise DeviceError(f"{where}: the board config has no {name!r} servo", DAMAGED_HINT)
+        values = {}
+        for f in ServoConfig.__dataclass_fields__:
+            value = entry.get(f)
+            if not _is_number(value) or (f in ("pin", "direction") and value != int(value)):
+                raise DeviceError(f"{where}: board {name}.{f} is missing or not a number", DAMAGED_HINT)
+            values[f] = int(value) if f in ("pin", "direction") else float(value)
+        servos[name] = ServoConfig(**values)
+    problems = doc.get("config_problems") or []
+    if not isinstance(problems, list):
+        raise DeviceError(f"{where}: board config_problems is not a list", DAMAGED_HINT)
+    return BoardConfig(_text(doc.get("chip")), _text(doc.get("machine")), servos["left"], servos["right"],
+                       tuple(str(p) for p in problems))
+
+
 @dataclass
 class RunRecord:
     """One hop's ``run.json``: the schedule, the firmware, the phases as they arrived, the verdict."""
@@ -140,6 +223,8 @@ class RunRecord:
     phases: list[Phase] = field(default_factory=list)
     # the board's raw ticks_us at the hop's start and end (30-bit: wrapped if end < start)
     firmware_ticks_us: list[int] | None = None
+    robot: RobotSource = field(default_factory=RobotSource)
+    board: BoardConfig | None = None     # pins, trims and chip read from the board before the hop
 
     def add_phase(self, phase: Phase) -> None:
         if all((p.cycle, p.phase) != (phase.cycle, phase.phase) for p in self.phases):
@@ -155,6 +240,8 @@ class RunRecord:
             "firmware_status": self.firmware_status,
             "port": self.port,
             "started_at": self.started_at,
+            "robot": asdict(self.robot),
+            "board": self.board.to_dict() if self.board else None,
             "schedule": asdict(self.schedule),
             "phases_expected": self.schedule.phases,
             "phases": [p.to_dict() for p in self.phases],
@@ -225,8 +312,18 @@ def read_run_record(path: Path) -> RunRecord:
         schedule=HopSchedule(**values), port=str(doc.get("port") or ""), status=str(doc.get("status") or INCOMPLETE),
         firmware_version=_text(doc.get("firmware_version")), firmware_status=_text(doc.get("firmware_status")),
         message=_text(doc.get("message")), started_at=str(doc.get("started_at") or ""), phases=phases,
-        firmware_ticks_us=_ticks(doc.get("firmware_ticks_us")),
+        firmware_ticks_us=_ticks(doc.get("firmware_ticks_us")), robot=_robot_source(path, doc.get("robot")),
+        board=None if doc.get("board") is None else board_config(doc["board"], str(path)),
     )
+
+
+def _robot_source(path: Path, value) -> RobotSource:
+    if value is None:
+        return RobotSource()       # a record from before the robot was recorded
+    if not isinstance(value, dict) or not all(value.get(k) is None or isinstance(value.get(k), str)
+                                               for k in ("preset", "robot_file", "leg_set")):
+        raise DeviceError(f"{path}: robot is not an object of preset/robot_file/leg_set names", DAMAGED_HINT)
+    return RobotSource(value.get("preset"), value.get("robot_file"), value.get("leg_set"))
 
 
 def _ticks(value) -> list[int] | None:

@@ -1,17 +1,18 @@
-"""Measured inputs of a report: marker tracks and run records, grouped by configuration.
+"""Measured inputs of a report or a hop fit: marker tracks and run records, grouped by configuration.
 
 ``--measured`` takes ``NAME=PATH[,PATH...]`` or plain paths. Each path is one trial:
 
 - a folder holding a track (``*.tracks.csv``, or one CSV/Tracker export with marker columns)
   and/or a ``run.json`` (the record ``locust hop`` wrote, read with
-  :func:`locust.device.record.read_run_record`);
+  :func:`locust.io.run_record.read_run_record`);
 - a track file (``locust track`` CSV or Tracker text export); a ``run.json`` beside it is
   its run record;
 - a ``run.json``; a single ``*.tracks.csv`` beside it is its track.
 
-A plain path's configuration comes from its folder's name (see
-:func:`.configs.name_from_path`); the trial remembers that it was guessed (``config_from``).
-Tracks are read by the track layer's one import (:func:`locust.track.importing.import_tracks`:
+A plain path's configuration is the leg set its run record names (``locust hop --leg-set``,
+or a leg-set ``--preset``), else its folder's name (see :func:`.configs.name_from_path`);
+the trial remembers which (``config_from``).
+Tracks are read by the track layer's one import (:func:`locust.io.importing.import_tracks`:
 a tracks CSV, a Tracker text export or a ``t,x,y`` CSV, with ``--units``, ``--rename`` and
 ``--mirror``), so the formats and conversions are the same everywhere.
 """
@@ -24,16 +25,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..device.record import RECORD_NAME as RUN_NAME
-from ..device.record import RunRecord, read_run_record
-from ..errors import DeviceError, ReportError, TrackError
-from ..track.importing import AS_IS, DESK_SPAN_M, TYPICAL_SPAN_M, ImportOptions, import_tracks, units_hint
-from ..track.tracks_csv import TRACKS_CSV_SUFFIX
+from ..errors import DeviceError, TrackError, TrialError
+from ..io.importing import AS_IS, DESK_SPAN_M, TYPICAL_SPAN_M, ImportOptions, import_tracks, units_hint
+from ..io.run_record import RECORD_NAME as RUN_NAME
+from ..io.run_record import RunRecord, read_run_record
+from ..io.tracks_csv import TRACKS_CSV_SUFFIX
 from .configs import check_name, name_from_path, sort_key
 
 TRACK_GLOB = f"*{TRACKS_CSV_SUFFIX}"
 CONFIG_GIVEN = "given"                   # --measured NAME=PATH
 CONFIG_FROM_FOLDER = "folder name"       # guessed by name_from_path
+CONFIG_FROM_RECORD = "run record"        # the leg set run.json names
 
 
 @dataclass(frozen=True)
@@ -58,7 +60,7 @@ class Trial:
     track: Track | None
     run_path: Path | None
     record: RunRecord | None = field(default=None, compare=False)
-    config_from: str = CONFIG_GIVEN      # how its configuration was known: given, or guessed from its folder
+    config_from: str = CONFIG_GIVEN      # how its configuration was known: given, its run record, or its folder
 
 
 def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose",
@@ -66,7 +68,7 @@ def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose",
     """``--measured`` values -> trials per configuration, in leg-set order; ``imports``
     (``--units``, ``--rename``, ``--mirror``) converts every track."""
     if not items:
-        raise ReportError("no measured inputs", "give --measured small=runs/small-1,runs/small-2 (or plain paths)")
+        raise TrialError("no measured inputs", "give --measured small=runs/small-1,runs/small-2 (or plain paths)")
     groups: dict[str, list[Trial]] = {}
     for item in items:
         name, paths = _split_item(item)
@@ -75,14 +77,15 @@ def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose",
             if name:
                 trial = load_trial(path, name, marker, imports)
             else:
-                trial = load_trial(path, name_from_path(path), marker, imports, config_from=CONFIG_FROM_FOLDER)
+                name, known_from = config_of(path)
+                trial = load_trial(path, name, marker, imports, config_from=known_from)
             groups.setdefault(trial.config, []).append(trial)
     for name, trials in groups.items():
         seen: set[tuple] = set()
         for t in trials:
             key = (t.track.path.resolve() if t.track else None, t.run_path.resolve() if t.run_path else None)
             if key in seen:
-                raise ReportError(f"configuration {name}: the trial {t.label} is given twice",
+                raise TrialError(f"configuration {name}: the trial {t.label} is given twice",
                                   "list each trial once")
             seen.add(key)
     return {k: groups[k] for k in sorted(groups, key=sort_key)}
@@ -93,24 +96,48 @@ def _split_item(item: str) -> tuple[str | None, list[str]]:
     if sep and name and "/" not in name and not Path(item).exists():
         paths = [p for p in rest.split(",") if p.strip()]
         if not paths:
-            raise ReportError(f"--measured {item!r} names no path", "e.g. --measured small=runs/s1,runs/s2")
+            raise TrialError(f"--measured {item!r} names no path", "e.g. --measured small=runs/s1,runs/s2")
         return check_name(name), [p.strip() for p in paths]
     return None, [item]
 
 
+def _must_exist(path: Path) -> None:
+    if not path.exists():
+        raise TrialError(f"{path}: no such file or folder", "check the --measured path")
+
+
+def _run_path(path: Path) -> Path | None:
+    """The run record of the trial at ``path``: the run.json itself, the one in the folder, or
+    the one beside the track."""
+    if path.is_dir():
+        return path / RUN_NAME if (path / RUN_NAME).is_file() else None
+    if path.name.endswith(".json"):
+        return path
+    return path.parent / RUN_NAME if (path.parent / RUN_NAME).is_file() else None
+
+
+def config_of(path: Path) -> tuple[str, str]:
+    """(configuration, how it is known) of the trial at ``path`` given without a name: the leg
+    set its run record names, else its folder's name."""
+    _must_exist(path)
+    run_path = _run_path(path)
+    leg_set = read_run(run_path).robot.leg_set if run_path else None
+    if leg_set:
+        return check_name(leg_set), CONFIG_FROM_RECORD
+    return name_from_path(path), CONFIG_FROM_FOLDER
+
+
 def load_trial(path: Path, config: str, marker: str = "nose", imports: ImportOptions = AS_IS,
                config_from: str = CONFIG_GIVEN) -> Trial:
-    if not path.exists():
-        raise ReportError(f"{path}: no such file or folder", "check the --measured path")
+    _must_exist(path)
+    run_path = _run_path(path)
     if path.is_dir():
-        run_path = path / RUN_NAME if (path / RUN_NAME).is_file() else None
         track_path = _one_track(path, required=run_path is None)
         label = path.name
     elif path.name.endswith(".json"):
-        run_path, track_path, label = path, _one_track(path.parent, required=False), path.parent.name
+        track_path, label = _one_track(path.parent, required=False), path.parent.name
     else:
-        beside = path.parent / RUN_NAME
-        run_path, track_path, label = (beside if beside.is_file() else None), path, path.parent.name or path.stem
+        track_path, label = path, path.parent.name or path.stem
     record = read_run(run_path) if run_path else None
     track = read_track(track_path, marker, imports) if track_path else None
     return Trial(config=config, label=label, track=track, run_path=run_path, record=record, config_from=config_from)
@@ -119,12 +146,12 @@ def load_trial(path: Path, config: str, marker: str = "nose", imports: ImportOpt
 def _one_track(folder: Path, required: bool) -> Path | None:
     found = sorted(folder.glob(TRACK_GLOB))
     if len(found) > 1:
-        raise ReportError(f"{folder}: several tracks ({', '.join(p.name for p in found)})",
+        raise TrialError(f"{folder}: several tracks ({', '.join(p.name for p in found)})",
                           "give the track file itself as the --measured path")
     if found:
         return found[0]
     if required:
-        raise ReportError(f"{folder}: no track (*.tracks.csv) and no run.json",
+        raise TrialError(f"{folder}: no track (*.tracks.csv) and no run.json",
                           "run `locust track VIDEO` there, or give the track file's path")
     return None
 
@@ -136,20 +163,20 @@ def read_track(path: Path, marker: str = "nose", imports: ImportOptions = AS_IS)
         t = tracks.time_s()
         x, y = tracks.positions(marker)
     except TrackError as exc:
-        raise ReportError(exc.message, exc.hint) from None
+        raise TrialError(exc.message, exc.hint) from None
     ok = np.isfinite(t) & np.isfinite(x) & np.isfinite(y)
     if not ok.any():
         scaled = tracks.has_pixels(marker)
         hint = ("the track has pixels but no metres: run `locust track` with --scale or --scale-aruco"
                 if scaled else f"the {marker} marker was never found: check the video and the marker colour")
-        raise ReportError(f"{path}: no {marker} position in metres in any frame", hint)
+        raise TrialError(f"{path}: no {marker} position in metres in any frame", hint)
     if ok.sum() < 10:
-        raise ReportError(f"{path}: only {int(ok.sum())} frames with a {marker} position",
+        raise TrialError(f"{path}: only {int(ok.sum())} frames with a {marker} position",
                           "a report needs the whole hop: track the full clip")
     order = np.argsort(t[ok], kind="stable")
     tt = t[ok][order]
     if np.any(np.diff(tt) <= 0):
-        raise ReportError(f"{path}: repeated time stamps in t_s",
+        raise TrialError(f"{path}: repeated time stamps in t_s",
                           "export the track again; each frame needs its own time")
     return Track(path=path, marker=marker, t_s=tt, x_m=x[ok][order], y_m=y[ok][order], frames=tracks.n_rows,
                  units=imports.units, mirrored=imports.mirror, m_per_px=metres_per_pixel(tracks, marker))
@@ -172,7 +199,7 @@ def read_run(path: Path) -> RunRecord:
     try:
         return read_run_record(path)
     except DeviceError as exc:
-        raise ReportError(exc.message, exc.hint) from None
+        raise TrialError(exc.message, exc.hint) from None
 
 
 def span_hint(track: Track) -> str | None:

@@ -1,0 +1,16 @@
+"""The file formats, each owned by one module (typed object, writer and reader side by side).
+
+This layer imports no other part of locust but ``errors``, ``fileio`` and the firmware's
+protocol table, so the simulation, tracking, calibration, the report, the sweeps and the
+robot all read and write files through it without importing one another.
+
+- :mod:`.delimited`    the tokenizer under every table of samples (tracks, exports, calibration CSVs)
+- :mod:`.tracks_csv`   ``<video>.tracks.csv``, the tracks everyone reads
+- :mod:`.tracker_text` Tracker's text export (*File > Export > Data*)
+- :mod:`.trk`          Tracker projects (``.trk``, ``.trz``) and their calibration
+- :mod:`.importing`    any track file in any unit, renamed, mirrored: the one conversion that
+                       ``track import``, ``calibrate`` and ``report`` read tracks through
+- :mod:`.camera_json`  ``<video>.camera.json``, the pinhole camera of a simulated video
+- :mod:`.run_record`   ``run.json``, a hop's run record
+- :mod:`.sweep_store`  a sweep's folder: ``sweep.json`` and ``results.csv``
+"""

@@ -1,0 +1,297 @@
+"""Tracker (Open Source Physics) projects: read ``.trk``/``.trz`` files into a typed object.
+
+A project's point tracks come out on its clip's frames (:func:`project_points`), in metres
+through its own calibration (:func:`project_tracks`, a :class:`~.tracks_csv.TracksCsv`).
+The text export's layout, reader and typed object are :mod:`.tracker_text`'s; writing a
+tracking result as a project or a text export is :mod:`locust.track.trk`'s.
+
+Pixel convention. Tracker's image coordinates are measured from the top-left *corner*
+of the image (``ImageCoordSystem``: "pixel position relative to the top left corner";
+Java2D draws pixel (i, j) over the square [i, i+1) x [j, j+1)), so the centre of pixel i
+is at i + 0.5. OpenCV puts it at i. Reading a project therefore subtracts 0.5 px from
+every point and from the axes origin; world coordinates are unchanged.
+
+Tracker's world frame (``ImageCoordSystem.updateTransforms``): ``xorigin, yorigin``
+(image px), ``angle`` (world x axis counter-clockwise on screen from the image x axis;
+stored in the file in *degrees* -- ``FrameDataLoader`` converts to radians on load),
+``xscale`` (image px per world length unit).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import tempfile
+import xml.etree.ElementTree as ET
+import zipfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import asdict, dataclass
+from pathlib import Path, PurePosixPath
+
+import numpy as np
+
+from ..errors import TrackError
+from .tracks_csv import MarkerColumns, TracksCsv
+
+TRACKER_TO_OPENCV_PX = -0.5
+POINT_CLASSES = ("PointMass",)  # Tracker's point tracks; vectors, tapes, axes are not tracks of a marker
+FPS_MIN, FPS_MAX = 1.0, 10000.0   # frames/s a camera films: a time-lapse at 1/s to a high-speed camera's 10 000/s
+LENGTH_UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "km": 1000.0, "in": 0.0254, "ft": 0.3048}
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """Pixels to world metres as Tracker's calibration stick and axes: a scale, an origin (a
+    pixel, OpenCV convention) and the direction of the world x axis, ``angle_deg``
+    counter-clockwise on screen from the image x axis (Tracker's ``ImageCoordSystem``)."""
+
+    m_per_px: float  # NaN: no scale given, world columns stay empty
+    origin_x_px: float
+    origin_y_px: float
+    angle_deg: float = 0.0
+    source: str = "none"
+
+    def to_world(self, px: np.ndarray, py: np.ndarray, marker: str | None = None,
+                 frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Image pixels -> world metres (y up). NaN stays NaN. One scale serves every marker and frame."""
+        a = math.radians(self.angle_deg)
+        dx = np.asarray(px, float) - self.origin_x_px
+        dy = -(np.asarray(py, float) - self.origin_y_px)
+        x = self.m_per_px * (dx * math.cos(a) + dy * math.sin(a))
+        y = self.m_per_px * (-dx * math.sin(a) + dy * math.cos(a))
+        return x, y
+
+    def axes_px(self) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float]]:
+        """World origin in pixels, and the on-screen unit directions of the world x and y axes."""
+        a = math.radians(self.angle_deg)
+        return (self.origin_x_px, self.origin_y_px), (math.cos(a), -math.sin(a)), (-math.sin(a), -math.cos(a))
+
+    def summary(self) -> str:
+        if not math.isfinite(self.m_per_px):
+            return "no scale given (--scale or --scale-aruco): the *_x_m/*_y_m columns are nan"
+        return (f"scale {self.m_per_px * 1000:.5g} mm/px ({self.source}), origin ({self.origin_x_px:.2f}, "
+                f"{self.origin_y_px:.2f}) px, x axis {self.angle_deg:g} deg")
+
+    def as_dict(self) -> dict:
+        """For the JSON sidecar (no scale: ``m_per_px`` nan, written ``null``)."""
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class TrackerClip:
+    """A project's clip: frames ``start`` to ``end`` (inclusive) every ``step``, at ``fps``
+    (NaN: the project gives no frame interval); time is zero at ``start``, as in Tracker."""
+
+    start: int
+    end: int
+    step: int
+    fps: float
+
+
+@dataclass
+class TrackerProject:
+    path: Path
+    video_path: str | None
+    clip: TrackerClip
+    calibration: Calibration
+    points: dict[str, dict[int, tuple[float, float]]]  # name -> frame -> (px, py), OpenCV convention
+
+
+def read_project(path: str | Path) -> TrackerProject:
+    """Parse a Tracker ``.trk`` file, or the ``.trk`` inside a ``.trz`` project zip."""
+    path = Path(path)
+    if not path.is_file():
+        raise TrackError(f"{path}: no such file", "give the path of a Tracker .trk or .trz file")
+    try:
+        if zipfile.is_zipfile(path):
+            with zipfile.ZipFile(path) as z:
+                names = sorted(n for n in z.namelist() if n.lower().endswith(".trk"))
+                if not names:
+                    raise TrackError(f"{path}: a zip without a .trk file",
+                                     "give a Tracker project (.trz) or tab (.trk)")
+                text = z.read(names[0])
+        else:
+            text = path.read_bytes()
+        root = ET.parse(io.BytesIO(text)).getroot()
+    except ET.ParseError as exc:
+        raise TrackError(f"{path}: not a Tracker file (XML error: {exc})", "give a .trk saved by Tracker") from None
+    except (zipfile.BadZipFile, OSError) as exc:
+        raise TrackError(f"{path}: cannot read ({exc})", "check the file is a complete Tracker project") from None
+    if "TrackerPanel" not in (root.get("class") or ""):
+        raise TrackError(f"{path}: an XML file but not a Tracker tab (root is {root.get('class')!r})",
+                         "give a .trk saved by Tracker")
+    return _project(path, root)
+
+
+def _prop(obj: ET.Element | None, name: str):
+    if obj is None:
+        return None
+    for p in obj.findall("property"):
+        if p.get("name") == name:
+            return p
+    return None
+
+
+def _value(obj, name, cast=float, default=None):
+    p = _prop(obj, name)
+    if p is None or p.text is None:
+        return default
+    try:
+        return cast(p.text.strip())
+    except ValueError:
+        return default
+
+
+def _object(p: ET.Element | None) -> ET.Element | None:
+    return None if p is None else p.find("object")
+
+
+def _project(path: Path, root: ET.Element) -> TrackerProject:
+    clip_obj = _object(_prop(root, "videoclip"))
+    control = _object(_prop(root, "clipcontrol"))
+    start = _value(clip_obj, "startframe", int, 0)
+    step = _value(clip_obj, "stepsize", int, 1)
+    count = _value(clip_obj, "stepcount", int, None)
+    dt_ms = _value(control, "delta_t", float, None)
+    video = _object(_prop(clip_obj, "video"))
+    video_path = _value(video, "path", str, None)
+
+    coords = _object(_prop(root, "coords"))
+    frame0 = None
+    if coords is not None:
+        fd = _prop(coords, "framedata")
+        frame0 = _object(fd.find("property")) if fd is not None and fd.find("property") is not None else None
+    unit = LENGTH_UNITS_M.get((_value(root, "length_unit", str, "m") or "m").strip(), math.nan)
+    px_per_unit = _value(frame0, "xscale", float, math.nan)
+    calibration = Calibration(
+        m_per_px=unit / px_per_unit if px_per_unit and math.isfinite(px_per_unit) else math.nan,
+        origin_x_px=_value(frame0, "xorigin", float, 0.0) + TRACKER_TO_OPENCV_PX,
+        origin_y_px=_value(frame0, "yorigin", float, 0.0) + TRACKER_TO_OPENCV_PX,
+        angle_deg=_value(frame0, "angle", float, 0.0),  # degrees in the file
+        source=f"tracker:{path.name}")
+
+    points: dict[str, dict[int, tuple[float, float]]] = {}
+    tracks = _prop(root, "tracks")
+    for item in (tracks.findall("property") if tracks is not None else []):
+        obj = item.find("object")
+        if obj is None or not (obj.get("class") or "").endswith(POINT_CLASSES):
+            continue
+        name = _value(obj, "name", str, f"track{len(points) + 1}")
+        fd = _prop(obj, "framedata")
+        pts = {}
+        for entry in (fd.findall("property") if fd is not None else []):
+            step_obj = entry.find("object")
+            x, y = _value(step_obj, "x"), _value(step_obj, "y")
+            if x is None or y is None:
+                continue
+            frame = int(entry.get("name", "[-1]").strip("[]"))
+            pts[frame] = (x + TRACKER_TO_OPENCV_PX, y + TRACKER_TO_OPENCV_PX)
+        points[name] = pts
+    if not points:
+        raise TrackError(f"{path}: no point-mass tracks in this Tracker file", "mark a point mass in Tracker first")
+    end = start + step * (count - 1) if count else max(max(p) for p in points.values() if p)
+    if dt_ms is not None and not 1000.0 / FPS_MAX <= dt_ms <= 1000.0 / FPS_MIN:
+        raise TrackError(f"{path}: the clip's frame interval (clip control delta_t) is {dt_ms:g} ms; a camera's is "
+                         f"{1000.0 / FPS_MAX:g} to {1000.0 / FPS_MIN:g} ms ({FPS_MIN:g} to {FPS_MAX:g} frames/s), "
+                         "and times are frame x delta_t",
+                         "set the clip's frame rate in Tracker (Video > Clip Settings) and save the project again")
+    fps = 1000.0 / dt_ms if dt_ms else math.nan
+    return TrackerProject(path, video_path, TrackerClip(start, end, step, fps), calibration, points)
+
+
+@dataclass(frozen=True)
+class ProjectPoints:
+    """One point track of a project on its clip's frames: pixels (OpenCV convention), NaN and
+    ``ok`` False where Tracker has no step; ``name`` made a plain column name, ``tracker_name``
+    as Tracker shows it."""
+
+    name: str
+    tracker_name: str
+    px: np.ndarray
+    py: np.ndarray
+    ok: np.ndarray
+
+
+def project_points(project: TrackerProject, names: list[str] | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, list[ProjectPoints]]:
+    """The clip's frames, their times (s; NaN without a frame rate) and the point tracks
+    ``names`` (default: all) on those frames."""
+    names = names or list(project.points)
+    unknown = [n for n in names if n not in project.points]
+    if unknown:
+        raise TrackError(f"{project.path.name}: no track named {', '.join(unknown)}",
+                         f"its point tracks are: {', '.join(project.points)}")
+    clip = project.clip
+    frames = np.arange(clip.start, clip.end + 1, clip.step, dtype=int)
+    t_s = (frames - clip.start) / clip.fps if math.isfinite(clip.fps) else frames * math.nan
+    tracks = []
+    for name in names:
+        pts = project.points[name]
+        px = np.array([pts.get(int(f), (math.nan, math.nan))[0] for f in frames])
+        py = np.array([pts.get(int(f), (math.nan, math.nan))[1] for f in frames])
+        tracks.append(ProjectPoints(_safe_name(name), name, px, py, np.isfinite(px)))
+    return frames, t_s, tracks
+
+
+def project_tracks(project: TrackerProject, names: list[str] | None = None) -> TracksCsv:
+    """A project's point tracks as a tracks CSV: pixels, and world metres through its calibration."""
+    frames, t_s, tracks = project_points(project, names)
+    markers = {}
+    for tr in tracks:
+        x_m, y_m = project.calibration.to_world(tr.px, tr.py)
+        markers[tr.name] = MarkerColumns(tr.name, tr.px, tr.py, x_m, y_m, tr.ok)
+    return TracksCsv(frame=frames, t_s=t_s, markers=markers)
+
+
+def _safe_name(name: str) -> str:
+    out = "".join(c if c.isalnum() else "_" for c in name.strip())
+    return out if out and out[0].isalpha() else f"m_{out}"
+
+
+def media_in_zip(project: TrackerProject, trk_path: Path) -> str | None:
+    """How a project written at ``trk_path`` names the video inside ``project``'s ``.trz``
+    (OSP's ``zip!/entry`` path); None for a plain ``.trk``, whose video is a file of its own."""
+    if not zipfile.is_zipfile(project.path) or not project.video_path:
+        return None
+    with zipfile.ZipFile(project.path) as z:
+        trk_name = next(n for n in sorted(z.namelist()) if n.lower().endswith(".trk"))
+    entry = (PurePosixPath(trk_name).parent / project.video_path.replace("\\", "/")).as_posix()
+    zip_rel = Path(os.path.relpath(project.path.resolve(), Path(trk_path).resolve().parent)).as_posix()
+    return f"{zip_rel}!/{entry}"
+
+
+@contextmanager
+def project_media(project: TrackerProject) -> Iterator[Path]:
+    """The video (or the image sequence's first file) a project opens, as a local path for the
+    duration of the ``with``: beside the ``.trk``, or unpacked from the ``.trz`` into a
+    temporary folder removed afterwards."""
+    if not project.video_path:
+        raise TrackError(f"{project.path}: the project names no video", "give the video itself as VIDEO")
+    rel = Path(project.video_path.replace("\\", "/"))
+    if not zipfile.is_zipfile(project.path):
+        media = rel if rel.is_absolute() else project.path.parent / rel
+        if not media.is_file():
+            raise TrackError(f"{project.path.name} opens {project.video_path}, which is not at {media}",
+                             "put the video where the project expects it, or give the video as VIDEO "
+                             f"with --calibration-from {project.path.name}")
+        yield media
+        return
+    with tempfile.TemporaryDirectory(prefix="locust-trz-") as tmp:
+        with zipfile.ZipFile(project.path) as z:
+            trk_dirs = {PurePosixPath(n).parent for n in z.namelist() if n.lower().endswith(".trk")}
+            wanted = [n for n in z.namelist() if not n.endswith("/")
+                      and any(PurePosixPath(n).parent == (d / rel).parent for d in trk_dirs)]
+            for name in wanted:
+                target = Path(tmp, *PurePosixPath(name).parts)
+                if ".." in PurePosixPath(name).parts:
+                    continue
+                target.parent.mkdir(parents=True, exist_ok=True)
+                target.write_bytes(z.read(name))
+        candidates = [Path(tmp, *d.parts) / rel for d in sorted(trk_dirs)]
+        media = next((c for c in candidates if c.is_file()), None)
+        if media is None:
+            raise TrackError(f"{project.path.name} opens {project.video_path}, which is not inside it",
+                             "give the video itself as VIDEO, with --calibration-from the project")
+        yield media

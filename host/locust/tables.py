@@ -1,0 +1,94 @@
+"""The short tables ``locust sim``, ``locust hop`` and ``locust virtual`` print for a person.
+
+Lengths in mm, angles in deg, times in ms or s; ``--json`` (where a command has it) stays the
+machine-readable form in SI units. Each function returns the lines; the command echoes them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+INDENT = "  "
+
+
+def table(header: Sequence[str], rows: Sequence[Sequence[str]], indent: str = INDENT) -> list[str]:
+    """Columns right-aligned to the wider of the header and its cells, two spaces apart."""
+    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(header)]
+    return [indent + "  ".join(cell.rjust(w) for cell, w in zip(line, widths, strict=True))
+            for line in (header, *rows)]
+
+
+def mm(length_m: float, decimals: int = 2) -> str:
+    """A length given in metres, written in mm (``nan`` when it is not finite)."""
+    return f"{length_m * 1000:.{decimals}f}" if math.isfinite(length_m) else "nan"
+
+
+def verdict(valid: bool) -> str:
+    return "valid" if valid else "INVALID"
+
+
+def sim_lines(r) -> list[str]:
+    """``locust sim``: a :class:`locust.sim.run.SimResult` as the verdict, one row per hop,
+    the totals, the convergence check and the notes."""
+    lines = [f"{r.robot}: {verdict(r.valid)} ({r.cycles} cycle{'' if r.cycles == 1 else 's'}, "
+             f"time step {r.timestep_s:g} s, "
+             f"{r.wall_s:.1f} s wall)"]
+    lines += [f"{INDENT}reason: {reason}" for reason in r.reasons]
+    if not r.valid:
+        return lines
+    lines.append(f"{INDENT}linkage: {r.grashof}, transmission angle {r.transmission_deg:.0f} deg")
+    lines += hop_table([vars(h) for h in r.hops])
+    lines.append(totals_line(r.distance_m, r.max_nose_height_m))
+    if r.convergence:
+        lines.append(INDENT + convergence_line(r.convergence))
+    lines += [f"{INDENT}note: {note}" for note in r.notes]
+    return lines
+
+
+def hop_table(hops: list[dict]) -> list[str]:
+    """One row per hop (the fields of :class:`locust.sim.hops.Hop`, as a dict): distance, nose
+    and centre-of-mass rise above standing in mm, flight in ms."""
+    rows = [[str(h["cycle"]), mm(h["distance_m"]), mm(h["nose_apex_m"]), mm(h["com_apex_m"]),
+             f"{h['flight_s'] * 1000:.1f}"] for h in hops]
+    return table(["hop", "distance mm", "nose rise mm", "CoM rise mm", "flight ms"], rows)
+
+
+def totals_line(distance_m: float, max_nose_height_m: float) -> str:
+    """The run's whole distance and its highest nose point, in mm."""
+    return f"{INDENT}total distance {mm(distance_m)} mm; highest nose {mm(max_nose_height_m)} mm above the floor"
+
+
+def convergence_line(c: dict) -> str:
+    """The time-step check of ``--check-convergence``: the change at half the step."""
+    said = "converged" if c["converged"] else "NOT converged (within 1 % or 0.1 mm asked)"
+    return (f"at half the time step ({c['half_timestep_s']:g} s): distance "
+            f"{c['distance_change_mm_per_hop']:.3f} mm per hop ({c['distance_rel_change'] * 100:.2f} %), "
+            f"highest nose {c['max_nose_height_change_mm']:.3f} mm ({c['max_nose_height_rel_change'] * 100:.2f} %): "
+            f"{said}")
+
+
+def spread_line(spread) -> str:
+    """``locust sim --samples``: the spread of the outcome over the draws."""
+    return (f"{INDENT}{spread.n} draws of {len(spread.uncertain)} uncertain values ({spread.n_valid} valid): "
+            f"distance sd {mm(spread.distance_m_sd, 3)} mm, highest nose sd {mm(spread.max_nose_height_m_sd, 3)} mm")
+
+
+def plant_lines(summary: dict) -> list[str]:
+    """``locust hop --port sim`` and ``locust virtual``: what the virtual robot's plant did
+    (the dict its ``close()`` returns: the live MuJoCo model's audited run, one row per push,
+    or the recorder's count)."""
+    if summary.get("plant") != "mujoco":
+        return [f"servo commands recorded: {summary.get('commands', 0)}"]
+    rtf = summary["realtime_factor"]
+    lines = [f"simulated robot: {verdict(summary['valid'])} ({summary['sim_time_s']:.3f} s simulated, "
+             f"{rtf:.1f}x real time)" if math.isfinite(rtf) else
+             f"simulated robot: {verdict(summary['valid'])} ({summary['sim_time_s']:.3f} s simulated)"]
+    lines += [f"{INDENT}reason: {reason}" for reason in summary["reasons"]]
+    if summary["valid"]:
+        if summary.get("hops"):
+            lines += hop_table(summary["hops"])
+        lines.append(totals_line(summary["distance_m"], summary["max_nose_height_m"]))
+    if summary.get("video_path"):
+        lines.append(f"{INDENT}video: {summary['video_path']} ({summary['frames']} frames)")
+    return lines

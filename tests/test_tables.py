@@ -1,0 +1,67 @@
+"""The tables `locust sim`, `locust hop` and `locust virtual` print: every figure is the
+result's own, in mm, to the printed precision (0.005 mm)."""
+
+import math
+import re
+
+from click.testing import CliRunner
+
+from locust.cli import cli
+from locust.params import preset
+from locust.sim.run import run
+from locust.tables import mm, plant_lines, sim_lines, table
+
+ROUNDING_MM = 0.005     # two decimals
+
+
+def _rows(lines: list[str], header: str) -> list[list[str]]:
+    at = next(i for i, line in enumerate(lines) if line.split() == header.split())
+    return [line.split() for line in lines[at + 1:] if re.match(r"^\s+\d+\s", line)]
+
+
+def test_sim_table_is_the_results_own_numbers_in_mm():
+    r = run(preset("seed"), cycles=3)
+    assert r.valid
+    res = CliRunner().invoke(cli, ["sim", "--preset", "seed", "--cycles", "3"])
+    assert res.exit_code == 0, res.output
+    lines = res.output.splitlines()
+    assert lines[0].startswith("seed: valid (3 cycles, time step 0.001 s")
+    rows = _rows(lines, "hop  distance mm  nose rise mm  CoM rise mm  flight ms")
+    assert [int(row[0]) for row in rows] == [1, 2, 3]
+    for row, hop in zip(rows, r.hops, strict=True):
+        assert abs(float(row[1]) - hop.distance_m * 1000) <= ROUNDING_MM
+        assert abs(float(row[2]) - hop.nose_apex_m * 1000) <= ROUNDING_MM
+        assert abs(float(row[3]) - hop.com_apex_m * 1000) <= ROUNDING_MM
+        assert abs(float(row[4]) - hop.flight_s * 1000) <= 0.05
+    total = re.search(r"total distance (-?[\d.]+) mm; highest nose (-?[\d.]+) mm", res.output)
+    assert abs(float(total.group(1)) - r.distance_m * 1000) <= ROUNDING_MM
+    assert abs(float(total.group(2)) - r.max_nose_height_m * 1000) <= ROUNDING_MM
+    assert "distance_m=" not in res.output and "e-0" not in res.output
+
+
+def test_invalid_run_prints_its_reasons_and_no_table():
+    r = run(preset("seed"), cycles=1)
+    bad = type(r)(**{**vars(r), "valid": False, "reasons": ["energy from nowhere"]})
+    assert sim_lines(bad) == [sim_lines(r)[0].replace("valid", "INVALID", 1), "  reason: energy from nowhere"]
+
+
+def test_table_right_aligns_each_column():
+    assert table(["hop", "distance mm"], [["1", "18.59"], ["10", "-0.40"]]) == [
+        "  hop  distance mm",
+        "    1        18.59",
+        "   10        -0.40"]
+    assert mm(0.018585325) == "18.59" and mm(math.nan) == "nan" and mm(1e-9, 3) == "0.000"
+
+
+def test_plant_lines_give_the_live_runs_figures_in_mm():
+    hop = {"cycle": 1, "distance_m": 0.01858532534294068, "nose_apex_m": 0.0412, "com_apex_m": 0.0101,
+           "flight_s": 0.0453}
+    summary = {"plant": "mujoco", "distance_m": 0.01858532534294068, "max_nose_height_m": 0.0612, "sim_time_s": 2.829,
+               "valid": True, "reasons": [], "realtime_factor": 23.7, "video_path": None, "frames": 0, "hops": [hop]}
+    assert plant_lines(summary) == ["simulated robot: valid (2.829 s simulated, 23.7x real time)",
+                                    "  hop  distance mm  nose rise mm  CoM rise mm  flight ms",
+                                    "    1        18.59         41.20        10.10       45.3",
+                                    "  total distance 18.59 mm; highest nose 61.20 mm above the floor"]
+    bad = {**summary, "valid": False, "reasons": ["aborted"], "hops": []}
+    assert plant_lines(bad) == ["simulated robot: INVALID (2.829 s simulated, 23.7x real time)", "  reason: aborted"]
+    assert plant_lines({"plant": "record", "commands": 7}) == ["servo commands recorded: 7"]
