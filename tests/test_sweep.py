@@ -392,7 +392,7 @@ def test_interrupted_optimize_keeps_finished_trials_without_a_traceback(tmp_path
                        timeout=300)
     assert r.returncode == 130, r.stderr
     assert "Traceback" not in r.stderr and "KeyboardInterrupt" not in r.stderr
-    assert "interrupted" in r.stderr and "1 finished trials are kept" in r.stderr
+    assert "interrupted" in r.stderr and "1 finished trial kept" in r.stderr
     meta = json.loads((out / "optimize.json").read_text())
     assert meta["trials"] == 2 and meta["complete"] + meta["pruned"] == 1
     rerun = subprocess.run(LOCUST + args, capture_output=True, text=True, timeout=300)

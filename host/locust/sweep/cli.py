@@ -147,6 +147,7 @@ def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_n
         click.echo(f"best design as a robot file: {summary.best_robot}")
     click.echo(f"results: {out / 'trials.csv'}, {out / 'optimize.json'}, {out / 'history.png'}")
     if summary.interrupted:
-        click.echo(f"interrupted: the trial under way was dropped; {summary.complete + summary.pruned} finished "
-                   "trials are kept in the study and the files above; rerun the same command to continue", err=True)
+        kept = summary.complete + summary.pruned
+        click.echo(f"interrupted: {kept} finished trial{'s' * (kept != 1)} kept in the study and the files above "
+                   "(a trial under way is not); rerun the same command to continue", err=True)
         sys.exit(130)
