@@ -40,6 +40,14 @@ def test_from_robot_toml_follows_its_link_lengths(tmp_path):
     s = json.loads(_run("--from-robot", tmp_path / "robot.toml", "--json").output)
     assert s["hinges_x_mm"] == pytest.approx([45, 85, 105, 175], abs=1e-6)
     assert s["bounds_mm"]["width"] == pytest.approx(195)
+    # its values are not the seed's, though the file kept the name "seed": named by the file
+    assert s["source"] == "flat pattern of robot"
+    params.save_robot(robot.renamed("optimize best of opt"), tmp_path / "best.toml")
+    assert json.loads(_run("--from-robot", tmp_path / "best.toml", "--json").output)["source"] == \
+        "flat pattern of optimize best of opt"
+    params.save_robot(params.preset("seed"), tmp_path / "plain.toml")   # the seed itself keeps its name
+    assert json.loads(_run("--from-robot", tmp_path / "plain.toml", "--json").output)["source"] == \
+        "flat pattern of seed"
 
 
 def test_zz_out_writes_every_file_and_previews(tmp_path):

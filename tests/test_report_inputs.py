@@ -20,6 +20,7 @@ from locust.report.landscape import design_value, read_landscape
 from locust.trials.configs import configuration, name_from_path, parse_added
 from locust.trials.measure import align, measure_hops, onset_time
 from locust.trials.measured import parse_measured
+from probing import assert_clear_error, invoke, tree
 
 
 def staircase(fps=30.0, lead_s=0.4, period_s=1.3, hops=(0.20, 0.25, 0.15), apex=(0.05, 0.08, 0.03), noise=0.0, seed=0):
@@ -161,13 +162,9 @@ PIXELS_ONLY = "frame,t_s,nose_px,nose_py,nose_x_m,nose_y_m,nose_ok\n" + "".join(
 def test_bad_measured_inputs_are_clear_errors_and_write_nothing(tmp_path, setup, message, hint):
     path = setup(tmp_path)
     out = tmp_path / "out"
-    res = report("--measured", path, "--out", out)
-    assert res.exit_code == 2, res.output
-    assert "Traceback" not in res.output and res.exception is None or isinstance(res.exception, SystemExit)
-    assert "error:" in res.output and message in res.output
-    if hint:
-        assert "hint:" in res.output and hint in res.output
-    assert not out.exists()
+    before = tree(tmp_path)
+    assert_clear_error(invoke(["report", "--measured", path, "--out", out]), message, hint)
+    assert tree(tmp_path) == before   # no --out made, every input as it was
 
 
 def test_runs_with_different_schedules_are_refused_before_simulating(tmp_path):

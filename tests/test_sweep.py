@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import random
 import signal
 import subprocess
 import sys
@@ -13,9 +14,10 @@ from pathlib import Path
 import pytest
 
 from locust.errors import SweepError
-from locust.params import preset
+from locust.params import load_robot, preset
 from locust.sweep.design import design_robot, evaluate, parse_axis, parse_bound, precheck
 from locust.sweep.run import best_row, run_sweep
+from probing import assert_refused_and_unchanged, invoke
 
 LOCUST = [sys.executable, "-c", "from locust.cli import main; main()"]
 
@@ -192,9 +194,15 @@ def test_optimize_prunes_invalid_designs_and_keeps_the_study(tmp_path):
     meta = json.loads((tmp_path / "o" / "optimize.json").read_text())
     for reason in meta["pruned_reasons"].values():
         assert reason  # every pruned trial carries its reason
-    if first.best is not None:
-        assert first.best["geometry.coupler_m"] <= 0.1166
-        assert precheck(design_robot(base, {"geometry.coupler_m": first.best["geometry.coupler_m"]})) is None
+    # seed 3 draws two couplers that cannot close and three that can: a best exists
+    assert (first.complete, first.pruned) == (3, 2)
+    assert first.best["geometry.coupler_m"] <= 0.1166
+    assert precheck(design_robot(base, {"geometry.coupler_m": first.best["geometry.coupler_m"]})) is None
+    # the best design as a robot file: its values, and a name that says what it is
+    best = load_robot(tmp_path / "o" / "best.toml")
+    assert best.name == f"optimize best of {tmp_path / 'o'}"
+    assert best.geometry.coupler_m == first.best["geometry.coupler_m"]
+    assert evaluate(best, {}, 1)["distance_m"] == first.best["distance_m"]
     # the journal keeps the study: a second run continues it
     again = run_optimize(base, bounds, trials=2, cycles=1, folder=tmp_path / "o", seed=4)
     assert again.trials == 7
@@ -281,3 +289,247 @@ def test_results_csv_round_trips_through_its_owner_and_only_a_torn_last_line_is_
     path.write_text(lines[0] + lines[1].replace("True", "Ture") + lines[2])
     with pytest.raises(SweepError, match="line 2: malformed row"):
         read_results(tmp_path / "s")
+
+
+# -- optimize: storage, settings and interrupts ---------------------------------------
+OPT = ["optimize", "--vary", "geometry.coupler_m=0.01:0.2", "--trials", "1", "--cycles", "1", "--seed", "3"]
+
+
+@pytest.fixture(scope="module")
+def journal_text(tmp_path_factory) -> str:
+    """A real journal of a two-trial study (one valid, one pruned)."""
+    from locust.sweep.optimize import run_optimize
+
+    base = preset("seed")
+    folder = tmp_path_factory.mktemp("j") / "o"
+    run_optimize(base, [parse_bound("geometry.coupler_m=0.01:0.2", base)], trials=2, cycles=1, folder=folder, seed=3)
+    return (folder / "study.journal").read_text()
+
+
+def _not_journals(journal: str) -> dict[str, bytes]:
+    """Files Optuna would append to or choke on: a user's text, binary, JSON that is no journal
+    operation, and a real journal cut short or damaged at generated places."""
+    rng = random.Random(28)
+    cases = {"notes": b"my notes\nsecond line\n", "no-newline": b"x", "binary": bytes(range(256)),
+             "latin-1": "caf\xe9\n".encode("latin-1"), "json-list": b"[1, 2]\n",
+             "json-no-op": b'{"study_name": "locust"}\n', "op-not-int": b'{"op_code": "0"}\n',
+             "first-not-create": journal.split("\n", 1)[1].encode(), "blank-line": ("\n" + journal).encode()}
+    ends = [i for i, c in enumerate(journal) if c == "\n"]
+    for _ in range(6):   # cut inside a line: a torn last line
+        cut = rng.choice([i for i in range(1, len(journal)) if i - 1 not in ends])
+        cases[f"torn-at-{cut}"] = journal[:cut].encode()
+    for _ in range(4):   # one line's byte replaced in the middle of the file
+        at = rng.randrange(ends[0] + 2, ends[-2])
+        cases[f"garbled-at-{at}"] = (journal[:at] + "\x00" + journal[at + 1:]).encode()
+    return cases
+
+
+def test_optimize_refuses_a_storage_file_that_is_not_a_whole_journal_and_leaves_it(tmp_path, journal_text,
+                                                                                   monkeypatch):
+    from locust.sweep import optimize
+
+    monkeypatch.setattr(optimize, "JOURNAL_RECHECK_S", (0.0,))   # no other process writes these
+    for name, data in _not_journals(journal_text).items():
+        folder = tmp_path / name
+        folder.mkdir()
+        (folder / "notes.txt").write_bytes(data)
+        assert_refused_and_unchanged(folder, [*OPT, "--out", folder / "o", "--storage", folder / "notes.txt"],
+                                     "journal", "notes.txt")
+        # the same bytes as the default journal of an --out folder
+        (folder / "o").mkdir()
+        (folder / "o" / "study.journal").write_bytes(data)
+        assert_refused_and_unchanged(folder, [*OPT, "--out", folder / "o"], "journal")
+
+
+def test_optimize_refuses_a_sqlite_storage_that_is_not_an_optuna_database(tmp_path):
+    import sqlite3
+
+    (tmp_path / "notes.db").write_text("my notes\n")
+    con = sqlite3.connect(tmp_path / "mine.db")
+    con.execute("CREATE TABLE birds (name TEXT)")
+    con.commit()
+    con.close()
+    assert_refused_and_unchanged(tmp_path, [*OPT, "--out", tmp_path / "o", "--storage",
+                                            f"sqlite:///{tmp_path / 'notes.db'}"], "not an SQLite database")
+    assert_refused_and_unchanged(tmp_path, [*OPT, "--out", tmp_path / "o", "--storage",
+                                            f"sqlite:///{tmp_path / 'mine.db'}"], "without Optuna's tables", "birds")
+
+
+def test_optimize_refuses_to_continue_a_study_with_other_settings(tmp_path):
+    out = tmp_path / "o"
+    first = invoke([*OPT, "--out", out])
+    assert first.exit_code == 0, first.output
+    for other, differs in ((["--cycles", "6"], "cycles"), (["--set", "geometry.crank_m=0.041"], "geometry.crank_m"),
+                           (["--vary", "geometry.leg_m=0.05:0.09"], "vary"), (["--preset", "large"], "base")):
+        assert_refused_and_unchanged(tmp_path, [*OPT, "--out", out, *other], "other settings", differs)
+    again = invoke([*OPT, "--out", out])   # the same settings continue the study
+    assert again.exit_code == 0 and "2 trials" in again.output
+
+
+# Ctrl-C in the middle of the second trial, delivered by the process to itself: the same
+# SIGINT a terminal sends, at a point that does not depend on the machine's speed.
+_INTERRUPTED_IN_SECOND_TRIAL = """
+import os, signal, sys
+from locust.sweep import optimize
+evaluate = optimize.evaluate
+calls = []
+def evaluate_then_interrupt(*args):
+    calls.append(1)
+    if len(calls) == 2:
+        os.kill(os.getpid(), signal.SIGINT)
+    return evaluate(*args)
+optimize.evaluate = evaluate_then_interrupt
+from locust.cli import main
+sys.argv[0] = "locust"
+main()
+"""
+
+
+def test_interrupted_optimize_keeps_finished_trials_without_a_traceback(tmp_path):
+    out = tmp_path / "o"
+    args = [*OPT, "--trials", "4", "--out", str(out)]
+    r = subprocess.run([sys.executable, "-c", _INTERRUPTED_IN_SECOND_TRIAL, *args], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 130, r.stderr
+    assert "Traceback" not in r.stderr and "KeyboardInterrupt" not in r.stderr
+    assert "interrupted" in r.stderr and "1 finished trial kept" in r.stderr
+    meta = json.loads((out / "optimize.json").read_text())
+    assert meta["trials"] == 2 and meta["complete"] + meta["pruned"] == 1
+    rerun = subprocess.run(LOCUST + args, capture_output=True, text=True, timeout=300)
+    assert rerun.returncode == 0, rerun.stderr
+    assert "6 trials" in rerun.stdout   # 2 before (1 finished, 1 dropped) + 4
+
+
+# -- sweep: workers, schedulers ---------------------------------------------------------
+# A worker kills itself (SIGKILL, as the kernel's out-of-memory killer does) when given design
+# 2; the leader, its other worker and the rows already written are untouched.
+_WORKER_KILLED_AT_DESIGN_2 = """
+import os, signal, sys
+from locust.sweep import run
+run_task = run.run_task
+def run_task_or_die(task):
+    if task.design == 2:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return run_task(task)
+run.run_task = run_task_or_die
+from locust.cli import main
+sys.argv[0] = "locust"
+main()
+"""
+
+
+def test_a_killed_worker_is_a_clear_error_and_the_rerun_resumes(tmp_path):
+    from locust.sweep.execute import default_jobs
+
+    if default_jobs() < 2:
+        pytest.skip("needs two cores: with one, the sweep runs in the leader itself")
+    out = tmp_path / "s"
+    args = ["sweep", "--preset", "seed", "--vary", "geometry.leg_m=0.055:0.07:4", "--cycles", "1",
+            "--jobs", "2", "--out", str(out), "--json"]
+    died = subprocess.run([sys.executable, "-c", _WORKER_KILLED_AT_DESIGN_2, *args], capture_output=True,
+                          text=True, timeout=300)
+    assert died.returncode == 2, died.stderr
+    assert "Traceback" not in died.stderr and "BrokenProcessPool" not in died.stderr
+    assert "error: a worker process died" in died.stderr and "hint:" in died.stderr and "resume" in died.stderr
+    kept = read_rows(out)
+    assert {int(r["design"]) for r in kept} <= {0, 1, 3}
+    rerun = subprocess.run(LOCUST + args, capture_output=True, text=True, timeout=300)
+    assert rerun.returncode == 0, rerun.stderr
+    report = json.loads(rerun.stdout)
+    assert (report["resumed"], report["computed"]) == (len(kept), 4 - len(kept))
+    rows = read_rows(out)
+    assert [int(r["design"]) for r in rows] == [0, 1, 2, 3]
+    for old in kept:
+        assert rows[int(old["design"])] == old
+
+
+def test_jobs_are_capped_at_the_designs_and_the_cores_and_the_sweep_says_so(tmp_path):
+    from locust.sweep.execute import default_jobs
+
+    base = preset("seed")
+    said = []
+    s = run_sweep(base, [parse_axis("geometry.coupler_m=0.205:0.21:2", base)], cycles=1, out=tmp_path / "s",
+                  jobs=1024, plots=False, say=said.append)
+    used = min(2, default_jobs())
+    assert said == [f"--jobs 1024: starting {used} worker{'s' * (used != 1)} (2 designs to run, "
+                    f"{default_jobs()} cores)"]
+    assert json.loads((tmp_path / "s" / "sweep.json").read_text())["last_run"]["jobs"] == used
+    assert len(s.rows) == 2
+
+
+class _Impostor:
+    """A TCP server on 127.0.0.1 that is not a Dask scheduler: it greets every connection with
+    ``greeting`` (None: says nothing) and then closes it."""
+
+    def __init__(self, greeting: bytes | None):
+        import socket
+        import threading
+
+        self.greeting = greeting
+        self.sock = socket.create_server(("127.0.0.1", 0))
+        self.port = self.sock.getsockname()[1]
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self):
+
+        self.sock.settimeout(0.2)
+        while not self.stop.is_set():
+            try:
+                conn, _ = self.sock.accept()
+            except OSError:
+                continue
+            with conn:
+                if self.greeting is None:
+                    self.stop.wait(10)
+                else:
+                    try:
+                        conn.sendall(self.greeting)
+                    except OSError:
+                        pass
+
+    def close(self):
+        self.stop.set()
+        self.thread.join()
+        self.sock.close()
+
+
+def _impostor_greetings() -> dict[str, bytes | None]:
+    rng = random.Random(28)
+    cases: dict[str, bytes | None] = {
+        "http": b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n", "ssh": b"SSH-2.0-OpenSSH_9.6\r\n",
+        "exabytes": (3 << 60).to_bytes(8, "little") + b"\x01" + b"\x00" * 7, "ones": b"\xff" * 64,
+        "short": b"\x3a\x00", "closes": b"",
+        # a Dask-shaped header whose frame lengths do not add up
+        "inconsistent": (58).to_bytes(8, "little") + (1).to_bytes(8, "little") + (99).to_bytes(8, "little")
+        + b"\x00" * 42,
+        "silent": None}
+    for k in range(4):
+        cases[f"random-{k}"] = rng.randbytes(rng.randrange(1, 200))
+    return cases
+
+
+def test_a_scheduler_address_where_no_dask_answers_is_refused_promptly(tmp_path):
+    """Each case returns within the probe's few seconds (a hang would hang the test)."""
+    for name, greeting in _impostor_greetings().items():
+        server = _Impostor(greeting)
+        try:
+            folder = tmp_path / name
+            folder.mkdir()
+            (folder / "notes.txt").write_text("mine")
+            assert_refused_and_unchanged(folder, ["sweep", "--vary", "scale=0:0.01:2", "--cycles", "1",
+                                                  "--scheduler", f"tcp://127.0.0.1:{server.port}",
+                                                  "--out", folder / "s"], "Dask scheduler")
+        finally:
+            server.close()
+
+
+def test_a_real_dask_scheduler_passes_the_probe():
+    from dask.distributed import LocalCluster
+
+    from locust.sweep.execute import probe_dask_scheduler
+
+    with LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
+                      dashboard_address=None) as cluster:
+        probe_dask_scheduler(cluster.scheduler_address)   # raises if refused

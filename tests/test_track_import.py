@@ -23,6 +23,7 @@ from locust.io import tracks_csv as tc
 from locust.io import trk as trk_io
 from locust.io.importing import ImportOptions, import_tracks, likely_units, span_warnings, units_hint
 from locust.track import trk
+from probing import assert_clear_error
 
 # SYNTHETIC: a Tracker export calibrated in cm, one track named "A" (title line), one step missing
 CM_EXPORT = ("# SYNTHETIC Tracker export in cm (written by tests/test_track_import.py)\n"
@@ -41,12 +42,7 @@ def track(*args):
 
 
 def fails(res, *words):
-    assert res.exit_code == 2, res.output
-    assert res.exception is None or isinstance(res.exception, SystemExit), res.exception
-    assert "Traceback" not in res.output
-    assert "error:" in res.output and "hint:" in res.output, res.output
-    for w in words:
-        assert w in res.output, res.output
+    assert_clear_error(res, *words)   # exit 2, error: and hint: with the words, no traceback
 
 
 def test_tracker_export_in_cm_becomes_metres_with_the_new_name(tmp_path):

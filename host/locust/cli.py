@@ -131,6 +131,9 @@ def main() -> None:
         click.echo("  hint: install locust-hopper in its own virtual environment (`make install` makes one), "
                    "or `pip uninstall locust` here", err=True)
         sys.exit(2)
+    from .fileio import unwind_on_termination
+
+    unwind_on_termination()   # a kill (TERM) unwinds: no temporary file is left behind
     cli(prog_name="locust")
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import os
+import re
+import signal
 import stat
 import tempfile
 from pathlib import Path
@@ -72,11 +74,14 @@ def temp_beside(path: str | os.PathLike, suffix: str = ".tmp") -> tuple[int, str
     (an existing file's own mode, when it is replaced).
 
     Write it, then ``os.replace`` it onto ``path``: the rename is what makes a write atomic.
+    Its name, ``.NAME.PID.XXXXXXXX<suffix>``, carries the writer's process id: temporaries of
+    the same ``path`` left by a writer that no longer runs (killed with -9) are removed first.
     """
     path = Path(path)
     make_folder(path.parent)
+    remove_stale_temporaries(path)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=suffix, dir=path.parent)
     except OSError as exc:
         raise WriteError(f"cannot write in {path.parent} ({exc.strerror})", DISK_HINT) from None
     try:
@@ -87,6 +92,71 @@ def temp_beside(path: str | os.PathLike, suffix: str = ".tmp") -> tuple[int, str
         mode = 0o666 & ~umask
     os.fchmod(fd, mode)  # mkstemp makes 0600
     return fd, tmp
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):   # another user's process: alive
+        return pid > 0
+    return True
+
+
+def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
+    """Remove the temporaries :func:`temp_beside` made for ``path`` whose writer process is
+    gone (a kill -9 leaves them; a rerun writing the same ``path`` clears them). Only names
+    of exactly that form, regular files, are touched. Returns what was removed."""
+    path = Path(path)
+    pattern = re.compile(rf"\.{re.escape(path.name)}\.(\d{{1,10}})\.[a-z0-9_]{{8}}(\.[A-Za-z0-9]{{1,8}})?")
+    removed = []
+    try:
+        names = os.listdir(path.parent)
+    except OSError:
+        return removed
+    for name in names:
+        match = pattern.fullmatch(name)
+        if not match or _pid_alive(int(match[1])):
+            continue
+        stale = path.parent / name
+        try:
+            if stat.S_ISREG(os.lstat(stale).st_mode):
+                stale.unlink()
+                removed.append(stale)
+        except OSError:
+            pass
+    return removed
+
+
+def unwind_on_termination() -> None:
+    """Make SIGTERM and SIGHUP (a kill, a closed terminal) end this process as an exception
+    does (``SystemExit`` with 128 + the signal's number): ``finally`` and ``except
+    BaseException`` blocks run, so a writer removes its temporary file. Main thread only."""
+    def unwind(signum, frame):
+        raise SystemExit(128 + signum)
+
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        if signal.getsignal(sig) == signal.SIG_DFL:
+            signal.signal(sig, unwind)
+
+
+def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
+    """Raise :class:`WriteError` unless the video just encoded at ``tmp`` (for ``path``) reads
+    back with its ``frames`` frames: OpenCV's writer ignores a failed write (a full disk) and
+    leaves a truncated file no player opens."""
+    if frames == 0:
+        return
+    import cv2
+
+    cap = cv2.VideoCapture(str(tmp))
+    try:
+        count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
+    finally:
+        cap.release()
+    if count != frames:
+        raise WriteError(f"{path}: the video could not be written completely ({count} of {frames} frames read "
+                         "back); the disk may be full", DISK_HINT)
 
 
 def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> Path:

@@ -1,39 +1,131 @@
-"""Progress bars on stderr, silent when stderr is not a terminal (logs, pipes, CI)."""
+"""Progress on stderr for long work: a bar on a terminal, a plain line every ~10 s elsewhere
+(logs, pipes, CI), so a long fit is never silent.
+
+The time left is the work left over the rate measured since the first step finished (the
+setup before it is no guide to the rest), shown only once that rate rests on at least
+:data:`ETA_MIN_STEPS` steps and :data:`ETA_MIN_S` seconds.
+"""
 
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterable
+import time
+from collections.abc import Callable, Iterable
 from typing import Any
 
-import click
+ETA_MIN_STEPS = 3        # steps measured before a time left is shown
+ETA_MIN_S = 2.0          # seconds measured before a time left is shown
+PLAIN_EVERY_S = 10.0     # off a terminal: one line this often
+BAR_EVERY_S = 0.2        # on a terminal: redraw at most this often
+BAR_WIDTH = 30
 
 
-class _Silent:
-    """What ``progress`` gives off a terminal: the same use, no output."""
+def format_duration(seconds: float) -> str:
+    """``1:05:09``, ``8:05``, ``0:42`` (hours only when there are some)."""
+    s = max(0, int(round(seconds)))
+    h, rest = divmod(s, 3600)
+    m, s = divmod(rest, 60)
+    return f"{h}:{m:02d}:{s:02d}" if h else f"{m}:{s:02d}"
 
-    def __init__(self, items: Iterable | None):
-        self._items = items
 
-    def __enter__(self) -> _Silent:
+class Progress:
+    """``length`` steps (or ``items``), reported on ``file`` as a bar (``tty``) or as plain lines.
+
+    ``clock`` is the time source (seconds); tests give their own.
+    """
+
+    def __init__(self, items: Iterable | None = None, length: int | None = None, label: str = "",
+                 file: Any = None, tty: bool | None = None, clock: Callable[[], float] = time.monotonic,
+                 show_pos: bool = True, show_eta: bool = True, **_: Any):
+        if length is None and items is not None:
+            try:
+                length = len(items)   # type: ignore[arg-type]
+            except TypeError:
+                length = None
+        self.items, self.length, self.label = items, length, label
+        self.file = file if file is not None else sys.stderr
+        self.tty = self.file.isatty() if tty is None else tty
+        self.clock, self.show_pos, self.show_eta = clock, show_pos, show_eta
+        self.pos = 0
+        self.start = clock()
+        self._first: tuple[float, int] | None = None   # (time, pos) when the first step finished
+        self._last_shown = self.start if not self.tty else -float("inf")
+        self._drawn = False
+
+    # -- what is shown -------------------------------------------------------------------
+    def eta_s(self) -> float | None:
+        """Seconds left at the rate measured since the first step, or None until it means something."""
+        if self.length is None or self._first is None:
+            return None
+        t0, p0 = self._first
+        steps, spent = self.pos - p0, self.clock() - t0
+        if steps < ETA_MIN_STEPS or spent < ETA_MIN_S:
+            return None
+        return max(self.length - self.pos, 0) * spent / steps
+
+    def line(self) -> str:
+        parts = [self.label] if self.label else []
+        if self.length:
+            frac = min(self.pos / self.length, 1.0)
+            if self.tty:
+                filled = int(round(frac * BAR_WIDTH))
+                parts.append("[" + "#" * filled + "-" * (BAR_WIDTH - filled) + "]")
+            parts.append(f"{frac * 100:3.0f} %")
+            if self.show_pos:
+                parts.append(f"{self.pos}/{self.length}")
+        elif self.show_pos:
+            parts.append(str(self.pos))
+        parts.append(f"{format_duration(self.clock() - self.start)} elapsed")
+        eta = self.eta_s() if self.show_eta else None
+        if eta is not None and self.pos < (self.length or 0):
+            parts.append(f"about {format_duration(eta)} left")
+        return "  ".join(parts)
+
+    def _show(self, force: bool = False) -> None:
+        now = self.clock()
+        if not force and now - self._last_shown < (BAR_EVERY_S if self.tty else PLAIN_EVERY_S):
+            return
+        self._last_shown = now
+        if self.tty:
+            self.file.write("\r\x1b[K" + self.line())
+            self._drawn = True
+        else:
+            self.file.write(self.line() + "\n")
+        self.file.flush()
+
+    # -- the click.progressbar interface ------------------------------------------------
+    def update(self, n_steps: int = 1, current_item: Any = None) -> None:
+        self.pos += n_steps
+        if self._first is None and self.pos > 0:
+            self._first = (self.clock(), self.pos)
+        self._show()
+
+    def __enter__(self) -> Progress:
+        if self.tty:
+            self._show(force=True)
         return self
 
     def __exit__(self, *exc: Any) -> bool:
+        if self.tty and self._drawn:
+            self._show(force=True)
+            self.file.write("\n")
+            self.file.flush()
         return False
 
     def __iter__(self):
-        return iter(self._items if self._items is not None else ())
+        for item in self.items if self.items is not None else ():
+            yield item
+            self.update(1)
 
-    def update(self, n_steps: int = 1, current_item: Any = None) -> None:
-        pass
 
-
-def progress(items: Iterable | None = None, length: int | None = None, label: str = "", **options: Any):
-    """``click.progressbar`` over ``items`` or ``length`` steps on stderr; silent off a terminal.
+def progress(items: Iterable | None = None, length: int | None = None, label: str = "", **options: Any) -> Progress:
+    """Progress over ``items`` or ``length`` steps on stderr: a bar on a terminal, a plain line
+    every ~10 s elsewhere.
 
     Use as ``with progress(length=n, label="x") as bar: ... bar.update(1)`` or
     ``with progress(items, label="x") as bar: for item in bar: ...``.
     """
-    if not sys.stderr.isatty():
-        return _Silent(items)
-    return click.progressbar(items, length=length, label=label, file=sys.stderr, **options)
+    return Progress(items, length=length, label=label, **options)
+
+
+__all__ = ["Progress", "format_duration", "progress"]

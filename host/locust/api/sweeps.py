@@ -65,7 +65,7 @@ def sweep_axes(base: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axi
 
 def sweep(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis], cycles: int = 3, *,
           out: str | Path | None = None, jobs: int | None = None, scheduler: str = "local", samples: int = 0,
-          progress: Callable[[int], None] | None = None) -> SweepResults:
+          progress: Callable[[int], None] | None = None, say: Callable[[str], None] | None = None) -> SweepResults:
     """Simulate every combination of the varied values and find the best valid design.
 
     Each design is checked before it is simulated (the four-bar assembles and stays closed over
@@ -93,6 +93,8 @@ def sweep(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis], 
         Rank designs by their mean over this many draws of the uncertain values.
     progress : callable, optional
         Called with 1 as each design finishes.
+    say : callable, optional
+        Told, as a line of text, when fewer workers start than ``jobs`` asked for.
 
     Returns
     -------
@@ -109,11 +111,11 @@ def sweep(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis], 
     axes = sweep_axes(robot, vary)
     if out is not None:
         summary = run_sweep(robot, axes, cycles, Path(out), scheduler=scheduler, jobs=jobs, progress=progress,
-                            samples=samples)
+                            samples=samples, say=say)
         return SweepResults(**vars(summary), names=tuple(a.name for a in axes))
     with tempfile.TemporaryDirectory(prefix="locust-sweep-") as tmp:
         summary = run_sweep(robot, axes, cycles, Path(tmp), scheduler=scheduler, jobs=jobs, progress=progress,
-                            plots=False, samples=samples)
+                            plots=False, samples=samples, say=say)
     summary.folder = None
     return SweepResults(**vars(summary), names=tuple(a.name for a in axes))
 

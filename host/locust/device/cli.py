@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from ..errors import DeviceError
+from ..errors import DeviceError, LocustError
 from ..fileio import json_text
 from ..firmware import config as fw_config
 from ..io import run_record as R
@@ -161,6 +161,7 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     # a kill (SIGTERM) or a closed terminal (SIGHUP) ends the hop as Ctrl-C does: the robot to
     # rest, the record says so, a --port sim virtual robot stops
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
+    rec = None
     try:
         with open_port(port, plant=plant, video=video, robot=robot, info=_info, video_fps=video_fps) as device:
             with Link(device) as link:
@@ -169,7 +170,12 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
                                   on_phase=lambda p: (bar.update(1),
                                                       setattr(bar, "label", f"cycle {p.cycle} {p.phase}")),
                                   robot=source)
-    except BaseException:
+    except BaseException as exc:
+        if rec is not None and rec.status == R.COMPLETE and isinstance(exc, LocustError):
+            # the hop ran, what ends it failed (the virtual robot's video onto a full disk):
+            # the record keeps every phase and says what is missing
+            rec.status, rec.message = R.INCOMPLETE, f"after the hop: {exc.message}"
+            R.write(rec, directory)
         _remove_empty(directory, made if out is not None else directory)   # a hop that never started
         raise                                                              # leaves no empty folder
     finally:

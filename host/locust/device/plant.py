@@ -68,6 +68,10 @@ class MujocoPlant:
         self.sim.advance_to(t_s)
         return {"plant": "mujoco", **(self.sim.close() or {})}
 
+    def abort(self) -> None:
+        """After a failure: no half-written video is left."""
+        self.sim.abort()
+
 
 def mujoco_available() -> bool:
     import importlib.util

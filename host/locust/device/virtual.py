@@ -55,7 +55,8 @@ import tty
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import DeviceError
+from ..errors import DeviceError, LocustError
+from ..fileio import DISK_HINT
 from ..firmware import config as fw_config
 from ..orphans import die_with_parent
 from .plant import Plant, RecordingPlant
@@ -225,6 +226,7 @@ class VirtualRobot:
         self._raw_boot_pending = False  # rebooted from the raw REPL: enter it again at the prompt
         self._pwm_pending = b""
         self.summary: dict | None = None
+        self.plant_error: BaseException | None = None   # raised by stop()
 
     # -- lifecycle ---------------------------------------------------------------------
     def start(self) -> VirtualRobot:
@@ -315,6 +317,11 @@ class VirtualRobot:
         shutil.rmtree(self._tmp, ignore_errors=True)
         if self._log:
             self._log.close()
+        if self.plant_error is not None:
+            exc = self.plant_error
+            what = exc.message if isinstance(exc, LocustError) else f"{exc.__class__.__name__}: {exc}"
+            raise DeviceError(f"the virtual robot's simulation failed, so its video and summary were not written "
+                              f"({what})", exc.hint if isinstance(exc, LocustError) and exc.hint else DISK_HINT)
         if plant_unfinished:
             raise DeviceError(f"the virtual robot's simulation did not finish within {PLANT_CLOSE_TIMEOUT_S:g} s "
                               "of the hop (its video was not written)",
@@ -475,9 +482,27 @@ class VirtualRobot:
         return self._config_cache[1]
 
     def _feed_plant(self) -> None:
+        """The plant thread: an error of the plant (its video onto a full disk) is kept for
+        :meth:`stop` to raise in the caller's thread, and the plant is aborted."""
+        stopped = []
+        try:
+            self._feed_plant_until_stopped(stopped)
+        except BaseException as exc:   # handed to the main thread
+            self.plant_error = exc
+            abort = getattr(self.plant, "abort", None)
+            if abort is not None:
+                try:
+                    abort()
+                except Exception:   # the first error is the one reported
+                    pass
+            while not stopped and self._plant_queue.get() is not None:   # until stop() says so
+                pass
+
+    def _feed_plant_until_stopped(self, stopped: list) -> None:
         while True:
             item = self._plant_queue.get()
             if item is None:
+                stopped.append(True)
                 break
             t_s, pin, pulse_us = item
             if self._period_anchor_s is None:

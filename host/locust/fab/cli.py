@@ -26,6 +26,8 @@ def _robot(spec: str):
         robot = params.preset(spec)
     elif Path(spec).suffix.lower() == ".toml" or Path(spec).exists():
         robot = params.load_robot(Path(spec))
+        if robot.name in params.PRESETS and robot != params.preset(robot.name):
+            robot = robot.renamed(Path(spec).stem)   # a changed preset keeps its name: say which file it is
     else:
         robot = None
     if robot is not None:

@@ -30,7 +30,7 @@ import mujoco
 import numpy as np
 
 from ..errors import SimError
-from ..fileio import atomic_write_text, temp_beside
+from ..fileio import atomic_write_text, check_encoded, temp_beside
 from ..io.camera_json import CameraFile, MarkerPlane, camera_json_beside, write_camera_json
 from ..markers import MARKER_COLOURS
 from ..params import Robot
@@ -277,6 +277,7 @@ class ClipRecorder:
             self.poser.close()
             if not self.rows:
                 raise SimError(f"no frames to write to {self.path}", "simulate for at least one frame period")
+            check_encoded(self.tmp_path, self.frames, self.path)
             truth_path, camera_path = sidecar_paths(self.path)
             atomic_write_text(truth_path, self.truth_csv())
             write_camera_json(camera_path, self.camera_file())

@@ -269,10 +269,16 @@ class LiveSim:
     def __enter__(self) -> LiveSim:
         return self
 
+    def abort(self) -> None:
+        """End a failed run: its video is dropped (no half-written file), the result says aborted."""
+        if self._result is None:
+            if self._recorder is not None:
+                self._recorder.abort()
+            self._result = LiveResult(float("nan"), float("nan"), self.sim_time_s, False, ["aborted"], math.nan)
+
     def __exit__(self, *exc) -> None:
         if self._result is None and self._recorder is not None and exc[0] is not None:
-            self._recorder.abort()   # a failed run leaves no half-written video
-            self._result = LiveResult(float("nan"), float("nan"), self.sim_time_s, False, ["aborted"], math.nan)
+            self.abort()   # a failed run leaves no half-written video
         elif self._result is None:
             self.close()
 

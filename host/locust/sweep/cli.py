@@ -63,7 +63,7 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
     with progress(length=total, label=f"sweep ({scheduler})", show_pos=True, show_eta=True) as bar:
         try:
             summary = run_sweep(base, axes, cycles, out=out, scheduler=scheduler, jobs=jobs, progress=bar.update,
-                                samples=samples or 0)
+                                samples=samples or 0, say=lambda line: click.echo(line, err=True))
         except KeyboardInterrupt:
             click.echo(f"\ninterrupted: finished designs are in {out}/results.csv; "
                        "rerun the same command to resume", err=True)
@@ -143,4 +143,10 @@ def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_n
         where = ", ".join(f"{x.name}={b[x.name]:.6g}" for x in bounds)
         click.echo(f"best: trial {b['trial']} ({where}): {b['distance_m'] * 100:.2f} cm, "
                    f"highest nose {b['max_nose_height_m'] * 100:.2f} cm")
+        click.echo(f"best design as a robot file: {summary.best_robot}")
     click.echo(f"results: {out / 'trials.csv'}, {out / 'optimize.json'}, {out / 'history.png'}")
+    if summary.interrupted:
+        kept = summary.complete + summary.pruned
+        click.echo(f"interrupted: {kept} finished trial{'s' * (kept != 1)} kept in the study and the files above "
+                   "(a trial under way is not); rerun the same command to continue", err=True)
+        sys.exit(130)

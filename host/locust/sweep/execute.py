@@ -13,8 +13,11 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
+import socket
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from typing import Any
 
@@ -29,6 +32,17 @@ def default_jobs() -> int:
         return max(1, os.cpu_count() or 1)
 
 
+def plan_jobs(jobs: int | None, designs: int) -> tuple[int, str | None]:
+    """Workers to start for ``designs`` designs: ``jobs`` (default: every core), never more than
+    the designs nor the cores, and why, when fewer than asked."""
+    cores = default_jobs()
+    wanted = jobs or cores
+    used = max(1, min(wanted, designs, cores))
+    if jobs is None or used == jobs:
+        return used, None
+    return used, f"--jobs {jobs}: starting {used} worker{'s' * (used != 1)} ({designs} designs to run, {cores} cores)"
+
+
 def check_scheduler(scheduler: str) -> str:
     if scheduler in ("local", "dask-local") or scheduler.startswith("tcp://"):
         return scheduler
@@ -41,9 +55,18 @@ def _serial(fn: Callable, items: Sequence) -> Iterator[Any]:
         yield fn(item)
 
 
+def _worker_start(parent_pid: int) -> None:
+    """In a pool worker: die with the leader, and die plainly on SIGTERM (the pool's own way to
+    stop its workers): the leader's handler, inherited by fork, would unwind a worker into
+    sending its SystemExit back through a pipe no one reads any more."""
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_DFL)
+    die_with_parent(parent_pid)
+
+
 def _pool(fn: Callable, items: Sequence, jobs: int) -> Iterator[Any]:
     ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=die_with_parent,
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_start,
                                initargs=(os.getpid(),))
     pending: set[Future] = set()
     queue = list(items)[::-1]
@@ -53,7 +76,13 @@ def _pool(fn: Callable, items: Sequence, jobs: int) -> Iterator[Any]:
                 pending.add(pool.submit(fn, queue.pop()))
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)
             for fut in finished:
-                yield fut.result()
+                try:
+                    result = fut.result()
+                except BrokenProcessPool:
+                    raise SweepError("a worker process died (killed, or out of memory) before its design finished",
+                                     "every finished design is kept in results.csv: rerun the same command to "
+                                     "resume (with fewer --jobs if memory ran out)") from None
+                yield result
     finally:
         for fut in pending:
             fut.cancel()
@@ -88,8 +117,9 @@ def dask_client(scheduler: str, jobs: int):
             client.close()
             cluster.close()
         return
+    probe_dask_scheduler(scheduler)
     try:
-        client = Client(scheduler, timeout="15s")
+        client = Client(scheduler, timeout=f"{2 * PROBE_TIMEOUT_S:g}s")
     except (OSError, TimeoutError) as exc:
         raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: {exc}",
                          "start one with `dask scheduler` and workers with `dask worker "
@@ -98,6 +128,55 @@ def dask_client(scheduler: str, jobs: int):
         yield client
     finally:
         client.close()
+
+
+# how long a scheduler's address may take to accept and greet before it is refused
+PROBE_TIMEOUT_S = 4.0
+# a Dask greeting: 8 bytes (little-endian) giving the length of what follows, then 8 bytes
+# giving the number of frames and 8 per frame for their lengths; it is a few dozen bytes
+_GREETING_MAX_BYTES = 1 << 16
+
+
+def probe_dask_scheduler(scheduler: str, timeout_s: float = PROBE_TIMEOUT_S) -> None:
+    """Refuse (:class:`SweepError`) an address where no Dask scheduler answers within
+    ``timeout_s``: nothing listening, a silent server, or one whose greeting is not Dask's (read
+    as Dask's, its first bytes could ask for exabytes, and the client would wait forever)."""
+    where = scheduler.removeprefix("tcp://")
+    host, _, port = where.rpartition(":")
+    hint = ("give the address `dask scheduler` printed (tcp://HOST:PORT, workers started with `dask worker "
+            f"{scheduler}` and locust installed on them), or use --scheduler local")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise SweepError(f"--scheduler {scheduler!r}: not tcp://HOST:PORT", hint)
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s) as sock:
+            sock.settimeout(timeout_s)
+            head = _receive(sock, 16)
+            size = int.from_bytes(head[:8], "little")
+            frames = int.from_bytes(head[8:], "little")
+            if not 16 <= size <= _GREETING_MAX_BYTES or not 1 <= frames <= 64:
+                raise ValueError("not a Dask greeting")
+            rest = _receive(sock, size - 8)
+            lengths = [int.from_bytes(rest[8 * i:8 * i + 8], "little") for i in range(frames)]
+            if 8 + 8 * frames + sum(lengths) != size:
+                raise ValueError("not a Dask greeting")
+    except TimeoutError:
+        raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: no answer in {timeout_s:g} s",
+                         hint) from None
+    except ValueError:
+        raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: something else answers there "
+                         "(its first bytes are not a Dask greeting)", hint) from None
+    except OSError as exc:
+        raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: {exc.strerror or exc}", hint) from None
+
+
+def _receive(sock: socket.socket, n: int) -> bytes:
+    data = b""
+    while len(data) < n:
+        chunk = sock.recv(n - len(data))
+        if not chunk:
+            raise ValueError("closed before greeting")
+        data += chunk
+    return data
 
 
 @contextmanager

@@ -5,11 +5,19 @@ audited). A design that fails is pruned with its reason (``user_attrs["reason"]`
 becomes the best. The study lives in a journal file by default (``study.journal`` in the output
 folder; several processes may share it), or in any database Optuna's RDB storage takes
 (``sqlite:///study.db``, ``postgresql://...``) to share one study between machines.
+
+A study records what it searches (the base robot's values, the ranges, the cycles) as its user
+attribute ``locust``: a rerun with other settings is refused, never ranked against it. A storage
+file that is not an Optuna journal or database (a user's notes, a damaged journal) is refused
+and left as it is. The best design is written as a robot file, ``best.toml``.
 """
 
 from __future__ import annotations
 
+import json
 import math
+import sqlite3
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,12 +25,19 @@ from typing import Any
 
 from ..errors import SweepError
 from ..fileio import atomic_write_json, atomic_write_text, make_folder
-from ..params import Robot
-from .design import SCALE, Bound, evaluate
+from ..params import Robot, save_robot
+from .design import SCALE, Bound, design_robot, evaluate
 
 RDB_PREFIXES = ("sqlite:", "postgresql", "mysql", "oracle", "mssql")
 # what run_optimize writes in its folder; anything else there is someone else's
-OWN_FILES = frozenset({"trials.csv", "optimize.json", "history.png", "study.journal", "study.journal.lock"})
+OWN_FILES = frozenset({"trials.csv", "optimize.json", "history.png", "best.toml", "study.journal",
+                       "study.journal.lock"})
+# the study's user attribute holding what it searches
+SETTINGS_ATTR = "locust"
+SQLITE_MAGIC = b"SQLite format 3\x00"
+# pauses before reading a journal again when its last line is cut short (a process sharing the
+# study may be writing it): 1.7 s in all before it is taken for a damaged one
+JOURNAL_RECHECK_S = (0.0, 0.2, 0.5, 1.0)
 
 
 def check_folder(folder: Path) -> None:
@@ -43,6 +58,8 @@ def check_folder(folder: Path) -> None:
 
 def check_storage(url: str | None) -> None:
     if url is None or url.startswith(RDB_PREFIXES):
+        if url is not None and url.startswith("sqlite:///"):
+            check_sqlite_file(Path(url.removeprefix("sqlite:///")), url)
         return
     path = url.removeprefix("journal:")
     if "://" in path or not path.strip():
@@ -51,6 +68,88 @@ def check_storage(url: str | None) -> None:
     parent = Path(path).parent
     if not parent.is_dir():
         raise SweepError(f"--storage {url}: the folder {parent} does not exist", "create it, or give another path")
+    check_journal_file(Path(path))
+
+
+def check_journal_file(path: Path) -> None:
+    """Refuse (:class:`SweepError`) an existing file that is not a whole Optuna journal: one JSON
+    operation per line, the first creating a study, the last ending with its newline. Optuna
+    would append to anything (a user's notes) and cannot read a damaged one back."""
+    if not path.exists() or (path.is_file() and path.stat().st_size == 0):
+        return
+    hint = "give --storage a new file path (or a new --out folder); this file is left as it is"
+    if not path.is_file():
+        raise SweepError(f"{path} is not a file; refusing it as an Optuna journal", hint)
+    for wait_s in JOURNAL_RECHECK_S:   # another process sharing the study may be appending a line
+        time.sleep(wait_s)
+        try:
+            text = path.read_bytes().decode("utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise SweepError(f"{path}: not an Optuna journal (not UTF-8 text: {exc})", hint) from None
+        lines = text.split("\n")
+        if not lines[-1]:
+            break
+    if lines[-1]:
+        raise SweepError(f"{path}: a damaged Optuna journal (its last line is cut short)",
+                         "restore the file from a copy, or " + hint)
+    for k, line in enumerate(lines[:-1]):
+        try:
+            op = json.loads(line)
+        except ValueError:
+            op = None
+        if not isinstance(op, dict) or not isinstance(op.get("op_code"), int) or (k == 0 and op["op_code"] != 0):
+            what = "a damaged Optuna journal" if k else "not an Optuna journal"
+            raise SweepError(f"{path}, line {k + 1}: {what} (each line must be one Optuna operation in JSON)",
+                             hint)
+
+
+def check_sqlite_file(path: Path, url: str) -> None:
+    """Refuse an existing file that is not an SQLite database holding Optuna's tables (or none):
+    Optuna would add its tables to someone else's database, or fail on a text file."""
+    if not path.exists():
+        return
+    hint = "give a new database file (sqlite:///new.db); this file is left as it is"
+    try:
+        with open(path, "rb") as fh:
+            magic = fh.read(len(SQLITE_MAGIC))
+    except OSError as exc:
+        raise SweepError(f"--storage {url}: cannot read {path} ({exc.strerror})", hint) from None
+    if path.stat().st_size == 0:
+        return
+    if magic != SQLITE_MAGIC:
+        raise SweepError(f"--storage {url}: {path} is not an SQLite database", hint)
+    try:
+        con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        try:
+            tables = {r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        finally:
+            con.close()
+    except sqlite3.Error as exc:
+        raise SweepError(f"--storage {url}: {path} cannot be read as a database ({exc})", hint) from None
+    if tables and "studies" not in tables:
+        raise SweepError(f"--storage {url}: {path} is a database without Optuna's tables "
+                         f"({', '.join(sorted(tables)[:4])})", hint)
+
+
+def settings(base: Robot, bounds: list[Bound], cycles: int) -> dict[str, Any]:
+    """What a study searches, as JSON holds it: a rerun must ask for exactly this."""
+    return json.loads(json.dumps({"base": base.name, "parameters": base.flat(),
+                                  "vary": [{"name": b.name, "low": b.low, "high": b.high} for b in bounds],
+                                  "cycles": cycles}))
+
+
+def check_settings(study, wanted: dict[str, Any], where: str) -> None:
+    """Refuse to continue a study that searches something else (or that this tool did not make)."""
+    held = study.user_attrs.get(SETTINGS_ATTR)
+    hint = "give a new --out folder (or --storage / --study), or rerun the exact command that made it"
+    if held is None:
+        raise SweepError(f"{where}: study {study.study_name!r} was not made by `locust optimize`", hint)
+    if held != wanted:
+        diff = [k for k in ("base", "vary", "cycles") if held.get(k) != wanted.get(k)]
+        params = held.get("parameters") or {}
+        diff += [k for k, v in wanted["parameters"].items() if params.get(k) != v][:3]
+        raise SweepError(f"{where}: study {study.study_name!r} searches other settings ({', '.join(diff) or 'ranges'} "
+                         "differ); its trials cannot be ranked against these", hint)
 
 
 def open_storage(url: str | None, folder: Path):
@@ -86,6 +185,8 @@ class OptimizeSummary:
     pruned: int
     best: dict[str, Any] | None
     folder: Path
+    interrupted: bool = False
+    best_robot: Path | None = None    # best.toml, the best design as a robot file
 
 
 def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, folder: Path,
@@ -93,8 +194,11 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
                  progress: Callable[[int], None] | None = None) -> OptimizeSummary:
     import optuna
 
-    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    # a trial's failure (an interrupt included) is reported by the caller, not logged with its traceback
+    optuna.logging.set_verbosity(optuna.logging.ERROR)
     check_folder(folder)
+    if storage is None:
+        check_journal_file(folder / "study.journal")
     check_storage(storage)
     integers = {b.name for b in bounds if is_integer(base, b.name)}
     for b in bounds:
@@ -106,13 +210,20 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
     storage_obj = open_storage(storage, folder)
     # a resumed study must not draw its first samples again: the sampler's seed moves on with
     # the number of trials the study already holds
+    wanted = settings(base, bounds, cycles)
+    where = storage or str(folder / "study.journal")
     try:
-        done_before = len(optuna.load_study(study_name=study_name, storage=storage_obj).trials)
+        held = optuna.load_study(study_name=study_name, storage=storage_obj)
     except KeyError:
-        done_before = 0
+        held = None
+    if held is not None:
+        check_settings(held, wanted, where)
+    done_before = len(held.trials) if held is not None else 0
     study = optuna.create_study(study_name=study_name, storage=storage_obj,
                                 direction="maximize", load_if_exists=True,
                                 sampler=optuna.samplers.TPESampler(seed=seed + done_before))
+    if held is None:
+        study.set_user_attr(SETTINGS_ATTR, wanted)
 
     def suggest(trial: optuna.Trial, b: Bound) -> float | int:
         if b.name in integers:
@@ -131,11 +242,14 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
         return row["distance_m"]
 
     callbacks = [lambda study, trial: progress(1)] if progress else []
-    study.optimize(objective, n_trials=trials, n_jobs=jobs, callbacks=callbacks, catch=())
-    return summarise(study, folder)
+    try:
+        study.optimize(objective, n_trials=trials, n_jobs=jobs, callbacks=callbacks, catch=())
+    except KeyboardInterrupt:   # the trial under way is dropped (FAIL); every finished one is kept
+        return summarise(study, folder, base, interrupted=True)
+    return summarise(study, folder, base)
 
 
-def summarise(study, folder: Path) -> OptimizeSummary:
+def summarise(study, folder: Path, base: Robot, interrupted: bool = False) -> OptimizeSummary:
     import optuna
 
     states = optuna.trial.TrialState
@@ -146,13 +260,20 @@ def summarise(study, folder: Path) -> OptimizeSummary:
         t = max(done, key=lambda t: (t.value, -t.number))
         best = {"trial": t.number, "distance_m": t.value, **t.params,
                 "max_nose_height_m": t.user_attrs.get("max_nose_height_m")}
+    best_robot = None
+    if best is not None:
+        robot = design_robot(base, dict(t.params)).renamed(f"optimize best of {folder}")
+        best_robot = save_robot(robot, folder / "best.toml")
     df = study.trials_dataframe(attrs=("number", "state", "value", "params", "user_attrs"))
     atomic_write_text(folder / "trials.csv", df.to_csv(index=False))
     atomic_write_json(folder / "optimize.json", {
-        "study": study.study_name, "trials": len(study.trials), "complete": len(done), "pruned": len(pruned),
-        "best": best, "pruned_reasons": {t.number: t.user_attrs.get("reason", "") for t in pruned}})
+        "study": study.study_name, "settings": study.user_attrs.get(SETTINGS_ATTR),
+        "trials": len(study.trials), "complete": len(done), "pruned": len(pruned),
+        "best": best, "best_robot": best_robot,
+        "pruned_reasons": {t.number: t.user_attrs.get("reason", "") for t in pruned}})
     _plot_history(done, pruned, folder / "history.png")
-    return OptimizeSummary(study.study_name, len(study.trials), len(done), len(pruned), best, folder)
+    return OptimizeSummary(study.study_name, len(study.trials), len(done), len(pruned), best, folder,
+                           interrupted, best_robot)
 
 
 def _plot_history(done, pruned, path: Path) -> None:

@@ -22,7 +22,7 @@ from ..errors import SweepError
 from ..io.sweep_store import SweepStore
 from ..params import Robot
 from .design import Axis, evaluate
-from .execute import default_jobs, mapper
+from .execute import default_jobs, mapper, plan_jobs, probe_dask_scheduler
 
 
 @dataclass(frozen=True)
@@ -95,19 +95,27 @@ class SweepSummary:
 
 def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: str = "local",
               jobs: int | None = None, progress: Callable[[int], None] | None = None,
-              plots: bool = True, samples: int = 0) -> SweepSummary:
+              plots: bool = True, samples: int = 0, say: Callable[[str], None] | None = None) -> SweepSummary:
     """Run (or resume) the sweep into ``out``. ``progress(n)`` is called as each design finishes.
 
-    An interrupt (Ctrl-C) leaves every finished row on disk and re-raises.
+    Workers: ``jobs`` (default every core), never more than the designs left nor the cores
+    (``say`` is told when fewer than asked start). An interrupt (Ctrl-C) leaves every finished
+    row on disk and re-raises; a worker that dies is a :class:`SweepError`, the rows kept.
     """
-    jobs = jobs or default_jobs()
     designs = grid(axes)
     names = [a.name for a in axes]
     meta = {"request": request(base, axes, cycles, samples), "designs": len(designs), "scheduler": scheduler,
-            "jobs": jobs}
+            "jobs": jobs or default_jobs()}
+    if scheduler.startswith("tcp://"):
+        probe_dask_scheduler(scheduler)   # before the folder is touched
     store = SweepStore.open(out, meta, names)
     resumed = len(store.done)
     todo = [Task(base, i, tuple(v.items()), cycles, samples) for i, v in enumerate(designs) if i not in store.done]
+    if not scheduler.startswith("tcp://"):   # a cluster's workers are its own
+        jobs, why = plan_jobs(jobs, len(todo))
+        if why and say and todo:
+            say(why)
+    jobs = jobs or default_jobs()
     t0 = time.perf_counter()
     finished = False
     try:

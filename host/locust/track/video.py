@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 
 from ..errors import TrackError
-from ..fileio import temp_beside
+from ..fileio import check_encoded, temp_beside
 from ..io.trk import FPS_MAX, FPS_MIN
 
 # FFmpeg's own log lines ("moov atom not found" ...) are noise next to our error
@@ -268,9 +268,12 @@ def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: 
         if not writer.isOpened():
             raise TrackError(f"OpenCV cannot encode {fourcc} to {path}",
                              "check the folder is writable and the codec name")
+        written = 0
         for frame in frames:
             writer.write(frame)
+            written += 1
         writer.release()
+        check_encoded(tmp, written, path)
         os.replace(tmp, path)
     except BaseException:
         writer.release()
