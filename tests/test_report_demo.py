@@ -77,11 +77,10 @@ def test_report_numbers_are_the_pipelines_own(demo):
     text = demo["report"].read_text(encoding="utf-8")
     for cfg in doc["configurations"]:
         r = run(leg_set(calibrated, cfg["name"]), cycles=CYCLES)
-        assert cfg["predicted"]["valid"] == r.valid
-        if r.valid:
-            assert cfg["predicted"]["distance_m"] == pytest.approx(r.distance_m, abs=1e-9)
-            cell = f'data-config="{cfg["name"]}" data-field="predicted_distance_cm">{r.distance_m * 100:.2f}<'
-            assert cell in text
+        assert r.valid and cfg["predicted"]["valid"], r.reasons   # the seed with its leg sets hops validly
+        assert cfg["predicted"]["distance_m"] == pytest.approx(r.distance_m, abs=1e-9)
+        cell = f'data-config="{cfg["name"]}" data-field="predicted_distance_cm">{r.distance_m * 100:.2f}<'
+        assert cell in text
 
 
 def test_measured_hops_match_the_virtual_robots_own(demo):

@@ -198,8 +198,8 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     with d.stage(2, total, f"hop Small, Medium, Large x {trials} on the virtual robot, {cycles} cycles, filmed"):
         with d.bar(trials_dirs, "hops") as bar:
             for name, trial in bar:
-                d.call(["hop", "--port", "sim", *seed_leg_set_options(name), *truth_sets, "--cycles", str(cycles),
-                        "--video", str(trial / "hop.mp4"), "--out", str(trial)])
+                d.call(["hop", "--port", "sim", *seed_leg_set_options(name), "--leg-set", name, *truth_sets,
+                        "--cycles", str(cycles), "--video", str(trial / "hop.mp4"), "--out", str(trial)])
                 d.expect(trial / "hop.mp4", trial / "run.json")
     with d.stage(3, total, "track nose and foot in the videos"):
         with d.bar(trials_dirs, "tracks") as bar:
