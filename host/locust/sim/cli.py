@@ -23,6 +23,13 @@ from ..tables import sim_lines, spread_line
               help="Render an MP4 (offscreen) and write the true marker pixels beside it (<video>.truth.csv).")
 @click.option("--camera", type=click.Choice(["track", "fixed"]), default="track", show_default=True,
               help="For --video: follow the robot, or hold still (for measuring with `locust track`).")
+@click.option("--still", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Render a side photo (PNG) of the robot settled at the 0 deg command, with the board and the "
+                   "stickers `locust measure stance` reads, and their true pixels beside it (<still>.truth.csv).")
+@click.option("--still-push", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="The same of the robot held up at the push command (the same camera).")
+@click.option("--board", default=None, metavar="SPEC",
+              help="For --still: the board beside the robot (default aruco:4X4_50:5x4:40:10).")
 @click.option("--check-convergence", is_flag=True,
               help="Rerun at half the time step and report the relative change.")
 @click.option("--samples", type=click.IntRange(2, 4096), default=None, metavar="N",
@@ -30,7 +37,8 @@ from ..tables import sim_lines, spread_line
                    "(one batched rollout) and report the sd of distance and highest nose "
                    "(--json: distance_m_sd, max_nose_height_m_sd).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of --samples.")
-def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence, samples, seed):
+def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push, board, check_convergence, samples,
+        seed):
     """Settle the robot on the floor, then run the bang-bang hop schedule.
 
     Every run is audited (non-finite state, loop closure, energy, MuJoCo warnings). A run
@@ -42,6 +50,7 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
       locust sim --preset seed-notebook --json          # the notebook's Part 2 figures
       locust sim --preset large --set servo.stall_torque_nm=0.18 --video large.mp4
       locust sim --config calibration/robot.toml --samples 16   # with its spread
+      locust sim --preset small --still rest.png --still-push push.png   # for locust measure stance
     """
     from ..api.simulation import simulate
     from .run import check_convergence as converge
@@ -52,6 +61,14 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
         from .clip import check_video_path
 
         check_video_path(video)  # fail before simulating, not after
+    if still is not None or still_push is not None:
+        from ..arucoboard import DEFAULT_BOARD, parse_board
+        from .still import check_still_path
+
+        for path in (still, still_push):
+            if path is not None:
+                check_still_path(path)
+        board = parse_board(board or DEFAULT_BOARD)
     try:
         result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed,
                           keep_states=video is not None)  # the video reuses the rollout
@@ -67,6 +84,12 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
         info = result.video(video, camera=camera)
         result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
 
+    if (still is not None or still_push is not None) and result.valid:
+        from .still import render_stills
+
+        for info in render_stills(robot, still, still_push, board=board):
+            result.notes.append(f"still: {info.path} ({info.pose.kind}, crank {info.pose.crank_deg:.2f} deg from the "
+                                f"ground link); truth: {info.truth_path}")
     spread = getattr(result, "spread", None)
     if as_json:
         out = result.to_json()
