@@ -242,7 +242,7 @@ def fit_points(robot: Robot, observed: np.ndarray, start: tuple[np.ndarray, bool
     """
     if start is not None:
         sol = least_squares(_residuals, start[0], args=(robot, observed, start[1]), x_scale="jac")
-        return sol.x, start[1], float(np.sum(sol.fun ** 2))
+        return _wrapped(sol.x), start[1], float(np.sum(sol.fun ** 2))
     best = None
     for mirrored in (False, True):
         for ground in (-30.0, 0.0, 30.0):
@@ -250,8 +250,16 @@ def fit_points(robot: Robot, observed: np.ndarray, start: tuple[np.ndarray, bool
                                 args=(robot, observed, mirrored), x_scale="jac")
             cost = float(np.sum(sol.fun ** 2))
             if best is None or cost < best[2]:
-                best = (sol.x, mirrored, cost)
+                best = (_wrapped(sol.x), mirrored, cost)
     return best
+
+
+def _wrapped(p: np.ndarray) -> np.ndarray:
+    """The angles (ground, each pitch and crank) in [-180, 180)."""
+    p = p.copy()
+    for i in [0, *range(4, len(p), 4), *range(5, len(p), 4)]:
+        p[i] = (p[i] + 180.0) % 360.0 - 180.0
+    return p
 
 
 def _per_point_m(robot: Robot, p: np.ndarray, observed: np.ndarray, mirrored: bool) -> np.ndarray:
@@ -339,10 +347,6 @@ def fit_stance(robot: Robot, photos: list[Photo], servo_give_deg, draws: int = B
         boot.append([q[0], q[1], q[5], _pitch_deg(robot, q, mirrored),
                      q[9] - q[5] if len(photos) > 1 else math.nan])
     boot = np.array(boot)
-    # the crank's angle as the four-bar's frame has it, in [-180, 180)
-    turns = 360.0 * math.floor((p[5] + 180.0) / 360.0)
-    p[5::4] -= turns
-    boot[:, 2] -= turns
     give = servo_give_deg(p[5], p[0], p[1])
     give = servo_give_deg(p[5] - give, p[0], p[1])
     residual = {ph.path.name: {n: float(d) * 1000.0 for n, d in zip(STICKERS, dist)}

@@ -1,0 +1,186 @@
+"""``locust sim --still`` and ``locust measure stance`` against the simulation's own truth.
+
+The stills are synthetic: MuJoCo renders of a robot whose stance is known. Each is re-encoded
+as a JPEG with added pixel noise (:func:`as_photo`) before it is measured, so that only the
+picture carries over, never the truth files beside it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from locust.arucoboard import DEFAULT_BOARD
+from locust.cli import cli
+from locust.io.camera_json import read_camera_json
+from locust.measure.cli import _points
+from locust.measure.stance import find_stickers, fit_points
+from locust.params import preset
+from locust.sim.stickers import STICKERS
+
+# the robot of the fast tests: Medium, its stance inside the as-built uncertainties
+TRUTH = {"geometry.crank_start_deg": -95.0, "geometry.ground_angle_deg": 5.0, "geometry.servo_axis_x_m": 0.018}
+SETS = [f"{k}={v}" for k, v in TRUTH.items()]
+NOISE_LEVELS = 2.0       # sd of the added pixel noise, in grey levels of 255
+JPEG_QUALITY = 90
+
+
+def as_photo(png: Path, jpg: Path, seed: int) -> Path:
+    """A synthetic 'photo' of a rendered still: its pixels with Gaussian noise of
+    NOISE_LEVELS, saved as a JPEG of JPEG_QUALITY."""
+    image = cv2.imread(str(png)).astype(float)
+    image += np.random.default_rng(seed).normal(0.0, NOISE_LEVELS, image.shape)
+    cv2.imwrite(str(jpg), np.clip(np.rint(image), 0, 255).astype(np.uint8), [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY])
+    return jpg
+
+
+def read_truth(path: Path) -> tuple[dict[str, float], dict[str, dict[str, float]]]:
+    """A still's truth CSV: the values of its comment line and each sticker's row."""
+    lines = path.read_text().splitlines()
+    values = {}
+    for part in lines[1].lstrip("# ").split(";"):
+        key, _, rest = part.strip().partition(" = ")
+        values[key] = float(rest.split()[0])
+    header = lines[3].split(",")
+    rows = {}
+    for line in lines[4:]:
+        cells = line.split(",")
+        rows[cells[0]] = {h: float(c) for h, c in zip(header[1:], cells[1:])}
+    return values, rows
+
+
+def run_cli(*args: str):
+    return CliRunner().invoke(cli, list(args), catch_exceptions=False)
+
+
+@pytest.fixture(scope="module")
+def stills(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("stills")
+    result = run_cli("sim", "--preset", "medium", *sum((["--set", s] for s in SETS), []), "--cycles", "1",
+                     "--still", str(folder / "rest.png"), "--still-push", str(folder / "push.png"))
+    assert result.exit_code == 0, result.output
+    return {kind: {"png": folder / f"{kind}.png", "truth": read_truth(folder / f"{kind}.truth.csv"),
+                   "camera": folder / f"{kind}.camera.json",
+                   "jpg": as_photo(folder / f"{kind}.png", folder / f"{kind}.jpg", seed=k)}
+            for k, kind in enumerate(("rest", "push"))}
+
+
+def test_the_truth_pixels_are_where_the_stickers_are_drawn(stills):
+    for kind, s in stills.items():
+        _, rows = s["truth"]
+        found, _ = find_stickers(cv2.imread(str(s["png"])), s["png"], {})
+        for name in STICKERS:
+            assert rows[name]["seen_frac"] == 1.0, (kind, name)
+            assert math.dist(found[name], (rows[name]["px"], rows[name]["py"])) < 0.3, (kind, name)
+        # the camera file projects each sticker's world position onto its true pixel
+        cam = read_camera_json(s["camera"])
+        world = np.array([[rows[n]["x_m"], rows[n]["y_m"], rows[n]["z_m"]] for n in STICKERS])
+        pc = (world - cam.positions_m[0]) @ cam.rotation.T
+        uv = (pc @ cam.K.T)[:, :2] / pc[:, 2:]
+        assert np.allclose(uv, [[rows[n]["px"], rows[n]["py"]] for n in STICKERS], atol=1e-3)
+
+
+def test_the_sticker_model_is_the_simulated_pose(stills):
+    """The planar model the fit uses, at the true stance, puts the stickers where MuJoCo posed them."""
+    robot = preset("medium").with_values(TRUTH)
+    views, cranks = [], []
+    for kind in ("rest", "push"):
+        values, rows = stills[kind]["truth"]
+        views.append([[-rows[n]["x_m"], rows[n]["z_m"]] for n in STICKERS])   # seen from +y: x runs left
+        cranks.append(values["crank_deg"])
+    p, mirrored, rss = fit_points(robot, np.vstack(views))
+    assert not mirrored
+    assert math.sqrt(rss / 24) < 2e-6                    # metres: the loop closes to a few um in MuJoCo
+    assert p[0] == pytest.approx(5.0, abs=0.01)
+    assert p[1] == pytest.approx(0.018, abs=1e-5)
+    assert p[5] == pytest.approx(cranks[0], abs=0.01)
+    assert p[9] == pytest.approx(cranks[1], abs=0.01)
+
+
+def test_measure_stance_from_two_photos_writes_the_whole_robot(stills, tmp_path):
+    out = tmp_path / "measured.toml"
+    result = run_cli("measure", "stance", str(stills["rest"]["jpg"]), str(stills["push"]["jpg"]), "--preset", "medium",
+                     "--write", str(out), "--json")
+    assert result.exit_code == 0, result.output
+    got = json.loads(result.output)
+    for key, tol in (("crank_start_deg", 2.0), ("ground_angle_deg", 3.0), ("servo_axis_x_m", 0.002)):
+        truth = TRUTH[f"geometry.{key}"]
+        assert got[key]["value"] == pytest.approx(truth, abs=tol)
+        lo, hi = got[key]["ci95"]
+        assert lo <= truth <= hi, key
+    turn = stills["push"]["truth"][0]["servo_deg"] - stills["rest"]["truth"][0]["servo_deg"]
+    assert got["push_turn_deg"]["value"] == pytest.approx(turn, abs=0.5)
+    assert got["rest_pitch_deg"]["value"] == pytest.approx(stills["rest"]["truth"][0]["plate_pitch_deg"], abs=0.5)
+
+    params = run_cli("params", "--config", str(out), "--json")
+    assert params.exit_code == 0, params.output
+    doc = json.loads(params.output)
+    text = json.dumps(doc)
+    assert text.count('"measured:rest.jpg"') == 3
+    sim = run_cli("sim", "--config", str(out), "--cycles", "1", "--json")
+    assert sim.exit_code == 0, sim.output
+    assert json.loads(sim.output)["valid"] is True
+    # the written robot is the preset but for the measured values
+    again = run_cli("measure", "stance", str(stills["rest"]["jpg"]), "--preset", "medium", "--write", str(out))
+    assert again.exit_code == 2 and "exists" in again.output
+
+
+def test_pixels_given_in_trackers_convention_are_half_a_pixel_from_opencvs():
+    assert _points(("knee=10,20",), "tracker", "--point") == {"knee": (9.5, 19.5)}
+    assert _points(("knee=10,20",), "opencv", "--point") == {"knee": (10.0, 20.0)}
+
+
+def test_an_unknown_sticker_name_is_refused(stills):
+    result = run_cli("measure", "stance", str(stills["rest"]["jpg"]), "--preset", "medium", "--point", "toe=1,2")
+    assert result.exit_code == 2
+    assert "error: --point 'toe=1,2'" in result.output and "knee" in result.output
+
+
+def test_a_photo_without_the_board_is_refused(stills, tmp_path):
+    image = cv2.imread(str(stills["rest"]["jpg"]))
+    # paint the half of the picture the board stands in (it stands beside the robot, to its right)
+    xs = [r["px"] for r in stills["rest"]["truth"][1].values()]
+    image[:, int(max(xs)) + 40:] = 128
+    bad = tmp_path / "noboard.jpg"
+    cv2.imwrite(str(bad), image)
+    result = run_cli("measure", "stance", str(bad), "--preset", "medium")
+    assert result.exit_code == 2
+    assert f"error: noboard.jpg: board {DEFAULT_BOARD} not found" in result.output
+    assert "hint:" in result.output
+
+
+def test_an_oblique_photo_is_refused(stills, tmp_path):
+    image = cv2.imread(str(stills["rest"]["jpg"]))
+    h, w = image.shape[:2]
+    # the camera turned about the vertical: the picture's right edge 12 % taller than its left
+    src = np.float32([[0, 0], [w, 0], [w, h], [0, h]])
+    dst = np.float32([[0, 0.06 * h], [w, 0], [w, h], [0, 0.94 * h]])
+    warped = cv2.warpPerspective(image, cv2.getPerspectiveTransform(src, dst), (w, h))
+    cv2.imwrite(str(tmp_path / "oblique.jpg"), warped)
+    result = run_cli("measure", "stance", str(tmp_path / "oblique.jpg"), "--preset", "medium")
+    assert result.exit_code == 2
+    assert "error: oblique.jpg is not square to the board: its right edge is" in result.output
+    share = float(result.output.split("its right edge is ")[1].split(" %")[0])
+    assert 4.0 < share < 12.0        # the board spans part of the picture's width
+    assert "hint:" in result.output
+
+
+def test_a_point_no_pose_reaches_is_named_with_its_distance(stills):
+    _, rows = stills["rest"]["truth"]
+    shift_px = 30.0
+    knee = (rows["knee"]["px"] + shift_px, rows["knee"]["py"])
+    result = run_cli("measure", "stance", str(stills["rest"]["jpg"]), "--preset", "medium", "--pixels", "opencv",
+                     "--point", f"knee={knee[0]},{knee[1]}")
+    assert result.exit_code == 2
+    assert "error: rest.jpg: the knee sticker is " in result.output
+    off_mm = float(result.output.split("the knee sticker is ")[1].split(" mm")[0])
+    # the scale at the leg's plane, from the camera the still was rendered with
+    cam = read_camera_json(stills["rest"]["camera"])
+    mm_per_px = cam.m_per_px_at(rows["knee"]["y_m"]) * 1000.0
+    assert off_mm == pytest.approx(shift_px * mm_per_px, rel=0.25)
