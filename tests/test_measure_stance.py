@@ -184,3 +184,89 @@ def test_a_point_no_pose_reaches_is_named_with_its_distance(stills):
     cam = read_camera_json(stills["rest"]["camera"])
     mm_per_px = cam.m_per_px_at(rows["knee"]["y_m"]) * 1000.0
     assert off_mm == pytest.approx(shift_px * mm_per_px, rel=0.25)
+
+
+# -- ten robots across the threshold (slow) ----------------------------------------------
+# Drawn from the as-built uncertainties (crank -100 +- 10 deg, ground 0 +- 15 deg, axis
+# 20 +- 5 mm, plate 4 +- 1 g; normal, clipped at 2 sd) on a random leg set, seed 1, and kept in
+# the order drawn until each regime had three; the rear-and-return band is a few degrees of
+# crank wide, so two of its three are drawn the same way (seed 5) with the crank stepped by
+# 2 deg across it (-90 and -88 deg).
+TEN = [  # leg set, crank_start_deg, ground_angle_deg, servo_axis_x_m, body_mass_kg, regime of the truth
+    ("medium", -91.78, 4.96, 0.01348, 0.00491, "stays_low"),
+    ("medium", -95.54, -8.05, 0.02291, 0.00436, "goes_over"),
+    ("small", -99.72, 8.2, 0.01632, 0.00384, "goes_over"),
+    ("small", -104.82, 8.98, 0.0202, 0.00371, "goes_over"),
+    ("large", -102.57, 0.12, 0.01862, 0.00529, "goes_over"),
+    ("small", -103.78, 30.0, 0.02323, 0.00466, "stays_low"),
+    ("large", -92.48, 3.8, 0.02448, 0.00365, "rears_and_returns"),
+    ("medium", -87.81, 5.74, 0.01562, 0.00249, "stays_low"),
+    ("large", -90.0, -3.73, 0.0221, 0.00514, "rears_and_returns"),
+    ("large", -88.0, -8.29, 0.01608, 0.00475, "rears_and_returns"),
+]
+REAR_NOSE_M = 0.03       # the nose above this and back down, every hop: rears and returns
+CAME_DOWN_M = 0.01       # the nose ending higher than this above its standing height: it went over
+
+
+def regime(robot) -> str:
+    """goes_over / rears_and_returns / stays_low, from one audited run of the hop schedule."""
+    from locust.sim.audit import audit
+    from locust.sim.hops import summarise
+    from locust.sim.rollout import simulate
+
+    traj = simulate(robot)
+    assert audit(traj).valid
+    summary = summarise(traj)
+    apex = [h.nose_apex_m for h in summary.hops]
+    if summary.end_nose_rise_m > CAME_DOWN_M:
+        return "goes_over"
+    if min(apex) > REAR_NOSE_M:
+        return "rears_and_returns"
+    return "stays_low" if max(apex) < REAR_NOSE_M else "mixed"
+
+
+@pytest.mark.slow
+def test_ten_robots_across_the_threshold_are_measured_and_rebuilt(tmp_path):
+    from locust.arucoboard import parse_board
+    from locust.measure.stance import STANCE_KEYS, fit_stance, model_servo_give, read_photo
+    from locust.sim.still import render_stills
+
+    spec = parse_board(DEFAULT_BOARD)
+    rows, regimes = [], []
+    for k, (leg, crank, ground, axis, mass, expected) in enumerate(TEN):
+        base = preset(leg).with_values({"geometry.body_mass_kg": mass})   # the plate weighed
+        truth = base.with_values(dict(zip(STANCE_KEYS, (crank, ground, axis))))
+        actual = regime(truth)
+        assert actual == expected, (k, actual)
+        regimes.append(actual)
+        infos = render_stills(truth, tmp_path / f"rest{k}.png", tmp_path / f"push{k}.png", board=spec)
+        photos = [read_photo(as_photo(i.path, i.path.with_suffix(".jpg"), seed=10 * k + j), spec, {})
+                  for j, i in enumerate(infos)]
+        got = fit_stance(base, photos, model_servo_give(base), seed=k)
+        measured = {key: est.value for key, est in got.values().items()}
+        rebuilt = base.with_values(measured)
+        unweighed = preset(leg).with_values(measured)   # for the table only: the preset's 4 g plate
+        rows.append((leg, (crank, ground, axis), got, actual, regime(rebuilt), regime(unweighed)))
+
+    print(f"\n{'leg':7s} {'crank deg: truth, measured, 95 %':>34s} {'ground deg':>34s} {'axis mm':>34s}  "
+          f"{'truth':18s} {'rebuilt':18s} rebuilt with a 4 g plate")
+    for leg, truth, got, actual, again, plain in rows:
+        cells = []
+        for t, est, k in zip(truth, got.values().values(), (1.0, 1.0, 1000.0)):
+            cells.append(f"{t * k:7.2f} {est.value * k:8.3f} [{est.ci95[0] * k:7.2f},{est.ci95[1] * k:7.2f}]")
+        print(f"{leg:7s} " + " ".join(f"{c:>34s}" for c in cells) + f"  {actual:18s} {again:18s} {plain}")
+    for i, key in enumerate(STANCE_KEYS):
+        errors = [abs(got.values()[key].value - truth[i]) for _, truth, got, *_ in rows]
+        covered = sum(got.values()[key].ci95[0] <= truth[i] <= got.values()[key].ci95[1] for _, truth, got, *_ in rows)
+        print(f"{key}: largest error {max(errors):.4g}, intervals cover {covered} of {len(rows)}")
+    print(f"outcome kept: {sum(r[3] == r[4] for r in rows)} of {len(rows)}; "
+          f"with the preset's plate: {sum(r[3] == r[5] for r in rows)} of {len(rows)}")
+
+    assert all(regimes.count(r) >= 3 for r in ("goes_over", "rears_and_returns", "stays_low"))
+    for i, tol in enumerate((2.0, 3.0, 0.002)):
+        errors = [abs(got.values()[STANCE_KEYS[i]].value - truth[i]) for _, truth, got, *_ in rows]
+        assert max(errors) <= tol, (STANCE_KEYS[i], errors)
+        covered = sum(est.ci95[0] <= truth[i] <= est.ci95[1]
+                      for _, truth, got, *_ in rows for est in [got.values()[STANCE_KEYS[i]]])
+        assert covered >= 8, (STANCE_KEYS[i], covered)
+    assert sum(r[3] == r[4] for r in rows) >= 9

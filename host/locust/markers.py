@@ -23,7 +23,7 @@ STICKER_COLOURS: dict[str, tuple[str, str]] = {
     "tail": ("#ffff00", "on the plate's side, 10 mm in from its leg end"),
     "axis": ("#ff0000", "on the crank, over the servo horn's axis"),
     "crank": ("#00ff00", "on the crank, 8 mm in from the crank-coupler joint (its tip)"),
-    "knee": ("#0000ff", "on the coupler, 8 mm from the coupler-leg joint (the joint itself touches the floor)"),
+    "knee": ("#0000ff", "on the leg, 8 mm up from the coupler-leg joint (the joint itself touches the floor)"),
     "foot": ("#00ffff", "on the leg, 25 mm up from the coupler-leg joint (the videos' foot dot)"),
 }
 

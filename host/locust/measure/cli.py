@@ -85,7 +85,7 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
     if write is not None:
         if write.exists() and not force:
             raise MeasureError(f"{write} exists", "choose another path, or add --force to overwrite it")
-        check_distinct({"REST": rest, "PUSH": push, "--write": write})
+        check_distinct({"--write": write}, inputs=[p for p in (rest, push) if p is not None])
     if push_points and push is None:
         raise MeasureError("--push-point without a PUSH photo", "give the PUSH photo after REST")
     photos = [read_photo(rest, spec, _points(points, pixels, "--point"))]

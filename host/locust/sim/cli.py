@@ -84,8 +84,11 @@ def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push,
         info = result.video(video, camera=camera)
         result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
 
-    if (still is not None or still_push is not None) and result.valid:
+    if still is not None or still_push is not None:
         from .still import render_stills
+
+        if not result.valid:
+            raise SimError("not rendering stills of an invalid robot", "fix the reasons listed above first")
 
         for info in render_stills(robot, still, still_push, board=board):
             result.notes.append(f"still: {info.path} ({info.pose.kind}, crank {info.pose.crank_deg:.2f} deg from the "

@@ -1,8 +1,8 @@
 """Where the stickers of a still photo sit: on which body, and in the plate's own frame.
 
 Six coloured dots (:data:`locust.markers.STICKER_COLOURS`) mark the points a student marks on
-a side photo of the robot: the plate's two ends, the servo horn's axis, the crank's tip, the
-coupler near the coupler-leg joint and the leg. Each sits a fixed distance along its link, so
+a side photo of the robot: the plate's two ends, the servo horn's axis, the crank's tip, and
+the leg near the coupler-leg joint and further up. Each sits a fixed distance along its link, so
 one function gives where the render draws it (:func:`on_bodies`) and another where the stance
 puts it in the plate's frame (:func:`plate_points`), the model ``locust measure stance`` fits.
 
@@ -28,7 +28,8 @@ STICKERS = tuple(STICKER_COLOURS)   # nose, tail, axis, crank, knee, foot
 STICKER_RADIUS_M = 0.003            # a 6 mm dot
 PLATE_INSET_M = 0.010               # the plate's dots, in from each end
 CRANK_INSET_M = 0.008               # the crank's tip dot, in from the crank-coupler joint (near the floor at rest)
-KNEE_INSET_M = 0.008                # the coupler's dot, from the coupler-leg joint (which touches the floor)
+KNEE_UP_M = 0.008                   # the knee dot, up the leg from the coupler-leg joint (the coupler may lie
+                                    # on the floor, the joint touches it)
 FOOT_UP_M = 0.025                   # the leg's dot, up from the coupler-leg joint (the videos' foot dot)
 
 
@@ -42,7 +43,7 @@ def on_bodies(g: Geometry) -> dict[str, tuple[str, float]]:
             "tail": ("chassis", g.body_length_m / 2 - PLATE_INSET_M),
             "axis": ("L_crank", 0.0),
             "crank": ("L_crank", g.crank_m - CRANK_INSET_M),
-            "knee": ("L_coupler", g.coupler_m - KNEE_INSET_M),
+            "knee": ("L_leg", KNEE_UP_M),
             "foot": ("L_leg", FOOT_UP_M)}
 
 
@@ -57,7 +58,7 @@ def plate_points(g: Geometry, crank_deg: float, ground_angle_deg: float, servo_a
     asm = assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, crank_deg)
     p1, p2, p3, p4 = (np.asarray(p) for p in (asm.p1_m, asm.p2_m, asm.p3_m, asm.p4_m))
     tip = p2 + CRANK_INSET_M * (p1 - p2) / g.crank_m
-    knee = p3 + KNEE_INSET_M * (p2 - p3) / g.coupler_m
+    knee = p3 + KNEE_UP_M * (p4 - p3) / g.leg_m
     foot = p3 + FOOT_UP_M * (p4 - p3) / g.leg_m
     linkage = np.array([p1, tip, knee, foot]) - p1          # from the servo axis, four-bar frame
     mount = np.column_stack([linkage[:, 0], -linkage[:, 1]])   # the model's mirror (sim/model.py)
@@ -82,5 +83,5 @@ def to_view(points_m: np.ndarray, x0_m: float, y0_m: float, pitch_deg: float, mi
     return np.column_stack([x0_m + u[:, 0] * c - u[:, 1] * s, y0_m + u[:, 0] * s + u[:, 1] * c])
 
 
-__all__ = ["CRANK_INSET_M", "FOOT_UP_M", "KNEE_INSET_M", "PLATE_INSET_M", "STICKERS", "STICKER_RADIUS_M", "on_bodies",
+__all__ = ["CRANK_INSET_M", "FOOT_UP_M", "KNEE_UP_M", "PLATE_INSET_M", "STICKERS", "STICKER_RADIUS_M", "on_bodies",
            "plate_points", "to_view"]

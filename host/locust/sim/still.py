@@ -274,7 +274,9 @@ def render_stills(robot: Robot, rest_path: str | os.PathLike | None = None,
              "push": None if push_path is None else check_still_path(push_path)}
     if paths["rest"] is None and paths["push"] is None:
         raise SimError("no still to render", "give --still REST.png and/or --still-push PUSH.png")
-    check_distinct({"--still": paths["rest"], "--still-push": paths["push"]})
+    options = {"--still": paths["rest"], "--still-push": paths["push"]}
+    check_distinct({f"{option}{what}": p for option, path in options.items() if path is not None
+                    for what, p in zip(("", " truth", " camera"), (path, *sidecar_paths(path)))})
     rest = rest_pose(robot)
     poses = {"rest": rest, "push": push_pose(robot, rest)}
     model, face_y = _still_model(robot, spec, None)
