@@ -101,6 +101,11 @@ def test_the_sticker_model_is_the_simulated_pose(stills):
     assert p[1] == pytest.approx(0.018, abs=1e-5)
     assert p[5] == pytest.approx(cranks[0], abs=0.01)
     assert p[9] == pytest.approx(cranks[1], abs=0.01)
+    # photographed from the robot's right the view is mirrored: the same stance, found as such
+    mirrored_view = np.vstack(views) * [-1.0, 1.0]
+    q, mirrored, _ = fit_points(robot, mirrored_view)
+    assert mirrored
+    assert q[[0, 1, 5, 9]] == pytest.approx(p[[0, 1, 5, 9]], abs=1e-4)
 
 
 def test_measure_stance_from_two_photos_writes_the_whole_robot(stills, tmp_path):
@@ -129,6 +134,22 @@ def test_measure_stance_from_two_photos_writes_the_whole_robot(stills, tmp_path)
     # the written robot is the preset but for the measured values
     again = run_cli("measure", "stance", str(stills["rest"]["jpg"]), "--preset", "medium", "--write", str(out))
     assert again.exit_code == 2 and "exists" in again.output
+
+
+def test_one_photo_gives_the_stance_without_the_push(stills):
+    result = run_cli("measure", "stance", str(stills["rest"]["jpg"]), "--preset", "medium", "--json")
+    assert result.exit_code == 0, result.output
+    got = json.loads(result.output)
+    assert got["push_turn_deg"] is None
+    for key, tol in (("crank_start_deg", 2.0), ("ground_angle_deg", 3.0), ("servo_axis_x_m", 0.002)):
+        lo, hi = got[key]["ci95"]
+        assert lo <= TRUTH[f"geometry.{key}"] <= hi and hi - lo < tol, key
+
+
+def test_a_still_never_overwrites(stills):
+    result = run_cli("sim", "--preset", "medium", "--still", str(stills["rest"]["png"]))
+    assert result.exit_code == 2
+    assert f"error: {stills['rest']['png']} exists already; not overwriting it" in result.output
 
 
 def test_pixels_given_in_trackers_convention_are_half_a_pixel_from_opencvs():
