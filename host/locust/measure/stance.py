@@ -16,8 +16,9 @@ robot's weight; that give is the model's (the measured robot settled on the floo
 
 Intervals: a parametric bootstrap. Each draw moves every detected board corner by the
 board's own reprojection scatter and every sticker by the fit's residual scatter (in
-pixels; at least :data:`MIN_STICKER_SD_PX`), fits the plane and the stance again, and the
-2.5 and 97.5 percentiles of the draws are the 95 % interval.
+pixels; at least :data:`MIN_STICKER_SD_PX`), fits the plane and the stance again; the 2.5 and
+97.5 percentiles of the draws, moved by the fitted value's distance from the draws' median,
+are the 95 % interval.
 """
 
 from __future__ import annotations

@@ -30,7 +30,7 @@ import cv2
 import mujoco
 import numpy as np
 
-from ..arucoboard import DEFAULT_BOARD, BoardSpec, parse_board
+from ..arucoboard import BOARD_MARGIN_MM, DEFAULT_BOARD, BoardSpec, parse_board
 from ..errors import SimError
 from ..fileio import atomic_write_bytes, atomic_write_text, check_distinct
 from ..io.camera_json import CameraFile, MarkerPlane, write_camera_json
@@ -170,8 +170,7 @@ def _facing_plus_y() -> list[float]:
 
 
 def _board_size_m(board: BoardSpec) -> tuple[float, float]:
-    from ..arucoboard import BOARD_MARGIN_MM
-
+    """The printed sheet's size (the board and its white margin), metres."""
     return (board.width_mm + 2 * BOARD_MARGIN_MM) / 1000.0, (board.height_mm + 2 * BOARD_MARGIN_MM) / 1000.0
 
 
