@@ -98,7 +98,7 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
         for key, est in result.values().items():
             lo, hi = est.ci95
             robot = robot.with_values({key: est.value}, Provenance(
-                source=f"measured:{rest.name}", uncertainty=est.sd, date=today,
+                source=f"measured:{rest.name}", uncertainty=est.std, date=today,
                 note=f"95% interval [{lo:.5g}, {hi:.5g}], parametric bootstrap of the pixel noise and the board's "
                      f"pose ({result.draws} draws); locust measure stance"))
         save_robot(robot, write)

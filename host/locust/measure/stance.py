@@ -32,6 +32,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..arucoboard import BoardSpec
+from ..calibrate.fitstats import Estimate
 from ..errors import GeometryError, MeasureError
 from ..params import Robot
 from ..sim.stickers import STICKERS, plate_points, to_view
@@ -57,18 +58,6 @@ class Photo:
 
 
 @dataclass(frozen=True)
-class Estimate:
-    """A measured value with its 95 % interval and standard deviation (bootstrap)."""
-
-    value: float
-    ci95: tuple[float, float]
-    sd: float
-
-    def to_json(self) -> dict:
-        return {"value": self.value, "ci95": list(self.ci95), "sd": self.sd}
-
-
-@dataclass(frozen=True)
 class StanceResult:
     """What the photos say, each value with its interval."""
 
@@ -90,9 +79,9 @@ class StanceResult:
         return dict(zip(STANCE_KEYS, (self.crank_start_deg, self.ground_angle_deg, self.servo_axis_x_m)))
 
     def to_json(self) -> dict:
-        return {"crank_start_deg": self.crank_start_deg.to_json(), "ground_angle_deg": self.ground_angle_deg.to_json(),
-                "servo_axis_x_m": self.servo_axis_x_m.to_json(), "rest_pitch_deg": self.rest_pitch_deg.to_json(),
-                "push_turn_deg": None if self.push_turn_deg is None else self.push_turn_deg.to_json(),
+        return {"crank_start_deg": self.crank_start_deg.as_dict(), "ground_angle_deg": self.ground_angle_deg.as_dict(),
+                "servo_axis_x_m": self.servo_axis_x_m.as_dict(), "rest_pitch_deg": self.rest_pitch_deg.as_dict(),
+                "push_turn_deg": None if self.push_turn_deg is None else self.push_turn_deg.as_dict(),
                 "push_command_deg": self.push_command_deg, "rest_crank_seen_deg": self.rest_crank_seen_deg,
                 "servo_give_deg": self.servo_give_deg, "residual_mm": self.residual_mm,
                 "sticker_sd_px": self.sticker_sd_px, "corner_sd_px": self.corner_sd_px,
@@ -325,7 +314,7 @@ def _pitch_deg(robot: Robot, p: np.ndarray, mirrored: bool) -> float:
 def _estimate(value: float, draws: np.ndarray) -> Estimate:
     lo, hi = np.percentile(draws, [2.5, 97.5])
     shift = value - float(np.median(draws))
-    return Estimate(value, (float(lo + shift), float(hi + shift)), float(np.std(draws, ddof=1)))
+    return Estimate(value, float(np.std(draws, ddof=1)), float(lo + shift), float(hi + shift))
 
 
 def fit_stance(robot: Robot, photos: list[Photo], servo_give_deg, draws: int = BOOTSTRAP_DRAWS,
@@ -362,5 +351,5 @@ def fit_stance(robot: Robot, photos: list[Photo], servo_give_deg, draws: int = B
         residual_mm=residual, sticker_sd_px=sticker_sd, corner_sd_px=corner_sd, draws=draws, mirrored=mirrored)
 
 
-__all__ = ["BOOTSTRAP_DRAWS", "Estimate", "OBLIQUE_LIMIT", "Photo", "REACH_LIMIT_M", "STANCE_KEYS", "StanceResult",
+__all__ = ["BOOTSTRAP_DRAWS", "OBLIQUE_LIMIT", "Photo", "REACH_LIMIT_M", "STANCE_KEYS", "StanceResult",
            "board_corners", "find_stickers", "fit_points", "fit_stance", "model_servo_give", "read_photo", "to_plane"]
