@@ -307,3 +307,23 @@ def test_ten_robots_across_the_threshold_are_measured_and_rebuilt(drawn, tmp_pat
                       for _, truth, got, *_ in rows for est in [got.values()[STANCE_KEYS[i]]])
         assert covered >= 8, (STANCE_KEYS[i], covered)
     assert sum(r[3] == r[4] for r in rows) >= 9
+
+
+@pytest.mark.parametrize("drawn", [TEN["axis 20 +- 5 mm"][2], TEN["axis 28 +- 3 mm"][2]],
+                         ids=lambda d: f"{d[0]}-{d[5]}")
+def test_a_drawn_robot_is_measured_and_rebuilt_in_its_regime(drawn, tmp_path):
+    """Two of the ten (a Small that goes over, a Large that rears and returns) in the default run."""
+    from locust.arucoboard import parse_board
+    from locust.measure.stance import STANCE_KEYS, fit_stance, model_servo_give, read_photo
+    from locust.sim.still import render_stills
+
+    leg, crank, ground, axis, mass, expected = drawn
+    spec = parse_board(DEFAULT_BOARD)
+    base = preset(leg).with_values({"geometry.body_mass_kg": mass})
+    truth = base.with_values(dict(zip(STANCE_KEYS, (crank, ground, axis))))
+    infos = render_stills(truth, tmp_path / "rest.png", tmp_path / "push.png", board=spec)
+    photos = [read_photo(as_photo(i.path, i.path.with_suffix(".jpg"), seed=j), spec, {}) for j, i in enumerate(infos)]
+    got = fit_stance(base, photos, model_servo_give(base), draws=100)
+    for (key, est), t, tol in zip(got.values().items(), (crank, ground, axis), (2.0, 3.0, 0.002)):
+        assert est.value == pytest.approx(t, abs=tol), key
+    assert regime(base.with_values({k: e.value for k, e in got.values().items()})) == expected
