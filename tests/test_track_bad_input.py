@@ -182,15 +182,21 @@ def test_real_footage_without_stickers_is_refused(shared_data, tmp_path, name):
 
 
 # -- an upside-down video: heights inverted ------------------------------------------------
-def _rest_hop_rest(seed: int, upside_down: bool, w: int = 320, h: int = 180, fps: float = 60.0):
+def _rest_hop_rest(seed: int, upside_down: bool, w: int = 320, h: int = 180, fps: float = 60.0,
+                   over: bool = False):
     """SYNTHETIC: a magenta sticker resting on the floor, one ballistic hop, resting again
-    (the heights a filmed hop has), drawn right way up or turned over (the phone upside down)."""
+    (the heights a filmed hop has), drawn right way up or turned over (the phone upside down).
+    ``over``: the robot goes over and rests on its back, the sticker at 0.6-0.8 of its rise."""
     rng = np.random.default_rng(seed)
     rest_before, rest_after = rng.integers(8, 20), rng.integers(8, 20)
     rise_px = rng.uniform(30, 120)
     flight = int(round(2 * math.sqrt(2 * rise_px * 0.002 / 9.81) * fps)) + 2    # 2 mm a pixel
     u = np.linspace(0, 1, flight)
-    y = np.r_[np.zeros(rest_before), 4 * rise_px * u * (1 - u), np.zeros(rest_after)]
+    end_px = rng.uniform(0.6, 0.8) * rise_px if over else 0.0
+    if over:     # it lies on its back longer than it stood: most still frames are high
+        rest_after += 30
+    arc = np.where(u < 0.5, 4 * rise_px * u * (1 - u), end_px + (rise_px - end_px) * 4 * u * (1 - u))
+    y = np.r_[np.zeros(rest_before), arc, np.full(rest_after, end_px)]
     x = rng.uniform(40, 80) + np.r_[np.zeros(rest_before), u * rng.uniform(60, 160), np.full(rest_after, 0.0)]
     x[rest_before + flight:] = x[rest_before + flight - 1]
     floor_py = h - rng.uniform(20, 40)
@@ -203,9 +209,9 @@ def _rest_hop_rest(seed: int, upside_down: bool, w: int = 320, h: int = 180, fps
         yield cv2.flip(frame, -1) if upside_down else frame
 
 
-def _hop_clip(folder, seed, upside_down):
-    path = folder / f"hop{seed}{'_flipped' if upside_down else ''}.avi"
-    encode_video(path, _rest_hop_rest(seed, upside_down), 60.0, (320, 180), "MJPG")
+def _hop_clip(folder, seed, upside_down, over=False):
+    path = folder / f"hop{seed}{'_over' if over else ''}{'_flipped' if upside_down else ''}.avi"
+    encode_video(path, _rest_hop_rest(seed, upside_down, over=over), 60.0, (320, 180), "MJPG")
     return path
 
 
@@ -223,6 +229,20 @@ def test_an_upside_down_hop_is_flagged_and_an_upright_one_is_not(tmp_path, seed)
     turned = invoke(["track", tmp_path / f"hop{seed}_flipped.avi", *args, "--angle", "180", "--out",
                      tmp_path / "turned.csv"])
     assert turned.exit_code == 0 and "upside down" not in turned.stderr, turned.output
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_robot_that_went_over_is_judged_from_where_it_stood_on_the_floor(tmp_path, seed):
+    """The nose rests high on the robot's back after the hop (at the top of its still
+    heights): upright, no warning; the same video turned over still gets one."""
+    args = ["--marker", "nose=color:#ff00ff", "--scale", "0,0,500,0=1.0", "--overlay", "none"]
+    upright = invoke(["track", _hop_clip(tmp_path, seed, False, over=True), *args])
+    assert upright.exit_code == 0 and "upside down" not in upright.stderr, upright.output
+    flipped = invoke(["track", _hop_clip(tmp_path, seed, True, over=True), *args])
+    assert flipped.exit_code == 0, flipped.output
+    share = re.search(r"nose stands still at the top of its heights \(\d+ still frames at y = \S+ m, (\d+)% ",
+                      flipped.stderr)
+    assert share and int(share.group(1)) >= 90, flipped.stderr
 
 
 # -- the one-command form's options that are subcommands now ---------------------------------
