@@ -201,13 +201,33 @@ def test_mpremote_exec_on_an_idle_robot_then_flash_and_hop(env, tmp_path):
         stuck = _run(["pose", "--port", device, "--rest"], env)
         assert stuck.returncode == 2 and "MicroPython REPL" in stuck.stderr and "Ctrl-D" in stuck.stderr
 
+        # `hop` soft-resets a board it finds at the REPL (as mpremote does) and goes on
+        hop = _run(["hop", "--port", device, "--cycles", "1", "--json", "--out", str(tmp_path / "run0")], env)
+        assert hop.returncode == 0, hop.stderr
+        rec = json.loads(hop.stdout)
+        assert rec["status"] == "complete" and len(rec["phases"]) == 2
+
         # `locust flash` gets in from the REPL and restarts the command loop; `hop` works again
+        mp = subprocess.run([MPREMOTE, "connect", device, "exec", "print(6*7)"], capture_output=True, text=True,
+                            timeout=30)
+        assert mp.stdout.strip() == "42", mp.stdout + mp.stderr
         flashed = _run(["flash", "--port", device], env)
         assert flashed.returncode == 0, flashed.stderr
         hop = _run(["hop", "--port", device, "--cycles", "1", "--json", "--out", str(tmp_path / "run")], env)
         assert hop.returncode == 0, hop.stderr
         rec = json.loads(hop.stdout)
         assert rec["status"] == "complete" and len(rec["phases"]) == 2
+
+
+def test_a_virtual_robot_with_nothing_flashed_says_so(tmp_path):
+    """`hop --port sim` before any `locust flash --port sim`: which command flashes it, and no
+    virtual robot started for nothing (no pty named, no run folder)."""
+    env = dict(os.environ, LOCUST_VIRTUAL_DIR=str(tmp_path / "virtual"))
+    res = _run(["hop", "--port", "sim", "--cycles", "1", "--out", str(tmp_path / "run")], env)
+    assert res.returncode == 2, res.stderr
+    assert "error: nothing flashed: run `locust flash --port sim`" in res.stderr
+    assert "/dev/pts" not in res.stderr and "REPL" not in res.stderr
+    assert not (tmp_path / "run").exists()
 
 
 def test_ctrl_c_stops_the_idle_loop_not_a_hop_and_ctrl_d_resumes(env):

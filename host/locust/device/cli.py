@@ -84,7 +84,7 @@ def flash(port, compile_mpy, reset_config, servo_sets, preset, config, sets):
 
     edits = [_parse_servo_set(s) for s in servo_sets]
     servo = resolve_robot(preset, config, sets).servo if reset_config else None
-    with open_port(port, plant="record", info=_info) as device:
+    with open_port(port, plant="record", info=_info, firmware=False) as device:
         # the edits are checked against the board's chip before any file is written
         result = do_flash(device, compile_mpy=compile_mpy, servo=servo, edits=edits,
                           progress=lambda s: _info(f"  {s}"))
@@ -333,7 +333,7 @@ def repl(port):
     # a closed terminal (SIGHUP) or a kill (SIGTERM) must still stop a --port sim virtual robot
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
     try:
-        with open_port(port, plant="record", info=_info) as device:
+        with open_port(port, plant="record", info=_info, firmware=False) as device:
             _info(f"mpremote REPL on {device}: Ctrl-C for the >>> prompt, Ctrl-D there restarts the firmware, "
                   "Ctrl-] or Ctrl-X leaves")
             run_repl(device)
