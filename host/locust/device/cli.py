@@ -162,8 +162,10 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     # rest, the record says so, a --port sim virtual robot stops
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
     rec = None
+    simulated: dict = {}     # the virtual robot's simulated hops (--port sim)
     try:
-        with open_port(port, plant=plant, video=video, robot=robot, info=_info, video_fps=video_fps) as device:
+        with open_port(port, plant=plant, video=video, robot=robot, info=_info, video_fps=video_fps,
+                       on_close=simulated.update) as device:
             with Link(device) as link:
                 with progress(length=schedule.phases, label="hop") as bar:
                     rec = run_hop(link, schedule, directory,
@@ -183,7 +185,10 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
             signal.signal(sig, handler)
     path = directory / R.RECORD_NAME
     if as_json:
-        click.echo(json_text(rec.to_dict()), nl=False)
+        doc = rec.to_dict()
+        if simulated.get("plant") == "mujoco":
+            doc["simulated"] = simulated      # what the virtual robot's simulation did, SI units
+        click.echo(json_text(doc), nl=False)
     j = R.jitter(rec.phases)
     _info(f"{rec.status}: {len(rec.phases)}/{schedule.phases} phases"
           + (f", start error max {j.max_abs_ms:.3f} ms (mean {j.mean_ms:.3f}, sd {j.std_ms:.3f})" if j else "")

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from ..errors import DeviceError
@@ -14,9 +14,11 @@ from .ports import SIM, autodetect, list_serial_ports
 
 @contextlib.contextmanager
 def open_port(port: str | None, plant: str = "auto", video: Path | None = None, robot=None,
-              info=None, video_fps: int = 60, firmware: bool = True) -> Iterator[str]:
+              info=None, video_fps: int = 60, firmware: bool = True,
+              on_close: Callable[[dict], None] | None = None) -> Iterator[str]:
     """Yields the device path to open. ``sim`` runs a virtual robot for the ``with`` block;
-    with ``firmware`` (a command that talks to the firmware) its flash must hold one."""
+    with ``firmware`` (a command that talks to the firmware) its flash must hold one.
+    ``on_close`` gets the virtual robot's plant summary (its simulated hops) when it stops."""
     if port == SIM:
         from .virtual import VirtualRobot, default_flash_dir
 
@@ -33,6 +35,8 @@ def open_port(port: str | None, plant: str = "auto", video: Path | None = None, 
             yield vr.device_path
         finally:
             summary = vr.stop()
+            if on_close is not None:
+                on_close(summary)
             if info and summary.get("plant") == "mujoco":
                 for line in plant_lines(summary):
                     info(line)
