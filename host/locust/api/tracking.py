@@ -78,7 +78,7 @@ def _marker_specs(markers: Mapping[str, str] | Sequence[str] | None) -> list[str
     return list(markers)
 
 
-def _calibration(info, scale, origin, angle_deg: float, camera_json):
+def _calibration(info, scale, origin, angle_deg: float, camera_json, pixels: str = "tracker"):
     from ..io.camera_json import camera_json_beside
     from ..track import calib, camera
 
@@ -93,14 +93,15 @@ def _calibration(info, scale, origin, angle_deg: float, camera_json):
     if scale is not None:
         x1, y1, x2, y2, length_m = (float(v) for v in scale)
         m_per_px, source = calib.m_per_px_from_stick(x1, y1, x2, y2, length_m), f"stick {tuple(scale)}"
-    return calib.build(info.height_px, m_per_px, origin, angle_deg, source)
+    return calib.build(info.height_px, m_per_px, calib.typed_px(*origin, pixels) if origin is not None else None,
+                       angle_deg, source)
 
 
 def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None = None, *,
           scale: tuple[float, float, float, float, float] | None = None, origin: tuple[float, float] | None = None,
           angle_deg: float = 0.0, camera_json: str | Path | None = None, start: int = 0, end: int | None = None,
           step: int = 1, fps: float | None = None, color_tol: int = 80, search_px: int = 40,
-          progress: Callable[[int], None] | None = None) -> Tracks:
+          pixels: str = "tracker", progress: Callable[[int], None] | None = None) -> Tracks:
     """Find markers in every frame of a video (or an image sequence), as Tracker's autotracker would.
 
     Parameters
@@ -125,6 +126,11 @@ def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None =
         The true frame rate, for slow-motion footage; default the file's.
     color_tol, search_px : int
         Colour tolerance (0-255) and the search window's half size (px).
+    pixels : {"tracker", "opencv"}, default "tracker"
+        Convention of the pixel positions given in ``markers``, ``scale`` and ``origin``:
+        Tracker's (origin at the image's top-left corner, as Tracker's table shows them) or
+        OpenCV's (origin at the top-left pixel's centre, 0.5 px from Tracker's). The returned
+        pixel columns are OpenCV's.
 
     Returns
     -------
@@ -144,8 +150,9 @@ def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None =
 
     info = probe(Path(video))
     clip = Clip(start, end, step, fps).resolved(info)
-    models = parse_markers(_marker_specs(markers), ModelOptions(color_tol=color_tol, search_half_px=search_px))
-    calibration = _calibration(info, scale, origin, angle_deg, camera_json)
+    models = parse_markers(_marker_specs(markers),
+                           ModelOptions(color_tol=color_tol, search_half_px=search_px, pixels=pixels))
+    calibration = _calibration(info, scale, origin, angle_deg, camera_json, pixels)
     result = track_video(info, clip, models, calibration, progress=progress)
     return Tracks(tracks_of(result), result)
 
