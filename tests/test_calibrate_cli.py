@@ -195,3 +195,51 @@ def test_plot_never_lands_in_a_read_only_data_folder(recs, tmp_path, monkeypatch
         assert (work / "ramp-fit.png").stat().st_size > 1000
     finally:
         data.chmod(0o755)
+
+
+# -- calibrate hop starts from the robot its runs record ---------------------------------------
+def _recorded_run(folder, preset_name=None, robot_file=None, leg=None):
+    """A run.json (no track) recording which robot was hopped, as `locust hop` writes it."""
+    from locust.io import run_record as R
+
+    rec = R.RunRecord(schedule=R.HopSchedule(cycles=1, push_deg=-30, push_ms=300, wait_ms=1000), port="sim",
+                      status=R.COMPLETE, robot=R.RobotSource(preset=preset_name, robot_file=robot_file, leg_set=leg))
+    folder.mkdir(parents=True)
+    R.write(rec, folder)
+    return folder
+
+
+def test_calibrate_hop_starts_from_the_robot_its_runs_record(tmp_path):
+    """Runs hopped with --preset small and --preset medium share the robot as built (the
+    small preset, +0 cm): that is the start, said on the first line, not the seed."""
+    from locust.api.calibration import robot_of_runs
+    from locust.params import preset
+
+    s = _recorded_run(tmp_path / "small-1", "small", leg="small")
+    m = _recorded_run(tmp_path / "medium-1", "medium", leg="medium")
+    robot, said = robot_of_runs([f"small={s}", f"medium={m}"])
+    assert robot.flat() == preset("small").flat() and robot.flat() != preset("seed").flat()
+    assert said.startswith("robot: small (the robot as built")
+    res = CliRunner().invoke(cli, ["calibrate", "hop", f"small={s}", f"medium={m}", "--no-plot"])
+    assert res.exit_code == 2
+    assert res.stderr.splitlines()[0] == said            # then: no track to fit
+    seed_robot, _ = robot_of_runs([f"small={_recorded_run(tmp_path / 'seed-1', 'seed', leg='small')}"])
+    assert seed_robot.flat() == preset("seed").flat()
+
+
+def test_calibrate_hop_refuses_runs_on_different_robots_unless_told(tmp_path):
+    s = _recorded_run(tmp_path / "small-1", "small", leg="small")
+    seed = _recorded_run(tmp_path / "large-1", "seed", leg="large")
+    res = CliRunner().invoke(cli, ["calibrate", "hop", f"small={s}", f"large={seed}", "--no-plot"])
+    assert res.exit_code == 2 and "the runs record different robots" in res.stderr, res.output
+    assert "--config" in res.stderr
+    told = CliRunner().invoke(cli, ["calibrate", "hop", f"small={s}", f"large={seed}", "--no-plot",
+                                    "--config", str(_robot_file(tmp_path))])
+    assert told.exit_code == 2 and "different robots" not in told.stderr      # on to the runs: no track
+    assert told.stderr.splitlines()[0] == f"robot: {tmp_path / 'robot.toml'}"
+
+
+def _robot_file(folder):
+    from locust.params import preset, save_robot
+
+    return save_robot(preset("small"), folder / "robot.toml")

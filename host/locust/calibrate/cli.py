@@ -322,7 +322,8 @@ def ramp(data, ramp_markers, robot_marker, into, resolution_deg, imports, timing
 @click.option("--fit", "fit_keys", default=",".join(H.DEFAULT_KEYS), show_default=True, metavar="KEY[,KEY...]",
               help="Robot parameters to fit, shared by every run (any real-valued key of `locust params`).")
 @click.option("--config", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Robot to start from [default: the --write file if it exists, else the seed preset].")
+              help="Robot to start from, the values every run shares [default: the --write file if it exists, "
+                   "else the robot the runs' run.json record; runs on different robots are refused].")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help="Override a starting value (repeatable).")
 @click.option("--max-iter", type=click.IntRange(1, 200), default=30, show_default=True, help="Solver iterations.")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
@@ -351,7 +352,17 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
     H.check_fittable(keys)
     write_path = write_target(write_path)
     start_from = config or (write_path if write_path and Path(write_path).exists() else None)
-    base = resolve_robot(None, start_from, sets)
+    if start_from is not None:
+        base = resolve_robot(None, start_from, sets)
+        click.echo(f"robot: {start_from}" + (" (the --write file)" if start_from != config else ""), err=True)
+    else:        # the robot the runs were hopped on, as their records say
+        from ..api.calibration import robot_of_runs
+        from ..params import check_robot, parse_set_options
+
+        base, said = robot_of_runs(list(runs))
+        overrides = parse_set_options(sets)
+        base = check_robot(base.with_values(overrides, "override") if overrides else base)
+        click.echo(said, err=True)
     with progress(length=max_iter, label="fitting hops") as bar:
         facade_fit = calibrate_hops(base, list(runs), keys, max_iter=max_iter, progress=bar.update)
     fit = facade_fit.result

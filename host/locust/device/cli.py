@@ -203,8 +203,11 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
 def _hopped_robot(preset, config, sets, leg_set_name):
     """(robot, what run.json records of it): --config or --preset, the leg set on it, --set."""
     from ..params import LEG_SETS, check_robot, leg_set, parse_set_options
+    from ..params_cli import DEFAULTED
 
-    preset_set = preset if config is None and preset in LEG_SETS else None
+    defaulted = click.get_current_context().meta.get(DEFAULTED, False)
+    # a leg-set preset names the legs hopped when given; the default one (the robot as built) does not
+    preset_set = preset if config is None and preset in LEG_SETS and not defaulted else None
     if leg_set_name is not None:
         leg_set_name = R.check_leg_set(leg_set_name)
         if preset_set and leg_set_name != preset_set:
