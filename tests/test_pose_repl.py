@@ -37,9 +37,9 @@ def _run(args, env, timeout=90):
 
 
 @contextlib.contextmanager
-def _virtual(env, pwm_log=None):
+def _virtual(env, pwm_log=None, extra=()):
     """`locust virtual` in the background; yields its /dev/pts/N."""
-    args = ["virtual", "--plant", "record"] + (["--pwm-log", str(pwm_log)] if pwm_log else [])
+    args = ["virtual", "--plant", "record", *extra] + (["--pwm-log", str(pwm_log)] if pwm_log else [])
     proc = subprocess.Popen(LOCUST + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
         device = proc.stdout.readline().strip()
@@ -217,6 +217,18 @@ def test_mpremote_exec_on_an_idle_robot_then_flash_and_hop(env, tmp_path):
         assert hop.returncode == 0, hop.stderr
         rec = json.loads(hop.stdout)
         assert rec["status"] == "complete" and len(rec["phases"]) == 2
+
+
+def test_a_hop_on_locust_virtual_records_the_robot_it_simulates(env, tmp_path):
+    """`locust virtual --preset medium`, then `hop --port /dev/pts/N`: run.json records medium
+    (the virtual robot's), not the hop's own default."""
+    with _virtual(env, extra=("--preset", "medium")) as device:
+        hop = _run(["hop", "--port", device, "--cycles", "1", "--push-ms", "50", "--wait-ms", "50",
+                    "--out", str(tmp_path / "run")], env)
+        assert hop.returncode == 0, hop.stderr
+        assert f"robot: medium, the one the virtual robot on {device} simulates" in hop.stderr
+    robot = json.loads((tmp_path / "run" / "run.json").read_text())["robot"]
+    assert (robot["preset"], robot["leg_set"]) == ("medium", "medium"), robot
 
 
 def test_a_virtual_robot_with_nothing_flashed_says_so(tmp_path):

@@ -13,7 +13,7 @@ from ..fileio import json_text
 from ..firmware import config as fw_config
 from ..io import run_record as R
 from ..params import Schedule, resolve_robot
-from ..params_cli import robot_options
+from ..params_cli import DEFAULTED, robot_options
 from ..progress import progress
 from ..tables import plant_lines
 from .plant import PLANTS
@@ -147,6 +147,7 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     from .session import open_port
 
     robot, source = _hopped_robot(preset, config, sets, leg_set_name)
+    source = _virtual_robot_source(port, source)
     s = robot.schedule
     schedule = R.HopSchedule(cycles=cycles or s.cycles, push_deg=s.push_deg if push_deg is None else push_deg,
                              push_ms=push_ms or round(s.push_s * 1000), wait_ms=wait_ms or round(s.wait_s * 1000),
@@ -200,10 +201,29 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
         raise DeviceError(f"the hop did not complete: {rec.message}", f"the partial record is in {path}")
 
 
+def _virtual_robot_source(port, source):
+    """The robot a ``locust virtual`` on ``port`` simulates, when it is one: that is what hops."""
+    from .announce import announced
+    from .ports import SIM
+
+    if port in (None, SIM):
+        return source
+    theirs = announced(port)
+    if theirs is None:
+        return source
+    if theirs.leg_set is None and source.leg_set is not None:
+        theirs = R.RobotSource(theirs.preset, theirs.robot_file, source.leg_set)    # --leg-set names the legs
+    mine = click.get_current_context().meta.get(DEFAULTED, False)
+    if not mine and (theirs.preset, theirs.robot_file) != (source.preset, source.robot_file):
+        _info(f"warning: the virtual robot on {port} simulates {theirs.robot_file or theirs.preset}, "
+              f"not {source.robot_file or source.preset}: run.json records its robot")
+    _info(f"robot: {theirs.robot_file or theirs.preset}, the one the virtual robot on {port} simulates")
+    return theirs
+
+
 def _hopped_robot(preset, config, sets, leg_set_name):
     """(robot, what run.json records of it): --config or --preset, the leg set on it, --set."""
     from ..params import LEG_SETS, check_robot, leg_set, parse_set_options
-    from ..params_cli import DEFAULTED
 
     defaulted = click.get_current_context().meta.get(DEFAULTED, False)
     # a leg-set preset names the legs hopped when given; the default one (the robot as built) does not
@@ -404,8 +424,11 @@ def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, s
 
     if pwm_log is not None and pwm_log.exists():
         raise DeviceError(f"{pwm_log} exists; a log is never overwritten", "choose another --pwm-log path")
-    robot = resolve_robot(preset, config, sets)
+    from .announce import announce, withdraw
+
+    robot, source = _hopped_robot(preset, config, sets, None)
     vr = VirtualRobot(flash_dir, make_plant(plant, robot, video, video_fps), log_path=pwm_log, chip=chip).start()
+    announce(vr.device_path, source)      # a hop on its pty records this robot
     click.echo(vr.device_path)
     sys.stdout.flush()
     _info(f"virtual robot ({vr.chip}): flash {vr.flash_dir}, {vr.scheduling} scheduling, "
@@ -417,6 +440,7 @@ def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, s
     except KeyboardInterrupt:
         pass
     finally:
+        withdraw(vr.device_path)
         summary = vr.stop()
         _info(f"virtual robot stopped after {vr.boots} boot(s)")
         for line in plant_lines(summary):
