@@ -28,16 +28,19 @@ def verdict(valid: bool) -> str:
     return "valid" if valid else "INVALID"
 
 
-def sim_lines(r) -> list[str]:
+def sim_lines(r, verbose: bool = False) -> list[str]:
     """``locust sim``: a :class:`locust.sim.run.SimResult` as the verdict, one row per hop,
-    the totals, the convergence check and the notes."""
+    the totals, the convergence check and the notes; ``verbose``: the linkage's kinematics too
+    (Grashof class and transmission angle: words for the expert, kept out of the first look)."""
     lines = [f"{r.robot}: {verdict(r.valid)} ({r.cycles} cycle{'' if r.cycles == 1 else 's'}, "
              f"time step {r.timestep_s:g} s, "
              f"{r.wall_s:.1f} s wall)"]
     lines += [f"{INDENT}reason: {reason}" for reason in r.reasons]
     if not r.valid:
         return lines
-    lines.append(f"{INDENT}linkage: {r.grashof}, transmission angle {r.transmission_deg:.0f} deg")
+    if verbose:
+        lines.append(f"{INDENT}linkage: {r.grashof} (Grashof class), worst transmission angle "
+                     f"{r.transmission_deg:.0f} deg (the angle at which the coupler pushes the leg; 90 is best)")
     lines += hop_table([vars(h) for h in r.hops])
     lines.append(totals_line(r.distance_m, r.max_nose_height_m))
     if r.convergence:
