@@ -59,6 +59,36 @@ def test_hop_on_the_virtual_robot_lists_and_prints_its_simulated_hops(env, tmp_p
                                                         abs=0.006)
 
 
+def test_locust_virtual_prints_each_hop_as_it_goes(env, tmp_path):
+    """`locust virtual` (the live MuJoCo model) prints each hop's row while it runs, not only at
+    exit: both hops of a two-cycle `hop` on its pty show while it is still running, each the
+    distance the hop's own record of the simulation gives (within the printed 0.005 mm)."""
+    import threading
+
+    proc = subprocess.Popen(LOCUST + ["virtual", "--preset", "seed"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=env)
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(iter(proc.stderr.readline, "")), daemon=True)
+    try:
+        device = proc.stdout.readline().strip()
+        assert device.startswith("/dev/pts/"), device
+        reader.start()
+        hop = _run(["hop", "--port", device, "--preset", "seed", "--cycles", "2", "--out", str(tmp_path / "run")], env)
+        assert hop.returncode == 0, hop.stderr
+        deadline = time.monotonic() + 30
+        rows = []
+        while time.monotonic() < deadline and len(rows) < 2:
+            rows = [ln.split() for ln in list(lines) if ln.split()[:1] in (["1"], ["2"])]
+            time.sleep(0.1)
+        assert proc.poll() is None               # still running: printed as it goes
+        assert [r[0] for r in rows] == ["1", "2"], lines
+    finally:
+        proc.send_signal(signal.SIGTERM)
+        proc.communicate(timeout=60)
+    final = [ln.split() for ln in lines if ln.split()[:1] in (["1"], ["2"])][-2:]
+    assert [float(r[1]) for r in rows] == pytest.approx([float(r[1]) for r in final], abs=0.006)
+
+
 def test_flash_refuses_a_pin_the_chip_cannot_drive_and_writes_nothing(env, tmp_path):
     """GPIO6 of a classic ESP32 is its SPI flash: refused with the usable pins as the hint, before
     any file is written; the firmware on the board is untouched and still hops."""

@@ -15,7 +15,7 @@ from ..io import run_record as R
 from ..params import Schedule, resolve_robot
 from ..params_cli import DEFAULTED, robot_options
 from ..progress import progress
-from ..tables import plant_lines
+from ..tables import hop_table, plant_lines
 from .plant import PLANTS
 
 CHIPS = tuple(fw_config.CHIPS)  # the chips whose pin rules the firmware knows, and the virtual robot models
@@ -427,7 +427,15 @@ def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, s
     from .announce import announce, withdraw
 
     robot, source = _hopped_robot(preset, config, sets, None)
-    vr = VirtualRobot(flash_dir, make_plant(plant, robot, video, video_fps), log_path=pwm_log, chip=chip).start()
+    shown = []
+
+    def show_hop(hop: dict) -> None:       # each hop as it is done, the rows `locust sim` prints
+        header, row = hop_table([{**hop, "cycle": len(shown) + 1}])
+        _info(row if shown else f"{header}\n{row}")
+        shown.append(hop)
+
+    vr = VirtualRobot(flash_dir, make_plant(plant, robot, video, video_fps, on_hop=show_hop), log_path=pwm_log,
+                      chip=chip).start()
     announce(vr.device_path, source)      # a hop on its pty records this robot
     click.echo(vr.device_path)
     sys.stdout.flush()
