@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import shutil
 from pathlib import Path
 
@@ -243,3 +244,37 @@ def _robot_file(folder):
     from locust.params import preset, save_robot
 
     return save_robot(preset("small"), folder / "robot.toml")
+
+
+# -- what `locust calibrate` prints for a person -----------------------------------------------
+def test_fitted_values_print_with_units_and_four_figures():
+    """`k  5.587e-2  N·m/rad  ± 1.0 %  (95 %: ... … ...)`: the JSON's own value to 4 figures, its
+    unit in a column (N·m, never nm), one sd as a share of the value, the 95 % interval; no
+    Python lists or 12-digit floats."""
+    args = ["calibrate", "beam", str(RECORDINGS / "synthetic_beam.csv"), "--mass-kg", "0.01", "--length-m", "0.05",
+            "--no-plot"]
+    text = CliRunner().invoke(cli, args).stdout
+    fit = json.loads(CliRunner().invoke(cli, [*args, "--json"]).stdout)
+    for key, unit in (("hinge_stiffness_nm_per_rad", "N·m/rad"), ("hinge_damping_nms_per_rad", "N·m·s/rad"),
+                      ("natural_frequency_hz", "Hz")):
+        v = fit[key]
+        line = next(ln for ln in text.splitlines() if ln.split()[0] == key.split("_n")[0].split("_hz")[0])
+        m = re.fullmatch(r"(\S+)\s+(\S+)\s+(\S+)\s+± (\S+) %\s+\(95 %: (\S+) … (\S+)\)", line)
+        assert m, line
+        assert m.group(3) == unit
+        assert float(m.group(2)) == pytest.approx(v["value"], rel=5e-4)
+        assert float(m.group(4)) == pytest.approx(100 * v["std"] / v["value"], abs=0.051)
+        assert [float(m.group(5)), float(m.group(6))] == pytest.approx(v["ci95"], rel=5e-4)
+    assert "[" not in text and "'" not in text and not re.search(r"\d\.\d{6,}", text)
+
+
+def test_the_hinge_interval_is_flagged_where_its_residual_is_model_error(shared_data):
+    """docs/calibrate.md: on Damping_test.trk the residual (0.8 mm RMS) is model error, so the
+    intervals computed for independent errors are too narrow: the printed line says so."""
+    res = CliRunner().invoke(cli, ["calibrate", "hinge", str(shared_data / "hinge" / "Damping_test.trk"),
+                                   "--inertia-kgm2", "8.5e-7", "--gravity", "out-of-plane", "--coulomb", "off",
+                                   "--no-plot"])
+    assert res.exit_code == 0, res.output
+    flagged = [ln for ln in res.stdout.splitlines() if "TOO NARROW" in ln]
+    assert [ln.split()[0] for ln in flagged] == ["hinge_stiffness", "hinge_damping"]
+    assert "0.79 mm RMS" in flagged[0]

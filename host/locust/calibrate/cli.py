@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import functools
-import math
 from dataclasses import replace
 from pathlib import Path
 
@@ -15,6 +14,7 @@ from ..io.importing import ImportOptions, import_options
 from ..options import FINITE, POSITIVE
 from ..plotting import check_figure_path
 from ..progress import progress
+from ..tables import estimate_line, value_line
 from . import hinge as HG
 from . import hop as H
 from . import inputs
@@ -436,18 +436,24 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
     _print_text(out)
 
 
+HINGE_MODEL_ERROR_M = 0.0002   # hinge residual beyond ~3x a video's tracking noise: model error (docs/calibrate.md)
+
+
 def _print_text(out: dict) -> None:
     click.echo(f"# {out['experiment']}: {out['source']}")
+    click.echo(f"{'':28s} {'value':>10s}  {'unit':10s} ± 1 sd    (95 % interval)")
+    narrow = ""
+    if out["experiment"] == "hinge" and (out.get("rms_residual_m") or 0) > HINGE_MODEL_ERROR_M:
+        narrow = (f"   TOO NARROW: the residual ({1000 * out['rms_residual_m']:.2f} mm RMS) is model error, "
+                  "not tracking noise (docs/calibrate.md, Hinge)")
     for key, val in out.items():
         if key in ("experiment", "source", "notes", "warnings", "written", "plot", "angles_deg", "validation",
                    "validation_plot", "gyro_gain_units_per_rad_per_s"):
             continue
         if isinstance(val, dict) and "value" in val:
-            _print_text_value(key, val)
-        elif isinstance(val, list) and all(isinstance(v, float) for v in val):
-            click.echo(f"{key:30s} {', '.join(format(v, '.6g') for v in val)}")
+            _print_text_value(key, val, narrow if key.startswith("hinge_") else "")
         elif val is not None:
-            click.echo(f"{key:30s} {val if not isinstance(val, float) else format(val, '.6g')}")
+            click.echo(value_line(key, val))
     for k, gain in enumerate(out.get("gyro_gain_units_per_rad_per_s") or []):
         if gain is not None:
             _print_text_value(f"gyro_gain_units_per_rad_per_s[{k}]", gain)
@@ -469,13 +475,9 @@ def _print_text(out: dict) -> None:
                    else f"nothing written to {out['written']['path']}: no value was identifiable")
 
 
-def _print_text_value(key: str, val: dict) -> None:
+def _print_text_value(key: str, val: dict, note: str = "") -> None:
     flag = "" if val.get("identifiable", True) else "   NOT IDENTIFIABLE"
     if val.get("given"):
-        click.echo(f"{key:30s} {val['value']:<12.6g} (given)")
-    elif val["std"] is None or not math.isfinite(val["std"]):
-        click.echo(f"{key:30s} {val['value']:<12.6g} (undetermined){flag}")
+        click.echo(value_line(key, val["value"]) + "  (given)")
     else:
-        lo, hi = val["ci95"]
-        click.echo(f"{key:30s} {val['value']:<12.6g} ± {val['std']:.3g} (1σ)  "
-                   f"95% CI [{lo:.6g}, {hi:.6g}]{flag}")
+        click.echo(estimate_line(key, val["value"], val["std"], val.get("ci95"), flag + note))
