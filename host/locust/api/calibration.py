@@ -57,6 +57,23 @@ class Fit:
         """Everything the fit found, as ``locust calibrate --json`` prints it."""
         return self.result.summary()
 
+    def to_dataframe(self):
+        """One row per fitted robot value.
+
+        Returns
+        -------
+        pandas.DataFrame
+            index ``key`` (dotted name); ``value``, ``std`` (1 sd), ``ci95_low``, ``ci95_high``,
+            ``unit`` (from the key's name: ``N·m/rad`` for ``_nm_per_rad``).
+        """
+        import pandas as pd
+
+        from ..tables import split_unit
+
+        rows = [{"key": k, "value": e.value, "std": e.std, "ci95_low": e.ci95[0], "ci95_high": e.ci95[1],
+                 "unit": split_unit(k)[1]} for k, e in self.parameters.items()]
+        return pd.DataFrame(rows, columns=["key", "value", "std", "ci95_low", "ci95_high", "unit"]).set_index("key")
+
     def plot(self, run: int = 0):
         """Data and model above, residuals below (per recording); for a hop fit, run ``run``'s
         tracked markers against the fitted simulation.

@@ -51,6 +51,52 @@ class Tracks:
                 cols[f"{name}_ok"] = t.markers[name].ok.copy()
         return pd.DataFrame(cols)
 
+    def tidy(self):
+        """One row per marker per frame (trackpy's habit), with velocity and acceleration.
+
+        Velocity and acceleration are Tracker's finite differences on the world metres:
+        ``v[i] = (x[i+1] - x[i-1]) / (t[i+1] - t[i-1])`` and, at a steady frame rate,
+        ``a[i] = (x[i+2] - 2 x[i] + x[i-2]) / (4 dt²)`` (central differences of the central
+        differences); NaN at the ends of the clip and next to a frame where the marker is lost.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``frame``, ``t_s``, ``marker``, ``x_px``, ``y_px`` (OpenCV pixels), ``x_m``, ``y_m``,
+            ``ok``, ``vx_m_per_s``, ``vy_m_per_s``, ``ax_m_per_s2``, ``ay_m_per_s2``.
+        """
+        import pandas as pd
+
+        t, parts = self.tracks.t_s, []
+        for name, m in self.tracks.markers.items():
+            x, y = self.tracks.positions(name)
+            v = [_central(t, c) for c in (x, y)]
+            a = [_central(t, c) for c in v]
+            parts.append(pd.DataFrame({
+                "frame": self.tracks.frame, "t_s": t, "marker": name, "x_px": m.px, "y_px": m.py, "x_m": x, "y_m": y,
+                "ok": m.ok, "vx_m_per_s": v[0], "vy_m_per_s": v[1], "ax_m_per_s2": a[0], "ay_m_per_s2": a[1]}))
+        if not parts:
+            return pd.DataFrame(columns=["frame", "t_s", "marker", "x_px", "y_px", "x_m", "y_m", "ok", "vx_m_per_s",
+                                         "vy_m_per_s", "ax_m_per_s2", "ay_m_per_s2"])
+        return pd.concat(parts, ignore_index=True).sort_values(["frame", "marker"], kind="stable",
+                                                               ignore_index=True)
+
+    def plot(self):
+        """Each marker's world x and y against time (matplotlib Figure)."""
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(7, 3.5), layout="constrained")
+        ax_x, ax_y = fig.subplots(1, 2)
+        for name in self.markers:
+            x, y = self.positions(name)
+            ax_x.plot(self.tracks.t_s, x * 1000, ".-", ms=3, label=name)
+            ax_y.plot(self.tracks.t_s, y * 1000, ".-", ms=3, label=name)
+        for ax, what in ((ax_x, "x (forward)"), (ax_y, "y (up)")):
+            ax.set_xlabel("t [s]")
+            ax.set_ylabel(f"{what} [mm]")
+        ax_x.legend(fontsize=8)
+        return fig
+
     def write(self, path: str | Path, overwrite: bool = False) -> Path:
         """Write the tracks CSV (atomic; an existing file only with ``overwrite``)."""
         from ..io.tracks_csv import write_tracks_csv
@@ -66,6 +112,14 @@ class Tracks:
         for name, m in t.markers.items():
             lines.append(f"  {name}: found in {int(np.count_nonzero(m.ok))} of {len(m.ok)} frames")
         return "\n".join(lines)
+
+
+def _central(t: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Central differences dv/dt, NaN at both ends (Tracker leaves them blank)."""
+    out = np.full(len(v), np.nan)
+    if len(v) >= 3:
+        out[1:-1] = (v[2:] - v[:-2]) / (t[2:] - t[:-2])
+    return out
 
 
 def _marker_specs(markers: Mapping[str, str] | Sequence[str] | None) -> list[str]:
