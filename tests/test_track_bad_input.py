@@ -297,3 +297,32 @@ def test_a_dim_patch_or_a_speck_is_never_taken(tmp_path, chroma_share, radius_px
     encode_video(tmp_path / "dim.avi", frames, 30.0, (160, 120), "FFV1")
     assert_refused_and_unchanged(tmp_path, ["track", tmp_path / "dim.avi", "--marker", "nose=color:#ff00ff"],
                                  "never found", "nose (color:#ff00ff)")
+
+
+def test_a_virtual_robot_that_went_over_is_upright_and_its_flipped_video_is_not(tmp_path):
+    """The simulation films Small going over onto its back (its nose rests high after the
+    hop, the foot sticker dips as the leg pushes and is then hidden): upright, no warning; the
+    same frames turned over (both axes, a phone held upside down), one."""
+    import locust
+    from locust.track.video import read_frames
+
+    from locust.sim.live import LiveSim
+
+    robot = locust.robot("small")
+    s = robot.schedule
+    path = tmp_path / "over.mp4"       # filmed as the virtual robot films a hop: standing first
+    sim = LiveSim(robot, video_path=str(path), fps=30, width=320, height=240, cycles=1)
+    sim.advance_to(0.1)
+    sim.set_servo_angles_deg(s.push_deg, s.push_deg)
+    sim.advance_to(0.1 + s.push_s)
+    sim.set_servo_angles_deg(0.0, 0.0)
+    sim.advance_to(0.1 + s.push_s + s.wait_s)
+    assert sim.close()["valid"]
+    upright = invoke(["track", path, "--overlay", "none"])
+    assert upright.exit_code == 0 and "upside down" not in upright.stderr, upright.output
+    info = probe(path)
+    frames = [cv2.flip(f, -1) for _, f in read_frames(info, Clip().resolved(info))]
+    encode_video(tmp_path / "flipped.avi", iter(frames), info.file_fps, (info.width_px, info.height_px), "MJPG")
+    flipped = invoke(["track", tmp_path / "flipped.avi", "--scale", "0,0,100,0=0.05", "--overlay", "none"])
+    assert flipped.exit_code == 0, flipped.output
+    assert "nose stands still at the top of its heights" in flipped.stderr, flipped.stderr

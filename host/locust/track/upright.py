@@ -7,8 +7,9 @@ above. So the still sightings before a marker's first move lie at the bottom of 
 of heights. Where they lie at the top instead, world y points down: the video was filmed
 with the phone upside down (or its axes turned over with ``--angle``), and every height is
 inverted. Where the robot rests later (on its back, high) says nothing about the floor and
-is not used. A marker that moves from its first sighting, or hardly moves up or down, gives
-no verdict.
+is not used. The verdict is the video's, from the marker that moves up and down the most (a
+sticker low on a leg dips as the leg pushes); a marker that moves from its first sighting,
+or hardly moves up or down, gives none.
 """
 
 from __future__ import annotations
@@ -34,8 +35,10 @@ def standing_still(x: np.ndarray, y: np.ndarray, ok: np.ndarray, tolerance: floa
 
 
 def upside_down_warnings(result: TrackResult) -> list[str]:
-    """One line for each marker that stands, before its first move, at the top of its heights."""
-    lines = []
+    """One line when the video's heights look upside down, judged from the marker that moves
+    up and down the most (in pixels) among those that stand still before their first move: a
+    marker low on a leg may dip as the leg pushes, the robot's rise decides."""
+    best = None
     for track in result.markers:
         x, y = result.world(track)
         ok = track.ok & np.isfinite(y) & np.isfinite(track.py)
@@ -47,12 +50,16 @@ def upside_down_warnings(result: TrackResult) -> list[str]:
         still = standing_still(x, y, ok, STILL_SHARE * (high - low))
         if still.size < MIN_STILL:
             continue
-        rest = float(np.median(y[still]))
-        share = (rest - low) / (high - low)
-        if share > TOP_SHARE:
-            lines.append(f"{track.name} stands still at the top of its heights ({still.size} still frames at "
-                         f"y = {rest:.4g} m, {share:.0%} of the way from {low:.4g} to {high:.4g} m) before its "
-                         "first move: a robot starts standing on the floor, at the bottom; the heights look "
-                         "upside down (a video filmed upside down?); rotate the video, or give --angle 180 to "
-                         "turn the axes over")
-    return lines
+        rise_px = float(np.ptp(track.py[ok]))
+        if best is None or rise_px > best[0]:
+            best = (rise_px, track.name, still.size, float(np.median(y[still])), low, high)
+    if best is None:
+        return []
+    _, name, n_still, rest, low, high = best
+    share = (rest - low) / (high - low)
+    if share <= TOP_SHARE:
+        return []
+    return [f"{name} stands still at the top of its heights ({n_still} still frames at y = {rest:.4g} m, "
+            f"{share:.0%} of the way from {low:.4g} to {high:.4g} m) before its first move: a robot starts "
+            "standing on the floor, at the bottom; the heights look upside down (a video filmed upside down?); "
+            "rotate the video, or give --angle 180 to turn the axes over"]
