@@ -304,9 +304,8 @@ def test_a_virtual_robot_that_went_over_is_upright_and_its_flipped_video_is_not(
     hop, the foot sticker dips as the leg pushes and is then hidden): upright, no warning; the
     same frames turned over (both axes, a phone held upside down), one."""
     import locust
-    from locust.track.video import read_frames
-
     from locust.sim.live import LiveSim
+    from locust.track.video import read_frames
 
     robot = locust.robot("small")
     s = robot.schedule
