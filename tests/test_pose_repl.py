@@ -226,7 +226,7 @@ def test_a_hop_on_locust_virtual_records_the_robot_it_simulates(env, tmp_path):
         hop = _run(["hop", "--port", device, "--cycles", "1", "--push-ms", "50", "--wait-ms", "50",
                     "--out", str(tmp_path / "run")], env)
         assert hop.returncode == 0, hop.stderr
-        assert f"robot: medium, the one the virtual robot on {device} simulates" in hop.stderr
+        assert hop.stderr.splitlines()[0] == f"robot: medium, the one the virtual robot on {device} simulates"
     robot = json.loads((tmp_path / "run" / "run.json").read_text())["robot"]
     assert (robot["preset"], robot["leg_set"]) == ("medium", "medium"), robot
 

@@ -25,20 +25,23 @@ def default_robot() -> tuple[str | None, Path | None, str]:
                                   "--preset or --config to choose another)")
 
 
-def robot_options(func):
+def robot_options(func=None, *, say: bool = True):
     """The shared --preset / --config / --set options of every command that needs a robot.
 
     With neither --preset nor --config the command runs on :func:`default_robot`, and its
-    first line of output (on stderr) says which."""
-
+    first line of output (on stderr) says which; ``say=False``: the command prints that line
+    itself (the click context's meta ``DEFAULTED`` holds it), once it knows better."""
+    if func is None:
+        return functools.partial(robot_options, say=say)
     command = func
 
     @functools.wraps(command)
     def wrapper(*args, preset, config, **kwargs):
         if preset is None and config is None:
             preset, config, said = default_robot()
-            click.echo(said, err=True)
-            click.get_current_context().meta[DEFAULTED] = True
+            if say:
+                click.echo(said, err=True)
+            click.get_current_context().meta[DEFAULTED] = said
         return command(*args, preset=preset, config=config, **kwargs)
 
     func = click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",

@@ -130,7 +130,7 @@ def _parse_servo_set(item: str, option: str = "--servo") -> tuple[str, float]:
                    "run.json for `locust report`. Default: the --preset when it is a leg set. "
                    "A known leg set is built on the --config robot for the virtual robot.")
 @_plant_options
-@robot_options
+@robot_options(say=False)   # the robot line comes once a virtual robot on --port is known
 def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, leg_set_name, plant, video, video_fps,
         preset, config, sets):
     """Run the bang-bang hop schedule (push, wait; N cycles) and save the run record.
@@ -206,10 +206,11 @@ def _virtual_robot_source(port, source):
     from .announce import announced
     from .ports import SIM
 
-    if port in (None, SIM):
-        return source
-    theirs = announced(port)
+    said = click.get_current_context().meta.get(DEFAULTED)
+    theirs = announced(port) if port not in (None, SIM) else None
     if theirs is None:
+        if said:
+            _info(said)
         return source
     if theirs.leg_set is None and source.leg_set is not None:
         theirs = R.RobotSource(theirs.preset, theirs.robot_file, source.leg_set)    # --leg-set names the legs
