@@ -201,3 +201,54 @@ def test_hop_fit_is_a_fit():
                                                                fit.parameters[key].std)
     assert "small:synthetic-small" in prov.note
     assert len(fit.plot().axes) == 4                             # nose and foot, x and y
+
+
+# -- tidy tracks, figures and tables on every result, help(locust) -----------------------------
+def test_tidy_tracks_have_trackers_velocity_and_acceleration():
+    """SYNTHETIC: a ball thrown at 1.5 m/s forward and 2 m/s up, 30 frames/s, one frame lost:
+    one row per marker per frame; central differences are exact on a parabola, so vx = 1.5,
+    vy = 2 - 9.81 t and ay = -9.81 m/s² to 1e-9 wherever the neighbours are seen."""
+    from locust.api.tracking import Tracks
+    from locust.io.tracks_csv import MarkerColumns, TracksCsv
+
+    t = np.arange(20) / 30.0
+    x, y = 0.1 + 1.5 * t, 0.2 + 2.0 * t - 9.81 / 2 * t ** 2
+    ok = np.ones(20, dtype=bool)
+    ok[10] = False
+    nan = np.full(20, np.nan)
+    tracks = Tracks(TracksCsv(frame=np.arange(20), t_s=t, markers={
+        "ball": MarkerColumns("ball", px=nan, py=nan, x_m=np.where(ok, x, np.nan), y_m=np.where(ok, y, np.nan), ok=ok),
+        "still": MarkerColumns("still", px=nan, py=nan, x_m=np.zeros(20), y_m=np.zeros(20), ok=np.ones(20, bool))},
+        comments=("synthetic",)))
+    df = tracks.tidy()
+    assert list(df.columns[:7]) == ["frame", "t_s", "marker", "x_px", "y_px", "x_m", "y_m"]
+    assert len(df) == 40 and list(df.marker[:2]) == ["ball", "still"] and list(df.frame[:2]) == [0, 0]
+    ball = df[df.marker == "ball"].set_index("frame")
+    seen_v = [f for f in range(1, 19) if f not in (9, 11)]
+    seen_a = [f for f in range(2, 18) if f not in (8, 9, 10, 11, 12)]
+    assert ball.vx_m_per_s[seen_v].to_numpy() == pytest.approx(np.full(len(seen_v), 1.5), abs=1e-9)
+    assert ball.vy_m_per_s[seen_v].to_numpy() == pytest.approx(2.0 - 9.81 * t[seen_v], abs=1e-9)
+    assert ball.ay_m_per_s2[seen_a].to_numpy() == pytest.approx(np.full(len(seen_a), -9.81), abs=1e-9)
+    assert ball.vx_m_per_s[[0, 19, 9, 11]].isna().all() and ball.ay_m_per_s2[[0, 1, 18, 19, 8, 12]].isna().all()
+    assert isinstance(df, pd.DataFrame) and len(tracks.plot().axes) == 2
+
+
+def test_fit_and_sweep_have_tables_and_figures(tmp_path):
+    fit = locust.calibrate_ramp(RECORDINGS / "synthetic_ramp.csv")
+    table = fit.to_dataframe()
+    est = fit.parameters["contact.foot_friction"]
+    assert table.loc["contact.foot_friction", "value"] == est.value
+    assert (table.loc["contact.foot_friction", "ci95_low"], table.loc["contact.foot_friction", "ci95_high"]) == est.ci95
+    swept = locust.sweep(locust.robot("seed"), vary={"scale": (0.0, 0.01, 2)}, cycles=1, jobs=1)
+    fig = swept.plot()
+    (ax,) = fig.axes
+    assert list(ax.lines[0].get_ydata()) == pytest.approx([r["distance_m"] * 1000 for r in swept.rows if r["valid"]])
+
+
+def test_help_locust_lists_every_function():
+    import pydoc
+
+    text = pydoc.render_doc(locust, renderer=pydoc.plaintext)
+    for name in ("robot(", "simulate(", "sweep(", "track(", "read_tracks(", "calibrate_beam", "calibrate_hops",
+                 "report(", ".tidy()", ".to_dataframe()", ".plot()"):
+        assert name in text, name

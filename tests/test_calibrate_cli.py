@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import shutil
 from pathlib import Path
 
@@ -195,3 +196,85 @@ def test_plot_never_lands_in_a_read_only_data_folder(recs, tmp_path, monkeypatch
         assert (work / "ramp-fit.png").stat().st_size > 1000
     finally:
         data.chmod(0o755)
+
+
+# -- calibrate hop starts from the robot its runs record ---------------------------------------
+def _recorded_run(folder, preset_name=None, robot_file=None, leg=None):
+    """A run.json (no track) recording which robot was hopped, as `locust hop` writes it."""
+    from locust.io import run_record as R
+
+    rec = R.RunRecord(schedule=R.HopSchedule(cycles=1, push_deg=-30, push_ms=300, wait_ms=1000), port="sim",
+                      status=R.COMPLETE, robot=R.RobotSource(preset=preset_name, robot_file=robot_file, leg_set=leg))
+    folder.mkdir(parents=True)
+    R.write(rec, folder)
+    return folder
+
+
+def test_calibrate_hop_starts_from_the_robot_its_runs_record(tmp_path):
+    """Runs hopped with --preset small and --preset medium share the robot as built (the
+    small preset, +0 cm): that is the start, said on the first line, not the seed."""
+    from locust.api.calibration import robot_of_runs
+    from locust.params import preset
+
+    s = _recorded_run(tmp_path / "small-1", "small", leg="small")
+    m = _recorded_run(tmp_path / "medium-1", "medium", leg="medium")
+    robot, said = robot_of_runs([f"small={s}", f"medium={m}"])
+    assert robot.flat() == preset("small").flat() and robot.flat() != preset("seed").flat()
+    assert said.startswith("robot: small (the robot as built")
+    res = CliRunner().invoke(cli, ["calibrate", "hop", f"small={s}", f"medium={m}", "--no-plot"])
+    assert res.exit_code == 2
+    assert res.stderr.splitlines()[0] == said            # then: no track to fit
+    seed_robot, _ = robot_of_runs([f"small={_recorded_run(tmp_path / 'seed-1', 'seed', leg='small')}"])
+    assert seed_robot.flat() == preset("seed").flat()
+
+
+def test_calibrate_hop_refuses_runs_on_different_robots_unless_told(tmp_path):
+    s = _recorded_run(tmp_path / "small-1", "small", leg="small")
+    seed = _recorded_run(tmp_path / "large-1", "seed", leg="large")
+    res = CliRunner().invoke(cli, ["calibrate", "hop", f"small={s}", f"large={seed}", "--no-plot"])
+    assert res.exit_code == 2 and "the runs record different robots" in res.stderr, res.output
+    assert "--config" in res.stderr
+    told = CliRunner().invoke(cli, ["calibrate", "hop", f"small={s}", f"large={seed}", "--no-plot",
+                                    "--config", str(_robot_file(tmp_path))])
+    assert told.exit_code == 2 and "different robots" not in told.stderr      # on to the runs: no track
+    assert told.stderr.splitlines()[0] == f"robot: {tmp_path / 'robot.toml'}"
+
+
+def _robot_file(folder):
+    from locust.params import preset, save_robot
+
+    return save_robot(preset("small"), folder / "robot.toml")
+
+
+# -- what `locust calibrate` prints for a person -----------------------------------------------
+def test_fitted_values_print_with_units_and_four_figures():
+    """`k  5.587e-2  N·m/rad  ± 1.0 %  (95 %: ... … ...)`: the JSON's own value to 4 figures, its
+    unit in a column (N·m, never nm), one sd as a share of the value, the 95 % interval; no
+    Python lists or 12-digit floats."""
+    args = ["calibrate", "beam", str(RECORDINGS / "synthetic_beam.csv"), "--mass-kg", "0.01", "--length-m", "0.05",
+            "--no-plot"]
+    text = CliRunner().invoke(cli, args).stdout
+    fit = json.loads(CliRunner().invoke(cli, [*args, "--json"]).stdout)
+    for key, unit in (("hinge_stiffness_nm_per_rad", "N·m/rad"), ("hinge_damping_nms_per_rad", "N·m·s/rad"),
+                      ("natural_frequency_hz", "Hz")):
+        v = fit[key]
+        line = next(ln for ln in text.splitlines() if ln.split()[0] == key.split("_n")[0].split("_hz")[0])
+        m = re.fullmatch(r"(\S+)\s+(\S+)\s+(\S+)\s+± (\S+) %\s+\(95 %: (\S+) … (\S+)\)", line)
+        assert m, line
+        assert m.group(3) == unit
+        assert float(m.group(2)) == pytest.approx(v["value"], rel=5e-4)
+        assert float(m.group(4)) == pytest.approx(100 * v["std"] / v["value"], abs=0.051)
+        assert [float(m.group(5)), float(m.group(6))] == pytest.approx(v["ci95"], rel=5e-4)
+    assert "[" not in text and "'" not in text and not re.search(r"\d\.\d{6,}", text)
+
+
+def test_the_hinge_interval_is_flagged_where_its_residual_is_model_error(shared_data):
+    """docs/calibrate.md: on Damping_test.trk the residual (0.8 mm RMS) is model error, so the
+    intervals computed for independent errors are too narrow: the printed line says so."""
+    res = CliRunner().invoke(cli, ["calibrate", "hinge", str(shared_data / "hinge" / "Damping_test.trk"),
+                                   "--inertia-kgm2", "8.5e-7", "--gravity", "out-of-plane", "--coulomb", "off",
+                                   "--no-plot"])
+    assert res.exit_code == 0, res.output
+    flagged = [ln for ln in res.stdout.splitlines() if "TOO NARROW" in ln]
+    assert [ln.split()[0] for ln in flagged] == ["hinge_stiffness", "hinge_damping"]
+    assert "0.79 mm RMS" in flagged[0]

@@ -15,6 +15,7 @@ import pytest
 
 from locust.firmware import config as fw_config
 from locust.io import run_record as R
+from locust.params import preset, save_robot
 from locust.trials.measured import config_of
 from probing import assert_refused_and_unchanged, tree
 
@@ -22,8 +23,9 @@ LOCUST = [sys.executable, "-m", "locust.cli"]
 QUICK = ["--cycles", "1", "--push-ms", "50", "--wait-ms", "50", "--plant", "record"]
 
 
-def _run(args, env, timeout=90):
-    return subprocess.run(LOCUST + [str(a) for a in args], capture_output=True, text=True, env=env, timeout=timeout)
+def _run(args, env, timeout=90, cwd=None):
+    return subprocess.run(LOCUST + [str(a) for a in args], capture_output=True, text=True, env=env, timeout=timeout,
+                          cwd=cwd)
 
 
 @pytest.fixture()
@@ -54,7 +56,7 @@ def test_config_reads_the_board_back_and_sets_a_trim_without_flashing(env, flash
 
     # a hop records the pins and trims read from the board, and the robot and leg set hopped
     out = tmp_path / "run"            # a folder name that names no leg set
-    hop = _run(["hop", "--port", "sim", *QUICK, "--leg-set", "Large", "--out", out], env)
+    hop = _run(["hop", "--port", "sim", *QUICK, "--preset", "seed", "--leg-set", "Large", "--out", out], env)
     assert hop.returncode == 0, hop.stderr
     rec = R.read_run_record(out / R.RECORD_NAME)
     assert rec.status == R.COMPLETE
@@ -75,6 +77,25 @@ def test_a_preset_leg_set_is_recorded_and_a_contradicting_leg_set_refused(env, t
                                             "--out", tmp_path / "x"], "contradicts --preset small")
     assert_refused_and_unchanged(tmp_path, ["hop", "--port", "sim", "--leg-set", "big legs!",
                                             "--out", tmp_path / "x"], "not a plain name")
+
+
+def test_the_default_robot_is_the_one_as_built_or_the_calibrated_one_here(env, tmp_path):
+    """No --preset or --config: the robot as built (small, no leg set claimed) where the current
+    folder has no calibration/robot.toml, that file where it has one; the first line says which."""
+    hop = _run(["hop", "--port", "sim", *QUICK, "--out", tmp_path / "a"], env, cwd=tmp_path)
+    assert hop.returncode == 0, hop.stderr
+    assert hop.stderr.splitlines()[0].startswith("robot: small, the robot as built")
+    assert R.read_run_record(tmp_path / "a" / R.RECORD_NAME).robot == R.RobotSource("small", None, None)
+    (tmp_path / "calibration").mkdir()
+    save_robot(preset("large"), tmp_path / "calibration" / "robot.toml")
+    hop = _run(["hop", "--port", "sim", *QUICK, "--out", tmp_path / "b"], env, cwd=tmp_path)
+    assert hop.returncode == 0, hop.stderr
+    assert hop.stderr.splitlines()[0].startswith("robot: calibration/robot.toml")
+    assert R.read_run_record(tmp_path / "b" / R.RECORD_NAME).robot == R.RobotSource(None, "calibration/robot.toml",
+                                                                                  None)
+    sim = _run(["sim", "--cycles", "1", "--json"], env, cwd=tmp_path)
+    assert sim.stderr.splitlines()[0].startswith("robot: calibration/robot.toml")
+    assert json.loads(sim.stdout)["robot"] == "large"
 
 
 def test_a_missing_trial_folder_is_no_such_folder_not_an_unknown_configuration(tmp_path):

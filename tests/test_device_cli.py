@@ -42,6 +42,53 @@ def test_flash_then_hop_six_cycles_on_time(env, tmp_path):
     assert json.loads((tmp_path / "run" / "run.json").read_text()) == rec
 
 
+def test_hop_on_the_virtual_robot_lists_and_prints_its_simulated_hops(env, tmp_path):
+    """`hop --port sim --preset small --cycles 2 --video --json`: two simulated hops, in the
+    JSON and in the table on stderr, each within 0.1 mm of `locust sim`'s (the live model
+    runs the firmware's commands; the rollout the schedule's)."""
+    sim = json.loads(_run(["sim", "--preset", "small", "--cycles", "2", "--json"], env).stdout)
+    proc = _run(["hop", "--port", "sim", "--preset", "small", "--cycles", "2", "--json", "--video",
+                 str(tmp_path / "v.mp4"), "--fps", "10", "--out", str(tmp_path / "run")], env, timeout=240)
+    assert proc.returncode == 0, proc.stderr
+    simulated = json.loads(proc.stdout)["simulated"]
+    assert simulated["valid"] and len(simulated["hops"]) == 2
+    for live, planned in zip(simulated["hops"], sim["hops"], strict=True):
+        assert live["distance_m"] == pytest.approx(planned["distance_m"], abs=1e-4)
+    rows = [line.split() for line in proc.stderr.splitlines() if line.split()[:1] in (["1"], ["2"])]
+    assert [float(r[1]) for r in rows] == pytest.approx([h["distance_m"] * 1000 for h in simulated["hops"]],
+                                                        abs=0.006)
+
+
+def test_locust_virtual_prints_each_hop_as_it_goes(env, tmp_path):
+    """`locust virtual` (the live MuJoCo model) prints each hop's row while it runs, not only at
+    exit: both hops of a two-cycle `hop` on its pty show while it is still running, each the
+    distance the hop's own record of the simulation gives (within the printed 0.005 mm)."""
+    import threading
+
+    proc = subprocess.Popen(LOCUST + ["virtual", "--preset", "seed"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=env)
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(iter(proc.stderr.readline, "")), daemon=True)
+    try:
+        device = proc.stdout.readline().strip()
+        assert device.startswith("/dev/pts/"), device
+        reader.start()
+        hop = _run(["hop", "--port", device, "--preset", "seed", "--cycles", "2", "--out", str(tmp_path / "run")], env)
+        assert hop.returncode == 0, hop.stderr
+        deadline = time.monotonic() + 30
+        rows = []
+        while time.monotonic() < deadline and len(rows) < 2:
+            rows = [ln.split() for ln in list(lines) if ln.split()[:1] in (["1"], ["2"])]
+            time.sleep(0.1)
+        assert proc.poll() is None               # still running: printed as it goes
+        assert [r[0] for r in rows] == ["1", "2"], lines
+    finally:
+        proc.send_signal(signal.SIGTERM)
+        proc.communicate(timeout=60)
+    final = [ln.split() for ln in lines if ln.split()[:1] in (["1"], ["2"])][-2:]
+    assert [float(r[1]) for r in rows] == pytest.approx([float(r[1]) for r in final], abs=0.006)
+
+
 def test_flash_refuses_a_pin_the_chip_cannot_drive_and_writes_nothing(env, tmp_path):
     """GPIO6 of a classic ESP32 is its SPI flash: refused with the usable pins as the hint, before
     any file is written; the firmware on the board is untouched and still hops."""

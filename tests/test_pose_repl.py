@@ -37,9 +37,9 @@ def _run(args, env, timeout=90):
 
 
 @contextlib.contextmanager
-def _virtual(env, pwm_log=None):
+def _virtual(env, pwm_log=None, extra=()):
     """`locust virtual` in the background; yields its /dev/pts/N."""
-    args = ["virtual", "--plant", "record"] + (["--pwm-log", str(pwm_log)] if pwm_log else [])
+    args = ["virtual", "--plant", "record", *extra] + (["--pwm-log", str(pwm_log)] if pwm_log else [])
     proc = subprocess.Popen(LOCUST + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
         device = proc.stdout.readline().strip()
@@ -201,13 +201,45 @@ def test_mpremote_exec_on_an_idle_robot_then_flash_and_hop(env, tmp_path):
         stuck = _run(["pose", "--port", device, "--rest"], env)
         assert stuck.returncode == 2 and "MicroPython REPL" in stuck.stderr and "Ctrl-D" in stuck.stderr
 
+        # `hop` soft-resets a board it finds at the REPL (as mpremote does) and goes on
+        hop = _run(["hop", "--port", device, "--cycles", "1", "--json", "--out", str(tmp_path / "run0")], env)
+        assert hop.returncode == 0, hop.stderr
+        rec = json.loads(hop.stdout)
+        assert rec["status"] == "complete" and len(rec["phases"]) == 2
+
         # `locust flash` gets in from the REPL and restarts the command loop; `hop` works again
+        mp = subprocess.run([MPREMOTE, "connect", device, "exec", "print(6*7)"], capture_output=True, text=True,
+                            timeout=30)
+        assert mp.stdout.strip() == "42", mp.stdout + mp.stderr
         flashed = _run(["flash", "--port", device], env)
         assert flashed.returncode == 0, flashed.stderr
         hop = _run(["hop", "--port", device, "--cycles", "1", "--json", "--out", str(tmp_path / "run")], env)
         assert hop.returncode == 0, hop.stderr
         rec = json.loads(hop.stdout)
         assert rec["status"] == "complete" and len(rec["phases"]) == 2
+
+
+def test_a_hop_on_locust_virtual_records_the_robot_it_simulates(env, tmp_path):
+    """`locust virtual --preset medium`, then `hop --port /dev/pts/N`: run.json records medium
+    (the virtual robot's), not the hop's own default."""
+    with _virtual(env, extra=("--preset", "medium")) as device:
+        hop = _run(["hop", "--port", device, "--cycles", "1", "--push-ms", "50", "--wait-ms", "50",
+                    "--out", str(tmp_path / "run")], env)
+        assert hop.returncode == 0, hop.stderr
+        assert hop.stderr.splitlines()[0] == f"robot: medium, the one the virtual robot on {device} simulates"
+    robot = json.loads((tmp_path / "run" / "run.json").read_text())["robot"]
+    assert (robot["preset"], robot["leg_set"]) == ("medium", "medium"), robot
+
+
+def test_a_virtual_robot_with_nothing_flashed_says_so(tmp_path):
+    """`hop --port sim` before any `locust flash --port sim`: which command flashes it, and no
+    virtual robot started for nothing (no pty named, no run folder)."""
+    env = dict(os.environ, LOCUST_VIRTUAL_DIR=str(tmp_path / "virtual"))
+    res = _run(["hop", "--port", "sim", "--cycles", "1", "--out", str(tmp_path / "run")], env)
+    assert res.returncode == 2, res.stderr
+    assert "error: nothing flashed: run `locust flash --port sim`" in res.stderr
+    assert "/dev/pts" not in res.stderr and "REPL" not in res.stderr
+    assert not (tmp_path / "run").exists()
 
 
 def test_ctrl_c_stops_the_idle_loop_not_a_hop_and_ctrl_d_resumes(env):

@@ -79,7 +79,10 @@ def test_report_numbers_are_the_pipelines_own(demo):
         r = run(leg_set(calibrated, cfg["name"]), cycles=CYCLES)
         assert r.valid and cfg["predicted"]["valid"], r.reasons   # the seed with its leg sets hops validly
         assert cfg["predicted"]["distance_m"] == pytest.approx(r.distance_m, abs=1e-9)
-        cell = f'data-config="{cfg["name"]}" data-field="predicted_distance_cm">{r.distance_m * 100:.2f}<'
+        # the summary's distance is the marker's, as the figure draws it (tests/test_report_headline.py)
+        marker_m = sum(h["distance_m"] for h in cfg["predicted_marker_hops"])
+        assert cfg["predicted_distance_m"] == pytest.approx(marker_m, abs=1e-12)
+        cell = f'data-config="{cfg["name"]}" data-field="predicted_distance_cm">{marker_m * 100:.2f}<'
         assert cell in text
 
 

@@ -95,7 +95,7 @@ def test_mirrored_mm_read_as_metres_is_warned_not_stopped(trials):
     html, cells, doc = report_of(res)
     kinds = {w["kind"]: w["message"] for w in doc["warnings"]}
     assert set(kinds) == {"mirrored", "units"}
-    predicted = doc["configurations"][0]["predicted"]["distance_m"]
+    predicted = doc["configurations"][0]["predicted_distance_m"]    # the marker's
     assert predicted > 0.002                                  # the seed hops forward (a few mm)
     assert kinds["mirrored"] == (f"tracker: the tracked nose travels -600 m overall where the model predicts "
                                  f"+{predicted * 100:.1f} cm: the camera likely saw the hop mirrored (filmed "

@@ -6,6 +6,7 @@ import csv
 import json
 import math
 import random
+import re
 import signal
 import subprocess
 import sys
@@ -533,3 +534,19 @@ def test_a_real_dask_scheduler_passes_the_probe():
     with LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
                       dashboard_address=None) as cluster:
         probe_dask_scheduler(cluster.scheduler_address)   # raises if refused
+
+
+def test_sweep_prints_hop_figures_in_mm_like_every_table(tmp_path):
+    """Hop figures in mm (as `locust sim`, `hop` and `virtual`): the best design's line is its
+    results.csv row times 1000, to the printed 0.005 mm."""
+    import csv
+
+    res = subprocess.run(LOCUST + ["sweep", "--preset", "seed", "--vary", "scale=0:0.01:2", "--cycles", "1",
+                                   "--jobs", "1", "--out", str(tmp_path / "sw")], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    m = re.search(r"best valid design (\d+) \(scale=\S+\): (-?[\d.]+) mm, highest nose (-?[\d.]+) mm", res.stdout)
+    assert m, res.stdout
+    row = list(csv.DictReader((tmp_path / "sw" / "results.csv").open()))[int(m.group(1))]
+    assert float(m.group(2)) == pytest.approx(float(row["distance_m"]) * 1000, abs=0.005)
+    assert float(m.group(3)) == pytest.approx(float(row["max_nose_height_m"]) * 1000, abs=0.005)
+    assert " cm" not in res.stdout

@@ -37,6 +37,11 @@ def test_sim_table_is_the_results_own_numbers_in_mm():
     assert abs(float(total.group(1)) - r.distance_m * 1000) <= ROUNDING_MM
     assert abs(float(total.group(2)) - r.max_nose_height_m * 1000) <= ROUNDING_MM
     assert "distance_m=" not in res.output and "e-0" not in res.output
+    # the linkage's kinematics in its own words only under --verbose, with the result's figure
+    assert "Grashof" not in res.output and "transmission" not in res.output
+    verbose = CliRunner().invoke(cli, ["sim", "--preset", "seed", "--cycles", "3", "--verbose"])
+    line = next(ln for ln in verbose.output.splitlines() if "transmission angle" in ln)
+    assert f"linkage: {r.grashof} (Grashof class), worst transmission angle {r.transmission_deg:.0f} deg" in line
 
 
 def test_invalid_run_prints_its_reasons_and_no_table():

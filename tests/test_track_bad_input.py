@@ -182,15 +182,21 @@ def test_real_footage_without_stickers_is_refused(shared_data, tmp_path, name):
 
 
 # -- an upside-down video: heights inverted ------------------------------------------------
-def _rest_hop_rest(seed: int, upside_down: bool, w: int = 320, h: int = 180, fps: float = 60.0):
+def _rest_hop_rest(seed: int, upside_down: bool, w: int = 320, h: int = 180, fps: float = 60.0,
+                   over: bool = False):
     """SYNTHETIC: a magenta sticker resting on the floor, one ballistic hop, resting again
-    (the heights a filmed hop has), drawn right way up or turned over (the phone upside down)."""
+    (the heights a filmed hop has), drawn right way up or turned over (the phone upside down).
+    ``over``: the robot goes over and rests on its back, the sticker at 0.6-0.8 of its rise."""
     rng = np.random.default_rng(seed)
     rest_before, rest_after = rng.integers(8, 20), rng.integers(8, 20)
     rise_px = rng.uniform(30, 120)
     flight = int(round(2 * math.sqrt(2 * rise_px * 0.002 / 9.81) * fps)) + 2    # 2 mm a pixel
     u = np.linspace(0, 1, flight)
-    y = np.r_[np.zeros(rest_before), 4 * rise_px * u * (1 - u), np.zeros(rest_after)]
+    end_px = rng.uniform(0.6, 0.8) * rise_px if over else 0.0
+    if over:     # it lies on its back longer than it stood: most still frames are high
+        rest_after += 30
+    arc = np.where(u < 0.5, 4 * rise_px * u * (1 - u), end_px + (rise_px - end_px) * 4 * u * (1 - u))
+    y = np.r_[np.zeros(rest_before), arc, np.full(rest_after, end_px)]
     x = rng.uniform(40, 80) + np.r_[np.zeros(rest_before), u * rng.uniform(60, 160), np.full(rest_after, 0.0)]
     x[rest_before + flight:] = x[rest_before + flight - 1]
     floor_py = h - rng.uniform(20, 40)
@@ -203,9 +209,9 @@ def _rest_hop_rest(seed: int, upside_down: bool, w: int = 320, h: int = 180, fps
         yield cv2.flip(frame, -1) if upside_down else frame
 
 
-def _hop_clip(folder, seed, upside_down):
-    path = folder / f"hop{seed}{'_flipped' if upside_down else ''}.avi"
-    encode_video(path, _rest_hop_rest(seed, upside_down), 60.0, (320, 180), "MJPG")
+def _hop_clip(folder, seed, upside_down, over=False):
+    path = folder / f"hop{seed}{'_over' if over else ''}{'_flipped' if upside_down else ''}.avi"
+    encode_video(path, _rest_hop_rest(seed, upside_down, over=over), 60.0, (320, 180), "MJPG")
     return path
 
 
@@ -223,6 +229,20 @@ def test_an_upside_down_hop_is_flagged_and_an_upright_one_is_not(tmp_path, seed)
     turned = invoke(["track", tmp_path / f"hop{seed}_flipped.avi", *args, "--angle", "180", "--out",
                      tmp_path / "turned.csv"])
     assert turned.exit_code == 0 and "upside down" not in turned.stderr, turned.output
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_robot_that_went_over_is_judged_from_where_it_stood_on_the_floor(tmp_path, seed):
+    """The nose rests high on the robot's back after the hop (at the top of its still
+    heights): upright, no warning; the same video turned over still gets one."""
+    args = ["--marker", "nose=color:#ff00ff", "--scale", "0,0,500,0=1.0", "--overlay", "none"]
+    upright = invoke(["track", _hop_clip(tmp_path, seed, False, over=True), *args])
+    assert upright.exit_code == 0 and "upside down" not in upright.stderr, upright.output
+    flipped = invoke(["track", _hop_clip(tmp_path, seed, True, over=True), *args])
+    assert flipped.exit_code == 0, flipped.output
+    share = re.search(r"nose stands still at the top of its heights \(\d+ still frames at y = \S+ m, (\d+)% ",
+                      flipped.stderr)
+    assert share and int(share.group(1)) >= 90, flipped.stderr
 
 
 # -- the one-command form's options that are subcommands now ---------------------------------
@@ -277,3 +297,31 @@ def test_a_dim_patch_or_a_speck_is_never_taken(tmp_path, chroma_share, radius_px
     encode_video(tmp_path / "dim.avi", frames, 30.0, (160, 120), "FFV1")
     assert_refused_and_unchanged(tmp_path, ["track", tmp_path / "dim.avi", "--marker", "nose=color:#ff00ff"],
                                  "never found", "nose (color:#ff00ff)")
+
+
+def test_a_virtual_robot_that_went_over_is_upright_and_its_flipped_video_is_not(tmp_path):
+    """The simulation films Small going over onto its back (its nose rests high after the
+    hop, the foot sticker dips as the leg pushes and is then hidden): upright, no warning; the
+    same frames turned over (both axes, a phone held upside down), one."""
+    import locust
+    from locust.sim.live import LiveSim
+    from locust.track.video import read_frames
+
+    robot = locust.robot("small")
+    s = robot.schedule
+    path = tmp_path / "over.mp4"       # filmed as the virtual robot films a hop: standing first
+    sim = LiveSim(robot, video_path=str(path), fps=30, width=320, height=240, cycles=1)
+    sim.advance_to(0.1)
+    sim.set_servo_angles_deg(s.push_deg, s.push_deg)
+    sim.advance_to(0.1 + s.push_s)
+    sim.set_servo_angles_deg(0.0, 0.0)
+    sim.advance_to(0.1 + s.push_s + s.wait_s)
+    assert sim.close()["valid"]
+    upright = invoke(["track", path, "--overlay", "none"])
+    assert upright.exit_code == 0 and "upside down" not in upright.stderr, upright.output
+    info = probe(path)
+    frames = [cv2.flip(f, -1) for _, f in read_frames(info, Clip().resolved(info))]
+    encode_video(tmp_path / "flipped.avi", iter(frames), info.file_fps, (info.width_px, info.height_px), "MJPG")
+    flipped = invoke(["track", tmp_path / "flipped.avi", "--scale", "0,0,100,0=0.05", "--overlay", "none"])
+    assert flipped.exit_code == 0, flipped.output
+    assert "nose stands still at the top of its heights" in flipped.stderr, flipped.stderr

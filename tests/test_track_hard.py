@@ -16,7 +16,7 @@ from locust.track.board import BoardSpec, board_points, parse_board, parse_plane
 from locust.track.export import track_events
 from locust.track.hardclip import STICKER_HEX, make_hard_video, read_truth_csv
 from locust.track.predict import Trajectory
-from locust.track.spec import parse_marker
+from locust.track.spec import ModelOptions, parse_marker
 
 W, H, N = 960, 540, 100
 
@@ -81,6 +81,11 @@ def test_preview_lists_sticker_and_pen_cap(hard, tmp_path):
     assert np.hypot(*(pos - [truth.px[0], truth.py[0]]).T).min() <= 1.0
     found = [ln for ln in res.output.splitlines() if "marker s: found at" in ln][0]
     fx, fy = (float(v) for v in found.rsplit(" ", 1)[1].split(","))
+    assert np.hypot(fx - 0.5 - truth.px[0], fy - 0.5 - truth.py[0]) <= 0.5   # Tracker's pixels: OpenCV's + 0.5
+    res = _run("preview", path, "--frame", 0, "--marker", f"s=color:{STICKER_HEX}", "--out", tmp_path / "q",
+               "--pixels", "opencv")
+    found = [ln for ln in res.output.splitlines() if "marker s: found at" in ln][0]
+    fx, fy = (float(v) for v in found.rsplit(" ", 1)[1].split(","))
     assert np.hypot(fx - truth.px[0], fy - truth.py[0]) <= 0.5
 
 
@@ -107,11 +112,11 @@ def test_plane_points_fallback_matches_truth(hard, tmp_path):
     for x, y in corners:
         v = truth.plane_to_image @ np.array([x, y, 1.0])
         pts.append(f"{v[0] / v[2]:.4f},{v[1] / v[2]:.4f}={x},{y}")
-    plane = parse_plane_points(";".join(pts))
+    plane = parse_plane_points(";".join(pts), "opencv")       # the truth's pixels are OpenCV's
     xm, ym = plane.to_world(truth.px, truth.py)
     ok = truth.in_picture
     assert np.abs(xm[ok] - truth.x_m[ok]).max() < 2e-5 and np.abs(ym[ok] - truth.y_m[ok]).max() < 2e-5
-    res = _run(path, "--marker", f"s=color:{STICKER_HEX}", "--plane-points", ";".join(pts),
+    res = _run(path, "--marker", f"s=color:{STICKER_HEX}", "--plane-points", ";".join(pts), "--pixels", "opencv",
                "--out", tmp_path / "pp.csv", "--overlay", "none")
     assert res.exit_code == 0, res.output
     ok, err, e_mm = _score(pd.read_csv(tmp_path / "pp.csv"), truth)
@@ -125,7 +130,8 @@ def test_board_and_marker_spec_errors():
     assert parse_board("aruco:4x4_50:5X4:40:10") == BoardSpec("DICT_4X4_50", 5, 4, 40.0, 10.0)
     with pytest.raises(TrackError, match="color:#RRGGBB@X,Y"):
         parse_marker("s=color:#ff00ff@12")
-    assert parse_marker("s=color:#ff00ff@12.5,7").start_px == (12.5, 7.0)
+    assert parse_marker("s=color:#ff00ff@12.5,7").start_px == (12.0, 6.5)     # Tracker's pixels by default
+    assert parse_marker("s=color:#ff00ff@12.5,7", ModelOptions(pixels="opencv")).start_px == (12.5, 7.0)
 
 
 def test_trajectory_extrapolates_a_parabola():

@@ -18,7 +18,8 @@ from locust.cli import cli
 
 def _track(video, tmp_path, end, *markers):
     out = tmp_path / f"{video.stem}.csv"
-    args = ["track", str(video), "--end", str(end), "--out", str(out), "--overlay", "none"]
+    # the spots were picked off `locust track preview` in OpenCV's pixels
+    args = ["track", str(video), "--end", str(end), "--out", str(out), "--overlay", "none", "--pixels", "opencv"]
     for m in markers:
         args += ["--marker", m]
     res = CliRunner().invoke(cli, args)

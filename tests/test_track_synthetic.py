@@ -45,7 +45,8 @@ def test_colour_markers_subpixel_and_occlusion(hop, tmp_path):
 def test_template_marker_follows_known_truth(hop, tmp_path):
     path, truth = hop
     x0, y0 = truth.px["nose"][0], truth.py["nose"][0]
-    res = _run(path, "--marker", f"nose=template:{x0:.4f},{y0:.4f}@0", "--out", tmp_path / "t.csv", "--overlay", "none")
+    res = _run(path, "--marker", f"nose=template:{x0:.4f},{y0:.4f}@0", "--pixels", "opencv",
+               "--out", tmp_path / "t.csv", "--overlay", "none")
     assert res.exit_code == 0, res.output
     df = pd.read_csv(tmp_path / "t.csv")
     err = np.hypot(df["nose_px"] - truth.px["nose"], df["nose_py"] - truth.py["nose"])
@@ -55,7 +56,7 @@ def test_template_marker_follows_known_truth(hop, tmp_path):
 
 def test_scale_origin_angle_and_clip_settings(hop, tmp_path):
     path, truth = hop
-    res = _run(path, "--scale", "100,300,500,300=0.8", "--origin", "100,300", "--angle", "30",
+    res = _run(path, "--scale", "100,300,500,300=0.8", "--origin", "100,300", "--angle", "30", "--pixels", "opencv",
                "--start", 4, "--end", 40, "--step", 3, "--fps", 240, "--out", tmp_path / "c.csv", "--overlay", "none")
     assert res.exit_code == 0, res.output
     df = pd.read_csv(tmp_path / "c.csv")

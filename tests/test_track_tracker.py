@@ -27,26 +27,29 @@ def _tracker_points(folder) -> dict[int, tuple[float, float]]:
             for f, (x, y) in project.points["ball"].items()}
 
 
-def test_template_tracker_matches_trackers_autotracker(balltoss, monkeypatch):
-    monkeypatch.chdir(balltoss)
-    res = CliRunner().invoke(cli, ["track", "videos/BallToss_new_BallToss.mp4",
-                                   "--marker", "ball=template:131.28,207.86@2"])
+def _ball_error_px(balltoss, *args):
+    """Distance (px) of each of frames 3..12 from Tracker's own step, both in OpenCV's pixels."""
+    res = CliRunner().invoke(cli, ["track", "videos/BallToss_new_BallToss.mp4", *args, "--force"])
     assert res.exit_code == 0, res.output
-    df = pd.read_csv(balltoss / "videos" / "BallToss_new_BallToss.tracks.csv")
-    ref = _tracker_points(balltoss)
-    frames = list(range(3, 13))
-    got = df.set_index("frame").loc[frames]
+    got = pd.read_csv(balltoss / "videos" / "BallToss_new_BallToss.tracks.csv").set_index("frame").loc[3:12]
     assert got["ball_ok"].all(), "a frame is missing"
-    # A template marker reports the key point plus the displacement it measured, and so
-    # does Tracker; comparing displacements from the key frame makes the comparison
-    # independent of the half pixel between Tracker's and OpenCV's pixel origins.
-    key = np.array(ref[2])
-    ours = got[["ball_px", "ball_py"]].to_numpy() - np.array([131.28, 207.86])
-    theirs = np.array([ref[f] for f in frames]) - key
-    err = np.hypot(*(ours - theirs).T)
-    assert err.mean() < 1.0, err
-    assert err.mean() < 0.6  # measured 0.46 px
-    assert err.max() < 1.0
+    project = trk_io.read_project(balltoss / "BallToss_BallToss.trk")      # Tracker's points, in OpenCV's pixels
+    theirs = np.array([project.points["ball"][f] for f in range(3, 13)])
+    return np.hypot(*(got[["ball_px", "ball_py"]].to_numpy() - theirs).T)
+
+
+def test_template_tracker_matches_trackers_autotracker(balltoss, monkeypatch):
+    """The help's own example, Tracker's numbers for the ball on frame 2 as Tracker's table
+    shows them, is read in Tracker's convention by default: within 0.5 px of Tracker's points
+    (measured 0.40 mean, 0.72 max); the same point typed in OpenCV's convention tracks the same;
+    Tracker's numbers read as OpenCV's are half a pixel off in x and y (1.06 mean, 1.45 max)."""
+    monkeypatch.chdir(balltoss)
+    tracker = _ball_error_px(balltoss, "--marker", "ball=template:131.28,207.86@2")
+    assert tracker.mean() < 0.5 and tracker.max() < 0.8, tracker
+    opencv = _ball_error_px(balltoss, "--marker", "ball=template:130.78,207.36@2", "--pixels", "opencv")
+    np.testing.assert_allclose(opencv, tracker, atol=1e-9)
+    misread = _ball_error_px(balltoss, "--marker", "ball=template:131.28,207.86@2", "--pixels", "opencv")
+    assert misread.mean() > 0.9, misread
 
 
 def test_trk_reader_reproduces_trackers_world_data(shared_data):

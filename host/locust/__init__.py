@@ -8,6 +8,17 @@ The Python API (:mod:`locust.api`), for notebooks and scripts::
     r.video("hop.mp4", overwrite=True)
     locust.sweep(locust.robot("seed"), vary={"scale": (0.0, 0.05, 30)}, cycles=3).to_dataframe()
 
+Functions (each with a numpydoc docstring: ``help(locust.simulate)``):
+
+- ``robot(preset_or_path, **values)``: a :class:`Robot` (presets seed, small, medium, large).
+- ``simulate(robot, cycles)``: a ``SimResult`` (``.trace()``, ``.video()``, ``.plot()``).
+- ``sweep(robot, vary, cycles)``: a ``SweepResults`` (``.to_dataframe()``, ``.plot()``, ``.best``).
+- ``track(video, markers)``, ``read_tracks(path)``: ``Tracks`` (``.to_dataframe()``, ``.tidy()``:
+  one row per marker per frame with velocity and acceleration, ``.plot()``, ``.write()``).
+- ``calibrate_beam/hinge/servo/ramp/hops(...)``: a ``Fit`` (``.parameters``, ``.to_dataframe()``,
+  ``.plot()``, ``.apply(robot)``).
+- ``report(robot, measured)``: the HTML comparison of simulation and filmed hops.
+
 Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
 """
 

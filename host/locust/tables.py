@@ -28,16 +28,19 @@ def verdict(valid: bool) -> str:
     return "valid" if valid else "INVALID"
 
 
-def sim_lines(r) -> list[str]:
+def sim_lines(r, verbose: bool = False) -> list[str]:
     """``locust sim``: a :class:`locust.sim.run.SimResult` as the verdict, one row per hop,
-    the totals, the convergence check and the notes."""
+    the totals, the convergence check and the notes; ``verbose``: the linkage's kinematics too
+    (Grashof class and transmission angle: words for the expert, kept out of the first look)."""
     lines = [f"{r.robot}: {verdict(r.valid)} ({r.cycles} cycle{'' if r.cycles == 1 else 's'}, "
              f"time step {r.timestep_s:g} s, "
              f"{r.wall_s:.1f} s wall)"]
     lines += [f"{INDENT}reason: {reason}" for reason in r.reasons]
     if not r.valid:
         return lines
-    lines.append(f"{INDENT}linkage: {r.grashof}, transmission angle {r.transmission_deg:.0f} deg")
+    if verbose:
+        lines.append(f"{INDENT}linkage: {r.grashof} (Grashof class), worst transmission angle "
+                     f"{r.transmission_deg:.0f} deg (the angle at which the coupler pushes the leg; 90 is best)")
     lines += hop_table([vars(h) for h in r.hops])
     lines.append(totals_line(r.distance_m, r.max_nose_height_m))
     if r.convergence:
@@ -92,3 +95,55 @@ def plant_lines(summary: dict) -> list[str]:
     if summary.get("video_path"):
         lines.append(f"{INDENT}video: {summary['video_path']} ({summary['frames']} frames)")
     return lines
+
+
+# -- fitted values, as `locust calibrate` prints them ------------------------------------------
+UNIT_SUFFIXES = (   # a key's unit from its name's end (longest first): _nm_ is newton-metres, never nm
+    ("_nms_per_rad", "N·m·s/rad"), ("_nm_per_rad", "N·m/rad"), ("_ns_per_m", "N·s/m"), ("_n_per_m", "N/m"),
+    ("_rad_per_s", "rad/s"), ("_kgm2", "kg·m²"), ("_kg", "kg"), ("_hz", "Hz"), ("_deg", "deg"), ("_mm", "mm"),
+    ("_nm", "N·m"), ("_rad", "rad"), ("_m", "m"), ("_s", "s"),
+)
+
+
+def split_unit(key: str) -> tuple[str, str]:
+    """``hinge_stiffness_nm_per_rad`` -> (``hinge_stiffness``, ``N·m/rad``); no unit: (key, "")."""
+    section, dot, name = key.rpartition(".")
+    for suffix, unit in UNIT_SUFFIXES:
+        if name.endswith(suffix) and len(name) > len(suffix):
+            return section + dot + name[: -len(suffix)], unit
+    return key, ""
+
+
+def sig(value: float, digits: int = 4) -> str:
+    """``digits`` significant figures; powers of ten as ``1.458e-4`` below 1e-3 and from 1e5."""
+    if not math.isfinite(value) or value == 0:
+        return f"{value:g}"
+    if 1e-3 <= abs(value) < 1e5:
+        return f"{value:#.{digits}g}".rstrip(".")
+    mantissa, exp = f"{value:.{digits - 1}e}".split("e")
+    return f"{mantissa}e{int(exp)}"
+
+
+def value_line(key: str, value, unit_of_key: bool = True) -> str:
+    """A plain figure with its unit column: numbers to 4 significant figures, lists joined."""
+    name, unit = split_unit(key) if unit_of_key else (key, "")
+    if isinstance(value, (list, tuple)):
+        text = ", ".join(sig(v) if isinstance(v, float) else str(v) for v in value)
+    elif isinstance(value, float):
+        text = sig(value)
+    else:
+        text = str(value)
+    return f"{name:28s} {text:>10s}  {unit}".rstrip() if len(text) <= 10 else f"{name:28s} {text}  {unit}".rstrip()
+
+
+def estimate_line(key: str, value: float, std: float | None, ci95=None, note: str = "") -> str:
+    """``k = 1.458e-4 N·m/rad ± 0.2 %  (95 %: 1.453e-4 … 1.463e-4)`` as a table row: the key less
+    its unit, the value, the unit, one standard deviation as a share of the value, the interval."""
+    name, unit = split_unit(key)
+    head = f"{name:28s} {sig(value):>10s}  {unit:10s}"
+    if std is None or not math.isfinite(std):
+        return f"{head} (undetermined){note}"
+    rel = 100 * std / abs(value) if value else math.inf
+    spread = f"± {rel:.1f} %" if rel < 10 else f"± {rel:.0f} %" if math.isfinite(rel) else f"± {sig(std)}"
+    interval = f"  (95 %: {sig(ci95[0])} … {sig(ci95[1])})" if ci95 and None not in ci95 else ""
+    return f"{head} {spread}{interval}{note}"

@@ -57,6 +57,23 @@ class Fit:
         """Everything the fit found, as ``locust calibrate --json`` prints it."""
         return self.result.summary()
 
+    def to_dataframe(self):
+        """One row per fitted robot value.
+
+        Returns
+        -------
+        pandas.DataFrame
+            index ``key`` (dotted name); ``value``, ``std`` (1 sd), ``ci95_low``, ``ci95_high``,
+            ``unit`` (from the key's name: ``N·m/rad`` for ``_nm_per_rad``).
+        """
+        import pandas as pd
+
+        from ..tables import split_unit
+
+        rows = [{"key": k, "value": e.value, "std": e.std, "ci95_low": e.ci95[0], "ci95_high": e.ci95[1],
+                 "unit": split_unit(k)[1]} for k, e in self.parameters.items()]
+        return pd.DataFrame(rows, columns=["key", "value", "std", "ci95_low", "ci95_high", "unit"]).set_index("key")
+
     def plot(self, run: int = 0):
         """Data and model above, residuals below (per recording); for a hop fit, run ``run``'s
         tracked markers against the fitted simulation.
@@ -320,14 +337,16 @@ def calibrate_ramp(data: PathLike | Sequence[PathLike] | np.ndarray, *, into: st
                subtitle=f"mu {fit.mu_static.value:.4g} from {fit.n_trials} trials", warnings=warnings)
 
 
-def calibrate_hops(robot: Robot, runs: Mapping[str, PathLike] | Sequence[PathLike | object],
+def calibrate_hops(robot: Robot | None, runs: Mapping[str, PathLike] | Sequence[PathLike | object],
                    keys: Sequence[str] | None = None, *, max_iter: int = 30, progress=None) -> Fit:
     """Fit the model to filmed hops of one or more leg sets at once (the physics is shared).
 
     Parameters
     ----------
-    robot : Robot
+    robot : Robot or None
         The starting values (e.g. the bench-calibrated robot); each run's leg set is built on it.
+        None: the robot the runs' run.json record (:func:`robot_of_runs`; runs on different
+        robots are refused).
     runs : dict or list
         Leg set -> a ``locust hop --out`` folder (its ``run.json`` and the track of its video),
         or the command line's ``["small=runs/s1", "runs/large-1", ...]`` (a folder named after
@@ -356,6 +375,8 @@ def calibrate_hops(robot: Robot, runs: Mapping[str, PathLike] | Sequence[PathLik
             raise CalibrationError(f"{item}: the run {path} is given twice; each run counts once in the fit",
                                    "give each run folder once (a repeat is another filmed hop, another folder)")
         named.append((path, leg_set))
+    if robot is None:
+        robot, _ = robot_of_runs([f"{leg}={path}" for path, leg in named])
     folders = iter(named)
     loaded = [item if isinstance(item, H.HopRun) else H.load_run(*next(folders), robot) for item in runs]
     fit = H.fit_hops(loaded, keys, max_iter=max_iter, progress=progress)
@@ -363,6 +384,45 @@ def calibrate_hops(robot: Robot, runs: Mapping[str, PathLike] | Sequence[PathLik
     note = "filmed hops " + ", ".join(f"{r.config}:{Path(r.source).name}" for r in fit.runs)
     return Fit("hops", H.PROVENANCE_NAME, values, fit, note=note,
                subtitle=f"{len(fit.runs)} runs, RMS {1000 * fit.rms_m:.2f} mm", warnings=[])
+
+
+def robot_of_runs(runs: Sequence[PathLike]) -> tuple[Robot, str]:
+    """The robot the runs were hopped on, as their run.json files record it, and a line
+    saying so: the robot file, or the preset (a leg-set preset's runs share the robot as
+    built, the ``small`` preset, on which each run's own leg set is built). Runs recording
+    different robots are refused: which values they share is not known."""
+    from ..io.run_record import RECORD_NAME, read_run_record
+    from ..params import LEG_SETS, load_robot, preset
+
+    seen: dict[tuple[str, str], list[str]] = {}
+    for item in runs:
+        path, _ = _run_folder(str(item))
+        record = path / RECORD_NAME if path.is_dir() else path
+        if not record.is_file():
+            continue            # load_run says what is missing
+        src = read_run_record(record).robot
+        if src.robot_file:       # as given to `locust hop --config`
+            key = ("file", src.robot_file)
+        elif src.preset:
+            key = ("preset", "small" if src.preset in LEG_SETS else src.preset)
+        else:
+            continue            # an older record: it does not say
+        seen.setdefault(key, []).append(str(path))
+    if len(seen) > 1:
+        said = "; ".join(f"{', '.join(paths)}: {kind} {name}" for (kind, name), paths in seen.items())
+        raise CalibrationError(f"the runs record different robots ({said}): a fit shares their values",
+                               "give --config ROBOT.toml (in the API: robot=) with the values the runs share, "
+                               "or fit the runs of each robot apart")
+    if not seen:
+        return preset("small"), "robot: small, the robot as built (the runs' run.json do not say which robot)"
+    ((kind, name), paths), = seen.items()
+    if kind == "file":
+        if not Path(name).is_file():
+            raise CalibrationError(f"the runs record robot file {name}, which is not there",
+                                   "give --config with that robot.toml (or the values the runs shared)")
+        return load_robot(name), f"robot: {name}, as the runs' run.json record"
+    what = "the robot as built, each run's leg set on it" if name == "small" else f"preset {name}"
+    return preset(name), f"robot: {name} ({what}), as the runs' run.json record"
 
 
 def _run_folder(item: str) -> tuple[Path, str]:

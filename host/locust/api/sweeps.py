@@ -38,6 +38,25 @@ class SweepResults(SweepSummary):
 
         return pd.DataFrame(self.rows)
 
+    def plot(self, y: str = "distance_m"):
+        """``y`` (a column of :meth:`to_dataframe`) of each valid design against the first
+        varied value, in mm for lengths (matplotlib Figure); the best design ringed."""
+        from matplotlib.figure import Figure
+
+        df = self.to_dataframe()
+        ok = df[df["valid"].astype(bool)]
+        name = self.names[0]
+        scale, unit = (1000.0, "mm") if y.endswith("_m") else (1.0, "")
+        fig = Figure(figsize=(6, 3.5), layout="constrained")
+        ax = fig.subplots()
+        ax.plot(ok[name], ok[y] * scale, "o-", ms=4)
+        if self.best is not None:
+            ax.plot([self.best[name]], [self.best[y] * scale], "o", mfc="none", mec="C3", ms=12, label="best")
+            ax.legend(fontsize=8)
+        ax.set_xlabel(name + (" [m]" if name.endswith("_m") or name == "scale" else ""))
+        ax.set_ylabel(f"{y.removesuffix('_m')} [{unit}]" if unit else y)
+        return fig
+
     def __repr__(self) -> str:
         valid = sum(1 for r in self.rows if r["valid"])
         head = f"SweepResults: {len(self.rows)} designs of {', '.join(self.names)}, {valid} valid"

@@ -51,6 +51,52 @@ class Tracks:
                 cols[f"{name}_ok"] = t.markers[name].ok.copy()
         return pd.DataFrame(cols)
 
+    def tidy(self):
+        """One row per marker per frame (trackpy's habit), with velocity and acceleration.
+
+        Velocity and acceleration are Tracker's finite differences on the world metres:
+        ``v[i] = (x[i+1] - x[i-1]) / (t[i+1] - t[i-1])`` and, at a steady frame rate,
+        ``a[i] = (x[i+2] - 2 x[i] + x[i-2]) / (4 dt²)`` (central differences of the central
+        differences); NaN at the ends of the clip and next to a frame where the marker is lost.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``frame``, ``t_s``, ``marker``, ``x_px``, ``y_px`` (OpenCV pixels), ``x_m``, ``y_m``,
+            ``ok``, ``vx_m_per_s``, ``vy_m_per_s``, ``ax_m_per_s2``, ``ay_m_per_s2``.
+        """
+        import pandas as pd
+
+        t, parts = self.tracks.t_s, []
+        for name, m in self.tracks.markers.items():
+            x, y = self.tracks.positions(name)
+            v = [_central(t, c) for c in (x, y)]
+            a = [_central(t, c) for c in v]
+            parts.append(pd.DataFrame({
+                "frame": self.tracks.frame, "t_s": t, "marker": name, "x_px": m.px, "y_px": m.py, "x_m": x, "y_m": y,
+                "ok": m.ok, "vx_m_per_s": v[0], "vy_m_per_s": v[1], "ax_m_per_s2": a[0], "ay_m_per_s2": a[1]}))
+        if not parts:
+            return pd.DataFrame(columns=["frame", "t_s", "marker", "x_px", "y_px", "x_m", "y_m", "ok", "vx_m_per_s",
+                                         "vy_m_per_s", "ax_m_per_s2", "ay_m_per_s2"])
+        return pd.concat(parts, ignore_index=True).sort_values(["frame", "marker"], kind="stable",
+                                                               ignore_index=True)
+
+    def plot(self):
+        """Each marker's world x and y against time (matplotlib Figure)."""
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(7, 3.5), layout="constrained")
+        ax_x, ax_y = fig.subplots(1, 2)
+        for name in self.markers:
+            x, y = self.positions(name)
+            ax_x.plot(self.tracks.t_s, x * 1000, ".-", ms=3, label=name)
+            ax_y.plot(self.tracks.t_s, y * 1000, ".-", ms=3, label=name)
+        for ax, what in ((ax_x, "x (forward)"), (ax_y, "y (up)")):
+            ax.set_xlabel("t [s]")
+            ax.set_ylabel(f"{what} [mm]")
+        ax_x.legend(fontsize=8)
+        return fig
+
     def write(self, path: str | Path, overwrite: bool = False) -> Path:
         """Write the tracks CSV (atomic; an existing file only with ``overwrite``)."""
         from ..io.tracks_csv import write_tracks_csv
@@ -68,6 +114,14 @@ class Tracks:
         return "\n".join(lines)
 
 
+def _central(t: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Central differences dv/dt, NaN at both ends (Tracker leaves them blank)."""
+    out = np.full(len(v), np.nan)
+    if len(v) >= 3:
+        out[1:-1] = (v[2:] - v[:-2]) / (t[2:] - t[:-2])
+    return out
+
+
 def _marker_specs(markers: Mapping[str, str] | Sequence[str] | None) -> list[str]:
     from ..track.spec import default_specs
 
@@ -78,7 +132,7 @@ def _marker_specs(markers: Mapping[str, str] | Sequence[str] | None) -> list[str
     return list(markers)
 
 
-def _calibration(info, scale, origin, angle_deg: float, camera_json):
+def _calibration(info, scale, origin, angle_deg: float, camera_json, pixels: str = "tracker"):
     from ..io.camera_json import camera_json_beside
     from ..track import calib, camera
 
@@ -93,14 +147,15 @@ def _calibration(info, scale, origin, angle_deg: float, camera_json):
     if scale is not None:
         x1, y1, x2, y2, length_m = (float(v) for v in scale)
         m_per_px, source = calib.m_per_px_from_stick(x1, y1, x2, y2, length_m), f"stick {tuple(scale)}"
-    return calib.build(info.height_px, m_per_px, origin, angle_deg, source)
+    return calib.build(info.height_px, m_per_px, calib.typed_px(*origin, pixels) if origin is not None else None,
+                       angle_deg, source)
 
 
 def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None = None, *,
           scale: tuple[float, float, float, float, float] | None = None, origin: tuple[float, float] | None = None,
           angle_deg: float = 0.0, camera_json: str | Path | None = None, start: int = 0, end: int | None = None,
           step: int = 1, fps: float | None = None, color_tol: int = 80, search_px: int = 40,
-          progress: Callable[[int], None] | None = None) -> Tracks:
+          pixels: str = "tracker", progress: Callable[[int], None] | None = None) -> Tracks:
     """Find markers in every frame of a video (or an image sequence), as Tracker's autotracker would.
 
     Parameters
@@ -125,6 +180,11 @@ def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None =
         The true frame rate, for slow-motion footage; default the file's.
     color_tol, search_px : int
         Colour tolerance (0-255) and the search window's half size (px).
+    pixels : {"tracker", "opencv"}, default "tracker"
+        Convention of the pixel positions given in ``markers``, ``scale`` and ``origin``:
+        Tracker's (origin at the image's top-left corner, as Tracker's table shows them) or
+        OpenCV's (origin at the top-left pixel's centre, 0.5 px from Tracker's). The returned
+        pixel columns are OpenCV's.
 
     Returns
     -------
@@ -144,8 +204,9 @@ def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None =
 
     info = probe(Path(video))
     clip = Clip(start, end, step, fps).resolved(info)
-    models = parse_markers(_marker_specs(markers), ModelOptions(color_tol=color_tol, search_half_px=search_px))
-    calibration = _calibration(info, scale, origin, angle_deg, camera_json)
+    models = parse_markers(_marker_specs(markers),
+                           ModelOptions(color_tol=color_tol, search_half_px=search_px, pixels=pixels))
+    calibration = _calibration(info, scale, origin, angle_deg, camera_json, pixels)
     result = track_video(info, clip, models, calibration, progress=progress)
     return Tracks(tracks_of(result), result)
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import functools
-import math
 from dataclasses import replace
 from pathlib import Path
 
@@ -15,6 +14,7 @@ from ..io.importing import ImportOptions, import_options
 from ..options import FINITE, POSITIVE
 from ..plotting import check_figure_path
 from ..progress import progress
+from ..tables import estimate_line, value_line
 from . import hinge as HG
 from . import hop as H
 from . import inputs
@@ -322,7 +322,8 @@ def ramp(data, ramp_markers, robot_marker, into, resolution_deg, imports, timing
 @click.option("--fit", "fit_keys", default=",".join(H.DEFAULT_KEYS), show_default=True, metavar="KEY[,KEY...]",
               help="Robot parameters to fit, shared by every run (any real-valued key of `locust params`).")
 @click.option("--config", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Robot to start from [default: the --write file if it exists, else the seed preset].")
+              help="Robot to start from, the values every run shares [default: the --write file if it exists, "
+                   "else the robot the runs' run.json record; runs on different robots are refused].")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help="Override a starting value (repeatable).")
 @click.option("--max-iter", type=click.IntRange(1, 200), default=30, show_default=True, help="Solver iterations.")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
@@ -351,7 +352,17 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
     H.check_fittable(keys)
     write_path = write_target(write_path)
     start_from = config or (write_path if write_path and Path(write_path).exists() else None)
-    base = resolve_robot(None, start_from, sets)
+    if start_from is not None:
+        base = resolve_robot(None, start_from, sets)
+        click.echo(f"robot: {start_from}" + (" (the --write file)" if start_from != config else ""), err=True)
+    else:        # the robot the runs were hopped on, as their records say
+        from ..api.calibration import robot_of_runs
+        from ..params import check_robot, parse_set_options
+
+        base, said = robot_of_runs(list(runs))
+        overrides = parse_set_options(sets)
+        base = check_robot(base.with_values(overrides, "override") if overrides else base)
+        click.echo(said, err=True)
     with progress(length=max_iter, label="fitting hops") as bar:
         facade_fit = calibrate_hops(base, list(runs), keys, max_iter=max_iter, progress=bar.update)
     fit = facade_fit.result
@@ -425,18 +436,24 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
     _print_text(out)
 
 
+HINGE_MODEL_ERROR_M = 0.0002   # hinge residual beyond ~3x a video's tracking noise: model error (docs/calibrate.md)
+
+
 def _print_text(out: dict) -> None:
     click.echo(f"# {out['experiment']}: {out['source']}")
+    click.echo(f"{'':28s} {'value':>10s}  {'unit':10s} ± 1 sd    (95 % interval)")
+    narrow = ""
+    if out["experiment"] == "hinge" and (out.get("rms_residual_m") or 0) > HINGE_MODEL_ERROR_M:
+        narrow = (f"   TOO NARROW: the residual ({1000 * out['rms_residual_m']:.2f} mm RMS) is model error, "
+                  "not tracking noise (docs/calibrate.md, Hinge)")
     for key, val in out.items():
         if key in ("experiment", "source", "notes", "warnings", "written", "plot", "angles_deg", "validation",
                    "validation_plot", "gyro_gain_units_per_rad_per_s"):
             continue
         if isinstance(val, dict) and "value" in val:
-            _print_text_value(key, val)
-        elif isinstance(val, list) and all(isinstance(v, float) for v in val):
-            click.echo(f"{key:30s} {', '.join(format(v, '.6g') for v in val)}")
+            _print_text_value(key, val, narrow if key.startswith("hinge_") else "")
         elif val is not None:
-            click.echo(f"{key:30s} {val if not isinstance(val, float) else format(val, '.6g')}")
+            click.echo(value_line(key, val))
     for k, gain in enumerate(out.get("gyro_gain_units_per_rad_per_s") or []):
         if gain is not None:
             _print_text_value(f"gyro_gain_units_per_rad_per_s[{k}]", gain)
@@ -458,13 +475,9 @@ def _print_text(out: dict) -> None:
                    else f"nothing written to {out['written']['path']}: no value was identifiable")
 
 
-def _print_text_value(key: str, val: dict) -> None:
+def _print_text_value(key: str, val: dict, note: str = "") -> None:
     flag = "" if val.get("identifiable", True) else "   NOT IDENTIFIABLE"
     if val.get("given"):
-        click.echo(f"{key:30s} {val['value']:<12.6g} (given)")
-    elif val["std"] is None or not math.isfinite(val["std"]):
-        click.echo(f"{key:30s} {val['value']:<12.6g} (undetermined){flag}")
+        click.echo(value_line(key, val["value"]) + "  (given)")
     else:
-        lo, hi = val["ci95"]
-        click.echo(f"{key:30s} {val['value']:<12.6g} ± {val['std']:.3g} (1σ)  "
-                   f"95% CI [{lo:.6g}, {hi:.6g}]{flag}")
+        click.echo(estimate_line(key, val["value"], val["std"], val.get("ci95"), flag + note))

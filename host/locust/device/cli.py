@@ -13,9 +13,9 @@ from ..fileio import json_text
 from ..firmware import config as fw_config
 from ..io import run_record as R
 from ..params import Schedule, resolve_robot
-from ..params_cli import robot_options
+from ..params_cli import DEFAULTED, robot_options
 from ..progress import progress
-from ..tables import plant_lines
+from ..tables import hop_table, plant_lines
 from .plant import PLANTS
 
 CHIPS = tuple(fw_config.CHIPS)  # the chips whose pin rules the firmware knows, and the virtual robot models
@@ -84,7 +84,7 @@ def flash(port, compile_mpy, reset_config, servo_sets, preset, config, sets):
 
     edits = [_parse_servo_set(s) for s in servo_sets]
     servo = resolve_robot(preset, config, sets).servo if reset_config else None
-    with open_port(port, plant="record", info=_info) as device:
+    with open_port(port, plant="record", info=_info, firmware=False) as device:
         # the edits are checked against the board's chip before any file is written
         result = do_flash(device, compile_mpy=compile_mpy, servo=servo, edits=edits,
                           progress=lambda s: _info(f"  {s}"))
@@ -130,7 +130,7 @@ def _parse_servo_set(item: str, option: str = "--servo") -> tuple[str, float]:
                    "run.json for `locust report`. Default: the --preset when it is a leg set. "
                    "A known leg set is built on the --config robot for the virtual robot.")
 @_plant_options
-@robot_options
+@robot_options(say=False)   # the robot line comes once a virtual robot on --port is known
 def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, leg_set_name, plant, video, video_fps,
         preset, config, sets):
     """Run the bang-bang hop schedule (push, wait; N cycles) and save the run record.
@@ -147,6 +147,7 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     from .session import open_port
 
     robot, source = _hopped_robot(preset, config, sets, leg_set_name)
+    source = _virtual_robot_source(port, source)
     s = robot.schedule
     schedule = R.HopSchedule(cycles=cycles or s.cycles, push_deg=s.push_deg if push_deg is None else push_deg,
                              push_ms=push_ms or round(s.push_s * 1000), wait_ms=wait_ms or round(s.wait_s * 1000),
@@ -162,8 +163,10 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     # rest, the record says so, a --port sim virtual robot stops
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
     rec = None
+    simulated: dict = {}     # the virtual robot's simulated hops (--port sim)
     try:
-        with open_port(port, plant=plant, video=video, robot=robot, info=_info, video_fps=video_fps) as device:
+        with open_port(port, plant=plant, video=video, robot=robot, info=_info, video_fps=video_fps,
+                       on_close=simulated.update) as device:
             with Link(device) as link:
                 with progress(length=schedule.phases, label="hop") as bar:
                     rec = run_hop(link, schedule, directory,
@@ -183,7 +186,10 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
             signal.signal(sig, handler)
     path = directory / R.RECORD_NAME
     if as_json:
-        click.echo(json_text(rec.to_dict()), nl=False)
+        doc = rec.to_dict()
+        if simulated.get("plant") == "mujoco":
+            doc["simulated"] = simulated      # what the virtual robot's simulation did, SI units
+        click.echo(json_text(doc), nl=False)
     j = R.jitter(rec.phases)
     _info(f"{rec.status}: {len(rec.phases)}/{schedule.phases} phases"
           + (f", start error max {j.max_abs_ms:.3f} ms (mean {j.mean_ms:.3f}, sd {j.std_ms:.3f})" if j else "")
@@ -195,11 +201,34 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
         raise DeviceError(f"the hop did not complete: {rec.message}", f"the partial record is in {path}")
 
 
+def _virtual_robot_source(port, source):
+    """The robot a ``locust virtual`` on ``port`` simulates, when it is one: that is what hops."""
+    from .announce import announced
+    from .ports import SIM
+
+    said = click.get_current_context().meta.get(DEFAULTED)
+    theirs = announced(port) if port not in (None, SIM) else None
+    if theirs is None:
+        if said:
+            _info(said)
+        return source
+    if theirs.leg_set is None and source.leg_set is not None:
+        theirs = R.RobotSource(theirs.preset, theirs.robot_file, source.leg_set)    # --leg-set names the legs
+    mine = click.get_current_context().meta.get(DEFAULTED, False)
+    if not mine and (theirs.preset, theirs.robot_file) != (source.preset, source.robot_file):
+        _info(f"warning: the virtual robot on {port} simulates {theirs.robot_file or theirs.preset}, "
+              f"not {source.robot_file or source.preset}: run.json records its robot")
+    _info(f"robot: {theirs.robot_file or theirs.preset}, the one the virtual robot on {port} simulates")
+    return theirs
+
+
 def _hopped_robot(preset, config, sets, leg_set_name):
     """(robot, what run.json records of it): --config or --preset, the leg set on it, --set."""
     from ..params import LEG_SETS, check_robot, leg_set, parse_set_options
 
-    preset_set = preset if config is None and preset in LEG_SETS else None
+    defaulted = click.get_current_context().meta.get(DEFAULTED, False)
+    # a leg-set preset names the legs hopped when given; the default one (the robot as built) does not
+    preset_set = preset if config is None and preset in LEG_SETS and not defaulted else None
     if leg_set_name is not None:
         leg_set_name = R.check_leg_set(leg_set_name)
         if preset_set and leg_set_name != preset_set:
@@ -333,7 +362,7 @@ def repl(port):
     # a closed terminal (SIGHUP) or a kill (SIGTERM) must still stop a --port sim virtual robot
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
     try:
-        with open_port(port, plant="record", info=_info) as device:
+        with open_port(port, plant="record", info=_info, firmware=False) as device:
             _info(f"mpremote REPL on {device}: Ctrl-C for the >>> prompt, Ctrl-D there restarts the firmware, "
                   "Ctrl-] or Ctrl-X leaves")
             run_repl(device)
@@ -396,8 +425,19 @@ def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, s
 
     if pwm_log is not None and pwm_log.exists():
         raise DeviceError(f"{pwm_log} exists; a log is never overwritten", "choose another --pwm-log path")
-    robot = resolve_robot(preset, config, sets)
-    vr = VirtualRobot(flash_dir, make_plant(plant, robot, video, video_fps), log_path=pwm_log, chip=chip).start()
+    from .announce import announce, withdraw
+
+    robot, source = _hopped_robot(preset, config, sets, None)
+    shown = []
+
+    def show_hop(hop: dict) -> None:       # each hop as it is done, the rows `locust sim` prints
+        header, row = hop_table([{**hop, "cycle": len(shown) + 1}])
+        _info(row if shown else f"{header}\n{row}")
+        shown.append(hop)
+
+    vr = VirtualRobot(flash_dir, make_plant(plant, robot, video, video_fps, on_hop=show_hop), log_path=pwm_log,
+                      chip=chip).start()
+    announce(vr.device_path, source)      # a hop on its pty records this robot
     click.echo(vr.device_path)
     sys.stdout.flush()
     _info(f"virtual robot ({vr.chip}): flash {vr.flash_dir}, {vr.scheduling} scheduling, "
@@ -409,6 +449,7 @@ def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, s
     except KeyboardInterrupt:
         pass
     finally:
+        withdraw(vr.device_path)
         summary = vr.stop()
         _info(f"virtual robot stopped after {vr.boots} boot(s)")
         for line in plant_lines(summary):

@@ -45,7 +45,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
     rec = R.RunRecord(schedule=schedule, port=link.port, message="running", robot=robot or R.RobotSource())
     R.write(rec, directory)
     try:
-        hello = link.hello()
+        hello = link.hello(soft_reset=True)    # mpremote leaves a board at the REPL
         rec.firmware_version = hello.get("version")
         if hello.get("hopping"):
             link.call("stop")

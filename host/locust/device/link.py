@@ -163,18 +163,28 @@ class Link:
                            "check the USB cable; the robot returns to rest on its own when the host goes silent")
 
     # -- handshake and heartbeat -----------------------------------------------------
-    def hello(self, wait_s: float = 3.0) -> dict:
-        """The identity/version handshake, retried for ``wait_s`` (a board may be booting)."""
+    def hello(self, wait_s: float = 3.0, soft_reset: bool = False) -> dict:
+        """The identity/version handshake, retried for ``wait_s`` (a board may be booting).
+
+        ``soft_reset``: a board found at the MicroPython REPL (mpremote leaves it there) is
+        soft-reset once, as mpremote itself does, and gets ``wait_s`` more to start main.py."""
         deadline = time.monotonic() + wait_s
+        reset_sent = False
         while True:
             try:
                 msg = self.request("hello", timeout_s=min(0.5, max(0.05, deadline - time.monotonic())))
                 break
             except DeviceError:
+                if soft_reset and not reset_sent and self.error is None and self.repl_seen:
+                    self.soft_reset()
+                    reset_sent = True
+                    deadline = time.monotonic() + wait_s
+                    continue
                 if self.error is None and time.monotonic() >= deadline and self.repl_seen:
                     port = self.port
+                    what = "a soft reset did not start it: " if reset_sent else ""
                     raise DeviceError(f"no locust firmware answered on {port}: it is at the MicroPython REPL "
-                                      "(after Ctrl-C, mpremote or `locust repl`, or with no main.py)",
+                                      f"({what}after Ctrl-C, mpremote or `locust repl`, or with no main.py)",
                                       f"restart the firmware: Ctrl-D at the >>> prompt of `locust repl --port {port}` "
                                       f"(a soft reset runs main.py), `mpremote connect {port} reset`, "
                                       f"or `locust flash --port {port}` (which also installs it)") from None
@@ -195,6 +205,13 @@ class Link:
                               f"this host speaks {P.PROTOCOL}",
                               f"flash the matching firmware with `locust flash --port {self.port}`")
         return msg
+
+    def soft_reset(self) -> None:
+        """From the MicroPython REPL back to main.py: Ctrl-C clears the line typed so far,
+        Ctrl-B leaves the raw REPL (whose own soft reset skips main.py), Ctrl-D soft-resets."""
+        self.write(b"\r\x03\x02")
+        time.sleep(0.05)    # the REPL redraws its prompt before the reset byte
+        self.write(b"\x04")
 
     def start_heartbeat(self, interval_s: float) -> None:
         """Ping every ``interval_s`` until stop_heartbeat(): the robot's proof the host is alive.

@@ -14,6 +14,7 @@ push -30 on both legs) taking effect at ``t_s`` seconds since the virtual robot 
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
@@ -49,20 +50,46 @@ class RecordingPlant:
         return {"plant": "record", "commands": len(self.commands)}
 
 
-class MujocoPlant:
-    """The live MuJoCo model, stepped up to each command's time."""
+IDLE_LAG_S = 0.5     # idle, the model is stepped up to this long before now: no command comes that late
+HOP_REST_S = 0.5     # servos at rest this long after a push: the hop is done (or the next push starts)
 
-    def __init__(self, robot, video_path: Path | None = None, video_fps: int = 60):
+
+class MujocoPlant:
+    """The live MuJoCo model, stepped up to each command's time (and, idle, close behind the
+    clock); ``on_hop`` gets each hop's row (:class:`locust.sim.hops.Hop`'s fields) once it is done."""
+
+    def __init__(self, robot, video_path: Path | None = None, video_fps: int = 60,
+                 on_hop: Callable[[dict], None] | None = None):
         try:
             from ..sim.live import LiveSim
         except ImportError as exc:
             raise DeviceError(f"the live MuJoCo model is not available ({exc})",
                               "use --plant record, or install the simulation part of locust") from None
         self.sim = LiveSim(robot, video_path=str(video_path) if video_path else None, fps=video_fps)
+        self.on_hop = on_hop
+        self._told = 0
 
     def command(self, t_s: float, left_deg: float, right_deg: float) -> None:
         self.sim.advance_to(t_s)
         self.sim.set_servo_angles_deg(left_deg, right_deg)
+        self._tell()
+
+    def idle(self, t_s: float) -> None:
+        """No command for a while: step the model up to ``IDLE_LAG_S`` before ``t_s`` (the
+        same steps a later command would take it through) and tell the hops now done."""
+        if self.on_hop is None:
+            return
+        if t_s - IDLE_LAG_S > self.sim.sim_time_s:
+            self.sim.advance_to(t_s - IDLE_LAG_S)
+        self._tell()
+
+    def _tell(self) -> None:
+        if self.on_hop is None:
+            return
+        hops = self.sim.finished_hops(HOP_REST_S)
+        for hop in hops[self._told:]:
+            self.on_hop(hop)
+        self._told = max(self._told, len(hops))
 
     def close(self, t_s: float) -> dict:
         self.sim.advance_to(t_s)
@@ -82,7 +109,8 @@ def mujoco_available() -> bool:
         return False
 
 
-def make_plant(kind: str, robot=None, video_path: Path | None = None, video_fps: int = 60) -> Plant:
+def make_plant(kind: str, robot=None, video_path: Path | None = None, video_fps: int = 60,
+               on_hop: Callable[[dict], None] | None = None) -> Plant:
     """``auto`` is the MuJoCo model when it is installed (or a video is asked for), else a recorder."""
     if kind == "auto":
         kind = "mujoco" if (video_path is not None or mujoco_available()) else "record"
@@ -90,7 +118,7 @@ def make_plant(kind: str, robot=None, video_path: Path | None = None, video_fps:
         if robot is None:
             from ..params import preset
             robot = preset("seed")
-        return MujocoPlant(robot, video_path, video_fps)
+        return MujocoPlant(robot, video_path, video_fps, on_hop)
     if kind == "record":
         return RecordingPlant()
     raise DeviceError(f"unknown plant {kind!r}", f"choose one of {', '.join(PLANTS)}")

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
+from ..errors import DeviceError
 from ..tables import plant_lines
 from .plant import make_plant
 from .ports import SIM, autodetect, list_serial_ports
@@ -13,10 +14,19 @@ from .ports import SIM, autodetect, list_serial_ports
 
 @contextlib.contextmanager
 def open_port(port: str | None, plant: str = "auto", video: Path | None = None, robot=None,
-              info=None, video_fps: int = 60) -> Iterator[str]:
-    """Yields the device path to open. ``sim`` runs a virtual robot for the ``with`` block."""
+              info=None, video_fps: int = 60, firmware: bool = True,
+              on_close: Callable[[dict], None] | None = None) -> Iterator[str]:
+    """Yields the device path to open. ``sim`` runs a virtual robot for the ``with`` block;
+    with ``firmware`` (a command that talks to the firmware) its flash must hold one.
+    ``on_close`` gets the virtual robot's plant summary (its simulated hops) when it stops."""
     if port == SIM:
-        from .virtual import VirtualRobot
+        from .virtual import VirtualRobot, default_flash_dir
+
+        flash = default_flash_dir()
+        if firmware and not (flash / "main.py").exists():
+            raise DeviceError(f"nothing flashed: run `locust flash --port sim` (the virtual robot's flash "
+                              f"folder {flash} has no firmware)",
+                              "flash it once: it stays flashed for every later --port sim command")
 
         vr = VirtualRobot(plant=make_plant(plant, robot, video, video_fps)).start()
         try:
@@ -25,6 +35,8 @@ def open_port(port: str | None, plant: str = "auto", video: Path | None = None, 
             yield vr.device_path
         finally:
             summary = vr.stop()
+            if on_close is not None:
+                on_close(summary)
             if info and summary.get("plant") == "mujoco":
                 for line in plant_lines(summary):
                     info(line)

@@ -499,8 +499,13 @@ class VirtualRobot:
                 pass
 
     def _feed_plant_until_stopped(self, stopped: list) -> None:
+        idle = getattr(self.plant, "idle", None)
         while True:
-            item = self._plant_queue.get()
+            try:
+                item = self._plant_queue.get(timeout=0.1 if idle else None)
+            except queue.Empty:
+                idle(self.now_s())       # nothing written for 0.1 s: the plant may go on (a live model)
+                continue
             if item is None:
                 stopped.append(True)
                 break

@@ -207,8 +207,9 @@ def _figures(comps: list[Comparison], configs: dict[str, Configuration], land: L
 
 def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker: str) -> str:
     items = [
-        "Predicted distances are locust.sim.run.run()'s audited result for each configuration, unchanged: "
-        "the chassis travel from the first push to the end of the last cycle, and over each cycle.",
+        f"Predicted distances and heights are those of the model's {marker} marker in locust.sim.run.run()'s "
+        "audited rollout, cut into hops and zeroed exactly as the track is (the chassis' travel differs "
+        "from the marker's on a robot that ends on its back).",
         f"Predicted heights are those of the model's {marker} marker (the disc the camera follows, where the "
         f"sticker goes), from the same rollout: a point on a pitching body rises by its own amount, so the "
         f"model's {marker} site would not be the same point.",
@@ -306,6 +307,7 @@ def report_json(base: Robot, robot_source: str, comps, configs, timing, land, ma
             "name": c.config, "added_m": cfg.added_m, "cycles": c.cycles, "period_s": c.period_s,
             "link_lengths_m": list(cfg.robot.link_lengths_m()),
             "predicted": c.prediction.result.to_json(),
+            "predicted_distance_m": c.predicted_distance_m,     # the marker's, as the figure and the headline
             "predicted_jump_m": c.predicted_jump_m,
             "predicted_marker_hops": [asdict(h) for h in c.prediction.hops],
             "onset_latency_s": c.prediction.onset_latency_s,

@@ -72,8 +72,8 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
                           imports=imports)
     for c in result.comparisons:
         r = c.prediction.result
-        pred = f"predicted {r.distance_m * 100:.2f} cm" if r.valid else "simulation INVALID"
-        meas = (f"measured {c.distance.mean * 100:.2f} cm over {c.distance.n} trial(s)" if c.distance.n
+        pred = f"predicted {c.predicted_distance_m * 1000:.1f} mm" if r.valid else "simulation INVALID"
+        meas = (f"measured {c.distance.mean * 1000:.1f} mm over {c.distance.n} trial(s)" if c.distance.n
                 else "no track")
         click.echo(f"{c.config:8s} {pred}, {meas}", err=True)
     for warning in collapsed(result.warnings):     # one line for what several trials share

@@ -87,7 +87,10 @@ class Comparison:
 
     @property
     def predicted_distance_m(self) -> float:
-        return self.prediction.result.distance_m
+        """The simulated marker's travel over the cycles, cut and zeroed as a track's hops
+        are (the chassis' travel differs from it on a robot that ends on its back)."""
+        hops = self.prediction.hops
+        return float(sum(h.distance_m for h in hops)) if hops else math.nan
 
     @property
     def resolution_m(self) -> float:
@@ -110,8 +113,9 @@ class Comparison:
 def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: float) -> Comparison:
     """Measure every trial with a track on the prediction's clock and pair hop by hop.
 
-    Predicted hop distance: run()'s chassis travel over the cycle (the robot is at rest at
-    both ends, so the marker travels the same); predicted apex: the simulated marker's.
+    Like with like: the predicted hops are the simulated marker's (the same marker as the
+    track), measured by the same function from the same zero (where it stood) with the same
+    cut (the schedule's cycles, each ending at rest), never the chassis travel of ``run()``.
     """
     latency = prediction.onset_latency_s if prediction.valid else 0.0
     measured = []
@@ -125,15 +129,14 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
             hint = span_hint(tr)        # noise in mm read as metres looks like a robot already moving
             raise ReportError(exc.message, f"{hint}; {exc.hint}" if hint else exc.hint) from None
         measured.append(MeasuredTrial(trial, trace, measure_hops(trace, period_s, trial_cycles(trial, cycles))))
-    sim_hops = {h.cycle: h for h in prediction.result.hops}          # run(): chassis travel per hop
-    sim_apex = {h.hop: h.apex_m for h in prediction.hops}            # the tracked marker's apex
+    sim_hops = {h.hop: h for h in prediction.hops}            # the simulated marker's hops
     nan = math.nan
     rows = []
     for m in measured:
         for h in m.hops:
             p = sim_hops.get(h.hop)
             rows.append(HopRow(prediction.config, m.trial.label, h.hop, h.distance_m,
-                               p.distance_m if p else nan, h.apex_m, sim_apex.get(h.hop, nan)))
+                               p.distance_m if p else nan, h.apex_m, p.apex_m if p else nan))
     return Comparison(
         config=prediction.config, prediction=prediction, all_trials=list(trials), trials=measured, rows=rows,
         cycles=cycles,

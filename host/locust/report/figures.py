@@ -148,11 +148,8 @@ def hops_figure(comps: list[Comparison], spreads: dict | None = None) -> bytes:
             ys = [getattr(r, f"measured_{key}_m") * CM for r in c.rows]
             ax.plot(xs, ys, "o", color=col, ms=5, alpha=0.8, label=f"{_label(c)} measured")
             if c.prediction.valid:
-                if key == "distance":   # run()'s chassis travel per hop
-                    px = [h.cycle for h in c.prediction.result.hops]
-                    pv = [h.distance_m for h in c.prediction.result.hops]
-                else:                   # the simulated marker's apex
-                    px, pv = [h.hop for h in c.prediction.hops], [h.apex_m for h in c.prediction.hops]
+                # the simulated marker's hops, cut as the track's are
+                px, pv = [h.hop for h in c.prediction.hops], [getattr(h, f"{key}_m") for h in c.prediction.hops]
                 sp = spreads.get(c.config)
                 err = None if sp is None else [v * CM for v in getattr(sp, f"hop_{key}_sd_m")][:len(pv)]
                 ax.errorbar(px, [v * CM for v in pv], yerr=err, fmt="--", color=col, lw=1.2, capsize=3,

@@ -4,8 +4,8 @@ The robot's values that carry an uncertainty are drawn as ``locust sim --samples
 them (:func:`locust.sim.samples.draw`), all draws of a configuration are simulated in one
 batched rollout, and each valid draw's marker trace is taken like the prediction's own
 (:func:`.predict.marker_trace`, the same rows, so the draws share one clock). The band is
-the draws' mean +- one standard deviation at every instant; each hop's distance (chassis
-travel, as ``run()`` gives it) and marker apex get their standard deviation over the draws.
+the draws' mean +- one standard deviation at every instant; each hop's marker distance and
+apex (cut as the prediction's own are) get their standard deviation over the draws.
 """
 
 from __future__ import annotations
@@ -16,7 +16,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..params import Robot
-from ..sim.hops import summarise
 from ..sim.samples import simulate_draws
 from ..trials.measure import measure_hops
 from .predict import marker_trace
@@ -48,8 +47,9 @@ def spread(robot: Robot, cycles: int, marker: str, n: int, seed: int = 0) -> Spr
             continue
         trace = marker_trace(traj, marker)
         traces.append(trace)
-        dist.append([h.distance_m for h in summarise(traj).hops])
-        apex.append([h.apex_m for h in measure_hops(trace, period, cycles)])
+        hops = measure_hops(trace, period, cycles)
+        dist.append([h.distance_m for h in hops])
+        apex.append([h.apex_m for h in hops])
     if len(traces) < 2:
         return None
     xs = np.array([t.x_m for t in traces])

@@ -6,8 +6,9 @@ before the first push, Gaussian position noise, a few lost frames) and writes wh
 ``locust track`` and ``locust hop`` would have written: ``synthetic.tracks.csv`` (first line
 ``# synthetic``) and a ``run.json`` built with the device layer's own record types, its
 phase start errors drawn at random (labelled synthetic in its ``message``). The truth is
-returned: the true robot's per-hop chassis travel (``run()``) and its nose marker's highest
-point in each cycle above standing (from the 240 Hz trace the camera samples).
+returned: the true robot's nose marker, per hop, as a camera sees it: its travel (at rest at
+the end of a cycle minus at its start, :func:`locust.trials.measure.measure_hops`) and its
+highest point in the cycle above standing (from the 240 Hz trace the camera samples).
 """
 
 from __future__ import annotations
@@ -82,7 +83,10 @@ def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int 
             commanded = c * period_us + offset_us
             record.add_phase(Phase(c + 1, name, commanded, commanded + int(rng.integers(20, 400))))
     run_path = write_record(record, folder)
+    from ..trials.measure import measure_hops
+
     period_s = s.push_s + s.wait_s
     apex = [float(trace.y_m[(trace.t_s >= c * period_s) & (trace.t_s < (c + 1) * period_s)].max())
             for c in range(cycles)]
-    return SyntheticTruth([h.distance_m for h in result.hops], apex, result.distance_m, track_path, run_path)
+    hops = [h.distance_m for h in measure_hops(trace, period_s, cycles)]
+    return SyntheticTruth(hops, apex, float(sum(hops)), track_path, run_path)

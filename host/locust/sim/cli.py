@@ -37,8 +37,10 @@ from ..tables import sim_lines, spread_line
                    "(one batched rollout) and report the sd of distance and highest nose "
                    "(--json: distance_m_sd, max_nose_height_m_sd).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of --samples.")
+@click.option("--verbose", "-v", is_flag=True,
+              help="Also the linkage's kinematics: its Grashof class and worst transmission angle.")
 def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push, board, check_convergence, samples,
-        seed):
+        seed, verbose):
     """Settle the robot on the floor, then run the bang-bang hop schedule.
 
     Every run is audited (non-finite state, loop closure, energy, MuJoCo warnings). A run
@@ -101,7 +103,7 @@ def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push,
                        samples=spread.to_json())
         click.echo(json_text(out), nl=False)
         return
-    for line in sim_lines(result):
+    for line in sim_lines(result, verbose=verbose):
         click.echo(line)
     if spread is not None:
         click.echo(spread_line(spread))

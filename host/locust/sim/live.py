@@ -252,6 +252,26 @@ class LiveSim:
         hops = _per_push(traj) if verdict.valid and self._steps > self._settle_steps else []
         return LiveResult(distance, nose, sim_s, verdict.valid, verdict.reasons, rtf, video_path, frames, hops)
 
+    def finished_hops(self, rest_s: float) -> list[dict]:
+        """The hops done so far, cut as :meth:`close` cuts them: a hop is done once the next push
+        has started or the servos have been at rest ``rest_s`` since it (so the last hop of a
+        schedule shows while the robot stays idle). Empty after a run that breaks its audit."""
+        with self._lock:
+            settle = getattr(self, "_settle_steps", self._steps)
+            ctrl = np.concatenate(self._ctrl_chunks)[settle:] if self._ctrl_chunks else np.empty(0)
+            pushing = ctrl != 0.0
+            starts = np.flatnonzero(pushing & ~np.concatenate(([False], pushing[:-1])))
+            if len(starts) == 0:
+                return []
+            last_push = int(np.flatnonzero(pushing)[-1])
+            done = len(starts) - 1 + int(len(ctrl) - 1 - last_push >= round(rest_s / self.dt))
+            if done == 0:
+                return []
+            traj = self.trajectory()
+            if not audit(traj).valid:
+                return []
+            return _per_push(traj)[:done]
+
     def trajectory(self) -> Trajectory:
         """The record so far, in the rollout's form (one row per physics step, settle included)."""
         nsd = self.model.nsensordata

@@ -12,12 +12,13 @@ from ..fileio import json_text
 from ..params import resolve_robot
 from ..params_cli import robot_options
 from ..progress import progress
+from ..tables import mm
 
 
 def _describe(row: dict, names: list[str]) -> str:
     where = ", ".join(f"{n}={row[n]:.6g}" for n in names)
-    return (f"design {row['design']} ({where}): {row['distance_m'] * 100:.2f} cm, "
-            f"highest nose {row['max_nose_height_m'] * 100:.2f} cm, {row['hops']} airborne hops")
+    return (f"design {row['design']} ({where}): {mm(row['distance_m'])} mm, "
+            f"highest nose {mm(row['max_nose_height_m'])} mm, {row['hops']} airborne hops")
 
 
 @click.command()
@@ -141,8 +142,8 @@ def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_n
     else:
         b = summary.best
         where = ", ".join(f"{x.name}={b[x.name]:.6g}" for x in bounds)
-        click.echo(f"best: trial {b['trial']} ({where}): {b['distance_m'] * 100:.2f} cm, "
-                   f"highest nose {b['max_nose_height_m'] * 100:.2f} cm")
+        click.echo(f"best: trial {b['trial']} ({where}): {mm(b['distance_m'])} mm, "
+                   f"highest nose {mm(b['max_nose_height_m'])} mm")
         click.echo(f"best design as a robot file: {summary.best_robot}")
     click.echo(f"results: {out / 'trials.csv'}, {out / 'optimize.json'}, {out / 'history.png'}")
     if summary.interrupted:

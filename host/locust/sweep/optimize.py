@@ -283,14 +283,14 @@ def _plot_history(done, pruned, path: Path) -> None:
     fig, ax = plt.subplots(figsize=(7.5, 4))
     if done:
         xs = [t.number for t in done]
-        ys = [t.value * 100 for t in done]
+        ys = [t.value * 1000 for t in done]     # hop figures in mm, as every table
         best = [max(ys[: i + 1]) for i in range(len(ys))]
         ax.plot(xs, ys, "o", ms=4, color="#1f77b4", label="valid trial")
         ax.step(xs, best, where="post", color="#ff7f0e", label="best so far")
     if pruned:
         ax.plot([t.number for t in pruned], [0] * len(pruned), "x", color="#d62728", label="pruned: invalid design")
     ax.set_xlabel("trial")
-    ax.set_ylabel("distance (cm)")
+    ax.set_ylabel("distance (mm)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     save_png(fig, path)

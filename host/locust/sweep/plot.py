@@ -13,7 +13,8 @@ from ..params import LEG_SETS, Robot, preset
 from ..plotting import pyplot, save_png
 from .design import SCALE, Axis, axis_scale
 
-METRICS = (("distance_m", "distance (cm)"), ("max_nose_height_m", "highest nose point (cm)"))
+METRICS = (("distance_m", "distance (mm)"), ("max_nose_height_m", "highest nose point (mm)"))   # hop figures: mm
+MM = 1000.0
 
 
 def _leg_set_marks(axis: Axis, base: Robot) -> list[tuple[str, float]]:
@@ -37,13 +38,13 @@ def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robo
         for r in ok:
             by_x[r[axis.name]] = max(by_x.get(r[axis.name], -math.inf), r[key])
         xs = sorted(by_x)
-        ax.plot([x * x_scale for x in xs], [by_x[x] * 100 for x in xs], "o-", ms=4, color="#1f77b4",
+        ax.plot([x * x_scale for x in xs], [by_x[x] * MM for x in xs], "o-", ms=4, color="#1f77b4",
                 label=f"valid ({len(ok)})")
         if bad:
             ax.plot([r[axis.name] * x_scale for r in bad], [0.0] * len(bad), "x", color="#d62728",
                     label=f"invalid ({len(bad)}): not a result")
         if best is not None:
-            ax.plot(best[axis.name] * x_scale, best[key] * 100, "*", ms=14, color="#ff7f0e",
+            ax.plot(best[axis.name] * x_scale, best[key] * MM, "*", ms=14, color="#ff7f0e",
                     label="best valid (distance)")
         for name, v in _leg_set_marks(axis, base):
             ax.axvline(v * x_scale, color="0.4", ls=":", lw=1)
@@ -68,7 +69,7 @@ def _heatmap(rows: list[dict[str, Any]], ax_a: Axis, ax_b: Axis, path: Path) -> 
         for r in rows:
             if r["valid"]:
                 i, j = vb.index(r[ax_b.name]), va.index(r[ax_a.name])
-                grid[i, j] = np.fmax(grid[i, j], r[key] * 100)
+                grid[i, j] = np.fmax(grid[i, j], r[key] * MM)
         img = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis",
                         extent=_extent([v * ka for v in va]) + _extent([v * kb for v in vb]))
         fig.colorbar(img, ax=ax, label=title)

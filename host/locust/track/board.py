@@ -32,7 +32,7 @@ import numpy as np
 from ..arucoboard import DEFAULT_BOARD, MIN_BOARD_MARKERS, BoardSpec, parse_board  # noqa: F401
 from ..errors import TrackError
 from ..fileio import atomic_write_bytes
-from .calib import NUM
+from .calib import NUM, PIXEL_CONVENTIONS
 from .video import read_frames
 
 BOARD_DPI = 300
@@ -144,8 +144,9 @@ def board_homography(info, clip, spec: BoardSpec, frames: int = DETECT_FRAMES) -
     return _fit(np.vstack(image_pts), np.vstack(plane_pts), f"board {spec.text()} ({len(image_pts)} frames)", first)
 
 
-def parse_plane_points(text: str) -> PlaneHomography:
-    """``PX,PY=X_M,Y_M;...`` (four or more) -> the homography through them."""
+def parse_plane_points(text: str, pixels: str = "tracker") -> PlaneHomography:
+    """``PX,PY=X_M,Y_M;...`` (four or more) -> the homography through them; the pixels typed
+    in convention ``pixels`` (:func:`locust.track.spec.typed_px`)."""
     pairs = [p for p in re.split(r"[;\s]+", text.strip()) if p]
     rx = re.compile(rf"({NUM}),({NUM})=({NUM}),({NUM})")
     rows = [rx.fullmatch(p) for p in pairs]
@@ -153,4 +154,5 @@ def parse_plane_points(text: str) -> PlaneHomography:
         raise TrackError(f"--plane-points {text!r}: expected four or more PX,PY=X_M,Y_M separated by ';'",
                          "e.g. --plane-points '102,880=0,0;1650,870=1.2,0;1600,240=1.2,0.5;150,250=0,0.5'")
     v = np.array([[float(x) for x in m.groups()] for m in rows])
+    v[:, :2] += PIXEL_CONVENTIONS[pixels]
     return _fit(v[:, :2], v[:, 2:], "plane points")

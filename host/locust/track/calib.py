@@ -13,7 +13,7 @@ import math
 import re
 
 from ..errors import TrackError
-from ..io.trk import Calibration
+from ..io.trk import TRACKER_TO_OPENCV_PX, Calibration
 
 NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 
@@ -31,6 +31,21 @@ def parse_scale(text: str) -> tuple[float, float, float, float, float]:
         raise TrackError(f"--scale {text!r}: the two ends are less than a pixel apart",
                          "use the two ends of the stick, as far apart as it shows")
     return x1, y1, x2, y2, length
+
+
+PIXEL_CONVENTIONS = {"tracker": TRACKER_TO_OPENCV_PX, "opencv": 0.0}   # added to a typed position: OpenCV's
+PIXELS_HELP = ("Convention of the pixel positions typed in --marker, --origin, --scale and --plane-points: "
+               "tracker (Tracker's table: origin at the image's top-left corner, a pixel's centre at i + 0.5) "
+               "or opencv (origin at the top-left pixel's centre). Output pixel columns are OpenCV's.")
+
+
+def typed_px(x: float, y: float, pixels: str) -> tuple[float, float]:
+    """A pixel position typed in convention ``pixels`` (``tracker`` or ``opencv``), in OpenCV's."""
+    if pixels not in PIXEL_CONVENTIONS:
+        raise TrackError(f"pixel convention {pixels!r} is not known", "give tracker or opencv")
+    d = PIXEL_CONVENTIONS[pixels]
+    return x + d, y + d
+
 
 
 def parse_point(text: str, option: str) -> tuple[float, float]:

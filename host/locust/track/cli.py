@@ -23,6 +23,7 @@ from ..progress import progress
 from . import board, calib, camera, export, overlay, preview, trk
 from .aruco import side_px_in_video
 from .board import DEFAULT_BOARD
+from .calib import PIXEL_CONVENTIONS, typed_px
 from .options import CALIBRATION, CLIP, FORMAT, OUTPUT, marker_options, stacked
 from .runner import track_video
 from .upright import upside_down_warnings
@@ -53,7 +54,10 @@ def track():
     another program's tracks converted to locust's tracks CSV.
 
     \b
-    Pixels follow OpenCV: origin at the centre of the top-left pixel, x right, y down.
+    Pixel positions you type (--marker, --origin, --scale) are Tracker's by default
+    (--pixels tracker: origin at the image's top-left corner, as in Tracker's table) or
+    OpenCV's (--pixels opencv: origin at the top-left pixel's centre, 0.5 px apart); the
+    pixel columns written are OpenCV's, x right, y down.
     World columns are metres, y up. `locust track VIDEO ...` is short for
     `locust track video VIDEO ...`.
 
@@ -77,8 +81,8 @@ def track():
 @click.option("--trk", "trk_out", type=click.Path(dir_okay=False, path_type=Path),
               help="Also write the tracks as a Tracker project (.trk) that opens the video or image sequence with "
                    "the clip's timing and calibration, one point mass per marker: correct frames by hand in Tracker.")
-def video_command(video, models, start, end, step, fps, out, force, fmt, overlay_kind, trk_out, calibration_from,
-                  **calibration):
+def video_command(video, models, pixels, start, end, step, fps, out, force, fmt, overlay_kind, trk_out,
+                  calibration_from, **calibration):
     """Track the markers of VIDEO (a video file, an image sequence's folder or first file, or a
     Tracker project that opens one).
 
@@ -116,6 +120,7 @@ def video_command(video, models, start, end, step, fps, out, force, fmt, overlay
                          "not both", "one calibration per run")
     if project is not None and fps is None and math.isfinite(project.clip.fps):
         fps = project.clip.fps
+    calibration["pixels"] = pixels
     with _media(video, project) as media:
         _track(media, video, project, models, calibration, Clip(start, end, step, fps), out, fmt, overlay_kind,
                force, trk_out)
@@ -215,7 +220,7 @@ def board_command(png, board_text, force):
 @click.option("--frame", default=0, show_default=True, type=int, help="The frame to show.")
 @marker_options
 @stacked(*OUTPUT)
-def preview_command(video, frame, models, out, force):
+def preview_command(video, frame, models, pixels, out, force):
     """Write one FRAME of VIDEO with a pixel grid, the most saturated blobs listed (colour,
     position) and what the --marker specs find there, to <out>.preview.png: pick colours
     and start points for `locust track video` without a GUI.
@@ -238,7 +243,11 @@ def preview_command(video, frame, models, out, force):
         click.echo(b.line(k))
     if not blobs:
         click.echo("  none (no strongly coloured patch in this frame)")
+    if found:
+        click.echo(f"markers ({pixels}'s pixels, as --marker takes them):")
     for name, p in found.items():
+        if p:   # found in OpenCV's pixels: shown in the convention the specs are typed in
+            p = (p[0] - PIXEL_CONVENTIONS[pixels], p[1] - PIXEL_CONVENTIONS[pixels])
         click.echo(f"  marker {name}: " + (f"found at {p[0]:.1f},{p[1]:.1f}" if p else "not found"))
     click.echo(f"wrote {path}")
 
@@ -302,13 +311,13 @@ def _track(video: Path, named: Path, project, models: list, cal: dict, clip: Cli
                              "one calibration per run")
         if cal["board_text"] and cal["plane_points"]:
             raise TrackError("give --board or --plane-points, not both", "one calibration per run")
-        calibration = (board.parse_plane_points(cal["plane_points"]) if cal["plane_points"]
+        calibration = (board.parse_plane_points(cal["plane_points"], cal["pixels"]) if cal["plane_points"]
                        else board.board_homography(info, clip, board.parse_board(cal["board_text"])))
     elif project is not None:
         calibration = project.calibration
     else:
         calibration = _calibration(info, clip, cal["scale"], cal["scale_aruco"], cal["aruco_dict"], cal["origin"],
-                                   cal["angle"], cal["camera_json"])
+                                   cal["angle"], cal["camera_json"], cal["pixels"])
     paths = _outputs(_base_path(out, named), fmt, overlay_kind)
     if trk_out is not None:
         paths["trk"] = trk_out
@@ -335,7 +344,7 @@ def _track(video: Path, named: Path, project, models: list, cal: dict, clip: Cli
     _report(result, written)
 
 
-def _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, camera_json=None):
+def _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, camera_json=None, pixels="tracker"):
     if scale and scale_aruco:
         raise TrackError("give --scale or --scale-aruco, not both", "one calibration per run")
     by_hand = bool(scale or scale_aruco or origin)
@@ -355,7 +364,7 @@ def _calibration(info, clip, scale, scale_aruco, aruco_dict, origin, angle, came
         marker_id, side_m = calib.parse_aruco_scale(scale_aruco)
         frame, side = side_px_in_video(info, clip, marker_id, aruco_dict)
         m_per_px, source = side_m / side, f"aruco {marker_id} side {side_m} m = {side:.3f} px on frame {frame}"
-    point = calib.parse_point(origin, "--origin") if origin else None
+    point = typed_px(*calib.parse_point(origin, "--origin"), pixels) if origin else None
     return calib.build(info.height_px, m_per_px, point, angle, source)
 
 

@@ -11,6 +11,7 @@ import click
 
 from ..errors import TrackError
 from .aruco import DEFAULT_DICTIONARY
+from .calib import PIXEL_CONVENTIONS, PIXELS_HELP
 from .spec import ModelOptions, parse_markers
 from .video import check_fps
 
@@ -34,20 +35,23 @@ FORMAT = [click.option("--format", "fmt", type=click.Choice(["csv", "tracker"]),
 
 
 def marker_options(func):
-    """``--marker`` and the matching settings; the command gets them as ``models``."""
+    """``--marker``, ``--pixels`` and the matching settings; the command gets the markers as
+    ``models`` and the convention of typed pixel positions as ``pixels``."""
 
     @functools.wraps(func)
-    def wrapper(*args, markers, color_tol, search_px, template_radius, accept, likeness, evolve, **kwargs):
+    def wrapper(*args, markers, color_tol, search_px, template_radius, accept, likeness, evolve, pixels, **kwargs):
         if not math.isfinite(accept):
             raise TrackError(f"--accept {accept}: not a finite number", "give --accept as a plain number, see --help")
-        options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0, likeness)
-        return func(*args, models=parse_markers(list(markers), options), **kwargs)
+        options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0, likeness, pixels)
+        return func(*args, models=parse_markers(list(markers), options), pixels=pixels, **kwargs)
 
     return stacked(
         click.option("--marker", "markers", multiple=True, metavar="NAME=SPEC",
                      help="A marker to track; repeatable. SPEC is color:#RRGGBB[@X,Y] (X,Y: where it is on the "
                           "first frame), template:X,Y@FRAME or aruco:ID[@DICT]. "
                           "Default: the robot's nose (#ff00ff) and foot (#00ffff) colours."),
+        click.option("--pixels", type=click.Choice(list(PIXEL_CONVENTIONS)), default="tracker", show_default=True,
+                     help=PIXELS_HELP),
         click.option("--color-tol", default=80, show_default=True, type=click.IntRange(1, 255),
                      help="Colour markers: largest per-channel difference (0-255) still counted as the marker; "
                           "at 80 a pixel of the marker's hue (+-16 deg) also counts down to 0.3 of its saturation "

@@ -6,6 +6,12 @@ Specs::
     template:X,Y@FRAME     Tracker's autotracker, template around (X, Y) on FRAME
     aruco:ID[@DICT]        an ArUco marker (default dictionary DICT_4X4_50)
 
+Pixel positions typed here (and ``--origin``, ``--plane-points``, ``--scale``) are read in
+Tracker's convention by default (``--pixels tracker``: origin at the top-left *corner* of the
+image, so pixel i's centre is at i + 0.5; what a student copies from Tracker's table), or in
+OpenCV's (``--pixels opencv``: origin at the centre of the top-left pixel), and turned into
+OpenCV's, which every output pixel column uses, by :func:`locust.track.calib.typed_px`.
+
 With no ``--marker`` the markers are the robot's own colours from
 :data:`locust.markers.MARKER_COLOURS` (nose magenta, foot cyan), which the simulation
 renders too.
@@ -19,6 +25,7 @@ from dataclasses import dataclass
 from ..errors import TrackError
 from ..markers import MARKER_COLOURS
 from .aruco import DEFAULT_DICTIONARY, ArucoMarker
+from .calib import typed_px
 from .color import ColorMarker, parse_hex
 from .template import TemplateMarker
 
@@ -28,7 +35,7 @@ NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)"
 
 @dataclass(frozen=True)
 class ModelOptions:
-    """Settings shared by all markers of one run."""
+    """Settings shared by all markers of one run; ``pixels``: the convention of typed positions."""
 
     color_tol: int = 80
     search_half_px: int = 40
@@ -36,6 +43,7 @@ class ModelOptions:
     accept: float = 0.5
     evolve: float = 0.2
     likeness: float = 0.5
+    pixels: str = "tracker"
 
 
 def default_specs() -> list[str]:
@@ -60,7 +68,7 @@ def parse_marker(text: str, options: ModelOptions = ModelOptions()):
                 raise TrackError(f"--marker {text!r}: colour spec must be color:#RRGGBB or color:#RRGGBB@X,Y",
                                  "give the sticker's pixel position on the first frame, e.g. color:#e8308c@412,630 "
                                  "(locust track preview VIDEO shows the positions)")
-            start_px = (float(m.group(1)), float(m.group(2)))
+            start_px = typed_px(float(m.group(1)), float(m.group(2)), options.pixels)
         return ColorMarker(name, spec, parse_hex(colour), tolerance=options.color_tol,
                            search_half_px=options.search_half_px, start_px=start_px)
     if kind == "template":
@@ -68,7 +76,8 @@ def parse_marker(text: str, options: ModelOptions = ModelOptions()):
         if not m:
             raise TrackError(f"--marker {text!r}: template spec must be template:X,Y@FRAME",
                              "give the pixel position of the feature on a frame, e.g. template:131.28,207.86@2")
-        return TemplateMarker(name, spec, float(m.group(1)), float(m.group(2)), int(m.group(3)),
+        x, y = typed_px(float(m.group(1)), float(m.group(2)), options.pixels)
+        return TemplateMarker(name, spec, x, y, int(m.group(3)),
                               radius_px=options.template_radius_px, search_half_px=options.search_half_px,
                               accept=options.accept, evolve=options.evolve,
                               min_likeness=options.likeness)

@@ -1,11 +1,15 @@
-"""Whether tracked heights are upright: a hopping robot rests on the floor.
+"""Whether tracked heights are upright: a hopping robot starts standing on the floor.
 
-A marker on the robot stands still only while the robot stands on the floor (before,
-between and after its hops); in flight it moves. Its still sightings therefore lie at the
-bottom of its range of heights. Where they lie at the top instead, world y points down: the
-video was filmed with the phone upside down (or its axes turned over with ``--angle``), and
-every height is inverted. A marker that never stands still, or hardly moves up or down,
-gives no verdict.
+A hop starts from the floor: before its first push the robot stands on its feet, and every
+marker on it stands still at its standing height. From there the robot can only rise (the
+floor is below it): its hops, and a robot that goes over and comes to rest on its back, lie
+above. So the still sightings before a marker's first move lie at the bottom of its range
+of heights. Where they lie at the top instead, world y points down: the video was filmed
+with the phone upside down (or its axes turned over with ``--angle``), and every height is
+inverted. Where the robot rests later (on its back, high) says nothing about the floor and
+is not used. The verdict is the video's, from the marker that moves up and down the most (a
+sticker low on a leg dips as the leg pushes); a marker that moves from its first sighting,
+or hardly moves up or down, gives none.
 """
 
 from __future__ import annotations
@@ -15,34 +19,47 @@ import numpy as np
 from .runner import TrackResult
 
 STILL_SHARE = 0.02     # a step between frames under this share of the height range is standing still
-MIN_STILL = 5          # still steps needed for a verdict
+MIN_STILL = 5          # still steps before the first move needed for a verdict
 MIN_RISE_PX = 10.0     # least vertical travel in the picture (px) to judge by
-TOP_SHARE = 0.5        # still sightings above this share of the height range: upside down
+TOP_SHARE = 0.5        # standing before the first move above this share of the height range: upside down
+
+
+def standing_still(x: np.ndarray, y: np.ndarray, ok: np.ndarray, tolerance: float) -> np.ndarray:
+    """Frames of the still stretch a track opens with: consecutive sightings that move under
+    ``tolerance`` until the first that moves more (or a lost frame)."""
+    idx = np.flatnonzero(ok)
+    step = np.hypot(np.diff(x[idx]), np.diff(y[idx]))
+    moves = (np.diff(idx) != 1) | (step > tolerance)
+    first_move = int(np.argmax(moves)) if moves.any() else step.size
+    return idx[1:first_move + 1]
 
 
 def upside_down_warnings(result: TrackResult) -> list[str]:
-    """One line for each marker whose still sightings lie at the top of its heights."""
-    lines = []
+    """One line when the video's heights look upside down, judged from the marker that moves
+    up and down the most (in pixels) among those that stand still before their first move: a
+    marker low on a leg may dip as the leg pushes, the robot's rise decides."""
+    best = None
     for track in result.markers:
-        _, y = result.world(track)
+        x, y = result.world(track)
         ok = track.ok & np.isfinite(y) & np.isfinite(track.py)
         if ok.sum() < 2 * MIN_STILL or np.ptp(track.py[ok]) < MIN_RISE_PX:
             continue
-        x, _ = result.world(track)
         low, high = np.percentile(y[ok], [1, 99])
         if not high > low:
             continue
-        idx = np.flatnonzero(ok)
-        next_frame = np.diff(idx) == 1
-        step = np.hypot(np.diff(x[idx]), np.diff(y[idx]))
-        still = idx[1:][next_frame & (step <= STILL_SHARE * (high - low))]
+        still = standing_still(x, y, ok, STILL_SHARE * (high - low))
         if still.size < MIN_STILL:
             continue
-        rest = float(np.median(y[still]))
-        share = (rest - low) / (high - low)
-        if share > TOP_SHARE:
-            lines.append(f"{track.name} stands still at the top of its heights ({still.size} still frames at "
-                         f"y = {rest:.4g} m, {share:.0%} of the way from {low:.4g} to {high:.4g} m): a robot rests "
-                         "on the floor, at the bottom; the heights look upside down (a video filmed upside down?); "
-                         "rotate the video, or give --angle 180 to turn the axes over")
-    return lines
+        rise_px = float(np.ptp(track.py[ok]))
+        if best is None or rise_px > best[0]:
+            best = (rise_px, track.name, still.size, float(np.median(y[still])), low, high)
+    if best is None:
+        return []
+    _, name, n_still, rest, low, high = best
+    share = (rest - low) / (high - low)
+    if share <= TOP_SHARE:
+        return []
+    return [f"{name} stands still at the top of its heights ({n_still} still frames at y = {rest:.4g} m, "
+            f"{share:.0%} of the way from {low:.4g} to {high:.4g} m) before its first move: a robot starts "
+            "standing on the floor, at the bottom; the heights look upside down (a video filmed upside down?); "
+            "rotate the video, or give --angle 180 to turn the axes over"]
