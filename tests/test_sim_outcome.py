@@ -36,13 +36,15 @@ def test_rules_on_their_thresholds(hops, expected):
 # (preset, values, outcome, nose rise range per hop in cm); each near-threshold setting is
 # inside the as-built uncertainties (crank angle -100 +- 10 deg, ground angle 0 +- 15 deg)
 KNOWN = [
-    ("small", {}, O.GOES_OVER, (10.0, 11.5)),
-    ("medium", {}, O.GOES_OVER, (11.5, 12.5)),
-    ("large", {}, O.GOES_OVER, (12.8, 13.8)),
-    ("large", {"geometry.crank_start_deg": -94.0}, O.REARS_AND_RETURNS, (6.0, 8.1)),
-    ("medium", {"geometry.ground_angle_deg": 15.0}, O.REARS_AND_RETURNS, (6.0, 7.8)),
-    ("small", {"geometry.crank_start_deg": -80.0}, O.STAYS_LOW, (0.5, 0.9)),
-    ("large", {"geometry.crank_start_deg": -85.0}, O.STAYS_LOW, (1.2, 1.6)),
+    ("small", {}, O.GOES_OVER, (11.0, 12.0)),
+    ("medium", {}, O.GOES_OVER, (12.2, 13.2)),
+    ("large", {}, O.GOES_OVER, (13.4, 14.4)),
+    ("medium", {"geometry.crank_start_deg": -90.0}, O.GOES_OVER, (-0.5, 0.5)),    # right over, plate flat
+    ("small", {"geometry.crank_start_deg": -89.0}, O.REARS_AND_RETURNS, (6.5, 7.5)),
+    ("medium", {"geometry.ground_angle_deg": 18.0}, O.REARS_AND_RETURNS, (7.5, 11.0)),
+    ("large", {"geometry.crank_start_deg": -90.0}, O.REARS_AND_RETURNS, (9.0, 12.0)),
+    ("small", {"geometry.crank_start_deg": -88.0}, O.STAYS_LOW, (2.0, 2.8)),
+    ("small", {"geometry.crank_start_deg": -80.0}, O.STAYS_LOW, (0.1, 0.5)),
 ]
 
 
@@ -55,8 +57,9 @@ def test_simulated_runs_of_known_regime(preset, values, expected, nose_cm):
     assert all(lo / 100 < h.nose_apex_m < hi / 100 for h in r.hops[-5:]), [h.nose_apex_m for h in r.hops]
     turns = [h.end_turn_deg for h in r.hops]
     if expected == O.GOES_OVER:
-        # on its back after the first push, turned 90-112 deg from standing, and it stays
-        assert all(90.0 < t < 112.0 for t in turns), turns
+        # on its back after the first push (turned 91-107 deg from standing, or right over
+        # onto the plate's top, 212 deg), and it stays
+        assert all(90.0 < t < 110.0 for t in turns) or all(200.0 < t < 220.0 for t in turns), turns
     else:
         # each cycle ends standing as it started, within a degree
         assert all(abs(t) < 1.0 for t in turns), turns
@@ -122,7 +125,7 @@ def test_sim_json_and_samples_give_the_outcome_and_its_shares(tmp_path):
     assert res.exit_code == 0, res.output
     out = json.loads(res.output)
     assert out["outcome"] == O.GOES_OVER
-    assert out["nose_load_kg"] == pytest.approx(0.00496, abs=5e-5)
+    assert out["nose_load_kg"] == pytest.approx(0.00420, abs=5e-5)
     assert out["total_mass_kg"] == pytest.approx(0.03113, abs=5e-5)
     draws = out["samples"]
     shares = out["outcomes"]

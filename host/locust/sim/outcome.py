@@ -26,9 +26,10 @@ The thresholds and why:
   "several centimetres" of a hop are above it, a robot shuffling on its feet is well below.
 - :data:`OVER_TURN_DEG` = 45 deg: a robot that has come back down stands within a degree
   of its start (0.0 deg measured on every returning hop of the presets' near-threshold
-  settings), while one that went over rests on its tail and legs turned 93-110 deg (Small,
-  Medium and Large as preset: 93.5, 102.1, 109.7 deg; nose 10.5-12.9 cm up). 45 deg is
-  far from both.
+  settings), while one that went over rests on its leg-end edge and legs turned 91-107 deg
+  (Small, Medium and Large as preset: 91.4, 99.1, 106.5 deg; nose 11-14 cm up), or right
+  over onto the plate's top, 212 deg (Medium with the crank at -90 deg). 45 deg is far from
+  both.
 
 ``classify(hops)`` is a stable interface (other packages call it): its name, its one
 argument (a sequence of objects with ``nose_apex_m`` and ``end_turn_deg``) and its return

@@ -92,7 +92,7 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
     lo, hi = GOOD_TRANSMISSION_DEG
     if summary and summary.end_nose_rise_m > STAYED_UP_M:
         notes.append(f"did not come back down: the nose ends {summary.end_nose_rise_m * 100:.1f} cm above its "
-                     "standing height (the robot rears and stays), so a hop's nose rise after the one that "
+                     "standing height (it went over onto its back), so a hop's nose rise after the one that "
                      "reared is its resting height, not a hop")
     if not lo <= asm.transmission_deg <= hi:
         notes.append(f"poor transmission angle {asm.transmission_deg:.0f} deg at the start (outside {lo:g}-{hi:g})")
