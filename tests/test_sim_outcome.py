@@ -137,3 +137,22 @@ def test_sim_json_and_samples_give_the_outcome_and_its_shares(tmp_path):
             assert s["distance_m"]["mean"] == pytest.approx(sum(mine) / len(mine), rel=1e-12)
     assert 0 < shares[O.GOES_OVER]["share"] < 1, draws["outcome"]       # seed 3 splits them
     assert out["sensitivity"]["deciding"] == ["geometry.crank_start_deg"]
+
+
+def test_the_report_shows_each_outcomes_share_of_the_draws():
+    """The report's spread (``locust report --samples``) classifies its draws as ``locust sim
+    --samples`` does: Medium with only its crank angle uncertain, seed 3, splits the same way,
+    and the HTML table gives each outcome's count of the draws."""
+    from locust.report.page import outcome_table
+    from locust.report.spread import spread
+    from locust.sim.samples import sample
+
+    robot = only_uncertain(P.preset("medium"), {"geometry.crank_start_deg": 10.0})
+    sp = spread(robot, 2, "nose", 6, seed=3)
+    ref = sample(robot, 6, cycles=2, seed=3)
+    assert {k: v.n for k, v in sp.outcomes.items()} == {k: v.n for k, v in ref.outcomes.items()}
+    assert sum(o.share for o in sp.outcomes.values()) == pytest.approx(1.0, abs=1e-12)
+    over = sp.outcomes[O.GOES_OVER]
+    assert over.distance_m.mean == pytest.approx(ref.outcomes[O.GOES_OVER].distance_m.mean, rel=1e-12)
+    html = outcome_table({"medium": sp}, {"medium": "Medium"})
+    assert f"{over.n} of {sp.n_valid}" in html and "goes over" in html
