@@ -14,6 +14,20 @@ MARKER_COLOURS: dict[str, tuple[str, str]] = {
 }
 
 
+# Stickers for a still photo of the robot from its left side (``locust sim --still``,
+# ``locust measure stance``): six hues 60 degrees apart, so each is told from the others by
+# colour alone; the video markers' two colours are kept for the nose and the foot.
+# name -> (#RRGGBB, where it sits); the distances are sim/stickers.py's
+STICKER_COLOURS: dict[str, tuple[str, str]] = {
+    "nose": ("#ff00ff", "on the plate's side, 10 mm in from its nose end"),
+    "tail": ("#ffff00", "on the plate's side, 10 mm in from its leg end"),
+    "axis": ("#ff0000", "on the crank, over the servo horn's axis"),
+    "crank": ("#00ff00", "on the crank, 8 mm in from the crank-coupler joint (its tip)"),
+    "knee": ("#0000ff", "on the leg, 8 mm up from the coupler-leg joint (the joint itself touches the floor)"),
+    "foot": ("#00ffff", "on the leg, 25 mm up from the coupler-leg joint (the videos' foot dot)"),
+}
+
+
 def hex_to_rgb01(hex_colour: str) -> tuple[float, float, float]:
     h = hex_colour.lstrip("#")
     return tuple(int(h[i:i + 2], 16) / 255.0 for i in (0, 2, 4))  # type: ignore[return-value]

@@ -1,7 +1,10 @@
-"""``locust measure``: the robot as built, from measurements a student takes in minutes."""
+"""``locust measure``: the robot as built, from photos (docs/measure.md) and a kitchen scale
+(docs/hardware.md)."""
 
 from __future__ import annotations
 
+import datetime
+import re
 from pathlib import Path
 
 import click
@@ -11,12 +14,139 @@ from ..fileio import json_text
 from ..options import POSITIVE
 from ..params_cli import robot_options
 
+PIXEL_CONVENTIONS = ("tracker", "opencv")
 TERMS_SHOWN = 3
 
 
 @click.group()
 def measure():
-    """Measure the robot as built (docs/hardware.md, "Measure your robot")."""
+    """Measure the robot as built: its stance from photos (docs/measure.md), its nose load on
+    a kitchen scale (docs/hardware.md)."""
+
+
+def _points(items: tuple[str, ...], convention: str, option: str) -> dict[str, tuple[float, float]]:
+    """``NAME=X,Y`` -> OpenCV pixels (Tracker's are half a pixel further right and down)."""
+    from ..io.trk import TRACKER_TO_OPENCV_PX
+    from ..sim.stickers import STICKERS
+
+    shift = TRACKER_TO_OPENCV_PX if convention == "tracker" else 0.0
+    out = {}
+    for item in items:
+        m = re.fullmatch(r"\s*(\w+)\s*=\s*([-+]?[\d.]+)\s*,\s*([-+]?[\d.]+)\s*", item)
+        if not m or m.group(1) not in STICKERS:
+            raise MeasureError(f"{option} {item!r} is not NAME=X,Y with NAME one of {', '.join(STICKERS)}",
+                               f"e.g. {option} knee=412.5,633")
+        try:
+            out[m.group(1)] = (float(m.group(2)) + shift, float(m.group(3)) + shift)
+        except ValueError:
+            raise MeasureError(f"{option} {item!r}: X and Y must be numbers of pixels",
+                               f"e.g. {option} knee=412.5,633") from None
+    return out
+
+
+@measure.command()
+@click.argument("rest", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("push", type=click.Path(exists=True, dir_okay=False, path_type=Path), required=False)
+@robot_options
+@click.option("--board", default=None, metavar="SPEC",
+              help="The board standing in the leg's plane, as `locust track board` prints it "
+                   "(default aruco:4X4_50:5x4:40:10).")
+@click.option("--point", "points", multiple=True, metavar="NAME=X,Y",
+              help="A sticker's pixel in REST, instead of finding it by colour (nose, tail, axis, crank, knee, "
+                   "foot). Repeatable.")
+@click.option("--push-point", "push_points", multiple=True, metavar="NAME=X,Y",
+              help="The same for PUSH. Repeatable.")
+@click.option("--pixels", type=click.Choice(PIXEL_CONVENTIONS), default="tracker", show_default=True,
+              help="Convention of the given pixels: Tracker's (a pixel's centre at i + 0.5) or OpenCV's (at i).")
+@click.option("--write", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Write the whole robot with the measured values in place (refuses to overwrite).")
+@click.option("--force", is_flag=True, help="With --write: overwrite an existing file.")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@click.option("--draws", type=click.IntRange(20, 5000), default=200, show_default=True,
+              help="Bootstrap draws for the intervals.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed of the bootstrap.")
+def stance(rest, push, preset, config, sets, board, points, push_points, pixels, write, force, as_json, draws,
+           seed):
+    """Fit the robot's stance to a side photo at rest (and one held at the push command).
+
+    REST shows the robot standing at the 0 deg command, PUSH (optional) the robot held up at
+    the push command (`locust pose -30 -30 --port P`), both from the robot's left with the
+    board standing in the plane of the left leg and the six stickers in place (docs/measure.md).
+    The link lengths and the plate are the robot's (--preset, --config, --set).
+
+    \b
+    Examples:
+      locust measure stance rest.jpg push.jpg --preset small --write measured.toml
+      locust measure stance rest.jpg --preset large --point knee=412.5,633
+    """
+    from ..arucoboard import DEFAULT_BOARD, parse_board
+    from ..fileio import check_distinct
+    from ..params import Provenance, resolve_robot, save_robot
+    from .stance import fit_stance, model_servo_give, read_photo
+
+    robot = resolve_robot(preset, config, sets)
+    spec = parse_board(board or DEFAULT_BOARD)
+    if write is not None:
+        if write.exists() and not force:
+            raise MeasureError(f"{write} exists", "choose another path, or add --force to overwrite it")
+        check_distinct({"--write": write}, inputs=[p for p in (rest, push) if p is not None])
+    if push_points and push is None:
+        raise MeasureError("--push-point without a PUSH photo", "give the PUSH photo after REST")
+    photos = [read_photo(rest, spec, _points(points, pixels, "--point"))]
+    if push is not None:
+        photos.append(read_photo(push, spec, _points(push_points, pixels, "--push-point")))
+    result = fit_stance(robot, photos, model_servo_give(robot), draws=draws, seed=seed)
+
+    if write is not None:
+        today = datetime.date.today().isoformat()
+        for key, est in result.values().items():
+            lo, hi = est.ci95
+            robot = robot.with_values({key: est.value}, Provenance(
+                source=f"measured:{rest.name}", uncertainty=est.std, date=today,
+                note=f"95% interval [{lo:.5g}, {hi:.5g}], parametric bootstrap of the pixel noise and the board's "
+                     f"pose ({result.draws} draws); locust measure stance"))
+        save_robot(robot, write)
+    if as_json:
+        out = result.to_json()
+        out["wrote"] = None if write is None else str(write)
+        click.echo(json_text(out), nl=False)
+        return
+    for line in _lines(result, photos):
+        click.echo(line)
+    if write is not None:
+        click.echo(f"wrote {write}")
+
+
+def _lines(result, photos) -> list[str]:
+    from .stance import STANCE_KEYS
+
+    lines = []
+    for ph in photos:
+        given = [n for n, s in ph.sources.items() if s == "given"]
+        worst = max(result.residual_mm[ph.path.name].items(), key=lambda kv: kv[1])
+        lines.append(f"{ph.path.name}: board {len(ph.corners_px)} corners ({ph.corner_sd_px:.2f} px); stickers by "
+                     f"colour{', ' + ', '.join(given) + ' given' if given else ''}; farthest from the fit: "
+                     f"{worst[0]} {worst[1]:.2f} mm")
+    units = {"geometry.crank_start_deg": (1.0, "deg"), "geometry.ground_angle_deg": (1.0, "deg"),
+             "geometry.servo_axis_x_m": (1000.0, "mm")}
+    lines.append(f"{'value':32s} {'measured':>10s}  {'95 % interval':>22s}")
+    for key, est in zip(STANCE_KEYS, result.values().values()):
+        k, unit = units[key]
+        lo, hi = est.ci95
+        lines.append(f"{key + ' (' + unit + ')':32s} {est.value * k:10.2f}  [{lo * k:9.2f}, {hi * k:9.2f}]")
+    est = result.rest_pitch_deg
+    lines.append(f"{'plate pitch at rest (deg)':32s} {est.value:10.2f}  [{est.ci95[0]:9.2f}, {est.ci95[1]:9.2f}]")
+    if result.push_turn_deg is not None:
+        est = result.push_turn_deg
+        same = (est.value < 0) == (result.push_command_deg < 0)
+        lines.append(f"{'crank turn at the push (deg)':32s} {est.value:10.2f}  [{est.ci95[0]:9.2f}, "
+                     f"{est.ci95[1]:9.2f}]  for the {result.push_command_deg:g} deg command"
+                     f"{'' if same else ': the other way than the model turns it'}")
+    lines.append(f"the crank stood at {result.rest_crank_seen_deg:.2f} deg in {photos[0].path.name}; the model's servo "
+                 f"gives {result.servo_give_deg:.2f} deg under the robot's weight, taken off")
+    lines.append(f"intervals: parametric bootstrap, {result.draws} draws (stickers {result.sticker_sd_px:.2f} px, "
+                 f"board corners {result.corner_sd_px:.2f} px)")
+    return lines
 
 
 def _mm(e) -> str:

@@ -23,6 +23,13 @@ from ..tables import nose_load_line, sensitivity_lines, sim_lines, spread_lines
               help="Render an MP4 (offscreen) and write the true marker pixels beside it (<video>.truth.csv).")
 @click.option("--camera", type=click.Choice(["track", "fixed"]), default="track", show_default=True,
               help="For --video: follow the robot, or hold still (for measuring with `locust track`).")
+@click.option("--still", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Render a side photo (PNG) of the robot settled at the 0 deg command, with the board and the "
+                   "stickers `locust measure stance` reads, and their true pixels beside it (<still>.truth.csv).")
+@click.option("--still-push", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="The same of the robot held up at the push command (the same camera).")
+@click.option("--board", default=None, metavar="SPEC",
+              help="For --still: the board beside the robot (default aruco:4X4_50:5x4:40:10).")
 @click.option("--check-convergence", is_flag=True,
               help="Rerun at half the time step and report the relative change.")
 @click.option("--samples", type=click.IntRange(2, 4096), default=None, metavar="N",
@@ -34,7 +41,8 @@ from ..tables import nose_load_line, sensitivity_lines, sim_lines, spread_lines
               help="Move each uncertain value alone to -/+2 sd and report the outcome at each end: the "
                    "values that decide the regime (default: with --samples, when its draws split).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of --samples.")
-def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence, samples, seed, sensitivity):
+def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push, board, check_convergence, samples,
+        seed, sensitivity):
     """Settle the robot on the floor, then run the bang-bang hop schedule.
 
     Every run is audited (non-finite state, loop closure, energy, MuJoCo warnings). A run
@@ -50,6 +58,7 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
       locust sim --preset large --set servo.stall_torque_nm=0.18 --video large.mp4
       locust sim --config calibration/robot.toml --samples 16   # with its spread
       locust sim --preset medium --samples 32 --json     # outcome shares
+      locust sim --preset small --still rest.png --still-push push.png   # for locust measure stance
     """
     from ..api.simulation import SimResult, simulate
     from .run import check_convergence as converge
@@ -60,6 +69,14 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
         from .clip import check_video_path
 
         check_video_path(video)  # fail before simulating, not after
+    if still is not None or still_push is not None:
+        from ..arucoboard import DEFAULT_BOARD, parse_board
+        from .still import check_still_path
+
+        for path in (still, still_push):
+            if path is not None:
+                check_still_path(path)
+        board = parse_board(board or DEFAULT_BOARD)
     try:
         result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed,
                           keep_states=video is not None,  # the video reuses the rollout
@@ -77,6 +94,15 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
         info = result.video(video, camera=camera)
         result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
 
+    if still is not None or still_push is not None:
+        from .still import render_stills
+
+        if not result.valid:
+            raise SimError("not rendering stills of an invalid robot", "fix the reasons listed above first")
+
+        for info in render_stills(robot, still, still_push, board=board):
+            result.notes.append(f"still: {info.path} ({info.pose.kind}, crank {info.pose.crank_deg:.2f} deg from the "
+                                f"ground link); truth: {info.truth_path}")
     spread, sens = getattr(result, "spread", None), getattr(result, "sensitivity", None)
     if as_json:
         click.echo(json_text(result.to_json()), nl=False)

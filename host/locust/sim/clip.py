@@ -107,6 +107,41 @@ class PoseRenderer:
             self.renderer = None
 
 
+def face_centre_m(model: mujoco.MjModel, data: mujoco.MjData, geom_id: int) -> np.ndarray:
+    """Centre of what the camera sees of a marker posed in ``data``: a disc's camera-facing
+    (+y) face, a sphere's centre."""
+    centre = data.geom_xpos[geom_id].copy()
+    if model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
+        axis = data.geom_xmat[geom_id].reshape(3, 3)[:, 2]
+        centre += np.sign(axis[1]) * axis * float(model.geom_size[geom_id][1])  # the +y face
+    return centre
+
+
+def seen_fraction(model: mujoco.MjModel, data: mujoco.MjData, cam: PinholeCamera, centre_m: np.ndarray,
+                  geom_id: int) -> float:
+    """Share of the marker (a disc or a sphere) ``geom_id`` (as the camera sees it) that no other geom hides.
+
+    Rays go from the camera centre to points spread over what the camera sees of the
+    marker (``_DISC_SAMPLES``): a disc's face, or a sphere's disc across the line of
+    sight; a ray that meets the marker first sees it.
+    """
+    radius = float(model.geom_size[geom_id][0])
+    if model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
+        axes = data.geom_xmat[geom_id].reshape(3, 3)[:, :2].T   # the face's own two axes
+    else:
+        sight = centre_m - cam.position_m
+        sight /= np.linalg.norm(sight)
+        across = np.cross(sight, cam.rotation[1])
+        across /= np.linalg.norm(across)
+        axes = np.vstack([across, np.cross(sight, across)])
+    seen, hit = 0, np.array([-1], dtype=np.int32)
+    for target in centre_m + radius * _DISC_SAMPLES @ axes:
+        ray = target - cam.position_m
+        mujoco.mj_ray(model, data, cam.position_m, ray / np.linalg.norm(ray), None, 1, -1, hit)
+        seen += int(hit[0]) == geom_id
+    return seen / len(_DISC_SAMPLES)
+
+
 # -- one clip: frames, truth rows, sidecars ------------------------------------------
 @dataclass
 class VideoInfo:
@@ -201,38 +236,13 @@ class ClipRecorder:
         self.cameras.append(cam)
 
     def _marker_face_m(self, geom_id: int) -> np.ndarray:
-        """Centre of what the camera sees of a marker: a disc's camera-facing face, a sphere's centre."""
-        centre = self.data.geom_xpos[geom_id].copy()
-        if self.model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
-            axis = self.data.geom_xmat[geom_id].reshape(3, 3)[:, 2]
-            centre += np.sign(axis[1]) * axis * float(self.model.geom_size[geom_id][1])  # the +y face
-        return centre
+        return face_centre_m(self.model, self.data, geom_id)
 
     def _in_image(self, px: tuple[float, float]) -> bool:
         return -0.5 <= px[0] <= self.width - 0.5 and -0.5 <= px[1] <= self.height - 0.5
 
     def _seen_fraction(self, cam: PinholeCamera, centre_m: np.ndarray, geom_id: int) -> float:
-        """Share of the marker (as the camera sees it) that no other geom hides.
-
-        Rays go from the camera centre to points spread over what the camera sees of the
-        marker (``_DISC_SAMPLES``): a disc's face, or a sphere's disc across the line of
-        sight; a ray that meets the marker first sees it.
-        """
-        radius = float(self.model.geom_size[geom_id][0])
-        if self.model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
-            axes = self.data.geom_xmat[geom_id].reshape(3, 3)[:, :2].T   # the face's own two axes
-        else:
-            sight = centre_m - cam.position_m
-            sight /= np.linalg.norm(sight)
-            across = np.cross(sight, cam.rotation[1])
-            across /= np.linalg.norm(across)
-            axes = np.vstack([across, np.cross(sight, across)])
-        seen, hit = 0, np.array([-1], dtype=np.int32)
-        for target in centre_m + radius * _DISC_SAMPLES @ axes:
-            ray = target - cam.position_m
-            mujoco.mj_ray(self.model, self.data, cam.position_m, ray / np.linalg.norm(ray), None, 1, -1, hit)
-            seen += int(hit[0]) == geom_id
-        return seen / len(_DISC_SAMPLES)
+        return seen_fraction(self.model, self.data, cam, centre_m, geom_id)
 
     def truth_csv(self) -> str:
         lines = [(f"# simulated ground truth: MuJoCo render of robot {self.robot_name!r}, camera {self.camera}; "
@@ -364,5 +374,5 @@ def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = Non
     return rec.finish()
 
 
-__all__ = ["MARKERS", "VISIBLE_FRAC", "ClipRecorder", "PoseRenderer", "VideoInfo", "check_video_path", "frame_times_s",
-           "render_video", "sidecar_paths", "validate_size"]
+__all__ = ["MARKERS", "VISIBLE_FRAC", "ClipRecorder", "PoseRenderer", "VideoInfo", "check_video_path", "face_centre_m",
+           "frame_times_s", "render_video", "seen_fraction", "sidecar_paths", "validate_size"]

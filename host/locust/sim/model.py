@@ -372,6 +372,12 @@ def _layout(model: mujoco.MjModel) -> SensorLayout:
 def build(robot: Robot) -> BuiltModel:
     """Compile the robot's model. Raises ``GeometryError`` or ``SimError`` with the reason."""
     spec, asm = build_spec(robot)
+    return compile_spec(spec, asm, robot)
+
+
+def compile_spec(spec: mujoco.MjSpec, asm: Assembly, robot: Robot) -> BuiltModel:
+    """Compile a spec of ``robot``'s model (:func:`build_spec`, perhaps with parts added: a
+    still's stickers, a hand holding the plate) into a :class:`BuiltModel`."""
     try:
         model = spec.compile()
     except ValueError as exc:  # MuJoCo's compiler reports bad values this way
