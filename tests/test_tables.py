@@ -58,12 +58,13 @@ def test_plant_lines_give_the_live_runs_figures_in_mm():
     hop = {"cycle": 1, "distance_m": 0.01858532534294068, "nose_apex_m": 0.0412, "com_apex_m": 0.0101,
            "flight_s": 0.0453}
     summary = {"plant": "mujoco", "distance_m": 0.01858532534294068, "max_nose_height_m": 0.0612, "sim_time_s": 2.829,
-               "valid": True, "reasons": [], "realtime_factor": 23.7, "video_path": None, "frames": 0, "hops": [hop]}
-    assert plant_lines(summary) == ["simulated robot: valid (2.829 s simulated, 23.7x real time)",
+               "valid": True, "reasons": [], "realtime_factor": 23.7, "video_path": None, "frames": 0, "hops": [hop],
+               "outcome": "rears_and_returns"}
+    assert plant_lines(summary) == ["simulated robot: valid, rears and returns (2.829 s simulated, 23.7x real time)",
                                     "  hop  distance mm  nose rise mm  CoM rise mm  flight ms",
                                     "    1        18.59         41.20        10.10       45.3",
                                     "  total distance 18.59 mm; highest nose 61.20 mm above the floor"]
-    bad = {**summary, "valid": False, "reasons": ["aborted"], "hops": []}
+    bad = {**summary, "valid": False, "reasons": ["aborted"], "hops": [], "outcome": None}
     assert plant_lines(bad) == ["simulated robot: INVALID (2.829 s simulated, 23.7x real time)", "  reason: aborted"]
     assert plant_lines({"plant": "record", "commands": 7}) == ["servo commands recorded: 7"]
 

@@ -126,9 +126,10 @@ def plant_lines(summary: dict) -> list[str]:
     if summary.get("plant") != "mujoco":
         return [f"servo commands recorded: {summary.get('commands', 0)}"]
     rtf = summary["realtime_factor"]
-    lines = [f"simulated robot: {verdict(summary['valid'])} ({summary['sim_time_s']:.3f} s simulated, "
+    said = verdict(summary["valid"]) + (f", {outcome_words(summary['outcome'])}" if summary.get("outcome") else "")
+    lines = [f"simulated robot: {said} ({summary['sim_time_s']:.3f} s simulated, "
              f"{rtf:.1f}x real time)" if math.isfinite(rtf) else
-             f"simulated robot: {verdict(summary['valid'])} ({summary['sim_time_s']:.3f} s simulated)"]
+             f"simulated robot: {said} ({summary['sim_time_s']:.3f} s simulated)"]
     lines += [f"{INDENT}reason: {reason}" for reason in summary["reasons"]]
     if summary["valid"]:
         if summary.get("hops"):
