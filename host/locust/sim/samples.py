@@ -3,7 +3,7 @@
 Every value of the robot file that carries an uncertainty (one standard deviation, written
 by ``locust calibrate`` beside the value) is drawn from a normal distribution about it,
 independently; a positive value stays positive (draws below a tenth of it are put there).
-All draws are simulated in one batched ``mujoco.rollout`` and each is audited and summarised
+All draws are simulated in one batched ``mujoco.rollout`` on every core and each is audited and summarised
 like ``locust sim``'s own run; the spread of the valid ones is the prediction's uncertainty.
 """
 
@@ -23,7 +23,6 @@ from .model import build
 from .rollout import Trajectory, simulate_batch
 from .schedule import control_plan
 
-THREADS = 2
 MIN_FRACTION = 0.1      # a positive value's draws are kept above this fraction of it
 
 
@@ -81,7 +80,7 @@ def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 
         except GeometryError:
             builts.append(None)
     ok = [b for b in builts if b is not None]
-    trajs = iter(simulate_batch(ok, plan, keep_states=keep_states, threads=THREADS) if ok else [])
+    trajs = iter(simulate_batch(ok, plan, keep_states=keep_states) if ok else [])
     out: list[Trajectory | None] = []
     for b in builts:
         traj = next(trajs) if b is not None else None
