@@ -29,13 +29,10 @@ from locust.sim.rollout import available_cores
 from locust.sim.samples import draw, sample, uncertain_values
 
 
-def timed(fn, repeat: int):
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
+def timed(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t0, out
 
 
 def one_at_a_time(robots, cycles: int) -> list:
@@ -65,11 +62,11 @@ def main() -> None:
     best = {"batch": math.inf, "one": math.inf, "serial": math.inf}
     spread = serial = None
     for _ in range(args.repeat):
-        t, spread = timed(lambda: sample(robot, n, cycles=cycles), 1)
+        t, spread = timed(lambda: sample(robot, n, cycles=cycles))
         best["batch"] = min(best["batch"], t)
-        t, _ = timed(lambda: sample(robot, 1, cycles=cycles), 1)
+        t, _ = timed(lambda: sample(robot, 1, cycles=cycles))
         best["one"] = min(best["one"], t)
-        t, serial = timed(lambda: one_at_a_time(draw(robot, n), cycles), 1)
+        t, serial = timed(lambda: one_at_a_time(draw(robot, n), cycles))
         best["serial"] = min(best["serial"], t)
 
     same = all((math.isnan(a) and (s is None or not s.valid)) or (s is not None and s.valid and a == s.distance_m)

@@ -214,7 +214,7 @@ class SimResult(_run.SimResult):
 
 
 def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: int = 0,
-             keep_states: bool = True) -> SimResult:
+             keep_states: bool = True, progress=None) -> SimResult:
     """Settle the robot on the floor, run its hop schedule, audit the run and measure the hops.
 
     Parameters
@@ -232,6 +232,8 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
     keep_states : bool, default True
         Keep every step's state for ``trace()`` and ``video()`` (False: the figures only, for
         runs of many cycles).
+    progress : callable, optional
+        ``progress(k)`` as each batch of ``k`` draws is done (``samples``).
 
     Returns
     -------
@@ -261,7 +263,7 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
     if samples and result.valid:
         from ..sim.samples import sample
 
-        result.spread = sample(robot, samples, cycles=cycles, seed=seed)
+        result.spread = sample(robot, samples, cycles=cycles, seed=seed, progress=progress)
     return result
 
 

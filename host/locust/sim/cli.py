@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from contextlib import nullcontext
 from pathlib import Path
 
 import click
@@ -11,6 +12,7 @@ from ..errors import GeometryError, SimError
 from ..fileio import json_text
 from ..params import resolve_robot
 from ..params_cli import robot_options
+from ..progress import progress
 from ..tables import sim_lines, spread_line
 
 
@@ -53,8 +55,10 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
 
         check_video_path(video)  # fail before simulating, not after
     try:
-        result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed,
-                          keep_states=video is not None)  # the video reuses the rollout
+        with progress(length=samples, label=f"{samples} draws") if samples else nullcontext() as bar:
+            result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed,
+                              keep_states=video is not None,  # the video reuses the rollout
+                              progress=bar.update if bar else None)
     except GeometryError as exc:
         if not as_json:
             raise

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,9 +21,10 @@ from ..params import Provenance, Robot, problems, real_keys
 from .audit import audit
 from .hops import summarise
 from .model import build
-from .rollout import Trajectory, simulate_batch
+from .rollout import Trajectory, available_cores, simulate_batch
 from .schedule import control_plan
 
+BATCH_PER_CORE = 4      # draws per core in one rollout call when progress is shown
 MIN_FRACTION = 0.1      # a positive value's draws are kept above this fraction of it
 
 
@@ -68,10 +70,14 @@ def draw(robot: Robot, n: int, seed: int = 0) -> list[Robot]:
 
 
 def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 0,
-                   keep_states: bool = False) -> list[Trajectory | None]:
-    """``n`` draws of ``robot`` simulated in one batch, each audited: a draw's trajectory, or
-    None for a draw outside the parameter limits, whose linkage cannot close, or that fails
-    its audit (as a sweep's design would be an invalid row)."""
+                   keep_states: bool = False, progress: Callable[[int], None] | None = None
+                   ) -> list[Trajectory | None]:
+    """``n`` draws of ``robot`` simulated in batches on every core, each audited: a draw's
+    trajectory, or None for a draw outside the parameter limits, whose linkage cannot close,
+    or that fails its audit (as a sweep's design would be an invalid row).
+
+    With ``progress``, the draws go in batches of :data:`BATCH_PER_CORE` per core, and
+    ``progress(k)`` is called as each batch of ``k`` draws is done (one call otherwise)."""
     plan = control_plan(robot.schedule, robot.solver, cycles)
     builts = []
     for r in draw(robot, n, seed):
@@ -80,7 +86,15 @@ def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 
         except GeometryError:
             builts.append(None)
     ok = [b for b in builts if b is not None]
-    trajs = iter(simulate_batch(ok, plan, keep_states=keep_states) if ok else [])
+    if progress and len(ok) < n:
+        progress(n - len(ok))
+    size = BATCH_PER_CORE * available_cores() if progress else max(len(ok), 1)
+    done: list[Trajectory] = []
+    for first in range(0, len(ok), size):
+        done += simulate_batch(ok[first:first + size], plan, keep_states=keep_states)
+        if progress:
+            progress(len(ok[first:first + size]))
+    trajs = iter(done)
     out: list[Trajectory | None] = []
     for b in builts:
         traj = next(trajs) if b is not None else None
@@ -88,10 +102,11 @@ def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 
     return out
 
 
-def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0) -> Samples:
+def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0,
+           progress: Callable[[int], None] | None = None) -> Samples:
     """Simulate ``n`` draws of ``robot`` in one batch; their distances and nose heights."""
     dist, nose = [], []
-    for traj in simulate_draws(robot, n, cycles, seed):
+    for traj in simulate_draws(robot, n, cycles, seed, progress=progress):
         summary = summarise(traj) if traj is not None else None
         dist.append(summary.distance_m if summary else math.nan)
         nose.append(summary.max_nose_height_m if summary else math.nan)
