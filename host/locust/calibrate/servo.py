@@ -330,7 +330,7 @@ def simulate_deg(model: mujoco.MjModel, servos: list[Servo], timings: list[Timin
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state0 = np.zeros(mujoco.mj_stateSize(model, spec))
     mujoco.mj_getState(model, data, state0, spec)
-    models = [with_servo(model, s) for s in servos]
+    models = [with_servo(model, s, scratch=data) for s in servos]
     state, _, _ = rollout_threads(models, np.repeat(state0[None], len(servos), axis=0), ctrl)
     qpos_col = 1  # FULLPHYSICS: time, qpos, qvel, ...
     q = np.concatenate([np.full((len(servos), 1), math.radians(angle0_deg)), state[:, :, qpos_col]], axis=1)
@@ -378,7 +378,7 @@ def simulate_rate(model: mujoco.MjModel, servos: list[Servo], delays_s: list[flo
     unique = list(dict.fromkeys(servos))
     which = [unique.index(s) for s in servos]
     nsim = len(unique)
-    models = [m for s in unique for m in [with_servo(model, s)] * nkind]
+    models = [m for s in unique for m in [with_servo(model, s, scratch=data)] * nkind]
     state, _, _ = rollout_threads(models, np.tile(state0, (nsim, 1)), np.tile(ctrl, (nsim, 1, 1)))
     qvel_col = 1 + model.nq
     v = np.concatenate([np.zeros((nsim * nkind, 1)), state[:, :, qvel_col]], axis=1).reshape(nsim, nkind, -1)
