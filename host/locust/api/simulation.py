@@ -234,7 +234,7 @@ class SimResult(_run.SimResult):
 
 
 def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: int = 0,
-             keep_states: bool = True, sensitivity: bool | None = None) -> SimResult:
+             keep_states: bool = True, progress=None, sensitivity: bool | None = None) -> SimResult:
     """Settle the robot on the floor, run its hop schedule, audit the run and measure the hops.
 
     Parameters
@@ -254,6 +254,8 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
     keep_states : bool, default True
         Keep every step's state for ``trace()`` and ``video()`` (False: the figures only, for
         runs of many cycles).
+    progress : callable, optional
+        ``progress(k)`` as each batch of ``k`` draws is done (``samples``).
     sensitivity : bool, optional
         Which measured values decide the outcome: each uncertain value alone at -/+ 2 sd
         (``result.sensitivity``, :func:`locust.sim.sensitivity.outcome_sensitivity`). True:
@@ -294,7 +296,7 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
     if samples and result.valid:
         from ..sim.samples import sample
 
-        result.spread = sample(robot, samples, cycles=cycles, seed=seed)
+        result.spread = sample(robot, samples, cycles=cycles, seed=seed, progress=progress)
     mixed = result.spread is not None and max(o.share for o in result.spread.outcomes.values()) < 1.0
     if result.valid and (sensitivity or (sensitivity is None and mixed)):
         from ..sim.sensitivity import outcome_sensitivity

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from contextlib import nullcontext
 from pathlib import Path
 
 import click
@@ -11,6 +12,7 @@ from ..errors import GeometryError, SimError
 from ..fileio import json_text
 from ..params import resolve_robot
 from ..params_cli import robot_options
+from ..progress import progress
 from ..tables import nose_load_line, sensitivity_lines, sim_lines, spread_lines
 
 
@@ -78,9 +80,11 @@ def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push,
                 check_still_path(path)
         board = parse_board(board or DEFAULT_BOARD)
     try:
-        result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed,
-                          keep_states=video is not None,  # the video reuses the rollout
-                          sensitivity=sensitivity)
+        with progress(length=samples, label=f"{samples} draws") if samples else nullcontext() as bar:
+            result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed,
+                              keep_states=video is not None,  # the video reuses the rollout
+                              progress=bar.update if bar else None,
+                              sensitivity=sensitivity)
     except GeometryError as exc:
         if not as_json:
             raise

@@ -20,7 +20,7 @@ from .hops import summarise
 from .model import build
 from .outcome import classify
 from .rollout import simulate_batch
-from .samples import MIN_FRACTION, THREADS, uncertain_values
+from .samples import MIN_FRACTION, uncertain_values
 from .schedule import control_plan
 
 K_SD = 2.0
@@ -66,7 +66,7 @@ def _outcomes(robots: list[Robot], cycles: int | None) -> list[str | None]:
             builts.append(None)
     ok = [b for b in builts if b is not None]
     plan = control_plan(robots[0].schedule, robots[0].solver, cycles)
-    trajs = iter(simulate_batch(ok, plan, threads=THREADS) if ok else [])
+    trajs = iter(simulate_batch(ok, plan) if ok else [])
     out: list[str | None] = []
     for b in builts:
         traj = next(trajs) if b is not None else None
