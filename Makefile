@@ -36,6 +36,7 @@ test-all: install sysdeps
 
 bench: install
 	$(PY) bench/sim_speed.py
+	$(PY) bench/robust_speed.py
 	$(PY) bench/track_speed.py
 	$(PY) bench/track_hard.py
 	$(PY) bench/sweep_speed.py --skip-grid

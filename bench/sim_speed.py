@@ -4,10 +4,11 @@ The notebook's method is its Part 2 loop as written (per-step Python, ``data.sit
 lookups, Euler at dt = 1e-4 s, its own model). locust's is ``locust.sim.run.run`` on the
 ``seed`` preset (the hobby servo of docs/servo.md) at the package default, and a few other
 routes on the same model so that what each choice buys, and costs in accuracy, is visible.
-Every route runs the seed design for 3 hops on one core; all timings are taken in this one
-run, interleaved, best of ``--repeat``. Accuracy: each route against itself at half the step
-(the convergence check ``locust sim --check-convergence`` makes) and against the converged
-reference (rk4 at 1/8 of the default step).
+Every route runs the seed design for 3 hops on one core, and then each preset (seed, small,
+medium, large) at its own default; all timings are taken in this one run, best of
+``--repeat``. Accuracy: each route against itself at half the step (the convergence check
+``locust sim --check-convergence`` makes) and against the converged reference (rk4 at 1/8 of
+the default step).
 
 Last line: ``sim speedup <N>x at deviation <D>% (<M> mm per hop) vs dt/2``: N is the
 notebook loop's time over the package default's, D and M the default's distance change at
@@ -30,6 +31,7 @@ from locust.sim.run import run
 from notebook_reference import notebook_run
 
 CYCLES = 3
+PRESETS = ("seed", "small", "medium", "large")
 ROUTES = [   # (name, solver overrides); the first is the package default
     ("locust default (rk4)", {}),
     ("implicitfast, same step", {"solver.integrator": "implicitfast"}),
@@ -65,6 +67,7 @@ def main() -> None:
 
     default = preset("seed")
     ref = run(default.with_values({"solver.timestep_s": default.solver.timestep_s / 8}), cycles=CYCLES)
+    print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"reference: seed, rk4 at {default.solver.timestep_s / 8:g} s: {ref.distance_m * 1000:.3f} mm "
           f"({ref.distance_m * 1000 / CYCLES:.3f} mm per hop), nose {ref.max_nose_height_m * 1000:.3f} mm")
     nb_t, _ = timed(lambda: notebook_run(dt=1e-4, num_hops=CYCLES), args.repeat)
@@ -83,6 +86,19 @@ def main() -> None:
         valid = "" if r.valid else "  INVALID: " + "; ".join(r.reasons)
         print(f"{name:34s} {robot.solver.timestep_s:8.1e} {t:7.3f} {nb_t / t:7.2f} {r.distance_m * 1000 / CYCLES:7.3f} "
               f"{dev_half:7.2f} {mm_half:11.3f} {dev_ref:6.2f}{valid}", flush=True)
+    # every preset at its own default (its leg set's step), against the same notebook time
+    print(f"{'preset (its default)':34s} {'dt_s':>8s} {'time_s':>7s} {'speedup':>7s} {'mm/hop':>7s} "
+          f"{'dt/2 %':>7s} {'dt/2 mm/hop':>11s} {'nose dt/2 mm':>12s}")
+    for name in PRESETS:
+        robot = preset(name)
+        t, r = timed(lambda robot=robot: run(robot, cycles=CYCLES), args.repeat)
+        half = run(robot, cycles=CYCLES, timestep_s=robot.solver.timestep_s / 2)
+        dev_half = abs(r.distance_m - half.distance_m) / abs(half.distance_m) * 100
+        mm_half = abs(r.distance_m - half.distance_m) * 1000 / CYCLES
+        nose_mm = abs(r.max_nose_height_m - half.max_nose_height_m) * 1000
+        print(f"{name + ' (' + robot.solver.integrator + ')':34s} {robot.solver.timestep_s:8.1e} {t:7.3f} "
+              f"{nb_t / t:7.2f} {r.distance_m * 1000 / CYCLES:7.3f} {dev_half:7.2f} {mm_half:11.3f} "
+              f"{nose_mm:12.3f}", flush=True)
     _, speedup, dev, mm = rows[0]
     print(f"sim speedup {speedup:.1f}x at deviation {dev:.2f}% ({mm:.3f} mm per hop) vs dt/2")
 

@@ -5,6 +5,7 @@ on SYNTHETIC steps (known truth) and on the real SG90 recordings in ../shared/da
 from __future__ import annotations
 
 import dataclasses
+import io
 import math
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from locust.calibrate.gyro_log import looks_like_gyro_log, parse_gyro_log, read_
 from locust.calibrate.recordings import read_table
 from locust.errors import CalibrationError
 from locust.params import Servo
+from locust.progress import Progress
 
 SG90 = S.ServoTruth().servo   # the synthetic recordings' SG90 (the AA swing's fit alone)
 PRESET = Servo()              # the presets' SG90: the AA swing and the gyro steps together
@@ -92,17 +94,51 @@ def test_synthetic_step_other_load_and_frame_rate_is_recovered():
     assert fit.rms_half_step[0] == pytest.approx(fit.rms_residual_deg, rel=0.02)   # converged in dt
 
 
-def test_two_loads_give_the_stall_torque():
-    """SYNTHETIC: the same SG90 on two loads; no stall torque given, all four identified."""
+def test_two_loads_give_the_stall_torque(monkeypatch):
+    """SYNTHETIC: the same SG90 on two loads; no stall torque given, all four identified. Its
+    progress, on a clock that counts the physics steps simulated (the fit's work, whatever
+    the machine's load), gives a time left within a factor of 2 from a quarter on."""
     light = S.ServoTruth()
     heavy = dataclasses.replace(light, inertia_kgm2=1e-3, half_period_s=1.2)
-    fit = SV.fit_servo([recording(light, 4), recording(heavy, 5)], kv_nms_per_rad=0.0)
+    steps = [0.0]
+    simulate = SV.rollout_threads
+
+    def counted(models, state, control, threads=None):
+        steps[0] += control.shape[0] * control.shape[1]
+        return simulate(models, state, control, threads)
+
+    monkeypatch.setattr(SV, "rollout_threads", counted)
+    calls: list[tuple[float, int]] = []
+    fit = SV.fit_servo([recording(light, 4), recording(heavy, 5)], kv_nms_per_rad=0.0,
+                       progress=lambda n: calls.append((steps[0], n)))
     assert all(fit.identifiable.values()), fit.notes
     for name in ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "stall_torque_nm"):
         true = getattr(SG90, name)
         est = fit.estimates[name]
         assert est.value == pytest.approx(true, rel=0.05), name
         assert abs(est.value - true) < 4 * est.std, name
+    assert_time_left_within_twice(calls, steps[0], SV.progress_steps(2))
+
+
+def assert_time_left_within_twice(calls: list[tuple[float, int]], end: float, length: int) -> None:
+    """A fit's progress calls (clock reading, steps), replayed on a bar and read 1000 times
+    along the clock as a display would: every time left shown from a quarter of the steps on
+    is within a factor of 2 of what the fit really took to finish (the steps add up to the length)."""
+    assert sum(n for _, n in calls) == length
+    clock = [calls[0][0]]
+    bar = Progress(length=length, file=io.StringIO(), tty=False, clock=lambda: clock[0])
+    checked, k = 0, 0
+    for now in np.linspace(calls[0][0], end, 1000):
+        while k < len(calls) and calls[k][0] <= now:
+            clock[0] = calls[k][0]
+            bar.update(calls[k][1])
+            k += 1
+        clock[0] = now
+        eta, left = bar.eta_s(), end - now
+        if length / 4 <= bar.pos < length and eta is not None and left > 0.01 * end:
+            assert left / 2 <= eta <= 2 * left, (bar.pos, eta, left)
+            checked += 1
+    assert checked > 0
 
 
 def test_stalled_servo_gives_stall_torque_not_kp():

@@ -78,3 +78,36 @@ def test_items_are_iterated_and_counted():
                                            (3725, "1:02:05"), (-3, "0:00")])
 def test_durations(seconds, text):
     assert format_duration(seconds) == text
+
+
+class _Out(io.StringIO):
+    def __init__(self, tty: bool):
+        super().__init__()
+        self.tty = tty
+
+    def isatty(self) -> bool:
+        return self.tty
+
+
+@pytest.mark.parametrize("tty", [False, True])
+def test_the_demo_shows_a_childs_progress_and_keeps_all_its_output(tty):
+    """A demo stage's command runs in a child whose output goes to a log: its progress lines
+    (every ~10 s, a pipe being no terminal) are shown as they come, nothing else is."""
+    from locust.demo import relay_progress
+
+    clock, child = Clock(), io.StringIO()
+    with Progress(length=30, label="fitting hops", file=child, tty=False, clock=clock) as bar:
+        for _ in range(30):
+            clock.t += 1.0
+            bar.update(1)
+    lines = ["loading robot.toml\n", *child.getvalue().splitlines(keepends=True), "wrote robot.toml\n"]
+    out = _Out(tty)
+    assert relay_progress(iter(lines), out) == "".join(lines)
+    shown = out.getvalue()
+    assert "robot.toml" not in shown
+    progress_lines = child.getvalue().splitlines()
+    assert len(progress_lines) == 3          # at 10, 20 and 30 s
+    if tty:
+        assert shown == "".join("\r\x1b[K      " + p for p in progress_lines) + "\n"
+    else:
+        assert shown.splitlines() == ["      " + p for p in progress_lines]

@@ -4,12 +4,13 @@ result's own, in mm, to the printed precision (0.005 mm)."""
 import math
 import re
 
+import pytest
 from click.testing import CliRunner
 
 from locust.cli import cli
 from locust.params import preset
 from locust.sim.run import run
-from locust.tables import mm, plant_lines, sim_lines, table
+from locust.tables import mean_sd, mm, plant_lines, sim_lines, table
 
 ROUNDING_MM = 0.005     # two decimals
 
@@ -25,7 +26,7 @@ def test_sim_table_is_the_results_own_numbers_in_mm():
     res = CliRunner().invoke(cli, ["sim", "--preset", "seed", "--cycles", "3"])
     assert res.exit_code == 0, res.output
     lines = res.output.splitlines()
-    assert lines[0].startswith("seed: valid (3 cycles, time step 0.001 s")
+    assert lines[0].startswith(f"seed: valid, {r.outcome.replace('_', ' ')} (3 cycles, time step 0.001 s")
     rows = _rows(lines, "hop  distance mm  nose rise mm  CoM rise mm  flight ms")
     assert [int(row[0]) for row in rows] == [1, 2, 3]
     for row, hop in zip(rows, r.hops, strict=True):
@@ -62,11 +63,23 @@ def test_plant_lines_give_the_live_runs_figures_in_mm():
     hop = {"cycle": 1, "distance_m": 0.01858532534294068, "nose_apex_m": 0.0412, "com_apex_m": 0.0101,
            "flight_s": 0.0453}
     summary = {"plant": "mujoco", "distance_m": 0.01858532534294068, "max_nose_height_m": 0.0612, "sim_time_s": 2.829,
-               "valid": True, "reasons": [], "realtime_factor": 23.7, "video_path": None, "frames": 0, "hops": [hop]}
-    assert plant_lines(summary) == ["simulated robot: valid (2.829 s simulated, 23.7x real time)",
+               "valid": True, "reasons": [], "realtime_factor": 23.7, "video_path": None, "frames": 0, "hops": [hop],
+               "outcome": "rears_and_returns"}
+    assert plant_lines(summary) == ["simulated robot: valid, rears and returns (2.829 s simulated, 23.7x real time)",
                                     "  hop  distance mm  nose rise mm  CoM rise mm  flight ms",
                                     "    1        18.59         41.20        10.10       45.3",
                                     "  total distance 18.59 mm; highest nose 61.20 mm above the floor"]
-    bad = {**summary, "valid": False, "reasons": ["aborted"], "hops": []}
+    bad = {**summary, "valid": False, "reasons": ["aborted"], "hops": [], "outcome": None}
     assert plant_lines(bad) == ["simulated robot: INVALID (2.829 s simulated, 23.7x real time)", "  reason: aborted"]
     assert plant_lines({"plant": "record", "commands": 7}) == ["servo commands recorded: 7"]
+
+
+@pytest.mark.parametrize("mean_m, sd_m, text", [
+    (-0.0671, 0.0104, "-67 ± 10"),          # sd to two figures, the mean to the same place
+    (0.0133, 0.0096, "13.3 ± 9.6"),
+    (0.1238, 0.00097, "123.80 ± 0.97"),
+    (0.0082, float("nan"), "8.2"),          # one draw: no sd
+    (float("nan"), float("nan"), "nan"),
+])
+def test_mean_sd_keeps_sensible_digits(mean_m, sd_m, text):
+    assert mean_sd(mean_m, sd_m) == text

@@ -99,6 +99,29 @@ def recording_truth(paths: list[Path]) -> dict[str, float]:
     return truth
 
 
+# a progress line (locust.progress) always says how long it has run
+PROGRESS_MARK = " elapsed"
+
+
+def relay_progress(lines, out) -> str:
+    """All of a child command's output (``lines``), returned whole; its progress lines, which
+    it prints every ~10 s off a terminal, shown on ``out`` as they come, indented under the
+    stage (on a terminal, redrawn in place)."""
+    tty = out.isatty()
+    kept, shown = [], False
+    for line in lines:
+        kept.append(line)
+        if PROGRESS_MARK in line:
+            text = "      " + line.strip()
+            out.write("\r\x1b[K" + text if tty else text + "\n")
+            out.flush()
+            shown = True
+    if tty and shown:
+        out.write("\n")
+        out.flush()
+    return "".join(kept)
+
+
 class Demo:
     """Runs ``locust`` commands in this process, logging each and timing each stage."""
 
@@ -119,14 +142,15 @@ class Demo:
         self.steps += 1
         log = self.logs / f"{self.steps:02d}-{args[0]}{'-' + args[1] if args[0] == 'calibrate' else ''}.log"
         cmd = [sys.executable, "-m", "locust.cli", *args]
-        proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                              text=True, env={**os.environ, **self.env})
-        atomic_write_text(log, f"$ locust {' '.join(args)}\n{proc.stdout}")
+        with subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                              text=True, env={**os.environ, **self.env}) as proc:
+            output = relay_progress(proc.stdout, self.stderr)
+        atomic_write_text(log, f"$ locust {' '.join(args)}\n{output}")
         if proc.returncode != 0:
-            tail = "\n".join("    " + ln for ln in proc.stdout.strip().splitlines()[-6:])
+            tail = "\n".join("    " + ln for ln in output.strip().splitlines()[-6:])
             raise ReportError(f"demo stopped: `locust {' '.join(args)}` failed (exit {proc.returncode}):\n{tail}",
                               f"its whole output is in {log}")
-        return proc.stdout
+        return output
 
     def expect(self, *paths: Path) -> None:
         """The files the last command should have written; a command that exits 0 without them

@@ -1,8 +1,10 @@
 """Progress on stderr for long work: a bar on a terminal, a plain line every ~10 s elsewhere
 (logs, pipes, CI), so a long fit is never silent.
 
-The time left is the work left over the rate measured since the first step finished (the
-setup before it is no guide to the rest), shown only once that rate rests on at least
+The time left is the work left at the rate measured from the first step finished (the setup
+before it is no guide to the rest) to the latest, less the time since the latest: it counts
+down through a long step instead of growing as if the work had slowed (a fit's last solver
+iteration can take most of its run). It is shown only once that rate rests on at least
 :data:`ETA_MIN_STEPS` steps and :data:`ETA_MIN_S` seconds.
 """
 
@@ -49,19 +51,22 @@ class Progress:
         self.pos = 0
         self.start = clock()
         self._first: tuple[float, int] | None = None   # (time, pos) when the first step finished
+        self._latest_s = self.start                      # when the latest step finished
         self._last_shown = self.start if not self.tty else -float("inf")
         self._drawn = False
 
     # -- what is shown -------------------------------------------------------------------
     def eta_s(self) -> float | None:
-        """Seconds left at the rate measured since the first step, or None until it means something."""
+        """Seconds left at the rate measured from the first step to the latest, less the time
+        since the latest; None until that rate means something."""
         if self.length is None or self._first is None:
             return None
         t0, p0 = self._first
-        steps, spent = self.pos - p0, self.clock() - t0
+        steps, spent = self.pos - p0, self._latest_s - t0
         if steps < ETA_MIN_STEPS or spent < ETA_MIN_S:
             return None
-        return max(self.length - self.pos, 0) * spent / steps
+        left = max(self.length - self.pos, 0) * spent / steps - (self.clock() - self._latest_s)
+        return max(left, 0.0)
 
     def line(self) -> str:
         parts = [self.label] if self.label else []
@@ -96,8 +101,9 @@ class Progress:
     # -- the click.progressbar interface ------------------------------------------------
     def update(self, n_steps: int = 1, current_item: Any = None) -> None:
         self.pos += n_steps
+        self._latest_s = self.clock()
         if self._first is None and self.pos > 0:
-            self._first = (self.clock(), self.pos)
+            self._first = (self._latest_s, self.pos)
         self._show()
 
     def __enter__(self) -> Progress:

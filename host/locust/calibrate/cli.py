@@ -261,7 +261,7 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
                                "leave them out for t_s,angle_deg,command_deg recordings and gyro logs")
     from ..api.calibration import fit_servo_recordings
 
-    with progress(length=3 * 60, label="fitting servo") as bar:
+    with progress(length=S.progress_steps(len(recordings)), label="fitting servo") as bar:
         facade_fit = fit_servo_recordings(recordings, stall_torque_nm, kv_nms_per_rad=kv_nms_per_rad, fit_kv=fit_kv,
                                           progress=bar.update)
     fit = facade_fit.result

@@ -27,7 +27,7 @@ Both are fitted and reported; neither is a property of the servo, and neither is
 to ``robot.toml``.
 
 All candidates of a solver iteration are simulated at once (``mujoco.rollout``, one model
-per candidate) and the error, each recording's divided by its own RMS, is minimised with
+per candidate, on every core) and the error, each recording's divided by its own RMS, is minimised with
 MuJoCo's own least-squares solver (``mujoco.minimize.least_squares``) from the best few
 points of a batched grid. Standard errors come from the residual Jacobian at the optimum
 (cluster-robust over the steps when there are enough of them); a parameter is reported *not
@@ -45,10 +45,11 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-from mujoco import minimize, rollout
+from mujoco import minimize
 
 from ..errors import CalibrationError
 from ..params import GRAVITY_M_PER_S2, Servo
+from ..sim.rollout import rollout_threads
 from ..sim.servo import configure, with_servo
 from .curves import Curves
 from .fitstats import Estimate, cluster_covariance, covariance, linear_shift
@@ -74,6 +75,13 @@ RATE_PRE_SAMPLES = 2      # ... and from this many samples before it (at rest)
 # step a cluster (fitstats.cluster_covariance); with fewer, s^2 (J^T J)^-1.
 CLUSTERS_PER_PARAMETER = 2
 STARTS = 2                # solver runs from the best points of the grid (distinct armatures)
+MAX_ITER = 60             # iterations of one solver run at most
+EXPECTED_ITERATIONS = 15  # what a run takes, for progress until one has run (both SG90s: 43 in 3 runs)
+# the solver's regularisation grows by this factor after each rejected step (MuJoCo's default
+# 10**0.1): at the optimum, where every step is rejected, a run ends after a few dozen single
+# simulations instead of about 140 (both SG90 recordings: the same values to 6 digits, 32 -> 21 s
+# of CPU)
+MU_FACTOR = 10 ** 0.5
 FD_STEP = 1e-6
 
 
@@ -295,6 +303,13 @@ def simulate_deg(model: mujoco.MjModel, servos: list[Servo], timings: list[Timin
     by the rounding. The simulated angle is then continuous in the timing (a saturated servo
     would otherwise not notice an edge moving inside one step), at no cost in steps.
     """
+    # candidates alike in servo and timing (a Jacobian's columns of another recording's
+    # variables) share one simulation
+    keys = list(zip(servos, timings))
+    unique = list(dict.fromkeys(keys))
+    if len(unique) < len(keys):
+        sims = simulate_deg(model, [k[0] for k in unique], [k[1] for k in unique], rec, angle0_deg, t_out)
+        return sims[[unique.index(k) for k in keys]]
     t, u = rec.t_s, rec.command_deg
     t_out = t if t_out is None else np.asarray(t_out, dtype=float)
     dt = model.opt.timestep
@@ -315,8 +330,8 @@ def simulate_deg(model: mujoco.MjModel, servos: list[Servo], timings: list[Timin
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state0 = np.zeros(mujoco.mj_stateSize(model, spec))
     mujoco.mj_getState(model, data, state0, spec)
-    models = [with_servo(model, s) for s in servos]
-    state, _ = rollout.rollout(models, data, np.repeat(state0[None], len(servos), axis=0), ctrl)
+    models = [with_servo(model, s, scratch=data) for s in servos]
+    state, _, _ = rollout_threads(models, np.repeat(state0[None], len(servos), axis=0), ctrl)
     qpos_col = 1  # FULLPHYSICS: time, qpos, qvel, ...
     q = np.concatenate([np.full((len(servos), 1), math.radians(angle0_deg)), state[:, :, qpos_col]], axis=1)
     grid = t[0] + dt * np.arange(nstep + 1)
@@ -338,22 +353,39 @@ def simulate_rate(model: mujoco.MjModel, servos: list[Servo], delays_s: list[flo
              else [np.asarray(row, dtype=float) for row in t_out])
     span = max(float(a.max()) for a in after) - min(0.0, min(delays_s))
     nstep = math.ceil(span / dt) + 2
-    nwin, ncand = len(wins), len(servos)
+    # without a weight to lift, a step's response depends only on its size, and a step down is
+    # a step up mirrored: each size is simulated once, from 0, and read with its sign
+    # (exact for a symmetric clamp and damping; with a weight, each step from where it starts)
+    steps = [(u[e - 1], u[e]) for e, _, _ in wins]
+    if rec.rig.gravity_moment_nm == 0:
+        sign = [1.0 if b > a else -1.0 for a, b in steps]
+        steps = [(0.0, abs(b - a)) for a, b in steps]
+    else:
+        sign = [1.0] * len(steps)
+    kinds = list(dict.fromkeys(steps))
+    of_window = [kinds.index(st) for st in steps]
+    nkind = len(kinds)
     data = mujoco.MjData(model)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     size = mujoco.mj_stateSize(model, spec)
-    state0 = np.zeros((nwin, size))
-    for w, (e, _, _) in enumerate(wins):
-        data.qpos[0], data.qvel[0] = math.radians(u[e - 1]), 0.0
+    state0 = np.zeros((nkind, size))
+    for w, (start, _) in enumerate(kinds):
+        data.qpos[0], data.qvel[0] = math.radians(start), 0.0
         mujoco.mj_getState(model, data, state0[w], spec)
-    ctrl = np.repeat(np.radians([u[e] for e, _, _ in wins])[:, None, None], nstep, axis=1)
-    models = [m for s in servos for m in [with_servo(model, s)] * nwin]
-    state, _ = rollout.rollout(models, data, np.tile(state0, (ncand, 1)), np.tile(ctrl, (ncand, 1, 1)))
+    ctrl = np.repeat(np.radians([end for _, end in kinds])[:, None, None], nstep, axis=1)
+    # the delay only moves where the response is read: candidates that differ in it alone
+    # (a Jacobian's timing and gain columns, the grid's delays) share one simulation
+    unique = list(dict.fromkeys(servos))
+    which = [unique.index(s) for s in servos]
+    nsim = len(unique)
+    models = [m for s in unique for m in [with_servo(model, s, scratch=data)] * nkind]
+    state, _, _ = rollout_threads(models, np.tile(state0, (nsim, 1)), np.tile(ctrl, (nsim, 1, 1)))
     qvel_col = 1 + model.nq
-    v = np.concatenate([np.zeros((ncand * nwin, 1)), state[:, :, qvel_col]], axis=1).reshape(ncand, nwin, -1)
+    v = np.concatenate([np.zeros((nsim * nkind, 1)), state[:, :, qvel_col]], axis=1).reshape(nsim, nkind, -1)
+    v = v[:, of_window] * np.array(sign)[None, :, None]
     grid = dt * np.arange(nstep + 1)
     out = []
-    for c, delay in enumerate(delays_s):
+    for c, delay in zip(which, delays_s):
         parts = [np.where(a > delay, np.interp(a - delay, grid, v[c, w]), 0.0) for w, a in enumerate(after)]
         out.append(np.concatenate(parts))
     return np.array(out)
@@ -494,18 +526,34 @@ class _Residual:
 def _solve(residual: _Residual, max_iter: int, progress: Callable[[int], None] | None) -> tuple[np.ndarray, int]:
     """Least squares from each grid start, the best kept; with several recordings, each then
     weighed by its own noise and the best polished. Returns (x, iterations)."""
+    # Progress: each run is max_iter steps, an iteration worth max_iter / (the iterations the
+    # run before took; EXPECTED_ITERATIONS for the first), never past its run's end until it
+    # ends; a run that ends early fills its share then. A bar's rate is then about a run's
+    # time, and its time left the runs still to go (tests/test_calibrate_servo.py).
+    shown = [0, EXPECTED_ITERATIONS]   # steps shown in this run, iterations the last run took
+
     def on_iter(trace):
         if progress:
-            progress(1)
+            step = min(max(1, round(max_iter / shown[1])), max_iter - 1 - shown[0])
+            if step > 0:
+                shown[0] += step
+                progress(step)
 
     def least_squares(x0):
         x, trace = minimize.least_squares(x0, residual, bounds=bounds, max_iter=max_iter, verbose=0,
-                                          iter_callback=on_iter, eps=FD_STEP, xtol=1e-8, gtol=1e-10)
+                                          iter_callback=on_iter, eps=FD_STEP, xtol=1e-8, gtol=1e-10,
+                                          mu_factor=MU_FACTOR)
+        if progress:
+            progress(max_iter - shown[0])
+        shown[:] = [0, max(len(trace), 1)]
         return np.asarray(x).ravel(), len(trace)
 
     bounds = residual.layout.bounds()
     best, best_cost, iterations = None, math.inf, 0
-    for x0 in _grid_starts(residual.recs, residual.layout, residual, bounds):
+    starts = _grid_starts(residual.recs, residual.layout, residual, bounds)
+    if progress and len(starts) < STARTS:   # fewer distinct starts than planned
+        progress(max_iter * (STARTS - len(starts)))
+    for x0 in starts:
         x, n = least_squares(x0)
         iterations += n
         cost = float(np.sum(residual(x.reshape(-1, 1)) ** 2))
@@ -517,6 +565,12 @@ def _solve(residual: _Residual, max_iter: int, progress: Callable[[int], None] |
         x, n = least_squares(x)
         iterations += n
     return x, iterations
+
+
+def progress_steps(n_recordings: int, max_iter: int = MAX_ITER) -> int:
+    """Steps that :func:`fit_servo`'s ``progress`` reports in all: ``max_iter`` per solver run,
+    one per start and a polish with several recordings (see ``_solve``)."""
+    return (STARTS + (n_recordings > 1)) * max_iter
 
 
 def _nuisance_values(layout: _Layout, timings: list[Timing], gains: list[float | None]) -> tuple[list, list]:
@@ -623,7 +677,7 @@ def _convergence_notes(recs: list[Recording], per_rec: list[float], rms_half: li
 
 
 def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None, *,
-              kv_nms_per_rad: float | None = None, max_iter: int = 60,
+              kv_nms_per_rad: float | None = None, max_iter: int = MAX_ITER,
               progress: Callable[[int], None] | None = None) -> ServoFit:
     """Identify the servo from one or more recordings (angle or rate); see the module docstring.
     ``stall_torque_nm`` and ``kv_nms_per_rad``, when given, are held at that value."""

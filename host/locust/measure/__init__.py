@@ -1,5 +1,6 @@
-"""Measuring the robot as built from photos (``locust measure``).
+"""Measuring the robot as built (``locust measure``).
 
 ``stance.py``: the stance from side photos with a board and stickers (``measure stance``);
-``cli.py``: the command group.
+``nose_load.py``: the servo axis's place along the plate (and the plate's mass) from the
+nose's weight on a kitchen scale (``measure nose-load``); ``cli.py``: the command group.
 """

@@ -21,6 +21,7 @@ class Hop:
     nose_apex_m: float           # highest nose point above standing nose height
     com_apex_m: float            # highest centre of mass above standing height
     flight_s: float              # longest time with no part of the robot on the floor
+    end_turn_deg: float = 0.0    # plate pitch at the cycle's end less its standing pitch (nose up +)
 
 
 @dataclass(frozen=True)
@@ -31,6 +32,7 @@ class HopSummary:
     standing_nose_m: float
     standing_com_m: float
     end_nose_rise_m: float       # nose height at the end of the run above its standing height
+    end_turn_deg: float = 0.0    # plate pitch at the end of the run less its standing pitch (nose up +)
 
 
 def _longest_run(mask: np.ndarray) -> int:
@@ -41,6 +43,14 @@ def _longest_run(mask: np.ndarray) -> int:
     return int((edges[1::2] - edges[::2]).max())
 
 
+def plate_pitch_deg(nose_xyz: np.ndarray, chassis_xyz: np.ndarray) -> np.ndarray:
+    """The plate's pitch in the legs' plane at each row: the angle of the line from the
+    plate's centre to its nose above the floor, nose up positive, unwrapped over the rows so
+    that a robot turning over past the vertical keeps counting (deg)."""
+    d = np.asarray(nose_xyz) - np.asarray(chassis_xyz)
+    return np.degrees(np.unwrap(np.arctan2(d[:, 2], d[:, 0])))
+
+
 def summarise(traj: Trajectory) -> HopSummary:
     s, sd, plan = traj.built.sensors, traj.sensordata, traj.plan
     nose_z = sd[:, s.nose_pos][:, 2]
@@ -49,6 +59,8 @@ def summarise(traj: Trajectory) -> HopSummary:
     airborne = sd[:, s.floor_contact][:, 0] < 0.5
     stand = plan.settle_steps - 1 if plan.settle_steps > 0 else len(x) - 1
     standing_nose, standing_com = float(nose_z[stand]), float(com_z[stand])
+    turn = plate_pitch_deg(sd[:, s.nose_pos], sd[:, s.chassis_pos])
+    turn = turn - turn[stand]
     x_start = (float(x[plan.settle_steps - 1]) if plan.settle_steps > 0
                else float(traj.initial_sensordata[s.chassis_pos][0]))
 
@@ -63,10 +75,11 @@ def summarise(traj: Trajectory) -> HopSummary:
             nose_apex_m=float(nose_z[a:b].max() - standing_nose),
             com_apex_m=float(com_z[a:b].max() - standing_com),
             flight_s=_longest_run(airborne[a:b]) * traj.timestep_s,
+            end_turn_deg=float(turn[b - 1]),
         ))
     run_nose = nose_z[plan.settle_steps:]
     if plan.settle_steps == 0:  # the notebook counts the drop too
         run_nose = np.concatenate(([traj.initial_sensordata[s.nose_pos][2]], nose_z))
     return HopSummary(hops=hops, distance_m=float(x[-1] - x_start), max_nose_height_m=float(run_nose.max()),
                       standing_nose_m=standing_nose, standing_com_m=standing_com,
-                      end_nose_rise_m=float(nose_z[-1] - standing_nose))
+                      end_nose_rise_m=float(nose_z[-1] - standing_nose), end_turn_deg=float(turn[-1]))

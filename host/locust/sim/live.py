@@ -22,6 +22,7 @@ import math
 import threading
 import time
 from dataclasses import asdict, dataclass, field, replace
+from types import SimpleNamespace
 
 import mujoco
 import numpy as np
@@ -33,6 +34,7 @@ from .camera import CAMERAS, frame_views
 from .clip import ClipRecorder, check_video_path, validate_size
 from .hops import summarise
 from .model import build
+from .outcome import classify
 from .rollout import Trajectory, simulate
 from .schedule import ControlPlan
 
@@ -55,6 +57,7 @@ class LiveResult:
     video_path: str | None = None
     frames: int = 0
     hops: list[dict] = field(default_factory=list)   # per push: Hop's fields (locust.sim.hops.Hop)
+    outcome: str | None = None   # goes_over / rears_and_returns / stays_low over the pushes (None: none)
 
     def to_dict(self) -> dict:
         return dict(self.__dict__)
@@ -250,7 +253,9 @@ class LiveSim:
         else:  # nothing happened after the settle phase
             distance, nose = 0.0, float(traj.sensordata[-1, self.built.sensors.nose_pos][2])
         hops = _per_push(traj) if verdict.valid and self._steps > self._settle_steps else []
-        return LiveResult(distance, nose, sim_s, verdict.valid, verdict.reasons, rtf, video_path, frames, hops)
+        outcome = classify([SimpleNamespace(**h) for h in hops]) if hops else None
+        return LiveResult(distance, nose, sim_s, verdict.valid, verdict.reasons, rtf, video_path, frames, hops,
+                          outcome)
 
     def finished_hops(self, rest_s: float) -> list[dict]:
         """The hops done so far, cut as :meth:`close` cuts them: a hop is done once the next push

@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass
 
@@ -43,6 +44,27 @@ class Trajectory:
         return self.sensordata[:, s]
 
 
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity), at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:
+        return max(1, os.cpu_count() or 1)
+
+
+def rollout_threads(models: list[mujoco.MjModel], initial_state: np.ndarray, control: np.ndarray,
+                    threads: int | None = None) -> tuple[np.ndarray, np.ndarray, list[mujoco.MjData]]:
+    """One ``mujoco.rollout`` call over ``models`` (one per row of ``initial_state`` and
+    ``control``) on ``threads`` threads (default: every core), none more than there are models.
+
+    Returns (state, sensordata, the MjData of each thread: their warnings)."""
+    n = max(1, min(threads or available_cores(), len(models)))
+    datas = [mujoco.MjData(models[0]) for _ in range(n)]
+    state, sensordata = mj_rollout.rollout(models if len(models) > 1 else models[0],
+                                           datas if n > 1 else datas[0], initial_state, control)
+    return state, sensordata, datas
+
+
 def initial_state(built: BuiltModel) -> tuple[np.ndarray, np.ndarray]:
     model = built.model
     data = mujoco.MjData(model)
@@ -69,21 +91,18 @@ def simulate_built(built: BuiltModel, plan: ControlPlan, keep_states: bool = Fal
 
 
 def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: bool = False,
-                   threads: int = 1) -> list[Trajectory]:
+                   threads: int | None = None) -> list[Trajectory]:
     """Several models of one structure (a fit's candidates, draws of the uncertain values) on
-    one plan, in one ``mujoco.rollout`` call on ``threads`` threads. MuJoCo counts its warnings
-    per thread, not per model: when a batch raised any, each model is run again alone, so that
-    every trajectory carries its own warnings for the audit."""
+    one plan, in one ``mujoco.rollout`` call on ``threads`` threads (default: every core).
+    MuJoCo counts its warnings per thread, not per model: when a batch raised any, each model
+    is run again alone, so that every trajectory carries its own warnings for the audit."""
     models = [b.model for b in builts]
     starts = [initial_state(b) for b in builts]
     control = np.zeros((len(models), plan.nstep, models[0].nu))
     for act in builts[0].servo_actuators:
         control[:, :, act] = plan.ctrl_rad
-    datas = [mujoco.MjData(models[0]) for _ in range(max(1, min(threads, len(models))))]
     t0 = time.perf_counter()
-    state, sensordata = mj_rollout.rollout(models if len(models) > 1 else models[0],
-                                           datas if len(datas) > 1 else datas[0],
-                                           np.array([s for s, _ in starts]), control)
+    state, sensordata, datas = rollout_threads(models, np.array([s for s, _ in starts]), control, threads)
     wall = time.perf_counter() - t0
     nq = models[0].nq
     if len(models) > 1 and any(d.warning[i].number for d in datas for i in range(len(d.warning))):

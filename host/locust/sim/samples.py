@@ -3,14 +3,18 @@
 Every value of the robot file that carries an uncertainty (one standard deviation, written
 by ``locust calibrate`` beside the value) is drawn from a normal distribution about it,
 independently; a positive value stays positive (draws below a tenth of it are put there).
-All draws are simulated in one batched ``mujoco.rollout`` and each is audited and summarised
+All draws are simulated in one batched ``mujoco.rollout`` on every core and each is audited and summarised
 like ``locust sim``'s own run; the spread of the valid ones is the prediction's uncertainty.
+Each valid draw is also classified (:mod:`.outcome`): near the threshold the draws split
+between going over and coming back, so each outcome's share and its own figures are the
+prediction, not one mean and sd across both.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,10 +24,11 @@ from ..params import Provenance, Robot, problems, real_keys
 from .audit import audit
 from .hops import summarise
 from .model import build
-from .rollout import Trajectory, simulate_batch
+from .outcome import OutcomeFigures, classify, outcome_shares
+from .rollout import Trajectory, available_cores, simulate_batch
 from .schedule import control_plan
 
-THREADS = 2
+BATCH_PER_CORE = 4      # draws per core in one rollout call when progress is shown
 MIN_FRACTION = 0.1      # a positive value's draws are kept above this fraction of it
 
 
@@ -41,6 +46,8 @@ class Samples:
     distance_m_sd: float
     max_nose_height_m_mean: float
     max_nose_height_m_sd: float
+    outcome: list[str | None] = dataclasses.field(default_factory=list)   # per draw (None: invalid)
+    outcomes: dict[str, OutcomeFigures] = dataclasses.field(default_factory=dict)
 
     def to_json(self) -> dict:
         return dataclasses.asdict(self)
@@ -69,10 +76,14 @@ def draw(robot: Robot, n: int, seed: int = 0) -> list[Robot]:
 
 
 def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 0,
-                   keep_states: bool = False) -> list[Trajectory | None]:
-    """``n`` draws of ``robot`` simulated in one batch, each audited: a draw's trajectory, or
-    None for a draw outside the parameter limits, whose linkage cannot close, or that fails
-    its audit (as a sweep's design would be an invalid row)."""
+                   keep_states: bool = False, progress: Callable[[int], None] | None = None
+                   ) -> list[Trajectory | None]:
+    """``n`` draws of ``robot`` simulated in batches on every core, each audited: a draw's
+    trajectory, or None for a draw outside the parameter limits, whose linkage cannot close,
+    or that fails its audit (as a sweep's design would be an invalid row).
+
+    With ``progress``, the draws go in batches of :data:`BATCH_PER_CORE` per core, and
+    ``progress(k)`` is called as each batch of ``k`` draws is done (one call otherwise)."""
     plan = control_plan(robot.schedule, robot.solver, cycles)
     builts = []
     for r in draw(robot, n, seed):
@@ -81,7 +92,15 @@ def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 
         except GeometryError:
             builts.append(None)
     ok = [b for b in builts if b is not None]
-    trajs = iter(simulate_batch(ok, plan, keep_states=keep_states, threads=THREADS) if ok else [])
+    if progress and len(ok) < n:
+        progress(n - len(ok))
+    size = BATCH_PER_CORE * available_cores() if progress else max(len(ok), 1)
+    done: list[Trajectory] = []
+    for first in range(0, len(ok), size):
+        done += simulate_batch(ok[first:first + size], plan, keep_states=keep_states)
+        if progress:
+            progress(len(ok[first:first + size]))
+    trajs = iter(done)
     out: list[Trajectory | None] = []
     for b in builts:
         traj = next(trajs) if b is not None else None
@@ -89,13 +108,15 @@ def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 
     return out
 
 
-def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0) -> Samples:
+def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0,
+           progress: Callable[[int], None] | None = None) -> Samples:
     """Simulate ``n`` draws of ``robot`` in one batch; their distances and nose heights."""
-    dist, nose = [], []
-    for traj in simulate_draws(robot, n, cycles, seed):
+    dist, nose, kind = [], [], []
+    for traj in simulate_draws(robot, n, cycles, seed, progress=progress):
         summary = summarise(traj) if traj is not None else None
         dist.append(summary.distance_m if summary else math.nan)
         nose.append(summary.max_nose_height_m if summary else math.nan)
+        kind.append(classify(summary.hops) if summary else None)
     d, h = np.array(dist), np.array(nose)
     valid = np.isfinite(d) & np.isfinite(h)
 
@@ -107,4 +128,4 @@ def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0) -> Sa
     (dm, ds), (hm, hs) = stats(d), stats(h)
     return Samples(n=n, n_valid=int(valid.sum()), seed=seed, uncertain=uncertain_values(robot), distance_m=dist,
                    max_nose_height_m=nose, distance_m_mean=dm, distance_m_sd=ds, max_nose_height_m_mean=hm,
-                   max_nose_height_m_sd=hs)
+                   max_nose_height_m_sd=hs, outcome=kind, outcomes=outcome_shares(kind, dist, nose))

@@ -23,13 +23,12 @@ from typing import Any
 
 from ..errors import SweepError
 from ..orphans import die_with_parent
+from ..sim.rollout import available_cores
 
 
 def default_jobs() -> int:
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:
-        return max(1, os.cpu_count() or 1)
+    """Every core this process may use."""
+    return available_cores()
 
 
 def plan_jobs(jobs: int | None, designs: int) -> tuple[int, str | None]:
