@@ -161,4 +161,25 @@ def test_optimize_writes_the_front_resumes_after_a_kill_and_refuses_other_object
     journal = (out / "study.journal").read_bytes()
     other = invoke([*OPT[:3], "--objective", "flight", *OPT[5:], "--trials", "3", "--out", out])
     assert other.exit_code == 2 and "other settings (objectives differ)" in other.output
+    more = invoke([*OPT[:11], "--robust", "3", *OPT[13:], "--trials", "3", "--out", out])
+    assert more.exit_code == 2 and "other settings (robust differ)" in more.output
     assert (out / "study.journal").read_bytes() == journal
+
+
+@pytest.mark.slow
+def test_trials_run_on_local_processes_and_on_a_dask_cluster_share_one_study(tmp_path):
+    base = preset("seed")
+    bounds = [parse_bound("scale=0:0.02", base)]
+    out = tmp_path / "o"
+    first = run_optimize(base, bounds, trials=4, cycles=1, folder=out, jobs=2)
+    assert (first.trials, first.computed, first.complete + first.pruned) == (4, 4, 4)
+    second = run_optimize(base, bounds, trials=6, cycles=1, folder=out, jobs=2, scheduler="dask-local")
+    assert (second.trials, second.computed, second.complete + second.pruned) == (6, 2, 6)
+    rows = read_csv(out / "trials.csv")
+    assert [int(r["trial"]) for r in rows] == list(range(6))
+    # each trial's figure is its design's, whichever process judged it
+    from locust.sweep.robust import DesignJudge
+    judge = DesignJudge(base, 1, (OBJECTIVES["distance"],))
+    for r in rows[::3]:
+        if r["state"] == "complete":
+            assert float(r["distance_m"]) == judge({"scale": float(r["scale"])}).figures["distance_m"]
