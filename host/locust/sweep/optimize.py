@@ -18,8 +18,6 @@ only those missing, so a study killed part way resumes where it stopped.
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 from collections.abc import Callable
@@ -28,7 +26,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SweepError
-from ..fileio import atomic_write_json, atomic_write_text, make_folder
+from ..fileio import atomic_write_json, make_folder
+from ..io.study_store import write_tables
 from ..params import Robot, save_robot
 from .design import SCALE, Bound, design_robot
 from .objectives import OBJECTIVES, OUTCOMES, Judgement, Objective
@@ -299,15 +298,6 @@ def trial_rows(study, names: list[str], objectives: list[Objective], max_flip: f
     return rows
 
 
-def csv_text(rows: list[dict[str, Any]], columns: list[str]) -> str:
-    out = io.StringIO()
-    writer = csv.DictWriter(out, fieldnames=columns, lineterminator="\n", extrasaction="ignore")
-    writer.writeheader()
-    for r in rows:
-        writer.writerow({c: repr(v) if isinstance(v, float) else v for c, v in r.items()})
-    return out.getvalue()
-
-
 def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max_flip: float | None,
               computed: int = 0, interrupted: bool = False) -> OptimizeSummary:
     """Write trials.csv, pareto.csv, pareto.png, optimize.json and a robot file for each pick."""
@@ -319,10 +309,7 @@ def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max
     front = [by_number[t.number] for t in study.best_trials]
     front.sort(key=lambda r: r["trial"])
     chosen = picks(front, objectives) if front else {}
-    columns = list(rows[0]) if rows else ["trial", "state", *names]
-    atomic_write_text(folder / "trials.csv", csv_text(rows, columns))
-    pareto_rows = [{**r, "pick": " ".join(k for k, c in chosen.items() if c is r)} for r in front]
-    atomic_write_text(folder / "pareto.csv", csv_text(pareto_rows, [*columns, "pick"]))
+    write_tables(folder, rows, [{**r, "pick": " ".join(k for k, c in chosen.items() if c is r)} for r in front])
     robots = {}
     for pick, r in chosen.items():
         robot = design_robot(base, {n: r[n] for n in names}).renamed(f"optimize {pick} of {folder}")

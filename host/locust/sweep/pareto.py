@@ -41,12 +41,23 @@ def picks(front: list[dict[str, Any]], objectives: list[Objective]) -> dict[str,
 
 def plot_front(rows: list[dict[str, Any]], front: list[dict[str, Any]], chosen: dict[str, dict[str, Any]],
                objectives: list[Objective], max_flip: float | None, path: Path, title: str) -> Path:
-    """The front against its first two objectives (one objective: against the trial number):
-    dominated trials grey, trials that go over too often marked, the front and its picks named."""
+    """``pareto.png``: :func:`draw_front` on a figure of its own."""
     from ..plotting import pyplot, save_png
 
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 5))
+    fig, ax = pyplot().subplots(figsize=(7.5, 5))
+    draw_front(ax, rows, front, chosen, objectives, max_flip, title)
+    return save_png(fig, path)
+
+
+def picks_of(front: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """The picks of a front read back from ``pareto.csv`` (its ``pick`` column)."""
+    return {name: r for r in front for name in r["pick"].split()}
+
+
+def draw_front(ax, rows: list[dict[str, Any]], front: list[dict[str, Any]], chosen: dict[str, dict[str, Any]],
+               objectives: list[Objective], max_flip: float | None, title: str) -> None:
+    """The front against its first two objectives (one objective: against the trial number):
+    dominated trials grey, trials that go over too often marked, the front and its picks named."""
     done = [r for r in rows if r["state"] == "complete"]
     flipped = [r for r in done if not r["feasible"]]
     front_ids = {r["trial"] for r in front}
@@ -81,7 +92,6 @@ def plot_front(rows: list[dict[str, Any]], front: list[dict[str, Any]], chosen: 
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    return save_png(fig, path)
 
 
 def describe(row: dict[str, Any], names: list[str], objectives: list[Objective]) -> str:
