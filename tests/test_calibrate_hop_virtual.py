@@ -92,4 +92,4 @@ def test_written_values_carry_their_provenance_and_spread(fitted):
         assert entry["source"] == "fit:hops" and entry["uncertainty"] > 0
         assert entry["value"] == pytest.approx(fitted["fit"]["parameters"][key]["value"])
     out = json.loads(_locust(["sim", "--config", str(fitted["toml"]), "--samples", "16", "--json"], fitted["env"]))
-    assert out["distance_m_sd"] > 0 and out["max_nose_height_m_sd"] > 0
+    assert out["samples"]["distance_m_sd"] > 0 and out["samples"]["max_nose_height_m_sd"] > 0

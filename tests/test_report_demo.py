@@ -126,3 +126,6 @@ def test_demo_closes_the_loop(demo):
     for cfg in doc["configurations"]:
         assert cfg["predicted_before_fit"]["valid"]
         assert cfg["predicted_spread"]["n_valid"] >= 2
+        shares = [o["share"] for o in cfg["predicted_spread"]["outcomes"].values()]
+        assert sum(shares) == pytest.approx(1.0, abs=1e-12), cfg["name"]
+    assert 'id="outcomes"' in demo["report"].read_text()

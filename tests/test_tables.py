@@ -25,7 +25,7 @@ def test_sim_table_is_the_results_own_numbers_in_mm():
     res = CliRunner().invoke(cli, ["sim", "--preset", "seed", "--cycles", "3"])
     assert res.exit_code == 0, res.output
     lines = res.output.splitlines()
-    assert lines[0].startswith("seed: valid (3 cycles, time step 0.001 s")
+    assert lines[0].startswith(f"seed: valid, {r.outcome.replace('_', ' ')} (3 cycles, time step 0.001 s")
     rows = _rows(lines, "hop  distance mm  nose rise mm  CoM rise mm  flight ms")
     assert [int(row[0]) for row in rows] == [1, 2, 3]
     for row, hop in zip(rows, r.hops, strict=True):

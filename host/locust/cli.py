@@ -34,6 +34,7 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
     "report": ("locust.report.cli", "report", "Compare simulation and measurement in an HTML report."),
     "demo": ("locust.demo", "demo", "Run the whole toolkit end to end on the virtual robot."),
     "fab": ("locust.fab.cli", "fab", "Generate the five-layer laminate cut files (DXF)."),
+    "measure": ("locust.measure.cli", "measure", "Measure the robot as built from photos (stance)."),
 }
 
 

@@ -61,5 +61,9 @@ class ReportError(LocustError):
     """Building comparison reports."""
 
 
+class MeasureError(LocustError):
+    """Measuring the robot from photos: the board, the stickers, a pose the linkage cannot take."""
+
+
 class WriteError(LocustError):
     """Writing a result: a read-only or non-regular target, a read-only folder, a full disk."""

@@ -521,7 +521,10 @@ def _seed() -> Robot:
 # "Measure your robot", says how to measure yours. What the photos do not show is a datasheet
 # figure or the notebook's, named as such.
 _TOP = "photo:assembled_top_view.png"
-_LOOP = "photo:folded_leg_loop.png"
+# the top view's scale, read from the SG90s lying in it (the breadboard's 55 mm, 200 px, is
+# farther from the camera and foreshortened): 32 mm over the tabs = 91 px, the 22.8 mm body
+# = 71 px
+_TOP_SCALE = "scale 3.0 +- 0.3 px/mm from the SG90s in the photo (32 mm over the tabs = 91 px)"
 _SG90 = "datasheet:SG90"
 _CUT = "cut_file:zz.dxf"
 _HINGE = "fit:Damping_test.trk"
@@ -532,23 +535,30 @@ AS_BUILT: dict[str, tuple[Any, Provenance]] = {
     "geometry.coupler_m": (0.02, Provenance(_CUT, note="strip 8-10 cm")),
     "geometry.leg_m": (0.06, Provenance(_CUT, note="strip 10-16 cm")),
     "geometry.link_width_m": (0.03, Provenance(_CUT, note="the strip is 3 cm wide")),
-    "geometry.crank_start_deg": (-100.0, Provenance(_LOOP, uncertainty=10.0,
-        note="the folded loop at rest: 100 deg between the ground link and the crank (63, 97, 99 deg at the "
-             "other corners), the horn fitted with the loop unstressed")),
-    "geometry.ground_angle_deg": (0.0, Provenance(_TOP, uncertainty=15.0,
-        note="the ground link lies along the servo's side, parallel to the plate")),
-    "geometry.body_length_m": (0.12, Provenance(_TOP, uncertainty=0.01, note="about 12 cm against the servo's 23 mm")),
-    "geometry.body_width_m": (0.12, Provenance(_TOP, uncertainty=0.01, note="about 12 cm against the servo's 23 mm")),
+    # no photo shows the robot from the side: the crank's angle at rest and the ground link's
+    # angle to the plate are estimates (locust measure stance measures them from two stills)
+    "geometry.crank_start_deg": (-100.0, Provenance("estimate", uncertainty=10.0,
+        note="the loose loop (folded_leg_loop.png) rests at 100 deg between ground link and crank, but on the "
+             "servo the horn sits on its spline in steps of about 18 deg, which no photo shows: measure it")),
+    "geometry.ground_angle_deg": (0.0, Provenance("estimate", uncertainty=15.0,
+        note="the ground link taken along the servo's side, parallel to the plate; the top view looks down on "
+             "the plate and cannot show this side-plane angle: measure it")),
+    "geometry.body_length_m": (0.12, Provenance(_TOP, uncertainty=0.01,
+        note=f"{_TOP_SCALE}: the plate's near edge 370 px = 123 mm, its far edge 328 px = 109 mm")),
+    "geometry.body_width_m": (0.12, Provenance(_TOP, uncertainty=0.01,
+        note=f"{_TOP_SCALE}: the plate's edge across the legs 353 px = 118 mm")),
     "geometry.nose_x_m": (-0.06, Provenance(_TOP, uncertainty=0.005, note="the plate's edge away from the legs")),
     "geometry.body_mass_kg": (0.004, Provenance("datasheet:cardstock", uncertainty=0.001,
         note="the plate alone: 12 x 12 cm of black cardstock at about 270 g/m^2; weigh yours")),
     "geometry.link_density_kg_per_m3": (700.0, Provenance("datasheet:cardstock", uncertainty=150.0,
         note="two 270 g/m^2 cardstock layers, 0.05 mm PET film, two adhesive layers: about 0.7 kg/m^2 "
              "over the 1 mm laminate (a Small strip 3.8 g); weigh a strip")),
-    "geometry.servo_axis_x_m": (0.02, Provenance(_TOP, uncertainty=0.005,
-        note="the horns 4 cm in from the plate's leg-end edge (the loops reach past it)")),
-    "geometry.leg_mount_y_m": (0.045, Provenance(_TOP, uncertainty=0.003,
-        note="servos back to back on the centre line: 29 mm of servo, then half the 3 cm loop")),
+    "geometry.servo_axis_x_m": (0.028, Provenance(_TOP, uncertainty=0.003,
+        note=f"{_TOP_SCALE}: the visible horn's centre 96 px (32 +- 3 mm) in from the plate's leg-end edge, "
+             "6 cm from the plate's middle (the loops reach past the edge)")),
+    "geometry.leg_mount_y_m": (0.045, Provenance(_TOP, uncertainty=0.005,
+        note="servos back to back on the centre line: 29 mm of servo, then half the 3 cm loop; the loops' "
+             "tops are 40 and 55 mm from the servos' joint in the photo (perspective)")),
     "geometry.servo_axis_below_plate_m": (0.0065, Provenance(_SG90, uncertainty=0.002,
         note="the servo on its side under the plate, the shaft at mid-width of its 12 mm")),
     "geometry.servo_mass_kg": (0.009, Provenance(_SG90, uncertainty=0.0005)),
@@ -557,8 +567,8 @@ AS_BUILT: dict[str, tuple[Any, Provenance]] = {
     "geometry.servo_height_m": (0.029, Provenance(_SG90)),
     "geometry.servo_body_x_m": (0.0055, Provenance(_SG90, uncertainty=0.001,
         note="the shaft 6 mm from one end of the 23 mm body; the body toward the plate's leg end (photo)")),
-    "geometry.servo_body_y_m": (0.0145, Provenance(_TOP, uncertainty=0.002,
-        note="back to back on the centre line: half the servo's 29 mm")),
+    "geometry.servo_body_y_m": (0.0145, Provenance(_SG90, uncertainty=0.002,
+        note="half the servo's 29 mm: the top view shows them back to back on the centre line")),
     # locust calibrate hinge on the course's damping test (calibration/protocols/hinge.md): a
     # folded film hinge, not the cardstock beam (the seed's 0.056 was the beam's); viscous model,
     # link 8.5e-7 kg*m^2 about the hinge; the team's own fit gave 1.60e-4 and 2.14e-6
@@ -571,8 +581,9 @@ AS_BUILT: dict[str, tuple[Any, Provenance]] = {
         note="the recording's 5 V supply: the identified stall torque, speed and gain hold there")),
     "servo.winding_resistance_ohm": (10.0, Provenance(_SG90, uncertainty=1.5,
         note="stall current about 0.6 A at 6 V")),
-    "power.supply_voltage_v": (5.0, Provenance(_TOP, uncertainty=0.25,
-        note="the servos on the USB-powered ESP32's 5 V, through the breadboard")),
+    "power.supply_voltage_v": (5.0, Provenance("datasheet:USB", uncertainty=0.25,
+        note="USB's 5 V +- 5 %: the top view shows the servos on the USB-powered ESP32's 5 V, through the "
+             "breadboard")),
     "power.source_resistance_ohm": (0.5, Provenance("estimate:USB", uncertainty=0.3,
         note="USB cable (about 0.2 ohm a conductor) and breadboard contacts; measure the servo plug's "
              "voltage with both servos held stalled")),

@@ -32,7 +32,9 @@ def robot_options(func):
 def params(preset, config, sets, as_json, write, force):
     """Show the robot parameters, with their source and uncertainty.
 
-    Every key can be overridden on any command with --set KEY=VALUE.
+    Every key can be overridden on any command with --set KEY=VALUE. Below them, the
+    model's load under the nose standing at rest, as a kitchen scale reads it (--json:
+    nose_load_kg; `locust measure nose-load` takes the scale's reading back).
     """
     robot = P.resolve_robot(preset, config, sets)
     if write:
@@ -41,13 +43,30 @@ def params(preset, config, sets, as_json, write, force):
         P.save_robot(robot, write)
         click.echo(f"wrote {write}")
         return
+    load, why = _standing(robot)
     if as_json:
         out = {k: {"value": v, **{a: b for a, b in vars(robot.source_of(k)).items() if b is not None}}
                for k, v in robot.flat().items()}
-        click.echo(json_text({"name": robot.name, "values": out}), nl=False)
+        click.echo(json_text({"name": robot.name, "values": out,
+                              "nose_load_kg": load.nose_load_kg if load else None,
+                              "total_mass_kg": load.total_mass_kg if load else None}), nl=False)
         return
     click.echo(f"# {robot.name}")
     for key, value in robot.flat().items():
         prov = robot.source_of(key)
         unc = f" ± {prov.uncertainty:g}" if prov.uncertainty is not None else ""
         click.echo(f"{key:42s} {value!s:>12}{unc:12s}  [{prov.source}]")
+    click.echo(f"# standing at rest: {load.nose_load_kg * 1000:.1f} g of its {load.total_mass_kg * 1000:.1f} g on the "
+               "nose (a kitchen scale under it, feet level with the pan)" if load else
+               f"# standing at rest: no nose load ({why})")
+
+
+def _standing(robot: P.Robot):
+    """The model's standing load (:func:`locust.sim.statics.standing_load`), or None and why not."""
+    from .errors import LocustError
+    from .sim.statics import standing_load
+
+    try:
+        return standing_load(robot), ""
+    except LocustError as exc:
+        return None, exc.message

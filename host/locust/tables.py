@@ -28,10 +28,16 @@ def verdict(valid: bool) -> str:
     return "valid" if valid else "INVALID"
 
 
+def outcome_words(outcome: str) -> str:
+    """``goes_over`` -> ``goes over`` (locust.sim.outcome's names, for a person)."""
+    return outcome.replace("_", " ")
+
+
 def sim_lines(r) -> list[str]:
     """``locust sim``: a :class:`locust.sim.run.SimResult` as the verdict, one row per hop,
     the totals, the convergence check and the notes."""
-    lines = [f"{r.robot}: {verdict(r.valid)} ({r.cycles} cycle{'' if r.cycles == 1 else 's'}, "
+    said = f"{verdict(r.valid)}, {outcome_words(r.outcome)}" if r.outcome else verdict(r.valid)
+    lines = [f"{r.robot}: {said} ({r.cycles} cycle{'' if r.cycles == 1 else 's'}, "
              f"time step {r.timestep_s:g} s, "
              f"{r.wall_s:.1f} s wall)"]
     lines += [f"{INDENT}reason: {reason}" for reason in r.reasons]
@@ -59,6 +65,12 @@ def totals_line(distance_m: float, max_nose_height_m: float) -> str:
     return f"{INDENT}total distance {mm(distance_m)} mm; highest nose {mm(max_nose_height_m)} mm above the floor"
 
 
+def nose_load_line(nose_load_kg: float, total_mass_kg: float) -> str:
+    """The standing robot's weight on its nose: what a kitchen scale under the nose reads."""
+    return (f"{INDENT}standing: {nose_load_kg * 1000:.1f} g of its {total_mass_kg * 1000:.1f} g on the nose "
+            "(a kitchen scale under the nose, the feet level with its pan)")
+
+
 def convergence_line(c: dict) -> str:
     """The time-step check of ``--check-convergence``: the change at half the step."""
     said = "converged" if c["converged"] else "NOT converged (within 1 % or 0.1 mm asked)"
@@ -68,10 +80,43 @@ def convergence_line(c: dict) -> str:
             f"{said}")
 
 
-def spread_line(spread) -> str:
-    """``locust sim --samples``: the spread of the outcome over the draws."""
-    return (f"{INDENT}{spread.n} draws of {len(spread.uncertain)} uncertain values ({spread.n_valid} valid): "
-            f"distance sd {mm(spread.distance_m_sd, 3)} mm, highest nose sd {mm(spread.max_nose_height_m_sd, 3)} mm")
+def mean_sd(mean: float, sd: float, scale: float = 1000.0) -> str:
+    """``mean +- sd`` to sensible digits: the sd to two significant figures, the mean to the
+    same decimal place (a single draw: its value, one decimal). Values in SI times ``scale``."""
+    if not math.isfinite(mean):
+        return "nan"
+    if not math.isfinite(sd):
+        return f"{mean * scale:.1f}"
+    s = sd * scale
+    decimals = max(0, 1 - math.floor(math.log10(s))) if s > 0 else 1
+    return f"{mean * scale:.{decimals}f} ± {s:.{decimals}f}"
+
+
+def spread_lines(spread) -> list[str]:
+    """``locust sim --samples``: each outcome's share of the draws and its own figures, mean
+    ± sd in mm (never one sd across outcomes: near the threshold the spread is bimodal)."""
+    lines = [f"{INDENT}{spread.n} draws of {len(spread.uncertain)} uncertain values ({spread.n_valid} valid):"]
+    for name, o in spread.outcomes.items():
+        line = f"{INDENT * 2}{outcome_words(name):17s} {o.n:3d} of {spread.n_valid} ({o.share * 100:3.0f} %)"
+        if o.n:
+            line += (f": distance {mean_sd(o.distance_m.mean, o.distance_m.sd)} mm, highest nose "
+                     f"{mean_sd(o.max_nose_height_m.mean, o.max_nose_height_m.sd)} mm")
+        lines.append(line)
+    return lines
+
+
+def sensitivity_lines(sens) -> list[str]:
+    """The values whose interval reaches another outcome (:mod:`locust.sim.sensitivity`)."""
+    nominal = outcome_words(sens.nominal) if sens.nominal else "invalid"
+    deciding = sens.deciding
+    if not deciding:
+        return [f"{INDENT}no single value at -/+{sens.k_sd:g} sd changes the outcome ({nominal})"]
+    lines = [f"{INDENT}decided by (each value alone at -/+{sens.k_sd:g} sd; as given it {nominal}):"]
+    for e in deciding:
+        ends = [f"{v:.4g} {outcome_words(o) if o else 'invalid'}" for v, o in
+                ((e.low_value, e.low_outcome), (e.high_value, e.high_outcome))]
+        lines.append(f"{INDENT * 2}{e.key} (sd {e.sd:g}): {ends[0]}; {ends[1]}")
+    return lines
 
 
 def plant_lines(summary: dict) -> list[str]:

@@ -22,18 +22,31 @@ class SimResult(_run.SimResult):
     """What :func:`simulate` returns: the audited figures of :class:`locust.sim.run.SimResult`
     (``valid``, ``reasons``, ``distance_m``, ``max_nose_height_m``, ``hops``, ``notes`` ...),
     the robot they belong to (``params``), the rollout (``trajectory``, every step's state),
-    and, with ``samples``, the spread over draws of the uncertain values (``spread``).
+    and, with ``samples``, the spread over draws of the uncertain values (``spread``). The
+    standing robot's weight on its nose, as a kitchen scale under it reads, is
+    ``nose_load_kg`` (of ``total_mass_kg``; :mod:`locust.sim.statics`).
 
     ``repr`` is a short table in mm and degrees; in a notebook it is an HTML table.
     """
 
     params: Robot | None = field(default=None, repr=False, compare=False)
     spread: object | None = field(default=None, repr=False, compare=False)   # locust.sim.samples.Samples
+    nose_load_kg: float = float("nan")     # standing at the 0 deg command, the nose's share of the weight
+    total_mass_kg: float = float("nan")
+    sensitivity: object | None = field(default=None, repr=False, compare=False)  # sim.sensitivity.Sensitivity
 
     def to_json(self) -> dict:
-        out = _run.SimResult.to_json(dataclasses.replace(self, params=None, spread=None))
-        for key in ("params", "spread"):
+        """The figures (as :class:`locust.sim.run.SimResult`), the nose load, and with samples
+        each outcome's share and figures (``outcomes``) and the draws (``samples``); with a
+        sensitivity, ``sensitivity``."""
+        out = _run.SimResult.to_json(dataclasses.replace(self, params=None, spread=None, sensitivity=None))
+        for key in ("params", "spread", "sensitivity"):
             out.pop(key, None)
+        if self.spread is not None:
+            sp = self.spread.to_json()
+            out.update(outcomes=sp["outcomes"], samples=sp)
+        if self.sensitivity is not None:
+            out["sensitivity"] = self.sensitivity.to_json()
         return out
 
     # -- tables ----------------------------------------------------------------------
@@ -173,16 +186,23 @@ class SimResult(_run.SimResult):
 
     # -- display ---------------------------------------------------------------------
     def _rows(self) -> list[tuple[str, str]]:
-        rows = [("valid", "yes" if self.valid else "NO: " + "; ".join(self.reasons)),
+        rows = [("valid", f"yes, {self.outcome.replace('_', ' ')}" if self.valid and self.outcome
+                 else "yes" if self.valid else "NO: " + "; ".join(self.reasons)),
                 ("cycles", f"{self.cycles}  (dt {self.timestep_s:g} s)")]
         if self.valid:
             rows += [("distance", f"{self.distance_m * 1000:.2f} mm"),
                      ("max nose height", f"{self.max_nose_height_m * 1000:.2f} mm"),
-                     ("linkage", f"{self.grashof}, transmission {self.transmission_deg:.0f} deg")]
+                     ("linkage", f"{self.grashof}, transmission {self.transmission_deg:.0f} deg"),
+                     ("nose load", f"{self.nose_load_kg * 1000:.1f} g of {self.total_mass_kg * 1000:.1f} g standing")]
         if self.spread is not None:
-            sp = self.spread
-            rows.append(("spread", f"distance sd {sp.distance_m_sd * 1000:.2f} mm, nose height sd "
-                                   f"{sp.max_nose_height_m_sd * 1000:.2f} mm over {sp.n} draws"))
+            from ..tables import spread_lines
+
+            rows += [("draws" if i == 0 else "", line.strip()) for i, line in enumerate(spread_lines(self.spread))]
+        if self.sensitivity is not None:
+            from ..tables import sensitivity_lines
+
+            rows += [("sensitivity" if i == 0 else "", line.strip())
+                     for i, line in enumerate(sensitivity_lines(self.sensitivity))]
         return rows
 
     def _hop_rows(self) -> list[tuple[str, ...]]:
@@ -214,7 +234,7 @@ class SimResult(_run.SimResult):
 
 
 def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: int = 0,
-             keep_states: bool = True) -> SimResult:
+             keep_states: bool = True, sensitivity: bool | None = None) -> SimResult:
     """Settle the robot on the floor, run its hop schedule, audit the run and measure the hops.
 
     Parameters
@@ -225,19 +245,27 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
         Hop cycles (push + wait) to run; default the robot's ``schedule.cycles``.
     samples : int, default 0
         With N >= 2, also simulate N draws of the values that carry an uncertainty in the
-        robot (one batched rollout): ``result.spread`` (``distance_m_sd``,
-        ``max_nose_height_m_sd``, ...).
+        robot (one batched rollout): ``result.spread``, with ``outcomes`` (each outcome's
+        share of the valid draws and the mean and sd of its own distance and highest nose:
+        near the threshold the draws split, and one sd across both would hide it) and the
+        draws themselves.
     seed : int, default 0
         Random seed of the draws.
     keep_states : bool, default True
         Keep every step's state for ``trace()`` and ``video()`` (False: the figures only, for
         runs of many cycles).
+    sensitivity : bool, optional
+        Which measured values decide the outcome: each uncertain value alone at -/+ 2 sd
+        (``result.sensitivity``, :func:`locust.sim.sensitivity.outcome_sensitivity`). True:
+        always; False: never; None (default): when the draws of ``samples`` split between
+        outcomes.
 
     Returns
     -------
     SimResult
         ``.valid`` (a run that breaks its own audit is never a result: ``.reasons`` says why),
-        ``.distance_m``, ``.max_nose_height_m``, ``.hops``, ``.trace()``, ``.video(path)``,
+        ``.outcome`` (``goes_over``, ``rears_and_returns`` or ``stays_low``), ``.distance_m``,
+        ``.max_nose_height_m``, ``.hops``, ``.nose_load_kg``, ``.trace()``, ``.video(path)``,
         ``.plot()``. The same call gives the same numbers every time.
 
     Raises
@@ -258,10 +286,20 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
     """
     base = _run.run(robot, cycles=cycles, keep_states=keep_states)
     result = SimResult(**{f.name: getattr(base, f.name) for f in dataclasses.fields(base)}, params=robot)
+    if result.valid:
+        from ..sim.statics import standing_load
+
+        load = standing_load(robot)
+        result.nose_load_kg, result.total_mass_kg = load.nose_load_kg, load.total_mass_kg
     if samples and result.valid:
         from ..sim.samples import sample
 
         result.spread = sample(robot, samples, cycles=cycles, seed=seed)
+    mixed = result.spread is not None and max(o.share for o in result.spread.outcomes.values()) < 1.0
+    if result.valid and (sensitivity or (sensitivity is None and mixed)):
+        from ..sim.sensitivity import outcome_sensitivity
+
+        result.sensitivity = outcome_sensitivity(robot, cycles=cycles)
     return result
 
 

@@ -121,7 +121,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
 
     timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
     warnings = notices(comps)
-    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings)
+    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings, spreads)
     doc = report_json(base, robot_source, comps, configs, timing, land, marker, warnings)
     doc["optimize"] = {"folder": str(front.folder), "front": front.front} if front is not None else None
     for entry in doc["configurations"]:
@@ -255,7 +255,7 @@ def _track_reading(t) -> str:
 
 
 def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, land, marker: str,
-                warnings: Sequence[Notice] = ()) -> str:
+                warnings: Sequence[Notice] = (), spreads: dict | None = None) -> str:
     labels = {n: c.label for n, c in configs.items()}
     added = {n: c.added_m for n, c in configs.items()}
     inputs = []
@@ -271,6 +271,7 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
     sections = [("Warnings", H.warnings_list(collapsed(warnings)))] if warnings else []
     sections += [
         ("Summary", H.summary_table(comps, labels, added)),
+        *([("Outcome over the draws", H.outcome_table(spreads, labels))] if spreads else []),
         ("Figures", "".join(H.figure_html(f) for f in figs)),
         ("Per-hop errors", H.hop_table(comps, labels)),
         ("Firmware timing", H.timing_table(timing, labels)),

@@ -94,7 +94,8 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
             td(cm(c.predicted_jump_m), name, "predicted_jump_cm"),
             td(cm_pm(c.jump.mean, c.jump.std), name, "measured_jump_cm"),
             td(cm(jump_err), name, "jump_error_cm"), td(pct(jump_err, c.predicted_jump_m, c.resolution_m)),
-            td("valid" if valid else "INVALID: " + "; ".join(c.prediction.result.reasons), name, "sim_status",
+            td(f"valid, {outcome.replace('_', ' ')}" if valid and (outcome := c.prediction.result.outcome)
+               else "valid" if valid else "INVALID: " + "; ".join(c.prediction.result.reasons), name, "sim_status",
                left=True),
         ]
         rows.append(f'<tr{"" if valid else " class=invalid"}>{"".join(cells)}</tr>')
@@ -106,6 +107,24 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
             + ", ".join(f"{esc(label)} {res * 100:.3g} cm" for label, res in known)
             + '; an error smaller than that is not measured and reads "within 1 px".</p>')
     return table(headers, rows, id_="summary") + note
+
+
+def outcome_table(spreads: dict, labels: dict[str, str]) -> str:
+    """Each configuration's draws (``--samples``) by outcome: its share, and its own distance
+    and highest nose as mean ± sd (one sd across outcomes would hide a split)."""
+    rows = []
+    for name, sp in spreads.items():
+        if sp is None:
+            continue
+        for outcome, o in sp.outcomes.items():
+            cells = [td(labels[name], left=True), td(outcome.replace("_", " "), left=True),
+                     td(f"{o.n} of {sp.n_valid} ({o.share * 100:.0f} %)", name, f"outcome_share:{outcome}"),
+                     td(cm_pm(o.distance_m.mean, o.distance_m.sd if math.isfinite(o.distance_m.sd) else None)),
+                     td(cm_pm(o.max_nose_height_m.mean,
+                              o.max_nose_height_m.sd if math.isfinite(o.max_nose_height_m.sd) else None))]
+            rows.append(f"<tr>{''.join(cells)}</tr>")
+    headers = ["configuration", "outcome", "draws", "distance (cm)", "highest nose (cm)"]
+    return table(headers, rows, left_cols=2, id_="outcomes")
 
 
 def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:

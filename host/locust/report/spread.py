@@ -6,17 +6,21 @@ batched rollout, and each valid draw's marker trace is taken like the prediction
 (:func:`.predict.marker_trace`, the same rows, so the draws share one clock). The band is
 the draws' mean +- one standard deviation at every instant; each hop's distance (chassis
 travel, as ``run()`` gives it) and marker apex get their standard deviation over the draws.
+Each valid draw is classified (:mod:`locust.sim.outcome`), and each outcome's share and its
+own distance and highest nose are kept, as ``locust sim --samples`` reports them.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..params import Robot
 from ..sim.hops import summarise
+from ..sim.outcome import OutcomeFigures, classify, outcome_shares
 from ..sim.samples import simulate_draws
 from ..trials.measure import measure_hops
 from .predict import marker_trace
@@ -33,22 +37,28 @@ class Spread:
     y_sd_m: np.ndarray
     hop_distance_sd_m: list[float]     # per hop (nan with fewer than two valid draws)
     hop_apex_sd_m: list[float]
+    outcomes: dict[str, OutcomeFigures] = field(default_factory=dict)   # each outcome's share and figures
 
     def to_json(self) -> dict:
         return {"n": self.n, "n_valid": self.n_valid, "hop_distance_sd_m": self.hop_distance_sd_m,
-                "hop_apex_sd_m": self.hop_apex_sd_m}
+                "hop_apex_sd_m": self.hop_apex_sd_m,
+                "outcomes": {k: dataclasses.asdict(v) for k, v in self.outcomes.items()}}
 
 
 def spread(robot: Robot, cycles: int, marker: str, n: int, seed: int = 0) -> Spread | None:
     """``n`` draws of ``robot`` over ``cycles``; None when fewer than two are valid."""
     period = robot.schedule.push_s + robot.schedule.wait_s
-    traces, dist, apex = [], [], []
+    traces, dist, apex, kinds, run_dist, run_nose = [], [], [], [], [], []
     for traj in simulate_draws(robot, n, cycles, seed, keep_states=True):
         if traj is None:
             continue
         trace = marker_trace(traj, marker)
         traces.append(trace)
-        dist.append([h.distance_m for h in summarise(traj).hops])
+        summary = summarise(traj)
+        kinds.append(classify(summary.hops))
+        run_dist.append(summary.distance_m)
+        run_nose.append(summary.max_nose_height_m)
+        dist.append([h.distance_m for h in summary.hops])
         apex.append([h.apex_m for h in measure_hops(trace, period, cycles)])
     if len(traces) < 2:
         return None
@@ -60,4 +70,5 @@ def spread(robot: Robot, cycles: int, marker: str, n: int, seed: int = 0) -> Spr
         return [float(v) if math.isfinite(v) else math.nan for v in np.std(a, axis=0, ddof=1)]
 
     return Spread(n=n, n_valid=len(traces), t_s=traces[0].t_s, x_mean_m=xs.mean(0), x_sd_m=xs.std(0, ddof=1),
-                  y_mean_m=ys.mean(0), y_sd_m=ys.std(0, ddof=1), hop_distance_sd_m=sd(dist), hop_apex_sd_m=sd(apex))
+                  y_mean_m=ys.mean(0), y_sd_m=ys.std(0, ddof=1), hop_distance_sd_m=sd(dist), hop_apex_sd_m=sd(apex),
+                  outcomes=outcome_shares(kinds, run_dist, run_nose))

@@ -11,7 +11,7 @@ from ..errors import GeometryError, SimError
 from ..fileio import json_text
 from ..params import resolve_robot
 from ..params_cli import robot_options
-from ..tables import sim_lines, spread_line
+from ..tables import nose_load_line, sensitivity_lines, sim_lines, spread_lines
 
 
 @click.command()
@@ -27,14 +27,21 @@ from ..tables import sim_lines, spread_line
               help="Rerun at half the time step and report the relative change.")
 @click.option("--samples", type=click.IntRange(2, 4096), default=None, metavar="N",
               help="Also simulate N draws of the values that carry an uncertainty in the robot file "
-                   "(one batched rollout) and report the sd of distance and highest nose "
-                   "(--json: distance_m_sd, max_nose_height_m_sd).")
+                   "(one batched rollout) and report each outcome's share of them and its own distance "
+                   "and highest nose, mean ± sd (--json: outcomes). When the draws split between "
+                   "outcomes, also which values decide it (--sensitivity).")
+@click.option("--sensitivity/--no-sensitivity", default=None,
+              help="Move each uncertain value alone to -/+2 sd and report the outcome at each end: the "
+                   "values that decide the regime (default: with --samples, when its draws split).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of --samples.")
-def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence, samples, seed):
+def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence, samples, seed, sensitivity):
     """Settle the robot on the floor, then run the bang-bang hop schedule.
 
     Every run is audited (non-finite state, loop closure, energy, MuJoCo warnings). A run
     that fails its audit is reported invalid with the reasons, and exits 1 unless --json.
+    A valid run's outcome is one of: goes over (ends on its back), rears and returns (nose
+    above 3 cm and back down, every hop), stays low. The standing robot's weight on its nose
+    (a kitchen scale under the nose: `locust measure nose-load`) is printed with it.
 
     \b
     Examples:
@@ -42,8 +49,9 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
       locust sim --preset seed-notebook --json          # the notebook's Part 2 figures
       locust sim --preset large --set servo.stall_torque_nm=0.18 --video large.mp4
       locust sim --config calibration/robot.toml --samples 16   # with its spread
+      locust sim --preset medium --samples 32 --json     # outcome shares
     """
-    from ..api.simulation import simulate
+    from ..api.simulation import SimResult, simulate
     from .run import check_convergence as converge
     from .run import invalid_result
 
@@ -54,11 +62,13 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
         check_video_path(video)  # fail before simulating, not after
     try:
         result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed,
-                          keep_states=video is not None)  # the video reuses the rollout
+                          keep_states=video is not None,  # the video reuses the rollout
+                          sensitivity=sensitivity)
     except GeometryError as exc:
         if not as_json:
             raise
-        result = invalid_result(robot, exc.message + (f" ({exc.hint})" if exc.hint else ""), cycles)
+        bad = invalid_result(robot, exc.message + (f" ({exc.hint})" if exc.hint else ""), cycles)
+        result = SimResult(**vars(bad), params=robot)
     if check_convergence and result.valid:
         result.convergence = converge(robot, result, cycles=cycles)
     if video is not None:
@@ -67,18 +77,16 @@ def sim(preset, config, sets, cycles, as_json, video, camera, check_convergence,
         info = result.video(video, camera=camera)
         result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
 
-    spread = getattr(result, "spread", None)
+    spread, sens = getattr(result, "spread", None), getattr(result, "sensitivity", None)
     if as_json:
-        out = result.to_json()
-        if spread is not None:
-            out.update(distance_m_sd=spread.distance_m_sd, max_nose_height_m_sd=spread.max_nose_height_m_sd,
-                       samples=spread.to_json())
-        click.echo(json_text(out), nl=False)
+        click.echo(json_text(result.to_json()), nl=False)
         return
     for line in sim_lines(result):
         click.echo(line)
-    if spread is not None:
-        click.echo(spread_line(spread))
+    if result.valid:
+        click.echo(nose_load_line(result.nose_load_kg, result.total_mass_kg))
+    for line in (spread_lines(spread) if spread is not None else []) + (sensitivity_lines(sens) if sens else []):
+        click.echo(line)
     if not result.valid:
         sys.exit(1)
 

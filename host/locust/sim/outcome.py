@@ -26,9 +26,10 @@ The thresholds and why:
   "several centimetres" of a hop are above it, a robot shuffling on its feet is well below.
 - :data:`OVER_TURN_DEG` = 45 deg: a robot that has come back down stands within a degree
   of its start (0.0 deg measured on every returning hop of the presets' near-threshold
-  settings), while one that went over rests on its tail and legs turned 93-110 deg (Small,
-  Medium and Large as preset: 93.5, 102.1, 109.7 deg; nose 10.5-12.9 cm up). 45 deg is
-  far from both.
+  settings), while one that went over rests on its leg-end edge and legs turned 91-107 deg
+  (Small, Medium and Large as preset: 91.4, 99.1, 106.5 deg; nose 11-14 cm up), or right
+  over onto the plate's top, 212 deg (Medium with the crank at -90 deg). 45 deg is far from
+  both.
 
 ``classify(hops)`` is a stable interface (other packages call it): its name, its one
 argument (a sequence of objects with ``nose_apex_m`` and ``end_turn_deg``) and its return
@@ -37,7 +38,9 @@ argument (a sequence of objects with ``nose_apex_m`` and ``end_turn_deg``) and i
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Protocol
 
 GOES_OVER = "goes_over"
@@ -87,4 +90,58 @@ def classify(hops: Sequence[HopFigures]) -> str:
     return STAYS_LOW
 
 
-__all__ = ["GOES_OVER", "REARS_AND_RETURNS", "STAYS_LOW", "OUTCOMES", "REAR_M", "OVER_TURN_DEG", "classify"]
+@dataclass(frozen=True)
+class MeanSd:
+    mean: float      # nan with no draws
+    sd: float        # sample standard deviation (n - 1); nan with fewer than two draws
+
+
+@dataclass(frozen=True)
+class OutcomeFigures:
+    """One outcome over a set of draws: its share and its own figures' mean and sd."""
+
+    share: float             # of the classified (valid) draws; the shares sum to 1
+    n: int
+    distance_m: MeanSd
+    max_nose_height_m: MeanSd
+
+
+def _mean_sd(values: list[float]) -> MeanSd:
+    n = len(values)
+    if n == 0:
+        return MeanSd(math.nan, math.nan)
+    mean = math.fsum(values) / n
+    sd = math.sqrt(math.fsum((v - mean) ** 2 for v in values) / (n - 1)) if n > 1 else math.nan
+    return MeanSd(mean, sd)
+
+
+def outcome_shares(outcomes: Sequence[str | None], distance_m: Sequence[float],
+                   max_nose_height_m: Sequence[float]) -> dict[str, OutcomeFigures]:
+    """Each outcome's share of the draws and the mean and sd of its own draws' figures.
+
+    Parameters
+    ----------
+    outcomes : sequence of str or None
+        Per draw, one of :data:`OUTCOMES`, or None for a draw that is not a result (failed its
+        audit); those are left out of the shares.
+    distance_m, max_nose_height_m : sequence of float
+        Per draw, the run's distance and highest nose point (m).
+
+    Returns
+    -------
+    dict
+        Every name of :data:`OUTCOMES` (in that order) -> :class:`OutcomeFigures`; the shares
+        sum to 1 when any draw is classified (all 0 when none is).
+    """
+    n = sum(o is not None for o in outcomes)
+    out = {}
+    for name in OUTCOMES:
+        picked = [i for i, o in enumerate(outcomes) if o == name]
+        out[name] = OutcomeFigures(share=len(picked) / n if n else 0.0, n=len(picked),
+                                   distance_m=_mean_sd([distance_m[i] for i in picked]),
+                                   max_nose_height_m=_mean_sd([max_nose_height_m[i] for i in picked]))
+    return out
+
+
+__all__ = ["GOES_OVER", "REARS_AND_RETURNS", "STAYS_LOW", "OUTCOMES", "REAR_M", "OVER_TURN_DEG", "classify",
+           "MeanSd", "OutcomeFigures", "outcome_shares"]

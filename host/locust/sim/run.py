@@ -19,6 +19,7 @@ from .audit import audit
 from .fourbar import GOOD_TRANSMISSION_DEG
 from .hops import Hop, summarise
 from .model import build
+from .outcome import classify
 from .rollout import Trajectory, simulate
 
 
@@ -43,6 +44,8 @@ class SimResult:
     transmission_deg: float = float("nan")
     notes: list[str] = field(default_factory=list)
     convergence: dict[str, float] | None = None
+    # goes_over / rears_and_returns / stays_low (locust.sim.outcome); None when invalid
+    outcome: str | None = None
     # the rollout behind the figures, states included: only with run(..., keep_states=True);
     # never part of the JSON
     trajectory: Trajectory | None = field(default=None, repr=False, compare=False)
@@ -89,7 +92,7 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
     lo, hi = GOOD_TRANSMISSION_DEG
     if summary and summary.end_nose_rise_m > STAYED_UP_M:
         notes.append(f"did not come back down: the nose ends {summary.end_nose_rise_m * 100:.1f} cm above its "
-                     "standing height (the robot rears and stays), so a hop's nose rise after the one that "
+                     "standing height (it went over onto its back), so a hop's nose rise after the one that "
                      "reared is its resting height, not a hop")
     if not lo <= asm.transmission_deg <= hi:
         notes.append(f"poor transmission angle {asm.transmission_deg:.0f} deg at the start (outside {lo:g}-{hi:g})")
@@ -105,6 +108,7 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
         servo_noload_speed_rad_per_s=robot.servo.noload_speed_rad_per_s, grashof=asm.grashof,
         transmission_deg=asm.transmission_deg,
         notes=notes, trajectory=traj if keep_states else None,
+        outcome=classify(summary.hops) if summary else None,
     )
 
 

@@ -5,6 +5,9 @@ by ``locust calibrate`` beside the value) is drawn from a normal distribution ab
 independently; a positive value stays positive (draws below a tenth of it are put there).
 All draws are simulated in one batched ``mujoco.rollout`` and each is audited and summarised
 like ``locust sim``'s own run; the spread of the valid ones is the prediction's uncertainty.
+Each valid draw is also classified (:mod:`.outcome`): near the threshold the draws split
+between going over and coming back, so each outcome's share and its own figures are the
+prediction, not one mean and sd across both.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from ..params import Provenance, Robot, problems, real_keys
 from .audit import audit
 from .hops import summarise
 from .model import build
+from .outcome import OutcomeFigures, classify, outcome_shares
 from .rollout import Trajectory, simulate_batch
 from .schedule import control_plan
 
@@ -41,6 +45,8 @@ class Samples:
     distance_m_sd: float
     max_nose_height_m_mean: float
     max_nose_height_m_sd: float
+    outcome: list[str | None] = dataclasses.field(default_factory=list)   # per draw (None: invalid)
+    outcomes: dict[str, OutcomeFigures] = dataclasses.field(default_factory=dict)
 
     def to_json(self) -> dict:
         return dataclasses.asdict(self)
@@ -91,11 +97,12 @@ def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 
 
 def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0) -> Samples:
     """Simulate ``n`` draws of ``robot`` in one batch; their distances and nose heights."""
-    dist, nose = [], []
+    dist, nose, kind = [], [], []
     for traj in simulate_draws(robot, n, cycles, seed):
         summary = summarise(traj) if traj is not None else None
         dist.append(summary.distance_m if summary else math.nan)
         nose.append(summary.max_nose_height_m if summary else math.nan)
+        kind.append(classify(summary.hops) if summary else None)
     d, h = np.array(dist), np.array(nose)
     valid = np.isfinite(d) & np.isfinite(h)
 
@@ -107,4 +114,4 @@ def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0) -> Sa
     (dm, ds), (hm, hs) = stats(d), stats(h)
     return Samples(n=n, n_valid=int(valid.sum()), seed=seed, uncertain=uncertain_values(robot), distance_m=dist,
                    max_nose_height_m=nose, distance_m_mean=dm, distance_m_sd=ds, max_nose_height_m_mean=hm,
-                   max_nose_height_m_sd=hs)
+                   max_nose_height_m_sd=hs, outcome=kind, outcomes=outcome_shares(kind, dist, nose))

@@ -1,0 +1,113 @@
+"""Which measured values decide a prediction's regime: a one-at-a-time sensitivity.
+
+Each value of the robot that carries an uncertainty (one standard deviation, as
+:func:`.samples.uncertain_values` finds them) is moved alone to its value less and plus
+``k_sd`` standard deviations (2 by default: the ends of its 95 % interval), the others held,
+and the run's outcome (:mod:`.outcome`) is taken at each end. A value whose interval holds
+another outcome than the nominal robot's decides the regime: measuring it better is what
+settles the prediction. All the runs go in one batched rollout.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from ..errors import GeometryError
+from ..params import Provenance, Robot, problems
+from .audit import audit
+from .hops import summarise
+from .model import build
+from .outcome import classify
+from .rollout import simulate_batch
+from .samples import MIN_FRACTION, THREADS, uncertain_values
+from .schedule import control_plan
+
+K_SD = 2.0
+
+
+@dataclass(frozen=True)
+class KeyEffect:
+    """One value at either end of its interval, and the outcome there (None: not a valid run)."""
+
+    key: str
+    sd: float
+    low_value: float
+    low_outcome: str | None
+    high_value: float
+    high_outcome: str | None
+
+
+@dataclass(frozen=True)
+class Sensitivity:
+    nominal: str | None          # the robot's own outcome
+    k_sd: float                  # the ends are the value -/+ k_sd standard deviations
+    effects: list[KeyEffect]     # every uncertain value, in the robot file's order
+
+    @property
+    def deciding(self) -> list[KeyEffect]:
+        """The values whose interval reaches another outcome than the nominal one."""
+        return [e for e in self.effects if e.low_outcome != self.nominal or e.high_outcome != self.nominal]
+
+    def to_json(self) -> dict:
+        out = dataclasses.asdict(self)
+        out["deciding"] = [e.key for e in self.deciding]
+        return out
+
+
+def _outcomes(robots: list[Robot], cycles: int | None) -> list[str | None]:
+    """Each robot's outcome, all simulated in one batch; None for one that cannot be run or
+    fails its audit."""
+    builts = []
+    for r in robots:
+        try:
+            builts.append(None if problems(r, cycles) else build(r))
+        except GeometryError:
+            builts.append(None)
+    ok = [b for b in builts if b is not None]
+    plan = control_plan(robots[0].schedule, robots[0].solver, cycles)
+    trajs = iter(simulate_batch(ok, plan, threads=THREADS) if ok else [])
+    out: list[str | None] = []
+    for b in builts:
+        traj = next(trajs) if b is not None else None
+        out.append(classify(summarise(traj).hops) if traj is not None and audit(traj).valid else None)
+    return out
+
+
+def outcome_sensitivity(robot: Robot, cycles: int | None = None, k_sd: float = K_SD) -> Sensitivity:
+    """The outcome of ``robot`` and of each uncertain value moved alone to -/+ ``k_sd`` sd.
+
+    Parameters
+    ----------
+    robot : Robot
+        With uncertainties on the values to test (from its robot file or preset).
+    cycles : int, optional
+        Hop cycles; default the robot's ``schedule.cycles``.
+    k_sd : float, default 2
+        How far each value moves, in its standard deviations (2: its 95 % interval).
+
+    Returns
+    -------
+    Sensitivity
+        ``nominal`` (the robot's own outcome), ``effects`` (one :class:`KeyEffect` per
+        uncertain value) and ``deciding`` (those whose interval holds another outcome).
+        A positive value is kept above a tenth of itself, as the draws of ``--samples`` are.
+    """
+    sds = uncertain_values(robot)
+    ends = []
+    for key, sd in sds.items():
+        centre = robot.get(key)
+        for sign in (-1.0, 1.0):
+            value = centre + sign * k_sd * sd
+            ends.append(max(value, MIN_FRACTION * centre) if centre > 0 else value)
+    prov = Provenance(source="sensitivity", note=f"one value at -/+{k_sd:g} sd")
+    robots = [robot] + [robot.with_values({key: ends[2 * i + j]}, prov)
+                        for i, key in enumerate(sds) for j in range(2)]
+    kinds = _outcomes(robots, cycles)
+    effects = [KeyEffect(key=key, sd=sd, low_value=ends[2 * i], low_outcome=kinds[1 + 2 * i],
+                         high_value=ends[2 * i + 1], high_outcome=kinds[2 + 2 * i])
+               for i, (key, sd) in enumerate(sds.items())]
+    return Sensitivity(nominal=kinds[0], k_sd=k_sd, effects=effects)
+
+
+__all__ = ["KeyEffect", "Sensitivity", "outcome_sensitivity", "K_SD"]
