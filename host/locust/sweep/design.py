@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import GeometryError, LocustError, SweepError
 from ..params import Provenance, Robot, all_keys, outside_limits, problems, with_added_length
 from ..sim.fourbar import assemble
-from ..sim.outcome import GOES_OVER, OUTCOMES, classify
+from ..sim.outcome import GOES_OVER, OUTCOMES
 
 SCALE = "scale"
 CRANK_CHECK_STEP_DEG = 1.0
@@ -244,7 +244,7 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 
     if not result.valid:
         return invalid_row("; ".join(result.reasons), result.grashof, result.transmission_deg)
     hops = result.hops
-    outcome = classify(hops)
+    outcome = result.outcome
     distance_m, nose_m, flip = result.distance_m, result.max_nose_height_m, float(outcome == GOES_OVER)
     if samples:
         spread = sampled(robot, samples, cycles)
@@ -263,16 +263,15 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 
 
 
 def sampled(robot: Robot, samples: int, cycles: int) -> tuple[str, float, float, float] | None:
-    """Over ``samples`` draws of the uncertain values (seed 0, the same deviates for every
-    design): the most common outcome, the share that goes over, and the means of distance and
-    highest nose point over the valid draws; None when fewer than two are valid."""
-    from ..sim.hops import summarise
-    from ..sim.samples import simulate_draws
+    """Over ``samples`` draws of the uncertain values (:func:`locust.sim.samples.sample`, seed 0:
+    the same deviates for every design): the most common outcome, the share that goes over, and
+    the means of distance and highest nose point over the valid draws; None when fewer than two
+    are valid."""
+    from ..sim.samples import sample
 
-    runs = [summarise(t) for t in simulate_draws(robot, samples, cycles=cycles) if t is not None]
-    if len(runs) < 2:
+    spread = sample(robot, samples, cycles=cycles)
+    kinds = [k for k in spread.outcome if k is not None]
+    if spread.n_valid < 2 or not kinds:
         return None
-    outcomes = [classify(r.hops) for r in runs]
-    common = max(OUTCOMES, key=outcomes.count)
-    return (common, outcomes.count(GOES_OVER) / len(runs), float(np.mean([r.distance_m for r in runs])),
-            float(np.mean([r.max_nose_height_m for r in runs])))
+    return (max(OUTCOMES, key=kinds.count), kinds.count(GOES_OVER) / len(kinds), spread.distance_m_mean,
+            spread.max_nose_height_m_mean)
