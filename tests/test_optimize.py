@@ -183,3 +183,37 @@ def test_trials_run_on_local_processes_and_on_a_dask_cluster_share_one_study(tmp
     for r in rows[::3]:
         if r["state"] == "complete":
             assert float(r["distance_m"]) == judge({"scale": float(r["scale"])}).figures["distance_m"]
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--objective", "height"], ("no such objective", "distance, nose_rise, flight")),
+    (["--objective", "distance", "--objective", "distance"], ("given twice",)),
+    (["--step", "geometry.crank_start_deg=18"], ("no --vary range of that name",)),
+    (["--step", "scale=0.5"], ("a step must be above 0 and at most HIGH - LOW",)),
+    (["--step", "scale"], ("not NAME=STEP",)),
+    (["--vary", "geometry.leg_m=0.05,0.05"], ("given twice",)),
+    (["--vary", "geometry.leg_m=0.05,9"], ("geometry.leg_m = 9",)),
+])
+def test_optimize_bad_input_is_refused_before_anything_runs(tmp_path, extra, words):
+    res = invoke(["optimize", "--vary", "scale=0:0.02", *extra, "--out", tmp_path / "o"])
+    assert res.exit_code == 2 and "error:" in res.output and "hint:" in res.output, res.output
+    for w in words:
+        assert w in res.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_stepped_and_categorical_design_variables(tmp_path):
+    base = preset("medium")
+    horn = parse_bound("geometry.crank_start_deg=-136:-60", base, step=18.0)
+    # the spline's steps from -136 up to the last one at or below -60: -136 + 4 x 18 = -64
+    assert (horn.low, horn.high, horn.step) == (-136.0, -64.0, 18.0)
+    legs = parse_bound("geometry.leg_m=0.06,0.07,0.08", base)
+    assert legs.choices == (0.06, 0.07, 0.08) and (legs.low, legs.high) == (0.06, 0.08)
+    # a study draws only those values (a synthetic judge: no simulation)
+    run_optimize(base, [horn, legs], trials=12, cycles=1, folder=tmp_path / "o", seed=1,
+                 judge=lambda v: standin({"scale": (v["geometry.crank_start_deg"] + 136) / 72,
+                                          "schedule.push_s": (v["geometry.leg_m"] - 0.06) / 0.02}))
+    rows = read_csv(tmp_path / "o" / "trials.csv")
+    assert {float(r["geometry.crank_start_deg"]) for r in rows} <= {-136.0, -118.0, -100.0, -82.0, -64.0}
+    assert {float(r["geometry.leg_m"]) for r in rows} <= {0.06, 0.07, 0.08}
+    assert len({float(r["geometry.crank_start_deg"]) for r in rows}) >= 3
