@@ -72,26 +72,46 @@ def draw_front(ax, rows: list[dict[str, Any]], front: list[dict[str, Any]], chos
     fy = lambda r: r[oy.column] * oy.plot_factor   # noqa: E731
     grey = [r for r in done if r["feasible"] and r["trial"] not in front_ids]
     ax.plot([fx(r) for r in grey], [fy(r) for r in grey], "o", ms=5, color="0.7", label=f"dominated ({len(grey)})")
+    feasible = grey + list(front)
+    box = _box([fx(r) for r in feasible], [fy(r) for r in feasible]) if len(feasible) > 1 else None
     if flipped:
         why = f"flip share over {max_flip:g}" if max_flip is not None else "goes over"
+        outside = sum(1 for r in flipped if box and not _inside(box, fx(r), fy(r)))
+        more = f", {outside} outside the axes" if outside else ""
         ax.plot([fx(r) for r in flipped], [fy(r) for r in flipped], "x", ms=7, color="#d62728",
-                label=f"{why} ({len(flipped)})")
+                label=f"{why} ({len(flipped)}{more})")
     ordered = sorted(front, key=fx)
     ax.plot([fx(r) for r in ordered], [fy(r) for r in ordered], "o-", ms=6, color="#1f77b4",
             label=f"Pareto front ({len(front)})")
     named: dict[int, list[str]] = {}
     for name, r in chosen.items():
         named.setdefault(r["trial"], []).append(name)
-    for trial, names in named.items():
+    for k, (trial, names) in enumerate(named.items()):
         r = chosen[names[0]]
         ax.plot(fx(r), fy(r), "*", ms=13, color="#ff7f0e")
         ax.annotate(f"{', '.join(names)} (trial {trial})", (fx(r), fy(r)), textcoords="offset points",
-                    xytext=(-6, -12), ha="right", fontsize=8, color="#c05800")
+                    xytext=(-8, -14 - 12 * k), ha="right", fontsize=8, color="#c05800",
+                    arrowprops={"arrowstyle": "-", "color": "#c05800", "lw": 0.5})
+    if box:   # the feasible designs fill the axes; a design far over the flip limit is counted above
+        ax.set_xlim(box[0], box[1])
+        ax.set_ylim(box[2], box[3])
     ax.set_xlabel(xlabel)
     ax.set_ylabel(oy.label)
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="best")
+
+
+def _box(xs: list[float], ys: list[float], margin: float = 0.15) -> tuple[float, float, float, float]:
+    """Axis limits around the points, ``margin`` of their span (or of the value) on each side."""
+    def pad(lo: float, hi: float) -> tuple[float, float]:
+        m = margin * ((hi - lo) or abs(hi) or 1.0)
+        return lo - m, hi + m
+    return (*pad(min(xs), max(xs)), *pad(min(ys), max(ys)))
+
+
+def _inside(box: tuple[float, float, float, float], x: float, y: float) -> bool:
+    return box[0] <= x <= box[1] and box[2] <= y <= box[3]
 
 
 def describe(row: dict[str, Any], names: list[str], objectives: list[Objective]) -> str:
