@@ -156,3 +156,17 @@ def test_the_report_shows_each_outcomes_share_of_the_draws():
     assert over.distance_m.mean == pytest.approx(ref.outcomes[O.GOES_OVER].distance_m.mean, rel=1e-12)
     html = outcome_table({"medium": sp}, {"medium": "Medium"})
     assert f"{over.n} of {sp.n_valid}" in html and "goes over" in html
+
+
+def test_the_api_shows_the_outcome_shares_as_the_command_does():
+    """``locust.simulate(robot, samples=6, seed=3)`` on the same robot as the command above:
+    the same split, shown in its table, and ``sensitivity=False`` leaves it out."""
+    import locust
+
+    robot = only_uncertain(P.preset("medium"), {"geometry.crank_start_deg": 10.0})
+    r = locust.simulate(robot, cycles=2, samples=6, seed=3, keep_states=False, sensitivity=False)
+    assert r.outcome == O.GOES_OVER and r.sensitivity is None
+    over = r.spread.outcomes[O.GOES_OVER]
+    assert 0 < over.n < r.spread.n_valid
+    assert f"goes over           {over.n} of {r.spread.n_valid} (" in repr(r)
+    assert r.to_json()["outcomes"][O.GOES_OVER]["n"] == over.n

@@ -4,12 +4,13 @@ result's own, in mm, to the printed precision (0.005 mm)."""
 import math
 import re
 
+import pytest
 from click.testing import CliRunner
 
 from locust.cli import cli
 from locust.params import preset
 from locust.sim.run import run
-from locust.tables import mm, plant_lines, sim_lines, table
+from locust.tables import mean_sd, mm, plant_lines, sim_lines, table
 
 ROUNDING_MM = 0.005     # two decimals
 
@@ -65,3 +66,14 @@ def test_plant_lines_give_the_live_runs_figures_in_mm():
     bad = {**summary, "valid": False, "reasons": ["aborted"], "hops": []}
     assert plant_lines(bad) == ["simulated robot: INVALID (2.829 s simulated, 23.7x real time)", "  reason: aborted"]
     assert plant_lines({"plant": "record", "commands": 7}) == ["servo commands recorded: 7"]
+
+
+@pytest.mark.parametrize("mean_m, sd_m, text", [
+    (-0.0671, 0.0104, "-67 ± 10"),          # sd to two figures, the mean to the same place
+    (0.0133, 0.0096, "13.3 ± 9.6"),
+    (0.1238, 0.00097, "123.80 ± 0.97"),
+    (0.0082, float("nan"), "8.2"),          # one draw: no sd
+    (float("nan"), float("nan"), "nan"),
+])
+def test_mean_sd_keeps_sensible_digits(mean_m, sd_m, text):
+    assert mean_sd(mean_m, sd_m) == text

@@ -16,7 +16,7 @@ TERMS_SHOWN = 3
 
 @click.group()
 def measure():
-    """Measure the robot as built (docs/measure.md)."""
+    """Measure the robot as built (docs/hardware.md, "Measure your robot")."""
 
 
 def _mm(e) -> str:
@@ -40,7 +40,7 @@ def nose_load(grams, preset, config, sets, resolution_g, total_g, write, force, 
 
     Stand the robot with its nose on the scale's pan and its feet level with the pan (on a
     book as thick as the scale), servos at rest (0 deg), and read GRAMS. The model's robot
-    is moved along geometry.servo_axis_x_m until it reads the same (docs/measure.md says why
+    is moved along geometry.servo_axis_x_m until it reads the same (docs/hardware.md says why
     that value); the interval counts the scale's resolution and every other uncertain value
     of the robot file, and is combined with the file's own interval for the axis.
 
