@@ -53,3 +53,24 @@ def assert_refused_and_unchanged(folder: Path, args: list, *words: str) -> None:
     res = invoke(args)
     assert_clear_error(res, *words)
     assert tree(folder) == before
+
+
+def signalled_in_design(signal_name: str, call: int) -> str:
+    """A Python script running the ``locust`` command line that sends itself ``signal_name``
+    (SIGINT: Ctrl-C; SIGKILL: a lost machine) as it starts judging its ``call``-th design of
+    ``locust optimize``: a point that does not depend on the machine's speed."""
+    return f"""
+import os, signal, sys
+from locust.sweep import robust
+judge = robust.DesignJudge.__call__
+calls = []
+def judge_or_signal(self, values):
+    calls.append(1)
+    if len(calls) == {call}:
+        os.kill(os.getpid(), signal.{signal_name})
+    return judge(self, values)
+robust.DesignJudge.__call__ = judge_or_signal
+from locust.cli import main
+sys.argv[0] = "locust"
+main()
+"""

@@ -8,6 +8,7 @@ lost frames (locust.report.synthetic); the model's predictions must be run()'s o
 from __future__ import annotations
 
 import base64
+import json
 import re
 import shutil
 import subprocess
@@ -21,7 +22,8 @@ from locust.cli import cli
 from locust.params import Provenance, leg_set, preset, save_robot
 from locust.report.synthetic import simulated_nose, write_synthetic_trial
 from locust.sim.run import run
-from locust.sweep.design import Axis
+from locust.sweep.design import Axis, parse_bound
+from locust.sweep.optimize import run_optimize
 from locust.sweep.run import run_sweep
 
 CYCLES = 2
@@ -77,12 +79,13 @@ def world(tmp_path_factory):
             truth[f"{name}-{k}"] = write_synthetic_trial(root / "hops" / f"{name}-{k}", true_robot, CYCLES,
                                                          seed=k, camera_lead_s=CAMERA_LEAD_S, truth=sim)
     sweep = run_sweep(seed, [Axis("scale", 0.0, 0.01, 2)], CYCLES, root / "sweep", jobs=1, plots=False)
+    study = run_optimize(seed, [parse_bound("scale=0:0.01", seed)], 3, CYCLES, root / "study")
     res = invoke("--measured", root / "hops" / "small-1", "--measured", root / "hops" / "small-2",
                  "--measured", root / "hops" / "medium-1", "--preset", "seed", "--sweep", root / "sweep",
-                 "--out", root / "out")
+                 "--optimize", root / "study", "--out", root / "out")
     assert res.exit_code == 0, res.output
     html = Path(res.stdout.strip().splitlines()[-1])
-    return {"root": root, "truth": truth, "html": html, "cells": parse(html), "sweep": sweep}
+    return {"root": root, "truth": truth, "html": html, "cells": parse(html), "sweep": sweep, "study": study}
 
 
 def cm(value_m: float) -> str:
@@ -201,6 +204,16 @@ def test_report_is_self_contained_with_named_figures(world):
     # parameter table with provenance
     assert world["cells"].cells[("", "param:contact.foot_friction")] == "1.7"
     assert "fig-landscape" in text
+
+
+def test_report_draws_an_optimize_study_s_front_and_names_its_pick(world):
+    text = world["html"].read_text(encoding="utf-8")
+    assert "fig-pareto" in text
+    best = world["study"].best     # one objective: the front is the farthest design
+    assert f"best-distance: trial {best['trial']} (scale={best['scale'] * 100:.4g} cm)" in text
+    doc = json.loads((world["html"].parent / "report.json").read_text())
+    assert [r["trial"] for r in doc["optimize"]["front"]] == [best["trial"]]
+    assert doc["optimize"]["front"][0]["distance_m"] == best["distance_m"]
 
 
 def test_changing_a_calibrated_stiffness_changes_the_predictions(world, tmp_path):

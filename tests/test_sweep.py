@@ -18,7 +18,7 @@ from locust.errors import SweepError
 from locust.params import load_robot, preset
 from locust.sweep.design import design_robot, evaluate, parse_axis, parse_bound, precheck
 from locust.sweep.run import best_row, run_sweep
-from probing import assert_refused_and_unchanged, invoke
+from probing import assert_refused_and_unchanged, invoke, signalled_in_design
 
 LOCUST = [sys.executable, "-c", "from locust.cli import main; main()"]
 
@@ -92,11 +92,27 @@ def test_impossible_linkages_are_rejected_with_reasons_and_never_best(tmp_path):
     assert meta["best"]["design"] == best["design"] and meta["finished"] is True
 
 
-def test_best_row_ignores_invalid_rows_even_with_larger_numbers():
-    rows = [{"design": 0, "valid": False, "distance_m": 9.0}, {"design": 1, "valid": True, "distance_m": 0.2},
-            {"design": 2, "valid": True, "distance_m": 0.3}]
+def test_best_row_ignores_invalid_rows_and_robots_on_their_backs_even_with_larger_numbers():
+    rows = [{"design": 0, "valid": False, "outcome": "", "distance_m": 9.0},
+            {"design": 1, "valid": True, "outcome": "stays_low", "distance_m": 0.2},
+            {"design": 2, "valid": True, "outcome": "rears_and_returns", "distance_m": 0.3},
+            {"design": 3, "valid": True, "outcome": "goes_over", "distance_m": 0.5}]
     assert best_row(rows)["design"] == 2
-    assert best_row([rows[0]]) is None
+    assert best_row([rows[0], rows[3]]) is None
+
+
+def test_a_sweep_marks_each_design_s_outcome_and_never_ranks_a_robot_on_its_back(tmp_path):
+    # Medium as built goes over at a -40 deg push (it ends on its back, nose about 12 cm up: the
+    # highest "jump" of the sweep) and stays on its feet at -15 deg
+    base = preset("medium")
+    summary = run_sweep(base, [parse_axis("schedule.push_deg=-40:-15:2", base)], cycles=1, out=tmp_path / "s",
+                        jobs=1)
+    over, low = summary.rows
+    assert (over["outcome"], over["flip_share"]) == ("goes_over", 1.0)
+    assert low["outcome"] in ("rears_and_returns", "stays_low") and low["flip_share"] == 0.0
+    assert over["max_nose_height_m"] > 0.1 > low["max_nose_height_m"]
+    assert summary.best["design"] == low["design"]
+    assert [r["outcome"] for r in read_rows(tmp_path / "s")] == ["goes_over", low["outcome"]]
 
 
 def test_a_folder_holding_another_sweep_or_other_files_is_refused(tmp_path):
@@ -200,14 +216,15 @@ def test_optimize_prunes_invalid_designs_and_keeps_the_study(tmp_path):
     assert first.best["geometry.coupler_m"] <= 0.1166
     assert precheck(design_robot(base, {"geometry.coupler_m": first.best["geometry.coupler_m"]})) is None
     # the best design as a robot file: its values, and a name that says what it is
-    best = load_robot(tmp_path / "o" / "best.toml")
-    assert best.name == f"optimize best of {tmp_path / 'o'}"
+    best = load_robot(tmp_path / "o" / "best-distance.toml")
+    assert best.name == f"optimize best-distance of {tmp_path / 'o'}"
     assert best.geometry.coupler_m == first.best["geometry.coupler_m"]
+    # the figure optimised is the distance a hop: one cycle here
     assert evaluate(best, {}, 1)["distance_m"] == first.best["distance_m"]
-    # the journal keeps the study: a second run continues it
-    again = run_optimize(base, bounds, trials=2, cycles=1, folder=tmp_path / "o", seed=4)
-    assert again.trials == 7
-    assert (tmp_path / "o" / "history.png").stat().st_size > 5_000
+    # the journal keeps the study: --trials is what it should hold, a rerun computes the rest
+    again = run_optimize(base, bounds, trials=7, cycles=1, folder=tmp_path / "o", seed=4)
+    assert (again.trials, again.computed) == (7, 2)
+    assert (tmp_path / "o" / "pareto.png").stat().st_size > 5_000
 
 
 def test_optimize_on_sqlite_storage(tmp_path):
@@ -264,10 +281,12 @@ def test_results_csv_round_trips_through_its_owner_and_only_a_torn_last_line_is_
     from locust.io.sweep_store import SweepStore, read_results
 
     rows = [  # SYNTHETIC rows (made-up figures, not simulations)
-        {"design": 0, "scale": 0.0, "valid": True, "reason": "", "distance_m": 0.009292704540008771,
+        {"design": 0, "scale": 0.0, "valid": True, "reason": "", "outcome": "rears_and_returns", "flip_share": 0.125,
+         "distance_m": 0.009292704540008771,
          "max_nose_height_m": 0.1 + 0.2, "nose_apex_max_m": 1e-17, "com_apex_max_m": 2.5e-3, "hops": 3,
          "grashof": "change-point", "transmission_deg": 77.15523372599155},
-        {"design": 1, "scale": 0.01, "valid": False, "reason": "energy audit failed, twice", "distance_m": math.nan,
+        {"design": 1, "scale": 0.01, "valid": False, "reason": "energy audit failed, twice", "outcome": "",
+         "flip_share": math.nan, "distance_m": math.nan,
          "max_nose_height_m": math.nan, "nose_apex_max_m": math.nan, "com_apex_max_m": math.nan, "hops": 0,
          "grashof": "crank-rocker", "transmission_deg": 80.0},
     ]
@@ -327,9 +346,9 @@ def _not_journals(journal: str) -> dict[str, bytes]:
 
 def test_optimize_refuses_a_storage_file_that_is_not_a_whole_journal_and_leaves_it(tmp_path, journal_text,
                                                                                    monkeypatch):
-    from locust.sweep import optimize
+    from locust.sweep import storage
 
-    monkeypatch.setattr(optimize, "JOURNAL_RECHECK_S", (0.0,))   # no other process writes these
+    monkeypatch.setattr(storage, "JOURNAL_RECHECK_S", (0.0,))   # no other process writes these
     for name, data in _not_journals(journal_text).items():
         folder = tmp_path / name
         folder.mkdir()
@@ -363,27 +382,13 @@ def test_optimize_refuses_to_continue_a_study_with_other_settings(tmp_path):
     for other, differs in ((["--cycles", "6"], "cycles"), (["--set", "geometry.crank_m=0.041"], "geometry.crank_m"),
                            (["--vary", "geometry.leg_m=0.05:0.09"], "vary"), (["--preset", "large"], "base")):
         assert_refused_and_unchanged(tmp_path, [*OPT, "--out", out, *other], "other settings", differs)
-    again = invoke([*OPT, "--out", out])   # the same settings continue the study
-    assert again.exit_code == 0 and "2 trials" in again.output
+    again = invoke([*OPT[:3], "--trials", "2", *OPT[5:], "--out", out])   # the same settings continue the study
+    assert again.exit_code == 0 and "2 trials (1 computed now)" in again.output
 
 
 # Ctrl-C in the middle of the second trial, delivered by the process to itself: the same
 # SIGINT a terminal sends, at a point that does not depend on the machine's speed.
-_INTERRUPTED_IN_SECOND_TRIAL = """
-import os, signal, sys
-from locust.sweep import optimize
-evaluate = optimize.evaluate
-calls = []
-def evaluate_then_interrupt(*args):
-    calls.append(1)
-    if len(calls) == 2:
-        os.kill(os.getpid(), signal.SIGINT)
-    return evaluate(*args)
-optimize.evaluate = evaluate_then_interrupt
-from locust.cli import main
-sys.argv[0] = "locust"
-main()
-"""
+_INTERRUPTED_IN_SECOND_TRIAL = signalled_in_design("SIGINT", 2)
 
 
 def test_interrupted_optimize_keeps_finished_trials_without_a_traceback(tmp_path):
@@ -398,7 +403,8 @@ def test_interrupted_optimize_keeps_finished_trials_without_a_traceback(tmp_path
     assert meta["trials"] == 2 and meta["complete"] + meta["pruned"] == 1
     rerun = subprocess.run(LOCUST + args, capture_output=True, text=True, timeout=300)
     assert rerun.returncode == 0, rerun.stderr
-    assert "6 trials" in rerun.stdout   # 2 before (1 finished, 1 dropped) + 4
+    # 2 before (1 finished, 1 dropped), and the 3 more that make 4 finished
+    assert "5 trials (3 computed now)" in rerun.stdout
 
 
 # -- sweep: workers, schedulers ---------------------------------------------------------

@@ -21,7 +21,7 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
     "params": ("locust.params_cli", "params", "Show or write robot parameters (presets, robot.toml, --set)."),
     "sim": ("locust.sim.cli", "sim", "Simulate the hop schedule in MuJoCo, audited."),
     "sweep": ("locust.sweep.cli", "sweep", "Sweep design parameters over a grid, in parallel."),
-    "optimize": ("locust.sweep.cli", "optimize", "Optimise hop distance with Optuna."),
+    "optimize": ("locust.sweep.cli", "optimize", "Designs that hop far and high without going over (Optuna)."),
     "ports": ("locust.device.cli", "ports", "List serial ports and mark the likely ESP32."),
     "flash": ("locust.device.cli", "flash", "Copy the MicroPython firmware to the board (mpremote)."),
     "hop": ("locust.device.cli", "hop", "Run the bang-bang hop schedule on the robot; save a run record."),

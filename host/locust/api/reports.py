@@ -13,7 +13,8 @@ def report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str | Path
            out: str | Path = "reports", cycles: int | None = None, sweep: str | Path | None = None,
            added: Mapping[str, float] | None = None, marker: str = "nose", samples: int = 0,
            side_by_side: bool = False, before: Robot | None = None, robot_source: str | None = None,
-           imports: ImportOptions = AS_IS, progress: Callable[[str], None] | None = None):
+           imports: ImportOptions = AS_IS, progress: Callable[[str], None] | None = None,
+           study: str | Path | None = None):
     """Simulate each leg set and compare it with its measured trials, in one HTML page.
 
     Parameters
@@ -37,6 +38,8 @@ def report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str | Path
         Draws of the uncertain values per configuration: bands on the predictions.
     before : Robot, optional
         The robot before a fit: its predictions drawn too.
+    study : path-like, optional
+        A ``locust optimize --out`` folder: its Pareto front and picked designs.
 
     Returns
     -------
@@ -53,7 +56,8 @@ def report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str | Path
     groups = parse_measured(list(measured), marker=marker, imports=imports)
     return build_report(robot, groups, Path(out), robot_source=robot_source or robot.name, cycles=cycles,
                         sweep=Path(sweep) if sweep is not None else None, added=dict(added or {}), marker=marker,
-                        progress=progress, side_by_side=side_by_side, samples=samples, before=before)
+                        progress=progress, side_by_side=side_by_side, samples=samples, before=before,
+                        study=Path(study) if study is not None else None)
 
 
 __all__ = ["report"]

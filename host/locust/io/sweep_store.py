@@ -25,9 +25,9 @@ from ..fileio import atomic_write_json, atomic_write_text, make_folder
 RESULTS = "results.csv"
 META = "sweep.json"
 LOCK = ".sweep.lock"
-RESULT_FIELDS = ("valid", "reason", "distance_m", "max_nose_height_m", "nose_apex_max_m",
+RESULT_FIELDS = ("valid", "reason", "outcome", "flip_share", "distance_m", "max_nose_height_m", "nose_apex_max_m",
                  "com_apex_max_m", "hops", "grashof", "transmission_deg")   # a design's result row
-_FLOATS = {"distance_m", "max_nose_height_m", "nose_apex_max_m", "com_apex_max_m", "transmission_deg"}
+_FLOATS = {"flip_share", "distance_m", "max_nose_height_m", "nose_apex_max_m", "com_apex_max_m", "transmission_deg"}
 
 
 def columns(axis_names: list[str]) -> list[str]:

@@ -28,6 +28,7 @@ from .landscape import Landscape, read_landscape
 from .predict import predict
 from .sidebyside import plan_side_by_side, write_side_by_side
 from .spread import spread
+from .study import read_front, study_figure
 
 REPORT_NAME = "report.html"
 DASHBOARD_NAME = "dashboard.png"
@@ -94,9 +95,11 @@ def parameter_rows(robot: Robot) -> list[dict]:
 def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, robot_source: str,
                  cycles: int | None = None, sweep: Path | None = None, added: dict[str, float] | None = None,
                  marker: str = "nose", progress: Callable[[str], None] | None = None,
-                 side_by_side: bool = False, samples: int = 0, before: Robot | None = None) -> ReportResult:
+                 side_by_side: bool = False, samples: int = 0, before: Robot | None = None,
+                 study: Path | None = None) -> ReportResult:
     """``samples``: draws of the robot's uncertain values per configuration (bands and error
-    bars on the predictions); ``before``: the robot before a fit, its predictions drawn too."""
+    bars on the predictions); ``before``: the robot before a fit, its predictions drawn too;
+    ``study``: a ``locust optimize`` folder, its Pareto front drawn."""
     progress = progress or (lambda msg: None)
     added = added or {}
     unknown = sorted(set(added) - set(measured))
@@ -104,6 +107,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
         raise ReportError(f"--added names {', '.join(unknown)}, which no --measured input is",
                           f"configurations given: {', '.join(measured)}")
     land = read_landscape(sweep) if sweep is not None else None   # fail early on a bad sweep folder
+    front = read_front(study) if study is not None else None
     t0 = time.perf_counter()
 
     configs, comps, spreads, befores = _simulate(base, measured, added, cycles, marker, progress, side_by_side,
@@ -111,12 +115,15 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
 
     progress("drawing figures")
     figs = _figures(comps, configs, land, spreads, befores)
+    if front is not None:
+        figs.insert(-1, study_figure(front))
     dash = F.dashboard(comps, land, configs)
 
     timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
     warnings = notices(comps)
     html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings, spreads)
     doc = report_json(base, robot_source, comps, configs, timing, land, marker, warnings)
+    doc["optimize"] = {"folder": str(front.folder), "front": front.front} if front is not None else None
     for entry in doc["configurations"]:
         sp, old = spreads.get(entry["name"]), befores.get(entry["name"])
         entry["predicted_spread"] = sp.to_json() if sp is not None else None

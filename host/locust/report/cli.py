@@ -26,6 +26,8 @@ def _stage(msg: str) -> None:
               help="Length added to every link for configuration NAME (small/medium/large default to 0/0.01/0.02).")
 @click.option("--sweep", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="A `locust sweep --out` folder: its landscape is drawn with the physical designs marked.")
+@click.option("--optimize", "study", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="A `locust optimize --out` folder: its Pareto front and the designs it picks.")
 @click.option("--cycles", type=click.IntRange(1, 100), default=None,
               help="Hop cycles to simulate and measure [the run records' cycles, else the robot's schedule].")
 @click.option("--marker", default="nose", show_default=True,
@@ -41,7 +43,7 @@ def _stage(msg: str) -> None:
 @click.option("--before", "before_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="The robot.toml before a fit (e.g. `locust calibrate hop`): its predictions are drawn too.")
 @import_options
-def report(measured, config, preset, sets, added, sweep, cycles, marker, out, side_by_side, samples, before_path,
+def report(measured, config, preset, sets, added, sweep, study, cycles, marker, out, side_by_side, samples, before_path,
            imports):
     """Compare simulation and measurement for each configuration in one self-contained HTML page.
 
@@ -69,7 +71,7 @@ def report(measured, config, preset, sets, added, sweep, cycles, marker, out, si
     result = build_report(robot, list(measured), out=out, robot_source=source, cycles=cycles, sweep=sweep,
                           added=parse_added(added), marker=marker, progress=_stage, side_by_side=side_by_side,
                           samples=samples or 0, before=load_robot(before_path) if before_path else None,
-                          imports=imports)
+                          imports=imports, study=study)
     for c in result.comparisons:
         r = c.prediction.result
         pred = f"predicted {c.predicted_distance_m * 1000:.1f} mm" if r.valid else "simulation INVALID"

@@ -17,7 +17,7 @@ from ..tables import mm
 
 def _describe(row: dict, names: list[str]) -> str:
     where = ", ".join(f"{n}={row[n]:.6g}" for n in names)
-    return (f"design {row['design']} ({where}): {mm(row['distance_m'])} mm, "
+    return (f"design {row['design']} ({where}, {row['outcome']}): {mm(row['distance_m'])} mm, "
             f"highest nose {mm(row['max_nose_height_m'])} mm, {row['hops']} airborne hops")
 
 
@@ -77,8 +77,9 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
                               "wall_s": summary.wall_s, "best": summary.best,
                               "plots": [str(p) for p in summary.plots]}), nl=False)
         return
+    over = sum(1 for r in valid if r["outcome"] == "goes_over")
     click.echo(f"{len(rows)} designs ({summary.resumed} from an earlier run, {summary.computed} computed in "
-               f"{summary.wall_s:.1f} s), {len(valid)} valid")
+               f"{summary.wall_s:.1f} s), {len(valid)} valid, {over} of them going over onto their backs")
     reasons: dict[str, int] = {}
     for r in rows:
         if not r["valid"]:
@@ -87,7 +88,7 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
     for reason, n in sorted(reasons.items(), key=lambda kv: -kv[1]):
         click.echo(f"  invalid x{n}: {reason}")
     if summary.best is None:
-        click.echo("no valid design: nothing to recommend")
+        click.echo("no valid design that stays on its feet: nothing to recommend")
     else:
         click.echo("best valid " + _describe(summary.best, names))
     click.echo(f"results: {summary.folder / 'results.csv'}")
@@ -95,57 +96,102 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
         click.echo(f"plot: {p}")
 
 
+def _steps(items: tuple[str, ...]) -> dict[str, float]:
+    out = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        try:
+            out[name.strip()] = float(text)
+        except ValueError:
+            raise SweepError(f"--step {item!r} is not NAME=STEP", "e.g. --step geometry.crank_start_deg=18") from None
+        if not sep:
+            raise SweepError(f"--step {item!r} is not NAME=STEP", "e.g. --step geometry.crank_start_deg=18")
+    return out
+
+
 @click.command()
 @robot_options
-@click.option("--vary", "varies", multiple=True, required=True, metavar="NAME=LOW:HIGH",
-              help="A parameter (dotted name or `scale`) and its range. Repeat for several.")
-@click.option("--trials", type=click.IntRange(1, 100000), default=50, show_default=True)
+@click.option("--vary", "varies", multiple=True, required=True, metavar="NAME=LOW:HIGH|NAME=A,B,C",
+              help="A parameter (dotted name or `scale`) and its range, or its values A,B,C (a categorical). "
+                   "Repeat for several.")
+@click.option("--step", "steps", multiple=True, metavar="NAME=STEP",
+              help="Take a --vary range in steps (a horn's spline step: geometry.crank_start_deg=18).")
+@click.option("--objective", "objective_names", multiple=True, metavar="distance|nose_rise|flight",
+              help="What to maximise, per hop over the run (repeat for a Pareto front; default distance).")
+@click.option("--robust", "draws", type=click.IntRange(2, 256), default=None, metavar="N",
+              help="Judge each design over N draws of the robot file's uncertain values (the same draws for "
+                   "every design); each objective is their --quantile.")
+@click.option("--quantile", type=click.FloatRange(0, 1), default=0.1, show_default=True,
+              help="With --robust: the quantile of the draws taken as the figure (0.1: what 9 draws in 10 beat).")
+@click.option("--max-flip", type=click.FloatRange(0, 1), default=None, metavar="P",
+              help="The largest share of draws (or the nominal run) that may go over onto its back.")
+@click.option("--trials", type=click.IntRange(1, 100000), default=50, show_default=True,
+              help="Finished trials the study should hold; a rerun computes only those missing.")
 @click.option("--cycles", type=click.IntRange(1, 100), default=3, show_default=True)
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
-              help="Folder for trials.csv, optimize.json, history.png (and the journal by default).")
+              help="Folder for pareto.csv, pareto.png, trials.csv, optimize.json, best-*.toml "
+                   "(and the journal by default).")
 @click.option("--storage", default=None, metavar="URL",
               help="Optuna storage: a journal file path (default OUT/study.journal) or an RDB URL "
                    "such as sqlite:///study.db to share a study between machines.")
 @click.option("--study", "study_name", default="locust", show_default=True, help="Study name in the storage.")
+@click.option("--sampler", type=click.Choice(["tpe", "nsga2"]), default="tpe", show_default=True,
+              help="Optuna's multi-objective TPE or NSGA-II.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Sampler seed.")
 @click.option("--jobs", type=click.IntRange(1, 1024), default=1, show_default=True,
-              help="Trials run at once in this process (the simulation releases the GIL).")
-def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_name, seed, jobs):
-    """Search continuous parameter ranges for the farthest hop (Optuna TPE).
+              help="Trials run at once, each in its own process (or Dask worker).")
+@click.option("--scheduler", default="local", show_default=True, metavar="local|dask-local|tcp://HOST:PORT",
+              help="local: --jobs processes; dask-local or tcp://...: a Dask cluster (its workers must reach "
+                   "--storage).")
+def optimize(preset, config, sets, varies, steps, objective_names, draws, quantile, max_flip, trials, cycles, out,
+             storage, study_name, sampler, seed, jobs, scheduler):
+    """Search design ranges for the hops that go farthest and highest without going over (Optuna).
 
-    Invalid designs are pruned with their reason and never become the best. Rerunning with the
-    same --out (or --storage) continues the study.
+    Each design is checked, simulated, audited and classified (goes_over, rears_and_returns,
+    stays_low); a design that goes over scores 0 (a robot on its back does not hop again).
+    Invalid designs are pruned with their reason. Rerunning with the same --out (or --storage)
+    resumes the study; other settings are refused.
 
     \b
-    Example:
-      locust optimize --vary geometry.leg_m=0.05:0.09 --vary geometry.crank_start_deg=-110:-70 \\
-          --vary schedule.push_deg=-40:-20 --vary schedule.push_s=0.15:0.4 --trials 60 --out opt
+    Examples:
+      locust optimize --preset medium --objective distance --objective nose_rise \\
+          --vary scale=0:0.02 --vary schedule.push_deg=-40:-15 --robust 8 --max-flip 0.05 \\
+          --trials 24 --out o
+      locust optimize --vary geometry.crank_start_deg=-126:-54 --step geometry.crank_start_deg=18 \\
+          --objective nose_rise --trials 20 --out horn
     """
     from .design import parse_bound
+    from .objectives import objectives_named
     from .optimize import run_optimize
 
     base = resolve_robot(preset, config, sets)
-    bounds = [parse_bound(v, base) for v in varies]
+    step_of = _steps(steps)
+    bounds = [parse_bound(v, base, step_of.get(v.partition("=")[0].strip())) for v in varies]
     if len({b.name for b in bounds}) != len(bounds):
         raise SweepError("--vary names a parameter twice", "give each parameter one --vary")
+    unknown = sorted(set(step_of) - {b.name for b in bounds})
+    if unknown:
+        raise SweepError(f"--step {unknown[0]}: no --vary range of that name", "give --vary NAME=LOW:HIGH with it")
+    objectives = objectives_named(list(objective_names))
     with progress(length=trials, label="optimize", show_pos=True, show_eta=True) as bar:
-        try:
-            summary = run_optimize(base, bounds, trials, cycles, out, storage=storage, study_name=study_name,
-                                   seed=seed, jobs=jobs, progress=bar.update)
-        except KeyboardInterrupt:
-            click.echo("\ninterrupted: finished trials are kept in the study; rerun to continue", err=True)
-            sys.exit(130)
-    click.echo(f"study {summary.study_name!r}: {summary.trials} trials, {summary.complete} valid, "
-               f"{summary.pruned} pruned as invalid")
-    if summary.best is None:
-        click.echo("no valid design yet")
-    else:
-        b = summary.best
-        where = ", ".join(f"{x.name}={b[x.name]:.6g}" for x in bounds)
-        click.echo(f"best: trial {b['trial']} ({where}): {mm(b['distance_m'])} mm, "
-                   f"highest nose {mm(b['max_nose_height_m'])} mm")
-        click.echo(f"best design as a robot file: {summary.best_robot}")
-    click.echo(f"results: {out / 'trials.csv'}, {out / 'optimize.json'}, {out / 'history.png'}")
+        summary = run_optimize(base, bounds, trials, cycles, out, storage=storage, study_name=study_name,
+                               seed=seed, jobs=jobs, progress=bar.update, objectives=objectives, draws=draws or 0,
+                               quantile=quantile, max_flip=max_flip, sampler=sampler, scheduler=scheduler)
+    _report(summary, bounds, objectives, out)
+
+
+def _report(summary, bounds, objectives, out: Path) -> None:
+    from .pareto import describe
+
+    click.echo(f"study {summary.study_name!r}: {summary.trials} trials ({summary.computed} computed now), "
+               f"{summary.complete} valid, {summary.pruned} pruned as invalid; {len(summary.front)} on the front")
+    if not summary.picks:
+        click.echo("no valid design within the flip limit yet")
+    names = [b.name for b in bounds]
+    for pick, row in summary.picks.items():
+        click.echo(f"{pick}: " + describe(row, names, objectives))
+        click.echo(f"  as a robot file: {summary.robots[pick]}")
+    click.echo(f"results: {out / 'pareto.csv'}, {out / 'pareto.png'}, {out / 'trials.csv'}, {out / 'optimize.json'}")
     if summary.interrupted:
         kept = summary.complete + summary.pruned
         click.echo(f"interrupted: {kept} finished trial{'s' * (kept != 1)} kept in the study and the files above "

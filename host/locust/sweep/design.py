@@ -10,7 +10,7 @@ either is a row with ``valid`` false and the reason, never a result.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import GeometryError, LocustError, SweepError
 from ..params import Provenance, Robot, all_keys, outside_limits, problems, with_added_length
 from ..sim.fourbar import assemble
+from ..sim.outcome import GOES_OVER, OUTCOMES
 
 SCALE = "scale"
 CRANK_CHECK_STEP_DEG = 1.0
@@ -50,11 +51,22 @@ class Axis:
 
 @dataclass(frozen=True)
 class Bound:
-    """``NAME=LOW:HIGH``: a continuous range for the optimiser."""
+    """``NAME=LOW:HIGH`` (a range, in steps of ``step`` when given) or ``NAME=A,B,C`` (the
+    values ``choices``, a categorical) for the optimiser."""
 
     name: str
     low: float
     high: float
+    step: float | None = None
+    choices: tuple[float, ...] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"name": self.name, "low": self.low, "high": self.high}
+        if self.step is not None:
+            out["step"] = self.step
+        if self.choices is not None:
+            out["choices"] = list(self.choices)
+        return out
 
 
 def check_name(name: str, base: Robot) -> None:
@@ -126,25 +138,53 @@ def parse_axis(item: str, base: Robot) -> Axis:
     return Axis(name, start, stop, int(n))
 
 
-def parse_bound(item: str, base: Robot) -> Bound:
+def parse_bound(item: str, base: Robot, step: float | None = None) -> Bound:
+    """``NAME=LOW:HIGH`` (with ``step``: LOW, LOW + step, ... up to HIGH) or ``NAME=A,B,C``."""
     name, rest = _split(item)
     check_name(name, base)
+    if "," in rest:
+        choices = _numbers(rest.replace(",", ":"), rest.count(",") + 1, "A,B,C", item)
+        if len(set(choices)) != len(choices):
+            raise SweepError(f"--vary {item!r}: a value is given twice", "give each value once")
+        for v in choices:
+            check_range(item, name, v, v, base)
+        return Bound(name, min(choices), max(choices), choices=tuple(choices))
     low, high = _numbers(rest, 2, "LOW:HIGH", item)
     if not low < high:
         raise SweepError(f"--vary {item!r}: LOW {low:g} must be below HIGH {high:g}",
                          "e.g. --vary geometry.leg_m=0.05:0.09")
     check_range(item, name, low, high, base)
-    return Bound(name, low, high)
+    if step is not None:
+        if not (math.isfinite(step) and 0 < step <= high - low):
+            raise SweepError(f"--step {name}={step:g}: a step must be above 0 and at most HIGH - LOW "
+                             f"({high - low:g})", "e.g. --step geometry.crank_start_deg=18 (a horn's spline step)")
+        # Optuna's stepped range ends on the last step at or below HIGH
+        high = low + math.floor((high - low) / step + 1e-9) * step
+    return Bound(name, low, high, step=step)
+
+
+LINKS = tuple(f"geometry.{k}" for k in ("ground_m", "crank_m", "coupler_m", "leg_m"))
 
 
 def design_robot(base: Robot, values: dict[str, float]) -> Robot:
-    """``base`` with the design's values; ``scale`` first, named parameters over it."""
+    """``base`` with the design's values; ``scale`` first, named parameters over it.
+
+    A value the design sets keeps the uncertainty of the value it replaces: a link cut to a new
+    length, or a horn set on another spline step, is built no more exactly than the one it
+    replaces was known, and draws of the uncertain values (``--samples``, ``--robust``) meet
+    every design with the same deviates.
+    """
     robot = base
     if SCALE in values:
         robot = with_added_length(robot, values[SCALE])
     named = {k: v for k, v in values.items() if k != SCALE}
     if named:
         robot = robot.with_values(named, Provenance(source="sweep"))
+    changed = (LINKS if SCALE in values else ()) + tuple(named)
+    for key in changed:
+        sd = base.source_of(key).uncertainty
+        if sd is not None and robot.source_of(key).uncertainty is None:
+            robot = robot.with_provenance(key, replace(robot.source_of(key), uncertainty=sd))
     return robot
 
 
@@ -173,8 +213,8 @@ def precheck(robot: Robot) -> str | None:
 
 def invalid_row(reason: str, grashof: str = "", transmission_deg: float = math.nan) -> dict[str, Any]:
     nan = math.nan
-    return {"valid": False, "reason": reason, "distance_m": nan, "max_nose_height_m": nan,
-            "nose_apex_max_m": nan, "com_apex_max_m": nan, "hops": 0, "grashof": grashof,
+    return {"valid": False, "reason": reason, "outcome": "", "flip_share": nan, "distance_m": nan,
+            "max_nose_height_m": nan, "nose_apex_max_m": nan, "com_apex_max_m": nan, "hops": 0, "grashof": grashof,
             "transmission_deg": transmission_deg}
 
 
@@ -182,9 +222,11 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 
     """Check, simulate and audit one design -> the result fields of its row.
 
     A pure function of its arguments: whichever process or machine runs it, the row is the same.
-    With ``samples``, ``distance_m`` and ``max_nose_height_m`` are the means over that many
-    draws of the robot file's uncertain values (:mod:`locust.sim.samples`, seed 0), so designs
-    are ranked by what they do on average over what is not known about the robot.
+    ``outcome`` is the run's class (:func:`locust.sim.outcome.classify`) and ``flip_share`` 1
+    when it goes over, else 0. With ``samples``, ``distance_m`` and ``max_nose_height_m`` are
+    the means over that many draws of the robot file's uncertain values (:func:`sampled`), so
+    designs are ranked by what they do on average over what is not known about the robot;
+    ``outcome`` is the draws' most common class and ``flip_share`` the share that goes over.
     """
     from ..sim.run import run
 
@@ -202,20 +244,34 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 
     if not result.valid:
         return invalid_row("; ".join(result.reasons), result.grashof, result.transmission_deg)
     hops = result.hops
-    distance_m, nose_m = result.distance_m, result.max_nose_height_m
+    outcome = result.outcome
+    distance_m, nose_m, flip = result.distance_m, result.max_nose_height_m, float(outcome == GOES_OVER)
     if samples:
-        from ..sim.samples import sample
-
-        spread = sample(robot, samples, cycles=cycles)
-        if not math.isfinite(spread.distance_m_mean):
+        spread = sampled(robot, samples, cycles)
+        if spread is None:
             return invalid_row(f"fewer than two of {samples} draws of the uncertain values are valid",
                                result.grashof, result.transmission_deg)
-        distance_m, nose_m = spread.distance_m_mean, spread.max_nose_height_m_mean
+        outcome, flip, distance_m, nose_m = spread
     return {
-        "valid": True, "reason": "", "distance_m": distance_m,
+        "valid": True, "reason": "", "outcome": outcome, "flip_share": flip, "distance_m": distance_m,
         "max_nose_height_m": nose_m,
         "nose_apex_max_m": max(h.nose_apex_m for h in hops),
         "com_apex_max_m": max(h.com_apex_m for h in hops),
         "hops": sum(1 for h in hops if h.flight_s > 0),
         "grashof": result.grashof, "transmission_deg": result.transmission_deg,
     }
+
+
+def sampled(robot: Robot, samples: int, cycles: int) -> tuple[str, float, float, float] | None:
+    """Over ``samples`` draws of the uncertain values (:func:`locust.sim.samples.sample`, seed 0:
+    the same deviates for every design): the most common outcome, the share that goes over, and
+    the means of distance and highest nose point over the valid draws; None when fewer than two
+    are valid."""
+    from ..sim.samples import sample
+
+    spread = sample(robot, samples, cycles=cycles)
+    kinds = [k for k in spread.outcome if k is not None]
+    if spread.n_valid < 2 or not kinds:
+        return None
+    return (max(OUTCOMES, key=kinds.count), kinds.count(GOES_OVER) / len(kinds), spread.distance_m_mean,
+            spread.max_nose_height_m_mean)

@@ -79,8 +79,9 @@ def _pool(fn: Callable, items: Sequence, jobs: int) -> Iterator[Any]:
                     result = fut.result()
                 except BrokenProcessPool:
                     raise SweepError("a worker process died (killed, or out of memory) before its design finished",
-                                     "every finished design is kept in results.csv: rerun the same command to "
-                                     "resume (with fewer --jobs if memory ran out)") from None
+                                     "every finished design is kept (a sweep's results.csv, an optimize study's "
+                                     "journal): rerun the same command to resume (with fewer --jobs if memory "
+                                     "ran out)") from None
                 yield result
     finally:
         for fut in pending:

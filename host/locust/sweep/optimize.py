@@ -1,141 +1,55 @@
-"""``run_optimize``: continuous search for the farthest hop with Optuna.
+"""``run_optimize``: the designs that hop farthest and highest without going over, with Optuna.
 
-Each trial is a design evaluated exactly as a sweep evaluates it (checked, simulated,
-audited). A design that fails is pruned with its reason (``user_attrs["reason"]``) and never
-becomes the best. The study lives in a journal file by default (``study.journal`` in the output
-folder; several processes may share it), or in any database Optuna's RDB storage takes
-(``sqlite:///study.db``, ``postgresql://...``) to share one study between machines.
+Each trial is a design judged by a judge (:class:`locust.sweep.robust.DesignJudge`: checked,
+simulated, audited, classified, on its nominal run or over draws of its uncertain values) on
+one or more objectives (:mod:`locust.sweep.objectives`), all maximised. With several
+objectives the study is multi-objective (Optuna's TPE or NSGA-II) and its result is the Pareto
+front. ``max_flip`` is an Optuna constraint (``trial.set_constraint``): a design whose share of
+draws that go over exceeds it is infeasible, never on the front. A design that fails is pruned
+with its reason (``user_attrs["reason"]``).
 
-A study records what it searches (the base robot's values, the ranges, the cycles) as its user
-attribute ``locust``: a rerun with other settings is refused, never ranked against it. A storage
-file that is not an Optuna journal or database (a user's notes, a damaged journal) is refused
-and left as it is. The best design is written as a robot file, ``best.toml``.
+The study lives in a journal file by default (``study.journal`` in the output folder; several
+processes may share it), or in any database Optuna's RDB storage takes (``sqlite:///study.db``,
+``postgresql://...``). It records what it searches (base robot, ranges, cycles, objectives,
+draws, quantile, flip limit) as its user attribute ``locust``: a rerun with other settings is
+refused. ``trials`` is the number of finished trials the study should hold: a rerun computes
+only those missing, so a study killed part way resumes where it stopped.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import sqlite3
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ..errors import SweepError
-from ..fileio import atomic_write_json, atomic_write_text, make_folder
+from ..fileio import atomic_write_json, make_folder
+from ..io.study_store import write_tables
 from ..params import Robot, save_robot
-from .design import SCALE, Bound, design_robot, evaluate
+from .design import SCALE, Bound, design_robot
+from .objectives import OBJECTIVES, OUTCOMES, Judgement, Objective
+from .pareto import picks, plot_front
+from .storage import SETTINGS_ATTR, check_folder, check_journal_file, check_storage, open_storage
 
-RDB_PREFIXES = ("sqlite:", "postgresql", "mysql", "oracle", "mssql")
-# what run_optimize writes in its folder; anything else there is someone else's
-OWN_FILES = frozenset({"trials.csv", "optimize.json", "history.png", "best.toml", "study.journal",
-                       "study.journal.lock"})
-# the study's user attribute holding what it searches
-SETTINGS_ATTR = "locust"
-SQLITE_MAGIC = b"SQLite format 3\x00"
-# pauses before reading a journal again when its last line is cut short (a process sharing the
-# study may be writing it): 1.7 s in all before it is taken for a damaged one
-JOURNAL_RECHECK_S = (0.0, 0.2, 0.5, 1.0)
+SAMPLERS = ("tpe", "nsga2")
+# states of a trial that is over: the study holds its result (or its reason)
+FINISHED = ("COMPLETE", "PRUNED")
 
 
-def check_folder(folder: Path) -> None:
-    """Refuse a folder holding files this command did not write (a user's ``trials.csv``
-    included: a folder of ours always has ``optimize.json`` or the study's journal beside it)."""
-    if not folder.exists():
-        return
-    if not folder.is_dir():
-        raise SweepError(f"--out {folder} is a file", "give a folder (new, or one `locust optimize` made)")
-    names = {p.name for p in folder.iterdir() if not p.name.startswith(".")}
-    foreign = sorted(names - OWN_FILES)
-    ours = bool(names & {"optimize.json", "study.journal"})
-    if foreign or (names and not ours):
-        shown = ", ".join((foreign or sorted(names))[:5])
-        raise SweepError(f"{folder} holds files `locust optimize` did not write ({shown}); refusing to write there",
-                         "choose a new or empty --out folder")
-
-
-def check_storage(url: str | None) -> None:
-    if url is None or url.startswith(RDB_PREFIXES):
-        if url is not None and url.startswith("sqlite:///"):
-            check_sqlite_file(Path(url.removeprefix("sqlite:///")), url)
-        return
-    path = url.removeprefix("journal:")
-    if "://" in path or not path.strip():
-        raise SweepError(f"--storage {url}: not a journal file path nor a database URL Optuna knows",
-                         "give a file path (e.g. opt/study.journal) or sqlite:///study.db, postgresql://..., mysql://...")
-    parent = Path(path).parent
-    if not parent.is_dir():
-        raise SweepError(f"--storage {url}: the folder {parent} does not exist", "create it, or give another path")
-    check_journal_file(Path(path))
-
-
-def check_journal_file(path: Path) -> None:
-    """Refuse (:class:`SweepError`) an existing file that is not a whole Optuna journal: one JSON
-    operation per line, the first creating a study, the last ending with its newline. Optuna
-    would append to anything (a user's notes) and cannot read a damaged one back."""
-    if not path.exists() or (path.is_file() and path.stat().st_size == 0):
-        return
-    hint = "give --storage a new file path (or a new --out folder); this file is left as it is"
-    if not path.is_file():
-        raise SweepError(f"{path} is not a file; refusing it as an Optuna journal", hint)
-    for wait_s in JOURNAL_RECHECK_S:   # another process sharing the study may be appending a line
-        time.sleep(wait_s)
-        try:
-            text = path.read_bytes().decode("utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise SweepError(f"{path}: not an Optuna journal (not UTF-8 text: {exc})", hint) from None
-        lines = text.split("\n")
-        if not lines[-1]:
-            break
-    if lines[-1]:
-        raise SweepError(f"{path}: a damaged Optuna journal (its last line is cut short)",
-                         "restore the file from a copy, or " + hint)
-    for k, line in enumerate(lines[:-1]):
-        try:
-            op = json.loads(line)
-        except ValueError:
-            op = None
-        if not isinstance(op, dict) or not isinstance(op.get("op_code"), int) or (k == 0 and op["op_code"] != 0):
-            what = "a damaged Optuna journal" if k else "not an Optuna journal"
-            raise SweepError(f"{path}, line {k + 1}: {what} (each line must be one Optuna operation in JSON)",
-                             hint)
-
-
-def check_sqlite_file(path: Path, url: str) -> None:
-    """Refuse an existing file that is not an SQLite database holding Optuna's tables (or none):
-    Optuna would add its tables to someone else's database, or fail on a text file."""
-    if not path.exists():
-        return
-    hint = "give a new database file (sqlite:///new.db); this file is left as it is"
-    try:
-        with open(path, "rb") as fh:
-            magic = fh.read(len(SQLITE_MAGIC))
-    except OSError as exc:
-        raise SweepError(f"--storage {url}: cannot read {path} ({exc.strerror})", hint) from None
-    if path.stat().st_size == 0:
-        return
-    if magic != SQLITE_MAGIC:
-        raise SweepError(f"--storage {url}: {path} is not an SQLite database", hint)
-    try:
-        con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
-        try:
-            tables = {r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
-        finally:
-            con.close()
-    except sqlite3.Error as exc:
-        raise SweepError(f"--storage {url}: {path} cannot be read as a database ({exc})", hint) from None
-    if tables and "studies" not in tables:
-        raise SweepError(f"--storage {url}: {path} is a database without Optuna's tables "
-                         f"({', '.join(sorted(tables)[:4])})", hint)
-
-
-def settings(base: Robot, bounds: list[Bound], cycles: int) -> dict[str, Any]:
+def settings(base: Robot, bounds: list[Bound], cycles: int, objectives: list[Objective] | None = None,
+             draws: int = 0, quantile: float | None = None, max_flip: float | None = None,
+             sampler: str = "tpe") -> dict[str, Any]:
     """What a study searches, as JSON holds it: a rerun must ask for exactly this."""
-    return json.loads(json.dumps({"base": base.name, "parameters": base.flat(),
-                                  "vary": [{"name": b.name, "low": b.low, "high": b.high} for b in bounds],
-                                  "cycles": cycles}))
+    return json.loads(json.dumps({
+        "base": base.name, "parameters": base.flat(), "vary": [b.to_dict() for b in bounds], "cycles": cycles,
+        "objectives": [o.name for o in objectives or []], "robust": draws,
+        "quantile": quantile if draws else None, "max_flip": max_flip, "sampler": sampler}))
+
+
+SETTING_NAMES = ("base", "vary", "cycles", "objectives", "robust", "quantile", "max_flip", "sampler")
 
 
 def check_settings(study, wanted: dict[str, Any], where: str) -> None:
@@ -145,36 +59,90 @@ def check_settings(study, wanted: dict[str, Any], where: str) -> None:
     if held is None:
         raise SweepError(f"{where}: study {study.study_name!r} was not made by `locust optimize`", hint)
     if held != wanted:
-        diff = [k for k in ("base", "vary", "cycles") if held.get(k) != wanted.get(k)]
+        diff = [k for k in SETTING_NAMES if held.get(k) != wanted.get(k)]
         params = held.get("parameters") or {}
         diff += [k for k, v in wanted["parameters"].items() if params.get(k) != v][:3]
         raise SweepError(f"{where}: study {study.study_name!r} searches other settings ({', '.join(diff) or 'ranges'} "
                          "differ); its trials cannot be ranked against these", hint)
 
 
-def open_storage(url: str | None, folder: Path):
-    import optuna
-    from optuna.storages import JournalStorage
-    from optuna.storages.journal import JournalFileBackend
-
-    if url is None:
-        return JournalStorage(JournalFileBackend(str(folder / "study.journal")))
-    if url.startswith(RDB_PREFIXES):
-        try:
-            return optuna.storages.RDBStorage(url)
-        except Exception as exc:  # sqlalchemy raises many kinds
-            raise SweepError(f"--storage {url}: cannot open ({exc.__class__.__name__}: {exc})",
-                             "check the URL, e.g. sqlite:///study.db; the database driver must be installed") from None
-    path = url.removeprefix("journal:")
-    return JournalStorage(JournalFileBackend(path))
-
-
 def is_integer(base: Robot, name: str) -> bool:
-    """Whether the parameter ``name`` holds whole numbers (schedule.cycles, solver.iterations)."""
+    """Whether the parameter ``name`` holds whole numbers (solver.iterations)."""
     if name == SCALE:
         return False
     value = base.get(name)
     return isinstance(value, int) and not isinstance(value, bool)
+
+
+@dataclass(frozen=True)
+class StudySpec:
+    """Everything a process needs to run one trial of the study (picklable)."""
+
+    storage: str | None
+    folder: Path
+    study_name: str
+    bounds: tuple[Bound, ...]
+    integers: frozenset[str]
+    objectives: tuple[Objective, ...]
+    judge: Callable[[dict[str, Any]], Judgement]
+    max_flip: float | None
+    sampler: str
+    seed: int
+    trials: int
+
+
+def make_sampler(name: str, seed: int):
+    import optuna
+
+    if name == "nsga2":
+        return optuna.samplers.NSGAIISampler(seed=seed, population_size=12)
+    # constant_liar: trials under way in other processes are not proposed again
+    return optuna.samplers.TPESampler(seed=seed, n_startup_trials=8, multivariate=True, constant_liar=True)
+
+
+def finished_trials(study) -> list:
+    return [t for t in study.get_trials(deepcopy=False) if t.state.name in FINISHED]
+
+
+def run_trial(spec: StudySpec, index: int) -> int:
+    """Run one trial of the study (in this process or a worker): its number, or -1 when the
+    study already holds ``spec.trials`` finished trials."""
+    import optuna
+
+    optuna.logging.set_verbosity(optuna.logging.ERROR)
+    storage = open_storage(spec.storage, spec.folder)
+    sampler = make_sampler(spec.sampler, spec.seed + index)
+    study = optuna.load_study(study_name=spec.study_name, storage=storage, sampler=sampler)
+    if len(finished_trials(study)) >= spec.trials:
+        return -1
+    numbers = []
+
+    def objective(trial: optuna.Trial) -> list[float]:
+        numbers.append(trial.number)
+        values = {b.name: suggest(trial, b, spec.integers) for b in spec.bounds}
+        judged = spec.judge(values)
+        trial.set_user_attr("draws", judged.draws)
+        trial.set_user_attr("draws_valid", judged.draws_valid)
+        if not judged.valid:
+            trial.set_user_attr("reason", judged.reason)
+            raise optuna.TrialPruned(judged.reason)
+        trial.set_user_attr("means", judged.means)
+        trial.set_user_attr("outcome_shares", judged.outcome_shares)
+        trial.set_user_attr("flip_share", judged.flip_share)
+        if spec.max_flip is not None:
+            trial.set_constraint("flip_share", judged.flip_share - spec.max_flip)
+        return [judged.figures[o.column] for o in spec.objectives]
+
+    study.optimize(objective, n_trials=1, catch=())
+    return numbers[0] if numbers else -1
+
+
+def suggest(trial, b: Bound, integers: frozenset[str]) -> float | int:
+    if b.choices is not None:
+        return trial.suggest_categorical(b.name, list(b.choices))
+    if b.name in integers:
+        return trial.suggest_int(b.name, math.ceil(b.low), math.floor(b.high))
+    return trial.suggest_float(b.name, b.low, b.high, step=b.step)
 
 
 @dataclass
@@ -183,24 +151,74 @@ class OptimizeSummary:
     trials: int
     complete: int
     pruned: int
-    best: dict[str, Any] | None
+    front: list[dict[str, Any]]
+    picks: dict[str, dict[str, Any]]
     folder: Path
+    computed: int = 0
     interrupted: bool = False
-    best_robot: Path | None = None    # best.toml, the best design as a robot file
+    robots: dict[str, Path] | None = None     # best-<objective>.toml, knee.toml
+
+    @property
+    def best(self) -> dict[str, Any] | None:
+        """The first objective's best design on the front."""
+        return next(iter(self.picks.values()), None)
 
 
 def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, folder: Path,
                  storage: str | None = None, study_name: str = "locust", seed: int = 0, jobs: int = 1,
-                 progress: Callable[[int], None] | None = None) -> OptimizeSummary:
+                 progress: Callable[[int], None] | None = None, objectives: list[Objective] | None = None,
+                 judge: Callable[[dict[str, Any]], Judgement] | None = None, draws: int = 0,
+                 quantile: float = 0.1, max_flip: float | None = None, sampler: str = "tpe",
+                 scheduler: str = "local") -> OptimizeSummary:
+    """Run (or resume) the study into ``folder`` until it holds ``trials`` finished trials.
+
+    Parameters
+    ----------
+    base : Robot
+        The robot every design starts from.
+    bounds : list of Bound
+        The design variables and their ranges.
+    trials : int
+        Finished trials (complete or pruned) the study should hold; a rerun computes the rest.
+    cycles : int
+        Hop cycles each design runs.
+    folder : Path
+        Output folder (and the journal, unless ``storage``).
+    objectives : list of Objective
+        What is maximised (default: distance).
+    judge : callable, optional
+        ``judge(values) -> Judgement``; default :class:`~locust.sweep.robust.DesignJudge` of
+        ``base`` with ``draws`` and ``quantile``.
+    draws : int
+        0: each design's nominal run; N: N draws of its uncertain values, the figure optimised
+        being the ``quantile`` over them.
+    max_flip : float, optional
+        The largest share of draws that may go over (an Optuna constraint).
+    jobs, scheduler : int, str
+        Trials run at once: ``jobs`` local processes, or a Dask cluster (``dask-local``,
+        ``tcp://HOST:PORT``; its workers must reach the storage).
+
+    Returns
+    -------
+    OptimizeSummary
+    """
     import optuna
 
-    # a trial's failure (an interrupt included) is reported by the caller, not logged with its traceback
+    from .execute import check_scheduler, mapper, plan_jobs, probe_dask_scheduler
+    from .robust import DesignJudge
+
     optuna.logging.set_verbosity(optuna.logging.ERROR)
+    objectives = objectives or [OBJECTIVES["distance"]]
+    if sampler not in SAMPLERS:
+        raise SweepError(f"--sampler {sampler!r}: not one of {', '.join(SAMPLERS)}", "use tpe or nsga2")
+    check_scheduler(scheduler)
+    if scheduler.startswith("tcp://"):
+        probe_dask_scheduler(scheduler)
     check_folder(folder)
     if storage is None:
         check_journal_file(folder / "study.journal")
     check_storage(storage)
-    integers = {b.name for b in bounds if is_integer(base, b.name)}
+    integers = frozenset(b.name for b in bounds if is_integer(base, b.name))
     for b in bounds:
         if b.name in integers and math.floor(b.high) < math.ceil(b.low):
             raise SweepError(f"--vary {b.name}={b.low:g}:{b.high:g} holds no whole number, and {b.name} is one",
@@ -208,9 +226,7 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
                              f"{math.floor(b.low) + 2}")
     make_folder(folder)
     storage_obj = open_storage(storage, folder)
-    # a resumed study must not draw its first samples again: the sampler's seed moves on with
-    # the number of trials the study already holds
-    wanted = settings(base, bounds, cycles)
+    wanted = settings(base, bounds, cycles, objectives, draws, quantile, max_flip, sampler)
     where = storage or str(folder / "study.journal")
     try:
         held = optuna.load_study(study_name=study_name, storage=storage_obj)
@@ -218,79 +234,97 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
         held = None
     if held is not None:
         check_settings(held, wanted, where)
-    done_before = len(held.trials) if held is not None else 0
-    study = optuna.create_study(study_name=study_name, storage=storage_obj,
-                                direction="maximize", load_if_exists=True,
-                                sampler=optuna.samplers.TPESampler(seed=seed + done_before))
+    study = optuna.create_study(study_name=study_name, storage=storage_obj, load_if_exists=True,
+                                directions=["maximize"] * len(objectives))
     if held is None:
         study.set_user_attr(SETTINGS_ATTR, wanted)
-
-    def suggest(trial: optuna.Trial, b: Bound) -> float | int:
-        if b.name in integers:
-            return trial.suggest_int(b.name, math.ceil(b.low), math.floor(b.high))
-        return trial.suggest_float(b.name, b.low, b.high)
-
-    def objective(trial: optuna.Trial) -> float:
-        values = {b.name: suggest(trial, b) for b in bounds}
-        row = evaluate(base, values, cycles)
-        for key in ("max_nose_height_m", "nose_apex_max_m", "com_apex_max_m"):
-            if math.isfinite(row[key]):
-                trial.set_user_attr(key, row[key])
-        if not row["valid"]:
-            trial.set_user_attr("reason", row["reason"])
-            raise optuna.TrialPruned(row["reason"])
-        return row["distance_m"]
-
-    callbacks = [lambda study, trial: progress(1)] if progress else []
+    before = len(study.trials)
+    left = max(0, trials - len(finished_trials(study)))
+    judge = judge or DesignJudge(base, cycles, tuple(objectives), draws, quantile)
+    spec = StudySpec(storage, folder, study_name, tuple(bounds), integers, tuple(objectives), judge, max_flip,
+                     sampler, seed, trials)
+    # a resumed study must not draw its first samples again: each trial's sampler seed moves on
+    # with the trials the study held before it
+    items = [before + k for k in range(left)]
+    if not scheduler.startswith("tcp://"):
+        jobs, _ = plan_jobs(jobs, len(items))
+    computed = 0
+    if progress and trials > left:
+        progress(trials - left)   # finished before this run
     try:
-        study.optimize(objective, n_trials=trials, n_jobs=jobs, callbacks=callbacks, catch=())
+        with mapper(scheduler, jobs) as run_map:
+            for number in run_map(TrialOf(spec), items):
+                computed += number >= 0
+                if progress:
+                    progress(1)
     except KeyboardInterrupt:   # the trial under way is dropped (FAIL); every finished one is kept
-        return summarise(study, folder, base, interrupted=True)
-    return summarise(study, folder, base)
+        return summarise(optuna.load_study(study_name=study_name, storage=storage_obj), folder, base, objectives,
+                         max_flip, computed, interrupted=True)
+    return summarise(optuna.load_study(study_name=study_name, storage=storage_obj), folder, base, objectives,
+                     max_flip, computed)
 
 
-def summarise(study, folder: Path, base: Robot, interrupted: bool = False) -> OptimizeSummary:
-    import optuna
+@dataclass(frozen=True)
+class TrialOf:
+    """A picklable ``run_trial`` of one study: what each process maps over trial indices."""
 
-    states = optuna.trial.TrialState
-    done = [t for t in study.trials if t.state == states.COMPLETE]
-    pruned = [t for t in study.trials if t.state == states.PRUNED]
-    best = None
-    if done:
-        t = max(done, key=lambda t: (t.value, -t.number))
-        best = {"trial": t.number, "distance_m": t.value, **t.params,
-                "max_nose_height_m": t.user_attrs.get("max_nose_height_m")}
-    best_robot = None
-    if best is not None:
-        robot = design_robot(base, dict(t.params)).renamed(f"optimize best of {folder}")
-        best_robot = save_robot(robot, folder / "best.toml")
-    df = study.trials_dataframe(attrs=("number", "state", "value", "params", "user_attrs"))
-    atomic_write_text(folder / "trials.csv", df.to_csv(index=False))
+    spec: StudySpec
+
+    def __call__(self, index: int) -> int:
+        return run_trial(self.spec, index)
+
+
+def trial_rows(study, names: list[str], objectives: list[Objective], max_flip: float | None) -> list[dict[str, Any]]:
+    """One tidy row per trial: its state, design values by dotted name, each objective's figure
+    optimised and its mean, the flip share and every outcome's share, the draws, the reason."""
+    rows = []
+    for t in study.get_trials(deepcopy=False):
+        state = t.state.name.lower()
+        means = t.user_attrs.get("means", {})
+        shares = t.user_attrs.get("outcome_shares", {})
+        row: dict[str, Any] = {"trial": t.number, "state": state}
+        row.update({n: t.params.get(n, math.nan) for n in names})
+        for k, o in enumerate(objectives):
+            row[o.column] = t.values[k] if state == "complete" else math.nan
+            row[f"{o.column}_mean"] = means.get(o.column, math.nan)
+        flip = t.user_attrs.get("flip_share", math.nan)
+        row["flip_share"] = flip
+        row.update({f"share_{name}": shares.get(name, math.nan) for name in OUTCOMES})
+        row["feasible"] = state == "complete" and (max_flip is None or flip <= max_flip)
+        row["draws"] = t.user_attrs.get("draws", 0)
+        row["draws_valid"] = t.user_attrs.get("draws_valid", 0)
+        row["reason"] = t.user_attrs.get("reason", "")
+        rows.append(row)
+    return rows
+
+
+def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max_flip: float | None,
+              computed: int = 0, interrupted: bool = False) -> OptimizeSummary:
+    """Write trials.csv, pareto.csv, pareto.png, optimize.json and a robot file for each pick."""
+    held = study.user_attrs.get(SETTINGS_ATTR) or {}
+    names = [v["name"] for v in held.get("vary", [])]
+    rows = trial_rows(study, names, objectives, max_flip)
+    by_number = {r["trial"]: r for r in rows}
+    # Optuna's own front: complete trials that no other feasible one dominates, feasible only
+    front = [by_number[t.number] for t in study.best_trials]
+    front.sort(key=lambda r: r["trial"])
+    chosen = picks(front, objectives) if front else {}
+    write_tables(folder, rows, [{**r, "pick": " ".join(k for k, c in chosen.items() if c is r)} for r in front])
+    robots = {}
+    for pick, r in chosen.items():
+        robot = design_robot(base, {n: r[n] for n in names}).renamed(f"optimize {pick} of {folder}")
+        robots[pick] = save_robot(robot, folder / f"{pick}.toml")
+    done = [r for r in rows if r["state"] == "complete"]
+    pruned = [r for r in rows if r["state"] == "pruned"]
     atomic_write_json(folder / "optimize.json", {
-        "study": study.study_name, "settings": study.user_attrs.get(SETTINGS_ATTR),
-        "trials": len(study.trials), "complete": len(done), "pruned": len(pruned),
-        "best": best, "best_robot": best_robot,
-        "pruned_reasons": {t.number: t.user_attrs.get("reason", "") for t in pruned}})
-    _plot_history(done, pruned, folder / "history.png")
-    return OptimizeSummary(study.study_name, len(study.trials), len(done), len(pruned), best, folder,
-                           interrupted, best_robot)
-
-
-def _plot_history(done, pruned, path: Path) -> None:
-    from ..plotting import pyplot, save_png
-
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 4))
+        "study": study.study_name, "settings": held, "trials": len(rows), "complete": len(done),
+        "pruned": len(pruned), "feasible": sum(r["feasible"] for r in rows), "front": front,
+        "picks": {k: r["trial"] for k, r in chosen.items()}, "robots": robots,
+        "pruned_reasons": {r["trial"]: r["reason"] for r in pruned}})
     if done:
-        xs = [t.number for t in done]
-        ys = [t.value * 1000 for t in done]     # hop figures in mm, as every table
-        best = [max(ys[: i + 1]) for i in range(len(ys))]
-        ax.plot(xs, ys, "o", ms=4, color="#1f77b4", label="valid trial")
-        ax.step(xs, best, where="post", color="#ff7f0e", label="best so far")
-    if pruned:
-        ax.plot([t.number for t in pruned], [0] * len(pruned), "x", color="#d62728", label="pruned: invalid design")
-    ax.set_xlabel("trial")
-    ax.set_ylabel("distance (mm)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    save_png(fig, path)
+        title = f"{study.study_name}: {len(done)} designs, {len(front)} on the front"
+        if held.get("robust"):
+            title += f" (quantile {held['quantile']:g} of {held['robust']} draws)"
+        plot_front(rows, front, chosen, objectives, max_flip, folder / "pareto.png", title)
+    return OptimizeSummary(study.study_name, len(rows), len(done), len(pruned), front, chosen, folder, computed,
+                           interrupted, robots)

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..params import LEG_SETS, Robot, preset
 from ..plotting import pyplot, save_png
+from ..sim.outcome import GOES_OVER
 from .design import SCALE, Axis, axis_scale
 
 METRICS = (("distance_m", "distance (mm)"), ("max_nose_height_m", "highest nose point (mm)"))   # hop figures: mm
@@ -30,7 +31,8 @@ def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robo
     plt = pyplot()
     x_scale, label = axis_scale(axis.name)
     fig, panels = plt.subplots(1, 2, figsize=(11, 4.2))
-    ok = [r for r in rows if r["valid"]]
+    ok = [r for r in rows if r["valid"] and r["outcome"] != GOES_OVER]
+    over = [r for r in rows if r["valid"] and r["outcome"] == GOES_OVER]
     bad = [r for r in rows if not r["valid"]]
     for ax, (key, ylab) in zip(panels, METRICS):
         # with several axes, each value's best over the others
@@ -39,7 +41,10 @@ def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robo
             by_x[r[axis.name]] = max(by_x.get(r[axis.name], -math.inf), r[key])
         xs = sorted(by_x)
         ax.plot([x * x_scale for x in xs], [by_x[x] * MM for x in xs], "o-", ms=4, color="#1f77b4",
-                label=f"valid ({len(ok)})")
+                label=f"valid, stays on its feet ({len(ok)})")
+        if over:
+            ax.plot([r[axis.name] * x_scale for r in over], [r[key] * MM for r in over], "v", ms=6, mfc="none",
+                    color="#9467bd", label=f"goes over onto its back ({len(over)}): not a jump")
         if bad:
             ax.plot([r[axis.name] * x_scale for r in bad], [0.0] * len(bad), "x", color="#d62728",
                     label=f"invalid ({len(bad)}): not a result")
@@ -66,17 +71,24 @@ def _heatmap(rows: list[dict[str, Any]], ax_a: Axis, ax_b: Axis, path: Path) -> 
     fig, panels = plt.subplots(1, 2, figsize=(12, 4.8))
     for ax, (key, title) in zip(panels, METRICS):
         grid = np.full((len(vb), len(va)), np.nan)
+        over = np.zeros_like(grid, dtype=bool)
         for r in rows:
-            if r["valid"]:
-                i, j = vb.index(r[ax_b.name]), va.index(r[ax_a.name])
+            i, j = vb.index(r[ax_b.name]), va.index(r[ax_a.name])
+            if r["valid"] and r["outcome"] != GOES_OVER:
                 grid[i, j] = np.fmax(grid[i, j], r[key] * MM)
+            elif r["valid"]:
+                over[i, j] = True
         img = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis",
                         extent=_extent([v * ka for v in va]) + _extent([v * kb for v in vb]))
         fig.colorbar(img, ax=ax, label=title)
-        bad = np.isnan(grid)
+        jj, ii = np.meshgrid(np.asarray(va) * ka, np.asarray(vb) * kb)
+        over &= np.isnan(grid)
+        bad = np.isnan(grid) & ~over
+        if over.any():
+            ax.plot(jj[over], ii[over], "v", color="#9467bd", mfc="none", ms=5, label="goes over onto its back")
         if bad.any():
-            jj, ii = np.meshgrid(np.asarray(va) * ka, np.asarray(vb) * kb)
             ax.plot(jj[bad], ii[bad], "x", color="#d62728", ms=5, label="invalid (no valid design)")
+        if bad.any() or over.any():
             ax.legend(fontsize=8, loc="upper right")
         ax.set_xlabel(label_a)
         ax.set_ylabel(label_b)

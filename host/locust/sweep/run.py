@@ -21,6 +21,7 @@ from typing import Any
 from ..errors import SweepError
 from ..io.sweep_store import SweepStore
 from ..params import Robot
+from ..sim.outcome import GOES_OVER
 from .design import Axis, evaluate
 from .execute import default_jobs, mapper, plan_jobs, probe_dask_scheduler
 
@@ -65,8 +66,9 @@ def grid(axes: list[Axis]) -> list[dict[str, float]]:
 
 
 def best_row(rows: list[dict[str, Any]]) -> dict[str, Any] | None:
-    """The valid design that went farthest (lowest design number on a tie); never an invalid one."""
-    valid = [r for r in rows if r["valid"] and math.isfinite(r["distance_m"])]
+    """The valid design that went farthest (lowest design number on a tie); never an invalid one,
+    nor one that goes over onto its back."""
+    valid = [r for r in rows if r["valid"] and r["outcome"] != GOES_OVER and math.isfinite(r["distance_m"])]
     return max(valid, key=lambda r: (r["distance_m"], -r["design"])) if valid else None
 
 

@@ -1,0 +1,131 @@
+"""What a design is judged by: objectives by name, per hop over the run, and their robust figure.
+
+Each objective is a figure of one simulated run, per hop (the run's figure over its cycles):
+
+- ``distance``: ``distance_m``, chassis travel over the run divided by the hop cycles (m a hop);
+- ``nose_rise``: ``nose_rise_m``, the nose's highest point above its standing height, the mean
+  over the hops (m);
+- ``flight``: ``flight_s``, the longest time with no part of the robot on the floor, the mean
+  over the hops (s).
+
+All three are maximised. A draw (or a nominal run) that goes over onto its back scores 0 on
+every objective: a robot on its back does not hop again, and its nose resting high is not a
+jump. Over ``N`` draws, the figure optimised is the ``quantile`` of the draws' figures (0.1:
+the figure 9 draws in 10 beat); the mean is reported beside it. The flip share is the share of
+the valid draws that go over; a draw that fails its audit is left out of every share and
+figure.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import SweepError
+from ..sim.outcome import GOES_OVER, OUTCOMES
+
+
+@dataclass(frozen=True)
+class Objective:
+    """One objective: its command-line name, its column (with unit) and what it measures."""
+
+    name: str
+    column: str
+    label: str          # axis label, in the unit the plots draw it in
+    plot_factor: float  # column unit -> plotted unit
+
+
+OBJECTIVES = {
+    "distance": Objective("distance", "distance_m", "distance a hop (mm)", 1000.0),
+    "nose_rise": Objective("nose_rise", "nose_rise_m", "nose rise a hop (mm)", 1000.0),
+    "flight": Objective("flight", "flight_s", "flight a hop (ms)", 1000.0),
+}
+
+
+def objectives_named(names: list[str] | tuple[str, ...]) -> list[Objective]:
+    """The objectives ``names`` in the order given; an unknown or repeated name is refused."""
+    if not names:
+        return [OBJECTIVES["distance"]]
+    out = []
+    for name in names:
+        if name not in OBJECTIVES:
+            raise SweepError(f"--objective {name!r}: no such objective",
+                             f"choose from {', '.join(OBJECTIVES)}")
+        if OBJECTIVES[name] in out:
+            raise SweepError(f"--objective {name} given twice", "give each objective once")
+        out.append(OBJECTIVES[name])
+    return out
+
+
+@dataclass(frozen=True)
+class DrawFigures:
+    """One simulated run's outcome and its per-hop figures, by objective column."""
+
+    outcome: str
+    figures: dict[str, float]
+
+
+@dataclass(frozen=True)
+class Judgement:
+    """A design judged over its draws (or its nominal run alone).
+
+    ``figures`` holds each objective's figure optimised (the quantile over the draws, or the
+    nominal run's figure), ``means`` its mean over the same draws; shares are of the valid draws.
+    """
+
+    valid: bool
+    reason: str
+    figures: dict[str, float] = field(default_factory=dict)
+    means: dict[str, float] = field(default_factory=dict)
+    flip_share: float = math.nan
+    outcome_shares: dict[str, float] = field(default_factory=dict)
+    draws: int = 0
+    draws_valid: int = 0
+
+
+def per_hop_figures(distance_m: float, hops: list, cycles: int, outcome: str) -> DrawFigures:
+    """A run's per-hop figures from its travel over the run and its hops
+    (:class:`locust.sim.hops.Hop`); every figure 0 when the run went over."""
+    if outcome == GOES_OVER:
+        return DrawFigures(outcome, {o.column: 0.0 for o in OBJECTIVES.values()})
+    return DrawFigures(outcome, {
+        "distance_m": distance_m / cycles,
+        "nose_rise_m": float(np.mean([h.nose_apex_m for h in hops])) if hops else 0.0,
+        "flight_s": float(np.mean([h.flight_s for h in hops])) if hops else 0.0,
+    })
+
+
+def judge_draws(draws: list[DrawFigures | None], objectives: list[Objective], quantile: float | None,
+                min_valid_share: float = 0.5) -> Judgement:
+    """Aggregate the draws of one design (None: a draw that failed its audit).
+
+    Parameters
+    ----------
+    draws : list of DrawFigures or None
+        Every draw, the same draws for every design.
+    objectives : list of Objective
+        What the design is judged by.
+    quantile : float or None
+        The quantile of the draws' figures taken as the figure optimised (0.1: the figure 9 in
+        10 draws beat); None for a single nominal run, whose figure is taken as it is.
+    min_valid_share : float
+        Fewer valid draws than this share make the design invalid.
+
+    Returns
+    -------
+    Judgement
+    """
+    valid = [d for d in draws if d is not None]
+    n = len(draws)
+    if not valid or len(valid) < min_valid_share * n:
+        return Judgement(False, f"{n - len(valid)} of {n} draws of the uncertain values fail their audit",
+                         draws=n, draws_valid=len(valid))
+    shares = {name: sum(d.outcome == name for d in valid) / len(valid) for name in OUTCOMES}
+    figures, means = {}, {}
+    for o in objectives:
+        values = np.array([d.figures[o.column] for d in valid], dtype=float)
+        means[o.column] = float(np.mean(values))
+        figures[o.column] = float(np.quantile(values, quantile)) if quantile is not None else float(values[0])
+    return Judgement(True, "", figures, means, shares[GOES_OVER], shares, n, len(valid))
