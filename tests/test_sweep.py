@@ -550,9 +550,11 @@ def test_sweep_prints_hop_figures_in_mm_like_every_table(tmp_path):
     res = subprocess.run(LOCUST + ["sweep", "--preset", "seed", "--vary", "scale=0:0.01:2", "--cycles", "1",
                                    "--jobs", "1", "--out", str(tmp_path / "sw")], capture_output=True, text=True)
     assert res.returncode == 0, res.stderr
-    m = re.search(r"best valid design (\d+) \(scale=\S+\): (-?[\d.]+) mm, highest nose (-?[\d.]+) mm", res.stdout)
+    m = re.search(r"best valid design (\d+) \(scale=[^,)]+, (\w+)\): (-?[\d.]+) mm, highest nose (-?[\d.]+) mm",
+                  res.stdout)
     assert m, res.stdout
     row = list(csv.DictReader((tmp_path / "sw" / "results.csv").open()))[int(m.group(1))]
-    assert float(m.group(2)) == pytest.approx(float(row["distance_m"]) * 1000, abs=0.005)
-    assert float(m.group(3)) == pytest.approx(float(row["max_nose_height_m"]) * 1000, abs=0.005)
+    assert m.group(2) == row["outcome"]
+    assert float(m.group(3)) == pytest.approx(float(row["distance_m"]) * 1000, abs=0.005)
+    assert float(m.group(4)) == pytest.approx(float(row["max_nose_height_m"]) * 1000, abs=0.005)
     assert " cm" not in res.stdout
