@@ -34,6 +34,7 @@ import numpy as np
 
 from ..errors import TrackError
 from .tracks_csv import MarkerColumns, TracksCsv
+from .trz import open_trz, read_member, unpack_members
 
 TRACKER_TO_OPENCV_PX = -0.5
 POINT_CLASSES = ("PointMass",)  # Tracker's point tracks; vectors, tapes, axes are not tracks of a marker
@@ -106,12 +107,12 @@ def read_project(path: str | Path) -> TrackerProject:
         raise TrackError(f"{path}: no such file", "give the path of a Tracker .trk or .trz file")
     try:
         if zipfile.is_zipfile(path):
-            with zipfile.ZipFile(path) as z:
+            with open_trz(path) as z:
                 names = sorted(n for n in z.namelist() if n.lower().endswith(".trk"))
                 if not names:
                     raise TrackError(f"{path}: a zip without a .trk file",
                                      "give a Tracker project (.trz) or tab (.trk)")
-                text = z.read(names[0])
+                text = read_member(path, z, names[0])
         else:
             text = path.read_bytes()
         root = ET.parse(io.BytesIO(text)).getroot()
@@ -255,7 +256,7 @@ def media_in_zip(project: TrackerProject, trk_path: Path) -> str | None:
     (OSP's ``zip!/entry`` path); None for a plain ``.trk``, whose video is a file of its own."""
     if not zipfile.is_zipfile(project.path) or not project.video_path:
         return None
-    with zipfile.ZipFile(project.path) as z:
+    with open_trz(project.path) as z:
         trk_name = next(n for n in sorted(z.namelist()) if n.lower().endswith(".trk"))
     entry = (PurePosixPath(trk_name).parent / project.video_path.replace("\\", "/")).as_posix()
     zip_rel = Path(os.path.relpath(project.path.resolve(), Path(trk_path).resolve().parent)).as_posix()
@@ -278,17 +279,15 @@ def project_media(project: TrackerProject) -> Iterator[Path]:
                              f"with --calibration-from {project.path.name}")
         yield media
         return
+    if rel.is_absolute() or ".." in rel.parts:
+        raise TrackError(f"{project.path.name} opens {project.video_path}, which is outside the project zip",
+                         "give the video itself as VIDEO, with --calibration-from the project")
     with tempfile.TemporaryDirectory(prefix="locust-trz-") as tmp:
-        with zipfile.ZipFile(project.path) as z:
+        with open_trz(project.path) as z:
             trk_dirs = {PurePosixPath(n).parent for n in z.namelist() if n.lower().endswith(".trk")}
             wanted = [n for n in z.namelist() if not n.endswith("/")
                       and any(PurePosixPath(n).parent == (d / rel).parent for d in trk_dirs)]
-            for name in wanted:
-                target = Path(tmp, *PurePosixPath(name).parts)
-                if ".." in PurePosixPath(name).parts:
-                    continue
-                target.parent.mkdir(parents=True, exist_ok=True)
-                target.write_bytes(z.read(name))
+            unpack_members(project.path, z, wanted, Path(tmp))
         candidates = [Path(tmp, *d.parts) / rel for d in sorted(trk_dirs)]
         media = next((c for c in candidates if c.is_file()), None)
         if media is None:
