@@ -736,3 +736,55 @@ def test_a_two_million_row_recording_is_refused_before_it_is_parsed(tmp_path, mo
     rec.write_text("t,x,y\n" + rows + "\n")
     assert_refused_and_unchanged(tmp_path, ["calibrate", "beam", rec, "--mass-kg", "0.01", "--no-plot"],
                                  f"{MAX_ROWS + 2:,} lines", "cut the recording")
+
+
+def _robot_structure(d: Path, rng) -> tuple[Path, str]:
+    """A robot file whose structure no robot.toml has: (its path, a word of the error)."""
+    key = rng.choice(NUMBER_KEYS)
+    section, name = key.split(".")
+    depth = rng.randrange(500, 3000)
+    kind = rng.choice(["overflow", "list", "table", "deep-inline", "deep-list", "base", "name", "section",
+                       "not-a-file"])
+    if kind == "overflow":   # an integer no float holds, plain or as {value = ...}
+        big = rng.choice(["", "-"]) + "1" + "0" * rng.randrange(309, 2000)
+        text = f"{name} = {big}" if rng.random() < 0.5 else f"{name} = {{value = {big}}}"
+        return robot_toml(d, f"[{section}]\n{text}\n"), "too large for a number"
+    if kind == "list":
+        return robot_toml(d, f"[{section}]\n{name} = [{rng.uniform(0, 1)}, 2]\n"), "a list, where a number"
+    if kind == "table":
+        inner = rng.choice([f"{{value = {{a = {rng.random()}}}}}", f"{{value = [{rng.random()}]}}"])
+        return robot_toml(d, f"[{section}]\n{name} = {inner}\n"), "where a number"
+    if kind == "deep-inline":
+        return robot_toml(d, f"[{section}]\n{name} = " + "{a = " * depth + "1" + "}" * depth + "\n"), "too deep"
+    if kind == "deep-list":
+        where = rng.choice([f"[{section}]\n{name} = ", "name = ", "base = "])
+        return robot_toml(d, where + "[" * depth + "]" * depth + "\n"), "too deep"
+    if kind == "base":
+        return robot_toml(d, rng.choice(['base = ["seed"]\n', "base = {a = 1}\n", "base = 3\n"])), "not a preset"
+    if kind == "name":
+        return robot_toml(d, rng.choice(['name = ["mine"]\n', "name = {a = 1}\n", "name = 3\n"])), "not a string"
+    if kind == "section":
+        return robot_toml(d, f"{section} = {rng.choice(['1', '[1]', 'true'])}\n"), f"section [{section}]"
+    choice = rng.randrange(3)
+    if choice == 0:
+        os.mkfifo(d / "fifo.toml")
+        return d / "fifo.toml", "not a regular file"
+    if choice == 1:
+        (d / "folder.toml").mkdir()
+        return d / "folder.toml", "not a regular file"
+    return Path(rng.choice(["/dev/zero", "/dev/urandom"])), "not a regular file"
+
+
+@pytest.mark.timeout(60)   # a pipe read as a robot.toml blocked for ever
+@pytest.mark.parametrize("k, rng", _draws(9, 30))
+def test_probe_robot_files_whose_structure_is_no_robot_s(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    robot, word = _robot_structure(tmp_path, rng)
+    ramp = robot_toml(tmp_path, "trial,angle_deg\n1,30\n2,31\n3,29\n", "ramp.csv")
+    commands = [["params", "--config", robot], ["sim", "--cycles", "1", "--config", robot],
+                ["fab", "--from-robot", robot],
+                ["report", "--before", robot, "--measured", f"small={trial(tmp_path)}", "--out", tmp_path / "rep"],
+                ["calibrate", "ramp", ramp, "--write", robot, "--no-plot"]]
+    t0 = time.monotonic()
+    assert_refused_and_unchanged(tmp_path, commands[k % len(commands)], str(robot.name), word)
+    assert time.monotonic() - t0 < 10
