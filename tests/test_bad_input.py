@@ -788,3 +788,34 @@ def test_probe_robot_files_whose_structure_is_no_robot_s(tmp_path, monkeypatch, 
     t0 = time.monotonic()
     assert_refused_and_unchanged(tmp_path, commands[k % len(commands)], str(robot.name), word)
     assert time.monotonic() - t0 < 10
+
+
+def _calibration_input(d: Path, rng) -> tuple[list, list[str]]:
+    """A calibration command given a recording that is not a file, or a load no servo holds."""
+    if rng.random() < 0.3:
+        moment = rng.choice([-1, 1]) * 10 ** rng.uniform(math.log10(5.001), 300)
+        return (["calibrate", "servo", copy_servo(d), "--inertia-kgm2", "1.5e-5", "--gravity-moment-nm",
+                 repr(moment), "--no-plot"], ["--gravity-moment-nm", "5 N*m"])
+    choice, word = rng.randrange(4), "not a regular file"
+    if choice == 0:
+        os.mkfifo(d / "fifo.csv")
+        rec = d / "fifo.csv"
+    elif choice == 1:
+        (d / "folder.csv").mkdir()
+        rec, word = d / "folder.csv", "is a directory"
+    else:
+        rec = Path(rng.choice(["/dev/zero", "/dev/urandom"]))
+    kind = rng.choice(["beam", "ramp", "hinge", "servo"])
+    extra = {"beam": ["--mass-kg", "0.01"], "ramp": [], "servo": ["--inertia-kgm2", "1.5e-5"],
+             "hinge": ["--inertia-kgm2", "8.5e-7", "--gravity", "out-of-plane"]}[kind]
+    return ["calibrate", kind, rec, *extra, "--no-plot"], [rec.name, word]
+
+
+@pytest.mark.timeout(60)   # a pipe read as a recording blocked for ever, /dev/zero filled the memory
+@pytest.mark.parametrize("k, rng", _draws(10))
+def test_probe_calibration_recordings_that_are_not_files_and_loads_no_servo_holds(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    args, words = _calibration_input(tmp_path, rng)
+    t0 = time.monotonic()
+    assert_refused_and_unchanged(tmp_path, args, *words)
+    assert time.monotonic() - t0 < 10
