@@ -22,6 +22,7 @@ from pathlib import Path
 
 import pytest
 
+from locust.fab.dxf_read import MAX_ARC_SEGMENTS
 from locust.io import run_record as R
 from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
 from probing import assert_clear_error, assert_refused_and_unchanged, invoke, tree
@@ -816,6 +817,62 @@ def _calibration_input(d: Path, rng) -> tuple[list, list[str]]:
 def test_probe_calibration_recordings_that_are_not_files_and_loads_no_servo_holds(tmp_path, monkeypatch, k, rng):
     monkeypatch.chdir(tmp_path)
     args, words = _calibration_input(tmp_path, rng)
+    t0 = time.monotonic()
+    assert_refused_and_unchanged(tmp_path, args, *words)
+    assert time.monotonic() - t0 < 10
+
+
+def _hostile_dxf(d: Path, rng) -> tuple[list, list[str]]:
+    """A body outline with one entity no laser cuts: a number not finite, an arc of a radius or
+    bulge that flattens into millions of chords; or a gap tolerance that is no distance."""
+    import ezdxf
+
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    plate = {"layer": "plate"}
+    kind = rng.choice(["not-finite", "radius", "bulge", "gap"])
+    if kind == "gap":
+        msp.add_lwpolyline(RECT, close=True, dxfattribs=plate)
+        doc.saveas(d / "part.dxf")
+        gap = rng.choice([0.0, -1.0, -1e300, 10.5, 1e300, -10 ** rng.uniform(-6, 3)])
+        return ["fab", d / "part.dxf", "--gap-tol-mm", repr(gap)], ["--gap-tol-mm"]
+    bad = rng.choice([math.inf, -math.inf, math.nan])
+    if kind == "not-finite":
+        where = rng.randrange(4)
+        if where == 0:
+            msp.add_lwpolyline([(0, 0), (50, 0), (50, bad), (0, 30)], close=True, dxfattribs=plate)
+        elif where == 1:
+            msp.add_lwpolyline([(0, 0, 0), (50, 0, bad), (50, 30, 0), (0, 30, 0)], format="xyb", close=True,
+                               dxfattribs=plate)
+        else:
+            msp.add_lwpolyline(RECT, close=True, dxfattribs=plate)
+            if where == 2:   # its centre, or (infinite) its radius
+                centre, radius = ((10, 10), abs(bad)) if math.isinf(bad) and rng.random() < 0.5 else ((bad, 10), 2)
+                msp.add_circle(centre, radius, dxfattribs=plate)
+            else:
+                msp.add_line((0, 0), (bad, 5), dxfattribs=plate)
+        words = ["not a finite number"]
+    elif kind == "radius":
+        msp.add_lwpolyline(RECT, close=True, dxfattribs=plate)
+        radius = 10 ** rng.uniform(9, 300)
+        (msp.add_arc((10, 10), radius, 0, 90, dxfattribs=plate) if rng.random() < 0.5
+         else msp.add_circle((10, 10), radius, dxfattribs=plate))
+        words = ["chords", f"{MAX_ARC_SEGMENTS:,}"]
+    else:
+        bulge = rng.choice([-1, 1]) * 10 ** rng.uniform(9, 300)
+        msp.add_lwpolyline([(0, 0, 0), (50, 0, bulge), (50, 30, 0), (0, 30, 0)], format="xyb", close=True,
+                           dxfattribs=plate)
+        words = ["chords", f"{MAX_ARC_SEGMENTS:,}"]
+    doc.saveas(d / "part.dxf")
+    return ["fab", d / "part.dxf"], ["part.dxf", *words]
+
+
+@pytest.mark.timeout(60)   # an arc of radius 1e12 mm flattened for ever
+@pytest.mark.parametrize("k, rng", _draws(11))
+def test_probe_drawings_with_numbers_no_laser_cuts(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    args, words = _hostile_dxf(tmp_path, rng)
     t0 = time.monotonic()
     assert_refused_and_unchanged(tmp_path, args, *words)
     assert time.monotonic() - t0 < 10
