@@ -20,6 +20,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from locust.fab.dxf_read import MAX_ARC_SEGMENTS
@@ -876,3 +877,68 @@ def test_probe_drawings_with_numbers_no_laser_cuts(tmp_path, monkeypatch, k, rng
     t0 = time.monotonic()
     assert_refused_and_unchanged(tmp_path, args, *words)
     assert time.monotonic() - t0 < 10
+
+
+# -- long simulations: refused by their memory, ended by a signal within a second or two --
+@pytest.mark.parametrize("samples", [64, 512, 4096])
+def test_a_batch_over_the_memory_limit_is_refused_before_any_simulation(tmp_path, monkeypatch, samples):
+    from locust.sim.batching import MAX_BATCH_BYTES
+
+    monkeypatch.chdir(tmp_path)
+    t0 = time.monotonic()
+    assert_refused_and_unchanged(tmp_path, ["sim", "--samples", samples, "--cycles", "1000"],
+                                 f"{samples} simulation(s)", f"{MAX_BATCH_BYTES / 2**30:g} GiB")
+    assert time.monotonic() - t0 < 10   # the 1000-cycle run alone takes minutes
+
+
+def test_a_chunked_rollout_is_the_one_call_record_bit_for_bit(monkeypatch):
+    import mujoco
+    from mujoco import rollout as mj_rollout
+
+    from locust.sim import batching
+    from locust.sim.model import build
+    from locust.sim.rollout import initial_state
+    from locust.sim.schedule import control_plan
+
+    robot = preset("seed")
+    built, plan = build(robot), control_plan(robot.schedule, robot.solver, 1)
+    control = np.zeros((1, plan.nstep, built.model.nu))
+    control[0][:, list(built.servo_actuators)] = plan.ctrl_rad[:, None]
+    start = initial_state(built)[0][None]
+    whole_state, whole_sensors = mj_rollout.rollout(built.model, mujoco.MjData(built.model), start, control)
+    monkeypatch.setattr(batching, "CHUNK_MODEL_STEPS", 397)   # a prime: chunks end anywhere in a phase
+    assert len(batching.chunk_bounds(plan.nstep, 1)) > 2
+    states, sensors, final, _ = batching.rollout_chunked([built.model], [mujoco.MjData(built.model)], start,
+                                                         control, keep_states=True)
+    assert np.array_equal(sensors, whole_sensors) and np.array_equal(states, whole_state)
+    assert np.array_equal(final, whole_state[:, -1])
+
+
+def _cpu_s(pid: int) -> float:
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc (Linux)")
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_ends_a_long_simulation_within_two_seconds(tmp_path, sig):
+    """1000 cycles are minutes of mujoco.rollout: the signal is taken between two chunks."""
+    proc = subprocess.Popen(LOCUST + ["sim", "--cycles", "1000"], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and proc.poll() is None and _cpu_s(proc.pid) < 4.0:
+        time.sleep(0.05)   # polling the CPU time it has used: past the imports and the build, into the rollout
+    assert proc.poll() is None, proc.stderr.read()
+    t0 = time.monotonic()
+    proc.send_signal(sig)
+    try:
+        _, stderr = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:   # the signal was not taken: no simulation left running
+            proc.kill()
+            proc.wait()
+    seconds = time.monotonic() - t0
+    assert seconds < 2.0, seconds
+    assert proc.returncode != 0 and "Traceback" not in stderr, stderr
+    assert list(tmp_path.iterdir()) == []

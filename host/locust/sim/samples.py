@@ -16,8 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import GeometryError
-from ..params import Provenance, Robot, problems, real_keys
+from ..params import Provenance, Robot, check_robot, problems, real_keys
 from .audit import audit
+from .batching import check_batch
 from .hops import summarise
 from .model import build
 from .rollout import Trajectory, simulate_batch
@@ -68,12 +69,21 @@ def draw(robot: Robot, n: int, seed: int = 0) -> list[Robot]:
     return [robot.with_values(dict(zip(keys, row.tolist())), prov) for row in values]
 
 
+def check_draws(robot: Robot, n: int, cycles: int | None = None, keep_states: bool = False):
+    """The plan of ``n`` draws of ``robot``; refused (:class:`~locust.errors.SimError`) before
+    any is drawn, built or run when their record would be over the batch's memory limit."""
+    check_robot(robot, cycles)
+    plan = control_plan(robot.schedule, robot.solver, cycles)
+    check_batch(build(robot).model, n, plan.nstep, keep_states)
+    return plan
+
+
 def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 0,
                    keep_states: bool = False) -> list[Trajectory | None]:
     """``n`` draws of ``robot`` simulated in one batch, each audited: a draw's trajectory, or
     None for a draw outside the parameter limits, whose linkage cannot close, or that fails
     its audit (as a sweep's design would be an invalid row)."""
-    plan = control_plan(robot.schedule, robot.solver, cycles)
+    plan = check_draws(robot, n, cycles, keep_states)
     builts = []
     for r in draw(robot, n, seed):
         try:
