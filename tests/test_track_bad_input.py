@@ -324,3 +324,43 @@ def test_a_dim_patch_or_a_speck_is_never_taken(tmp_path, chroma_share, radius_px
     encode_video(tmp_path / "dim.avi", frames, 30.0, (160, 120), "FFV1")
     assert_refused_and_unchanged(tmp_path, ["track", tmp_path / "dim.avi", "--marker", "nose=color:#ff00ff"],
                                  "never found", "nose (color:#ff00ff)")
+
+
+# -- calibrations no camera or print can have: points on a line, a board of 10 um, a camera
+#    file of nested brackets --------------------------------------------------------------
+def _bad_calibration(folder, rng) -> tuple[list, list[str]]:
+    import random as _random
+
+    assert isinstance(rng, _random.Random)
+    kind = rng.choice(["collinear", "repeated", "board", "camera"])
+    video = folder / "hop.mp4"
+    if kind in ("collinear", "repeated"):
+        px = [(rng.uniform(0, 320), rng.uniform(0, 180)) for _ in range(4)]
+        xy = [(rng.uniform(0, 1), rng.uniform(0, 1)) for _ in range(4)]
+        line = rng.choice(["px", "xy"])
+        if kind == "collinear":   # every point on one line, in pixels or on the plane
+            a, d = (rng.uniform(0, 100), rng.uniform(0, 100)), (rng.uniform(-1, 1), rng.uniform(-1, 1))
+            pts = [(a[0] + t * d[0], a[1] + t * d[1]) for t in (rng.uniform(-50, 50) for _ in range(4))]
+        else:                     # one point given four times
+            pts = [(rng.uniform(0, 100), rng.uniform(0, 100))] * 4
+        px, xy = (pts, xy) if line == "px" else (px, pts)
+        text = ";".join(f"{p[0]:.4f},{p[1]:.4f}={q[0]:.4f},{q[1]:.4f}" for p, q in zip(px, xy))
+        return ["track", video, "--overlay", "none", "--out", folder / "o", "--plane-points", text], \
+            ["--plane-points", "pixels" if line == "px" else "plane positions"]
+    if kind == "board":
+        marker = rng.choice([10 ** rng.uniform(-9, -0.01), 10 ** rng.uniform(2.71, 9)])
+        cols = rng.randrange(2, 6)
+        return ["track", "board", folder / "b.png", "--board", f"aruco:4X4_50:{cols}x4:{marker:.6g}:0"], ["--board"]
+    depth = rng.randrange(2_000, 200_000)
+    o, c = rng.choice([("[", "]"), ('{"a":', "}")])
+    (folder / "hop.camera.json").write_text(o * depth + "1" + c * depth)
+    return ["track", video, "--overlay", "none", "--out", folder / "o"], ["hop.camera.json", "nested too deep"]
+
+
+@pytest.mark.parametrize("seed", range(16))
+def test_a_calibration_no_camera_or_print_has_is_refused(hop, tmp_path, seed):
+    import random
+
+    (tmp_path / "hop.mp4").write_bytes((hop / "hop.mp4").read_bytes())
+    args, words = _bad_calibration(tmp_path, random.Random(seed))
+    assert_refused_and_unchanged(tmp_path, args, *words)

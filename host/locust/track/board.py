@@ -37,6 +37,13 @@ BOARD_DPI = 300
 BOARD_MARGIN_MM = 10.0
 DEFAULT_BOARD = "aruco:4X4_50:5x4:40:10"   # 240 x 190 mm: fits an A4 sheet
 DETECT_FRAMES = 30       # frames searched for the board at the start of the clip
+# A printed marker: at BOARD_DPI a 4x4 marker's 6 cells need 1 mm at least; a board is printed
+# on at most an A0 sheet (1189 mm).
+BOARD_MARKER_MM = (1.0, 500.0)
+BOARD_MAX_MM = 1189.0
+# --plane-points span an area: their narrowest spread at least this fraction of their widest
+# (a sheet's corners seen at 80 deg from square still span 0.17); below it the map is a guess
+MIN_POINT_SPREAD = 0.01
 MIN_BOARD_MARKERS = 2    # 8 corners: enough for a homography, with some redundancy
 
 
@@ -95,6 +102,14 @@ def parse_board(text: str) -> BoardSpec:
     cols, rows, marker_mm, gap_mm = int(m.group(2)), int(m.group(3)), float(m.group(4)), float(m.group(5))
     if cols < 1 or rows < 1 or cols * rows < MIN_BOARD_MARKERS or not marker_mm > 0 or gap_mm < 0:
         raise TrackError(f"--board {text!r}: needs at least {MIN_BOARD_MARKERS} markers of positive size", hint)
+    low, high = BOARD_MARKER_MM
+    if not low <= marker_mm <= high:
+        raise TrackError(f"--board {text!r}: markers of {marker_mm:g} mm; a printed marker is {low:g} to {high:g} mm "
+                         f"(below {low:g} mm a {BOARD_DPI} dpi print cannot draw its cells)", hint)
+    width_mm = max(cols, rows) * (marker_mm + gap_mm)
+    if width_mm > BOARD_MAX_MM:
+        raise TrackError(f"--board {text!r}: {width_mm:g} mm across; a printed board is at most {BOARD_MAX_MM:g} mm "
+                         "(A0's long side)", hint)
     spec = BoardSpec(dictionary, cols, rows, marker_mm, gap_mm)
     n_ids = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, dictionary)).bytesList.shape[0]
     if cols * rows > n_ids:
@@ -165,7 +180,7 @@ class PlaneHomography:
 
 def _fit(image_pts: np.ndarray, plane_pts: np.ndarray, source: str, frame: int | None = None) -> PlaneHomography:
     H, _ = cv2.findHomography(image_pts.astype(np.float64), plane_pts.astype(np.float64), 0)
-    if H is None:
+    if H is None or not np.isfinite(H).all() or abs(np.linalg.det(H)) < 1e-300:
         raise TrackError(f"{source}: no homography fits these points",
                          "the points must not lie on one line; spread them over the plane")
     v = np.c_[image_pts, np.ones(len(image_pts))] @ H.T
@@ -217,4 +232,17 @@ def parse_plane_points(text: str) -> PlaneHomography:
         raise TrackError(f"--plane-points {text!r}: expected four or more PX,PY=X_M,Y_M separated by ';'",
                          "e.g. --plane-points '102,880=0,0;1650,870=1.2,0;1600,240=1.2,0.5;150,250=0,0.5'")
     v = np.array([[float(x) for x in m.groups()] for m in rows])
+    for pts, unit, what in ((v[:, :2], "px", "pixels"), (v[:, 2:], "m", "plane positions")):
+        if not np.isfinite(pts).all() or len(np.unique(pts, axis=0)) < 4 or _spread(pts) < MIN_POINT_SPREAD:
+            raise TrackError(f"--plane-points {text!r}: the {what} are not four distinct points spread off one line "
+                             f"(their narrowest spread under {MIN_POINT_SPREAD:g} of their widest)",
+                             f"give four or more points spread over the plane ({unit}), no three of them on one "
+                             "line, e.g. the corners of a sheet")
     return _fit(v[:, :2], v[:, 2:], "plane points")
+
+
+def _spread(pts: np.ndarray) -> float:
+    """How far ``pts`` are from lying on one line: the ratio of the smaller to the larger
+    singular value of the centred points (0 on a line)."""
+    sv = np.linalg.svd(pts - pts.mean(axis=0), compute_uv=False)
+    return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
