@@ -39,6 +39,10 @@ from .trz import MAX_TRK_BYTES, open_trz, read_member, unpack_members
 TRACKER_TO_OPENCV_PX = -0.5
 POINT_CLASSES = ("PointMass",)  # Tracker's point tracks; vectors, tapes, axes are not tracks of a marker
 FPS_MIN, FPS_MAX = 1.0, 10000.0   # frames/s a camera films: a time-lapse at 1/s to a high-speed camera's 10 000/s
+# An entity declaration, in the encodings an XML file may have: a Tracker tab has none, and a
+# billion laughs or an external entity needs one (expat would expand 8 MB of it before its
+# amplification limit stops it)
+_ENTITY_MARKS = tuple("<!ENTITY".encode(e) for e in ("utf-8", "utf-16-le", "utf-16-be", "utf-32-le", "utf-32-be"))
 # A clip's frames: 0 to a million, an hour at 240 frames/s or 100 s at 10 000 (a hop
 # experiment is seconds); the clip's frames and each track are arrays of that length.
 MAX_CLIP_FRAMES = 1_000_000
@@ -123,6 +127,9 @@ def read_project(path: str | Path) -> TrackerProject:
                              "Tracker tab", _RESAVE)
         else:
             text = path.read_bytes()
+        if any(mark in text for mark in _ENTITY_MARKS):
+            raise TrackError(f"{path}: not a Tracker file: it declares XML entities (<!ENTITY), which Tracker never "
+                             "writes; refused before any is expanded", "give a .trk saved by Tracker")
         root = ET.parse(io.BytesIO(text)).getroot()
     except ET.ParseError as exc:
         raise TrackError(f"{path}: not a Tracker file (XML error: {exc})", "give a .trk saved by Tracker") from None
