@@ -20,8 +20,10 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from locust.fab.dxf_read import MAX_ARC_SEGMENTS
 from locust.io import run_record as R
 from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
 from probing import assert_clear_error, assert_refused_and_unchanged, invoke, tree
@@ -736,3 +738,207 @@ def test_a_two_million_row_recording_is_refused_before_it_is_parsed(tmp_path, mo
     rec.write_text("t,x,y\n" + rows + "\n")
     assert_refused_and_unchanged(tmp_path, ["calibrate", "beam", rec, "--mass-kg", "0.01", "--no-plot"],
                                  f"{MAX_ROWS + 2:,} lines", "cut the recording")
+
+
+def _robot_structure(d: Path, rng) -> tuple[Path, str]:
+    """A robot file whose structure no robot.toml has: (its path, a word of the error)."""
+    key = rng.choice(NUMBER_KEYS)
+    section, name = key.split(".")
+    depth = rng.randrange(500, 3000)
+    kind = rng.choice(["overflow", "list", "table", "deep-inline", "deep-list", "base", "name", "section",
+                       "not-a-file"])
+    if kind == "overflow":   # an integer no float holds, plain or as {value = ...}
+        big = rng.choice(["", "-"]) + "1" + "0" * rng.randrange(309, 2000)
+        text = f"{name} = {big}" if rng.random() < 0.5 else f"{name} = {{value = {big}}}"
+        return robot_toml(d, f"[{section}]\n{text}\n"), "too large for a number"
+    if kind == "list":
+        return robot_toml(d, f"[{section}]\n{name} = [{rng.uniform(0, 1)}, 2]\n"), "a list, where a number"
+    if kind == "table":
+        inner = rng.choice([f"{{value = {{a = {rng.random()}}}}}", f"{{value = [{rng.random()}]}}"])
+        return robot_toml(d, f"[{section}]\n{name} = {inner}\n"), "where a number"
+    if kind == "deep-inline":
+        return robot_toml(d, f"[{section}]\n{name} = " + "{a = " * depth + "1" + "}" * depth + "\n"), "too deep"
+    if kind == "deep-list":
+        where = rng.choice([f"[{section}]\n{name} = ", "name = ", "base = "])
+        return robot_toml(d, where + "[" * depth + "]" * depth + "\n"), "too deep"
+    if kind == "base":
+        return robot_toml(d, rng.choice(['base = ["seed"]\n', "base = {a = 1}\n", "base = 3\n"])), "not a preset"
+    if kind == "name":
+        return robot_toml(d, rng.choice(['name = ["mine"]\n', "name = {a = 1}\n", "name = 3\n"])), "not a string"
+    if kind == "section":
+        return robot_toml(d, f"{section} = {rng.choice(['1', '[1]', 'true'])}\n"), f"section [{section}]"
+    choice = rng.randrange(3)
+    if choice == 0:
+        os.mkfifo(d / "fifo.toml")
+        return d / "fifo.toml", "not a regular file"
+    if choice == 1:
+        (d / "folder.toml").mkdir()
+        return d / "folder.toml", "not a regular file"
+    return Path(rng.choice(["/dev/zero", "/dev/urandom"])), "not a regular file"
+
+
+@pytest.mark.timeout(60)   # a pipe read as a robot.toml blocked for ever
+@pytest.mark.parametrize("k, rng", _draws(9, 30))
+def test_probe_robot_files_whose_structure_is_no_robot_s(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    robot, word = _robot_structure(tmp_path, rng)
+    ramp = robot_toml(tmp_path, "trial,angle_deg\n1,30\n2,31\n3,29\n", "ramp.csv")
+    commands = [["params", "--config", robot], ["sim", "--cycles", "1", "--config", robot],
+                ["fab", "--from-robot", robot],
+                ["report", "--before", robot, "--measured", f"small={trial(tmp_path)}", "--out", tmp_path / "rep"],
+                ["calibrate", "ramp", ramp, "--write", robot, "--no-plot"]]
+    t0 = time.monotonic()
+    assert_refused_and_unchanged(tmp_path, commands[k % len(commands)], str(robot.name), word)
+    assert time.monotonic() - t0 < 10
+
+
+def _calibration_input(d: Path, rng) -> tuple[list, list[str]]:
+    """A calibration command given a recording that is not a file, or a load no servo holds."""
+    if rng.random() < 0.3:
+        moment = rng.choice([-1, 1]) * 10 ** rng.uniform(math.log10(5.001), 300)
+        return (["calibrate", "servo", copy_servo(d), "--inertia-kgm2", "1.5e-5", "--gravity-moment-nm",
+                 repr(moment), "--no-plot"], ["--gravity-moment-nm", "5 N*m"])
+    choice, word = rng.randrange(4), "not a regular file"
+    if choice == 0:
+        os.mkfifo(d / "fifo.csv")
+        rec = d / "fifo.csv"
+    elif choice == 1:
+        (d / "folder.csv").mkdir()
+        rec, word = d / "folder.csv", "is a directory"
+    else:
+        rec = Path(rng.choice(["/dev/zero", "/dev/urandom"]))
+    kind = rng.choice(["beam", "ramp", "hinge", "servo"])
+    extra = {"beam": ["--mass-kg", "0.01"], "ramp": [], "servo": ["--inertia-kgm2", "1.5e-5"],
+             "hinge": ["--inertia-kgm2", "8.5e-7", "--gravity", "out-of-plane"]}[kind]
+    return ["calibrate", kind, rec, *extra, "--no-plot"], [rec.name, word]
+
+
+@pytest.mark.timeout(60)   # a pipe read as a recording blocked for ever, /dev/zero filled the memory
+@pytest.mark.parametrize("k, rng", _draws(10))
+def test_probe_calibration_recordings_that_are_not_files_and_loads_no_servo_holds(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    args, words = _calibration_input(tmp_path, rng)
+    t0 = time.monotonic()
+    assert_refused_and_unchanged(tmp_path, args, *words)
+    assert time.monotonic() - t0 < 10
+
+
+def _hostile_dxf(d: Path, rng) -> tuple[list, list[str]]:
+    """A body outline with one entity no laser cuts: a number not finite, an arc of a radius or
+    bulge that flattens into millions of chords; or a gap tolerance that is no distance."""
+    import ezdxf
+
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    plate = {"layer": "plate"}
+    kind = rng.choice(["not-finite", "radius", "bulge", "gap"])
+    if kind == "gap":
+        msp.add_lwpolyline(RECT, close=True, dxfattribs=plate)
+        doc.saveas(d / "part.dxf")
+        gap = rng.choice([0.0, -1.0, -1e300, 10.5, 1e300, -10 ** rng.uniform(-6, 3)])
+        return ["fab", d / "part.dxf", "--gap-tol-mm", repr(gap)], ["--gap-tol-mm"]
+    bad = rng.choice([math.inf, -math.inf, math.nan])
+    if kind == "not-finite":
+        where = rng.randrange(4)
+        if where == 0:
+            msp.add_lwpolyline([(0, 0), (50, 0), (50, bad), (0, 30)], close=True, dxfattribs=plate)
+        elif where == 1:
+            msp.add_lwpolyline([(0, 0, 0), (50, 0, bad), (50, 30, 0), (0, 30, 0)], format="xyb", close=True,
+                               dxfattribs=plate)
+        else:
+            msp.add_lwpolyline(RECT, close=True, dxfattribs=plate)
+            if where == 2:   # its centre, or (infinite) its radius
+                centre, radius = ((10, 10), abs(bad)) if math.isinf(bad) and rng.random() < 0.5 else ((bad, 10), 2)
+                msp.add_circle(centre, radius, dxfattribs=plate)
+            else:
+                msp.add_line((0, 0), (bad, 5), dxfattribs=plate)
+        words = ["not a finite number"]
+    elif kind == "radius":
+        msp.add_lwpolyline(RECT, close=True, dxfattribs=plate)
+        radius = 10 ** rng.uniform(9, 300)
+        (msp.add_arc((10, 10), radius, 0, 90, dxfattribs=plate) if rng.random() < 0.5
+         else msp.add_circle((10, 10), radius, dxfattribs=plate))
+        words = ["chords", f"{MAX_ARC_SEGMENTS:,}"]
+    else:
+        bulge = rng.choice([-1, 1]) * 10 ** rng.uniform(9, 300)
+        msp.add_lwpolyline([(0, 0, 0), (50, 0, bulge), (50, 30, 0), (0, 30, 0)], format="xyb", close=True,
+                           dxfattribs=plate)
+        words = ["chords", f"{MAX_ARC_SEGMENTS:,}"]
+    doc.saveas(d / "part.dxf")
+    return ["fab", d / "part.dxf"], ["part.dxf", *words]
+
+
+@pytest.mark.timeout(60)   # an arc of radius 1e12 mm flattened for ever
+@pytest.mark.parametrize("k, rng", _draws(11))
+def test_probe_drawings_with_numbers_no_laser_cuts(tmp_path, monkeypatch, k, rng):
+    monkeypatch.chdir(tmp_path)
+    args, words = _hostile_dxf(tmp_path, rng)
+    t0 = time.monotonic()
+    assert_refused_and_unchanged(tmp_path, args, *words)
+    assert time.monotonic() - t0 < 10
+
+
+# -- long simulations: refused by their memory, ended by a signal within a second or two --
+@pytest.mark.parametrize("samples", [64, 512, 4096])
+def test_a_batch_over_the_memory_limit_is_refused_before_any_simulation(tmp_path, monkeypatch, samples):
+    from locust.sim.batching import MAX_BATCH_BYTES
+
+    monkeypatch.chdir(tmp_path)
+    t0 = time.monotonic()
+    assert_refused_and_unchanged(tmp_path, ["sim", "--samples", samples, "--cycles", "1000"],
+                                 f"{samples} simulation(s)", f"{MAX_BATCH_BYTES / 2**30:g} GiB")
+    assert time.monotonic() - t0 < 10   # the 1000-cycle run alone takes minutes
+
+
+def test_a_chunked_rollout_is_the_one_call_record_bit_for_bit(monkeypatch):
+    import mujoco
+    from mujoco import rollout as mj_rollout
+
+    from locust.sim import batching
+    from locust.sim.model import build
+    from locust.sim.rollout import initial_state
+    from locust.sim.schedule import control_plan
+
+    robot = preset("seed")
+    built, plan = build(robot), control_plan(robot.schedule, robot.solver, 1)
+    control = np.zeros((1, plan.nstep, built.model.nu))
+    control[0][:, list(built.servo_actuators)] = plan.ctrl_rad[:, None]
+    start = initial_state(built)[0][None]
+    whole_state, whole_sensors = mj_rollout.rollout(built.model, mujoco.MjData(built.model), start, control)
+    monkeypatch.setattr(batching, "CHUNK_MODEL_STEPS", 397)   # a prime: chunks end anywhere in a phase
+    assert len(batching.chunk_bounds(plan.nstep, 1)) > 2
+    states, sensors, final, _ = batching.rollout_chunked([built.model], [mujoco.MjData(built.model)], start,
+                                                         control, keep_states=True)
+    assert np.array_equal(sensors, whole_sensors) and np.array_equal(states, whole_state)
+    assert np.array_equal(final, whole_state[:, -1])
+
+
+def _cpu_s(pid: int) -> float:
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc (Linux)")
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_ends_a_long_simulation_within_two_seconds(tmp_path, sig):
+    """1000 cycles are minutes of mujoco.rollout: the signal is taken between two chunks."""
+    proc = subprocess.Popen(LOCUST + ["sim", "--cycles", "1000"], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and proc.poll() is None and _cpu_s(proc.pid) < 4.0:
+        time.sleep(0.05)   # polling the CPU time it has used: past the imports and the build, into the rollout
+    assert proc.poll() is None, proc.stderr.read()
+    t0 = time.monotonic()
+    proc.send_signal(sig)
+    try:
+        _, stderr = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:   # the signal was not taken: no simulation left running
+            proc.kill()
+            proc.wait()
+    seconds = time.monotonic() - t0
+    assert seconds < 2.0, seconds
+    assert proc.returncode != 0 and "Traceback" not in stderr, stderr
+    assert list(tmp_path.iterdir()) == []

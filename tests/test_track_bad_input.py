@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 import pytest
 
+from locust.io.trk import MAX_CLIP_FRAMES
 from locust.track.calib import build
 from locust.track.runner import MarkerTrack, TrackResult
 from locust.track.synth import make_hop_video, paint_dot
@@ -74,6 +75,52 @@ def test_a_project_with_a_camera_s_interval_gives_its_times(tmp_path):
     assert res.exit_code == 0, res.output
     t = np.loadtxt(tmp_path / "o.csv", delimiter=",", skiprows=1, usecols=1, comments="#")
     assert np.allclose(t, np.arange(10) * 4.1666667e-3, rtol=0, atol=5e-7)   # the CSV writes t_s to the us
+
+
+# -- a Tracker project's frames, clip and axes: every value a generator draws is refused ----
+def _bad_project(text: str, rng) -> tuple[str, str]:
+    """``text`` (a project of 10 frames) with one value no Tracker project holds: (text, a word
+    of the error)."""
+    kind = rng.choice(["frame", "clip", "axes", "empty"])
+    if kind == "frame":
+        bad = rng.choice(["[x]", f"[{rng.uniform(0, 9):.2f}]", f"[{2 ** 31}]", f"[{2 ** 63}]",
+                          f"[-{rng.randrange(1, 99)}]", "[]", str(rng.randrange(10)), f"[{'9' * 400}]",
+                          f"[{MAX_CLIP_FRAMES + rng.randrange(1, 10 ** 9)}]"])
+        return text.replace(f'name="[{rng.randrange(10)}]"', f'name="{bad}"', 1), "frame"
+    if kind == "clip":
+        name = rng.choice(["stepcount", "startframe", "stepsize"])
+        bad = {"stepcount": [2 ** 31, 2 ** 63, MAX_CLIP_FRAMES + 2, -5],
+               "startframe": [-1, 2 ** 31, 2 ** 63, MAX_CLIP_FRAMES + 1],
+               "stepsize": [0, -2, 2 ** 31]}[name]
+        return re.sub(rf'(name="{name}" type="int">)[^<]*', rf"\g<1>{rng.choice(bad)}", text), "clip"
+    if kind == "axes":
+        name = rng.choice(["xorigin", "yorigin", "angle"])
+        bad = rng.choice(["inf", "-Infinity", "NaN", "1e999"])
+        return re.sub(rf'(name="{name}" type="double">)[^<]*', rf"\g<1>{bad}", text), name
+    steps = re.sub(r'<property name="\[\d+\]" type="object">\s*<object class="[^"]*PointMass\$FrameData">'
+                   r'.*?</object>\s*</property>\s*', "", text, flags=re.S)
+    return re.sub(r'<property name="stepcount"[^<]*</property>\s*', "", steps), "no marked steps"
+
+
+@pytest.mark.parametrize("seed", range(24))
+@pytest.mark.parametrize("command", ["from-trk", "import"])
+def test_a_project_whose_frames_clip_or_axes_are_no_tracker_s_is_refused(tmp_path, seed, command):
+    import random
+
+    text, word = _bad_project(_project_text(tmp_path, "33.333333"), random.Random(seed))
+    assert text != _project_text(tmp_path, "33.333333")
+    (tmp_path / "p.trk").write_text(text)
+    assert_refused_and_unchanged(tmp_path, ["track", command, tmp_path / "p.trk", "--out", tmp_path / "o.csv"],
+                                 "p.trk", word)
+
+
+def test_a_tab_over_the_size_limit_is_refused_before_it_is_read(tmp_path):
+    from locust.io.trz import MAX_TRK_BYTES
+
+    with open(tmp_path / "p.trk", "wb") as f:
+        f.truncate(MAX_TRK_BYTES + 1)   # sparse: no disk used
+    assert_refused_and_unchanged(tmp_path, ["track", "from-trk", tmp_path / "p.trk"], "p.trk",
+                                 f"{MAX_TRK_BYTES:,}")
 
 
 # -- imports: times must increase row to row ------------------------------------------------
@@ -325,3 +372,43 @@ def test_a_virtual_robot_that_went_over_is_upright_and_its_flipped_video_is_not(
     flipped = invoke(["track", tmp_path / "flipped.avi", "--scale", "0,0,100,0=0.05", "--overlay", "none"])
     assert flipped.exit_code == 0, flipped.output
     assert "nose stands still at the top of its heights" in flipped.stderr, flipped.stderr
+
+
+# -- calibrations no camera or print can have: points on a line, a board of 10 um, a camera
+#    file of nested brackets --------------------------------------------------------------
+def _bad_calibration(folder, rng) -> tuple[list, list[str]]:
+    import random as _random
+
+    assert isinstance(rng, _random.Random)
+    kind = rng.choice(["collinear", "repeated", "board", "camera"])
+    video = folder / "hop.mp4"
+    if kind in ("collinear", "repeated"):
+        px = [(rng.uniform(0, 320), rng.uniform(0, 180)) for _ in range(4)]
+        xy = [(rng.uniform(0, 1), rng.uniform(0, 1)) for _ in range(4)]
+        line = rng.choice(["px", "xy"])
+        if kind == "collinear":   # every point on one line, in pixels or on the plane
+            a, d = (rng.uniform(0, 100), rng.uniform(0, 100)), (rng.uniform(-1, 1), rng.uniform(-1, 1))
+            pts = [(a[0] + t * d[0], a[1] + t * d[1]) for t in (rng.uniform(-50, 50) for _ in range(4))]
+        else:                     # one point given four times
+            pts = [(rng.uniform(0, 100), rng.uniform(0, 100))] * 4
+        px, xy = (pts, xy) if line == "px" else (px, pts)
+        text = ";".join(f"{p[0]:.4f},{p[1]:.4f}={q[0]:.4f},{q[1]:.4f}" for p, q in zip(px, xy))
+        return ["track", video, "--overlay", "none", "--out", folder / "o", "--plane-points", text], \
+            ["--plane-points", "pixels" if line == "px" else "plane positions"]
+    if kind == "board":
+        marker = rng.choice([10 ** rng.uniform(-9, -0.01), 10 ** rng.uniform(2.71, 9)])
+        cols = rng.randrange(2, 6)
+        return ["track", "board", folder / "b.png", "--board", f"aruco:4X4_50:{cols}x4:{marker:.6g}:0"], ["--board"]
+    depth = rng.randrange(2_000, 200_000)
+    o, c = rng.choice([("[", "]"), ('{"a":', "}")])
+    (folder / "hop.camera.json").write_text(o * depth + "1" + c * depth)
+    return ["track", video, "--overlay", "none", "--out", folder / "o"], ["hop.camera.json", "nested too deep"]
+
+
+@pytest.mark.parametrize("seed", range(16))
+def test_a_calibration_no_camera_or_print_has_is_refused(hop, tmp_path, seed):
+    import random
+
+    (tmp_path / "hop.mp4").write_bytes((hop / "hop.mp4").read_bytes())
+    args, words = _bad_calibration(tmp_path, random.Random(seed))
+    assert_refused_and_unchanged(tmp_path, args, *words)

@@ -19,6 +19,10 @@ from .errors import TrackError
 BOARD_MARGIN_MM = 10.0
 DEFAULT_BOARD = "aruco:4X4_50:5x4:40:10"   # 240 x 190 mm: fits an A4 sheet
 MIN_BOARD_MARKERS = 2    # 8 corners: enough for a homography, with some redundancy
+# A printed marker: at 300 dpi a 4x4 marker's 6 cells need 1 mm at least; a board is printed
+# on at most an A0 sheet (1189 mm).
+BOARD_MARKER_MM = (1.0, 500.0)
+BOARD_MAX_MM = 1189.0
 
 
 @dataclass(frozen=True)
@@ -76,6 +80,14 @@ def parse_board(text: str) -> BoardSpec:
     cols, rows, marker_mm, gap_mm = int(m.group(2)), int(m.group(3)), float(m.group(4)), float(m.group(5))
     if cols < 1 or rows < 1 or cols * rows < MIN_BOARD_MARKERS or not marker_mm > 0 or gap_mm < 0:
         raise TrackError(f"--board {text!r}: needs at least {MIN_BOARD_MARKERS} markers of positive size", hint)
+    low, high = BOARD_MARKER_MM
+    if not low <= marker_mm <= high:
+        raise TrackError(f"--board {text!r}: markers of {marker_mm:g} mm; a printed marker is {low:g} to {high:g} mm "
+                         f"(below {low:g} mm a 300 dpi print cannot draw its cells)", hint)
+    width_mm = max(cols, rows) * (marker_mm + gap_mm)
+    if width_mm > BOARD_MAX_MM:
+        raise TrackError(f"--board {text!r}: {width_mm:g} mm across; a printed board is at most {BOARD_MAX_MM:g} mm "
+                         "(A0's long side)", hint)
     spec = BoardSpec(dictionary, cols, rows, marker_mm, gap_mm)
     n_ids = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, dictionary)).bytesList.shape[0]
     if cols * rows > n_ids:

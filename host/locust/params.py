@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import stat
 import tomllib
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
@@ -312,8 +313,11 @@ def _coerce(key: str, raw: Any) -> Any:
                 raise ValueError("not a whole number")
             return int(value)
         return str(raw)
+    except OverflowError:
+        raise ParamsError(f"bad value {_shown(raw)} for {key}: too large for a number", f"{key} takes a {ftype}") \
+            from None
     except (TypeError, ValueError) as exc:
-        raise ParamsError(f"bad value {raw!r} for {key}: {exc}", f"{key} takes a {ftype}") from None
+        raise ParamsError(f"bad value {_shown(raw)} for {key}: {exc}", f"{key} takes a {ftype}") from None
 
 
 def parse_set_options(items: tuple[str, ...] | list[str]) -> dict[str, str]:
@@ -695,11 +699,43 @@ def _uncertainty(path: Path, key: str, raw: Any) -> float | None:
     return float(raw)
 
 
+# A robot.toml is a few kB (every value with its source and note: under 20 kB).
+MAX_ROBOT_FILE_BYTES = 1_000_000
+
+
+def _check_robot_file(path: Path) -> None:
+    """:class:`ParamsError` unless ``path`` is a regular file of at most
+    :data:`MAX_ROBOT_FILE_BYTES`: a pipe or a device is refused before it is opened (reading
+    one blocks or never ends)."""
+    info = path.stat()
+    if not stat.S_ISREG(info.st_mode):
+        raise ParamsError(f"{path}: not a regular file (a pipe, device or folder)",
+                          "give the path of a robot.toml file")
+    if info.st_size > MAX_ROBOT_FILE_BYTES:
+        raise ParamsError(f"{path}: {info.st_size:,} bytes, over the {MAX_ROBOT_FILE_BYTES:,} a robot.toml can be",
+                          "give a robot.toml (a few kB, as `locust params --write` makes)")
+
+
+def _shown(raw: Any) -> str:
+    """``raw`` as an error shows it: a table or a list by its kind, anything else by a short repr."""
+    if isinstance(raw, dict):
+        return "a table"
+    if isinstance(raw, list):
+        return "a list"
+    text = repr(raw)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
 def load_robot(path: str | Path) -> Robot:
     """Read a robot.toml. Missing values fall back to the seed preset's."""
     path = Path(path)
     try:
+        _check_robot_file(path)
         doc = tomllib.loads(path.read_bytes().decode("utf-8"))
+    except RecursionError:
+        raise ParamsError(f"{path}: not a robot.toml: its tables or lists are nested too deep to read",
+                          "a robot.toml has sections of key = value (or {value = ..., source = ...}) and no "
+                          "deeper nesting; regenerate it with `locust params --write`") from None
     except FileNotFoundError:
         raise ParamsError(f"{path}: no such file", "give the path of a robot.toml, or use --preset") from None
     except UnicodeDecodeError as exc:
@@ -712,15 +748,20 @@ def load_robot(path: str | Path) -> Robot:
     except tomllib.TOMLDecodeError as exc:
         raise ParamsError(f"{path}: not valid TOML ({exc})",
                           "fix the file, or regenerate it with `locust params --write`") from None
-    base = doc.get("base", "seed")
-    if base not in PRESETS:
-        raise ParamsError(f"{path}: base = {base!r} is not a preset", f"choose one of {', '.join(PRESETS)}")
-    robot = preset(base).renamed(str(doc.get("name", path.stem)))
+    base, name = doc.get("base", "seed"), doc.get("name", path.stem)
+    if not isinstance(base, str) or base not in PRESETS:
+        raise ParamsError(f"{path}: base = {_shown(base)} is not a preset", f"choose one of {', '.join(PRESETS)}")
+    if not isinstance(name, str):
+        raise ParamsError(f"{path}: name = {_shown(name)} is not a string", 'write it in quotes: name = "mine"')
+    robot = preset(base).renamed(name)
     for section, table in doc.items():
         if section in ("name", "base"):
             continue
-        if section not in SECTIONS or not isinstance(table, dict):
+        if section not in SECTIONS:
             raise ParamsError(f"{path}: unknown section [{section}]", f"sections are {', '.join(SECTIONS)}")
+        if not isinstance(table, dict):
+            raise ParamsError(f"{path}: {section} = {_shown(table)}, where a section [{section}] of values belongs",
+                              f"write its values under a line [{section}]")
         for name, entry in table.items():
             key = f"{section}.{name}"
             try:
@@ -730,6 +771,10 @@ def load_robot(path: str | Path) -> Robot:
             if isinstance(entry, dict):
                 if "value" not in entry:
                     raise ParamsError(f"{path}: {key} has no 'value'", "write it as {value = ..., source = \"...\"}")
+                for field in ("source", "date", "note"):
+                    if isinstance(entry.get(field), (dict, list)):
+                        raise ParamsError(f"{path}: {key} has {field} = {_shown(entry[field])}, not a string",
+                                          f'write it in quotes: {field} = "..."')
                 prov = Provenance(
                     source=str(entry.get("source", "default")),
                     uncertainty=_uncertainty(path, key, entry.get("uncertainty")),
@@ -739,6 +784,10 @@ def load_robot(path: str | Path) -> Robot:
                 value = entry["value"]
             else:
                 prov, value = Provenance(source=f"file:{path.name}"), entry
+            if isinstance(value, (dict, list)):
+                raise ParamsError(f"{path}: {key} = {_shown(value)}, where a number belongs",
+                                  f"write one value: {key.split('.')[1]} = 0.05, or "
+                                  '{value = 0.05, source = "..."}')
             try:
                 robot = robot.with_values({key: value}, prov)
             except ParamsError as exc:

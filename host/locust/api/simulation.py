@@ -286,6 +286,10 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
     >>> r.trace().columns[:3].tolist()
     ['t_s', 'nose_x_m', 'nose_z_m']
     """
+    if samples:
+        from ..sim.samples import check_draws
+
+        check_draws(robot, samples, cycles)   # before the robot's own run
     base = _run.run(robot, cycles=cycles, keep_states=keep_states)
     result = SimResult(**{f.name: getattr(base, f.name) for f in dataclasses.fields(base)}, params=robot)
     if result.valid:

@@ -48,7 +48,7 @@ import numpy as np
 from mujoco import minimize
 
 from ..errors import CalibrationError
-from ..params import GRAVITY_M_PER_S2, Servo
+from ..params import GRAVITY_M_PER_S2, LIMITS, Servo
 from ..sim.rollout import rollout_threads
 from ..sim.servo import configure, with_servo
 from .curves import Curves
@@ -92,6 +92,14 @@ class ServoRig:
     inertia_kgm2: float
     gravity_moment_nm: float = 0.0   # load weight x lever arm, horn horizontal (angle 0)
     timestep_s: float = 1e-3     # converged: docs/servo.md compares 5e-4
+
+    def __post_init__(self):
+        # a load no hobby servo holds up is a typo or a unit slip: the stall torque's limit
+        most = LIMITS["servo.stall_torque_nm"]
+        if not abs(self.gravity_moment_nm) <= most.high:
+            raise CalibrationError(f"--gravity-moment-nm {self.gravity_moment_nm:g} is beyond +-{most.high:g} N*m "
+                                   f"({most.reason})", "the load's weight x lever arm in N*m with the horn "
+                                   "horizontal, e.g. 0.023 kg x 9.81 m/s^2 x 0.03 m = 0.0068")
 
 
 class _Commanded:

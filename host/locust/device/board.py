@@ -11,13 +11,14 @@ from __future__ import annotations
 
 from ..io import run_record as R
 from .link import Link
+from .replies import check_config
 
 
 def read_board(link: Link, hello: dict | None = None) -> R.BoardConfig:
     """The config the firmware runs on (pins, trims, pulse ranges), its chip, and why it is
     not the saved config.json when it is not (the firmware's ``config_problems``)."""
     hello = hello or link.hello()
-    cfg = link.call("config")["config"]
+    cfg = check_config(link.call("config"), link.port)
     return R.board_config({**cfg, "chip": hello.get("chip"), "machine": hello.get("machine"),
                            "config_problems": hello.get("config_problems") or []}, f"the board on {link.port}")
 

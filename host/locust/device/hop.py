@@ -19,23 +19,20 @@ from ..firmware import protocol as P
 from ..io import run_record as R
 from .board import read_board
 from .link import CLOSED, Link
+from .replies import done_event, phase_event, report_page
 
 RECORD_EVERY_S = 0.25  # run.json is rewritten at most this often during a hop
-
-
-def _phase(ev: dict) -> R.Phase:
-    return R.Phase(int(ev["cycle"]), str(ev["phase"]), int(ev["commanded_us"]), int(ev["measured_us"]))
 
 
 def _fetch_report(link: Link, rec: R.RunRecord) -> None:
     """Ask for the firmware's own list of phases: fills any event lost on the line."""
     start = 0
     while True:
-        msg = link.call("report", start=start)
-        for cycle, phase, commanded_us, measured_us in msg["phases"]:
-            rec.add_phase(R.Phase(cycle, phase, commanded_us, measured_us))
-        start += len(msg["phases"])
-        if not msg["phases"] or start >= msg["total"]:
+        phases, total = report_page(link.call("report", start=start), link.port)
+        for phase in phases:
+            rec.add_phase(phase)
+        start += len(phases)
+        if not phases or start >= total:
             return
 
 
@@ -62,7 +59,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             R.write(rec, directory)
             raise DeviceError(f"the robot refused the hop: {rec.message}",
                               "see `locust hop --help` and docs/protocol.md for the limits")
-        hop_id = reply["id"]
+        hop_id = reply["id"]   # the id of our request: the reply was matched by it
         last_write = 0.0
         deadline = time.monotonic() + schedule.duration_s + 3.0
         while True:
@@ -82,7 +79,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             if ev.get("hop") != hop_id:
                 continue
             if ev.get("ev") == P.EV_PHASE:
-                phase = _phase(ev)
+                phase = phase_event(ev, link.port)
                 rec.add_phase(phase)
                 # rewriting the whole record at each of 2000 phases costs more than the phases
                 # last: a host that falls behind stops reading, the board's output blocks and its
@@ -92,8 +89,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
                     last_write = time.monotonic()
                 on_phase(phase)
             elif ev.get("ev") == P.EV_DONE:
-                rec.firmware_status = ev.get("status")
-                rec.firmware_ticks_us = ev.get("ticks_us")
+                rec.firmware_status, rec.firmware_ticks_us = done_event(ev, link.port)
                 break
         link.stop_heartbeat()
         if len(rec.phases) < schedule.phases:

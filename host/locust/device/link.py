@@ -19,6 +19,7 @@ import serial
 
 from ..errors import DeviceError
 from ..firmware import protocol as P
+from .replies import check_hello
 
 REPLY_LIMIT = 64 * 1024         # longest reply or event line read (requests are held to P.MAX_FRAME)
 CLOSED = {"ev": "link_closed"}  # put on the event queue when the port goes away
@@ -107,8 +108,9 @@ class Link:
                 self.repl_seen = False  # the command loop (re)started
             self.events.put(msg)
         else:
+            rid = msg.get("id")   # a reply to none of ours (an id of another type too) is kept aside
             with self._lock:
-                waiter = self._pending.pop(msg.get("id"), None)
+                waiter = self._pending.pop(rid, None) if type(rid) is int else None
             (waiter.put(msg) if waiter else self.unsolicited.append(msg))
 
     # -- writing -------------------------------------------------------------------
@@ -196,7 +198,7 @@ class Link:
         if not msg.get("ok") or msg.get("name") != P.NAME:
             raise DeviceError(f"{self.port} answered but is not the locust firmware: {msg}",
                               f"flash it with `locust flash --port {self.port}`")
-        version = msg.get("micropython")
+        version = check_hello(msg, self.port).get("micropython")
         if version is not None and tuple(version[:2]) < MIN_MICROPYTHON:  # older firmware does not say
             shown = ".".join(str(v) for v in version)
             raise DeviceError(f"the robot runs MicroPython {shown}; locust needs 1.26 or newer", OLD_MICROPYTHON_HINT)

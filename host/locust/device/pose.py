@@ -13,6 +13,7 @@ from ..errors import DeviceError
 from ..firmware import config as fw_config
 from ..firmware import protocol as P
 from .link import Link
+from .replies import pose_angles
 
 DEFAULT_TRAVEL_DEG = fw_config.default()["left"]["travel_deg"]
 
@@ -64,4 +65,4 @@ def pose(link: Link, left_deg: float | None, right_deg: float | None) -> tuple[f
         cmd, reply = "pose", link.request("pose", left_deg=left_deg, right_deg=right_deg)
     if not reply.get("ok"):
         raise _refused(cmd, reply)
-    return float(reply["left_deg"]), float(reply["right_deg"])
+    return pose_angles(reply, link.port)

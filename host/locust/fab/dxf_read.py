@@ -14,6 +14,7 @@ is a unit converted.
 from __future__ import annotations
 
 import contextlib
+import math
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,6 +41,15 @@ CURVES = {"LINE", "ARC", "LWPOLYLINE", "POLYLINE", "CIRCLE", "ELLIPSE", "SPLINE"
 # they are counted before any is expanded.
 MAX_INSERT_DEPTH = 8
 MAX_EXPANDED_ENTITIES = 50_000
+
+
+# An arc is flattened into chords no further than the sagitta from it: a circle of 10 m at
+# 1 um is 7,000 chords. An arc needing more (a radius of 10^12 mm, a bulge of 1e300) is no
+# outline for a laser and would take hours, so it is refused by its count before flattening.
+MAX_ARC_SEGMENTS = 100_000
+# The gap two ends may leave and still be joined: above 0 (0 joins nothing, below 0 is no
+# distance) and at most 10 mm (a laminate part is millimetres to centimetres).
+GAP_TOL_MM = (0.0, 10.0)
 
 
 @dataclass(frozen=True)
@@ -226,6 +236,77 @@ def _anchor(entity) -> np.ndarray | None:
     return None
 
 
+def _numbers(entity) -> list[float]:
+    """Every coordinate, radius, bulge, ratio and knot ``entity`` is drawn from, as stored."""
+    dxf, kind = entity.dxf, entity.dxftype()
+    out: list[float] = []
+    for attr in ("start", "end", "center", "major_axis", "radius", "ratio", "start_angle", "end_angle",
+                 "start_param", "end_param"):
+        value = dxf.get(attr) if dxf.is_supported(attr) else None
+        if value is not None:
+            out += list(value) if hasattr(value, "__iter__") else [value]
+    if kind == "LWPOLYLINE":
+        out += [v for point in entity.get_points("xyb") for v in point]
+    elif kind == "POLYLINE":
+        for v in entity.vertices:
+            out += [*v.dxf.location, v.dxf.get("bulge", 0.0)]
+    elif kind == "SPLINE":
+        out += [c for p in (*entity.control_points, *entity.fit_points) for c in p] + list(entity.knots)
+    return [float(v) for v in out]
+
+
+def _arc_segments(radius: float, angle_rad: float, sagitta: float) -> float:
+    """Chords an arc of ``radius`` through ``angle_rad`` takes to stay within ``sagitta``."""
+    if not radius > sagitta:
+        return 1.0
+    x = sagitta / radius
+    step = 2.0 * (math.acos(1.0 - x) if x > 1e-8 else math.sqrt(2.0 * x))   # acos(1 - x) ~ sqrt(2x)
+    return abs(angle_rad) / step if step > 0 else math.inf
+
+
+def _bulge_segments(entity, sagitta: float) -> float:
+    """The most chords any bulged segment of a polyline takes."""
+    if entity.dxftype() == "LWPOLYLINE":
+        pts = [(x, y, b) for x, y, b in entity.get_points("xyb")]
+    else:
+        pts = [(v.dxf.location[0], v.dxf.location[1], v.dxf.get("bulge", 0.0)) for v in entity.vertices]
+    most = 0.0
+    for (x0, y0, b), (x1, y1, _) in zip(pts, pts[1:] + pts[:1]):
+        chord = math.hypot(x1 - x0, y1 - y0)
+        if b and chord > 0:
+            angle = 4.0 * math.atan(abs(b))
+            radius = chord / (2.0 * math.sin(angle / 2.0)) if math.sin(angle / 2.0) > 0 else math.inf
+            most = max(most, _arc_segments(radius, angle, sagitta) if math.isfinite(radius) else math.inf)
+    return most
+
+
+def check_entity(entity, layer: str, sagitta: float) -> None:
+    """:class:`FabError` if ``entity`` holds a number that is not finite, or an arc that would
+    flatten into more than :data:`MAX_ARC_SEGMENTS` chords at ``sagitta`` (drawing units)."""
+    try:
+        numbers = _numbers(entity)
+    except (TypeError, ValueError, AttributeError) as exc:
+        raise FabError(f"layer {layer!r}: {_label(entity)} cannot be read ({_short(exc)})",
+                       "fix the drawing in the CAD program, or redraw that entity") from None
+    if not all(math.isfinite(v) for v in numbers):
+        raise FabError(f"layer {layer!r}: {_label(entity)} has a coordinate, radius or bulge that is not a finite "
+                       "number (NaN or inf)", "fix the drawing in the CAD program, or redraw that entity")
+    kind = entity.dxftype()
+    if kind in ("ARC", "CIRCLE"):
+        segments = _arc_segments(abs(entity.dxf.radius), 2 * math.pi, sagitta)
+    elif kind == "ELLIPSE":
+        axis = entity.dxf.major_axis
+        segments = _arc_segments(math.hypot(axis[0], axis[1]), 2 * math.pi, sagitta)
+    elif kind in ("LWPOLYLINE", "POLYLINE"):
+        segments = _bulge_segments(entity, sagitta)
+    else:
+        segments = 0.0
+    if segments > MAX_ARC_SEGMENTS:
+        raise FabError(f"layer {layer!r}: {_label(entity)} is an arc that flattens into {segments:.3g} chords, over "
+                       f"the limit of {MAX_ARC_SEGMENTS:,} (a radius or bulge far beyond a laminate part's)",
+                       "check the drawing's units and that arc's radius (or the polyline's bulge), and redraw it")
+
+
 def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm: float,
                    sagitta_mm: float) -> list[Contour]:
     """The loops and open paths of one layer's curves."""
@@ -248,6 +329,7 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
 
     open_pieces = []
     for entity in entities:
+        check_entity(entity, layer, sag)
         try:
             closed = es.is_closed_entity(entity)
         except Exception:  # degenerate entity (zero radius, no vertices)
@@ -285,14 +367,22 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
 def read_drawing(path: str | Path, *, units: str | None = None, gap_tol_mm: float = 0.01,
                  sagitta_mm: float = 0.001, recover: bool = False) -> Drawing:
     """Read every curve of ``path`` into contours in millimetres (see the module doc)."""
+    low, high = GAP_TOL_MM
+    if not low < gap_tol_mm <= high:
+        raise FabError(f"--gap-tol-mm {gap_tol_mm:g} must be above {low:g} and at most {high:g} mm: the gap two "
+                       "ends may leave and still be joined", "the default, 0.01 mm, joins what a CAD program "
+                       "drew as meeting; give at most the gap you see in the drawing")
     doc, fixed = open_document(path, recover=recover)
     unit_name, mm_per_unit, units_from = drawing_units(doc, units)
     check_expansion(doc, path)
     by_layer, skipped = _entities_by_layer(doc.modelspace())
     contours: list[Contour] = []
     for layer in sorted(by_layer):
-        contours += layer_contours(by_layer[layer], layer, mm_per_unit=mm_per_unit,
-                                   gap_tol_mm=gap_tol_mm, sagitta_mm=sagitta_mm)
+        try:
+            contours += layer_contours(by_layer[layer], layer, mm_per_unit=mm_per_unit,
+                                       gap_tol_mm=gap_tol_mm, sagitta_mm=sagitta_mm)
+        except FabError as exc:
+            raise FabError(f"{path}: {exc.message}", exc.hint) from None
     for c in contours:
         if not np.isfinite(c.points_mm).all():
             raise FabError(f"{path}: layer {c.layer!r}: {', '.join(c.entities)} has a vertex that is not a "

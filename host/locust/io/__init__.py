@@ -8,6 +8,7 @@ robot all read and write files through it without importing one another.
 - :mod:`.tracks_csv`   ``<video>.tracks.csv``, the tracks everyone reads
 - :mod:`.tracker_text` Tracker's text export (*File > Export > Data*)
 - :mod:`.trk`          Tracker projects (``.trk``, ``.trz``) and their calibration
+- :mod:`.trz`          reading a ``.trz`` zip without trusting it: every member checked first
 - :mod:`.importing`    any track file in any unit, renamed, mirrored: the one conversion that
                        ``track import``, ``calibrate`` and ``report`` read tracks through
 - :mod:`.camera_json`  ``<video>.camera.json``, the pinhole camera of a simulated video

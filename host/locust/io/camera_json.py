@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import math
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -130,11 +131,21 @@ def write_camera_json(path: Path, camera: CameraFile) -> Path:
     return atomic_write_json(path, camera.to_dict())
 
 
+# A camera.json is kB (fixed) to a few MB (a moving camera's pose on every frame of minutes).
+MAX_CAMERA_JSON_BYTES = 64 * 2**20
+
+
 def read_camera_json(path: str | Path) -> CameraFile:
     """Read a ``camera.json``; a :class:`~locust.errors.TrackError` says what is missing or malformed."""
     path = Path(path)
     try:
+        if not stat.S_ISREG(path.stat().st_mode) or path.stat().st_size > MAX_CAMERA_JSON_BYTES:
+            raise TrackError(f"{path}: not a camera file (not a regular file, or over {MAX_CAMERA_JSON_BYTES:,} bytes)",
+                             "re-render the video, or move the file away and give --scale")
         doc = json.loads(path.read_text())
+    except RecursionError:
+        raise TrackError(f"{path}: not a camera file (its lists or objects are nested too deep to read)",
+                         "re-render the video, or move the file away and give --scale") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise TrackError(f"{path}: not a readable camera file ({exc})",
                          "re-render the video, or move the file away and give --scale") from None

@@ -24,6 +24,7 @@ from __future__ import annotations
 import csv
 import io
 import re
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -71,6 +72,9 @@ def read_text(path: str | Path) -> str:
     """The file's text (UTF-8, a byte-order mark dropped), or a TrackError naming it."""
     path = Path(path)
     try:
+        if not stat.S_ISREG(path.stat().st_mode):   # a pipe blocks, a device never ends: not opened
+            raise TrackError(f"{path}: not a regular file (a pipe, device or folder)",
+                             "give the path of a recording file (a CSV or a Tracker text export)")
         return path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise TrackError(f"{path}: no such file", "check the path of the recording") from None

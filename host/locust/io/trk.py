@@ -34,10 +34,20 @@ import numpy as np
 
 from ..errors import TrackError
 from .tracks_csv import MarkerColumns, TracksCsv
+from .trz import MAX_TRK_BYTES, open_trz, read_member, unpack_members
 
 TRACKER_TO_OPENCV_PX = -0.5
 POINT_CLASSES = ("PointMass",)  # Tracker's point tracks; vectors, tapes, axes are not tracks of a marker
 FPS_MIN, FPS_MAX = 1.0, 10000.0   # frames/s a camera films: a time-lapse at 1/s to a high-speed camera's 10 000/s
+# An entity declaration, in the encodings an XML file may have: a Tracker tab has none, and a
+# billion laughs or an external entity needs one (expat would expand 8 MB of it before its
+# amplification limit stops it)
+_ENTITY_MARKS = tuple("<!ENTITY".encode(e) for e in ("utf-8", "utf-16-le", "utf-16-be", "utf-32-le", "utf-32-be"))
+# A clip's frames: 0 to a million, an hour at 240 frames/s or 100 s at 10 000 (a hop
+# experiment is seconds); the clip's frames and each track are arrays of that length.
+MAX_CLIP_FRAMES = 1_000_000
+_CLIP_REASON = "an hour at 240 frames/s"
+_RESAVE = "open the project in Tracker and save it again, or export its data (File > Export > Data)"
 LENGTH_UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "km": 1000.0, "in": 0.0254, "ft": 0.3048}
 
 
@@ -106,14 +116,20 @@ def read_project(path: str | Path) -> TrackerProject:
         raise TrackError(f"{path}: no such file", "give the path of a Tracker .trk or .trz file")
     try:
         if zipfile.is_zipfile(path):
-            with zipfile.ZipFile(path) as z:
+            with open_trz(path) as z:
                 names = sorted(n for n in z.namelist() if n.lower().endswith(".trk"))
                 if not names:
                     raise TrackError(f"{path}: a zip without a .trk file",
                                      "give a Tracker project (.trz) or tab (.trk)")
-                text = z.read(names[0])
+                text = read_member(path, z, names[0])
+        elif path.stat().st_size > MAX_TRK_BYTES:
+            raise TrackError(f"{path}: {path.stat().st_size:,} bytes, over the limit of {MAX_TRK_BYTES:,} for a "
+                             "Tracker tab", _RESAVE)
         else:
             text = path.read_bytes()
+        if any(mark in text for mark in _ENTITY_MARKS):
+            raise TrackError(f"{path}: not a Tracker file: it declares XML entities (<!ENTITY), which Tracker never "
+                             "writes; refused before any is expanded", "give a .trk saved by Tracker")
         root = ET.parse(io.BytesIO(text)).getroot()
     except ET.ParseError as exc:
         raise TrackError(f"{path}: not a Tracker file (XML error: {exc})", "give a .trk saved by Tracker") from None
@@ -167,9 +183,9 @@ def _project(path: Path, root: ET.Element) -> TrackerProject:
     px_per_unit = _value(frame0, "xscale", float, math.nan)
     calibration = Calibration(
         m_per_px=unit / px_per_unit if px_per_unit and math.isfinite(px_per_unit) else math.nan,
-        origin_x_px=_value(frame0, "xorigin", float, 0.0) + TRACKER_TO_OPENCV_PX,
-        origin_y_px=_value(frame0, "yorigin", float, 0.0) + TRACKER_TO_OPENCV_PX,
-        angle_deg=_value(frame0, "angle", float, 0.0),  # degrees in the file
+        origin_x_px=_finite(path, frame0, "xorigin") + TRACKER_TO_OPENCV_PX,
+        origin_y_px=_finite(path, frame0, "yorigin") + TRACKER_TO_OPENCV_PX,
+        angle_deg=_finite(path, frame0, "angle"),  # degrees in the file
         source=f"tracker:{path.name}")
 
     points: dict[str, dict[int, tuple[float, float]]] = {}
@@ -186,12 +202,19 @@ def _project(path: Path, root: ET.Element) -> TrackerProject:
             x, y = _value(step_obj, "x"), _value(step_obj, "y")
             if x is None or y is None:
                 continue
-            frame = int(entry.get("name", "[-1]").strip("[]"))
+            frame = _frame(path, name, entry.get("name", ""))
             pts[frame] = (x + TRACKER_TO_OPENCV_PX, y + TRACKER_TO_OPENCV_PX)
+            if len(pts) > MAX_CLIP_FRAMES:
+                raise TrackError(f"{path}: track {name!r} has over {MAX_CLIP_FRAMES:,} steps, the most a clip has "
+                                 f"({_CLIP_REASON})", _RESAVE)
         points[name] = pts
     if not points:
         raise TrackError(f"{path}: no point-mass tracks in this Tracker file", "mark a point mass in Tracker first")
+    if not count and not any(points.values()):
+        raise TrackError(f"{path}: its point-mass tracks ({', '.join(points)}) have no marked steps and the clip "
+                         "gives no step count", "mark the point mass on its frames in Tracker and save again")
     end = start + step * (count - 1) if count else max(max(p) for p in points.values() if p)
+    _check_clip(path, start, end, step)
     if dt_ms is not None and not 1000.0 / FPS_MAX <= dt_ms <= 1000.0 / FPS_MIN:
         raise TrackError(f"{path}: the clip's frame interval (clip control delta_t) is {dt_ms:g} ms; a camera's is "
                          f"{1000.0 / FPS_MAX:g} to {1000.0 / FPS_MIN:g} ms ({FPS_MIN:g} to {FPS_MAX:g} frames/s), "
@@ -199,6 +222,32 @@ def _project(path: Path, root: ET.Element) -> TrackerProject:
                          "set the clip's frame rate in Tracker (Video > Clip Settings) and save the project again")
     fps = 1000.0 / dt_ms if dt_ms else math.nan
     return TrackerProject(path, video_path, TrackerClip(start, end, step, fps), calibration, points)
+
+
+def _finite(path: Path, obj, name: str) -> float:
+    """The axes' number ``name`` (0 where not given); :class:`TrackError` if it is not finite."""
+    value = _value(obj, name, float, 0.0)
+    if not math.isfinite(value):
+        raise TrackError(f"{path}: the axes' {name} is {value}, not a finite number", _RESAVE)
+    return value
+
+
+def _frame(path: Path, track: str, name: str) -> int:
+    """A step's frame number from its property name ``[N]``: a whole number 0 to the largest frame."""
+    text = name.strip()
+    digits = text[1:-1].strip() if text.startswith("[") and text.endswith("]") else ""
+    if not digits.isdigit() or len(digits) > 12 or int(digits) > MAX_CLIP_FRAMES:
+        raise TrackError(f"{path}: track {track!r} has a step on frame {name[:40]!r}; a frame is a whole number "
+                         f"0 to {MAX_CLIP_FRAMES:,} ({_CLIP_REASON})", _RESAVE)
+    return int(digits)
+
+
+def _check_clip(path: Path, start: int, end: int, step: int) -> None:
+    """:class:`TrackError` unless the clip's frames ``start:end:step`` are whole numbers 0 to
+    :data:`MAX_CLIP_FRAMES` in order."""
+    if not (0 <= start <= end <= MAX_CLIP_FRAMES and 1 <= step <= MAX_CLIP_FRAMES):
+        raise TrackError(f"{path}: the clip runs from frame {start} to {end} every {step}; frames are 0 to "
+                         f"{MAX_CLIP_FRAMES:,} ({_CLIP_REASON}), the step at least 1", _RESAVE)
 
 
 @dataclass(frozen=True)
@@ -255,7 +304,7 @@ def media_in_zip(project: TrackerProject, trk_path: Path) -> str | None:
     (OSP's ``zip!/entry`` path); None for a plain ``.trk``, whose video is a file of its own."""
     if not zipfile.is_zipfile(project.path) or not project.video_path:
         return None
-    with zipfile.ZipFile(project.path) as z:
+    with open_trz(project.path) as z:
         trk_name = next(n for n in sorted(z.namelist()) if n.lower().endswith(".trk"))
     entry = (PurePosixPath(trk_name).parent / project.video_path.replace("\\", "/")).as_posix()
     zip_rel = Path(os.path.relpath(project.path.resolve(), Path(trk_path).resolve().parent)).as_posix()
@@ -278,17 +327,15 @@ def project_media(project: TrackerProject) -> Iterator[Path]:
                              f"with --calibration-from {project.path.name}")
         yield media
         return
+    if rel.is_absolute() or ".." in rel.parts:
+        raise TrackError(f"{project.path.name} opens {project.video_path}, which is outside the project zip",
+                         "give the video itself as VIDEO, with --calibration-from the project")
     with tempfile.TemporaryDirectory(prefix="locust-trz-") as tmp:
-        with zipfile.ZipFile(project.path) as z:
+        with open_trz(project.path) as z:
             trk_dirs = {PurePosixPath(n).parent for n in z.namelist() if n.lower().endswith(".trk")}
             wanted = [n for n in z.namelist() if not n.endswith("/")
                       and any(PurePosixPath(n).parent == (d / rel).parent for d in trk_dirs)]
-            for name in wanted:
-                target = Path(tmp, *PurePosixPath(name).parts)
-                if ".." in PurePosixPath(name).parts:
-                    continue
-                target.parent.mkdir(parents=True, exist_ok=True)
-                target.write_bytes(z.read(name))
+            unpack_members(project.path, z, wanted, Path(tmp))
         candidates = [Path(tmp, *d.parts) / rel for d in sorted(trk_dirs)]
         media = next((c for c in candidates if c.is_file()), None)
         if media is None:

@@ -15,6 +15,7 @@ import numpy as np
 from mujoco import rollout as mj_rollout
 
 from ..params import Robot, check_robot
+from .batching import check_batch, rollout_chunked
 from .model import BuiltModel, build
 from .schedule import ControlPlan, control_plan
 
@@ -101,17 +102,18 @@ def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: boo
     control = np.zeros((len(models), plan.nstep, models[0].nu))
     for act in builts[0].servo_actuators:
         control[:, :, act] = plan.ctrl_rad
+    n_threads = max(1, min(threads or available_cores(), len(models)))
+    datas = [mujoco.MjData(models[0]) for _ in range(n_threads)]
+    check_batch(models[0], len(models), plan.nstep, keep_states)
     t0 = time.perf_counter()
-    state, sensordata, datas = rollout_threads(models, np.array([s for s, _ in starts]), control, threads)
+    states, sensordata, final, warnings = rollout_chunked(models, datas, np.array([s for s, _ in starts]), control,
+                                                          keep_states)
     wall = time.perf_counter() - t0
     nq = models[0].nq
-    if len(models) > 1 and any(d.warning[i].number for d in datas for i in range(len(d.warning))):
+    if len(models) > 1 and warnings:
         return [simulate_batch([b], plan, keep_states=keep_states)[0] for b in builts]
-    data = datas[0]
-    warnings = {mujoco.mjtWarning(i).name: int(data.warning[i].number)
-                for i in range(len(data.warning)) if data.warning[i].number}
     # FULLPHYSICS state starts with time, then qpos
     return [Trajectory(built=b, plan=plan, initial_sensordata=sensor0, sensordata=sensordata[k],
-                       final_qpos=state[k, -1, 1:1 + nq].copy(), warnings=dict(warnings), wall_s=wall,
-                       states=state[k] if keep_states else None)
+                       final_qpos=final[k, 1:1 + nq].copy(), warnings=dict(warnings), wall_s=wall,
+                       states=states[k] if keep_states else None)
             for k, (b, (_, sensor0)) in enumerate(zip(builts, starts))]

@@ -20,8 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import GeometryError
-from ..params import Provenance, Robot, problems, real_keys
+from ..params import Provenance, Robot, check_robot, problems, real_keys
 from .audit import audit
+from .batching import check_batch
 from .hops import summarise
 from .model import build
 from .outcome import OutcomeFigures, classify, outcome_shares
@@ -75,6 +76,15 @@ def draw(robot: Robot, n: int, seed: int = 0) -> list[Robot]:
     return [robot.with_values(dict(zip(keys, row.tolist())), prov) for row in values]
 
 
+def check_draws(robot: Robot, n: int, cycles: int | None = None, keep_states: bool = False):
+    """The plan of ``n`` draws of ``robot``; refused (:class:`~locust.errors.SimError`) before
+    any is drawn, built or run when their record would be over the batch's memory limit."""
+    check_robot(robot, cycles)
+    plan = control_plan(robot.schedule, robot.solver, cycles)
+    check_batch(build(robot).model, n, plan.nstep, keep_states)
+    return plan
+
+
 def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 0,
                    keep_states: bool = False, progress: Callable[[int], None] | None = None
                    ) -> list[Trajectory | None]:
@@ -84,7 +94,7 @@ def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 
 
     With ``progress``, the draws go in batches of :data:`BATCH_PER_CORE` per core, and
     ``progress(k)`` is called as each batch of ``k`` draws is done (one call otherwise)."""
-    plan = control_plan(robot.schedule, robot.solver, cycles)
+    plan = check_draws(robot, n, cycles, keep_states)
     builts = []
     for r in draw(robot, n, seed):
         try:

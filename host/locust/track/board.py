@@ -37,6 +37,9 @@ from .video import read_frames
 
 BOARD_DPI = 300
 DETECT_FRAMES = 30       # frames searched for the board at the start of the clip
+# --plane-points span an area: their narrowest spread at least this fraction of their widest
+# (a sheet's corners seen at 80 deg from square still span 0.17); below it the map is a guess
+MIN_POINT_SPREAD = 0.01
 
 
 def write_board_png(path: Path, spec: BoardSpec, dpi: int = BOARD_DPI) -> Path:
@@ -101,7 +104,7 @@ class PlaneHomography:
 
 def _fit(image_pts: np.ndarray, plane_pts: np.ndarray, source: str, frame: int | None = None) -> PlaneHomography:
     H, _ = cv2.findHomography(image_pts.astype(np.float64), plane_pts.astype(np.float64), 0)
-    if H is None:
+    if H is None or not np.isfinite(H).all() or abs(np.linalg.det(H)) < 1e-300:
         raise TrackError(f"{source}: no homography fits these points",
                          "the points must not lie on one line; spread them over the plane")
     v = np.c_[image_pts, np.ones(len(image_pts))] @ H.T
@@ -155,4 +158,17 @@ def parse_plane_points(text: str, pixels: str = "tracker") -> PlaneHomography:
                          "e.g. --plane-points '102,880=0,0;1650,870=1.2,0;1600,240=1.2,0.5;150,250=0,0.5'")
     v = np.array([[float(x) for x in m.groups()] for m in rows])
     v[:, :2] += PIXEL_CONVENTIONS[pixels]
+    for pts, unit, what in ((v[:, :2], "px", "pixels"), (v[:, 2:], "m", "plane positions")):
+        if not np.isfinite(pts).all() or len(np.unique(pts, axis=0)) < 4 or _spread(pts) < MIN_POINT_SPREAD:
+            raise TrackError(f"--plane-points {text!r}: the {what} are not four distinct points spread off one line "
+                             f"(their narrowest spread under {MIN_POINT_SPREAD:g} of their widest)",
+                             f"give four or more points spread over the plane ({unit}), no three of them on one "
+                             "line, e.g. the corners of a sheet")
     return _fit(v[:, :2], v[:, 2:], "plane points")
+
+
+def _spread(pts: np.ndarray) -> float:
+    """How far ``pts`` are from lying on one line: the ratio of the smaller to the larger
+    singular value of the centred points (0 on a line)."""
+    sv = np.linalg.svd(pts - pts.mean(axis=0), compute_uv=False)
+    return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0

@@ -1,0 +1,121 @@
+"""A board's replies and events checked like any input file: every field the host uses has
+its type and range, or the command stops with a :class:`DeviceError` quoting the line.
+
+The firmware of this toolkit always answers in shape; a reply out of shape comes from other
+firmware on the port, a damaged board or a line mangled past its CRC check. None of it may
+end the host in a traceback or reach the run record.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+
+from ..errors import DeviceError
+from ..firmware import protocol as P
+from ..io import run_record as R
+
+_HOP = P.COMMANDS["hop"]
+# The latest a phase can start, from the start of the hop: the longest schedule the firmware
+# takes (cycles x (push + wait) at their limits), twice over for a late measurement.
+MAX_PHASE_US = 2 * _HOP["cycles"][2] * (_HOP["push_ms"][2] + _HOP["wait_ms"][2]) * 1000
+MAX_CYCLE = _HOP["cycles"][2]
+PHASE_NAMES = ("push", "wait")
+TICKS_US_MAX = 2**30          # the board's ticks_us wrap at 2^30
+VERSION = re.compile(r"\d+(\.\d+)+([-+][0-9A-Za-z.]+)?")   # the firmware's release: 0.1.0
+MAX_TEXT = 200                # a version, chip or status name: a few words
+HINT = ("the port answers with something other than this toolkit's firmware, or the board is damaged: "
+        "flash it again with `locust flash --port PORT`")
+
+
+def malformed(port: str, what: str, msg) -> DeviceError:
+    """The error for reply or event ``msg`` whose ``what`` is out of shape, quoting the line."""
+    line = json.dumps(msg, separators=(",", ":"), default=repr)
+    shown = line if len(line) <= 300 else line[:297] + "..."
+    return DeviceError(f"{port}: the board's {what}, in the line {shown}",
+                       HINT.replace("PORT", port))
+
+
+def _is_int(value, low: int, high: int) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and low <= value <= high
+
+
+def _is_text(value) -> bool:
+    return isinstance(value, str) and len(value) <= MAX_TEXT
+
+
+def check_hello(msg: dict, port: str) -> dict:
+    """``msg`` if its version, protocol, chip, config problems and state have their types."""
+    version = msg.get("micropython")
+    if version is not None and not (isinstance(version, list) and 2 <= len(version) <= 4
+                                    and all(_is_int(v, 0, 10_000) for v in version)):
+        raise malformed(port, "MicroPython version is not a list of whole numbers like [1, 26, 0]", msg)
+    if msg.get("version") is not None and not (_is_text(msg["version"]) and VERSION.fullmatch(msg["version"])):
+        raise malformed(port, "firmware version is not a release number like 0.1.0", msg)
+    for key in ("chip", "machine", "platform"):
+        if msg.get(key) is not None and not _is_text(msg[key]):
+            raise malformed(port, f"{key} is not a short text", msg)
+    if not _is_int(msg.get("protocol"), 0, 10_000):
+        raise malformed(port, "protocol is not a whole number", msg)
+    problems = msg.get("config_problems")
+    if problems is not None and not (isinstance(problems, list) and all(_is_text(p) for p in problems)):
+        raise malformed(port, "config_problems is not a list of texts", msg)
+    if msg.get("hopping") is not None and not isinstance(msg["hopping"], bool):
+        raise malformed(port, "hopping is not true or false", msg)
+    return msg
+
+
+def check_config(msg: dict, port: str) -> dict:
+    """The ``config`` object of a ``config`` reply (its servos are checked by ``board_config``)."""
+    cfg = msg.get("config")
+    if not isinstance(cfg, dict):
+        raise malformed(port, "config reply holds no config object", msg)
+    return cfg
+
+
+def _phase_fields(port: str, what: str, msg, cycle, name, commanded_us, measured_us) -> R.Phase:
+    if not (_is_int(cycle, 0, MAX_CYCLE) and name in PHASE_NAMES and _is_int(commanded_us, 0, MAX_PHASE_US)
+            and _is_int(measured_us, 0, MAX_PHASE_US)):
+        raise malformed(port, f"{what} is not a cycle 0 to {MAX_CYCLE}, a phase ({' or '.join(PHASE_NAMES)}) and "
+                              f"two times 0 to {MAX_PHASE_US:,} us", msg)
+    return R.Phase(cycle, name, commanded_us, measured_us)
+
+
+def phase_event(ev: dict, port: str) -> R.Phase:
+    """The phase a ``phase`` event reports."""
+    return _phase_fields(port, "phase event", ev, ev.get("cycle"), ev.get("phase"), ev.get("commanded_us"),
+                         ev.get("measured_us"))
+
+
+def done_event(ev: dict, port: str) -> tuple[str, list[int] | None]:
+    """(status, ticks_us) of a ``done`` event."""
+    status, ticks = ev.get("status"), ev.get("ticks_us")
+    if not _is_text(status):
+        raise malformed(port, "done event has no status text", ev)
+    if ticks is not None and not (isinstance(ticks, list) and len(ticks) == 2
+                                  and all(_is_int(t, 0, TICKS_US_MAX) for t in ticks)):
+        raise malformed(port, "done event's ticks_us is not two whole numbers 0 to 2^30", ev)
+    return status, ticks
+
+
+def report_page(msg: dict, port: str) -> tuple[list[R.Phase], int]:
+    """(phases, total) of a ``report`` reply."""
+    rows, total = msg.get("phases"), msg.get("total")
+    if not (isinstance(rows, list) and _is_int(total, 0, 2 * MAX_CYCLE)):
+        raise malformed(port, "report reply has no list of phases and total", msg)
+    phases = []
+    for row in rows:
+        if not (isinstance(row, list) and len(row) == 4):
+            raise malformed(port, "report row is not [cycle, phase, commanded_us, measured_us]", msg)
+        phases.append(_phase_fields(port, "report row", msg, *row))
+    return phases, total
+
+
+def pose_angles(reply: dict, port: str) -> tuple[float, float]:
+    """(left_deg, right_deg) a ``pose`` or ``rest`` reply says the servos were set to."""
+    angles = reply.get("left_deg"), reply.get("right_deg")
+    if not all(isinstance(a, (int, float)) and not isinstance(a, bool) and math.isfinite(a) and abs(a) <= 180
+               for a in angles):
+        raise malformed(port, "pose reply has no left_deg and right_deg within +-180 deg", reply)
+    return float(angles[0]), float(angles[1])

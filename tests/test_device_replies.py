@@ -1,0 +1,175 @@
+"""A board that answers out of shape: a hello with a version that is no version, a config
+reply without its config, hop events missing keys or holding strings, infinities and 2^70.
+Each command that talks to it (``hop``, ``config``, ``pose``) stops with one clear
+``error:``/``hint:`` quoting the line, exit 2, no traceback (tests/probing.py).
+
+The board is a SYNTHETIC double on a pseudo-terminal: it speaks the real wire format
+(``locust.firmware.protocol``: ``$json*crc``), answers as the firmware does, and replaces
+one field of one reply or event by a value a seeded generator draws.
+"""
+
+from __future__ import annotations
+
+import os
+import pty
+import random
+import threading
+import time
+import tty
+
+import pytest
+
+from locust.firmware import config as fw_config
+from locust.firmware import protocol as P
+from probing import assert_clear_error, invoke, tree
+
+MISSING = object()
+
+
+class FakeBoard:
+    """The firmware's answers, on a pty; ``spoil(cmd_or_event, msg)`` may change any message
+    before it is sent."""
+
+    def __init__(self, spoil=lambda what, msg: msg):
+        self.master, self.slave = pty.openpty()
+        tty.setraw(self.slave)
+        self.port = os.ttyname(self.slave)
+        self.spoil = spoil
+        self.stopped = threading.Event()
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _send(self, what: str, msg: dict) -> None:
+        msg = self.spoil(what, msg)
+        os.write(self.master, P.encode(msg))   # json.dumps writes inf as Infinity, as a board's JSON may
+
+    def _answer(self, req: dict) -> None:
+        cmd, rid = req.get("cmd"), req.get("id")
+        if cmd == "hello":
+            self._send("hello", P.reply(rid, name=P.NAME, version=P.VERSION, protocol=P.PROTOCOL, platform="esp32",
+                                        micropython=[1, 26, 0], machine="ESP32 module", chip="esp32",
+                                        reset="power_on", config_problems=[], hopping=False))
+        elif cmd == "config":
+            self._send("config", P.reply(rid, config=fw_config.default("esp32")))
+        elif cmd == "hop":
+            self._send("hop", P.reply(rid))
+            push, wait = req["push_ms"] * 1000, req["wait_ms"] * 1000
+            for i in range(2 * req["cycles"]):
+                c, start = i // 2 + 1, (i // 2) * (push + wait) + (push if i % 2 else 0)
+                self._send("phase", P.event(P.EV_PHASE, hop=rid, i=i, cycle=c, phase="wait" if i % 2 else "push",
+                                            commanded_us=start, measured_us=start + 150))
+            self._send("done", P.event(P.EV_DONE, hop=rid, status=P.HOP_COMPLETE, phases=2 * req["cycles"],
+                                       total=2 * req["cycles"], max_err_us=150, rest_us=0, ticks_us=[100, 900]))
+        elif cmd in ("pose", "rest"):
+            self._send(cmd, P.reply(rid, left_deg=req.get("left_deg", 0.0), right_deg=req.get("right_deg", 0.0)))
+        elif cmd == "report":
+            self._send("report", P.reply(rid, status=P.HOP_COMPLETE, total=0, start=0, phases=[]))
+        else:   # ping, stop
+            self._send(cmd, P.reply(rid))
+
+    def _serve(self) -> None:
+        lines = P.LineReader()
+        while not self.stopped.is_set():
+            try:
+                data = os.read(self.master, 4096)
+            except OSError:
+                return
+            for line in lines.feed(data):
+                try:
+                    self._answer(P.decode(line))
+                except (P.ProtocolError, TypeError):
+                    continue
+
+    def close(self) -> None:
+        self.stopped.set()
+        os.close(self.slave)
+        os.close(self.master)
+        self.thread.join(timeout=2)
+
+
+def _with(field: str, value):
+    """A spoil that sets (or with MISSING, removes) ``field`` of every message it is given."""
+    def spoil(msg):
+        msg = dict(msg)
+        if value is MISSING:
+            msg.pop(field, None)
+        else:
+            msg[field] = value
+        return msg
+    return spoil
+
+
+INF, NAN, HUGE = float("inf"), float("nan"), 2**70
+WRONG_TYPES = [MISSING, "x", [], {}, True, None, INF]
+# (message, {field: values no board of this toolkit sends there}, commands that read it)
+TARGETS = [
+    ("hello", {"micropython": ["micropython", "1..26", 5, HUGE, INF, [], {}, [1], True, 1.5, [1, "26"], [HUGE, 0]],
+               "version": ["x", "1..26", "micropython", 5, HUGE, INF, [], {}, True, 1.5, "1." * 200 + "0"],
+               "protocol": [MISSING, "x", "1..26", HUGE, INF, NAN, [], {}, True, 1.5, None],
+               "chip": [5, HUGE, INF, [], {}, True, 1.5, "x" * 500],
+               "config_problems": ["x", 5, INF, {}, [1, 2], True, [["nested"]]],
+               "hopping": ["x", 5, INF, [], {}, 1.5, "micropython"]}, ["hop", "config", "pose"]),
+    ("config", {"config": [MISSING, "x", 5, INF, [], [1], True, None, 1.5]}, ["hop", "config"]),
+    ("phase", {"cycle": WRONG_TYPES + [HUGE, -HUGE, NAN, 1.5, -1, 5000],
+               "phase": WRONG_TYPES + [5, "micropython", "PUSH"],
+               "commanded_us": WRONG_TYPES + [HUGE, -HUGE, -INF, NAN, 1.5, -1],
+               "measured_us": WRONG_TYPES + [HUGE, -HUGE, -INF, NAN, 1.5, -1]}, ["hop"]),
+    ("done", {"status": [MISSING, 5, HUGE, INF, [], {}, True, None, 1.5, "x" * 500],
+              "ticks_us": ["x", 5, HUGE, INF, [], {}, [1], True, 1.5, [HUGE, 0], [1, INF]]}, ["hop"]),
+    ("hop", {"id": ["x", HUGE, INF, [], {}, [1], None, 1.5, True]}, ["hop"]),   # then no reply to this request
+    ("pose", {"left_deg": WRONG_TYPES + [HUGE, -INF, NAN, "micropython", 1e6],
+              "right_deg": WRONG_TYPES + [HUGE, -INF, NAN, "micropython", 1e6]}, ["pose"]),
+]
+
+
+PAIRS = [(what, field, values, commands) for what, fields, commands in TARGETS for field, values in fields.items()]
+
+
+def _draw(seed: int):
+    """(message, field, value, command): one field of one message replaced by a bad value;
+    every field in turn, the value and the command drawn."""
+    rng = random.Random(seed)
+    what, field, values, commands = PAIRS[seed % len(PAIRS)]
+    return what, field, rng.choice(values), rng.choice(commands)
+
+
+def _args(command: str, port: str, out) -> list:
+    if command == "hop":
+        return ["hop", "--port", port, "--cycles", "1", "--push-ms", "50", "--wait-ms", "50", "--out", out / "run"]
+    if command == "config":
+        return ["config", "--port", port]
+    return ["pose", "10", "-10", "--port", port]
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("seed", range(3 * len(PAIRS)))
+def test_a_malformed_reply_is_a_clear_error_quoting_the_line(tmp_path, monkeypatch, seed):
+    what, field, value, command = _draw(seed)
+    board = FakeBoard(lambda w, msg: _with(field, value)(msg) if w == what else msg)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "mine.txt").write_text("mine\n")
+    before = tree(tmp_path)
+    try:
+        t0 = time.monotonic()
+        res = invoke(_args(command, board.port, tmp_path))
+        seconds = time.monotonic() - t0
+    finally:
+        board.close()
+    assert_clear_error(res, *(["no reply to 'hop'"] if (what, field) == ("hop", "id") else
+                              ["the board's", "in the line {"]))
+    assert seconds < 10
+    after = {k: v for k, v in tree(tmp_path).items() if not k.startswith("run")}
+    assert after == before   # only the hop's own record, kept with what arrived
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("command", ["hop", "config", "pose"])
+def test_the_double_answers_as_the_firmware_does(tmp_path, command):
+    board = FakeBoard()
+    try:
+        res = invoke(_args(command, board.port, tmp_path))
+    finally:
+        board.close()
+    assert res.exit_code == 0, res.output
+    if command == "hop":
+        assert '"status": "complete"' in (tmp_path / "run" / "run.json").read_text()
