@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import click
 
 from . import params as P
 from .errors import ParamsError
-from .fileio import json_text
+from .fileio import json_text, locked
 
 
 def robot_options(func):
@@ -36,9 +37,7 @@ def params(preset, config, sets, as_json, write, force):
     """
     robot = P.resolve_robot(preset, config, sets)
     if write:
-        if write.exists() and not force:
-            raise ParamsError(f"{write} exists", "choose another path, or add --force to overwrite it")
-        P.save_robot(robot, write)
+        _write(robot, write, force, config, sets)
         click.echo(f"wrote {write}")
         return
     if as_json:
@@ -51,3 +50,20 @@ def params(preset, config, sets, as_json, write, force):
         prov = robot.source_of(key)
         unc = f" ± {prov.uncertainty:g}" if prov.uncertainty is not None else ""
         click.echo(f"{key:42s} {value!s:>12}{unc:12s}  [{prov.source}]")
+
+
+def _write(robot: P.Robot, write: Path, force: bool, config: Path | None, sets) -> None:
+    """--write: a new file is created exclusively (a file another command made a moment ago is
+    not replaced); --force replaces one under its lock; ``--config F --set ... --write F
+    --force`` updates F as it is now (another process's update kept), its comments kept."""
+    if not force:
+        if write.exists():
+            raise ParamsError(f"{write} exists", "choose another path, or add --force to overwrite it")
+        P.save_robot(robot, write, template=P.file_text(config) if config else None, exclusive=True)
+        return
+    if config is not None and os.path.realpath(config) == os.path.realpath(write):
+        overrides = P.parse_set_options(sets)
+        P.update_robot(write, lambda now: P.check_robot(now.with_values(overrides, "override") if overrides else now))
+        return
+    with locked(write):
+        P.save_robot(robot, write, template=P.file_text(config if config else write))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 from pathlib import Path
@@ -158,6 +159,7 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
                               "locust hop options")
     made = _first_missing(Path(out)) if out is not None else None
     directory = R.run_dir(out)
+    held = R.claim(directory)   # a second hop into the same --out is refused (the folder is the other's)
     # a kill (SIGTERM) or a closed terminal (SIGHUP) ends the hop as Ctrl-C does: the robot to
     # rest, the record says so, a --port sim virtual robot stops
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
@@ -181,6 +183,7 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
+        os.close(held)
     path = directory / R.RECORD_NAME
     if as_json:
         click.echo(json_text(rec.to_dict()), nl=False)

@@ -10,7 +10,6 @@ the same whatever ran it. Floats are written with ``repr``: they read back bit f
 from __future__ import annotations
 
 import csv
-import fcntl
 import io
 import json
 import math
@@ -20,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SweepError
-from ..fileio import atomic_write_json, atomic_write_text, make_folder
+from ..fileio import atomic_write_json, atomic_write_text, make_folder, try_lock
 
 RESULTS = "results.csv"
 META = "sweep.json"
@@ -167,11 +166,8 @@ class SweepStore:
 
     def _lock(self) -> None:
         """One sweep at a time per folder: a second one would compute and append the same rows."""
-        fd = os.open(self.folder / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
+        fd = try_lock(self.folder / LOCK)
+        if fd is None:
             raise SweepError(f"another sweep is running in {self.folder}",
                              "wait for it to finish (or stop it), or use another --out folder") from None
         self._lock_fd = fd
