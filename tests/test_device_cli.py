@@ -91,6 +91,24 @@ def test_bad_input_is_a_clear_error_and_nothing_is_lost(env, tmp_path):
     assert json.loads((out / "run.json").read_text())["status"] == "error"  # untouched
 
 
+def test_two_hops_into_one_folder_never_share_it(env, tmp_path):
+    """Two `hop --out same` at once: one runs, the other is refused before it starts (the folder
+    is locked for the run), and the record that is kept is the first's, whole."""
+    out = tmp_path / "same"
+    args = ["hop", "--port", "sim", "--cycles", "1", "--push-ms", "50", "--wait-ms", "50", "--plant", "record",
+            "--json", "--out", str(out)]
+    procs = [subprocess.Popen(LOCUST + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+             for _ in range(2)]
+    results = [(p.wait(timeout=90), *p.communicate()) for p in procs]
+    codes = sorted(rc for rc, _, _ in results)
+    assert codes == [0, 2], results
+    winner = next(o for rc, o, _ in results if rc == 0)
+    loser = next(e for rc, _, e in results if rc == 2)
+    assert "error:" in loser and "hint:" in loser and "Traceback" not in loser
+    assert ("another process is writing in" in loser) or ("never overwritten" in loser)
+    assert json.loads((out / "run.json").read_text()) == json.loads(winner)
+
+
 def _fuzz_frames(n, seed=4):
     """n lines, each answered by exactly one reply: random, corrupted and out-of-range frames.
 
