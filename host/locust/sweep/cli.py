@@ -109,7 +109,10 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
 @click.option("--seed", type=int, default=0, show_default=True, help="Sampler seed.")
 @click.option("--jobs", type=click.IntRange(1, 1024), default=1, show_default=True,
               help="Trials run at once in this process (the simulation releases the GIL).")
-def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_name, seed, jobs):
+@click.option("--repair", is_flag=True,
+              help="First mend a journal whose last line a full disk left torn: the file is saved as "
+                   "study.journal.torn-N beside it, then the torn line is cut (every whole trial kept).")
+def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_name, seed, jobs, repair):
     """Search continuous parameter ranges for the farthest hop (Optuna TPE).
 
     Invalid designs are pruned with their reason and never become the best. Rerunning with the
@@ -127,6 +130,8 @@ def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_n
     bounds = [parse_bound(v, base) for v in varies]
     if len({b.name for b in bounds}) != len(bounds):
         raise SweepError("--vary names a parameter twice", "give each parameter one --vary")
+    if repair:
+        _repair(storage, out)
     with progress(length=trials, label="optimize", show_pos=True, show_eta=True) as bar:
         try:
             summary = run_optimize(base, bounds, trials, cycles, out, storage=storage, study_name=study_name,
@@ -150,3 +155,17 @@ def optimize(preset, config, sets, varies, trials, cycles, out, storage, study_n
         click.echo(f"interrupted: {kept} finished trial{'s' * (kept != 1)} kept in the study and the files above "
                    "(a trial under way is not); rerun the same command to continue", err=True)
         sys.exit(130)
+
+
+def _repair(storage: str | None, out: Path) -> None:
+    """--repair: cut the torn last line of the study's journal file (saved beside it first)."""
+    from .journal import repair
+    from .optimize import RDB_PREFIXES
+
+    if storage is not None and storage.startswith(RDB_PREFIXES):
+        raise SweepError(f"--repair mends a journal file; --storage {storage} is a database",
+                         "leave --repair off (a database is not torn by a full disk)")
+    journal = Path(storage.removeprefix("journal:")) if storage else out / "study.journal"
+    if not journal.is_file():
+        raise SweepError(f"--repair: there is no journal {journal}", "give the --out (or --storage) of the study")
+    click.echo(repair(journal).line(), err=True)

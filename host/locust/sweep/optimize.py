@@ -27,11 +27,14 @@ from ..errors import SweepError
 from ..fileio import atomic_write_json, atomic_write_text, make_folder
 from ..params import Robot, save_robot
 from .design import SCALE, Bound, design_robot, evaluate
+from .journal import full_disk
 
 RDB_PREFIXES = ("sqlite:", "postgresql", "mysql", "oracle", "mssql")
 # what run_optimize writes in its folder; anything else there is someone else's
 OWN_FILES = frozenset({"trials.csv", "optimize.json", "history.png", "best.toml", "study.journal",
                        "study.journal.lock"})
+# a journal saved by --repair before its torn line was cut (sweep/journal.py)
+TORN_PREFIX = "study.journal.torn-"
 # the study's user attribute holding what it searches
 SETTINGS_ATTR = "locust"
 SQLITE_MAGIC = b"SQLite format 3\x00"
@@ -48,7 +51,7 @@ def check_folder(folder: Path) -> None:
     if not folder.is_dir():
         raise SweepError(f"--out {folder} is a file", "give a folder (new, or one `locust optimize` made)")
     names = {p.name for p in folder.iterdir() if not p.name.startswith(".")}
-    foreign = sorted(names - OWN_FILES)
+    foreign = sorted(n for n in names - OWN_FILES if not n.startswith(TORN_PREFIX))
     ours = bool(names & {"optimize.json", "study.journal"})
     if foreign or (names and not ours):
         shown = ", ".join((foreign or sorted(names))[:5])
@@ -90,8 +93,9 @@ def check_journal_file(path: Path) -> None:
         if not lines[-1]:
             break
     if lines[-1]:
-        raise SweepError(f"{path}: a damaged Optuna journal (its last line is cut short)",
-                         "restore the file from a copy, or " + hint)
+        raise SweepError(f"{path}: a damaged Optuna journal (its last line is cut short, as a full disk leaves it)",
+                         "rerun the same command with --repair: it saves the file beside it and cuts the torn "
+                         "line, keeping every whole trial; or " + hint)
     for k, line in enumerate(lines[:-1]):
         try:
             op = json.loads(line)
@@ -246,6 +250,14 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
         study.optimize(objective, n_trials=trials, n_jobs=jobs, callbacks=callbacks, catch=())
     except KeyboardInterrupt:   # the trial under way is dropped (FAIL); every finished one is kept
         return summarise(study, folder, base, interrupted=True)
+    except (OSError, AssertionError) as exc:   # Optuna's own assertion fails after its write did
+        full = full_disk(exc)
+        if full is None:
+            raise
+        raise SweepError(f"{where}: the disk is full ({full.strerror}) while the study was written: the trial "
+                         "under way is lost, every finished one is kept in it",
+                         "free some space on that disk, then rerun the same command with --repair (it saves the "
+                         "study as it is and cuts a line the full disk left torn)") from None
     return summarise(study, folder, base)
 
 
