@@ -29,8 +29,10 @@ class FiniteFloat(click.ParamType):
             self.fail(f"{value!r} is not a finite number", param, ctx)
         if self.positive and not number > 0:
             self.fail(f"{value!r} must be above 0", param, ctx)
-        if (self.low is not None and number < self.low) or (self.high is not None and number > self.high):
-            self.fail(f"{value!r} is not in {self.low:g}..{self.high:g}", param, ctx)
+        if self.low is not None and number < self.low:
+            self.fail(f"{value!r} is below {self.low:g}", param, ctx)
+        if self.high is not None and number > self.high:
+            self.fail(f"{value!r} is above {self.high:g}", param, ctx)
         return number
 
 
