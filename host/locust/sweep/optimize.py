@@ -26,7 +26,7 @@ from typing import Any
 from ..errors import SweepError
 from ..fileio import atomic_write_json, atomic_write_text, make_folder
 from ..params import Robot, save_robot
-from .design import SCALE, Bound, design_robot, evaluate
+from .design import Bound, design_robot, evaluate, is_integer
 from .journal import full_disk
 
 RDB_PREFIXES = ("sqlite:", "postgresql", "mysql", "oracle", "mssql")
@@ -171,14 +171,6 @@ def open_storage(url: str | None, folder: Path):
                              "check the URL, e.g. sqlite:///study.db; the database driver must be installed") from None
     path = url.removeprefix("journal:")
     return JournalStorage(JournalFileBackend(path))
-
-
-def is_integer(base: Robot, name: str) -> bool:
-    """Whether the parameter ``name`` holds whole numbers (schedule.cycles, solver.iterations)."""
-    if name == SCALE:
-        return False
-    value = base.get(name)
-    return isinstance(value, int) and not isinstance(value, bool)
 
 
 @dataclass
