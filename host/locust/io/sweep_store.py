@@ -155,13 +155,19 @@ class SweepStore:
                 raise SweepError(f"{folder} holds a different sweep (base, --vary, --cycles or parameters differ)",
                                  "use a new --out folder, or rerun the exact command that made it to resume")
             store.done = store._read_rows()
-        elif folder.exists() and any(folder.iterdir()):
+        elif folder.exists() and any(p.name != LOCK for p in folder.iterdir()):   # (a sweep that failed before
+            # its sweep.json was written, a full disk, leaves only its lock: it is started again)
             raise SweepError(f"{folder} exists and is not a sweep folder; refusing to write into it",
                              "choose a new or empty --out folder")
         make_folder(folder)
         store._lock()
-        atomic_write_json(meta_path, meta)
-        store._rewrite(sorted(store.done))
+        try:
+            atomic_write_json(meta_path, meta)
+            store._rewrite(sorted(store.done))
+        except BaseException:   # (a full disk) the lock goes with the failed start
+            os.close(store._lock_fd)
+            store._lock_fd = None
+            raise
         return store
 
     def _lock(self) -> None:
