@@ -6,7 +6,9 @@ non-ASCII text and a file name's undecodable byte (a lone surrogate)."""
 
 from __future__ import annotations
 
+import os
 import random
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -19,8 +21,8 @@ from locust.calibrate.fitstats import Estimate
 from locust.calibrate.write import write_fitted
 from locust.cli import cli
 from locust.errors import WriteError
+from locust.fileio import storable
 from locust.params import Provenance, load_robot, parse_set_options, preset, save_robot, update_robot
-from locust.robot_toml import storable
 
 ROOT = Path(__file__).resolve().parents[1]
 RAMP = ROOT / "calibration" / "recordings" / "synthetic_ramp.csv"
@@ -184,3 +186,14 @@ def test_two_concurrent_calibrate_writes_both_land_20_of_20(tmp_path):
         landed += all(robot.source_of(f"contact.{x}_friction").source == "fit:synthetic_ramp.csv"
                       for x in ("foot", "nose"))
     assert landed == 20
+
+
+def test_a_recording_named_with_an_undecodable_byte_is_written_and_plotted(tmp_path):
+    """`ramp\\xff.csv`: --write raised UnicodeEncodeError, and the default plot a matplotlib traceback."""
+    name = os.fsdecode(b"ramp\xff.csv")
+    shutil.copy(RAMP, tmp_path / name)
+    res = subprocess.run([sys.executable, "-c", "from locust.cli import main; main()", "calibrate", "ramp",
+                          str(tmp_path / name), "--write", str(tmp_path / "r.toml")], capture_output=True, timeout=120)
+    assert res.returncode == 0 and b"Traceback" not in res.stderr, res.stderr[-3000:]
+    assert (tmp_path / os.fsdecode(b"ramp\xff-fit.png")).stat().st_size > 10_000
+    assert load_robot(tmp_path / "r.toml").source_of("contact.foot_friction").source == "fit:ramp\\udcff.csv"

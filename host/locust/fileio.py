@@ -164,6 +164,13 @@ def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
                          "back); the disk may be full", DISK_HINT)
 
 
+def storable(text: str) -> str:
+    """``text`` as UTF-8 (and a font) can hold it: a lone surrogate (an undecodable byte of a
+    file name, as Python keeps it) becomes its backslash escape, ``\\udcff``; every other
+    character is kept."""
+    return text.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
 def write_error(path: str | os.PathLike, exc: OSError) -> WriteError:
     """The :class:`WriteError` for an ``OSError`` met writing ``path``; a full disk says so."""
     if exc.errno in (errno.ENOSPC, errno.EDQUOT):

@@ -35,9 +35,9 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from .errors import ParamsError
-from .fileio import atomic_write_text, locked
+from .fileio import atomic_write_text, locked, storable
 from .firmware import protocol
-from .robot_toml import document_text, storable
+from .robot_toml import document_text
 
 # Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
 GRAVITY_M_PER_S2 = 9.81

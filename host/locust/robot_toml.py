@@ -17,6 +17,8 @@ from typing import Any
 import tomlkit
 from tomlkit.items import InlineTable, Table
 
+from .fileio import storable
+
 HEADER = (
     "locust robot parameters. Each value: {value, source, uncertainty (1 sigma), date, note}.",
     "source: default | seed | photo:, cut_file:, datasheet:, data:, estimate:<what> | preset:<name>",
@@ -24,12 +26,6 @@ HEADER = (
 )
 
 PROVENANCE_KEYS = ("source", "uncertainty", "date", "note")
-
-
-def storable(text: str) -> str:
-    """``text`` as UTF-8 can hold it: a lone surrogate (an undecodable byte of a file name)
-    becomes its backslash escape, ``\\udcff``; every other character is kept."""
-    return text.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 def _item(value: Any) -> Any:
