@@ -6,8 +6,9 @@ mpremote is pinned (1.29.0): its Python API changes between releases. The steps:
    ask it for the REPL with the ``repl`` command (mpremote's Ctrl-C would stop an idle
    firmware too; the request is answered, so a running firmware is known to have let go);
 2. enter the raw REPL without a soft reset (on the unix port a soft reset ends the process);
-3. write each file (optionally compiled with ``mpy-cross``), then compare the board's
-   SHA-256 of every file with ours;
+3. write each file (optionally compiled with ``mpy-cross``) as ``NAME.part``, compare the
+   board's SHA-256 of every one with ours, then rename them into place: a full or failing
+   filesystem leaves the firmware on the board as it was;
 4. write ``config.json`` if the board has none (or when asked; pulse range and travel from
    the robot parameters, :func:`servo_config`), soft-reset (Ctrl-D from
    the friendly REPL runs ``main.py``; the USB port stays up), and complete the handshake.
