@@ -243,33 +243,53 @@ def locked(path: str | os.PathLike, wait_s: float = 60.0) -> Iterator[Path]:
     The lock is ``fcntl.flock`` on ``.NAME.lock`` beside ``path`` (the file itself is replaced
     by every atomic write, so a lock on it would not outlive the first update). Another process
     (or another lock in this one) updating the same ``path`` waits until this block ends; after
-    ``wait_s`` seconds of waiting it is :class:`WriteError`. The lock file is left in place:
-    removing it would let a third writer lock a new file while a second holds the old one.
+    ``wait_s`` seconds of waiting it is :class:`WriteError`. What :func:`write_target` refuses
+    is refused first, before any lock file is made. The lock file is removed as the lock is
+    released; a waiter that then holds the removed file's lock sees so and locks the new one.
     """
-    path = Path(path)
-    if path.is_symlink():
-        path = Path(os.path.realpath(path))
+    path = write_target(path)
     make_folder(path.parent)
     lock_path = path.parent / f".{path.name}.lock"
-    try:
-        fd = os.open(lock_path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
-    except OSError as exc:
-        raise write_error(lock_path, exc) from None
-    try:
-        deadline = time.monotonic() + wait_s
-        while True:
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            fd = os.open(lock_path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+        except OSError as exc:
+            raise write_error(lock_path, exc) from None
+        try:
+            _flock_until(fd, deadline, path, wait_s)
+            held = os.fstat(fd)
             try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                break
-            except BlockingIOError:
-                if time.monotonic() > deadline:
-                    raise WriteError(f"{path} is being updated by another process (it holds {lock_path}) "
-                                     f"and has been for over {wait_s:g} s",
-                                     "wait for that command to finish, then run this one again") from None
-                time.sleep(0.02)
+                now = os.stat(lock_path)
+            except FileNotFoundError:
+                now = None
+        except BaseException:
+            os.close(fd)
+            raise
+        if now is not None and (now.st_dev, now.st_ino) == (held.st_dev, held.st_ino):
+            break
+        os.close(fd)   # its holder removed it as it let go: lock the one there now
+    try:
         yield path
     finally:
-        os.close(fd)   # releases the lock
+        try:
+            os.unlink(lock_path)   # (still held: no one can lock it between this and the close)
+        except OSError:
+            pass
+        os.close(fd)
+
+
+def _flock_until(fd: int, deadline: float, path: Path, wait_s: float) -> None:
+    while True:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return
+        except BlockingIOError:
+            if time.monotonic() > deadline:
+                raise WriteError(f"{path} is being updated by another process (it holds .{path.name}.lock beside "
+                                 f"it) and has been for over {wait_s:g} s",
+                                 "wait for that command to finish, then run this one again") from None
+            time.sleep(0.02)
 
 
 def try_lock(path: str | os.PathLike) -> int | None:

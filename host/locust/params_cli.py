@@ -55,7 +55,8 @@ def params(preset, config, sets, as_json, write, force):
 def _write(robot: P.Robot, write: Path, force: bool, config: Path | None, sets) -> None:
     """--write: a new file is created exclusively (a file another command made a moment ago is
     not replaced); --force replaces one under its lock; ``--config F --set ... --write F
-    --force`` updates F as it is now (another process's update kept), its comments kept."""
+    --force`` updates F as it is now (another process's update kept), its comments kept.
+    A file written from a --config keeps that file's comments and layout."""
     if not force:
         if write.exists():
             raise ParamsError(f"{write} exists", "choose another path, or add --force to overwrite it")
@@ -65,5 +66,5 @@ def _write(robot: P.Robot, write: Path, force: bool, config: Path | None, sets) 
         overrides = P.parse_set_options(sets)
         P.update_robot(write, lambda now: P.check_robot(now.with_values(overrides, "override") if overrides else now))
         return
-    with locked(write):
-        P.save_robot(robot, write, template=P.file_text(config if config else write))
+    with locked(write):   # replaced by this robot: the layout of its --config, if any
+        P.save_robot(robot, write, template=P.file_text(config) if config else None)
