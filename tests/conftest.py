@@ -52,3 +52,23 @@ def env(tmp_path_factory):
     assert proc.returncode == 0, proc.stderr
     assert "files verified by SHA-256" in proc.stdout
     return env
+
+
+@pytest.fixture()
+def small_disk(tmp_path):
+    """A real 64 kB disk (a tmpfs: mounting it needs root; skipped, saying so, where it is not
+    allowed), and a function that fills it to ``free`` bytes left."""
+    import subprocess
+
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(disk)], capture_output=True)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here ({done.stderr.decode().strip()})")
+
+    def fill(free: int = 0) -> None:
+        st = os.statvfs(disk)
+        (disk / "fill").write_bytes(b"x" * max(0, st.f_bavail * st.f_frsize - free))
+
+    yield disk, fill
+    subprocess.run(["umount", "-l", str(disk)], check=False)   # (lazy: a file still open does not keep it)

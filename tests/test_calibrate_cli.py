@@ -152,8 +152,8 @@ def test_write_onto_a_robot_that_cannot_be_simulated_is_refused(recs):
     """The fit is shown, the file is left as it was (bytes), and the problem is named."""
     toml = recs / "robot.toml"
     text = to_toml(preset("seed").renamed("calibrated"))
-    assert "timestep_s = { value = 0.001," in text
-    toml.write_text(text.replace("timestep_s = { value = 0.001,", "timestep_s = { value = 0.5,"))
+    assert "timestep_s = {value = 0.001," in text
+    toml.write_text(text.replace("timestep_s = {value = 0.001,", "timestep_s = {value = 0.5,"))
     before = toml.read_bytes()
     res = run("calibrate", "ramp", recs / "synthetic_ramp.csv", "--write", toml, "--no-plot")
     assert res.exit_code == 2, res.output

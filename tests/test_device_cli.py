@@ -138,6 +138,105 @@ def test_bad_input_is_a_clear_error_and_nothing_is_lost(env, tmp_path):
     assert json.loads((out / "run.json").read_text())["status"] == "error"  # untouched
 
 
+def test_two_hops_into_one_folder_never_share_it(env, tmp_path):
+    """Two `hop --out same` at once: one runs, the other is refused before it starts (the folder
+    is locked for the run), and the record that is kept is the first's, whole."""
+    out = tmp_path / "same"
+    args = ["hop", "--port", "sim", "--cycles", "1", "--push-ms", "50", "--wait-ms", "50", "--plant", "record",
+            "--json", "--out", str(out)]
+    procs = [subprocess.Popen(LOCUST + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+             for _ in range(2)]
+    results = [(p.wait(timeout=90), *p.communicate()) for p in procs]
+    codes = sorted(rc for rc, _, _ in results)
+    assert codes == [0, 2], results
+    winner = next(o for rc, o, _ in results if rc == 0)
+    loser = next(e for rc, _, e in results if rc == 2)
+    assert "error:" in loser and "hint:" in loser and "Traceback" not in loser
+    assert ("another process is writing in" in loser) or ("never overwritten" in loser)
+    assert json.loads((out / "run.json").read_text()) == json.loads(winner)
+
+
+def _filmed_hop(env, folder: Path, fps: int = 60) -> subprocess.Popen:
+    return subprocess.Popen(LOCUST + ["hop", "--port", "sim", "--cycles", "1", "--push-ms", "100", "--wait-ms", "100",
+                                      "--video", str(folder / "v.mp4"), "--fps", str(fps), "--out", str(folder / "r")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+
+
+def _check_what_was_kept(proc: subprocess.Popen, folder: Path) -> tuple[int, dict | None]:
+    """After a TERM: no crash, no temporary video, and a record that says whether the video was kept."""
+    try:
+        _, stderr = proc.communicate(timeout=150)
+    except subprocess.TimeoutExpired:
+        proc.send_signal(signal.SIGABRT)
+        _, stderr = proc.communicate(timeout=10)
+        raise AssertionError("hung: " + stderr[-6000:]) from None
+    assert proc.returncode not in (-11, -6, 134, 139), stderr   # no segfault, no abort
+    assert "Fatal Python error" not in stderr and "Traceback" not in stderr, stderr
+    assert not [p.name for p in folder.iterdir() if p.name.startswith(".v.mp4")]   # no temporary left
+    record = folder / "r" / "run.json"
+    if not record.exists():
+        assert not (folder / "v.mp4").exists()
+        return proc.returncode, None
+    rec = json.loads(record.read_text())
+    if (folder / "v.mp4").exists():   # (a TERM during the hop: the robot to rest, the video of it finished)
+        assert "video was not kept" not in (rec["message"] or "")
+    else:   # the record must not say complete about a run whose video was dropped
+        assert rec["status"] != "complete" and "the video was not kept" in rec["message"], rec
+    return proc.returncode, rec
+
+
+def test_term_while_the_video_is_finished_keeps_a_true_record(env, tmp_path):
+    """TERM once the hop is done and its video is still being rendered: exit 2 with error:/hint:,
+    the record keeps both phases and says the video was not kept (it said complete, and the
+    interpreter crashed, before). A TERM that lands as the hop returns is the hop's: the video
+    is finished and kept, and the record says the hop was interrupted."""
+    proc = _filmed_hop(env, tmp_path, fps=120)
+    deadline = time.monotonic() + 90
+    while time.monotonic() < deadline and proc.poll() is None:
+        try:
+            if json.loads((tmp_path / "r" / "run.json").read_text())["status"] == "complete":
+                break
+        except (OSError, ValueError, KeyError):
+            pass
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGTERM)
+    rc, rec = _check_what_was_kept(proc, tmp_path)
+    assert rec is not None and len(rec["phases"]) == 2
+    if rc != 0:   # (a machine fast enough had the video written already: rc 0, video kept, record complete)
+        assert rc == 2 and rec["status"] == "incomplete" and rec["message"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(4))
+def test_term_at_a_random_moment_of_a_filmed_hop(env, tmp_path, seed):
+    """A TERM anywhere from start-up to the video's end (about 40 s in all)."""
+    import random
+
+    proc = _filmed_hop(env, tmp_path)
+    time.sleep(random.Random(seed).uniform(0.5, 9.0))
+    proc.send_signal(signal.SIGTERM)
+    _check_what_was_kept(proc, tmp_path)
+
+
+def test_video_frames_are_bounded_before_anything_starts(env, tmp_path):
+    proc = _run(["hop", "--port", "sim", "--cycles", "100", "--video", str(tmp_path / "v.mp4"), "--fps", "1000",
+                 "--out", str(tmp_path / "r")], env)
+    assert proc.returncode == 2 and "130500 frames, over the 10000" in proc.stderr and "hint:" in proc.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("args, message", [
+    (["hop", "--push-deg", "1e308"], "'1e308' is above 90"),
+    (["hop", "--push-deg", "nan"], "'nan' is not a finite number"),
+    (["config", "--set", "left.trim_deg=nan"], "nan is not a finite number; nothing was sent"),
+])
+def test_a_wrong_value_is_refused_before_it_is_sent(env, tmp_path, args, message):
+    proc = _run([*args, "--port", "sim", *(["--out", str(tmp_path / "r")] if args[0] == "hop" else [])], env)
+    assert proc.returncode == 2 and message in proc.stderr and "hint:" in proc.stderr, proc.stderr
+    assert "virtual robot on" not in proc.stderr   # refused before the (virtual) board was opened
+    assert list(tmp_path.iterdir()) == []
+
+
 def _fuzz_frames(n, seed=4):
     """n lines, each answered by exactly one reply: random, corrupted and out-of-range frames.
 

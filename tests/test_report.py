@@ -280,3 +280,13 @@ def test_report_loads_in_headless_chromium(world, tmp_path):
     assert attrs["data-errors"] == ""
     console = [ln for ln in proc.stderr.splitlines() if "CONSOLE" in ln or "Refused" in ln]
     assert console == []
+
+
+def test_a_full_disk_leaves_no_half_report(world, small_disk):
+    """A report onto a real full disk (a 64 kB tmpfs): error:/hint:, and no report/ folder left
+    (an empty one was, issue 39 item 7)."""
+    disk, fill = small_disk
+    fill(free=8192)
+    res = invoke("--measured", world["root"] / "hops" / "small-1", "--preset", "seed", "--out", disk / "out")
+    assert res.exit_code == 2 and "the disk is full" in res.output and "hint:" in res.output, res.output
+    assert not (disk / "out").exists() or list((disk / "out").iterdir()) == []

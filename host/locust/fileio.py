@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import errno
+import fcntl
 import json
 import os
 import re
 import signal
 import stat
 import tempfile
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -159,34 +164,160 @@ def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
                          "back); the disk may be full", DISK_HINT)
 
 
-def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> Path:
+def storable(text: str) -> str:
+    """``text`` as UTF-8 (and a font) can hold it: a lone surrogate (an undecodable byte of a
+    file name, as Python keeps it) becomes its backslash escape, ``\\udcff``; every other
+    character is kept."""
+    return text.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
+def write_error(path: str | os.PathLike, exc: OSError) -> WriteError:
+    """The :class:`WriteError` for an ``OSError`` met writing ``path``; a full disk says so."""
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        return WriteError(f"{path}: the disk is full ({exc.strerror}); nothing was replaced",
+                          "free some space on that disk (or write elsewhere) and run the command again")
+    return WriteError(f"{path}: cannot write it ({exc.strerror or exc})", DISK_HINT)
+
+
+def atomic_write_bytes(path: str | os.PathLike, data: bytes, *,
+                       check: Callable[[Path], None] | None = None, exclusive: bool = False) -> Path:
     """Write ``data`` to ``path`` through a temporary file and a rename.
 
     A reader never sees a half-written file, and an interrupted or failed write (a full disk)
     leaves the old file (if any) untouched and no temporary file behind. A symlink is followed
     (its target is updated); what :func:`write_target` refuses is never replaced.
+
+    Parameters
+    ----------
+    path : path-like
+        The file to write.
+    data : bytes
+        Its whole new content.
+    check : callable, optional
+        Called with the written temporary file before it replaces ``path``: it reads the file
+        back and raises (a :class:`~locust.errors.LocustError`) when it is not what was meant;
+        ``path`` is then left as it was.
+    exclusive : bool
+        Create ``path``, never replace it: :class:`WriteError` when it exists, even when another
+        process made it a moment ago (the temporary is hard-linked to its name, which the
+        kernel refuses for a name taken).
+
+    Returns
+    -------
+    Path
+        The file written (a symlink's target).
     """
-    path = write_target(path)
+    path = Path(path) if exclusive else write_target(path)
     fd, tmp = temp_beside(path)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        if check is not None:
+            check(Path(tmp))
+        if exclusive:
+            try:
+                os.link(tmp, path)
+            except FileExistsError:
+                raise WriteError(f"{path} exists; refusing to replace it",
+                                 "choose another path (or remove that file first)") from None
+            os.unlink(tmp)
+        else:
+            os.replace(tmp, path)
     except BaseException as exc:
         try:
             os.unlink(tmp)
         except FileNotFoundError:
             pass
         if isinstance(exc, OSError):
-            raise WriteError(f"{path}: cannot write it ({exc.strerror or exc})", DISK_HINT) from None
+            raise write_error(path, exc) from None
         raise
     return path
 
 
-def atomic_write_text(path: str | os.PathLike, text: str) -> Path:
-    return atomic_write_bytes(path, text.encode("utf-8"))
+@contextmanager
+def locked(path: str | os.PathLike, wait_s: float = 60.0) -> Iterator[Path]:
+    """Hold an exclusive lock for updating ``path`` (read, change, write back) while the block runs.
+
+    The lock is ``fcntl.flock`` on ``.NAME.lock`` beside ``path`` (the file itself is replaced
+    by every atomic write, so a lock on it would not outlive the first update). Another process
+    (or another lock in this one) updating the same ``path`` waits until this block ends; after
+    ``wait_s`` seconds of waiting it is :class:`WriteError`. What :func:`write_target` refuses
+    is refused first, before any lock file is made. The lock file is removed as the lock is
+    released; a waiter that then holds the removed file's lock sees so and locks the new one.
+    """
+    path = write_target(path)
+    make_folder(path.parent)
+    lock_path = path.parent / f".{path.name}.lock"
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            fd = os.open(lock_path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+        except OSError as exc:
+            raise write_error(lock_path, exc) from None
+        try:
+            _flock_until(fd, deadline, path, wait_s)
+            held = os.fstat(fd)
+            try:
+                now = os.stat(lock_path)
+            except FileNotFoundError:
+                now = None
+        except BaseException:
+            os.close(fd)
+            raise
+        if now is not None and (now.st_dev, now.st_ino) == (held.st_dev, held.st_ino):
+            break
+        os.close(fd)   # its holder removed it as it let go: lock the one there now
+    try:
+        yield path
+    finally:
+        try:
+            os.unlink(lock_path)   # (still held: no one can lock it between this and the close)
+        except OSError:
+            pass
+        os.close(fd)
+
+
+def _flock_until(fd: int, deadline: float, path: Path, wait_s: float) -> None:
+    while True:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return
+        except BlockingIOError:
+            if time.monotonic() > deadline:
+                raise WriteError(f"{path} is being updated by another process (it holds .{path.name}.lock beside "
+                                 f"it) and has been for over {wait_s:g} s",
+                                 "wait for that command to finish, then run this one again") from None
+            time.sleep(0.02)
+
+
+def try_lock(path: str | os.PathLike) -> int | None:
+    """An open descriptor of ``path`` (a folder, or a lock file made if missing) holding an
+    exclusive ``flock`` on it; None at once when another process holds one. Close the
+    descriptor to release it (a process that dies releases it too)."""
+    flags = os.O_RDONLY | os.O_DIRECTORY if os.path.isdir(path) else os.O_RDWR | os.O_CREAT
+    fd = os.open(path, flags | os.O_CLOEXEC, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        return None
+    return fd
+
+
+def claim_folder(folder: str | os.PathLike) -> int:
+    """:func:`try_lock` of ``folder``, or :class:`WriteError` when another process writes there now."""
+    fd = try_lock(folder)
+    if fd is None:
+        raise WriteError(f"another process is writing in {folder} now; refusing to share it",
+                         "give this command a folder of its own")
+    return fd
+
+
+def atomic_write_text(path: str | os.PathLike, text: str, **kwargs) -> Path:
+    """:func:`atomic_write_bytes` of ``text`` in UTF-8 (``check``, ``exclusive`` as there)."""
+    return atomic_write_bytes(path, text.encode("utf-8"), **kwargs)
 
 
 def atomic_write_json(path: str | os.PathLike, obj: Any) -> Path:

@@ -12,12 +12,13 @@ import click
 
 
 class FiniteFloat(click.ParamType):
-    """A finite number; with ``positive``, above zero."""
+    """A finite number; with ``positive``, above zero; with ``low``/``high``, within them."""
 
     name = "number"
 
-    def __init__(self, positive: bool = False):
+    def __init__(self, positive: bool = False, low: float | None = None, high: float | None = None):
         self.positive = positive
+        self.low, self.high = low, high
 
     def convert(self, value, param, ctx):
         try:
@@ -28,6 +29,10 @@ class FiniteFloat(click.ParamType):
             self.fail(f"{value!r} is not a finite number", param, ctx)
         if self.positive and not number > 0:
             self.fail(f"{value!r} must be above 0", param, ctx)
+        if self.low is not None and number < self.low:
+            self.fail(f"{value!r} is below {self.low:g}", param, ctx)
+        if self.high is not None and number > self.high:
+            self.fail(f"{value!r} is above {self.high:g}", param, ctx)
         return number
 
 

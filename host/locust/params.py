@@ -30,13 +30,15 @@ import dataclasses
 import math
 import stat
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any, NamedTuple
 
 from .errors import ParamsError
-from .fileio import atomic_write_text
+from .fileio import atomic_write_text, locked, storable
 from .firmware import protocol
+from .robot_toml import document_text
 
 # Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
 GRAVITY_M_PER_S2 = 9.81
@@ -795,41 +797,116 @@ def load_robot(path: str | Path) -> Robot:
     return robot
 
 
-def _toml_value(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        return repr(value)  # 'inf' and 'nan' are TOML too
-    return '"' + str(value).replace("\\", "\\\\").replace('"', '\\"') + '"'
+def to_toml(robot: Robot, template: str | None = None) -> str:
+    """``robot`` as robot.toml text (:func:`locust.robot_toml.document_text`); ``template``: the
+    text of the file it replaces, whose comments and layout are kept."""
+    sections = {
+        section: {f.name: (robot.get(f"{section}.{f.name}"),
+                           dataclasses.asdict(robot.source_of(f"{section}.{f.name}")))
+                  for f in fields(SECTIONS[section])}
+        for section in SECTIONS
+    }
+    return document_text(robot.name, sections, template)
 
 
-def to_toml(robot: Robot) -> str:
-    lines = [
-        "# locust robot parameters. Each value: {value, source, uncertainty (1 sigma), date, note}.",
-        "# source: default | seed | photo:, cut_file:, datasheet:, data:, estimate:<what> | preset:<name>",
-        "# | override | fit:<recording>.",
-        f"name = {_toml_value(robot.name)}",
-        "",
-    ]
-    for section in SECTIONS:
-        lines.append(f"[{section}]")
-        for f in fields(SECTIONS[section]):
-            key = f"{section}.{f.name}"
-            prov = robot.source_of(key)
-            parts = [f"value = {_toml_value(robot.get(key))}", f"source = {_toml_value(prov.source)}"]
-            for attr in ("uncertainty", "date", "note"):
-                v = getattr(prov, attr)
-                if v is not None:
-                    parts.append(f"{attr} = {_toml_value(v)}")
-            lines.append(f"{f.name} = {{ {', '.join(parts)} }}")
-        lines.append("")
-    return "\n".join(lines)
+def _same(a: Any, b: Any) -> bool:
+    """``a`` (read back) is ``b`` as the file stores it."""
+    if isinstance(b, str):
+        b = storable(b)
+    return a == b or (isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b))
 
 
-def save_robot(robot: Robot, path: str | Path) -> Path:
-    return atomic_write_text(path, to_toml(robot))
+def _read_back(robot: Robot, path: Path, tmp: Path) -> None:
+    """Refuse (:class:`ParamsError`) a written robot.toml that does not read back to ``robot``."""
+    try:
+        back = load_robot(tmp)
+    except ParamsError as exc:
+        raise ParamsError(f"{path}: the robot file written does not read back ({exc.message}); "
+                          "the old file is kept", "report this as a bug in locust, with the command run") from None
+    differ = [key for key, value in robot.flat().items()
+              if not _same(back.get(key), value)
+              or dataclasses.astuple(back.source_of(key)) != dataclasses.astuple(_stored(robot.source_of(key)))]
+    if back.name != storable(robot.name):
+        differ.insert(0, "name")
+    if differ:
+        raise ParamsError(f"{path}: the robot file written reads back different ({', '.join(differ[:5])}); "
+                          "the old file is kept", "report this as a bug in locust, with the command run")
+
+
+def _stored(prov: Provenance) -> Provenance:
+    """``prov`` as the file holds it (text UTF-8 can store)."""
+    return Provenance(*(storable(v) if isinstance(v, str) else v for v in dataclasses.astuple(prov)))
+
+
+def file_text(path: Path) -> str | None:
+    """The robot.toml at ``path`` as text, to keep its layout; None when there is none or it is
+    not TOML (then it is not replaced anyway: load_robot refused it first)."""
+    try:
+        text = path.read_bytes().decode("utf-8")
+        tomllib.loads(text)
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return None
+    return text
+
+
+def save_robot(robot: Robot, path: str | Path, *, template: str | None = None, exclusive: bool = False) -> Path:
+    """Write ``robot`` to the robot.toml ``path``, atomically, and read it back first.
+
+    Parameters
+    ----------
+    robot : Robot
+        What to write: every value with its provenance.
+    path : str or Path
+        The file; one there already is replaced (but see ``exclusive``).
+    template : str, optional
+        TOML text whose comments and layout the new file keeps (the file being replaced, or the
+        one the robot was read from).
+    exclusive : bool
+        Only create ``path``: :class:`~locust.errors.WriteError` if it exists, even when another
+        process made it a moment ago.
+
+    Returns
+    -------
+    Path
+        The file written. It reads back (``load_robot``) to ``robot``'s values and provenance,
+        or it is not written and the old file is kept (:class:`ParamsError`).
+    """
+    path = Path(path)
+    text = to_toml(robot, template)
+    return atomic_write_text(path, text, check=lambda tmp: _read_back(robot, path, tmp), exclusive=exclusive)
+
+
+def update_robot(path: str | Path, change: Callable[[Robot], Robot], *, start: Callable[[], Robot] | None = None,
+                 wait_s: float = 60.0) -> Path:
+    """Read the robot.toml ``path``, change it and write it back, as one step for every process.
+
+    Under an exclusive lock on ``path`` (:func:`locust.fileio.locked`), so two commands updating
+    one file (``calibrate ... --write`` of two experiments) each see the other's values: no
+    update is lost. The file's comments and layout are kept (:func:`save_robot`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The robot.toml to update.
+    change : callable
+        ``Robot -> Robot``, the update; it may raise to leave the file as it is.
+    start : callable, optional
+        The robot when ``path`` does not exist yet (default: the seed preset).
+    wait_s : float
+        How long to wait for another process's update, seconds.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    path = Path(path)
+    with locked(path, wait_s) as target:
+        if target.exists():
+            robot, template = load_robot(target), file_text(target)
+        else:
+            robot, template = (start or (lambda: preset("seed")))(), None
+        return save_robot(change(robot), path, template=template)
 
 
 def resolve_robot(preset_name: str | None = None, config: str | Path | None = None,

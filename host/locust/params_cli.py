@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import functools
+import os
 from pathlib import Path
 
 import click
 
 from . import params as P
 from .errors import ParamsError
-from .fileio import json_text
+from .fileio import json_text, locked
 
 ROBOT_FILE = Path("calibration") / "robot.toml"   # what `locust calibrate --write` makes: the robot as calibrated
 DEFAULT_PRESET = "small"                          # the robot as built, no legs added (README, "What the presets are")
@@ -70,9 +71,7 @@ def params(preset, config, sets, as_json, write, force):
     """
     robot = P.resolve_robot(preset, config, sets)
     if write:
-        if write.exists() and not force:
-            raise ParamsError(f"{write} exists", "choose another path, or add --force to overwrite it")
-        P.save_robot(robot, write)
+        _write(robot, write, force, config, sets)
         click.echo(f"wrote {write}")
         return
     load, why = _standing(robot)
@@ -102,3 +101,21 @@ def _standing(robot: P.Robot):
         return standing_load(robot), ""
     except LocustError as exc:
         return None, exc.message
+
+
+def _write(robot: P.Robot, write: Path, force: bool, config: Path | None, sets) -> None:
+    """--write: a new file is created exclusively (a file another command made a moment ago is
+    not replaced); --force replaces one under its lock; ``--config F --set ... --write F
+    --force`` updates F as it is now (another process's update kept), its comments kept.
+    A file written from a --config keeps that file's comments and layout."""
+    if not force:
+        if write.exists():
+            raise ParamsError(f"{write} exists", "choose another path, or add --force to overwrite it")
+        P.save_robot(robot, write, template=P.file_text(config) if config else None, exclusive=True)
+        return
+    if config is not None and os.path.realpath(config) == os.path.realpath(write):
+        overrides = P.parse_set_options(sets)
+        P.update_robot(write, lambda now: P.check_robot(now.with_values(overrides, "override") if overrides else now))
+        return
+    with locked(write):   # replaced by this robot: the layout of its --config, if any
+        P.save_robot(robot, write, template=P.file_text(config) if config else None)

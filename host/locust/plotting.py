@@ -36,7 +36,13 @@ def pyplot():
 
 def figure_bytes(fig, fmt: str = "png", dpi: int = 110) -> bytes:
     """The figure in ``fmt`` (png, svg, pdf), marked as this toolkit's; the figure is closed."""
+    from matplotlib.text import Text
+
+    from .fileio import storable
+
     plt = pyplot()
+    for text in fig.findobj(Text):   # a file name's undecodable byte (a lone surrogate) cannot be drawn
+        text.set_text(storable(text.get_text()))
     buf = io.BytesIO()
     fig.savefig(buf, format=fmt, dpi=dpi, bbox_inches="tight", metadata={_METADATA[fmt]: CREATOR})
     plt.close(fig)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..fileio import storable
 from ..plotting import save_png
 from .curves import Curves
 
@@ -32,7 +33,8 @@ def fit_figure(curves: Curves | list[Curves], subtitle: str = ""):
         else:
             top.plot(c.model_x, c.model_fine, "-", lw=1.2, color="#d62728", label="model")
         top.set_ylabel(c.y_label)
-        top.set_title(c.title + (f"\n{subtitle}" if subtitle and k == 0 else ""), fontsize=10)
+        # (a recording's name may hold an undecodable byte, which no font can draw)
+        top.set_title(storable(c.title + (f"\n{subtitle}" if subtitle and k == 0 else "")), fontsize=10)
         top.legend(loc="best", fontsize=8)
         top.grid(alpha=0.3)
         bottom.axhline(0, color="0.5", lw=0.8)

@@ -12,7 +12,7 @@ import math
 from pathlib import Path
 
 from ..errors import CalibrationError
-from ..params import Provenance, Robot, load_robot, preset, problems, save_robot
+from ..params import Provenance, Robot, preset, problems, update_robot
 from .fitstats import Estimate
 
 DEFAULT_ROBOT_TOML = Path("calibration") / "robot.toml"
@@ -54,17 +54,24 @@ def check_plausible(values: dict[str, Estimate]) -> None:
 def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str | Path, *,
                  note: str = "", date: str | None = None) -> Path:
     """Set each dotted key in ``values`` to its fitted value, with ``fit:<recording>``; refused
-    (nothing written) when a value is implausible or the robot could then not be simulated."""
+    (nothing written) when a value is implausible or the robot could then not be simulated.
+
+    The file is read, changed and written back under a lock (``params.update_robot``): two
+    calibrations writing one file at once both land; its comments and layout are kept."""
     check_plausible(values)
     path = Path(path)
-    robot = load_robot(path) if path.exists() else preset("seed").renamed("calibrated")
-    robot = with_fitted(robot, values, recording, note=note, date=date)
-    found = problems(robot)
-    if found:   # a calibration file is what sim and hop run: it must be one they can
-        raise CalibrationError(f"{path}: with the fitted values the robot cannot be simulated: "
-                               + "; ".join(found) + "; not written",
-                               "fix the value(s) in the robot file first (`locust params --config FILE` lists them)")
-    return save_robot(robot, path)
+
+    def change(robot: Robot) -> Robot:
+        robot = with_fitted(robot, values, recording, note=note, date=date)
+        found = problems(robot)
+        if found:   # a calibration file is what sim and hop run: it must be one they can
+            raise CalibrationError(f"{path}: with the fitted values the robot cannot be simulated: "
+                                   + "; ".join(found) + "; not written",
+                                   "fix the value(s) in the robot file first "
+                                   "(`locust params --config FILE` lists them)")
+        return robot
+
+    return update_robot(path, change, start=lambda: preset("seed").renamed("calibrated"))
 
 
 def with_fitted(robot: Robot, values: dict[str, Estimate], recording: str | Path, *, note: str = "",

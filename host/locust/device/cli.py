@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+import os
 import signal
 import sys
 from pathlib import Path
@@ -12,6 +14,7 @@ from ..errors import DeviceError, LocustError
 from ..fileio import json_text
 from ..firmware import config as fw_config
 from ..io import run_record as R
+from ..options import FiniteFloat
 from ..params import Schedule, resolve_robot
 from ..params_cli import DEFAULTED, robot_options
 from ..progress import progress
@@ -19,6 +22,7 @@ from ..tables import hop_table, plant_lines
 from .plant import PLANTS
 
 CHIPS = tuple(fw_config.CHIPS)  # the chips whose pin rules the firmware knows, and the virtual robot models
+MAX_VIDEO_FRAMES = 10_000    # the frames a virtual robot's video may hold (100 cycles at 60 frames/s: 7830)
 VIDEO_FPS = 60                # the virtual robot's camera, as docs/hardware.md asks of a real one
 PORT_HELP = "Serial port (e.g. /dev/ttyUSB0), or 'sim' for the virtual robot. Default: the one likely ESP32."
 ROBOT_SCHEDULE = Schedule()   # the robot parameters' default schedule, named in the hop options' help
@@ -104,16 +108,21 @@ def flash(port, compile_mpy, reset_config, servo_sets, preset, config, sets):
 def _parse_servo_set(item: str, option: str = "--servo") -> tuple[str, float]:
     key, sep, value = item.partition("=")
     try:
-        return key.strip(), float(value)
+        number = float(value)
     except ValueError:
         raise DeviceError(f"{option} {item!r} is not KEY=NUMBER", f"e.g. {option} left.trim_deg=-1.5") from None
+    if not math.isfinite(number):
+        raise DeviceError(f"{option} {item!r}: {value.strip()} is not a finite number; nothing was sent",
+                          f"e.g. {option} left.trim_deg=-1.5")
+    return key.strip(), number
 
 
 @click.command()
 @click.option("--port", default=None, help=PORT_HELP)
 @click.option("--cycles", type=click.IntRange(*R.hop_range("cycles")), default=None,
               help=f"Hop cycles [robot schedule: {ROBOT_SCHEDULE.cycles}].")
-@click.option("--push-deg", type=float, default=None,
+@click.option("--push-deg", type=FiniteFloat(low=R.hop_range("push_deg")[0], high=R.hop_range("push_deg")[1]),
+              default=None,
               help=f"Horn angle of the push, deg [robot schedule: {ROBOT_SCHEDULE.push_deg:g}].")
 @click.option("--push-ms", type=click.IntRange(*R.hop_range("push_ms")), default=None,
               help=f"Push time, ms [robot schedule: {ROBOT_SCHEDULE.push_s * 1000:g}].")
@@ -157,8 +166,11 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     robot = robot.with_values({"schedule.cycles": schedule.cycles, "schedule.push_deg": schedule.push_deg,
                                "schedule.push_s": schedule.push_ms / 1000, "schedule.wait_s": schedule.wait_ms / 1000},
                               "locust hop options")
+    if video is not None and port == "sim":
+        _video_frames(schedule, video, video_fps)
     made = _first_missing(Path(out)) if out is not None else None
     directory = R.run_dir(out)
+    held = R.claim(directory)   # a second hop into the same --out is refused (the folder is the other's)
     # a kill (SIGTERM) or a closed terminal (SIGHUP) ends the hop as Ctrl-C does: the robot to
     # rest, the record says so, a --port sim virtual robot stops
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
@@ -174,16 +186,18 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
                                                       setattr(bar, "label", f"cycle {p.cycle} {p.phase}")),
                                   robot=source)
     except BaseException as exc:
-        if rec is not None and rec.status == R.COMPLETE and isinstance(exc, LocustError):
-            # the hop ran, what ends it failed (the virtual robot's video onto a full disk):
-            # the record keeps every phase and says what is missing
-            rec.status, rec.message = R.INCOMPLETE, f"after the hop: {exc.message}"
-            R.write(rec, directory)
+        reported = _note_after_hop(rec, directory, exc) if isinstance(exc, LocustError) else exc
+        if isinstance(exc, KeyboardInterrupt) and not (directory / R.RECORD_NAME).exists():
+            reported = DeviceError("interrupted before the hop began: no run record was written",
+                                   "run the hop again when ready")
         _remove_empty(directory, made if out is not None else directory)   # a hop that never started
-        raise                                                              # leaves no empty folder
+        if reported is not exc:                                            # leaves no empty folder
+            raise reported from None
+        raise
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
+        os.close(held)
     path = directory / R.RECORD_NAME
     if as_json:
         doc = rec.to_dict()
@@ -220,6 +234,47 @@ def _virtual_robot_source(port, source):
               f"not {source.robot_file or source.preset}: run.json records its robot")
     _info(f"robot: {theirs.robot_file or theirs.preset}, the one the virtual robot on {port} simulates")
     return theirs
+
+
+def _video_frames(schedule: R.HopSchedule, video: Path, fps: int) -> None:
+    """Say how many frames the virtual robot's video will hold before the hop starts (each is
+    rendered on the CPU: a second of run at --fps 1000 is minutes of rendering); refuse more
+    than MAX_VIDEO_FRAMES (every schedule at the default 60 frames/s fits)."""
+    from ..sim.live import PREROLL_S
+
+    run_s = PREROLL_S + schedule.duration_s
+    frames = math.ceil(run_s * fps)
+    if frames > MAX_VIDEO_FRAMES:
+        raise DeviceError(f"--video {video}: {run_s:.1f} s of run at --fps {fps} is {frames} frames, over the "
+                          f"{MAX_VIDEO_FRAMES} a video of the virtual robot may hold (each is rendered on the CPU)",
+                          f"lower --fps (60 is a real camera's rate) or --cycles, to at most "
+                          f"{MAX_VIDEO_FRAMES // math.ceil(run_s)} frames/s for this schedule")
+    _info(f"video: about {frames} frames to render ({run_s:.1f} s at {fps} frames/s); the command ends when "
+          "the last is written")
+
+
+def _note_after_hop(rec, directory: Path, exc: LocustError) -> LocustError:
+    """The run record says what a failure after the phases cost (the virtual robot's video onto
+    a full disk, or interrupted while it was finished), and every phase is kept. Returns the
+    error to report: both failures, when the hop had failed first."""
+    from .virtual import VIDEO_NOT_KEPT
+
+    path = directory / R.RECORD_NAME
+    if rec is None and exc.message == VIDEO_NOT_KEPT and path.is_file():
+        rec = R.read_run_record(path)   # (the hop's own failure wrote it, or a signal came as it returned)
+    if rec is None:
+        return exc
+    if rec.status == R.COMPLETE:
+        rec.status, rec.message = R.INCOMPLETE, f"after the hop: {exc.message}"
+    elif exc.message == VIDEO_NOT_KEPT:
+        rec.message = f"{rec.message}; {VIDEO_NOT_KEPT}" if rec.message else VIDEO_NOT_KEPT
+    else:
+        return exc
+    R.write(rec, directory)
+    first = exc.__context__   # (the signal, raised while the hop's own error unwound)
+    while first is not None and not isinstance(first, LocustError):
+        first = first.__context__
+    return DeviceError(f"{first.message}; {exc.message}", first.hint) if first is not None else exc
 
 
 def _hopped_robot(preset, config, sets, leg_set_name):

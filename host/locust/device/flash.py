@@ -6,8 +6,9 @@ mpremote is pinned (1.29.0): its Python API changes between releases. The steps:
    ask it for the REPL with the ``repl`` command (mpremote's Ctrl-C would stop an idle
    firmware too; the request is answered, so a running firmware is known to have let go);
 2. enter the raw REPL without a soft reset (on the unix port a soft reset ends the process);
-3. write each file (optionally compiled with ``mpy-cross``), then compare the board's
-   SHA-256 of every file with ours;
+3. write each file (optionally compiled with ``mpy-cross``) as ``NAME.part``, compare the
+   board's SHA-256 of every one with ours, then rename them into place: a full or failing
+   filesystem leaves the firmware on the board as it was;
 4. write ``config.json`` if the board has none (or when asked; pulse range and travel from
    the robot parameters, :func:`servo_config`), soft-reset (Ctrl-D from
    the friendly REPL runs ``main.py``; the USB port stays up), and complete the handshake.
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -203,7 +205,7 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
         _write_files(transport, files, progress, result)
         if config is not None or not transport.fs_exists(fw_config.FILE):
             progress(f"writing {fw_config.FILE}")
-            transport.fs_writefile(fw_config.FILE, json.dumps(config or servo_config(Servo(), chip)).encode())
+            write_board_file(transport, fw_config.FILE, json.dumps(config or servo_config(Servo(), chip)).encode())
             result.config_written = True
         progress("resetting")
         transport.exit_raw_repl()
@@ -284,20 +286,66 @@ def _firmware_files(compile_mpy: bool, board_mpy: int) -> list[tuple[str, bytes]
     return files
 
 
+PART = ".part"   # a file being copied to the board is written under NAME.part, renamed when whole
+BOARD_FULL_HINT = ("the board's filesystem is full or failing: remove files you put on it (mpremote fs ls / rm), "
+                   "then flash again; its firmware files are as they were")
+
+
 def _write_files(transport, files: list[tuple[str, bytes]], progress: Callable[[str], None],
                  result: FlashResult) -> None:
-    """Copy each file (removing its stale .py/.mpy twin), then check each by SHA-256 on the board."""
-    for name, data in files:
-        progress(f"copying {name}")
-        transport.fs_writefile(name, data)
+    """Copy every file under a temporary name and check it by SHA-256 on the board, then rename
+    them all into place (removing each one's stale .py/.mpy twin): a full or failing filesystem
+    leaves the firmware on the board as it was, never a torn file."""
+    try:
+        for name, data in files:
+            progress(f"copying {name}")
+            _write_part(transport, name, data)
+        for name, data in files:
+            progress(f"verifying {name}")
+            digest = hashlib.sha256(data).hexdigest()
+            if transport.fs_hashfile(name + PART, "sha256").hex() != digest:
+                raise DeviceError(f"{name} on the board does not match the copy sent (SHA-256); the firmware on it "
+                                  "is as it was", "flash again; if it persists, " + BOARD_FULL_HINT)
+            result.files.append(FlashedFile(name, len(data), digest))
+    except BaseException:
+        _remove_parts(transport, [name for name, _ in files])
+        raise
+    for name, _ in files:
+        _rename(transport, name + PART, name)
         stem, ext = name.rsplit(".", 1)
         other = stem + (".py" if ext == "mpy" else ".mpy")
         if other not in KEEP_SOURCE and transport.fs_exists(other):
             transport.fs_rmfile(other)  # a stale .py would be imported before the new .mpy
-    for name, data in files:
-        progress(f"verifying {name}")
-        digest = hashlib.sha256(data).hexdigest()
-        if transport.fs_hashfile(name, "sha256").hex() != digest:
-            raise DeviceError(f"{name} on the board does not match the copy sent (SHA-256)",
-                              "flash again; if it persists, the board's filesystem may be full or failing")
-        result.files.append(FlashedFile(name, len(data), digest))
+
+
+def write_board_file(transport, name: str, data: bytes) -> None:
+    """Replace ``name`` on the board whole, or leave it as it was (written as NAME.part, renamed)."""
+    try:
+        _write_part(transport, name, data)
+    except BaseException:
+        _remove_parts(transport, [name])
+        raise
+    _rename(transport, name + PART, name)
+
+
+def _write_part(transport, name: str, data: bytes) -> None:
+    try:
+        transport.fs_writefile(name + PART, data)
+    except OSError as exc:   # mpremote turns the board's OSError into one: (errno, the file's name)
+        what = os.strerror(exc.errno) if exc.errno else str(exc)
+        raise DeviceError(f"cannot write {name} on the board ({what})", BOARD_FULL_HINT) from None
+
+
+def _rename(transport, old: str, new: str) -> None:
+    transport.exec(f"import os\nos.rename({old!r}, {new!r})")
+
+
+def _remove_parts(transport, names: list[str]) -> None:
+    from mpremote.transport import TransportError
+
+    for name in names:
+        try:
+            if transport.fs_exists(name + PART):
+                transport.fs_rmfile(name + PART)
+        except (TransportError, OSError):
+            pass

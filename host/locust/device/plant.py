@@ -68,6 +68,7 @@ class MujocoPlant:
         self.sim = LiveSim(robot, video_path=str(video_path) if video_path else None, fps=video_fps)
         self.on_hop = on_hop
         self._told = 0
+        self.films = video_path is not None   # it renders a video
 
     def command(self, t_s: float, left_deg: float, right_deg: float) -> None:
         self.sim.advance_to(t_s)
@@ -98,6 +99,10 @@ class MujocoPlant:
     def abort(self) -> None:
         """After a failure: no half-written video is left."""
         self.sim.abort()
+
+    def cancel(self) -> None:
+        """From another thread: make the thread feeding this plant stop soon (it then aborts)."""
+        self.sim.cancel()
 
 
 def mujoco_available() -> bool:

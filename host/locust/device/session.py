@@ -28,7 +28,14 @@ def open_port(port: str | None, plant: str = "auto", video: Path | None = None, 
                               f"folder {flash} has no firmware)",
                               "flash it once: it stays flashed for every later --port sim command")
 
-        vr = VirtualRobot(plant=make_plant(plant, robot, video, video_fps)).start()
+        model = make_plant(plant, robot, video, video_fps)
+        try:
+            vr = VirtualRobot(plant=model).start()
+        except BaseException:   # (a signal while it boots) the plant's video is dropped, not left half made
+            abort = getattr(model, "abort", None)
+            if abort is not None:
+                abort()
+            raise
         try:
             if info:
                 info(f"virtual robot on {vr.device_path} (flash {vr.flash_dir}, {vr.scheduling} scheduling)")
@@ -42,3 +49,4 @@ def open_port(port: str | None, plant: str = "auto", video: Path | None = None, 
                     info(line)
         return
     yield port or autodetect(list_serial_ports())
+

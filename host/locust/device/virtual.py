@@ -63,6 +63,8 @@ from .plant import Plant, RecordingPlant
 
 SHIM_DIR = Path(__file__).resolve().parent / "machine_shim"
 PWM_PERIOD_S = 0.020
+VIDEO_NOT_KEPT = "interrupted while the virtual robot's video was being finished: the video was not kept"
+PLANT_CANCEL_TIMEOUT_S = 30.0  # a cancelled plant stops within a frame or a step; this long at the most
 PLANT_CLOSE_TIMEOUT_S = 600.0  # the simulation may still be rendering its video when the hop ends
 TICKS_PERIOD = 1 << 30  # an ESP32's ticks_us() wraps at 2**30 us
 TICKS_LEAD_S = 7.0      # each boot's ticks start this long before a wrap (a 7.8 s hop started within 7 s crosses it)
@@ -213,6 +215,9 @@ class VirtualRobot:
         self._proc_lock = threading.Lock()
         self._threads: list[threading.Thread] = []
         self._plant_queue: queue.Queue = queue.Queue()
+        # set by the plant thread as it ends: waited on instead of Thread.join, which a signal
+        # interrupting it (Python 3.11) leaves saying the thread ended while it still runs
+        self._plant_done = threading.Event()
         self._t0 = time.monotonic()
         self._config_cache: tuple[float, dict] | None = None
         # one PWM timer for both servos (they run at the same 50 Hz: MicroPython's ESP32 PWM
@@ -227,6 +232,7 @@ class VirtualRobot:
         self._pwm_pending = b""
         self.summary: dict | None = None
         self.plant_error: BaseException | None = None   # raised by stop()
+        self.video_dropped = False   # cancel(): the plant was stopped, its video not kept
 
     # -- lifecycle ---------------------------------------------------------------------
     def start(self) -> VirtualRobot:
@@ -282,10 +288,46 @@ class VirtualRobot:
         self._next_reset_cause = RESET_SOFT  # until machine.reset() says otherwise
 
     def stop(self) -> dict:
-        """Stop the interpreter and the threads; close the plant; returns its summary."""
+        """Stop the interpreter and the threads; close the plant; returns its summary.
+
+        A signal while stopping (TERM, Ctrl-C: an exception raised here) cancels the plant
+        instead of waiting for its video: the plant thread, which owns the renderer and the
+        encoder, drops the video itself, and this thread waits for that before it lets the
+        exception end the process (the interpreter leaving under a thread still inside OpenGL
+        or the encoder crashed it). :attr:`video_dropped` then says so."""
         if self._stopping.is_set():
             return self.summary or {}
         self._stopping.set()
+        plant_thread = next((t for t in self._threads if t.name.endswith("-plant")), None)
+        try:
+            self._stop_interpreter()
+            # the plant thread finishes the simulation and its video: that can take a while
+            # on a loaded machine, and leaving early would lose the video
+            unfinished = plant_thread is not None and self._wait_plant(PLANT_CLOSE_TIMEOUT_S)
+        except BaseException:   # (KeyboardInterrupt, or SystemExit from a TERM handler)
+            self.cancel()
+            self._plant_queue.put(None)   # a plant thread waiting for a command ends too
+            if plant_thread is not None:
+                self._wait_plant(PLANT_CANCEL_TIMEOUT_S, cancel=True)
+            self._end_quietly()
+            self._release()
+            raise self._dropped() from None
+        self._release()
+        if self.video_dropped:
+            raise self._dropped()
+        if self.plant_error is not None:
+            exc = self.plant_error
+            what = exc.message if isinstance(exc, LocustError) else f"{exc.__class__.__name__}: {exc}"
+            raise DeviceError(f"the virtual robot's simulation failed, so its video and summary were not written "
+                              f"({what})", exc.hint if isinstance(exc, LocustError) and exc.hint else DISK_HINT)
+        if unfinished:
+            raise DeviceError(f"the virtual robot's simulation did not finish within {PLANT_CLOSE_TIMEOUT_S:g} s "
+                              "of the hop (its video was not written)",
+                              "rerun on a less loaded machine, or without --video")
+        return self.summary or {}
+
+    def _stop_interpreter(self) -> None:
+        """End MicroPython and every thread but the plant's, and hand the plant its last writes."""
         with self._proc_lock:
             proc = self._proc
         if proc and proc.poll() is None:
@@ -295,20 +337,56 @@ class VirtualRobot:
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
-        plant_thread = None
         for thread in self._threads:
-            if thread.name.endswith("-plant"):
-                plant_thread = thread
-            else:
+            if not thread.name.endswith("-plant"):
                 thread.join(timeout=5)
         self._drain_pwm()  # the last PWM writes (a pose, the rest after a hop) may still be in the FIFO
         self._plant_queue.put(None)
-        # the plant thread finishes the simulation and its video: that can take a while
-        # on a loaded machine, and leaving early would lose the video
-        plant_unfinished = False
-        if plant_thread is not None:
-            plant_thread.join(timeout=PLANT_CLOSE_TIMEOUT_S)
-            plant_unfinished = plant_thread.is_alive()
+
+    def _end_quietly(self) -> None:
+        """After an interruption: the interpreter killed and the other threads ended (they
+        see :attr:`_stopping` within 0.2 s) before their descriptors are closed; every further
+        signal meanwhile is taken."""
+        for step in (self._kill_interpreter, *(lambda t=t: t.join(timeout=2) for t in self._threads
+                                               if not t.name.endswith("-plant"))):
+            try:
+                step()
+            except BaseException:
+                pass
+
+    def _kill_interpreter(self) -> None:
+        with self._proc_lock:
+            proc = self._proc
+        if proc and proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+    def cancel(self) -> None:
+        """Drop the plant's video rather than finish it (the command was interrupted): the plant
+        thread stops at its next step or frame and removes it; :meth:`stop` then says so."""
+        self.video_dropped = True
+        cancel = getattr(self.plant, "cancel", None)
+        if cancel is not None:
+            cancel()
+
+    def _dropped(self) -> DeviceError:
+        what = VIDEO_NOT_KEPT if getattr(self.plant, "films", False) else "interrupted while the virtual robot stopped"
+        return DeviceError(what, "run it again to have the video; let the command end to keep it")
+
+    def _wait_plant(self, wait_s: float, cancel: bool = False) -> bool:
+        """Wait up to ``wait_s`` for the plant thread to end; True if it still runs. With
+        ``cancel``, every signal meanwhile is taken (the one that cancelled it is being handled)."""
+        deadline = time.monotonic() + wait_s
+        while not self._plant_done.is_set() and time.monotonic() < deadline:
+            try:
+                self._plant_done.wait(timeout=min(1.0, max(0.0, deadline - time.monotonic())))
+            except BaseException:
+                if not cancel:
+                    raise
+        return not self._plant_done.is_set()
+
+    def _release(self) -> None:
+        """Close the pseudo-terminals and the PWM pipe, remove the temporary folder, close the log."""
         for fd in (self._ma, self._sa, self._mb, self._sb, self._fifo, self._fifo_keep):
             try:
                 os.close(fd)
@@ -317,16 +395,6 @@ class VirtualRobot:
         shutil.rmtree(self._tmp, ignore_errors=True)
         if self._log:
             self._log.close()
-        if self.plant_error is not None:
-            exc = self.plant_error
-            what = exc.message if isinstance(exc, LocustError) else f"{exc.__class__.__name__}: {exc}"
-            raise DeviceError(f"the virtual robot's simulation failed, so its video and summary were not written "
-                              f"({what})", exc.hint if isinstance(exc, LocustError) and exc.hint else DISK_HINT)
-        if plant_unfinished:
-            raise DeviceError(f"the virtual robot's simulation did not finish within {PLANT_CLOSE_TIMEOUT_S:g} s "
-                              "of the hop (its video was not written)",
-                              "rerun on a less loaded machine, or without --video")
-        return self.summary or {}
 
     def __enter__(self) -> VirtualRobot:
         return self.start()
@@ -484,6 +552,12 @@ class VirtualRobot:
     def _feed_plant(self) -> None:
         """The plant thread: an error of the plant (its video onto a full disk) is kept for
         :meth:`stop` to raise in the caller's thread, and the plant is aborted."""
+        try:
+            self._feed_plant_guarded()
+        finally:
+            self._plant_done.set()
+
+    def _feed_plant_guarded(self) -> None:
         stopped = []
         try:
             self._feed_plant_until_stopped(stopped)

@@ -10,11 +10,14 @@ import click
 
 from ..errors import FabError
 from ..fileio import json_text
-from ..options import FINITE
+from ..options import FINITE, FiniteFloat
 from . import export, flat_pattern, laminate, preview
 from .design import LayerMap, design_from_drawing, parse_layer_options
 from .dxf_read import UNIT_BY_NAME, read_drawing
 from .summary import summary, summary_text
+
+# a fold's cut-out is a millimetre or two wide (the seed's 1 mm); one of 50 mm takes a whole link away
+MAX_HINGE_WIDTH_MM = 50.0
 
 
 def _robot(spec: str):
@@ -72,7 +75,8 @@ def _cad_check(out: Path, names: list[str]) -> dict:
 @click.option("--gap-tol-mm", type=FINITE, default=0.01, show_default=True,
               help="Join open outline pieces whose ends are this close.")
 @click.option("--recover", is_flag=True, help="Read a damaged DXF with ezdxf's recover mode.")
-@click.option("--hinge-width-mm", type=FINITE, default=1.0, show_default=True,
+@click.option("--hinge-width-mm", type=FiniteFloat(positive=True, high=MAX_HINGE_WIDTH_MM), default=1.0,
+              show_default=True,
               help="Width of the cut-out made from a fold line on a hinge layer.")
 @click.option("--stack", default=",".join(laminate.SEED_STACK), show_default=True,
               help="Layer materials, top to bottom (rigid, adhesive, flexible).")

@@ -229,11 +229,14 @@ def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
         raise FabError(f"{drawing.path}: the body outline encloses no area", "check the body layer")
 
     hinges: list[HingeCut] = []
-    for c in drawing.points:
-        if layer_map.role_of(c.layer) == "hinge":
-            raise FabError(f"layer {c.layer!r}: hinge {', '.join(c.entities)} at {_fmt(c.start_mm)} has no length "
-                           f"(shorter than --gap-tol-mm {gap_tol_mm:g})",
-                           "draw the fold line across the body, or delete it")
+    for c in drawing.points:   # a cut that cannot be made is an error, never a cut file without it
+        role = layer_map.role_of(c.layer)
+        if role in ("hinge", "cuts", "holes"):
+            what = {"hinge": "hinge", "cuts": "cut", "holes": "hole"}[role]
+            raise FabError(f"layer {c.layer!r}: {what} {', '.join(c.entities)} at {_fmt(c.start_mm)} has no length "
+                           f"(shorter than --gap-tol-mm {gap_tol_mm:g}, or of zero radius)",
+                           "draw the fold line across the body, or delete it" if role == "hinge"
+                           else "draw it to its size, or delete it")
     for c in by_role["hinge"]:
         if c.closed:
             poly = _polygon(c)

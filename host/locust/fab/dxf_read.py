@@ -41,6 +41,12 @@ CURVES = {"LINE", "ARC", "LWPOLYLINE", "POLYLINE", "CIRCLE", "ELLIPSE", "SPLINE"
 # they are counted before any is expanded.
 MAX_INSERT_DEPTH = 8
 MAX_EXPANDED_ENTITIES = 50_000
+# A SPLINE of more control or fit points than this is refused before it is flattened, and no
+# curve is flattened into more vertices than MAX_CURVE_VERTICES: a laser outline's spline has
+# tens to hundreds of points (500 flatten into about 2,000 vertices), while one of 200,000
+# control points grew memory by 300 MB/s for minutes.
+MAX_SPLINE_POINTS = 20_000
+MAX_CURVE_VERTICES = 200_000
 
 
 # An arc is flattened into chords no further than the sagitta from it: a circle of 10 m at
@@ -130,6 +136,10 @@ def drawing_units(doc, override: str | None) -> tuple[str, float, str]:
     if code in INSUNITS:
         name, mm = INSUNITS[code]
         return name, mm, "$INSUNITS"
+    if code != 0:   # 0 is "unitless"; any other code this table lacks is not a length unit it can read
+        raise FabError(f"$INSUNITS = {code} is not a drawing unit locust knows "
+                       f"({', '.join(f'{c} {n}' for c, (n, _) in sorted(INSUNITS.items()))})",
+                       f"give the drawing's unit with --units ({', '.join(UNIT_BY_NAME)})")
     return "mm", 1.0, "assumed (no $INSUNITS)"
 
 
@@ -186,6 +196,8 @@ def _entities_by_layer(msp) -> tuple[dict[str, list], Counter]:
             for sub in entity.virtual_entities():
                 visit(sub, layer, depth + 1)
         elif kind in CURVES:
+            if kind == "SPLINE":
+                _check_spline(entity, layer)
             by_layer[layer].append(entity)
         else:
             skipped[kind] += 1
@@ -200,8 +212,27 @@ def _label(entity) -> str:
     return f"{entity.dxftype()} #{handle}" if handle else entity.dxftype()
 
 
-def _flat(path, sagitta: float) -> np.ndarray:
-    pts = np.array([(v.x, v.y) for v in path.flattening(distance=sagitta)], dtype=float)
+def _check_spline(entity, layer: str) -> None:
+    n = max(entity.control_point_count(), entity.fit_point_count())
+    if n > MAX_SPLINE_POINTS:
+        raise FabError(f"layer {layer!r}: {_label(entity)} has {n:,} points, over the {MAX_SPLINE_POINTS:,} a cut "
+                       "outline's spline may have (refused before flattening it)",
+                       "simplify the curve in the CAD program (fewer control points), or draw it as a polyline")
+
+
+def _flat(path, sagitta: float, layer: str, labels: tuple[str, ...]) -> np.ndarray:
+    """``path`` as vertices ``sagitta`` from the curve, at most MAX_CURVE_VERTICES of them."""
+    vertices = []
+    for v in path.flattening(distance=sagitta):
+        vertices.append((v.x, v.y))
+        if len(vertices) > MAX_CURVE_VERTICES:
+            raise FabError(f"layer {layer!r}: {', '.join(labels[:3])} flattens into more than "
+                           f"{MAX_CURVE_VERTICES:,} vertices (refused before the rest)",
+                           "simplify the curve in the CAD program, or split it into shorter pieces")
+    pts = np.array(vertices, dtype=float).reshape(-1, 2)
+    if not np.isfinite(pts).all():   # (before the repeats are dropped: NaN is never "repeated")
+        raise FabError(f"layer {layer!r}: {', '.join(labels[:3])} has a vertex that is not a finite number "
+                       "(NaN or inf)", "fix the drawing in the CAD program, or redraw that entity")
     if len(pts) > 1:   # drop repeated vertices (segment joints)
         keep = np.r_[True, np.any(np.abs(np.diff(pts, axis=0)) > 1e-12, axis=1)]
         pts = pts[keep]
@@ -332,10 +363,16 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
         check_entity(entity, layer, sag)
         try:
             closed = es.is_closed_entity(entity)
-        except Exception:  # degenerate entity (zero radius, no vertices)
+        except MemoryError:
+            raise FabError(f"layer {layer!r}: {_label(entity)} is too large to read",
+                           "simplify it in the CAD program") from None
+        except Exception:  # degenerate entity (zero radius, no vertices): a point the caller names
+            point = _anchor(entity)
+            if point is not None:
+                emit(point, False, (_label(entity),))
             continue
         if closed:
-            emit(_flat(ezpath.make_path(entity), sag), True, (_label(entity),))
+            emit(_flat(ezpath.make_path(entity), sag, layer, (_label(entity),)), True, (_label(entity),))
         else:
             open_pieces.append(entity)
 
@@ -359,7 +396,7 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
     deposit = em.Deposit(edges, gap_tol=gap)
     for chain in em.find_all_simple_chains(deposit):
         labels = tuple(_label(e.payload) for e in chain)
-        pts = _flat(es.path2d_from_chain(chain), sag)
+        pts = _flat(es.path2d_from_chain(chain), sag, layer, labels)
         emit(pts, em.is_loop(chain, gap_tol=gap), labels)
     return out
 

@@ -15,13 +15,14 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from ..errors import DeviceError
-from ..fileio import atomic_write_json, make_folder, unique_dir
+from ..fileio import atomic_write_json, claim_folder, make_folder, unique_dir
 from ..firmware import protocol as P
 
 COMPLETE = "complete"
@@ -257,13 +258,31 @@ def run_dir(out: Path | None, root: Path = Path("data/runs")) -> Path:
     if out is None:
         return unique_dir(root, time.strftime("%Y%m%d-%H%M%S"))
     out = Path(out)
-    if (out / RECORD_NAME).exists():
-        raise DeviceError(f"{out / RECORD_NAME} already exists; a run record is never overwritten",
-                          "pass another --out directory, or leave --out off for a new data/runs/<timestamp>/")
+    _refuse_record(out)
     if out.exists() and not out.is_dir():
         raise DeviceError(f"--out {out} is a file, not a directory", "pass a directory path")
     make_folder(out)
     return out
+
+
+def _refuse_record(directory: Path) -> None:
+    if (directory / RECORD_NAME).exists():
+        raise DeviceError(f"{directory / RECORD_NAME} already exists; a run record is never overwritten",
+                          "pass another --out directory, or leave --out off for a new data/runs/<timestamp>/")
+
+
+def claim(directory: Path) -> int:
+    """Hold ``directory`` (from :func:`run_dir`) for one run: an exclusive lock on the folder,
+    refused at once while another process holds it, then the check that it holds no record yet
+    (another run may have finished there since :func:`run_dir` looked). Close the returned
+    descriptor when the run's record is final."""
+    fd = claim_folder(directory)
+    try:
+        _refuse_record(directory)
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd
 
 
 def write(record: RunRecord, directory: Path) -> Path:

@@ -10,7 +10,6 @@ the same whatever ran it. Floats are written with ``repr``: they read back bit f
 from __future__ import annotations
 
 import csv
-import fcntl
 import io
 import json
 import math
@@ -20,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SweepError
-from ..fileio import atomic_write_json, atomic_write_text, make_folder
+from ..fileio import atomic_write_json, atomic_write_text, make_folder, try_lock
 
 RESULTS = "results.csv"
 META = "sweep.json"
@@ -156,22 +155,25 @@ class SweepStore:
                 raise SweepError(f"{folder} holds a different sweep (base, --vary, --cycles or parameters differ)",
                                  "use a new --out folder, or rerun the exact command that made it to resume")
             store.done = store._read_rows()
-        elif folder.exists() and any(folder.iterdir()):
+        elif folder.exists() and any(p.name != LOCK for p in folder.iterdir()):   # (a sweep that failed before
+            # its sweep.json was written, a full disk, leaves only its lock: it is started again)
             raise SweepError(f"{folder} exists and is not a sweep folder; refusing to write into it",
                              "choose a new or empty --out folder")
         make_folder(folder)
         store._lock()
-        atomic_write_json(meta_path, meta)
-        store._rewrite(sorted(store.done))
+        try:
+            atomic_write_json(meta_path, meta)
+            store._rewrite(sorted(store.done))
+        except BaseException:   # (a full disk) the lock goes with the failed start
+            os.close(store._lock_fd)
+            store._lock_fd = None
+            raise
         return store
 
     def _lock(self) -> None:
         """One sweep at a time per folder: a second one would compute and append the same rows."""
-        fd = os.open(self.folder / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
+        fd = try_lock(self.folder / LOCK)
+        if fd is None:
             raise SweepError(f"another sweep is running in {self.folder}",
                              "wait for it to finish (or stop it), or use another --out folder") from None
         self._lock_fd = fd

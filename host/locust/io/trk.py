@@ -164,6 +164,14 @@ def _object(p: ET.Element | None) -> ET.Element | None:
     return None if p is None else p.find("object")
 
 
+def _check_clip(path: Path, start: int, step: int, count: int | None) -> None:
+    """A clip's frames count up from a frame >= 0 in steps >= 1, at least one of them."""
+    for name, value, low in (("startframe", start, 0), ("stepsize", step, 1), ("stepcount", count, 1)):
+        if value is not None and value < low:
+            raise TrackError(f"{path}: the clip's {name} is {value}; it must be at least {low}",
+                             "set the clip again in Tracker (Video > Clip Settings) and save the project")
+
+
 def _project(path: Path, root: ET.Element) -> TrackerProject:
     clip_obj = _object(_prop(root, "videoclip"))
     control = _object(_prop(root, "clipcontrol"))
@@ -171,6 +179,7 @@ def _project(path: Path, root: ET.Element) -> TrackerProject:
     step = _value(clip_obj, "stepsize", int, 1)
     count = _value(clip_obj, "stepcount", int, None)
     dt_ms = _value(control, "delta_t", float, None)
+    _check_clip(path, start, step, count)
     video = _object(_prop(clip_obj, "video"))
     video_path = _value(video, "path", str, None)
 
@@ -181,6 +190,10 @@ def _project(path: Path, root: ET.Element) -> TrackerProject:
         frame0 = _object(fd.find("property")) if fd is not None and fd.find("property") is not None else None
     unit = LENGTH_UNITS_M.get((_value(root, "length_unit", str, "m") or "m").strip(), math.nan)
     px_per_unit = _value(frame0, "xscale", float, math.nan)
+    if px_per_unit is not None and px_per_unit <= 0:   # (NaN: no scale, read as pixels)
+        raise TrackError(f"{path}: the coordinate system's scale (xscale) is {px_per_unit:g} px per unit; it must be "
+                         "above 0 (a negative one would mirror every position)",
+                         "set the scale again in Tracker (a calibration stick or tape) and save the project")
     calibration = Calibration(
         m_per_px=unit / px_per_unit if px_per_unit and math.isfinite(px_per_unit) else math.nan,
         origin_x_px=_finite(path, frame0, "xorigin") + TRACKER_TO_OPENCV_PX,

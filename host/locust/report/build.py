@@ -7,14 +7,16 @@ bad input stops the report before anything is written.
 
 from __future__ import annotations
 
+import contextlib
 import math
+import shutil
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from .. import __version__
-from ..errors import ReportError
+from ..errors import ReportError, WriteError
 from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, unique_dir
 from ..io.run_record import ERROR as REFUSED
 from ..params import Provenance, Robot
@@ -132,12 +134,20 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
 
     folder = unique_dir(out, "report")
-    html_path = atomic_write_text(folder / REPORT_NAME, html_text)
-    dash_path = atomic_write_bytes(folder / DASHBOARD_NAME, dash)
-    videos = write_side_by_side(sbs_plan, folder, progress) if sbs_plan is not None else []
-    if sbs_plan is not None:
-        doc["side_by_side"] = [v.to_json() for v in videos]
-    json_path = atomic_write_json(folder / JSON_NAME, {**doc, "wall_s": round(time.perf_counter() - t0, 2)})
+    try:
+        html_path = atomic_write_text(folder / REPORT_NAME, html_text)
+        dash_path = atomic_write_bytes(folder / DASHBOARD_NAME, dash)
+        videos = write_side_by_side(sbs_plan, folder, progress) if sbs_plan is not None else []
+        if sbs_plan is not None:
+            doc["side_by_side"] = [v.to_json() for v in videos]
+        json_path = atomic_write_json(folder / JSON_NAME, {**doc, "wall_s": round(time.perf_counter() - t0, 2)})
+    except WriteError:   # (a full disk) the new folder, made by this run, is not left half a report
+        shutil.rmtree(folder, ignore_errors=True)
+        raise
+    except BaseException:   # interrupted: what was written is kept; an empty folder is not
+        with contextlib.suppress(OSError):
+            folder.rmdir()
+        raise
     return ReportResult(folder, html_path, dash_path, json_path, comps, [f.key for f in figs],
                         warnings=warnings, side_by_side=videos)
 

@@ -102,6 +102,7 @@ class LiveSim:
         self._diverged = False
         self._result: LiveResult | None = None
         self._lock = threading.Lock()
+        self._cancelled = threading.Event()   # set from another thread: stop stepping and rendering
         self._fps = fps
         self._recorder: ClipRecorder | None = None
         self._next_frame = 0
@@ -114,7 +115,11 @@ class LiveSim:
             # a clip starts with the robot standing, as a real one would: filmed, at rest,
             # before the first command can arrive (the report finds the first push by it)
             self._recorder = self._open_video(path, fps, width, height, fixed_view)
-            self._run_to(self._steps + int(round(PREROLL_S / self.dt)))
+            try:
+                self._run_to(self._steps + int(round(PREROLL_S / self.dt)))
+            except BaseException:   # (a signal) no temporary video is left
+                self._recorder.abort()
+                raise
         self._settle_steps = self._steps
 
     # -- commands -------------------------------------------------------------------
@@ -145,6 +150,9 @@ class LiveSim:
     # -- stepping -------------------------------------------------------------------
     def _run_to(self, target_step: int) -> None:
         while self._steps < target_step and not self._diverged:
+            if self._cancelled.is_set():
+                raise SimError("the live simulation was cancelled (the command was interrupted)",
+                               "run it again to have its video")
             stop = target_step
             if self._recorder is not None:
                 frame_step = self._frame_step(self._next_frame)
@@ -293,6 +301,12 @@ class LiveSim:
 
     def __enter__(self) -> LiveSim:
         return self
+
+    def cancel(self) -> None:
+        """Ask the thread stepping this simulation (and rendering its video) to stop soon: its
+        next step or frame raises :class:`SimError`; it then calls :meth:`abort` itself. Any
+        thread may call this; only the owner touches the renderer and the encoder."""
+        self._cancelled.set()
 
     def abort(self) -> None:
         """End a failed run: its video is dropped (no half-written file), the result says aborted."""

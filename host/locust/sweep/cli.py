@@ -143,8 +143,11 @@ def _steps(items: tuple[str, ...]) -> dict[str, float]:
 @click.option("--scheduler", default="local", show_default=True, metavar="local|dask-local|tcp://HOST:PORT",
               help="local: --jobs processes; dask-local or tcp://...: a Dask cluster (its workers must reach "
                    "--storage).")
+@click.option("--repair", is_flag=True,
+              help="First mend a journal whose last line a full disk left torn: the file is saved as "
+                   "study.journal.torn-N beside it, then the torn line is cut (every whole trial kept).")
 def optimize(preset, config, sets, varies, steps, objective_names, draws, quantile, max_flip, trials, cycles, out,
-             storage, study_name, sampler, seed, jobs, scheduler):
+             storage, study_name, sampler, seed, jobs, scheduler, repair):
     """Search design ranges for the hops that go farthest and highest without going over (Optuna).
 
     Each design is checked, simulated, audited and classified (goes_over, rears_and_returns,
@@ -173,6 +176,8 @@ def optimize(preset, config, sets, varies, steps, objective_names, draws, quanti
     if unknown:
         raise SweepError(f"--step {unknown[0]}: no --vary range of that name", "give --vary NAME=LOW:HIGH with it")
     objectives = objectives_named(list(objective_names))
+    if repair:
+        _repair(storage, out)
     with progress(length=trials, label="optimize", show_pos=True, show_eta=True) as bar:
         summary = run_optimize(base, bounds, trials, cycles, out, storage=storage, study_name=study_name,
                                seed=seed, jobs=jobs, progress=bar.update, objectives=objectives, draws=draws or 0,
@@ -197,3 +202,17 @@ def _report(summary, bounds, objectives, out: Path) -> None:
         click.echo(f"interrupted: {kept} finished trial{'s' * (kept != 1)} kept in the study and the files above "
                    "(a trial under way is not); rerun the same command to continue", err=True)
         sys.exit(130)
+
+
+def _repair(storage: str | None, out: Path) -> None:
+    """--repair: cut the torn last line of the study's journal file (saved beside it first)."""
+    from .journal import repair
+    from .optimize import RDB_PREFIXES
+
+    if storage is not None and storage.startswith(RDB_PREFIXES):
+        raise SweepError(f"--repair mends a journal file; --storage {storage} is a database",
+                         "leave --repair off (a database is not torn by a full disk)")
+    journal = Path(storage.removeprefix("journal:")) if storage else out / "study.journal"
+    if not journal.is_file():
+        raise SweepError(f"--repair: there is no journal {journal}", "give the --out (or --storage) of the study")
+    click.echo(repair(journal).line(), err=True)

@@ -85,6 +85,14 @@ def check_name(name: str, base: Robot) -> None:
                          "give --cycles N instead (one run per number of hops, each with its own --out)")
 
 
+def is_integer(base: Robot, name: str) -> bool:
+    """Whether the parameter ``name`` holds whole numbers (schedule.cycles, solver.iterations)."""
+    if name == SCALE:
+        return False
+    value = base.get(name)
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
 def check_range(item: str, name: str, low: float, high: float, base: Robot) -> None:
     """Both ends of a --vary range within the limits of what it changes (``scale``: the four
     links), checked before any design runs: a range outside is a unit slip (centimetres typed
@@ -135,7 +143,15 @@ def parse_axis(item: str, base: Robot) -> Axis:
     if int(n) == 1 and start != stop:
         raise SweepError(f"--vary {item!r}: one design cannot span {start:g}..{stop:g}", "use N >= 2")
     check_range(item, name, start, stop, base)
-    return Axis(name, start, stop, int(n))
+    axis = Axis(name, start, stop, int(n))
+    if is_integer(base, name):
+        fractions = [v for v in axis.values() if v != round(v)]
+        if fractions:
+            raise SweepError(f"--vary {item!r}: {name} is a whole number, and this range gives "
+                             f"{', '.join(f'{v:g}' for v in fractions[:3])}",
+                             "choose START, STOP and N so that every step is whole, e.g. "
+                             f"--vary {name}={math.ceil(start)}:{math.ceil(start) + int(n) - 1}:{int(n)}")
+    return axis
 
 
 def parse_bound(item: str, base: Robot, step: float | None = None) -> Bound:

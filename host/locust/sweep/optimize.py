@@ -29,7 +29,8 @@ from ..errors import SweepError
 from ..fileio import atomic_write_json, make_folder
 from ..io.study_store import write_tables
 from ..params import Robot, save_robot
-from .design import SCALE, Bound, design_robot
+from .design import Bound, design_robot, is_integer
+from .journal import full_disk
 from .objectives import OBJECTIVES, OUTCOMES, Judgement, Objective
 from .pareto import picks, plot_front
 from .storage import SETTINGS_ATTR, check_folder, check_journal_file, check_storage, open_storage
@@ -64,14 +65,6 @@ def check_settings(study, wanted: dict[str, Any], where: str) -> None:
         diff += [k for k, v in wanted["parameters"].items() if params.get(k) != v][:3]
         raise SweepError(f"{where}: study {study.study_name!r} searches other settings ({', '.join(diff) or 'ranges'} "
                          "differ); its trials cannot be ranked against these", hint)
-
-
-def is_integer(base: Robot, name: str) -> bool:
-    """Whether the parameter ``name`` holds whole numbers (solver.iterations)."""
-    if name == SCALE:
-        return False
-    value = base.get(name)
-    return isinstance(value, int) and not isinstance(value, bool)
 
 
 @dataclass(frozen=True)
@@ -257,6 +250,14 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
                 computed += number >= 0
                 if progress:
                     progress(1)
+    except (OSError, AssertionError) as exc:   # Optuna's own assertion fails after its write did
+        full = full_disk(exc)
+        if full is None:
+            raise
+        raise SweepError(f"{where}: the disk is full ({full.strerror}) while the study was written: the trial "
+                         "under way is lost, every finished one is kept in it",
+                         "free some space on that disk, then rerun the same command with --repair (it saves the "
+                         "study as it is and cuts a line the full disk left torn)") from None
     except KeyboardInterrupt:   # the trial under way is dropped (FAIL); every finished one is kept
         return summarise(optuna.load_study(study_name=study_name, storage=storage_obj), folder, base, objectives,
                          max_flip, computed, interrupted=True)

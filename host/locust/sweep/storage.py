@@ -20,6 +20,8 @@ OWN_FILES = frozenset({"trials.csv", "pareto.csv", "optimize.json", "pareto.png"
                        "study.journal.lock"})
 # and a robot file for each end of the front: best-<objective>.toml
 OWN_PREFIX, OWN_SUFFIX = "best-", ".toml"
+# a journal saved by --repair before its torn line was cut (sweep/journal.py)
+TORN_PREFIX = "study.journal.torn-"
 # the study's user attribute holding what it searches
 SETTINGS_ATTR = "locust"
 SQLITE_MAGIC = b"SQLite format 3\x00"
@@ -36,7 +38,8 @@ def check_folder(folder: Path) -> None:
     if not folder.is_dir():
         raise SweepError(f"--out {folder} is a file", "give a folder (new, or one `locust optimize` made)")
     names = {p.name for p in folder.iterdir() if not p.name.startswith(".")}
-    foreign = sorted(n for n in names - OWN_FILES if not (n.startswith(OWN_PREFIX) and n.endswith(OWN_SUFFIX)))
+    foreign = sorted(n for n in names - OWN_FILES
+                     if not (n.startswith(OWN_PREFIX) and n.endswith(OWN_SUFFIX)) and not n.startswith(TORN_PREFIX))
     ours = bool(names & {"optimize.json", "study.journal"})
     if foreign or (names and not ours):
         shown = ", ".join((foreign or sorted(names))[:5])
@@ -78,8 +81,9 @@ def check_journal_file(path: Path) -> None:
         if not lines[-1]:
             break
     if lines[-1]:
-        raise SweepError(f"{path}: a damaged Optuna journal (its last line is cut short)",
-                         "restore the file from a copy, or " + hint)
+        raise SweepError(f"{path}: a damaged Optuna journal (its last line is cut short, as a full disk leaves it)",
+                         "rerun the same command with --repair: it saves the file beside it and cuts the torn "
+                         "line, keeping every whole trial; or " + hint)
     for k, line in enumerate(lines[:-1]):
         try:
             op = json.loads(line)

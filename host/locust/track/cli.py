@@ -27,7 +27,7 @@ from .calib import PIXEL_CONVENTIONS, typed_px
 from .options import CALIBRATION, CLIP, FORMAT, OUTPUT, marker_options, stacked
 from .runner import track_video
 from .upright import upside_down_warnings
-from .video import Clip, probe
+from .video import Clip, VideoInfo, probe, read_as_frame
 
 SUBCOMMANDS = ("video", "import", "from-trk", "board", "preview")
 # the options of the one-command `locust track` that became subcommands, and their new form
@@ -279,9 +279,10 @@ def _refuse_overwrite(paths: dict[str, Path], force: bool) -> None:
         raise TrackError(f"output exists: {', '.join(taken)}", "choose another --out, or add --force to replace it")
 
 
-def _refuse_inputs(paths: dict[str, Path], inputs: list[Path]) -> None:
+def _refuse_inputs(paths: dict[str, Path], inputs: list[Path], info: VideoInfo | None = None) -> None:
     """No output may land on an input: the video, a Tracker project, or a sidecar beside them
-    (``<video>.camera.json``, ``<video>.truth.csv``), ``--force`` or not."""
+    (``<video>.camera.json``, ``<video>.truth.csv``), ``--force`` or not; nor on any frame of an
+    image sequence, nor where the next run would read it as one of its frames."""
     guarded = set()
     for p in inputs:
         guarded |= {p.resolve(), camera_json_beside(p).resolve(), p.with_name(p.stem + ".truth.csv").resolve()}
@@ -289,6 +290,10 @@ def _refuse_inputs(paths: dict[str, Path], inputs: list[Path]) -> None:
     if clash:
         raise TrackError(f"--out would overwrite an input or its sidecar: {', '.join(clash)}",
                          "choose another --out (the default, <video>.tracks.csv, is always safe)")
+    frames = [str(p) for p in paths.values() if info is not None and read_as_frame(info, p)]
+    if frames:
+        raise TrackError(f"--out would write {', '.join(frames)}, a frame of the image sequence {info.path} (or a "
+                         "file the next run would read as one)", "choose an --out outside the sequence's folder")
 
 
 def _base_path(out: Path | None, source: Path) -> Path:
@@ -297,6 +302,9 @@ def _base_path(out: Path | None, source: Path) -> Path:
         return source.with_name(default_stem)
     if out.is_dir():
         return out / default_stem
+    if out.exists() and not out.is_file():
+        raise TrackError(f"--out {out} is a device or pipe, not a folder or a file name",
+                         "give a folder, or the path of the tracks file to write")
     return out
 
 
@@ -321,7 +329,7 @@ def _track(video: Path, named: Path, project, models: list, cal: dict, clip: Cli
     paths = _outputs(_base_path(out, named), fmt, overlay_kind)
     if trk_out is not None:
         paths["trk"] = trk_out
-    _refuse_inputs(paths, [p for p in (video, named, cal["camera_json"], project and project.path) if p])
+    _refuse_inputs(paths, [p for p in (video, named, cal["camera_json"], project and project.path) if p], info)
     _refuse_overwrite(paths, force)
 
     n = len(clip.frames())

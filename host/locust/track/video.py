@@ -124,6 +124,23 @@ def image_sequence(path: Path) -> tuple[Path, ...]:
     return tuple(files)
 
 
+def read_as_frame(info: VideoInfo, path: Path) -> bool:
+    """Whether a file at ``path`` is a frame of the image sequence ``info``, or would be read as
+    one by the next run on it: a file of its folder with an image suffix (a folder sequence), or
+    its numbered name with another number (``shot07.jpg`` after ``shot00.jpg``). False for a
+    video file."""
+    if not info.images:
+        return False
+    path = Path(os.path.abspath(path))
+    if path.resolve() in {p.resolve() for p in info.images}:
+        return True
+    if info.path.is_dir():
+        return path.parent.resolve() == info.path.resolve() and path.suffix.lower() in IMAGE_SUFFIXES
+    m = re.fullmatch(r"(.*?)(\d+)", info.path.stem)
+    return bool(m and path.parent.resolve() == info.path.resolve().parent and path.suffix == info.path.suffix
+                and re.fullmatch(re.escape(m[1]) + r"\d+", path.stem))
+
+
 def _probe_images(path: Path, files: tuple[Path, ...]) -> VideoInfo:
     if len(files) < 2:
         raise TrackError(f"{path}: a single image, not a video or an image sequence",
