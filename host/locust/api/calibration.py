@@ -336,6 +336,8 @@ def calibrate_hops(robot: Robot, runs: Mapping[str, PathLike] | Sequence[PathLik
         The robot values fitted (default: foot friction, hinge stiffness, servo no-load speed).
     max_iter : int, default 30
         Solver iterations.
+    progress : callable, optional
+        ``progress(done, planned)``: the simulations done and planned, after each batch.
 
     Returns
     -------
