@@ -445,6 +445,7 @@ def _run_fits(residual: _HopResidual, x: np.ndarray, step_changes: list[float]) 
     run_fits, clusters = [], []
     for k, run in enumerate(residual.runs):
         sim = simulate_markers(run, residual.robots_at(run, x[None, :]))[0]
+        residual.tally.add(1)
         res, shift = aligned_residual(run, sim)
         clusters.append(k * 10_000 + hop_index(run, shift))
         by_marker, j = {}, 0
