@@ -140,3 +140,59 @@ def test_creeping_tip_is_refused():
     with pytest.raises(CalibrationError, match="no ring-down") as err:
         B.fit_beam(t, y, 0.095, length_m=0.048)
     assert "static deflection" in err.value.hint
+
+
+# Ring-downs with a release transient at the drop (a finger leaving the mass, a higher mode
+# of the strip): extra tip displacement of 30-100 % of the swing, of either sign, gone within
+# 3-10 ms, a decaying offset or a ringing at the strip's second-mode ratio (6.27 x fn); the
+# drop lands anywhere between two frames; 30-240 frames/s; all SYNTHETIC.
+def _transient_truth(zeta: float, seed: int) -> tuple[S.BeamTruth, np.random.Generator]:
+    rng = np.random.default_rng(5000 + seed)
+    fps = COVERAGE_FPS[seed % len(COVERAGE_FPS)]
+    base = dataclasses.replace(S.BeamTruth(), damping_ratio=zeta, fps=fps,
+                               mass_kg=COVERAGE_MASS_KG.get(fps, S.BeamTruth.mass_kg),
+                               noise_m=COVERAGE_NOISE_M[seed // len(COVERAGE_FPS) % len(COVERAGE_NOISE_M)])
+    wn = 2 * np.pi * base.natural_frequency_hz
+    swing = np.hypot(base.mass_kg * 9.81 / base.stiffness_n_per_m, np.sqrt(2 * 9.81 * base.drop_height_m) / wn)
+    return dataclasses.replace(base, drop_at_s=0.1 + rng.uniform(0, 1) / fps,
+                               transient_m=rng.choice([-1, 1]) * rng.uniform(0.3, 1.0) * swing,
+                               transient_s=rng.uniform(0.003, 0.010),
+                               transient_hz=rng.choice([0.0, 6.27 * base.natural_frequency_hz])), rng
+
+
+@pytest.mark.parametrize("sign", [1, -1])
+def test_release_transient_is_skipped(sign):
+    """A transient of 8 mm dying out in 6 ms at a drop on a frame of a 240 frames/s ring-down
+    (zeta 0.24): the window starts after it and the fit holds the truth; a window pinned at
+    the drop (--start-s) keeps it, and its interval widens for it (zeta 0.28 [0.20, 0.36] for
+    a push along the motion); SYNTHETIC."""
+    truth = dataclasses.replace(S.BeamTruth(), damping_ratio=0.24, transient_m=sign * 0.008, transient_s=0.006)
+    for seed in range(3):
+        t, x, y = S.beam_tip_track(truth, np.random.default_rng(seed))
+        d = B.principal_displacement(x, y)
+        fit = B.fit_beam(t, d, truth.mass_kg)
+        assert fit.fit_start_s > truth.drop_at_s + 0.008        # two frames after the drop at least
+        est = fit.damping_ratio
+        assert est.value == pytest.approx(0.24, rel=0.04) and est.ci95_low <= 0.24 <= est.ci95_high, est
+        pinned = B.fit_beam(t, d, truth.mass_kg, start_s=truth.drop_at_s)
+        assert pinned.fit_start_s == truth.drop_at_s
+        assert abs(pinned.damping_ratio.value - 0.24) > 0.01        # the transient biases it ...
+        assert pinned.damping_ratio.ci95_low <= 0.24 <= pinned.damping_ratio.ci95_high     # ... and widens it
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("zeta", [0.03, 0.10, 0.24])
+def test_release_transient_intervals_cover_over_seeds(zeta):
+    """95 % intervals over 90 transient ring-downs at each damping ratio (measured: zeta's
+    held the truth in 86, 86 and 83 of 90 at 0.03, 0.10, 0.24; before the transient was
+    skipped and the window's start assessed, 86, 84 and 77; the frequency's: 89, 87, 89 and
+    before 85, 75, 73); SYNTHETIC. test_release_transient_is_skipped is its fast companion."""
+    covered = {"natural_frequency_hz": 0, "damping_ratio": 0}
+    for seed in range(90):
+        truth, rng = _transient_truth(zeta, seed)
+        t, x, y = S.beam_tip_track(truth, rng)
+        fit = B.fit_beam(t, B.principal_displacement(x, y), truth.mass_kg)
+        for name, true in (("natural_frequency_hz", truth.natural_frequency_hz), ("damping_ratio", zeta)):
+            est = getattr(fit, name)
+            covered[name] += est.ci95_low <= true <= est.ci95_high
+    assert min(covered.values()) >= 0.88 * 90, covered

@@ -73,7 +73,29 @@ def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0) -> H
 @pytest.fixture(scope="module")
 def small_fit():
     run = synthetic_run("small", TRUTH)      # three hops: a cluster-robust interval on two values needs three
-    return run, H.fit_hops([run], list(TRUTH), max_iter=20, grid_stages=2)
+    calls = []
+    fit = H.fit_hops([run], list(TRUTH), max_iter=20, grid_stages=2, progress=lambda done, planned: calls.append(
+        (done, planned)))
+    small_fit_progress.extend(calls)
+    return run, fit
+
+
+small_fit_progress: list[tuple[int, int]] = []
+
+
+def test_fit_reports_its_simulations_done_and_planned(small_fit):
+    """Progress in simulations: the count only grows and ends at the fit's own; the plan made
+    before the first simulation is within a factor of 2 of what the fit took (167 planned, 230
+    taken: the solver tries more than one candidate in some iterations), so a time left from
+    it is too; once the solver stops, the plan is exact."""
+    _, fit = small_fit
+    done = [d for d, _ in small_fit_progress]
+    assert all(b > a for a, b in zip(done, done[1:])) and done[-1] == fit.simulations
+    first_plan = H.planned_simulations(1, 2, 0, 20, 2)
+    assert fit.simulations / 2 <= first_plan <= 2 * fit.simulations
+    assert small_fit_progress[-1] == (fit.simulations, fit.simulations)
+    # every rollout call holds at most CHUNK candidates, so the count moves while a batch runs
+    assert max(b - a for a, b in zip([0, *done], done)) <= H.CHUNK
 
 
 def test_fit_recovers_the_values_the_traces_were_made_with(small_fit):

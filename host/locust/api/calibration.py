@@ -355,6 +355,8 @@ def calibrate_hops(robot: Robot | None, runs: Mapping[str, PathLike] | Sequence[
         The robot values fitted (default: foot friction, hinge stiffness, servo no-load speed).
     max_iter : int, default 30
         Solver iterations.
+    progress : callable, optional
+        ``progress(done, planned)``: the simulations done and planned, after each batch.
 
     Returns
     -------

@@ -8,7 +8,10 @@ The tip moves as a damped linear oscillator after the mass is dropped on it::
 fitted by least squares to the tip's displacement along the direction it moves most
 (the first principal axis of the track, so the camera need not be level), started from the
 best points of a grid over frequency and damping (:func:`_start_values`), with intervals
-widened for residuals correlated from frame to frame (``fitstats.serial_covariance``). Then, with the
+widened for residuals correlated from frame to frame (``fitstats.serial_covariance``) and for
+what the window's first samples may hold that the model does not (a release transient at the
+drop, skipped where it stands out of the noise: :func:`_past_release`; the values' move when
+the window starts one sample later: :func:`_start_shift`). Then, with the
 oscillating mass m (tip mass plus 33/140 of the beam's own mass, Rayleigh's cantilever
 result):
 
@@ -27,7 +30,7 @@ material and width as the beam.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -53,6 +56,8 @@ LOWEST_CYCLES = 0.5                         # lowest frequency the fit allows: c
 START_FN_STEP = 0.01                        # relative step of the start grid's frequencies
 START_ZETAS = (0.005, 0.02, 0.05, 0.1, 0.2, 0.35, 0.6)   # the start grid's damping ratios
 START_COUNT = 3                             # starts refined by least squares: the grid's best local minima
+RELEASE_S = 0.015                           # a release transient dies out within this of the drop ...
+RELEASE_Z = 4.0                             # ... and leaves residuals above this many noise sigmas
 START_SAMPLES = 2048                        # the start grid looks at the window's first samples (the ring-down)
 
 
@@ -134,11 +139,12 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
              source: str = "beam") -> BeamFit:
     """Fit a damped oscillation to the tip displacement; see the module docstring."""
     t, y = _checked_window(t_s, displacement_m, mass_kg, length_m, start_s, end_s, source)
-    t0 = float(t[0])
     fs_hz = 1.0 / float(np.median(np.diff(t)))
-    best = _least_squares(t, y, fs_hz)
+    t, y, best = _past_release(t, y, fs_hz, pinned=start_s is not None)
+    t0 = float(t[0])
     p, r = best.x, best.fun
     cov, rho = serial_covariance(best.jac, r)
+    cov = replace(cov, shift=_start_shift(t, y, fs_hz, best))
     rms, amp, fn, zeta = _checked_oscillation(p, r, t, fs_hz, source)
     m = mass_kg + RAYLEIGH_TIP_FRACTION * beam_mass_kg
     wn = 2 * np.pi * fn
@@ -194,8 +200,7 @@ def _least_squares(t: np.ndarray, y: np.ndarray, fs_hz: float):
     """The damped oscillation of least squares from each start of the grid (scipy's result):
     the frequency between LOWEST_CYCLES over the window and Nyquist."""
     t0 = float(t[0])
-    lo = [-np.inf, -np.inf, -np.inf, LOWEST_CYCLES / (t[-1] - t0), ZETA_BOUNDS[0]]
-    hi = [np.inf, np.inf, np.inf, fs_hz / 2, ZETA_BOUNDS[1]]
+    lo, hi = _bounds(t, fs_hz)
     best = None
     for fn0, zeta0 in _start_values(t, y, lo[3], hi[3]):
         c0, a0, b0 = _linear_part(t - t0, y, fn0, zeta0)
@@ -205,6 +210,46 @@ def _least_squares(t: np.ndarray, y: np.ndarray, fs_hz: float):
         if best is None or res.cost < best.cost:
             best = res
     return best
+
+
+def _past_release(t: np.ndarray, y: np.ndarray, fs_hz: float, pinned: bool = False):
+    """The window from where the oscillator holds, and its least-squares fit: (t, y, fit).
+
+    The drop can leave a release transient the model does not explain (a finger leaving
+    the mass, a higher mode of the strip dying out in a few milliseconds). A sample of the
+    first ``RELEASE_S`` whose residual is more than ``RELEASE_Z`` times the noise of the rest
+    of the window (its median absolute deviation) is such a transient: the window then
+    starts after the last one and is fitted again. ``pinned``: the user gave the start.
+    """
+    best = _least_squares(t, y, fs_hz)
+    while not pinned:
+        r = best.fun
+        lead = max(int(np.sum(t - t[0] < RELEASE_S)), 1)
+        noise = 1.4826 * float(np.median(np.abs(r[lead:] - np.median(r[lead:]))))
+        off = np.flatnonzero(np.abs(r[:lead]) > RELEASE_Z * noise)
+        if not off.size or len(t) - off[-1] - 1 < MIN_SAMPLES:
+            break
+        t, y = t[off[-1] + 1:], y[off[-1] + 1:]
+        best = _least_squares(t, y, fs_hz)
+    return t, y, best
+
+
+def _start_shift(t: np.ndarray, y: np.ndarray, fs_hz: float, best) -> np.ndarray:
+    """How far the fitted values move when the window starts one sample later: what the
+    start of a ring-down the model may not wholly explain (the drop's first frames) does to
+    them, added to their uncertainty as a type-B part."""
+    t1, y1 = t[1:], y[1:]
+    t0 = float(t[0])
+    res = optimize.least_squares(lambda p: damped_oscillation(t1, p, t0) - y1, best.x, bounds=_bounds(t, fs_hz),
+                                 x_scale="jac", method="trf")
+    return res.x - best.x
+
+
+def _bounds(t: np.ndarray, fs_hz: float) -> tuple[list[float], list[float]]:
+    """The fit's bounds: the frequency between ``LOWEST_CYCLES`` over the window and Nyquist,
+    the damping ratio within ``ZETA_BOUNDS``."""
+    return ([-np.inf, -np.inf, -np.inf, LOWEST_CYCLES / (t[-1] - t[0]), ZETA_BOUNDS[0]],
+            [np.inf, np.inf, np.inf, fs_hz / 2, ZETA_BOUNDS[1]])
 
 
 def _checked_oscillation(p: np.ndarray, r: np.ndarray, t: np.ndarray, fs_hz: float,

@@ -363,8 +363,12 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
         overrides = parse_set_options(sets)
         base = check_robot(base.with_values(overrides, "override") if overrides else base)
         click.echo(said, err=True)
-    with progress(length=max_iter, label="fitting hops") as bar:
-        facade_fit = calibrate_hops(base, list(runs), keys, max_iter=max_iter, progress=bar.update)
+    with progress(label="fitting hops: simulations") as bar:
+        def done(n: int, planned: int) -> None:
+            bar.length = planned
+            bar.update(n - bar.pos)
+
+        facade_fit = calibrate_hops(base, list(runs), keys, max_iter=max_iter, progress=done)
     fit = facade_fit.result
     out = fit.summary()
     if not no_plot:

@@ -2,7 +2,8 @@
 hinges in the real linkage, the servo's speed on the robot's own battery.
 
 Each run is a ``locust hop --out`` folder: its ``run.json`` (the firmware's measured phase
-times) and the track of its video (nose, and foot where it was tracked). The simulation of a
+times) and the track of its video (nose, and foot where it was tracked), up to
+``REST_KEPT_S`` after the schedule's last phase ends. The simulation of a
 run is driven by those measured phase times (settled on the floor first, as ``locust sim``
 does), on the run's leg set built on the robot being fitted (:func:`locust.params.leg_set`,
 the presets' rule: its links and its converged time step), so runs of different leg sets
@@ -12,24 +13,25 @@ Before the fit each run's step is checked at the start values: halved (at most
 ``STEP_TOLERANCE_M`` (RMS over the tracked frames), so the fitted model is the converged one.
 
 Residual: the tracked markers against the same markers of the simulation, both from where
-they stood by the track's rule (the median of its frames before the first nose motion),
-put on the schedule's clock by the rule the report uses (:mod:`locust.trials.measure`: the
-first nose motion of more than 3 mm, the track's start placed where the simulation's is
-relative to its first push) and then each run's clock offset fitted about it, for every
-candidate (:func:`aligned_residual`). Every candidate of a solver
-iteration, the finite-difference columns included, is simulated in one batched
-``mujoco.rollout`` per run; the solver is ``mujoco.minimize.least_squares`` on the
-logarithm of each positive parameter (a factor is what a friction or a stiffness is known
-to). Uncertainties (:mod:`.fitstats`): the frames of one hop share its errors (tracking,
-and a model that is not the robot: neighbouring residuals are correlated), so the covariance
-is cluster-robust with each hop of each run a cluster, from a central-difference Jacobian
-at the optimum with a step (``FD_STEP``) over the contacts' jaggedness, t on hops - 1 degrees
+they stood by the track's rule (the median of its frames before the first nose motion), put
+on the schedule's clock by the rule the report uses (:mod:`locust.trials.measure`: the first
+nose motion of more than 3 mm, the track's start placed where the simulation's is relative
+to its first push) and then each run's clock offset fitted about it, for every candidate
+(:func:`aligned_residual`). Every candidate of a solver iteration, the finite-difference
+columns included, is simulated in one batched ``mujoco.rollout`` per run (in calls of
+``CHUNK`` candidates, each set in a copy of the run's compiled model where the fitted values
+allow: :mod:`.hopmodels`); the solver is ``mujoco.minimize.least_squares`` on the logarithm
+of each positive parameter (a factor is what a friction or a stiffness is known to).
+Uncertainties (:mod:`.fitstats`): the frames of one hop share its errors (tracking, and a
+model that is not the robot: neighbouring residuals are correlated), so the covariance is
+cluster-robust with each hop of each run a cluster, from a central-difference Jacobian at
+the optimum with a step (``FD_STEP``) over the contacts' jaggedness, t on hops - 1 degrees
 of freedom; the fit's own time step adds the parameters' shift when it is halved (to first
 order, one more rollout per run), and so do the uncertainties of the values the fit holds
 fixed (from the bench calibrations: the hinge damping, the servo's armature, kp and stall
-torque), each carried through the fit's sensitivity to it (one batch per run, each held value
-one standard uncertainty either side), in quadrature. A value is *identifiable* when its 95%
-interval is within about +-50% and it did not run to the edge of its range (a factor
+torque), each carried through the fit's sensitivity to it (one batch per run, each held
+value one standard uncertainty either side), in quadrature. A value is *identifiable* when
+its 95% interval is within about +-50% and it did not run to the edge of its range (a factor
 ``BOUND_FACTOR`` either side of where it started).
 """
 
@@ -48,7 +50,7 @@ from scipy import optimize
 from ..errors import CalibrationError, GeometryError, ParamsError, SimError, TrialError
 from ..params import Provenance, Robot, fittable_keys, value_type
 from ..sim.kinematics import geom_positions, marker_geoms, trace_rows
-from ..sim.model import build
+from ..sim.model import BuiltModel, build
 from ..sim.rollout import simulate_batch
 from ..sim.samples import uncertain_values
 from ..sim.schedule import ControlPlan
@@ -56,16 +58,19 @@ from ..trials.configs import configuration
 from ..trials.measure import onset_time
 from ..trials.measured import load_trial, read_track
 from .fitstats import Estimate, cluster_covariance, fixed_covariance, linear_shift
+from .hopmodels import CandidateModels
 
 DEFAULT_KEYS = ("contact.foot_friction", "compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s")
 MARKERS = ("nose", "foot")
 PROVENANCE_NAME = "hops"       # written as source fit:hops
 TAIL_S = 0.5                   # simulated past the track's last frame (the alignment moves it)
+REST_KEPT_S = 0.5              # frames kept after the schedule's last phase ends (the robot at rest)
 BOUND_FACTOR = 5.0             # each value is searched within this factor of its start
 FD_STEP = 1e-2                 # finite-difference step of the log values (1 %: over the contacts' jaggedness)
 MAX_RELATIVE_STD = 0.25        # identifiable: 95% interval within about +-50%
 FAILED_M = 0.1                 # residual of a candidate whose simulation failed (metres)
 THREADS = 2
+CHUNK = 16                     # candidates a rollout call simulates (progress is reported between calls)
 STEP_TOLERANCE_M = 1e-4        # a run's step is converged when dt/2 moves its markers less (RMS) ...
 MAX_HALVINGS = 3               # ... halved up to this many times until it is
 SHIFT_SEARCH_S = 0.05          # each run's clock offset is fitted within this of the onset rule's ...
@@ -167,12 +172,24 @@ def load_run(path: Path, config: str, base: Robot) -> HopRun:
         before = foot.t_s < onset
         tracks["foot"] = MarkerTrack(foot.t_s, foot.x_m - float(np.median(foot.x_m[before])),
                                      foot.y_m - float(np.median(foot.y_m[before])))
+    # the frames of the schedule's cycles and REST_KEPT_S after: a video that runs on while the
+    # robot stands (the camera stopped late) adds rollout time and no information
+    last = phases[-1]
+    end_s = (last.measured_us - t0_us) * 1e-6 + (record.schedule.push_ms if last.phase == "push"
+                                                  else record.schedule.wait_ms) * 1e-3
+    tracks = {m: _until(tr, onset + end_s + REST_KEPT_S) for m, tr in tracks.items()}
     robot = configuration(base, config).robot
     if not math.isclose(robot.schedule.push_deg, record.schedule.push_deg):
         robot = robot.with_values({"schedule.push_deg": record.schedule.push_deg}, f"run:{trial.run_path}")
     return HopRun(source=Path(path), config=config, robot=robot,
                   phase_s=np.array([(p.measured_us - t0_us) * 1e-6 for p in phases]),
                   pushing=np.array([p.phase == "push" for p in phases]), onset_s=float(onset), tracks=tracks)
+
+
+def _until(track: MarkerTrack, last_s: float) -> MarkerTrack:
+    """``track``'s frames up to camera time ``last_s``."""
+    keep = track.t_s <= last_s
+    return MarkerTrack(track.t_s[keep], track.x_m[keep], track.y_m[keep])
 
 
 # -- simulating a run ------------------------------------------------------------------
@@ -191,10 +208,12 @@ def measured_plan(run: HopRun, robot: Robot) -> ControlPlan:
                        cycle_start_steps=starts)
 
 
-def simulate_markers(run: HopRun, robots: list[Robot]) -> list[dict[str, np.ndarray] | None]:
+def simulate_markers(run: HopRun, robots: list[Robot],
+                     builts: list[BuiltModel] | None = None) -> list[dict[str, np.ndarray] | None]:
     """Each robot's simulated markers on the schedule's clock (one batched rollout): marker ->
-    (3, n) rows t, x, y from where it stood; ``t`` = 0 at the first push. None: it failed."""
-    builts = [build(r) for r in robots]
+    (3, n) rows t, x, y from where it stood; ``t`` = 0 at the first push. None: it failed.
+    ``builts``: the robots' compiled models where the caller has them (:mod:`.hopmodels`)."""
+    builts = builts or [build(r) for r in robots]
     plan = measured_plan(run, robots[0])
     trajs = simulate_batch(builts, plan, keep_states=True, threads=THREADS)
     dt, settle = plan.timestep_s, plan.settle_steps
@@ -258,7 +277,7 @@ def aligned_residual(run: HopRun, sim: dict[str, np.ndarray] | None) -> tuple[np
     return residual_at(shift), shift
 
 
-def converged_step(run: HopRun, robot: Robot | None = None) -> tuple[HopRun, float]:
+def converged_step(run: HopRun, robot: Robot | None = None, tally: _Tally | None = None) -> tuple[HopRun, float]:
     """``run`` at a step where halving it moves its markers by at most ``STEP_TOLERANCE_M``
     (RMS over the tracked frames, each simulation on the clock by its own onset) at ``robot``'s
     values (the run's own when None), halved at most ``MAX_HALVINGS`` times; and that last
@@ -272,6 +291,8 @@ def converged_step(run: HopRun, robot: Robot | None = None) -> tuple[HopRun, flo
             try:
                 robot_dt = at.with_values({"solver.timestep_s": dt}, "fit: time step check")
                 pair.append(simulate_markers(run, [robot_dt])[0])
+                if tally:
+                    tally.add(1)
             except (GeometryError, SimError):
                 pair.append(None)
         if any(sim is None for sim in pair):
@@ -320,14 +341,14 @@ def check_keys(keys: list[str], runs: list[HopRun]) -> None:
                                    "the fit works on factors of a positive value; set a start with --set")
 
 
-def _converged_steps(runs: list[HopRun]) -> tuple[list[HopRun], list[str], list[float]]:
+def _converged_steps(runs: list[HopRun], tally: _Tally | None = None) -> tuple[list[HopRun], list[str], list[float]]:
     """Each run at the time step its markers converge in (:func:`converged_step`), with a note
     where that is not its leg set's step or where even the halved step moves them; returns
     (runs, notes, the RMS change of each run's markers at half its step)."""
     runs, step_notes, step_changes = list(runs), [], []
     for k, run in enumerate(runs):
         given = run.robot.solver.timestep_s
-        runs[k], change = converged_step(run)
+        runs[k], change = converged_step(run, tally=tally)
         step_changes.append(change)
         dt = runs[k].robot.solver.timestep_s
         if not change <= STEP_TOLERANCE_M:
@@ -341,37 +362,81 @@ def _converged_steps(runs: list[HopRun]) -> tuple[list[HopRun], list[str], list[
     return runs, step_notes, step_changes
 
 
+class _Tally:
+    """Simulations done and planned; ``progress(done, planned)`` after each batch."""
+
+    def __init__(self, planned: int = 0, progress: Callable[[int, int], None] | None = None):
+        self.done, self.planned, self.progress = 0, planned, progress
+
+    def add(self, n: int) -> None:
+        self.done += n
+        self.planned = max(self.planned, self.done)
+        if self.progress:
+            self.progress(self.done, self.planned)
+
+
+def planned_simulations(runs: int, keys: int, held: int, max_iter: int, grid_stages: int) -> int:
+    """The simulations a fit plans (the solver's at ``max_iter``, its most): each run's dt/2
+    check, the starting grid, the solver (the candidate and a forward difference a value each
+    iteration), the optimum's curves, central differences and dt/2, the held values either side."""
+    grid = GRID_LEVELS.get(keys, 0) ** keys * grid_stages
+    return runs * (2 + grid + max_iter * (keys + 1) + 1 + 2 * keys + 2 + 2 * held)
+
+
 class _HopResidual:
     """The markers' residual of every run, stacked, for candidate vectors ``x`` (columns): the
     fitted values are ``start * exp(x)``; ``sims`` counts the simulations it ran."""
 
-    def __init__(self, runs: list[HopRun], keys: tuple[str, ...], start: np.ndarray):
+    def __init__(self, runs: list[HopRun], keys: tuple[str, ...], start: np.ndarray, tally: _Tally | None = None):
         self.runs, self.keys, self.start = runs, keys, start
-        self.sims = 0
+        self.tally = tally or _Tally()
+        self.models: dict[int, CandidateModels] = {}    # per run: its candidates without the compiler
+
+    def values_at(self, xs: np.ndarray) -> list[dict[str, float]]:
+        """The fitted values (key -> value) at each row of ``xs``."""
+        return [dict(zip(self.keys, (self.start * np.exp(x)).tolist())) for x in xs]
+
+    def candidates(self, run: HopRun) -> CandidateModels:
+        """``run``'s compiled candidates (made at the first use)."""
+        k = self.runs.index(run)
+        if k not in self.models:
+            self.models[k] = CandidateModels(run.robot, self.keys)
+        return self.models[k]
 
     def robots_at(self, run: HopRun, xs: np.ndarray, refine: int = 1) -> list[Robot]:
         """``run``'s robot at each row of ``xs`` (its step divided by ``refine``)."""
         robot = run.robot
         if refine > 1:
             robot = robot.with_values({"solver.timestep_s": robot.solver.timestep_s / refine}, "fit: time step check")
-        return [robot.with_values(dict(zip(self.keys, (self.start * np.exp(x)).tolist())), "fit") for x in xs]
+        return [robot.with_values(values, "fit") for values in self.values_at(xs)]
 
-    def residuals_of(self, robots: Callable[[HopRun], list[Robot]]) -> np.ndarray:
-        """One residual column per robot ``robots(run)`` gives (one batch per run), runs stacked."""
+    def residuals_of(self, robots: Callable[[HopRun], list[Robot]],
+                     builts: Callable[[HopRun], list[BuiltModel]] | None = None) -> np.ndarray:
+        """One residual column per robot ``robots(run)`` gives (one batch per run), runs stacked;
+        ``builts(run)``: their compiled models, where the caller has them."""
         cols = []
         for run in self.runs:
             batch = robots(run)
-            try:
-                sims = simulate_markers(run, batch)
-            except (GeometryError, SimError):
-                sims = [None] * len(batch)
-            self.sims += len(batch)
-            cols.append(np.stack([aligned_residual(run, s)[0] for s in sims], axis=1))
+            models = builts(run) if builts else [None] * len(batch)
+            col = []
+            for k in range(0, len(batch), CHUNK):     # one rollout a chunk: progress between them
+                try:
+                    chunk = models[k:k + CHUNK]
+                    sims = simulate_markers(run, batch[k:k + CHUNK], None if chunk[0] is None else chunk)
+                except (GeometryError, SimError):
+                    sims = [None] * len(batch[k:k + CHUNK])
+                col += [aligned_residual(run, s)[0] for s in sims]
+                self.tally.add(len(sims))
+            cols.append(np.stack(col, axis=1))
         return np.concatenate(cols, axis=0)
 
     def __call__(self, x: np.ndarray, refine: int = 1) -> np.ndarray:
         xs = np.atleast_2d(np.asarray(x, dtype=float).T).reshape(-1, len(self.keys))
-        return self.residuals_of(lambda run: self.robots_at(run, xs, refine))
+        if refine > 1:
+            return self.residuals_of(lambda run: self.robots_at(run, xs, refine))
+        values = self.values_at(xs)
+        return self.residuals_of(lambda run: [run.robot] * len(values),
+                                 lambda run: [self.candidates(run).built(v) for v in values])
 
 
 def _run_fits(residual: _HopResidual, x: np.ndarray, step_changes: list[float]) -> tuple[list[RunFit], list]:
@@ -380,6 +445,7 @@ def _run_fits(residual: _HopResidual, x: np.ndarray, step_changes: list[float]) 
     run_fits, clusters = [], []
     for k, run in enumerate(residual.runs):
         sim = simulate_markers(run, residual.robots_at(run, x[None, :]))[0]
+        residual.tally.add(1)
         res, shift = aligned_residual(run, sim)
         clusters.append(k * 10_000 + hop_index(run, shift))
         by_marker, j = {}, 0
@@ -456,28 +522,45 @@ def _hop_estimates(cov, values: np.ndarray, x: np.ndarray, keys: tuple[str, ...]
 
 
 def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEYS, *, max_iter: int = 30,
-             grid_stages: int = GRID_STAGES, progress: Callable[[int], None] | None = None) -> HopFit:
+             grid_stages: int = GRID_STAGES, progress: Callable[[int, int], None] | None = None) -> HopFit:
     """Fit ``keys`` (shared by all runs) to the tracked markers; see the module docstring.
-    ``grid_stages``: stages of the starting grid (0: start at the robot's values)."""
+
+    Parameters
+    ----------
+    runs : list of HopRun
+        The filmed runs (:func:`load_run`).
+    keys : sequence of str
+        The values fitted, shared by all runs.
+    max_iter : int
+        The solver's iterations, at most.
+    grid_stages : int
+        Stages of the starting grid (0: start at the robot's values).
+    progress : callable, optional
+        ``progress(done, planned)`` after each batch of simulations: those done so far and
+        those the fit plans (:func:`planned_simulations`, replanned when the solver stops).
+
+    Returns
+    -------
+    HopFit
+    """
     t_start = time.perf_counter()
     keys = tuple(keys)
     if not runs:
         raise CalibrationError("no run given", "give the folders `locust hop --out` wrote")
     check_keys(list(keys), runs)
     start = np.array([runs[0].robot.get(k) for k in keys], dtype=float)
-    runs, notes, step_changes = _converged_steps(runs)
-    residual = _HopResidual(runs, keys, start)
+    held_count = len(held_uncertainties(runs, keys))
+    tally = _Tally(planned_simulations(len(runs), len(keys), held_count, max_iter, grid_stages), progress)
+    runs, notes, step_changes = _converged_steps(runs, tally)
+    residual = _HopResidual(runs, keys, start, tally)
     bound = math.log(BOUND_FACTOR)
     bounds = [np.full(len(keys), -bound), np.full(len(keys), bound)]
 
-    def on_iter(trace):
-        if progress:
-            progress(1)
-
     x0 = grid_start(residual, len(keys), grid_stages)
     x, trace = minimize.least_squares(x0, residual, bounds=bounds, eps=FD_STEP,
-                                      max_iter=max_iter, verbose=0, iter_callback=on_iter, xtol=1e-6, gtol=1e-8)
+                                      max_iter=max_iter, verbose=0, xtol=1e-6, gtol=1e-8)
     x = np.asarray(x, dtype=float).ravel()
+    tally.planned = tally.done + len(runs) * (1 + 2 * len(keys) + 2 + 2 * held_count)   # what is left
     values = start * np.exp(x)
     run_fits, clusters = _run_fits(residual, x, step_changes)
     # the optimum and its central differences in one batch per run, then the same at dt/2
@@ -488,7 +571,7 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     estimates, identifiable = _hop_estimates(cov, values, x, keys, start, bound, hops, notes)
     return HopFit(keys=keys, start=dict(zip(keys, start.tolist())), estimates=estimates, identifiable=identifiable,
                   runs=run_fits, notes=notes, rms_m=float(np.sqrt(np.mean(r**2))), iterations=len(trace),
-                  simulations=residual.sims, wall_s=time.perf_counter() - t_start,
+                  simulations=tally.done, wall_s=time.perf_counter() - t_start,
                   interval=_interval_text(hops, held))
 
 

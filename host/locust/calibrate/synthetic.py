@@ -31,6 +31,11 @@ class BeamTruth:
     duration_s: float = 1.5
     drop_at_s: float = 0.1
     noise_m: float = 0.0003
+    # a release transient at the drop (a finger leaving the mass, a higher mode of the strip):
+    # extra tip displacement that starts at the drop and dies out within transient_s
+    transient_m: float = 0.0                           # its size at the drop, along the tip's motion
+    transient_s: float = 0.005                         # gone (to e^-3) after this long
+    transient_hz: float = 0.0                          # 0: a decaying offset; else a decaying ringing
 
     @property
     def stiffness_n_per_m(self) -> float:
@@ -53,7 +58,10 @@ def beam_tip_track(truth: BeamTruth, rng: np.random.Generator, tilt_deg: float =
     """(t_s, x_m, y_m) of the beam tip: at rest, then the mass lands on it at ``drop_at_s``.
 
     Exact solution of m*y'' + b*y' + k*y = -m*g from y = 0, y' = -sqrt(2*g*h); the camera
-    is tilted by ``tilt_deg`` (the fit must not need a level camera).
+    is tilted by ``tilt_deg`` (the fit must not need a level camera). With ``transient_m``
+    the drop leaves a release transient the oscillator does not explain (a finger or a
+    higher mode of the strip): ``transient_m * exp(-3*tau/transient_s)``, times
+    ``cos(2*pi*transient_hz*tau)`` when that is not 0, added along the tip's motion.
     """
     t = np.arange(int(truth.duration_s * truth.fps)) / truth.fps
     wn = 2 * math.pi * truth.natural_frequency_hz
@@ -66,6 +74,9 @@ def beam_tip_track(truth: BeamTruth, rng: np.random.Generator, tilt_deg: float =
     b = (v0 + zeta * wn * a) / wd
     y = np.where(t < truth.drop_at_s, 0.0,
                  y_eq + np.exp(-zeta * wn * tau) * (a * np.cos(wd * tau) + b * np.sin(wd * tau)))
+    if truth.transient_m:
+        y = y + np.where(t < truth.drop_at_s, 0.0, truth.transient_m * np.exp(-3 * tau / truth.transient_s)
+                         * np.cos(2 * math.pi * truth.transient_hz * tau))
     tilt = math.radians(tilt_deg)
     x_m = 0.05 - math.sin(tilt) * y + rng.normal(0, truth.noise_m, len(t))
     y_m = 0.12 + math.cos(tilt) * y + rng.normal(0, truth.noise_m, len(t))
