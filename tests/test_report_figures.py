@@ -136,8 +136,8 @@ def test_the_sweep_heat_map_draws_lengths_in_centimetres(tmp_path, monkeypatch):
     shown = []
     monkeypatch.setattr(sweep_plot, "save_png", lambda fig, path: shown.append(fig) or Path(path))
     a, b = Axis("geometry.leg_m", 0.02, 0.04, 3), Axis("servo.kp_nm_per_rad", 1.0, 2.0, 2)
-    rows = [{"geometry.leg_m": x, "servo.kp_nm_per_rad": k, "valid": True, "distance_m": 0.01,
-             "max_nose_height_m": 0.002} for x in a.values() for k in b.values()]
+    rows = [{"geometry.leg_m": x, "servo.kp_nm_per_rad": k, "valid": True, "outcome": "stays_low",
+             "distance_m": 0.01, "max_nose_height_m": 0.002} for x in a.values() for k in b.values()]
     sweep_plot._heatmap(rows, a, b, tmp_path / "h.png")
     ax = shown[0].axes[0]
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("geometry.leg_m (cm)", "servo.kp_nm_per_rad")

@@ -107,9 +107,9 @@ def write_sweep(folder: Path, rows: list[str], vary="scale", cycles=3) -> Path:
 def test_sweep_landscape_reads_and_places_designs(tmp_path):
     # SYNTHETIC sweep results (numbers made up for the reader; not a simulation)
     folder = write_sweep(tmp_path / "synthetic-sweep", [
-        "0,0.0,True,,0.60,0.1,0.09,0.05,3,crank-rocker,80.0",
-        "1,0.01,True,,0.90,0.1,0.09,0.05,3,crank-rocker,80.0",
-        "2,0.02,False,energy audit failed,nan,nan,nan,nan,0,crank-rocker,80.0",
+        "0,0.0,True,,stays_low,nan,0.60,0.1,0.09,0.05,3,crank-rocker,80.0",
+        "1,0.01,True,,stays_low,nan,0.90,0.1,0.09,0.05,3,crank-rocker,80.0",
+        "2,0.02,False,energy audit failed,,nan,nan,nan,nan,nan,0,crank-rocker,80.0",
     ])
     land = read_landscape(folder)
     assert land.names == ["scale"] and land.cycles == 3 and land.designs == 3
@@ -122,10 +122,10 @@ def test_sweep_landscape_reads_and_places_designs(tmp_path):
 
 
 @pytest.mark.parametrize("rows, message", [
-    (["0,0.0,maybe,,0.6,0.1,0.09,0.05,3,crank-rocker,80.0"], "line 2: malformed row .valid = 'maybe'"),
+    (["0,0.0,maybe,,,nan,0.6,0.1,0.09,0.05,3,crank-rocker,80.0"], "line 2: malformed row .valid = 'maybe'"),
     # a malformed row before the last is never skipped (only a torn last line is dropped)
-    (["0,0.0,True,,0.6,0.1,0.09,0.05,3,crank-rocker,80.0", "1,0.01,True,,oops,0.1,0.09,0.05,3,crank-rocker,80.0",
-      "2,0.02,True,,0.6,0.1,0.09,0.05,3,crank-rocker,80.0"], "line 3: malformed row"),
+    (["0,0.0,True,,stays_low,nan,0.6,0.1,0.09,0.05,3,crank-rocker,80.0", "1,0.01,True,,stays_low,nan,oops,0.1,0.09,0.05,3,crank-rocker,80.0",
+      "2,0.02,True,,stays_low,nan,0.6,0.1,0.09,0.05,3,crank-rocker,80.0"], "line 3: malformed row"),
     ([], "no designs"),
 ])
 def test_bad_sweep_folders(tmp_path, rows, message):
