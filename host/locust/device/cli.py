@@ -123,7 +123,8 @@ def _parse_servo_set(item: str, option: str = "--servo") -> tuple[str, float]:
               default=R.hop_default("heartbeat_ms"), show_default=True,
               help="The robot returns to rest if the host is silent this long.")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="Directory for run.json (must not hold one). Default: data/runs/<timestamp>/.")
+              help="Directory for run.json (must not hold one), named on the first line. Default: "
+                   "data/runs/<timestamp>/. A hop the board never answered leaves no folder.")
 @click.option("--json", "as_json", is_flag=True, help="Print the run record as JSON.")
 @click.option("--leg-set", "leg_set_name", default=None, metavar="NAME",
               help="The legs on the robot (small, medium, large, or a name of your own), recorded in "
@@ -147,6 +148,11 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     from .session import open_port
 
     robot, source = _hopped_robot(preset, config, sets, leg_set_name)
+    made = _first_missing(Path(out) if out is not None else R.RUNS_ROOT)
+    directory = R.run_dir(out)
+    # what a hop that never started made goes again: the folders it created, none that was there
+    made = made if made is not None else (directory if out is None else None)
+    _info(f"output folder: {directory}")
     source = _virtual_robot_source(port, source)
     s = robot.schedule
     schedule = R.HopSchedule(cycles=cycles or s.cycles, push_deg=s.push_deg if push_deg is None else push_deg,
@@ -157,8 +163,6 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     robot = robot.with_values({"schedule.cycles": schedule.cycles, "schedule.push_deg": schedule.push_deg,
                                "schedule.push_s": schedule.push_ms / 1000, "schedule.wait_s": schedule.wait_ms / 1000},
                               "locust hop options")
-    made = _first_missing(Path(out)) if out is not None else None
-    directory = R.run_dir(out)
     # a kill (SIGTERM) or a closed terminal (SIGHUP) ends the hop as Ctrl-C does: the robot to
     # rest, the record says so, a --port sim virtual robot stops
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
@@ -179,8 +183,8 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
             # the record keeps every phase and says what is missing
             rec.status, rec.message = R.INCOMPLETE, f"after the hop: {exc.message}"
             R.write(rec, directory)
-        _remove_empty(directory, made if out is not None else directory)   # a hop that never started
-        raise                                                              # leaves no empty folder
+        _remove_empty(directory, made)   # a hop that never started leaves no folder
+        raise
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
