@@ -134,6 +134,21 @@ def test_fit_matches_the_command_line_and_applies(tmp_path):
     assert "95% CI" in prov.note and "Fit ramp" in repr(fit)
     fig = fit.plot()
     assert len(fig.axes) == 2
+    # the residuals' axis says its unit (tan of an angle: none); ticks on whole trials only,
+    # also for three trials (matplotlib's own ticks would be 1.00, 1.25, ...)
+    trials = locust.calibrate_ramp([31.0, 30.2, 30.6]).plot().axes[1]
+    trials.figure.canvas.draw()
+    assert trials.get_ylabel() == "residual (no unit)" and trials.get_xlabel() == "trial"
+    ticks = [t for t in trials.get_xticks() if trials.get_xlim()[0] <= t <= trials.get_xlim()[1]]
+    assert ticks == [1, 2, 3], ticks
+
+
+def test_fit_plots_residuals_in_the_datas_unit():
+    """Beam: tip displacement [mm] above, residual [mm] below; servo: rad/s both."""
+    beam = locust.calibrate_beam(RECORDINGS / "synthetic_beam.csv", mass_kg=0.01, length_m=0.05)
+    top, bottom = beam.plot().axes
+    assert (top.get_ylabel(), bottom.get_ylabel()) == ("tip displacement [mm]", "residual [mm]")
+    assert bottom.get_xlabel() == "t [s]"
 
 
 def test_read_tracks_to_dataframe():
