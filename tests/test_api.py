@@ -22,7 +22,7 @@ from locust.errors import LocustError, ParamsError, SimError
 ROOT = Path(__file__).resolve().parents[1]
 RECORDINGS = ROOT / "calibration" / "recordings"
 FACADE = ["robot", "simulate", "SimResult", "sweep", "SweepResults", "track", "read_tracks", "Tracks",
-          "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "Fit", "report"]
+          "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "Fit", "report", "optimize", "fab"]
 
 
 def test_all_lists_the_facade():
@@ -136,6 +136,21 @@ def test_fit_matches_the_command_line_and_applies(tmp_path):
     assert "95% CI" in prov.note and "Fit ramp" in repr(fit)
     fig = fit.plot()
     assert len(fig.axes) == 2
+    # the residuals' axis says its unit (tan of an angle: none); ticks on whole trials only,
+    # also for three trials (matplotlib's own ticks would be 1.00, 1.25, ...)
+    trials = locust.calibrate_ramp([31.0, 30.2, 30.6]).plot().axes[1]
+    trials.figure.canvas.draw()
+    assert trials.get_ylabel() == "residual (no unit)" and trials.get_xlabel() == "trial"
+    ticks = [t for t in trials.get_xticks() if trials.get_xlim()[0] <= t <= trials.get_xlim()[1]]
+    assert ticks == [1, 2, 3], ticks
+
+
+def test_fit_plots_residuals_in_the_datas_unit():
+    """Beam: tip displacement [mm] above, residual [mm] below; servo: rad/s both."""
+    beam = locust.calibrate_beam(RECORDINGS / "synthetic_beam.csv", mass_kg=0.01, length_m=0.05)
+    top, bottom = beam.plot().axes
+    assert (top.get_ylabel(), bottom.get_ylabel()) == ("tip displacement [mm]", "residual [mm]")
+    assert bottom.get_xlabel() == "t [s]"
 
 
 def test_read_tracks_to_dataframe():
@@ -254,3 +269,35 @@ def test_help_locust_lists_every_function():
     for name in ("robot(", "simulate(", "sweep(", "track(", "read_tracks(", "calibrate_beam", "calibrate_hops",
                  "report(", ".tidy()", ".to_dataframe()", ".plot()"):
         assert name in text, name
+
+
+def test_optimize_is_the_commands_search(tmp_path):
+    """locust.optimize over run_optimize: three trials of the push time; the best trial's
+    distance is what simulating that design gives (to 1e-12), its best.toml holds the value."""
+    base = locust.robot("small")
+    res = locust.optimize(base, {"schedule.push_s": (0.15, 0.4)}, trials=3, cycles=1, out=tmp_path / "opt")
+    assert (res.trials, res.complete + res.pruned) == (3, 3)
+    assert res.best is not None and 0.15 <= res.best["schedule.push_s"] <= 0.4
+    again = locust.simulate(locust.robot("small", **{"schedule.push_s": res.best["schedule.push_s"]}), cycles=1)
+    assert res.best["distance_m"] == pytest.approx(again.distance_m, abs=1e-12)
+    assert locust.robot(res.best_robot).schedule.push_s == res.best["schedule.push_s"]
+    assert (tmp_path / "opt" / "trials.csv").is_file()
+    with pytest.raises(LocustError, match="twice"):
+        locust.optimize(base, ["scale=0:0.01", "scale=0:0.02"], trials=1, out=tmp_path / "x")
+    assert "Parameters" in locust.optimize.__doc__
+
+
+def test_fab_is_the_commands_summary(tmp_path):
+    """locust.fab(robot) gives `locust fab --from-robot seed --json`'s summary; with out it
+    writes the cut files the summary lists, and the subpackage stays importable as before."""
+    from click.testing import CliRunner
+
+    from locust.cli import cli
+
+    mine = locust.fab(locust.robot("seed"))
+    theirs = json.loads(CliRunner().invoke(cli, ["fab", "--from-robot", "seed", "--json"]).stdout)
+    assert mine == theirs
+    written = locust.fab(locust.robot("seed"), out=tmp_path / "cut", previews=False)
+    assert sorted(p.name for p in (tmp_path / "cut").iterdir()) == sorted(written["files"])
+    assert "rigid_top.dxf" in written["files"] and "flat_pattern.dxf" in written["files"]
+    assert locust.fab.laminate.SEED_STACK and "Parameters" in locust.fab.__doc__

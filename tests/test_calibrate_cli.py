@@ -21,7 +21,8 @@ RECORDINGS = ROOT / "calibration" / "recordings"
 
 
 @pytest.fixture()
-def recs(tmp_path):
+def recs(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)      # the fit plots' default folder is the current one
     for name in ("synthetic_beam.csv", "synthetic_beam_tracker.txt", "synthetic_servo.csv", "synthetic_servo_heavy.csv",
                  "synthetic_ramp.csv", "synthetic_ramp_track.csv"):
         shutil.copy(RECORDINGS / name, tmp_path / name)
@@ -196,6 +197,28 @@ def test_plot_never_lands_in_a_read_only_data_folder(recs, tmp_path, monkeypatch
         assert (work / "ramp-fit.png").stat().st_size > 1000
     finally:
         data.chmod(0o755)
+
+
+def test_plots_go_to_the_out_folder_named_first_never_beside_the_data(recs, tmp_path, monkeypatch):
+    """A writable data folder gets no file either: the fit plot goes to --out (made), or to the
+    current folder, and the first line (stderr) names that folder."""
+    data = recs / "data"
+    data.mkdir()
+    shutil.copy(recs / "synthetic_beam.csv", data / "beam.csv")
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    res = CliRunner().invoke(cli, ["calibrate", "beam", str(data / "beam.csv"), "--mass-kg", "0.01",
+                                   "--out", "results/beam"])
+    assert res.exit_code == 0, res.output
+    assert res.stderr.splitlines()[0] == f"output folder: {work / 'results' / 'beam'}"
+    assert sorted(p.name for p in data.iterdir()) == ["beam.csv"]
+    assert (work / "results" / "beam" / "beam-fit.png").stat().st_size > 1000
+    assert f"plot: {Path('results/beam/beam-fit.png')}" in res.stdout
+    res = CliRunner().invoke(cli, ["calibrate", "ramp", str(recs / "synthetic_ramp.csv"), "--json"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["plot"] == "synthetic_ramp-fit.png"     # the current folder
+    assert (work / "synthetic_ramp-fit.png").is_file() and not (recs / "synthetic_ramp-fit.png").exists()
 
 
 # -- calibrate hop starts from the robot its runs record ---------------------------------------

@@ -51,7 +51,7 @@ def fitted(env, tmp_path_factory):
     toml = folder / "fitted.toml"
     t0 = time.perf_counter()
     out = _locust(["calibrate", "hop", *(f"{n}={folder / f'{n}-1'}" for n in LEG_SETS), "--json",
-                   "--write", str(toml)], env, timeout=3000)
+                   "--write", str(toml), "--out", str(folder / "plots")], env, timeout=3000)
     return {"fit": json.loads(out), "wall_s": time.perf_counter() - t0, "toml": toml, "folder": folder, "env": env}
 
 
@@ -81,7 +81,8 @@ def test_fit_leaves_little(fitted):
         # (0.039 and 0.050 mm on one filming, docs/calibrate.md)
         assert run["rms_residual_m"] < 1e-4, run
     for name in LEG_SETS:
-        assert (fitted["folder"] / f"{name}-1" / "hops-fit.png").stat().st_size > 10_000
+        assert (fitted["folder"] / "plots" / f"{name}-1-hops-fit.png").stat().st_size > 10_000
+        assert not (fitted["folder"] / f"{name}-1" / "hops-fit.png").exists()   # nothing into a run's folder
 
 
 def test_written_values_carry_their_provenance_and_spread(fitted):

@@ -49,6 +49,18 @@ def test_committed_notebook_shows_its_figures_tables_and_a_video():
     assert not [o for c in code for o in c.outputs if o.output_type == "error"]
 
 
+def test_committed_notebook_is_quiet_and_shows_no_local_path():
+    """Its outputs name files by name or by a path relative to the notebook (no /home/..., no
+    folder of the machine that ran it) and hold no progress lines on stderr."""
+    nb = nbformat.read(NOTEBOOK, as_version=4)
+    outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs]
+    assert not [o for o in outputs if o.get("name") == "stderr"]
+    texts = ["".join(o.get("text", "")) + "".join(v for k, v in o.get("data", {}).items() if k.startswith("text/"))
+             for o in outputs]
+    assert not [t for t in texts if str(ROOT) in t or "/home/" in t or "/tmp/" in t or "/work/" in t]
+    assert any("Fit beam: synthetic_beam.csv" in t for t in texts)
+
+
 @pytest.fixture(scope="module")
 def printed(tmp_path_factory) -> dict[str, dict]:
     """The JSON line each tagged cell prints, by tag, after running the notebook in a fresh kernel."""

@@ -226,7 +226,9 @@ def test_a_hop_on_locust_virtual_records_the_robot_it_simulates(env, tmp_path):
         hop = _run(["hop", "--port", device, "--cycles", "1", "--push-ms", "50", "--wait-ms", "50",
                     "--out", str(tmp_path / "run")], env)
         assert hop.returncode == 0, hop.stderr
-        assert hop.stderr.splitlines()[0] == f"robot: medium, the one the virtual robot on {device} simulates"
+        first, second = hop.stderr.splitlines()[:2]
+        assert first == f"output folder: {tmp_path / 'run'}"        # where the record goes, first
+        assert second == f"robot: medium, the one the virtual robot on {device} simulates"
     robot = json.loads((tmp_path / "run" / "run.json").read_text())["robot"]
     assert (robot["preset"], robot["leg_set"]) == ("medium", "medium"), robot
 
@@ -240,6 +242,23 @@ def test_a_virtual_robot_with_nothing_flashed_says_so(tmp_path):
     assert "error: nothing flashed: run `locust flash --port sim`" in res.stderr
     assert "/dev/pts" not in res.stderr and "REPL" not in res.stderr
     assert not (tmp_path / "run").exists()
+
+
+def test_a_hop_the_board_never_answered_leaves_no_run_folder(tmp_path):
+    """A port with no firmware behind it (a bare pty: nothing answers the handshake): the
+    error, and no data/runs/<timestamp>/ in the current folder (run.json is written only
+    once the board has answered)."""
+    master, slave = pty.openpty()
+    try:
+        res = subprocess.run(LOCUST + ["hop", "--port", os.ttyname(slave), "--cycles", "1"], cwd=tmp_path,
+                             capture_output=True, text=True, timeout=60)
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert res.returncode == 2, res.stderr
+    assert res.stderr.splitlines()[0].startswith("output folder: data/runs/"), res.stderr
+    assert "error: no locust firmware answered" in res.stderr
+    assert list(tmp_path.iterdir()) == []      # not data/, not data/runs/, not the timestamp folder
 
 
 def test_ctrl_c_stops_the_idle_loop_not_a_hop_and_ctrl_d_resumes(env):

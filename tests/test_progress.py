@@ -3,12 +3,13 @@ something; plain lines every ~10 s off a terminal. A made-up clock drives it (no
 
 from __future__ import annotations
 
+import contextlib
 import io
 import re
 
 import pytest
 
-from locust.progress import ETA_MIN_S, ETA_MIN_STEPS, PLAIN_EVERY_S, Progress, format_duration
+from locust.progress import ETA_MIN_S, ETA_MIN_STEPS, PLAIN_EVERY_S, Progress, format_duration, silenced
 
 
 class Clock:
@@ -111,3 +112,16 @@ def test_the_demo_shows_a_childs_progress_and_keeps_all_its_output(tty):
         assert shown == "".join("\r\x1b[K      " + p for p in progress_lines) + "\n"
     else:
         assert shown.splitlines() == ["      " + p for p in progress_lines]
+
+
+@pytest.mark.parametrize("tty", [False, True])
+def test_silenced_shows_nothing_and_ends_with_its_block(tty):
+    """Inside silenced() (a notebook cell) neither lines nor a bar; after it, as before."""
+    for quiet, expect_output in ((True, False), (False, True)):
+        clock, out = Clock(), io.StringIO()
+        with silenced() if quiet else contextlib.nullcontext():
+            with Progress(length=5, label="rendering", file=out, tty=tty, clock=clock) as bar:
+                for _ in range(5):
+                    clock.t += PLAIN_EVERY_S + 1
+                    bar.update(1)
+        assert bool(out.getvalue()) == expect_output, (quiet, out.getvalue())

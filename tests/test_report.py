@@ -88,8 +88,8 @@ def world(tmp_path_factory):
     return {"root": root, "truth": truth, "html": html, "cells": parse(html), "sweep": sweep, "study": study}
 
 
-def cm(value_m: float) -> str:
-    return f"{value_m * 100:.2f}"
+def mm(value_m: float) -> str:
+    return f"{value_m * 1000:.1f}"
 
 
 def marker_apexes(robot, cycles, marker="nose"):
@@ -128,24 +128,24 @@ def marker_distances(robot, cycles, marker="nose"):
 
 
 def test_predictions_are_the_pipelines_own(world):
-    """Distances: run()'s, to the printed 0.01 cm. Apexes: the simulated nose marker's (what
-    the camera follows), within 0.02 cm of MuJoCo's marker position at every step (the
-    report thins the trace to 240 Hz: about 0.002 cm lower at the top of the arc)."""
+    """Distances: run()'s, to the printed 0.1 mm. Apexes: the simulated nose marker's (what
+    the camera follows), within 0.2 mm of MuJoCo's marker position at every step (the
+    report thins the trace to 240 Hz: about 0.02 mm lower at the top of the arc)."""
     cells = world["cells"].cells
     for name in ("small", "medium"):
         robot = leg_set(preset("seed"), name)
         r = run(robot, cycles=CYCLES)
         assert r.valid
         marker_hops = marker_distances(robot, CYCLES)
-        assert cells[(name, "predicted_distance_cm")] == cm(sum(marker_hops))
+        assert cells[(name, "predicted_distance_mm")] == mm(sum(marker_hops))
         for k, d in enumerate(marker_hops, start=1):
-            assert cells[(name, f"hop_predicted_distance_cm:{name}-1#{k}")] == cm(d)
+            assert cells[(name, f"hop_predicted_distance_mm:{name}-1#{k}")] == mm(d)
             # these robots stand on their feet after each hop: the nose marker travels as the chassis
             assert d == pytest.approx(r.hops[k - 1].distance_m, abs=0.0005)
         apexes = marker_apexes(robot, CYCLES)
-        assert float(cells[(name, "predicted_jump_cm")]) == pytest.approx(max(apexes) * 100, abs=0.02)
+        assert float(cells[(name, "predicted_jump_mm")]) == pytest.approx(max(apexes) * 1000, abs=0.2)
         for k, a in enumerate(apexes, start=1):
-            assert float(cells[(name, f"hop_predicted_apex_cm:{name}-1#{k}")]) == pytest.approx(a * 100, abs=0.02)
+            assert float(cells[(name, f"hop_predicted_apex_mm:{name}-1#{k}")]) == pytest.approx(a * 1000, abs=0.2)
     # the sweep's designs at scale 0 and 0.01 are Small and Medium: every leg set converges at the
     # seed's own 1 ms (params.LEG_SETS), so the sweep's rows and the report's figures are one number
     rows = {round(r["scale"], 6): r for r in world["sweep"].rows}
@@ -161,25 +161,25 @@ def test_measured_hops_match_the_synthetic_truth(world):
     for label, truth in world["truth"].items():
         name = label.split("-")[0]
         for k, (d_true, a_true) in enumerate(zip(truth.hop_distance_m, truth.hop_apex_m), start=1):
-            d = float(cells[(name, f"hop_measured_distance_cm:{label}#{k}")]) / 100
-            a = float(cells[(name, f"hop_measured_apex_cm:{label}#{k}")]) / 100
+            d = float(cells[(name, f"hop_measured_distance_mm:{label}#{k}")]) / 1000
+            a = float(cells[(name, f"hop_measured_apex_mm:{label}#{k}")]) / 1000
             assert d == pytest.approx(d_true, abs=0.0015), (label, k)
             assert a == pytest.approx(a_true, abs=0.005), (label, k)
             assert a <= a_true + 0.0015
     # the true robot (softer hinges) hops 2.8 mm farther than the model over the two hops: the
     # report shows that error, to the measurement's resolution
-    err = float(cells[("small", "distance_error_cm")])
+    err = float(cells[("small", "distance_error_mm")])
     true_total = world["truth"]["small-1"].distance_m
     model_total = sum(marker_distances(leg_set(preset("seed"), "small"), CYCLES))
-    assert (true_total - model_total) * 100 == pytest.approx(0.276, abs=0.03)
-    assert err == pytest.approx((true_total - model_total) * 100, abs=0.06)
+    assert (true_total - model_total) * 1000 == pytest.approx(2.76, abs=0.3)
+    assert err == pytest.approx((true_total - model_total) * 1000, abs=0.6)
 
 
 def test_repeated_trials_have_error_bars_and_timing_is_the_records(world):
     cells = world["cells"].cells
     assert cells[("small", "trials")] == "2" and cells[("medium", "trials")] == "1"
-    assert "±" in cells[("small", "measured_jump_cm")]          # two trials: mean ± sd
-    assert "±" not in cells[("medium", "measured_jump_cm")]     # one trial: no error bar
+    assert "±" in cells[("small", "measured_jump_mm")]          # two trials: mean ± sd
+    assert "±" not in cells[("medium", "measured_jump_mm")]     # one trial: no error bar
     import json
 
     rec = json.loads((world["root"] / "hops" / "small-1" / "run.json").read_text())
@@ -219,7 +219,7 @@ def test_report_draws_an_optimize_study_s_front_and_names_its_pick(world):
 def test_changing_a_calibrated_stiffness_changes_the_predictions(world, tmp_path):
     """Hinge stiffness 0.056 -> 0.02 N*m/rad (as if refitted from a beam drop): run() moves Small
     by about 2 mm over two hops; the simulation is deterministic, so any difference above the
-    printed 0.01 cm is the input's. The report must print the new run()'s number and the new
+    printed 0.1 mm is the input's. The report must print the new run()'s number and the new
     provenance."""
     changed = preset("seed").with_values({"compliance.hinge_stiffness_nm_per_rad": 0.02},
                                          Provenance(source="fit:beam-test", uncertainty=0.002, date="2026-01-01"))
@@ -228,16 +228,16 @@ def test_changing_a_calibrated_stiffness_changes_the_predictions(world, tmp_path
                  "--out", tmp_path / "out")
     assert res.exit_code == 0, res.output
     cells = parse(Path(res.stdout.strip().splitlines()[-1])).cells
-    before = float(world["cells"].cells[("small", "predicted_distance_cm")])
-    after = float(cells[("small", "predicted_distance_cm")])
-    assert abs(after - before) >= 0.15
-    assert cells[("small", "predicted_distance_cm")] == cm(sum(marker_distances(leg_set(changed, "small"), CYCLES)))
+    before = float(world["cells"].cells[("small", "predicted_distance_mm")])
+    after = float(cells[("small", "predicted_distance_mm")])
+    assert abs(after - before) >= 1.5
+    assert cells[("small", "predicted_distance_mm")] == mm(sum(marker_distances(leg_set(changed, "small"), CYCLES)))
     assert cells[("", "param:compliance.hinge_stiffness_nm_per_rad")] == "0.02"
     # the measured side moves only with the hop windows, which the model's onset latency places
     # on the track's clock (a softer hinge starts the push later): by at most 0.3 mm here
-    a = float(cells[("small", "hop_measured_distance_cm:small-1#1")])
-    b = float(world["cells"].cells[("small", "hop_measured_distance_cm:small-1#1")])
-    assert a == pytest.approx(b, abs=0.03)
+    a = float(cells[("small", "hop_measured_distance_mm:small-1#1")])
+    b = float(world["cells"].cells[("small", "hop_measured_distance_mm:small-1#1")])
+    assert a == pytest.approx(b, abs=0.3)
 
 
 PROBE = """<script>

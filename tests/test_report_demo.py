@@ -82,7 +82,7 @@ def test_report_numbers_are_the_pipelines_own(demo):
         # the summary's distance is the marker's, as the figure draws it (tests/test_report_headline.py)
         marker_m = sum(h["distance_m"] for h in cfg["predicted_marker_hops"])
         assert cfg["predicted_distance_m"] == pytest.approx(marker_m, abs=1e-12)
-        cell = f'data-config="{cfg["name"]}" data-field="predicted_distance_cm">{marker_m * 100:.2f}<'
+        cell = f'data-config="{cfg["name"]}" data-field="predicted_distance_mm">{marker_m * 1000:.1f}<'
         assert cell in text
 
 

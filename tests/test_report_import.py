@@ -78,10 +78,10 @@ def test_units_mirror_rename_give_the_true_hops(trials):
                  "--preset", "seed", "--cycles", CYCLES, "--out", trials["root"] / "out-mm")
     html, cells, doc = report_of(res)
     for k, (d, a) in enumerate(zip(HOPS_M, APEX_M), start=1):
-        assert cells[("small", f"hop_measured_distance_cm:tracker#{k}")] == f"{d * 100:.2f}"
-        apex = float(cells[("small", f"hop_measured_apex_cm:tracker#{k}")]) / 100
+        assert cells[("small", f"hop_measured_distance_mm:tracker#{k}")] == f"{d * 1000:.1f}"
+        apex = float(cells[("small", f"hop_measured_apex_mm:tracker#{k}")]) / 1000
         assert a * (1 - 0.0278) - 1e-4 <= apex <= a + 1e-4      # 30 frames/s samples the arc's top
-    assert cells[("small", "measured_distance_cm")] == f"{sum(HOPS_M) * 100:.2f}"
+    assert cells[("small", "measured_distance_mm")] == f"{sum(HOPS_M) * 1000:.1f}"
     # given name, converted, no run record: nothing to warn about
     assert doc["warnings"] == [] and "warning" not in res.stderr and 'id="warnings"' not in html.read_text()
     (trial,) = doc["configurations"][0]["trials"]
@@ -98,10 +98,10 @@ def test_mirrored_mm_read_as_metres_is_warned_not_stopped(trials):
     predicted = doc["configurations"][0]["predicted_distance_m"]    # the marker's
     assert predicted > 0.002                                  # the seed hops forward (a few mm)
     assert kinds["mirrored"] == (f"tracker: the tracked nose travels -600 m overall where the model predicts "
-                                 f"+{predicted * 100:.1f} cm: the camera likely saw the hop mirrored (filmed "
+                                 f"+{predicted * 1000:.1f} mm: the camera likely saw the hop mirrored (filmed "
                                  "right-to-left): give --mirror")
     # hundreds of metres a hop: 250 m read, 0.25 m in mm
-    assert [float(cells[("small", f"hop_measured_distance_cm:tracker#{k}")]) / 100 for k in (1, 2, 3)] == \
+    assert [float(cells[("small", f"hop_measured_distance_mm:tracker#{k}")]) / 1000 for k in (1, 2, 3)] == \
         pytest.approx([-200.0, -250.0, -150.0], abs=1e-4)
     assert kinds["units"] == ("tracker: 250 m in one hop is not this robot's (at most 2 m): the track is likely "
                               "in mm, not m (0.25 m then): give --units mm")
@@ -114,7 +114,7 @@ def test_mirrored_mm_read_as_metres_is_warned_not_stopped(trials):
     _, _, doc = report_of(invoke("--measured", f"small={trials['export']}", "--rename", "A=nose", "--units", "mm",
                                  "--preset", "seed", "--cycles", CYCLES, "--out", trials["root"] / "out-dir"))
     assert [w["kind"] for w in doc["warnings"]] == ["mirrored"]
-    assert "travels -60.0 cm overall" in doc["warnings"][0]["message"]
+    assert "travels -600.0 mm overall" in doc["warnings"][0]["message"]
 
 
 def test_noisy_mm_read_as_metres_stops_with_the_unit_in_the_hint(trials):

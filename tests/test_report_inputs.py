@@ -124,7 +124,8 @@ def test_sweep_landscape_reads_and_places_designs(tmp_path):
 @pytest.mark.parametrize("rows, message", [
     (["0,0.0,maybe,,,nan,0.6,0.1,0.09,0.05,3,crank-rocker,80.0"], "line 2: malformed row .valid = 'maybe'"),
     # a malformed row before the last is never skipped (only a torn last line is dropped)
-    (["0,0.0,True,,stays_low,nan,0.6,0.1,0.09,0.05,3,crank-rocker,80.0", "1,0.01,True,,stays_low,nan,oops,0.1,0.09,0.05,3,crank-rocker,80.0",
+    (["0,0.0,True,,stays_low,nan,0.6,0.1,0.09,0.05,3,crank-rocker,80.0",
+      "1,0.01,True,,stays_low,nan,oops,0.1,0.09,0.05,3,crank-rocker,80.0",
       "2,0.02,True,,stays_low,nan,0.6,0.1,0.09,0.05,3,crank-rocker,80.0"], "line 3: malformed row"),
     ([], "no designs"),
 ])

@@ -117,3 +117,34 @@ def test_colour_marker_on_real_footage_never_takes_the_scale_stick(balltoss, mon
     err = np.hypot(*(ours - theirs).T)
     assert err.max() < 0.8, err       # measured 0.16 .. 0.56 px (displacements from frame 2)
     assert "0 jump(s)" in res.output
+
+
+def test_python_api_reuses_a_projects_calibration_and_writes_a_trk(balltoss, shared_data, tmp_path):
+    """locust.track() as `locust track video`: on BallToss.trz itself (its calibration and frame
+    rate) the ball's metres are within 0.8 px of Tracker's own world points; the unpacked video
+    with calibration_from= the project gives the same metres (1e-12); trk= writes a project that
+    reads back with the ball's steps and Tracker's scale; an existing trk is refused."""
+    import locust
+    from locust.errors import TrackError
+
+    ball = {"ball": "template:131.28,207.86@2"}
+    redo = tmp_path / "redo.trk"
+    tracks = locust.track(shared_data / "tracker" / "BallToss.trz", ball, trk=redo)
+    project = trk_io.read_project(shared_data / "tracker" / "BallToss.trz")
+    truth = trk.project_result(project)
+    tx, ty = truth.world(truth.markers[0])
+    x, y = tracks.positions("ball")
+    frames = list(range(3, 13))
+    err_px = np.hypot(x[frames] - tx[frames], y[frames] - ty[frames]) / project.calibration.m_per_px
+    assert err_px.max() < 0.8, err_px
+    assert tracks.to_dataframe().t_s[1] == pytest.approx(66.0 / 1000)          # the project's frame rate
+    again = locust.track(balltoss / "videos" / "BallToss_new_BallToss.mp4", ball,
+                         calibration_from=balltoss / "BallToss_BallToss.trk")
+    np.testing.assert_allclose(np.array(again.positions("ball")), np.array([x, y]), atol=1e-12)
+    back = trk_io.read_project(redo)
+    assert sorted(back.points["ball"]) == np.flatnonzero(np.isfinite(x)).tolist()    # each frame found
+    assert back.calibration.m_per_px == pytest.approx(project.calibration.m_per_px, rel=1e-9)
+    with pytest.raises(TrackError, match="exists"):
+        locust.track(shared_data / "tracker" / "BallToss.trz", ball, trk=redo)
+    with pytest.raises(TrackError, match="not both"):
+        locust.track(shared_data / "tracker" / "BallToss.trz", ball, scale=(0, 0, 100, 0, 0.1))

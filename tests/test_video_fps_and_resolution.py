@@ -64,6 +64,6 @@ def test_resolution_is_the_tracks_own_metres_per_pixel():
 def test_sub_pixel_error_reads_within_1_px():
     # a 0.3 mm difference on a 1.1 mm jump: below one pixel of 0.5 mm it is not measured;
     # with 0.1 mm pixels it is a real -27 %
-    assert pct(-0.0003, 0.0011, 5e-4) == "within 1 px (0.05 cm)"
+    assert pct(-0.0003, 0.0011, 5e-4) == "within 1 px (0.5 mm)"
     assert pct(-0.0003, 0.0011, 1e-4) == "-27.3 %"
     assert pct(-0.0003, 0.0011) == "-27.3 %"

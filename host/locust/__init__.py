@@ -18,6 +18,8 @@ Functions (each with a numpydoc docstring: ``help(locust.simulate)``):
 - ``calibrate_beam/hinge/servo/ramp/hops(...)``: a ``Fit`` (``.parameters``, ``.to_dataframe()``,
   ``.plot()``, ``.apply(robot)``).
 - ``report(robot, measured)``: the HTML comparison of simulation and filmed hops.
+- ``optimize(robot, vary, trials, out=...)``: Optuna's search for the farthest valid hop.
+- ``fab(robot_or_dxf, out=...)``: the laminate's cut files and their summary.
 
 Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
 """
@@ -29,7 +31,7 @@ __version__ = "0.1.0"
 
 __all__ = ["robot", "simulate", "SimResult", "sweep", "SweepResults", "track", "read_tracks", "Tracks",
            "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "calibrate_hops", "Fit", "report",
-           "Robot", "LocustError"]
+           "optimize", "fab", "Robot", "LocustError"]
 
 
 class _CallablePackage(_types.ModuleType):
@@ -53,9 +55,9 @@ class _CallablePackage(_types.ModuleType):
         return (self._function().__doc__ or "") + "\n\nThe package:\n\n" + (self.__dict__.get("__doc__") or "")
 
 
-from . import report, sweep, track  # noqa: E402  (the packages' __init__ hold no code)
+from . import fab, report, sweep, track  # noqa: E402  (the packages' __init__ hold no code)
 
-report.__class__ = sweep.__class__ = track.__class__ = _CallablePackage
+fab.__class__ = report.__class__ = sweep.__class__ = track.__class__ = _CallablePackage
 
 
 def __getattr__(name: str):

@@ -239,7 +239,7 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
         with d.stage(5, total, f"fit the filmed hops of {' and '.join(HOP_FIT_SETS)}: what the bench cannot reach"):
             atomic_write_text(bench_toml, robot_toml.read_text(encoding="utf-8"))
             fitted = [f"{name}={hops_dir / f'{name}-1'}" for name in HOP_FIT_SETS]
-            d.call(["calibrate", "hop", *fitted, "--write", str(robot_toml)])
+            d.call(["calibrate", "hop", *fitted, "--write", str(robot_toml), "--out", str(cal_dir)])
     with d.stage(total - 1, total, f"sweep the added link length over {designs} designs"):
         d.call(["sweep", "--config", str(robot_toml), "--vary", f"scale=0:0.03:{designs}", "--cycles", str(cycles),
                 "--out", str(folder / "sweep"), *(["--jobs", str(jobs)] if jobs else [])])

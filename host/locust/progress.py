@@ -10,9 +10,10 @@ iteration can take most of its run). It is shown only once that rate rests on at
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 ETA_MIN_STEPS = 3        # steps measured before a time left is shown
@@ -20,6 +21,7 @@ ETA_MIN_S = 2.0          # seconds measured before a time left is shown
 PLAIN_EVERY_S = 10.0     # off a terminal: one line this often
 BAR_EVERY_S = 0.2        # on a terminal: redraw at most this often
 BAR_WIDTH = 30
+_SILENT = [0]            # depth of silenced() blocks: while above 0 nothing is shown
 
 
 def format_duration(seconds: float) -> str:
@@ -87,6 +89,8 @@ class Progress:
         return "  ".join(parts)
 
     def _show(self, force: bool = False) -> None:
+        if _SILENT[0]:
+            return
         now = self.clock()
         if not force and now - self._last_shown < (BAR_EVERY_S if self.tty else PLAIN_EVERY_S):
             return
@@ -124,6 +128,16 @@ class Progress:
             self.update(1)
 
 
+@contextlib.contextmanager
+def silenced() -> Iterator[None]:
+    """No progress shown inside the block (a notebook's cell output, where the result says enough)."""
+    _SILENT[0] += 1
+    try:
+        yield
+    finally:
+        _SILENT[0] -= 1
+
+
 def progress(items: Iterable | None = None, length: int | None = None, label: str = "", **options: Any) -> Progress:
     """Progress over ``items`` or ``length`` steps on stderr: a bar on a terminal, a plain line
     every ~10 s elsewhere.
@@ -134,4 +148,4 @@ def progress(items: Iterable | None = None, length: int | None = None, label: st
     return Progress(items, length=length, label=label, **options)
 
 
-__all__ = ["Progress", "format_duration", "progress"]
+__all__ = ["Progress", "format_duration", "progress", "silenced"]

@@ -10,10 +10,12 @@ function           module                    returns
 ``read_tracks``    :mod:`.tracking`          :class:`.tracking.Tracks`
 ``calibrate_*``    :mod:`.calibration`       :class:`.calibration.Fit` (parameters, apply, plot)
 ``report``         :mod:`.reports`           :class:`locust.report.build.ReportResult`
+``optimize``       :mod:`.optimizing`        :class:`locust.sweep.optimize.OptimizeSummary`
+``fab``            :mod:`.fabrication`       dict (the manufacturing summary)
 =================  ========================  =====================================================
 
-The command line calls the same functions (``locust sim``, ``sweep``, ``report``, ``calibrate
-beam|hinge|servo|ramp``). Every name is also at the package top: ``locust.simulate``.
+The command line calls the same functions (``locust sim``, ``sweep``, ``report``, ``fab``,
+``calibrate beam|hinge|servo|ramp``). Every name is also at the package top: ``locust.simulate``.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ EXPORTS = {
     "calibrate_beam": "calibration", "calibrate_hinge": "calibration", "calibrate_ramp": "calibration",
     "calibrate_servo": "calibration", "calibrate_hops": "calibration", "Fit": "calibration",
     "report": "reports",
+    "optimize": "optimizing", "fab": "fabrication",
 }
 
 __all__ = list(EXPORTS)

@@ -4,6 +4,7 @@ and the robot with them applied)."""
 from __future__ import annotations
 
 import html
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,6 +17,7 @@ from ..calibrate.recordings import REAL_TIME, TimeOptions
 from ..errors import CalibrationError
 from ..io.importing import ImportOptions
 from ..params import Robot
+from ..tables import estimate_line, sig, split_unit
 
 PathLike = str | Path
 
@@ -91,15 +93,24 @@ class Fit:
 
         return fit_figure(self.result.curves, self.subtitle)
 
-    def _rows(self) -> list[tuple[str, str, str, str]]:
-        return [(key, f"{e.value:.6g}", f"{e.std:.3g}", f"[{e.ci95_low:.6g}, {e.ci95_high:.6g}]")
-                for key, e in self.parameters.items()]
+    def _rows(self) -> list[tuple[str, str, str, str, str]]:
+        """(name, value to 4 figures, unit, ± 1 sd in %, 95 % interval) as the CLI prints them."""
+        rows = []
+        for key, e in self.parameters.items():
+            name, unit = split_unit(key)
+            rel = f"± {100 * e.std / abs(e.value):.1f} %" if e.value and math.isfinite(e.std) else "undetermined"
+            rows.append((name, sig(e.value), unit, rel, f"{sig(e.ci95_low)} … {sig(e.ci95_high)}"))
+        return rows
+
+    def _source_name(self) -> str:
+        """The recording's file name (its folder is the reader's own: not shown)."""
+        return "+".join(Path(part).name for part in str(self.source).split("+"))
 
     def __repr__(self) -> str:
-        lines = [f"Fit {self.experiment}: {self.source}"]
+        lines = [f"Fit {self.experiment}: {self._source_name()}"]
         if self.subtitle:
             lines.append(f"  {self.subtitle}")
-        lines += [f"  {k:40s} {v:>12s} ± {s:<9s} 95% CI {ci}" for k, v, s, ci in self._rows()]
+        lines += ["  " + estimate_line(k, e.value, e.std, e.ci95) for k, e in self.parameters.items()]
         if not self.parameters:
             lines.append("  no robot value determined")
         lines += [f"  warning: {w}" for w in self.warnings]
@@ -107,10 +118,10 @@ class Fit:
 
     def _repr_html_(self) -> str:
         esc = html.escape
-        head = "".join(f"<th>{c}</th>" for c in ("parameter", "value", "std (1σ)", "95% interval"))
+        head = "".join(f"<th>{c}</th>" for c in ("parameter", "value", "unit", "1 sd", "95 % interval"))
         body = "".join("<tr>" + "".join(f"<td>{esc(c)}</td>" for c in row) + "</tr>" for row in self._rows())
         warn = "".join(f"<p>warning: {esc(w)}</p>" for w in self.warnings)
-        return (f"<b>Fit {esc(self.experiment)}</b>: {esc(self.source)}<br>{esc(self.subtitle)}"
+        return (f"<b>Fit {esc(self.experiment)}</b>: {esc(self._source_name())}<br>{esc(self.subtitle)}"
                 f"<table><tr>{head}</tr>{body}</table>{warn}")
 
 

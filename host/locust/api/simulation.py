@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import html
 import os
@@ -107,7 +108,7 @@ class SimResult(_run.SimResult):
 
     # -- video and figure ------------------------------------------------------------
     def video(self, path: str | os.PathLike, overwrite: bool = False, camera: str = "track", fps: int = 30,
-              width: int = 1280, height: int = 720):
+              width: int = 1280, height: int = 720, progress: bool = True):
         """Render this run (the same rollout, not a second one) to an MP4 with its truth sidecars.
 
         Parameters
@@ -123,6 +124,8 @@ class SimResult(_run.SimResult):
             Follow the robot, or hold still (for measuring the clip with :func:`locust.track`).
         fps, width, height : int
             Frame rate and size in pixels (even numbers).
+        progress : bool, default True
+            False: no progress lines on stderr while it renders (a notebook's output).
 
         Returns
         -------
@@ -134,12 +137,18 @@ class SimResult(_run.SimResult):
         >>> r = locust.simulate(locust.robot("small"), cycles=1)
         >>> r.video("hop.mp4", overwrite=True, width=320, height=240).frames   # doctest: +SKIP
         """
+        from ..progress import silenced
+
+        with contextlib.nullcontext() if progress else silenced():
+            return self._video(Path(path), overwrite, camera, fps, width, height)
+
+    def _video(self, path: Path, overwrite: bool, camera: str, fps: int, width: int, height: int):
         from ..sim.clip import render_video, sidecar_paths
 
         if not self.valid:
             raise SimError(f"not rendering an invalid simulation: {'; '.join(self.reasons)}",
                            "fix the reasons listed first")
-        traj, path = self._trajectory(), Path(path)
+        traj = self._trajectory()
         targets = (path, *sidecar_paths(path))
         if not overwrite or not any(p.exists() or p.is_symlink() for p in targets):
             return render_video(self.params, path, camera=camera, fps=fps, width=width, height=height,

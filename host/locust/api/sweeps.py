@@ -67,19 +67,27 @@ class SweepResults(SweepSummary):
                 f"highest nose {self.best['max_nose_height_m'] * 1000:.2f} mm")
 
 
-def sweep_axes(base: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis]) -> list[Axis]:
-    """The grid's axes: ``{"scale": (0.0, 0.05, 30)}``, ``{"geometry.leg_m": "0.04:0.1:7"}`` or
-    ``["scale=0:0.05:30", ...]`` (the command line's ``--vary``), each name checked once."""
+def varied(base: Robot, vary: Mapping[str, tuple | str] | Sequence, parse: Callable, kind: type,
+           example: str) -> list:
+    """``vary`` as a dict (name -> a tuple of numbers or their ``"a:b"`` text) or as the command
+    line's ``--vary NAME=...`` strings, each parsed by ``parse(text, base)`` unless it already is
+    a ``kind``, and each name given once."""
     if isinstance(vary, Mapping):
         items = [v if isinstance(v, str) else ":".join(repr(x) for x in v) for v in vary.values()]
         vary = [f"{name}={spec}" for name, spec in zip(vary, items)]
-    axes = [v if isinstance(v, Axis) else parse_axis(v, base) for v in vary]
-    names = [a.name for a in axes]
+    parsed = [v if isinstance(v, kind) else parse(v, base) for v in vary]
+    names = [p.name for p in parsed]
     if not names:
-        raise SweepError("nothing to vary", 'e.g. vary={"scale": (0.0, 0.05, 30)}')
+        raise SweepError("nothing to vary", f"e.g. vary={example}")
     if len(set(names)) != len(names):
         raise SweepError(f"--vary names a parameter twice: {', '.join(names)}", "give each parameter one --vary")
-    return axes
+    return parsed
+
+
+def sweep_axes(base: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis]) -> list[Axis]:
+    """The grid's axes: ``{"scale": (0.0, 0.05, 30)}``, ``{"geometry.leg_m": "0.04:0.1:7"}`` or
+    ``["scale=0:0.05:30", ...]`` (the command line's ``--vary``), each name checked once."""
+    return varied(base, vary, parse_axis, Axis, '{"scale": (0.0, 0.05, 30)}')
 
 
 def sweep(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis], cycles: int = 3, *,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -9,6 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import TrackError
+from ..io import trk as trk_io
+from ..io.importing import is_project
 from ..io.tracks_csv import TracksCsv
 
 
@@ -155,13 +159,15 @@ def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None =
           scale: tuple[float, float, float, float, float] | None = None, origin: tuple[float, float] | None = None,
           angle_deg: float = 0.0, camera_json: str | Path | None = None, start: int = 0, end: int | None = None,
           step: int = 1, fps: float | None = None, color_tol: int = 80, search_px: int = 40,
-          pixels: str = "tracker", progress: Callable[[int], None] | None = None) -> Tracks:
+          pixels: str = "tracker", calibration_from: str | Path | None = None, trk: str | Path | None = None,
+          overwrite: bool = False, progress: Callable[[int], None] | None = None) -> Tracks:
     """Find markers in every frame of a video (or an image sequence), as Tracker's autotracker would.
 
     Parameters
     ----------
     video : path-like
-        An MP4 (or the first image of a numbered sequence).
+        An MP4 (or the first image of a numbered sequence), or a Tracker project (``.trk``,
+        ``.trz``) that opens one: its calibration and frame rate are then used.
     markers : dict, optional
         Name -> spec: ``color:#RRGGBB[@X,Y]``, ``template:X,Y@FRAME`` or ``aruco:ID``.
         Default: the robot's nose (``#ff00ff``) and foot (``#00ffff``) colours.
@@ -185,6 +191,14 @@ def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None =
         Tracker's (origin at the image's top-left corner, as Tracker's table shows them) or
         OpenCV's (origin at the top-left pixel's centre, 0.5 px from Tracker's). The returned
         pixel columns are OpenCV's.
+    calibration_from : path-like, optional
+        A Tracker project (``.trk``/``.trz``) of the same camera: its calibration (scale,
+        origin, axes) and frame rate are used, as ``locust track video --calibration-from``.
+    trk : path-like, optional
+        Also write the tracks as a Tracker project (``.trk``) that opens the video with the
+        clip's timing and calibration, one point mass per marker (``--trk`` of the command).
+    overwrite : bool, default False
+        Replace an existing ``trk`` file; otherwise it is refused.
 
     Returns
     -------
@@ -202,13 +216,53 @@ def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None =
     from ..track.spec import ModelOptions, parse_markers
     from ..track.video import Clip, probe
 
-    info = probe(Path(video))
-    clip = Clip(start, end, step, fps).resolved(info)
+    video = Path(video)
+    project = _project(video, calibration_from, scale, origin, camera_json)
+    if project is not None and fps is None and math.isfinite(project.clip.fps):
+        fps = project.clip.fps
+    trk = _trk_target(trk, overwrite)
     models = parse_markers(_marker_specs(markers),
                            ModelOptions(color_tol=color_tol, search_half_px=search_px, pixels=pixels))
-    calibration = _calibration(info, scale, origin, angle_deg, camera_json, pixels)
-    result = track_video(info, clip, models, calibration, progress=progress)
+    opened = trk_io.project_media(project) if project is not None and is_project(video) \
+        else contextlib.nullcontext(video)
+    with opened as media:
+        info = probe(Path(media))
+        clip = Clip(start, end, step, fps).resolved(info)
+        calibration = project.calibration if project is not None else \
+            _calibration(info, scale, origin, angle_deg, camera_json, pixels)
+        result = track_video(info, clip, models, calibration, progress=progress)
+        if trk is not None:
+            from ..track.trk import write_project
+
+            write_project(result, trk, trk_io.media_in_zip(project, trk) if media != video else None)
     return Tracks(tracks_of(result), result)
+
+
+def _project(video: Path, calibration_from, scale, origin, camera_json):
+    """The Tracker project whose calibration is used: ``video`` itself when it is one, else
+    ``calibration_from``; refused beside another calibration."""
+    if is_project(video):
+        if calibration_from is not None:
+            raise TrackError("the video is a Tracker project: its calibration is used, leave out calibration_from",
+                             "or give the video itself")
+        project = trk_io.read_project(video)
+    else:
+        project = trk_io.read_project(calibration_from) if calibration_from is not None else None
+    if project is not None and (scale is not None or origin is not None or camera_json is not None):
+        raise TrackError("a Tracker project's calibration, or scale/origin/camera_json, not both",
+                         "one calibration per run")
+    return project
+
+
+def _trk_target(trk: str | Path | None, overwrite: bool) -> Path | None:
+    if trk is None:
+        return None
+    trk = Path(trk)
+    if trk.suffix.lower() != ".trk":
+        raise TrackError(f"trk={str(trk)!r}: a Tracker project is written as a .trk file", "e.g. trk='redo.trk'")
+    if trk.exists() and not overwrite:
+        raise TrackError(f"{trk} exists", "give another trk path, or overwrite=True to replace it")
+    return trk
 
 
 def read_tracks(path: str | Path, units: str = "m", rename: Mapping[str, str] | Sequence[str] = (),

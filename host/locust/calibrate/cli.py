@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from ..errors import CalibrationError
-from ..fileio import check_distinct, json_text
+from ..fileio import check_distinct, json_text, make_folder
 from ..io.importing import ImportOptions, import_options
 from ..options import FINITE, POSITIVE
 from ..plotting import check_figure_path
@@ -27,9 +27,9 @@ from .write import DEFAULT_ROBOT_TOML, check_plausible, implausible, write_fitte
 
 
 def output_options(func):
-    """--write [PATH], --json, --plot PATH / --no-plot, --force: shared by the experiments. Before
-    anything is read or fitted, the outputs are checked: each its own file, none an input
-    (TRACKS, DATA, --validate), the plot an image path that replaces no user file."""
+    """--write [PATH], --json, --out DIR, --plot PATH / --no-plot, --force: shared by the
+    experiments. Before anything is read or fitted, the outputs are checked: each its own file,
+    none an input (TRACKS, DATA, --validate), the plot an image path that replaces no user file."""
 
     command = func
 
@@ -41,6 +41,8 @@ def output_options(func):
         check_distinct({"--plot": plot, "--write": kwargs["write_path"]}, inputs)
         if plot is not None:
             check_figure_path(plot, kwargs["force"])
+        out_folder(kwargs.pop("out_dir"), plot.parent if plot is not None else None, kwargs["no_plot"],
+                   kwargs["as_json"])
         return command(*args, **kwargs)
 
     func = wrapper
@@ -49,8 +51,9 @@ def output_options(func):
     func = click.option("--no-plot", is_flag=True, help="Do not draw the fit plot.")(func)
     func = click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
                         help="Fit plot (data, model, residuals; .png, .svg or .pdf) [default: <recording>-fit.png "
-                             "beside it, or in the current folder when the recording's folder is read-only]. An "
-                             "existing file is replaced only when it is a figure this toolkit wrote.")(func)
+                             "in --out]. An existing file is replaced only when it is a figure this toolkit "
+                             "wrote.")(func)
+    func = out_option(func, "<recording>-fit.png")
     func = click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")(func)
     func = write_option(func, "Update this robot.toml with the fitted values only. Other values are kept; a new "
                               "file starts from the seed preset.")
@@ -63,6 +66,29 @@ def write_option(func, help_text: str):
                         is_flag=False, flag_value=_BARE_WRITE, default=None,
                         help=f"{help_text} [bare --write: {DEFAULT_ROBOT_TOML} in the current folder, which "
                              "must hold a calibration/ folder].")(func)
+
+
+def out_option(func, what: str):
+    """``--out DIR``: the one folder the fit plots go to, named on the first line (stderr)."""
+    return click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path), default=None,
+                        help=f"Folder for the fit plots ({what}), made if missing; named on the first line "
+                             "[default: the current folder; never the recordings' folder].")(func)
+
+
+_OUT_KEY = "locust.calibrate.out"
+
+
+def out_folder(out_dir: Path | None, plot_folder: Path | None, no_plot: bool, as_json: bool) -> Path | None:
+    """The folder the command's plots go to (--plot's, else --out, else the current folder), named
+    on stderr as the first line (with --json the JSON names each plot instead), made when the
+    first plot is drawn; None with --no-plot."""
+    if no_plot:
+        return None
+    folder = plot_folder if plot_folder is not None else (out_dir or Path("."))
+    click.get_current_context().meta[_OUT_KEY] = folder
+    if not as_json:
+        click.echo(f"output folder: {folder.resolve()}", err=True)
+    return folder
 
 
 _BARE_WRITE = ":bare --write:"
@@ -328,9 +354,10 @@ def ramp(data, ramp_markers, robot_marker, into, resolution_deg, imports, timing
 @click.option("--max-iter", type=click.IntRange(1, 200), default=30, show_default=True, help="Solver iterations.")
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")
 @click.option("--no-plot", is_flag=True, help="Do not draw the fit plots.")
+@functools.partial(out_option, what="<run>-hops-fit.png")
 @functools.partial(write_option, help_text="Update this robot.toml with the identifiable fitted values only, "
                                            "source fit:hops.")
-def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
+def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, out_dir, write_path):
     """Fit the model to filmed hops: friction, hinge stiffness, servo speed on the robot.
 
     Each RUN is a `locust hop --out` folder holding its run.json and the track of its video
@@ -339,7 +366,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
     physics is shared. The firmware's measured phase times drive each simulation; the
     tracked nose and foot are compared with the simulated markers, both aligned on the first
     push. Prints each value with its 95% interval and the RMS residual per run, and draws
-    <run>/hops-fit.png (tracked against the fitted simulation).
+    <run>-hops-fit.png in --out (tracked against the fitted simulation).
 
     \b
     Example:
@@ -351,6 +378,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
     keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
     H.check_fittable(keys)
     write_path = write_target(write_path)
+    folder = out_folder(out_dir, None, no_plot, as_json)
     start_from = config or (write_path if write_path and Path(write_path).exists() else None)
     if start_from is not None:
         base = resolve_robot(None, start_from, sets)
@@ -375,7 +403,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
         out["plots"] = []
         for run in fit.runs:
             if run.curves:
-                plot = Path(run.source) / "hops-fit.png"
+                plot = make_folder(folder) / f"{Path(run.source).name}-hops-fit.png"
                 out["plots"].append(str(H.plot_run(run, plot, f"RMS {1000 * run.rms_m:.2f} mm")))
     if write_path:
         values = facade_fit.parameters
@@ -402,11 +430,10 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, write_path):
 
 
 def default_plot_path(recording: Path, recording_name: Path | None = None) -> Path:
-    """``<recording>-fit.png`` beside the recording; in the current folder when the recording's
-    folder is read-only by its mode (someone else's data: nothing is written into it, even as root)."""
-    name = f"{Path(recording_name or recording).stem}-fit.png"
-    folder = recording.resolve().parent
-    return (folder if folder.stat().st_mode & 0o222 else Path.cwd()) / name
+    """``<recording>-fit.png`` in the command's output folder (:func:`out_folder`), never beside
+    the recording (a data folder, maybe someone else's)."""
+    folder = make_folder(click.get_current_context().meta.get(_OUT_KEY, Path(".")))
+    return folder / f"{Path(recording_name or recording).stem}-fit.png"
 
 
 def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_path: Path | None,

@@ -23,3 +23,11 @@ class Curves:
     @property
     def residual(self) -> np.ndarray:
         return self.data - self.model
+
+    @property
+    def residual_label(self) -> str:
+        """``residual [mm]``: data minus model, in the data's unit (``y_label``'s brackets);
+        ``residual (no unit)`` for a pure number such as the ramp's tan(angle)."""
+        unit = self.y_label[self.y_label.rfind("[") + 1:-1] if self.y_label.endswith("]") and "[" in self.y_label \
+            else ""
+        return f"residual [{unit}]" if unit else "residual (no unit)"

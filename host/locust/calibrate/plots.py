@@ -19,6 +19,7 @@ def plot_fit(curves: Curves | list[Curves], path: str | Path, subtitle: str = ""
 def fit_figure(curves: Curves | list[Curves], subtitle: str = ""):
     """The figure :func:`plot_fit` writes (a ``matplotlib.figure.Figure``, no display needed)."""
     from matplotlib.figure import Figure
+    from matplotlib.ticker import MaxNLocator
 
     panels = [curves] if isinstance(curves, Curves) else list(curves)
     fig = Figure(figsize=(7.5, 5.5 * len(panels)))
@@ -39,8 +40,10 @@ def fit_figure(curves: Curves | list[Curves], subtitle: str = ""):
         top.grid(alpha=0.3)
         bottom.axhline(0, color="0.5", lw=0.8)
         bottom.plot(c.x, c.residual, "o" if discrete else ".", ms=3, color="#2ca02c")
-        bottom.set_ylabel("residual")
+        bottom.set_ylabel(c.residual_label)
         bottom.set_xlabel(c.x_label)
+        if discrete:      # numbered trials (the ramp's): ticks on whole trials only
+            bottom.xaxis.set_major_locator(MaxNLocator(integer=True))
         bottom.grid(alpha=0.3)
     fig.tight_layout()
     return fig

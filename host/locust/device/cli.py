@@ -132,7 +132,8 @@ def _parse_servo_set(item: str, option: str = "--servo") -> tuple[str, float]:
               default=R.hop_default("heartbeat_ms"), show_default=True,
               help="The robot returns to rest if the host is silent this long.")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="Directory for run.json (must not hold one). Default: data/runs/<timestamp>/.")
+              help="Directory for run.json (must not hold one), named on the first line. Default: "
+                   "data/runs/<timestamp>/. A hop the board never answered leaves no folder.")
 @click.option("--json", "as_json", is_flag=True, help="Print the run record as JSON.")
 @click.option("--leg-set", "leg_set_name", default=None, metavar="NAME",
               help="The legs on the robot (small, medium, large, or a name of your own), recorded in "
@@ -156,6 +157,11 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     from .session import open_port
 
     robot, source = _hopped_robot(preset, config, sets, leg_set_name)
+    made = _first_missing(Path(out) if out is not None else R.RUNS_ROOT)
+    directory = R.run_dir(out)
+    # what a hop that never started made goes again: the folders it created, none that was there
+    made = made if made is not None else (directory if out is None else None)
+    _info(f"output folder: {directory}")
     source = _virtual_robot_source(port, source)
     s = robot.schedule
     schedule = R.HopSchedule(cycles=cycles or s.cycles, push_deg=s.push_deg if push_deg is None else push_deg,
@@ -167,9 +173,11 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
                                "schedule.push_s": schedule.push_ms / 1000, "schedule.wait_s": schedule.wait_ms / 1000},
                               "locust hop options")
     if video is not None and port == "sim":
-        _video_frames(schedule, video, video_fps)
-    made = _first_missing(Path(out)) if out is not None else None
-    directory = R.run_dir(out)
+        try:
+            _video_frames(schedule, video, video_fps)
+        except LocustError:
+            _remove_empty(directory, made)
+            raise
     held = R.claim(directory)   # a second hop into the same --out is refused (the folder is the other's)
     # a kill (SIGTERM) or a closed terminal (SIGHUP) ends the hop as Ctrl-C does: the robot to
     # rest, the record says so, a --port sim virtual robot stops
@@ -190,8 +198,8 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
         if isinstance(exc, KeyboardInterrupt) and not (directory / R.RECORD_NAME).exists():
             reported = DeviceError("interrupted before the hop began: no run record was written",
                                    "run the hop again when ready")
-        _remove_empty(directory, made if out is not None else directory)   # a hop that never started
-        if reported is not exc:                                            # leaves no empty folder
+        _remove_empty(directory, made)   # a hop that never started leaves no folder
+        if reported is not exc:
             raise reported from None
         raise
     finally:

@@ -40,10 +40,16 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             on_phase: Callable[[R.Phase], None] = lambda p: None,
             robot: R.RobotSource | None = None) -> R.RunRecord:
     rec = R.RunRecord(schedule=schedule, port=link.port, message="running", robot=robot or R.RobotSource())
-    R.write(rec, directory)
+    # no record until the board has answered: a hop that never started (nothing flashed, the
+    # wrong port, Ctrl-C at the handshake) leaves no run folder behind
     try:
         hello = link.hello(soft_reset=True)    # mpremote leaves a board at the REPL
-        rec.firmware_version = hello.get("version")
+    except KeyboardInterrupt:
+        raise DeviceError("interrupted before the board answered; no hop ran, nothing was recorded",
+                          "run the hop again when ready") from None
+    rec.firmware_version = hello.get("version")
+    R.write(rec, directory)
+    try:
         if hello.get("hopping"):
             link.call("stop")
         rec.board = read_board(link, hello)

@@ -11,10 +11,10 @@ import click
 from ..errors import FabError
 from ..fileio import json_text
 from ..options import FINITE, FiniteFloat
-from . import export, flat_pattern, laminate, preview
-from .design import LayerMap, design_from_drawing, parse_layer_options
-from .dxf_read import UNIT_BY_NAME, read_drawing
-from .summary import summary, summary_text
+from . import laminate
+from .design import parse_layer_options
+from .dxf_read import UNIT_BY_NAME
+from .summary import summary_text
 
 # a fold's cut-out is a millimetre or two wide (the seed's 1 mm); one of 50 mm takes a whole link away
 MAX_HINGE_WIDTH_MM = 50.0
@@ -117,41 +117,16 @@ def fab(dxf, from_robot, out, as_json, layers, units, gap_tol_mm, recover, hinge
     if (dxf is None) == (from_robot is None):
         raise FabError("give a DXF drawing or --from-robot, not both" if dxf else "nothing to draw",
                        "e.g. `locust fab zz.dxf --out cut/` or `locust fab --from-robot seed --json`")
-    if out is not None:
-        export.check_out(out)
-    hinges_x = None
-    fp = None
-    if from_robot:
-        fp = flat_pattern.from_robot(_robot(from_robot), glue_tab_mm=glue_tab_mm,
-                                     slot_width_mm=slot_width_mm, slot_length_mm=slot_length_mm)
-        design = flat_pattern.design(fp)
-        hinges_x = fp.hinges_x_mm
-    else:
-        drawing = read_drawing(dxf, units=units, gap_tol_mm=gap_tol_mm, recover=recover)
-        layer_map = LayerMap().with_overrides(parse_layer_options(layers))
-        design = design_from_drawing(drawing, layer_map, hinge_width_mm=hinge_width_mm, gap_tol_mm=gap_tol_mm)
+    from ..api.fabrication import fab as make_cut_files
 
-    specs = laminate.stack_from_materials(stack.split(","), tuple(mirror))
-    process = laminate.Process(kerf_mm=kerf_mm, support_width_mm=support_width_mm,
-                               jig_diameter_mm=jig_diameter_mm, jig_spacing_mm=jig_spacing_mm)
-    lam = laminate.build(design, specs, process)
-
-    # the cut files are made with or without --out: a kerf that cannot be applied is refused either way
-    files: dict[str, bytes] = export.cut_files(lam)
-    if out is None:
-        files = {}
-    else:
-        if fp is not None:
-            files["flat_pattern.dxf"] = flat_pattern.drawing_bytes(fp)
-        if not no_preview:
-            files.update(preview.preview_files(lam))
-    names = sorted(files) + (["summary.json"] if out is not None else [])
-    result = summary(lam, hinges_x_mm=hinges_x, files=names, out_dir=str(out) if out else None)
-    if out is not None:
-        files["summary.json"] = json_text(result).encode()
-        export.publish(out, files)
-        if cad_check:
-            result["cad_check"] = _cad_check(out, [n for n in names if n.endswith(".dxf")])
+    result = make_cut_files(_robot(from_robot) if from_robot else dxf, out=out, layers=parse_layer_options(layers),
+                            units=units, gap_tol_mm=gap_tol_mm, recover=recover, hinge_width_mm=hinge_width_mm,
+                            stack=stack.split(","), mirror=tuple(mirror), kerf_mm=kerf_mm,
+                            support_width_mm=support_width_mm, jig_diameter_mm=jig_diameter_mm,
+                            jig_spacing_mm=jig_spacing_mm, glue_tab_mm=glue_tab_mm, slot_width_mm=slot_width_mm,
+                            slot_length_mm=slot_length_mm, previews=not no_preview)
+    if out is not None and cad_check:
+        result["cad_check"] = _cad_check(out, [n for n in result["files"] if n.endswith(".dxf")])
     if as_json:
         click.echo(json_text(result), nl=False)
     else:

@@ -253,7 +253,10 @@ class RunRecord:
         }
 
 
-def run_dir(out: Path | None, root: Path = Path("data/runs")) -> Path:
+RUNS_ROOT = Path("data/runs")   # where a run without --out goes, under the current folder
+
+
+def run_dir(out: Path | None, root: Path = RUNS_ROOT) -> Path:
     """The directory of a new run record: ``out`` (must not hold one yet) or a fresh timestamped one."""
     if out is None:
         return unique_dir(root, time.strftime("%Y%m%d-%H%M%S"))

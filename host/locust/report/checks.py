@@ -160,5 +160,5 @@ def _track_notices(c: Comparison, m: MeasuredTrial, predicted_m: float) -> list[
 
 
 def _length(value_m: float) -> str:
-    """``+0.9 cm``, ``-600 m``: a signed travel in the unit that reads best."""
-    return f"{value_m * 100:+.1f} cm" if abs(value_m) < 1 else f"{value_m:+.4g} m"
+    """``+9.0 mm``, ``-600 m``: a signed travel in mm (the hop figures' unit), or metres from 1 m."""
+    return f"{value_m * 1000:+.1f} mm" if abs(value_m) < 1 else f"{value_m:+.4g} m"

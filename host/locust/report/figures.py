@@ -18,7 +18,7 @@ from .landscape import Landscape, design_value
 
 COLOURS = {"small": "#1f77b4", "medium": "#ff7f0e", "large": "#2ca02c"}   # the seed dashboard's
 OTHER = ["#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"]
-CM = 100.0
+MM = 1000.0   # hop figures in mm, as every command prints them
 
 
 def colour(name: str, names: list[str]) -> str:
@@ -51,18 +51,18 @@ def draw_traces(ax, c: Comparison, names: list[str], which: str, spread=None, be
     :class:`.predict.Prediction` on the robot before a fit) its trace dotted."""
     col = colour(c.config, names)
     for i, m in enumerate(c.trials):
-        ax.plot(m.trace.t_s, getattr(m.trace, f"{which}_m") * CM, color=col, lw=1.4, alpha=0.85,
+        ax.plot(m.trace.t_s, getattr(m.trace, f"{which}_m") * MM, color=col, lw=1.4, alpha=0.85,
                 label="measured" if i == 0 else None)
     p = c.prediction
     if spread is not None:
         mean, sd = getattr(spread, f"{which}_mean_m"), getattr(spread, f"{which}_sd_m")
-        ax.fill_between(spread.t_s, (mean - sd) * CM, (mean + sd) * CM, color="0.55", alpha=0.35, lw=0,
+        ax.fill_between(spread.t_s, (mean - sd) * MM, (mean + sd) * MM, color="0.55", alpha=0.35, lw=0,
                         label=f"predicted ±1 sd ({spread.n_valid} draws)")
     if before is not None and before.trace is not None:
-        ax.plot(before.trace.t_s, getattr(before.trace, f"{which}_m") * CM, ":", color="#b00020", lw=1.2,
+        ax.plot(before.trace.t_s, getattr(before.trace, f"{which}_m") * MM, ":", color="#b00020", lw=1.2,
                 label="predicted before the fit")
     if p.trace is not None:
-        ax.plot(p.trace.t_s, getattr(p.trace, f"{which}_m") * CM, "--", color="black", lw=1.2, label="predicted")
+        ax.plot(p.trace.t_s, getattr(p.trace, f"{which}_m") * MM, "--", color="black", lw=1.2, label="predicted")
     else:
         _invalid_note(ax, c)
     for k in range(c.cycles + 1):
@@ -82,8 +82,8 @@ def overlay_figure(comps: list[Comparison], spreads: dict | None = None, befores
         axes[1, j].set_title(f"{_label(c)}: nose height", loc="left", fontsize=10)
         axes[1, j].set_xlabel("time since first push (s)")
         legend_outside(axes[1, j], below=True, fontsize=8)
-    axes[0, 0].set_ylabel("forward (cm)")
-    axes[1, 0].set_ylabel("above standing (cm)")
+    axes[0, 0].set_ylabel("forward (mm)")
+    axes[1, 0].set_ylabel("above standing (mm)")
     fig.suptitle("Displacement and height vs time: measured (solid) and predicted (dashed)", fontsize=11)
     fig.tight_layout()
     return png_bytes(fig)
@@ -101,17 +101,17 @@ def draw_bars(ax, comps: list[Comparison], what: str) -> None:
         meas = [c.hop_distance for c in comps]
         pred = [c.predicted_hop_distance_m for c in comps]
     cols = [colour(n, names) for n in names]
-    heights = [s.mean * CM if s.n else 0.0 for s in meas]
-    errs = [(s.std or 0.0) * CM for s in meas]
+    heights = [s.mean * MM if s.n else 0.0 for s in meas]
+    errs = [(s.std or 0.0) * MM for s in meas]
     ax.bar(x - w / 2, heights, w, color=cols, yerr=errs, capsize=4, label="measured (mean ± 1 sd)", zorder=3)
-    pv = [p * CM if math.isfinite(p) else 0.0 for p in pred]
+    pv = [p * MM if math.isfinite(p) else 0.0 for p in pred]
     ax.bar(x + w / 2, pv, w, color="white", edgecolor=cols, hatch="//", lw=1.2, label="predicted", zorder=3)
     for i, (s, p) in enumerate(zip(meas, pred)):
         if s.n:
-            ax.annotate(f"{s.mean * CM:.2f}" + (f"±{s.std * CM:.2f}" if s.std is not None else ""),
+            ax.annotate(f"{s.mean * MM:.1f}" + (f"±{s.std * MM:.1f}" if s.std is not None else ""),
                         (x[i] - w / 2, heights[i]), xytext=(0, 3), textcoords="offset points",
                         ha="center", fontsize=7)
-        ax.annotate(f"{p * CM:.2f}" if math.isfinite(p) else "invalid", (x[i] + w / 2, pv[i]), xytext=(0, 3),
+        ax.annotate(f"{p * MM:.1f}" if math.isfinite(p) else "invalid", (x[i] + w / 2, pv[i]), xytext=(0, 3),
                     textcoords="offset points", ha="center", fontsize=7,
                     color="black" if math.isfinite(p) else "#b00020")
     ax.set_xticks(x, [_label(c) for c in comps])
@@ -126,10 +126,10 @@ def bars_figure(comps: list[Comparison], what: str) -> bytes:
     draw_bars(ax, comps, what)
     if what == "jump":
         ax.set_title("Jump height: highest nose point above standing", loc="left", fontsize=10)
-        ax.set_ylabel("height (cm)")
+        ax.set_ylabel("height (mm)")
     else:
         ax.set_title("Distance per hop", loc="left", fontsize=10)
-        ax.set_ylabel("distance (cm)")
+        ax.set_ylabel("distance (mm)")
     fig.tight_layout()
     return png_bytes(fig)
 
@@ -145,18 +145,18 @@ def hops_figure(comps: list[Comparison], spreads: dict | None = None) -> bytes:
         col = colour(c.config, names)
         for key, ax in (("distance", axes[0]), ("apex", axes[1])):
             xs = [r.hop for r in c.rows]
-            ys = [getattr(r, f"measured_{key}_m") * CM for r in c.rows]
+            ys = [getattr(r, f"measured_{key}_m") * MM for r in c.rows]
             ax.plot(xs, ys, "o", color=col, ms=5, alpha=0.8, label=f"{_label(c)} measured")
             if c.prediction.valid:
                 # the simulated marker's hops, cut as the track's are
                 px, pv = [h.hop for h in c.prediction.hops], [getattr(h, f"{key}_m") for h in c.prediction.hops]
                 sp = spreads.get(c.config)
-                err = None if sp is None else [v * CM for v in getattr(sp, f"hop_{key}_sd_m")][:len(pv)]
-                ax.errorbar(px, [v * CM for v in pv], yerr=err, fmt="--", color=col, lw=1.2, capsize=3,
+                err = None if sp is None else [v * MM for v in getattr(sp, f"hop_{key}_sd_m")][:len(pv)]
+                ax.errorbar(px, [v * MM for v in pv], yerr=err, fmt="--", color=col, lw=1.2, capsize=3,
                             label=f"{_label(c)} predicted" + (" ±1 sd" if err else ""))
     axes[0].set_title("Distance of each hop", loc="left", fontsize=10)
     axes[1].set_title("Nose apex of each hop", loc="left", fontsize=10)
-    for ax, unit in zip(axes, ("distance (cm)", "apex above standing (cm)")):
+    for ax, unit in zip(axes, ("distance (mm)", "apex above standing (mm)")):
         ax.set_xlabel("hop")
         ax.set_ylabel(unit)
         ax.grid(True, ls=":", alpha=0.5)
@@ -171,7 +171,7 @@ def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[s
     first = land.names[0]
     k, xlabel = axis_scale(first)
     xs = land.values[first] * k
-    hop = land.hop_distance_m * CM
+    hop = land.hop_distance_m * MM
     if len(land.names) == 1:
         order = np.argsort(xs)
         ok = land.valid[order]
@@ -186,19 +186,19 @@ def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[s
             col = colour(c.config, names)
             ax.axvline(xv, color=col, ls=":", lw=1.0)
             if c.prediction.valid:
-                ax.plot([xv], [c.predicted_hop_distance_m * CM], "o", mfc="white", mec=col, mew=2, ms=8)
+                ax.plot([xv], [c.predicted_hop_distance_m * MM], "o", mfc="white", mec=col, mew=2, ms=8)
             if c.hop_distance.n:
-                ax.errorbar([xv], [c.hop_distance.mean * CM], yerr=[(c.hop_distance.std or 0.0) * CM], fmt="s",
+                ax.errorbar([xv], [c.hop_distance.mean * MM], yerr=[(c.hop_distance.std or 0.0) * MM], fmt="s",
                             color=col, ms=7, capsize=4, label=f"{_label(c)}: measured ■, predicted ○")
             else:
                 ax.plot([], [], "o", mfc="white", mec=col, label=f"{_label(c)}: predicted ○")
-        ax.set_ylabel("distance per hop (cm)")
+        ax.set_ylabel("distance per hop (mm)")
     else:
         second = land.names[1]
         k2, ylabel = axis_scale(second)
         ys = land.values[second] * k2
         sc = ax.scatter(xs[land.valid], ys[land.valid], c=hop[land.valid], cmap="viridis", s=28)
-        ax.figure.colorbar(sc, ax=ax, label="distance per hop (cm)")
+        ax.figure.colorbar(sc, ax=ax, label="distance per hop (mm)")
         bad = ~land.valid
         if bad.any():
             ax.plot(xs[bad], ys[bad], "x", color="#b00020", ms=6, label="invalid (failed audit)")
@@ -280,25 +280,25 @@ def dashboard(comps: list[Comparison], land: Landscape | None, configs: dict[str
     for c in comps:
         col = colour(c.config, names)
         for i, m in enumerate(c.trials):
-            ax.plot(m.trace.t_s, m.trace.x_m * CM, color=col, lw=1.6, alpha=0.85,
+            ax.plot(m.trace.t_s, m.trace.x_m * MM, color=col, lw=1.6, alpha=0.85,
                     label=f"{_label(c)} measured" if i == 0 else None)
         if c.prediction.trace is not None:
-            ax.plot(c.prediction.trace.t_s, c.prediction.trace.x_m * CM, "--", color=col, lw=1.2,
+            ax.plot(c.prediction.trace.t_s, c.prediction.trace.x_m * MM, "--", color=col, lw=1.2,
                     label=f"{_label(c)} predicted")
     ax.set_title("Longitudinal displacement (nose)", loc="left", fontsize=11)
     ax.set_xlabel("time since first push (s)")
-    ax.set_ylabel("displacement (cm)")
+    ax.set_ylabel("displacement (mm)")
     ax.grid(True, ls=":", alpha=0.5)
     legend_outside(ax, fontsize=8)
     draw_bars(axes[0, 1], comps, "jump")
     axes[0, 1].set_title("Max vertical jump height (nose above standing)", loc="left", fontsize=11)
-    axes[0, 1].set_ylabel("height (cm)")
+    axes[0, 1].set_ylabel("height (mm)")
     if land is not None:
         draw_landscape(axes[1, 0], land, comps, configs)
     else:
         draw_bars(axes[1, 0], comps, "distance")
         axes[1, 0].set_title("Distance per hop", loc="left", fontsize=11)
-        axes[1, 0].set_ylabel("distance (cm)")
+        axes[1, 0].set_ylabel("distance (mm)")
     draw_timing(axes[1, 1], comps)
     fig.suptitle("locust: simulation against measurement, " + ", ".join(_label(c) for c in comps), fontsize=13)
     fig.tight_layout()

@@ -41,14 +41,15 @@ def esc(value) -> str:
     return html.escape(str(value), quote=True)
 
 
-def cm(value: float, digits: int = 2) -> str:
-    return f"{value * 100:.{digits}f}" if value is not None and math.isfinite(value) else "—"
+def mm(value: float, digits: int = 1) -> str:
+    """A length in metres as millimetres (the filmed unit of every hop figure), 0.1 mm by default."""
+    return f"{value * 1000:.{digits}f}" if value is not None and math.isfinite(value) else "—"
 
 
-def cm_pm(mean: float, std: float | None) -> str:
+def mm_pm(mean: float, std: float | None) -> str:
     if not math.isfinite(mean):
         return "—"
-    return cm(mean) + (f" ± {std * 100:.2f}" if std is not None else "")
+    return mm(mean) + (f" ± {std * 1000:.1f}" if std is not None else "")
 
 
 def pct(err: float, ref: float, resolution_m: float = math.nan) -> str:
@@ -57,7 +58,7 @@ def pct(err: float, ref: float, resolution_m: float = math.nan) -> str:
     if not (math.isfinite(err) and math.isfinite(ref)) or ref == 0:
         return "—"
     if math.isfinite(resolution_m) and abs(err) < resolution_m:
-        return f"within 1 px ({resolution_m * 100:.2f} cm)"
+        return f"within 1 px ({resolution_m * 1000:.1f} mm)"
     return f"{100 * err / abs(ref):+.1f} %"
 
 
@@ -85,26 +86,26 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
         dist_err = c.distance.mean - c.predicted_distance_m
         jump_err = c.jump.mean - c.predicted_jump_m
         cells = [
-            td(labels[name], left=True), td(f"+{added[name] * 100:g}"), td(str(c.distance.n), name, "trials"),
-            td(cm(c.predicted_distance_m), name, "predicted_distance_cm"),
-            td(cm_pm(c.distance.mean, c.distance.std), name, "measured_distance_cm"),
-            td(cm(dist_err), name, "distance_error_cm"), td(pct(dist_err, c.predicted_distance_m, c.resolution_m)),
-            td(cm(c.predicted_hop_distance_m), name, "predicted_hop_distance_cm"),
-            td(cm_pm(c.hop_distance.mean, c.hop_distance.std), name, "measured_hop_distance_cm"),
-            td(cm(c.predicted_jump_m), name, "predicted_jump_cm"),
-            td(cm_pm(c.jump.mean, c.jump.std), name, "measured_jump_cm"),
-            td(cm(jump_err), name, "jump_error_cm"), td(pct(jump_err, c.predicted_jump_m, c.resolution_m)),
+            td(labels[name], left=True), td(f"+{added[name] * 1000:g}"), td(str(c.distance.n), name, "trials"),
+            td(mm(c.predicted_distance_m), name, "predicted_distance_mm"),
+            td(mm_pm(c.distance.mean, c.distance.std), name, "measured_distance_mm"),
+            td(mm(dist_err), name, "distance_error_mm"), td(pct(dist_err, c.predicted_distance_m, c.resolution_m)),
+            td(mm(c.predicted_hop_distance_m), name, "predicted_hop_distance_mm"),
+            td(mm_pm(c.hop_distance.mean, c.hop_distance.std), name, "measured_hop_distance_mm"),
+            td(mm(c.predicted_jump_m), name, "predicted_jump_mm"),
+            td(mm_pm(c.jump.mean, c.jump.std), name, "measured_jump_mm"),
+            td(mm(jump_err), name, "jump_error_mm"), td(pct(jump_err, c.predicted_jump_m, c.resolution_m)),
             td(f"valid, {outcome.replace('_', ' ')}" if valid and (outcome := c.prediction.result.outcome)
                else "valid" if valid else "INVALID: " + "; ".join(c.prediction.result.reasons), name, "sim_status",
                left=True),
         ]
         rows.append(f'<tr{"" if valid else " class=invalid"}>{"".join(cells)}</tr>')
-    headers = ["configuration", "added (cm)", "trials", "predicted distance (cm)", "measured distance (cm)",
-               "error (cm)", "error", "predicted per hop (cm)", "measured per hop (cm)",
-               "predicted jump (cm)", "measured jump (cm)", "error (cm)", "error", "simulation"]
+    headers = ["configuration", "added (mm)", "trials", "predicted distance (mm)", "measured distance (mm)",
+               "error (mm)", "error", "predicted per hop (mm)", "measured per hop (mm)",
+               "predicted jump (mm)", "measured jump (mm)", "error (mm)", "error", "simulation"]
     known = [(labels[c.config], c.resolution_m) for c in comps if math.isfinite(c.resolution_m)]
     note = ("" if not known else '<p class="note">Tracking resolution (one pixel at the marker): '
-            + ", ".join(f"{esc(label)} {res * 100:.3g} cm" for label, res in known)
+            + ", ".join(f"{esc(label)} {res * 1000:.3g} mm" for label, res in known)
             + '; an error smaller than that is not measured and reads "within 1 px".</p>')
     return table(headers, rows, id_="summary") + note
 
@@ -119,11 +120,11 @@ def outcome_table(spreads: dict, labels: dict[str, str]) -> str:
         for outcome, o in sp.outcomes.items():
             cells = [td(labels[name], left=True), td(outcome.replace("_", " "), left=True),
                      td(f"{o.n} of {sp.n_valid} ({o.share * 100:.0f} %)", name, f"outcome_share:{outcome}"),
-                     td(cm_pm(o.distance_m.mean, o.distance_m.sd if math.isfinite(o.distance_m.sd) else None)),
-                     td(cm_pm(o.max_nose_height_m.mean,
+                     td(mm_pm(o.distance_m.mean, o.distance_m.sd if math.isfinite(o.distance_m.sd) else None)),
+                     td(mm_pm(o.max_nose_height_m.mean,
                               o.max_nose_height_m.sd if math.isfinite(o.max_nose_height_m.sd) else None))]
             rows.append(f"<tr>{''.join(cells)}</tr>")
-    headers = ["configuration", "outcome", "draws", "distance (cm)", "highest nose (cm)"]
+    headers = ["configuration", "outcome", "draws", "distance (mm)", "highest nose (mm)"]
     return table(headers, rows, left_cols=2, id_="outcomes")
 
 
@@ -134,17 +135,17 @@ def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
             key = f"{r.trial}#{r.hop}"
             rows.append("<tr>" + "".join([
                 td(labels[c.config], left=True), td(r.trial, left=True), td(str(r.hop)),
-                td(cm(r.measured_distance_m), c.config, f"hop_measured_distance_cm:{key}"),
-                td(cm(r.predicted_distance_m), c.config, f"hop_predicted_distance_cm:{key}"),
-                td(cm(r.distance_error_m)), td(pct(r.distance_error_m, r.predicted_distance_m, c.resolution_m)),
-                td(cm(r.measured_apex_m), c.config, f"hop_measured_apex_cm:{key}"),
-                td(cm(r.predicted_apex_m), c.config, f"hop_predicted_apex_cm:{key}"),
-                td(cm(r.apex_error_m)), td(pct(r.apex_error_m, r.predicted_apex_m, c.resolution_m)),
+                td(mm(r.measured_distance_m), c.config, f"hop_measured_distance_mm:{key}"),
+                td(mm(r.predicted_distance_m), c.config, f"hop_predicted_distance_mm:{key}"),
+                td(mm(r.distance_error_m)), td(pct(r.distance_error_m, r.predicted_distance_m, c.resolution_m)),
+                td(mm(r.measured_apex_m), c.config, f"hop_measured_apex_mm:{key}"),
+                td(mm(r.predicted_apex_m), c.config, f"hop_predicted_apex_mm:{key}"),
+                td(mm(r.apex_error_m)), td(pct(r.apex_error_m, r.predicted_apex_m, c.resolution_m)),
             ]) + "</tr>")
     if not rows:
         return '<p class="note">No tracks were given: nothing measured to compare hop by hop.</p>'
-    headers = ["configuration", "trial", "hop", "measured distance (cm)", "predicted (cm)", "error (cm)", "error",
-               "measured apex (cm)", "predicted (cm)", "error (cm)", "error"]
+    headers = ["configuration", "trial", "hop", "measured distance (mm)", "predicted (mm)", "error (mm)", "error",
+               "measured apex (mm)", "predicted (mm)", "error (mm)", "error"]
     return table(headers, rows, left_cols=2, id_="hops")
 
 
@@ -187,9 +188,9 @@ def params_table(param_rows: list[dict]) -> str:
 
 
 def links_table(link_rows: list[tuple[str, tuple[float, float, float, float]]]) -> str:
-    rows = ["<tr>" + td(name, left=True) + "".join(td(f"{v * 100:.2f}") for v in links) + "</tr>"
+    rows = ["<tr>" + td(name, left=True) + "".join(td(f"{v * 1000:.1f}") for v in links) + "</tr>"
             for name, links in link_rows]
-    return table(["configuration", "ground (cm)", "crank (cm)", "coupler (cm)", "leg (cm)"], rows, id_="links")
+    return table(["configuration", "ground (mm)", "crank (mm)", "coupler (mm)", "leg (mm)"], rows, id_="links")
 
 
 def figure_html(fig: Figure) -> str:
