@@ -3,9 +3,10 @@ the same marker's, from the same zero and cut into the same hops as the figure d
 
 On SYNTHETIC trials (locust.report.synthetic: the simulated nose of the very robot the model
 is, sampled like a 60 frames/s camera without noise) of two robots: Large with its crank at
--93 deg, which rears (nose about 55 mm up) and returns, 6.3 mm forward a hop (issue 33's
-rear-and-return band); and Small as preset, which goes over onto its back in its first hop,
-where the chassis (-74 mm) and the nose (about -127 mm) travel differently.
+-88 deg, which rears (nose about 76 mm up) and returns, about 7 mm forward a hop (issue 33's
+rear-and-return band, -90 to -86 deg with the presets' servo axis at 28 mm); and Small as
+preset, which goes over onto its back in its first hop, where the chassis (-74 mm) and the
+nose (about -127 mm) travel differently.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from locust.report.synthetic import write_synthetic_trial
 
 CYCLES = 2
 ROBOTS = {
-    "rearing": lambda: preset("large").with_values({"geometry.crank_start_deg": -93.0}),
+    "rearing": lambda: preset("large").with_values({"geometry.crank_start_deg": -88.0}),
     "over": lambda: preset("small"),
 }
 
