@@ -52,6 +52,11 @@ def test_image_sequence_cups_follow_trackers_points(cups_run, name, theirs):
     assert err[0] < 0.01, err             # the key frame: Tracker's numbers, typed in its convention, are its point
     assert err[ok].max() <= 1.2, err                               # acceptance 10 px; measured 0.79 / 0.94
     assert err[ok].mean() <= 0.6, err                              # acceptance 3 px; measured 0.50 / 0.56
+    # 0.5 px mean is within this reference's own scatter: Tracker's points here are clicked by
+    # hand (each on a grid of 240/959 px, the screen's pixels at Tracker's zoom). Most of the
+    # error is one constant offset over frames 1..8 (measured 0.46 / 0.59 px: the key frame's
+    # click, on a cup still against its holder); about it the track follows the clicks to
+    # 0.33 / 0.31 px mean. No evolve rate (0-40 %) or radius (4-8 px) brings both under 0.5.
 
 
 def test_cup_out_of_view_is_lost_not_stuck(cups_run):
