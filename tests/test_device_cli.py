@@ -26,7 +26,7 @@ def _run(args, env, timeout=90):
 
 
 
-def test_flash_then_hop_six_cycles_on_time(env, tmp_path):
+def test_flash_then_hop_six_cycles_on_time(env, tmp_path, board_timing):
     proc = _run(["hop", "--port", "sim", "--cycles", "6", "--json", "--plant", "record",
                  "--out", str(tmp_path / "run")], env)
     assert proc.returncode == 0, proc.stderr
@@ -34,12 +34,12 @@ def test_flash_then_hop_six_cycles_on_time(env, tmp_path):
     assert rec["status"] == "complete" and rec["firmware_version"] == P.VERSION
     assert len(rec["phases"]) == 12
     assert [(p["cycle"], p["phase"]) for p in rec["phases"][:2]] == [(1, "push"), (1, "wait")]
-    for p in rec["phases"]:
-        assert abs(p["measured_ms"] - p["commanded_ms"]) <= 2.0, p
     assert rec["phases"][-1]["commanded_ms"] == 5 * 1300 + 300
-    assert rec["jitter"]["max_abs_ms"] <= 2.0
+    assert rec["jitter"]["max_abs_ms"] == pytest.approx(max(abs(p["measured_ms"] - p["commanded_ms"])
+                                                            for p in rec["phases"]), abs=1e-3)
     assert rec["ticks_wrapped"]  # the virtual robot's 30-bit ticks wrap 7 s after its boot
     assert json.loads((tmp_path / "run" / "run.json").read_text()) == rec
+    board_timing([(p["measured_ms"] - p["commanded_ms"]) * 1000 for p in rec["phases"]])
 
 
 def test_hop_on_the_virtual_robot_lists_and_prints_its_simulated_hops(env, tmp_path):
@@ -273,7 +273,7 @@ def _fuzz_frames(n, seed=4):
     return frames
 
 
-def test_fuzzed_virtual_robot_survives_and_then_hops(env, tmp_path):
+def test_fuzzed_virtual_robot_survives_and_then_hops(env, tmp_path, board_timing):
     log = tmp_path / "pwm.csv"
     vproc = subprocess.Popen(LOCUST + ["virtual", "--plant", "record", "--pwm-log", str(log)],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
@@ -303,11 +303,12 @@ def test_fuzzed_virtual_robot_survives_and_then_hops(env, tmp_path):
         assert hop.returncode == 0, hop.stderr
         rec = json.loads(hop.stdout)
         assert rec["status"] == "complete" and len(rec["phases"]) == 2
-        assert all(abs(p["error_ms"]) <= 2.0 for p in rec["phases"])
+        errors_us = [p["error_ms"] * 1000 for p in rec["phases"]]
     finally:
         vproc.send_signal(signal.SIGTERM)
         vproc.communicate(timeout=30)
     assert vproc.returncode == 0
+    board_timing(errors_us)
     rows = [line.split(",") for line in log.read_text().splitlines()[2:]]
     angles = [float(r[5]) for r in rows if r[5]]
     assert len(angles) > 2 * moved

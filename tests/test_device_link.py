@@ -47,7 +47,7 @@ def test_flash_copies_verifies_and_shakes_hands(robot):
     assert vr.boots >= 2  # the soft reset rebooted the interpreter into main.py
 
 
-def test_hop_phases_on_time_and_servos_follow(robot, tmp_path):
+def test_hop_phases_on_time_and_servos_follow(robot, tmp_path, board_timing):
     vr, plant, _ = robot
     schedule = R.HopSchedule(cycles=2, push_deg=-30.0, push_ms=100, wait_ms=150)
     t_start = vr.now_s()
@@ -55,8 +55,7 @@ def test_hop_phases_on_time_and_servos_follow(robot, tmp_path):
         rec = run_hop(link, schedule, tmp_path)
     assert rec.status == R.COMPLETE and len(rec.phases) == 4
     assert [p.commanded_us for p in rec.phases] == [0, 100_000, 250_000, 350_000]
-    for p in rec.phases:
-        assert 0 <= p.error_us <= 2000
+    assert all(p.error_us >= 0 for p in rec.phases)     # never early
     pushes = [c for c in plant.commands if c.t_s > t_start and c.left_deg < -1]
     assert pushes and all(abs(c.left_deg + 30) < 0.01 for c in pushes)
     assert any(abs(c.right_deg + 30) < 0.01 for c in pushes)  # the mirrored leg, same horn angle
@@ -74,9 +73,10 @@ def test_hop_phases_on_time_and_servos_follow(robot, tmp_path):
         apart = math.ceil((b.t_written_s - starts[0]) / PWM_PERIOD_S - 1e-9) != \
             math.ceil((a.t_written_s - starts[0]) / PWM_PERIOD_S - 1e-9)
         assert b.t_effect_s - a.t_effect_s == pytest.approx(PWM_PERIOD_S if apart else 0.0, abs=1e-9)
+    board_timing([p.error_us for p in rec.phases])
 
 
-def test_silent_host_leaves_servos_at_rest_within_heartbeat(robot):
+def test_silent_host_leaves_servos_at_rest_within_heartbeat(robot, board_timing):
     vr, _, _ = robot
     with Link(vr.device_path) as link:
         link.hello()
@@ -97,7 +97,9 @@ def test_silent_host_leaves_servos_at_rest_within_heartbeat(robot):
     assert {w.servo for w in last} == {"left", "right"}
     for w in last:
         assert abs(w.horn_deg) < 1e-6
-        assert w.t_written_s - t_last_frame < 0.250 + 0.005  # rest commanded within the timeout
+    # rest commanded within the timeout: 250 ms, and 5 ms for the frame's way over the pty
+    board_timing([(w.t_written_s - t_last_frame - 0.250) * 1e6 for w in last], bound_us=5000,
+                 what="rest command after the heartbeat")
 
 
 def test_errors_over_the_wire_and_busy(robot):
@@ -126,7 +128,7 @@ def _reboot_into_firmware(link):
     raise AssertionError("no boot event")
 
 
-def test_hop_across_a_ticks_wrap_stays_on_time(robot, tmp_path):
+def test_hop_across_a_ticks_wrap_stays_on_time(robot, tmp_path, board_timing):
     """A board's ticks_us wraps at 2**30 us; the virtual robot's do so TICKS_LEAD_S (7 s) after
     each boot, so a 7.8 s hop started right after one crosses the wrap. Phase times are the
     firmware's own (its clock), as on a board."""
@@ -142,8 +144,8 @@ def test_hop_across_a_ticks_wrap_stays_on_time(robot, tmp_path):
     assert before < start < (1 << 30) and end < after and rec.to_dict()["ticks_wrapped"]
     assert rec.status == R.COMPLETE and len(rec.phases) == 12
     assert [p.commanded_us for p in rec.phases][-1] == 5 * 1_300_000 + 300_000
-    for p in rec.phases:
-        assert 0 <= p.error_us <= 2000, p
+    assert all(p.error_us >= 0 for p in rec.phases)     # never early
+    board_timing([p.error_us for p in rec.phases])
 
 
 def test_idle_robot_has_a_boards_ticks_and_soft_reset_leaves_servos_limp(robot):

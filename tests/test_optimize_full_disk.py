@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import errno
 import hashlib
+import re
 import shutil
 
 from click.testing import CliRunner
@@ -48,7 +49,8 @@ def test_a_journal_torn_by_a_full_disk_is_refused_then_repaired(tmp_path, small_
     assert f"saved as {backup}" in mended.output
     whole = torn[:torn.rfind(b"\n") + 1]
     assert journal.read_bytes().startswith(whole)   # every whole line kept, the study goes on from them
-    assert "valid" in mended.output and int(mended.output.split(" trials,")[0].split()[-1]) >= 7
+    held = re.search(r"study 'locust': (\d+) trials \(", mended.output)
+    assert held and "valid" in mended.output and int(held.group(1)) >= 7, mended.output
 
 
 def test_repair_keeps_whole_lines_and_the_file_as_it_was(tmp_path):

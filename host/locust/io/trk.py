@@ -164,7 +164,7 @@ def _object(p: ET.Element | None) -> ET.Element | None:
     return None if p is None else p.find("object")
 
 
-def _check_clip(path: Path, start: int, step: int, count: int | None) -> None:
+def _check_clip_settings(path: Path, start: int, step: int, count: int | None) -> None:
     """A clip's frames count up from a frame >= 0 in steps >= 1, at least one of them."""
     for name, value, low in (("startframe", start, 0), ("stepsize", step, 1), ("stepcount", count, 1)):
         if value is not None and value < low:
@@ -179,7 +179,7 @@ def _project(path: Path, root: ET.Element) -> TrackerProject:
     step = _value(clip_obj, "stepsize", int, 1)
     count = _value(clip_obj, "stepcount", int, None)
     dt_ms = _value(control, "delta_t", float, None)
-    _check_clip(path, start, step, count)
+    _check_clip_settings(path, start, step, count)
     video = _object(_prop(clip_obj, "video"))
     video_path = _value(video, "path", str, None)
 

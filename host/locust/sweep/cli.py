@@ -207,7 +207,7 @@ def _report(summary, bounds, objectives, out: Path) -> None:
 def _repair(storage: str | None, out: Path) -> None:
     """--repair: cut the torn last line of the study's journal file (saved beside it first)."""
     from .journal import repair
-    from .optimize import RDB_PREFIXES
+    from .storage import RDB_PREFIXES
 
     if storage is not None and storage.startswith(RDB_PREFIXES):
         raise SweepError(f"--repair mends a journal file; --storage {storage} is a database",
