@@ -37,6 +37,9 @@ from .tracks_csv import MarkerColumns, TracksCsv
 from .trz import MAX_TRK_BYTES, open_trz, read_member, unpack_members
 
 TRACKER_TO_OPENCV_PX = -0.5
+# a pixel position typed in each convention, plus this, is OpenCV's (Tracker's is the default a
+# person copies from its table)
+PIXEL_CONVENTIONS = {"tracker": TRACKER_TO_OPENCV_PX, "opencv": 0.0}
 POINT_CLASSES = ("PointMass",)  # Tracker's point tracks; vectors, tapes, axes are not tracks of a marker
 FPS_MIN, FPS_MAX = 1.0, 10000.0   # frames/s a camera films: a time-lapse at 1/s to a high-speed camera's 10 000/s
 # An entity declaration, in the encodings an XML file may have: a Tracker tab has none, and a

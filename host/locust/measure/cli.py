@@ -11,10 +11,10 @@ import click
 
 from ..errors import MeasureError
 from ..fileio import json_text
+from ..io.trk import PIXEL_CONVENTIONS
 from ..options import POSITIVE
 from ..params_cli import robot_options
 
-PIXEL_CONVENTIONS = ("tracker", "opencv")
 TERMS_SHOWN = 3
 
 
@@ -26,10 +26,9 @@ def measure():
 
 def _points(items: tuple[str, ...], convention: str, option: str) -> dict[str, tuple[float, float]]:
     """``NAME=X,Y`` -> OpenCV pixels (Tracker's are half a pixel further right and down)."""
-    from ..io.trk import TRACKER_TO_OPENCV_PX
     from ..sim.stickers import STICKERS
 
-    shift = TRACKER_TO_OPENCV_PX if convention == "tracker" else 0.0
+    shift = PIXEL_CONVENTIONS[convention]
     out = {}
     for item in items:
         m = re.fullmatch(r"\s*(\w+)\s*=\s*([-+]?[\d.]+)\s*,\s*([-+]?[\d.]+)\s*", item)
@@ -56,7 +55,7 @@ def _points(items: tuple[str, ...], convention: str, option: str) -> dict[str, t
                    "foot). Repeatable.")
 @click.option("--push-point", "push_points", multiple=True, metavar="NAME=X,Y",
               help="The same for PUSH. Repeatable.")
-@click.option("--pixels", type=click.Choice(PIXEL_CONVENTIONS), default="tracker", show_default=True,
+@click.option("--pixels", type=click.Choice(list(PIXEL_CONVENTIONS)), default="tracker", show_default=True,
               help="Convention of the given pixels: Tracker's (a pixel's centre at i + 0.5) or OpenCV's (at i).")
 @click.option("--write", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Write the whole robot with the measured values in place (refuses to overwrite).")

@@ -13,7 +13,7 @@ import math
 import re
 
 from ..errors import TrackError
-from ..io.trk import TRACKER_TO_OPENCV_PX, Calibration
+from ..io.trk import PIXEL_CONVENTIONS, Calibration
 
 NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 
@@ -33,7 +33,6 @@ def parse_scale(text: str) -> tuple[float, float, float, float, float]:
     return x1, y1, x2, y2, length
 
 
-PIXEL_CONVENTIONS = {"tracker": TRACKER_TO_OPENCV_PX, "opencv": 0.0}   # added to a typed position: OpenCV's
 PIXELS_HELP = ("Convention of the pixel positions typed in --marker, --origin, --scale and --plane-points: "
                "tracker (Tracker's table: origin at the image's top-left corner, a pixel's centre at i + 0.5) "
                "or opencv (origin at the top-left pixel's centre). Output pixel columns are OpenCV's.")
