@@ -409,7 +409,7 @@ def picked_colour(clip: Path, truth: Truth, pick: str = "first") -> tuple[str, i
 
 def run_locust_track(clip: Path, colour: str, x: int, y: int, out: Path) -> tuple[str, Path]:
     """``locust track`` on the clip, as on the command line; its printed summary and the tracks CSV."""
-    cmd = [sys.executable, "-m", "locust.cli", "track", str(clip), "--marker", f"nose=color:{colour}@{x},{y}",
+    cmd = [sys.executable, "-m", "locust.commands", "track", str(clip), "--marker", f"nose=color:{colour}@{x},{y}",
            "--board", BOARD, "--out", str(out)]
     proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if proc.returncode != 0:

@@ -48,7 +48,7 @@ def env(tmp_path_factory):
     import sys
 
     env = dict(os.environ, LOCUST_VIRTUAL_DIR=str(tmp_path_factory.mktemp("virtual")))
-    proc = subprocess.run([sys.executable, "-m", "locust.cli", "flash", "--port", "sim"],
+    proc = subprocess.run([sys.executable, "-m", "locust.commands", "flash", "--port", "sim"],
                           capture_output=True, text=True, env=env, timeout=90, check=False)
     assert proc.returncode == 0, proc.stderr
     assert "files verified by SHA-256" in proc.stdout

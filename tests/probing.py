@@ -14,7 +14,7 @@ from pathlib import Path
 
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 
 
 def tree(folder: Path) -> dict[str, tuple[bytes, int]]:
@@ -70,7 +70,7 @@ def judge_or_signal(self, values):
         os.kill(os.getpid(), signal.{signal_name})
     return judge(self, values)
 robust.DesignJudge.__call__ = judge_or_signal
-from locust.cli import main
+from locust.commands import main
 sys.argv[0] = "locust"
 main()
 """

@@ -3,11 +3,13 @@ a notebook session with exactly those names, checked against the figures the too
 
 from __future__ import annotations
 
+import importlib
 import inspect
 import json
 import os
 import subprocess
 import sys
+import types
 from pathlib import Path
 
 import numpy as np
@@ -21,8 +23,9 @@ from locust.errors import LocustError, ParamsError, SimError
 
 ROOT = Path(__file__).resolve().parents[1]
 RECORDINGS = ROOT / "calibration" / "recordings"
-FACADE = ["robot", "simulate", "SimResult", "sweep", "SweepResults", "track", "read_tracks", "Tracks",
-          "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "Fit", "report", "optimize", "fab"]
+FACADE = ["robot", "simulate", "SimResult", "sweep_designs", "SweepResults", "track_markers", "read_tracks", "Tracks",
+          "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "Fit", "make_report", "optimize",
+          "make_cut_files"]
 
 
 def test_all_lists_the_facade():
@@ -30,11 +33,12 @@ def test_all_lists_the_facade():
     assert set(FACADE) <= set(dir(locust))
     for name in FACADE:
         assert callable(getattr(locust, name)), name
-    # sweep, track and report are also the subpackages: both uses work
-    assert locust.sweep.run.run_sweep.__name__ == "run_sweep"
-    assert locust.track.runner.track_video.__name__ == "track_video"
-    assert "vary" in inspect.signature(locust.sweep).parameters
-    assert "Parameters" in locust.sweep.__doc__
+    # the API's names are not the subpackages' (sweep, track, report, fab stay plain modules)
+    for package in ("sweep", "track", "report", "fab"):
+        assert isinstance(importlib.import_module(f"locust.{package}"), types.ModuleType)
+        assert not callable(importlib.import_module(f"locust.{package}")), package
+    assert "vary" in inspect.signature(locust.sweep_designs).parameters
+    assert "Parameters" in locust.sweep_designs.__doc__
 
 
 def test_notebook_session(tmp_path):
@@ -75,7 +79,7 @@ def test_notebook_session(tmp_path):
     assert exc.value.hint
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
-    table = locust.sweep(locust.robot("seed"), vary={"scale": (0.0, 0.01, 2)}, cycles=1, jobs=1).to_dataframe()
+    table = locust.sweep_designs(locust.robot("seed"), vary={"scale": (0.0, 0.01, 2)}, cycles=1, jobs=1).to_dataframe()
     assert list(table.scale) == [0.0, 0.01] and table.valid.all()
     assert table.distance_m[0] == locust.simulate(locust.robot("seed"), cycles=1).distance_m
 
@@ -109,16 +113,17 @@ def test_robot_from_a_file_and_bad_names(tmp_path):
 
 def test_sweep_errors_are_the_library_s_own():
     with pytest.raises(LocustError, match="no such robot parameter"):
-        locust.sweep(locust.robot("seed"), vary={"geometry.nope_m": (0.0, 1.0, 2)})
+        locust.sweep_designs(locust.robot("seed"), vary={"geometry.nope_m": (0.0, 1.0, 2)})
     with pytest.raises(LocustError) as exc:
-        locust.sweep(locust.robot("seed"), vary={})
+        locust.sweep_designs(locust.robot("seed"), vary={})
     assert exc.value.hint
 
 
 def test_fit_matches_the_command_line_and_applies(tmp_path):
     data = RECORDINGS / "synthetic_ramp.csv"
     fit = locust.calibrate_ramp(data)
-    proc = subprocess.run([sys.executable, "-m", "locust.cli", "calibrate", "ramp", str(data), "--json", "--no-plot"],
+    proc = subprocess.run([sys.executable, "-m", "locust.commands", "calibrate", "ramp", str(data),
+                           "--json", "--no-plot"],
                           capture_output=True, text=True, check=True, timeout=120,
                           env=dict(os.environ, PYTHONPATH=str(ROOT / "host")))
     cli = json.loads(proc.stdout)["mu_static"]
@@ -256,7 +261,7 @@ def test_fit_and_sweep_have_tables_and_figures(tmp_path):
     est = fit.parameters["contact.foot_friction"]
     assert table.loc["contact.foot_friction", "value"] == est.value
     assert (table.loc["contact.foot_friction", "ci95_low"], table.loc["contact.foot_friction", "ci95_high"]) == est.ci95
-    swept = locust.sweep(locust.robot("seed"), vary={"scale": (0.0, 0.01, 2)}, cycles=1, jobs=1)
+    swept = locust.sweep_designs(locust.robot("seed"), vary={"scale": (0.0, 0.01, 2)}, cycles=1, jobs=1)
     fig = swept.plot()
     (ax,) = fig.axes
     assert list(ax.lines[0].get_ydata()) == pytest.approx([r["distance_m"] * 1000 for r in swept.rows if r["valid"]])
@@ -266,8 +271,8 @@ def test_help_locust_lists_every_function():
     import pydoc
 
     text = pydoc.render_doc(locust, renderer=pydoc.plaintext)
-    for name in ("robot(", "simulate(", "sweep(", "track(", "read_tracks(", "calibrate_beam", "calibrate_hops",
-                 "report(", ".tidy()", ".to_dataframe()", ".plot()"):
+    for name in ("robot(", "simulate(", "sweep_designs(", "track_markers(", "read_tracks(", "calibrate_beam",
+                 "calibrate_hops", "make_report(", "make_cut_files(", ".tidy()", ".to_dataframe()", ".plot()"):
         assert name in text, name
 
 
@@ -290,16 +295,16 @@ def test_optimize_is_the_commands_search(tmp_path):
 
 
 def test_fab_is_the_commands_summary(tmp_path):
-    """locust.fab(robot) gives `locust fab --from-robot seed --json`'s summary; with out it
+    """locust.make_cut_files(robot) gives `locust fab --from-robot seed --json`'s summary; with out it
     writes the cut files the summary lists, and the subpackage stays importable as before."""
     from click.testing import CliRunner
 
-    from locust.cli import cli
+    from locust.commands import cli
 
-    mine = locust.fab(locust.robot("seed"))
+    mine = locust.make_cut_files(locust.robot("seed"))
     theirs = json.loads(CliRunner().invoke(cli, ["fab", "--from-robot", "seed", "--json"]).stdout)
     assert mine == theirs
-    written = locust.fab(locust.robot("seed"), out=tmp_path / "cut", previews=False)
+    written = locust.make_cut_files(locust.robot("seed"), out=tmp_path / "cut", previews=False)
     assert sorted(p.name for p in (tmp_path / "cut").iterdir()) == sorted(written["files"])
     assert "rigid_top.dxf" in written["files"] and "flat_pattern.dxf" in written["files"]
     assert locust.fab.laminate.SEED_STACK and "Parameters" in locust.fab.__doc__

@@ -28,7 +28,7 @@ from locust.io import run_record as R
 from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
 from probing import assert_clear_error, assert_refused_and_unchanged, invoke, tree
 
-LOCUST = [sys.executable, "-m", "locust.cli"]
+LOCUST = [sys.executable, "-m", "locust.commands"]
 
 
 # -- inputs the cases use ------------------------------------------------------------

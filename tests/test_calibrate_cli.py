@@ -13,7 +13,7 @@ import pytest
 from click.testing import CliRunner
 
 from locust.calibrate.recordings import read_table
-from locust.cli import cli
+from locust.commands import cli
 from locust.params import load_robot, preset, to_toml
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -171,7 +171,7 @@ def test_missing_file_and_write_without_length(recs):
 
 def test_sim_runs_with_the_written_robot(recs):
     """`locust sim --config <written robot.toml>` runs on the fitted values."""
-    pytest.importorskip("locust.sim.cli", reason="the simulation command is not installed")
+    pytest.importorskip("locust.commands.sim", reason="the simulation command is not installed")
     toml = recs / "robot.toml"
     assert run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--length-m", 0.05,
                "--write", toml, "--no-plot").exit_code == 0

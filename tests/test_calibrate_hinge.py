@@ -20,7 +20,7 @@ from click.testing import CliRunner
 from locust.calibrate import hinge as H
 from locust.calibrate import synthetic as S
 from locust.calibrate.recordings import REAL_TIME, TimeOptions, clean_samples, read_table
-from locust.cli import cli
+from locust.commands import cli
 from locust.io.importing import ImportOptions
 
 POINT = "org.opensourcephysics.cabrillo.tracker.PointMass"

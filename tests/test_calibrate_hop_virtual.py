@@ -21,7 +21,7 @@ import tomllib
 
 import pytest
 
-from locust.demo import seed_leg_set_options
+from locust.commands.demo import seed_leg_set_options
 from locust.params import LEG_SETS as LEG_SETS_STEP
 
 pytestmark = pytest.mark.slow
@@ -32,7 +32,7 @@ LEG_SETS = ("small", "medium")
 
 
 def _locust(args, env, timeout=600):
-    proc = subprocess.run([sys.executable, "-m", "locust.cli", *args], capture_output=True, text=True, env=env,
+    proc = subprocess.run([sys.executable, "-m", "locust.commands", *args], capture_output=True, text=True, env=env,
                           timeout=timeout, check=False)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     return proc.stdout

@@ -15,7 +15,7 @@ from click.testing import CliRunner
 from locust.calibrate import beam as B
 from locust.calibrate import ramp as R
 from locust.calibrate.recordings import clean_samples, read_table
-from locust.cli import cli
+from locust.commands import cli
 
 RECORDINGS = Path(__file__).resolve().parents[1] / "calibration" / "recordings"
 

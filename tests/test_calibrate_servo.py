@@ -253,7 +253,7 @@ def test_cli_fits_angle_and_gyro_together_and_validates(tmp_path):
 
     from click.testing import CliRunner
 
-    from locust.calibrate.cli import calibrate
+    from locust.commands.calibrate import calibrate
 
     true = dataclasses.replace(PRESET, kp_nm_per_rad=0.5, kv_nms_per_rad=0.004)
     angle = dataclasses.replace(S.ServoTruth(), servo=true)

@@ -26,7 +26,7 @@ LEG_SETS = ("small", "medium", "large")
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory):
     out = tmp_path_factory.mktemp("fastdemo")
-    proc = subprocess.run([sys.executable, "-m", "locust.cli", "demo", "--out", str(out), "--cycles", "1",
+    proc = subprocess.run([sys.executable, "-m", "locust.commands", "demo", "--out", str(out), "--cycles", "1",
                            "--trials", "1", "--designs", "2", "--jobs", "1", "--no-fit-hops"],
                           capture_output=True, text=True, timeout=600, check=False)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]

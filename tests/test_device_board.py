@@ -19,7 +19,7 @@ from locust.params import preset, save_robot
 from locust.trials.measured import config_of
 from probing import assert_refused_and_unchanged, tree
 
-LOCUST = [sys.executable, "-m", "locust.cli"]
+LOCUST = [sys.executable, "-m", "locust.commands"]
 QUICK = ["--cycles", "1", "--push-ms", "50", "--wait-ms", "50", "--plant", "record"]
 
 

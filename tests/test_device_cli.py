@@ -17,7 +17,7 @@ from locust.firmware import protocol as P
 sys.path.insert(0, str(Path(__file__).resolve().parent / "firmware"))
 from lcg import Lcg
 
-LOCUST = [sys.executable, "-m", "locust.cli"]
+LOCUST = [sys.executable, "-m", "locust.commands"]
 
 
 def _run(args, env, timeout=90):

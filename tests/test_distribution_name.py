@@ -27,7 +27,7 @@ def _fake_distribution(site: Path, summary: str, version: str = "2.32.0") -> Pat
 def test_the_distribution_is_not_named_locust():
     meta = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
     assert meta["name"] == "locust-hopper"
-    assert meta["scripts"]["locust"] == "locust.cli:main"        # the command stays `locust`
+    assert meta["scripts"]["locust"] == "locust.commands:main"        # the command stays `locust`
     assert meta["description"].startswith(C.OUR_SUMMARY)
 
 

@@ -11,7 +11,7 @@ import pytest
 from click.testing import CliRunner
 
 from locust import params
-from locust.cli import cli
+from locust.commands import cli
 
 ZZ = Path(__file__).resolve().parents[1] / "data" / "dxf" / "zz.dxf"
 

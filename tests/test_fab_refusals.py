@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.fab.dxf_read import MAX_SPLINE_POINTS, read_drawing
 
 
@@ -66,7 +66,8 @@ def test_the_200k_point_spline_is_refused_within_seconds_in_bounded_memory(tmp_p
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
     t0 = time.monotonic()
-    proc = subprocess.run([sys.executable, "-c", "from locust.cli import main; main()", "fab", str(path), "--json"],
+    proc = subprocess.run([sys.executable, "-c", "from locust.commands import main; main()",
+                           "fab", str(path), "--json"],
                           capture_output=True, text=True, timeout=120, preexec_fn=cap)
     assert proc.returncode == 2, proc.stderr[-2000:]
     assert "has 200,000 points" in proc.stderr and "hint:" in proc.stderr and "Traceback" not in proc.stderr

@@ -11,9 +11,9 @@ import sys
 
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 
-LOCUST = [sys.executable, "-c", "from locust.cli import main; main()"]
+LOCUST = [sys.executable, "-c", "from locust.commands import main; main()"]
 
 
 def digests(folder):

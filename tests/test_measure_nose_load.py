@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner
 
 from locust import params as P
-from locust.cli import cli
+from locust.commands import cli
 from locust.measure.nose_load import AXIS_KEY, PLATE_KEY, measure_nose_load
 from locust.sim.samples import uncertain_values
 from locust.sim.statics import standing_load

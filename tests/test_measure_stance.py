@@ -17,9 +17,9 @@ import pytest
 from click.testing import CliRunner
 
 from locust.arucoboard import DEFAULT_BOARD
-from locust.cli import cli
+from locust.commands import cli
+from locust.commands.measure import _points
 from locust.io.camera_json import read_camera_json
-from locust.measure.cli import _points
 from locust.measure.stance import find_stickers, fit_points
 from locust.params import preset
 from locust.sim.stickers import STICKERS

@@ -16,7 +16,7 @@ from locust.sweep.objectives import OBJECTIVES, DrawFigures, Judgement, judge_dr
 from locust.sweep.optimize import run_optimize
 from probing import invoke, signalled_in_design
 
-LOCUST = [sys.executable, "-c", "from locust.cli import main; main()"]
+LOCUST = [sys.executable, "-c", "from locust.commands import main; main()"]
 TWO = [OBJECTIVES["distance"], OBJECTIVES["nose_rise"]]
 
 

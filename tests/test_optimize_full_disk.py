@@ -12,7 +12,7 @@ import shutil
 
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.sweep.journal import full_disk, repair
 
 VARY = ["--vary", "geometry.leg_m=0.05:0.07", "--cycles", "1"]

@@ -22,13 +22,13 @@ import pytest
 import serial
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.device.link import Link
 from locust.device.plant import RecordingPlant
 from locust.device.virtual import VirtualRobot
 from locust.firmware import protocol as P
 
-LOCUST = [sys.executable, "-m", "locust.cli"]
+LOCUST = [sys.executable, "-m", "locust.commands"]
 MPREMOTE = str(Path(sys.executable).with_name("mpremote"))
 
 

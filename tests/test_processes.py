@@ -18,7 +18,7 @@ import pytest
 import locust
 from locust.fileio import remove_stale_temporaries, temp_beside
 
-LOCUST = [sys.executable, "-c", "from locust.cli import main; main()"]
+LOCUST = [sys.executable, "-c", "from locust.commands import main; main()"]
 
 
 def _here(env: dict | None = None) -> dict:
@@ -69,7 +69,7 @@ def add_frame_then_signal(self, *args):
     if self.frames == 3:
         os.kill(os.getpid(), SIGNAL)
 clip.ClipRecorder.add_frame = add_frame_then_signal
-from locust.cli import main
+from locust.commands import main
 sys.argv[0] = "locust"
 main()
 """

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.params import Provenance, leg_set, preset, save_robot
 from locust.report.synthetic import simulated_nose, write_synthetic_trial
 from locust.sim.run import run

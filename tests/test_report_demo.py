@@ -33,7 +33,7 @@ CYCLES = 3
 def demo(tmp_path_factory):
     out = tmp_path_factory.mktemp("demo")
     t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "locust.cli", "demo", "--out", str(out)],
+    proc = subprocess.run([sys.executable, "-m", "locust.commands", "demo", "--out", str(out)],
                           capture_output=True, text=True, timeout=660)
     wall = time.perf_counter() - t0
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]

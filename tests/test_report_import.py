@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.io.run_record import HopSchedule, Phase, RunRecord
 from locust.io.run_record import write as write_record
 from locust.io.tracks_csv import MarkerColumns, TracksCsv, write_tracks_csv

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.errors import ReportError, TrialError
 from locust.io.sweep_store import columns as sweep_columns
 from locust.params import preset
@@ -204,7 +204,7 @@ def test_demo_virtual_robot_carries_the_recordings_truth():
     which replay the seed's identified values (calibration/make_synthetic.py); the servo's
     are those of the AA swing's fit alone (synthetic.SG90_AA_SWING)."""
     from locust.calibrate.synthetic import SG90_AA_SWING
-    from locust.demo import CALIBRATIONS, RECORDINGS, recording_truth
+    from locust.commands.demo import CALIBRATIONS, RECORDINGS, recording_truth
     from locust.params import preset
 
     truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])

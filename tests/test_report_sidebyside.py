@@ -22,7 +22,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.io.camera_json import read_camera_json
 from locust.markers import MARKER_COLOURS
 from locust.params import preset

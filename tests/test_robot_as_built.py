@@ -39,7 +39,7 @@ def test_params_json_has_no_photo_source_a_photo_cannot_show():
 
     from click.testing import CliRunner
 
-    from locust.cli import cli
+    from locust.commands import cli
 
     res = CliRunner().invoke(cli, ["params", "--preset", "medium", "--json"])
     assert res.exit_code == 0, res.output

@@ -19,7 +19,7 @@ from click.testing import CliRunner
 
 from locust.calibrate.fitstats import Estimate
 from locust.calibrate.write import write_fitted
-from locust.cli import cli
+from locust.commands import cli
 from locust.errors import WriteError
 from locust.fileio import storable
 from locust.params import Provenance, load_robot, parse_set_options, preset, save_robot, update_robot
@@ -178,7 +178,8 @@ def test_two_concurrent_calibrate_writes_both_land_20_of_20(tmp_path):
     landed = 0
     for k in range(20):
         path = tmp_path / f"same{k}.toml"
-        procs = [subprocess.Popen([sys.executable, "-c", "from locust.cli import main; main()", "calibrate", "ramp",
+        procs = [subprocess.Popen([sys.executable, "-c", "from locust.commands import main; main()",
+                                   "calibrate", "ramp",
                                    str(RAMP), "--into", into, "--write", str(path), "--no-plot"],
                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for into in ("foot", "nose")]
         assert [p.wait(timeout=120) for p in procs] == [0, 0]
@@ -192,7 +193,7 @@ def test_a_recording_named_with_an_undecodable_byte_is_written_and_plotted(tmp_p
     """`ramp\\xff.csv`: --write raised UnicodeEncodeError, and the default plot a matplotlib traceback."""
     name = os.fsdecode(b"ramp\xff.csv")
     shutil.copy(RAMP, tmp_path / name)
-    res = subprocess.run([sys.executable, "-c", "from locust.cli import main; main()", "calibrate", "ramp",
+    res = subprocess.run([sys.executable, "-c", "from locust.commands import main; main()", "calibrate", "ramp",
                           str(tmp_path / name), "--write", str(tmp_path / "r.toml"), "--out", str(tmp_path)],
                          capture_output=True, timeout=120)
     assert res.returncode == 0 and b"Traceback" not in res.stderr, res.stderr[-3000:]

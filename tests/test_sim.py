@@ -116,7 +116,7 @@ def test_unstable_servo_is_caught_by_the_audit():
 
 
 def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "locust.cli", *args], capture_output=True, text=True)
+    return subprocess.run([sys.executable, "-m", "locust.commands", *args], capture_output=True, text=True)
 
 
 def test_cli_refuses_impossible_linkage_with_reason():

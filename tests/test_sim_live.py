@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.errors import SimError
 from locust.params import preset
 from locust.sim.live import PREROLL_S, LiveSim

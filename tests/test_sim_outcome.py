@@ -116,7 +116,7 @@ def test_sim_json_and_samples_give_the_outcome_and_its_shares(tmp_path):
 
     from click.testing import CliRunner
 
-    from locust.cli import cli
+    from locust.commands import cli
 
     robot = only_uncertain(P.preset("medium"), {"geometry.crank_start_deg": 10.0})
     P.save_robot(robot, tmp_path / "r.toml")

@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.errors import SimError
 from locust.markers import MARKER_COLOURS
 from locust.params import preset

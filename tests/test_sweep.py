@@ -20,7 +20,7 @@ from locust.sweep.design import design_robot, evaluate, parse_axis, parse_bound,
 from locust.sweep.run import best_row, run_sweep
 from probing import assert_refused_and_unchanged, invoke, signalled_in_design
 
-LOCUST = [sys.executable, "-c", "from locust.cli import main; main()"]
+LOCUST = [sys.executable, "-c", "from locust.commands import main; main()"]
 
 
 def read_rows(folder: Path) -> list[dict[str, str]]:
@@ -143,7 +143,7 @@ def append_then_die(self, row):
     if len(self.done) == 2:
         os.kill(os.getpid(), signal.SIGKILL)
 store.SweepStore.append = append_then_die
-from locust.cli import main
+from locust.commands import main
 sys.argv[0] = "locust"
 main()
 """
@@ -419,7 +419,7 @@ def run_task_or_die(task):
         os.kill(os.getpid(), signal.SIGKILL)
     return run_task(task)
 run.run_task = run_task_or_die
-from locust.cli import main
+from locust.commands import main
 sys.argv[0] = "locust"
 main()
 """

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.errors import SweepError
 from locust.params import preset
 from locust.sweep.design import parse_axis

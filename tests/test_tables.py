@@ -7,7 +7,7 @@ import re
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.params import preset
 from locust.sim.run import run
 from locust.tables import mean_sd, mm, plant_lines, sim_lines, table

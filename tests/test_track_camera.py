@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.track.camera import PlaneCalibration, load
 from locust.track.synth import make_hop_video
 

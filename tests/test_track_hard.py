@@ -10,7 +10,7 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.errors import TrackError
 from locust.track.board import BoardSpec, board_points, parse_board, parse_plane_points
 from locust.track.export import track_events

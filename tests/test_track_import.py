@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.errors import TrackError
 from locust.io import tracker_text as tt
 from locust.io import tracks_csv as tc

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 
 
 def _track(video, tmp_path, end, *markers):

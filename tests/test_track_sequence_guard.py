@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.track.video import probe, read_as_frame
 
 

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.track.aruco import ArucoMarker
 from locust.track.calib import Calibration
 from locust.track.synth import aruco_frame, make_hop_video, write_video

@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.io import trk as trk_io
 from locust.io.tracker_text import read_tracker_export
 from locust.track import trk
@@ -120,7 +120,7 @@ def test_colour_marker_on_real_footage_never_takes_the_scale_stick(balltoss, mon
 
 
 def test_python_api_reuses_a_projects_calibration_and_writes_a_trk(balltoss, shared_data, tmp_path):
-    """locust.track() as `locust track video`: on BallToss.trz itself (its calibration and frame
+    """locust.track_markers() as `locust track video`: on BallToss.trz itself (its calibration and frame
     rate) the ball's metres are within 0.8 px of Tracker's own world points; the unpacked video
     with calibration_from= the project gives the same metres (1e-12); trk= writes a project that
     reads back with the ball's steps and Tracker's scale; an existing trk is refused."""
@@ -129,7 +129,7 @@ def test_python_api_reuses_a_projects_calibration_and_writes_a_trk(balltoss, sha
 
     ball = {"ball": "template:131.28,207.86@2"}
     redo = tmp_path / "redo.trk"
-    tracks = locust.track(shared_data / "tracker" / "BallToss.trz", ball, trk=redo)
+    tracks = locust.track_markers(shared_data / "tracker" / "BallToss.trz", ball, trk=redo)
     project = trk_io.read_project(shared_data / "tracker" / "BallToss.trz")
     truth = trk.project_result(project)
     tx, ty = truth.world(truth.markers[0])
@@ -138,13 +138,13 @@ def test_python_api_reuses_a_projects_calibration_and_writes_a_trk(balltoss, sha
     err_px = np.hypot(x[frames] - tx[frames], y[frames] - ty[frames]) / project.calibration.m_per_px
     assert err_px.max() < 0.8, err_px
     assert tracks.to_dataframe().t_s[1] == pytest.approx(66.0 / 1000)          # the project's frame rate
-    again = locust.track(balltoss / "videos" / "BallToss_new_BallToss.mp4", ball,
+    again = locust.track_markers(balltoss / "videos" / "BallToss_new_BallToss.mp4", ball,
                          calibration_from=balltoss / "BallToss_BallToss.trk")
     np.testing.assert_allclose(np.array(again.positions("ball")), np.array([x, y]), atol=1e-12)
     back = trk_io.read_project(redo)
     assert sorted(back.points["ball"]) == np.flatnonzero(np.isfinite(x)).tolist()    # each frame found
     assert back.calibration.m_per_px == pytest.approx(project.calibration.m_per_px, rel=1e-9)
     with pytest.raises(TrackError, match="exists"):
-        locust.track(shared_data / "tracker" / "BallToss.trz", ball, trk=redo)
+        locust.track_markers(shared_data / "tracker" / "BallToss.trz", ball, trk=redo)
     with pytest.raises(TrackError, match="not both"):
-        locust.track(shared_data / "tracker" / "BallToss.trz", ball, scale=(0, 0, 100, 0, 0.1))
+        locust.track_markers(shared_data / "tracker" / "BallToss.trz", ball, scale=(0, 0, 100, 0, 0.1))

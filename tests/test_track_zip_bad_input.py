@@ -34,7 +34,7 @@ from locust.track.trk import project_xml
 from locust.track.video import Clip, VideoInfo
 from probing import assert_clear_error, invoke, tree
 
-LOCUST = [sys.executable, "-m", "locust.cli"]
+LOCUST = [sys.executable, "-m", "locust.commands"]
 VIDEO = "videos/hop.mp4"
 
 

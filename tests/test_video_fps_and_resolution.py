@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 from locust.device.plant import make_plant
 from locust.io.tracks_csv import MarkerColumns, TracksCsv
 from locust.params import preset

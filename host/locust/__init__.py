@@ -6,58 +6,31 @@ The Python API (:mod:`locust.api`), for notebooks and scripts::
     r = locust.simulate(locust.robot("small", **{"servo.kp_nm_per_rad": 0.4}), cycles=3)
     r.trace()                          # pandas.DataFrame, one row per physics step
     r.video("hop.mp4", overwrite=True)
-    locust.sweep(locust.robot("seed"), vary={"scale": (0.0, 0.05, 30)}, cycles=3).to_dataframe()
+    locust.sweep_designs(locust.robot("seed"), vary={"scale": (0.0, 0.05, 30)}, cycles=3).to_dataframe()
 
 Functions (each with a numpydoc docstring: ``help(locust.simulate)``):
 
 - ``robot(preset_or_path, **values)``: a :class:`Robot` (presets seed, small, medium, large).
 - ``simulate(robot, cycles)``: a ``SimResult`` (``.trace()``, ``.video()``, ``.plot()``).
-- ``sweep(robot, vary, cycles)``: a ``SweepResults`` (``.to_dataframe()``, ``.plot()``, ``.best``).
-- ``track(video, markers)``, ``read_tracks(path)``: ``Tracks`` (``.to_dataframe()``, ``.tidy()``:
+- ``sweep_designs(robot, vary, cycles)``: a ``SweepResults`` (``.to_dataframe()``, ``.plot()``, ``.best``).
+- ``track_markers(video, markers)``, ``read_tracks(path)``: ``Tracks`` (``.to_dataframe()``, ``.tidy()``:
   one row per marker per frame with velocity and acceleration, ``.plot()``, ``.write()``).
 - ``calibrate_beam/hinge/servo/ramp/hops(...)``: a ``Fit`` (``.parameters``, ``.to_dataframe()``,
   ``.plot()``, ``.apply(robot)``).
-- ``report(robot, measured)``: the HTML comparison of simulation and filmed hops.
+- ``make_report(robot, measured)``: the HTML comparison of simulation and filmed hops.
 - ``optimize(robot, vary, trials, out=...)``: Optuna's search for the farthest valid hop.
-- ``fab(robot_or_dxf, out=...)``: the laminate's cut files and their summary.
+- ``make_cut_files(robot_or_dxf, out=...)``: the laminate's cut files and their summary.
 
 Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
 """
 
 import importlib as _importlib
-import types as _types
 
-__version__ = "0.1.0"
+from .version import __version__
 
-__all__ = ["robot", "simulate", "SimResult", "sweep", "SweepResults", "track", "read_tracks", "Tracks",
-           "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "calibrate_hops", "Fit", "report",
-           "optimize", "fab", "Robot", "LocustError"]
-
-
-class _CallablePackage(_types.ModuleType):
-    """A subpackage that is also the API function of its name: ``locust.sweep(...)`` calls
-    :func:`locust.api.sweeps.sweep`, while ``locust.sweep.run`` stays the module."""
-
-    def _function(self):
-        return getattr(_importlib.import_module("locust.api"), self.__name__.rpartition(".")[2])
-
-    def __call__(self, *args, **kwargs):
-        return self._function()(*args, **kwargs)
-
-    @property
-    def __signature__(self):
-        import inspect
-
-        return inspect.signature(self._function())
-
-    @property
-    def __doc__(self):
-        return (self._function().__doc__ or "") + "\n\nThe package:\n\n" + (self.__dict__.get("__doc__") or "")
-
-
-from . import fab, report, sweep, track  # noqa: E402  (the packages' __init__ hold no code)
-
-fab.__class__ = report.__class__ = sweep.__class__ = track.__class__ = _CallablePackage
+__all__ = ["robot", "simulate", "SimResult", "sweep_designs", "SweepResults", "track_markers", "read_tracks", "Tracks",
+           "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "calibrate_hops", "Fit",
+           "make_report", "optimize", "make_cut_files", "Robot", "LocustError", "__version__"]
 
 
 def __getattr__(name: str):

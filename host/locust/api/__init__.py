@@ -1,18 +1,18 @@
 """The Python API: what a notebook calls, each a function over the toolkit's own machinery.
 
-=================  ========================  =====================================================
-function           module                    returns
-=================  ========================  =====================================================
-``robot``          :mod:`.robots`            :class:`locust.params.Robot`
-``simulate``       :mod:`.simulation`        :class:`.simulation.SimResult` (trace, video, plot)
-``sweep``          :mod:`.sweeps`            :class:`.sweeps.SweepResults` (to_dataframe, best)
-``track``          :mod:`.tracking`          :class:`.tracking.Tracks` (to_dataframe)
-``read_tracks``    :mod:`.tracking`          :class:`.tracking.Tracks`
-``calibrate_*``    :mod:`.calibration`       :class:`.calibration.Fit` (parameters, apply, plot)
-``report``         :mod:`.reports`           :class:`locust.report.build.ReportResult`
-``optimize``       :mod:`.optimizing`        :class:`locust.sweep.optimize.OptimizeSummary`
-``fab``            :mod:`.fabrication`       dict (the manufacturing summary)
-=================  ========================  =====================================================
+====================  ========================  =====================================================
+function              module                    returns
+====================  ========================  =====================================================
+``robot``             :mod:`.robots`            :class:`locust.params.Robot`
+``simulate``          :mod:`.simulation`        :class:`locust.sim.run.SimResult` (trace, video, plot)
+``sweep_designs``     :mod:`.sweeps`            :class:`.sweeps.SweepResults` (to_dataframe, best)
+``track_markers``     :mod:`.tracking`          :class:`.tracking.Tracks` (to_dataframe)
+``read_tracks``       :mod:`.tracking`          :class:`.tracking.Tracks`
+``calibrate_*``       :mod:`.calibration`       :class:`.calibration.Fit` (parameters, apply, plot)
+``make_report``       :mod:`.reports`           :class:`locust.report.build.ReportResult`
+``optimize``          :mod:`.optimizing`        :class:`locust.sweep.optimize.OptimizeSummary`
+``make_cut_files``    :mod:`.fabrication`       dict (the manufacturing summary)
+====================  ========================  =====================================================
 
 The command line calls the same functions (``locust sim``, ``sweep``, ``report``, ``fab``,
 ``calibrate beam|hinge|servo|ramp``). Every name is also at the package top: ``locust.simulate``.
@@ -26,12 +26,12 @@ import importlib
 EXPORTS = {
     "robot": "robots",
     "simulate": "simulation", "SimResult": "simulation",
-    "sweep": "sweeps", "SweepResults": "sweeps",
-    "track": "tracking", "read_tracks": "tracking", "Tracks": "tracking",
+    "sweep_designs": "sweeps", "SweepResults": "sweeps",
+    "track_markers": "tracking", "read_tracks": "tracking", "Tracks": "tracking",
     "calibrate_beam": "calibration", "calibrate_hinge": "calibration", "calibrate_ramp": "calibration",
     "calibrate_servo": "calibration", "calibrate_hops": "calibration", "Fit": "calibration",
-    "report": "reports",
-    "optimize": "optimizing", "fab": "fabrication",
+    "make_report": "reports",
+    "optimize": "optimizing", "make_cut_files": "fabrication",
 }
 
 __all__ = list(EXPORTS)

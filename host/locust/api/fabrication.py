@@ -13,7 +13,7 @@ from ..fileio import json_text
 from ..params import Robot
 
 
-def fab(source: Robot | str | Path, *, out: str | Path | None = None,
+def make_cut_files(source: Robot | str | Path, *, out: str | Path | None = None,
         layers: Mapping[str, Sequence[str]] | None = None, units: str | None = None, gap_tol_mm: float = 0.01,
         recover: bool = False, hinge_width_mm: float = 1.0, stack: Sequence[str] = laminate.SEED_STACK,
         mirror: Sequence[str] = (), kerf_mm: float = 0.05, support_width_mm: float = 2.0,
@@ -62,7 +62,7 @@ def fab(source: Robot | str | Path, *, out: str | Path | None = None,
     Examples
     --------
     >>> import locust
-    >>> locust.fab(locust.robot("seed"))["layers"][0]["name"]          # doctest: +SKIP
+    >>> locust.make_cut_files(locust.robot("seed"))["layers"][0]["name"]          # doctest: +SKIP
     """
     out = Path(out) if out is not None else None
     if out is not None:

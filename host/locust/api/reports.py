@@ -9,7 +9,7 @@ from ..io.importing import AS_IS, ImportOptions
 from ..params import Robot
 
 
-def report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str | Path]] | Sequence[str], *,
+def make_report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str | Path]] | Sequence[str], *,
            out: str | Path = "reports", cycles: int | None = None, sweep: str | Path | None = None,
            added: Mapping[str, float] | None = None, marker: str = "nose", samples: int = 0,
            side_by_side: bool = False, before: Robot | None = None, robot_source: str | None = None,
@@ -60,4 +60,4 @@ def report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str | Path
                         study=Path(study) if study is not None else None)
 
 
-__all__ = ["report"]
+__all__ = ["make_report"]

@@ -90,7 +90,7 @@ def sweep_axes(base: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axi
     return varied(base, vary, parse_axis, Axis, '{"scale": (0.0, 0.05, 30)}')
 
 
-def sweep(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis], cycles: int = 3, *,
+def sweep_designs(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis], cycles: int = 3, *,
           out: str | Path | None = None, jobs: int | None = None, scheduler: str = "local", samples: int = 0,
           progress: Callable[[int], None] | None = None, say: Callable[[str], None] | None = None) -> SweepResults:
     """Simulate every combination of the varied values and find the best valid design.
@@ -131,7 +131,7 @@ def sweep(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis], 
     Examples
     --------
     >>> import locust
-    >>> res = locust.sweep(locust.robot("seed"), vary={"scale": (0.0, 0.02, 3)}, cycles=1, jobs=1)
+    >>> res = locust.sweep_designs(locust.robot("seed"), vary={"scale": (0.0, 0.02, 3)}, cycles=1, jobs=1)
     >>> res.to_dataframe()[["scale", "valid"]].shape
     (3, 2)
     """
@@ -147,4 +147,4 @@ def sweep(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis], 
     return SweepResults(**vars(summary), names=tuple(a.name for a in axes))
 
 
-__all__ = ["SweepResults", "sweep", "sweep_axes"]
+__all__ = ["SweepResults", "sweep_designs", "sweep_axes"]

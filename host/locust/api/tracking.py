@@ -155,7 +155,7 @@ def _calibration(info, scale, origin, angle_deg: float, camera_json, pixels: str
                        angle_deg, source)
 
 
-def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None = None, *,
+def track_markers(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None = None, *,
           scale: tuple[float, float, float, float, float] | None = None, origin: tuple[float, float] | None = None,
           angle_deg: float = 0.0, camera_json: str | Path | None = None, start: int = 0, end: int | None = None,
           step: int = 1, fps: float | None = None, color_tol: int = 80, search_px: int = 40,
@@ -209,7 +209,7 @@ def track(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None =
     --------
     >>> hop = locust.simulate(locust.robot("small"), cycles=1)
     >>> hop.video("hop.mp4", overwrite=True, camera="fixed", width=320, height=240)  # doctest: +SKIP
-    >>> locust.track("hop.mp4").to_dataframe()[["t_s", "nose_x_m", "nose_y_m"]]  # doctest: +SKIP
+    >>> locust.track_markers("hop.mp4").to_dataframe()[["t_s", "nose_x_m", "nose_y_m"]]  # doctest: +SKIP
     """
     from ..track.export import tracks_of
     from ..track.runner import track_video
@@ -293,4 +293,4 @@ def read_tracks(path: str | Path, units: str = "m", rename: Mapping[str, str] | 
     return Tracks(import_tracks(path, units, rename, mirror))
 
 
-__all__ = ["Tracks", "read_tracks", "track"]
+__all__ = ["Tracks", "read_tracks", "track_markers"]

@@ -32,11 +32,9 @@ printed to too few digits (they repeat) are rebuilt from the row order (:func:`r
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-import click
 import numpy as np
 
 from ..errors import CalibrationError, TrackError
@@ -140,23 +138,6 @@ class TimeOptions:
 
 
 REAL_TIME = TimeOptions()
-
-
-def time_options(func):
-    """``--time-scale``, ``--clip-fps`` on a click command, given to it as one :class:`TimeOptions`, ``timing``."""
-
-    @functools.wraps(func)
-    def wrapper(*args, time_scale, clip_fps, **kwargs):
-        return func(*args, timing=TimeOptions(time_scale, clip_fps), **kwargs)
-
-    wrapper = click.option("--clip-fps", type=float, default=None, metavar="FPS",
-                           help="Slow motion: the rate the clip was filmed at [frames/s]; the file's own rate "
-                                "(its median time step) is rescaled to it, e.g. a 240 frames/s clip exported "
-                                "at 30: --clip-fps 240.")(wrapper)
-    wrapper = click.option("--time-scale", type=float, default=None, metavar="S",
-                           help="Slow motion: real time = the file's time * S [-], e.g. 0.125 for a 240 "
-                                "frames/s clip exported at 30 [default: 1, times as they are].")(wrapper)
-    return wrapper
 
 
 # What a calibration recording holds: a few seconds to minutes of video (24-240 frames/s) or of

@@ -35,14 +35,12 @@ not plausible for what it shows (a beam tip swinging 0.9 m), which ``--units`` w
 
 from __future__ import annotations
 
-import functools
 import math
 import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-import click
 import numpy as np
 
 from ..errors import TrackError
@@ -126,25 +124,6 @@ def _split_rename(item: str) -> tuple[str, str]:
     if not sep or not old.strip() or not new.strip():
         raise TrackError(f"--rename {item!r} is not OLD=NEW", "e.g. --rename A=nose (repeatable)")
     return old.strip(), new.strip()
-
-
-def import_options(func):
-    """``--units``, ``--rename``, ``--mirror`` on a click command; the command gets them as one
-    checked :class:`ImportOptions` argument, ``imports`` (a bad value is a TrackError)."""
-
-    @functools.wraps(func)
-    def wrapper(*args, units, rename, mirror, **kwargs):
-        return func(*args, imports=ImportOptions.parse(units, rename, mirror), **kwargs)
-
-    wrapper = click.option("--mirror", is_flag=True,
-                           help="Flip x of the tracks (x -> -x): a hop filmed right-to-left reads left-to-right.")(
-                               wrapper)
-    wrapper = click.option("--rename", "rename", multiple=True, metavar="OLD=NEW",
-                           help="Rename a marker of the tracks (its name, or its Tracker name as written: "
-                                "'cm A=nose'); repeatable. A track with no name (a t,x,y CSV) is 'nose'.")(wrapper)
-    wrapper = click.option("--units", "units", default="m", show_default=True, metavar="m|cm|mm",
-                           help="Unit of the tracks' positions (Tracker's calibration unit), made metres.")(wrapper)
-    return wrapper
 
 
 def import_tracks(path: str | Path, units: str = "m", rename: Iterable[str] | Mapping[str, str] = (),

@@ -15,13 +15,13 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from .. import __version__
 from ..errors import ReportError, WriteError
 from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, unique_dir
 from ..io.run_record import ERROR as REFUSED
 from ..params import Provenance, Robot
 from ..trials.configs import Configuration, configuration
 from ..trials.measured import Trial
+from ..version import __version__
 from . import figures as F
 from . import page as H
 from .checks import VIRTUAL, Notice, collapsed, notices, recorded_on

@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
 from ..fileio import atomic_write_json
 from ..io.tracks_csv import MarkerColumns, TracksCsv, tracks_csv_text, write_tracks_csv
+from ..version import __version__
 from .runner import TrackResult
 
 PIXEL_CONVENTION = "OpenCV: origin at the centre of the top-left pixel, x right, y down"

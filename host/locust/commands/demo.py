@@ -1,6 +1,6 @@
 """``locust demo``: the whole toolkit end to end on the virtual robot.
 
-Each stage runs the real command (``python -m locust.cli ...``, one child process each), so
+Each stage runs the real command (``python -m locust.commands ...``, one child process each), so
 the demo exercises the same code paths a user does:
 
 1. ``locust flash --port sim``: the firmware into the demo's own virtual flash folder;
@@ -34,10 +34,10 @@ from pathlib import Path
 
 import click
 
-from .errors import ReportError
-from .fileio import atomic_write_json, atomic_write_text, unique_dir
-from .params import LEG_SETS, leg_set, preset
-from .progress import progress
+from ..errors import ReportError
+from ..fileio import atomic_write_json, atomic_write_text, unique_dir
+from ..params import LEG_SETS, leg_set, preset
+from ..progress import progress
 
 # The virtual robot is the seed robot with each leg set of params.LEG_SETS (the one definition:
 # its links and its converged step; what the demo's calibration models: its robot.toml's base is
@@ -141,7 +141,7 @@ class Demo:
         """
         self.steps += 1
         log = self.logs / f"{self.steps:02d}-{args[0]}{'-' + args[1] if args[0] == 'calibrate' else ''}.log"
-        cmd = [sys.executable, "-m", "locust.cli", *args]
+        cmd = [sys.executable, "-m", "locust.commands", *args]
         with subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                               text=True, env={**os.environ, **self.env}) as proc:
             output = relay_progress(proc.stdout, self.stderr)

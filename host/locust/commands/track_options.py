@@ -10,10 +10,10 @@ from pathlib import Path
 import click
 
 from ..errors import TrackError
-from .aruco import DEFAULT_DICTIONARY
-from .calib import PIXEL_CONVENTIONS, PIXELS_HELP
-from .spec import ModelOptions, parse_markers
-from .video import check_fps
+from ..track.aruco import DEFAULT_DICTIONARY
+from ..track.calib import PIXEL_CONVENTIONS, PIXELS_HELP
+from ..track.spec import ModelOptions, parse_markers
+from ..track.video import check_fps
 
 
 def stacked(*options):

@@ -11,9 +11,9 @@ import click
 from ..errors import GeometryError, SimError
 from ..fileio import json_text
 from ..params import resolve_robot
-from ..params_cli import robot_options
 from ..progress import progress
 from ..tables import nose_load_line, sensitivity_lines, sim_lines, spread_lines
+from .options import robot_options
 
 
 @click.command()
@@ -65,17 +65,17 @@ def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push,
       locust sim --preset small --still rest.png --still-push push.png   # for locust measure stance
     """
     from ..api.simulation import SimResult, simulate
-    from .run import check_convergence as converge
-    from .run import invalid_result
+    from ..sim.run import check_convergence as converge
+    from ..sim.run import invalid_result
 
     robot = resolve_robot(preset, config, sets)
     if video is not None:
-        from .clip import check_video_path
+        from ..sim.clip import check_video_path
 
         check_video_path(video)  # fail before simulating, not after
     if still is not None or still_push is not None:
         from ..arucoboard import DEFAULT_BOARD, parse_board
-        from .still import check_still_path
+        from ..sim.still import check_still_path
 
         for path in (still, still_push):
             if path is not None:
@@ -101,7 +101,7 @@ def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push,
         result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
 
     if still is not None or still_push is not None:
-        from .still import render_stills
+        from ..sim.still import render_stills
 
         if not result.valid:
             raise SimError("not rendering stills of an invalid robot", "fix the reasons listed above first")

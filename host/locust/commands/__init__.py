@@ -1,4 +1,4 @@
-"""The ``locust`` command: a thin table of verbs, each in its job's own ``cli`` module.
+"""The ``locust`` command: a thin table of verbs, each in its own module of this package.
 
 Commands are imported only when used, so ``locust --help`` and the quick commands
 start fast even though the simulation, vision and CAD libraries are heavy. Any
@@ -13,28 +13,29 @@ import sys
 
 import click
 
-from . import __version__
-from .errors import LocustError
+from ..errors import LocustError
+from ..version import __version__
 
 # verb -> (module, attribute, one-line help shown by `locust --help`)
 COMMANDS: dict[str, tuple[str, str, str]] = {
-    "params": ("locust.params_cli", "params", "Show or write robot parameters (presets, robot.toml, --set)."),
-    "sim": ("locust.sim.cli", "sim", "Simulate the hop schedule in MuJoCo, audited."),
-    "sweep": ("locust.sweep.cli", "sweep", "Sweep design parameters over a grid, in parallel."),
-    "optimize": ("locust.sweep.cli", "optimize", "Designs that hop far and high without going over (Optuna)."),
-    "ports": ("locust.device.cli", "ports", "List serial ports and mark the likely ESP32."),
-    "flash": ("locust.device.cli", "flash", "Copy the MicroPython firmware to the board (mpremote)."),
-    "hop": ("locust.device.cli", "hop", "Run the bang-bang hop schedule on the robot; save a run record."),
-    "config": ("locust.device.cli", "board_config", "Read the board's servo config back, or set a trim (no flashing)."),
-    "pose": ("locust.device.cli", "pose", "Move the servos to an angle and hold it (centring, trim)."),
-    "repl": ("locust.device.cli", "repl", "Open MicroPython's REPL on the robot (mpremote)."),
-    "virtual": ("locust.device.cli", "virtual", "Start a virtual robot on a pseudo-terminal."),
-    "track": ("locust.track.cli", "track", "Marker tracks from video, or converted from Tracker (5 subcommands)."),
-    "calibrate": ("locust.calibrate.cli", "calibrate", "Fit stiffness, damping, servo gains, friction."),
-    "report": ("locust.report.cli", "report", "Compare simulation and measurement in an HTML report."),
-    "demo": ("locust.demo", "demo", "Run the whole toolkit end to end on the virtual robot."),
-    "fab": ("locust.fab.cli", "fab", "Generate the five-layer laminate cut files (DXF)."),
-    "measure": ("locust.measure.cli", "measure", "Measure the robot as built from photos (stance)."),
+    "params": ("locust.commands.params", "params", "Show or write robot parameters (presets, robot.toml, --set)."),
+    "sim": ("locust.commands.sim", "sim", "Simulate the hop schedule in MuJoCo, audited."),
+    "sweep": ("locust.commands.sweep", "sweep", "Sweep design parameters over a grid, in parallel."),
+    "optimize": ("locust.commands.optimize", "optimize", "Designs that hop far and high without going over (Optuna)."),
+    "ports": ("locust.commands.ports", "ports", "List serial ports and mark the likely ESP32."),
+    "flash": ("locust.commands.flash", "flash", "Copy the MicroPython firmware to the board (mpremote)."),
+    "hop": ("locust.commands.hop", "hop", "Run the bang-bang hop schedule on the robot; save a run record."),
+    "config": ("locust.commands.config", "board_config",
+               "Read the board's servo config back, or set a trim (no flashing)."),
+    "pose": ("locust.commands.pose", "pose", "Move the servos to an angle and hold it (centring, trim)."),
+    "repl": ("locust.commands.repl", "repl", "Open MicroPython's REPL on the robot (mpremote)."),
+    "virtual": ("locust.commands.virtual", "virtual", "Start a virtual robot on a pseudo-terminal."),
+    "track": ("locust.commands.track", "track", "Marker tracks from video, or converted from Tracker (5 subcommands)."),
+    "calibrate": ("locust.commands.calibrate", "calibrate", "Fit stiffness, damping, servo gains, friction."),
+    "report": ("locust.commands.report", "report", "Compare simulation and measurement in an HTML report."),
+    "demo": ("locust.commands.demo", "demo", "Run the whole toolkit end to end on the virtual robot."),
+    "fab": ("locust.commands.fab", "fab", "Generate the five-layer laminate cut files (DXF)."),
+    "measure": ("locust.commands.measure", "measure", "Measure the robot as built from photos (stance)."),
 }
 
 
@@ -132,11 +133,7 @@ def main() -> None:
         click.echo("  hint: install locust-hopper in its own virtual environment (`make install` makes one), "
                    "or `pip uninstall locust` here", err=True)
         sys.exit(2)
-    from .fileio import unwind_on_termination
+    from ..fileio import unwind_on_termination
 
     unwind_on_termination()   # a kill (TERM) unwinds: no temporary file is left behind
     cli(prog_name="locust")
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

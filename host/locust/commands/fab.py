@@ -9,12 +9,12 @@ from pathlib import Path
 import click
 
 from ..errors import FabError
+from ..fab import laminate
+from ..fab.design import parse_layer_options
+from ..fab.dxf_read import UNIT_BY_NAME
+from ..fab.summary import summary_text
 from ..fileio import json_text
-from ..options import FINITE, FiniteFloat
-from . import laminate
-from .design import parse_layer_options
-from .dxf_read import UNIT_BY_NAME
-from .summary import summary_text
+from .options import FINITE, FiniteFloat
 
 # a fold's cut-out is a millimetre or two wide (the seed's 1 mm); one of 50 mm takes a whole link away
 MAX_HINGE_WIDTH_MM = 50.0
@@ -46,7 +46,7 @@ def _robot(spec: str):
 
 
 def _cad_check(out: Path, names: list[str]) -> dict:
-    from . import cadcheck
+    from ..fab import cadcheck
 
     bar = (click.progressbar(names, label="LibreCAD", file=sys.stderr, show_pos=True)
            if sys.stderr.isatty() else contextlib.nullcontext(names))
@@ -117,7 +117,7 @@ def fab(dxf, from_robot, out, as_json, layers, units, gap_tol_mm, recover, hinge
     if (dxf is None) == (from_robot is None):
         raise FabError("give a DXF drawing or --from-robot, not both" if dxf else "nothing to draw",
                        "e.g. `locust fab zz.dxf --out cut/` or `locust fab --from-robot seed --json`")
-    from ..api.fabrication import fab as make_cut_files
+    from ..api.fabrication import make_cut_files
 
     result = make_cut_files(_robot(from_robot) if from_robot else dxf, out=out, layers=parse_layer_options(layers),
                             units=units, gap_tol_mm=gap_tol_mm, recover=recover, hinge_width_mm=hinge_width_mm,

@@ -8,22 +8,21 @@ from pathlib import Path
 
 import click
 
+from ..calibrate import hinge as HG
+from ..calibrate import hop as H
+from ..calibrate import inputs
+from ..calibrate import ramp as R
+from ..calibrate import servo as S
+from ..calibrate.fitstats import Estimate
+from ..calibrate.plots import plot_fit
+from ..calibrate.write import DEFAULT_ROBOT_TOML, check_plausible, implausible, write_fitted
 from ..errors import CalibrationError
 from ..fileio import check_distinct, json_text, make_folder
-from ..io.importing import ImportOptions, import_options
-from ..options import FINITE, POSITIVE
+from ..io.importing import ImportOptions
 from ..plotting import check_figure_path
 from ..progress import progress
 from ..tables import estimate_line, value_line
-from . import hinge as HG
-from . import hop as H
-from . import inputs
-from . import ramp as R
-from . import servo as S
-from .fitstats import Estimate
-from .plots import plot_fit
-from .recordings import time_options
-from .write import DEFAULT_ROBOT_TOML, check_plausible, implausible, write_fitted
+from .options import FINITE, POSITIVE, import_options, time_options
 
 
 def output_options(func):

@@ -7,9 +7,8 @@ from pathlib import Path
 
 import click
 
-from ..io.importing import import_options
 from ..params import load_robot, resolve_robot
-from ..params_cli import robot_options
+from .options import import_options, robot_options
 
 
 def _stage(msg: str) -> None:
@@ -60,9 +59,9 @@ def report(measured, config, preset, sets, added, sweep, study, cycles, marker, 
                     --config calibration/robot.toml
       locust report --measured medium=a.tracks.csv,b.tracks.csv --preset seed --sweep sweep/ --cycles 6
     """
-    from ..api.reports import report as build_report
+    from ..api.reports import make_report as build_report
+    from ..report.checks import collapsed
     from ..trials.configs import parse_added
-    from .checks import collapsed
 
     robot = resolve_robot(preset, config, sets)
     source = str(config) if config else f"preset {preset}"

@@ -1,4 +1,4 @@
-"""``locust sweep`` and ``locust optimize``: design search on the audited simulation."""
+"""``locust optimize``: designs that hop far and high without going over (Optuna)."""
 
 from __future__ import annotations
 
@@ -8,92 +8,9 @@ from pathlib import Path
 import click
 
 from ..errors import SweepError
-from ..fileio import json_text
 from ..params import resolve_robot
-from ..params_cli import robot_options
 from ..progress import progress
-from ..tables import mm
-
-
-def _describe(row: dict, names: list[str]) -> str:
-    where = ", ".join(f"{n}={row[n]:.6g}" for n in names)
-    return (f"design {row['design']} ({where}, {row['outcome']}): {mm(row['distance_m'])} mm, "
-            f"highest nose {mm(row['max_nose_height_m'])} mm, {row['hops']} airborne hops")
-
-
-@click.command()
-@robot_options
-@click.option("--vary", "varies", multiple=True, required=True, metavar="NAME=START:STOP:N",
-              help="A parameter by dotted name, or `scale` (metres added to all four links), "
-                   "with N values from START to STOP. Repeat for a grid.")
-@click.option("--cycles", type=click.IntRange(1, 100), default=3, show_default=True, help="Hop cycles per design.")
-@click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
-              help="Folder for results.csv, sweep.json and plots. Rerun with the same folder to resume.")
-@click.option("--jobs", type=click.IntRange(1, 1024), default=None,
-              help="Parallel workers (default: every local core).")
-@click.option("--scheduler", default="local", show_default=True, metavar="local|dask-local|tcp://HOST:PORT",
-              help="local: a process per core; dask-local: a Dask LocalCluster; tcp://...: a Dask cluster.")
-@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
-@click.option("--samples", type=click.IntRange(2, 256), default=None, metavar="N",
-              help="Rank designs by their mean over N draws of the robot file's uncertain values: "
-                   "distance_m and max_nose_height_m are those means.")
-def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, samples):
-    """Simulate a grid of designs and report the best valid one.
-
-    Each design is checked before simulation (the four-bar assembles and stays closed over the
-    commanded crank range) and audited after; a design that fails is kept in results.csv with
-    `valid` False and the reason, and is never chosen as best. Rows are written as designs
-    finish, so an interrupted sweep resumes where it stopped.
-
-    \b
-    Examples:
-      locust sweep --preset seed --vary scale=0:0.05:30 --cycles 3 --out sweep-scale
-      locust sweep --vary geometry.leg_m=0.04:0.1:7 --vary geometry.crank_m=0.03:0.06:4 --out grid
-      locust sweep --vary scale=0:0.05:30 --scheduler tcp://10.0.0.5:8786 --out cluster-run
-    """
-    from ..api.sweeps import sweep as run_sweep
-    from ..api.sweeps import sweep_axes
-    from .execute import check_scheduler
-    from .run import grid_size
-
-    base = resolve_robot(preset, config, sets)
-    axes = sweep_axes(base, list(varies))
-    names = [a.name for a in axes]
-    check_scheduler(scheduler)
-    total = grid_size(axes)
-    with progress(length=total, label=f"sweep ({scheduler})", show_pos=True, show_eta=True) as bar:
-        try:
-            summary = run_sweep(base, axes, cycles, out=out, scheduler=scheduler, jobs=jobs, progress=bar.update,
-                                samples=samples or 0, say=lambda line: click.echo(line, err=True))
-        except KeyboardInterrupt:
-            click.echo(f"\ninterrupted: finished designs are in {out}/results.csv; "
-                       "rerun the same command to resume", err=True)
-            sys.exit(130)
-    rows = summary.rows
-    valid = [r for r in rows if r["valid"]]
-    if as_json:
-        click.echo(json_text({"folder": str(summary.folder), "designs": len(rows), "valid": len(valid),
-                              "computed": summary.computed, "resumed": summary.resumed,
-                              "wall_s": summary.wall_s, "best": summary.best,
-                              "plots": [str(p) for p in summary.plots]}), nl=False)
-        return
-    over = sum(1 for r in valid if r["outcome"] == "goes_over")
-    click.echo(f"{len(rows)} designs ({summary.resumed} from an earlier run, {summary.computed} computed in "
-               f"{summary.wall_s:.1f} s), {len(valid)} valid, {over} of them going over onto their backs")
-    reasons: dict[str, int] = {}
-    for r in rows:
-        if not r["valid"]:
-            key = r["reason"].split(":")[0]
-            reasons[key] = reasons.get(key, 0) + 1
-    for reason, n in sorted(reasons.items(), key=lambda kv: -kv[1]):
-        click.echo(f"  invalid x{n}: {reason}")
-    if summary.best is None:
-        click.echo("no valid design that stays on its feet: nothing to recommend")
-    else:
-        click.echo("best valid " + _describe(summary.best, names))
-    click.echo(f"results: {summary.folder / 'results.csv'}")
-    for p in summary.plots:
-        click.echo(f"plot: {p}")
+from .options import robot_options
 
 
 def _steps(items: tuple[str, ...]) -> dict[str, float]:
@@ -163,9 +80,9 @@ def optimize(preset, config, sets, varies, steps, objective_names, draws, quanti
       locust optimize --vary geometry.crank_start_deg=-126:-54 --step geometry.crank_start_deg=18 \\
           --objective nose_rise --trials 20 --out horn
     """
-    from .design import parse_bound
-    from .objectives import objectives_named
-    from .optimize import run_optimize
+    from ..sweep.design import parse_bound
+    from ..sweep.objectives import objectives_named
+    from ..sweep.optimize import run_optimize
 
     base = resolve_robot(preset, config, sets)
     step_of = _steps(steps)
@@ -186,7 +103,7 @@ def optimize(preset, config, sets, varies, steps, objective_names, draws, quanti
 
 
 def _report(summary, bounds, objectives, out: Path) -> None:
-    from .pareto import describe
+    from ..sweep.pareto import describe
 
     click.echo(f"study {summary.study_name!r}: {summary.trials} trials ({summary.computed} computed now), "
                f"{summary.complete} valid, {summary.pruned} pruned as invalid; {len(summary.front)} on the front")
@@ -206,8 +123,8 @@ def _report(summary, bounds, objectives, out: Path) -> None:
 
 def _repair(storage: str | None, out: Path) -> None:
     """--repair: cut the torn last line of the study's journal file (saved beside it first)."""
-    from .journal import repair
-    from .storage import RDB_PREFIXES
+    from ..sweep.journal import repair
+    from ..sweep.storage import RDB_PREFIXES
 
     if storage is not None and storage.startswith(RDB_PREFIXES):
         raise SweepError(f"--repair mends a journal file; --storage {storage} is a database",

@@ -17,17 +17,18 @@ from ..errors import TrackError
 from ..fileio import atomic_write_json
 from ..io import trk as trk_io
 from ..io.camera_json import camera_json_beside
-from ..io.importing import ImportOptions, import_options, import_tracks, is_project, span_warnings
+from ..io.importing import ImportOptions, import_tracks, is_project, span_warnings
 from ..io.tracks_csv import tracks_csv_beside, write_tracks_csv
 from ..progress import progress
-from . import board, calib, camera, export, overlay, preview, trk
-from .aruco import side_px_in_video
-from .board import DEFAULT_BOARD
-from .calib import PIXEL_CONVENTIONS, typed_px
-from .options import CALIBRATION, CLIP, FORMAT, OUTPUT, marker_options, stacked
-from .runner import track_video
-from .upright import upside_down_warnings
-from .video import Clip, VideoInfo, probe, read_as_frame
+from ..track import board, calib, camera, export, overlay, preview, trk
+from ..track.aruco import side_px_in_video
+from ..track.board import DEFAULT_BOARD
+from ..track.calib import PIXEL_CONVENTIONS, typed_px
+from ..track.runner import track_video
+from ..track.upright import upside_down_warnings
+from ..track.video import Clip, VideoInfo, probe, read_as_frame
+from .options import import_options
+from .track_options import CALIBRATION, CLIP, FORMAT, OUTPUT, marker_options, stacked
 
 SUBCOMMANDS = ("video", "import", "from-trk", "board", "preview")
 # the options of the one-command `locust track` that became subcommands, and their new form

@@ -12,8 +12,7 @@ import click
 from ..errors import MeasureError
 from ..fileio import json_text
 from ..io.trk import PIXEL_CONVENTIONS
-from ..options import POSITIVE
-from ..params_cli import robot_options
+from .options import POSITIVE, robot_options
 
 TERMS_SHOWN = 3
 
@@ -80,8 +79,8 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
     """
     from ..arucoboard import DEFAULT_BOARD, parse_board
     from ..fileio import check_distinct
+    from ..measure.stance import fit_stance, model_servo_give, read_photo
     from ..params import Provenance, resolve_robot, save_robot
-    from .stance import fit_stance, model_servo_give, read_photo
 
     robot = resolve_robot(preset, config, sets)
     spec = parse_board(board or DEFAULT_BOARD)
@@ -117,7 +116,7 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
 
 
 def _lines(result, photos) -> list[str]:
-    from .stance import STANCE_KEYS
+    from ..measure.stance import STANCE_KEYS
 
     lines = []
     for ph in photos:
@@ -179,7 +178,7 @@ def nose_load(grams, preset, config, sets, resolution_g, total_g, write, force, 
       locust measure nose-load 4.2 --resolution-g 0.1 --total-g 31.3 --config measured.toml --write robot.toml
     """
     from .. import params as P
-    from .nose_load import AXIS_KEY, PLATE_KEY, measure_nose_load
+    from ..measure.nose_load import AXIS_KEY, PLATE_KEY, measure_nose_load
 
     robot = P.resolve_robot(preset, config, sets)
     if write is not None and write.exists() and not force:

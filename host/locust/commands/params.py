@@ -2,58 +2,15 @@
 
 from __future__ import annotations
 
-import functools
 import os
 from pathlib import Path
 
 import click
 
-from . import params as P
-from .errors import ParamsError
-from .fileio import json_text, locked
-
-ROBOT_FILE = Path("calibration") / "robot.toml"   # what `locust calibrate --write` makes: the robot as calibrated
-DEFAULT_PRESET = "small"                          # the robot as built, no legs added (README, "What the presets are")
-DEFAULTED = "locust.robot_defaulted"              # click context meta: no --preset or --config was given
-
-
-def default_robot() -> tuple[str | None, Path | None, str]:
-    """(preset, robot file, the line saying which) when a command is given neither: the
-    calibrated robot in the current folder, else the robot as built."""
-    if ROBOT_FILE.is_file():
-        return None, ROBOT_FILE, f"robot: {ROBOT_FILE} (found here; --preset or --config to choose another)"
-    return DEFAULT_PRESET, None, (f"robot: {DEFAULT_PRESET}, the robot as built (no {ROBOT_FILE} here; "
-                                  "--preset or --config to choose another)")
-
-
-def robot_options(func=None, *, say: bool = True):
-    """The shared --preset / --config / --set options of every command that needs a robot.
-
-    With neither --preset nor --config the command runs on :func:`default_robot`, and its
-    first line of output (on stderr) says which; ``say=False``: the command prints that line
-    itself (the click context's meta ``DEFAULTED`` holds it), once it knows better."""
-    if func is None:
-        return functools.partial(robot_options, say=say)
-    command = func
-
-    @functools.wraps(command)
-    def wrapper(*args, preset, config, **kwargs):
-        if preset is None and config is None:
-            preset, config, said = default_robot()
-            if say:
-                click.echo(said, err=True)
-            click.get_current_context().meta[DEFAULTED] = said
-        return command(*args, preset=preset, config=config, **kwargs)
-
-    func = click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
-                        help="Override any parameter by its dotted name, "
-                             "e.g. --set servo.kp_nm_per_rad=0.4. Repeatable.")(wrapper)
-    func = click.option("--config", type=click.Path(dir_okay=False, path_type=Path), default=None,
-                        help=f"A robot.toml (e.g. {ROBOT_FILE}); overrides --preset.")(func)
-    func = click.option("--preset", type=click.Choice(list(P.PRESETS)), default=None,
-                        help=f"Built-in parameter set [default: {ROBOT_FILE} when the current folder has one, "
-                             f"else {DEFAULT_PRESET}, the robot as built].")(func)
-    return func
+from .. import params as P
+from ..errors import ParamsError
+from ..fileio import json_text, locked
+from .options import robot_options
 
 
 @click.command()
@@ -94,8 +51,8 @@ def params(preset, config, sets, as_json, write, force):
 
 def _standing(robot: P.Robot):
     """The model's standing load (:func:`locust.sim.statics.standing_load`), or None and why not."""
-    from .errors import LocustError
-    from .sim.statics import standing_load
+    from ..errors import LocustError
+    from ..sim.statics import standing_load
 
     try:
         return standing_load(robot), ""

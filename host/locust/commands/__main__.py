@@ -1,0 +1,5 @@
+"""``python -m locust.commands``: the ``locust`` command."""
+
+from . import main
+
+main()

@@ -1,0 +1,126 @@
+"""Click parameter types every command shares: numbers that must be finite (and positive).
+
+``click``'s own ``float`` takes ``nan`` and ``inf``; an option given one of them would reach a
+fit or a drawing as nonsense, so these refuse it where the command line is read.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from pathlib import Path
+
+import click
+
+from .. import params as P
+from ..calibrate.recordings import TimeOptions
+from ..io.importing import ImportOptions
+
+
+class FiniteFloat(click.ParamType):
+    """A finite number; with ``positive``, above zero; with ``low``/``high``, within them."""
+
+    name = "number"
+
+    def __init__(self, positive: bool = False, low: float | None = None, high: float | None = None):
+        self.positive = positive
+        self.low, self.high = low, high
+
+    def convert(self, value, param, ctx):
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            self.fail(f"{value!r} is not a number", param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        if self.positive and not number > 0:
+            self.fail(f"{value!r} must be above 0", param, ctx)
+        if self.low is not None and number < self.low:
+            self.fail(f"{value!r} is below {self.low:g}", param, ctx)
+        if self.high is not None and number > self.high:
+            self.fail(f"{value!r} is above {self.high:g}", param, ctx)
+        return number
+
+
+FINITE = FiniteFloat()
+POSITIVE = FiniteFloat(positive=True)
+
+
+ROBOT_FILE = Path("calibration") / "robot.toml"   # what `locust calibrate --write` makes: the robot as calibrated
+DEFAULT_PRESET = "small"                          # the robot as built, no legs added (README, "What the presets are")
+DEFAULTED = "locust.robot_defaulted"              # click context meta: no --preset or --config was given
+
+
+def default_robot() -> tuple[str | None, Path | None, str]:
+    """(preset, robot file, the line saying which) when a command is given neither: the
+    calibrated robot in the current folder, else the robot as built."""
+    if ROBOT_FILE.is_file():
+        return None, ROBOT_FILE, f"robot: {ROBOT_FILE} (found here; --preset or --config to choose another)"
+    return DEFAULT_PRESET, None, (f"robot: {DEFAULT_PRESET}, the robot as built (no {ROBOT_FILE} here; "
+                                  "--preset or --config to choose another)")
+
+
+def robot_options(func=None, *, say: bool = True):
+    """The shared --preset / --config / --set options of every command that needs a robot.
+
+    With neither --preset nor --config the command runs on :func:`default_robot`, and its
+    first line of output (on stderr) says which; ``say=False``: the command prints that line
+    itself (the click context's meta ``DEFAULTED`` holds it), once it knows better."""
+    if func is None:
+        return functools.partial(robot_options, say=say)
+    command = func
+
+    @functools.wraps(command)
+    def wrapper(*args, preset, config, **kwargs):
+        if preset is None and config is None:
+            preset, config, said = default_robot()
+            if say:
+                click.echo(said, err=True)
+            click.get_current_context().meta[DEFAULTED] = said
+        return command(*args, preset=preset, config=config, **kwargs)
+
+    func = click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
+                        help="Override any parameter by its dotted name, "
+                             "e.g. --set servo.kp_nm_per_rad=0.4. Repeatable.")(wrapper)
+    func = click.option("--config", type=click.Path(dir_okay=False, path_type=Path), default=None,
+                        help=f"A robot.toml (e.g. {ROBOT_FILE}); overrides --preset.")(func)
+    func = click.option("--preset", type=click.Choice(list(P.PRESETS)), default=None,
+                        help=f"Built-in parameter set [default: {ROBOT_FILE} when the current folder has one, "
+                             f"else {DEFAULT_PRESET}, the robot as built].")(func)
+    return func
+
+
+def import_options(func):
+    """``--units``, ``--rename``, ``--mirror`` on a click command; the command gets them as one
+    checked :class:`ImportOptions` argument, ``imports`` (a bad value is a TrackError)."""
+
+    @functools.wraps(func)
+    def wrapper(*args, units, rename, mirror, **kwargs):
+        return func(*args, imports=ImportOptions.parse(units, rename, mirror), **kwargs)
+
+    wrapper = click.option("--mirror", is_flag=True,
+                           help="Flip x of the tracks (x -> -x): a hop filmed right-to-left reads left-to-right.")(
+                               wrapper)
+    wrapper = click.option("--rename", "rename", multiple=True, metavar="OLD=NEW",
+                           help="Rename a marker of the tracks (its name, or its Tracker name as written: "
+                                "'cm A=nose'); repeatable. A track with no name (a t,x,y CSV) is 'nose'.")(wrapper)
+    wrapper = click.option("--units", "units", default="m", show_default=True, metavar="m|cm|mm",
+                           help="Unit of the tracks' positions (Tracker's calibration unit), made metres.")(wrapper)
+    return wrapper
+
+
+def time_options(func):
+    """``--time-scale``, ``--clip-fps`` on a click command, given to it as one :class:`TimeOptions`, ``timing``."""
+
+    @functools.wraps(func)
+    def wrapper(*args, time_scale, clip_fps, **kwargs):
+        return func(*args, timing=TimeOptions(time_scale, clip_fps), **kwargs)
+
+    wrapper = click.option("--clip-fps", type=float, default=None, metavar="FPS",
+                           help="Slow motion: the rate the clip was filmed at [frames/s]; the file's own rate "
+                                "(its median time step) is rescaled to it, e.g. a 240 frames/s clip exported "
+                                "at 30: --clip-fps 240.")(wrapper)
+    wrapper = click.option("--time-scale", type=float, default=None, metavar="S",
+                           help="Slow motion: real time = the file's time * S [-], e.g. 0.125 for a 240 "
+                                "frames/s clip exported at 30 [default: 1, times as they are].")(wrapper)
+    return wrapper
