@@ -98,7 +98,7 @@ def test_repr_is_a_short_table_in_mm():
 
 
 def test_robot_from_a_file_and_bad_names(tmp_path):
-    from locust.params import save_robot
+    from locust.io.robot_toml import save_robot
 
     path = save_robot(locust.robot("medium", **{"geometry.leg_m": 0.075}), tmp_path / "mine.toml")
     mine = locust.robot(path)

@@ -14,7 +14,8 @@ from click.testing import CliRunner
 
 from locust.calibrate.recordings import read_table
 from locust.commands import cli
-from locust.params import load_robot, preset, to_toml
+from locust.io.robot_toml import load_robot, to_toml
+from locust.params import preset
 
 ROOT = Path(__file__).resolve().parents[1]
 RECORDINGS = ROOT / "calibration" / "recordings"
@@ -264,7 +265,8 @@ def test_calibrate_hop_refuses_runs_on_different_robots_unless_told(tmp_path):
 
 
 def _robot_file(folder):
-    from locust.params import preset, save_robot
+    from locust.io.robot_toml import save_robot
+    from locust.params import preset
 
     return save_robot(preset("small"), folder / "robot.toml")
 

@@ -17,7 +17,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from locust.params import leg_set, load_robot
+from locust.io.robot_toml import load_robot
+from locust.params import leg_set
 from locust.sim.run import run
 
 LEG_SETS = ("small", "medium", "large")

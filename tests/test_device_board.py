@@ -15,7 +15,8 @@ import pytest
 
 from locust.firmware import config as fw_config
 from locust.io import run_record as R
-from locust.params import preset, save_robot
+from locust.io.robot_toml import save_robot
+from locust.params import preset
 from locust.trials.measured import config_of
 from probing import assert_refused_and_unchanged, tree
 

@@ -12,6 +12,7 @@ from click.testing import CliRunner
 
 from locust import params
 from locust.commands import cli
+from locust.io import robot_toml
 
 ZZ = Path(__file__).resolve().parents[1] / "data" / "dxf" / "zz.dxf"
 
@@ -36,16 +37,16 @@ def test_from_robot_json_hinges(name, hinges):
 
 def test_from_robot_toml_follows_its_link_lengths(tmp_path):
     robot = params.preset("seed").with_values({"geometry.ground_m": 0.045, "geometry.leg_m": 0.07})
-    params.save_robot(robot, tmp_path / "robot.toml")
+    robot_toml.save_robot(robot, tmp_path / "robot.toml")
     s = json.loads(_run("--from-robot", tmp_path / "robot.toml", "--json").output)
     assert s["hinges_x_mm"] == pytest.approx([45, 85, 105, 175], abs=1e-6)
     assert s["bounds_mm"]["width"] == pytest.approx(195)
     # its values are not the seed's, though the file kept the name "seed": named by the file
     assert s["source"] == "flat pattern of robot"
-    params.save_robot(robot.renamed("optimize best of opt"), tmp_path / "best.toml")
+    robot_toml.save_robot(robot.renamed("optimize best of opt"), tmp_path / "best.toml")
     assert json.loads(_run("--from-robot", tmp_path / "best.toml", "--json").output)["source"] == \
         "flat pattern of optimize best of opt"
-    params.save_robot(params.preset("seed"), tmp_path / "plain.toml")   # the seed itself keeps its name
+    robot_toml.save_robot(params.preset("seed"), tmp_path / "plain.toml")   # the seed itself keeps its name
     assert json.loads(_run("--from-robot", tmp_path / "plain.toml", "--json").output)["source"] == \
         "flat pattern of seed"
 

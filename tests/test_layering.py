@@ -1,7 +1,19 @@
-"""The package layering (docs/architecture.md): the file layer ``locust.io`` imports no job
-package, ``sim`` does not import ``track``, and ``calibrate`` does not import ``report``
-(both build on ``locust.trials``). Every import is counted, at module level or inside a
-function, read from the source with ``ast``."""
+"""The package layering (docs/architecture.md), from the bottom up:
+
+- the shared modules at the root (errors, fileio, progress, tables, plotting, markers,
+  arucoboard, orphans, version) and ``params``, the robot's parameters;
+- ``io``, the file formats, which imports no job package;
+- the job packages (sim, calibrate, track, sweep, report, fab, device, measure, trials);
+- ``api``, the functions a notebook calls;
+- ``commands``, the click commands, one module per verb;
+- the package root, which only names the API.
+
+Nothing imports upwards: no job package (nor io, params or a shared module) imports
+``locust.api``, ``locust.commands`` or the root (``from locust import x``, ``from .. import
+__version__``), and only ``commands`` uses click. Across the jobs: ``sim`` does not import
+``track``, and ``calibrate`` does not import ``report`` (both build on ``locust.trials``).
+Every import is counted, at module level or inside a function, read from the source with
+``ast``."""
 
 from __future__ import annotations
 
@@ -30,11 +42,25 @@ def imports_of(path: Path) -> set[str]:
     return out
 
 
-def offending(package: str, forbidden: tuple[str, ...]) -> dict[str, list[str]]:
+JOBS = ("sim", "calibrate", "track", "sweep", "report", "fab", "device", "measure", "trials")
+BELOW_API = (*JOBS, "io", "params", "firmware")        # packages
+SHARED = ("errors", "fileio", "progress", "tables", "plotting", "markers", "arucoboard", "orphans", "version")
+ROOT_NAMES = ("locust", "locust.__init__", "locust.__version__")
+
+
+def modules_of(package: str) -> list[Path]:
+    path = ROOT / package
+    return sorted(path.rglob("*.py")) if path.is_dir() else [ROOT / f"{package}.py"]
+
+
+def offending(package: str, forbidden: tuple[str, ...], root: bool = False) -> dict[str, list[str]]:
+    """The modules of ``package`` that import one of ``forbidden`` (``locust.<name>`` or below
+    it; ``root``: or the package root itself), with what they import."""
     found = {}
-    for path in sorted((ROOT / package).rglob("*.py")):
+    for path in modules_of(package):
         bad = sorted(m for m in imports_of(path)
-                     if any(m == f"locust.{f}" or m.startswith(f"locust.{f}.") for f in forbidden))
+                     if any(m == f"locust.{f}" or m.startswith(f"locust.{f}.") for f in forbidden)
+                     or (root and m in ROOT_NAMES))
         if bad:
             found[str(path.relative_to(ROOT))] = bad
     return found
@@ -55,3 +81,35 @@ def test_the_import_reader_resolves_relative_imports():
 ])
 def test_layering(package, forbidden):
     assert offending(package, forbidden) == {}
+
+
+@pytest.mark.parametrize("package", [*BELOW_API, *SHARED])
+def test_nothing_below_the_api_imports_upwards(package):
+    assert offending(package, ("api", "commands"), root=True) == {}
+
+
+def test_the_api_does_not_import_the_commands():
+    assert offending("api", ("commands",), root=True) == {}
+
+
+def test_params_and_io_stand_below_the_jobs():
+    assert offending("params", (*JOBS, "io", "api", "commands")) == {}
+
+
+def test_only_the_commands_use_click():
+    users = {str(p.relative_to(ROOT)) for p in ROOT.rglob("*.py")
+             if "click" in {m.split(".")[0] for m in imports_of(p)}}
+    assert users and all(u.startswith("commands/") for u in users), sorted(users)
+
+
+def test_the_rule_catches_an_upward_import(tmp_path, monkeypatch):
+    """The rule is only as good as this: a job module importing the API, the commands, the
+    version from the root, or ``import locust``, is each reported."""
+    pkg = tmp_path / "locust" / "sim"
+    pkg.mkdir(parents=True)
+    (pkg / "bad.py").write_text("from ..api import simulate\nfrom .. import __version__\n"
+                                "def f():\n    from locust.commands import main\n    import locust\n")
+    monkeypatch.setattr(__import__(__name__), "ROOT", tmp_path / "locust")
+    assert offending("sim", ("api", "commands"), root=True) == {
+        "sim/bad.py": ["locust", "locust.__version__", "locust.api", "locust.api.simulate", "locust.commands",
+                       "locust.commands.main"]}

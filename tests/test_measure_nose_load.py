@@ -13,6 +13,7 @@ from click.testing import CliRunner
 
 from locust import params as P
 from locust.commands import cli
+from locust.io import robot_toml
 from locust.measure.nose_load import AXIS_KEY, PLATE_KEY, measure_nose_load
 from locust.sim.samples import uncertain_values
 from locust.sim.statics import standing_load
@@ -100,7 +101,7 @@ def test_the_command_writes_the_robot_with_the_axis_measured(tmp_path):
     assert doc["axis"]["value"] == pytest.approx(0.028, abs=5e-4) and doc["axis"]["sd"] <= 0.003
     rounding = 0.001 / math.sqrt(12)        # 1 g: an error uniform over one gram
     assert doc["axis_sd_terms_m"]["scale resolution"] == pytest.approx(rounding / abs(doc["slope_kg_per_m"]))
-    written = P.load_robot(out)
+    written = robot_toml.load_robot(out)
     assert written.get(AXIS_KEY) == pytest.approx(doc["axis"]["value"], abs=1e-9)
     assert written.source_of(AXIS_KEY).source == "measured:kitchen_scale"
     before = out.read_bytes()

@@ -4,6 +4,7 @@ import pytest
 
 from locust import params as P
 from locust.errors import ParamsError
+from locust.io import robot_toml
 
 
 def test_presets_add_one_and_two_cm_to_every_link():
@@ -21,7 +22,7 @@ def test_seed_notebook_runs_the_notebook_way():
 
 
 def test_set_overrides_and_records_provenance():
-    r = P.resolve_robot("seed", None, ["servo.kp_nm_per_rad=25", "contact.self_collision=true"])
+    r = robot_toml.resolve_robot("seed", None, ["servo.kp_nm_per_rad=25", "contact.self_collision=true"])
     assert r.servo.kp_nm_per_rad == 25.0 and r.contact.self_collision is True
     assert r.source_of("servo.kp_nm_per_rad").source == "override"
 
@@ -34,7 +35,7 @@ def test_set_overrides_and_records_provenance():
 ])
 def test_bad_set_options(item, fragment):
     with pytest.raises(ParamsError) as err:
-        P.resolve_robot("seed", None, [item])
+        robot_toml.resolve_robot("seed", None, [item])
     assert fragment in err.value.message
 
 
@@ -42,8 +43,8 @@ def test_toml_round_trip_keeps_values_and_uncertainty(tmp_path):
     fitted = P.preset("medium").with_values(
         {"compliance.hinge_stiffness_nm_per_rad": 0.061},
         P.Provenance(source="fit:beam.csv", uncertainty=0.002, date="2026-11-21"))
-    path = P.save_robot(fitted, tmp_path / "robot.toml")
-    back = P.load_robot(path)
+    path = robot_toml.save_robot(fitted, tmp_path / "robot.toml")
+    back = robot_toml.load_robot(path)
     assert back.flat() == fitted.flat()
     prov = back.source_of("compliance.hinge_stiffness_nm_per_rad")
     assert (prov.source, prov.uncertainty, prov.date) == ("fit:beam.csv", 0.002, "2026-11-21")
@@ -53,7 +54,7 @@ def test_broken_toml_names_the_file(tmp_path):
     bad = tmp_path / "robot.toml"
     bad.write_text("[servo]\nkp_nm_per_rad = = 3\n")
     with pytest.raises(ParamsError) as err:
-        P.load_robot(bad)
+        robot_toml.load_robot(bad)
     assert str(bad) in err.value.message
 
 
@@ -61,17 +62,17 @@ def test_a_misspelt_base_preset_is_refused(tmp_path):
     """Before: `base = "meduim"` silently loaded the seed."""
     path = tmp_path / "robot.toml"
     path.write_text('name = "mine"\nbase = "meduim"\n')
-    with pytest.raises(P.ParamsError, match="base = 'meduim' is not a preset"):
-        P.load_robot(path)
+    with pytest.raises(ParamsError, match="base = 'meduim' is not a preset"):
+        robot_toml.load_robot(path)
     path.write_text('name = "mine"\nbase = "medium"\n')
-    assert P.load_robot(path).geometry.leg_m == pytest.approx(0.07)   # Medium: +1 cm on the seed's 6 cm
+    assert robot_toml.load_robot(path).geometry.leg_m == pytest.approx(0.07)   # Medium: +1 cm on the seed's 6 cm
 
 
 @pytest.mark.parametrize("raw", ['"big"', "-0.1", "nan", "true"])
 def test_an_uncertainty_that_is_not_a_number_is_an_error_not_a_traceback(tmp_path, raw):
     path = tmp_path / "robot.toml"
     path.write_text(f'[servo]\nkp_nm_per_rad = {{ value = 0.26, source = "fit:x", uncertainty = {raw} }}\n')
-    with pytest.raises(P.ParamsError, match=r"servo.kp_nm_per_rad has uncertainty = .* not a number >= 0"):
-        P.load_robot(path)
+    with pytest.raises(ParamsError, match=r"servo.kp_nm_per_rad has uncertainty = .* not a number >= 0"):
+        robot_toml.load_robot(path)
     path.write_text('[servo]\nkp_nm_per_rad = { value = 0.26, source = "fit:x", uncertainty = 0.019 }\n')
-    assert P.load_robot(path).source_of("servo.kp_nm_per_rad").uncertainty == 0.019
+    assert robot_toml.load_robot(path).source_of("servo.kp_nm_per_rad").uncertainty == 0.019

@@ -19,7 +19,8 @@ import pytest
 from click.testing import CliRunner
 
 from locust.commands import cli
-from locust.params import Provenance, leg_set, preset, save_robot
+from locust.io.robot_toml import save_robot
+from locust.params import Provenance, leg_set, preset
 from locust.report.synthetic import simulated_nose, write_synthetic_trial
 from locust.sim.run import run
 from locust.sweep.design import Axis, parse_bound

@@ -19,7 +19,8 @@ from pathlib import Path
 
 import pytest
 
-from locust.params import leg_set, load_robot
+from locust.io.robot_toml import load_robot
+from locust.params import leg_set
 from locust.sim.run import run
 
 pytestmark = pytest.mark.slow

@@ -36,7 +36,7 @@ def reported(request, tmp_path_factory):
     robot = ROBOTS[name]()
     write_synthetic_trial(root / name, robot, CYCLES, fps=60.0, noise_m=0.0, lost_frames=0)
     config = root / "robot.toml"
-    from locust.params import save_robot
+    from locust.io.robot_toml import save_robot
 
     save_robot(robot, config)
     res = CliRunner().invoke(cli, ["report", "--measured", f"{name}={root / name}", "--config", str(config),

@@ -22,7 +22,8 @@ from locust.calibrate.write import write_fitted
 from locust.commands import cli
 from locust.errors import WriteError
 from locust.fileio import storable
-from locust.params import Provenance, load_robot, parse_set_options, preset, save_robot, update_robot
+from locust.io.robot_toml import load_robot, save_robot, update_robot
+from locust.params import Provenance, parse_set_options, preset
 
 ROOT = Path(__file__).resolve().parents[1]
 RAMP = ROOT / "calibration" / "recordings" / "synthetic_ramp.csv"
@@ -112,7 +113,7 @@ def test_calibrate_write_after_a_robot_file_with_escapes_reads_back(tmp_path):
 
 
 def test_a_write_that_does_not_read_back_keeps_the_old_file(tmp_path, monkeypatch):
-    import locust.params as P
+    import locust.io.robot_toml as P
 
     path = tmp_path / "r.toml"
     save_robot(preset("seed"), path)
@@ -135,7 +136,8 @@ def test_a_new_file_is_created_exclusively(tmp_path):
 
 COUNTER = textwrap.dedent("""
     import sys
-    from locust.params import Provenance, update_robot
+    from locust.params import Provenance
+    from locust.io.robot_toml import update_robot
     path, who = sys.argv[1], sys.argv[2]
 
     def bump(robot):   # a read-modify-write: a lost update loses a count

@@ -10,6 +10,7 @@ from types import SimpleNamespace
 import pytest
 
 from locust import params as P
+from locust.io import robot_toml
 from locust.sim import outcome as O
 from locust.sim.run import run
 
@@ -119,7 +120,7 @@ def test_sim_json_and_samples_give_the_outcome_and_its_shares(tmp_path):
     from locust.commands import cli
 
     robot = only_uncertain(P.preset("medium"), {"geometry.crank_start_deg": 10.0})
-    P.save_robot(robot, tmp_path / "r.toml")
+    robot_toml.save_robot(robot, tmp_path / "r.toml")
     res = CliRunner().invoke(cli, ["sim", "--config", str(tmp_path / "r.toml"), "--cycles", "2", "--samples", "6",
                                    "--seed", "3", "--json"])
     assert res.exit_code == 0, res.output

@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 
 from locust.errors import SweepError
-from locust.params import load_robot, preset
+from locust.io.robot_toml import load_robot
+from locust.params import preset
 from locust.sweep.design import design_robot, evaluate, parse_axis, parse_bound, precheck
 from locust.sweep.run import best_row, run_sweep
 from probing import assert_refused_and_unchanged, invoke, signalled_in_design

@@ -404,8 +404,9 @@ def robot_of_runs(runs: Sequence[PathLike]) -> tuple[Robot, str]:
     saying so: the robot file, or the preset (a leg-set preset's runs share the robot as
     built, the ``small`` preset, on which each run's own leg set is built). Runs recording
     different robots are refused: which values they share is not known."""
+    from ..io.robot_toml import load_robot
     from ..io.run_record import RECORD_NAME, read_run_record
-    from ..params import LEG_SETS, load_robot, preset
+    from ..params import LEG_SETS, preset
 
     seen: dict[tuple[str, str], list[str]] = {}
     for item in runs:

@@ -6,7 +6,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ParamsError
-from ..params import PRESETS, Robot, check_robot, load_robot, preset
+from ..io.robot_toml import load_robot
+from ..params import PRESETS, Robot, check_robot, preset
 
 
 def robot(preset_or_path: str | Path = "seed", **overrides: Any) -> Robot:

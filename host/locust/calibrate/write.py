@@ -12,7 +12,8 @@ import math
 from pathlib import Path
 
 from ..errors import CalibrationError
-from ..params import Provenance, Robot, preset, problems, update_robot
+from ..io.robot_toml import update_robot
+from ..params import Provenance, Robot, preset, problems
 from .fitstats import Estimate
 
 DEFAULT_ROBOT_TOML = Path("calibration") / "robot.toml"
@@ -56,7 +57,7 @@ def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str |
     """Set each dotted key in ``values`` to its fitted value, with ``fit:<recording>``; refused
     (nothing written) when a value is implausible or the robot could then not be simulated.
 
-    The file is read, changed and written back under a lock (``params.update_robot``): two
+    The file is read, changed and written back under a lock (``robot_toml.update_robot``): two
     calibrations writing one file at once both land; its comments and layout are kept."""
     check_plausible(values)
     path = Path(path)

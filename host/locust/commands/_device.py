@@ -12,7 +12,8 @@ from ..device.plant import PLANTS
 from ..errors import DeviceError
 from ..firmware import config as fw_config
 from ..io import run_record as R
-from ..params import Schedule, resolve_robot
+from ..io.robot_toml import resolve_robot
+from ..params import Schedule
 from .options import DEFAULTED
 
 CHIPS = tuple(fw_config.CHIPS)  # the chips whose pin rules the firmware knows, and the virtual robot models

@@ -372,7 +372,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, out_dir, write
       locust calibrate hop small=runs/s1 large=runs/l1 --write calibration/robot.toml
     """
     from ..api.calibration import calibrate_hops
-    from ..params import resolve_robot
+    from ..io.robot_toml import resolve_robot
 
     keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
     H.check_fittable(keys)

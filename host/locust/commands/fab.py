@@ -14,6 +14,7 @@ from ..fab.design import parse_layer_options
 from ..fab.dxf_read import UNIT_BY_NAME
 from ..fab.summary import summary_text
 from ..fileio import json_text
+from ..io import robot_toml
 from .options import FINITE, FiniteFloat
 
 # a fold's cut-out is a millimetre or two wide (the seed's 1 mm); one of 50 mm takes a whole link away
@@ -28,7 +29,7 @@ def _robot(spec: str):
     if spec in params.PRESETS:
         robot = params.preset(spec)
     elif Path(spec).suffix.lower() == ".toml" or Path(spec).exists():
-        robot = params.load_robot(Path(spec))
+        robot = robot_toml.load_robot(Path(spec))
         if robot.name in params.PRESETS and robot != params.preset(robot.name):
             robot = robot.renamed(Path(spec).stem)   # a changed preset keeps its name: say which file it is
     else:

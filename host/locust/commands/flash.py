@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 
 from ..io import run_record as R
-from ..params import resolve_robot
+from ..io.robot_toml import resolve_robot
 from ._device import PORT_HELP, info, parse_servo_set
 from .options import robot_options
 

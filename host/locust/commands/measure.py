@@ -11,6 +11,7 @@ import click
 
 from ..errors import MeasureError
 from ..fileio import json_text
+from ..io import robot_toml
 from ..io.trk import PIXEL_CONVENTIONS
 from .options import POSITIVE, robot_options
 
@@ -79,8 +80,9 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
     """
     from ..arucoboard import DEFAULT_BOARD, parse_board
     from ..fileio import check_distinct
+    from ..io.robot_toml import resolve_robot, save_robot
     from ..measure.stance import fit_stance, model_servo_give, read_photo
-    from ..params import Provenance, resolve_robot, save_robot
+    from ..params import Provenance
 
     robot = resolve_robot(preset, config, sets)
     spec = parse_board(board or DEFAULT_BOARD)
@@ -177,15 +179,14 @@ def nose_load(grams, preset, config, sets, resolution_g, total_g, write, force, 
       locust measure nose-load 4 --preset medium
       locust measure nose-load 4.2 --resolution-g 0.1 --total-g 31.3 --config measured.toml --write robot.toml
     """
-    from .. import params as P
     from ..measure.nose_load import AXIS_KEY, PLATE_KEY, measure_nose_load
 
-    robot = P.resolve_robot(preset, config, sets)
+    robot = robot_toml.resolve_robot(preset, config, sets)
     if write is not None and write.exists() and not force:
         raise MeasureError(f"{write} exists", "choose another path, or add --force to overwrite it")
     res = measure_nose_load(robot, grams / 1000, resolution_g / 1000, None if total_g is None else total_g / 1000)
     if write is not None:
-        P.save_robot(res.robot, write)
+        robot_toml.save_robot(res.robot, write)
     if as_json:
         out = res.to_json()
         out["written"] = str(write) if write is not None else None

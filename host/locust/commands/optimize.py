@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from ..errors import SweepError
-from ..params import resolve_robot
+from ..io.robot_toml import resolve_robot
 from ..progress import progress
 from .options import robot_options
 

@@ -10,6 +10,7 @@ import click
 from .. import params as P
 from ..errors import ParamsError
 from ..fileio import json_text, locked
+from ..io import robot_toml
 from .options import robot_options
 
 
@@ -26,7 +27,7 @@ def params(preset, config, sets, as_json, write, force):
     model's load under the nose standing at rest, as a kitchen scale reads it (--json:
     nose_load_kg; `locust measure nose-load` takes the scale's reading back).
     """
-    robot = P.resolve_robot(preset, config, sets)
+    robot = robot_toml.resolve_robot(preset, config, sets)
     if write:
         _write(robot, write, force, config, sets)
         click.echo(f"wrote {write}")
@@ -68,11 +69,12 @@ def _write(robot: P.Robot, write: Path, force: bool, config: Path | None, sets) 
     if not force:
         if write.exists():
             raise ParamsError(f"{write} exists", "choose another path, or add --force to overwrite it")
-        P.save_robot(robot, write, template=P.file_text(config) if config else None, exclusive=True)
+        robot_toml.save_robot(robot, write, template=robot_toml.file_text(config) if config else None, exclusive=True)
         return
     if config is not None and os.path.realpath(config) == os.path.realpath(write):
         overrides = P.parse_set_options(sets)
-        P.update_robot(write, lambda now: P.check_robot(now.with_values(overrides, "override") if overrides else now))
+        robot_toml.update_robot(
+            write, lambda now: P.check_robot(now.with_values(overrides, "override") if overrides else now))
         return
     with locked(write):   # replaced by this robot: the layout of its --config, if any
-        P.save_robot(robot, write, template=P.file_text(config) if config else None)
+        robot_toml.save_robot(robot, write, template=robot_toml.file_text(config) if config else None)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from ..params import load_robot, resolve_robot
+from ..io.robot_toml import load_robot, resolve_robot
 from .options import import_options, robot_options
 
 

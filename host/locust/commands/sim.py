@@ -10,7 +10,7 @@ import click
 
 from ..errors import GeometryError, SimError
 from ..fileio import json_text
-from ..params import resolve_robot
+from ..io.robot_toml import resolve_robot
 from ..progress import progress
 from ..tables import nose_load_line, sensitivity_lines, sim_lines, spread_lines
 from .options import robot_options

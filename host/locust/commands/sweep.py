@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from ..fileio import json_text
-from ..params import resolve_robot
+from ..io.robot_toml import resolve_robot
 from ..progress import progress
 from ..tables import mm
 from .options import robot_options
@@ -50,8 +50,8 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
       locust sweep --vary geometry.leg_m=0.04:0.1:7 --vary geometry.crank_m=0.03:0.06:4 --out grid
       locust sweep --vary scale=0:0.05:30 --scheduler tcp://10.0.0.5:8786 --out cluster-run
     """
-    from ..api.sweeps import sweep_designs as run_sweep
     from ..api.sweeps import sweep_axes
+    from ..api.sweeps import sweep_designs as run_sweep
     from ..sweep.execute import check_scheduler
     from ..sweep.run import grid_size
 

@@ -2,8 +2,10 @@
 
 A project's point tracks come out on its clip's frames (:func:`project_points`), in metres
 through its own calibration (:func:`project_tracks`, a :class:`~.tracks_csv.TracksCsv`).
-The text export's layout, reader and typed object are :mod:`.tracker_text`'s; writing a
-tracking result as a project or a text export is :mod:`locust.track.trk`'s.
+A project is written here too (:func:`project_xml`, :func:`write_project`) from the same
+typed object and a :class:`ProjectVideo`, so what is written reads back as it was given.
+The text export's layout, reader and typed object are :mod:`.tracker_text`'s; turning a
+tracking result into either is :mod:`locust.track.trk`'s.
 
 Pixel convention. Tracker's image coordinates are measured from the top-left *corner*
 of the image (``ImageCoordSystem``: "pixel position relative to the top left corner";
@@ -27,12 +29,14 @@ import xml.etree.ElementTree as ET
 import zipfile
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path, PurePosixPath
+from xml.sax.saxutils import escape
 
 import numpy as np
 
 from ..errors import TrackError
+from ..fileio import atomic_write_text
 from .tracks_csv import MarkerColumns, TracksCsv
 from .trz import MAX_TRK_BYTES, open_trz, read_member, unpack_members
 
@@ -108,8 +112,9 @@ class TrackerProject:
     path: Path
     video_path: str | None
     clip: TrackerClip
-    calibration: Calibration
+    calibration: Calibration | None   # None: written without a Tracker calibration (a plane's homography)
     points: dict[str, dict[int, tuple[float, float]]]  # name -> frame -> (px, py), OpenCV convention
+    descriptions: dict[str, str] = field(default_factory=dict)   # name -> the track's description in Tracker
 
 
 def read_project(path: str | Path) -> TrackerProject:
@@ -358,3 +363,100 @@ def project_media(project: TrackerProject) -> Iterator[Path]:
             raise TrackError(f"{project.path.name} opens {project.video_path}, which is not inside it",
                              "give the video itself as VIDEO, with --calibration-from the project")
         yield media
+
+
+# --- Writing a Tracker project ---------------------------------------------------------
+
+TRACKER_VERSION = "6.0.6"  # the schema written: that of the .trk files Tracker 6.0.6 saves
+_CORE = "org.opensourcephysics.media.core"
+_TRACKER = "org.opensourcephysics.cabrillo.tracker"
+_TRACK_RGB = [(255, 0, 255), (0, 255, 255), (255, 255, 0), (255, 128, 0), (0, 128, 255), (0, 255, 128)]
+
+
+@dataclass(frozen=True)
+class ProjectVideo:
+    """The media a written project opens: its path as written (relative to the project, or inside
+    a ``.trz``), whether it is an image sequence (its first file), its size and frame count."""
+
+    media: str
+    images: bool
+    width_px: int
+    height_px: int
+    frame_count: int
+
+
+def _p(name: str, kind: str, value, indent: int) -> str:
+    text = repr(float(value)) if kind == "double" else (str(value).lower() if kind == "boolean" else str(value))
+    return f'{" " * indent}<property name="{name}" type="{kind}">{escape(text)}</property>\n'
+
+
+def _colour(rgb: tuple[int, int, int], indent: int) -> str:
+    pad = " " * indent
+    body = "".join(_p(c, "int", v, indent + 8) for c, v in zip(("red", "green", "blue", "alpha"), (*rgb, 255)))
+    return (f'{pad}<property name="color" type="object">\n{pad}<object class="java.awt.Color">\n{body}'
+            f"{pad}</object>\n{pad}</property>\n")
+
+
+def project_xml(project: TrackerProject, video: ProjectVideo) -> str:
+    """``project`` as a Tracker 6 project (``.trk`` XML): ``video``'s media, the clip's frames and
+    frame interval, the calibration (scale, origin, axes; none when it is None or has no scale)
+    and one point mass per track with a step on each of its frames (pixels in Tracker's
+    convention: the OpenCV pixels of ``project.points`` less :data:`TRACKER_TO_OPENCV_PX`)."""
+    clip = project.clip
+    dt_ms = 1000.0 / clip.fps
+    if video.images:
+        media = (f'        <object class="{_CORE}.ImageVideo">\n' + _p("path", "string", video.media, 12)
+                 + _p("delta_t", "double", dt_ms, 12) + "        </object>\n")
+    else:
+        media = ('        <object class="org.opensourcephysics.media.xuggle.XuggleVideo">\n'
+                 + _p("path", "string", video.media, 12) + "        </object>\n")
+    count = (clip.end - clip.start) // clip.step + 1
+    out = ['<?xml version="1.0" encoding="UTF-8"?>\n', f'<object class="{_TRACKER}.TrackerPanel">\n',
+           _p("semantic_version", "string", TRACKER_VERSION, 4), _p("width", "double", video.width_px, 4),
+           _p("height", "double", video.height_px, 4),
+           f'    <property name="videoclip" type="object">\n    <object class="{_CORE}.VideoClip">\n',
+           f'        <property name="video" type="object">\n{media}        </property>\n',
+           _p("video_framecount", "int", video.frame_count, 8), _p("startframe", "int", clip.start, 8),
+           _p("stepsize", "int", clip.step, 8), _p("stepcount", "int", count, 8), _p("starttime", "double", 0.0, 8),
+           _p("readout", "string", "frame", 8), _p("playallsteps", "boolean", True, 8),
+           "    </object>\n    </property>\n",
+           f'    <property name="clipcontrol" type="object">\n    <object class="{_CORE}.StepperClipControl">\n',
+           _p("rate", "double", 1.0, 8), _p("delta_t", "double", dt_ms, 8), _p("frame", "int", clip.start, 8),
+           "    </object>\n    </property>\n"]
+    cal = project.calibration
+    if cal is not None and math.isfinite(cal.m_per_px):
+        frame_data = "".join((_p("xorigin", "double", cal.origin_x_px - TRACKER_TO_OPENCV_PX, 16),
+                              _p("yorigin", "double", cal.origin_y_px - TRACKER_TO_OPENCV_PX, 16),
+                              _p("angle", "double", cal.angle_deg, 16), _p("xscale", "double", 1.0 / cal.m_per_px, 16),
+                              _p("yscale", "double", 1.0 / cal.m_per_px, 16)))
+        out += [f'    <property name="coords" type="object">\n    <object class="{_CORE}.ImageCoordSystem">\n',
+                _p("fixedorigin", "boolean", True, 8), _p("fixedangle", "boolean", True, 8),
+                _p("fixedscale", "boolean", True, 8), _p("locked", "boolean", False, 8),
+                f'        <property name="framedata" type="array" class="[L{_CORE}.ImageCoordSystem$FrameData;">\n'
+                f'            <property name="[0]" type="object">\n'
+                f'            <object class="{_CORE}.ImageCoordSystem$FrameData">\n{frame_data}'
+                "            </object>\n            </property>\n        </property>\n    </object>\n    </property>\n",
+                _p("length_unit", "string", "m", 4)]
+    out.append('    <property name="tracks" type="collection" class="java.util.ArrayList">\n')
+    for k, (name, steps_px) in enumerate(project.points.items()):
+        steps = "".join(
+            f'                <property name="[{int(f)}]" type="object">\n'
+            f'                <object class="{_TRACKER}.PointMass$FrameData">\n'
+            + _p("x", "double", float(x) - TRACKER_TO_OPENCV_PX, 20)
+            + _p("y", "double", float(y) - TRACKER_TO_OPENCV_PX, 20)
+            + "                </object>\n                </property>\n"
+            for f, (x, y) in steps_px.items())
+        out += ['        <property name="item" type="object">\n', f'        <object class="{_TRACKER}.PointMass">\n',
+                _p("mass", "double", 1.0, 12), _p("name", "string", name, 12),
+                _p("description", "string", project.descriptions.get(name, ""), 12),
+                _colour(_TRACK_RGB[k % len(_TRACK_RGB)], 12), _p("footprint", "string", "Footprint.Diamond", 12),
+                _p("visible", "boolean", True, 12), _p("trail", "boolean", True, 12),
+                f'            <property name="framedata" type="array" class="[L{_TRACKER}.PointMass$FrameData;">\n',
+                steps, "            </property>\n        </object>\n        </property>\n"]
+    out += ["    </property>\n", "</object>\n"]
+    return "".join(out)
+
+
+def write_project(project: TrackerProject, video: ProjectVideo) -> Path:
+    """Write ``project`` to ``project.path`` (see :func:`project_xml`), atomically."""
+    return atomic_write_text(project.path, project_xml(project, video))

@@ -27,8 +27,9 @@ from typing import Any
 
 from ..errors import SweepError
 from ..fileio import atomic_write_json, make_folder
+from ..io.robot_toml import save_robot
 from ..io.study_store import write_tables
-from ..params import Robot, save_robot
+from ..params import Robot
 from .design import Bound, design_robot, is_integer
 from .journal import full_disk
 from .objectives import OBJECTIVES, OUTCOMES, Judgement, Objective

@@ -1,0 +1,42 @@
+"""Robot parameters: one typed model with each value's unit and source.
+
+- :mod:`.model`: the parameter types (geometry, compliance, servo, contact, power, schedule,
+  solver), provenance, and access by dotted name.
+- :mod:`.limits`: each parameter's limits with their reasons; the checks before a simulation.
+- :mod:`.presets`: the built-in robots (seed, the robot as built, seed-notebook), every value
+  with its source.
+- :mod:`.legsets`: the filmed leg sets, the one table presets, reports and the hop fit use.
+
+``robot.toml`` is read and written by :mod:`locust.io.robot_toml`.
+"""
+
+from .legsets import LEG_SETS, LegSet, leg_set, with_added_length
+from .limits import LIMITS, MAX_SIM_STEPS, Limit, check_robot, outside_limits, problems
+from .model import (
+    GRAVITY_M_PER_S2,
+    PHYSICAL_SECTIONS,
+    SECTIONS,
+    UNBOUNDED_KEYS,
+    Compliance,
+    Contact,
+    Geometry,
+    Power,
+    Provenance,
+    Robot,
+    Schedule,
+    Servo,
+    Solver,
+    all_keys,
+    as_dict,
+    fittable_keys,
+    parse_set_options,
+    real_keys,
+    value_type,
+)
+from .presets import AS_BUILT, PRESETS, SG90_SOURCE, preset
+
+__all__ = ["GRAVITY_M_PER_S2", "Geometry", "Compliance", "Servo", "Contact", "Power", "Schedule", "Solver",
+           "SECTIONS", "Provenance", "Robot", "UNBOUNDED_KEYS", "all_keys", "value_type", "real_keys",
+           "PHYSICAL_SECTIONS", "fittable_keys", "parse_set_options", "as_dict", "Limit", "LIMITS",
+           "MAX_SIM_STEPS", "outside_limits", "problems", "check_robot", "with_added_length", "LegSet",
+           "LEG_SETS", "leg_set", "SG90_SOURCE", "AS_BUILT", "PRESETS", "preset"]

@@ -1,0 +1,65 @@
+"""The filmed leg sets (Small, Medium, Large: notebook Part 3), the one table presets, reports
+and the hop fit build a leg set from.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import ParamsError
+from .model import Provenance, Robot
+
+# Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
+
+def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
+                      note: str | None = None) -> Robot:
+    """``base`` with the same length added to all four links (the seed's ``scale`` variable)."""
+    g = base.geometry
+    values = {
+        "geometry.ground_m": round(g.ground_m + added_m, 9),
+        "geometry.crank_m": round(g.crank_m + added_m, 9),
+        "geometry.coupler_m": round(g.coupler_m + added_m, 9),
+        "geometry.leg_m": round(g.leg_m + added_m, 9),
+    }
+    note = note or f"+{added_m * 100:g} cm on every link"
+    return base.with_values(values, Provenance(source=source, note=note))
+
+
+@dataclass(frozen=True)
+class LegSet:
+    """A physical leg set: what it adds to the seed design and the step its hop needs."""
+
+    added_m: float          # length added to every link (notebook Part 3)
+    timestep_s: float       # the step at which its hop has converged (rk4; docs/servo.md)
+    step_note: str          # why that step
+
+
+# The one table of leg sets: presets, reports and the hop fit all build a leg set from it
+LEG_SETS = {
+    # rk4 at 1 ms keeps every leg set within 0.1 mm per hop of dt/2, on the seed design and on the
+    # robot as built alike (docs/servo.md, "Time step"): seed design 0.066 / 0.056 / 0.070 mm,
+    # as built 0.006 / 0.006 / 0.027 mm (nose 0.14 mm of 13.6 cm) for Small / Medium / Large
+    "small": LegSet(0.0, 1e-3, "within 0.07 mm per hop of dt/2"),
+    "medium": LegSet(0.01, 1e-3, "within 0.06 mm per hop of dt/2"),
+    "large": LegSet(0.02, 1e-3, "within 0.07 mm per hop of dt/2"),
+}
+
+
+def leg_set(base: Robot, name: str, source: str | None = None) -> Robot:
+    """The physical leg set ``name`` (small/medium/large) built on ``base``'s parameters: its
+    links, and its converged time step where ``base``'s is coarser (a finer one is kept);
+    ``source``: the provenance of what it changes (``preset:<name>``)."""
+    try:
+        spec = LEG_SETS[name]
+    except KeyError:
+        raise ParamsError(f"unknown leg set {name!r}", f"choose one of {', '.join(LEG_SETS)}") from None
+    source = source or f"preset:{name}"
+    note = f"notebook Part 3 leg set: +{spec.added_m * 100:g} cm on every link"
+    robot = with_added_length(base, spec.added_m, source=source, note=note).renamed(name)
+    if spec.timestep_s < base.solver.timestep_s:
+        robot = robot.with_values({"solver.timestep_s": spec.timestep_s},
+                                  Provenance(source=source,
+                                             note=f"converged step of this leg set, {spec.step_note} (docs/servo.md)"))
+    return robot
+
+

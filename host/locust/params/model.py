@@ -1,0 +1,333 @@
+"""Robot parameters: one typed model, read from and written to ``robot.toml``.
+
+Every number the toolkit uses about the robot lives here, with its unit in its name and
+its provenance beside it: ``default`` (a reasonable value nobody measured), ``seed`` (the
+team's notebook, Part 2), ``photo:<file>``, ``cut_file:<file>``, ``datasheet:<part>``,
+``data:<recording>`` or ``estimate:<what>`` (the robot as built), ``preset:<name>``,
+``override`` (``--set`` on the command line) or ``fit:<recording>`` (identified by
+``locust calibrate``, with an uncertainty and a date).
+
+This module: the parameter types, their sections and the access by dotted name
+(``Robot.get``, ``with_values``, ``parse_set_options``). Limits: :mod:`.limits`; presets and
+the robot as built: :mod:`.presets`; leg sets: :mod:`.legsets`; the file: :mod:`locust.io.robot_toml`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field, fields, replace
+from typing import Any
+
+from ..errors import ParamsError
+
+# Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
+
+# Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
+GRAVITY_M_PER_S2 = 9.81
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Linkage and chassis geometry, each value a length, angle or mass a student can measure
+    with a ruler, a protractor and a scale (docs/hardware.md, "Measure your robot").
+
+    Chassis frame: x along the plate from its nose (-x) to its leg end (+x), z toward the side
+    the servos and legs hang from (down when the robot stands: the notebook's chassis is
+    turned over, euler 180/pitch/180).
+    """
+
+    ground_m: float = 0.04          # blue link: glued to the servo, servo axis to front pivot
+    crank_m: float = 0.04           # yellow link: on the servo horn
+    coupler_m: float = 0.02         # green link
+    leg_m: float = 0.06             # red link: the leg, foot at its far end
+    crank_start_deg: float = -90.0  # crank angle at the 0 deg command (0 = along the ground link)
+    body_length_m: float = 0.12
+    body_width_m: float = 0.12
+    body_thickness_m: float = 0.001
+    body_mass_kg: float = 0.05      # the plate (the notebook's 0.05: everything that hops)
+    servo_axis_x_m: float = 0.02    # servo shaft axis along the plate, from the plate's centre
+    leg_mount_y_m: float = 0.045    # lateral offset of each leg loop's middle (left +, right -)
+    servo_axis_below_plate_m: float = 0.0  # servo shaft axis under the plate's mid-plane
+    ground_angle_deg: float = 0.0   # ground link against the plate (+: its front pivot nearer the plate)
+    servo_mass_kg: float = 0.0      # each servo body (the notebook's model: none)
+    servo_length_m: float = 0.023   # servo body along the plate (x)
+    servo_width_m: float = 0.012    # servo body across the plate (z)
+    servo_height_m: float = 0.029   # servo body along its shaft (y)
+    servo_body_x_m: float = 0.0055  # servo body's centre from its shaft axis, along x
+    servo_body_y_m: float = 0.0145  # servo body's centre from the plate's centre line, along y
+    link_width_m: float = 0.03
+    link_thickness_m: float = 0.001
+    link_density_kg_per_m3: float = 1000.0
+    nose_x_m: float = -0.06         # nose marker in the chassis frame
+    body_pitch_deg: float = -30.0   # initial chassis attitude (notebook: euler 180 -30 180)
+    drop_height_m: float = 0.08     # initial chassis height
+
+
+@dataclass(frozen=True)
+class Compliance:
+    """The folded linkage's flexure hinges (four a leg, the one at the servo axis in parallel
+    with the servo). A film hinge's stiffness, not a cardstock beam's: the links between the
+    hinges carry their loads along their length and are rigid in the model (docs/servo.md,
+    "Hinges and links" has the beam test's numbers for bending and buckling)."""
+
+    hinge_stiffness_nm_per_rad: float = 0.056375
+    hinge_damping_nms_per_rad: float = 0.00056375
+
+
+@dataclass(frozen=True)
+class Servo:
+    """Hobby servo (docs/servo.md): torque = clip(kp*(cmd-q) - kv*qdot, +-stall) - (stall/noload)*qdot,
+    with the gearbox's reflected rotor inertia (armature) on the servo joint.
+
+    Defaults: an SG90 identified from two real recordings fitted together by ``locust
+    calibrate servo`` (the course's AA-battery swing and a gyro on an unloaded horn stepped
+    10-130 deg) with the datasheet's stall torque; see SG90_SOURCE.
+    """
+
+    kp_nm_per_rad: float = 0.377           # proportional gain inside the torque clamp
+    stall_torque_nm: float = 0.15          # datasheet: 1.5-1.8 kg*cm
+    noload_speed_rad_per_s: float = 10.31  # inf: no speed limit (the notebook's model)
+    armature_kgm2: float = 4.65e-4         # rotor inertia x gear ratio^2, at the output shaft
+    kv_nms_per_rad: float = 0.0            # velocity feedback inside the clamp (notebook: 0.0069)
+    travel_deg: float = 45.0         # mechanical travel either side of rest
+    pulse_min_us: float = 500.0      # pulse at -range_deg/2
+    pulse_max_us: float = 2500.0     # pulse at +range_deg/2
+    range_deg: float = 180.0         # angle swept by pulse_min..pulse_max
+    # the DC motor behind the figures above: they hold at reference_voltage_v at the servo's
+    # terminals; the winding resistance sets how far the supply's resistance sags them
+    reference_voltage_v: float = 5.0
+    winding_resistance_ohm: float = 10.0
+
+
+@dataclass(frozen=True)
+class Contact:
+    """The floor's contacts, one explicit pair per robot part: each friction acts exactly as
+    given (docs/servo.md, "Contact and loop")."""
+
+    foot_friction: float = 1.7       # the leg's links on the floor (ramp: mu = tan(theta))
+    nose_friction: float = 1.6       # the plate (its nose edge) on the floor
+    torsional_friction: float = 0.006
+    rolling_friction: float = 0.00005
+    # contact softness as a drop test sees it: the impact's time constant (MuJoCo's solref
+    # timeconst) and the coefficient of restitution (0: no bounce), on every floor pair
+    timeconst_s: float = 0.02
+    restitution: float = 0.0
+    self_collision: bool = False     # links collide with the chassis and each other (notebook: yes)
+    # a link's edge on the floor is a rounded line (a capsule of the laminate's thickness);
+    # False: sharp box corners, the notebook's model (docs/servo.md, "Contact and loop")
+    rounded_edges: bool = True
+
+
+@dataclass(frozen=True)
+class Power:
+    """The servos' supply: both servos draw through one source resistance (USB cable, board,
+    breadboard), so the voltage at the servos sags under their current (docs/servo.md,
+    "Power")."""
+
+    supply_voltage_v: float = 5.0
+    source_resistance_ohm: float = 0.0
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """Open-loop bang-bang hop schedule."""
+
+    push_deg: float = -30.0
+    push_s: float = 0.3
+    wait_s: float = 1.0
+    cycles: int = 6
+
+
+@dataclass(frozen=True)
+class Solver:
+    """How the simulation is run (not a property of the robot, but of the result)."""
+
+    # rk4 at 1 ms: the seed design within 0.1 mm per hop of dt/2 with the SG90 of both servo
+    # recordings (0.066 mm at 1 ms, 0.29 mm at 2 ms; docs/servo.md, "Time step")
+    timestep_s: float = 1e-3
+    integrator: str = "rk4"          # euler | implicitfast | implicit | rk4
+    iterations: int = 10
+    tolerance: float = 1e-6
+    control_hz: float = 50.0         # rate at which servo commands change (PWM period)
+    settle_s: float = 0.5            # time on the floor, servos at rest, before the schedule
+    # the loop-closing connect: impedance 1 = rigid. Near-rigid by default (the folded linkage
+    # does not stretch: anchors stay within about 10 um under load), so its time constant only
+    # sets how fast a drift is corrected and need not be near the step (docs/servo.md)
+    loop_timeconst_s: float = 0.01   # (notebook: 0.02)
+    loop_dmin: float = 0.9999        # impedance at zero violation (notebook: 0.9)
+    loop_dmax: float = 0.9999        # impedance at full violation (notebook: 0.95)
+
+
+SECTIONS: dict[str, type] = {
+    "geometry": Geometry,
+    "compliance": Compliance,
+    "servo": Servo,
+    "contact": Contact,
+    "power": Power,
+    "schedule": Schedule,
+    "solver": Solver,
+}
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """Where a value came from."""
+
+    source: str = "default"
+    uncertainty: float | None = None  # one standard deviation, in the value's own unit
+    date: str | None = None
+    note: str | None = None
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A complete, named parameter set."""
+
+    name: str = "seed"
+    geometry: Geometry = field(default_factory=Geometry)
+    compliance: Compliance = field(default_factory=Compliance)
+    servo: Servo = field(default_factory=Servo)
+    contact: Contact = field(default_factory=Contact)
+    power: Power = field(default_factory=Power)
+    schedule: Schedule = field(default_factory=Schedule)
+    solver: Solver = field(default_factory=Solver)
+    provenance: dict[str, Provenance] = field(default_factory=dict, compare=False)
+
+    # -- dotted access ---------------------------------------------------------------
+    def get(self, key: str) -> Any:
+        section, name = split_key(key)
+        return getattr(getattr(self, section), name)
+
+    def source_of(self, key: str) -> Provenance:
+        split_key(key)
+        return self.provenance.get(key, Provenance())
+
+    def with_values(self, values: dict[str, Any], source: str | Provenance = "override") -> Robot:
+        """A copy with ``values`` (dotted keys) replaced, each recorded with ``source``."""
+        prov = source if isinstance(source, Provenance) else Provenance(source=source)
+        sections = {name: getattr(self, name) for name in SECTIONS}
+        provenance = dict(self.provenance)
+        for key, raw in values.items():
+            section, name = split_key(key)
+            sections[section] = replace(sections[section], **{name: _coerce(key, raw)})
+            provenance[key] = prov
+        return replace(self, provenance=provenance, **sections)
+
+    def with_provenance(self, key: str, prov: Provenance) -> Robot:
+        split_key(key)
+        return replace(self, provenance={**self.provenance, key: prov})
+
+    def renamed(self, name: str) -> Robot:
+        return replace(self, name=name)
+
+    def link_lengths_m(self) -> tuple[float, float, float, float]:
+        g = self.geometry
+        return (g.ground_m, g.crank_m, g.coupler_m, g.leg_m)
+
+    def flat(self) -> dict[str, Any]:
+        """Every value by its dotted name."""
+        return {key: self.get(key) for key in all_keys()}
+
+
+# keys for which +inf is a meaningful value ("no limit")
+UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s"})
+
+
+def all_keys() -> list[str]:
+    return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls)]
+
+
+def split_key(key: str) -> tuple[str, str]:
+    section, _, name = key.partition(".")
+    cls = SECTIONS.get(section)
+    if cls is None or name not in {f.name for f in fields(cls)}:
+        close = [k for k in all_keys() if k.endswith("." + name) or k.startswith(section + ".")]
+        hint = f"did you mean {', '.join(close[:4])}?" if close else "run `locust params` to list every key"
+        raise ParamsError(f"unknown robot parameter {key!r}", hint)
+    return section, name
+
+
+def value_type(key: str) -> str:
+    """The type of a dotted key's value: ``"float"``, ``"int"``, ``"bool"`` or ``"str"``
+    (ParamsError for an unknown key)."""
+    section, name = split_key(key)
+    ftype = {f.name: f.type for f in fields(SECTIONS[section])}[name]
+    return ftype if isinstance(ftype, str) else ftype.__name__
+
+
+def real_keys() -> list[str]:
+    """Every real-valued key (the ones a fit or a draw can move), in file order."""
+    return [key for key in all_keys() if value_type(key) == "float"]
+
+
+# what the robot is (a fit may identify these), against what it is told to do (schedule) and
+# how it is simulated (solver)
+PHYSICAL_SECTIONS = ("geometry", "compliance", "servo", "contact", "power")
+
+
+def fittable_keys() -> list[str]:
+    """The real-valued physical keys: the only ones a fit may move."""
+    return [key for key in real_keys() if key.partition(".")[0] in PHYSICAL_SECTIONS]
+
+
+def _coerce(key: str, raw: Any) -> Any:
+    ftype = value_type(key)
+    try:
+        if ftype == "bool":
+            if isinstance(raw, bool):
+                return raw
+            text = str(raw).strip().lower()
+            if text in ("1", "true", "yes", "on"):
+                return True
+            if text in ("0", "false", "no", "off"):
+                return False
+            raise ValueError("not true/false")
+        if isinstance(raw, bool) and ftype in ("float", "int"):
+            raise ValueError("true/false is not a number")
+        if ftype == "float":
+            value = float(raw)
+            if key in UNBOUNDED_KEYS and value == math.inf:
+                return value
+            if not math.isfinite(value):
+                raise ValueError("not finite")
+            return value
+        if ftype == "int":
+            value = float(raw)
+            if not math.isfinite(value) or value != int(value):
+                raise ValueError("not a whole number")
+            return int(value)
+        return str(raw)
+    except OverflowError:
+        raise ParamsError(f"bad value {shown_value(raw)} for {key}: too large for a number", f"{key} takes a {ftype}") \
+            from None
+    except (TypeError, ValueError) as exc:
+        raise ParamsError(f"bad value {shown_value(raw)} for {key}: {exc}", f"{key} takes a {ftype}") from None
+
+
+def parse_set_options(items: tuple[str, ...] | list[str]) -> dict[str, str]:
+    """``["geometry.leg_m=0.07", ...]`` -> ``{"geometry.leg_m": "0.07"}``, keys checked."""
+    out: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip() or not value.strip():
+            raise ParamsError(f"--set {item!r} is not KEY=VALUE", "e.g. --set servo.kp_nm_per_rad=0.4")
+        split_key(key.strip())
+        out[key.strip()] = value.strip()
+    return out
+
+
+
+def shown_value(raw: Any) -> str:
+    """``raw`` as an error shows it: a table or a list by its kind, anything else by a short repr."""
+    if isinstance(raw, dict):
+        return "a table"
+    if isinstance(raw, list):
+        return "a list"
+    text = repr(raw)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def as_dict(robot: Robot) -> dict[str, Any]:
+    """Plain nested dict of values (for JSON and hashing)."""
+    return {"name": robot.name, **{s: dataclasses.asdict(getattr(robot, s)) for s in SECTIONS}}
