@@ -23,7 +23,7 @@ from pathlib import Path
 
 from locust.params import preset
 from locust.sim.live import LiveSim  # importing locust.sim picks the offscreen GL backend
-from locust.sim.rollout import simulate
+from locust.sim.rollout import roll_out
 
 
 def drive(robot, cycles: int, video: Path | None) -> float:
@@ -54,7 +54,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for r in range(args.repeats):
             t = time.perf_counter()
-            simulate(robot, cycles=args.cycles)
+            roll_out(robot, cycles=args.cycles)
             best["rollout"] = min(best["rollout"], time.perf_counter() - t)
             best["live"] = min(best["live"], drive(robot, args.cycles, None))
             best["live+video"] = min(best["live+video"], drive(robot, args.cycles, Path(tmp) / f"live-{r}.mp4"))

@@ -92,7 +92,7 @@ def test_repr_is_a_short_table_in_mm():
     assert "<table>" in r._repr_html_() and f"{r.hops[0].distance_m * 1000:.2f}" in r._repr_html_()
     # the CLI's JSON is the simulation's own figures and the standing load: nothing else of the facade
     facade = ("params", "spread", "sensitivity", "nose_load_kg", "total_mass_kg")
-    assert set(r.to_json()) == set(locust.sim.run.SimResult(**{k: v for k, v in vars(r).items()
+    assert set(r.to_json()) == set(locust.sim.result.SimResult(**{k: v for k, v in vars(r).items()
                                                                if k not in facade}).to_json()) | set(facade[3:])
     assert f"nose load        {r.nose_load_kg * 1000:.1f} g" in text
 
@@ -307,4 +307,4 @@ def test_fab_is_the_commands_summary(tmp_path):
     written = locust.make_cut_files(locust.robot("seed"), out=tmp_path / "cut", previews=False)
     assert sorted(p.name for p in (tmp_path / "cut").iterdir()) == sorted(written["files"])
     assert "rigid_top.dxf" in written["files"] and "flat_pattern.dxf" in written["files"]
-    assert locust.fab.laminate.SEED_STACK and "Parameters" in locust.fab.__doc__
+    assert locust.fab.laminate.SEED_STACK and "Parameters" in locust.make_cut_files.__doc__

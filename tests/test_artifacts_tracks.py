@@ -29,7 +29,7 @@ from locust.io import trk as trk_io
 from locust.track import camera as track_camera
 from locust.track import trk
 from locust.track.export import tracks_of
-from locust.track.runner import MarkerTrack, TrackResult
+from locust.track.runner import TrackedMarker, TrackResult
 from locust.track.video import Clip, VideoInfo
 
 NAN = math.nan
@@ -206,7 +206,7 @@ def test_tracker_project_round_trip(tmp_path):
     ok = np.array([True, True, False, True, True, True])
     px = np.where(ok, 100.0 + 4.25 * (frames - 2), NAN)
     py = np.where(ok, 300.0 - 2.5 * (frames - 2), NAN)
-    nose = MarkerTrack("nose", "colour:pink", px, py, np.where(ok, 1.0, NAN), ok)
+    nose = TrackedMarker("nose", "colour:pink", px, py, np.where(ok, 1.0, NAN), ok)
     cal = trk_io.Calibration(m_per_px=1 / 2048, origin_x_px=12.5, origin_y_px=350.25, angle_deg=2.5, source="stick")
     clip = Clip(2, 7, 1, 30.0)
     video = VideoInfo(tmp_path / "hop.mp4", 640, 360, 12, 30.0)

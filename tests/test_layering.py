@@ -113,3 +113,20 @@ def test_the_rule_catches_an_upward_import(tmp_path, monkeypatch):
     assert offending("sim", ("api", "commands"), root=True) == {
         "sim/bad.py": ["locust", "locust.__version__", "locust.api", "locust.api.simulate", "locust.commands",
                        "locust.commands.main"]}
+
+
+def test_one_name_per_public_class_and_one_simulate():
+    """No two public classes of the toolkit share a name, and only the API defines ``simulate``
+    (module-level helpers such as ``build`` may repeat across modules)."""
+    classes, simulates = {}, []
+    for path in sorted(ROOT.rglob("*.py")):
+        if "firmware" in path.relative_to(ROOT).parts:   # MicroPython, on the board
+            continue
+        for node in ast.parse(path.read_text(), str(path)).body:
+            where = str(path.relative_to(ROOT))
+            if isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+                classes.setdefault(node.name, []).append(where)
+            elif isinstance(node, ast.FunctionDef) and node.name == "simulate":
+                simulates.append(where)
+    assert {name: at for name, at in classes.items() if len(at) > 1} == {}
+    assert simulates == ["api/simulation.py"]

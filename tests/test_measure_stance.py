@@ -248,9 +248,9 @@ def regime(robot) -> str:
     """goes_over / rears_and_returns / stays_low, from one audited run of the hop schedule."""
     from locust.sim.audit import audit
     from locust.sim.hops import summarise
-    from locust.sim.rollout import simulate
+    from locust.sim.rollout import roll_out
 
-    traj = simulate(robot)
+    traj = roll_out(robot)
     assert audit(traj).valid
     summary = summarise(traj)
     apex = [h.nose_apex_m for h in summary.hops]

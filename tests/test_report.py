@@ -99,9 +99,9 @@ def marker_apexes(robot, cycles, marker="nose"):
     import mujoco
     import numpy as np
 
-    from locust.sim.rollout import simulate
+    from locust.sim.rollout import roll_out
 
-    traj = simulate(robot, cycles=cycles, keep_states=True)
+    traj = roll_out(robot, cycles=cycles, keep_states=True)
     model, data = traj.built.model, mujoco.MjData(traj.built.model)
     gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"marker_{marker}")
     z = np.empty(len(traj.states))

@@ -73,9 +73,9 @@ def test_floor_pairs_carry_each_friction_exactly(monkeypatch):
     import mujoco
 
     from locust.sim import model as sim_model
-    from locust.sim.rollout import simulate
+    from locust.sim.rollout import roll_out
 
-    low = simulate(preset("seed").with_values({"contact.foot_friction": 0.7, "contact.nose_friction": 0.3}),
+    low = roll_out(preset("seed").with_values({"contact.foot_friction": 0.7, "contact.nose_friction": 0.3}),
                    cycles=1).built.model
     assert low.npair == 7                                   # the plate and three links a side
     mu = {mujoco.mj_id2name(low, mujoco.mjtObj.mjOBJ_PAIR, i): low.pair_friction[i, 0] for i in range(low.npair)}
@@ -83,9 +83,9 @@ def test_floor_pairs_carry_each_friction_exactly(monkeypatch):
     assert list(mu.values()) == pytest.approx([0.7] * 6, abs=1e-12)
 
     seed = preset("seed")
-    paired = simulate(seed, cycles=1)
+    paired = roll_out(seed, cycles=1)
     monkeypatch.setattr(sim_model, "_floor_pairs", lambda spec, contact: None)
-    automatic = simulate(seed, cycles=1)
+    automatic = roll_out(seed, cycles=1)
     assert automatic.built.model.npair == 0
     assert abs(paired.sensordata - automatic.sensordata).max() < 1e-12
 

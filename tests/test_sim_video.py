@@ -19,7 +19,7 @@ from locust.errors import SimError
 from locust.markers import MARKER_COLOURS
 from locust.params import preset
 from locust.sim.clip import VISIBLE_FRAC, render_video
-from locust.sim.rollout import simulate
+from locust.sim.rollout import roll_out
 from locust.sim.run import run
 
 W, H, FPS = 320, 240, 30
@@ -120,10 +120,10 @@ def test_truth_world_positions_are_the_audited_run(clips):
     """Frame k shows the rollout's state at t = k / fps: each marker is rigidly fixed to the
     nose / foot point the hop analytics use, at the offset the model puts it."""
     from locust.sim.model import MARKER_FOOT_UP, MARKER_NOSE_BACK, MARKER_NOSE_UP, MARKER_RADIUS_M
-    from locust.sim.rollout import simulate
+    from locust.sim.rollout import roll_out
 
     robot, infos = clips
-    traj = simulate(robot, cycles=1)
+    traj = roll_out(robot, cycles=1)
     s = traj.built.sensors
     truth = pd.read_csv(infos["fixed"].truth_path, comment="#")
     # mj_step evaluates sensors before it integrates: sensor row k is the pose at t = k dt
@@ -214,7 +214,7 @@ def test_renders_an_audited_run_without_simulating_again(clips, tmp_path):
     assert info.truth_path.read_text() == infos["fixed"].truth_path.read_text()
     assert info.camera_path.read_text() == infos["fixed"].camera_path.read_text()
     with pytest.raises(SimError, match="kept no states"):
-        render_video(robot, tmp_path / "stateless.mp4", trajectory=simulate(robot, cycles=1))
+        render_video(robot, tmp_path / "stateless.mp4", trajectory=roll_out(robot, cycles=1))
 
 
 def test_refuses_to_overwrite_and_bad_names(tmp_path):

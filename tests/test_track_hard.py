@@ -15,7 +15,7 @@ from locust.errors import TrackError
 from locust.track.board import BoardSpec, board_points, parse_board, parse_plane_points
 from locust.track.export import track_events
 from locust.track.hardclip import STICKER_HEX, make_hard_video, read_truth_csv
-from locust.track.predict import Trajectory
+from locust.track.predict import MarkerPath
 from locust.track.spec import ModelOptions, parse_marker
 
 W, H, N = 960, 540, 100
@@ -135,7 +135,7 @@ def test_board_and_marker_spec_errors():
 
 
 def test_trajectory_extrapolates_a_parabola():
-    tr = Trajectory()
+    tr = MarkerPath()
     f = np.arange(10, 15)
     for k in f:
         tr.add(int(k), (3.0 * k, 0.5 * k ** 2 - 4 * k))

@@ -34,7 +34,7 @@ def outcome_words(outcome: str) -> str:
 
 
 def sim_lines(r, verbose: bool = False) -> list[str]:
-    """``locust sim``: a :class:`locust.sim.run.SimResult` as the verdict, one row per hop,
+    """``locust sim``: a :class:`locust.sim.result.SimResult` as the verdict, one row per hop,
     the totals, the convergence check and the notes; ``verbose``: the linkage's kinematics too
     (Grashof class and transmission angle: words for the expert, kept out of the first look)."""
     said = f"{verdict(r.valid)}, {outcome_words(r.outcome)}" if r.outcome else verdict(r.valid)

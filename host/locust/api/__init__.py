@@ -4,7 +4,7 @@
 function              module                    returns
 ====================  ========================  =====================================================
 ``robot``             :mod:`.robots`            :class:`locust.params.Robot`
-``simulate``          :mod:`.simulation`        :class:`locust.sim.run.SimResult` (trace, video, plot)
+``simulate``          :mod:`.simulation`        :class:`locust.sim.result.SimResult` (trace, video, plot)
 ``sweep_designs``     :mod:`.sweeps`            :class:`.sweeps.SweepResults` (to_dataframe, best)
 ``track_markers``     :mod:`.tracking`          :class:`.tracking.Tracks` (to_dataframe)
 ``read_tracks``       :mod:`.tracking`          :class:`.tracking.Tracks`

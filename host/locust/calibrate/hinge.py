@@ -129,7 +129,8 @@ def swing_angle(x_m: np.ndarray, y_m: np.ndarray, pivot: tuple[float, float]) ->
 
 
 # -- the model ----------------------------------------------------------------------
-def simulate(t_s: np.ndarray, params: np.ndarray, rig: HingeRig, coulomb_width_rad_per_s: float = 0.0) -> np.ndarray:
+def simulate_hinge(t_s: np.ndarray, params: np.ndarray, rig: HingeRig,
+                   coulomb_width_rad_per_s: float = 0.0) -> np.ndarray:
     """theta(t) [rad] from ``params`` = (k, b, theta0, theta_start, rate_start[, tau_c]), t from t_s[0]."""
     k, b, th0, th_start, w_start = (float(v) for v in params[:5])
     tau_c = float(params[5]) if len(params) > 5 else 0.0
@@ -304,7 +305,7 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
             coulomb_note = f"not significant (score test p = {p_value:.2g}): left out"
     est = problem.estimates(chosen)
     p, radius, (px, py) = problem.split(chosen.x)
-    model = simulate(t, p, rig, problem.width)
+    model = simulate_hinge(t, p, rig, problem.width)
     k, b = float(p[0]), float(p[1])
     rest = _rest_angle(p, rig)
     stiff_total = k - rig.gravity_moment_nm * math.sin(rest)
@@ -315,7 +316,7 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
     fine_t = np.linspace(t[0], t[-1], max(10 * len(t), 2000))
     curves = Curves(x=t, data=np.degrees(measured), model=np.degrees(model), x_label="t [s]",
                     y_label="link angle about the hinge [deg]", title=f"hinge: {Path(source).name}",
-                    model_x=fine_t, model_fine=np.degrees(simulate(fine_t, p, rig, problem.width)))
+                    model_x=fine_t, model_fine=np.degrees(simulate_hinge(fine_t, p, rig, problem.width)))
     rx, ry = np.split(chosen.fun, 2)
     return HingeFit(
         source=source, rig=rig, hinge_stiffness_nm_per_rad=est["hinge_stiffness_nm_per_rad"],
@@ -355,7 +356,7 @@ class _Swing:
         return np.concatenate([self.p0 / self.dyn_scale, [1.0], np.zeros(self.n_geo - 1)])
 
     def split(self, q: np.ndarray):
-        """(simulate's params, radius [m], pivot [m]) of the scaled values ``q``."""
+        """(simulate_hinge's params, radius [m], pivot [m]) of the scaled values ``q``."""
         n = self.DYNAMIC + self.n_geo
         p = q[:self.DYNAMIC] * self.dyn_scale
         if len(q) > n:
@@ -365,7 +366,7 @@ class _Swing:
         return p, float(radius), (self.centre[0] + float(off[0]), self.centre[1] + float(off[1]))
 
     def angle(self, q: np.ndarray) -> np.ndarray:
-        return simulate(self.t, self.split(q)[0], self.rig, self.width)
+        return simulate_hinge(self.t, self.split(q)[0], self.rig, self.width)
 
     def residual(self, q: np.ndarray, theta: np.ndarray | None = None) -> np.ndarray:
         _, radius, (px, py) = self.split(q)

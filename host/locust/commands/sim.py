@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from contextlib import nullcontext
 from pathlib import Path
@@ -64,7 +65,7 @@ def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push,
       locust sim --preset medium --samples 32 --json     # outcome shares
       locust sim --preset small --still rest.png --still-push push.png   # for locust measure stance
     """
-    from ..api.simulation import SimResult, simulate
+    from ..api.simulation import simulate
     from ..sim.run import check_convergence as converge
     from ..sim.run import invalid_result
 
@@ -91,7 +92,7 @@ def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push,
         if not as_json:
             raise
         bad = invalid_result(robot, exc.message + (f" ({exc.hint})" if exc.hint else ""), cycles)
-        result = SimResult(**vars(bad), params=robot)
+        result = dataclasses.replace(bad, params=robot)
     if check_convergence and result.valid:
         result.convergence = converge(robot, result, cycles=cycles)
     if video is not None:

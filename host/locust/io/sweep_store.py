@@ -92,7 +92,7 @@ def read_rows(path: Path, axis_names: list[str]) -> list[dict[str, Any]]:
 
 
 @dataclass(frozen=True)
-class SweepResults:
+class StoredSweep:
     """A sweep folder read back: what was asked and every finished row."""
 
     folder: Path
@@ -106,7 +106,7 @@ class SweepResults:
         return [row[name] for row in self.rows]
 
 
-def read_results(folder: Path) -> SweepResults:
+def read_results(folder: Path) -> StoredSweep:
     """Read a ``locust sweep --out`` folder (``sweep.json`` and ``results.csv``)."""
     folder = Path(folder)
     meta_path, csv_path = folder / META, folder / RESULTS
@@ -123,7 +123,7 @@ def read_results(folder: Path) -> SweepResults:
         raise SweepError(f"{meta_path}: not a sweep description ({exc})", hint) from None
     if not names or cycles < 1:
         raise SweepError(f"{meta_path}: no varied parameter or no cycles", hint)
-    return SweepResults(folder=folder, base=str(req.get("base", "?")), axis_names=names, cycles=cycles,
+    return StoredSweep(folder=folder, base=str(req.get("base", "?")), axis_names=names, cycles=cycles,
                         rows=read_rows(csv_path, names), finished=bool(meta.get("finished", True)))
 
 

@@ -44,7 +44,7 @@ SLOPE_STEP_M = 0.001     # the slope of the load against the axis, by central di
 
 
 @dataclass(frozen=True)
-class Estimate:
+class GaussianValue:
     value: float
     sd: float                   # one standard deviation
 
@@ -60,10 +60,10 @@ class NoseLoadResult:
     nose_load_kg: float                  # the scale's reading under the nose
     resolution_kg: float
     total_mass_kg: float | None          # the whole robot's reading, when weighed
-    axis_from_scale: Estimate            # geometry.servo_axis_x_m from the nose load alone
-    axis_before: Estimate | None         # the robot file's own (sd None: no prior)
-    axis: Estimate                       # the two combined: what is written
-    plate_mass: Estimate | None          # geometry.body_mass_kg, when the whole robot is weighed
+    axis_from_scale: GaussianValue            # geometry.servo_axis_x_m from the nose load alone
+    axis_before: GaussianValue | None         # the robot file's own (sd None: no prior)
+    axis: GaussianValue                       # the two combined: what is written
+    plate_mass: GaussianValue | None          # geometry.body_mass_kg, when the whole robot is weighed
     slope_kg_per_m: float                # d(nose load)/d(axis) at the estimate
     axis_sd_terms_m: dict[str, float]    # the axis's sd from the scale alone, term by term
     predicted_nose_load_kg: float        # the model at the written values
@@ -71,7 +71,7 @@ class NoseLoadResult:
     robot: Robot = field(repr=False, compare=False)
 
     def to_json(self) -> dict:
-        def est(e: Estimate | None) -> dict | None:
+        def est(e: GaussianValue | None) -> dict | None:
             return None if e is None else {"value": e.value, "sd": e.sd, "ci95": list(e.ci95)}
 
         return {"nose_load_kg": self.nose_load_kg, "resolution_kg": self.resolution_kg,
@@ -86,7 +86,7 @@ def _nose(robot: Robot, axis_m: float) -> float:
     return standing_load(robot.with_values({AXIS_KEY: axis_m})).nose_load_kg
 
 
-def _plate_from_weight(robot: Robot, total_kg: float, resolution_kg: float) -> Estimate:
+def _plate_from_weight(robot: Robot, total_kg: float, resolution_kg: float) -> GaussianValue:
     """The plate's mass that makes the model weigh ``total_kg``: the reading less every other
     part; its sd from the resolution and the other parts' own uncertainties."""
     from ..sim.model import build
@@ -114,21 +114,22 @@ def _plate_from_weight(robot: Robot, total_kg: float, resolution_kg: float) -> E
             var += (mass(moved) - plate0 - others) ** 2
         except LocustError:   # a value that cannot be built at +1 sd adds nothing to the mass
             continue
-    return combine(Estimate(value, math.sqrt(var)), prior_of(robot, PLATE_KEY))
+    return combine(GaussianValue(value, math.sqrt(var)), prior_of(robot, PLATE_KEY))
 
 
-def prior_of(robot: Robot, key: str) -> Estimate | None:
+def prior_of(robot: Robot, key: str) -> GaussianValue | None:
     """The robot file's own value and sd for ``key`` (None when it carries no sd)."""
     sd = robot.source_of(key).uncertainty
-    return Estimate(robot.get(key), sd) if sd and math.isfinite(sd) and sd > 0 else None
+    return GaussianValue(robot.get(key), sd) if sd and math.isfinite(sd) and sd > 0 else None
 
 
-def combine(new: Estimate, prior: Estimate | None) -> Estimate:
+def combine(new: GaussianValue, prior: GaussianValue | None) -> GaussianValue:
     """Two independent estimates of one value, weighted by their variances."""
     if prior is None:
         return new
     w_new, w_prior = 1 / new.sd ** 2, 1 / prior.sd ** 2
-    return Estimate((new.value * w_new + prior.value * w_prior) / (w_new + w_prior), math.sqrt(1 / (w_new + w_prior)))
+    return GaussianValue((new.value * w_new + prior.value * w_prior) / (w_new + w_prior),
+                         math.sqrt(1 / (w_new + w_prior)))
 
 
 def measure_nose_load(robot: Robot, nose_load_kg: float, resolution_kg: float = 0.001,
@@ -199,7 +200,7 @@ def measure_nose_load(robot: Robot, nose_load_kg: float, resolution_kg: float = 
                 continue
         if changes and max(changes) > 0:
             terms[key] = max(changes) / abs(slope)
-    alone = Estimate(value, math.sqrt(sum(t * t for t in terms.values())))
+    alone = GaussianValue(value, math.sqrt(sum(t * t for t in terms.values())))
     before = prior_of(robot, AXIS_KEY)
     combined = combine(alone, before)
     said = (f"nose {nose_load_kg * 1000:g} g on a scale of {resolution_kg * 1000:g} g: "
@@ -215,4 +216,4 @@ def measure_nose_load(robot: Robot, nose_load_kg: float, resolution_kg: float = 
                           com_from_nose_m=final.com_from_nose_m, robot=out)
 
 
-__all__ = ["AXIS_KEY", "PLATE_KEY", "Estimate", "NoseLoadResult", "measure_nose_load"]
+__all__ = ["AXIS_KEY", "PLATE_KEY", "GaussianValue", "NoseLoadResult", "measure_nose_load"]

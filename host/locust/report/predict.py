@@ -25,7 +25,7 @@ from ..trials.measure import Aligned, MeasuredHop, measure_hops, onset_time
 class Prediction:
     config: str
     robot: Robot
-    result: object                 # locust.sim.run.SimResult
+    result: object                 # locust.sim.result.SimResult
     trace: Aligned | None          # the marker on the schedule's clock; None when invalid
     hops: list[MeasuredHop]        # the marker's hops, measured like a track's (empty when invalid)
     onset_latency_s: float         # first marker motion after the first push (nan when invalid)

@@ -45,7 +45,7 @@ from .camera import (
     pinhole_from_scene,
     set_scene_pinhole,
 )
-from .rollout import Trajectory, simulate
+from .rollout import Trajectory, roll_out
 
 MARKERS = tuple(MARKER_COLOURS)           # ("nose", "foot"): geoms "marker_<name>"
 VISIBLE_FRAC = 0.5                         # truth says a marker is visible when this much of it is seen
@@ -144,7 +144,7 @@ def seen_fraction(model: mujoco.MjModel, data: mujoco.MjData, cam: PinholeCamera
 
 # -- one clip: frames, truth rows, sidecars ------------------------------------------
 @dataclass
-class VideoInfo:
+class RenderedClip:
     video_path: Path
     truth_path: Path
     frames: int
@@ -281,7 +281,7 @@ class ClipRecorder:
             out[n] = {"plane_y_m": float(np.mean(y)), "max_off_plane_m": float(np.max(np.abs(y - np.mean(y))))}
         return out
 
-    def finish(self) -> VideoInfo:
+    def finish(self) -> RenderedClip:
         try:
             self.writer.release()
             self.poser.close()
@@ -295,7 +295,7 @@ class ClipRecorder:
         except BaseException:
             self.abort()
             raise
-        return VideoInfo(video_path=self.path, truth_path=truth_path, frames=self.frames, fps=self.fps,
+        return RenderedClip(video_path=self.path, truth_path=truth_path, frames=self.frames, fps=self.fps,
                          width=self.width, height=self.height, camera_path=camera_path, camera=self.camera)
 
     def abort(self) -> None:
@@ -326,7 +326,7 @@ def validate_size(fps: int, width: int, height: int) -> None:
 
 def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = None, camera: str = "track",
                  fps: int = 30, width: int = 1280, height: int = 720,
-                 trajectory: Trajectory | None = None) -> VideoInfo:
+                 trajectory: Trajectory | None = None) -> RenderedClip:
     """Simulate settle + ``cycles`` hops and render them to ``path`` (MP4), with truth sidecars.
 
     Frames sample the same rollout ``locust sim`` audits, at t = k / fps from the start of
@@ -341,7 +341,7 @@ def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = Non
     validate_size(fps, width, height)
     path = check_video_path(path)
     if trajectory is None:
-        trajectory = simulate(robot, cycles=cycles, keep_states=True)
+        trajectory = roll_out(robot, cycles=cycles, keep_states=True)
     elif trajectory.states is None:
         raise SimError("the trajectory to render kept no states",
                        "simulate it with keep_states=True, or let render_video simulate")
@@ -374,5 +374,6 @@ def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = Non
     return rec.finish()
 
 
-__all__ = ["MARKERS", "VISIBLE_FRAC", "ClipRecorder", "PoseRenderer", "VideoInfo", "check_video_path", "face_centre_m",
+__all__ = ["MARKERS", "VISIBLE_FRAC", "ClipRecorder", "PoseRenderer", "RenderedClip", "check_video_path",
+           "face_centre_m",
            "frame_times_s", "render_video", "seen_fraction", "sidecar_paths", "validate_size"]

@@ -35,7 +35,7 @@ from .clip import ClipRecorder, check_video_path, validate_size
 from .hops import summarise
 from .model import build
 from .outcome import classify
-from .rollout import Trajectory, simulate
+from .rollout import Trajectory, roll_out
 from .schedule import ControlPlan
 
 SIDES = ("left", "right")
@@ -194,7 +194,7 @@ class LiveSim:
         ms on the virtual robot). Rows past a blow-up are left out.
         """
         s, g = self.built.sensors, self.robot.geometry
-        traj = simulate(self.robot, cycles=cycles, built=self.built)
+        traj = roll_out(self.robot, cycles=cycles, built=self.built)
         sd = traj.sensordata[np.isfinite(traj.sensordata).all(axis=1)]
         sd = np.vstack([self._initial_sensordata[None, :], sd])
         points = np.vstack([sd[:, s.nose_pos], sd[:, s.foot_pos], sd[:, s.chassis_pos], sd[:, s.com_pos]])

@@ -1,6 +1,6 @@
 """Run the hop schedule on the model with ``mujoco.rollout`` (no Python per step).
 
-``simulate`` returns the raw per-step sensor record; :mod:`.audit` judges it and
+``roll_out`` returns the raw per-step sensor record; :mod:`.audit` judges it and
 :mod:`.hops` turns it into per-hop figures. :func:`run` does all three.
 """
 
@@ -76,7 +76,7 @@ def initial_state(built: BuiltModel) -> tuple[np.ndarray, np.ndarray]:
     return state, data.sensordata.copy()
 
 
-def simulate(robot: Robot, cycles: int | None = None, timestep_s: float | None = None,
+def roll_out(robot: Robot, cycles: int | None = None, timestep_s: float | None = None,
              built: BuiltModel | None = None, keep_states: bool = False) -> Trajectory:
     """Simulate settle + ``cycles`` hop cycles; the model is built unless given."""
     if timestep_s is not None:

@@ -1,4 +1,4 @@
-"""One audited simulation: build, roll out, audit, summarise -> :class:`SimResult`.
+"""One audited simulation: build, roll out, audit, summarise -> :class:`~.result.SimResult`.
 
 ``run(robot, keep_states=True)`` also keeps the rollout the result was computed from
 (``SimResult.trajectory``, with every step's state), so a video or a marker's trace can be
@@ -7,64 +7,17 @@ taken from the same simulation instead of a second one.
 
 from __future__ import annotations
 
-import dataclasses
-from dataclasses import dataclass, field
-from typing import Any
-
 import numpy as np
 
 from ..errors import GeometryError
 from ..params import Robot, check_robot
 from .audit import audit
 from .fourbar import GOOD_TRANSMISSION_DEG
-from .hops import Hop, summarise
+from .hops import summarise
 from .model import build
 from .outcome import classify
-from .rollout import Trajectory, simulate
-
-
-@dataclass
-class SimResult:
-    robot: str
-    valid: bool
-    reasons: list[str]
-    distance_m: float
-    max_nose_height_m: float
-    hops: list[Hop]
-    cycles: int
-    timestep_s: float
-    duration_s: float
-    wall_s: float
-    loop_residual_max_m: float
-    energy_surplus_max_j: float
-    servo_work_j: float
-    servo_peak_speed_rad_per_s: float = float("nan")     # fastest crank speed during the schedule
-    servo_noload_speed_rad_per_s: float = float("nan")   # the servo's top speed (inf: none)
-    grashof: str = ""
-    transmission_deg: float = float("nan")
-    notes: list[str] = field(default_factory=list)
-    convergence: dict[str, float] | None = None
-    # goes_over / rears_and_returns / stays_low (locust.sim.outcome); None when invalid
-    outcome: str | None = None
-    # the rollout behind the figures, states included: only with run(..., keep_states=True);
-    # never part of the JSON
-    trajectory: Trajectory | None = field(default=None, repr=False, compare=False)
-
-    def to_json(self) -> dict[str, Any]:
-        """Every field but the trajectory; NaN and inf become null where it is written
-        (:func:`locust.fileio.json_text`)."""
-        out = dataclasses.asdict(dataclasses.replace(self, trajectory=None))
-        del out["trajectory"]
-        return out
-
-
-def invalid_result(robot: Robot, reason: str, cycles: int | None = None) -> SimResult:
-    nan = float("nan")
-    return SimResult(robot=robot.name, valid=False, reasons=[reason], distance_m=nan, max_nose_height_m=nan,
-                     hops=[], cycles=cycles or robot.schedule.cycles, timestep_s=robot.solver.timestep_s,
-                     duration_s=0.0, wall_s=0.0, loop_residual_max_m=nan, energy_surplus_max_j=nan,
-                     servo_work_j=nan)
-
+from .result import SimResult, invalid_result
+from .rollout import roll_out
 
 # a robot whose nose ends the run this far above its standing height did not come back down
 # from a push (a robot that hops and lands again stands within a few millimetres of its start)
@@ -83,7 +36,7 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
         robot = robot.with_values({"solver.timestep_s": timestep_s})
     check_robot(robot, cycles)  # nothing unsimulatable reaches MuJoCo
     built = build(robot)
-    traj = simulate(robot, cycles=cycles, built=built, keep_states=keep_states)
+    traj = roll_out(robot, cycles=cycles, built=built, keep_states=keep_states)
     verdict = audit(traj)
     summary = summarise(traj) if verdict.valid else None
     nan = float("nan")

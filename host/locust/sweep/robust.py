@@ -65,11 +65,11 @@ class DesignJudge:
 
     def _figures(self, robot: Robot) -> list[DrawFigures | None]:
         from ..sim.model import build
-        from ..sim.rollout import simulate
+        from ..sim.rollout import roll_out
         from ..sim.samples import simulate_draws
 
         if self.draws == 0:
-            return [draw_figures(simulate(robot, cycles=self.cycles, built=build(robot)), self.cycles)]
+            return [draw_figures(roll_out(robot, cycles=self.cycles, built=build(robot)), self.cycles)]
         trajs = simulate_draws(robot, self.draws, cycles=self.cycles, seed=self.seed)
         # simulate_draws has audited each draw (None: outside the limits, or failed)
         return [draw_figures(t, self.cycles, audited=True) for t in trajs]

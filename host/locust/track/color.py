@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import TrackError
 from .detection import Detection, window
-from .predict import Trajectory
+from .predict import MarkerPath
 
 
 def parse_hex(colour: str) -> tuple[int, int, int]:
@@ -72,7 +72,7 @@ class ColorMarker:
     partial_fraction: float = 0.6  # below this share of the usual area: partly hidden
     start_px: tuple[float, float] | None = None
     hue_tol_deg: float = 16.0
-    track: Trajectory = field(default_factory=Trajectory)
+    track: MarkerPath = field(default_factory=MarkerPath)
     _areas: deque = field(default_factory=lambda: deque(maxlen=15))
     _widths: deque = field(default_factory=lambda: deque(maxlen=15))
     _usual_area: float = 0.0       # median of _areas (round, whole blobs), kept up to date

@@ -10,13 +10,13 @@ import numpy as np
 
 from ..errors import TrackError
 from ..fileio import atomic_write_bytes
-from .runner import MarkerTrack, TrackResult
+from .runner import TrackedMarker, TrackResult
 from .video import encode_video, read_frame, read_frames
 
 PALETTE_BGR = [(255, 0, 255), (255, 255, 0), (0, 255, 255), (0, 128, 255), (255, 128, 0), (128, 255, 0)]
 
 
-def _colour(track: MarkerTrack, k: int) -> tuple[int, int, int]:
+def _colour(track: TrackedMarker, k: int) -> tuple[int, int, int]:
     if track.spec.lower().startswith(("color:#", "colour:#")):
         h = track.spec.split("#", 1)[1]
         return int(h[4:6], 16), int(h[2:4], 16), int(h[0:2], 16)

@@ -86,7 +86,7 @@ def _fit_matrix(offsets: tuple[int, ...]) -> list[list[float]]:
 _NO_GAP = {n: tuple(range(1 - n, 1)) for n in range(1, 9)}
 
 
-class Trajectory:
+class MarkerPath:
     """Where a marker should be on a given frame, also across frames it was not seen.
 
     A least-squares constant-acceleration fit (per axis, over the frame number) to the last

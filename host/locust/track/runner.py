@@ -15,7 +15,7 @@ from .video import Clip, VideoInfo, read_frames
 
 
 @dataclass
-class MarkerTrack:
+class TrackedMarker:
     name: str
     spec: str
     px: np.ndarray
@@ -35,11 +35,11 @@ class TrackResult:
     clip: Clip
     frames: np.ndarray
     t_s: np.ndarray
-    markers: list[MarkerTrack]
+    markers: list[TrackedMarker]
     calibration: Calibration | PlaneCalibration
     source: str = "locust track"
 
-    def world(self, track: MarkerTrack) -> tuple[np.ndarray, np.ndarray]:
+    def world(self, track: TrackedMarker) -> tuple[np.ndarray, np.ndarray]:
         return self.calibration.to_world(track.px, track.py, track.name, self.frames)
 
 
@@ -70,7 +70,7 @@ def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibrat
             px[i], py[i], score[i], ok[i] = det.px, det.py, det.score, det.ok
         if progress:
             progress(1)
-    tracks = [MarkerTrack(m.name, m.spec, *cols[m.name]) for m in models]
+    tracks = [TrackedMarker(m.name, m.spec, *cols[m.name]) for m in models]
     if require_found:
         lost = [t for t in tracks if t.found() == 0]
         if lost:

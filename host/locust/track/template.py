@@ -6,7 +6,7 @@ The same steps as Tracker's ``TemplateMatcher`` / ``AutoTracker`` (Open Source P
    default mask is 16 px across) around (X, Y).
 2. On each later frame, the search window (+-``search_half_px``, Tracker's 40) is
    centred on where the track's motion puts the marker: a constant-acceleration fit to
-   its last positions (:class:`.predict.Trajectory`), extrapolated across frames where it
+   its last positions (:class:`.predict.MarkerPath`), extrapolated across frames where it
    was lost. Until two positions give a velocity the window is twice as large: Tracker's
    own BallToss ball moves 70 px between its first two steps.
 3. The match is the position of least RGB square difference (masked) in the window.
@@ -57,7 +57,7 @@ import numpy as np
 
 from ..errors import TrackError
 from .detection import Detection, window
-from .predict import Trajectory
+from .predict import MarkerPath
 
 AMBIGUITY = 1.5            # matches within this factor of the best square difference are look-alikes
 AMBIGUITY_IN_GATE = 3.0    # ... and within this factor, inside the motion gate
@@ -101,7 +101,7 @@ class TemplateMarker:
     accept: float = 0.5
     evolve: float = 0.2
     min_likeness: float = 0.5
-    trajectory: Trajectory = field(default_factory=Trajectory)
+    trajectory: MarkerPath = field(default_factory=MarkerPath)
     _template: np.ndarray | None = None
     _mask: np.ndarray | None = None
     _offset: tuple[float, float] = (0.0, 0.0)  # key point minus template centre pixel

@@ -20,14 +20,14 @@ from ..io import trk as trk_io
 from ..io.tracker_text import TrackerExport, TrackerTrack, tracker_export_text, write_tracker_export
 from ..io.trk import ProjectVideo, TrackerClip, TrackerProject, project_points
 from .calib import Calibration
-from .runner import MarkerTrack, TrackResult
+from .runner import TrackedMarker, TrackResult
 from .video import Clip
 
 
 def project_result(project: TrackerProject, names: list[str] | None = None) -> TrackResult:
     """The tracks of a Tracker project on its clip's frames (NaN where Tracker has no step)."""
     frames, t_s, points = project_points(project, names)
-    tracks = [MarkerTrack(p.name, f"tracker:{p.tracker_name}", p.px, p.py, np.where(p.ok, 1.0, math.nan), p.ok)
+    tracks = [TrackedMarker(p.name, f"tracker:{p.tracker_name}", p.px, p.py, np.where(p.ok, 1.0, math.nan), p.ok)
               for p in points]
     c = project.clip
     return TrackResult(None, Clip(c.start, c.end, c.step, c.fps), frames, t_s, tracks, project.calibration,
