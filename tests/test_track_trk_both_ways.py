@@ -56,7 +56,16 @@ def test_image_sequence_cups_follow_trackers_points(cups_run, name, theirs):
     # hand (each on a grid of 240/959 px, the screen's pixels at Tracker's zoom). Most of the
     # error is one constant offset over frames 1..8 (measured 0.46 / 0.59 px: the key frame's
     # click, on a cup still against its holder); about it the track follows the clicks to
-    # 0.33 / 0.31 px mean. No evolve rate (0-40 %) or radius (4-8 px) brings both under 0.5.
+    # 0.33 / 0.31 px mean. No evolve rate (0-40 %) or radius (4-8 px) brings both under 0.5,
+    # nor (measured on frames 1..8 at the 20 % evolve rate, cup 3 / cup 7, from 0.56 / 0.63):
+    # for the sub-pixel step a 3x3 quadratic (0.58 / 0.65) or a parabola on the square
+    # difference or on normalised correlation (0.57 / 0.63, 0.56 / 0.62), resampling about the
+    # best match in 0.05 px steps (the same to 0.1 px); a centre-weighted mask (sigma 3-6 px:
+    # 0.57 / 0.63; 2 px: 0.45 / 0.59 with a frame lost); the template cut at the sub-pixel key
+    # point (0.67-0.72 / 0.54-0.56) or about the marker's centre of symmetry (0.37-0.69 /
+    # 0.62-0.65, or cup 3 lost); a mask of the pixels that move by the next frame (0.57 /
+    # 0.64). The key frame's template alone, resampled onto each frame, is 0.73 / 0.63 px off:
+    # the cup's look against its holder on frame 0 is what sets the offset.
 
 
 def _cups_keyed_on(cups, key):
