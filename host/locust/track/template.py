@@ -29,10 +29,15 @@ Rules keep it off still things, which Tracker leaves to the user's eye:
 - *Likeness*: the matched patch must correlate with the template (zero-mean normalised
   correlation over the mask, all three channels) at ``min_likeness`` or more; an empty
   background where the marker was, after it left the picture, does not.
+- *First steps*: until three positions in a row give the track an acceleration, a match
+  farther than ``GATE_MIN_PX`` from the prediction is taken only when nothing else in the
+  window matches within ``AMBIGUITY`` of the best: a cup keyed in mid-fall, in a row of
+  look-alike cups closer together than it falls in a frame, could be any of them.
 
 A lost marker is ``nan`` (never a guess); it is looked for again on every later frame,
 around its path (extrapolated at most ``EXTRAPOLATE_FRAMES``) in a window and gate that grow
-while it stays lost, or within the ungrown gate of where it was last seen (a hand-held camera
+while it stays lost (a marker never seen to move: within ``GATE_MIN_PX``, grown, of its key
+point), or within the ungrown gate of where it was last seen (a hand-held camera
 jerks, and a jerk is no path to extrapolate). It comes back only where its match stands out
 and looks like it: Tracker's peak height ``REACQUIRE_PEAK`` and likeness
 ``REACQUIRE_LIKENESS`` (a small cup among look-alike cups peaks near 10 and stays lost). A
@@ -140,8 +145,11 @@ class TemplateMarker:
         growth = min(1.0 + LOST_GROWTH * lost, LOST_GROWTH_MAX)
         if traj.stretch < 2:
             half = 2 * self.search_half_px * growth
-            if traj.max_speed_px == 0.0:   # the key frame alone: no velocity yet, anywhere in the window
-                return traj.last_point, half, Gate(math.inf, math.inf)
+            if traj.max_speed_px == 0.0:   # the key frame alone: no velocity yet, anywhere in the window ...
+                if lost == 0:
+                    return traj.last_point, half, Gate(math.inf, math.inf)
+                # ... but once lost there, it comes back only near where it was picked
+                return traj.last_point, half, Gate(GATE_MIN_PX * growth, GATE_MIN_PX * growth)
             # just re-acquired: no velocity yet, but no faster than the marker has been seen to move
             radius = max(GATE_MIN_PX, GATE_STEP_FRACTION * traj.max_speed_px) * growth
             return traj.last_point, half, Gate(radius, radius)
@@ -190,6 +198,8 @@ class TemplateMarker:
             return Detection.missing(height)   # coming back takes a match that stands out in its window
         if off > 1.0:   # off its path
             return Detection.missing(height)
+        if self.trajectory.stretch < 3 and math.hypot(mx - px, my - py) > GATE_MIN_PX and _has_lookalike(diff, iy, ix):
+            return Detection.missing(height)   # no path yet to tell the marker from its look-alikes
         if like < self.min_likeness:
             return Detection.missing(height)
         dx = _gaussian_peak(*(peak(diff[iy, ix + k]) if 0 <= ix + k < diff.shape[1] else math.nan for k in (-1, 0, 1)))
@@ -240,6 +250,14 @@ def _nearest_lookalike(diff: np.ndarray, pred_x: float, pred_y: float, gate: Gat
     ys, xs = ys[inside], xs[inside]
     k = int(np.argmin(diff[ys, xs]))
     return int(ys[k]), int(xs[k])
+
+
+def _has_lookalike(diff: np.ndarray, iy: int, ix: int) -> bool:
+    """Whether a local minimum of ``diff`` other than the match at (iy, ix) matches within
+    ``AMBIGUITY`` of the best."""
+    minima = diff <= cv2.erode(diff, np.ones((3, 3), np.uint8))
+    minima[iy, ix] = False
+    return bool((minima & (diff <= AMBIGUITY * float(diff.min()))).any())
 
 
 def _valley_extent(diff: np.ndarray, iy: int, ix: int) -> float:
