@@ -7,7 +7,7 @@ import json
 import click
 import pytest
 
-from locust.device import cli as device_cli
+from locust.commands import hop as hop_command
 from locust.errors import DeviceError, TrialError
 from locust.firmware import protocol as P
 from locust.io import run_record as R
@@ -111,7 +111,7 @@ def test_schedule_limits_and_defaults_are_the_protocols():
     for name in ("cycles", "push_deg", "push_ms", "wait_ms", "heartbeat_ms"):
         assert getattr(sched, name) == hop[name][3]
         assert R.hop_range(name) == (hop[name][1], hop[name][2])
-    options = {o.name: o for o in device_cli.hop.params}
+    options = {o.name: o for o in hop_command.hop.params}
     for name in ("cycles", "push_ms", "wait_ms", "heartbeat_ms"):
         kind = options[name].type
         assert isinstance(kind, click.IntRange) and (kind.min, kind.max) == R.hop_range(name)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from locust import cli as C
+from locust import commands as C
 
 ROOT = Path(__file__).resolve().parents[1]
 
