@@ -51,7 +51,7 @@ def seed_leg_set_options(name: str) -> list[str]:
     return ["--preset", "seed", *[arg for key in keys for arg in ("--set", f"{key}={robot.get(key)!r}")]]
 
 
-RECORDINGS = Path(__file__).resolve().parents[2] / "calibration" / "recordings"
+RECORDINGS = Path(__file__).resolve().parents[3] / "calibration" / "recordings"
 # (subcommand, recording, its options); the servo recording is the AA swing's SG90 on a light
 # load, split with the datasheet's stall torque (no-load speed, armature and kp are written).
 CALIBRATIONS = (
