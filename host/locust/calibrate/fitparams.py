@@ -110,14 +110,14 @@ class FitParameter:
         return (value - self.origin) / self.scale
 
     def to_value(self, x: float) -> float:
-        """The value [unit] of the solver's variable ``x``."""
+        """The value [unit] of the solver's variable ``x`` (numpy's exp, as :meth:`FitParameters.from_vector`)."""
         if self.scaling == "log":
-            return self.origin * math.exp(x)
+            return self.origin * float(np.exp(x))
         return self.origin + self.scale * x
 
     def derivative(self, x: float) -> float:
         """d value / d x at ``x`` [unit]."""
-        return self.origin * math.exp(x) if self.scaling == "log" else self.scale
+        return self.origin * float(np.exp(x)) if self.scaling == "log" else self.scale
 
     def x_bounds(self) -> tuple[float, float]:
         """The bounds in the solver's variable, (low, high)."""
@@ -149,6 +149,9 @@ class FitParameters:
             raise CalibrationError(f"fit parameters named twice: {', '.join(twice)}", "give each value one name")
         self._free = tuple(p for p in self.params if not p.held)
         self._index = {p.name: i for i, p in enumerate(self._free)}
+        self._log = np.array([p.scaling == "log" for p in self._free], dtype=bool)
+        self._origin = np.array([p.origin for p in self._free], dtype=float)
+        self._scale = np.array([1.0 if p.scaling == "log" else p.scale for p in self._free], dtype=float)
 
     def __len__(self) -> int:
         return len(self.params)
@@ -215,18 +218,24 @@ class FitParameters:
         -------
         dict of str to float
         """
-        x = np.asarray(x, dtype=float).ravel()
-        if len(x) != self.size:
-            raise CalibrationError(f"a vector of {len(x)} for {self.size} free values", "one entry per free value")
+        free = self.free_values(x)
         out = {}
         for p in self.params:
-            out[p.name] = float(p.start) if p.held else p.to_value(float(x[self._index[p.name]]))
+            out[p.name] = float(p.start) if p.held else float(free[self._index[p.name]])
         return out
 
     def free_values(self, x: np.ndarray) -> np.ndarray:
         """The free values [their units] at ``x``, in the vector's order (size,)."""
+        x = self._checked(x)
+        out = self._origin + self._scale * x
+        out[self._log] = self._origin[self._log] * np.exp(x[self._log])
+        return out
+
+    def _checked(self, x: np.ndarray) -> np.ndarray:
         x = np.asarray(x, dtype=float).ravel()
-        return np.array([p.to_value(float(xi)) for p, xi in zip(self._free, x)])
+        if len(x) != self.size:
+            raise CalibrationError(f"a vector of {len(x)} for {self.size} free values", "one entry per free value")
+        return x
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """The solver's bounds, (low, high), each (size,)."""
@@ -241,15 +250,17 @@ class FitParameters:
 
     def derivatives(self, x: np.ndarray) -> np.ndarray:
         """d value / d x of each free value at ``x`` (size,): the diagonal of the chain rule."""
-        x = np.asarray(x, dtype=float).ravel()
-        return np.array([p.derivative(float(xi)) for p, xi in zip(self._free, x)])
+        x = self._checked(x)
+        out = self._scale.copy()
+        out[self._log] = self._origin[self._log] * np.exp(x[self._log])
+        return out
 
     def gradient(self, x: np.ndarray, name: str, factor: float = 1.0) -> np.ndarray:
         """Gradient in ``x`` of ``factor * value(name)`` (size,): for
         :meth:`.fitstats.Covariance.estimate` on a covariance of the solver's vector."""
         i = self._index[name]
         grad = np.zeros(self.size)
-        grad[i] = factor * self._free[i].derivative(float(np.asarray(x, dtype=float).ravel()[i]))
+        grad[i] = factor * self.derivatives(x)[i]
         return grad
 
     def to_values_jacobian(self, jac: np.ndarray, x: np.ndarray) -> np.ndarray:
