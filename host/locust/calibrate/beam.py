@@ -39,6 +39,7 @@ from scipy import optimize
 from ..errors import CalibrationError
 from ..io.importing import units_hint
 from .curves import Curves
+from .fitparams import FitParameter, FitParameters
 from .fitstats import Estimate, serial_covariance
 
 RAYLEIGH_TIP_FRACTION = 33.0 / 140.0  # share of a cantilever's own mass moving with its tip
@@ -148,8 +149,9 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
     rms, amp, fn, zeta = _checked_oscillation(p, r, t, fs_hz, source)
     m = mass_kg + RAYLEIGH_TIP_FRACTION * beam_mass_kg
     wn = 2 * np.pi * fn
-    grad_fn = np.array([0, 0, 0, 1.0, 0])
-    grad_zeta = np.array([0, 0, 0, 0, 1.0])
+    params = _parameters(t, fs_hz)
+    grad_fn = params.gradient(p, "natural_frequency_hz")
+    grad_zeta = params.gradient(p, "damping_ratio")
     k = m * wn**2
     b = 2 * zeta * m * wn
     grad_k = grad_fn * 2 * k / fn
@@ -200,11 +202,14 @@ def _least_squares(t: np.ndarray, y: np.ndarray, fs_hz: float):
     """The damped oscillation of least squares from each start of the grid (scipy's result):
     the frequency between LOWEST_CYCLES over the window and Nyquist."""
     t0 = float(t[0])
-    lo, hi = _bounds(t, fs_hz)
+    params = _parameters(t, fs_hz)
+    lo, hi = params.bounds()
+    fn = params["natural_frequency_hz"]
     best = None
-    for fn0, zeta0 in _start_values(t, y, lo[3], hi[3]):
+    for fn0, zeta0 in _start_values(t, y, fn.lower, fn.upper):
         c0, a0, b0 = _linear_part(t - t0, y, fn0, zeta0)
-        p0 = np.clip([c0, a0, b0, fn0, zeta0], np.nextafter(lo, np.inf), np.nextafter(hi, -np.inf))
+        start = dict(zip(params.free, (c0, a0, b0, fn0, zeta0)))
+        p0 = np.clip(params.as_vector(start), np.nextafter(lo, np.inf), np.nextafter(hi, -np.inf))
         res = optimize.least_squares(lambda p: damped_oscillation(t, p, t0) - y, p0, bounds=(lo, hi),
                                      x_scale="jac", method="trf")
         if best is None or res.cost < best.cost:
@@ -240,16 +245,25 @@ def _start_shift(t: np.ndarray, y: np.ndarray, fs_hz: float, best) -> np.ndarray
     them, added to their uncertainty as a type-B part."""
     t1, y1 = t[1:], y[1:]
     t0 = float(t[0])
-    res = optimize.least_squares(lambda p: damped_oscillation(t1, p, t0) - y1, best.x, bounds=_bounds(t, fs_hz),
+    res = optimize.least_squares(lambda p: damped_oscillation(t1, p, t0) - y1, best.x,
+                                 bounds=_parameters(t, fs_hz).bounds(),
                                  x_scale="jac", method="trf")
     return res.x - best.x
 
 
-def _bounds(t: np.ndarray, fs_hz: float) -> tuple[list[float], list[float]]:
-    """The fit's bounds: the frequency between ``LOWEST_CYCLES`` over the window and Nyquist,
-    the damping ratio within ``ZETA_BOUNDS``."""
-    return ([-np.inf, -np.inf, -np.inf, LOWEST_CYCLES / (t[-1] - t[0]), ZETA_BOUNDS[0]],
-            [np.inf, np.inf, np.inf, fs_hz / 2, ZETA_BOUNDS[1]])
+def _parameters(t: np.ndarray, fs_hz: float) -> FitParameters:
+    """The oscillation's values (:func:`damped_oscillation`'s ``p``, in its order), each the
+    solver's variable itself: the offset and the two amplitudes unbounded, the frequency
+    between ``LOWEST_CYCLES`` over the window and Nyquist, the damping ratio within
+    ``ZETA_BOUNDS``. Their start comes from the grid (:func:`_start_values`)."""
+    return FitParameters([
+        FitParameter("offset_m", "m", 0.0),
+        FitParameter("amplitude_cos_m", "m", 0.0),
+        FitParameter("amplitude_sin_m", "m", 0.0),
+        FitParameter("natural_frequency_hz", "Hz", LOWEST_CYCLES / (t[-1] - t[0]), LOWEST_CYCLES / (t[-1] - t[0]),
+                     fs_hz / 2),
+        FitParameter("damping_ratio", "1", ZETA_BOUNDS[0], *ZETA_BOUNDS),
+    ])
 
 
 def _checked_oscillation(p: np.ndarray, r: np.ndarray, t: np.ndarray, fs_hz: float,

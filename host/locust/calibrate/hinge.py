@@ -40,6 +40,7 @@ from scipy import integrate, optimize, stats
 from ..errors import CalibrationError
 from ..params import GRAVITY_M_PER_S2
 from .curves import Curves
+from .fitparams import FitParameter, FitParameters
 from .fitstats import Estimate, covariance
 
 GRAVITY_CHOICES = ("in-plane", "out-of-plane")
@@ -334,10 +335,11 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
 class _Swing:
     """The least-squares problem: the marker's x and y residuals [m] of a swing.
 
-    Its values, scaled to order one: k/k0, b/b0, theta0, the start angle, the start rate in
-    units of the damped angular frequency, the radius R/R0, then (when the pivot is fitted)
-    its offsets from the circle fit in units of R0, then (when fitted) tau_c in units of a
-    friction that would stop a tenth of the first swing's decay.
+    Its values (:meth:`parameters`), each linear in the solver's variable and scaled to order
+    one: k/k0, b/b0, theta0, the start angle, the start rate in units of the damped angular
+    frequency, the radius R/R0, then (when the pivot is fitted) its offsets from the circle
+    fit in units of R0, then (when fitted) tau_c in units of a friction that would stop a
+    tenth of the first swing's decay.
     """
 
     DYNAMIC = 5
@@ -351,19 +353,36 @@ class _Swing:
         self.tau_ref = 0.05 * p0[1] * shape.amplitude_rad * shape.damped_omega_rad_per_s
         self.dyn_scale = np.array([p0[0], p0[1], 1.0, 1.0, max(shape.damped_omega_rad_per_s, 1e-3)])
         self.n_geo = 3 if fit_pivot else 1
+        held = not fit_pivot
+        k0, b0, th0, th_start, rate0 = (float(v) for v in p0)
+        self.params = FitParameters([
+            FitParameter("hinge_stiffness_nm_per_rad", "N*m/rad", k0, 0.0, scale=self.dyn_scale[0]),
+            FitParameter("hinge_damping_nms_per_rad", "N*m*s/rad", b0, 0.0, scale=self.dyn_scale[1]),
+            FitParameter("neutral_angle_rad", "rad", th0),
+            FitParameter("start_angle_rad", "rad", th_start),
+            FitParameter("start_rate_rad_per_s", "rad/s", rate0, scale=self.dyn_scale[4]),
+            FitParameter("radius_m", "m", radius_m, 0.0, scale=radius_m),
+            FitParameter("pivot_x_m", "m", self.centre[0], scale=radius_m, reference=self.centre[0], held=held,
+                         source="given" if held else "circle fit"),
+            FitParameter("pivot_y_m", "m", self.centre[1], scale=radius_m, reference=self.centre[1], held=held,
+                         source="given" if held else "circle fit"),
+        ])
+        self.with_coulomb = self.params.extended(
+            FitParameter("coulomb_friction_nm", "N*m", self.tau_ref, 0.0, scale=self.tau_ref))
+
+    def parameters(self, q: np.ndarray) -> FitParameters:
+        """The values of the solver's vector ``q``: with Coulomb friction when it is one longer."""
+        return self.with_coulomb if len(q) > self.params.size else self.params
 
     def start(self) -> np.ndarray:
-        return np.concatenate([self.p0 / self.dyn_scale, [1.0], np.zeros(self.n_geo - 1)])
+        return self.params.as_vector()
 
     def split(self, q: np.ndarray):
         """(simulate_hinge's params, radius [m], pivot [m]) of the scaled values ``q``."""
-        n = self.DYNAMIC + self.n_geo
-        p = q[:self.DYNAMIC] * self.dyn_scale
-        if len(q) > n:
-            p = np.append(p, q[n] * self.tau_ref)
-        radius = q[self.DYNAMIC] * self.radius0
-        off = q[self.DYNAMIC + 1:n] * self.radius0 if self.fit_pivot else np.zeros(2)
-        return p, float(radius), (self.centre[0] + float(off[0]), self.centre[1] + float(off[1]))
+        v = self.parameters(q).from_vector(q)
+        p = np.array([v[name] for name in self.params.free[:self.DYNAMIC]]
+                     + ([v["coulomb_friction_nm"]] if "coulomb_friction_nm" in v else []))
+        return p, v["radius_m"], (v["pivot_x_m"], v["pivot_y_m"])
 
     def angle(self, q: np.ndarray) -> np.ndarray:
         return simulate_hinge(self.t, self.split(q)[0], self.rig, self.width)
@@ -396,22 +415,23 @@ class _Swing:
 
     def solve(self, q0: np.ndarray) -> optimize.OptimizeResult:
         """Least squares, k, b, the radius and tau_c kept positive."""
-        lo = np.full(len(q0), -np.inf)
-        positive = [0, 1, self.DYNAMIC] + ([len(q0) - 1] if len(q0) > self.DYNAMIC + self.n_geo else [])
-        lo[positive] = 0.0
+        lo, hi = self.parameters(q0).bounds()
         q0 = np.where(np.isfinite(lo), np.maximum(q0, 1e-9), q0)
-        return optimize.least_squares(self.residual, q0, jac=self.jacobian, bounds=(lo, np.inf), method="trf",
+        return optimize.least_squares(self.residual, q0, jac=self.jacobian, bounds=(lo, hi), method="trf",
                                       xtol=1e-10, ftol=1e-10, max_nfev=200)
 
     def estimates(self, result: optimize.OptimizeResult) -> dict[str, Estimate]:
         cov = covariance(result.jac, result.fun)
-        q, n = result.x, len(result.x)
-        p, _, _ = self.split(q)
-        out = {"hinge_stiffness_nm_per_rad": cov.estimate(float(p[0]), _unit(n, 0, self.dyn_scale[0])),
-               "hinge_damping_nms_per_rad": cov.estimate(float(p[1]), _unit(n, 1, self.dyn_scale[1])),
-               "neutral_angle_deg": cov.estimate(math.degrees(p[2]), _unit(n, 2, math.degrees(1.0)))}
-        if len(p) > self.DYNAMIC:
-            out["coulomb_friction_nm"] = cov.estimate(float(p[-1]), _unit(n, n - 1, self.tau_ref))
+        q = result.x
+        params = self.parameters(q)
+        v = params.from_vector(q)
+        out = {name: cov.estimate(v[name], params.gradient(q, name))
+               for name in ("hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad")}
+        out["neutral_angle_deg"] = cov.estimate(math.degrees(v["neutral_angle_rad"]),
+                                                params.gradient(q, "neutral_angle_rad", math.degrees(1.0)))
+        if "coulomb_friction_nm" in v:
+            out["coulomb_friction_nm"] = cov.estimate(v["coulomb_friction_nm"],
+                                                      params.gradient(q, "coulomb_friction_nm"))
         return out
 
     def coulomb_score_p(self, base: optimize.OptimizeResult) -> float:
@@ -430,13 +450,6 @@ class _Swing:
         ssr = float(base.fun @ base.fun) - drop
         f_stat = drop / max(ssr / (n - p), 1e-300)
         return float(stats.f.sf(f_stat, 1, n - p))
-
-
-def _unit(n: int, i: int, factor: float) -> np.ndarray:
-    """Gradient of ``factor * q[i]`` in the solver's values ``q``."""
-    grad = np.zeros(n)
-    grad[i] = factor
-    return grad
 
 
 def _rest_angle(p: np.ndarray, rig: HingeRig) -> float:

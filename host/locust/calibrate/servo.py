@@ -52,9 +52,12 @@ from ..params import GRAVITY_M_PER_S2, LIMITS, Servo
 from ..sim.rollout import rollout_threads
 from ..sim.servo import configure, with_servo
 from .curves import Curves
+from .fitparams import FitParameter, FitParameters
 from .fitstats import Estimate, cluster_covariance, covariance, linear_shift
 
 PARAMS = ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "kv_nms_per_rad", "stall_torque_nm")
+UNITS = {"noload_speed_rad_per_s": "rad/s", "armature_kgm2": "kg*m^2", "kp_nm_per_rad": "N*m/rad",
+         "kv_nms_per_rad": "N*m*s/rad", "stall_torque_nm": "N*m"}
 # search box of the physical parameters (wide: an SG90 sits well inside it)
 LOWER = {"noload_speed_rad_per_s": 0.5, "armature_kgm2": 1e-8, "kp_nm_per_rad": 1e-3, "kv_nms_per_rad": 1e-6,
          "stall_torque_nm": 1e-3}
@@ -400,70 +403,64 @@ def simulate_rate(model: mujoco.MjModel, servos: list[Servo], delays_s: list[flo
 
 
 # -- the fit ----------------------------------------------------------------------------
-@dataclass(frozen=True)
 class _Layout:
-    """Which solver variables there are: log of each fitted physical parameter, then per
-    recording the scaled delay, (if it has enough edges and two clocks) the scaled clock
-    error and (a rate recording) the log of its gyro gain."""
+    """The fit's values (:class:`.fitparams.FitParameters`): the servo's physical ones, each
+    log-scaled within ``LOWER``-``UPPER`` or held at a given value, then per recording its
+    delay (in ``DELAY_SCALE_S``), when it has enough edges and two clocks its clock error
+    (ratio - 1, in ``CLOCK_SCALE``), and for a rate recording the log of its gyro gain (the
+    gain's sign held from the recording)."""
 
-    fitted: tuple[str, ...]
-    clock: tuple[bool, ...]
-    gain: tuple[bool, ...]
-    stall_given: float | None
-    signs: tuple[float, ...] = ()
-    kv_given: float | None = None
+    def __init__(self, held: dict[str, float | None], clock: tuple[bool, ...], gain: tuple[bool, ...],
+                 signs: tuple[float, ...] = ()):
+        self.clock, self.gain = clock, gain
+        params = []
+        for name in PARAMS:
+            value = held.get(name)
+            # a fitted one's nominal: the middle of its box in log (the grid's starts replace it)
+            nominal = math.sqrt(LOWER[name] * UPPER[name]) if value is None else value
+            params.append(FitParameter(name, UNITS[name], nominal, LOWER[name], UPPER[name], scaling="log",
+                                       held=value is not None, source="given" if value is not None else ""))
+        self._nuisance = []
+        for k, (has_clock, has_gain) in enumerate(zip(clock, gain)):
+            params.append(FitParameter(f"delay_s[{k}]", "s", 0.0, -MAX_DELAY_S, MAX_DELAY_S, scale=DELAY_SCALE_S))
+            self._nuisance.append((k, "delay"))
+            if has_clock:
+                params.append(FitParameter(f"clock_error[{k}]", "1", 0.0, -MAX_CLOCK_ERROR, MAX_CLOCK_ERROR,
+                                           scale=CLOCK_SCALE))
+                self._nuisance.append((k, "clock"))
+            if has_gain:
+                sign = signs[k]
+                params.append(FitParameter(f"gyro_gain[{k}]", "units per rad/s", sign, sign * 1e-9, sign * 1e9,
+                                           scaling="log", reference=sign))
+                self._nuisance.append((k, "gain"))
+        self.params = FitParameters(params)
+        self.fitted = tuple(n for n in PARAMS if n in self.params.free)
 
     @property
     def size(self) -> int:
-        return len(self.fitted) + len(self.clock) + sum(self.clock) + sum(self.gain)
+        return self.params.size
+
+    @property
+    def stall_given(self) -> float | None:
+        """The stall torque [N*m] when held, else None."""
+        stall = self.params["stall_torque_nm"]
+        return stall.start if stall.held else None
 
     def unpack(self, x: np.ndarray) -> tuple[Servo, list[Timing], list[float | None]]:
-        values = dict(zip(self.fitted, np.exp(x[:len(self.fitted)])))
-        if self.stall_given is not None:
-            values["stall_torque_nm"] = self.stall_given
-        if self.kv_given is not None:
-            values["kv_nms_per_rad"] = self.kv_given
-        timings, gains, i = [], [], len(self.fitted)
+        values = self.params.from_vector(x)
+        timings, gains = [], []
         for k, (has_clock, has_gain) in enumerate(zip(self.clock, self.gain)):
-            delay = float(x[i]) * DELAY_SCALE_S
-            i += 1
-            ratio = 1.0
-            if has_clock:
-                ratio = 1.0 + float(x[i]) * CLOCK_SCALE
-                i += 1
-            gain = None
-            if has_gain:
-                gain = self.signs[k] * math.exp(float(x[i]))
-                i += 1
-            timings.append(Timing(delay, ratio))
-            gains.append(gain)
-        return Servo(**{k: float(v) for k, v in values.items()}), timings, gains
+            ratio = 1.0 + values[f"clock_error[{k}]"] if has_clock else 1.0
+            timings.append(Timing(values[f"delay_s[{k}]"], ratio))
+            gains.append(values[f"gyro_gain[{k}]"] if has_gain else None)
+        return Servo(**{n: values[n] for n in PARAMS}), timings, gains
 
     def nuisance(self) -> list[tuple[int, str]]:
         """(recording, what) of each variable after the physical ones, in order."""
-        out = []
-        for k, (has_clock, has_gain) in enumerate(zip(self.clock, self.gain)):
-            out.append((k, "delay"))
-            if has_clock:
-                out.append((k, "clock"))
-            if has_gain:
-                out.append((k, "gain"))
-        return out
+        return list(self._nuisance)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        lo = [math.log(LOWER[n]) for n in self.fitted]
-        hi = [math.log(UPPER[n]) for n in self.fitted]
-        for _, what in self.nuisance():
-            if what == "delay":
-                lo.append(-MAX_DELAY_S / DELAY_SCALE_S)
-                hi.append(MAX_DELAY_S / DELAY_SCALE_S)
-            elif what == "clock":
-                lo.append(-MAX_CLOCK_ERROR / CLOCK_SCALE)
-                hi.append(MAX_CLOCK_ERROR / CLOCK_SCALE)
-            else:
-                lo.append(math.log(1e-9))
-                hi.append(math.log(1e9))
-        return np.array(lo), np.array(hi)
+        return self.params.bounds()
 
 
 def _residual_parts(recs: list[Recording], models: list[mujoco.MjModel],
@@ -581,31 +578,14 @@ def progress_steps(n_recordings: int, max_iter: int = MAX_ITER) -> int:
     return (STARTS + (n_recordings > 1)) * max_iter
 
 
-def _nuisance_values(layout: _Layout, timings: list[Timing], gains: list[float | None]) -> tuple[list, list]:
-    """The nuisance variables' values and their d value / d x (the scale of each variable)."""
-    nvals, nscale = [], []
-    for k, what in layout.nuisance():
-        if what == "delay":
-            nvals.append(timings[k].delay_s)
-            nscale.append(DELAY_SCALE_S)
-        elif what == "clock":
-            nvals.append(timings[k].clock_ratio)
-            nscale.append(CLOCK_SCALE)
-        else:
-            nvals.append(gains[k])
-            nscale.append(gains[k])          # gain = sign*exp(x): d gain / d x = gain
-    return nvals, nscale
-
-
-def _covariance(residual: _Residual, x: np.ndarray, r: np.ndarray, scale: np.ndarray):
+def _covariance(residual: _Residual, x: np.ndarray, r: np.ndarray):
     """The covariance of the values (physical, then nuisance) at the solution ``x``: clustered
     by servo step when there are enough steps, with the time step's shift as a type-B part."""
     recs, layout = residual.recs, residual.layout
     jac, _ = minimize.jacobian_fd(residual, x.reshape(-1, 1), r.reshape(-1, 1), np.float64(1e-6), 0,
                                   [b.reshape(-1, 1) for b in layout.bounds()])
-    # d r / d p = d r / d x / (d p / d x): p = exp(x) for the physical ones (and the gains), p = scale*x for timing
     clusters = np.concatenate([_step_clusters(rec) + 10_000 * k for k, rec in enumerate(recs)])
-    jac_p = jac / scale[None, :]
+    jac_p = layout.params.to_values_jacobian(jac, x)      # d r / d p = (d r / d x) / (d p / d x)
     # the fit's time step: implicitfast is first order, so the values' distance to the dt -> 0
     # limit is about twice their shift when the step is halved (Richardson); a type-B part
     half = [rig_model(replace(rec.rig, timestep_s=rec.rig.timestep_s / 2)) for rec in recs]
@@ -641,11 +621,11 @@ def _identifiable(residual: _Residual, x: np.ndarray, r: np.ndarray, estimates: 
     """Mark each fitted value identifiable or not (interval, edge of its range, profile),
     with a note for each that is not."""
     fitted = residual.layout.fitted
-    bounds = residual.layout.bounds()
+    at_edge = residual.layout.params.near_bound(x, 1e-3)
     profile = _profile_ok(residual, x, r, len(fitted))
     for i, name in enumerate(fitted):
         ok = bool(np.isfinite(estimates[name].std) and estimates[name].relative_std <= MAX_RELATIVE_STD)
-        if min(x[i] - bounds[0][i], bounds[1][i] - x[i]) < 1e-3:
+        if at_edge[i]:
             ok = False
             notes.append(f"{name} ran to the edge of its range ({estimates[name].value:.3g}): the recordings do "
                          "not bound it")
@@ -694,18 +674,15 @@ def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None,
     t_start = time.perf_counter()
     recs = _checked_inputs(recordings, stall_torque_nm, kv_nms_per_rad)
     held = {"stall_torque_nm": stall_torque_nm, "kv_nms_per_rad": kv_nms_per_rad}
-    fitted = tuple(n for n in PARAMS if held.get(n) is None)
-    layout = _Layout(fitted, tuple(r.kind == "angle" and len(r.edges) >= MIN_EDGES_FOR_CLOCK for r in recs),
-                     tuple(r.kind == "rate" for r in recs), stall_torque_nm,
-                     tuple(r.gain_sign if r.kind == "rate" else 1.0 for r in recs), kv_nms_per_rad)
+    layout = _Layout(held, tuple(r.kind == "angle" and len(r.edges) >= MIN_EDGES_FOR_CLOCK for r in recs),
+                     tuple(r.kind == "rate" for r in recs),
+                     tuple(r.gain_sign if r.kind == "rate" else 1.0 for r in recs))
     residual = _Residual(recs, layout)
     x, iterations = _solve(residual, max_iter, progress)
     r = residual(x.reshape(-1, 1)).ravel()
-    phys = np.exp(x[:len(fitted)])
     servo, timings, gains = layout.unpack(x)
-    nvals, nscale = _nuisance_values(layout, timings, gains)
-    cov = _covariance(residual, x, r, np.concatenate([phys, nscale]))
-    estimates, identifiable, timing_std, gain_est = _estimates(cov, np.concatenate([phys, nvals]), layout, held,
+    cov = _covariance(residual, x, r)
+    estimates, identifiable, timing_std, gain_est = _estimates(cov, layout.params.free_values(x), layout, held,
                                                                len(recs))
 
     parts = _residual_parts(recs, residual.models, [(servo, timings, gains)])
@@ -798,17 +775,15 @@ def _grid_starts(recs, layout: _Layout, residual, bounds) -> list[np.ndarray]:
                         phys = {"noload_speed_rad_per_s": noload, "armature_kgm2": armature,
                                 "kp_nm_per_rad": stall / math.radians(linear_deg), "stall_torque_nm": stall,
                                 "kv_nms_per_rad": (kv_share or 0.0) * stall / noload}
-                        x = [math.log(phys[n]) for n in layout.fitted]
-                        for k, what in layout.nuisance():
+                        values = dict(phys)
+                        for k, rec in enumerate(recs):
                             delay_s, ratio = timing[k]
-                            if what == "delay":
-                                lag = tau_s if recs[k].kind == "angle" else 0.0
-                                x.append((delay_s - lag + delay_frames * frame_s[k]) / DELAY_SCALE_S)
-                            elif what == "clock":
-                                x.append((ratio - 1.0) / CLOCK_SCALE)
-                            else:
-                                x.append(math.log(recs[k].gain_guess()))
-                        cands.append(x)
+                            lag = tau_s if rec.kind == "angle" else 0.0
+                            values[f"delay_s[{k}]"] = delay_s - lag + delay_frames * frame_s[k]
+                            values[f"clock_error[{k}]"] = ratio - 1.0      # used where the clock is fitted
+                            if rec.kind == "rate":
+                                values[f"gyro_gain[{k}]"] = rec.gain_sign * rec.gain_guess()
+                        cands.append(layout.params.as_vector(values))
     lo, hi = bounds
     xs = np.clip(np.array(cands), lo + 1e-6, hi - 1e-6)
     cost = np.sum(residual(xs.T) ** 2, axis=0)
@@ -1005,7 +980,7 @@ def validate(servo: Servo, rec: Recording, gain: float | None = None) -> Validat
     elif rec.kind == "rate":
         gain = rec.gain_sign * abs(gain)
     has_clock = rec.kind == "angle" and len(rec.edges) >= MIN_EDGES_FOR_CLOCK
-    layout = _Layout((), (has_clock,), (False,), servo.stall_torque_nm)
+    layout = _Layout({n: getattr(servo, n) for n in PARAMS}, (has_clock,), (False,))
     model = rig_model(rec.rig)
 
     def residual(x: np.ndarray) -> np.ndarray:
@@ -1017,7 +992,7 @@ def validate(servo: Servo, rec: Recording, gain: float | None = None) -> Validat
     noload = servo.noload_speed_rad_per_s if math.isfinite(servo.noload_speed_rad_per_s) else 10.0
     delay_s, ratio = _timing_guess(rec, noload)
     frame_s = float(np.median(np.diff(rec.t_s)))
-    starts = [[(delay_s + f * frame_s) / DELAY_SCALE_S] + ([(ratio - 1.0) / CLOCK_SCALE] if has_clock else [])
+    starts = [layout.params.as_vector({"delay_s[0]": delay_s + f * frame_s, "clock_error[0]": ratio - 1.0})
               for f in (-1.5, -1.0, -0.5, 0.0, 0.5)]
     bounds = layout.bounds()
     lo, hi = bounds
