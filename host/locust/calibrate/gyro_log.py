@@ -92,6 +92,22 @@ def parse_gyro_log(text: str, path: str | Path) -> GyroLog:
 
 
 def read_gyro_log(path: str | Path) -> GyroLog:
+    """Read a controller's gyro log.
+
+    Parameters
+    ----------
+    path : path-like
+        The log: milliseconds, gyro rate and command per line (see :func:`parse_gyro_log`).
+
+    Returns
+    -------
+    GyroLog
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        The file cannot be read, or its clock does not increase.
+    """
     try:
         text = read_text(path)
     except TrackError as exc:

@@ -34,6 +34,26 @@ BOARD_M = (0.05, 3.0, 0.3)     # (least, most, typical) length between the ramp'
 
 @dataclass(frozen=True)
 class RampFit:
+    """The ramp's fit: static friction from the trials' critical angles.
+
+    Attributes
+    ----------
+    source : str
+        The recording(s).
+    mu_static : locust.calibrate.fitstats.Estimate
+        ``tan(mean angle)`` (no unit) with its 95% interval.
+    mean_angle_deg, std_angle_deg : float
+        The trials' mean and standard deviation [deg] (at least the reading's resolution / sqrt(12)).
+    n_trials : int
+        Trials used.
+    angles_deg : list of float
+        Each trial's critical angle [deg].
+    curves : Curves
+        tan(angle) per trial against the fitted mu.
+    notes : list of str
+        What was assumed (the spread raised to the reading resolution's).
+    """
+
     source: str
     mu_static: Estimate
     mean_angle_deg: float
@@ -45,6 +65,7 @@ class RampFit:
     notes: list[str] = field(default_factory=list)
 
     def summary(self) -> dict:
+        """Every figure of the fit, as ``locust calibrate ramp --json`` prints it."""
         return {"experiment": "ramp", "source": self.source, "mu_static": self.mu_static.as_dict(),
                 "mean_angle_deg": self.mean_angle_deg, "std_angle_deg": self.std_angle_deg,
                 "n_trials": self.n_trials, "angles_deg": self.angles_deg, "resolution_deg": self.resolution_deg,
@@ -53,8 +74,27 @@ class RampFit:
 
 def fit_ramp(angles_deg: np.ndarray, source: str = "ramp",
              resolution_deg: float = READING_RESOLUTION_DEG) -> RampFit:
-    """``resolution_deg``: how finely each angle was read; the trials' spread is taken as at
-    least ``resolution_deg / sqrt(12)`` (see the module docstring)."""
+    """Static friction ``mu = tan(mean critical angle)`` with a Student-t 95% interval.
+
+    Parameters
+    ----------
+    angles_deg : array_like
+        The trials' critical angles [deg from the horizontal]; NaN are dropped.
+    source : str
+        The recording's name, for messages and provenance.
+    resolution_deg : float, default 1.0
+        How finely each angle was read [deg]; the trials' spread is taken as at least
+        ``resolution_deg / sqrt(12)`` (see the module docstring).
+
+    Returns
+    -------
+    RampFit
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Fewer than two trials, an angle outside 0..90 deg, or a resolution that is not positive.
+    """
     if not (math.isfinite(resolution_deg) and resolution_deg > 0):
         raise CalibrationError(f"--resolution-deg {resolution_deg:g} must be a finite number above 0",
                                "the angle's reading resolution, e.g. 1 for a protractor read to the degree")
@@ -88,6 +128,18 @@ def fit_ramp(angles_deg: np.ndarray, source: str = "ramp",
 
 @dataclass(frozen=True)
 class SlipOnset:
+    """When the robot starts to slide down the tilting board.
+
+    Attributes
+    ----------
+    critical_angle_deg : float
+        The board's angle at the onset [deg].
+    onset_s : float
+        The onset's time in the track [s].
+    slip_m : float
+        How far the robot slid by the end of the record [m].
+    """
+
     critical_angle_deg: float
     onset_s: float
     slip_m: float          # how far the robot slid by the end of the record

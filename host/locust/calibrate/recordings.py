@@ -57,12 +57,32 @@ class Table:
 
     @property
     def n_rows(self) -> int:
+        """The number of samples."""
         return len(next(iter(self.columns.values()))) if self.columns else 0
 
     def has(self, *names: str) -> bool:
+        """Whether every column in ``names`` is present."""
         return all(n in self.columns for n in names)
 
     def require(self, *names: str, purpose: str = "") -> list[np.ndarray]:
+        """The columns ``names``, in order.
+
+        Parameters
+        ----------
+        *names : str
+            Column names (unit in their suffix).
+        purpose : str
+            What they are for, named in the message when one is missing.
+
+        Returns
+        -------
+        list of numpy.ndarray
+
+        Raises
+        ------
+        locust.errors.CalibrationError
+            A column is missing.
+        """
         missing = [n for n in names if n not in self.columns]
         if missing:
             what = f" for {purpose}" if purpose else ""
@@ -74,10 +94,27 @@ class Table:
         return [self.columns[n] for n in names]
 
     def markers(self) -> list[str]:
+        """The markers with both ``<name>_x_m`` and ``<name>_y_m`` columns."""
         return [c[:-4] for c in self.columns if c.endswith("_x_m") and c[:-4] + "_y_m" in self.columns]
 
     def marker(self, name: str | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Positions (x_m, y_m) of one marker; NaN where it was not found."""
+        """Positions of one marker; NaN where it was not found.
+
+        Parameters
+        ----------
+        name : str, optional
+            The marker; default the table's only one.
+
+        Returns
+        -------
+        x_m, y_m : numpy.ndarray
+            Positions [m].
+
+        Raises
+        ------
+        locust.errors.CalibrationError
+            No such marker, or no name given and not exactly one marker.
+        """
         names = self.markers()
         if name is None:
             if len(names) != 1:
@@ -96,6 +133,7 @@ class Table:
             raise CalibrationError(exc.message, exc.hint) from None
 
     def time_s(self) -> np.ndarray:
+        """The ``t_s`` column [s] (a CalibrationError when there is none)."""
         (t,) = self.require("t_s", purpose="time")
         return t
 

@@ -22,6 +22,24 @@ from .servo import RateRecording, ServoRig, StepRecording, Timing, rig_model, si
 
 @dataclass(frozen=True)
 class BeamTruth:
+    """A cardstock cantilever with a mass dropped on its tip, filmed from the side (SYNTHETIC
+    truth for the beam fit).
+
+    Attributes
+    ----------
+    damping_ratio : float
+        The tip's damping ratio (no unit).
+    drop_height_m, drop_at_s : float
+        The mass's fall onto the tip [m] and when it lands [s].
+    fps : float
+        Frames per second of the camera.
+    noise_m : float
+        The track's noise, one standard deviation [m].
+    transient_m, transient_s, transient_hz : float
+        A release transient at the drop: its size [m], its decay to e^-3 [s], its ringing
+        frequency [Hz] (0: a decaying offset).
+    """
+
     mass_kg: float = 0.010
     length_m: float = 0.05
     hinge_stiffness_nm_per_rad: float = 0.056375      # the seed's value
@@ -39,18 +57,22 @@ class BeamTruth:
 
     @property
     def stiffness_n_per_m(self) -> float:
+        """The tip's stiffness, hinge stiffness / length² [N/m]."""
         return self.hinge_stiffness_nm_per_rad / self.length_m**2
 
     @property
     def damping_ns_per_m(self) -> float:
+        """The tip's damping from the damping ratio [N·s/m]."""
         return 2 * self.damping_ratio * math.sqrt(self.stiffness_n_per_m * self.mass_kg)
 
     @property
     def hinge_damping_nms_per_rad(self) -> float:
+        """The hinge's damping, tip damping × length² [N·m·s/rad]."""
         return self.damping_ns_per_m * self.length_m**2
 
     @property
     def natural_frequency_hz(self) -> float:
+        """The undamped natural frequency of the loaded tip [Hz]."""
         return math.sqrt(self.stiffness_n_per_m / self.mass_kg) / (2 * math.pi)
 
 
@@ -111,10 +133,12 @@ class ServoTruth:
 
     @property
     def rig(self) -> ServoRig:
+        """The rig the fit is given: load inertia, gravity moment, time step."""
         return ServoRig(self.inertia_kgm2, self.gravity_moment_nm, timestep_s=self.timestep_s)
 
     @property
     def duration_s(self) -> float:
+        """The recording's length: the first edge and every half period after it [s]."""
         return self.first_edge_s + self.edges * self.half_period_s
 
 
@@ -145,6 +169,7 @@ class GyroTruth:
 
     @property
     def rig(self) -> ServoRig:
+        """The rig the fit is given: the gyro board's inertia, no gravity moment."""
         return ServoRig(self.inertia_kgm2, timestep_s=self.timestep_s)
 
 
@@ -192,6 +217,19 @@ def servo_step(truth: ServoTruth, rng: np.random.Generator):
 
 @dataclass(frozen=True)
 class RampTruth:
+    """Tilt trials of a robot on a ramp (SYNTHETIC truth for the ramp fit).
+
+    Attributes
+    ----------
+    mu_static : float
+        The true static friction (no unit).
+    trials : int
+        Trials drawn.
+    scatter_deg, reading_deg : float
+        Trial-to-trial scatter of the critical angle and the inclinometer's reading error,
+        one standard deviation each [deg].
+    """
+
     mu_static: float = 1.7          # the seed's foot friction
     trials: int = 10
     scatter_deg: float = 0.8        # trial-to-trial scatter of the critical angle
@@ -199,10 +237,23 @@ class RampTruth:
 
     @property
     def critical_angle_deg(self) -> float:
+        """atan(mu_static) [deg]."""
         return math.degrees(math.atan(self.mu_static))
 
 
 def ramp_angles(truth: RampTruth, rng: np.random.Generator) -> np.ndarray:
+    """The trials' critical angles as read, to 0.1 deg (SYNTHETIC).
+
+    Parameters
+    ----------
+    truth : RampTruth
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    numpy.ndarray
+        ``truth.trials`` angles [deg].
+    """
     sd = math.hypot(truth.scatter_deg, truth.reading_deg)
     return np.round(truth.critical_angle_deg + rng.normal(0, sd, truth.trials), 1)
 
@@ -261,6 +312,7 @@ class HingeTruth:
 
     @property
     def gravity_moment_nm(self) -> float:
+        """The link's weight moment with it horizontal [N·m]; 0 out of plane."""
         return self.mass_kg * GRAVITY_M_PER_S2 * self.com_m if self.gravity == "in-plane" else 0.0
 
 
