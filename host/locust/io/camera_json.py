@@ -88,6 +88,7 @@ class CameraFile:
 
     @property
     def planes_y_m(self) -> dict[str, float]:
+        """Each marker's plane, its distance along the camera's depth axis y [m]."""
         return {n: p.plane_y_m for n, p in self.marker_planes.items()}
 
     def m_per_px_at(self, plane_y_m: float) -> float:

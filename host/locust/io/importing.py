@@ -68,6 +68,26 @@ class ImportOptions:
     @classmethod
     def parse(cls, units: str | None = "m", rename: Iterable[str] | Mapping[str, str] = (),
               mirror: bool = False) -> ImportOptions:
+        """The options checked, from the command line's spelling.
+
+        Parameters
+        ----------
+        units : {"m", "cm", "mm"} or None
+            The file's unit of length (None: metres).
+        rename : iterable of "OLD=NEW", or mapping OLD -> NEW
+            Marker renames.
+        mirror : bool
+            Flip x (a hop filmed going left).
+
+        Returns
+        -------
+        ImportOptions
+
+        Raises
+        ------
+        locust.errors.TrackError
+            An unknown unit or a malformed rename.
+        """
         return cls(parse_units(units), parse_rename(rename), bool(mirror))
 
     @property
@@ -77,6 +97,7 @@ class ImportOptions:
 
     @property
     def divisor(self) -> int:
+        """What a position in ``units`` is divided by to be in metres (1, 100 or 1000)."""
         return UNITS[self.units]
 
     def describe(self) -> str:

@@ -1,4 +1,4 @@
-"""``robot.toml``: the robot's parameters with their provenance, read and written here alone.
+r"""``robot.toml``: the robot's parameters with their provenance, read and written here alone.
 
 ``load_robot`` reads and checks a file into a :class:`~locust.params.Robot`; ``save_robot``
 writes one through a real TOML writer (tomlkit) and reads each write back before it replaces
@@ -7,7 +7,7 @@ command names (a preset or a file,
 with ``--set`` values on it). Given the file being replaced, it changes that document in place, so
 the comments and the layout a person gave it are kept; every string is escaped by tomlkit
 (control characters, quotes, backslashes, newlines), and a string Python holds but UTF-8
-cannot (a file name's undecodable byte, kept as a lone surrogate) is written as its ``\\udcXX``
+cannot (a file name's undecodable byte, kept as a lone surrogate) is written as its ``\udcXX``
 escape text.
 """
 

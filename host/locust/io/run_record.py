@@ -68,15 +68,27 @@ class HopSchedule:
 
     @property
     def phases(self) -> int:
+        """Phases commanded: a push and a wait per cycle."""
         return 2 * self.cycles
 
     @property
     def duration_s(self) -> float:
+        """The schedule's length, (push + wait) per cycle [s]."""
         return self.cycles * (self.push_ms + self.wait_ms) / 1000.0
 
 
 @dataclass(frozen=True)
 class Phase:
+    """One phase's start as commanded and as the firmware measured it (its clock, microseconds).
+
+    Attributes
+    ----------
+    cycle : int
+        The cycle it belongs to, from 0.
+    phase : str
+        ``push`` or ``wait``.
+    """
+
     cycle: int
     phase: str            # "push" or "wait"
     commanded_us: int     # commanded start, from the start of the hop (firmware clock)
@@ -84,21 +96,26 @@ class Phase:
 
     @property
     def error_us(self) -> int:
+        """Measured minus commanded start [µs]: positive late."""
         return self.measured_us - self.commanded_us
 
     @property
     def commanded_ms(self) -> float:
+        """The commanded start from the start of the hop [ms]."""
         return us_to_ms(self.commanded_us)
 
     @property
     def measured_ms(self) -> float:
+        """The measured start (the new PWM duty written) [ms]."""
         return us_to_ms(self.measured_us)
 
     @property
     def error_ms(self) -> float:
+        """Measured minus commanded start [ms]: positive late."""
         return us_to_ms(self.error_us)
 
     def to_dict(self) -> dict:
+        """The phase as ``run.json`` holds it, times in ms and µs."""
         return {
             "cycle": self.cycle,
             "phase": self.phase,
@@ -123,6 +140,17 @@ class Jitter:
 
 
 def jitter(phases: list[Phase]) -> Jitter | None:
+    """The start-time errors' statistics over ``phases``.
+
+    Parameters
+    ----------
+    phases : list of Phase
+
+    Returns
+    -------
+    Jitter or None
+        Mean, population standard deviation and extremes [ms], to 0.1 µs; None without phases.
+    """
     if not phases:
         return None
     errs = [p.error_ms for p in phases]
@@ -179,9 +207,11 @@ class BoardConfig:
 
     @property
     def on_defaults(self) -> bool:
+        """Whether the firmware ran on its defaults (its config.json had problems)."""
         return bool(self.problems)
 
     def to_dict(self) -> dict:
+        """The config as the run record's ``board`` holds it."""
         return {"chip": self.chip, "machine": self.machine, "left": asdict(self.left),
                 "right": asdict(self.right), "config_problems": list(self.problems)}
 
@@ -228,11 +258,13 @@ class RunRecord:
     board: BoardConfig | None = None     # pins, trims and chip read from the board before the hop
 
     def add_phase(self, phase: Phase) -> None:
+        """Record a phase once (a repeated report is dropped), keeping commanded order."""
         if all((p.cycle, p.phase) != (phase.cycle, phase.phase) for p in self.phases):
             self.phases.append(phase)
             self.phases.sort(key=lambda p: p.commanded_us)
 
     def to_dict(self) -> dict:
+        """The record as ``run.json`` holds it, with the phases' jitter."""
         j = jitter(self.phases)
         return {
             "status": self.status,

@@ -30,6 +30,17 @@ _FLOATS = {"flip_share", "distance_m", "max_nose_height_m", "nose_apex_max_m", "
 
 
 def columns(axis_names: list[str]) -> list[str]:
+    """``results.csv``'s header: ``design``, the varied names, then the result fields.
+
+    Parameters
+    ----------
+    axis_names : list of str
+        The varied parameters' dotted names, in order.
+
+    Returns
+    -------
+    list of str
+    """
     return ["design", *axis_names, *RESULT_FIELDS]
 
 
@@ -103,6 +114,7 @@ class StoredSweep:
     finished: bool                     # False: an interrupted sweep, some designs missing
 
     def column(self, name: str) -> list[Any]:
+        """One column's values over the rows, in file order."""
         return [row[name] for row in self.rows]
 
 
@@ -129,6 +141,20 @@ def read_results(folder: Path) -> StoredSweep:
 
 @dataclass
 class SweepStore:
+    """A sweep being written: its folder held under a lock, each finished design's row
+    appended to ``results.csv`` as it arrives, ``sweep.json`` rewritten atomically.
+
+    Attributes
+    ----------
+    folder : pathlib.Path
+    meta : dict
+        ``sweep.json``'s content.
+    axis_names : list of str
+        The varied names, in column order.
+    done : dict of int to dict
+        Design number -> its row, for the designs already written.
+    """
+
     folder: Path
     meta: dict[str, Any]
     axis_names: list[str]
@@ -138,6 +164,7 @@ class SweepStore:
 
     @property
     def results_path(self) -> Path:
+        """The folder's ``results.csv``."""
         return self.folder / RESULTS
 
     @classmethod
@@ -228,5 +255,6 @@ class SweepStore:
             self._lock_fd = None
 
     def write_meta(self, **extra: Any) -> None:
+        """Update ``sweep.json`` with ``extra`` and write it atomically."""
         self.meta.update(extra)
         atomic_write_json(self.folder / META, self.meta)

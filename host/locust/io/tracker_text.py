@@ -80,6 +80,7 @@ class TrackerExport:
 
     @property
     def n_rows(self) -> int:
+        """The longest track's number of rows."""
         lengths = [len(a) for t in self.tracks.values() for a in (t.t_s, t.x_m, t.y_m, *t.other.values())
                    if a is not None]
         return max(lengths, default=0)

@@ -93,6 +93,7 @@ class TracksCsv:
 
     @property
     def n_rows(self) -> int:
+        """The number of frames."""
         return len(self.t_s)
 
     @property

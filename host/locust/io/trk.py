@@ -86,6 +86,7 @@ class Calibration:
         return (self.origin_x_px, self.origin_y_px), (math.cos(a), -math.sin(a)), (-math.sin(a), -math.cos(a))
 
     def summary(self) -> str:
+        """The calibration in one line (scale in mm/px, origin in px, x axis in deg)."""
         if not math.isfinite(self.m_per_px):
             return "no scale given (--scale or --scale-aruco): the *_x_m/*_y_m columns are nan"
         return (f"scale {self.m_per_px * 1000:.5g} mm/px ({self.source}), origin ({self.origin_x_px:.2f}, "
@@ -109,6 +110,23 @@ class TrackerClip:
 
 @dataclass
 class TrackerProject:
+    """A Tracker project (``.trk``) as read or to be written.
+
+    Attributes
+    ----------
+    path : pathlib.Path
+        The project file.
+    video_path : str or None
+        The video as the project names it.
+    clip : TrackerClip
+    calibration : Calibration or None
+        Scale, origin and axes; None for a project written without one (a plane's homography).
+    points : dict of str to dict of int to (float, float)
+        Track name -> frame -> (px, py) in pixels, OpenCV's convention.
+    descriptions : dict of str to str
+        Track name -> its description in Tracker.
+    """
+
     path: Path
     video_path: str | None
     clip: TrackerClip
