@@ -25,6 +25,18 @@ _HOP = protocol.COMMANDS["hop"]   # argument -> (kind, lowest, highest, default)
 
 
 class Limit(NamedTuple):
+    """One parameter's admissible range, in the parameter's unit, and why.
+
+    Attributes
+    ----------
+    low, high : float
+        The bounds.
+    low_ok, high_ok : bool
+        Whether each bound itself is admissible (closed) or not (open).
+    reason : str
+        What the range stands for (e.g. "a link of a desk hopper"), shown when it is broken.
+    """
+
     low: float
     high: float
     low_ok: bool

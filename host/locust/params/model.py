@@ -196,15 +196,65 @@ class Robot:
 
     # -- dotted access ---------------------------------------------------------------
     def get(self, key: str) -> Any:
+        """A value by its dotted name.
+
+        Parameters
+        ----------
+        key : str
+            ``section.name``, e.g. ``geometry.leg_m`` (the unit is the name's suffix).
+
+        Returns
+        -------
+        Any
+            The value, in the unit its name says.
+
+        Raises
+        ------
+        locust.errors.ParamsError
+            Not a parameter of the model.
+        """
         section, name = split_key(key)
         return getattr(getattr(self, section), name)
 
     def source_of(self, key: str) -> Provenance:
+        """Where a value comes from (an empty :class:`Provenance` when not recorded).
+
+        Parameters
+        ----------
+        key : str
+            A dotted name.
+
+        Returns
+        -------
+        Provenance
+
+        Raises
+        ------
+        locust.errors.ParamsError
+            Not a parameter of the model.
+        """
         split_key(key)
         return self.provenance.get(key, Provenance())
 
     def with_values(self, values: dict[str, Any], source: str | Provenance = "override") -> Robot:
-        """A copy with ``values`` (dotted keys) replaced, each recorded with ``source``."""
+        """A copy with ``values`` replaced, each recorded with ``source``.
+
+        Parameters
+        ----------
+        values : dict of str to Any
+            Dotted name -> value, in the unit the name says (coerced to the field's type).
+        source : str or Provenance
+            Where the values come from.
+
+        Returns
+        -------
+        Robot
+
+        Raises
+        ------
+        locust.errors.ParamsError
+            An unknown name or a value of the wrong type.
+        """
         prov = source if isinstance(source, Provenance) else Provenance(source=source)
         sections = {name: getattr(self, name) for name in SECTIONS}
         provenance = dict(self.provenance)
@@ -215,13 +265,16 @@ class Robot:
         return replace(self, provenance=provenance, **sections)
 
     def with_provenance(self, key: str, prov: Provenance) -> Robot:
+        """A copy with ``key``'s provenance replaced (its value kept)."""
         split_key(key)
         return replace(self, provenance={**self.provenance, key: prov})
 
     def renamed(self, name: str) -> Robot:
+        """A copy named ``name``."""
         return replace(self, name=name)
 
     def link_lengths_m(self) -> tuple[float, float, float, float]:
+        """The four-bar's ground, crank, coupler and leg lengths [m]."""
         g = self.geometry
         return (g.ground_m, g.crank_m, g.coupler_m, g.leg_m)
 
@@ -235,10 +288,27 @@ UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s"})
 
 
 def all_keys() -> list[str]:
+    """Every parameter's dotted name, section by section in field order."""
     return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls)]
 
 
 def split_key(key: str) -> tuple[str, str]:
+    """A dotted name's section and field, checked.
+
+    Parameters
+    ----------
+    key : str
+        ``section.name``.
+
+    Returns
+    -------
+    section, name : str
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        Not a parameter of the model (the hint names close ones).
+    """
     section, _, name = key.partition(".")
     cls = SECTIONS.get(section)
     if cls is None or name not in {f.name for f in fields(cls)}:
