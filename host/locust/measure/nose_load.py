@@ -45,11 +45,22 @@ SLOPE_STEP_M = 0.001     # the slope of the load against the axis, by central di
 
 @dataclass(frozen=True)
 class GaussianValue:
+    """A measured value with a normal uncertainty, in the unit of the quantity it stands for.
+
+    Attributes
+    ----------
+    value : float
+        The estimate.
+    sd : float
+        One standard deviation.
+    """
+
     value: float
     sd: float                   # one standard deviation
 
     @property
     def ci95(self) -> tuple[float, float]:
+        """The normal 95% interval, value ± 1.96 sd."""
         return (self.value - Z95 * self.sd, self.value + Z95 * self.sd)
 
 
@@ -71,6 +82,8 @@ class NoseLoadResult:
     robot: Robot = field(repr=False, compare=False)
 
     def to_json(self) -> dict:
+        """The result as ``locust measure nose-load --json`` prints it (SI units, as the names say)."""
+
         def est(e: GaussianValue | None) -> dict | None:
             return None if e is None else {"value": e.value, "sd": e.sd, "ci95": list(e.ci95)}
 
