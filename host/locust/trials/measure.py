@@ -43,6 +43,19 @@ class Aligned:
 
 @dataclass(frozen=True)
 class MeasuredHop:
+    """One hop of a filmed trial, measured on the nose's track.
+
+    Attributes
+    ----------
+    hop : int
+        The hop's number, from 1.
+    distance_m : float
+        How far forward the nose's rest moved over that cycle [m]; NaN when the track does not
+        cover it.
+    apex_m : float
+        The nose's highest point in that cycle above where it stood [m]; NaN when not covered.
+    """
+
     hop: int
     distance_m: float        # nan when the track does not cover the cycle
     apex_m: float

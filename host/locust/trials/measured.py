@@ -55,6 +55,24 @@ class Track:
 
 @dataclass(frozen=True)
 class Trial:
+    """One filmed trial: its configuration, its track and its run record.
+
+    Attributes
+    ----------
+    config : str
+        The configuration's key (a leg set's name).
+    label : str
+        The short name tables show: the trial's folder.
+    track : Track or None
+        The nose's positions; None for a run without a track.
+    run_path : pathlib.Path or None
+        Its ``run.json``.
+    record : locust.io.run_record.RunRecord or None
+        The run record read.
+    config_from : str
+        How the configuration was known: given, from the run record, or from the folder's name.
+    """
+
     config: str
     label: str                       # short name shown in tables: the trial's folder
     track: Track | None
@@ -129,6 +147,32 @@ def config_of(path: Path) -> tuple[str, str]:
 
 def load_trial(path: Path, config: str, marker: str = "nose", imports: ImportOptions = AS_IS,
                config_from: str = CONFIG_GIVEN) -> Trial:
+    """One trial from a run folder, its ``run.json`` or a track file.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A folder (holding at most one ``*.tracks.csv`` and maybe a ``run.json``), a ``run.json``
+        or a track file.
+    config : str
+        Its configuration's key.
+    marker : str, default "nose"
+        The marker read from the track.
+    imports : locust.io.importing.ImportOptions
+        How the track is converted (``--units``, ``--rename``, ``--mirror``).
+    config_from : str
+        How ``config`` was known.
+
+    Returns
+    -------
+    Trial
+
+    Raises
+    ------
+    locust.errors.TrialError
+        No such path, several tracks or none where one is needed, or a track without the marker
+        in metres.
+    """
     _must_exist(path)
     run_path = _run_path(path)
     if path.is_dir():
