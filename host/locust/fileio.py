@@ -165,8 +165,8 @@ def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
 
 
 def storable(text: str) -> str:
-    """``text`` as UTF-8 (and a font) can hold it: a lone surrogate (an undecodable byte of a
-    file name, as Python keeps it) becomes its backslash escape, ``\\udcff``; every other
+    r"""``text`` as UTF-8 (and a font) can hold it: a lone surrogate (an undecodable byte of a
+    file name, as Python keeps it) becomes its backslash escape, ``\udcff``; every other
     character is kept."""
     return text.encode("utf-8", "backslashreplace").decode("utf-8")
 

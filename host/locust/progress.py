@@ -71,6 +71,8 @@ class Progress:
         return max(left, 0.0)
 
     def line(self) -> str:
+        """The progress as shown: label, bar (on a terminal), percent or count, time elapsed and
+        the time left once the rate is known."""
         parts = [self.label] if self.label else []
         if self.length:
             frac = min(self.pos / self.length, 1.0)
@@ -104,6 +106,8 @@ class Progress:
 
     # -- the click.progressbar interface ------------------------------------------------
     def update(self, n_steps: int = 1, current_item: Any = None) -> None:
+        """Count ``n_steps`` more steps done (``current_item`` is accepted as click's bar does,
+        and ignored)."""
         self.pos += n_steps
         self._latest_s = self.clock()
         if self._first is None and self.pos > 0:

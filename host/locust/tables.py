@@ -25,6 +25,7 @@ def mm(length_m: float, decimals: int = 2) -> str:
 
 
 def verdict(valid: bool) -> str:
+    """``valid`` or ``INVALID``, as the command line prints a simulation's audit."""
     return "valid" if valid else "INVALID"
 
 
