@@ -147,7 +147,22 @@ class SlipOnset:
 
 def board_length_warning(length_m: float, units: str = "m", source: str = "ramp") -> str | None:
     """A warning when the distance between the ramp's markers is not a board's, naming the
-    ``--units`` that would make it one."""
+    ``--units`` that would make it one.
+
+    Parameters
+    ----------
+    length_m : float
+        The markers' distance as read [m].
+    units : str
+        The ``--units`` the track was read in.
+    source : str
+        The recording's name, for the message.
+
+    Returns
+    -------
+    str or None
+        The warning; None for a plausible board (or a length that is not finite).
+    """
     low, high, typical = BOARD_M
     if not math.isfinite(length_m) or low <= length_m <= high:
         return None
@@ -158,7 +173,31 @@ def board_length_warning(length_m: float, units: str = "m", source: str = "ramp"
 def critical_angle_from_track(t_s: np.ndarray, ramp_a: tuple[np.ndarray, np.ndarray],
                               ramp_b: tuple[np.ndarray, np.ndarray], robot: tuple[np.ndarray, np.ndarray], *,
                               source: str = "ramp", min_slip_m: float = 0.005) -> SlipOnset:
-    """Ramp angle when the robot starts to slide, from a side-view track (see module doc)."""
+    """Ramp angle when the robot starts to slide, from a side-view track (see module doc).
+
+    Parameters
+    ----------
+    t_s : numpy.ndarray
+        Time [s].
+    ramp_a, ramp_b : tuple of numpy.ndarray
+        x and y [m] of the markers on the board's hinge end and far end.
+    robot : tuple of numpy.ndarray
+        x and y [m] of the robot's marker.
+    source : str
+        The recording's name, for messages.
+    min_slip_m : float, default 0.005
+        The slide along the board [m] that counts as the robot sliding.
+
+    Returns
+    -------
+    SlipOnset
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Fewer than 10 frames with all three markers, a board that does not tilt, or a robot
+        that never slides.
+    """
     t = np.asarray(t_s, dtype=float)
     ax, ay = ramp_a
     bx, by = ramp_b

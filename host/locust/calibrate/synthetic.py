@@ -84,6 +84,19 @@ def beam_tip_track(truth: BeamTruth, rng: np.random.Generator, tilt_deg: float =
     the drop leaves a release transient the oscillator does not explain (a finger or a
     higher mode of the strip): ``transient_m * exp(-3*tau/transient_s)``, times
     ``cos(2*pi*transient_hz*tau)`` when that is not 0, added along the tip's motion.
+
+    Parameters
+    ----------
+    truth : BeamTruth
+    rng : numpy.random.Generator
+        The noise's source.
+    tilt_deg : float, default 3
+        The camera's tilt [deg].
+
+    Returns
+    -------
+    t_s, x_m, y_m : numpy.ndarray
+        Time [s] and the tip's position in the camera's frame [m] (SYNTHETIC).
     """
     t = np.arange(int(truth.duration_s * truth.fps)) / truth.fps
     wn = 2 * math.pi * truth.natural_frequency_hz
@@ -175,7 +188,19 @@ class GyroTruth:
 
 def gyro_steps(truth: GyroTruth, rng: np.random.Generator):
     """(t_s, command_deg, rate_units): the rig model's speed at the samples, the horn at rest
-    between steps, plus noise, rounded."""
+    between steps, plus noise, rounded.
+
+    Parameters
+    ----------
+    truth : GyroTruth
+    rng : numpy.random.Generator
+        The noise's source.
+
+    Returns
+    -------
+    t_s, command_deg, rate_units : numpy.ndarray
+        Time [s], command [deg], the gyro's reading in whole counts (SYNTHETIC).
+    """
     duration = truth.first_edge_s + 2 * len(truth.steps_deg) * truth.level_s
     t = np.arange(int(duration / truth.sample_s)) * truth.sample_s
     level = np.floor((t - truth.first_edge_s) / truth.level_s).astype(int)
@@ -205,7 +230,19 @@ def _rest_deg(truth: ServoTruth) -> float:
 
 
 def servo_step(truth: ServoTruth, rng: np.random.Generator):
-    """(t_s, angle_deg, command_deg): the rig model stepped from rest, plus angle noise."""
+    """(t_s, angle_deg, command_deg): the rig model stepped from rest, plus angle noise.
+
+    Parameters
+    ----------
+    truth : ServoTruth
+    rng : numpy.random.Generator
+        The noise's source.
+
+    Returns
+    -------
+    t_s, angle_deg, command_deg : numpy.ndarray
+        Time [s], horn angle and command [deg] (SYNTHETIC).
+    """
     t = np.arange(int(truth.duration_s * truth.fps)) / truth.fps
     n_edges = np.clip(np.floor((t - truth.first_edge_s) / truth.half_period_s) + 1, 0, truth.edges)
     command = np.where(n_edges % 2 == 1, truth.target_deg, truth.start_deg)
@@ -261,7 +298,33 @@ def ramp_angles(truth: RampTruth, rng: np.random.Generator) -> np.ndarray:
 def ramp_tilt_track(truth: RampTruth, rng: np.random.Generator, *, fps: float = 60.0, rate_deg_per_s: float = 4.0,
                     board_m: float = 0.30, noise_m: float = 0.0005, mu_kinetic_ratio: float = 0.8):
     """One tilting trial filmed from the side: markers ``ramp_a`` (hinge end), ``ramp_b`` (far
-    end of the board) and ``robot``. Returns (t_s, {marker: (x_m, y_m)}, critical_angle_deg)."""
+    end of the board) and ``robot``. Returns (t_s, {marker: (x_m, y_m)}, critical_angle_deg).
+
+    Parameters
+    ----------
+    truth : RampTruth
+    rng : numpy.random.Generator
+        The noise's source.
+    fps : float, default 60
+        Frames per second.
+    rate_deg_per_s : float, default 4
+        How fast the board tilts [deg/s].
+    board_m : float, default 0.30
+        The distance between the board's markers [m].
+    noise_m : float, default 0.0005
+        The markers' noise, one standard deviation [m].
+    mu_kinetic_ratio : float, default 0.8
+        Sliding friction as a share of static friction.
+
+    Returns
+    -------
+    t_s : numpy.ndarray
+        Time [s].
+    markers : dict of str to (numpy.ndarray, numpy.ndarray)
+        Marker -> x and y [m] (SYNTHETIC).
+    critical_angle_deg : float
+        The true angle at which the robot starts to slide [deg].
+    """
     crit = truth.critical_angle_deg
     t = np.arange(int((crit + 8) / rate_deg_per_s * fps)) / fps
     theta = np.radians(rate_deg_per_s * t)
@@ -330,7 +393,19 @@ def hinge_swing_track(truth: HingeTruth, rng: np.random.Generator):
     I*theta'' = -k*(theta - theta0) - b*theta' - M*g*D*cos(theta) - tau_c*sign(theta') (gravity
     in plane only), integrated by an explicit Runge-Kutta method of order 8 (DOP853, relative
     tolerance 1e-11; the sign smoothed over 1e-4 rad/s): not the fit's own integrator.
-    Gaussian noise of ``noise_m`` on each coordinate."""
+    Gaussian noise of ``noise_m`` on each coordinate.
+
+    Parameters
+    ----------
+    truth : HingeTruth
+    rng : numpy.random.Generator
+        The noise's source.
+
+    Returns
+    -------
+    t_s, x, y : numpy.ndarray
+        Time [s] and the marker's position in ``truth.units`` (SYNTHETIC).
+    """
     t = np.arange(int(round(truth.duration_s * truth.fps))) / truth.fps
     k, b = truth.hinge_stiffness_nm_per_rad, truth.hinge_damping_nms_per_rad
     th0, mgd, inertia = math.radians(truth.neutral_angle_deg), truth.gravity_moment_nm, truth.inertia_kgm2

@@ -131,13 +131,38 @@ def _plate_from_weight(robot: Robot, total_kg: float, resolution_kg: float) -> G
 
 
 def prior_of(robot: Robot, key: str) -> GaussianValue | None:
-    """The robot file's own value and sd for ``key`` (None when it carries no sd)."""
+    """The robot file's own value and sd for ``key`` (None when it carries no sd).
+
+    Parameters
+    ----------
+    robot : Robot
+    key : str
+        A dotted name.
+
+    Returns
+    -------
+    GaussianValue or None
+        In the unit the name says.
+    """
     sd = robot.source_of(key).uncertainty
     return GaussianValue(robot.get(key), sd) if sd and math.isfinite(sd) and sd > 0 else None
 
 
 def combine(new: GaussianValue, prior: GaussianValue | None) -> GaussianValue:
-    """Two independent estimates of one value, weighted by their variances."""
+    """Two independent estimates of one value, weighted by their variances.
+
+    Parameters
+    ----------
+    new : GaussianValue
+        The new estimate.
+    prior : GaussianValue or None
+        The earlier one, in the same unit; None: ``new`` alone.
+
+    Returns
+    -------
+    GaussianValue
+        The inverse-variance weighted mean and its sd.
+    """
     if prior is None:
         return new
     w_new, w_prior = 1 / new.sd ** 2, 1 / prior.sd ** 2

@@ -265,12 +265,38 @@ class Robot:
         return replace(self, provenance=provenance, **sections)
 
     def with_provenance(self, key: str, prov: Provenance) -> Robot:
-        """A copy with ``key``'s provenance replaced (its value kept)."""
+        """A copy with ``key``'s provenance replaced (its value kept).
+
+        Parameters
+        ----------
+        key : str
+            A dotted name.
+        prov : Provenance
+            Its new source, uncertainty and note.
+
+        Returns
+        -------
+        Robot
+
+        Raises
+        ------
+        locust.errors.ParamsError
+            Not a parameter of the model.
+        """
         split_key(key)
         return replace(self, provenance={**self.provenance, key: prov})
 
     def renamed(self, name: str) -> Robot:
-        """A copy named ``name``."""
+        """A copy named ``name``.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        Robot
+        """
         return replace(self, name=name)
 
     def link_lengths_m(self) -> tuple[float, float, float, float]:
@@ -320,7 +346,17 @@ def split_key(key: str) -> tuple[str, str]:
 
 def value_type(key: str) -> str:
     """The type of a dotted key's value: ``"float"``, ``"int"``, ``"bool"`` or ``"str"``
-    (ParamsError for an unknown key)."""
+    (ParamsError for an unknown key).
+
+    Parameters
+    ----------
+    key : str
+        A dotted name.
+
+    Returns
+    -------
+    str
+    """
     section, name = split_key(key)
     ftype = {f.name: f.type for f in fields(SECTIONS[section])}[name]
     return ftype if isinstance(ftype, str) else ftype.__name__
@@ -376,7 +412,23 @@ def _coerce(key: str, raw: Any) -> Any:
 
 
 def parse_set_options(items: tuple[str, ...] | list[str]) -> dict[str, str]:
-    """``["geometry.leg_m=0.07", ...]`` -> ``{"geometry.leg_m": "0.07"}``, keys checked."""
+    """``["geometry.leg_m=0.07", ...]`` -> ``{"geometry.leg_m": "0.07"}``, keys checked.
+
+    Parameters
+    ----------
+    items : sequence of str
+        ``KEY=VALUE`` strings (the command line's ``--set``).
+
+    Returns
+    -------
+    dict of str to str
+        Dotted name -> the value's text (converted by :meth:`Robot.with_values`).
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        An item without ``=``, or an unknown name.
+    """
     out: dict[str, str] = {}
     for item in items:
         key, sep, value = item.partition("=")
@@ -389,7 +441,18 @@ def parse_set_options(items: tuple[str, ...] | list[str]) -> dict[str, str]:
 
 
 def shown_value(raw: Any) -> str:
-    """``raw`` as an error shows it: a table or a list by its kind, anything else by a short repr."""
+    """``raw`` as an error shows it: a table or a list by its kind, anything else by a short repr.
+
+    Parameters
+    ----------
+    raw : Any
+        A value as read from a file.
+
+    Returns
+    -------
+    str
+        At most 40 characters.
+    """
     if isinstance(raw, dict):
         return "a table"
     if isinstance(raw, list):
@@ -399,5 +462,15 @@ def shown_value(raw: Any) -> str:
 
 
 def as_dict(robot: Robot) -> dict[str, Any]:
-    """Plain nested dict of values (for JSON and hashing)."""
+    """Plain nested dict of values (for JSON and hashing).
+
+    Parameters
+    ----------
+    robot : Robot
+
+    Returns
+    -------
+    dict
+        ``name`` and, per section, its values by field name (units in the names).
+    """
     return {"name": robot.name, **{s: dataclasses.asdict(getattr(robot, s)) for s in SECTIONS}}

@@ -102,6 +102,21 @@ def name_from_path(path: Path) -> str:
     """A trial's configuration from where it lies: its folder's name less a trial number.
 
     ``hops/small/run.json`` -> small; ``hops/medium-2/`` -> medium; ``large_trial3/`` -> large.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A run folder, its ``run.json`` or a track file.
+
+    Returns
+    -------
+    str
+        The configuration's key.
+
+    Raises
+    ------
+    locust.errors.TrialError
+        No plain name left once the trial number is taken off.
     """
     folder = path if path.is_dir() else path.parent
     for part in (folder.name, folder.parent.name):
@@ -113,13 +128,39 @@ def name_from_path(path: Path) -> str:
 
 
 def sort_key(name: str) -> tuple[int, str]:
-    """Known leg sets in size order first, then the rest by name."""
+    """Known leg sets in size order first, then the rest by name.
+
+    Parameters
+    ----------
+    name : str
+        A configuration's key.
+
+    Returns
+    -------
+    tuple of (int, str)
+    """
     order = list(LEG_SETS)
     return (order.index(name), "") if name in order else (len(order), name)
 
 
 def parse_added(items: tuple[str, ...] | list[str]) -> dict[str, float]:
-    """``["v2=0.015"]`` -> ``{"v2": 0.015}`` (metres added to every link)."""
+    """``["v2=0.015"]`` -> ``{"v2": 0.015}`` (metres added to every link).
+
+    Parameters
+    ----------
+    items : sequence of str
+        ``NAME=METRES`` (the command line's ``--added``).
+
+    Returns
+    -------
+    dict of str to float
+        Configuration -> length added to every link [m].
+
+    Raises
+    ------
+    locust.errors.TrialError
+        An item that is not ``NAME=METRES``, or a name that is not plain.
+    """
     out: dict[str, float] = {}
     for item in items:
         name, sep, value = item.partition("=")
