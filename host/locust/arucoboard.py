@@ -56,7 +56,20 @@ class BoardSpec:
 
     def image(self, px_per_mm: float, margin_mm: float = BOARD_MARGIN_MM) -> np.ndarray:
         """The board drawn at ``px_per_mm``, with a white margin (grey levels, uint8): marker k
-        at column k % cols, row k // cols from the top, as ``cv2.aruco.GridBoard`` numbers them."""
+        at column k % cols, row k // cols from the top, as ``cv2.aruco.GridBoard`` numbers them.
+
+        Parameters
+        ----------
+        px_per_mm : float
+            Resolution [px/mm].
+        margin_mm : float
+            The white margin [mm].
+
+        Returns
+        -------
+        numpy.ndarray
+            2-D uint8.
+        """
         d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
         to_px = lambda mm: int(round(mm * px_per_mm))   # noqa: E731
         img = np.full((to_px(self.height_mm + 2 * margin_mm), to_px(self.width_mm + 2 * margin_mm)), 255, np.uint8)
@@ -71,7 +84,23 @@ class BoardSpec:
 
 
 def parse_board(text: str) -> BoardSpec:
-    """``aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM`` -> :class:`BoardSpec`."""
+    """``aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM`` -> :class:`BoardSpec`.
+
+    Parameters
+    ----------
+    text : str
+        e.g. ``aruco:4X4_50:5x7:30:6`` (sizes in mm).
+
+    Returns
+    -------
+    BoardSpec
+
+    Raises
+    ------
+    locust.errors.TrackError
+        Not that form, an unknown dictionary, too few markers or too many for the dictionary,
+        or sizes no printed board has.
+    """
     m = re.fullmatch(r"\s*aruco:(\w+):(\d+)[xX](\d+):(\d+(?:\.\d*)?):(\d+(?:\.\d*)?)\s*", text)
     hint = "e.g. --board aruco:4X4_50:5x4:40:10 (5 x 4 markers of 40 mm, 10 mm apart)"
     if not m:
