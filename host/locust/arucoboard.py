@@ -46,11 +46,21 @@ class BoardSpec:
         return self.rows * self.marker_mm + (self.rows - 1) * self.gap_mm
 
     def text(self) -> str:
-        """The board as the command line spells it: ``aruco:4X4_50:COLSxROWS:MARKER_MM:GAP_MM``."""
+        """The board as the command line spells it: ``aruco:4X4_50:COLSxROWS:MARKER_MM:GAP_MM``.
+
+        Returns
+        -------
+        str
+        """
         return f"aruco:{self.dictionary[5:]}:{self.cols}x{self.rows}:{self.marker_mm:g}:{self.gap_mm:g}"
 
     def board(self) -> cv2.aruco.GridBoard:
-        """OpenCV's grid board, its marker and gap in metres."""
+        """OpenCV's grid board, its marker and gap in metres.
+
+        Returns
+        -------
+        cv2.aruco.GridBoard
+        """
         d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
         return cv2.aruco.GridBoard((self.cols, self.rows), self.marker_mm / 1000.0, self.gap_mm / 1000.0, d)
 

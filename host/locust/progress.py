@@ -69,7 +69,13 @@ class Progress:
     # -- what is shown -------------------------------------------------------------------
     def eta_s(self) -> float | None:
         """Seconds left at the rate measured from the first step to the latest, less the time
-        since the latest; None until that rate means something."""
+        since the latest; None until that rate means something.
+
+        Returns
+        -------
+        float or None
+            [s].
+        """
         if self.length is None or self._first is None:
             return None
         t0, p0 = self._first
@@ -81,7 +87,12 @@ class Progress:
 
     def line(self) -> str:
         """The progress as shown: label, bar (on a terminal), percent or count, time elapsed and
-        the time left once the rate is known."""
+        the time left once the rate is known.
+
+        Returns
+        -------
+        str
+        """
         parts = [self.label] if self.label else []
         if self.length:
             frac = min(self.pos / self.length, 1.0)

@@ -65,7 +65,12 @@ class RampFit:
     notes: list[str] = field(default_factory=list)
 
     def summary(self) -> dict:
-        """Every figure of the fit, as ``locust calibrate ramp --json`` prints it."""
+        """Every figure of the fit, as ``locust calibrate ramp --json`` prints it.
+
+        Returns
+        -------
+        dict
+        """
         return {"experiment": "ramp", "source": self.source, "mu_static": self.mu_static.as_dict(),
                 "mean_angle_deg": self.mean_angle_deg, "std_angle_deg": self.std_angle_deg,
                 "n_trials": self.n_trials, "angles_deg": self.angles_deg, "resolution_deg": self.resolution_deg,

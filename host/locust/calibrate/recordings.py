@@ -104,7 +104,12 @@ class Table:
         return [self.columns[n] for n in names]
 
     def markers(self) -> list[str]:
-        """The markers with both ``<name>_x_m`` and ``<name>_y_m`` columns."""
+        """The markers with both ``<name>_x_m`` and ``<name>_y_m`` columns.
+
+        Returns
+        -------
+        list of str
+        """
         return [c[:-4] for c in self.columns if c.endswith("_x_m") and c[:-4] + "_y_m" in self.columns]
 
     def marker(self, name: str | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -143,7 +148,13 @@ class Table:
             raise CalibrationError(exc.message, exc.hint) from None
 
     def time_s(self) -> np.ndarray:
-        """The ``t_s`` column [s] (a CalibrationError when there is none)."""
+        """The ``t_s`` column [s] (a CalibrationError when there is none).
+
+        Returns
+        -------
+        numpy.ndarray
+            [s].
+        """
         (t,) = self.require("t_s", purpose="time")
         return t
 

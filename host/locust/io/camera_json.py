@@ -117,7 +117,12 @@ class CameraFile:
         return depth / float(self.K[0, 0])
 
     def to_dict(self) -> dict:
-        """The file's JSON document."""
+        """The file's JSON document.
+
+        Returns
+        -------
+        dict
+        """
         R, K = self.rotation, self.K
         out: dict = {"note": CAMERA_NOTE, "camera": self.camera, "width_px": self.width_px, "height_px": self.height_px}
         if self.fps is not None:

@@ -101,7 +101,12 @@ class ImportOptions:
         return UNITS[self.units]
 
     def describe(self) -> str:
-        """``cm -> m, renamed A -> nose, x mirrored``."""
+        """``cm -> m, renamed A -> nose, x mirrored``.
+
+        Returns
+        -------
+        str
+        """
         parts = [f"positions in {self.units}" + ("" if self.units == "m" else " -> m")]
         parts += [f"renamed {old} -> {new}" for old, new in self.rename]
         if self.mirror:
@@ -109,7 +114,12 @@ class ImportOptions:
         return ", ".join(parts)
 
     def options_text(self) -> str:
-        """The command-line options that give these settings (empty for the identity)."""
+        """The command-line options that give these settings (empty for the identity).
+
+        Returns
+        -------
+        str
+        """
         parts = [] if self.units == "m" else [f"--units {self.units}"]
         parts += [f"--rename {_quote(f'{old}={new}')}" for old, new in self.rename]
         return " ".join(parts + (["--mirror"] if self.mirror else []))

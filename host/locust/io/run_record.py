@@ -147,7 +147,12 @@ class Phase:
         return us_to_ms(self.error_us)
 
     def to_dict(self) -> dict:
-        """The phase as ``run.json`` holds it, times in ms and µs."""
+        """The phase as ``run.json`` holds it, times in ms and µs.
+
+        Returns
+        -------
+        dict
+        """
         return {
             "cycle": self.cycle,
             "phase": self.phase,
@@ -257,7 +262,12 @@ class BoardConfig:
         return bool(self.problems)
 
     def to_dict(self) -> dict:
-        """The config as the run record's ``board`` holds it."""
+        """The config as the run record's ``board`` holds it.
+
+        Returns
+        -------
+        dict
+        """
         return {"chip": self.chip, "machine": self.machine, "left": asdict(self.left),
                 "right": asdict(self.right), "config_problems": list(self.problems)}
 
@@ -332,7 +342,12 @@ class RunRecord:
             self.phases.sort(key=lambda p: p.commanded_us)
 
     def to_dict(self) -> dict:
-        """The record as ``run.json`` holds it, with the phases' jitter."""
+        """The record as ``run.json`` holds it, with the phases' jitter.
+
+        Returns
+        -------
+        dict
+        """
         j = jitter(self.phases)
         return {
             "status": self.status,

@@ -105,12 +105,23 @@ class TrackerExport:
         return self._labelled()[name]
 
     def markers_with_positions(self) -> list[str]:
-        """Tracks with both an ``x`` and a ``y`` column."""
+        """Tracks with both an ``x`` and a ``y`` column.
+
+        Returns
+        -------
+        list of str
+        """
         return [m for m, t in self.tracks.items() if t.x_m is not None and t.y_m is not None]
 
     def time_s(self) -> np.ndarray:
         """The time of each row: the tracks' ``t`` columns as one, which must agree where
-        two have a value; an export without ``t`` is refused."""
+        two have a value; an export without ``t`` is refused.
+
+        Returns
+        -------
+        numpy.ndarray
+            [s].
+        """
         times: list[np.ndarray] = []
         for t in self.tracks.values():
             if t.t_s is not None and not any(t.t_s is s for s in times):

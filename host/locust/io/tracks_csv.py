@@ -142,12 +142,23 @@ class TracksCsv:
         raise KeyError(name)
 
     def markers_with_positions(self) -> list[str]:
-        """Markers with both world columns in the file."""
+        """Markers with both world columns in the file.
+
+        Returns
+        -------
+        list of str
+        """
         cols = set(self.columns)
         return [m for m in self.markers if f"{m}_x_m" in cols and f"{m}_y_m" in cols]
 
     def time_s(self) -> np.ndarray:
-        """The ``t_s`` column; a file without one is refused."""
+        """The ``t_s`` column; a file without one is refused.
+
+        Returns
+        -------
+        numpy.ndarray
+            [s].
+        """
         if "t_s" not in self.columns:
             raise missing_time(self.path, self.columns)
         return self.t_s

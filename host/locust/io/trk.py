@@ -94,19 +94,37 @@ class Calibration:
         return x, y
 
     def axes_px(self) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float]]:
-        """World origin in pixels, and the on-screen unit directions of the world x and y axes."""
+        """World origin in pixels, and the on-screen unit directions of the world x and y axes.
+
+        Returns
+        -------
+        origin_px : (float, float)
+            The world origin [px].
+        x_axis, y_axis : (float, float)
+            Unit directions on screen.
+        """
         a = math.radians(self.angle_deg)
         return (self.origin_x_px, self.origin_y_px), (math.cos(a), -math.sin(a)), (-math.sin(a), -math.cos(a))
 
     def summary(self) -> str:
-        """The calibration in one line (scale in mm/px, origin in px, x axis in deg)."""
+        """The calibration in one line (scale in mm/px, origin in px, x axis in deg).
+
+        Returns
+        -------
+        str
+        """
         if not math.isfinite(self.m_per_px):
             return "no scale given (--scale or --scale-aruco): the *_x_m/*_y_m columns are nan"
         return (f"scale {self.m_per_px * 1000:.5g} mm/px ({self.source}), origin ({self.origin_x_px:.2f}, "
                 f"{self.origin_y_px:.2f}) px, x axis {self.angle_deg:g} deg")
 
     def as_dict(self) -> dict:
-        """For the JSON sidecar (no scale: ``m_per_px`` nan, written ``null``)."""
+        """For the JSON sidecar (no scale: ``m_per_px`` nan, written ``null``).
+
+        Returns
+        -------
+        dict
+        """
         return asdict(self)
 
 

@@ -82,7 +82,12 @@ class NoseLoadResult:
     robot: Robot = field(repr=False, compare=False)
 
     def to_json(self) -> dict:
-        """The result as ``locust measure nose-load --json`` prints it (SI units, as the names say)."""
+        """The result as ``locust measure nose-load --json`` prints it (SI units, as the names say).
+
+        Returns
+        -------
+        dict
+        """
 
         def est(e: GaussianValue | None) -> dict | None:
             return None if e is None else {"value": e.value, "sd": e.sd, "ci95": list(e.ci95)}

@@ -77,11 +77,21 @@ class StanceResult:
 
     def values(self) -> dict[str, Estimate]:
         """The robot values the photos determine: crank start [deg], ground angle [deg] and
-        servo axis [m], by dotted name."""
+        servo axis [m], by dotted name.
+
+        Returns
+        -------
+        dict of str to locust.calibrate.fitstats.Estimate
+        """
         return dict(zip(STANCE_KEYS, (self.crank_start_deg, self.ground_angle_deg, self.servo_axis_x_m)))
 
     def to_json(self) -> dict:
-        """The result as ``locust measure stance --json`` prints it (units as the names say)."""
+        """The result as ``locust measure stance --json`` prints it (units as the names say).
+
+        Returns
+        -------
+        dict
+        """
         return {"crank_start_deg": self.crank_start_deg.as_dict(), "ground_angle_deg": self.ground_angle_deg.as_dict(),
                 "servo_axis_x_m": self.servo_axis_x_m.as_dict(), "rest_pitch_deg": self.rest_pitch_deg.as_dict(),
                 "push_turn_deg": None if self.push_turn_deg is None else self.push_turn_deg.as_dict(),

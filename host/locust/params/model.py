@@ -300,12 +300,24 @@ class Robot:
         return replace(self, name=name)
 
     def link_lengths_m(self) -> tuple[float, float, float, float]:
-        """The four-bar's ground, crank, coupler and leg lengths [m]."""
+        """The four-bar's ground, crank, coupler and leg lengths [m].
+
+        Returns
+        -------
+        tuple of float
+            [m].
+        """
         g = self.geometry
         return (g.ground_m, g.crank_m, g.coupler_m, g.leg_m)
 
     def flat(self) -> dict[str, Any]:
-        """Every value by its dotted name."""
+        """Every value by its dotted name.
+
+        Returns
+        -------
+        dict of str to Any
+            Each value in the unit its name says.
+        """
         return {key: self.get(key) for key in all_keys()}
 
 
@@ -314,7 +326,12 @@ UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s"})
 
 
 def all_keys() -> list[str]:
-    """Every parameter's dotted name, section by section in field order."""
+    """Every parameter's dotted name, section by section in field order.
+
+    Returns
+    -------
+    list of str
+    """
     return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls)]
 
 
@@ -363,7 +380,12 @@ def value_type(key: str) -> str:
 
 
 def real_keys() -> list[str]:
-    """Every real-valued key (the ones a fit or a draw can move), in file order."""
+    """Every real-valued key (the ones a fit or a draw can move), in file order.
+
+    Returns
+    -------
+    list of str
+    """
     return [key for key in all_keys() if value_type(key) == "float"]
 
 
@@ -373,7 +395,12 @@ PHYSICAL_SECTIONS = ("geometry", "compliance", "servo", "contact", "power")
 
 
 def fittable_keys() -> list[str]:
-    """The real-valued physical keys: the only ones a fit may move."""
+    """The real-valued physical keys: the only ones a fit may move.
+
+    Returns
+    -------
+    list of str
+    """
     return [key for key in real_keys() if key.partition(".")[0] in PHYSICAL_SECTIONS]
 
 
