@@ -185,7 +185,11 @@ def calibrate_beam(tracks: PathLike, mass_kg: float, *, length_m: float | None =
     start_s, end_s : float, optional
         The fit window (default: from the first swing after the drop to the end).
     units : {"m", "cm", "mm"}
-        The track's unit. ``imports`` and ``timing``: the command line's options, parsed.
+        The track's unit.
+    imports : locust.io.importing.ImportOptions, optional
+        ``--units``, ``--rename``, ``--mirror`` already parsed (instead of ``units``).
+    timing : locust.calibrate.recordings.TimeOptions
+        ``--time-scale`` / ``--clip-fps``: a slow-motion recording back on real time.
 
     Returns
     -------
@@ -241,8 +245,18 @@ def calibrate_hinge(tracks: PathLike, inertia_kgm2: float, gravity: str, *, mass
         With ``gravity="in-plane"``: the link's mass and hinge-to-centre-of-mass distance.
     pivot : (x, y), optional
         The hinge in the track's metres, held fixed (default: fitted).
+    marker : str, optional
+        The link's marker (default: the only one).
+    start_s, end_s : float, optional
+        The fit window [s] (default: from the first turning point after the release to the end).
     coulomb : {"auto", "off", "on"}
         Coulomb friction: fitted only when the swing shows it (auto).
+    units : {"m", "cm", "mm"}
+        The track's unit.
+    imports : locust.io.importing.ImportOptions, optional
+        The track's options already parsed (instead of ``units``).
+    timing : locust.calibrate.recordings.TimeOptions
+        The slow-motion time scale.
 
     Returns
     -------
@@ -288,8 +302,14 @@ def calibrate_servo(recordings: PathLike | Sequence[PathLike], inertia_kgm2: flo
         From a stall test or the datasheet (SG90: about 0.15); splits what one load gives.
     kv_nms_per_rad : float, default 0
         Velocity feedback held at this value (unless ``fit_kv``).
+    fit_kv : bool, default False
+        Fit the velocity feedback as well.
     gravity_moment_nm : float or list of float, default 0
         The load's weight moment with the horn horizontal: once, or once per recording.
+    timing : locust.calibrate.recordings.TimeOptions
+        The slow-motion time scale of filmed recordings.
+    progress : callable, optional
+        Called with each progress line of the fit.
 
     Returns
     -------
@@ -368,6 +388,16 @@ def calibrate_ramp(data: PathLike | Sequence[PathLike] | np.ndarray, *, into: st
         (markers ``ramp_markers`` on the board's ends and ``robot_marker``), or the angles.
     into : {"foot", "nose"}
         Which friction the result is: ``contact.foot_friction`` or ``contact.nose_friction``.
+    ramp_markers : str
+        ``A,B``: a track's markers on the board's hinge end and far end.
+    robot_marker : str
+        A track's marker on the robot.
+    units : {"m", "cm", "mm"}
+        A track's unit.
+    imports : locust.io.importing.ImportOptions, optional
+        A track's options already parsed (instead of ``units``).
+    timing : locust.calibrate.recordings.TimeOptions
+        The slow-motion time scale of a filmed track.
     resolution_deg : float, default 1.0
         How finely each angle was read (a protractor's 1 degree graduation): the trials' spread
         is taken as at least ``resolution_deg / sqrt(12)``, so trials read alike still give an

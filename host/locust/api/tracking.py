@@ -234,6 +234,8 @@ def track_markers(video: str | Path, markers: Mapping[str, str] | Sequence[str] 
         clip's timing and calibration, one point mass per marker (``--trk`` of the command).
     overwrite : bool, default False
         Replace an existing ``trk`` file; otherwise it is refused.
+    progress : callable, optional
+        Called with 1 after each frame.
 
     Returns
     -------
