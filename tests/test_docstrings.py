@@ -83,17 +83,36 @@ def test_public_definitions_have_docstrings(package, files):
 
 
 def api_functions():
-    """Each public module-level function of ``locust.api`` and its docstring."""
+    """Each public module-level function of ``locust.api``: its docstring and its arguments."""
     for path in modules_of("api"):
         for node in ast.parse(path.read_text(), str(path)).body:
             if isinstance(node, ast.FunctionDef) and not node.name.startswith("_"):
-                yield pytest.param(ast.get_docstring(node) or "", id=f"{path.stem}.{node.name}")
+                a = node.args
+                names = [x.arg for x in a.posonlyargs + a.args + a.kwonlyargs]
+                names += [x.arg for x in (a.vararg, a.kwarg) if x is not None]
+                yield pytest.param(ast.get_docstring(node) or "", names, id=f"{path.stem}.{node.name}")
 
 
-@pytest.mark.parametrize("doc", list(api_functions()))
-def test_api_functions_have_numpydoc_sections(doc):
+def documented_parameters(doc: str) -> set[str]:
+    """The names a numpydoc ``Parameters`` section documents (``a, b : float`` names two)."""
+    match = re.search(r"^Parameters\n-+\n(.*?)(?:^\w+\n-+$|\Z)", doc, re.M | re.S)
+    if not match:
+        return set()
+    heads = [line.split(" : ")[0] for line in match.group(1).splitlines() if line and not line[0].isspace()]
+    return {name.strip().lstrip("*") for head in heads for name in head.split(",")}
+
+
+@pytest.mark.parametrize(("doc", "arguments"), list(api_functions()))
+def test_api_functions_have_numpydoc_sections(doc, arguments):
     for section in ("Parameters", "Returns"):
         assert re.search(rf"^{section}\n-{{{len(section)}}}$", doc, re.M), f"no {section} section"
+    assert sorted(set(arguments) - documented_parameters(doc)) == [], "arguments not in Parameters"
+
+
+def test_documented_parameters_reads_numpydoc():
+    doc = "Sum.\n\nParameters\n----------\na, b : float\n    Lengths [m].\n*rest\n\nReturns\n-------\nfloat\n"
+    assert documented_parameters(doc) == {"a", "b", "rest"}
+    assert documented_parameters("Sum.\n\nReturns\n-------\nfloat\n") == set()
 
 
 def test_every_exported_api_function_is_checked():
