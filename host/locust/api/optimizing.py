@@ -93,8 +93,9 @@ def optimize(robot: Robot, vary: Mapping[str, tuple[float, float] | str] | Seque
     Examples
     --------
     >>> import locust, tempfile
-    >>> res = locust.optimize(locust.robot("small"), {"schedule.push_s": (0.15, 0.4)}, trials=3,
-    ...                       cycles=1, out=tempfile.mkdtemp() + "/opt")
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     res = locust.optimize(locust.robot("small"), {"schedule.push_s": (0.15, 0.4)}, trials=3,
+    ...                           cycles=1, out=folder + "/opt")
     >>> res.trials, res.complete, res.pruned
     (3, 3, 0)
     """
