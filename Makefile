@@ -2,6 +2,8 @@
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 PYTHON ?= python3
+# the modules whose >>> examples run in `make test`, from this folder (they read calibration/recordings)
+DOCTESTS := host/locust/api
 export MUJOCO_GL ?= osmesa
 export PYOPENGL_PLATFORM ?= osmesa
 
@@ -29,6 +31,7 @@ demo: install sysdeps
 test: install sysdeps
 	$(VENV)/bin/ruff check host tests bench
 	$(PY) -m pytest -q; rc=$$?; [ $$rc -eq 5 ] && { echo "no tests collected"; exit 0; }; exit $$rc
+	$(PY) -m pytest -q --doctest-modules $(DOCTESTS); rc=$$?; [ $$rc -eq 5 ] && { echo "no doctests collected"; exit 0; }; exit $$rc
 
 # Everything, including the slow system tests.
 test-all: install sysdeps

@@ -37,22 +37,49 @@ class BoardSpec:
 
     @property
     def width_mm(self) -> float:
+        """The printed grid's width, markers and gaps [mm]."""
         return self.cols * self.marker_mm + (self.cols - 1) * self.gap_mm
 
     @property
     def height_mm(self) -> float:
+        """The printed grid's height, markers and gaps [mm]."""
         return self.rows * self.marker_mm + (self.rows - 1) * self.gap_mm
 
     def text(self) -> str:
+        """The board as the command line spells it: ``aruco:4X4_50:COLSxROWS:MARKER_MM:GAP_MM``.
+
+        Returns
+        -------
+        str
+        """
         return f"aruco:{self.dictionary[5:]}:{self.cols}x{self.rows}:{self.marker_mm:g}:{self.gap_mm:g}"
 
     def board(self) -> cv2.aruco.GridBoard:
+        """OpenCV's grid board, its marker and gap in metres.
+
+        Returns
+        -------
+        cv2.aruco.GridBoard
+        """
         d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
         return cv2.aruco.GridBoard((self.cols, self.rows), self.marker_mm / 1000.0, self.gap_mm / 1000.0, d)
 
     def image(self, px_per_mm: float, margin_mm: float = BOARD_MARGIN_MM) -> np.ndarray:
         """The board drawn at ``px_per_mm``, with a white margin (grey levels, uint8): marker k
-        at column k % cols, row k // cols from the top, as ``cv2.aruco.GridBoard`` numbers them."""
+        at column k % cols, row k // cols from the top, as ``cv2.aruco.GridBoard`` numbers them.
+
+        Parameters
+        ----------
+        px_per_mm : float
+            Resolution [px/mm].
+        margin_mm : float
+            The white margin [mm].
+
+        Returns
+        -------
+        numpy.ndarray
+            2-D uint8.
+        """
         d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
         to_px = lambda mm: int(round(mm * px_per_mm))   # noqa: E731
         img = np.full((to_px(self.height_mm + 2 * margin_mm), to_px(self.width_mm + 2 * margin_mm)), 255, np.uint8)
@@ -67,7 +94,23 @@ class BoardSpec:
 
 
 def parse_board(text: str) -> BoardSpec:
-    """``aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM`` -> :class:`BoardSpec`."""
+    """``aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM`` -> :class:`BoardSpec`.
+
+    Parameters
+    ----------
+    text : str
+        e.g. ``aruco:4X4_50:5x7:30:6`` (sizes in mm).
+
+    Returns
+    -------
+    BoardSpec
+
+    Raises
+    ------
+    locust.errors.TrackError
+        Not that form, an unknown dictionary, too few markers or too many for the dictionary,
+        or sizes no printed board has.
+    """
     m = re.fullmatch(r"\s*aruco:(\w+):(\d+)[xX](\d+):(\d+(?:\.\d*)?):(\d+(?:\.\d*)?)\s*", text)
     hint = "e.g. --board aruco:4X4_50:5x4:40:10 (5 x 4 markers of 40 mm, 10 mm apart)"
     if not m:

@@ -26,6 +26,18 @@ def write_target(path: str | os.PathLike) -> Path:
 
     Refuses (:class:`WriteError`) what a write must never replace: a device, a folder, a pipe or
     any other non-regular file, and a file its owner made read-only.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    locust.errors.WriteError
     """
     path = Path(path)
     if path.is_symlink():
@@ -47,7 +59,16 @@ def write_target(path: str | os.PathLike) -> Path:
 
 def refuse_read_only_folder(folder: Path) -> None:
     """:class:`WriteError` when ``folder`` exists and its mode gives no one write access: someone
-    else's data (as root the kernel would allow the write; the mode says what its owner meant)."""
+    else's data (as root the kernel would allow the write; the mode says what its owner meant).
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+
+    Raises
+    ------
+    locust.errors.WriteError
+    """
     try:
         mode = folder.stat().st_mode
     except OSError:
@@ -59,7 +80,21 @@ def refuse_read_only_folder(folder: Path) -> None:
 
 def make_folder(folder: str | os.PathLike) -> Path:
     """``mkdir -p`` that says what went wrong (:class:`WriteError`) and writes into no read-only
-    folder: the nearest existing ancestor's mode decides, as for files."""
+    folder: the nearest existing ancestor's mode decides, as for files.
+
+    Parameters
+    ----------
+    folder : path-like
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    locust.errors.WriteError
+        A file in the way, a read-only ancestor, or an OS error.
+    """
     folder = Path(folder)
     existing = folder
     while not existing.exists() and existing.parent != existing:
@@ -81,6 +116,21 @@ def temp_beside(path: str | os.PathLike, suffix: str = ".tmp") -> tuple[int, str
     Write it, then ``os.replace`` it onto ``path``: the rename is what makes a write atomic.
     Its name, ``.NAME.PID.XXXXXXXX<suffix>``, carries the writer's process id: temporaries of
     the same ``path`` left by a writer that no longer runs (killed with -9) are removed first.
+
+    Parameters
+    ----------
+    path : path-like
+        The file the temporary will replace.
+    suffix : str
+
+    Returns
+    -------
+    fd : int
+    name : str
+
+    Raises
+    ------
+    locust.errors.WriteError
     """
     path = Path(path)
     make_folder(path.parent)
@@ -112,7 +162,16 @@ def _pid_alive(pid: int) -> bool:
 def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
     """Remove the temporaries :func:`temp_beside` made for ``path`` whose writer process is
     gone (a kill -9 leaves them; a rerun writing the same ``path`` clears them). Only names
-    of exactly that form, regular files, are touched. Returns what was removed."""
+    of exactly that form, regular files, are touched. Returns what was removed.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    list of pathlib.Path
+    """
     path = Path(path)
     pattern = re.compile(rf"\.{re.escape(path.name)}\.(\d{{1,10}})\.[a-z0-9_]{{8}}(\.[A-Za-z0-9]{{1,8}})?")
     removed = []
@@ -149,7 +208,21 @@ def unwind_on_termination() -> None:
 def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
     """Raise :class:`WriteError` unless the video just encoded at ``tmp`` (for ``path``) reads
     back with its ``frames`` frames: OpenCV's writer ignores a failed write (a full disk) and
-    leaves a truncated file no player opens."""
+    leaves a truncated file no player opens.
+
+    Parameters
+    ----------
+    tmp : path-like
+        The encoded video.
+    frames : int
+        The frames written.
+    path : pathlib.Path
+        The video's final path, for the message.
+
+    Raises
+    ------
+    locust.errors.WriteError
+    """
     if frames == 0:
         return
     import cv2
@@ -165,14 +238,33 @@ def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
 
 
 def storable(text: str) -> str:
-    """``text`` as UTF-8 (and a font) can hold it: a lone surrogate (an undecodable byte of a
-    file name, as Python keeps it) becomes its backslash escape, ``\\udcff``; every other
-    character is kept."""
+    r"""``text`` as UTF-8 (and a font) can hold it: a lone surrogate (an undecodable byte of a
+    file name, as Python keeps it) becomes its backslash escape, ``\udcff``; every other
+    character is kept.
+
+    Parameters
+    ----------
+    text : str
+
+    Returns
+    -------
+    str
+    """
     return text.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 def write_error(path: str | os.PathLike, exc: OSError) -> WriteError:
-    """The :class:`WriteError` for an ``OSError`` met writing ``path``; a full disk says so."""
+    """The :class:`WriteError` for an ``OSError`` met writing ``path``; a full disk says so.
+
+    Parameters
+    ----------
+    path : path-like
+    exc : OSError
+
+    Returns
+    -------
+    locust.errors.WriteError
+    """
     if exc.errno in (errno.ENOSPC, errno.EDQUOT):
         return WriteError(f"{path}: the disk is full ({exc.strerror}); nothing was replaced",
                           "free some space on that disk (or write elsewhere) and run the command again")
@@ -246,6 +338,22 @@ def locked(path: str | os.PathLike, wait_s: float = 60.0) -> Iterator[Path]:
     ``wait_s`` seconds of waiting it is :class:`WriteError`. What :func:`write_target` refuses
     is refused first, before any lock file is made. The lock file is removed as the lock is
     released; a waiter that then holds the removed file's lock sees so and locks the new one.
+
+    Parameters
+    ----------
+    path : path-like
+    wait_s : float
+        How long to wait for another holder [s].
+
+    Yields
+    ------
+    pathlib.Path
+        The file a write to ``path`` lands on (:func:`write_target`).
+
+    Raises
+    ------
+    locust.errors.WriteError
+        Waited ``wait_s`` in vain, or a target :func:`write_target` refuses.
     """
     path = write_target(path)
     make_folder(path.parent)
@@ -295,7 +403,16 @@ def _flock_until(fd: int, deadline: float, path: Path, wait_s: float) -> None:
 def try_lock(path: str | os.PathLike) -> int | None:
     """An open descriptor of ``path`` (a folder, or a lock file made if missing) holding an
     exclusive ``flock`` on it; None at once when another process holds one. Close the
-    descriptor to release it (a process that dies releases it too)."""
+    descriptor to release it (a process that dies releases it too).
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    int or None
+    """
     flags = os.O_RDONLY | os.O_DIRECTORY if os.path.isdir(path) else os.O_RDWR | os.O_CREAT
     fd = os.open(path, flags | os.O_CLOEXEC, 0o644)
     try:
@@ -307,7 +424,21 @@ def try_lock(path: str | os.PathLike) -> int | None:
 
 
 def claim_folder(folder: str | os.PathLike) -> int:
-    """:func:`try_lock` of ``folder``, or :class:`WriteError` when another process writes there now."""
+    """:func:`try_lock` of ``folder``, or :class:`WriteError` when another process writes there now.
+
+    Parameters
+    ----------
+    folder : path-like
+
+    Returns
+    -------
+    int
+        The lock's descriptor.
+
+    Raises
+    ------
+    locust.errors.WriteError
+    """
     fd = try_lock(folder)
     if fd is None:
         raise WriteError(f"another process is writing in {folder} now; refusing to share it",
@@ -316,19 +447,59 @@ def claim_folder(folder: str | os.PathLike) -> int:
 
 
 def atomic_write_text(path: str | os.PathLike, text: str, **kwargs) -> Path:
-    """:func:`atomic_write_bytes` of ``text`` in UTF-8 (``check``, ``exclusive`` as there)."""
+    """:func:`atomic_write_bytes` of ``text`` in UTF-8 (``check``, ``exclusive`` as there).
+
+    Parameters
+    ----------
+    path : path-like
+    text : str
+    **kwargs
+        ``check``, ``exclusive``.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    locust.errors.WriteError
+    """
     return atomic_write_bytes(path, text.encode("utf-8"), **kwargs)
 
 
 def atomic_write_json(path: str | os.PathLike, obj: Any) -> Path:
-    """Write ``obj`` as strict JSON (:func:`json_text`), atomically."""
+    """Write ``obj`` as strict JSON (:func:`json_text`), atomically.
+
+    Parameters
+    ----------
+    path : path-like
+    obj : Any
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    locust.errors.WriteError
+    """
     return atomic_write_text(path, json_text(obj))
 
 
 def json_text(obj: Any) -> str:
     """Strict JSON, indented, with a final newline: the one place where a number that JSON
     cannot hold (NaN, +-inf: an undetermined figure) becomes ``null``, numpy values become
-    plain ones and paths strings. Every JSON file and every ``--json`` output goes through it."""
+    plain ones and paths strings. Every JSON file and every ``--json`` output goes through it.
+
+    Parameters
+    ----------
+    obj : Any
+
+    Returns
+    -------
+    str
+    """
     return json.dumps(_strict(obj), indent=2, allow_nan=False) + "\n"
 
 
@@ -358,6 +529,21 @@ def unique_dir(parent: str | os.PathLike, stem: str) -> Path:
     """Create and return a new directory ``parent/stem`` (or ``stem-2``, ``stem-3``…).
 
     Never returns a directory that already existed: results are never overwritten.
+
+    Parameters
+    ----------
+    parent : path-like
+    stem : str
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    locust.errors.WriteError
+    FileExistsError
+        Every suffixed name taken.
     """
     parent = make_folder(parent)
     try:
@@ -378,7 +564,17 @@ def check_distinct(outputs: dict[str, str | os.PathLike | None],
     """Before anything is written: every output of one command is its own file, and none is
     one of its inputs (:class:`WriteError`). ``outputs``: by the option that names each
     (``--plot``, ``--write``; None: not written). Paths are compared resolved (links followed,
-    ``./`` and ``..`` removed), so two spellings of one file are one file."""
+    ``./`` and ``..`` removed), so two spellings of one file are one file.
+
+    Parameters
+    ----------
+    outputs : dict of str to path-like or None
+    inputs : sequence of path-like
+
+    Raises
+    ------
+    locust.errors.WriteError
+    """
     read = {os.path.realpath(p): Path(p) for p in inputs}
     written: dict[str, str] = {}
     for option, path in outputs.items():

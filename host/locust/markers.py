@@ -29,5 +29,16 @@ STICKER_COLOURS: dict[str, tuple[str, str]] = {
 
 
 def hex_to_rgb01(hex_colour: str) -> tuple[float, float, float]:
+    """A ``#RRGGBB`` colour as red, green and blue, each 0..1.
+
+    Parameters
+    ----------
+    hex_colour : str
+        ``#RRGGBB`` (the ``#`` optional).
+
+    Returns
+    -------
+    tuple of float
+    """
     h = hex_colour.lstrip("#")
     return tuple(int(h[i:i + 2], 16) / 255.0 for i in (0, 2, 4))  # type: ignore[return-value]

@@ -23,7 +23,12 @@ _PR_SET_PDEATHSIG = 1
 def die_with_parent(parent_pid: int) -> None:
     """In a child: be killed when ``parent_pid`` dies, however it dies (kill -9, out of memory).
 
-    Elsewhere than Linux nothing happens (the parent's own shutdown then has to do it)."""
+    Elsewhere than Linux nothing happens (the parent's own shutdown then has to do it).
+
+    Parameters
+    ----------
+    parent_pid : int
+    """
     if _PRCTL is None:
         return
     _PRCTL(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)

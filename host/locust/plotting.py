@@ -35,7 +35,19 @@ def pyplot():
 
 
 def figure_bytes(fig, fmt: str = "png", dpi: int = 110) -> bytes:
-    """The figure in ``fmt`` (png, svg, pdf), marked as this toolkit's; the figure is closed."""
+    """The figure in ``fmt`` (png, svg, pdf), marked as this toolkit's; the figure is closed.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    fmt : str
+    dpi : int
+        Dots per inch.
+
+    Returns
+    -------
+    bytes
+    """
     from matplotlib.text import Text
 
     from .fileio import storable
@@ -50,12 +62,31 @@ def figure_bytes(fig, fmt: str = "png", dpi: int = 110) -> bytes:
 
 
 def png_bytes(fig, dpi: int = 110) -> bytes:
-    """The figure as PNG bytes; the figure is closed."""
+    """The figure as PNG bytes; the figure is closed.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    dpi : int
+
+    Returns
+    -------
+    bytes
+    """
     return figure_bytes(fig, "png", dpi)
 
 
 def is_own_figure(path: str | Path) -> bool:
-    """Whether ``path`` is a figure this toolkit wrote (its format's signature and creator)."""
+    """Whether ``path`` is a figure this toolkit wrote (its format's signature and creator).
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    bool
+    """
     path = Path(path)
     fmt = path.suffix.lower().lstrip(".")
     if fmt not in _SIGNATURE:
@@ -73,7 +104,23 @@ def is_own_figure(path: str | Path) -> bool:
 def check_figure_path(path: str | Path, force: bool = False, option: str | None = "--plot") -> Path:
     """``path`` if a figure may be written there, else :class:`WriteError`: it must end in an
     image suffix, and an existing file is replaced only when it is one of this toolkit's
-    figures (or ``force``)."""
+    figures (or ``force``).
+
+    Parameters
+    ----------
+    path : path-like
+    force : bool
+    option : str or None
+        The option that named ``path``, for messages.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    locust.errors.WriteError
+    """
     path = Path(path)
     what = f"{option} {path}" if option else str(path)
     if path.suffix.lower() not in FIGURE_SUFFIXES:
@@ -88,7 +135,26 @@ def check_figure_path(path: str | Path, force: bool = False, option: str | None 
 def save_png(fig, path: str | Path, dpi: int = 110, force: bool = False, option: str | None = None) -> Path:
     """Write the figure to ``path`` atomically, in the format its suffix names (png, svg, pdf);
     the figure is closed. Refused (:class:`WriteError`, the figure closed, nothing written) as
-    :func:`check_figure_path` says."""
+    :func:`check_figure_path` says.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    path : path-like
+    dpi : int
+    force : bool
+        Replace a file that is not this toolkit's figure.
+    option : str or None
+        The option that named ``path``, for messages.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    locust.errors.WriteError
+    """
     from .fileio import atomic_write_bytes
 
     try:

@@ -25,7 +25,16 @@ _SILENT = [0]            # depth of silenced() blocks: while above 0 nothing is 
 
 
 def format_duration(seconds: float) -> str:
-    """``1:05:09``, ``8:05``, ``0:42`` (hours only when there are some)."""
+    """``1:05:09``, ``8:05``, ``0:42`` (hours only when there are some).
+
+    Parameters
+    ----------
+    seconds : float
+
+    Returns
+    -------
+    str
+    """
     s = max(0, int(round(seconds)))
     h, rest = divmod(s, 3600)
     m, s = divmod(rest, 60)
@@ -60,7 +69,13 @@ class Progress:
     # -- what is shown -------------------------------------------------------------------
     def eta_s(self) -> float | None:
         """Seconds left at the rate measured from the first step to the latest, less the time
-        since the latest; None until that rate means something."""
+        since the latest; None until that rate means something.
+
+        Returns
+        -------
+        float or None
+            [s].
+        """
         if self.length is None or self._first is None:
             return None
         t0, p0 = self._first
@@ -71,6 +86,13 @@ class Progress:
         return max(left, 0.0)
 
     def line(self) -> str:
+        """The progress as shown: label, bar (on a terminal), percent or count, time elapsed and
+        the time left once the rate is known.
+
+        Returns
+        -------
+        str
+        """
         parts = [self.label] if self.label else []
         if self.length:
             frac = min(self.pos / self.length, 1.0)
@@ -104,6 +126,14 @@ class Progress:
 
     # -- the click.progressbar interface ------------------------------------------------
     def update(self, n_steps: int = 1, current_item: Any = None) -> None:
+        """Count ``n_steps`` more steps done (``current_item`` is accepted as click's bar does,
+        and ignored).
+
+        Parameters
+        ----------
+        n_steps : int
+        current_item : Any
+        """
         self.pos += n_steps
         self._latest_s = self.clock()
         if self._first is None and self.pos > 0:
@@ -144,6 +174,21 @@ def progress(items: Iterable | None = None, length: int | None = None, label: st
 
     Use as ``with progress(length=n, label="x") as bar: ... bar.update(1)`` or
     ``with progress(items, label="x") as bar: for item in bar: ...``.
+
+    Parameters
+    ----------
+    items : iterable, optional
+        What is iterated (its length the steps, when it has one).
+    length : int, optional
+        The number of steps.
+    label : str
+        Shown before the bar.
+    **options
+        :class:`Progress`'s ``file``, ``tty``, ``clock``, ``show_pos``, ``show_eta``.
+
+    Returns
+    -------
+    Progress
     """
     return Progress(items, length=length, label=label, **options)
 

@@ -13,30 +13,84 @@ INDENT = "  "
 
 
 def table(header: Sequence[str], rows: Sequence[Sequence[str]], indent: str = INDENT) -> list[str]:
-    """Columns right-aligned to the wider of the header and its cells, two spaces apart."""
+    """Columns right-aligned to the wider of the header and its cells, two spaces apart.
+
+    Parameters
+    ----------
+    header : sequence of str
+    rows : sequence of sequence of str
+    indent : str
+        Before each line.
+
+    Returns
+    -------
+    list of str
+        The header line, then one line per row.
+    """
     widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(header)]
     return [indent + "  ".join(cell.rjust(w) for cell, w in zip(line, widths, strict=True))
             for line in (header, *rows)]
 
 
 def mm(length_m: float, decimals: int = 2) -> str:
-    """A length given in metres, written in mm (``nan`` when it is not finite)."""
+    """A length given in metres, written in mm (``nan`` when it is not finite).
+
+    Parameters
+    ----------
+    length_m : float
+        [m].
+    decimals : int
+
+    Returns
+    -------
+    str
+        [mm], without the unit.
+    """
     return f"{length_m * 1000:.{decimals}f}" if math.isfinite(length_m) else "nan"
 
 
 def verdict(valid: bool) -> str:
+    """``valid`` or ``INVALID``, as the command line prints a simulation's audit.
+
+    Parameters
+    ----------
+    valid : bool
+
+    Returns
+    -------
+    str
+    """
     return "valid" if valid else "INVALID"
 
 
 def outcome_words(outcome: str) -> str:
-    """``goes_over`` -> ``goes over`` (locust.sim.outcome's names, for a person)."""
+    """``goes_over`` -> ``goes over`` (locust.sim.outcome's names, for a person).
+
+    Parameters
+    ----------
+    outcome : str
+
+    Returns
+    -------
+    str
+    """
     return outcome.replace("_", " ")
 
 
 def sim_lines(r, verbose: bool = False) -> list[str]:
     """``locust sim``: a :class:`locust.sim.result.SimResult` as the verdict, one row per hop,
     the totals, the convergence check and the notes; ``verbose``: the linkage's kinematics too
-    (Grashof class and transmission angle: words for the expert, kept out of the first look)."""
+    (Grashof class and transmission angle: words for the expert, kept out of the first look).
+
+    Parameters
+    ----------
+    r : locust.sim.result.SimResult
+    verbose : bool
+
+    Returns
+    -------
+    list of str
+    """
     said = f"{verdict(r.valid)}, {outcome_words(r.outcome)}" if r.outcome else verdict(r.valid)
     lines = [f"{r.robot}: {said} ({r.cycles} cycle{'' if r.cycles == 1 else 's'}, "
              f"time step {r.timestep_s:g} s, "
@@ -57,25 +111,67 @@ def sim_lines(r, verbose: bool = False) -> list[str]:
 
 def hop_table(hops: list[dict]) -> list[str]:
     """One row per hop (the fields of :class:`locust.sim.hops.Hop`, as a dict): distance, nose
-    and centre-of-mass rise above standing in mm, flight in ms."""
+    and centre-of-mass rise above standing in mm, flight in ms.
+
+    Parameters
+    ----------
+    hops : list of dict
+        Lengths in metres, times in seconds.
+
+    Returns
+    -------
+    list of str
+    """
     rows = [[str(h["cycle"]), mm(h["distance_m"]), mm(h["nose_apex_m"]), mm(h["com_apex_m"]),
              f"{h['flight_s'] * 1000:.1f}"] for h in hops]
     return table(["hop", "distance mm", "nose rise mm", "CoM rise mm", "flight ms"], rows)
 
 
 def totals_line(distance_m: float, max_nose_height_m: float) -> str:
-    """The run's whole distance and its highest nose point, in mm."""
+    """The run's whole distance and its highest nose point, in mm.
+
+    Parameters
+    ----------
+    distance_m, max_nose_height_m : float
+        [m].
+
+    Returns
+    -------
+    str
+    """
     return f"{INDENT}total distance {mm(distance_m)} mm; highest nose {mm(max_nose_height_m)} mm above the floor"
 
 
 def nose_load_line(nose_load_kg: float, total_mass_kg: float) -> str:
-    """The standing robot's weight on its nose: what a kitchen scale under the nose reads."""
+    """The standing robot's weight on its nose: what a kitchen scale under the nose reads.
+
+    Parameters
+    ----------
+    nose_load_kg, total_mass_kg : float
+        [kg].
+
+    Returns
+    -------
+    str
+        Both in grams, with how a kitchen scale reads it.
+    """
     return (f"{INDENT}standing: {nose_load_kg * 1000:.1f} g of its {total_mass_kg * 1000:.1f} g on the nose "
             "(a kitchen scale under the nose, the feet level with its pan)")
 
 
 def convergence_line(c: dict) -> str:
-    """The time-step check of ``--check-convergence``: the change at half the step."""
+    """The time-step check of ``--check-convergence``: the change at half the step.
+
+    Parameters
+    ----------
+    c : dict
+        The check's figures: the half step [s], the changes in distance per hop and in highest
+        nose [mm] and relative, and whether they converged.
+
+    Returns
+    -------
+    str
+    """
     said = "converged" if c["converged"] else "NOT converged (within 1 % or 0.1 mm asked)"
     return (f"at half the time step ({c['half_timestep_s']:g} s): distance "
             f"{c['distance_change_mm_per_hop']:.3f} mm per hop ({c['distance_rel_change'] * 100:.2f} %), "
@@ -85,7 +181,19 @@ def convergence_line(c: dict) -> str:
 
 def mean_sd(mean: float, sd: float, scale: float = 1000.0) -> str:
     """``mean +- sd`` to sensible digits: the sd to two significant figures, the mean to the
-    same decimal place (a single draw: its value, one decimal). Values in SI times ``scale``."""
+    same decimal place (a single draw: its value, one decimal). Values in SI times ``scale``.
+
+    Parameters
+    ----------
+    mean, sd : float
+        In SI units.
+    scale : float
+        Applied to both (1000: metres shown in mm).
+
+    Returns
+    -------
+    str
+    """
     if not math.isfinite(mean):
         return "nan"
     if not math.isfinite(sd):
@@ -97,7 +205,17 @@ def mean_sd(mean: float, sd: float, scale: float = 1000.0) -> str:
 
 def spread_lines(spread) -> list[str]:
     """``locust sim --samples``: each outcome's share of the draws and its own figures, mean
-    ± sd in mm (never one sd across outcomes: near the threshold the spread is bimodal)."""
+    ± sd in mm (never one sd across outcomes: near the threshold the spread is bimodal).
+
+    Parameters
+    ----------
+    spread : locust.sim.samples.Samples
+        The draws' outcomes and figures.
+
+    Returns
+    -------
+    list of str
+    """
     lines = [f"{INDENT}{spread.n} draws of {len(spread.uncertain)} uncertain values ({spread.n_valid} valid):"]
     for name, o in spread.outcomes.items():
         line = f"{INDENT * 2}{outcome_words(name):17s} {o.n:3d} of {spread.n_valid} ({o.share * 100:3.0f} %)"
@@ -109,7 +227,16 @@ def spread_lines(spread) -> list[str]:
 
 
 def sensitivity_lines(sens) -> list[str]:
-    """The values whose interval reaches another outcome (:mod:`locust.sim.sensitivity`)."""
+    """The values whose interval reaches another outcome (:mod:`locust.sim.sensitivity`).
+
+    Parameters
+    ----------
+    sens : locust.sim.sensitivity.Sensitivity
+
+    Returns
+    -------
+    list of str
+    """
     nominal = outcome_words(sens.nominal) if sens.nominal else "invalid"
     deciding = sens.deciding
     if not deciding:
@@ -125,7 +252,16 @@ def sensitivity_lines(sens) -> list[str]:
 def plant_lines(summary: dict) -> list[str]:
     """``locust hop --port sim`` and ``locust virtual``: what the virtual robot's plant did
     (the dict its ``close()`` returns: the live MuJoCo model's audited run, one row per push,
-    or the recorder's count)."""
+    or the recorder's count).
+
+    Parameters
+    ----------
+    summary : dict
+
+    Returns
+    -------
+    list of str
+    """
     if summary.get("plant") != "mujoco":
         return [f"servo commands recorded: {summary.get('commands', 0)}"]
     rtf = summary["realtime_factor"]
@@ -152,7 +288,17 @@ UNIT_SUFFIXES = (   # a key's unit from its name's end (longest first): _nm_ is 
 
 
 def split_unit(key: str) -> tuple[str, str]:
-    """``hinge_stiffness_nm_per_rad`` -> (``hinge_stiffness``, ``N·m/rad``); no unit: (key, "")."""
+    """``hinge_stiffness_nm_per_rad`` -> (``hinge_stiffness``, ``N·m/rad``); no unit: (key, "").
+
+    Parameters
+    ----------
+    key : str
+        A name with a unit suffix (``_m``, ``_nm_per_rad``, ...).
+
+    Returns
+    -------
+    name, unit : str
+    """
     section, dot, name = key.rpartition(".")
     for suffix, unit in UNIT_SUFFIXES:
         if name.endswith(suffix) and len(name) > len(suffix):
@@ -161,7 +307,17 @@ def split_unit(key: str) -> tuple[str, str]:
 
 
 def sig(value: float, digits: int = 4) -> str:
-    """``digits`` significant figures; powers of ten as ``1.458e-4`` below 1e-3 and from 1e5."""
+    """``digits`` significant figures; powers of ten as ``1.458e-4`` below 1e-3 and from 1e5.
+
+    Parameters
+    ----------
+    value : float
+    digits : int
+
+    Returns
+    -------
+    str
+    """
     if not math.isfinite(value) or value == 0:
         return f"{value:g}"
     if 1e-3 <= abs(value) < 1e5:
@@ -171,7 +327,20 @@ def sig(value: float, digits: int = 4) -> str:
 
 
 def value_line(key: str, value, unit_of_key: bool = True) -> str:
-    """A plain figure with its unit column: numbers to 4 significant figures, lists joined."""
+    """A plain figure with its unit column: numbers to 4 significant figures, lists joined.
+
+    Parameters
+    ----------
+    key : str
+        The value's name (a dotted key whose suffix is its unit).
+    value : float, list or str
+    unit_of_key : bool
+        Take the unit from the key's suffix.
+
+    Returns
+    -------
+    str
+    """
     name, unit = split_unit(key) if unit_of_key else (key, "")
     if isinstance(value, (list, tuple)):
         text = ", ".join(sig(v) if isinstance(v, float) else str(v) for v in value)
@@ -184,7 +353,24 @@ def value_line(key: str, value, unit_of_key: bool = True) -> str:
 
 def estimate_line(key: str, value: float, std: float | None, ci95=None, note: str = "") -> str:
     """``k = 1.458e-4 N·m/rad ± 0.2 %  (95 %: 1.453e-4 … 1.463e-4)`` as a table row: the key less
-    its unit, the value, the unit, one standard deviation as a share of the value, the interval."""
+    its unit, the value, the unit, one standard deviation as a share of the value, the interval.
+
+    Parameters
+    ----------
+    key : str
+        The value's name, its unit the suffix.
+    value : float
+    std : float or None
+        One standard deviation, in the value's unit.
+    ci95 : (float, float), optional
+        The 95% interval.
+    note : str
+        Appended.
+
+    Returns
+    -------
+    str
+    """
     name, unit = split_unit(key)
     head = f"{name:28s} {sig(value):>10s}  {unit:10s}"
     if std is None or not math.isfinite(std):

@@ -24,12 +24,26 @@ PathLike = str | Path
 
 @dataclass(frozen=True)
 class Fit:
-    """One calibration's outcome.
+    """One calibration's outcome: the robot values a recording determines, with intervals.
 
-    ``parameters``: robot parameter (dotted name) -> :class:`~locust.calibrate.fitstats.Estimate`
-    (``.value``, ``.std`` one standard deviation, ``.ci95`` the 95% interval), only the values
-    the recordings determine; ``result``: the experiment's own fit (every other quantity,
-    ``.summary()``); ``warnings``: what looked wrong in the recording.
+    Attributes
+    ----------
+    experiment : str
+        ``beam``, ``hinge``, ``servo``, ``ramp`` or ``hops``.
+    source : str
+        The recording(s) fitted, ``+``-joined; the values' provenance ``fit:<source>``.
+    parameters : dict of str to locust.calibrate.fitstats.Estimate
+        Robot parameter (dotted name, unit in its suffix) -> ``.value``, ``.std`` (one standard
+        deviation) and ``.ci95`` (the 95% interval), in the parameter's unit; only the values
+        the recordings determine.
+    result : object
+        The experiment's own fit (every other quantity, ``.summary()``).
+    note, subtitle : str
+        The provenance note written with the values; the plot's subtitle (RMS per recording).
+    warnings : list of str
+        What looked wrong in the recording.
+    input_note : str
+        How the input was read (a unit or timing assumed), as the command line prints it.
     """
 
     experiment: str
@@ -45,6 +59,16 @@ class Fit:
         """``robot`` with the fitted values, each with its source ``fit:<recording>``, its
         uncertainty and the date, as ``locust calibrate --write`` records them.
 
+        Parameters
+        ----------
+        robot : locust.params.Robot
+            The robot the values are put into (left unchanged).
+
+        Returns
+        -------
+        locust.params.Robot
+            A copy with the fitted values.
+
         Raises
         ------
         locust.errors.CalibrationError
@@ -56,7 +80,13 @@ class Fit:
         return with_fitted(robot, self.parameters, self.source, note=self.note)
 
     def summary(self) -> dict:
-        """Everything the fit found, as ``locust calibrate --json`` prints it."""
+        """Everything the fit found, as ``locust calibrate --json`` prints it.
+
+        Returns
+        -------
+        dict
+            The experiment's figures by name (units in the names' suffixes).
+        """
         return self.result.summary()
 
     def to_dataframe(self):
@@ -79,6 +109,11 @@ class Fit:
     def plot(self, run: int = 0):
         """Data and model above, residuals below (per recording); for a hop fit, run ``run``'s
         tracked markers against the fitted simulation.
+
+        Parameters
+        ----------
+        run : int, default 0
+            Which run of a hop fit to draw (ignored by the other fits).
 
         Returns
         -------
@@ -150,7 +185,11 @@ def calibrate_beam(tracks: PathLike, mass_kg: float, *, length_m: float | None =
     start_s, end_s : float, optional
         The fit window (default: from the first swing after the drop to the end).
     units : {"m", "cm", "mm"}
-        The track's unit. ``imports`` and ``timing``: the command line's options, parsed.
+        The track's unit.
+    imports : locust.io.importing.ImportOptions, optional
+        ``--units``, ``--rename``, ``--mirror`` already parsed (instead of ``units``).
+    timing : locust.calibrate.recordings.TimeOptions
+        ``--time-scale`` / ``--clip-fps``: a slow-motion recording back on real time.
 
     Returns
     -------
@@ -160,8 +199,12 @@ def calibrate_beam(tracks: PathLike, mass_kg: float, *, length_m: float | None =
 
     Examples
     --------
+    From the repository's root, on its synthetic recording:
+
+    >>> import locust
     >>> fit = locust.calibrate_beam("calibration/recordings/synthetic_beam.csv", 0.01, length_m=0.05)
-    >>> fit.parameters["compliance.hinge_stiffness_nm_per_rad"].ci95   # doctest: +SKIP
+    >>> [round(v, 4) for v in fit.parameters["compliance.hinge_stiffness_nm_per_rad"].ci95]
+    [0.0545, 0.0572]
     """
     from ..calibrate import beam as B
     from ..calibrate.recordings import clean_samples, read_table
@@ -202,8 +245,18 @@ def calibrate_hinge(tracks: PathLike, inertia_kgm2: float, gravity: str, *, mass
         With ``gravity="in-plane"``: the link's mass and hinge-to-centre-of-mass distance.
     pivot : (x, y), optional
         The hinge in the track's metres, held fixed (default: fitted).
+    marker : str, optional
+        The link's marker (default: the only one).
+    start_s, end_s : float, optional
+        The fit window [s] (default: from the first turning point after the release to the end).
     coulomb : {"auto", "off", "on"}
         Coulomb friction: fitted only when the swing shows it (auto).
+    units : {"m", "cm", "mm"}
+        The track's unit.
+    imports : locust.io.importing.ImportOptions, optional
+        The track's options already parsed (instead of ``units``).
+    timing : locust.calibrate.recordings.TimeOptions
+        The slow-motion time scale.
 
     Returns
     -------
@@ -249,8 +302,14 @@ def calibrate_servo(recordings: PathLike | Sequence[PathLike], inertia_kgm2: flo
         From a stall test or the datasheet (SG90: about 0.15); splits what one load gives.
     kv_nms_per_rad : float, default 0
         Velocity feedback held at this value (unless ``fit_kv``).
+    fit_kv : bool, default False
+        Fit the velocity feedback as well.
     gravity_moment_nm : float or list of float, default 0
         The load's weight moment with the horn horizontal: once, or once per recording.
+    timing : locust.calibrate.recordings.TimeOptions
+        The slow-motion time scale of filmed recordings.
+    progress : callable, optional
+        Called with each progress line of the fit.
 
     Returns
     -------
@@ -259,6 +318,9 @@ def calibrate_servo(recordings: PathLike | Sequence[PathLike], inertia_kgm2: flo
 
     Examples
     --------
+    Not run as a doctest: the fit takes about ten seconds.
+
+    >>> import locust
     >>> fit = locust.calibrate_servo("calibration/recordings/synthetic_servo.csv", 1.5e-5,
     ...                              stall_torque_nm=0.15)            # doctest: +SKIP
     >>> fit.parameters["servo.noload_speed_rad_per_s"].value          # doctest: +SKIP
@@ -278,7 +340,26 @@ def calibrate_servo(recordings: PathLike | Sequence[PathLike], inertia_kgm2: flo
 def fit_servo_recordings(recs: list, stall_torque_nm: float | None = None, *, kv_nms_per_rad: float = 0.0,
                          fit_kv: bool = False, progress=None) -> Fit:
     """:func:`calibrate_servo` on recordings already read (``locust.calibrate.servo.StepRecording``,
-    ``RateRecording``: a horn track through its pivot, as ``locust calibrate servo --pivot`` makes)."""
+    ``RateRecording``: a horn track through its pivot, as ``locust calibrate servo --pivot`` makes).
+
+    Parameters
+    ----------
+    recs : list of StepRecording or RateRecording
+        The recordings, each with its rig (load inertia [kg·m²], gravity moment [N·m]).
+    stall_torque_nm : float, optional
+        The stall torque [N·m] held at this value (from a datasheet); default: fitted.
+    kv_nms_per_rad : float, default 0
+        Velocity feedback [N·m·s/rad] held at this value (unless ``fit_kv``).
+    fit_kv : bool, default False
+        Fit the velocity feedback as well.
+    progress : callable, optional
+        Called with each progress line of the fit.
+
+    Returns
+    -------
+    Fit
+        The ``servo.*`` values the recordings determine (never those not identifiable).
+    """
     from ..calibrate import servo as S
 
     inertias = [r.rig.inertia_kgm2 for r in recs]
@@ -307,6 +388,16 @@ def calibrate_ramp(data: PathLike | Sequence[PathLike] | np.ndarray, *, into: st
         (markers ``ramp_markers`` on the board's ends and ``robot_marker``), or the angles.
     into : {"foot", "nose"}
         Which friction the result is: ``contact.foot_friction`` or ``contact.nose_friction``.
+    ramp_markers : str
+        ``A,B``: a track's markers on the board's hinge end and far end.
+    robot_marker : str
+        A track's marker on the robot.
+    units : {"m", "cm", "mm"}
+        A track's unit.
+    imports : locust.io.importing.ImportOptions, optional
+        A track's options already parsed (instead of ``units``).
+    timing : locust.calibrate.recordings.TimeOptions
+        The slow-motion time scale of a filmed track.
     resolution_deg : float, default 1.0
         How finely each angle was read (a protractor's 1 degree graduation): the trials' spread
         is taken as at least ``resolution_deg / sqrt(12)``, so trials read alike still give an
@@ -319,7 +410,9 @@ def calibrate_ramp(data: PathLike | Sequence[PathLike] | np.ndarray, *, into: st
 
     Examples
     --------
-    >>> locust.calibrate_ramp([59.5, 60.1, 58.7]).parameters["contact.foot_friction"].value  # doctest: +SKIP
+    >>> import locust
+    >>> round(locust.calibrate_ramp([59.5, 60.1, 58.7]).parameters["contact.foot_friction"].value, 3)
+    1.693
     """
     from ..calibrate import ramp as R
     from ..calibrate.inputs import ramp_angles
@@ -402,8 +495,25 @@ def calibrate_hops(robot: Robot | None, runs: Mapping[str, PathLike] | Sequence[
 def robot_of_runs(runs: Sequence[PathLike]) -> tuple[Robot, str]:
     """The robot the runs were hopped on, as their run.json files record it, and a line
     saying so: the robot file, or the preset (a leg-set preset's runs share the robot as
-    built, the ``small`` preset, on which each run's own leg set is built). Runs recording
-    different robots are refused: which values they share is not known."""
+    built, the ``small`` preset, on which each run's own leg set is built).
+
+    Parameters
+    ----------
+    runs : sequence of path-like
+        Run folders (or their ``run.json``); those without a record are passed over.
+
+    Returns
+    -------
+    robot : locust.params.Robot
+        The recorded robot; ``small`` when no record says which.
+    line : str
+        Where the robot came from, as the command line prints it.
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        The runs record different robots: which values they share is not known.
+    """
     from ..io.robot_toml import load_robot
     from ..io.run_record import RECORD_NAME, read_run_record
     from ..params import LEG_SETS, preset

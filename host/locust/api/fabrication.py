@@ -50,8 +50,8 @@ def make_cut_files(source: Robot | str | Path, *, out: str | Path | None = None,
     Returns
     -------
     dict
-        The manufacturing summary (``summary.json``'s content): layers, areas in mm², the
-        hinges, the files written.
+        The manufacturing summary (``summary.json``'s content): the layer stack, areas in mm²,
+        the hinges' positions in mm, the files written.
 
     Raises
     ------
@@ -62,7 +62,11 @@ def make_cut_files(source: Robot | str | Path, *, out: str | Path | None = None,
     Examples
     --------
     >>> import locust
-    >>> locust.make_cut_files(locust.robot("seed"))["layers"][0]["name"]          # doctest: +SKIP
+    >>> summary = locust.make_cut_files(locust.robot("seed"))
+    >>> [layer["name"] for layer in summary["stack"]]
+    ['rigid_top', 'adhesive_top', 'flexible', 'adhesive_bottom', 'rigid_bottom']
+    >>> summary["hinges_x_mm"]
+    [40.0, 80.0, 100.0, 160.0]
     """
     out = Path(out) if out is not None else None
     if out is not None:

@@ -14,7 +14,24 @@ from .sweeps import varied
 
 def optimize_bounds(base: Robot, vary: Mapping[str, tuple[float, float] | str] | Sequence[str | Bound]) -> list[Bound]:
     """The searched ranges: ``{"geometry.leg_m": (0.05, 0.09)}``, ``{"schedule.push_s": "0.15:0.4"}``
-    or ``["geometry.leg_m=0.05:0.09", ...]`` (the command line's ``--vary``), each name once."""
+    or ``["geometry.leg_m=0.05:0.09", ...]`` (the command line's ``--vary``), each name once.
+
+    Parameters
+    ----------
+    base : locust.params.Robot
+        The robot optimised.
+    vary : mapping or sequence
+        Name -> (low, high) in the parameter's unit, or the same as text.
+
+    Returns
+    -------
+    list of locust.sweep.design.Bound
+
+    Raises
+    ------
+    locust.errors.SweepError
+        Nothing varied, a name given twice, or a range that cannot be read.
+    """
     return varied(base, vary, parse_bound, Bound, '{"geometry.leg_m": (0.05, 0.09)}')
 
 
@@ -75,10 +92,12 @@ def optimize(robot: Robot, vary: Mapping[str, tuple[float, float] | str] | Seque
 
     Examples
     --------
-    >>> import locust
-    >>> res = locust.optimize(locust.robot("small"), {"schedule.push_s": (0.15, 0.4)}, trials=3,
-    ...                       cycles=1, out="opt")                     # doctest: +SKIP
-    >>> res.best["distance_m"]                                        # doctest: +SKIP
+    >>> import locust, tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     res = locust.optimize(locust.robot("small"), {"schedule.push_s": (0.15, 0.4)}, trials=3,
+    ...                           cycles=1, out=folder + "/opt")
+    >>> res.trials, res.complete, res.pruned
+    (3, 3, 0)
     """
     bounds = optimize_bounds(robot, vary)
     return run_optimize(robot, bounds, trials, cycles, Path(out), storage=storage, study_name=study_name,

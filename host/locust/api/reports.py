@@ -31,11 +31,22 @@ def make_report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str |
     cycles : int, optional
         Hop cycles to simulate and measure (default: the run records', else the robot's).
     sweep : path-like, optional
-        A sweep folder (:func:`locust.sweep` with ``out``): its landscape, the designs marked.
+        A sweep folder (:func:`locust.sweep_designs` with ``out``): its landscape, the designs
+        marked.
+    added : dict of str to float, optional
+        Configuration -> the length added to every link [m], for names that are not leg sets.
     marker : str, default "nose"
         The marker compared.
     samples : int, default 0
         Draws of the uncertain values per configuration: bands on the predictions.
+    side_by_side : bool, default False
+        Also write, per trial, its video beside the simulation's.
+    robot_source : str, optional
+        What the page says the robot is (default its name).
+    imports : locust.io.importing.ImportOptions
+        How each track is converted (``--units``, ``--rename``, ``--mirror``).
+    progress : callable, optional
+        Called with each progress line.
     before : Robot, optional
         The robot before a fit: its predictions drawn too.
     study : path-like, optional

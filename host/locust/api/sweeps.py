@@ -1,4 +1,4 @@
-"""``locust.sweep``: a grid of designs, each checked, simulated and audited; the best valid one."""
+"""``locust.sweep_designs``: a grid of designs, each checked, simulated and audited; the best valid one."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ RANGE = tuple[float, float, int]
 
 @dataclass
 class SweepResults(SweepSummary):
-    """What :func:`sweep` returns: every design's row (``rows``), the best valid one (``best``,
+    """What :func:`sweep_designs` returns: every design's row (``rows``), the best valid one (``best``,
     None when none is valid), the varied names (``names``) and, when written to a folder,
     ``folder`` and the landscape ``plots``.
     """
@@ -39,8 +39,18 @@ class SweepResults(SweepSummary):
         return pd.DataFrame(self.rows)
 
     def plot(self, y: str = "distance_m"):
-        """``y`` (a column of :meth:`to_dataframe`) of each valid design against the first
-        varied value, in mm for lengths (matplotlib Figure); the best design ringed."""
+        """``y`` of each valid design against the first varied value, in mm for lengths; the
+        best design ringed.
+
+        Parameters
+        ----------
+        y : str, default "distance_m"
+            A column of :meth:`to_dataframe`.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from matplotlib.figure import Figure
 
         df = self.to_dataframe()
@@ -71,7 +81,32 @@ def varied(base: Robot, vary: Mapping[str, tuple | str] | Sequence, parse: Calla
            example: str) -> list:
     """``vary`` as a dict (name -> a tuple of numbers or their ``"a:b"`` text) or as the command
     line's ``--vary NAME=...`` strings, each parsed by ``parse(text, base)`` unless it already is
-    a ``kind``, and each name given once."""
+    a ``kind``, and each name given once.
+
+    Parameters
+    ----------
+    base : locust.params.Robot
+        The robot whose parameters are varied (names are checked against it).
+    vary : mapping or sequence
+        Name -> tuple of numbers or ``"a:b[:n]"`` text, or ``NAME=a:b[:n]`` strings or ``kind`` objects;
+        values in the parameter's unit.
+    parse : callable
+        ``parse(text, base)`` -> a ``kind`` (:func:`locust.sweep.design.parse_axis` or ``parse_bound``).
+    kind : type
+        What ``parse`` makes (``Axis`` or ``Bound``).
+    example : str
+        The hint's example when nothing is varied.
+
+    Returns
+    -------
+    list
+        One ``kind`` per varied name, in the order given.
+
+    Raises
+    ------
+    locust.errors.SweepError
+        Nothing varied, a name given twice, or a value ``parse`` refuses.
+    """
     if isinstance(vary, Mapping):
         items = [v if isinstance(v, str) else ":".join(repr(x) for x in v) for v in vary.values()]
         vary = [f"{name}={spec}" for name, spec in zip(vary, items)]
@@ -86,7 +121,24 @@ def varied(base: Robot, vary: Mapping[str, tuple | str] | Sequence, parse: Calla
 
 def sweep_axes(base: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis]) -> list[Axis]:
     """The grid's axes: ``{"scale": (0.0, 0.05, 30)}``, ``{"geometry.leg_m": "0.04:0.1:7"}`` or
-    ``["scale=0:0.05:30", ...]`` (the command line's ``--vary``), each name checked once."""
+    ``["scale=0:0.05:30", ...]`` (the command line's ``--vary``), each name checked once.
+
+    Parameters
+    ----------
+    base : locust.params.Robot
+        The robot swept.
+    vary : mapping or sequence
+        Name -> (low, high, count) in the parameter's unit, or the same as text.
+
+    Returns
+    -------
+    list of locust.sweep.design.Axis
+
+    Raises
+    ------
+    locust.errors.SweepError
+        Nothing varied, a name given twice, or a range that cannot be read.
+    """
     return varied(base, vary, parse_axis, Axis, '{"scale": (0.0, 0.05, 30)}')
 
 

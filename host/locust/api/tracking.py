@@ -29,10 +29,22 @@ class Tracks:
 
     @property
     def markers(self) -> list[str]:
+        """The markers' names, in the file's order."""
         return list(self.tracks.markers)
 
     def positions(self, marker: str) -> tuple[np.ndarray, np.ndarray]:
-        """``marker``'s world x and y (m), NaN where it was not found."""
+        """``marker``'s world x and y, NaN where it was not found.
+
+        Parameters
+        ----------
+        marker : str
+            One of :attr:`markers`.
+
+        Returns
+        -------
+        x_m, y_m : numpy.ndarray
+            Per frame, forward and up [m].
+        """
         return self.tracks.positions(marker)
 
     def to_dataframe(self):
@@ -86,7 +98,12 @@ class Tracks:
                                                                ignore_index=True)
 
     def plot(self):
-        """Each marker's world x and y against time (matplotlib Figure)."""
+        """Each marker's world x and y [mm] against time [s].
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from matplotlib.figure import Figure
 
         fig = Figure(figsize=(7, 3.5), layout="constrained")
@@ -102,7 +119,25 @@ class Tracks:
         return fig
 
     def write(self, path: str | Path, overwrite: bool = False) -> Path:
-        """Write the tracks CSV (atomic; an existing file only with ``overwrite``)."""
+        """Write the tracks CSV (atomic; an existing file only with ``overwrite``).
+
+        Parameters
+        ----------
+        path : path-like
+            The CSV to write.
+        overwrite : bool, default False
+            Replace an existing file; otherwise it is refused.
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+
+        Raises
+        ------
+        locust.errors.TrackError
+            ``path`` exists and ``overwrite`` is False.
+        """
         from ..io.tracks_csv import write_tracks_csv
 
         path = Path(path)
@@ -199,6 +234,8 @@ def track_markers(video: str | Path, markers: Mapping[str, str] | Sequence[str] 
         clip's timing and calibration, one point mass per marker (``--trk`` of the command).
     overwrite : bool, default False
         Replace an existing ``trk`` file; otherwise it is refused.
+    progress : callable, optional
+        Called with 1 after each frame.
 
     Returns
     -------
@@ -207,7 +244,10 @@ def track_markers(video: str | Path, markers: Mapping[str, str] | Sequence[str] 
 
     Examples
     --------
-    >>> hop = locust.simulate(locust.robot("small"), cycles=1)
+    Not run as a doctest: it renders a video and tracks it.
+
+    >>> import locust
+    >>> hop = locust.simulate(locust.robot("small"), cycles=1)                     # doctest: +SKIP
     >>> hop.video("hop.mp4", overwrite=True, camera="fixed", width=320, height=240)  # doctest: +SKIP
     >>> locust.track_markers("hop.mp4").to_dataframe()[["t_s", "nose_x_m", "nose_y_m"]]  # doctest: +SKIP
     """
@@ -285,7 +325,10 @@ def read_tracks(path: str | Path, units: str = "m", rename: Mapping[str, str] | 
 
     Examples
     --------
-    >>> locust.read_tracks("calibration/recordings/synthetic_beam.csv").markers   # doctest: +SKIP
+    From the repository's root:
+
+    >>> import locust
+    >>> locust.read_tracks("calibration/recordings/synthetic_beam.csv").markers
     ['tip']
     """
     from ..io.importing import import_tracks

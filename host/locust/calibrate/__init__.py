@@ -1,11 +1,23 @@
-"""``locust calibrate``: identify the robot's physics from the three Part 2 experiments.
+"""Identifying the robot's physics from recordings (``locust calibrate``, ``locust.calibrate_*``).
 
-- ``beam``: a cardstock cantilever with a dropped tip mass -> hinge stiffness and damping.
-- ``servo``: a servo stepped while carrying a battery -> kp, kv and torque limit of the
-  position-servo law the MuJoCo model uses.
-- ``ramp``: a ramp tilted until the robot slides -> static friction, mu = tan(theta).
+The experiments, one fit each (numbers in, a result dataclass out, values with intervals):
 
-Each fit is a pure function (numbers in, a result dataclass out); reading recordings,
-plotting and updating ``robot.toml`` happen at the edges (``recordings``, ``plots``,
-``write``, ``cli``).
+- :mod:`.beam`: a cardstock cantilever with a dropped tip mass -> the tip's stiffness [N/m] and
+  damping [N·s/m]; with the beam's length, their pseudo-rigid-body hinge equivalents (k L², b L²),
+  which hold for the robot only if its hinge is of the same material and width.
+- :mod:`.hinge`: a link ringing down on a flexure hinge -> the hinge's stiffness, damping and
+  neutral angle.
+- :mod:`.servo`: a servo stepped while carrying a load (filmed horn or rate gyro) -> no-load
+  speed, armature, kp and kv of the position-servo law the MuJoCo model uses.
+- :mod:`.ramp`: a ramp tilted until the robot slides -> static friction, mu = tan(theta).
+- :mod:`.hop`: filmed hops -> what no bench experiment reaches (friction under impact, the
+  folded hinges in the linkage, the servo on the robot's battery); :mod:`.hopmodels` sets a
+  candidate's values in one compiled MuJoCo model instead of compiling each.
+
+Shared by the fits: :mod:`.fitstats` (intervals from the Jacobian, cluster-robust where
+residuals are correlated) and :mod:`.curves` (data and model for a plot). At the edges:
+:mod:`.recordings` (CSV, ``locust track`` CSV, Tracker files as one table), :mod:`.gyro_log`
+(a controller's gyro log), :mod:`.inputs` (each experiment's recordings as its fit's inputs),
+:mod:`.plots` (the fit plots), :mod:`.write` (fitted values into ``robot.toml``) and
+:mod:`.synthetic` (SYNTHETIC recordings from known parameters, for the demo and the tests).
 """

@@ -22,6 +22,7 @@ class Curves:
 
     @property
     def residual(self) -> np.ndarray:
+        """Data minus model, in the data's unit."""
         return self.data - self.model
 
     @property

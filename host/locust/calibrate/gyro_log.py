@@ -58,7 +58,17 @@ def _numbers(line: str) -> list[float] | None:
 
 
 def looks_like_gyro_log(text: str) -> bool:
-    """Whether ``text`` is laid out as a gyro log: its first data line is three numbers."""
+    """Whether ``text`` is laid out as a gyro log: its first data line is three numbers.
+
+    Parameters
+    ----------
+    text : str
+        A recording's contents.
+
+    Returns
+    -------
+    bool
+    """
     rows, _ = _data_lines(text)
     if not rows:
         return False
@@ -67,7 +77,25 @@ def looks_like_gyro_log(text: str) -> bool:
 
 
 def parse_gyro_log(text: str, path: str | Path) -> GyroLog:
-    """The gyro log in ``text`` (the contents of ``path``)."""
+    """The gyro log in ``text`` (the contents of ``path``).
+
+    Parameters
+    ----------
+    text : str
+        The log's contents.
+    path : str or path-like
+        Where it came from, for messages.
+
+    Returns
+    -------
+    GyroLog
+        Time [s], command [deg] and gyro rate (the gyro's own unit), with the comment lines.
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        A line that is not three finite numbers, no rows, or a clock that does not increase.
+    """
     path = Path(path)
     rows, comments = _data_lines(text)
     data = []
@@ -92,6 +120,22 @@ def parse_gyro_log(text: str, path: str | Path) -> GyroLog:
 
 
 def read_gyro_log(path: str | Path) -> GyroLog:
+    """Read a controller's gyro log.
+
+    Parameters
+    ----------
+    path : path-like
+        The log: milliseconds, gyro rate and command per line (see :func:`parse_gyro_log`).
+
+    Returns
+    -------
+    GyroLog
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        The file cannot be read, or its clock does not increase.
+    """
     try:
         text = read_text(path)
     except TrackError as exc:

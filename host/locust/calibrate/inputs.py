@@ -18,7 +18,31 @@ from .recordings import REAL_TIME, TimeOptions, clean_samples, read_recording_te
 
 
 def servo_recording(path: Path, rig, pivot, step, marker, imports: ImportOptions, timing: TimeOptions = REAL_TIME):
-    """One servo recording, of the kind its layout says: a gyro log (rate) or an angle table."""
+    """One servo recording, of the kind its layout says: a gyro log (rate) or an angle table.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The recording.
+    rig : locust.calibrate.servo.ServoRig
+        The load it carried (inertia [kg·m²], gravity moment [N·m]).
+    pivot, step, marker : str or None
+        A horn track only: the horn's pivot ``X,Y`` [m], the step ``FROM,TO,AT_S`` [deg, deg, s]
+        and the tip's marker name (the command line's options).
+    imports : locust.io.importing.ImportOptions
+        How a track file is read (unit, renaming, mirroring).
+    timing : TimeOptions
+        The time scale (slow motion) of a filmed recording.
+
+    Returns
+    -------
+    StepRecording or RateRecording
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        ``pivot`` given for a gyro log, or a recording that cannot be read as a servo step.
+    """
     text = read_recording_text(path)
     if looks_like_gyro_log(text):
         if pivot is not None:
@@ -33,6 +57,27 @@ def servo_recording(path: Path, rig, pivot, step, marker, imports: ImportOptions
 
 
 def per_recording(values: tuple[float, ...], n: int, option: str) -> list[float]:
+    """An option's values, one per recording: given once for all, or once for each.
+
+    Parameters
+    ----------
+    values : tuple of float
+        The option's values as given.
+    n : int
+        The number of recordings.
+    option : str
+        The option's name, for the message.
+
+    Returns
+    -------
+    list of float
+        ``n`` values.
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Neither once nor ``n`` times.
+    """
     if len(values) == 1:
         return list(values) * n
     if len(values) != n:
@@ -51,6 +96,32 @@ def servo_series(
     imports: ImportOptions,
     timing: TimeOptions = REAL_TIME,
 ):
+    """A servo step's time, angle and command from a table or a horn track.
+
+    Parameters
+    ----------
+    data : pathlib.Path
+        A table with ``t_s``, ``angle_deg`` and ``command_deg`` columns, or (with ``pivot``) a
+        track of the horn's tip.
+    pivot : str or None
+        The horn's pivot ``X,Y`` [m] in the track's frame.
+    step : str or None
+        ``FROM,TO,AT_S``: the commanded step [deg] and when it was sent [s] (needed with ``pivot``).
+    marker : str or None
+        The tip's marker (default: the track's only one).
+    imports, timing
+        As for :func:`servo_recording`.
+
+    Returns
+    -------
+    t_s, angle_deg, command_deg : numpy.ndarray
+        The cleaned samples [s, deg, deg].
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        A missing column or option, or too few samples.
+    """
     table = read_table(data, imports, timing)
     if pivot is None:
         t, angle, command = table.require("t_s", "angle_deg", "command_deg", purpose="a servo step")
@@ -70,7 +141,33 @@ def servo_series(
 def ramp_angles(
     path: Path, ramp_markers: str, robot_marker: str, imports: ImportOptions, timing: TimeOptions = REAL_TIME
 ) -> tuple[list[float], str | None, bool]:
-    """The trials' angles in ``path``, a plausibility warning, and whether it was a track."""
+    """The trials' angles in ``path``, a plausibility warning, and whether it was a track.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A table with an ``angle_deg`` column (one trial a row) or a side-view track of the ramp.
+    ramp_markers : str
+        ``A,B``: the markers on the board's two ends.
+    robot_marker : str
+        The robot's marker.
+    imports, timing
+        As for :func:`servo_recording`.
+
+    Returns
+    -------
+    angles_deg : list of float
+        The critical angles [deg].
+    warning : str or None
+        The board's length is not a board's (a wrong unit), naming the likely one.
+    tracked : bool
+        Whether ``path`` was a track.
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Neither angles nor the named markers, or no slide in the track.
+    """
     table = read_table(path, imports, timing)
     if table.has("angle_deg"):
         return [float(a) for a in table.columns["angle_deg"] if np.isfinite(a)], None, table.tracks is not None
@@ -85,6 +182,26 @@ def ramp_angles(
 
 
 def parse_floats(text: str, n: int, option: str, hint: str) -> list[float]:
+    """``n`` comma-separated numbers of an option.
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+    n : int
+        How many numbers it must hold.
+    option, hint : str
+        The option's name and the hint shown when it is wrong.
+
+    Returns
+    -------
+    list of float
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Not ``n`` numbers.
+    """
     try:
         vals = [float(v) for v in text.split(",")]
     except ValueError:

@@ -12,12 +12,46 @@ from .curves import Curves
 
 def plot_fit(curves: Curves | list[Curves], path: str | Path, subtitle: str = "", force: bool = False) -> Path:
     """One recording's ``Curves``, or several stacked (each with its residuals below it); ``force``:
-    replace an existing file that is not one of this toolkit's figures."""
+    replace an existing file that is not one of this toolkit's figures.
+
+    Parameters
+    ----------
+    curves : Curves or list of Curves
+        What to draw.
+    path : path-like
+        The figure's file; its suffix chooses PNG, SVG or PDF.
+    subtitle : str
+        A line under the title (the fit's RMS per recording).
+    force : bool, default False
+        Replace a file that is not one of this toolkit's figures.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    locust.errors.WriteError
+        ``path`` cannot be written, or holds another file and ``force`` is False.
+    """
     return save_png(fit_figure(curves, subtitle), path, dpi=110, force=force, option="--plot")
 
 
 def fit_figure(curves: Curves | list[Curves], subtitle: str = ""):
-    """The figure :func:`plot_fit` writes (a ``matplotlib.figure.Figure``, no display needed)."""
+    """The figure :func:`plot_fit` writes (a ``matplotlib.figure.Figure``, no display needed).
+
+    Parameters
+    ----------
+    curves : Curves or list of Curves
+        What to draw.
+    subtitle : str
+        A line under the title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     from matplotlib.figure import Figure
     from matplotlib.ticker import MaxNLocator
 

@@ -34,6 +34,26 @@ BOARD_M = (0.05, 3.0, 0.3)     # (least, most, typical) length between the ramp'
 
 @dataclass(frozen=True)
 class RampFit:
+    """The ramp's fit: static friction from the trials' critical angles.
+
+    Attributes
+    ----------
+    source : str
+        The recording(s).
+    mu_static : locust.calibrate.fitstats.Estimate
+        ``tan(mean angle)`` (no unit) with its 95% interval.
+    mean_angle_deg, std_angle_deg : float
+        The trials' mean and standard deviation [deg] (at least the reading's resolution / sqrt(12)).
+    n_trials : int
+        Trials used.
+    angles_deg : list of float
+        Each trial's critical angle [deg].
+    curves : Curves
+        tan(angle) per trial against the fitted mu.
+    notes : list of str
+        What was assumed (the spread raised to the reading resolution's).
+    """
+
     source: str
     mu_static: Estimate
     mean_angle_deg: float
@@ -45,6 +65,12 @@ class RampFit:
     notes: list[str] = field(default_factory=list)
 
     def summary(self) -> dict:
+        """Every figure of the fit, as ``locust calibrate ramp --json`` prints it.
+
+        Returns
+        -------
+        dict
+        """
         return {"experiment": "ramp", "source": self.source, "mu_static": self.mu_static.as_dict(),
                 "mean_angle_deg": self.mean_angle_deg, "std_angle_deg": self.std_angle_deg,
                 "n_trials": self.n_trials, "angles_deg": self.angles_deg, "resolution_deg": self.resolution_deg,
@@ -53,8 +79,27 @@ class RampFit:
 
 def fit_ramp(angles_deg: np.ndarray, source: str = "ramp",
              resolution_deg: float = READING_RESOLUTION_DEG) -> RampFit:
-    """``resolution_deg``: how finely each angle was read; the trials' spread is taken as at
-    least ``resolution_deg / sqrt(12)`` (see the module docstring)."""
+    """Static friction ``mu = tan(mean critical angle)`` with a Student-t 95% interval.
+
+    Parameters
+    ----------
+    angles_deg : array_like
+        The trials' critical angles [deg from the horizontal]; NaN are dropped.
+    source : str
+        The recording's name, for messages and provenance.
+    resolution_deg : float, default 1.0
+        How finely each angle was read [deg]; the trials' spread is taken as at least
+        ``resolution_deg / sqrt(12)`` (see the module docstring).
+
+    Returns
+    -------
+    RampFit
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Fewer than two trials, an angle outside 0..90 deg, or a resolution that is not positive.
+    """
     if not (math.isfinite(resolution_deg) and resolution_deg > 0):
         raise CalibrationError(f"--resolution-deg {resolution_deg:g} must be a finite number above 0",
                                "the angle's reading resolution, e.g. 1 for a protractor read to the degree")
@@ -88,6 +133,18 @@ def fit_ramp(angles_deg: np.ndarray, source: str = "ramp",
 
 @dataclass(frozen=True)
 class SlipOnset:
+    """When the robot starts to slide down the tilting board.
+
+    Attributes
+    ----------
+    critical_angle_deg : float
+        The board's angle at the onset [deg].
+    onset_s : float
+        The onset's time in the track [s].
+    slip_m : float
+        How far the robot slid by the end of the record [m].
+    """
+
     critical_angle_deg: float
     onset_s: float
     slip_m: float          # how far the robot slid by the end of the record
@@ -95,7 +152,22 @@ class SlipOnset:
 
 def board_length_warning(length_m: float, units: str = "m", source: str = "ramp") -> str | None:
     """A warning when the distance between the ramp's markers is not a board's, naming the
-    ``--units`` that would make it one."""
+    ``--units`` that would make it one.
+
+    Parameters
+    ----------
+    length_m : float
+        The markers' distance as read [m].
+    units : str
+        The ``--units`` the track was read in.
+    source : str
+        The recording's name, for the message.
+
+    Returns
+    -------
+    str or None
+        The warning; None for a plausible board (or a length that is not finite).
+    """
     low, high, typical = BOARD_M
     if not math.isfinite(length_m) or low <= length_m <= high:
         return None
@@ -106,7 +178,31 @@ def board_length_warning(length_m: float, units: str = "m", source: str = "ramp"
 def critical_angle_from_track(t_s: np.ndarray, ramp_a: tuple[np.ndarray, np.ndarray],
                               ramp_b: tuple[np.ndarray, np.ndarray], robot: tuple[np.ndarray, np.ndarray], *,
                               source: str = "ramp", min_slip_m: float = 0.005) -> SlipOnset:
-    """Ramp angle when the robot starts to slide, from a side-view track (see module doc)."""
+    """Ramp angle when the robot starts to slide, from a side-view track (see module doc).
+
+    Parameters
+    ----------
+    t_s : numpy.ndarray
+        Time [s].
+    ramp_a, ramp_b : tuple of numpy.ndarray
+        x and y [m] of the markers on the board's hinge end and far end.
+    robot : tuple of numpy.ndarray
+        x and y [m] of the robot's marker.
+    source : str
+        The recording's name, for messages.
+    min_slip_m : float, default 0.005
+        The slide along the board [m] that counts as the robot sliding.
+
+    Returns
+    -------
+    SlipOnset
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Fewer than 10 frames with all three markers, a board that does not tilt, or a robot
+        that never slides.
+    """
     t = np.asarray(t_s, dtype=float)
     ax, ay = ramp_a
     bx, by = ramp_b

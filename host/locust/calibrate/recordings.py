@@ -57,12 +57,42 @@ class Table:
 
     @property
     def n_rows(self) -> int:
+        """The number of samples."""
         return len(next(iter(self.columns.values()))) if self.columns else 0
 
     def has(self, *names: str) -> bool:
+        """Whether every column in ``names`` is present.
+
+        Parameters
+        ----------
+        *names : str
+            Column names.
+
+        Returns
+        -------
+        bool
+        """
         return all(n in self.columns for n in names)
 
     def require(self, *names: str, purpose: str = "") -> list[np.ndarray]:
+        """The columns ``names``, in order.
+
+        Parameters
+        ----------
+        *names : str
+            Column names (unit in their suffix).
+        purpose : str
+            What they are for, named in the message when one is missing.
+
+        Returns
+        -------
+        list of numpy.ndarray
+
+        Raises
+        ------
+        locust.errors.CalibrationError
+            A column is missing.
+        """
         missing = [n for n in names if n not in self.columns]
         if missing:
             what = f" for {purpose}" if purpose else ""
@@ -74,10 +104,32 @@ class Table:
         return [self.columns[n] for n in names]
 
     def markers(self) -> list[str]:
+        """The markers with both ``<name>_x_m`` and ``<name>_y_m`` columns.
+
+        Returns
+        -------
+        list of str
+        """
         return [c[:-4] for c in self.columns if c.endswith("_x_m") and c[:-4] + "_y_m" in self.columns]
 
     def marker(self, name: str | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Positions (x_m, y_m) of one marker; NaN where it was not found."""
+        """Positions of one marker; NaN where it was not found.
+
+        Parameters
+        ----------
+        name : str, optional
+            The marker; default the table's only one.
+
+        Returns
+        -------
+        x_m, y_m : numpy.ndarray
+            Positions [m].
+
+        Raises
+        ------
+        locust.errors.CalibrationError
+            No such marker, or no name given and not exactly one marker.
+        """
         names = self.markers()
         if name is None:
             if len(names) != 1:
@@ -96,6 +148,13 @@ class Table:
             raise CalibrationError(exc.message, exc.hint) from None
 
     def time_s(self) -> np.ndarray:
+        """The ``t_s`` column [s] (a CalibrationError when there is none).
+
+        Returns
+        -------
+        numpy.ndarray
+            [s].
+        """
         (t,) = self.require("t_s", purpose="time")
         return t
 
@@ -116,7 +175,27 @@ class TimeOptions:
     clip_fps: float | None = None       # the rate the clip was filmed at [frames/s]
 
     def factor(self, t_s: np.ndarray, path: Path) -> tuple[float, str]:
-        """The factor on the file's times, and what to say about it ('' when 1)."""
+        """The factor on the file's times, and what to say about it ('' when 1).
+
+        Parameters
+        ----------
+        t_s : numpy.ndarray
+            The file's times [s] (for ``clip_fps``: the rate the file says).
+        path : pathlib.Path
+            The recording, for messages.
+
+        Returns
+        -------
+        factor : float
+            Real time = file time × factor.
+        note : str
+            What was done, as the command line says it.
+
+        Raises
+        ------
+        locust.errors.CalibrationError
+            Both options given, a scale that is not positive, or ``clip_fps`` without a usable rate.
+        """
         if self.time_scale is not None and self.clip_fps is not None:
             raise CalibrationError("give --time-scale or --clip-fps, not both",
                                    "--clip-fps F: the clip was filmed at F frames/s; --time-scale S: t_real = t*S")
@@ -155,7 +234,21 @@ SIZE_HINT = ("cut the recording to the experiment (a few seconds to minutes), e.
 
 def read_recording_text(path: str | Path) -> str:
     """The text of a recording (a CSV, a Tracker export, a gyro log): refused
-    (:class:`CalibrationError`) before parsing when it is larger than a recording can be."""
+    (:class:`CalibrationError`) before parsing when it is larger than a recording can be.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        The file cannot be read, or holds more bytes or lines than a recording can.
+    """
     path = Path(path)
     try:
         size = path.stat().st_size
@@ -178,7 +271,23 @@ def read_recording_text(path: str | Path) -> str:
 def check_values(table: Table) -> Table:
     """``table`` if every value is a number a recording can hold: NaN (not found) is kept, an
     infinite or absurdly large one (1e308 in a position in metres) is a :class:`CalibrationError`
-    naming its column and row."""
+    naming its column and row.
+
+    Parameters
+    ----------
+    table : Table
+        A recording read.
+
+    Returns
+    -------
+    Table
+        ``table`` itself.
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        An infinite or absurdly large value.
+    """
     for name, col in table.columns.items():
         limit = next((v for k, v in LARGEST.items() if name.endswith(k)), LARGEST_OTHER)
         bad = np.flatnonzero(np.abs(np.nan_to_num(col, nan=0.0)) > limit)
@@ -194,7 +303,27 @@ def check_values(table: Table) -> Table:
 def read_table(path: str | Path, imports: ImportOptions = AS_IS, timing: TimeOptions = REAL_TIME) -> Table:
     """Read a recording; see the module docstring for the formats understood. ``imports``
     (``--units``, ``--rename``, ``--mirror``) converts a track; a plain CSV is read as it is;
-    ``timing`` rescales a slow-motion recording's times."""
+    ``timing`` rescales a slow-motion recording's times.
+
+    Parameters
+    ----------
+    path : path-like
+        The recording.
+    imports : locust.io.importing.ImportOptions
+        How a track is converted.
+    timing : TimeOptions
+        The slow-motion time scale.
+
+    Returns
+    -------
+    Table
+        Columns in SI units (``t_s`` [s], ``<marker>_x_m`` [m], ...).
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        A file that cannot be read as any of the formats, or holds impossible values.
+    """
     path = Path(path)
     try:
         if is_project(path):
@@ -213,7 +342,17 @@ def regular_time(table: Table) -> Table:
     3 significant digits: 10.5, 10.5, 10.5, 10.6 at 30 frames/s) gets them back from the row
     order, one frame a row, when a line through (row, time) stays within half the printed step
     plus half a frame of every time; the note says so. Other recordings are returned as they are
-    (a real step back in time is :func:`clean_samples`' error)."""
+    (a real step back in time is :func:`clean_samples`' error).
+
+    Parameters
+    ----------
+    table : Table
+        A recording read.
+
+    Returns
+    -------
+    Table
+    """
     if "t_s" not in table.columns:
         return table
     t = table.columns["t_s"]
@@ -233,7 +372,23 @@ def regular_time(table: Table) -> Table:
 
 
 def rescale_time(table: Table, timing: TimeOptions) -> Table:
-    """``table`` with its times (``t_s``, and its tracks') multiplied as ``timing`` says."""
+    """``table`` with its times (``t_s``, and its tracks') multiplied as ``timing`` says.
+
+    Parameters
+    ----------
+    table : Table
+        A recording read.
+    timing : TimeOptions
+
+    Returns
+    -------
+    Table
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Options that contradict each other (see :meth:`TimeOptions.factor`).
+    """
     if "t_s" not in table.columns:
         return table
     factor, note = timing.factor(table.columns["t_s"], table.path)
@@ -245,7 +400,26 @@ def rescale_time(table: Table, timing: TimeOptions) -> Table:
 
 
 def parse_table(text: str, path: Path, imports: ImportOptions = AS_IS) -> Table:
-    """The recording in ``text`` (the contents of ``path``), in whichever of the three formats."""
+    """The recording in ``text`` (the contents of ``path``), in whichever of the three formats.
+
+    Parameters
+    ----------
+    text : str
+        The recording's contents.
+    path : pathlib.Path
+        Where it came from (for messages, and a Tracker project's own reading).
+    imports : locust.io.importing.ImportOptions
+        How a track is converted.
+
+    Returns
+    -------
+    Table
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Not a table of numbers in any of the formats.
+    """
     try:
         doc = split_text(text, path)
         layout = track_layout(doc)
@@ -264,7 +438,31 @@ def parse_table(text: str, path: Path, imports: ImportOptions = AS_IS) -> Table:
 
 def clean_samples(path: Path, what: str, t_s: np.ndarray, *series: np.ndarray,
                   min_samples: int) -> tuple[np.ndarray, ...]:
-    """Rows where time and every series are finite, time increasing; enough of them."""
+    """Rows where time and every series are finite, time increasing; enough of them.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The recording, for messages.
+    what : str
+        What the series are (``the servo angle``), for messages.
+    t_s : numpy.ndarray
+        Time [s].
+    *series : numpy.ndarray
+        The series sampled at ``t_s``, each in its own unit.
+    min_samples : int
+        How many rows a fit needs.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``t_s`` and each series, on the rows kept.
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Too few rows, or time that does not increase.
+    """
     t_s = np.asarray(t_s, dtype=float)
     keep = np.isfinite(t_s)
     for s in series:

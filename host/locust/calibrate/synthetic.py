@@ -22,6 +22,24 @@ from .servo import RateRecording, ServoRig, StepRecording, Timing, rig_model, si
 
 @dataclass(frozen=True)
 class BeamTruth:
+    """A cardstock cantilever with a mass dropped on its tip, filmed from the side (SYNTHETIC
+    truth for the beam fit).
+
+    Attributes
+    ----------
+    damping_ratio : float
+        The tip's damping ratio (no unit).
+    drop_height_m, drop_at_s : float
+        The mass's fall onto the tip [m] and when it lands [s].
+    fps : float
+        Frames per second of the camera.
+    noise_m : float
+        The track's noise, one standard deviation [m].
+    transient_m, transient_s, transient_hz : float
+        A release transient at the drop: its size [m], its decay to e^-3 [s], its ringing
+        frequency [Hz] (0: a decaying offset).
+    """
+
     mass_kg: float = 0.010
     length_m: float = 0.05
     hinge_stiffness_nm_per_rad: float = 0.056375      # the seed's value
@@ -39,18 +57,22 @@ class BeamTruth:
 
     @property
     def stiffness_n_per_m(self) -> float:
+        """The tip's stiffness, hinge stiffness / length² [N/m]."""
         return self.hinge_stiffness_nm_per_rad / self.length_m**2
 
     @property
     def damping_ns_per_m(self) -> float:
+        """The tip's damping from the damping ratio [N·s/m]."""
         return 2 * self.damping_ratio * math.sqrt(self.stiffness_n_per_m * self.mass_kg)
 
     @property
     def hinge_damping_nms_per_rad(self) -> float:
+        """The hinge's damping, tip damping × length² [N·m·s/rad]."""
         return self.damping_ns_per_m * self.length_m**2
 
     @property
     def natural_frequency_hz(self) -> float:
+        """The undamped natural frequency of the loaded tip [Hz]."""
         return math.sqrt(self.stiffness_n_per_m / self.mass_kg) / (2 * math.pi)
 
 
@@ -62,6 +84,19 @@ def beam_tip_track(truth: BeamTruth, rng: np.random.Generator, tilt_deg: float =
     the drop leaves a release transient the oscillator does not explain (a finger or a
     higher mode of the strip): ``transient_m * exp(-3*tau/transient_s)``, times
     ``cos(2*pi*transient_hz*tau)`` when that is not 0, added along the tip's motion.
+
+    Parameters
+    ----------
+    truth : BeamTruth
+    rng : numpy.random.Generator
+        The noise's source.
+    tilt_deg : float, default 3
+        The camera's tilt [deg].
+
+    Returns
+    -------
+    t_s, x_m, y_m : numpy.ndarray
+        Time [s] and the tip's position in the camera's frame [m] (SYNTHETIC).
     """
     t = np.arange(int(truth.duration_s * truth.fps)) / truth.fps
     wn = 2 * math.pi * truth.natural_frequency_hz
@@ -111,10 +146,12 @@ class ServoTruth:
 
     @property
     def rig(self) -> ServoRig:
+        """The rig the fit is given: load inertia, gravity moment, time step."""
         return ServoRig(self.inertia_kgm2, self.gravity_moment_nm, timestep_s=self.timestep_s)
 
     @property
     def duration_s(self) -> float:
+        """The recording's length: the first edge and every half period after it [s]."""
         return self.first_edge_s + self.edges * self.half_period_s
 
 
@@ -145,12 +182,25 @@ class GyroTruth:
 
     @property
     def rig(self) -> ServoRig:
+        """The rig the fit is given: the gyro board's inertia, no gravity moment."""
         return ServoRig(self.inertia_kgm2, timestep_s=self.timestep_s)
 
 
 def gyro_steps(truth: GyroTruth, rng: np.random.Generator):
     """(t_s, command_deg, rate_units): the rig model's speed at the samples, the horn at rest
-    between steps, plus noise, rounded."""
+    between steps, plus noise, rounded.
+
+    Parameters
+    ----------
+    truth : GyroTruth
+    rng : numpy.random.Generator
+        The noise's source.
+
+    Returns
+    -------
+    t_s, command_deg, rate_units : numpy.ndarray
+        Time [s], command [deg], the gyro's reading in whole counts (SYNTHETIC).
+    """
     duration = truth.first_edge_s + 2 * len(truth.steps_deg) * truth.level_s
     t = np.arange(int(duration / truth.sample_s)) * truth.sample_s
     level = np.floor((t - truth.first_edge_s) / truth.level_s).astype(int)
@@ -180,7 +230,19 @@ def _rest_deg(truth: ServoTruth) -> float:
 
 
 def servo_step(truth: ServoTruth, rng: np.random.Generator):
-    """(t_s, angle_deg, command_deg): the rig model stepped from rest, plus angle noise."""
+    """(t_s, angle_deg, command_deg): the rig model stepped from rest, plus angle noise.
+
+    Parameters
+    ----------
+    truth : ServoTruth
+    rng : numpy.random.Generator
+        The noise's source.
+
+    Returns
+    -------
+    t_s, angle_deg, command_deg : numpy.ndarray
+        Time [s], horn angle and command [deg] (SYNTHETIC).
+    """
     t = np.arange(int(truth.duration_s * truth.fps)) / truth.fps
     n_edges = np.clip(np.floor((t - truth.first_edge_s) / truth.half_period_s) + 1, 0, truth.edges)
     command = np.where(n_edges % 2 == 1, truth.target_deg, truth.start_deg)
@@ -192,6 +254,19 @@ def servo_step(truth: ServoTruth, rng: np.random.Generator):
 
 @dataclass(frozen=True)
 class RampTruth:
+    """Tilt trials of a robot on a ramp (SYNTHETIC truth for the ramp fit).
+
+    Attributes
+    ----------
+    mu_static : float
+        The true static friction (no unit).
+    trials : int
+        Trials drawn.
+    scatter_deg, reading_deg : float
+        Trial-to-trial scatter of the critical angle and the inclinometer's reading error,
+        one standard deviation each [deg].
+    """
+
     mu_static: float = 1.7          # the seed's foot friction
     trials: int = 10
     scatter_deg: float = 0.8        # trial-to-trial scatter of the critical angle
@@ -199,10 +274,23 @@ class RampTruth:
 
     @property
     def critical_angle_deg(self) -> float:
+        """atan(mu_static) [deg]."""
         return math.degrees(math.atan(self.mu_static))
 
 
 def ramp_angles(truth: RampTruth, rng: np.random.Generator) -> np.ndarray:
+    """The trials' critical angles as read, to 0.1 deg (SYNTHETIC).
+
+    Parameters
+    ----------
+    truth : RampTruth
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    numpy.ndarray
+        ``truth.trials`` angles [deg].
+    """
     sd = math.hypot(truth.scatter_deg, truth.reading_deg)
     return np.round(truth.critical_angle_deg + rng.normal(0, sd, truth.trials), 1)
 
@@ -210,7 +298,33 @@ def ramp_angles(truth: RampTruth, rng: np.random.Generator) -> np.ndarray:
 def ramp_tilt_track(truth: RampTruth, rng: np.random.Generator, *, fps: float = 60.0, rate_deg_per_s: float = 4.0,
                     board_m: float = 0.30, noise_m: float = 0.0005, mu_kinetic_ratio: float = 0.8):
     """One tilting trial filmed from the side: markers ``ramp_a`` (hinge end), ``ramp_b`` (far
-    end of the board) and ``robot``. Returns (t_s, {marker: (x_m, y_m)}, critical_angle_deg)."""
+    end of the board) and ``robot``. Returns (t_s, {marker: (x_m, y_m)}, critical_angle_deg).
+
+    Parameters
+    ----------
+    truth : RampTruth
+    rng : numpy.random.Generator
+        The noise's source.
+    fps : float, default 60
+        Frames per second.
+    rate_deg_per_s : float, default 4
+        How fast the board tilts [deg/s].
+    board_m : float, default 0.30
+        The distance between the board's markers [m].
+    noise_m : float, default 0.0005
+        The markers' noise, one standard deviation [m].
+    mu_kinetic_ratio : float, default 0.8
+        Sliding friction as a share of static friction.
+
+    Returns
+    -------
+    t_s : numpy.ndarray
+        Time [s].
+    markers : dict of str to (numpy.ndarray, numpy.ndarray)
+        Marker -> x and y [m] (SYNTHETIC).
+    critical_angle_deg : float
+        The true angle at which the robot starts to slide [deg].
+    """
     crit = truth.critical_angle_deg
     t = np.arange(int((crit + 8) / rate_deg_per_s * fps)) / fps
     theta = np.radians(rate_deg_per_s * t)
@@ -261,6 +375,7 @@ class HingeTruth:
 
     @property
     def gravity_moment_nm(self) -> float:
+        """The link's weight moment with it horizontal [N·m]; 0 out of plane."""
         return self.mass_kg * GRAVITY_M_PER_S2 * self.com_m if self.gravity == "in-plane" else 0.0
 
 
@@ -278,7 +393,19 @@ def hinge_swing_track(truth: HingeTruth, rng: np.random.Generator):
     I*theta'' = -k*(theta - theta0) - b*theta' - M*g*D*cos(theta) - tau_c*sign(theta') (gravity
     in plane only), integrated by an explicit Runge-Kutta method of order 8 (DOP853, relative
     tolerance 1e-11; the sign smoothed over 1e-4 rad/s): not the fit's own integrator.
-    Gaussian noise of ``noise_m`` on each coordinate."""
+    Gaussian noise of ``noise_m`` on each coordinate.
+
+    Parameters
+    ----------
+    truth : HingeTruth
+    rng : numpy.random.Generator
+        The noise's source.
+
+    Returns
+    -------
+    t_s, x, y : numpy.ndarray
+        Time [s] and the marker's position in ``truth.units`` (SYNTHETIC).
+    """
     t = np.arange(int(round(truth.duration_s * truth.fps))) / truth.fps
     k, b = truth.hinge_stiffness_nm_per_rad, truth.hinge_damping_nms_per_rad
     th0, mgd, inertia = math.radians(truth.neutral_angle_deg), truth.gravity_moment_nm, truth.inertia_kgm2

@@ -36,7 +36,18 @@ UNIT_HINT = ("check the recording's units: times in seconds (not ms), angles in 
 
 
 def implausible(values: dict[str, Estimate]) -> list[str]:
-    """Fitted values no desk hopper has (a unit slipped), one message each."""
+    """Fitted values no desk hopper has (a unit slipped), one message each.
+
+    Parameters
+    ----------
+    values : dict of str to locust.calibrate.fitstats.Estimate
+        Dotted name -> fitted value, in the unit its name says.
+
+    Returns
+    -------
+    list of str
+        Empty when every value is plausible.
+    """
     out = []
     for key, est in values.items():
         low, high = PLAUSIBLE.get(key, (-math.inf, math.inf))
@@ -46,7 +57,18 @@ def implausible(values: dict[str, Estimate]) -> list[str]:
 
 
 def check_plausible(values: dict[str, Estimate]) -> None:
-    """Refuse (:class:`CalibrationError`) to write implausible fitted values."""
+    """Refuse (:class:`CalibrationError`) to write implausible fitted values.
+
+    Parameters
+    ----------
+    values : dict of str to locust.calibrate.fitstats.Estimate
+        Dotted name -> fitted value, in the unit its name says.
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        A value no desk hopper has.
+    """
     found = implausible(values)
     if found:
         raise CalibrationError("; ".join(found) + "; not written", UNIT_HINT)
@@ -58,7 +80,31 @@ def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str |
     (nothing written) when a value is implausible or the robot could then not be simulated.
 
     The file is read, changed and written back under a lock (``robot_toml.update_robot``): two
-    calibrations writing one file at once both land; its comments and layout are kept."""
+    calibrations writing one file at once both land; its comments and layout are kept.
+
+    Parameters
+    ----------
+    path : path-like
+        The ``robot.toml`` (started from the seed preset when missing).
+    values : dict of str to locust.calibrate.fitstats.Estimate
+        Dotted name -> fitted value, in the unit its name says.
+    recording : str or path-like
+        The recording fitted: the values' source ``fit:<recording>``.
+    note : str
+        Added to each value's note.
+    date : str, optional
+        The fit's date (default today).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        An implausible value, or a robot that could then not be simulated.
+    """
     check_plausible(values)
     path = Path(path)
 
@@ -78,7 +124,25 @@ def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str |
 def with_fitted(robot: Robot, values: dict[str, Estimate], recording: str | Path, *, note: str = "",
                 date: str | None = None) -> Robot:
     """``robot`` with each dotted key in ``values`` set to its fitted value, its source
-    ``fit:<recording>``, its uncertainty (1 sigma), the date and the 95% interval in its note."""
+    ``fit:<recording>``, its uncertainty (1 sigma), the date and the 95% interval in its note.
+
+    Parameters
+    ----------
+    robot : locust.params.Robot
+    values : dict of str to locust.calibrate.fitstats.Estimate
+        Dotted name -> fitted value, in the unit its name says.
+    recording : str or path-like
+        The recording fitted.
+    note : str
+        Added to each value's note.
+    date : str, optional
+        The fit's date (default today).
+
+    Returns
+    -------
+    locust.params.Robot
+        A copy with the values.
+    """
     date = date or _dt.date.today().isoformat()
     for key, est in values.items():
         ci = f"95% CI [{est.ci95_low:.6g}, {est.ci95_high:.6g}]"

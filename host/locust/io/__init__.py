@@ -1,8 +1,8 @@
 """The file formats, each owned by one module (typed object, writer and reader side by side).
 
-This layer imports no other part of locust but ``errors``, ``fileio`` and the firmware's
-protocol table, so the simulation, tracking, calibration, the report, the sweeps and the
-robot all read and write files through it without importing one another.
+This layer imports no other part of locust but ``errors``, ``fileio``, the firmware's protocol
+table and (for ``robot.toml``) ``params``, so the simulation, tracking, calibration, the report
+and the sweeps all read and write files through it without importing one another.
 
 - :mod:`.delimited`    the tokenizer under every table of samples (tracks, exports, calibration CSVs)
 - :mod:`.tracks_csv`   ``<video>.tracks.csv``, the tracks everyone reads
@@ -14,4 +14,7 @@ robot all read and write files through it without importing one another.
 - :mod:`.camera_json`  ``<video>.camera.json``, the pinhole camera of a simulated video
 - :mod:`.run_record`   ``run.json``, a hop's run record
 - :mod:`.sweep_store`  a sweep's folder: ``sweep.json`` and ``results.csv``
+- :mod:`.study_store`  an optimisation's folder: ``trials.csv`` and ``pareto.csv``
+- :mod:`.robot_toml`   ``robot.toml``, the robot's parameters with their provenance, and the robot
+                       a command names (a preset or a file, with ``--set`` values)
 """

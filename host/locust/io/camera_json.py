@@ -38,7 +38,16 @@ CHASSIS_MID_PLANE_Y_M = 0.0   # the robot's mid-plane, where a fixed camera's m/
 
 
 def camera_json_beside(video: Path) -> Path:
-    """``hop.mp4`` -> ``hop.camera.json`` (where the simulation writes it)."""
+    """``hop.mp4`` -> ``hop.camera.json`` (where the simulation writes it).
+
+    Parameters
+    ----------
+    video : pathlib.Path
+
+    Returns
+    -------
+    pathlib.Path
+    """
     return video.with_name(video.stem + CAMERA_JSON_SUFFIX)
 
 
@@ -88,15 +97,32 @@ class CameraFile:
 
     @property
     def planes_y_m(self) -> dict[str, float]:
+        """Each marker's plane, its distance along the camera's depth axis y [m]."""
         return {n: p.plane_y_m for n, p in self.marker_planes.items()}
 
     def m_per_px_at(self, plane_y_m: float) -> float:
-        """Metres per pixel at the plane ``y = plane_y_m``, seen from the first camera position."""
+        """Metres per pixel at the plane ``y = plane_y_m``, seen from the first camera position.
+
+        Parameters
+        ----------
+        plane_y_m : float
+            The plane's place along the world y axis [m].
+
+        Returns
+        -------
+        float
+            [m/px].
+        """
         depth = float(((np.atleast_2d([0.0, plane_y_m, 0.0]) - self.positions_m[0]) @ self.rotation.T)[0, 2])
         return depth / float(self.K[0, 0])
 
     def to_dict(self) -> dict:
-        """The file's JSON document."""
+        """The file's JSON document.
+
+        Returns
+        -------
+        dict
+        """
         R, K = self.rotation, self.K
         out: dict = {"note": CAMERA_NOTE, "camera": self.camera, "width_px": self.width_px, "height_px": self.height_px}
         if self.fps is not None:
@@ -127,7 +153,23 @@ class CameraFile:
 
 
 def write_camera_json(path: Path, camera: CameraFile) -> Path:
-    """Write ``camera`` to ``path`` (e.g. :func:`camera_json_beside` a video) atomically."""
+    """Write ``camera`` to ``path`` (e.g. :func:`camera_json_beside` a video) atomically.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+    camera : CameraFile
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    locust.errors.WriteError
+        The file cannot be written.
+    """
     return atomic_write_json(path, camera.to_dict())
 
 
@@ -136,7 +178,21 @@ MAX_CAMERA_JSON_BYTES = 64 * 2**20
 
 
 def read_camera_json(path: str | Path) -> CameraFile:
-    """Read a ``camera.json``; a :class:`~locust.errors.TrackError` says what is missing or malformed."""
+    """Read a ``camera.json``; a :class:`~locust.errors.TrackError` says what is missing or malformed.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    CameraFile
+
+    Raises
+    ------
+    locust.errors.TrackError
+        Not a readable camera file, a value missing, or matrices that are not 3x3 finite numbers.
+    """
     path = Path(path)
     try:
         if not stat.S_ISREG(path.stat().st_mode) or path.stat().st_size > MAX_CAMERA_JSON_BYTES:

@@ -57,7 +57,23 @@ class DelimitedText:
 
     def columns(self, names: list[str]) -> np.ndarray:
         """The data as floats, one column per name (``names`` label the header's columns in
-        messages and decide where ``true``/``false`` is allowed); a short row is NaN-padded."""
+        messages and decide where ``true``/``false`` is allowed); a short row is NaN-padded.
+
+        Parameters
+        ----------
+        names : list of str
+            The header's column names.
+
+        Returns
+        -------
+        numpy.ndarray
+            (rows, len(names)) floats.
+
+        Raises
+        ------
+        locust.errors.TrackError
+            A row with more fields than the header, or a field that is not a number.
+        """
         data = np.full((len(self.rows), len(names)), np.nan)
         for k, (lineno, row) in enumerate(self.rows):
             if len(row) > len(names) and any(f.strip() for f in row[len(names):]):
@@ -69,7 +85,21 @@ class DelimitedText:
 
 
 def read_text(path: str | Path) -> str:
-    """The file's text (UTF-8, a byte-order mark dropped), or a TrackError naming it."""
+    """The file's text (UTF-8, a byte-order mark dropped), or a TrackError naming it.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    locust.errors.TrackError
+        No such file, not a regular file, or not text.
+    """
     path = Path(path)
     try:
         if not stat.S_ISREG(path.stat().st_mode):   # a pipe blocks, a device never ends: not opened
@@ -83,7 +113,23 @@ def read_text(path: str | Path) -> str:
 
 
 def split_text(text: str, path: str | Path) -> DelimitedText:
-    """Split ``text`` (the contents of ``path``) into comments, header and data rows."""
+    """Split ``text`` (the contents of ``path``) into comments, header and data rows.
+
+    Parameters
+    ----------
+    text : str
+    path : path-like
+        For messages.
+
+    Returns
+    -------
+    DelimitedText
+
+    Raises
+    ------
+    locust.errors.TrackError
+        An empty file, no header, or no numeric rows.
+    """
     path = Path(path)
     # a line of tabs alone is a row of empty cells (a frame no track has), not a blank line
     lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() or "\t" in ln]
@@ -108,7 +154,21 @@ def split_text(text: str, path: str | Path) -> DelimitedText:
 
 
 def check_names(names: list[str], path: Path, lineno: int) -> None:
-    """Every column named, no name twice."""
+    """Every column named, no name twice.
+
+    Parameters
+    ----------
+    names : list of str
+        The header's names.
+    path : pathlib.Path
+    lineno : int
+        The header's line, for messages.
+
+    Raises
+    ------
+    locust.errors.TrackError
+        An empty name, or a name given twice.
+    """
     seen: set[str] = set()
     for n in names:
         if not n:

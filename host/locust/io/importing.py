@@ -68,6 +68,26 @@ class ImportOptions:
     @classmethod
     def parse(cls, units: str | None = "m", rename: Iterable[str] | Mapping[str, str] = (),
               mirror: bool = False) -> ImportOptions:
+        """The options checked, from the command line's spelling.
+
+        Parameters
+        ----------
+        units : {"m", "cm", "mm"} or None
+            The file's unit of length (None: metres).
+        rename : iterable of "OLD=NEW", or mapping OLD -> NEW
+            Marker renames.
+        mirror : bool
+            Flip x (a hop filmed going left).
+
+        Returns
+        -------
+        ImportOptions
+
+        Raises
+        ------
+        locust.errors.TrackError
+            An unknown unit or a malformed rename.
+        """
         return cls(parse_units(units), parse_rename(rename), bool(mirror))
 
     @property
@@ -77,10 +97,16 @@ class ImportOptions:
 
     @property
     def divisor(self) -> int:
+        """What a position in ``units`` is divided by to be in metres (1, 100 or 1000)."""
         return UNITS[self.units]
 
     def describe(self) -> str:
-        """``cm -> m, renamed A -> nose, x mirrored``."""
+        """``cm -> m, renamed A -> nose, x mirrored``.
+
+        Returns
+        -------
+        str
+        """
         parts = [f"positions in {self.units}" + ("" if self.units == "m" else " -> m")]
         parts += [f"renamed {old} -> {new}" for old, new in self.rename]
         if self.mirror:
@@ -88,7 +114,12 @@ class ImportOptions:
         return ", ".join(parts)
 
     def options_text(self) -> str:
-        """The command-line options that give these settings (empty for the identity)."""
+        """The command-line options that give these settings (empty for the identity).
+
+        Returns
+        -------
+        str
+        """
         parts = [] if self.units == "m" else [f"--units {self.units}"]
         parts += [f"--rename {_quote(f'{old}={new}')}" for old, new in self.rename]
         return " ".join(parts + (["--mirror"] if self.mirror else []))
@@ -98,7 +129,23 @@ AS_IS = ImportOptions()    # metres, names as they are, not mirrored
 
 
 def parse_units(units: str | None) -> str:
-    """``"CM"`` -> ``"cm"``; anything but m, cm, mm is a TrackError."""
+    """``"CM"`` -> ``"cm"``; anything but m, cm, mm is a TrackError.
+
+    Parameters
+    ----------
+    units : str or None
+        None: metres.
+
+    Returns
+    -------
+    str
+        ``m``, ``cm`` or ``mm``.
+
+    Raises
+    ------
+    locust.errors.TrackError
+        Another unit.
+    """
     key = (units or "m").strip().lower()
     if key not in UNITS:
         raise TrackError(f"unknown unit {units!r} for --units", UNITS_HINT)
@@ -106,7 +153,21 @@ def parse_units(units: str | None) -> str:
 
 
 def parse_rename(items: Iterable[str] | Mapping[str, str]) -> tuple[tuple[str, str], ...]:
-    """``["cm A=nose"]`` (or ``{"cm A": "nose"}``) -> ``(("cm A", "nose"),)``, each checked."""
+    """``["cm A=nose"]`` (or ``{"cm A": "nose"}``) -> ``(("cm A", "nose"),)``, each checked.
+
+    Parameters
+    ----------
+    items : iterable of "OLD=NEW", or mapping OLD -> NEW
+
+    Returns
+    -------
+    tuple of (str, str)
+
+    Raises
+    ------
+    locust.errors.TrackError
+        A new name that is not a marker name, or a marker renamed twice.
+    """
     pairs = list(items.items()) if isinstance(items, Mapping) else [_split_rename(i) for i in items]
     seen: set[str] = set()
     for old, new in pairs:
@@ -131,7 +192,30 @@ def import_tracks(path: str | Path, units: str = "m", rename: Iterable[str] | Ma
     """A track file in any of the three layouts, as locust's tracks in metres (see the module).
 
     ``units``, ``rename`` and ``mirror`` as on the command line (``rename``: ``["A=nose"]`` or
-    ``{"A": "nose"}``), or ``options`` already parsed."""
+    ``{"A": "nose"}``), or ``options`` already parsed.
+
+    Parameters
+    ----------
+    path : path-like
+        A tracks CSV, a Tracker text export or project, or a t,x,y CSV.
+    units : {"m", "cm", "mm"}
+        The file's unit of length.
+    rename : iterable of str or mapping
+    mirror : bool
+        Flip x.
+    options : ImportOptions, optional
+        Instead of the three above.
+
+    Returns
+    -------
+    TracksCsv
+        Positions in metres, time in seconds.
+
+    Raises
+    ------
+    locust.errors.TrackError
+        A file in no known layout, a bad option, or time that does not increase.
+    """
     options = options or ImportOptions.parse(units, rename, mirror)
     if is_project(path):
         return import_project(path, options)
@@ -145,13 +229,39 @@ PROJECT_SUFFIXES = (".trk", ".trz")
 
 
 def is_project(path: str | Path) -> bool:
-    """Whether ``path`` names a Tracker project (``.trk``, or a ``.trz`` zip holding one)."""
+    """Whether ``path`` names a Tracker project (``.trk``, or a ``.trz`` zip holding one).
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    bool
+    """
     return Path(path).suffix.lower() in PROJECT_SUFFIXES
 
 
 def import_project(path: str | Path, options: ImportOptions = AS_IS) -> TracksCsv:
     """A Tracker project's point tracks in metres through its own calibration (:mod:`.trk`),
-    renamed and mirrored by ``options``; a comment says which scale, origin and rate were used."""
+    renamed and mirrored by ``options``; a comment says which scale, origin and rate were used.
+
+    Parameters
+    ----------
+    path : path-like
+        A ``.trk`` or ``.trz``.
+    options : ImportOptions
+        ``--units``, ``--rename``, ``--mirror``, parsed.
+
+    Returns
+    -------
+    TracksCsv
+
+    Raises
+    ------
+    locust.errors.TrackError
+        ``--units`` given, or a project without a scale or a frame rate.
+    """
     from .trk import project_tracks, read_project
 
     path = Path(path)
@@ -174,7 +284,16 @@ def import_project(path: str | Path, options: ImportOptions = AS_IS) -> TracksCs
 
 
 def track_layout(doc: DelimitedText) -> str | None:
-    """``tracker``, ``tracks`` (locust's CSV), ``txy`` (a plain CSV of one marker), or None."""
+    """``tracker``, ``tracks`` (locust's CSV), ``txy`` (a plain CSV of one marker), or None.
+
+    Parameters
+    ----------
+    doc : locust.io.delimited.DelimitedText
+
+    Returns
+    -------
+    str or None
+    """
     if doc.tracker_layout:
         return "tracker"
     if is_tracks_header(doc.header):
@@ -188,7 +307,23 @@ LAYOUT_NAMES = {"tracker": "Tracker text export", "tracks": "tracks CSV", "txy":
 
 
 def tracks_from_delimited(doc: DelimitedText, options: ImportOptions = AS_IS) -> TracksCsv:
-    """The tracks of a file already split by :func:`.delimited.split_text`, converted by ``options``."""
+    """The tracks of a file already split by :func:`.delimited.split_text`, converted by ``options``.
+
+    Parameters
+    ----------
+    doc : locust.io.delimited.DelimitedText
+    options : ImportOptions
+        ``--units``, ``--rename``, ``--mirror``, parsed.
+
+    Returns
+    -------
+    TracksCsv
+
+    Raises
+    ------
+    locust.errors.TrackError
+        A layout that is none of the three, or no x and y columns.
+    """
     layout = track_layout(doc)
     if layout is None:
         raise TrackError(f"{doc.path}: neither a Tracker text export, a t,x,y CSV nor a tracks CSV "
@@ -215,7 +350,20 @@ def check_times(doc: DelimitedText, t_s) -> None:
     skipped): velocities, onsets and fits all divide by the step. Names the file's lines.
     :func:`import_tracks` applies it; the calibration layer reads through
     :func:`tracks_from_delimited` and rebuilds times rounded to repeating values from the row
-    order itself (``locust.calibrate.recordings.regular_time``)."""
+    order itself (``locust.calibrate.recordings.regular_time``).
+
+    Parameters
+    ----------
+    doc : locust.io.delimited.DelimitedText
+        The file, for its line numbers.
+    t_s : numpy.ndarray
+        Its times [s].
+
+    Raises
+    ------
+    locust.errors.TrackError
+        A time that repeats or goes back.
+    """
     t = np.asarray(t_s, dtype=float)
     rows = np.flatnonzero(np.isfinite(t))
     step = np.diff(t[rows])
@@ -322,7 +470,18 @@ TYPICAL_SPAN_M = 0.3
 
 def span_warnings(tracks: TracksCsv, options: ImportOptions = AS_IS) -> list[str]:
     """A warning for each marker whose positions span more than :data:`DESK_SPAN_M`, with the
-    ``--units`` that would bring it back to a desk's size."""
+    ``--units`` that would bring it back to a desk's size.
+
+    Parameters
+    ----------
+    tracks : TracksCsv
+    options : ImportOptions
+        ``--units``, ``--rename``, ``--mirror``, parsed.
+
+    Returns
+    -------
+    list of str
+    """
     out = []
     for name in tracks.markers_with_positions():
         x, y = tracks.positions(name)
@@ -339,7 +498,21 @@ def span_warnings(tracks: TracksCsv, options: ImportOptions = AS_IS) -> list[str
 
 def likely_units(size_m: float, low_m: float, high_m: float, typical_m: float, given: str = "m") -> str | None:
     """The ``--units`` under which a length read as ``size_m`` (with ``--units given``) would
-    lie in ``[low_m, high_m]``, the one nearest ``typical_m``; None when no other unit does."""
+    lie in ``[low_m, high_m]``, the one nearest ``typical_m``; None when no other unit does.
+
+    Parameters
+    ----------
+    size_m : float
+        The length as read [m].
+    low_m, high_m, typical_m : float
+        The plausible range and the typical size [m].
+    given : str
+        The ``--units`` it was read with.
+
+    Returns
+    -------
+    str or None
+    """
     if not (math.isfinite(size_m) and size_m > 0):
         return None
     raw = size_m * UNITS[given]                 # the number in the file
@@ -348,7 +521,18 @@ def likely_units(size_m: float, low_m: float, high_m: float, typical_m: float, g
 
 
 def units_hint(size_m: float, low_m: float, high_m: float, typical_m: float, given: str = "m") -> str:
-    """What to say about a size out of ``[low_m, high_m]``: the unit that fits, or to check the scale."""
+    """What to say about a size out of ``[low_m, high_m]``: the unit that fits, or to check the scale.
+
+    Parameters
+    ----------
+    size_m, low_m, high_m, typical_m : float
+        As for :func:`likely_units` [m].
+    given : str
+
+    Returns
+    -------
+    str
+    """
     unit = likely_units(size_m, low_m, high_m, typical_m, given)
     read = "read as metres" if given == "m" else f"read in {given} (--units {given})"
     if unit is None:

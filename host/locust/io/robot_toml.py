@@ -1,4 +1,4 @@
-"""``robot.toml``: the robot's parameters with their provenance, read and written here alone.
+r"""``robot.toml``: the robot's parameters with their provenance, read and written here alone.
 
 ``load_robot`` reads and checks a file into a :class:`~locust.params.Robot`; ``save_robot``
 writes one through a real TOML writer (tomlkit) and reads each write back before it replaces
@@ -7,7 +7,7 @@ command names (a preset or a file,
 with ``--set`` values on it). Given the file being replaced, it changes that document in place, so
 the comments and the layout a person gave it are kept; every string is escaped by tomlkit
 (control characters, quotes, backslashes, newlines), and a string Python holds but UTF-8
-cannot (a file name's undecodable byte, kept as a lone surrogate) is written as its ``\\udcXX``
+cannot (a file name's undecodable byte, kept as a lone surrogate) is written as its ``\udcXX``
 escape text.
 """
 
@@ -134,7 +134,23 @@ def _check_robot_file(path: Path) -> None:
 
 
 def load_robot(path: str | Path) -> Robot:
-    """Read a robot.toml. Missing values fall back to the seed preset's."""
+    """Read a robot.toml. Missing values fall back to the seed preset's.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    locust.params.Robot
+        Each value with its provenance from the file.
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        No such file, not UTF-8 or not TOML, an unknown section or key, a value of the wrong type
+        or out of its limits.
+    """
     path = Path(path)
     try:
         _check_robot_file(path)
@@ -204,8 +220,18 @@ def load_robot(path: str | Path) -> Robot:
 
 
 def to_toml(robot: Robot, template: str | None = None) -> str:
-    """``robot`` as robot.toml text (:func:`locust.robot_toml.document_text`); ``template``: the
-    text of the file it replaces, whose comments and layout are kept."""
+    """``robot`` as robot.toml text (:func:`document_text`); ``template``: the
+    text of the file it replaces, whose comments and layout are kept.
+
+    Parameters
+    ----------
+    robot : locust.params.Robot
+    template : str, optional
+
+    Returns
+    -------
+    str
+    """
     sections = {
         section: {f.name: (robot.get(f"{section}.{f.name}"),
                            dataclasses.asdict(robot.source_of(f"{section}.{f.name}")))
@@ -246,7 +272,16 @@ def _stored(prov: Provenance) -> Provenance:
 
 def file_text(path: Path) -> str | None:
     """The robot.toml at ``path`` as text, to keep its layout; None when there is none or it is
-    not TOML (then it is not replaced anyway: load_robot refused it first)."""
+    not TOML (then it is not replaced anyway: load_robot refused it first).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+
+    Returns
+    -------
+    str or None
+    """
     try:
         text = path.read_bytes().decode("utf-8")
         tomllib.loads(text)
@@ -317,7 +352,27 @@ def update_robot(path: str | Path, change: Callable[[Robot], Robot], *, start: C
 
 def resolve_robot(preset_name: str | None = None, config: str | Path | None = None,
                   sets: tuple[str, ...] | list[str] = ()) -> Robot:
-    """The robot a command runs on: ``--config`` file, else ``--preset``, then ``--set``."""
+    """The robot a command runs on: ``--config`` file, else ``--preset``, then ``--set``.
+
+    Parameters
+    ----------
+    preset_name : str, optional
+        A preset (default ``seed``), used when no ``config`` is given.
+    config : path-like, optional
+        A robot.toml.
+    sets : sequence of str
+        ``KEY=VALUE`` overrides (``--set``), recorded with source ``override``.
+
+    Returns
+    -------
+    locust.params.Robot
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        An unknown preset, a file :func:`load_robot` refuses, a bad ``--set``, or a robot that
+        cannot be simulated.
+    """
     robot = load_robot(config) if config else preset(preset_name or "seed")
     overrides = parse_set_options(sets)
     return check_robot(robot.with_values(overrides, "override") if overrides else robot)

@@ -42,17 +42,49 @@ HOP_ARGS = P.COMMANDS["hop"]
 
 
 def hop_range(name: str) -> tuple[int | float, int | float]:
-    """(lowest, highest) the firmware accepts for the ``hop`` argument ``name``."""
+    """(lowest, highest) the firmware accepts for the ``hop`` argument ``name``.
+
+    Parameters
+    ----------
+    name : str
+        ``cycles``, ``push_deg``, ``push_ms``, ``wait_ms`` or ``heartbeat_ms``.
+
+    Returns
+    -------
+    tuple
+        In the argument's unit (its name's suffix).
+    """
     return HOP_ARGS[name][1], HOP_ARGS[name][2]
 
 
 def hop_default(name: str) -> int | float:
-    """The value the firmware uses for the ``hop`` argument ``name`` when none is sent."""
+    """The value the firmware uses for the ``hop`` argument ``name`` when none is sent.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    int or float
+        In the argument's unit.
+    """
     return HOP_ARGS[name][3]
 
 
 def us_to_ms(us: int) -> float:
-    """Microseconds (the firmware's clock) to milliseconds: the one conversion of phase times."""
+    """Microseconds (the firmware's clock) to milliseconds: the one conversion of phase times.
+
+    Parameters
+    ----------
+    us : int
+        [µs].
+
+    Returns
+    -------
+    float
+        [ms].
+    """
     return us / 1000.0
 
 
@@ -68,15 +100,27 @@ class HopSchedule:
 
     @property
     def phases(self) -> int:
+        """Phases commanded: a push and a wait per cycle."""
         return 2 * self.cycles
 
     @property
     def duration_s(self) -> float:
+        """The schedule's length, (push + wait) per cycle [s]."""
         return self.cycles * (self.push_ms + self.wait_ms) / 1000.0
 
 
 @dataclass(frozen=True)
 class Phase:
+    """One phase's start as commanded and as the firmware measured it (its clock, microseconds).
+
+    Attributes
+    ----------
+    cycle : int
+        The cycle it belongs to, from 0.
+    phase : str
+        ``push`` or ``wait``.
+    """
+
     cycle: int
     phase: str            # "push" or "wait"
     commanded_us: int     # commanded start, from the start of the hop (firmware clock)
@@ -84,21 +128,31 @@ class Phase:
 
     @property
     def error_us(self) -> int:
+        """Measured minus commanded start [µs]: positive late."""
         return self.measured_us - self.commanded_us
 
     @property
     def commanded_ms(self) -> float:
+        """The commanded start from the start of the hop [ms]."""
         return us_to_ms(self.commanded_us)
 
     @property
     def measured_ms(self) -> float:
+        """The measured start (the new PWM duty written) [ms]."""
         return us_to_ms(self.measured_us)
 
     @property
     def error_ms(self) -> float:
+        """Measured minus commanded start [ms]: positive late."""
         return us_to_ms(self.error_us)
 
     def to_dict(self) -> dict:
+        """The phase as ``run.json`` holds it, times in ms and µs.
+
+        Returns
+        -------
+        dict
+        """
         return {
             "cycle": self.cycle,
             "phase": self.phase,
@@ -123,6 +177,17 @@ class Jitter:
 
 
 def jitter(phases: list[Phase]) -> Jitter | None:
+    """The start-time errors' statistics over ``phases``.
+
+    Parameters
+    ----------
+    phases : list of Phase
+
+    Returns
+    -------
+    Jitter or None
+        Mean, population standard deviation and extremes [ms], to 0.1 µs; None without phases.
+    """
     if not phases:
         return None
     errs = [p.error_ms for p in phases]
@@ -137,7 +202,21 @@ _LEG_SET_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_+-]*$")
 
 
 def check_leg_set(name: str) -> str:
-    """A leg set's name as recorded: a plain name, lower case (``report`` groups trials by it)."""
+    """A leg set's name as recorded: a plain name, lower case (``report`` groups trials by it).
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    locust.errors.DeviceError
+        Not a plain name.
+    """
     key = str(name).strip().lower()
     if not _LEG_SET_NAME.match(key):
         raise DeviceError(f"leg set {name!r} is not a plain name",
@@ -179,16 +258,40 @@ class BoardConfig:
 
     @property
     def on_defaults(self) -> bool:
+        """Whether the firmware ran on its defaults (its config.json had problems)."""
         return bool(self.problems)
 
     def to_dict(self) -> dict:
+        """The config as the run record's ``board`` holds it.
+
+        Returns
+        -------
+        dict
+        """
         return {"chip": self.chip, "machine": self.machine, "left": asdict(self.left),
                 "right": asdict(self.right), "config_problems": list(self.problems)}
 
 
 def board_config(doc, where: str = "the board") -> BoardConfig:
     """A :class:`BoardConfig` from ``{"chip", "machine", "left", "right", "config_problems"}``
-    (the run record's ``board``, or the board's hello and config replies put together)."""
+    (the run record's ``board``, or the board's hello and config replies put together).
+
+    Parameters
+    ----------
+    doc : dict
+        The config as read (pins, trims [deg], pulse widths [µs], ranges [deg]).
+    where : str
+        Where it came from, for messages.
+
+    Returns
+    -------
+    BoardConfig
+
+    Raises
+    ------
+    locust.errors.DeviceError
+        Not an object, a servo missing, a field missing or not a number.
+    """
     if not isinstance(doc, dict):
         raise DeviceError(f"{where}: the board config is not an object", DAMAGED_HINT)
     servos = {}
@@ -228,11 +331,23 @@ class RunRecord:
     board: BoardConfig | None = None     # pins, trims and chip read from the board before the hop
 
     def add_phase(self, phase: Phase) -> None:
+        """Record a phase once (a repeated report is dropped), keeping commanded order.
+
+        Parameters
+        ----------
+        phase : Phase
+        """
         if all((p.cycle, p.phase) != (phase.cycle, phase.phase) for p in self.phases):
             self.phases.append(phase)
             self.phases.sort(key=lambda p: p.commanded_us)
 
     def to_dict(self) -> dict:
+        """The record as ``run.json`` holds it, with the phases' jitter.
+
+        Returns
+        -------
+        dict
+        """
         j = jitter(self.phases)
         return {
             "status": self.status,
@@ -257,7 +372,25 @@ RUNS_ROOT = Path("data/runs")   # where a run without --out goes, under the curr
 
 
 def run_dir(out: Path | None, root: Path = RUNS_ROOT) -> Path:
-    """The directory of a new run record: ``out`` (must not hold one yet) or a fresh timestamped one."""
+    """The directory of a new run record: ``out`` (must not hold one yet) or a fresh timestamped one.
+
+    Parameters
+    ----------
+    out : pathlib.Path or None
+        The folder asked for (``--out``); None: a new ``<root>/<timestamp>/``.
+    root : pathlib.Path
+        Where timestamped folders go.
+
+    Returns
+    -------
+    pathlib.Path
+        The folder, made.
+
+    Raises
+    ------
+    locust.errors.DeviceError
+        ``out`` is a file, or already holds a run record.
+    """
     if out is None:
         return unique_dir(root, time.strftime("%Y%m%d-%H%M%S"))
     out = Path(out)
@@ -278,7 +411,24 @@ def claim(directory: Path) -> int:
     """Hold ``directory`` (from :func:`run_dir`) for one run: an exclusive lock on the folder,
     refused at once while another process holds it, then the check that it holds no record yet
     (another run may have finished there since :func:`run_dir` looked). Close the returned
-    descriptor when the run's record is final."""
+    descriptor when the run's record is final.
+
+    Parameters
+    ----------
+    directory : pathlib.Path
+
+    Returns
+    -------
+    int
+        The lock's file descriptor.
+
+    Raises
+    ------
+    locust.errors.DeviceError
+        The folder holds a run record already.
+    locust.errors.WriteError
+        Another process holds the folder.
+    """
     fd = claim_folder(directory)
     try:
         _refuse_record(directory)
@@ -289,7 +439,22 @@ def claim(directory: Path) -> int:
 
 
 def write(record: RunRecord, directory: Path) -> Path:
-    """Write ``record`` as ``directory/run.json`` (atomically); the path written."""
+    """Write ``record`` as ``directory/run.json`` (atomically); the path written.
+
+    Parameters
+    ----------
+    record : RunRecord
+    directory : pathlib.Path
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    locust.errors.WriteError
+        The file cannot be written.
+    """
     return atomic_write_json(Path(directory) / RECORD_NAME, record.to_dict())
 
 
@@ -300,6 +465,20 @@ def read_run_record(path: Path) -> RunRecord:
     milliseconds, ``phases_expected``, ``jitter``) are not read, they follow from the rest.
     A file that is not a run record, or a damaged one, raises :class:`DeviceError` naming
     the file and the field.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A ``run.json``.
+
+    Returns
+    -------
+    RunRecord
+
+    Raises
+    ------
+    locust.errors.DeviceError
+        No such file, not JSON, not a run record, or a damaged field.
     """
     path = Path(path)
     try:

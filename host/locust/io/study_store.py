@@ -35,7 +35,19 @@ def _cell(value: Any) -> str:
 
 
 def table_text(rows: list[dict[str, Any]], columns: list[str]) -> str:
-    """The CSV text of ``rows`` under ``columns`` (floats by ``repr``)."""
+    """The CSV text of ``rows`` under ``columns`` (floats by ``repr``).
+
+    Parameters
+    ----------
+    rows : list of dict
+        Column -> value.
+    columns : list of str
+        The header.
+
+    Returns
+    -------
+    str
+    """
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(columns)
@@ -45,7 +57,21 @@ def table_text(rows: list[dict[str, Any]], columns: list[str]) -> str:
 
 
 def write_tables(folder: Path, rows: list[dict[str, Any]], front: list[dict[str, Any]]) -> None:
-    """Write ``trials.csv`` (every row) and ``pareto.csv`` (the front, each with its ``pick``)."""
+    """Write ``trials.csv`` (every row) and ``pareto.csv`` (the front, each with its ``pick``).
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+    rows : list of dict
+        Every trial's row.
+    front : list of dict
+        The Pareto front's rows.
+
+    Raises
+    ------
+    locust.errors.WriteError
+        A file cannot be written.
+    """
     columns = list(rows[0]) if rows else ["trial", "state"]
     atomic_write_text(Path(folder) / TRIALS, table_text(rows, columns))
     atomic_write_text(Path(folder) / PARETO, table_text(front, [*columns, "pick"]))
@@ -81,7 +107,21 @@ class StudyResults:
 
 
 def read_study(folder: Path) -> StudyResults:
-    """Read a ``locust optimize --out`` folder (``optimize.json``, ``trials.csv``, ``pareto.csv``)."""
+    """Read a ``locust optimize --out`` folder (``optimize.json``, ``trials.csv``, ``pareto.csv``).
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+
+    Returns
+    -------
+    StudyResults
+
+    Raises
+    ------
+    locust.errors.SweepError
+        A file missing, or not what ``locust optimize`` writes.
+    """
     folder = Path(folder)
     hint = "give the --out folder of a `locust optimize` run"
     for name in (META, TRIALS, PARETO):

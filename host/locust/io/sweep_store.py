@@ -30,6 +30,17 @@ _FLOATS = {"flip_share", "distance_m", "max_nose_height_m", "nose_apex_max_m", "
 
 
 def columns(axis_names: list[str]) -> list[str]:
+    """``results.csv``'s header: ``design``, the varied names, then the result fields.
+
+    Parameters
+    ----------
+    axis_names : list of str
+        The varied parameters' dotted names, in order.
+
+    Returns
+    -------
+    list of str
+    """
     return ["design", *axis_names, *RESULT_FIELDS]
 
 
@@ -66,7 +77,24 @@ def read_rows(path: Path, axis_names: list[str]) -> list[dict[str, Any]]:
 
     Only a torn last line is dropped: an interrupt can cut the row being appended, and a
     finished row always ends with a newline. Any other row that does not parse is an error
-    naming its line, never skipped."""
+    naming its line, never skipped.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A ``results.csv``.
+    axis_names : list of str
+        The varied names, in column order.
+
+    Returns
+    -------
+    list of dict
+
+    Raises
+    ------
+    locust.errors.SweepError
+        Unreadable, other columns, or a malformed row other than a torn last one.
+    """
     try:
         with open(path, encoding="utf-8", newline="") as fh:
             text = fh.read()
@@ -103,11 +131,35 @@ class StoredSweep:
     finished: bool                     # False: an interrupted sweep, some designs missing
 
     def column(self, name: str) -> list[Any]:
+        """One column's values over the rows, in file order.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        list
+        """
         return [row[name] for row in self.rows]
 
 
 def read_results(folder: Path) -> StoredSweep:
-    """Read a ``locust sweep --out`` folder (``sweep.json`` and ``results.csv``)."""
+    """Read a ``locust sweep --out`` folder (``sweep.json`` and ``results.csv``).
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+
+    Returns
+    -------
+    StoredSweep
+
+    Raises
+    ------
+    locust.errors.SweepError
+        A file missing, a ``sweep.json`` that does not describe a sweep, or a bad row.
+    """
     folder = Path(folder)
     meta_path, csv_path = folder / META, folder / RESULTS
     hint = "give the --out folder of a `locust sweep`"
@@ -129,6 +181,20 @@ def read_results(folder: Path) -> StoredSweep:
 
 @dataclass
 class SweepStore:
+    """A sweep being written: its folder held under a lock, each finished design's row
+    appended to ``results.csv`` as it arrives, ``sweep.json`` rewritten atomically.
+
+    Attributes
+    ----------
+    folder : pathlib.Path
+    meta : dict
+        ``sweep.json``'s content.
+    axis_names : list of str
+        The varied names, in column order.
+    done : dict of int to dict
+        Design number -> its row, for the designs already written.
+    """
+
     folder: Path
     meta: dict[str, Any]
     axis_names: list[str]
@@ -138,11 +204,30 @@ class SweepStore:
 
     @property
     def results_path(self) -> Path:
+        """The folder's ``results.csv``."""
         return self.folder / RESULTS
 
     @classmethod
     def open(cls, folder: Path, meta: dict[str, Any], axis_names: list[str]) -> SweepStore:
-        """Start a sweep in ``folder`` or resume the same sweep there."""
+        """Start a sweep in ``folder`` or resume the same sweep there.
+
+        Parameters
+        ----------
+        folder : pathlib.Path
+        meta : dict
+            ``sweep.json``'s content: the request (base, varied axes, cycles) and the robot.
+        axis_names : list of str
+
+        Returns
+        -------
+        SweepStore
+            Holding the folder's lock, with the rows already written in :attr:`done`.
+
+        Raises
+        ------
+        locust.errors.SweepError
+            The folder holds another sweep or other files, or another sweep is running there.
+        """
         folder = Path(folder)
         store = cls(folder, meta, axis_names)
         meta_path = folder / META
@@ -205,7 +290,13 @@ class SweepStore:
         atomic_write_text(self.results_path, buf.getvalue())
 
     def append(self, row: dict[str, Any]) -> None:
-        """Record one finished design now (flushed to disk before returning)."""
+        """Record one finished design now (flushed to disk before returning).
+
+        Parameters
+        ----------
+        row : dict
+            ``design``, the varied values and the result fields.
+        """
         self.done[row["design"]] = row
         if self._fh is None:
             self._fh = open(self.results_path, "a", newline="")
@@ -216,7 +307,15 @@ class SweepStore:
         os.fsync(self._fh.fileno())
 
     def close(self, complete: bool, **meta: Any) -> None:
-        """Stop appending; when finished, rewrite the rows in design order; record ``meta``."""
+        """Stop appending; when finished, rewrite the rows in design order; record ``meta``.
+
+        Parameters
+        ----------
+        complete : bool
+            Every design done.
+        **meta
+            Added to ``sweep.json``.
+        """
         if self._fh is not None:
             self._fh.close()
             self._fh = None
@@ -228,5 +327,6 @@ class SweepStore:
             self._lock_fd = None
 
     def write_meta(self, **extra: Any) -> None:
+        """Update ``sweep.json`` with ``extra`` and write it atomically."""
         self.meta.update(extra)
         atomic_write_json(self.folder / META, self.meta)

@@ -80,6 +80,7 @@ class TrackerExport:
 
     @property
     def n_rows(self) -> int:
+        """The longest track's number of rows."""
         lengths = [len(a) for t in self.tracks.values() for a in (t.t_s, t.x_m, t.y_m, *t.other.values())
                    if a is not None]
         return max(lengths, default=0)
@@ -91,16 +92,36 @@ class TrackerExport:
         return tuple(self._labelled())
 
     def column(self, name: str) -> np.ndarray:
-        """One column by its name in :attr:`columns`."""
+        """One column by its name in :attr:`columns`.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        numpy.ndarray
+        """
         return self._labelled()[name]
 
     def markers_with_positions(self) -> list[str]:
-        """Tracks with both an ``x`` and a ``y`` column."""
+        """Tracks with both an ``x`` and a ``y`` column.
+
+        Returns
+        -------
+        list of str
+        """
         return [m for m, t in self.tracks.items() if t.x_m is not None and t.y_m is not None]
 
     def time_s(self) -> np.ndarray:
         """The time of each row: the tracks' ``t`` columns as one, which must agree where
-        two have a value; an export without ``t`` is refused."""
+        two have a value; an export without ``t`` is refused.
+
+        Returns
+        -------
+        numpy.ndarray
+            [s].
+        """
         times: list[np.ndarray] = []
         for t in self.tracks.values():
             if t.t_s is not None and not any(t.t_s is s for s in times):
@@ -119,14 +140,37 @@ class TrackerExport:
         return out
 
     def positions(self, marker: str) -> tuple[np.ndarray, np.ndarray]:
-        """``marker``'s x and y (Tracker's unit: metres when calibrated so), NaN where it has no step."""
+        """``marker``'s x and y (Tracker's unit: metres when calibrated so), NaN where it has no step.
+
+        Parameters
+        ----------
+        marker : str
+
+        Returns
+        -------
+        x, y : numpy.ndarray
+
+        Raises
+        ------
+        locust.errors.TrackError
+            No such marker.
+        """
         track = self.tracks.get(marker)
         if track is None or track.x_m is None or track.y_m is None:
             raise no_marker(self.path, marker, self.markers_with_positions())
         return track.x_m.copy(), track.y_m.copy()
 
     def has_pixels(self, marker: str) -> bool:
-        """Always False: a text export holds world values only."""
+        """Always False: a text export holds world values only.
+
+        Parameters
+        ----------
+        marker : str
+
+        Returns
+        -------
+        bool
+        """
         return False
 
     def _labelled(self) -> dict[str, np.ndarray]:
@@ -143,7 +187,21 @@ class TrackerExport:
 
     @classmethod
     def from_delimited(cls, doc: DelimitedText) -> TrackerExport:
-        """The tracks in a file already split by :func:`.delimited.split_text`."""
+        """The tracks in a file already split by :func:`.delimited.split_text`.
+
+        Parameters
+        ----------
+        doc : locust.io.delimited.DelimitedText
+
+        Returns
+        -------
+        TrackerExport
+
+        Raises
+        ------
+        locust.errors.TrackError
+            The file cannot be read, or a line is not what the layout says (file and line named).
+        """
         header, names_row = doc.header, doc.names_row
         current = DEFAULT_TRACK
         if names_row is not None and len(names_row) == 1 and names_row[0].strip():
@@ -173,13 +231,31 @@ class TrackerExport:
 
 
 def marker_name(name: str) -> str:
-    """A Tracker name as a marker name: ``cm A`` -> ``cm_A`` (``track`` when nothing is left)."""
+    """A Tracker name as a marker name: ``cm A`` -> ``cm_A`` (``track`` when nothing is left).
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    str
+    """
     return re.sub(r"\W+", "_", name.strip()).strip("_") or DEFAULT_TRACK
 
 
 def tracker_export_text(export: TrackerExport) -> str:
     """Tracker's layout: a row of track names, a row of Tracker's column names, then
-    tab-separated values (6 significant digits); a NaN is an empty cell."""
+    tab-separated values (6 significant digits); a NaN is an empty cell.
+
+    Parameters
+    ----------
+    export : TrackerExport
+
+    Returns
+    -------
+    str
+    """
     names: list[str] = []
     heads: list[str] = []
     cols: list[np.ndarray] = []
@@ -196,15 +272,61 @@ def tracker_export_text(export: TrackerExport) -> str:
 
 
 def write_tracker_export(path: Path, export: TrackerExport) -> Path:
-    """Write ``export`` to ``path`` atomically."""
+    """Write ``export`` to ``path`` atomically.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+    export : TrackerExport
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    locust.errors.WriteError
+        The file cannot be written.
+    """
     return atomic_write_text(path, tracker_export_text(export))
 
 
 def parse_tracker_export(text: str, path: str | Path) -> TrackerExport:
-    """The tracks in ``text`` (the contents of ``path``)."""
+    """The tracks in ``text`` (the contents of ``path``).
+
+    Parameters
+    ----------
+    text : str
+    path : path-like
+        For messages.
+
+    Returns
+    -------
+    TrackerExport
+
+    Raises
+    ------
+    locust.errors.TrackError
+        The file cannot be read, or a line is not what the layout says (file and line named).
+    """
     return TrackerExport.from_delimited(split_text(text, path))
 
 
 def read_tracker_export(path: str | Path) -> TrackerExport:
-    """Read a Tracker text export; a :class:`~locust.errors.TrackError` names the file and line of any fault."""
+    """Read a Tracker text export; a :class:`~locust.errors.TrackError` names the file and line of any fault.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    TrackerExport
+
+    Raises
+    ------
+    locust.errors.TrackError
+        The file cannot be read, or a line is not what the layout says (file and line named).
+    """
     return parse_tracker_export(read_text(path), path)

@@ -43,7 +43,16 @@ MARKER_COLUMNS = ("px", "py", "x_m", "y_m", "ok")   # per marker, in the order w
 
 
 def tracks_csv_beside(video: Path) -> Path:
-    """``hop.mp4`` -> ``hop.tracks.csv``: where ``locust track`` writes a video's tracks."""
+    """``hop.mp4`` -> ``hop.tracks.csv``: where ``locust track`` writes a video's tracks.
+
+    Parameters
+    ----------
+    video : pathlib.Path
+
+    Returns
+    -------
+    pathlib.Path
+    """
     return video.with_name(video.stem + TRACKS_CSV_SUFFIX)
 
 
@@ -93,6 +102,7 @@ class TracksCsv:
 
     @property
     def n_rows(self) -> int:
+        """The number of frames."""
         return len(self.t_s)
 
     @property
@@ -103,7 +113,23 @@ class TracksCsv:
         return ("frame", "t_s", *(f"{m}_{c}" for m in self.markers for c in MARKER_COLUMNS), *self.other)
 
     def column(self, name: str) -> np.ndarray:
-        """One column by its name in the file, as floats (``_ok`` as 1.0/0.0)."""
+        """One column by its name in the file, as floats (``_ok`` as 1.0/0.0).
+
+        Parameters
+        ----------
+        name : str
+            A column of :attr:`columns`.
+
+        Returns
+        -------
+        numpy.ndarray
+            In the column's unit (px, m, s).
+
+        Raises
+        ------
+        KeyError
+            No such column.
+        """
         if name == "frame":
             return self.frame.astype(float)
         if name == "t_s":
@@ -116,31 +142,79 @@ class TracksCsv:
         raise KeyError(name)
 
     def markers_with_positions(self) -> list[str]:
-        """Markers with both world columns in the file."""
+        """Markers with both world columns in the file.
+
+        Returns
+        -------
+        list of str
+        """
         cols = set(self.columns)
         return [m for m in self.markers if f"{m}_x_m" in cols and f"{m}_y_m" in cols]
 
     def time_s(self) -> np.ndarray:
-        """The ``t_s`` column; a file without one is refused."""
+        """The ``t_s`` column; a file without one is refused.
+
+        Returns
+        -------
+        numpy.ndarray
+            [s].
+        """
         if "t_s" not in self.columns:
             raise missing_time(self.path, self.columns)
         return self.t_s
 
     def positions(self, marker: str) -> tuple[np.ndarray, np.ndarray]:
-        """``marker``'s world x and y (m), NaN in the frames where it was lost."""
+        """``marker``'s world x and y (m), NaN in the frames where it was lost.
+
+        Parameters
+        ----------
+        marker : str
+
+        Returns
+        -------
+        x_m, y_m : numpy.ndarray
+
+        Raises
+        ------
+        locust.errors.TrackError
+            No such marker (the message names those there are).
+        """
         if marker not in self.markers_with_positions():
             raise no_marker(self.path, marker, self.markers_with_positions())
         m = self.markers[marker]
         return np.where(m.ok, m.x_m, np.nan), np.where(m.ok, m.y_m, np.nan)
 
     def has_pixels(self, marker: str) -> bool:
-        """Whether ``marker`` has a finite pixel position anywhere (tracked, even if not in metres)."""
+        """Whether ``marker`` has a finite pixel position anywhere (tracked, even if not in metres).
+
+        Parameters
+        ----------
+        marker : str
+
+        Returns
+        -------
+        bool
+        """
         m = self.markers.get(marker)
         return m is not None and bool(np.isfinite(m.px).any())
 
     @classmethod
     def from_delimited(cls, doc: DelimitedText) -> TracksCsv:
-        """The tracks in a file already split by :func:`.delimited.split_text`."""
+        """The tracks in a file already split by :func:`.delimited.split_text`.
+
+        Parameters
+        ----------
+        doc : locust.io.delimited.DelimitedText
+
+        Returns
+        -------
+        TracksCsv
+
+        Raises
+        ------
+        locust.errors.TrackError
+            The file cannot be read, or a line is not what the layout says (file and line named).
+        """
         names = list(doc.header)
         check_names(names, doc.path, doc.header_line)
         data = doc.columns(names)
@@ -171,7 +245,16 @@ class TracksCsv:
 
 
 def tracks_csv_text(tracks: TracksCsv) -> str:
-    """The file's text: comments, header, one row per frame (``nan`` for a missing value)."""
+    """The file's text: comments, header, one row per frame (``nan`` for a missing value).
+
+    Parameters
+    ----------
+    tracks : TracksCsv
+
+    Returns
+    -------
+    str
+    """
     out = io.StringIO()
     for line in tracks.comments:
         out.write(f"# {line}\n")
@@ -192,24 +275,84 @@ def tracks_csv_text(tracks: TracksCsv) -> str:
 
 
 def write_tracks_csv(path: Path, tracks: TracksCsv) -> Path:
-    """Write ``tracks`` to ``path`` atomically."""
+    """Write ``tracks`` to ``path`` atomically.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+    tracks : TracksCsv
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    locust.errors.WriteError
+        The file cannot be written.
+    """
     return atomic_write_text(path, tracks_csv_text(tracks))
 
 
 def parse_tracks_csv(text: str, path: str | Path) -> TracksCsv:
-    """The tracks in ``text`` (the contents of ``path``)."""
+    """The tracks in ``text`` (the contents of ``path``).
+
+    Parameters
+    ----------
+    text : str
+    path : path-like
+        For messages.
+
+    Returns
+    -------
+    TracksCsv
+
+    Raises
+    ------
+    locust.errors.TrackError
+        The file cannot be read, or a line is not what the layout says (file and line named).
+    """
     return TracksCsv.from_delimited(split_text(text, path))
 
 
 def read_tracks_csv(path: str | Path) -> TracksCsv:
-    """Read a tracks CSV; a :class:`~locust.errors.TrackError` names the file and line of any fault."""
+    """Read a tracks CSV; a :class:`~locust.errors.TrackError` names the file and line of any fault.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    TracksCsv
+
+    Raises
+    ------
+    locust.errors.TrackError
+        The file cannot be read, or a line is not what the layout says (file and line named).
+    """
     return parse_tracks_csv(read_text(path), path)
 
 
 def read_track_file(path: str | Path) -> TracksCsv | TrackerExport:
     """A marker track in either layout ``locust track`` writes: a tracks CSV
     (:class:`TracksCsv`) or Tracker's text export (:class:`.tracker_text.TrackerExport`).
-    Both answer ``time_s()``, ``positions(marker)``, ``has_pixels(marker)`` and ``n_rows``."""
+    Both answer ``time_s()``, ``positions(marker)``, ``has_pixels(marker)`` and ``n_rows``.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    TracksCsv or locust.io.tracker_text.TrackerExport
+
+    Raises
+    ------
+    locust.errors.TrackError
+        The file cannot be read, or a line is not what the layout says (file and line named).
+    """
     from . import tracker_text  # it builds on this module's errors
 
     doc = split_text(read_text(path), path)
@@ -217,19 +360,50 @@ def read_track_file(path: str | Path) -> TracksCsv | TrackerExport:
 
 
 def is_tracks_header(names: list[str]) -> bool:
-    """Whether a header names marker columns (``<m>_px``, ``<m>_py``, ``<m>_x_m``, ``<m>_y_m``)."""
+    """Whether a header names marker columns (``<m>_px``, ``<m>_py``, ``<m>_x_m``, ``<m>_y_m``).
+
+    Parameters
+    ----------
+    names : list of str
+
+    Returns
+    -------
+    bool
+    """
     kinds = [_marker_column(n) for n in names]
     return any(k is not None and k[1] != "ok" for k in kinds)
 
 
 def missing_time(path: Path | None, columns) -> TrackError:
-    """The error for a track file without a time column."""
+    """The error for a track file without a time column.
+
+    Parameters
+    ----------
+    path : pathlib.Path or None
+    columns : iterable of str
+        The columns the file has.
+
+    Returns
+    -------
+    locust.errors.TrackError
+    """
     return TrackError(f"{path}: missing column t_s for time (found: {', '.join(columns) or 'none'})",
                       "the file needs the columns t_s")
 
 
 def no_marker(path: Path | None, marker: str, names: list[str]) -> TrackError:
-    """The error for a marker the file has no positions of (``names``: the markers it has)."""
+    """The error for a marker the file has no positions of (``names``: the markers it has).
+
+    Parameters
+    ----------
+    path : pathlib.Path or None
+    marker : str
+    names : list of str
+
+    Returns
+    -------
+    locust.errors.TrackError
+    """
     return TrackError(f"{path}: no marker {marker!r} (markers: {', '.join(names) or 'none'})",
                       "check the name given with --marker")
 
@@ -243,7 +417,16 @@ def _marker_column(name: str) -> tuple[str, str] | None:
 
 def same_array(a: np.ndarray | None, b: np.ndarray | None) -> bool:
     """Equal arrays, NaN equal to NaN (and None equal to None): how the track formats' typed
-    objects compare their columns."""
+    objects compare their columns.
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray or None
+
+    Returns
+    -------
+    bool
+    """
     if a is None or b is None:
         return a is None and b is None
     a, b = np.asarray(a), np.asarray(b)

@@ -72,7 +72,20 @@ class Calibration:
 
     def to_world(self, px: np.ndarray, py: np.ndarray, marker: str | None = None,
                  frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Image pixels -> world metres (y up). NaN stays NaN. One scale serves every marker and frame."""
+        """Image pixels -> world metres (y up). NaN stays NaN. One scale serves every marker and frame.
+
+        Parameters
+        ----------
+        px, py : numpy.ndarray
+            Pixels, OpenCV's convention.
+        marker, frames
+            Not used by this calibration (the interface of calibrations that depend on them).
+
+        Returns
+        -------
+        x_m, y_m : numpy.ndarray
+            World metres, x along the calibrated axis, y up.
+        """
         a = math.radians(self.angle_deg)
         dx = np.asarray(px, float) - self.origin_x_px
         dy = -(np.asarray(py, float) - self.origin_y_px)
@@ -81,18 +94,37 @@ class Calibration:
         return x, y
 
     def axes_px(self) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float]]:
-        """World origin in pixels, and the on-screen unit directions of the world x and y axes."""
+        """World origin in pixels, and the on-screen unit directions of the world x and y axes.
+
+        Returns
+        -------
+        origin_px : (float, float)
+            The world origin [px].
+        x_axis, y_axis : (float, float)
+            Unit directions on screen.
+        """
         a = math.radians(self.angle_deg)
         return (self.origin_x_px, self.origin_y_px), (math.cos(a), -math.sin(a)), (-math.sin(a), -math.cos(a))
 
     def summary(self) -> str:
+        """The calibration in one line (scale in mm/px, origin in px, x axis in deg).
+
+        Returns
+        -------
+        str
+        """
         if not math.isfinite(self.m_per_px):
             return "no scale given (--scale or --scale-aruco): the *_x_m/*_y_m columns are nan"
         return (f"scale {self.m_per_px * 1000:.5g} mm/px ({self.source}), origin ({self.origin_x_px:.2f}, "
                 f"{self.origin_y_px:.2f}) px, x axis {self.angle_deg:g} deg")
 
     def as_dict(self) -> dict:
-        """For the JSON sidecar (no scale: ``m_per_px`` nan, written ``null``)."""
+        """For the JSON sidecar (no scale: ``m_per_px`` nan, written ``null``).
+
+        Returns
+        -------
+        dict
+        """
         return asdict(self)
 
 
@@ -109,6 +141,23 @@ class TrackerClip:
 
 @dataclass
 class TrackerProject:
+    """A Tracker project (``.trk``) as read or to be written.
+
+    Attributes
+    ----------
+    path : pathlib.Path
+        The project file.
+    video_path : str or None
+        The video as the project names it.
+    clip : TrackerClip
+    calibration : Calibration or None
+        Scale, origin and axes; None for a project written without one (a plane's homography).
+    points : dict of str to dict of int to (float, float)
+        Track name -> frame -> (px, py) in pixels, OpenCV's convention.
+    descriptions : dict of str to str
+        Track name -> its description in Tracker.
+    """
+
     path: Path
     video_path: str | None
     clip: TrackerClip
@@ -118,7 +167,23 @@ class TrackerProject:
 
 
 def read_project(path: str | Path) -> TrackerProject:
-    """Parse a Tracker ``.trk`` file, or the ``.trk`` inside a ``.trz`` project zip."""
+    """Parse a Tracker ``.trk`` file, or the ``.trk`` inside a ``.trz`` project zip.
+
+    Parameters
+    ----------
+    path : path-like
+        A ``.trk`` or ``.trz``.
+
+    Returns
+    -------
+    TrackerProject
+
+    Raises
+    ------
+    locust.errors.TrackError
+        No such file, a zip without a ``.trk``, a file over the size limit, XML that is not a
+        Tracker project (or declares entities).
+    """
     path = Path(path)
     if not path.is_file():
         raise TrackError(f"{path}: no such file", "give the path of a Tracker .trk or .trz file")
@@ -287,7 +352,27 @@ class ProjectPoints:
 def project_points(project: TrackerProject, names: list[str] | None = None
                    ) -> tuple[np.ndarray, np.ndarray, list[ProjectPoints]]:
     """The clip's frames, their times (s; NaN without a frame rate) and the point tracks
-    ``names`` (default: all) on those frames."""
+    ``names`` (default: all) on those frames.
+
+    Parameters
+    ----------
+    project : TrackerProject
+    names : list of str, optional
+        The point tracks, by their names (default: all).
+
+    Returns
+    -------
+    frames : numpy.ndarray
+        The clip's frame numbers.
+    t_s : numpy.ndarray
+        Their times [s], zero at the clip's start.
+    tracks : list of ProjectPoints
+
+    Raises
+    ------
+    locust.errors.TrackError
+        A name the project does not hold.
+    """
     names = names or list(project.points)
     unknown = [n for n in names if n not in project.points]
     if unknown:
@@ -306,7 +391,24 @@ def project_points(project: TrackerProject, names: list[str] | None = None
 
 
 def project_tracks(project: TrackerProject, names: list[str] | None = None) -> TracksCsv:
-    """A project's point tracks as a tracks CSV: pixels, and world metres through its calibration."""
+    """A project's point tracks as a tracks CSV: pixels, and world metres through its calibration.
+
+    Parameters
+    ----------
+    project : TrackerProject
+    names : list of str, optional
+        The point tracks, by their names (default: all).
+
+    Returns
+    -------
+    locust.io.tracks_csv.TracksCsv
+        Pixels and, with a calibration, metres.
+
+    Raises
+    ------
+    locust.errors.TrackError
+        A name the project does not hold.
+    """
     frames, t_s, tracks = project_points(project, names)
     markers = {}
     for tr in tracks:
@@ -322,7 +424,19 @@ def _safe_name(name: str) -> str:
 
 def media_in_zip(project: TrackerProject, trk_path: Path) -> str | None:
     """How a project written at ``trk_path`` names the video inside ``project``'s ``.trz``
-    (OSP's ``zip!/entry`` path); None for a plain ``.trk``, whose video is a file of its own."""
+    (OSP's ``zip!/entry`` path); None for a plain ``.trk``, whose video is a file of its own.
+
+    Parameters
+    ----------
+    project : TrackerProject
+        A project read from a ``.trz``, or a plain ``.trk``.
+    trk_path : pathlib.Path
+        Where the new project is written.
+
+    Returns
+    -------
+    str or None
+    """
     if not zipfile.is_zipfile(project.path) or not project.video_path:
         return None
     with open_trz(project.path) as z:
@@ -336,7 +450,21 @@ def media_in_zip(project: TrackerProject, trk_path: Path) -> str | None:
 def project_media(project: TrackerProject) -> Iterator[Path]:
     """The video (or the image sequence's first file) a project opens, as a local path for the
     duration of the ``with``: beside the ``.trk``, or unpacked from the ``.trz`` into a
-    temporary folder removed afterwards."""
+    temporary folder removed afterwards.
+
+    Parameters
+    ----------
+    project : TrackerProject
+
+    Yields
+    ------
+    pathlib.Path
+
+    Raises
+    ------
+    locust.errors.TrackError
+        The project names no video, or one that is not where it says.
+    """
     if not project.video_path:
         raise TrackError(f"{project.path}: the project names no video", "give the video itself as VIDEO")
     rel = Path(project.video_path.replace("\\", "/"))
@@ -401,7 +529,18 @@ def project_xml(project: TrackerProject, video: ProjectVideo) -> str:
     """``project`` as a Tracker 6 project (``.trk`` XML): ``video``'s media, the clip's frames and
     frame interval, the calibration (scale, origin, axes; none when it is None or has no scale)
     and one point mass per track with a step on each of its frames (pixels in Tracker's
-    convention: the OpenCV pixels of ``project.points`` less :data:`TRACKER_TO_OPENCV_PX`)."""
+    convention: the OpenCV pixels of ``project.points`` less :data:`TRACKER_TO_OPENCV_PX`).
+
+    Parameters
+    ----------
+    project : TrackerProject
+    video : ProjectVideo
+        The media it opens.
+
+    Returns
+    -------
+    str
+    """
     clip = project.clip
     dt_ms = 1000.0 / clip.fps
     if video.images:
@@ -458,5 +597,21 @@ def project_xml(project: TrackerProject, video: ProjectVideo) -> str:
 
 
 def write_project(project: TrackerProject, video: ProjectVideo) -> Path:
-    """Write ``project`` to ``project.path`` (see :func:`project_xml`), atomically."""
+    """Write ``project`` to ``project.path`` (see :func:`project_xml`), atomically.
+
+    Parameters
+    ----------
+    project : TrackerProject
+    video : ProjectVideo
+
+    Returns
+    -------
+    pathlib.Path
+        ``project.path``.
+
+    Raises
+    ------
+    locust.errors.WriteError
+        The file cannot be written.
+    """
     return atomic_write_text(project.path, project_xml(project, video))

@@ -65,7 +65,20 @@ def _kind_problem(info: zipfile.ZipInfo) -> str | None:
 
 
 def check_members(path: Path, z: zipfile.ZipFile) -> None:
-    """:class:`TrackError` naming the first member of ``z`` that is not safe to read."""
+    """:class:`TrackError` naming the first member of ``z`` that is not safe to read.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``.trz``, for messages.
+    z : zipfile.ZipFile
+
+    Raises
+    ------
+    locust.errors.TrackError
+        Too many members, or one that is not safe (an absolute or escaping name, a link, over
+        the size limits).
+    """
     infos = z.infolist()
     if len(infos) > MAX_MEMBERS:
         raise TrackError(f"{path}: a zip of {len(infos):,} members, over the limit of {MAX_MEMBERS:,} "
@@ -80,7 +93,21 @@ def check_members(path: Path, z: zipfile.ZipFile) -> None:
 @contextmanager
 def open_trz(path: str | Path) -> Iterator[zipfile.ZipFile]:
     """The zip at ``path``, every member checked (:func:`check_members`); a damaged zip is a
-    :class:`TrackError`."""
+    :class:`TrackError`.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Yields
+    ------
+    zipfile.ZipFile
+
+    Raises
+    ------
+    locust.errors.TrackError
+        Not a readable zip, or a member not safe to read.
+    """
     path = Path(path)
     try:
         z = zipfile.ZipFile(path)
@@ -111,7 +138,27 @@ def _chunks(path: Path, z: zipfile.ZipFile, name: str, limit: int) -> Iterator[b
 
 
 def read_member(path: Path, z: zipfile.ZipFile, name: str, limit: int = MAX_TRK_BYTES) -> bytes:
-    """Member ``name`` of ``z`` (opened by :func:`open_trz`) in memory, at most ``limit`` bytes."""
+    """Member ``name`` of ``z`` (opened by :func:`open_trz`) in memory, at most ``limit`` bytes.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``.trz``, for messages.
+    z : zipfile.ZipFile
+    name : str
+        The member.
+    limit : int
+        The most bytes read.
+
+    Returns
+    -------
+    bytes
+
+    Raises
+    ------
+    locust.errors.TrackError
+        The member unpacks to more than ``limit`` bytes, or is damaged.
+    """
     info = z.getinfo(name)
     if info.file_size > limit:
         raise TrackError(f"{path}: member {name!r} says it unpacks to {info.file_size:,} bytes, over the "
@@ -121,7 +168,23 @@ def read_member(path: Path, z: zipfile.ZipFile, name: str, limit: int = MAX_TRK_
 
 def unpack_members(path: Path, z: zipfile.ZipFile, names: list[str], folder: Path) -> None:
     """Copy members ``names`` of ``z`` (opened by :func:`open_trz`, so every name is relative
-    and plain) under ``folder``, a fresh temporary folder; at most :data:`MAX_UNPACKED_BYTES` in all."""
+    and plain) under ``folder``, a fresh temporary folder; at most :data:`MAX_UNPACKED_BYTES` in all.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``.trz``, for messages.
+    z : zipfile.ZipFile
+    names : list of str
+        The members copied.
+    folder : pathlib.Path
+        Where they go.
+
+    Raises
+    ------
+    locust.errors.TrackError
+        A member that would land outside ``folder``, more than the limit in all, or damaged.
+    """
     root = folder.resolve()
     left = MAX_UNPACKED_BYTES
     for name in names:

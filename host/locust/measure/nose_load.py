@@ -45,11 +45,22 @@ SLOPE_STEP_M = 0.001     # the slope of the load against the axis, by central di
 
 @dataclass(frozen=True)
 class GaussianValue:
+    """A measured value with a normal uncertainty, in the unit of the quantity it stands for.
+
+    Attributes
+    ----------
+    value : float
+        The estimate.
+    sd : float
+        One standard deviation.
+    """
+
     value: float
     sd: float                   # one standard deviation
 
     @property
     def ci95(self) -> tuple[float, float]:
+        """The normal 95% interval, value ± 1.96 sd."""
         return (self.value - Z95 * self.sd, self.value + Z95 * self.sd)
 
 
@@ -71,6 +82,13 @@ class NoseLoadResult:
     robot: Robot = field(repr=False, compare=False)
 
     def to_json(self) -> dict:
+        """The result as ``locust measure nose-load --json`` prints it (SI units, as the names say).
+
+        Returns
+        -------
+        dict
+        """
+
         def est(e: GaussianValue | None) -> dict | None:
             return None if e is None else {"value": e.value, "sd": e.sd, "ci95": list(e.ci95)}
 
@@ -118,13 +136,38 @@ def _plate_from_weight(robot: Robot, total_kg: float, resolution_kg: float) -> G
 
 
 def prior_of(robot: Robot, key: str) -> GaussianValue | None:
-    """The robot file's own value and sd for ``key`` (None when it carries no sd)."""
+    """The robot file's own value and sd for ``key`` (None when it carries no sd).
+
+    Parameters
+    ----------
+    robot : Robot
+    key : str
+        A dotted name.
+
+    Returns
+    -------
+    GaussianValue or None
+        In the unit the name says.
+    """
     sd = robot.source_of(key).uncertainty
     return GaussianValue(robot.get(key), sd) if sd and math.isfinite(sd) and sd > 0 else None
 
 
 def combine(new: GaussianValue, prior: GaussianValue | None) -> GaussianValue:
-    """Two independent estimates of one value, weighted by their variances."""
+    """Two independent estimates of one value, weighted by their variances.
+
+    Parameters
+    ----------
+    new : GaussianValue
+        The new estimate.
+    prior : GaussianValue or None
+        The earlier one, in the same unit; None: ``new`` alone.
+
+    Returns
+    -------
+    GaussianValue
+        The inverse-variance weighted mean and its sd.
+    """
     if prior is None:
         return new
     w_new, w_prior = 1 / new.sd ** 2, 1 / prior.sd ** 2

@@ -76,9 +76,22 @@ class StanceResult:
     mirrored: bool
 
     def values(self) -> dict[str, Estimate]:
+        """The robot values the photos determine: crank start [deg], ground angle [deg] and
+        servo axis [m], by dotted name.
+
+        Returns
+        -------
+        dict of str to locust.calibrate.fitstats.Estimate
+        """
         return dict(zip(STANCE_KEYS, (self.crank_start_deg, self.ground_angle_deg, self.servo_axis_x_m)))
 
     def to_json(self) -> dict:
+        """The result as ``locust measure stance --json`` prints it (units as the names say).
+
+        Returns
+        -------
+        dict
+        """
         return {"crank_start_deg": self.crank_start_deg.as_dict(), "ground_angle_deg": self.ground_angle_deg.as_dict(),
                 "servo_axis_x_m": self.servo_axis_x_m.as_dict(), "rest_pitch_deg": self.rest_pitch_deg.as_dict(),
                 "push_turn_deg": None if self.push_turn_deg is None else self.push_turn_deg.as_dict(),
@@ -92,7 +105,31 @@ class StanceResult:
 # -- the board -------------------------------------------------------------------------
 def board_corners(spec: BoardSpec, image_bgr: np.ndarray, path: Path) -> tuple[np.ndarray, np.ndarray, float]:
     """The board's detected corners (px), their board places (m) and their reprojection scatter
-    (px, one coordinate); :class:`MeasureError` when it is missing or seen at a slant."""
+    (px, one coordinate); :class:`MeasureError` when it is missing or seen at a slant.
+
+    Parameters
+    ----------
+    spec : locust.arucoboard.BoardSpec
+        The printed board.
+    image_bgr : numpy.ndarray
+        The photo (OpenCV's BGR).
+    path : pathlib.Path
+        The photo's file, for messages.
+
+    Returns
+    -------
+    corners_px : numpy.ndarray
+        (N, 2) detected corners [px].
+    corners_m : numpy.ndarray
+        (N, 2) their places on the board [m], x right, y up.
+    sd_px : float
+        The reprojection scatter, one coordinate [px].
+
+    Raises
+    ------
+    locust.errors.MeasureError
+        The board is not found, or is seen at too much of a slant.
+    """
     from ..track.board import board_points
 
     found = board_points(spec, image_bgr)
@@ -137,7 +174,29 @@ def _check_square(H: np.ndarray, spec: BoardSpec, path: Path) -> None:
 def find_stickers(image_bgr: np.ndarray, path: Path, given: dict[str, tuple[float, float]]) \
         -> tuple[dict[str, tuple[float, float]], dict[str, str]]:
     """Each sticker's centre (OpenCV px): ``given`` ones as they are, the others found by their
-    colour (:mod:`locust.track.color`)."""
+    colour (:mod:`locust.track.color`).
+
+    Parameters
+    ----------
+    image_bgr : numpy.ndarray
+        The photo (OpenCV's BGR).
+    path : pathlib.Path
+        The photo's file, for messages.
+    given : dict of str to (float, float)
+        Sticker -> its centre [px], given instead of found.
+
+    Returns
+    -------
+    centres : dict of str to (float, float)
+        Sticker -> centre [px].
+    sources : dict of str to str
+        Sticker -> ``colour`` or ``given``.
+
+    Raises
+    ------
+    locust.errors.MeasureError
+        A sticker is not found by its colour.
+    """
     from ..markers import STICKER_COLOURS
     from ..track.color import ColorMarker, parse_hex
 
@@ -156,7 +215,26 @@ def find_stickers(image_bgr: np.ndarray, path: Path, given: dict[str, tuple[floa
 
 
 def read_photo(path: Path, spec: BoardSpec, given: dict[str, tuple[float, float]]) -> Photo:
-    """A photo's board corners and stickers (``given``: OpenCV pixels that replace colour)."""
+    """A photo's board corners and stickers (``given``: OpenCV pixels that replace colour).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A PNG or JPEG.
+    spec : locust.arucoboard.BoardSpec
+        The printed board in the photo.
+    given : dict of str to (float, float)
+        Sticker -> its centre [px].
+
+    Returns
+    -------
+    Photo
+
+    Raises
+    ------
+    locust.errors.MeasureError
+        Not a readable image, no board, or a sticker not found.
+    """
     image = cv2.imread(str(path), cv2.IMREAD_COLOR)
     if image is None:
         raise MeasureError(f"{path}: not a readable image", "give a photo or a video frame as PNG or JPEG")
@@ -167,7 +245,18 @@ def read_photo(path: Path, spec: BoardSpec, given: dict[str, tuple[float, float]
 
 def model_servo_give(robot: Robot):
     """The servo's give at rest as the model has it, for a stance (the measured robot settled
-    on the floor at the 0 deg command, :func:`locust.sim.still.rest_pose`), in degrees."""
+    on the floor at the 0 deg command, :func:`locust.sim.still.rest_pose`), in degrees.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot measured.
+
+    Returns
+    -------
+    callable
+        ``give(crank_start_deg, ground_angle_deg, servo_axis_x_m)`` -> the give [deg].
+    """
     from ..sim.still import rest_pose
 
     def give(crank_start_deg: float, ground_angle_deg: float, servo_axis_x_m: float) -> float:
@@ -177,7 +266,22 @@ def model_servo_give(robot: Robot):
 
 
 def to_plane(corners_px: np.ndarray, corners_m: np.ndarray, points_px: np.ndarray) -> np.ndarray:
-    """Pixels -> board plane (m) through the homography of the board's corners."""
+    """Pixels -> board plane (m) through the homography of the board's corners.
+
+    Parameters
+    ----------
+    corners_px : numpy.ndarray
+        (N, 2) board corners [px].
+    corners_m : numpy.ndarray
+        (N, 2) their places on the board [m].
+    points_px : numpy.ndarray
+        (M, 2) points [px].
+
+    Returns
+    -------
+    numpy.ndarray
+        (M, 2) the points on the board's plane [m].
+    """
     H, _ = cv2.findHomography(corners_px, corners_m, 0)
     return cv2.perspectiveTransform(np.asarray(points_px, float)[None], H)[0]
 
@@ -229,6 +333,24 @@ def fit_points(robot: Robot, observed: np.ndarray, start: tuple[np.ndarray, bool
     whether the photo is mirrored (taken from the robot's right) and the residual sum of squares.
     Without ``start`` both sides and a spread of ground angles are tried, each crank started
     where its stickers point.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot measured (its links and sticker places).
+    observed : numpy.ndarray
+        The stickers on the board's plane [m], 6 per photo.
+    start : (numpy.ndarray, bool), optional
+        Parameters and mirroring to start from.
+
+    Returns
+    -------
+    params : numpy.ndarray
+        ``[ground_deg, axis_m, (x0_m, y0_m, pitch_deg, crank_deg) per photo]``.
+    mirrored : bool
+        Whether the photos were taken from the robot's right.
+    ssr_m2 : float
+        The residual sum of squares [m²].
     """
     if start is not None:
         sol = least_squares(_residuals, start[0], args=(robot, observed, start[1]), x_scale="jac")
@@ -320,7 +442,26 @@ def _estimate(value: float, draws: np.ndarray) -> Estimate:
 def fit_stance(robot: Robot, photos: list[Photo], servo_give_deg, draws: int = BOOTSTRAP_DRAWS,
                seed: int = 0) -> StanceResult:
     """Fit the stance to one photo (rest) or two (rest, push); ``servo_give_deg(crank_start_deg,
-    ground_angle_deg, servo_axis_x_m)`` is the servo's give at rest, as the model has it."""
+    ground_angle_deg, servo_axis_x_m)`` is the servo's give at rest, as the model has it.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot measured.
+    photos : list of Photo
+        The rest photo, and optionally the push photo.
+    servo_give_deg : callable
+        See above (:func:`model_servo_give`).
+    draws : int
+        Bootstrap draws for the intervals.
+    seed : int
+        The bootstrap's seed.
+
+    Returns
+    -------
+    StanceResult
+        Crank start and ground angle [deg], servo axis [m], each with its interval.
+    """
     observed = np.vstack([_plane_points(ph) for ph in photos])
     p, mirrored, rss = fit_points(robot, observed)
     _check_reach(robot, photos, observed, p, mirrored)

@@ -13,7 +13,20 @@ from .model import Provenance, Robot
 
 def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
                       note: str | None = None) -> Robot:
-    """``base`` with the same length added to all four links (the seed's ``scale`` variable)."""
+    """``base`` with the same length added to all four links (the seed's ``scale`` variable).
+
+    Parameters
+    ----------
+    base : Robot
+    added_m : float
+        The length added to each link [m] (may be negative).
+    source, note : str
+        The provenance recorded for the four link lengths.
+
+    Returns
+    -------
+    Robot
+    """
     g = base.geometry
     values = {
         "geometry.ground_m": round(g.ground_m + added_m, 9),
@@ -48,7 +61,26 @@ LEG_SETS = {
 def leg_set(base: Robot, name: str, source: str | None = None) -> Robot:
     """The physical leg set ``name`` (small/medium/large) built on ``base``'s parameters: its
     links, and its converged time step where ``base``'s is coarser (a finer one is kept);
-    ``source``: the provenance of what it changes (``preset:<name>``)."""
+    ``source``: the provenance of what it changes (``preset:<name>``).
+
+    Parameters
+    ----------
+    base : Robot
+        The robot the leg set is put on.
+    name : str
+        ``small``, ``medium`` or ``large``.
+    source : str, optional
+        The provenance of the values changed (default ``preset:<name>``).
+
+    Returns
+    -------
+    Robot
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        An unknown leg set.
+    """
     try:
         spec = LEG_SETS[name]
     except KeyError:

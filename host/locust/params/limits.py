@@ -25,6 +25,18 @@ _HOP = protocol.COMMANDS["hop"]   # argument -> (kind, lowest, highest, default)
 
 
 class Limit(NamedTuple):
+    """One parameter's admissible range, in the parameter's unit, and why.
+
+    Attributes
+    ----------
+    low, high : float
+        The bounds.
+    low_ok, high_ok : bool
+        Whether each bound itself is admissible (closed) or not (open).
+    reason : str
+        What the range stands for (e.g. "a link of a desk hopper"), shown when it is broken.
+    """
+
     low: float
     high: float
     low_ok: bool
@@ -111,7 +123,19 @@ MAX_SIM_STEPS = 2_000_000
 
 
 def outside_limits(key: str, value: float) -> str | None:
-    """Why ``value`` is outside ``key``'s limits (with the limit and its reason), or None."""
+    """Why ``value`` is outside ``key``'s limits (with the limit and its reason), or None.
+
+    Parameters
+    ----------
+    key : str
+        A dotted name.
+    value : float
+        Its value, in the unit its name says.
+
+    Returns
+    -------
+    str or None
+    """
     low, high, low_ok, high_ok, reason = LIMITS[key]
     if (value > low or (low_ok and value == low)) and (value < high or (high_ok and value == high)):
         return None
@@ -123,7 +147,19 @@ def outside_limits(key: str, value: float) -> str | None:
 
 
 def problems(robot: Robot, cycles: int | None = None) -> list[str]:
-    """Every reason ``robot`` cannot be simulated or run as given (empty: it can)."""
+    """Every reason ``robot`` cannot be simulated or run as given (empty: it can).
+
+    Parameters
+    ----------
+    robot : Robot
+    cycles : int, optional
+        Hop cycles to be simulated (default the schedule's): their physics steps are held to
+        the simulation's limit.
+
+    Returns
+    -------
+    list of str
+    """
     out = [p for key in LIMITS if (p := outside_limits(key, robot.get(key)))]
     s, sol, sch = robot.servo, robot.solver, robot.schedule
     if abs(sch.push_deg) > s.travel_deg and not outside_limits("schedule.push_deg", sch.push_deg):
@@ -144,7 +180,24 @@ def problems(robot: Robot, cycles: int | None = None) -> list[str]:
 
 
 def check_robot(robot: Robot, cycles: int | None = None) -> Robot:
-    """``robot`` if it can be simulated and run; else :class:`ParamsError` naming every problem."""
+    """``robot`` if it can be simulated and run; else :class:`ParamsError` naming every problem.
+
+    Parameters
+    ----------
+    robot : Robot
+    cycles : int, optional
+        Hop cycles to be simulated (default the schedule's).
+
+    Returns
+    -------
+    Robot
+        ``robot`` itself.
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        Every problem :func:`problems` finds, in one message.
+    """
     found = problems(robot, cycles)
     if found:
         raise ParamsError("; ".join(found),

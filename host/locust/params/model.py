@@ -196,15 +196,65 @@ class Robot:
 
     # -- dotted access ---------------------------------------------------------------
     def get(self, key: str) -> Any:
+        """A value by its dotted name.
+
+        Parameters
+        ----------
+        key : str
+            ``section.name``, e.g. ``geometry.leg_m`` (the unit is the name's suffix).
+
+        Returns
+        -------
+        Any
+            The value, in the unit its name says.
+
+        Raises
+        ------
+        locust.errors.ParamsError
+            Not a parameter of the model.
+        """
         section, name = split_key(key)
         return getattr(getattr(self, section), name)
 
     def source_of(self, key: str) -> Provenance:
+        """Where a value comes from (an empty :class:`Provenance` when not recorded).
+
+        Parameters
+        ----------
+        key : str
+            A dotted name.
+
+        Returns
+        -------
+        Provenance
+
+        Raises
+        ------
+        locust.errors.ParamsError
+            Not a parameter of the model.
+        """
         split_key(key)
         return self.provenance.get(key, Provenance())
 
     def with_values(self, values: dict[str, Any], source: str | Provenance = "override") -> Robot:
-        """A copy with ``values`` (dotted keys) replaced, each recorded with ``source``."""
+        """A copy with ``values`` replaced, each recorded with ``source``.
+
+        Parameters
+        ----------
+        values : dict of str to Any
+            Dotted name -> value, in the unit the name says (coerced to the field's type).
+        source : str or Provenance
+            Where the values come from.
+
+        Returns
+        -------
+        Robot
+
+        Raises
+        ------
+        locust.errors.ParamsError
+            An unknown name or a value of the wrong type.
+        """
         prov = source if isinstance(source, Provenance) else Provenance(source=source)
         sections = {name: getattr(self, name) for name in SECTIONS}
         provenance = dict(self.provenance)
@@ -215,18 +265,59 @@ class Robot:
         return replace(self, provenance=provenance, **sections)
 
     def with_provenance(self, key: str, prov: Provenance) -> Robot:
+        """A copy with ``key``'s provenance replaced (its value kept).
+
+        Parameters
+        ----------
+        key : str
+            A dotted name.
+        prov : Provenance
+            Its new source, uncertainty and note.
+
+        Returns
+        -------
+        Robot
+
+        Raises
+        ------
+        locust.errors.ParamsError
+            Not a parameter of the model.
+        """
         split_key(key)
         return replace(self, provenance={**self.provenance, key: prov})
 
     def renamed(self, name: str) -> Robot:
+        """A copy named ``name``.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        Robot
+        """
         return replace(self, name=name)
 
     def link_lengths_m(self) -> tuple[float, float, float, float]:
+        """The four-bar's ground, crank, coupler and leg lengths [m].
+
+        Returns
+        -------
+        tuple of float
+            [m].
+        """
         g = self.geometry
         return (g.ground_m, g.crank_m, g.coupler_m, g.leg_m)
 
     def flat(self) -> dict[str, Any]:
-        """Every value by its dotted name."""
+        """Every value by its dotted name.
+
+        Returns
+        -------
+        dict of str to Any
+            Each value in the unit its name says.
+        """
         return {key: self.get(key) for key in all_keys()}
 
 
@@ -235,10 +326,32 @@ UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s"})
 
 
 def all_keys() -> list[str]:
+    """Every parameter's dotted name, section by section in field order.
+
+    Returns
+    -------
+    list of str
+    """
     return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls)]
 
 
 def split_key(key: str) -> tuple[str, str]:
+    """A dotted name's section and field, checked.
+
+    Parameters
+    ----------
+    key : str
+        ``section.name``.
+
+    Returns
+    -------
+    section, name : str
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        Not a parameter of the model (the hint names close ones).
+    """
     section, _, name = key.partition(".")
     cls = SECTIONS.get(section)
     if cls is None or name not in {f.name for f in fields(cls)}:
@@ -250,14 +363,29 @@ def split_key(key: str) -> tuple[str, str]:
 
 def value_type(key: str) -> str:
     """The type of a dotted key's value: ``"float"``, ``"int"``, ``"bool"`` or ``"str"``
-    (ParamsError for an unknown key)."""
+    (ParamsError for an unknown key).
+
+    Parameters
+    ----------
+    key : str
+        A dotted name.
+
+    Returns
+    -------
+    str
+    """
     section, name = split_key(key)
     ftype = {f.name: f.type for f in fields(SECTIONS[section])}[name]
     return ftype if isinstance(ftype, str) else ftype.__name__
 
 
 def real_keys() -> list[str]:
-    """Every real-valued key (the ones a fit or a draw can move), in file order."""
+    """Every real-valued key (the ones a fit or a draw can move), in file order.
+
+    Returns
+    -------
+    list of str
+    """
     return [key for key in all_keys() if value_type(key) == "float"]
 
 
@@ -267,7 +395,12 @@ PHYSICAL_SECTIONS = ("geometry", "compliance", "servo", "contact", "power")
 
 
 def fittable_keys() -> list[str]:
-    """The real-valued physical keys: the only ones a fit may move."""
+    """The real-valued physical keys: the only ones a fit may move.
+
+    Returns
+    -------
+    list of str
+    """
     return [key for key in real_keys() if key.partition(".")[0] in PHYSICAL_SECTIONS]
 
 
@@ -306,7 +439,23 @@ def _coerce(key: str, raw: Any) -> Any:
 
 
 def parse_set_options(items: tuple[str, ...] | list[str]) -> dict[str, str]:
-    """``["geometry.leg_m=0.07", ...]`` -> ``{"geometry.leg_m": "0.07"}``, keys checked."""
+    """``["geometry.leg_m=0.07", ...]`` -> ``{"geometry.leg_m": "0.07"}``, keys checked.
+
+    Parameters
+    ----------
+    items : sequence of str
+        ``KEY=VALUE`` strings (the command line's ``--set``).
+
+    Returns
+    -------
+    dict of str to str
+        Dotted name -> the value's text (converted by :meth:`Robot.with_values`).
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        An item without ``=``, or an unknown name.
+    """
     out: dict[str, str] = {}
     for item in items:
         key, sep, value = item.partition("=")
@@ -319,7 +468,18 @@ def parse_set_options(items: tuple[str, ...] | list[str]) -> dict[str, str]:
 
 
 def shown_value(raw: Any) -> str:
-    """``raw`` as an error shows it: a table or a list by its kind, anything else by a short repr."""
+    """``raw`` as an error shows it: a table or a list by its kind, anything else by a short repr.
+
+    Parameters
+    ----------
+    raw : Any
+        A value as read from a file.
+
+    Returns
+    -------
+    str
+        At most 40 characters.
+    """
     if isinstance(raw, dict):
         return "a table"
     if isinstance(raw, list):
@@ -329,5 +489,15 @@ def shown_value(raw: Any) -> str:
 
 
 def as_dict(robot: Robot) -> dict[str, Any]:
-    """Plain nested dict of values (for JSON and hashing)."""
+    """Plain nested dict of values (for JSON and hashing).
+
+    Parameters
+    ----------
+    robot : Robot
+
+    Returns
+    -------
+    dict
+        ``name`` and, per section, its values by field name (units in the names).
+    """
     return {"name": robot.name, **{s: dataclasses.asdict(getattr(robot, s)) for s in SECTIONS}}

@@ -185,6 +185,24 @@ PRESETS = {
 
 
 def preset(name: str) -> Robot:
+    """A built-in robot, every value with its source.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`PRESETS`: ``seed``; ``small``, ``medium``, ``large`` (the robot as built
+        with each filmed leg set); ``seed-notebook``.
+
+    Returns
+    -------
+    Robot
+        A new copy.
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        An unknown name.
+    """
     try:
         return PRESETS[name]()
     except KeyError:

@@ -22,6 +22,19 @@ _NAME_OK = re.compile(r"^[A-Za-z][A-Za-z0-9_+-]*$")
 
 @dataclass(frozen=True)
 class Configuration:
+    """One configuration the trials were hopped in: a leg set, or the base robot with every
+    link lengthened by ``added_m``.
+
+    Attributes
+    ----------
+    name : str
+        Its key, lower case (``small``).
+    added_m : float
+        The length added to every link of the base robot [m].
+    robot : locust.params.Robot
+        The robot in this configuration.
+    """
+
     name: str          # lower case key: "small"
     added_m: float     # length added to every link of the base robot
     robot: Robot
@@ -33,7 +46,26 @@ class Configuration:
 
 
 def configuration(base: Robot, name: str, added_m: float | None = None) -> Configuration:
-    """The configuration ``name`` on ``base``: a known leg set, or ``base`` plus ``added_m``."""
+    """The configuration ``name`` on ``base``: a known leg set, or ``base`` plus ``added_m``.
+
+    Parameters
+    ----------
+    base : locust.params.Robot
+        The robot the leg set is built on.
+    name : str
+        A leg set's name (``small``, ``medium``, ``large``) or the user's own.
+    added_m : float, optional
+        The length added to every link [m]; default the leg set's own (0 for an unknown name).
+
+    Returns
+    -------
+    Configuration
+
+    Raises
+    ------
+    locust.errors.TrialError
+        ``name`` is not a plain name.
+    """
     key = check_name(name)
     if key in LEG_SETS and (added_m is None or added_m == LEG_SETS[key].added_m):
         return Configuration(name=key, added_m=LEG_SETS[key].added_m, robot=leg_set(base, key, source=f"leg-set:{key}"))
@@ -44,6 +76,21 @@ def configuration(base: Robot, name: str, added_m: float | None = None) -> Confi
 
 
 def check_name(name: str) -> str:
+    """A configuration's name as a key: stripped, lower case, a plain name.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    locust.errors.TrialError
+        Not letters, digits, ``-``, ``_`` or ``+`` after a first letter.
+    """
     key = name.strip().lower()
     if not _NAME_OK.match(key):
         raise TrialError(f"configuration name {name!r} is not a plain name",
@@ -55,6 +102,21 @@ def name_from_path(path: Path) -> str:
     """A trial's configuration from where it lies: its folder's name less a trial number.
 
     ``hops/small/run.json`` -> small; ``hops/medium-2/`` -> medium; ``large_trial3/`` -> large.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A run folder, its ``run.json`` or a track file.
+
+    Returns
+    -------
+    str
+        The configuration's key.
+
+    Raises
+    ------
+    locust.errors.TrialError
+        No plain name left once the trial number is taken off.
     """
     folder = path if path.is_dir() else path.parent
     for part in (folder.name, folder.parent.name):
@@ -66,13 +128,39 @@ def name_from_path(path: Path) -> str:
 
 
 def sort_key(name: str) -> tuple[int, str]:
-    """Known leg sets in size order first, then the rest by name."""
+    """Known leg sets in size order first, then the rest by name.
+
+    Parameters
+    ----------
+    name : str
+        A configuration's key.
+
+    Returns
+    -------
+    tuple of (int, str)
+    """
     order = list(LEG_SETS)
     return (order.index(name), "") if name in order else (len(order), name)
 
 
 def parse_added(items: tuple[str, ...] | list[str]) -> dict[str, float]:
-    """``["v2=0.015"]`` -> ``{"v2": 0.015}`` (metres added to every link)."""
+    """``["v2=0.015"]`` -> ``{"v2": 0.015}`` (metres added to every link).
+
+    Parameters
+    ----------
+    items : sequence of str
+        ``NAME=METRES`` (the command line's ``--added``).
+
+    Returns
+    -------
+    dict of str to float
+        Configuration -> length added to every link [m].
+
+    Raises
+    ------
+    locust.errors.TrialError
+        An item that is not ``NAME=METRES``, or a name that is not plain.
+    """
     out: dict[str, float] = {}
     for item in items:
         name, sep, value = item.partition("=")

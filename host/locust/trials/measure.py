@@ -43,6 +43,19 @@ class Aligned:
 
 @dataclass(frozen=True)
 class MeasuredHop:
+    """One hop of a filmed trial, measured on the nose's track.
+
+    Attributes
+    ----------
+    hop : int
+        The hop's number, from 1.
+    distance_m : float
+        How far forward the nose's rest moved over that cycle [m]; NaN when the track does not
+        cover it.
+    apex_m : float
+        The nose's highest point in that cycle above where it stood [m]; NaN when not covered.
+    """
+
     hop: int
     distance_m: float        # nan when the track does not cover the cycle
     apex_m: float
@@ -50,7 +63,29 @@ class MeasuredHop:
 
 def onset_time(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, threshold_m: float = ONSET_M,
                where: str = "track") -> tuple[float, float, float]:
-    """(time the nose first moved ``threshold_m`` from where it stood, standing x, standing y)."""
+    """(time the nose first moved ``threshold_m`` from where it stood, standing x, standing y).
+
+    Parameters
+    ----------
+    t_s, x_m, y_m : numpy.ndarray
+        The nose's track: time [s], forward and up [m].
+    threshold_m : float
+        The move that counts as motion [m].
+    where : str
+        The track's name, for messages.
+
+    Returns
+    -------
+    onset_s : float
+        When the nose first moved (interpolated between frames) [s].
+    x0_m, y0_m : float
+        Where it stood [m].
+
+    Raises
+    ------
+    locust.errors.TrialError
+        The nose never moves that far, or is already moving when the clip starts.
+    """
     dist = np.hypot(x_m - x_m[0], y_m - y_m[0])
     moved = np.flatnonzero(dist > threshold_m)
     if moved.size == 0:
@@ -68,14 +103,48 @@ def onset_time(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, threshold_m: f
 
 def align(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, onset_latency_s: float,
           where: str = "track") -> Aligned:
-    """Put a trace on the schedule's clock, its start ``onset_latency_s`` before its first motion."""
+    """Put a trace on the schedule's clock, its start ``onset_latency_s`` before its first motion.
+
+    Parameters
+    ----------
+    t_s, x_m, y_m : numpy.ndarray
+        The nose's track: time [s], forward and up [m].
+    onset_latency_s : float
+        The delay from the schedule's start to the nose's first motion [s] (the model's).
+    where : str
+        The track's name, for messages.
+
+    Returns
+    -------
+    Aligned
+        The trace from where the nose stood [m], on the schedule's clock [s].
+
+    Raises
+    ------
+    locust.errors.TrialError
+        No onset found (see :func:`onset_time`).
+    """
     onset, x0, y0 = onset_time(t_s, x_m, y_m, where=where)
     start = onset - onset_latency_s
     return Aligned(t_s=t_s - start, x_m=x_m - x0, y_m=y_m - y0, onset_s=onset, start_s=start)
 
 
 def measure_hops(trace: Aligned, period_s: float, cycles: int) -> list[MeasuredHop]:
-    """Distance and apex of each of ``cycles`` hops of an aligned trace."""
+    """Distance and apex of each of ``cycles`` hops of an aligned trace.
+
+    Parameters
+    ----------
+    trace : Aligned
+        A trace on the schedule's clock.
+    period_s : float
+        One cycle, push and wait [s].
+    cycles : int
+        Cycles hopped.
+
+    Returns
+    -------
+    list of MeasuredHop
+    """
     t, x, y = trace.t_s, trace.x_m, trace.y_m
     t_end = float(t[-1])
     rest = [0.0]  # standing, by construction of the aligned trace

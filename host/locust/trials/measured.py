@@ -55,6 +55,24 @@ class Track:
 
 @dataclass(frozen=True)
 class Trial:
+    """One filmed trial: its configuration, its track and its run record.
+
+    Attributes
+    ----------
+    config : str
+        The configuration's key (a leg set's name).
+    label : str
+        The short name tables show: the trial's folder.
+    track : Track or None
+        The nose's positions; None for a run without a track.
+    run_path : pathlib.Path or None
+        Its ``run.json``.
+    record : locust.io.run_record.RunRecord or None
+        The run record read.
+    config_from : str
+        How the configuration was known: given, from the run record, or from the folder's name.
+    """
+
     config: str
     label: str                       # short name shown in tables: the trial's folder
     track: Track | None
@@ -66,7 +84,28 @@ class Trial:
 def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose",
                    imports: ImportOptions = AS_IS) -> dict[str, list[Trial]]:
     """``--measured`` values -> trials per configuration, in leg-set order; ``imports``
-    (``--units``, ``--rename``, ``--mirror``) converts every track."""
+    (``--units``, ``--rename``, ``--mirror``) converts every track.
+
+    Parameters
+    ----------
+    items : sequence of str
+        ``NAME=PATH[,PATH...]`` or plain paths (the configuration then from the run record or the
+        folder's name).
+    marker : str, default "nose"
+        The marker read from each track.
+    imports : locust.io.importing.ImportOptions
+        How each track is converted (``--units``, ``--rename``, ``--mirror``).
+
+    Returns
+    -------
+    dict of str to list of Trial
+        Configuration -> its trials.
+
+    Raises
+    ------
+    locust.errors.TrialError
+        No items, a trial given twice, or a trial that cannot be read.
+    """
     if not items:
         raise TrialError("no measured inputs", "give --measured small=runs/small-1,runs/small-2 (or plain paths)")
     groups: dict[str, list[Trial]] = {}
@@ -118,7 +157,25 @@ def _run_path(path: Path) -> Path | None:
 
 def config_of(path: Path) -> tuple[str, str]:
     """(configuration, how it is known) of the trial at ``path`` given without a name: the leg
-    set its run record names, else its folder's name."""
+    set its run record names, else its folder's name.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A run folder, its ``run.json`` or a track file.
+
+    Returns
+    -------
+    config : str
+        The configuration's key.
+    known_from : str
+        ``run record`` or ``folder name``.
+
+    Raises
+    ------
+    locust.errors.TrialError
+        Neither names a configuration.
+    """
     _must_exist(path)
     run_path = _run_path(path)
     leg_set = read_run(run_path).robot.leg_set if run_path else None
@@ -129,6 +186,32 @@ def config_of(path: Path) -> tuple[str, str]:
 
 def load_trial(path: Path, config: str, marker: str = "nose", imports: ImportOptions = AS_IS,
                config_from: str = CONFIG_GIVEN) -> Trial:
+    """One trial from a run folder, its ``run.json`` or a track file.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A folder (holding at most one ``*.tracks.csv`` and maybe a ``run.json``), a ``run.json``
+        or a track file.
+    config : str
+        Its configuration's key.
+    marker : str, default "nose"
+        The marker read from the track.
+    imports : locust.io.importing.ImportOptions
+        How the track is converted (``--units``, ``--rename``, ``--mirror``).
+    config_from : str
+        How ``config`` was known.
+
+    Returns
+    -------
+    Trial
+
+    Raises
+    ------
+    locust.errors.TrialError
+        No such path, several tracks or none where one is needed, or a track without the marker
+        in metres.
+    """
     _must_exist(path)
     run_path = _run_path(path)
     if path.is_dir():
@@ -157,7 +240,27 @@ def _one_track(folder: Path, required: bool) -> Path | None:
 
 
 def read_track(path: Path, marker: str = "nose", imports: ImportOptions = AS_IS) -> Track:
-    """The ``marker``'s positions in ``path`` (converted by ``imports``); lost frames dropped, time sorted."""
+    """The ``marker``'s positions in ``path`` (converted by ``imports``); lost frames dropped, time sorted.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A track file.
+    marker : str, default "nose"
+    imports : locust.io.importing.ImportOptions
+        How each track is converted (``--units``, ``--rename``, ``--mirror``).
+
+    Returns
+    -------
+    Track
+        Time [s], x forward and y up [m].
+
+    Raises
+    ------
+    locust.errors.TrialError
+        The file cannot be read, or has fewer than 10 frames with the marker in metres, or repeated
+        times.
+    """
     try:
         tracks = import_tracks(path, options=imports)
         t = tracks.time_s()
@@ -184,7 +287,19 @@ def read_track(path: Path, marker: str = "nose", imports: ImportOptions = AS_IS)
 
 def metres_per_pixel(tracks, marker: str) -> float:
     """The track's own resolution: the median of (step in metres) / (step in pixels) over the
-    frame-to-frame steps of at least a pixel; nan for a track without pixel columns."""
+    frame-to-frame steps of at least a pixel; nan for a track without pixel columns.
+
+    Parameters
+    ----------
+    tracks : locust.io.tracks_csv.TracksCsv
+        The file's tracks.
+    marker : str
+
+    Returns
+    -------
+    float
+        [m/px].
+    """
     columns = getattr(tracks, "markers", {}).get(marker)
     if columns is None or not hasattr(columns, "px"):
         return math.nan
@@ -195,7 +310,22 @@ def metres_per_pixel(tracks, marker: str) -> float:
 
 
 def read_run(path: Path) -> RunRecord:
-    """A run record (``locust hop``), read by the device layer that writes it."""
+    """A run record (``locust hop``), read by the device layer that writes it.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A ``run.json``.
+
+    Returns
+    -------
+    locust.io.run_record.RunRecord
+
+    Raises
+    ------
+    locust.errors.TrialError
+        A record that cannot be read.
+    """
     try:
         return read_run_record(path)
     except DeviceError as exc:
@@ -203,7 +333,17 @@ def read_run(path: Path) -> RunRecord:
 
 
 def span_hint(track: Track) -> str | None:
-    """What to say when a track spans more than a desk robot's camera sees (its units are off)."""
+    """What to say when a track spans more than a desk robot's camera sees (its units are off).
+
+    Parameters
+    ----------
+    track : Track
+
+    Returns
+    -------
+    str or None
+        None when the span fits a desk.
+    """
     span = float(max(np.ptp(track.x_m), np.ptp(track.y_m))) if len(track.x_m) else 0.0
     if span <= DESK_SPAN_M:
         return None
