@@ -36,10 +36,29 @@ class CameraView:
     elevation_deg: float = ELEVATION_DEG
 
     def at_x(self, x_m: float) -> CameraView:
+        """The same view moved along the floor to look at ``x_m``.
+
+        Parameters
+        ----------
+        x_m : float
+            The new look-at point's x [m].
+
+        Returns
+        -------
+        CameraView
+            The view with ``lookat_m[0] = x_m``.
+        """
         return CameraView((x_m, self.lookat_m[1], self.lookat_m[2]), self.distance_m,
                           self.azimuth_deg, self.elevation_deg)
 
     def mjv_camera(self) -> mujoco.MjvCamera:
+        """The view as MuJoCo's free camera.
+
+        Returns
+        -------
+        mujoco.MjvCamera
+            A free camera at this look-at point, distance, azimuth and elevation.
+        """
         cam = mujoco.MjvCamera()
         cam.type = mujoco.mjtCamera.mjCAMERA_FREE
         cam.lookat[:] = self.lookat_m
@@ -68,25 +87,75 @@ class PinholeCamera:
 
     @property
     def translation_m(self) -> np.ndarray:
+        """The translation t of ``X_cam = R X + t`` [m]."""
         return -self.rotation @ self.position_m
 
     def to_camera(self, points_m: np.ndarray) -> np.ndarray:
+        """World points in the camera's frame.
+
+        Parameters
+        ----------
+        points_m : ndarray
+            (N, 3) or (3,) world points [m].
+
+        Returns
+        -------
+        ndarray
+            (N, 3) points in the camera frame (x right, y down, z forward) [m].
+        """
         return (np.atleast_2d(points_m) - self.position_m) @ self.rotation.T
 
     def project(self, points_m: np.ndarray) -> np.ndarray:
-        """World points (N, 3) in metres -> pixel centres (N, 2)."""
+        """World points (N, 3) in metres -> pixel centres (N, 2).
+
+        Parameters
+        ----------
+        points_m : ndarray
+            (N, 3) or (3,) world points [m], in front of the camera.
+
+        Returns
+        -------
+        ndarray
+            (N, 2) pixel coordinates [px], origin at the centre of the top-left pixel.
+        """
         pc = self.to_camera(points_m)
         return np.column_stack([self.fx_px * pc[:, 0] / pc[:, 2] + self.cx_px,
                                 self.fy_px * pc[:, 1] / pc[:, 2] + self.cy_px])
 
     def m_per_px_at_depth(self, depth_m: float) -> float:
+        """The size of one pixel on a plane facing the camera.
+
+        Parameters
+        ----------
+        depth_m : float
+            The plane's distance along the optical axis [m].
+
+        Returns
+        -------
+        float
+            Metres per pixel (horizontally) at that depth [m/px].
+        """
         return depth_m / self.fx_px
 
     def intrinsics(self) -> dict:
+        """The intrinsics as a JSON object.
+
+        Returns
+        -------
+        dict
+            ``fx_px``, ``fy_px``, ``cx_px``, ``cy_px`` [px] and the 3x3 matrix ``K``.
+        """
         return {"fx_px": self.fx_px, "fy_px": self.fy_px, "cx_px": self.cx_px, "cy_px": self.cy_px,
                 "K": [[self.fx_px, 0.0, self.cx_px], [0.0, self.fy_px, self.cy_px], [0.0, 0.0, 1.0]]}
 
     def extrinsics(self) -> dict:
+        """The extrinsics as a JSON object.
+
+        Returns
+        -------
+        dict
+            ``rotation_world_to_camera`` (3x3), ``translation_m`` and ``position_m`` [m].
+        """
         return {"rotation_world_to_camera": self.rotation.tolist(),
                 "translation_m": self.translation_m.tolist(), "position_m": self.position_m.tolist()}
 

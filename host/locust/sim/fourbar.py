@@ -56,6 +56,19 @@ def grashof_class(ground_m: float, crank_m: float, coupler_m: float, leg_m: floa
 
 
 def check_lengths(ground_m: float, crank_m: float, coupler_m: float, leg_m: float) -> None:
+    """Refuse link lengths no four-bar can be built from.
+
+    Parameters
+    ----------
+    ground_m, crank_m, coupler_m, leg_m : float
+        The four link lengths [m].
+
+    Raises
+    ------
+    GeometryError
+        A length that is not a positive number, or a longest link not shorter than the other
+        three together.
+    """
     names = {"geometry.ground_m": ground_m, "geometry.crank_m": crank_m,
              "geometry.coupler_m": coupler_m, "geometry.leg_m": leg_m}
     for key, value in names.items():

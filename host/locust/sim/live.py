@@ -48,6 +48,32 @@ PREROLL_S = 0.5   # a video opens on the robot standing still this long before t
 
 @dataclass(frozen=True)
 class LiveResult:
+    """What a live simulation has done so far.
+
+    Attributes
+    ----------
+    distance_m : float
+        Chassis x from the end of the settle phase to now [m].
+    max_nose_height_m : float
+        Highest nose point since the settle phase [m].
+    sim_time_s : float
+        Simulated time since the settle phase [s].
+    valid : bool
+        The run passed its audit.
+    reasons : list of str
+        Why not, when invalid.
+    realtime_factor : float
+        Simulated seconds per wall second spent stepping (and rendering).
+    video_path : str or None
+        The video written, if any.
+    frames : int
+        Frames in it.
+    hops : list of dict
+        Per push, :class:`locust.sim.hops.Hop`'s fields.
+    outcome : str or None
+        ``goes_over``, ``rears_and_returns`` or ``stays_low`` over the pushes (None: no push yet).
+    """
+
     distance_m: float            # chassis x, end of the settle phase -> now
     max_nose_height_m: float     # highest nose point since the settle phase
     sim_time_s: float            # simulated time since the settle phase
@@ -60,6 +86,13 @@ class LiveResult:
     outcome: str | None = None   # goes_over / rears_and_returns / stays_low over the pushes (None: none)
 
     def to_dict(self) -> dict:
+        """The fields by name.
+
+        Returns
+        -------
+        dict
+            A shallow copy of the fields.
+        """
         return dict(self.__dict__)
 
 
@@ -145,6 +178,7 @@ class LiveSim:
 
     @property
     def sim_time_s(self) -> float:
+        """Simulated time since the end of the settle phase [s]."""
         return (self._steps - getattr(self, "_settle_steps", self._steps)) * self.dt
 
     # -- stepping -------------------------------------------------------------------

@@ -275,6 +275,22 @@ class SimResult:
 
 
 def invalid_result(robot: Robot, reason: str, cycles: int | None = None) -> SimResult:
+    """A result for a robot that could not be simulated: invalid, with one reason, every figure nan.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot.
+    reason : str
+        Why it was not simulated.
+    cycles : int, optional
+        Cycles asked for; default the robot's schedule's.
+
+    Returns
+    -------
+    SimResult
+        ``valid`` False, no hops, zero duration.
+    """
     nan = float("nan")
     return SimResult(robot=robot.name, valid=False, reasons=[reason], distance_m=nan, max_nose_height_m=nan,
                      hops=[], cycles=cycles or robot.schedule.cycles, timestep_s=robot.solver.timestep_s,
