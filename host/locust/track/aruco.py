@@ -21,6 +21,23 @@ DEFAULT_DICTIONARY = "DICT_4X4_50"
 
 
 def make_detector(dictionary: str = DEFAULT_DICTIONARY) -> cv2.aruco.ArucoDetector:
+    """An ArUco detector for ``dictionary`` with sub-pixel corner refinement.
+
+    Parameters
+    ----------
+    dictionary : str
+        One of ``cv2.aruco``'s predefined dictionaries, e.g. ``DICT_4X4_50``.
+
+    Returns
+    -------
+    cv2.aruco.ArucoDetector
+        The detector.
+
+    Raises
+    ------
+    TrackError
+        The dictionary is not one of OpenCV's.
+    """
     if not dictionary.startswith("DICT_") or not hasattr(cv2.aruco, dictionary):
         raise TrackError(f"unknown ArUco dictionary {dictionary!r}",
                          "use one of cv2.aruco's names, e.g. DICT_4X4_50, DICT_5X5_100, DICT_6X6_250")
@@ -53,11 +70,38 @@ def centre_of(corners: np.ndarray) -> tuple[float, float]:
 
 
 def side_px(corners: np.ndarray) -> float:
+    """Mean side length of a marker's four-corner outline.
+
+    Parameters
+    ----------
+    corners : ndarray
+        (4, 2) corners in order [px].
+
+    Returns
+    -------
+    float
+        Mean side [px].
+    """
     return float(np.mean(np.linalg.norm(corners - np.roll(corners, -1, axis=0), axis=1)))
 
 
 @dataclass
 class ArucoMarker:
+    """An ArUco marker tracked by its id: searched near the predicted position, else in the
+    whole frame; its position is the intersection of its diagonals.
+
+    Attributes
+    ----------
+    name, spec : str
+        The marker's name and its ``--marker`` spec.
+    marker_id : int
+        The ArUco id.
+    dictionary : str
+        The ArUco dictionary's name.
+    history : MotionHistory
+        Its last positions, for the search window.
+    """
+
     name: str
     spec: str
     marker_id: int
@@ -67,6 +111,20 @@ class ArucoMarker:
     _side_px: float = 0.0
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
+        """Find the marker in one frame.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number (frames come in order).
+        image_bgr : ndarray
+            The frame, BGR (or grey).
+
+        Returns
+        -------
+        Detection
+            Its centre [px]; ``score`` is its mean side length [px] (0 when not found).
+        """
         if self._detector is None:
             self._detector = make_detector(self.dictionary)
         corners = None

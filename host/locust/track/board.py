@@ -76,27 +76,78 @@ class PlaneHomography:
 
     def to_world(self, px: np.ndarray, py: np.ndarray, marker: str | None = None,
                  frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Pixels to plane metres through the homography.
+
+        Parameters
+        ----------
+        px, py : ndarray
+            Pixel positions, OpenCV convention [px].
+        marker : str, optional
+            Unused (one plane for every marker); there for the calibrations' common call.
+        frames : ndarray, optional
+            Unused (a fixed camera); there for the calibrations' common call.
+
+        Returns
+        -------
+        x_m, y_m : ndarray
+            Positions in the plane, origin at its corner, y up [m].
+        """
         px, py = np.asarray(px, float), np.asarray(py, float)
         v = np.stack([px, py, np.ones_like(px)], axis=-1) @ self.H.T
         with np.errstate(divide="ignore", invalid="ignore"):
             return v[..., 0] / v[..., 2], v[..., 1] / v[..., 2]
 
     def to_image(self, x_m: np.ndarray, y_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Plane metres to pixels through the inverse homography.
+
+        Parameters
+        ----------
+        x_m, y_m : ndarray
+            Positions in the plane [m].
+
+        Returns
+        -------
+        px, py : ndarray
+            Pixel positions, OpenCV convention [px].
+        """
         v = np.stack([np.asarray(x_m, float), np.asarray(y_m, float), np.ones(np.shape(x_m))], axis=-1) @ self.H_inv.T
         return v[..., 0] / v[..., 2], v[..., 1] / v[..., 2]
 
     def axes_px(self):
+        """The plane's origin in pixels and the on-screen unit directions of its x and y axes.
+
+        Returns
+        -------
+        origin : tuple of float
+            (px, py) of the plane's origin [px].
+        x_dir, y_dir : tuple of float
+            Unit vectors in the image of the plane's +x and +y.
+        """
         o = self.to_image(np.array([0.0, 0.01, 0.0]), np.array([0.0, 0.0, 0.01]))
         uv = np.stack(o, axis=-1)
         dirs = [(uv[k] - uv[0]) / np.linalg.norm(uv[k] - uv[0]) for k in (1, 2)]
         return tuple(uv[0]), tuple(dirs[0]), tuple(dirs[1])
 
     def summary(self) -> str:
+        """One line saying where the plane comes from, its fit residual [mm] and scale [mm/px].
+
+        Returns
+        -------
+        str
+            The line.
+        """
         where = f" on frame {self.frame}" if self.frame is not None else ""
         return (f"plane from {self.source}{where}: {self.n_points} points, fit residual {self.residual_mm:.2f} mm; "
                 f"x_m/y_m in the plane, origin at its corner, y up (about {self.m_per_px * 1000:.3g} mm/px there)")
 
     def as_dict(self) -> dict:
+        """The calibration as the tracks' JSON sidecar records it.
+
+        Returns
+        -------
+        dict
+            Source, model, the 3x3 image-to-plane homography, fit residual [mm], points and frame.
+        """
         return {"source": self.source, "model": "plane homography, image px -> plane m (y up)",
                 "H_image_to_plane": self.H.tolist(), "fit_residual_mm": self.residual_mm,
                 "points": self.n_points, "frame": self.frame}

@@ -76,11 +76,25 @@ class PlaneCalibration:
         return tuple(uv[0]), tuple(dirs[0]), tuple(dirs[1])  # type: ignore[return-value]
 
     def summary(self) -> str:
+        """One line saying which camera file and marker planes [mm] give the world positions.
+
+        Returns
+        -------
+        str
+            The line.
+        """
         planes = ", ".join(f"{n} y = {y * 1000:.1f} mm" for n, y in self.planes_y_m.items())
         return (f"world from {Path(self.path).name} ({self.camera} pinhole camera; marker planes {planes}): "
                 f"x along the floor, y up, metres")
 
     def as_dict(self) -> dict:
+        """The calibration as the tracks' JSON sidecar records it.
+
+        Returns
+        -------
+        dict
+            Source, camera file, K [px], rotation, position [m] (or per frame), marker planes [m].
+        """
         return {"source": self.source, "camera_json": self.path, "model": "pinhole camera, plane homography per marker",
                 "camera": self.camera, "K": self.K.tolist(), "rotation_world_to_camera": self.rotation.tolist(),
                 "position_m": self.positions_m[0].tolist() if len(self.positions_m) == 1 else "per frame (camera_json)",

@@ -63,6 +63,33 @@ class FrameHSV:
 
 @dataclass
 class ColorMarker:
+    """A coloured sticker tracked by colour: the blob nearest the predicted position, its
+    coverage-weighted centroid (see the module docstring).
+
+    Attributes
+    ----------
+    name, spec : str
+        The marker's name and its ``--marker`` spec.
+    bgr : tuple of int
+        The sticker's colour, 8-bit BGR.
+    tolerance : int
+        Largest per-channel difference from ``bgr`` a marker pixel may have (8-bit levels).
+    search_half_px : int
+        Half-size of the search window around the prediction [px].
+    min_area_px : int
+        Smallest blob taken for the marker [px].
+    partial_fraction : float
+        Below this share of the usual area a blob is partly hidden: not found.
+    start_px : tuple of float or None
+        Where to look for the sticker until it is first seen [px]; None: the whole frame.
+    hue_tol_deg : float
+        Largest hue difference from the marker's colour [deg].
+    track : MarkerPath
+        Its positions so far, for the prediction.
+    frame_hsv : FrameHSV
+        The frame's HSV picture, shared by the markers of one run.
+    """
+
     name: str
     spec: str
     bgr: tuple[int, int, int]
@@ -103,6 +130,21 @@ class ColorMarker:
         self._pixel, self._pixel_hsv = np.zeros((1, 1, 3), np.uint8), np.zeros((1, 1, 3), np.uint8)
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
+        """Find the sticker in one frame.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number (frames come in order).
+        image_bgr : ndarray
+            The frame, BGR.
+
+        Returns
+        -------
+        Detection
+            Its centre [px]; ``score`` is the blob's area over the usual area (1 on the first
+            sightings).
+        """
         det = self._find(frame, image_bgr) or Detection.missing(0.0)
         if det.ok and self.track.last_frame is None:
             self._note_distractors(image_bgr, det)
@@ -545,6 +587,18 @@ def _along(angle_rad: float, velocity: tuple[float, float], diameter_px: float) 
 
 
 class BlobShape(NamedTuple):   # a tuple: one is made per blob looked at, every frame
+    """A blob's area and equivalent ellipse.
+
+    Attributes
+    ----------
+    area_px : float
+        Area [px²].
+    major_px, minor_px : float
+        Full lengths of the equivalent ellipse's axes (4 sigma): a disc's diameter [px].
+    angle_rad : float
+        Direction of the major axis, image x right, y down [rad].
+    """
+
     area_px: float
     major_px: float     # full lengths of the equivalent ellipse (4 sigma): a disc's diameter
     minor_px: float

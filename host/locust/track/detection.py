@@ -24,9 +24,28 @@ class Detection:
 
     @staticmethod
     def missing(score: float = math.nan) -> Detection:
+        """A detection of a marker that was not found.
+
+        Parameters
+        ----------
+        score : float
+            The model's score for the frame.
+
+        Returns
+        -------
+        Detection
+            ``ok`` False, ``px`` and ``py`` nan.
+        """
         return Detection(math.nan, math.nan, score, False)
 
     def point(self) -> tuple[float, float] | None:
+        """The position, or None when not found.
+
+        Returns
+        -------
+        tuple of float or None
+            (px, py) [px].
+        """
         return (self.px, self.py) if self.ok else None
 
 
@@ -36,7 +55,21 @@ class MarkerModel(Protocol):
     name: str
     spec: str
 
-    def locate(self, frame: int, image_bgr: np.ndarray) -> Detection: ...
+    def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
+        """Find the marker in one frame.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number.
+        image_bgr : ndarray
+            The frame, BGR.
+
+        Returns
+        -------
+        Detection
+            Where it is [px], or not found.
+        """
 
 
 def window(centre: tuple[float, float], half_px: int, shape: tuple[int, ...]) -> tuple[int, int, int, int]:

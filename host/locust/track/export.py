@@ -37,6 +37,21 @@ def csv_text(result: TrackResult) -> str:
 
 
 def sidecar(result: TrackResult, csv_path: Path) -> dict:
+    """The JSON sidecar of a tracks CSV: source video, clip, calibration, and per marker its
+    found frames, events and scores.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+    csv_path : Path
+        The CSV it goes beside (its name is recorded).
+
+    Returns
+    -------
+    dict
+        The sidecar (format ``locust.track/1``).
+    """
     clip = result.clip
     src: dict = {"kind": result.source}
     if result.video is not None:
@@ -82,6 +97,21 @@ class TrackEvents:
 
 
 def track_events(px: np.ndarray, py: np.ndarray, ok: np.ndarray) -> TrackEvents:
+    """How a marker's track holds together: gaps, re-acquisitions and jumps.
+
+    Parameters
+    ----------
+    px, py : ndarray
+        Its positions per frame [px].
+    ok : ndarray of bool
+        Whether it was found on each frame.
+
+    Returns
+    -------
+    TrackEvents
+        Gaps (a trailing one counted), the longest [frames], re-acquisitions, and steps over
+        50 px and 5 times the median step.
+    """
     idx = np.flatnonzero(ok)
     if idx.size == 0:
         return TrackEvents(0, 0, 0, 0)
@@ -96,6 +126,18 @@ def track_events(px: np.ndarray, py: np.ndarray, ok: np.ndarray) -> TrackEvents:
 
 
 def summary_lines(result: TrackResult) -> list[str]:
+    """What was tracked, one line per marker: frames found, median score, missing frames and events.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+
+    Returns
+    -------
+    list of str
+        The lines to print.
+    """
     lines = []
     n = len(result.frames)
     for t in result.markers:

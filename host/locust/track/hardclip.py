@@ -41,6 +41,30 @@ TRUTH_HEADER = "frame,t_s,px,py,in_picture,whole_in_picture,x_m,y_m"
 
 @dataclass
 class HardTruth:
+    """The truth of a SYNTHETIC hard clip.
+
+    Attributes
+    ----------
+    frames : ndarray
+        Frame numbers.
+    fps : float
+        Frame rate [1/s].
+    px, py : ndarray
+        True sticker centre [px] (nan when out of the picture).
+    whole : ndarray of bool
+        The whole sticker is inside the picture.
+    x_m, y_m : ndarray
+        True position in the board plane, y up [m].
+    radius_px : float
+        The sticker's radius [px].
+    board : BoardSpec
+        The board filmed.
+    plane_to_image : ndarray
+        3x3 homography, plane metres to pixels.
+    sticker_hex : str
+        The sticker's colour, ``#RRGGBB``.
+    """
+
     frames: np.ndarray
     fps: float
     px: np.ndarray            # true centre, pixels (NaN when out of the picture)
@@ -55,6 +79,7 @@ class HardTruth:
 
     @property
     def in_picture(self) -> np.ndarray:
+        """Whether the sticker's centre is in the picture, per frame."""
         return np.isfinite(self.px)
 
     def write_csv(self, path: Path) -> Path:

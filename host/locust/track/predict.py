@@ -62,6 +62,13 @@ class MotionHistory:
         self.last_found: Point | None = None
 
     def add(self, point: Point | None) -> None:
+        """Record the next frame's position.
+
+        Parameters
+        ----------
+        point : tuple of float or None
+            (px, py) [px]; None when not found.
+        """
         self._points.append(point)
         if point is not None:
             self.last_found = point
@@ -101,6 +108,15 @@ class MarkerPath:
         self._coef: list[tuple[float, float]] | None = None
 
     def add(self, frame: int, point: Point | None) -> None:
+        """Record a position found; a frame not found (None) adds nothing.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number.
+        point : tuple of float or None
+            (px, py) [px].
+        """
         if point is None:
             return
         if self._found:
@@ -117,6 +133,7 @@ class MarkerPath:
 
     @property
     def last_frame(self) -> int | None:
+        """The frame of the last sighting; None before the first."""
         return self._found[-1][0] if self._found else None
 
     def frames_lost(self, frame: int) -> int:
@@ -138,6 +155,18 @@ class MarkerPath:
         return self._coef
 
     def predict(self, frame: int) -> Point | None:
+        """Where the fit puts the marker on ``frame``.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number.
+
+        Returns
+        -------
+        tuple of float or None
+            (px, py) [px]; None before any sighting.
+        """
         c = self._fit()
         if c is None:
             return None
@@ -161,6 +190,7 @@ class MarkerPath:
 
     @property
     def last_point(self) -> Point | None:
+        """The last position found [px]; None before the first."""
         return (self._found[-1][1], self._found[-1][2]) if self._found else None
 
     @property

@@ -24,12 +24,36 @@ MIN_VALUE = 50
 
 @dataclass(frozen=True)
 class Blob:
+    """A blob of saturated colour in a preview frame.
+
+    Attributes
+    ----------
+    px, py : float
+        Its centroid [px].
+    area_px : int
+        Area [px].
+    hex : str
+        Median colour, ``#RRGGBB``.
+    """
+
     px: float
     py: float
     area_px: int
     hex: str          # median colour, #RRGGBB
 
     def line(self, k: int) -> str:
+        """The blob as a numbered line of the preview's listing.
+
+        Parameters
+        ----------
+        k : int
+            Its number.
+
+        Returns
+        -------
+        str
+            Number, colour, position [px] and area [px].
+        """
         return f"  {k:2d}  {self.hex}  at {self.px:.0f},{self.py:.0f}  ({self.area_px} px)"
 
 

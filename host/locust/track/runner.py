@@ -16,6 +16,20 @@ from .video import Clip, VideoInfo, read_frames
 
 @dataclass
 class TrackedMarker:
+    """One marker's track over a clip.
+
+    Attributes
+    ----------
+    name, spec : str
+        The marker's name and its spec.
+    px, py : ndarray
+        Position per frame, OpenCV convention [px]; nan where not found.
+    score : ndarray
+        The model's score per frame (its meaning is the model's).
+    ok : ndarray of bool
+        Whether it was found on each frame.
+    """
+
     name: str
     spec: str
     px: np.ndarray
@@ -24,6 +38,13 @@ class TrackedMarker:
     ok: np.ndarray
 
     def found(self) -> int:
+        """Number of frames the marker was found on.
+
+        Returns
+        -------
+        int
+            The count.
+        """
         return int(self.ok.sum())
 
 
@@ -40,6 +61,18 @@ class TrackResult:
     source: str = "locust track"
 
     def world(self, track: TrackedMarker) -> tuple[np.ndarray, np.ndarray]:
+        """A marker's track in world metres through the result's calibration.
+
+        Parameters
+        ----------
+        track : TrackedMarker
+            One of the result's markers.
+
+        Returns
+        -------
+        x_m, y_m : ndarray
+            Position per frame, y up [m].
+        """
         return self.calibration.to_world(track.px, track.py, track.name, self.frames)
 
 

@@ -36,6 +36,20 @@ LINK_BGR = [(0, 0, 200), (0, 170, 0), (0, 200, 220), (200, 60, 0)]  # red, green
 
 @dataclass
 class SynthTruth:
+    """The true marker centres of a SYNTHETIC video.
+
+    Attributes
+    ----------
+    frames : ndarray
+        Frame numbers.
+    fps : float
+        Frame rate [1/s].
+    px, py : dict of str to ndarray
+        Per marker, its true centre per frame, OpenCV convention [px].
+    visible : dict of str to ndarray
+        Per marker, whether it is in view on each frame.
+    """
+
     frames: np.ndarray
     fps: float
     px: dict[str, np.ndarray]
@@ -43,6 +57,18 @@ class SynthTruth:
     visible: dict[str, np.ndarray]
 
     def write_csv(self, path: Path) -> Path:
+        """Write the truth as CSV (``frame, t_s`` and per marker ``px, py, visible``), atomically.
+
+        Parameters
+        ----------
+        path : Path
+            The file.
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
         names = list(self.px)
         lines = ["# synthetic: locust.track.synth; true marker centres, pixels, OpenCV convention",
                  ",".join(["frame", "t_s"] + [f"{n}_{c}" for n in names for c in ("px", "py", "visible")])]
@@ -55,6 +81,22 @@ class SynthTruth:
 
 
 def checker_floor(width: int, height: int, square_px: int = 40, levels: tuple[int, int] = (38, 52)) -> np.ndarray:
+    """A grey checkerboard floor, float32 BGR.
+
+    Parameters
+    ----------
+    width, height : int
+        Image size [px].
+    square_px : int
+        Square side [px].
+    levels : tuple of int
+        Dark and light grey (8-bit levels).
+
+    Returns
+    -------
+    ndarray
+        ``(height, width, 3)`` float32 image.
+    """
     yy, xx = np.indices((height, width))
     dark = ((xx // square_px + yy // square_px) % 2).astype(bool)
     img = np.where(dark, levels[0], levels[1]).astype(np.float32)
@@ -78,6 +120,19 @@ def dot_coverage(cx: float, cy: float, radius_px: float, shape: tuple[int, int])
 
 
 def paint_dot(img: np.ndarray, cx: float, cy: float, radius_px: float, bgr) -> None:
+    """Paint a disc into ``img`` in place, each pixel blended by the share of it the disc covers.
+
+    Parameters
+    ----------
+    img : ndarray
+        Float BGR image.
+    cx, cy : float
+        The disc's centre, OpenCV convention [px].
+    radius_px : float
+        Its radius [px].
+    bgr : sequence of int
+        Its colour.
+    """
     alpha, x0, y0 = dot_coverage(cx, cy, radius_px, img.shape[:2])
     h, w = alpha.shape
     region = img[y0:y0 + h, x0:x0 + w]
@@ -112,6 +167,27 @@ def hop_truth(n_frames: int, width: int, height: int, fps: float, rng: np.random
 
 def render_hop_frame(i: int, truth: SynthTruth, floor: np.ndarray, radius_px: float,
                      rng: np.random.Generator) -> np.ndarray:
+    """Frame ``i`` of the SYNTHETIC hop video: chassis, links and the two marker dots on the
+    floor, a grey card over the foot where it is hidden, then optics blur and noise.
+
+    Parameters
+    ----------
+    i : int
+        The frame's index into ``truth``.
+    truth : SynthTruth
+        The true marker centres.
+    floor : ndarray
+        The background (:func:`checker_floor`).
+    radius_px : float
+        The dots' radius [px].
+    rng : numpy.random.Generator
+        Source of the sensor noise.
+
+    Returns
+    -------
+    ndarray
+        The frame, uint8 BGR.
+    """
     img = floor.copy()
     nx, ny = truth.px["nose"][i], truth.py["nose"][i]
     fx, fy = truth.px["foot"][i], truth.py["foot"][i]

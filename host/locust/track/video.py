@@ -35,6 +35,22 @@ os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
 
 @dataclass(frozen=True)
 class VideoInfo:
+    """A video file or image sequence as probed.
+
+    Attributes
+    ----------
+    path : Path
+        The file (or the sequence's first image).
+    width_px, height_px : int
+        Frame size [px].
+    frame_count : int
+        Frames in it.
+    file_fps : float
+        The rate the file states [1/s] (0 or nan when it states none).
+    images : tuple of Path
+        An image sequence's files, in frame order; empty for a video file.
+    """
+
     path: Path
     width_px: int
     height_px: int
@@ -68,6 +84,23 @@ class Clip:
     fps: float | None = None
 
     def resolved(self, info: VideoInfo) -> Clip:
+        """The clip on ``info``: ``end`` and ``fps`` filled in, every setting checked.
+
+        Parameters
+        ----------
+        info : VideoInfo
+            The probed video.
+
+        Returns
+        -------
+        Clip
+            With ``end`` and ``fps`` set.
+
+        Raises
+        ------
+        TrackError
+            A step below 1, a start or end outside the video, or no usable frame rate.
+        """
         last = info.frame_count - 1
         end = last if self.end is None else self.end
         fps = self.fps if self.fps is not None else info.file_fps
@@ -91,10 +124,29 @@ class Clip:
         return Clip(self.start, end, self.step, float(fps))
 
     def frames(self) -> range:
+        """The frame numbers of a resolved clip.
+
+        Returns
+        -------
+        range
+            From ``start`` to ``end`` inclusive, by ``step``.
+        """
         assert self.end is not None, "resolve the clip first"
         return range(self.start, self.end + 1, self.step)
 
     def time_s(self, frame: int) -> float:
+        """A frame's time in a resolved clip, zero at its first frame.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number.
+
+        Returns
+        -------
+        float
+            ``(frame - start) / fps`` [s].
+        """
         assert self.fps is not None, "resolve the clip first"
         return (frame - self.start) / self.fps
 
