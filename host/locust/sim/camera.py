@@ -168,6 +168,23 @@ def pinhole_from_scene(scene: mujoco.MjvScene, width_px: int, height_px: int) ->
     half-width; 0: the width follows the viewport's aspect ratio). Pixel i spans window
     coordinates [i, i + 1], so its centre is at i + 0.5: OpenCV's index is window - 0.5.
     :func:`set_scene_pinhole` is the inverse.
+
+    Parameters
+    ----------
+    scene : mujoco.MjvScene
+        A scene after ``update_scene``.
+    width_px, height_px : int
+        The viewport's size [px].
+
+    Returns
+    -------
+    PinholeCamera
+        Intrinsics [px] and pose (world-to-camera rotation, centre [m]).
+
+    Raises
+    ------
+    SimError
+        An orthographic render camera.
     """
     cams = [scene.camera[0], scene.camera[1]]   # the two eyes coincide without stereo
     gl = cams[0]
@@ -195,6 +212,18 @@ def free_camera_at(cam: PinholeCamera, distance_m: float = 1.0) -> CameraView:
     The free camera has no roll and its own field of view: :func:`set_scene_pinhole` then
     puts ``cam``'s exact orientation and intrinsics on the scene. Rendering through this view
     first places what follows the camera (the headlight) where ``cam`` is.
+
+    Parameters
+    ----------
+    cam : PinholeCamera
+        The camera to stand in for.
+    distance_m : float
+        How far ahead of the camera the look-at point is put [m].
+
+    Returns
+    -------
+    CameraView
+        The free camera's look-at point [m], distance [m], azimuth and elevation [deg].
     """
     f = np.asarray(cam.rotation[2], dtype=float)
     azimuth = math.degrees(math.atan2(f[1], f[0]))
@@ -207,7 +236,15 @@ def set_scene_pinhole(scene: mujoco.MjvScene, cam: PinholeCamera) -> None:
     """Make ``scene`` (after ``update_scene``) render through ``cam`` in a ``cam.width_px`` x
     ``cam.height_px`` viewport: its pose (world -> camera rotation, centre) and intrinsics
     (fx, fy, cx, cy), the inverse of :func:`pinhole_from_scene`. The near and far planes stay
-    MuJoCo's."""
+    MuJoCo's.
+
+    Parameters
+    ----------
+    scene : mujoco.MjvScene
+        The scene; both eyes of its camera are set.
+    cam : PinholeCamera
+        The camera to render through.
+    """
     w, h = cam.width_px, cam.height_px
     for gl in (scene.camera[0], scene.camera[1]):
         near = float(gl.frustum_near)
@@ -233,6 +270,26 @@ def frame_views(points_m: np.ndarray, chassis_x_m: np.ndarray, body_length_m: fl
 
     ``points_m`` (N, 3): positions the robot reaches (nose, foot, chassis ...). Both views
     look horizontally at the plane ``y = plane_y_m``; the floor (z = 0) stays in the frame.
+
+    Parameters
+    ----------
+    points_m : ndarray
+        (N, 3) world positions the robot reaches [m].
+    chassis_x_m : ndarray
+        The chassis' x over the run [m]; the tracking view starts at its first value.
+    body_length_m : float
+        The plate's length [m]; the tracking view is four body lengths wide.
+    plane_y_m : float
+        The plane both views look at [m].
+    fovy_deg : float
+        The camera's vertical field of view [deg].
+    aspect : float
+        Width over height of the frame.
+
+    Returns
+    -------
+    fixed, track : CameraView
+        The fixed view and the tracking view.
     """
     x_lo, x_hi = float(np.min(points_m[:, 0])) - MARGIN_M, float(np.max(points_m[:, 0])) + MARGIN_M
     z_lo = min(0.0, float(np.min(points_m[:, 2]))) - MARGIN_M

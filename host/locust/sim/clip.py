@@ -141,7 +141,22 @@ class PoseRenderer:
 
 def face_centre_m(model: mujoco.MjModel, data: mujoco.MjData, geom_id: int) -> np.ndarray:
     """Centre of what the camera sees of a marker posed in ``data``: a disc's camera-facing
-    (+y) face, a sphere's centre."""
+    (+y) face, a sphere's centre.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The model.
+    data : mujoco.MjData
+        Its data, posed.
+    geom_id : int
+        The marker's geom.
+
+    Returns
+    -------
+    ndarray
+        (3,) world position [m].
+    """
     centre = data.geom_xpos[geom_id].copy()
     if model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
         axis = data.geom_xmat[geom_id].reshape(3, 3)[:, 2]
@@ -156,6 +171,24 @@ def seen_fraction(model: mujoco.MjModel, data: mujoco.MjData, cam: PinholeCamera
     Rays go from the camera centre to points spread over what the camera sees of the
     marker (``_DISC_SAMPLES``): a disc's face, or a sphere's disc across the line of
     sight; a ray that meets the marker first sees it.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The model.
+    data : mujoco.MjData
+        Its data, posed.
+    cam : PinholeCamera
+        The camera.
+    centre_m : ndarray
+        (3,) the marker's seen centre (:func:`face_centre_m`) [m].
+    geom_id : int
+        The marker's geom.
+
+    Returns
+    -------
+    float
+        Share of the sample rays that meet the marker first, 0..1.
     """
     radius = float(model.geom_size[geom_id][0])
     if model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
@@ -208,12 +241,39 @@ class RenderedClip:
 
 
 def sidecar_paths(path: Path) -> tuple[Path, Path]:
-    """A clip's two sidecars: ``<stem>.truth.csv`` and ``<stem>.camera.json``."""
+    """A clip's two sidecars: ``<stem>.truth.csv`` and ``<stem>.camera.json``.
+
+    Parameters
+    ----------
+    path : Path
+        The clip (or still) path.
+
+    Returns
+    -------
+    truth, camera : Path
+        The two sidecar paths beside it.
+    """
     return path.with_name(path.stem + ".truth.csv"), camera_json_beside(path)
 
 
 def check_video_path(path: str | os.PathLike) -> Path:
-    """Refuse names OpenCV cannot write as MP4 and never overwrite an earlier render."""
+    """Refuse names OpenCV cannot write as MP4 and never overwrite an earlier render.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The video path asked for.
+
+    Returns
+    -------
+    Path
+        The same path, checked.
+
+    Raises
+    ------
+    SimError
+        Not ``.mp4``, the video or a sidecar exists already, or its folder is a file.
+    """
     path = Path(path)
     if path.suffix.lower() != ".mp4":
         raise SimError(f"video path {path} does not end in .mp4", "name the video <something>.mp4")
@@ -458,6 +518,34 @@ def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = Non
     ``trajectory``: a rollout of ``robot`` already made with its states kept (e.g.
     ``run(robot, keep_states=True).trajectory``) is rendered as it is, not simulated again;
     ``cycles`` is then the trajectory's own.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot to simulate.
+    path : str or os.PathLike
+        The MP4 to write; it and its sidecars must not exist.
+    cycles : int, optional
+        Cycles to simulate; default the robot's schedule's.
+    camera : str
+        ``track`` (follows the chassis) or ``fixed``.
+    fps : int
+        Frame rate [1/s].
+    width, height : int
+        Frame size [px].
+    trajectory : Trajectory, optional
+        A rollout of ``robot`` with its states kept, rendered instead of a new one.
+
+    Returns
+    -------
+    RenderedClip
+        The video and its sidecars.
+
+    Raises
+    ------
+    SimError
+        An unknown camera, a bad size or path, a trajectory without states, a simulation that
+        fails its audit, or a video that cannot be written.
     """
     if camera not in CAMERAS:
         raise SimError(f"camera {camera!r} is not known", f"choose one of {', '.join(CAMERAS)}")

@@ -82,7 +82,18 @@ def _longest_run(mask: np.ndarray) -> int:
 def plate_pitch_deg(nose_xyz: np.ndarray, chassis_xyz: np.ndarray) -> np.ndarray:
     """The plate's pitch in the legs' plane at each row: the angle of the line from the
     plate's centre to its nose above the floor, nose up positive, unwrapped over the rows so
-    that a robot turning over past the vertical keeps counting (deg)."""
+    that a robot turning over past the vertical keeps counting (deg).
+
+    Parameters
+    ----------
+    nose_xyz, chassis_xyz : ndarray
+        (N, 3) nose and plate-centre positions [m].
+
+    Returns
+    -------
+    ndarray
+        (N,) pitch [deg].
+    """
     d = np.asarray(nose_xyz) - np.asarray(chassis_xyz)
     return np.degrees(np.unwrap(np.arctan2(d[:, 2], d[:, 0])))
 

@@ -69,7 +69,13 @@ class SimResult:
         """Every figure but the rollout and the robot; from :func:`locust.simulate`, also the standing
         load, with samples each outcome's share and figures (``outcomes``) and the draws
         (``samples``), and with a sensitivity, ``sensitivity``. NaN and inf become null where it is
-        written (:func:`locust.fileio.json_text`)."""
+        written (:func:`locust.fileio.json_text`).
+
+        Returns
+        -------
+        dict
+            The figures by name, in SI units as the field names say.
+        """
         out = dataclasses.asdict(dataclasses.replace(self, trajectory=None, params=None, spread=None, sensitivity=None))
         for key in ("trajectory", "params", "spread", "sensitivity"):
             del out[key]
