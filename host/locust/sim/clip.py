@@ -435,7 +435,9 @@ class ClipRecorder:
         Raises
         ------
         SimError
-            No frames, or the encoded video does not read back.
+            No frames to write.
+        WriteError
+            The encoded video does not read back whole.
         """
         try:
             self.writer.release()

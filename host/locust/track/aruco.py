@@ -50,7 +50,22 @@ def make_detector(dictionary: str = DEFAULT_DICTIONARY) -> cv2.aruco.ArucoDetect
 
 
 def find_corners(detector: cv2.aruco.ArucoDetector, image_bgr: np.ndarray, marker_id: int) -> np.ndarray | None:
-    """The four corners (4x2, pixels) of ``marker_id`` in ``image_bgr``, or None."""
+    """The four corners (4x2, pixels) of ``marker_id`` in ``image_bgr``, or None.
+
+    Parameters
+    ----------
+    detector : cv2.aruco.ArucoDetector
+        From :func:`make_detector`.
+    image_bgr : ndarray
+        The image, BGR or grey.
+    marker_id : int
+        The ArUco id.
+
+    Returns
+    -------
+    ndarray or None
+        (4, 2) corners [px], OpenCV's order; None when the marker is not seen.
+    """
     gray = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2GRAY) if image_bgr.ndim == 3 else image_bgr
     corners, ids, _ = detector.detectMarkers(gray)
     if ids is None:
@@ -60,7 +75,18 @@ def find_corners(detector: cv2.aruco.ArucoDetector, image_bgr: np.ndarray, marke
 
 
 def centre_of(corners: np.ndarray) -> tuple[float, float]:
-    """Intersection of the diagonals 0-2 and 1-3."""
+    """Intersection of the diagonals 0-2 and 1-3.
+
+    Parameters
+    ----------
+    corners : ndarray
+        (4, 2) corners in order [px].
+
+    Returns
+    -------
+    tuple of float
+        The centre (px, py) [px].
+    """
     p0, p1, p2, p3 = corners
     d1, d2 = p2 - p0, p3 - p1
     a = np.array([d1, -d2]).T
@@ -146,7 +172,31 @@ class ArucoMarker:
 
 
 def side_px_in_video(info, clip, marker_id: int, dictionary: str = DEFAULT_DICTIONARY) -> tuple[int, float]:
-    """The first frame of ``clip`` showing ``marker_id``, and the marker's side there (px)."""
+    """The first frame of ``clip`` showing ``marker_id``, and the marker's side there (px).
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+    clip : Clip
+        The resolved clip.
+    marker_id : int
+        The ArUco id.
+    dictionary : str
+        Its dictionary.
+
+    Returns
+    -------
+    frame : int
+        The first frame showing the marker.
+    side_px : float
+        Its mean side there [px].
+
+    Raises
+    ------
+    TrackError
+        The marker is in no frame of the clip.
+    """
     from .video import read_frames
 
     detector = make_detector(dictionary)

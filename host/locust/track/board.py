@@ -43,7 +43,22 @@ MIN_POINT_SPREAD = 0.01
 
 
 def write_board_png(path: Path, spec: BoardSpec, dpi: int = BOARD_DPI) -> Path:
-    """Write the board at ``dpi`` (recorded in the PNG) for printing at 100 %."""
+    """Write the board at ``dpi`` (recorded in the PNG) for printing at 100 %.
+
+    Parameters
+    ----------
+    path : Path
+        The PNG to write (atomically).
+    spec : BoardSpec
+        The board.
+    dpi : int
+        Print resolution [dots/inch].
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     from PIL import Image
 
     buf = io.BytesIO()
@@ -164,7 +179,21 @@ def _fit(image_pts: np.ndarray, plane_pts: np.ndarray, source: str, frame: int |
 
 
 def board_points(spec: BoardSpec, image_bgr: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """Detected board corners in ``image_bgr`` (px) and their plane positions (m, y up), or None."""
+    """Detected board corners in ``image_bgr`` (px) and their plane positions (m, y up), or None.
+
+    Parameters
+    ----------
+    spec : BoardSpec
+        The board.
+    image_bgr : ndarray
+        A frame, BGR.
+
+    Returns
+    -------
+    tuple of ndarray or None
+        (N, 2) corners [px] and (N, 2) plane positions [m]; None when fewer than the board's
+        minimum of markers are seen.
+    """
     from .aruco import make_detector
 
     gray = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2GRAY) if image_bgr.ndim == 3 else image_bgr
@@ -181,7 +210,29 @@ def board_points(spec: BoardSpec, image_bgr: np.ndarray) -> tuple[np.ndarray, np
 
 def board_homography(info, clip, spec: BoardSpec, frames: int = DETECT_FRAMES) -> PlaneHomography:
     """Fit the plane to the board's corners in every one of the clip's first ``frames`` frames
-    that shows it (a still camera: the corners' noise averages out over the frames)."""
+    that shows it (a still camera: the corners' noise averages out over the frames).
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+    clip : Clip
+        The resolved clip.
+    spec : BoardSpec
+        The board filmed.
+    frames : int
+        How many of the clip's first frames to look in.
+
+    Returns
+    -------
+    PlaneHomography
+        Pixels to plane metres, with its fit residual [mm].
+
+    Raises
+    ------
+    TrackError
+        The board is in none of those frames, or no homography fits.
+    """
     image_pts, plane_pts, first = [], [], None
     for k, (frame, image) in enumerate(read_frames(info, clip)):
         if k >= frames:
@@ -200,7 +251,25 @@ def board_homography(info, clip, spec: BoardSpec, frames: int = DETECT_FRAMES) -
 
 def parse_plane_points(text: str, pixels: str = "tracker") -> PlaneHomography:
     """``PX,PY=X_M,Y_M;...`` (four or more) -> the homography through them; the pixels typed
-    in convention ``pixels`` (:func:`locust.track.spec.typed_px`)."""
+    in convention ``pixels`` (:func:`locust.track.spec.typed_px`).
+
+    Parameters
+    ----------
+    text : str
+        The ``--plane-points`` value: pixels and plane metres.
+    pixels : str
+        ``tracker`` or ``opencv``.
+
+    Returns
+    -------
+    PlaneHomography
+        Pixels to plane metres.
+
+    Raises
+    ------
+    TrackError
+        Fewer than four points, a bad number, or points on one line.
+    """
     pairs = [p for p in re.split(r"[;\s]+", text.strip()) if p]
     rx = re.compile(rf"({NUM}),({NUM})=({NUM}),({NUM})")
     rows = [rx.fullmatch(p) for p in pairs]

@@ -19,7 +19,23 @@ NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 
 
 def parse_scale(text: str) -> tuple[float, float, float, float, float]:
-    """``X1,Y1,X2,Y2=LENGTH_M`` -> the stick's two ends (px) and its length (m)."""
+    """``X1,Y1,X2,Y2=LENGTH_M`` -> the stick's two ends (px) and its length (m).
+
+    Parameters
+    ----------
+    text : str
+        The ``--scale`` value.
+
+    Returns
+    -------
+    tuple of float
+        x1, y1, x2, y2 [px] and the length [m].
+
+    Raises
+    ------
+    TrackError
+        Not that form, a length that is not positive, or ends less than a pixel apart.
+    """
     m = re.fullmatch(rf"\s*({NUM})\s*,\s*({NUM})\s*,\s*({NUM})\s*,\s*({NUM})\s*=\s*({NUM})\s*", text)
     if not m:
         raise TrackError(f"--scale {text!r}: expected X1,Y1,X2,Y2=LENGTH_M",
@@ -39,7 +55,25 @@ PIXELS_HELP = ("Convention of the pixel positions typed in --marker, --origin, -
 
 
 def typed_px(x: float, y: float, pixels: str) -> tuple[float, float]:
-    """A pixel position typed in convention ``pixels`` (``tracker`` or ``opencv``), in OpenCV's."""
+    """A pixel position typed in convention ``pixels`` (``tracker`` or ``opencv``), in OpenCV's.
+
+    Parameters
+    ----------
+    x, y : float
+        The position as typed [px].
+    pixels : str
+        ``tracker`` (pixel centres at i + 0.5) or ``opencv`` (at i).
+
+    Returns
+    -------
+    tuple of float
+        (x, y) in OpenCV's convention [px].
+
+    Raises
+    ------
+    TrackError
+        An unknown convention.
+    """
     if pixels not in PIXEL_CONVENTIONS:
         raise TrackError(f"pixel convention {pixels!r} is not known", "give tracker or opencv")
     d = PIXEL_CONVENTIONS[pixels]

@@ -34,7 +34,23 @@ from .predict import MarkerPath
 
 
 def parse_hex(colour: str) -> tuple[int, int, int]:
-    """``#RRGGBB`` -> (B, G, R) as OpenCV stores pixels."""
+    """``#RRGGBB`` -> (B, G, R) as OpenCV stores pixels.
+
+    Parameters
+    ----------
+    colour : str
+        ``#RRGGBB`` (the ``#`` may be left out).
+
+    Returns
+    -------
+    tuple of int
+        (B, G, R), 8-bit.
+
+    Raises
+    ------
+    TrackError
+        Not six hex digits.
+    """
     h = colour.strip().lstrip("#")
     if len(h) != 6 or any(c not in "0123456789abcdefABCDEF" for c in h):
         raise TrackError(f"colour {colour!r} is not #RRGGBB", "write the colour as 6 hex digits, e.g. color:#ff00ff")
@@ -53,7 +69,24 @@ class FrameHSV:
         self._hsv: dict[int, np.ndarray] = {}
 
     def of(self, frame: int, image: np.ndarray, step: int = 1) -> np.ndarray:
-        """HSV of every ``step``-th pixel of every ``step``-th row of ``image``."""
+        """HSV of every ``step``-th pixel of every ``step``-th row of ``image``.
+
+        Computed once per frame and step, shared by the markers that ask.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number (another frame, or another image array, drops the cached pictures).
+        image : ndarray
+            The frame, BGR.
+        step : int
+            Sampling step [px].
+
+        Returns
+        -------
+        ndarray
+            The HSV picture, OpenCV 8-bit (hue 0..179).
+        """
         if frame != self._frame or image is not self._image:
             self._frame, self._image, self._hsv = frame, image, {}
         if step not in self._hsv:
@@ -519,7 +552,20 @@ def every(image: np.ndarray, step: int) -> np.ndarray:
     """``image[::step, ::step]`` as a contiguous picture. OpenCV's nearest-pixel resize to
     1/step takes exactly those pixels where the sizes divide by ``step``, ten times faster
     than NumPy's copy of a strided view (a 1280x720 frame at step 2: 0.26 ms against 2.9 ms);
-    a last row or column past a whole number of steps is copied on its own."""
+    a last row or column past a whole number of steps is copied on its own.
+
+    Parameters
+    ----------
+    image : ndarray
+        An image.
+    step : int
+        Sampling step [px].
+
+    Returns
+    -------
+    ndarray
+        The sampled image, contiguous.
+    """
     h, w = image.shape[:2]
     hq, wq = h // step, w // step
     if step == 1 or hq == 0 or wq == 0:

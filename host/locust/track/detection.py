@@ -74,7 +74,22 @@ class MarkerModel(Protocol):
 
 def window(centre: tuple[float, float], half_px: int, shape: tuple[int, ...]) -> tuple[int, int, int, int]:
     """Integer window ``(x0, y0, x1, y1)`` (exclusive end) of half-size ``half_px`` around
-    ``centre``, clipped to an image of ``shape``."""
+    ``centre``, clipped to an image of ``shape``.
+
+    Parameters
+    ----------
+    centre : tuple of float
+        (x, y) [px].
+    half_px : int
+        Half-size [px].
+    shape : tuple of int
+        The image's shape (height, width, ...).
+
+    Returns
+    -------
+    tuple of int
+        (x0, y0, x1, y1) [px].
+    """
     cx, cy = int(round(centre[0])), int(round(centre[1]))
     h, w = shape[:2]
     return max(cx - half_px, 0), max(cy - half_px, 0), min(cx + half_px + 1, w), min(cy + half_px + 1, h)

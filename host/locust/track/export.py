@@ -23,7 +23,18 @@ PIXEL_CONVENTION = "OpenCV: origin at the centre of the top-left pixel, x right,
 
 
 def tracks_of(result: TrackResult) -> TracksCsv:
-    """The tracks CSV of ``result``: pixels, world metres through its calibration, found or not."""
+    """The tracks CSV of ``result``: pixels, world metres through its calibration, found or not.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+
+    Returns
+    -------
+    TracksCsv
+        Frames, times [s] and per marker pixels [px], positions [m] and found flags.
+    """
     markers = {}
     for tr in result.markers:
         xm, ym = result.world(tr)
@@ -32,7 +43,18 @@ def tracks_of(result: TrackResult) -> TracksCsv:
 
 
 def csv_text(result: TrackResult) -> str:
-    """The text of ``result``'s tracks CSV."""
+    """The text of ``result``'s tracks CSV.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+
+    Returns
+    -------
+    str
+        The CSV.
+    """
     return tracks_csv_text(tracks_of(result))
 
 
@@ -76,7 +98,20 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
 
 
 def write_tracks(result: TrackResult, csv_path: Path) -> tuple[Path, Path]:
-    """Write ``csv_path`` and its sidecar ``<stem>.json``, each atomically."""
+    """Write ``csv_path`` and its sidecar ``<stem>.json``, each atomically.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+    csv_path : Path
+        The CSV to write.
+
+    Returns
+    -------
+    csv_path, json_path : Path
+        The files written.
+    """
     json_path = csv_path.with_suffix(".json")
     write_tracks_csv(csv_path, tracks_of(result))
     atomic_write_json(json_path, sidecar(result, csv_path))

@@ -23,7 +23,18 @@ LOOKBACK = 4  # Tracker's predictionLookback
 
 
 def predict_next(history: Iterable[Point | None]) -> Point | None:
-    """Predicted next position from ``history`` (oldest first, ``None`` = not found)."""
+    """Predicted next position from ``history`` (oldest first, ``None`` = not found).
+
+    Parameters
+    ----------
+    history : iterable of (tuple of float or None)
+        Recent positions [px].
+
+    Returns
+    -------
+    tuple of float or None
+        (px, py) [px]; None when nothing recent was found.
+    """
     prev = list(history)[-LOOKBACK:][::-1]  # prev[0] is the latest
     prev += [None] * (LOOKBACK - len(prev))
     if prev[0] is None:
@@ -74,11 +85,23 @@ class MotionHistory:
             self.last_found = point
 
     def has_velocity(self) -> bool:
-        """True when the last two positions are both known."""
+        """True when the last two positions are both known.
+
+        Returns
+        -------
+        bool
+            Whether a velocity can be taken.
+        """
         return len(self._points) >= 2 and self._points[-1] is not None and self._points[-2] is not None
 
     def search_centre(self) -> Point | None:
-        """The look-ahead prediction, or the last position seen when there is none."""
+        """The look-ahead prediction, or the last position seen when there is none.
+
+        Returns
+        -------
+        tuple of float or None
+            (px, py) [px]; None before the first sighting.
+        """
         return predict_next(self._points) or self.last_found
 
 
@@ -137,7 +160,18 @@ class MarkerPath:
         return self._found[-1][0] if self._found else None
 
     def frames_lost(self, frame: int) -> int:
-        """Frames since the last one found, not counting ``frame`` itself (0: found just before)."""
+        """Frames since the last one found, not counting ``frame`` itself (0: found just before).
+
+        Parameters
+        ----------
+        frame : int
+            The frame being searched.
+
+        Returns
+        -------
+        int
+            Frames lost; 0 before the first sighting.
+        """
         return frame - self._found[-1][0] - 1 if self._found else 0
 
     def _fit(self) -> list[tuple[float, float]] | None:
@@ -177,7 +211,18 @@ class MarkerPath:
         return x, y
 
     def predict_motion(self, frame: int) -> tuple[Point, Point] | None:
-        """``predict(frame)`` and the motion into it, ``predict(frame) - predict(frame - 1)``."""
+        """``predict(frame)`` and the motion into it, ``predict(frame) - predict(frame - 1)``.
+
+        Parameters
+        ----------
+        frame : int
+            The frame being searched.
+
+        Returns
+        -------
+        tuple of (tuple of float) or None
+            The predicted position and motion [px, px/frame]; None before the first sighting.
+        """
         c = self._fit()
         if c is None:
             return None

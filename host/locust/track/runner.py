@@ -80,8 +80,33 @@ def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibrat
                 progress: Callable[[int], None] | None = None, require_found: bool = True) -> TrackResult:
     """Run every marker model over a resolved ``clip`` of the video ``info``.
 
-    ``progress(n)`` is called after each frame. With ``require_found`` a marker that was
+    ``progress(1)`` is called after each frame. With ``require_found`` a marker that was
     never found anywhere in the clip raises TrackError (nothing is written then).
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+    clip : Clip
+        The resolved clip.
+    models : list
+        The marker models (:func:`.spec.parse_markers`).
+    calibration : Calibration or PlaneCalibration
+        Pixels to metres.
+    progress : callable, optional
+        Called with 1 after each frame.
+    require_found : bool
+        Refuse a marker never found.
+
+    Returns
+    -------
+    TrackResult
+        Every marker's track on the clip's frames.
+
+    Raises
+    ------
+    TrackError
+        A template's key frame outside the clip, or (with ``require_found``) a marker never found.
     """
     frames = np.array(list(clip.frames()), dtype=int)
     n = len(frames)

@@ -58,7 +58,25 @@ def default_specs() -> list[str]:
 
 
 def parse_marker(text: str, options: ModelOptions = ModelOptions()):
-    """One ``NAME=SPEC`` string -> a marker model (see the module doc)."""
+    """One ``NAME=SPEC`` string -> a marker model (see the module doc).
+
+    Parameters
+    ----------
+    text : str
+        ``NAME=SPEC``.
+    options : ModelOptions
+        The models' settings.
+
+    Returns
+    -------
+    ColorMarker, TemplateMarker or ArucoMarker
+        The marker model.
+
+    Raises
+    ------
+    TrackError
+        A bad name or spec.
+    """
     name, sep, spec = text.partition("=")
     name, spec = name.strip(), spec.strip()
     if not sep or not NAME_RE.match(name):
