@@ -172,6 +172,7 @@ class SimResult:
 
         Examples
         --------
+        >>> import locust
         >>> r = locust.simulate(locust.robot("small"), cycles=1)
         >>> r.video("hop.mp4", overwrite=True, width=320, height=240).frames   # doctest: +SKIP
         """
