@@ -54,7 +54,7 @@ class ReportResult:
     warnings : list of Notice
         The notices about the inputs (:func:`.checks.notices`): printed, on the page, in the JSON.
     side_by_side : list of SideBySide
-        One video per trial with ``side_by_side``; empty without it.
+        With ``side_by_side``, each trial's video or why it has none; empty without it.
     """
 
     folder: Path

@@ -41,7 +41,7 @@ class Landscape:
     distance_m : ndarray
         Total distance over ``cycles`` [m] (nan when invalid).
     reason : list of str
-        Why each invalid design failed (empty when valid).
+        Per design, the ``reason`` column of ``results.csv`` (why an invalid one failed).
     finished : bool
         False for an interrupted sweep, some designs missing.
     """

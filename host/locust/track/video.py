@@ -40,13 +40,13 @@ class VideoInfo:
     Attributes
     ----------
     path : Path
-        The file (or the sequence's first image).
+        The path probed: a video file, an image folder or a sequence's first image.
     width_px, height_px : int
         Frame size [px].
     frame_count : int
         Frames in it.
     file_fps : float
-        The rate the file states [1/s] (0 or nan when it states none).
+        The rate the file states [1/s] (0 for an image sequence, or a file that states none).
     images : tuple of Path
         An image sequence's files, in frame order; empty for a video file.
     """
