@@ -39,6 +39,24 @@ JSON_NAME = "report.json"
 
 @dataclass(frozen=True)
 class ReportResult:
+    """What :func:`build_report` wrote and what it computed.
+
+    Attributes
+    ----------
+    folder : Path
+        The new report folder.
+    html_path, dashboard_path, json_path : Path
+        ``report.html``, ``dashboard.png`` and ``report.json`` in it.
+    comparisons : list of Comparison
+        One per configuration, in the order given.
+    figures : list of str
+        The keys of the page's figures, in page order.
+    warnings : list of Notice
+        The notices about the inputs (:func:`.checks.notices`): printed, on the page, in the JSON.
+    side_by_side : list of SideBySide
+        With ``side_by_side``, each trial's video or why it has none; empty without it.
+    """
+
     folder: Path
     html_path: Path
     dashboard_path: Path
@@ -50,7 +68,26 @@ class ReportResult:
 
 
 def run_schedule(name: str, trials: list[Trial]) -> dict | None:
-    """The schedule the trials' run records share (push_deg, push_s, wait_s, cycles), if any."""
+    """The schedule the trials' run records share (push_deg, push_s, wait_s, cycles), if any.
+
+    Parameters
+    ----------
+    name : str
+        The configuration's name, for the messages.
+    trials : list of Trial
+        Its trials; those without a run record are skipped.
+
+    Returns
+    -------
+    dict or None
+        ``push_deg`` [deg], ``push_s`` and ``wait_s`` [s], ``cycles`` (the most any run
+        recorded) and ``source`` (the first run record's path); None when no trial has a record.
+
+    Raises
+    ------
+    ReportError
+        A run the robot refused, or runs on different schedules.
+    """
     seen = {}
     for t in trials:
         if t.record is None:
@@ -75,7 +112,21 @@ def run_schedule(name: str, trials: list[Trial]) -> dict | None:
 
 
 def with_run_schedule(robot: Robot, sched: dict | None) -> Robot:
-    """The robot running the schedule its runs recorded (only the values that differ change)."""
+    """The robot running the schedule its runs recorded (only the values that differ change).
+
+    Parameters
+    ----------
+    robot : Robot
+        The configuration's robot.
+    sched : dict or None
+        A schedule from :func:`run_schedule`; None leaves the robot as it is.
+
+    Returns
+    -------
+    Robot
+        ``robot`` with ``schedule.push_deg`` [deg], ``schedule.push_s`` and ``schedule.wait_s`` [s]
+        set from the run, their source the run record.
+    """
     if sched is None:
         return robot
     changed = {f"schedule.{k}": sched[k] for k in ("push_deg", "push_s", "wait_s")
@@ -86,6 +137,19 @@ def with_run_schedule(robot: Robot, sched: dict | None) -> Robot:
 
 
 def parameter_rows(robot: Robot) -> list[dict]:
+    """The robot's parameters as rows of the page's parameter table.
+
+    Parameters
+    ----------
+    robot : Robot
+        The report's base robot.
+
+    Returns
+    -------
+    list of dict
+        One per dotted parameter: ``key``, ``value`` (as text, 6 significant digits), and its
+        provenance's ``uncertainty``, ``source``, ``date`` and ``note``.
+    """
     rows = []
     for key, value in robot.flat().items():
         prov = robot.source_of(key)
@@ -99,9 +163,51 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
                  marker: str = "nose", progress: Callable[[str], None] | None = None,
                  side_by_side: bool = False, samples: int = 0, before: Robot | None = None,
                  study: Path | None = None) -> ReportResult:
-    """``samples``: draws of the robot's uncertain values per configuration (bands and error
-    bars on the predictions); ``before``: the robot before a fit, its predictions drawn too;
-    ``study``: a ``locust optimize`` folder, its Pareto front drawn."""
+    """Simulate each configuration, compare it with its trials, and write a new report folder.
+
+    Parameters
+    ----------
+    base : Robot
+        The robot whose leg sets are the configurations.
+    measured : dict of str to list of Trial
+        Per configuration (leg-set name), its trials; an empty list predicts only.
+    out : Path
+        Where the new ``report`` folder is made (never an existing one).
+    robot_source : str
+        Where ``base`` came from, as the page names it.
+    cycles : int, optional
+        Cycles to simulate; default the runs' recorded cycles, else the robot's schedule.
+    sweep : Path, optional
+        A ``locust sweep`` folder, its landscape drawn with the configurations marked.
+    added : dict of str to float, optional
+        Per configuration, the length added to every link [m].
+    marker : str
+        The tracked marker compared with the model's ``marker_<name>`` disc.
+    progress : callable, optional
+        Called with a line of text at each step.
+    side_by_side : bool
+        Also write a video of each trial beside the simulation.
+    samples : int
+        Draws of the robot's uncertain values per configuration (bands and error bars on the
+        predictions); 0 for none.
+    before : Robot, optional
+        The robot before a fit; its predictions are drawn too.
+    study : Path, optional
+        A ``locust optimize`` folder; its Pareto front is drawn.
+
+    Returns
+    -------
+    ReportResult
+        The folder and files written, and the comparisons.
+
+    Raises
+    ------
+    ReportError
+        A bad input (unknown ``added`` name, bad sweep or study folder, refused or mixed runs,
+        ``cycles`` beyond the runs'); nothing is written then.
+    WriteError
+        The files could not be written; the new folder is removed.
+    """
     progress = progress or (lambda msg: None)
     added = added or {}
     unknown = sorted(set(added) - set(measured))
@@ -267,6 +373,36 @@ def _track_reading(t) -> str:
 
 def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, land, marker: str,
                 warnings: Sequence[Notice] = (), spreads: dict | None = None) -> str:
+    """The report page.
+
+    Parameters
+    ----------
+    base : Robot
+        The report's base robot.
+    robot_source : str
+        Where it came from.
+    comps : list of Comparison
+        One per configuration.
+    configs : dict of str to Configuration
+        The configurations by name.
+    figs : list of Figure
+        The page's figures, in order.
+    timing : list of TimingRow
+        The firmware timing rows of every run.
+    land : Landscape or None
+        The sweep landscape, if any.
+    marker : str
+        The tracked marker's name.
+    warnings : sequence of Notice
+        Shown at the top, collapsed (:func:`.checks.collapsed`).
+    spreads : dict of str to Spread, optional
+        Per configuration, its spread over the draws; adds the outcome table.
+
+    Returns
+    -------
+    str
+        The whole HTML page.
+    """
     labels = {n: c.label for n, c in configs.items()}
     added = {n: c.added_m for n, c in configs.items()}
     inputs = []
@@ -316,6 +452,34 @@ def _trial_json(t) -> dict:
 
 def report_json(base: Robot, robot_source: str, comps, configs, timing, land, marker: str,
                 warnings: Sequence[Notice] = ()) -> dict:
+    """The content of ``report.json`` (without its ``wall_s``).
+
+    Parameters
+    ----------
+    base : Robot
+        The report's base robot.
+    robot_source : str
+        Where it came from.
+    comps : list of Comparison
+        One per configuration.
+    configs : dict of str to Configuration
+        The configurations by name.
+    timing : list of TimingRow
+        The firmware timing rows of every run.
+    land : Landscape or None
+        The sweep landscape, if any.
+    marker : str
+        The tracked marker's name.
+    warnings : sequence of Notice
+        The notices about the inputs.
+
+    Returns
+    -------
+    dict
+        Robot, version, marker, sweep, warnings, and per configuration its added length
+        [m], link lengths [m], predicted and measured figures [m] and hop rows; NaN is left for
+        the writer to turn into null.
+    """
     out = {"robot": base.name, "robot_source": robot_source, "locust_version": __version__, "marker": marker,
            "sweep": str(land.folder) if land else None, "warnings": [w.to_json() for w in warnings],
            "configurations": []}

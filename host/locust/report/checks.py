@@ -44,6 +44,22 @@ END_SAMPLES = 5          # the last samples of a track, averaged as where it end
 
 @dataclass(frozen=True)
 class Notice:
+    """One warning about a report's input.
+
+    Attributes
+    ----------
+    kind : str
+        ``configuration-guessed``, ``virtual-robot``, ``mirrored`` or ``units``.
+    config : str
+        The configuration (leg set) it concerns.
+    trial : str
+        The trial's label.
+    message : str
+        The warning, with this trial's details.
+    summary : str
+        The same warning without this trial's details: notices sharing it are shown as one line.
+    """
+
     kind: str            # configuration-guessed | virtual-robot | mirrored | units
     config: str
     trial: str
@@ -52,12 +68,30 @@ class Notice:
     summary: str = ""
 
     def to_json(self) -> dict:
+        """The notice as ``report.json`` keeps it.
+
+        Returns
+        -------
+        dict
+            Each field by name.
+        """
         return asdict(self)
 
 
 def collapsed(found: list[Notice]) -> list[Notice]:
     """The notices as they are shown: those that say the same of several trials (one ``kind``
-    and ``summary``) become one notice naming how many trials and which, in first-seen order."""
+    and ``summary``) become one notice naming how many trials and which, in first-seen order.
+
+    Parameters
+    ----------
+    found : list of Notice
+        The notices, as :func:`notices` returns them.
+
+    Returns
+    -------
+    list of Notice
+        The notices to show.
+    """
     groups: dict[tuple[str, str], list[Notice]] = {}
     for n in found:
         groups.setdefault((n.kind, n.summary or n.message), []).append(n)
@@ -74,7 +108,20 @@ def collapsed(found: list[Notice]) -> list[Notice]:
 
 def recorded_on(record: RunRecord | None) -> tuple[str | None, str]:
     """Where a trial's run was recorded (robot, virtual robot, synthetic; None without a
-    run record) and why that is known."""
+    run record) and why that is known.
+
+    Parameters
+    ----------
+    record : RunRecord or None
+        The trial's run record.
+
+    Returns
+    -------
+    where : str or None
+        ``robot``, ``virtual robot`` or ``synthetic``; None without a record.
+    why : str
+        The evidence, as a phrase for the page.
+    """
     if record is None:
         return None, "no run record"
     port = record.port.strip()
@@ -92,7 +139,19 @@ def recorded_on(record: RunRecord | None) -> tuple[str | None, str]:
 
 
 def notices(comps: list[Comparison]) -> list[Notice]:
-    """Every warning about the comparisons' inputs, configuration by configuration."""
+    """Every warning about the comparisons' inputs, configuration by configuration.
+
+    Parameters
+    ----------
+    comps : list of Comparison
+        The report's comparisons.
+
+    Returns
+    -------
+    list of Notice
+        Guessed leg sets and virtual-robot runs for every trial; mirrored tracks and implausible
+        units for every trial with a track.
+    """
     out: list[Notice] = []
     for c in comps:
         for t in c.all_trials:

@@ -21,12 +21,36 @@ from .predict import Prediction
 
 @dataclass(frozen=True)
 class Stat:
+    """A figure over repeated trials, in the unit of the values it summarises.
+
+    Attributes
+    ----------
+    mean : float
+        Mean of the finite values (nan when there are none).
+    std : float or None
+        Sample standard deviation (n - 1); None with fewer than two values.
+    n : int
+        Number of finite values.
+    """
+
     mean: float
     std: float | None        # None with fewer than two values
     n: int
 
 
 def stat(values: list[float]) -> Stat:
+    """The mean, sample standard deviation and count of the finite values.
+
+    Parameters
+    ----------
+    values : list of float
+        One figure per trial; nan values are left out.
+
+    Returns
+    -------
+    Stat
+        In the values' unit.
+    """
     v = np.asarray([x for x in values if math.isfinite(x)], dtype=float)
     if v.size == 0:
         return Stat(math.nan, None, 0)
@@ -35,6 +59,22 @@ def stat(values: list[float]) -> Stat:
 
 @dataclass(frozen=True)
 class HopRow:
+    """One hop of one trial, measured against predicted; the marker's figures [m].
+
+    Attributes
+    ----------
+    config : str
+        The configuration.
+    trial : str
+        The trial's label.
+    hop : int
+        The hop (cycle) number, from 1.
+    measured_distance_m, predicted_distance_m : float
+        The marker's travel over the hop [m]; nan where the track or the simulation has none.
+    measured_apex_m, predicted_apex_m : float
+        The marker's highest point in the hop above standing [m].
+    """
+
     config: str
     trial: str
     hop: int
@@ -45,35 +85,75 @@ class HopRow:
 
     @property
     def distance_error_m(self) -> float:
+        """Measured minus predicted hop distance [m]."""
         return self.measured_distance_m - self.predicted_distance_m
 
     @property
     def apex_error_m(self) -> float:
+        """Measured minus predicted apex [m]."""
         return self.measured_apex_m - self.predicted_apex_m
 
 
 @dataclass(frozen=True)
 class MeasuredTrial:
+    """A trial's track on the prediction's clock, cut into hops.
+
+    Attributes
+    ----------
+    trial : Trial
+        The trial.
+    trace : Aligned
+        Its marker trace, t = 0 at the first push [s], from where it stood [m].
+    hops : list of MeasuredHop
+        Its hops, cut at the schedule's cycles.
+    """
+
     trial: Trial
     trace: Aligned
     hops: list[MeasuredHop]
 
     @property
     def total_distance_m(self) -> float:
+        """The marker's travel summed over the hops [m]."""
         return float(sum(h.distance_m for h in self.hops))
 
     @property
     def mean_hop_m(self) -> float:
+        """Mean hop distance [m]; nan without hops."""
         return float(np.mean([h.distance_m for h in self.hops])) if self.hops else math.nan
 
     @property
     def jump_m(self) -> float:
+        """Highest apex over the hops above standing [m]; nan when none is finite."""
         apexes = [h.apex_m for h in self.hops if math.isfinite(h.apex_m)]
         return max(apexes) if apexes else math.nan
 
 
 @dataclass(frozen=True)
 class Comparison:
+    """One configuration's prediction, its trials, and the figures comparing them.
+
+    Attributes
+    ----------
+    config : str
+        The configuration.
+    prediction : Prediction
+        What the simulation predicts.
+    all_trials : list of Trial
+        Every trial given, with or without a track.
+    trials : list of MeasuredTrial
+        The trials with a track, measured.
+    rows : list of HopRow
+        Every measured hop against the predicted one.
+    cycles : int
+        Cycles simulated.
+    period_s : float
+        One cycle, push plus wait [s].
+    distance, hop_distance, jump : Stat
+        Measured total distance over the cycles, mean distance per hop and highest nose apex
+        above standing [m], over the trials.
+    """
+
     config: str
     prediction: Prediction
     all_trials: list[Trial]   # every trial given, with or without a track
@@ -101,6 +181,7 @@ class Comparison:
 
     @property
     def predicted_hop_distance_m(self) -> float:
+        """Predicted marker travel per cycle [m]."""
         return self.predicted_distance_m / self.cycles
 
     @property
@@ -116,6 +197,27 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
     Like with like: the predicted hops are the simulated marker's (the same marker as the
     track), measured by the same function from the same zero (where it stood) with the same
     cut (the schedule's cycles, each ending at rest), never the chassis travel of ``run()``.
+
+    Parameters
+    ----------
+    prediction : Prediction
+        The configuration's prediction; its onset latency places the tracks' clock.
+    trials : list of Trial
+        The configuration's trials; those without a track are kept but not measured.
+    cycles : int
+        Cycles simulated (a trial with a run record is cut at its own commanded cycles).
+    period_s : float
+        One cycle, push plus wait [s].
+
+    Returns
+    -------
+    Comparison
+        The pairs and the figures over the trials.
+
+    Raises
+    ------
+    ReportError
+        A track whose start cannot be found (with a units hint where it looks misread).
     """
     latency = prediction.onset_latency_s if prediction.valid else 0.0
     measured = []
@@ -146,12 +248,43 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
 
 
 def trial_cycles(trial: Trial, default: int) -> int:
-    """The cycles the trial's run record commanded; ``default`` without a record."""
+    """The cycles the trial's run record commanded; ``default`` without a record.
+
+    Parameters
+    ----------
+    trial : Trial
+        The trial.
+    default : int
+        Cycles to use without a run record.
+
+    Returns
+    -------
+    int
+        Number of cycles.
+    """
     return trial.record.schedule.cycles if trial.record else default
 
 
 @dataclass(frozen=True)
 class TimingRow:
+    """One run record's firmware timing.
+
+    Attributes
+    ----------
+    config : str
+        The configuration.
+    trial : str
+        The trial's label.
+    status : str
+        The run's status as recorded.
+    phases, phases_expected : int
+        Phases recorded, and those the schedule commands.
+    firmware : str
+        The firmware version (``?`` when unrecorded).
+    jitter : Jitter or None
+        Phase start errors, measured minus commanded [ms].
+    """
+
     config: str
     trial: str
     status: str
@@ -166,6 +299,18 @@ def timing_rows(config: str, trials: list[Trial]) -> list[TimingRow]:
 
     Recomputed from the record's phases with the device layer's own :func:`jitter`, so a
     record that lost its summary still has one.
+
+    Parameters
+    ----------
+    config : str
+        The configuration.
+    trials : list of Trial
+        Its trials; those without a run record are skipped.
+
+    Returns
+    -------
+    list of TimingRow
+        One per run record.
     """
     rows = []
     for t in trials:

@@ -22,6 +22,20 @@ MM = 1000.0   # hop figures in mm, as every command prints them
 
 
 def colour(name: str, names: list[str]) -> str:
+    """A configuration's colour: the seed dashboard's for small, medium and large, others in turn.
+
+    Parameters
+    ----------
+    name : str
+        The configuration.
+    names : list of str
+        Every configuration of the report, in order.
+
+    Returns
+    -------
+    str
+        A matplotlib colour (``#rrggbb``).
+    """
     if name in COLOURS:
         return COLOURS[name]
     others = [n for n in names if n not in COLOURS]
@@ -29,7 +43,17 @@ def colour(name: str, names: list[str]) -> str:
 
 
 def legend_outside(ax, below: bool = False, **kw) -> None:
-    """The axes' legend beside them on the right (or ``below`` them), off the data."""
+    """The axes' legend beside them on the right (or ``below`` them), off the data.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes whose labelled artists are listed.
+    below : bool
+        Under the axes in two columns instead of on the right.
+    **kw
+        Passed to ``Axes.legend`` (``fontsize`` defaults to 7).
+    """
     place = (dict(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2) if below
              else dict(loc="upper left", bbox_to_anchor=(1.02, 1.0)))
     ax.legend(frameon=False, fontsize=kw.pop("fontsize", 7), borderaxespad=0.0, **place, **kw)
@@ -48,7 +72,23 @@ def _invalid_note(ax, c: Comparison) -> None:
 def draw_traces(ax, c: Comparison, names: list[str], which: str, spread=None, before=None) -> None:
     """Nose forward travel (``which='x'``) or height (``'y'``) against time, one configuration;
     with a :class:`.spread.Spread` the draws' mean +- 1 sd as a band, with ``before`` (a
-    :class:`.predict.Prediction` on the robot before a fit) its trace dotted."""
+    :class:`.predict.Prediction` on the robot before a fit) its trace dotted.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Where to draw, in mm against seconds since the first push.
+    c : Comparison
+        The configuration's comparison.
+    names : list of str
+        Every configuration, for the colours.
+    which : str
+        ``x`` (forward) or ``y`` (up).
+    spread : Spread, optional
+        The prediction's spread over draws.
+    before : Prediction, optional
+        The prediction on the robot before a fit.
+    """
     col = colour(c.config, names)
     for i, m in enumerate(c.trials):
         ax.plot(m.trace.t_s, getattr(m.trace, f"{which}_m") * MM, color=col, lw=1.4, alpha=0.85,
@@ -71,6 +111,22 @@ def draw_traces(ax, c: Comparison, names: list[str], which: str, spread=None, be
 
 
 def overlay_figure(comps: list[Comparison], spreads: dict | None = None, befores: dict | None = None) -> bytes:
+    """Displacement (top row) and height (bottom row) against time, one column per configuration.
+
+    Parameters
+    ----------
+    comps : list of Comparison
+        The configurations.
+    spreads : dict of str to Spread, optional
+        Per configuration, a band of the draws.
+    befores : dict of str to Prediction, optional
+        Per configuration, the prediction before a fit.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     plt = pyplot()
     names = [c.config for c in comps]
     spreads, befores = spreads or {}, befores or {}
@@ -90,7 +146,17 @@ def overlay_figure(comps: list[Comparison], spreads: dict | None = None, befores
 
 
 def draw_bars(ax, comps: list[Comparison], what: str) -> None:
-    """Measured (mean, +-1 sd across trials) beside predicted, per configuration."""
+    """Measured (mean, +-1 sd across trials) beside predicted, per configuration.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Where to draw, in mm.
+    comps : list of Comparison
+        The configurations.
+    what : str
+        ``jump`` (highest nose apex) or anything else for the distance per hop.
+    """
     names = [c.config for c in comps]
     x = np.arange(len(comps))
     w = 0.38
@@ -121,6 +187,20 @@ def draw_bars(ax, comps: list[Comparison], what: str) -> None:
 
 
 def bars_figure(comps: list[Comparison], what: str) -> bytes:
+    """Measured against predicted jump height or distance per hop, as bars.
+
+    Parameters
+    ----------
+    comps : list of Comparison
+        The configurations.
+    what : str
+        ``jump`` or ``distance``.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(max(5.0, 2.2 * len(comps)), 4.0))
     draw_bars(ax, comps, what)
@@ -136,7 +216,20 @@ def bars_figure(comps: list[Comparison], what: str) -> bytes:
 
 def hops_figure(comps: list[Comparison], spreads: dict | None = None) -> bytes:
     """Per-hop distance and apex, every trial, against the prediction (with ±1 sd error bars
-    over the draws of a :class:`.spread.Spread`)."""
+    over the draws of a :class:`.spread.Spread`).
+
+    Parameters
+    ----------
+    comps : list of Comparison
+        The configurations.
+    spreads : dict of str to Spread, optional
+        Per configuration, the error bars of the prediction.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     plt = pyplot()
     names = [c.config for c in comps]
     spreads = spreads or {}
@@ -167,6 +260,20 @@ def hops_figure(comps: list[Comparison], spreads: dict | None = None) -> bytes:
 
 
 def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[str, Configuration]) -> None:
+    """The sweep's distance per hop over its first axis (a line) or first two axes (colour),
+    with each configuration's prediction and measurement where it sits.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Where to draw, distances in mm.
+    land : Landscape
+        The sweep.
+    comps : list of Comparison
+        The configurations.
+    configs : dict of str to Configuration
+        The configurations by name, for their place on the axes.
+    """
     names = [c.config for c in comps]
     first = land.names[0]
     k, xlabel = axis_scale(first)
@@ -215,7 +322,20 @@ def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[s
 
 
 def landscape_caption(land: Landscape, comps: list[Comparison]) -> str:
-    """What :func:`draw_landscape` draws, in words: only marks that are drawn are named."""
+    """What :func:`draw_landscape` draws, in words: only marks that are drawn are named.
+
+    Parameters
+    ----------
+    land : Landscape
+        The sweep.
+    comps : list of Comparison
+        The configurations.
+
+    Returns
+    -------
+    str
+        The caption.
+    """
     bad = int((~land.valid).sum())
     if len(land.names) == 1:
         text = f"Simulated distance per hop over the sweep in {land.folder}"
@@ -235,6 +355,22 @@ def landscape_caption(land: Landscape, comps: list[Comparison]) -> str:
 
 
 def landscape_figure(land: Landscape, comps: list[Comparison], configs: dict[str, Configuration]) -> bytes:
+    """The sweep landscape with the configurations marked (:func:`draw_landscape`).
+
+    Parameters
+    ----------
+    land : Landscape
+        The sweep.
+    comps : list of Comparison
+        The configurations.
+    configs : dict of str to Configuration
+        The configurations by name.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 4.5))
     draw_landscape(ax, land, comps, configs)
@@ -243,7 +379,15 @@ def landscape_figure(land: Landscape, comps: list[Comparison], configs: dict[str
 
 
 def draw_timing(ax, comps: list[Comparison]) -> None:
-    """Phase start error (measured - commanded, firmware clock) of every run, per phase."""
+    """Phase start error (measured - commanded, firmware clock) of every run, per phase.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Where to draw, errors in ms.
+    comps : list of Comparison
+        The configurations; trials without a run record are left out.
+    """
     names = [c.config for c in comps]
     drawn = False
     for c in comps:
@@ -264,6 +408,18 @@ def draw_timing(ax, comps: list[Comparison]) -> None:
 
 
 def timing_figure(comps: list[Comparison]) -> bytes:
+    """The firmware timing of every run (:func:`draw_timing`).
+
+    Parameters
+    ----------
+    comps : list of Comparison
+        The configurations.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 3.6))
     draw_timing(ax, comps)
@@ -272,7 +428,22 @@ def timing_figure(comps: list[Comparison]) -> bytes:
 
 
 def dashboard(comps: list[Comparison], land: Landscape | None, configs: dict[str, Configuration]) -> bytes:
-    """One PNG like the seed's dashboard, measured and predicted together."""
+    """One PNG like the seed's dashboard, measured and predicted together.
+
+    Parameters
+    ----------
+    comps : list of Comparison
+        The configurations.
+    land : Landscape or None
+        The sweep; without one, the distance per hop as bars takes its panel.
+    configs : dict of str to Configuration
+        The configurations by name.
+
+    Returns
+    -------
+    bytes
+        The dashboard as PNG (100 dpi).
+    """
     plt = pyplot()
     names = [c.config for c in comps]
     fig, axes = plt.subplots(2, 2, figsize=(14, 9.5))

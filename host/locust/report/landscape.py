@@ -21,6 +21,31 @@ from ..trials.configs import Configuration
 
 @dataclass(frozen=True)
 class Landscape:
+    """A sweep's designs and their outcomes, read from a ``locust sweep`` folder.
+
+    Attributes
+    ----------
+    folder : Path
+        The sweep folder.
+    base : str
+        The base robot's name.
+    names : list of str
+        The varied names, in order (``scale`` or dotted parameters).
+    cycles : int
+        Cycles each design was simulated.
+    values : dict of str to ndarray
+        Per varied name, one value per design, in that parameter's unit (``scale``: metres added
+        to every link).
+    valid : ndarray of bool
+        Whether each design's simulation passed its audit.
+    distance_m : ndarray
+        Total distance over ``cycles`` [m] (nan when invalid).
+    reason : list of str
+        Per design, the ``reason`` column of ``results.csv`` (why an invalid one failed).
+    finished : bool
+        False for an interrupted sweep, some designs missing.
+    """
+
     folder: Path
     base: str
     names: list[str]                  # varied names, in order
@@ -33,15 +58,33 @@ class Landscape:
 
     @property
     def hop_distance_m(self) -> np.ndarray:
+        """Distance per cycle of each design [m]."""
         return self.distance_m / self.cycles
 
     @property
     def designs(self) -> int:
+        """Number of designs read."""
         return len(self.valid)
 
 
 def read_landscape(folder: Path) -> Landscape:
-    """The landscape of a sweep folder, read by its owner (:mod:`locust.io.sweep_store`)."""
+    """The landscape of a sweep folder, read by its owner (:mod:`locust.io.sweep_store`).
+
+    Parameters
+    ----------
+    folder : Path
+        A ``locust sweep --out`` folder.
+
+    Returns
+    -------
+    Landscape
+        Its designs.
+
+    Raises
+    ------
+    ReportError
+        The folder is not a sweep, or has no finished design.
+    """
     try:
         res = read_results(Path(folder))
     except SweepError as exc:
@@ -57,7 +100,21 @@ def read_landscape(folder: Path) -> Landscape:
 
 
 def design_value(config: Configuration, name: str) -> float:
-    """Where ``config`` sits on the sweep axis ``name``."""
+    """Where ``config`` sits on the sweep axis ``name``.
+
+    Parameters
+    ----------
+    config : Configuration
+        A configuration of the report.
+    name : str
+        The axis: ``scale`` or a dotted parameter.
+
+    Returns
+    -------
+    float
+        On ``scale``, the length the configuration adds to every link [m]; otherwise that
+        parameter's value in its robot, in its unit (nan when it is not a robot parameter).
+    """
     if name == SCALE:
         return config.added_m
     try:

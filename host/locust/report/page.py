@@ -31,6 +31,18 @@ ul.warn{background:#fff6e5;border:1px solid #f0c36d;padding:.6em 1em .6em 2.2em}
 
 @dataclass(frozen=True)
 class Figure:
+    """One figure of the page.
+
+    Attributes
+    ----------
+    key : str
+        Its id (``fig-<key>`` on the page).
+    title, caption : str
+        Its title and caption.
+    png : bytes
+        The image, PNG.
+    """
+
     key: str
     title: str
     caption: str
@@ -38,15 +50,54 @@ class Figure:
 
 
 def esc(value) -> str:
+    """``value`` as text, HTML-escaped (quotes included).
+
+    Parameters
+    ----------
+    value : object
+        Anything; ``str()`` is taken.
+
+    Returns
+    -------
+    str
+        Safe in element text and attribute values.
+    """
     return html.escape(str(value), quote=True)
 
 
 def mm(value: float, digits: int = 1) -> str:
-    """A length in metres as millimetres (the filmed unit of every hop figure), 0.1 mm by default."""
+    """A length in metres as millimetres (the filmed unit of every hop figure), 0.1 mm by default.
+
+    Parameters
+    ----------
+    value : float or None
+        A length [m].
+    digits : int
+        Digits after the decimal point.
+
+    Returns
+    -------
+    str
+        The length in mm; ``—`` for None or a non-finite value.
+    """
     return f"{value * 1000:.{digits}f}" if value is not None and math.isfinite(value) else "—"
 
 
 def mm_pm(mean: float, std: float | None) -> str:
+    """A mean length, and its standard deviation when there is one, in millimetres.
+
+    Parameters
+    ----------
+    mean : float
+        The mean [m].
+    std : float or None
+        The standard deviation [m].
+
+    Returns
+    -------
+    str
+        ``12.3 ± 0.4`` [mm]; ``—`` when the mean is not finite.
+    """
     if not math.isfinite(mean):
         return "—"
     return mm(mean) + (f" ± {std * 1000:.1f}" if std is not None else "")
@@ -54,7 +105,22 @@ def mm_pm(mean: float, std: float | None) -> str:
 
 def pct(err: float, ref: float, resolution_m: float = math.nan) -> str:
     """The error in percent of ``ref``; "within 1 px" when it is smaller than the tracking
-    resolution (one pixel, in metres), which no percentage of a small jump can beat."""
+    resolution (one pixel, in metres), which no percentage of a small jump can beat.
+
+    Parameters
+    ----------
+    err : float
+        The error [m].
+    ref : float
+        The reference, the predicted figure [m].
+    resolution_m : float
+        One pixel at the marker [m]; nan when unknown.
+
+    Returns
+    -------
+    str
+        ``+4.2 %``, ``within 1 px (0.4 mm)``, or ``—`` without a finite, nonzero reference.
+    """
     if not (math.isfinite(err) and math.isfinite(ref)) or ref == 0:
         return "—"
     if math.isfinite(resolution_m) and abs(err) < resolution_m:
@@ -63,6 +129,24 @@ def pct(err: float, ref: float, resolution_m: float = math.nan) -> str:
 
 
 def td(text: str, config: str | None = None, field: str | None = None, left: bool = False) -> str:
+    """One table cell, its text escaped.
+
+    Parameters
+    ----------
+    text : str
+        The cell's text.
+    config : str, optional
+        Its configuration, as ``data-config``.
+    field : str, optional
+        What it holds, as ``data-field``.
+    left : bool
+        Left-aligned and wrapping (class ``l``).
+
+    Returns
+    -------
+    str
+        The ``<td>`` element.
+    """
     attrs = "" if not left else ' class="l"'
     if config is not None:
         attrs += f' data-config="{esc(config)}"'
@@ -72,6 +156,24 @@ def td(text: str, config: str | None = None, field: str | None = None, left: boo
 
 
 def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = "") -> str:
+    """A table from its headers and ready-made rows.
+
+    Parameters
+    ----------
+    headers : list of str
+        Column headers.
+    rows : list of str
+        ``<tr>`` elements.
+    left_cols : int
+        How many leading columns' headers are left-aligned.
+    id_ : str
+        The table's id; none when empty.
+
+    Returns
+    -------
+    str
+        The ``<table>`` element.
+    """
     head = "".join(f'<th class="l">{esc(h)}</th>' if i < left_cols else f"<th>{esc(h)}</th>"
                    for i, h in enumerate(headers))
     ident = f' id="{esc(id_)}"' if id_ else ""
@@ -79,6 +181,23 @@ def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = ""
 
 
 def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[str, float]) -> str:
+    """Per configuration, predicted and measured distance, distance per hop and jump, their
+    errors in mm and percent, and the simulation's status; then the tracking resolution.
+
+    Parameters
+    ----------
+    comps : list of Comparison
+        The configurations.
+    labels : dict of str to str
+        The configurations' display names.
+    added : dict of str to float
+        The length each adds to every link [m].
+
+    Returns
+    -------
+    str
+        The table (id ``summary``) and its note, HTML.
+    """
     rows = []
     for c in comps:
         name = c.config
@@ -112,7 +231,20 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
 
 def outcome_table(spreads: dict, labels: dict[str, str]) -> str:
     """Each configuration's draws (``--samples``) by outcome: its share, and its own distance
-    and highest nose as mean ± sd (one sd across outcomes would hide a split)."""
+    and highest nose as mean ± sd (one sd across outcomes would hide a split).
+
+    Parameters
+    ----------
+    spreads : dict of str to Spread or None
+        Per configuration, its spread (None ones are left out).
+    labels : dict of str to str
+        The configurations' display names.
+
+    Returns
+    -------
+    str
+        The table (id ``outcomes``), lengths in mm, HTML.
+    """
     rows = []
     for name, sp in spreads.items():
         if sp is None:
@@ -129,6 +261,20 @@ def outcome_table(spreads: dict, labels: dict[str, str]) -> str:
 
 
 def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
+    """Every measured hop against the predicted one: distance and apex [mm], with errors.
+
+    Parameters
+    ----------
+    comps : list of Comparison
+        The configurations.
+    labels : dict of str to str
+        The configurations' display names.
+
+    Returns
+    -------
+    str
+        The table (id ``hops``), or a note when no track was given, HTML.
+    """
     rows = []
     for c in comps:
         for r in c.rows:
@@ -150,6 +296,20 @@ def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
 
 
 def timing_table(rows: list[TimingRow], labels: dict[str, str]) -> str:
+    """Each run's phase start errors: mean, sd, largest, latest and earliest [ms].
+
+    Parameters
+    ----------
+    rows : list of TimingRow
+        One per run record.
+    labels : dict of str to str
+        The configurations' display names.
+
+    Returns
+    -------
+    str
+        The table (id ``timing``), or a note when no run record was given, HTML.
+    """
     if not rows:
         return '<p class="note">No run records were given.</p>'
     out = []
@@ -169,13 +329,36 @@ def timing_table(rows: list[TimingRow], labels: dict[str, str]) -> str:
 
 
 def warnings_list(notices) -> str:
-    """The report's warnings (:class:`.checks.Notice`), each with its kind, configuration and trial."""
+    """The report's warnings (:class:`.checks.Notice`), each with its kind, configuration and trial.
+
+    Parameters
+    ----------
+    notices : iterable of Notice
+        The warnings to list.
+
+    Returns
+    -------
+    str
+        The ``<ul id="warnings">`` element.
+    """
     items = "".join(f'<li data-kind="{esc(n.kind)}" data-config="{esc(n.config)}" data-trial="{esc(n.trial)}">'
                     f"{esc(n.message)}</li>" for n in notices)
     return f'<ul class="warn" id="warnings">{items}</ul>'
 
 
 def params_table(param_rows: list[dict]) -> str:
+    """The robot's parameters with value, uncertainty (1 sd, in the parameter's unit) and source.
+
+    Parameters
+    ----------
+    param_rows : list of dict
+        Rows as :func:`locust.report.build.parameter_rows` makes them.
+
+    Returns
+    -------
+    str
+        The table (id ``params``), HTML.
+    """
     rows = []
     for p in param_rows:
         unc = p["uncertainty"]
@@ -188,18 +371,58 @@ def params_table(param_rows: list[dict]) -> str:
 
 
 def links_table(link_rows: list[tuple[str, tuple[float, float, float, float]]]) -> str:
+    """Each configuration's four link lengths [mm].
+
+    Parameters
+    ----------
+    link_rows : list of (str, tuple of float)
+        Display name and (ground, crank, coupler, leg) lengths [m].
+
+    Returns
+    -------
+    str
+        The table (id ``links``), HTML.
+    """
     rows = ["<tr>" + td(name, left=True) + "".join(td(f"{v * 1000:.1f}") for v in links) + "</tr>"
             for name, links in link_rows]
     return table(["configuration", "ground (mm)", "crank (mm)", "coupler (mm)", "leg (mm)"], rows, id_="links")
 
 
 def figure_html(fig: Figure) -> str:
+    """A figure, its PNG embedded as base64, with its title and caption.
+
+    Parameters
+    ----------
+    fig : Figure
+        The figure.
+
+    Returns
+    -------
+    str
+        The ``<figure id="fig-<key>">`` element.
+    """
     data = base64.b64encode(fig.png).decode("ascii")
     return (f'<figure id="fig-{esc(fig.key)}"><img src="data:image/png;base64,{data}" alt="{esc(fig.title)}">'
             f"<figcaption><b>{esc(fig.title)}.</b> {esc(fig.caption)}</figcaption></figure>")
 
 
 def page(title: str, meta_lines: list[str], sections: list[tuple[str, str]]) -> str:
+    """The whole page: title, meta lines, then each section under its heading.
+
+    Parameters
+    ----------
+    title : str
+        The page's title.
+    meta_lines : list of str
+        Lines under the title, escaped.
+    sections : list of (str, str)
+        Heading and HTML content.
+
+    Returns
+    -------
+    str
+        The HTML document, with its Content-Security-Policy.
+    """
     meta = "".join(f"<div>{esc(line)}</div>" for line in meta_lines)
     body = "".join(f"<h2>{esc(h)}</h2>{content}" for h, content in sections)
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"

@@ -23,6 +23,27 @@ from ..trials.measure import Aligned, MeasuredHop, measure_hops, onset_time
 
 @dataclass
 class Prediction:
+    """What the simulation predicts for one configuration.
+
+    Attributes
+    ----------
+    config : str
+        The configuration.
+    robot : Robot
+        The robot simulated.
+    result : SimResult
+        The audited result of :func:`locust.sim.run.run`.
+    trace : Aligned or None
+        The marker on the schedule's clock [s, m]; None when invalid.
+    hops : list of MeasuredHop
+        The marker's hops, measured like a track's (empty when invalid).
+    onset_latency_s : float
+        First marker motion after the first push [s] (nan when invalid).
+    trajectory : Trajectory or None
+        The rollout with every step's state: only with ``predict(..., keep_states=True)`` and a
+        valid run.
+    """
+
     config: str
     robot: Robot
     result: object                 # locust.sim.result.SimResult
@@ -34,12 +55,38 @@ class Prediction:
 
     @property
     def valid(self) -> bool:
+        """Whether the simulation passed its audit."""
         return bool(self.result.valid)
 
 
 def predict(config: str, robot: Robot, cycles: int, marker: str = "nose", keep_states: bool = False) -> Prediction:
-    """``keep_states``: keep the rollout (``Prediction.trajectory``) for a video of it
-    (:mod:`.sidebyside`); otherwise its states go once the trace is taken."""
+    """Simulate ``robot`` and take its marker's trace and hops as a track's are taken.
+
+    Parameters
+    ----------
+    config : str
+        The configuration's name.
+    robot : Robot
+        Its robot.
+    cycles : int
+        Cycles to simulate.
+    marker : str
+        The model's ``marker_<marker>`` disc to follow.
+    keep_states : bool
+        Keep the rollout (``Prediction.trajectory``) for a video of it (:mod:`.sidebyside`);
+        otherwise its states go once the trace is taken.
+
+    Returns
+    -------
+    Prediction
+        Invalid, with the audit's reasons, when the simulation fails its audit or the geometry
+        cannot be built.
+
+    Raises
+    ------
+    ReportError
+        The model carries no such marker.
+    """
     from ..sim.run import invalid_result, run
 
     try:
@@ -59,7 +106,25 @@ def predict(config: str, robot: Robot, cycles: int, marker: str = "nose", keep_s
 
 def marker_trace(traj, marker: str) -> Aligned:
     """The ``marker_<marker>`` disc's centre, t = 0 at the first push, from where it stood
-    at the end of the settle phase; x forward, y up. ``traj`` must have kept its states."""
+    at the end of the settle phase; x forward, y up.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        A rollout that kept its states.
+    marker : str
+        The marker's name (``nose``, ``foot``).
+
+    Returns
+    -------
+    Aligned
+        ``t_s`` [s] and ``x_m``, ``y_m`` [m], thinned to ``sim.kinematics.TRACE_HZ``.
+
+    Raises
+    ------
+    ReportError
+        The model carries no such marker.
+    """
     from ..sim.kinematics import carries_marker, marker_positions, trace_rows
 
     if not carries_marker(traj, marker):

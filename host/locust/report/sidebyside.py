@@ -56,7 +56,25 @@ FONT = cv2.FONT_HERSHEY_SIMPLEX
 
 @dataclass(frozen=True)
 class Job:
-    """One side-by-side video to render, every input checked."""
+    """One side-by-side video to render, every input checked.
+
+    Attributes
+    ----------
+    comparison : Comparison
+        The trial's configuration.
+    measured : MeasuredTrial
+        The trial, its track aligned to the schedule.
+    video : VideoInfo
+        The filmed video.
+    camera : CameraFile or None
+        The filmed camera; None: the simulation's own.
+    camera_note : str
+        Where the camera comes from, or why not from the video.
+    frame0 : float
+        The frame at t = 0 on the track's clock: ``t_track = (frame - frame0) / fps`` [frames].
+    fps : float
+        Frames per second of the track's clock [1/s].
+    """
 
     comparison: Comparison
     measured: MeasuredTrial
@@ -68,16 +86,52 @@ class Job:
 
     @property
     def label(self) -> str:
+        """The trial's label."""
         return self.measured.trial.label
 
     def t_s(self, frame: int) -> float:
-        """Frame ``frame``'s time on the schedule's clock (t = 0 at the first push)."""
+        """Frame ``frame``'s time on the schedule's clock (t = 0 at the first push).
+
+        Parameters
+        ----------
+        frame : int
+            A video frame number.
+
+        Returns
+        -------
+        float
+            Its time [s].
+        """
         return (frame - self.frame0) / self.fps - self.measured.trace.start_s
 
 
 @dataclass(frozen=True)
 class SideBySide:
-    """What became of one trial: its video written, or why not."""
+    """What became of one trial: its video written, or why not.
+
+    Attributes
+    ----------
+    config : str
+        The configuration.
+    trial : str
+        The trial's label.
+    video : Path or None
+        The filmed video.
+    path : Path or None
+        The side-by-side video (None: skipped).
+    camera : str or None
+        ``camera.json`` (the filmed camera) or the simulation's own fixed camera.
+    note : str
+        Where the camera comes from, or why the trial was skipped.
+    frames : int
+        Frames written.
+    fps : float
+        Frame rate of the written video [1/s].
+    width_px, height_px : int
+        Its size (both halves) [px].
+    t0_s : float
+        The first frame's time on the schedule's clock [s].
+    """
 
     config: str
     trial: str
@@ -92,18 +146,51 @@ class SideBySide:
     t0_s: float = math.nan           # the first frame's time on the schedule's clock
 
     def to_json(self) -> dict:
+        """The fields as a JSON object.
+
+        Returns
+        -------
+        dict
+            Each field by name, paths as text.
+        """
         return {k: str(v) if isinstance(v, Path) else v for k, v in self.__dict__.items()}
 
 
 # -- planning: what to render, checked before anything is written ----------------------
 @dataclass(frozen=True)
 class Plan:
+    """The side-by-side videos to render, and the trials that get none.
+
+    Attributes
+    ----------
+    jobs : list of Job
+        To render.
+    skipped : list of SideBySide
+        No track, no video or no valid simulation, and why.
+    """
+
     jobs: list[Job]                  # to render
     skipped: list[SideBySide]        # no track, no video or no valid simulation, and why
 
 
 def plan_side_by_side(comps: list[Comparison]) -> Plan:
-    """The trials to render and those skipped; an unreadable video stops here (ReportError)."""
+    """The trials to render and those skipped; an unreadable video stops here (ReportError).
+
+    Parameters
+    ----------
+    comps : list of Comparison
+        The report's configurations.
+
+    Returns
+    -------
+    Plan
+        The jobs, their videos probed and cameras read, and the skipped trials.
+
+    Raises
+    ------
+    ReportError
+        A video that cannot be probed, or one with no frame rate and a track without frame numbers.
+    """
     jobs, skipped = [], []
     for c in comps:
         measured = {id(m.trial): m for m in c.trials}
@@ -126,7 +213,18 @@ def plan_side_by_side(comps: list[Comparison]) -> Plan:
 
 def find_video(trial) -> Path | None:
     """The trial's filmed video: beside its track (``x.tracks.csv`` -> ``x.mp4``), else
-    ``hop.mp4`` in its folder."""
+    ``hop.mp4`` in its folder.
+
+    Parameters
+    ----------
+    trial : Trial
+        A measured trial.
+
+    Returns
+    -------
+    Path or None
+        The video; None when there is none.
+    """
     folders = []
     if trial.track is not None:
         track = trial.track.path
@@ -148,7 +246,20 @@ def _probe(video: Path) -> VideoInfo:
 
 
 def filmed_camera(info: VideoInfo) -> tuple[CameraFile | None, str]:
-    """The camera the video was filmed with (its ``camera.json``), or None and why not."""
+    """The camera the video was filmed with (its ``camera.json``), or None and why not.
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+
+    Returns
+    -------
+    camera : CameraFile or None
+        The camera, when its file is beside the video, readable and of the video's size.
+    note : str
+        Where the camera comes from, or why the cameras differ.
+    """
     path = camera_json_beside(info.path)
     if not path.is_file():
         return None, f"no {path.name} beside the video: the cameras differ"
@@ -165,7 +276,27 @@ def filmed_camera(info: VideoInfo) -> tuple[CameraFile | None, str]:
 def frame_clock(track_path: Path, info: VideoInfo) -> tuple[float, float]:
     """(frame0, fps) with ``t_track = (frame - frame0) / fps`` for the track's video frames:
     fitted to the track's ``frame`` and ``t_s`` columns; without frame numbers (a Tracker
-    export, a plain ``t,x,y`` CSV), frame 0 at t = 0 at the file's rate."""
+    export, a plain ``t,x,y`` CSV), frame 0 at t = 0 at the file's rate.
+
+    Parameters
+    ----------
+    track_path : Path
+        The trial's track file.
+    info : VideoInfo
+        The probed video.
+
+    Returns
+    -------
+    frame0 : float
+        The frame at t = 0 on the track's clock [frames].
+    fps : float
+        Frames per second [1/s].
+
+    Raises
+    ------
+    ReportError
+        Neither the track's frame numbers nor the file give a frame rate.
+    """
     try:
         tracks = read_track_file(track_path)
     except TrackError:
@@ -186,7 +317,27 @@ def frame_clock(track_path: Path, info: VideoInfo) -> tuple[float, float]:
 # -- rendering -----------------------------------------------------------------------
 def write_side_by_side(plan: Plan, folder: Path, say: Callable[[str], None] | None = None) -> list[SideBySide]:
     """Render every job into ``folder`` (``<trial>.side_by_side.mp4``, never over a file);
-    what became of each trial, the skipped ones (said on ``say``) last."""
+    what became of each trial, the skipped ones (said on ``say``) last.
+
+    Parameters
+    ----------
+    plan : Plan
+        From :func:`plan_side_by_side`.
+    folder : Path
+        The report's folder.
+    say : callable, optional
+        Called with a line of text per trial.
+
+    Returns
+    -------
+    list of SideBySide
+        The written videos, then the skipped trials.
+
+    Raises
+    ------
+    ReportError
+        A file of that name exists, or the video cannot be encoded.
+    """
     say = say or (lambda msg: None)
     taken: set[str] = set()
     out = []
@@ -249,7 +400,18 @@ def _frames(job: Job) -> Iterator[np.ndarray]:
 
 
 def filmed_pinholes(camera: CameraFile) -> list:
-    """The camera.json as pinhole cameras: one (fixed) or one per video frame (track)."""
+    """The camera.json as pinhole cameras: one (fixed) or one per video frame (track).
+
+    Parameters
+    ----------
+    camera : CameraFile
+        The filmed camera.
+
+    Returns
+    -------
+    list of PinholeCamera
+        One per recorded position.
+    """
     from ..sim.camera import PinholeCamera
 
     K = camera.K
@@ -259,7 +421,22 @@ def filmed_pinholes(camera: CameraFile) -> list:
 
 
 def own_view(traj, robot, aspect: float):
-    """The simulation's fixed camera framed on its hops (from standing on), as ``render_video``'s."""
+    """The simulation's fixed camera framed on its hops (from standing on), as ``render_video``'s.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The rollout, with its sensor data.
+    robot : Robot
+        Its robot (the body length sets the margin).
+    aspect : float
+        Width over height of the frame.
+
+    Returns
+    -------
+    PinholeCamera
+        The fixed camera.
+    """
     from ..sim.camera import frame_views
 
     s, stand = traj.built.sensors, max(traj.plan.settle_steps - 1, 0)

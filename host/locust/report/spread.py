@@ -28,6 +28,26 @@ from .predict import marker_trace
 
 @dataclass(frozen=True)
 class Spread:
+    """The prediction's spread over draws of the robot's uncertain values.
+
+    Attributes
+    ----------
+    n : int
+        Draws simulated.
+    n_valid : int
+        Draws that passed their audit.
+    t_s : ndarray
+        The schedule's clock [s].
+    x_mean_m, x_sd_m, y_mean_m, y_sd_m : ndarray
+        Mean and sample standard deviation over the valid draws of the marker's forward and
+        vertical position at every instant [m].
+    hop_distance_sd_m, hop_apex_sd_m : list of float
+        Per hop, the standard deviation of the marker's distance and apex [m] (nan with fewer
+        than two finite values).
+    outcomes : dict of str to OutcomeFigures
+        Each outcome's share of the valid draws and its distance and highest nose.
+    """
+
     n: int                         # draws
     n_valid: int
     t_s: np.ndarray                # the schedule's clock
@@ -40,13 +60,40 @@ class Spread:
     outcomes: dict[str, OutcomeFigures] = field(default_factory=dict)   # each outcome's share and figures
 
     def to_json(self) -> dict:
+        """The spread as ``report.json`` keeps it (no traces).
+
+        Returns
+        -------
+        dict
+            ``n``, ``n_valid``, per-hop ``hop_distance_sd_m`` and ``hop_apex_sd_m`` [m], and each
+            outcome's share and figures.
+        """
         return {"n": self.n, "n_valid": self.n_valid, "hop_distance_sd_m": self.hop_distance_sd_m,
                 "hop_apex_sd_m": self.hop_apex_sd_m,
                 "outcomes": {k: dataclasses.asdict(v) for k, v in self.outcomes.items()}}
 
 
 def spread(robot: Robot, cycles: int, marker: str, n: int, seed: int = 0) -> Spread | None:
-    """``n`` draws of ``robot`` over ``cycles``; None when fewer than two are valid."""
+    """``n`` draws of ``robot`` over ``cycles``, simulated in one batch.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot; its values with an uncertainty are drawn.
+    cycles : int
+        Cycles to simulate.
+    marker : str
+        The model's marker to follow.
+    n : int
+        Number of draws.
+    seed : int
+        Seed of the draws.
+
+    Returns
+    -------
+    Spread or None
+        None when fewer than two draws are valid.
+    """
     period = robot.schedule.push_s + robot.schedule.wait_s
     traces, dist, apex, kinds, run_dist, run_nose = [], [], [], [], [], []
     for traj in simulate_draws(robot, n, cycles, seed, keep_states=True):

@@ -17,7 +17,23 @@ from . import page as H
 
 
 def read_front(folder: Path) -> StudyResults:
-    """The study in ``folder``; a folder that is not one is a :class:`ReportError`."""
+    """The study in ``folder``; a folder that is not one is a :class:`ReportError`.
+
+    Parameters
+    ----------
+    folder : Path
+        A ``locust optimize`` folder.
+
+    Returns
+    -------
+    StudyResults
+        Its trials and Pareto front.
+
+    Raises
+    ------
+    ReportError
+        The folder is not a readable study.
+    """
     try:
         return read_study(folder)
     except SweepError as exc:
@@ -25,7 +41,18 @@ def read_front(folder: Path) -> StudyResults:
 
 
 def study_figure(study: StudyResults) -> H.Figure:
-    """The front, its ends and knee, with a caption saying how each design was judged."""
+    """The front, its ends and knee, with a caption saying how each design was judged.
+
+    Parameters
+    ----------
+    study : StudyResults
+        The study, from :func:`read_front`.
+
+    Returns
+    -------
+    Figure
+        The ``pareto`` figure of the page (PNG bytes and caption).
+    """
     objectives = [OBJECTIVES[name] for name in study.objectives]
     chosen = picks_of(study.front)
     fig, ax = pyplot().subplots(figsize=(8, 5))

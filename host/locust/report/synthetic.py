@@ -26,6 +26,20 @@ TRACK_NAME = "synthetic.tracks.csv"
 
 @dataclass(frozen=True)
 class SyntheticTruth:
+    """The true hops of a synthetic trial and where it was written (SYNTHETIC data).
+
+    Attributes
+    ----------
+    hop_distance_m : list of float
+        Per hop, the true nose marker's travel [m].
+    hop_apex_m : list of float
+        Per hop, its highest point above standing [m].
+    distance_m : float
+        Sum of the hop distances [m].
+    track_path, run_path : Path
+        The written ``synthetic.tracks.csv`` and ``run.json``.
+    """
+
     hop_distance_m: list[float]
     hop_apex_m: list[float]
     distance_m: float
@@ -34,7 +48,27 @@ class SyntheticTruth:
 
 
 def simulated_nose(robot: Robot, cycles: int):
-    """The true robot's audited result and its nose marker's trace (schedule clock, 240 Hz)."""
+    """The true robot's audited result and its nose marker's trace (schedule clock, 240 Hz).
+
+    Parameters
+    ----------
+    robot : Robot
+        The "true" robot.
+    cycles : int
+        Cycles to simulate.
+
+    Returns
+    -------
+    result : SimResult
+        The audited result (its states dropped).
+    trace : Aligned
+        The nose marker, t = 0 at the first push [s], from where it stood [m].
+
+    Raises
+    ------
+    ValueError
+        The simulation failed its audit.
+    """
     from ..sim.run import run
     from .predict import marker_trace
 
@@ -48,7 +82,34 @@ def simulated_nose(robot: Robot, cycles: int):
 def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int = 0, fps: float = 30.0,
                           noise_m: float = 0.0005, camera_lead_s: float = 0.25, lost_frames: int = 3,
                           truth=None) -> SyntheticTruth:
-    """Write one synthetic trial into ``folder``; ``truth`` reuses a :func:`simulated_nose`."""
+    """Write one SYNTHETIC trial into ``folder``: a tracks CSV and a run record.
+
+    Parameters
+    ----------
+    folder : Path
+        Made if missing.
+    robot : Robot
+        The "true" robot simulated.
+    cycles : int
+        Cycles to simulate.
+    seed : int
+        Seed of the noise, the lost frames and the phase start errors.
+    fps : float
+        The camera's frame rate [1/s].
+    noise_m : float
+        Standard deviation of the Gaussian position noise [m].
+    camera_lead_s : float
+        Filmed standing time before the first push [s].
+    lost_frames : int
+        Frames marked not found, drawn after frame 12.
+    truth : tuple, optional
+        A :func:`simulated_nose` result to reuse instead of simulating again.
+
+    Returns
+    -------
+    SyntheticTruth
+        The true hops and the written paths.
+    """
     from ..io.run_record import COMPLETE, HopSchedule, Phase, RunRecord
     from ..io.run_record import write as write_record
     from ..io.tracks_csv import MarkerColumns, TracksCsv, write_tracks_csv

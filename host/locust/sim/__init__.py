@@ -1,5 +1,16 @@
-"""Four-bar solver, MuJoCo model builder, audited hop rollout, marker kinematics, camera and
-video clips, live simulation."""
+"""The simulated robot in MuJoCo: build the model, roll out the hop schedule, audit, measure,
+film.
+
+``fourbar`` solves the leg linkage; ``servo`` and ``model`` build the MuJoCo model (MjSpec);
+``schedule`` turns the hop schedule into a per-step command; ``rollout`` and ``batching`` run
+it with ``mujoco.rollout``; ``audit`` invalidates a run that breaks its own physics; ``hops``
+and ``outcome`` measure each hop and name the run's regime; ``run`` does all of that for one
+robot and returns ``result``'s :class:`~.result.SimResult`; ``samples`` and ``sensitivity``
+simulate draws and one-at-a-time moves of the uncertain values; ``statics`` finds the
+standing robot's load on its nose; ``kinematics`` poses the markers at kept states;
+``camera``, ``clip``, ``still`` and ``stickers`` render videos and stills with their
+ground truth; ``live`` steps the model as the virtual robot's servo commands arrive.
+"""
 
 import os
 

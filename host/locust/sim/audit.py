@@ -36,6 +36,26 @@ SETTLED_SPEED_LIMIT_M_PER_S = 0.05   # sqrt(2 KE / mass) when the first push is 
 
 @dataclass
 class Audit:
+    """The audit of one run: whether it is valid, why not, and the figures it was judged on.
+
+    Attributes
+    ----------
+    valid : bool
+        No check failed.
+    reasons : list of str
+        Each failed check, with its measured value and limit.
+    loop_residual_max_m : float
+        Largest distance between a leg's two loop anchors during the run [m].
+    energy_surplus_max_j : float
+        Largest mechanical energy above its start plus the servos' work, E(t) - E(0) - W_servo(t) [J].
+    servo_work_j : float
+        Positive work the servos did [J].
+    warnings : dict of str to int
+        MuJoCo's warnings by name, with their counts.
+    notes : list of str
+        What is worth knowing but does not invalidate the run (a soft loop).
+    """
+
     valid: bool
     reasons: list[str] = field(default_factory=list)
     loop_residual_max_m: float = float("nan")
@@ -46,6 +66,18 @@ class Audit:
 
 
 def audit(traj: Trajectory) -> Audit:
+    """Check a rollout against its own physics (the checks are listed in the module docstring).
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The rollout, with its sensor data.
+
+    Returns
+    -------
+    Audit
+        Invalid, with its reasons, when any check fails.
+    """
     s = traj.built.sensors
     sd = traj.sensordata
     reasons: list[str] = []

@@ -36,10 +36,29 @@ class CameraView:
     elevation_deg: float = ELEVATION_DEG
 
     def at_x(self, x_m: float) -> CameraView:
+        """The same view moved along the floor to look at ``x_m``.
+
+        Parameters
+        ----------
+        x_m : float
+            The new look-at point's x [m].
+
+        Returns
+        -------
+        CameraView
+            The view with ``lookat_m[0] = x_m``.
+        """
         return CameraView((x_m, self.lookat_m[1], self.lookat_m[2]), self.distance_m,
                           self.azimuth_deg, self.elevation_deg)
 
     def mjv_camera(self) -> mujoco.MjvCamera:
+        """The view as MuJoCo's free camera.
+
+        Returns
+        -------
+        mujoco.MjvCamera
+            A free camera at this look-at point, distance, azimuth and elevation.
+        """
         cam = mujoco.MjvCamera()
         cam.type = mujoco.mjtCamera.mjCAMERA_FREE
         cam.lookat[:] = self.lookat_m
@@ -68,25 +87,75 @@ class PinholeCamera:
 
     @property
     def translation_m(self) -> np.ndarray:
+        """The translation t of ``X_cam = R X + t`` [m]."""
         return -self.rotation @ self.position_m
 
     def to_camera(self, points_m: np.ndarray) -> np.ndarray:
+        """World points in the camera's frame.
+
+        Parameters
+        ----------
+        points_m : ndarray
+            (N, 3) or (3,) world points [m].
+
+        Returns
+        -------
+        ndarray
+            (N, 3) points in the camera frame (x right, y down, z forward) [m].
+        """
         return (np.atleast_2d(points_m) - self.position_m) @ self.rotation.T
 
     def project(self, points_m: np.ndarray) -> np.ndarray:
-        """World points (N, 3) in metres -> pixel centres (N, 2)."""
+        """World points (N, 3) in metres -> pixel centres (N, 2).
+
+        Parameters
+        ----------
+        points_m : ndarray
+            (N, 3) or (3,) world points [m], in front of the camera.
+
+        Returns
+        -------
+        ndarray
+            (N, 2) pixel coordinates [px], origin at the centre of the top-left pixel.
+        """
         pc = self.to_camera(points_m)
         return np.column_stack([self.fx_px * pc[:, 0] / pc[:, 2] + self.cx_px,
                                 self.fy_px * pc[:, 1] / pc[:, 2] + self.cy_px])
 
     def m_per_px_at_depth(self, depth_m: float) -> float:
+        """The size of one pixel on a plane facing the camera.
+
+        Parameters
+        ----------
+        depth_m : float
+            The plane's distance along the optical axis [m].
+
+        Returns
+        -------
+        float
+            Metres per pixel (horizontally) at that depth [m/px].
+        """
         return depth_m / self.fx_px
 
     def intrinsics(self) -> dict:
+        """The intrinsics as a JSON object.
+
+        Returns
+        -------
+        dict
+            ``fx_px``, ``fy_px``, ``cx_px``, ``cy_px`` [px] and the 3x3 matrix ``K``.
+        """
         return {"fx_px": self.fx_px, "fy_px": self.fy_px, "cx_px": self.cx_px, "cy_px": self.cy_px,
                 "K": [[self.fx_px, 0.0, self.cx_px], [0.0, self.fy_px, self.cy_px], [0.0, 0.0, 1.0]]}
 
     def extrinsics(self) -> dict:
+        """The extrinsics as a JSON object.
+
+        Returns
+        -------
+        dict
+            ``rotation_world_to_camera`` (3x3), ``translation_m`` and ``position_m`` [m].
+        """
         return {"rotation_world_to_camera": self.rotation.tolist(),
                 "translation_m": self.translation_m.tolist(), "position_m": self.position_m.tolist()}
 
@@ -99,6 +168,23 @@ def pinhole_from_scene(scene: mujoco.MjvScene, width_px: int, height_px: int) ->
     half-width; 0: the width follows the viewport's aspect ratio). Pixel i spans window
     coordinates [i, i + 1], so its centre is at i + 0.5: OpenCV's index is window - 0.5.
     :func:`set_scene_pinhole` is the inverse.
+
+    Parameters
+    ----------
+    scene : mujoco.MjvScene
+        A scene after ``update_scene``.
+    width_px, height_px : int
+        The viewport's size [px].
+
+    Returns
+    -------
+    PinholeCamera
+        Intrinsics [px] and pose (world-to-camera rotation, centre [m]).
+
+    Raises
+    ------
+    SimError
+        An orthographic render camera.
     """
     cams = [scene.camera[0], scene.camera[1]]   # the two eyes coincide without stereo
     gl = cams[0]
@@ -126,6 +212,18 @@ def free_camera_at(cam: PinholeCamera, distance_m: float = 1.0) -> CameraView:
     The free camera has no roll and its own field of view: :func:`set_scene_pinhole` then
     puts ``cam``'s exact orientation and intrinsics on the scene. Rendering through this view
     first places what follows the camera (the headlight) where ``cam`` is.
+
+    Parameters
+    ----------
+    cam : PinholeCamera
+        The camera to stand in for.
+    distance_m : float
+        How far ahead of the camera the look-at point is put [m].
+
+    Returns
+    -------
+    CameraView
+        The free camera's look-at point [m], distance [m], azimuth and elevation [deg].
     """
     f = np.asarray(cam.rotation[2], dtype=float)
     azimuth = math.degrees(math.atan2(f[1], f[0]))
@@ -138,7 +236,15 @@ def set_scene_pinhole(scene: mujoco.MjvScene, cam: PinholeCamera) -> None:
     """Make ``scene`` (after ``update_scene``) render through ``cam`` in a ``cam.width_px`` x
     ``cam.height_px`` viewport: its pose (world -> camera rotation, centre) and intrinsics
     (fx, fy, cx, cy), the inverse of :func:`pinhole_from_scene`. The near and far planes stay
-    MuJoCo's."""
+    MuJoCo's.
+
+    Parameters
+    ----------
+    scene : mujoco.MjvScene
+        The scene; both eyes of its camera are set.
+    cam : PinholeCamera
+        The camera to render through.
+    """
     w, h = cam.width_px, cam.height_px
     for gl in (scene.camera[0], scene.camera[1]):
         near = float(gl.frustum_near)
@@ -164,6 +270,26 @@ def frame_views(points_m: np.ndarray, chassis_x_m: np.ndarray, body_length_m: fl
 
     ``points_m`` (N, 3): positions the robot reaches (nose, foot, chassis ...). Both views
     look horizontally at the plane ``y = plane_y_m``; the floor (z = 0) stays in the frame.
+
+    Parameters
+    ----------
+    points_m : ndarray
+        (N, 3) world positions the robot reaches [m].
+    chassis_x_m : ndarray
+        The chassis' x over the run [m]; the tracking view starts at its first value.
+    body_length_m : float
+        The plate's length [m]; the tracking view is four body lengths wide.
+    plane_y_m : float
+        The plane both views look at [m].
+    fovy_deg : float
+        The camera's vertical field of view [deg].
+    aspect : float
+        Width over height of the frame.
+
+    Returns
+    -------
+    fixed, track : CameraView
+        The fixed view and the tracking view.
     """
     x_lo, x_hi = float(np.min(points_m[:, 0])) - MARGIN_M, float(np.max(points_m[:, 0])) + MARGIN_M
     z_lo = min(0.0, float(np.min(points_m[:, 2]))) - MARGIN_M

@@ -81,6 +81,18 @@ class PoseRenderer:
                            "or MUJOCO_GL=egl on a GPU") from None
 
     def pose(self, qpos: np.ndarray) -> mujoco.MjData:
+        """Pose the private data at ``qpos`` (kinematics, centres of mass, lights; no step).
+
+        Parameters
+        ----------
+        qpos : ndarray
+            The model's joint positions, ``(nq,)`` [m, rad, quaternion as MuJoCo keeps them].
+
+        Returns
+        -------
+        mujoco.MjData
+            The posed private data.
+        """
         d = self.data
         d.qpos[:] = qpos
         mujoco.mj_kinematics(self.model, d)
@@ -89,6 +101,25 @@ class PoseRenderer:
         return d
 
     def render(self, camera: CameraView | PinholeCamera) -> tuple[np.ndarray, PinholeCamera]:
+        """Render the posed model through ``camera``.
+
+        Parameters
+        ----------
+        camera : CameraView or PinholeCamera
+            The free camera's view, or a pinhole camera of this renderer's size.
+
+        Returns
+        -------
+        rgb : ndarray
+            ``(height, width, 3)`` uint8 image, RGB.
+        pinhole : PinholeCamera
+            The camera the frame was rendered through.
+
+        Raises
+        ------
+        SimError
+            A pinhole camera of another size than the renderer's.
+        """
         pinhole = camera if isinstance(camera, PinholeCamera) else None
         if pinhole is not None and (pinhole.width_px, pinhole.height_px) != (self.width, self.height):
             raise SimError(f"a {pinhole.width_px}x{pinhole.height_px} camera cannot render a "
@@ -102,6 +133,7 @@ class PoseRenderer:
         return self.renderer.render(), cam
 
     def close(self) -> None:
+        """Free the offscreen renderer; closing twice is harmless."""
         if getattr(self, "renderer", None) is not None:
             self.renderer.close()
             self.renderer = None
@@ -109,7 +141,22 @@ class PoseRenderer:
 
 def face_centre_m(model: mujoco.MjModel, data: mujoco.MjData, geom_id: int) -> np.ndarray:
     """Centre of what the camera sees of a marker posed in ``data``: a disc's camera-facing
-    (+y) face, a sphere's centre."""
+    (+y) face, a sphere's centre.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The model.
+    data : mujoco.MjData
+        Its data, posed.
+    geom_id : int
+        The marker's geom.
+
+    Returns
+    -------
+    ndarray
+        (3,) world position [m].
+    """
     centre = data.geom_xpos[geom_id].copy()
     if model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
         axis = data.geom_xmat[geom_id].reshape(3, 3)[:, 2]
@@ -124,6 +171,24 @@ def seen_fraction(model: mujoco.MjModel, data: mujoco.MjData, cam: PinholeCamera
     Rays go from the camera centre to points spread over what the camera sees of the
     marker (``_DISC_SAMPLES``): a disc's face, or a sphere's disc across the line of
     sight; a ray that meets the marker first sees it.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The model.
+    data : mujoco.MjData
+        Its data, posed.
+    cam : PinholeCamera
+        The camera.
+    centre_m : ndarray
+        (3,) the marker's seen centre (:func:`face_centre_m`) [m].
+    geom_id : int
+        The marker's geom.
+
+    Returns
+    -------
+    float
+        Share of the sample rays that meet the marker first, 0..1.
     """
     radius = float(model.geom_size[geom_id][0])
     if model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
@@ -145,6 +210,26 @@ def seen_fraction(model: mujoco.MjModel, data: mujoco.MjData, cam: PinholeCamera
 # -- one clip: frames, truth rows, sidecars ------------------------------------------
 @dataclass
 class RenderedClip:
+    """A rendered video and its sidecars.
+
+    Attributes
+    ----------
+    video_path : Path
+        The MP4.
+    truth_path : Path
+        ``<stem>.truth.csv``: every marker's true pixel and world position per frame.
+    frames : int
+        Frames written.
+    fps : int
+        Frame rate [1/s].
+    width, height : int
+        Frame size [px].
+    camera_path : Path or None
+        ``<stem>.camera.json``: the camera's intrinsics and pose.
+    camera : str
+        ``track`` (follows the chassis) or ``fixed``.
+    """
+
     video_path: Path
     truth_path: Path
     frames: int
@@ -156,12 +241,39 @@ class RenderedClip:
 
 
 def sidecar_paths(path: Path) -> tuple[Path, Path]:
-    """A clip's two sidecars: ``<stem>.truth.csv`` and ``<stem>.camera.json``."""
+    """A clip's two sidecars: ``<stem>.truth.csv`` and ``<stem>.camera.json``.
+
+    Parameters
+    ----------
+    path : Path
+        The clip (or still) path.
+
+    Returns
+    -------
+    truth, camera : Path
+        The two sidecar paths beside it.
+    """
     return path.with_name(path.stem + ".truth.csv"), camera_json_beside(path)
 
 
 def check_video_path(path: str | os.PathLike) -> Path:
-    """Refuse names OpenCV cannot write as MP4 and never overwrite an earlier render."""
+    """Refuse names OpenCV cannot write as MP4 and never overwrite an earlier render.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The video path asked for.
+
+    Returns
+    -------
+    Path
+        The same path, checked.
+
+    Raises
+    ------
+    SimError
+        Not ``.mp4``, the video or a sidecar exists already, or its folder is a file.
+    """
     path = Path(path)
     if path.suffix.lower() != ".mp4":
         raise SimError(f"video path {path} does not end in .mp4", "name the video <something>.mp4")
@@ -221,9 +333,19 @@ class ClipRecorder:
 
     @property
     def frames(self) -> int:
+        """Frames added so far."""
         return len(self.rows)
 
     def add_frame(self, qpos: np.ndarray, t_s: float) -> None:
+        """Pose and render the model, write the frame and record where its markers are.
+
+        Parameters
+        ----------
+        qpos : ndarray
+            The model's joint positions for this frame.
+        t_s : float
+            The frame's time [s].
+        """
         d = self.poser.pose(qpos)
         view = self.view.at_x(float(d.xpos[self.chassis_id][0])) if self.camera == "track" else self.view
         rgb, cam = self.poser.render(view)
@@ -245,6 +367,14 @@ class ClipRecorder:
         return seen_fraction(self.model, self.data, cam, centre_m, geom_id)
 
     def truth_csv(self) -> str:
+        """The truth sidecar's text: per frame, each marker's pixel, visibility, seen fraction and
+        world x, z.
+
+        Returns
+        -------
+        str
+            CSV with a ``#`` comment line, pixels [px] and positions [m].
+        """
         lines = [(f"# simulated ground truth: MuJoCo render of robot {self.robot_name!r}, camera {self.camera}; "
                   "pixels in the OpenCV convention (origin at the centre of the top-left pixel, x right, y down); "
                   "world x along the floor, z up, metres"),
@@ -260,7 +390,14 @@ class ClipRecorder:
         return "\n".join(lines) + "\n"
 
     def camera_file(self) -> CameraFile:
-        """The camera this clip was rendered with, as its owner (:mod:`locust.io.camera_json`) writes it."""
+        """The camera this clip was rendered with, as its owner (:mod:`locust.io.camera_json`) writes it.
+
+        Returns
+        -------
+        CameraFile
+            Intrinsics, rotation, one position (fixed) or one per frame (track) [m], and the
+            markers' planes.
+        """
         first = self.cameras[0]
         K = np.array([[first.fx_px, 0.0, first.cx_px], [0.0, first.fy_px, first.cy_px], [0.0, 0.0, 1.0]])
         fixed = self.camera == "fixed"
@@ -274,7 +411,13 @@ class ClipRecorder:
                   "azimuth_deg": self.view.azimuth_deg, "elevation_deg": self.view.elevation_deg})
 
     def marker_planes(self) -> dict:
-        """The plane y = const each marker's visible centre moves in, and how far it strays from it."""
+        """The plane y = const each marker's visible centre moves in, and how far it strays from it.
+
+        Returns
+        -------
+        dict of str to dict
+            Per marker, ``plane_y_m`` (the mean y) and ``max_off_plane_m`` [m].
+        """
         out = {}
         for n in MARKERS:
             y = np.array([r.world_m[n][1] for r in self.rows])
@@ -282,6 +425,20 @@ class ClipRecorder:
         return out
 
     def finish(self) -> RenderedClip:
+        """Write the sidecars and move the video into place; on any failure leave nothing behind.
+
+        Returns
+        -------
+        RenderedClip
+            The video and its sidecars.
+
+        Raises
+        ------
+        SimError
+            No frames to write.
+        WriteError
+            The encoded video does not read back whole.
+        """
         try:
             self.writer.release()
             self.poser.close()
@@ -299,6 +456,7 @@ class ClipRecorder:
                          width=self.width, height=self.height, camera_path=camera_path, camera=self.camera)
 
     def abort(self) -> None:
+        """Release the writer and renderer and delete the temporary video."""
         if getattr(self, "writer", None) is not None:
             self.writer.release()
         if getattr(self, "poser", None) is not None:
@@ -310,11 +468,38 @@ class ClipRecorder:
 
 
 def frame_times_s(duration_s: float, fps: int) -> np.ndarray:
-    """One frame every 1/fps from t = 0: ``round(duration * fps)`` frames."""
+    """One frame every 1/fps from t = 0: ``round(duration * fps)`` frames.
+
+    Parameters
+    ----------
+    duration_s : float
+        The span to film [s].
+    fps : int
+        Frame rate [1/s].
+
+    Returns
+    -------
+    ndarray
+        The frames' times [s].
+    """
     return np.arange(round(duration_s * fps)) / fps
 
 
 def validate_size(fps: int, width: int, height: int) -> None:
+    """Refuse a frame rate or frame size the video writer should not be given.
+
+    Parameters
+    ----------
+    fps : int
+        Frame rate, a whole number in 1..1000 [1/s].
+    width, height : int
+        Frame size, even whole numbers in 16..4096 [px].
+
+    Raises
+    ------
+    SimError
+        Any of them out of range.
+    """
     if not (isinstance(fps, int) and 1 <= fps <= 1000):
         raise SimError(f"video fps = {fps!r} is not a whole number of frames per second in 1..1000",
                        "use e.g. fps=30")
@@ -335,6 +520,34 @@ def render_video(robot: Robot, path: str | os.PathLike, cycles: int | None = Non
     ``trajectory``: a rollout of ``robot`` already made with its states kept (e.g.
     ``run(robot, keep_states=True).trajectory``) is rendered as it is, not simulated again;
     ``cycles`` is then the trajectory's own.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot to simulate.
+    path : str or os.PathLike
+        The MP4 to write; it and its sidecars must not exist.
+    cycles : int, optional
+        Cycles to simulate; default the robot's schedule's.
+    camera : str
+        ``track`` (follows the chassis) or ``fixed``.
+    fps : int
+        Frame rate [1/s].
+    width, height : int
+        Frame size [px].
+    trajectory : Trajectory, optional
+        A rollout of ``robot`` with its states kept, rendered instead of a new one.
+
+    Returns
+    -------
+    RenderedClip
+        The video and its sidecars.
+
+    Raises
+    ------
+    SimError
+        An unknown camera, a bad size or path, a trajectory without states, a simulation that
+        fails its audit, or a video that cannot be written.
     """
     if camera not in CAMERAS:
         raise SimError(f"camera {camera!r} is not known", f"choose one of {', '.join(CAMERAS)}")

@@ -42,6 +42,16 @@ def grashof_class(ground_m: float, crank_m: float, coupler_m: float, leg_m: floa
     ``"crank-rocker"``, ``"double-crank"``, ``"double-rocker"`` (Grashof: s + l < p + q, so at
     least one link turns fully), ``"change-point"`` (s + l == p + q: it can fold flat) or
     ``"non-grashof"`` (triple rocker: no link turns fully).
+
+    Parameters
+    ----------
+    ground_m, crank_m, coupler_m, leg_m : float
+        The four link lengths [m].
+
+    Returns
+    -------
+    str
+        The class's name.
     """
     links = [ground_m, crank_m, coupler_m, leg_m]
     shortest_m, longest_m = min(links), max(links)
@@ -56,6 +66,19 @@ def grashof_class(ground_m: float, crank_m: float, coupler_m: float, leg_m: floa
 
 
 def check_lengths(ground_m: float, crank_m: float, coupler_m: float, leg_m: float) -> None:
+    """Refuse link lengths no four-bar can be built from.
+
+    Parameters
+    ----------
+    ground_m, crank_m, coupler_m, leg_m : float
+        The four link lengths [m].
+
+    Raises
+    ------
+    GeometryError
+        A length that is not a positive number, or a longest link not shorter than the other
+        three together.
+    """
     names = {"geometry.ground_m": ground_m, "geometry.crank_m": crank_m,
              "geometry.coupler_m": coupler_m, "geometry.leg_m": leg_m}
     for key, value in names.items():
@@ -73,7 +96,25 @@ def check_lengths(ground_m: float, crank_m: float, coupler_m: float, leg_m: floa
 
 def assemble(ground_m: float, crank_m: float, coupler_m: float, leg_m: float,
              crank_deg: float) -> Assembly:
-    """Assemble the loop at ``crank_deg``; :class:`GeometryError` names the violated condition."""
+    """Assemble the loop at ``crank_deg``; :class:`GeometryError` names the violated condition.
+
+    Parameters
+    ----------
+    ground_m, crank_m, coupler_m, leg_m : float
+        The four link lengths [m].
+    crank_deg : float
+        The crank's angle from the ground link [deg].
+
+    Returns
+    -------
+    Assembly
+        The joint positions [m], link angles [deg], transmission angle [deg] and Grashof class.
+
+    Raises
+    ------
+    GeometryError
+        Bad lengths, or a loop that cannot close at this crank angle.
+    """
     check_lengths(ground_m, crank_m, coupler_m, leg_m)
     th = math.radians(crank_deg)
     p1 = (-ground_m / 2, 0.0)

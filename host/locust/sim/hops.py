@@ -16,6 +16,24 @@ from .rollout import Trajectory
 
 @dataclass(frozen=True)
 class Hop:
+    """One schedule cycle's figures from a simulated run.
+
+    Attributes
+    ----------
+    cycle : int
+        The cycle, from 1.
+    distance_m : float
+        Chassis x travelled during the cycle [m].
+    nose_apex_m : float
+        Highest nose point above standing nose height [m].
+    com_apex_m : float
+        Highest centre of mass above its standing height [m].
+    flight_s : float
+        Longest time with no part of the robot on the floor [s].
+    end_turn_deg : float
+        Plate pitch at the cycle's end less its standing pitch, nose up positive [deg].
+    """
+
     cycle: int
     distance_m: float            # chassis x travelled during the cycle
     nose_apex_m: float           # highest nose point above standing nose height
@@ -26,6 +44,24 @@ class Hop:
 
 @dataclass(frozen=True)
 class HopSummary:
+    """The whole run's figures and its hops.
+
+    Attributes
+    ----------
+    hops : list of Hop
+        One per cycle.
+    distance_m : float
+        Chassis x from the start of the schedule to the end of the run [m].
+    max_nose_height_m : float
+        Highest nose point during the run, above the floor [m] (the notebook's metric).
+    standing_nose_m, standing_com_m : float
+        Nose and centre-of-mass height standing, at the end of the settle phase [m].
+    end_nose_rise_m : float
+        Nose height at the end of the run above its standing height [m].
+    end_turn_deg : float
+        Plate pitch at the end of the run less its standing pitch, nose up positive [deg].
+    """
+
     hops: list[Hop]
     distance_m: float            # chassis x, start of the schedule -> end of the run
     max_nose_height_m: float     # highest nose point during the run (the notebook's metric)
@@ -46,12 +82,35 @@ def _longest_run(mask: np.ndarray) -> int:
 def plate_pitch_deg(nose_xyz: np.ndarray, chassis_xyz: np.ndarray) -> np.ndarray:
     """The plate's pitch in the legs' plane at each row: the angle of the line from the
     plate's centre to its nose above the floor, nose up positive, unwrapped over the rows so
-    that a robot turning over past the vertical keeps counting (deg)."""
+    that a robot turning over past the vertical keeps counting (deg).
+
+    Parameters
+    ----------
+    nose_xyz, chassis_xyz : ndarray
+        (N, 3) nose and plate-centre positions [m].
+
+    Returns
+    -------
+    ndarray
+        (N,) pitch [deg].
+    """
     d = np.asarray(nose_xyz) - np.asarray(chassis_xyz)
     return np.degrees(np.unwrap(np.arctan2(d[:, 2], d[:, 0])))
 
 
 def summarise(traj: Trajectory) -> HopSummary:
+    """Cut a rollout into its schedule's cycles and measure each hop.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The rollout, with its sensor data and control plan.
+
+    Returns
+    -------
+    HopSummary
+        The run's figures and one :class:`Hop` per cycle.
+    """
     s, sd, plan = traj.built.sensors, traj.sensordata, traj.plan
     nose_z = sd[:, s.nose_pos][:, 2]
     com_z = sd[:, s.com_pos][:, 2]

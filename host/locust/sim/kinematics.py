@@ -25,6 +25,22 @@ def trace_rows(timestep_s: float, settle_steps: int, nstep: int) -> tuple[np.nda
     last, the stride the largest that keeps at least ``TRACE_HZ`` samples a second, plus the
     last row of the settle phase (where the robot stood). The trace's times are
     ``(rows + 1 - settle_steps) * timestep_s``: row i is the state after step i + 1.
+
+    Parameters
+    ----------
+    timestep_s : float
+        The physics step [s].
+    settle_steps : int
+        Steps in the settle phase.
+    nstep : int
+        Steps in the rollout.
+
+    Returns
+    -------
+    rows : ndarray
+        The state rows, ascending.
+    stand : int
+        The standing row.
     """
     stride = max(1, int(1.0 / (TRACE_HZ * timestep_s)))
     stand = max(settle_steps - 1, 0)
@@ -37,7 +53,20 @@ def _marker_geom(model: mujoco.MjModel, marker: str) -> int:
 
 
 def carries_marker(traj: Trajectory, marker: str) -> bool:
-    """Whether the trajectory's model carries the ``marker_<marker>`` disc."""
+    """Whether the trajectory's model carries the ``marker_<marker>`` disc.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The rollout.
+    marker : str
+        The marker's name (``nose``, ``foot``).
+
+    Returns
+    -------
+    bool
+        True when the model has the geom.
+    """
     return _marker_geom(traj.built.model, marker) >= 0
 
 
@@ -45,6 +74,25 @@ def marker_positions(traj: Trajectory, marker: str, rows: np.ndarray) -> np.ndar
     """World position (N, 3), metres, of the ``marker_<marker>`` geom's centre at state rows ``rows``.
 
     Row i is the state after physics step i + 1 (as in ``traj.states``).
+
+    Parameters
+    ----------
+    traj : Trajectory
+        A rollout that kept its states.
+    marker : str
+        The marker's name.
+    rows : ndarray
+        State rows.
+
+    Returns
+    -------
+    ndarray
+        (len(rows), 3) positions [m].
+
+    Raises
+    ------
+    SimError
+        The trajectory kept no states, or the model has no such marker.
     """
     if traj.states is None:
         raise SimError("the trajectory kept no states to pose the model from",
@@ -57,12 +105,42 @@ def marker_positions(traj: Trajectory, marker: str, rows: np.ndarray) -> np.ndar
 
 
 def marker_geoms(model: mujoco.MjModel, markers) -> list[int]:
-    """Geom ids of the ``marker_<name>`` discs (-1 where the model has none)."""
+    """Geom ids of the ``marker_<name>`` discs (-1 where the model has none).
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The model.
+    markers : iterable of str
+        Marker names.
+
+    Returns
+    -------
+    list of int
+        One geom id per marker.
+    """
     return [_marker_geom(model, m) for m in markers]
 
 
 def geom_positions(model: mujoco.MjModel, states: np.ndarray, geoms, rows: np.ndarray) -> np.ndarray:
-    """World positions (len(rows), len(geoms), 3), metres, of geom centres at FULLPHYSICS state rows."""
+    """World positions (len(rows), len(geoms), 3), metres, of geom centres at FULLPHYSICS state rows.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The model.
+    states : ndarray
+        FULLPHYSICS states, one row per step.
+    geoms : iterable of int
+        Geom ids.
+    rows : ndarray
+        State rows.
+
+    Returns
+    -------
+    ndarray
+        (len(rows), len(geoms), 3) positions [m].
+    """
     data = mujoco.MjData(model)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     geoms = list(geoms)

@@ -48,6 +48,32 @@ PREROLL_S = 0.5   # a video opens on the robot standing still this long before t
 
 @dataclass(frozen=True)
 class LiveResult:
+    """What a live simulation has done so far.
+
+    Attributes
+    ----------
+    distance_m : float
+        Chassis x from the end of the settle phase to now [m].
+    max_nose_height_m : float
+        Highest nose point since the settle phase [m].
+    sim_time_s : float
+        Simulated time since the settle phase [s].
+    valid : bool
+        The run passed its audit.
+    reasons : list of str
+        Why not, when invalid.
+    realtime_factor : float
+        Simulated seconds per wall second spent stepping (and rendering).
+    video_path : str or None
+        The video written, if any.
+    frames : int
+        Frames in it.
+    hops : list of dict
+        Per push, :class:`locust.sim.hops.Hop`'s fields.
+    outcome : str or None
+        ``goes_over``, ``rears_and_returns`` or ``stays_low`` over the pushes (None: no push yet).
+    """
+
     distance_m: float            # chassis x, end of the settle phase -> now
     max_nose_height_m: float     # highest nose point since the settle phase
     sim_time_s: float            # simulated time since the settle phase
@@ -60,6 +86,13 @@ class LiveResult:
     outcome: str | None = None   # goes_over / rears_and_returns / stays_low over the pushes (None: none)
 
     def to_dict(self) -> dict:
+        """The fields by name.
+
+        Returns
+        -------
+        dict
+            A shallow copy of the fields.
+        """
         return dict(self.__dict__)
 
 
@@ -124,7 +157,18 @@ class LiveSim:
 
     # -- commands -------------------------------------------------------------------
     def set_servo_angles_deg(self, left_deg: float, right_deg: float) -> None:
-        """Horn angles vs rest (push = -30 on both legs); they hold until the next call."""
+        """Horn angles vs rest (push = -30 on both legs); they hold until the next call.
+
+        Parameters
+        ----------
+        left_deg, right_deg : float
+            The left and right horn angles from rest [deg].
+
+        Raises
+        ------
+        SimError
+            A command that is not a finite number, or a closed simulation.
+        """
         for side, value in zip(SIDES, (left_deg, right_deg)):
             if not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise SimError(f"servo command {side} = {value!r} deg is not a finite number",
@@ -135,7 +179,18 @@ class LiveSim:
                 self.data.ctrl[act] = math.radians(float(value))
 
     def advance_to(self, t_s: float) -> None:
-        """Step physics up to ``t_s`` seconds after the settle phase (an earlier time does nothing)."""
+        """Step physics up to ``t_s`` seconds after the settle phase (an earlier time does nothing).
+
+        Parameters
+        ----------
+        t_s : float
+            Time since the end of the settle phase [s], finite and >= 0.
+
+        Raises
+        ------
+        SimError
+            A bad time, a closed or cancelled simulation.
+        """
         if not isinstance(t_s, (int, float)) or not math.isfinite(t_s) or t_s < 0:
             raise SimError(f"advance_to({t_s!r}): time must be a finite number of seconds >= 0",
                            "pass the seconds since the virtual robot started")
@@ -145,6 +200,7 @@ class LiveSim:
 
     @property
     def sim_time_s(self) -> float:
+        """Simulated time since the end of the settle phase [s]."""
         return (self._steps - getattr(self, "_settle_steps", self._steps)) * self.dt
 
     # -- stepping -------------------------------------------------------------------
@@ -231,7 +287,13 @@ class LiveSim:
             raise SimError("the live simulation is closed", "make a new LiveSim for another run")
 
     def close(self) -> dict:
-        """Finish the video; audit and summarise the run. Calling it again returns the same."""
+        """Finish the video; audit and summarise the run. Calling it again returns the same.
+
+        Returns
+        -------
+        dict
+            :class:`LiveResult`'s fields.
+        """
         with self._lock:
             if self._result is None:
                 self._result = self._finish()
@@ -268,7 +330,18 @@ class LiveSim:
     def finished_hops(self, rest_s: float) -> list[dict]:
         """The hops done so far, cut as :meth:`close` cuts them: a hop is done once the next push
         has started or the servos have been at rest ``rest_s`` since it (so the last hop of a
-        schedule shows while the robot stays idle). Empty after a run that breaks its audit."""
+        schedule shows while the robot stays idle). Empty after a run that breaks its audit.
+
+        Parameters
+        ----------
+        rest_s : float
+            Time at rest after a push that ends its hop [s].
+
+        Returns
+        -------
+        list of dict
+            Per finished hop, :class:`locust.sim.hops.Hop`'s fields.
+        """
         with self._lock:
             settle = getattr(self, "_settle_steps", self._steps)
             ctrl = np.concatenate(self._ctrl_chunks)[settle:] if self._ctrl_chunks else np.empty(0)
@@ -286,7 +359,13 @@ class LiveSim:
             return _per_push(traj)[:done]
 
     def trajectory(self) -> Trajectory:
-        """The record so far, in the rollout's form (one row per physics step, settle included)."""
+        """The record so far, in the rollout's form (one row per physics step, settle included).
+
+        Returns
+        -------
+        Trajectory
+            Sensor data and commands so far, no states kept.
+        """
         nsd = self.model.nsensordata
         sd = np.concatenate(self._chunks) if self._chunks else np.empty((0, nsd))
         ctrl = np.concatenate(self._ctrl_chunks) if self._ctrl_chunks else np.empty(0)

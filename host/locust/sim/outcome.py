@@ -1,4 +1,4 @@
-"""The regime of a simulated run: does the robot go over, rear and return, or stay low?
+"""The regime of a simulated run: whether the robot goes over, rears and returns, or stays low.
 
 Each leg set of the robot as built sits near a threshold: a push that carries the centre of
 mass behind the feet turns the robot over onto its back, where it stays; a weaker one rears
@@ -53,6 +53,8 @@ OVER_TURN_DEG = 45.0    # a cycle that ends turned more than this nose up has go
 
 
 class HopFigures(Protocol):
+    """What :func:`classify` reads of a hop: ``nose_apex_m`` [m] and ``end_turn_deg`` [deg]."""
+
     nose_apex_m: float
     end_turn_deg: float
 
@@ -92,6 +94,16 @@ def classify(hops: Sequence[HopFigures]) -> str:
 
 @dataclass(frozen=True)
 class MeanSd:
+    """A figure's mean and spread over draws, in the figure's unit.
+
+    Attributes
+    ----------
+    mean : float
+        Mean (nan with no draws).
+    sd : float
+        Sample standard deviation (n - 1); nan with fewer than two draws.
+    """
+
     mean: float      # nan with no draws
     sd: float        # sample standard deviation (n - 1); nan with fewer than two draws
 

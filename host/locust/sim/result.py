@@ -69,7 +69,13 @@ class SimResult:
         """Every figure but the rollout and the robot; from :func:`locust.simulate`, also the standing
         load, with samples each outcome's share and figures (``outcomes``) and the draws
         (``samples``), and with a sensitivity, ``sensitivity``. NaN and inf become null where it is
-        written (:func:`locust.fileio.json_text`)."""
+        written (:func:`locust.fileio.json_text`).
+
+        Returns
+        -------
+        dict
+            The figures by name, in SI units as the field names say.
+        """
         out = dataclasses.asdict(dataclasses.replace(self, trajectory=None, params=None, spread=None, sensitivity=None))
         for key in ("trajectory", "params", "spread", "sensitivity"):
             del out[key]
@@ -166,6 +172,7 @@ class SimResult:
 
         Examples
         --------
+        >>> import locust
         >>> r = locust.simulate(locust.robot("small"), cycles=1)
         >>> r.video("hop.mp4", overwrite=True, width=320, height=240).frames   # doctest: +SKIP
         """
@@ -275,6 +282,22 @@ class SimResult:
 
 
 def invalid_result(robot: Robot, reason: str, cycles: int | None = None) -> SimResult:
+    """A result for a robot that could not be simulated: invalid, with one reason, every figure nan.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot.
+    reason : str
+        Why it was not simulated.
+    cycles : int, optional
+        Cycles asked for; default the robot's schedule's.
+
+    Returns
+    -------
+    SimResult
+        ``valid`` False, no hops, zero duration.
+    """
     nan = float("nan")
     return SimResult(robot=robot.name, valid=False, reasons=[reason], distance_m=nan, max_nose_height_m=nan,
                      hops=[], cycles=cycles or robot.schedule.cycles, timestep_s=robot.solver.timestep_s,

@@ -31,6 +31,29 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
     With ``keep_states`` the result carries the :class:`~.rollout.Trajectory` it was computed
     from, every step's full physics state kept (``result.trajectory.states``); without it,
     ``result.trajectory`` is None. The figures are the same either way.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot.
+    cycles : int, optional
+        Cycles to simulate; default the robot's schedule's.
+    timestep_s : float, optional
+        Physics step instead of the robot's ``solver.timestep_s`` [s].
+    keep_states : bool
+        Keep the rollout with every step's state.
+
+    Returns
+    -------
+    SimResult
+        The audited figures; invalid, with reasons, when the run breaks its audit.
+
+    Raises
+    ------
+    ParamsError
+        A robot or cycle count outside the limits a simulation can run.
+    GeometryError
+        A linkage that cannot be built.
     """
     if timestep_s is not None:
         robot = robot.with_values({"solver.timestep_s": timestep_s})
@@ -66,7 +89,18 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
 
 
 def peak_servo_speed(traj) -> float:
-    """Largest |crank speed| of either servo once the schedule has started."""
+    """Largest |crank speed| of either servo once the schedule has started.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The rollout.
+
+    Returns
+    -------
+    float
+        The peak speed [rad/s]; nan when no sample is finite.
+    """
     vel = traj.sensordata[traj.plan.settle_steps:, traj.built.sensors.actuator_velocity]
     finite = vel[np.isfinite(vel)]
     return float(np.abs(finite).max()) if finite.size else float("nan")
@@ -78,7 +112,23 @@ CONVERGED_MM = 0.1       # ... or within 0.1 mm (per hop for the distance)
 
 def check_convergence(robot: Robot, result: SimResult, cycles: int | None = None) -> dict[str, float | bool]:
     """Rerun at half the time step: change of distance (mm per hop and %) and of nose height
-    (mm and %); ``converged`` when each is within 1 % or 0.1 mm (per hop)."""
+    (mm and %); ``converged`` when each is within 1 % or 0.1 mm (per hop).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot simulated.
+    result : SimResult
+        Its result at its own time step.
+    cycles : int, optional
+        Cycles, as for ``result``.
+
+    Returns
+    -------
+    dict
+        The half step [s], its validity, distance [m] and nose height [m], the changes (in mm
+        per hop, mm, and relative) and ``converged``.
+    """
     half = run(robot, cycles=cycles, timestep_s=result.timestep_s / 2)
     hops = max(len(result.hops), 1)
 

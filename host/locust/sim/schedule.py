@@ -18,6 +18,22 @@ from ..params import Schedule, Solver
 
 @dataclass(frozen=True)
 class ControlPlan:
+    """The servo command at every physics step of a run.
+
+    Attributes
+    ----------
+    ctrl_rad : ndarray
+        ``(nstep,)`` servo command for every physics step [rad].
+    timestep_s : float
+        The physics step [s].
+    steps_per_tick : int
+        Physics steps per control tick.
+    settle_steps : int
+        Steps before the first push.
+    cycle_start_steps : ndarray
+        ``(cycles + 1,)`` step index where each cycle starts; the last is the end.
+    """
+
     ctrl_rad: np.ndarray          # (nstep,) servo command for every physics step, radians
     timestep_s: float
     steps_per_tick: int
@@ -26,19 +42,54 @@ class ControlPlan:
 
     @property
     def nstep(self) -> int:
+        """Number of physics steps."""
         return int(self.ctrl_rad.shape[0])
 
     @property
     def duration_s(self) -> float:
+        """The run's length, settle phase included [s]."""
         return self.nstep * self.timestep_s
 
 
 def steps_per_tick(control_hz: float, timestep_s: float) -> int:
+    """Physics steps per control tick: ``floor(1 / (hz * dt))``, round-off forgiven, at least 1.
+
+    Parameters
+    ----------
+    control_hz : float
+        The control rate [Hz].
+    timestep_s : float
+        The physics step [s].
+
+    Returns
+    -------
+    int
+        Steps per tick.
+    """
     return max(1, int(math.floor(1.0 / (control_hz * timestep_s) + 1e-6)))
 
 
 def control_plan(schedule: Schedule, solver: Solver, cycles: int | None = None,
                  timestep_s: float | None = None) -> ControlPlan:
+    """The schedule as a per-step command: a settle phase at rest, then each cycle's push (at
+    ``push_deg``) and wait (at 0), changing only on control ticks.
+
+    Parameters
+    ----------
+    schedule : Schedule
+        Push angle [deg], push and wait times [s] and cycles.
+    solver : Solver
+        Timestep [s], control rate [Hz] and settle time [s].
+    cycles : int, optional
+        Cycles instead of the schedule's.
+    timestep_s : float, optional
+        Physics step instead of the solver's [s].
+
+    Returns
+    -------
+    ControlPlan
+        The command at every step.
+    """
     dt = solver.timestep_s if timestep_s is None else timestep_s
     n_cycles = schedule.cycles if cycles is None else cycles
     hz = solver.control_hz

@@ -40,6 +40,18 @@ class KeyEffect:
 
 @dataclass(frozen=True)
 class Sensitivity:
+    """The one-at-a-time sensitivity of a robot's outcome to its uncertain values.
+
+    Attributes
+    ----------
+    nominal : str or None
+        The robot's own outcome (None: not a valid run).
+    k_sd : float
+        The ends are each value -/+ ``k_sd`` standard deviations.
+    effects : list of KeyEffect
+        Every uncertain value, in the robot file's order.
+    """
+
     nominal: str | None          # the robot's own outcome
     k_sd: float                  # the ends are the value -/+ k_sd standard deviations
     effects: list[KeyEffect]     # every uncertain value, in the robot file's order
@@ -50,6 +62,13 @@ class Sensitivity:
         return [e for e in self.effects if e.low_outcome != self.nominal or e.high_outcome != self.nominal]
 
     def to_json(self) -> dict:
+        """The sensitivity as a JSON object, with the deciding values' keys.
+
+        Returns
+        -------
+        dict
+            The fields, and ``deciding``: the keys whose interval reaches another outcome.
+        """
         out = dataclasses.asdict(self)
         out["deciding"] = [e.key for e in self.deciding]
         return out

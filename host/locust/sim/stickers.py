@@ -38,6 +38,16 @@ def on_bodies(g: Geometry) -> dict[str, tuple[str, float]]:
 
     The plate's dots are on the chassis (its x axis runs along the plate); the link dots on
     the left leg's links, whose bodies start at their first joint and run along the link.
+
+    Parameters
+    ----------
+    g : Geometry
+        The robot's geometry.
+
+    Returns
+    -------
+    dict of str to (str, float)
+        Per sticker, its body and distance along it [m].
     """
     return {"nose": ("chassis", g.nose_x_m + PLATE_INSET_M),
             "tail": ("chassis", g.body_length_m / 2 - PLATE_INSET_M),
@@ -54,6 +64,22 @@ def plate_points(g: Geometry, crank_deg: float, ground_angle_deg: float, servo_a
     ``crank_start_deg`` plus the servo's deflection under load). The link lengths, the plate
     and the axis' depth under the plate are ``g``'s. Raises :class:`~locust.errors.GeometryError`
     where the loop cannot close.
+
+    Parameters
+    ----------
+    g : Geometry
+        The robot's geometry.
+    crank_deg : float
+        The crank's angle from the ground link [deg].
+    ground_angle_deg : float
+        The ground link's angle to the plate [deg].
+    servo_axis_x_m : float
+        The servo axis' position along the plate [m].
+
+    Returns
+    -------
+    ndarray
+        (len(STICKERS), 2) positions [m].
     """
     asm = assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, crank_deg)
     p1, p2, p3, p4 = (np.asarray(p) for p in (asm.p1_m, asm.p2_m, asm.p3_m, asm.p4_m))
@@ -76,6 +102,22 @@ def to_view(points_m: np.ndarray, x0_m: float, y0_m: float, pitch_deg: float, mi
     runs to the right of the view, its legs' side (z) down; the plate is then turned by
     ``pitch_deg`` (counter-clockwise in the view: its leg end up) and shifted by
     ``(x0_m, y0_m)``. ``mirrored``: seen from the robot's right, x runs to the left.
+
+    Parameters
+    ----------
+    points_m : ndarray
+        (N, 2) plate-frame points [m].
+    x0_m, y0_m : float
+        Where the plate's origin goes in the view [m].
+    pitch_deg : float
+        The plate's pitch in the view [deg].
+    mirrored : bool
+        Seen from the robot's right.
+
+    Returns
+    -------
+    ndarray
+        (N, 2) view-plane points [m].
     """
     p = np.asarray(points_m, float)
     u = np.column_stack([-p[:, 0] if mirrored else p[:, 0], -p[:, 1]])

@@ -101,7 +101,23 @@ def _servo_deg(model: mujoco.MjModel, qpos: np.ndarray) -> float:
 
 
 def rest_pose(robot: Robot) -> StillPose:
-    """The robot settled on the floor at the 0 deg command (``solver.settle_s``), audited."""
+    """The robot settled on the floor at the 0 deg command (``solver.settle_s``), audited.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot.
+
+    Returns
+    -------
+    StillPose
+        The pose, its servo and crank angles [deg].
+
+    Raises
+    ------
+    SimError
+        The settling run fails its audit.
+    """
     spec, asm = build_spec(robot)
     built = compile_spec(spec, asm, robot)
     qpos = _audited_final(built, _plan(robot, 0.0, 0.0), "rest")
@@ -111,7 +127,25 @@ def rest_pose(robot: Robot) -> StillPose:
 
 def push_pose(robot: Robot, rest: StillPose) -> StillPose:
     """The robot held by its plate :data:`HELD_ABOVE_M` above its rest pose, the push command
-    held for :data:`HOLD_S`, audited."""
+    held for :data:`HOLD_S`, audited.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot.
+    rest : StillPose
+        Its rest pose (:func:`rest_pose`).
+
+    Returns
+    -------
+    StillPose
+        The held pose at the push command, its servo and crank angles [deg].
+
+    Raises
+    ------
+    SimError
+        The holding run fails its audit.
+    """
     g = robot.geometry
     chassis_z = float(rest.qpos[2])
     quat = rest.qpos[3:7]
@@ -215,7 +249,23 @@ def _reach_m(model: mujoco.MjModel, poses: list[StillPose]) -> np.ndarray:
 
 # -- writing ---------------------------------------------------------------------------
 def check_still_path(path: str | os.PathLike) -> Path:
-    """An image name OpenCV writes (PNG or JPEG) that neither it nor its sidecars exist."""
+    """An image name OpenCV writes (PNG or JPEG) that neither it nor its sidecars exist.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The still path asked for.
+
+    Returns
+    -------
+    Path
+        The same path, checked.
+
+    Raises
+    ------
+    SimError
+        Not ``.png``/``.jpg``, the still or a sidecar exists, or its folder is a file.
+    """
     path = Path(path)
     if path.suffix.lower() not in IMAGE_FORMATS:
         raise SimError(f"still path {path} does not end in .png or .jpg", "name the still <something>.png")
@@ -265,7 +315,26 @@ def render_stills(robot: Robot, rest_path: str | os.PathLike | None = None,
     """Render the rest still to ``rest_path`` and the push still to ``push_path`` (either may
     be None), through one fixed camera, each with its truth and camera sidecars.
 
-    Returns the :class:`StillInfo` of each written still, rest first.
+    Parameters
+    ----------
+    robot : Robot
+        The robot.
+    rest_path, push_path : str or os.PathLike, optional
+        Where to write the rest and push stills.
+    board : str or BoardSpec
+        The ArUco board lying behind the robot.
+    width, height : int
+        Image size [px].
+
+    Returns
+    -------
+    list of StillInfo
+        Each written still, rest first.
+
+    Raises
+    ------
+    SimError
+        No path given, a bad size or path, or a pose that fails its audit.
     """
     spec = parse_board(board) if isinstance(board, str) else board
     validate_size(1, width, height)

@@ -7,6 +7,7 @@ y down. World coordinates are metres with y up.
 Modules, one job each:
 
 - :mod:`.video`     decoding, clip settings (start/end/step/fps), bad-file errors
+- :mod:`.detection` what every marker model returns for a frame, and its search window
 - :mod:`.predict`   Tracker's constant-acceleration look-ahead for search windows
 - :mod:`.color`     coloured stickers: colour-picked, coverage-weighted centroid
 - :mod:`.template`  Tracker's autotracker: evolving template, Gaussian sub-pixel peak
@@ -19,13 +20,13 @@ Modules, one job each:
 - :mod:`.runner`    the frame loop that ties video, markers and calibration together
 - :mod:`.export`    a result as the tracks CSV + JSON sidecar
 - :mod:`.upright`   whether the heights are the right way up (a robot rests on the floor)
-- :mod:`.options`   the subcommands' click options, each defined once (:mod:`.cli`)
-- :mod:`.trk`       a result as a Tracker project (.trk) or in Tracker's text-export layout; a
-                    Tracker project as a result
+- :mod:`.trk`       a result as the typed objects of a Tracker project (.trk) or Tracker's text
+                    export, which :mod:`locust.io` writes; a Tracker project as a result
 - :mod:`.overlay`   PNG / video of the tracks drawn on the footage
 - :mod:`.synth`     synthetic videos with known sub-pixel truth
 - :mod:`.hardclip`  synthetic phone-like clips: look-alike, shadow, blur, exit, tilted board
 
 The files it reads and writes (tracks CSV, Tracker's text export and projects, ``camera.json``,
-imports of foreign tracks) are owned by :mod:`locust.io`.
+imports of foreign tracks) are owned by :mod:`locust.io`; the ``locust track`` command and its
+options are in :mod:`locust.commands`.
 """

@@ -21,6 +21,23 @@ DEFAULT_DICTIONARY = "DICT_4X4_50"
 
 
 def make_detector(dictionary: str = DEFAULT_DICTIONARY) -> cv2.aruco.ArucoDetector:
+    """An ArUco detector for ``dictionary`` with sub-pixel corner refinement.
+
+    Parameters
+    ----------
+    dictionary : str
+        One of ``cv2.aruco``'s predefined dictionaries, e.g. ``DICT_4X4_50``.
+
+    Returns
+    -------
+    cv2.aruco.ArucoDetector
+        The detector.
+
+    Raises
+    ------
+    TrackError
+        The dictionary is not one of OpenCV's.
+    """
     if not dictionary.startswith("DICT_") or not hasattr(cv2.aruco, dictionary):
         raise TrackError(f"unknown ArUco dictionary {dictionary!r}",
                          "use one of cv2.aruco's names, e.g. DICT_4X4_50, DICT_5X5_100, DICT_6X6_250")
@@ -33,7 +50,22 @@ def make_detector(dictionary: str = DEFAULT_DICTIONARY) -> cv2.aruco.ArucoDetect
 
 
 def find_corners(detector: cv2.aruco.ArucoDetector, image_bgr: np.ndarray, marker_id: int) -> np.ndarray | None:
-    """The four corners (4x2, pixels) of ``marker_id`` in ``image_bgr``, or None."""
+    """The four corners (4x2, pixels) of ``marker_id`` in ``image_bgr``, or None.
+
+    Parameters
+    ----------
+    detector : cv2.aruco.ArucoDetector
+        From :func:`make_detector`.
+    image_bgr : ndarray
+        The image, BGR or grey.
+    marker_id : int
+        The ArUco id.
+
+    Returns
+    -------
+    ndarray or None
+        (4, 2) corners [px], OpenCV's order; None when the marker is not seen.
+    """
     gray = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2GRAY) if image_bgr.ndim == 3 else image_bgr
     corners, ids, _ = detector.detectMarkers(gray)
     if ids is None:
@@ -43,7 +75,18 @@ def find_corners(detector: cv2.aruco.ArucoDetector, image_bgr: np.ndarray, marke
 
 
 def centre_of(corners: np.ndarray) -> tuple[float, float]:
-    """Intersection of the diagonals 0-2 and 1-3."""
+    """Intersection of the diagonals 0-2 and 1-3.
+
+    Parameters
+    ----------
+    corners : ndarray
+        (4, 2) corners in order [px].
+
+    Returns
+    -------
+    tuple of float
+        The centre (px, py) [px].
+    """
     p0, p1, p2, p3 = corners
     d1, d2 = p2 - p0, p3 - p1
     a = np.array([d1, -d2]).T
@@ -53,11 +96,38 @@ def centre_of(corners: np.ndarray) -> tuple[float, float]:
 
 
 def side_px(corners: np.ndarray) -> float:
+    """Mean side length of a marker's four-corner outline.
+
+    Parameters
+    ----------
+    corners : ndarray
+        (4, 2) corners in order [px].
+
+    Returns
+    -------
+    float
+        Mean side [px].
+    """
     return float(np.mean(np.linalg.norm(corners - np.roll(corners, -1, axis=0), axis=1)))
 
 
 @dataclass
 class ArucoMarker:
+    """An ArUco marker tracked by its id: searched near the predicted position, else in the
+    whole frame; its position is the intersection of its diagonals.
+
+    Attributes
+    ----------
+    name, spec : str
+        The marker's name and its ``--marker`` spec.
+    marker_id : int
+        The ArUco id.
+    dictionary : str
+        The ArUco dictionary's name.
+    history : MotionHistory
+        Its last positions, for the search window.
+    """
+
     name: str
     spec: str
     marker_id: int
@@ -67,6 +137,20 @@ class ArucoMarker:
     _side_px: float = 0.0
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
+        """Find the marker in one frame.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number (frames come in order).
+        image_bgr : ndarray
+            The frame, BGR (or grey).
+
+        Returns
+        -------
+        Detection
+            Its centre [px]; ``score`` is its mean side length [px] (0 when not found).
+        """
         if self._detector is None:
             self._detector = make_detector(self.dictionary)
         corners = None
@@ -88,7 +172,31 @@ class ArucoMarker:
 
 
 def side_px_in_video(info, clip, marker_id: int, dictionary: str = DEFAULT_DICTIONARY) -> tuple[int, float]:
-    """The first frame of ``clip`` showing ``marker_id``, and the marker's side there (px)."""
+    """The first frame of ``clip`` showing ``marker_id``, and the marker's side there (px).
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+    clip : Clip
+        The resolved clip.
+    marker_id : int
+        The ArUco id.
+    dictionary : str
+        Its dictionary.
+
+    Returns
+    -------
+    frame : int
+        The first frame showing the marker.
+    side_px : float
+        Its mean side there [px].
+
+    Raises
+    ------
+    TrackError
+        The marker is in no frame of the clip.
+    """
     from .video import read_frames
 
     detector = make_detector(dictionary)

@@ -43,7 +43,22 @@ MIN_POINT_SPREAD = 0.01
 
 
 def write_board_png(path: Path, spec: BoardSpec, dpi: int = BOARD_DPI) -> Path:
-    """Write the board at ``dpi`` (recorded in the PNG) for printing at 100 %."""
+    """Write the board at ``dpi`` (recorded in the PNG) for printing at 100 %.
+
+    Parameters
+    ----------
+    path : Path
+        The PNG to write (atomically).
+    spec : BoardSpec
+        The board.
+    dpi : int
+        Print resolution [dots/inch].
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     from PIL import Image
 
     buf = io.BytesIO()
@@ -76,27 +91,78 @@ class PlaneHomography:
 
     def to_world(self, px: np.ndarray, py: np.ndarray, marker: str | None = None,
                  frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Pixels to plane metres through the homography.
+
+        Parameters
+        ----------
+        px, py : ndarray
+            Pixel positions, OpenCV convention [px].
+        marker : str, optional
+            Unused (one plane for every marker); there for the calibrations' common call.
+        frames : ndarray, optional
+            Unused (a fixed camera); there for the calibrations' common call.
+
+        Returns
+        -------
+        x_m, y_m : ndarray
+            Positions in the plane, origin at its corner, y up [m].
+        """
         px, py = np.asarray(px, float), np.asarray(py, float)
         v = np.stack([px, py, np.ones_like(px)], axis=-1) @ self.H.T
         with np.errstate(divide="ignore", invalid="ignore"):
             return v[..., 0] / v[..., 2], v[..., 1] / v[..., 2]
 
     def to_image(self, x_m: np.ndarray, y_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Plane metres to pixels through the inverse homography.
+
+        Parameters
+        ----------
+        x_m, y_m : ndarray
+            Positions in the plane [m].
+
+        Returns
+        -------
+        px, py : ndarray
+            Pixel positions, OpenCV convention [px].
+        """
         v = np.stack([np.asarray(x_m, float), np.asarray(y_m, float), np.ones(np.shape(x_m))], axis=-1) @ self.H_inv.T
         return v[..., 0] / v[..., 2], v[..., 1] / v[..., 2]
 
     def axes_px(self):
+        """The plane's origin in pixels and the on-screen unit directions of its x and y axes.
+
+        Returns
+        -------
+        origin : tuple of float
+            (px, py) of the plane's origin [px].
+        x_dir, y_dir : tuple of float
+            Unit vectors in the image of the plane's +x and +y.
+        """
         o = self.to_image(np.array([0.0, 0.01, 0.0]), np.array([0.0, 0.0, 0.01]))
         uv = np.stack(o, axis=-1)
         dirs = [(uv[k] - uv[0]) / np.linalg.norm(uv[k] - uv[0]) for k in (1, 2)]
         return tuple(uv[0]), tuple(dirs[0]), tuple(dirs[1])
 
     def summary(self) -> str:
+        """One line saying where the plane comes from, its fit residual [mm] and scale [mm/px].
+
+        Returns
+        -------
+        str
+            The line.
+        """
         where = f" on frame {self.frame}" if self.frame is not None else ""
         return (f"plane from {self.source}{where}: {self.n_points} points, fit residual {self.residual_mm:.2f} mm; "
                 f"x_m/y_m in the plane, origin at its corner, y up (about {self.m_per_px * 1000:.3g} mm/px there)")
 
     def as_dict(self) -> dict:
+        """The calibration as the tracks' JSON sidecar records it.
+
+        Returns
+        -------
+        dict
+            Source, model, the 3x3 image-to-plane homography, fit residual [mm], points and frame.
+        """
         return {"source": self.source, "model": "plane homography, image px -> plane m (y up)",
                 "H_image_to_plane": self.H.tolist(), "fit_residual_mm": self.residual_mm,
                 "points": self.n_points, "frame": self.frame}
@@ -113,7 +179,21 @@ def _fit(image_pts: np.ndarray, plane_pts: np.ndarray, source: str, frame: int |
 
 
 def board_points(spec: BoardSpec, image_bgr: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """Detected board corners in ``image_bgr`` (px) and their plane positions (m, y up), or None."""
+    """Detected board corners in ``image_bgr`` (px) and their plane positions (m, y up), or None.
+
+    Parameters
+    ----------
+    spec : BoardSpec
+        The board.
+    image_bgr : ndarray
+        A frame, BGR.
+
+    Returns
+    -------
+    tuple of ndarray or None
+        (N, 2) corners [px] and (N, 2) plane positions [m]; None when fewer than the board's
+        minimum of markers are seen.
+    """
     from .aruco import make_detector
 
     gray = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2GRAY) if image_bgr.ndim == 3 else image_bgr
@@ -130,7 +210,29 @@ def board_points(spec: BoardSpec, image_bgr: np.ndarray) -> tuple[np.ndarray, np
 
 def board_homography(info, clip, spec: BoardSpec, frames: int = DETECT_FRAMES) -> PlaneHomography:
     """Fit the plane to the board's corners in every one of the clip's first ``frames`` frames
-    that shows it (a still camera: the corners' noise averages out over the frames)."""
+    that shows it (a still camera: the corners' noise averages out over the frames).
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+    clip : Clip
+        The resolved clip.
+    spec : BoardSpec
+        The board filmed.
+    frames : int
+        How many of the clip's first frames to look in.
+
+    Returns
+    -------
+    PlaneHomography
+        Pixels to plane metres, with its fit residual [mm].
+
+    Raises
+    ------
+    TrackError
+        The board is in none of those frames, or no homography fits.
+    """
     image_pts, plane_pts, first = [], [], None
     for k, (frame, image) in enumerate(read_frames(info, clip)):
         if k >= frames:
@@ -149,7 +251,25 @@ def board_homography(info, clip, spec: BoardSpec, frames: int = DETECT_FRAMES) -
 
 def parse_plane_points(text: str, pixels: str = "tracker") -> PlaneHomography:
     """``PX,PY=X_M,Y_M;...`` (four or more) -> the homography through them; the pixels typed
-    in convention ``pixels`` (:func:`locust.track.spec.typed_px`)."""
+    in convention ``pixels`` (:func:`locust.track.spec.typed_px`).
+
+    Parameters
+    ----------
+    text : str
+        The ``--plane-points`` value: pixels and plane metres.
+    pixels : str
+        ``tracker`` or ``opencv``.
+
+    Returns
+    -------
+    PlaneHomography
+        Pixels to plane metres.
+
+    Raises
+    ------
+    TrackError
+        Fewer than four points, a bad number, or points on one line.
+    """
     pairs = [p for p in re.split(r"[;\s]+", text.strip()) if p]
     rx = re.compile(rf"({NUM}),({NUM})=({NUM}),({NUM})")
     rows = [rx.fullmatch(p) for p in pairs]

@@ -19,7 +19,23 @@ NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 
 
 def parse_scale(text: str) -> tuple[float, float, float, float, float]:
-    """``X1,Y1,X2,Y2=LENGTH_M`` -> the stick's two ends (px) and its length (m)."""
+    """``X1,Y1,X2,Y2=LENGTH_M`` -> the stick's two ends (px) and its length (m).
+
+    Parameters
+    ----------
+    text : str
+        The ``--scale`` value.
+
+    Returns
+    -------
+    tuple of float
+        x1, y1, x2, y2 [px] and the length [m].
+
+    Raises
+    ------
+    TrackError
+        Not that form, a length that is not positive, or ends less than a pixel apart.
+    """
     m = re.fullmatch(rf"\s*({NUM})\s*,\s*({NUM})\s*,\s*({NUM})\s*,\s*({NUM})\s*=\s*({NUM})\s*", text)
     if not m:
         raise TrackError(f"--scale {text!r}: expected X1,Y1,X2,Y2=LENGTH_M",
@@ -39,7 +55,25 @@ PIXELS_HELP = ("Convention of the pixel positions typed in --marker, --origin, -
 
 
 def typed_px(x: float, y: float, pixels: str) -> tuple[float, float]:
-    """A pixel position typed in convention ``pixels`` (``tracker`` or ``opencv``), in OpenCV's."""
+    """A pixel position typed in convention ``pixels`` (``tracker`` or ``opencv``), in OpenCV's.
+
+    Parameters
+    ----------
+    x, y : float
+        The position as typed [px].
+    pixels : str
+        ``tracker`` (pixel centres at i + 0.5) or ``opencv`` (at i).
+
+    Returns
+    -------
+    tuple of float
+        (x, y) in OpenCV's convention [px].
+
+    Raises
+    ------
+    TrackError
+        An unknown convention.
+    """
     if pixels not in PIXEL_CONVENTIONS:
         raise TrackError(f"pixel convention {pixels!r} is not known", "give tracker or opencv")
     d = PIXEL_CONVENTIONS[pixels]
@@ -48,6 +82,25 @@ def typed_px(x: float, y: float, pixels: str) -> tuple[float, float]:
 
 
 def parse_point(text: str, option: str) -> tuple[float, float]:
+    """``X,Y`` in pixels, as an option gives it.
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+    option : str
+        The option's name, for the message.
+
+    Returns
+    -------
+    tuple of float
+        (x, y) [px].
+
+    Raises
+    ------
+    TrackError
+        Not two numbers separated by a comma.
+    """
     m = re.fullmatch(rf"\s*({NUM})\s*,\s*({NUM})\s*", text)
     if not m:
         raise TrackError(f"{option} {text!r}: expected X,Y in pixels", f"e.g. {option} 131.3,207.9")
@@ -55,6 +108,25 @@ def parse_point(text: str, option: str) -> tuple[float, float]:
 
 
 def parse_aruco_scale(text: str) -> tuple[int, float]:
+    """``--scale-aruco ID=SIDE_M``: the marker whose printed side sets the scale.
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+
+    Returns
+    -------
+    marker_id : int
+        The ArUco id.
+    side_m : float
+        Its printed side length [m].
+
+    Raises
+    ------
+    TrackError
+        Not ``ID=SIDE_M`` with a positive side.
+    """
     m = re.fullmatch(rf"\s*(\d+)\s*=\s*({NUM})\s*", text)
     if not m or not float(m.group(2)) > 0:
         raise TrackError(f"--scale-aruco {text!r}: expected ID=SIDE_M (the printed side length in metres)",
@@ -63,10 +135,44 @@ def parse_aruco_scale(text: str) -> tuple[int, float]:
 
 
 def m_per_px_from_stick(x1: float, y1: float, x2: float, y2: float, length_m: float) -> float:
+    """The scale given by a calibration stick of known length between two pixels.
+
+    Parameters
+    ----------
+    x1, y1, x2, y2 : float
+        The stick's ends [px].
+    length_m : float
+        Its length [m].
+
+    Returns
+    -------
+    float
+        Metres per pixel [m/px].
+    """
     return length_m / math.hypot(x2 - x1, y2 - y1)
 
 
 def build(height_px: int, m_per_px: float = math.nan, origin: tuple[float, float] | None = None,
           angle_deg: float = 0.0, source: str = "none") -> Calibration:
+    """A calibration; the origin defaults to the bottom-left pixel's centre.
+
+    Parameters
+    ----------
+    height_px : int
+        The frame's height [px].
+    m_per_px : float
+        Scale [m/px]; nan for none (pixels only).
+    origin : tuple of float, optional
+        The world origin (x, y) [px].
+    angle_deg : float
+        The x axis's angle to the image's x axis, counter-clockwise [deg].
+    source : str
+        How the scale was set, as recorded.
+
+    Returns
+    -------
+    Calibration
+        The calibration.
+    """
     ox, oy = origin if origin is not None else (0.0, float(height_px - 1))
     return Calibration(m_per_px, ox, oy, angle_deg, source)

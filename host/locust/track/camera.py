@@ -45,7 +45,27 @@ class PlaneCalibration:
     def to_world(self, px: np.ndarray, py: np.ndarray, marker: str | None = None,
                  frames: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Pixels of ``marker`` (on video ``frames``) -> world x and height, metres. NaN stays NaN;
-        a marker without a known plane gives NaN."""
+        a marker without a known plane gives NaN.
+
+        Parameters
+        ----------
+        px, py : ndarray
+            Pixel positions, OpenCV convention [px].
+        marker : str, optional
+            The marker whose plane the points lie in.
+        frames : ndarray, optional
+            The video frame of each point (a camera that moves has a position per frame).
+
+        Returns
+        -------
+        x_m, y_m : ndarray
+            World x along the floor and height [m].
+
+        Raises
+        ------
+        TrackError
+            A frame beyond the camera file's positions.
+        """
         px, py = np.asarray(px, float), np.asarray(py, float)
         if marker not in self.planes_y_m:
             nan = np.full(px.shape, math.nan)
@@ -67,7 +87,15 @@ class PlaneCalibration:
 
     def axes_px(self) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float]]:
         """The world origin (on the first marker's plane) in pixels, and the on-screen unit
-        directions of world x and height, as the first frame's camera sees them."""
+        directions of world x and height, as the first frame's camera sees them.
+
+        Returns
+        -------
+        origin : tuple of float
+            The world origin [px].
+        x_dir, y_dir : tuple of float
+            Unit vectors in the image of world +x and up.
+        """
         y = next(iter(self.planes_y_m.values()), 0.0)
         pts = np.array([[0.0, y, 0.0], [0.01, y, 0.0], [0.0, y, 0.01]]) - self.positions_m[0]
         cam = pts @ self.rotation.T @ self.K.T
@@ -76,11 +104,25 @@ class PlaneCalibration:
         return tuple(uv[0]), tuple(dirs[0]), tuple(dirs[1])  # type: ignore[return-value]
 
     def summary(self) -> str:
+        """One line saying which camera file and marker planes [mm] give the world positions.
+
+        Returns
+        -------
+        str
+            The line.
+        """
         planes = ", ".join(f"{n} y = {y * 1000:.1f} mm" for n, y in self.planes_y_m.items())
         return (f"world from {Path(self.path).name} ({self.camera} pinhole camera; marker planes {planes}): "
                 f"x along the floor, y up, metres")
 
     def as_dict(self) -> dict:
+        """The calibration as the tracks' JSON sidecar records it.
+
+        Returns
+        -------
+        dict
+            Source, camera file, K [px], rotation, position [m] (or per frame), marker planes [m].
+        """
         return {"source": self.source, "camera_json": self.path, "model": "pinhole camera, plane homography per marker",
                 "camera": self.camera, "K": self.K.tolist(), "rotation_world_to_camera": self.rotation.tolist(),
                 "position_m": self.positions_m[0].tolist() if len(self.positions_m) == 1 else "per frame (camera_json)",
@@ -90,7 +132,25 @@ class PlaneCalibration:
 
 
 def load(path: str | Path, width_px: int, height_px: int) -> PlaneCalibration:
-    """Read a ``camera.json`` written by the simulation, checked against the video's size."""
+    """Read a ``camera.json`` written by the simulation, checked against the video's size.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``camera.json``.
+    width_px, height_px : int
+        The video's size [px].
+
+    Returns
+    -------
+    PlaneCalibration
+        Pixels to world metres through that camera.
+
+    Raises
+    ------
+    TrackError
+        An unreadable file, or a camera of another size than the video.
+    """
     camera = read_camera_json(path)
     if (camera.width_px, camera.height_px) != (width_px, height_px):
         raise TrackError(f"{path} describes a {camera.width_px}x{camera.height_px} camera, but the video is "

@@ -34,7 +34,23 @@ from .predict import MarkerPath
 
 
 def parse_hex(colour: str) -> tuple[int, int, int]:
-    """``#RRGGBB`` -> (B, G, R) as OpenCV stores pixels."""
+    """``#RRGGBB`` -> (B, G, R) as OpenCV stores pixels.
+
+    Parameters
+    ----------
+    colour : str
+        ``#RRGGBB`` (the ``#`` may be left out).
+
+    Returns
+    -------
+    tuple of int
+        (B, G, R), 8-bit.
+
+    Raises
+    ------
+    TrackError
+        Not six hex digits.
+    """
     h = colour.strip().lstrip("#")
     if len(h) != 6 or any(c not in "0123456789abcdefABCDEF" for c in h):
         raise TrackError(f"colour {colour!r} is not #RRGGBB", "write the colour as 6 hex digits, e.g. color:#ff00ff")
@@ -53,7 +69,24 @@ class FrameHSV:
         self._hsv: dict[int, np.ndarray] = {}
 
     def of(self, frame: int, image: np.ndarray, step: int = 1) -> np.ndarray:
-        """HSV of every ``step``-th pixel of every ``step``-th row of ``image``."""
+        """HSV of every ``step``-th pixel of every ``step``-th row of ``image``.
+
+        Computed once per frame and step, shared by the markers that ask.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number (another frame, or another image array, drops the cached pictures).
+        image : ndarray
+            The frame, BGR.
+        step : int
+            Sampling step [px].
+
+        Returns
+        -------
+        ndarray
+            The HSV picture, OpenCV 8-bit (hue 0..179).
+        """
         if frame != self._frame or image is not self._image:
             self._frame, self._image, self._hsv = frame, image, {}
         if step not in self._hsv:
@@ -63,6 +96,33 @@ class FrameHSV:
 
 @dataclass
 class ColorMarker:
+    """A coloured sticker tracked by colour: the blob nearest the predicted position, its
+    coverage-weighted centroid (see the module docstring).
+
+    Attributes
+    ----------
+    name, spec : str
+        The marker's name and its ``--marker`` spec.
+    bgr : tuple of int
+        The sticker's colour, 8-bit BGR.
+    tolerance : int
+        Largest per-channel difference from ``bgr`` a marker pixel may have (8-bit levels).
+    search_half_px : int
+        Half-size of the search window around the prediction [px].
+    min_area_px : int
+        Smallest blob taken for the marker [px].
+    partial_fraction : float
+        Below this share of the usual area a blob is partly hidden: not found.
+    start_px : tuple of float or None
+        Where to look for the sticker until it is first seen [px]; None: the whole frame.
+    hue_tol_deg : float
+        Largest hue difference from the marker's colour [deg].
+    track : MarkerPath
+        Its positions so far, for the prediction.
+    frame_hsv : FrameHSV
+        The frame's HSV picture, shared by the markers of one run.
+    """
+
     name: str
     spec: str
     bgr: tuple[int, int, int]
@@ -103,6 +163,21 @@ class ColorMarker:
         self._pixel, self._pixel_hsv = np.zeros((1, 1, 3), np.uint8), np.zeros((1, 1, 3), np.uint8)
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
+        """Find the sticker in one frame.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number (frames come in order).
+        image_bgr : ndarray
+            The frame, BGR.
+
+        Returns
+        -------
+        Detection
+            Its centre [px]; ``score`` is the blob's area over the usual area (1 on the first
+            sightings).
+        """
         det = self._find(frame, image_bgr) or Detection.missing(0.0)
         if det.ok and self.track.last_frame is None:
             self._note_distractors(image_bgr, det)
@@ -477,7 +552,20 @@ def every(image: np.ndarray, step: int) -> np.ndarray:
     """``image[::step, ::step]`` as a contiguous picture. OpenCV's nearest-pixel resize to
     1/step takes exactly those pixels where the sizes divide by ``step``, ten times faster
     than NumPy's copy of a strided view (a 1280x720 frame at step 2: 0.26 ms against 2.9 ms);
-    a last row or column past a whole number of steps is copied on its own."""
+    a last row or column past a whole number of steps is copied on its own.
+
+    Parameters
+    ----------
+    image : ndarray
+        An image.
+    step : int
+        Sampling step [px].
+
+    Returns
+    -------
+    ndarray
+        The sampled image, contiguous.
+    """
     h, w = image.shape[:2]
     hq, wq = h // step, w // step
     if step == 1 or hq == 0 or wq == 0:
@@ -545,6 +633,18 @@ def _along(angle_rad: float, velocity: tuple[float, float], diameter_px: float) 
 
 
 class BlobShape(NamedTuple):   # a tuple: one is made per blob looked at, every frame
+    """A blob's area and equivalent ellipse.
+
+    Attributes
+    ----------
+    area_px : float
+        Area [px²].
+    major_px, minor_px : float
+        Full lengths of the equivalent ellipse's axes (4 sigma): a disc's diameter [px].
+    angle_rad : float
+        Direction of the major axis, image x right, y down [rad].
+    """
+
     area_px: float
     major_px: float     # full lengths of the equivalent ellipse (4 sigma): a disc's diameter
     minor_px: float

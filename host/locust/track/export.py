@@ -23,7 +23,18 @@ PIXEL_CONVENTION = "OpenCV: origin at the centre of the top-left pixel, x right,
 
 
 def tracks_of(result: TrackResult) -> TracksCsv:
-    """The tracks CSV of ``result``: pixels, world metres through its calibration, found or not."""
+    """The tracks CSV of ``result``: pixels, world metres through its calibration, found or not.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+
+    Returns
+    -------
+    TracksCsv
+        Frames, times [s] and per marker pixels [px], positions [m] and found flags.
+    """
     markers = {}
     for tr in result.markers:
         xm, ym = result.world(tr)
@@ -32,11 +43,37 @@ def tracks_of(result: TrackResult) -> TracksCsv:
 
 
 def csv_text(result: TrackResult) -> str:
-    """The text of ``result``'s tracks CSV."""
+    """The text of ``result``'s tracks CSV.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+
+    Returns
+    -------
+    str
+        The CSV.
+    """
     return tracks_csv_text(tracks_of(result))
 
 
 def sidecar(result: TrackResult, csv_path: Path) -> dict:
+    """The JSON sidecar of a tracks CSV: source video, clip, calibration, and per marker its
+    found frames, events and scores.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+    csv_path : Path
+        The CSV it goes beside (its name is recorded).
+
+    Returns
+    -------
+    dict
+        The sidecar (format ``locust.track/1``).
+    """
     clip = result.clip
     src: dict = {"kind": result.source}
     if result.video is not None:
@@ -61,7 +98,20 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
 
 
 def write_tracks(result: TrackResult, csv_path: Path) -> tuple[Path, Path]:
-    """Write ``csv_path`` and its sidecar ``<stem>.json``, each atomically."""
+    """Write ``csv_path`` and its sidecar ``<stem>.json``, each atomically.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+    csv_path : Path
+        The CSV to write.
+
+    Returns
+    -------
+    csv_path, json_path : Path
+        The files written.
+    """
     json_path = csv_path.with_suffix(".json")
     write_tracks_csv(csv_path, tracks_of(result))
     atomic_write_json(json_path, sidecar(result, csv_path))
@@ -82,6 +132,21 @@ class TrackEvents:
 
 
 def track_events(px: np.ndarray, py: np.ndarray, ok: np.ndarray) -> TrackEvents:
+    """How a marker's track holds together: gaps, re-acquisitions and jumps.
+
+    Parameters
+    ----------
+    px, py : ndarray
+        Its positions per frame [px].
+    ok : ndarray of bool
+        Whether it was found on each frame.
+
+    Returns
+    -------
+    TrackEvents
+        Gaps (a trailing one counted), the longest [frames], re-acquisitions, and steps over
+        50 px and 5 times the median step.
+    """
     idx = np.flatnonzero(ok)
     if idx.size == 0:
         return TrackEvents(0, 0, 0, 0)
@@ -96,6 +161,18 @@ def track_events(px: np.ndarray, py: np.ndarray, ok: np.ndarray) -> TrackEvents:
 
 
 def summary_lines(result: TrackResult) -> list[str]:
+    """What was tracked, one line per marker: frames found, median score, missing frames and events.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+
+    Returns
+    -------
+    list of str
+        The lines to print.
+    """
     lines = []
     n = len(result.frames)
     for t in result.markers:

@@ -41,6 +41,30 @@ TRUTH_HEADER = "frame,t_s,px,py,in_picture,whole_in_picture,x_m,y_m"
 
 @dataclass
 class HardTruth:
+    """The truth of a SYNTHETIC hard clip.
+
+    Attributes
+    ----------
+    frames : ndarray
+        Frame numbers.
+    fps : float
+        Frame rate [1/s].
+    px, py : ndarray
+        True sticker centre [px] (nan when out of the picture).
+    whole : ndarray of bool
+        The whole sticker is inside the picture.
+    x_m, y_m : ndarray
+        True position in the board plane, y up [m].
+    radius_px : float
+        The sticker's radius [px].
+    board : BoardSpec
+        The board filmed.
+    plane_to_image : ndarray
+        3x3 homography, plane metres to pixels.
+    sticker_hex : str
+        The sticker's colour, ``#RRGGBB``.
+    """
+
     frames: np.ndarray
     fps: float
     px: np.ndarray            # true centre, pixels (NaN when out of the picture)
@@ -55,10 +79,22 @@ class HardTruth:
 
     @property
     def in_picture(self) -> np.ndarray:
+        """Whether the sticker's centre is in the picture, per frame."""
         return np.isfinite(self.px)
 
     def write_csv(self, path: Path) -> Path:
-        """``<stem>.truth.csv``; :func:`read_truth_csv` reads it back."""
+        """``<stem>.truth.csv``; :func:`read_truth_csv` reads it back.
+
+        Parameters
+        ----------
+        path : Path
+            The file to write (atomically).
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
         meta = {"fps": self.fps, "radius_px": self.radius_px, "board": self.board.text(),
                 "plane_to_image": self.plane_to_image.tolist(), "sticker_hex": self.sticker_hex}
         lines = ["# synthetic: locust.track.hardclip; sticker centre in pixels (OpenCV convention, nan out of "
@@ -72,7 +108,23 @@ class HardTruth:
 
 
 def read_truth_csv(path: str | os.PathLike) -> HardTruth:
-    """A hard clip's ``<stem>.truth.csv`` as written by :meth:`HardTruth.write_csv`."""
+    """A hard clip's ``<stem>.truth.csv`` as written by :meth:`HardTruth.write_csv`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The truth file.
+
+    Returns
+    -------
+    HardTruth
+        The truth it holds.
+
+    Raises
+    ------
+    TrackError
+        Not a hard-clip truth file.
+    """
     from .board import parse_board
 
     lines = Path(path).read_text().splitlines()
@@ -89,7 +141,18 @@ def read_truth_csv(path: str | os.PathLike) -> HardTruth:
 
 def plane_to_image(width: int, height: int) -> np.ndarray:
     """A tilted view of the plane: the plane rectangle x -0.15..0.95 m, y -0.05..0.45 m seen as
-    a trapezoid (its right side nearer the camera, its top leaning away)."""
+    a trapezoid (its right side nearer the camera, its top leaning away).
+
+    Parameters
+    ----------
+    width, height : int
+        The frame's size [px].
+
+    Returns
+    -------
+    ndarray
+        3x3 homography, plane metres to pixels.
+    """
     plane = np.float32([[-0.15, -0.05], [0.95, -0.05], [0.95, 0.45], [-0.15, 0.45]])
     image = np.float32([[0.03, 0.97], [0.99, 0.99], [0.96, 0.02], [0.08, 0.10]]) * np.float32([width, height])
     return cv2.getPerspectiveTransform(plane, image).astype(np.float64)
@@ -97,7 +160,20 @@ def plane_to_image(width: int, height: int) -> np.ndarray:
 
 def hop_path(t: np.ndarray, rest_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Plane position (m) at times ``t`` (s): at rest for ``rest_s``, a ballistic hop whose
-    apex is out of the picture, a short bounce on landing, rest."""
+    apex is out of the picture, a short bounce on landing, rest.
+
+    Parameters
+    ----------
+    t : ndarray
+        Times [s].
+    rest_s : float
+        Time at rest before the hop [s].
+
+    Returns
+    -------
+    x_m, y_m : ndarray
+        Plane position, y up [m].
+    """
     flight = 0.62                                      # s
     x0, x1, y0 = 0.30, 0.78, 0.22                      # above the board, which spans 0..0.24 x 0..0.14 m
     vy = GRAVITY_M_S2 * flight / 2
@@ -167,7 +243,32 @@ def make_hard_video(path: str | os.PathLike, width: int = 1920, height: int = 10
     """Write a SYNTHETIC hard clip and ``<stem>.truth.csv`` beside it; return the truth.
 
     The sticker and the pen cap are both ``sticker_hex``; the exposure is ``exposure_frames``
-    of the frame time (0.3: a phone in daylight at 60 fps; 1.0: indoors)."""
+    of the frame time (0.3: a phone in daylight at 60 fps; 1.0: indoors).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The video to write.
+    width, height : int
+        Frame size [px].
+    n_frames : int
+        Frames.
+    fps : float
+        Frame rate [1/s].
+    exposure_frames : float
+        Exposure as a share of the frame time (motion blur).
+    seed : int
+        Seed of the noise.
+    fourcc : str
+        The codec's four-character code.
+    sticker_hex : str
+        The sticker's (and the look-alike's) colour, ``#RRGGBB``.
+
+    Returns
+    -------
+    HardTruth
+        The truth, also written as ``<stem>.truth.csv``.
+    """
     path = Path(path)
     rng = np.random.default_rng(seed)
     H = plane_to_image(width, height)

@@ -30,7 +30,24 @@ def draw_tracks(image: np.ndarray, result: TrackResult, upto: int | None = None,
                 trail: int | None = None) -> np.ndarray:
     """Draw each marker's path (and its latest point) on a copy of ``image``: the whole path,
     or with ``upto`` (a frame of a video) the last ``trail`` frames of it, the point found in
-    that frame ringed, and a marker lost there named as lost in the top-left corner."""
+    that frame ringed, and a marker lost there named as lost in the top-left corner.
+
+    Parameters
+    ----------
+    image : ndarray
+        A frame, BGR.
+    result : TrackResult
+        The tracks.
+    upto : int, optional
+        The frame drawn on; None: the whole paths.
+    trail : int, optional
+        Frames of path drawn before ``upto``.
+
+    Returns
+    -------
+    ndarray
+        The annotated copy.
+    """
     out = image.copy()
     n = len(result.frames) if upto is None else upto + 1
     first = 0 if trail is None else max(n - trail, 0)
@@ -68,7 +85,25 @@ def draw_tracks(image: np.ndarray, result: TrackResult, upto: int | None = None,
 
 
 def write_png(result: TrackResult, path: Path) -> Path:
-    """The clip's last frame with every track on it."""
+    """The clip's last frame with every track on it.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks, with their video.
+    path : Path
+        The PNG to write (atomically).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    TrackError
+        The result has no video (tracks read from a Tracker project).
+    """
     if result.video is None:
         raise TrackError("no video to draw on", "give the video to draw tracks on")
     image = read_frame(result.video, int(result.frames[-1]))
@@ -78,7 +113,27 @@ def write_png(result: TrackResult, path: Path) -> Path:
 
 def write_video(result: TrackResult, path: Path, progress: Callable[[int], None] | None = None) -> Path:
     """The whole clip, each frame with the last ``TRAIL_FRAMES`` of every track and the point
-    found in it, or the marker named as lost (MPEG-4, at the clip's rate)."""
+    found in it, or the marker named as lost (MPEG-4, at the clip's rate).
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks, with their video.
+    path : Path
+        The video to write.
+    progress : callable, optional
+        Called with 1 after each frame.
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    TrackError
+        The result has no video, or the video cannot be written.
+    """
     v = result.video
 
     def drawn():

@@ -23,7 +23,18 @@ LOOKBACK = 4  # Tracker's predictionLookback
 
 
 def predict_next(history: Iterable[Point | None]) -> Point | None:
-    """Predicted next position from ``history`` (oldest first, ``None`` = not found)."""
+    """Predicted next position from ``history`` (oldest first, ``None`` = not found).
+
+    Parameters
+    ----------
+    history : iterable of (tuple of float or None)
+        Recent positions [px].
+
+    Returns
+    -------
+    tuple of float or None
+        (px, py) [px]; None when nothing recent was found.
+    """
     prev = list(history)[-LOOKBACK:][::-1]  # prev[0] is the latest
     prev += [None] * (LOOKBACK - len(prev))
     if prev[0] is None:
@@ -62,16 +73,35 @@ class MotionHistory:
         self.last_found: Point | None = None
 
     def add(self, point: Point | None) -> None:
+        """Record the next frame's position.
+
+        Parameters
+        ----------
+        point : tuple of float or None
+            (px, py) [px]; None when not found.
+        """
         self._points.append(point)
         if point is not None:
             self.last_found = point
 
     def has_velocity(self) -> bool:
-        """True when the last two positions are both known."""
+        """True when the last two positions are both known.
+
+        Returns
+        -------
+        bool
+            Whether a velocity can be taken.
+        """
         return len(self._points) >= 2 and self._points[-1] is not None and self._points[-2] is not None
 
     def search_centre(self) -> Point | None:
-        """The look-ahead prediction, or the last position seen when there is none."""
+        """The look-ahead prediction, or the last position seen when there is none.
+
+        Returns
+        -------
+        tuple of float or None
+            (px, py) [px]; None before the first sighting.
+        """
         return predict_next(self._points) or self.last_found
 
 
@@ -101,6 +131,15 @@ class MarkerPath:
         self._coef: list[tuple[float, float]] | None = None
 
     def add(self, frame: int, point: Point | None) -> None:
+        """Record a position found; a frame not found (None) adds nothing.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number.
+        point : tuple of float or None
+            (px, py) [px].
+        """
         if point is None:
             return
         if self._found:
@@ -117,10 +156,22 @@ class MarkerPath:
 
     @property
     def last_frame(self) -> int | None:
+        """The frame of the last sighting; None before the first."""
         return self._found[-1][0] if self._found else None
 
     def frames_lost(self, frame: int) -> int:
-        """Frames since the last one found, not counting ``frame`` itself (0: found just before)."""
+        """Frames since the last one found, not counting ``frame`` itself (0: found just before).
+
+        Parameters
+        ----------
+        frame : int
+            The frame being searched.
+
+        Returns
+        -------
+        int
+            Frames lost; 0 before the first sighting.
+        """
         return frame - self._found[-1][0] - 1 if self._found else 0
 
     def _fit(self) -> list[tuple[float, float]] | None:
@@ -138,6 +189,18 @@ class MarkerPath:
         return self._coef
 
     def predict(self, frame: int) -> Point | None:
+        """Where the fit puts the marker on ``frame``.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number.
+
+        Returns
+        -------
+        tuple of float or None
+            (px, py) [px]; None before any sighting.
+        """
         c = self._fit()
         if c is None:
             return None
@@ -148,7 +211,18 @@ class MarkerPath:
         return x, y
 
     def predict_motion(self, frame: int) -> tuple[Point, Point] | None:
-        """``predict(frame)`` and the motion into it, ``predict(frame) - predict(frame - 1)``."""
+        """``predict(frame)`` and the motion into it, ``predict(frame) - predict(frame - 1)``.
+
+        Parameters
+        ----------
+        frame : int
+            The frame being searched.
+
+        Returns
+        -------
+        tuple of (tuple of float) or None
+            The predicted position and motion [px, px/frame]; None before the first sighting.
+        """
         c = self._fit()
         if c is None:
             return None
@@ -161,6 +235,7 @@ class MarkerPath:
 
     @property
     def last_point(self) -> Point | None:
+        """The last position found [px]; None before the first."""
         return (self._found[-1][1], self._found[-1][2]) if self._found else None
 
     @property

@@ -24,17 +24,56 @@ MIN_VALUE = 50
 
 @dataclass(frozen=True)
 class Blob:
+    """A blob of saturated colour in a preview frame.
+
+    Attributes
+    ----------
+    px, py : float
+        Its centroid [px].
+    area_px : int
+        Area [px].
+    hex : str
+        Median colour, ``#RRGGBB``.
+    """
+
     px: float
     py: float
     area_px: int
     hex: str          # median colour, #RRGGBB
 
     def line(self, k: int) -> str:
+        """The blob as a numbered line of the preview's listing.
+
+        Parameters
+        ----------
+        k : int
+            Its number.
+
+        Returns
+        -------
+        str
+            Number, colour, position [px] and area [px].
+        """
         return f"  {k:2d}  {self.hex}  at {self.px:.0f},{self.py:.0f}  ({self.area_px} px)"
 
 
 def saturated_blobs(image_bgr: np.ndarray, count: int = 10, min_area_px: int = 6) -> list[Blob]:
-    """The ``count`` largest blobs of strongly saturated colour, largest first."""
+    """The ``count`` largest blobs of strongly saturated colour, largest first.
+
+    Parameters
+    ----------
+    image_bgr : ndarray
+        The frame, BGR.
+    count : int
+        How many blobs at most.
+    min_area_px : int
+        Smallest blob [px].
+
+    Returns
+    -------
+    list of Blob
+        The blobs.
+    """
     hsv = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2HSV)
     mask = cv2.inRange(hsv, (0, MIN_SATURATION, MIN_VALUE), (179, 255, 255))
     n, labels, stats, cents = cv2.connectedComponentsWithStats(mask, connectivity=8)
@@ -55,7 +94,15 @@ def _label(image: np.ndarray, text: str, at: tuple[int, int], colour=(255, 255, 
 
 
 def draw_grid(image: np.ndarray, step_px: int) -> None:
-    """Grid lines every ``step_px`` (inverted pixels: visible on any background), labelled."""
+    """Grid lines every ``step_px`` (inverted pixels: visible on any background), labelled.
+
+    Parameters
+    ----------
+    image : ndarray
+        The frame, BGR; drawn on in place.
+    step_px : int
+        Grid spacing [px].
+    """
     h, w = image.shape[:2]
     image[:, ::step_px] = 255 - image[:, ::step_px]
     image[::step_px, :] = 255 - image[::step_px, :]
@@ -67,7 +114,31 @@ def draw_grid(image: np.ndarray, step_px: int) -> None:
 
 def preview(info, frame: int, models: list, path: Path) -> tuple[list[Blob], dict[str, tuple[float, float] | None]]:
     """Write the annotated ``frame`` of the video to ``path``; return the blobs and what each
-    marker model finds there (None: nothing)."""
+    marker model finds there (None: nothing).
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+    frame : int
+        The frame to show.
+    models : list
+        Marker models to try on it.
+    path : Path
+        The PNG to write.
+
+    Returns
+    -------
+    blobs : list of Blob
+        The saturated blobs.
+    found : dict of str to (tuple of float or None)
+        Per marker, where it was found [px].
+
+    Raises
+    ------
+    TrackError
+        A frame outside the video.
+    """
     if not 0 <= frame < info.frame_count:
         raise TrackError(f"--frame {frame}: the video has frames 0..{info.frame_count - 1}", "pick a frame in it")
     image = next(img for _, img in read_frames(info, Clip(frame, frame).resolved(info)))

@@ -16,6 +16,20 @@ from .video import Clip, VideoInfo, read_frames
 
 @dataclass
 class TrackedMarker:
+    """One marker's track over a clip.
+
+    Attributes
+    ----------
+    name, spec : str
+        The marker's name and its spec.
+    px, py : ndarray
+        Position per frame, OpenCV convention [px]; nan where not found.
+    score : ndarray
+        The model's score per frame (its meaning is the model's).
+    ok : ndarray of bool
+        Whether it was found on each frame.
+    """
+
     name: str
     spec: str
     px: np.ndarray
@@ -24,6 +38,13 @@ class TrackedMarker:
     ok: np.ndarray
 
     def found(self) -> int:
+        """Number of frames the marker was found on.
+
+        Returns
+        -------
+        int
+            The count.
+        """
         return int(self.ok.sum())
 
 
@@ -40,6 +61,18 @@ class TrackResult:
     source: str = "locust track"
 
     def world(self, track: TrackedMarker) -> tuple[np.ndarray, np.ndarray]:
+        """A marker's track in world metres through the result's calibration.
+
+        Parameters
+        ----------
+        track : TrackedMarker
+            One of the result's markers.
+
+        Returns
+        -------
+        x_m, y_m : ndarray
+            Position per frame, y up [m].
+        """
         return self.calibration.to_world(track.px, track.py, track.name, self.frames)
 
 
@@ -47,8 +80,33 @@ def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibrat
                 progress: Callable[[int], None] | None = None, require_found: bool = True) -> TrackResult:
     """Run every marker model over a resolved ``clip`` of the video ``info``.
 
-    ``progress(n)`` is called after each frame. With ``require_found`` a marker that was
+    ``progress(1)`` is called after each frame. With ``require_found`` a marker that was
     never found anywhere in the clip raises TrackError (nothing is written then).
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+    clip : Clip
+        The resolved clip.
+    models : list
+        The marker models (:func:`.spec.parse_markers`).
+    calibration : Calibration or PlaneCalibration
+        Pixels to metres.
+    progress : callable, optional
+        Called with 1 after each frame.
+    require_found : bool
+        Refuse a marker never found.
+
+    Returns
+    -------
+    TrackResult
+        Every marker's track on the clip's frames.
+
+    Raises
+    ------
+    TrackError
+        A template's key frame outside the clip, or (with ``require_found``) a marker never found.
     """
     frames = np.array(list(clip.frames()), dtype=int)
     n = len(frames)

@@ -47,11 +47,36 @@ class ModelOptions:
 
 
 def default_specs() -> list[str]:
+    """The default markers: ``nose`` and ``foot`` by their sticker colours.
+
+    Returns
+    -------
+    list of str
+        ``NAME=color:#RRGGBB`` specs.
+    """
     return [f"{name}=color:{hex_colour}" for name, (hex_colour, _) in MARKER_COLOURS.items()]
 
 
 def parse_marker(text: str, options: ModelOptions = ModelOptions()):
-    """One ``NAME=SPEC`` string -> a marker model (see the module doc)."""
+    """One ``NAME=SPEC`` string -> a marker model (see the module doc).
+
+    Parameters
+    ----------
+    text : str
+        ``NAME=SPEC``.
+    options : ModelOptions
+        The models' settings.
+
+    Returns
+    -------
+    ColorMarker, TemplateMarker or ArucoMarker
+        The marker model.
+
+    Raises
+    ------
+    TrackError
+        A bad name or spec.
+    """
     name, sep, spec = text.partition("=")
     name, spec = name.strip(), spec.strip()
     if not sep or not NAME_RE.match(name):
@@ -92,6 +117,25 @@ def parse_marker(text: str, options: ModelOptions = ModelOptions()):
 
 
 def parse_markers(texts: list[str] | tuple[str, ...], options: ModelOptions = ModelOptions()) -> list:
+    """The marker models of ``--marker`` options (the default set when none is given).
+
+    Parameters
+    ----------
+    texts : list of str
+        ``NAME=SPEC`` strings.
+    options : ModelOptions
+        The models' settings.
+
+    Returns
+    -------
+    list
+        One marker model per spec.
+
+    Raises
+    ------
+    TrackError
+        A bad spec, or a name used twice.
+    """
     models = [parse_marker(t, options) for t in (texts or default_specs())]
     names = [m.name for m in models]
     dupes = sorted({n for n in names if names.count(n) > 1})

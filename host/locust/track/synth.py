@@ -36,6 +36,20 @@ LINK_BGR = [(0, 0, 200), (0, 170, 0), (0, 200, 220), (200, 60, 0)]  # red, green
 
 @dataclass
 class SynthTruth:
+    """The true marker centres of a SYNTHETIC video.
+
+    Attributes
+    ----------
+    frames : ndarray
+        Frame numbers.
+    fps : float
+        Frame rate [1/s].
+    px, py : dict of str to ndarray
+        Per marker, its true centre per frame, OpenCV convention [px].
+    visible : dict of str to ndarray
+        Per marker, whether it is in view on each frame.
+    """
+
     frames: np.ndarray
     fps: float
     px: dict[str, np.ndarray]
@@ -43,6 +57,18 @@ class SynthTruth:
     visible: dict[str, np.ndarray]
 
     def write_csv(self, path: Path) -> Path:
+        """Write the truth as CSV (``frame, t_s`` and per marker ``px, py, visible``), atomically.
+
+        Parameters
+        ----------
+        path : Path
+            The file.
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
         names = list(self.px)
         lines = ["# synthetic: locust.track.synth; true marker centres, pixels, OpenCV convention",
                  ",".join(["frame", "t_s"] + [f"{n}_{c}" for n in names for c in ("px", "py", "visible")])]
@@ -55,6 +81,22 @@ class SynthTruth:
 
 
 def checker_floor(width: int, height: int, square_px: int = 40, levels: tuple[int, int] = (38, 52)) -> np.ndarray:
+    """A grey checkerboard floor, float32 BGR.
+
+    Parameters
+    ----------
+    width, height : int
+        Image size [px].
+    square_px : int
+        Square side [px].
+    levels : tuple of int
+        Dark and light grey (8-bit levels).
+
+    Returns
+    -------
+    ndarray
+        ``(height, width, 3)`` float32 image.
+    """
     yy, xx = np.indices((height, width))
     dark = ((xx // square_px + yy // square_px) % 2).astype(bool)
     img = np.where(dark, levels[0], levels[1]).astype(np.float32)
@@ -62,7 +104,24 @@ def checker_floor(width: int, height: int, square_px: int = 40, levels: tuple[in
 
 
 def dot_coverage(cx: float, cy: float, radius_px: float, shape: tuple[int, int]) -> tuple[np.ndarray, int, int]:
-    """Exact-ish coverage (0..1) of a disc on a small patch; returns (alpha, x0, y0)."""
+    """Exact-ish coverage (0..1) of a disc on a small patch; returns (alpha, x0, y0).
+
+    Parameters
+    ----------
+    cx, cy : float
+        The disc's centre, OpenCV convention [px].
+    radius_px : float
+        Its radius [px].
+    shape : tuple of int
+        The image's (height, width).
+
+    Returns
+    -------
+    alpha : ndarray
+        Coverage of each patch pixel, 0..1.
+    x0, y0 : int
+        The patch's top-left pixel [px].
+    """
     pad = int(np.ceil(radius_px)) + 2
     x0, y0 = int(np.floor(cx)) - pad, int(np.floor(cy)) - pad
     size = 2 * pad + 2
@@ -78,6 +137,19 @@ def dot_coverage(cx: float, cy: float, radius_px: float, shape: tuple[int, int])
 
 
 def paint_dot(img: np.ndarray, cx: float, cy: float, radius_px: float, bgr) -> None:
+    """Paint a disc into ``img`` in place, each pixel blended by the share of it the disc covers.
+
+    Parameters
+    ----------
+    img : ndarray
+        Float BGR image.
+    cx, cy : float
+        The disc's centre, OpenCV convention [px].
+    radius_px : float
+        Its radius [px].
+    bgr : sequence of int
+        Its colour.
+    """
     alpha, x0, y0 = dot_coverage(cx, cy, radius_px, img.shape[:2])
     h, w = alpha.shape
     region = img[y0:y0 + h, x0:x0 + w]
@@ -85,7 +157,24 @@ def paint_dot(img: np.ndarray, cx: float, cy: float, radius_px: float, bgr) -> N
 
 
 def camera(img: np.ndarray, rng: np.random.Generator, blur_sigma_px: float = 0.6, noise_dn: float = 2.0) -> np.ndarray:
-    """Optics blur, sensor noise, 8-bit output."""
+    """Optics blur, sensor noise, 8-bit output.
+
+    Parameters
+    ----------
+    img : ndarray
+        A float image.
+    rng : numpy.random.Generator
+        Source of the noise.
+    blur_sigma_px : float
+        Gaussian blur [px]; 0 for none.
+    noise_dn : float
+        Noise standard deviation [8-bit levels].
+
+    Returns
+    -------
+    ndarray
+        The uint8 image.
+    """
     if blur_sigma_px > 0:
         img = cv2.GaussianBlur(img, (0, 0), blur_sigma_px)
     img = img + rng.normal(0.0, noise_dn, img.shape).astype(np.float32)
@@ -94,7 +183,26 @@ def camera(img: np.ndarray, rng: np.random.Generator, blur_sigma_px: float = 0.6
 
 def hop_truth(n_frames: int, width: int, height: int, fps: float, rng: np.random.Generator,
               occluded: tuple[int, int] | None = None) -> SynthTruth:
-    """A forward hop: the nose flies a parabola, the foot swings below it."""
+    """A forward hop: the nose flies a parabola, the foot swings below it.
+
+    Parameters
+    ----------
+    n_frames : int
+        Frames.
+    width, height : int
+        Frame size [px].
+    fps : float
+        Frame rate [1/s].
+    rng : numpy.random.Generator
+        Source of the sub-pixel offsets.
+    occluded : tuple of int, optional
+        First and last frame the foot is hidden.
+
+    Returns
+    -------
+    SynthTruth
+        The true centres [px].
+    """
     t = np.arange(n_frames) / fps
     T = t[-1] if n_frames > 1 else 1.0
     x0 = 0.2 * width + rng.uniform(0, 1)
@@ -112,6 +220,27 @@ def hop_truth(n_frames: int, width: int, height: int, fps: float, rng: np.random
 
 def render_hop_frame(i: int, truth: SynthTruth, floor: np.ndarray, radius_px: float,
                      rng: np.random.Generator) -> np.ndarray:
+    """Frame ``i`` of the SYNTHETIC hop video: chassis, links and the two marker dots on the
+    floor, a grey card over the foot where it is hidden, then optics blur and noise.
+
+    Parameters
+    ----------
+    i : int
+        The frame's index into ``truth``.
+    truth : SynthTruth
+        The true marker centres.
+    floor : ndarray
+        The background (:func:`checker_floor`).
+    radius_px : float
+        The dots' radius [px].
+    rng : numpy.random.Generator
+        Source of the sensor noise.
+
+    Returns
+    -------
+    ndarray
+        The frame, uint8 BGR.
+    """
     img = floor.copy()
     nx, ny = truth.px["nose"][i], truth.py["nose"][i]
     fx, fy = truth.px["foot"][i], truth.py["foot"][i]
@@ -136,7 +265,32 @@ def render_hop_frame(i: int, truth: SynthTruth, floor: np.ndarray, radius_px: fl
 def make_hop_video(path: str | os.PathLike, width: int = 640, height: int = 360, n_frames: int = 48,
                    fps: float = 60.0, radius_px: float = 6.0, occluded: tuple[int, int] | None = None,
                    seed: int = 0, fourcc: str = "mp4v") -> SynthTruth:
-    """Write a synthetic hop video and ``<stem>.truth.csv`` beside it; return the truth."""
+    """Write a synthetic hop video and ``<stem>.truth.csv`` beside it; return the truth.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The video to write.
+    width, height : int
+        Frame size [px].
+    n_frames : int
+        Frames.
+    fps : float
+        Frame rate [1/s].
+    radius_px : float
+        The dots' radius [px].
+    occluded : tuple of int, optional
+        First and last frame the foot is hidden.
+    seed : int
+        Seed of the offsets and noise.
+    fourcc : str
+        The codec's four-character code.
+
+    Returns
+    -------
+    SynthTruth
+        The truth.
+    """
     path = Path(path)
     rng = np.random.default_rng(seed)
     truth = hop_truth(n_frames, width, height, fps, rng, occluded)
@@ -154,6 +308,28 @@ def aruco_frame(marker_id: int, centre_px: tuple[float, float], side_px: float, 
 
     The marker is warped onto an ``S`` times larger canvas and reduced with INTER_AREA,
     like the dots. ``side_px`` is the black square's side; its centre is ``centre_px``.
+
+    Parameters
+    ----------
+    marker_id : int
+        The ArUco id.
+    centre_px : tuple of float
+        The marker's centre, OpenCV convention [px].
+    side_px : float
+        The black square's side [px].
+    angle_deg : float
+        Its rotation in the image, counter-clockwise on screen [deg].
+    size : tuple of int
+        The frame's (width, height) [px].
+    dictionary : str
+        The ArUco dictionary.
+    rng : numpy.random.Generator, optional
+        Source of the noise; default seeded 0.
+
+    Returns
+    -------
+    ndarray
+        The frame, uint8 BGR.
     """
     rng = rng or np.random.default_rng(0)
     cells = int(dictionary.split("_")[1].split("X")[0]) + 2  # data bits + black border

@@ -25,7 +25,20 @@ from .video import Clip
 
 
 def project_result(project: TrackerProject, names: list[str] | None = None) -> TrackResult:
-    """The tracks of a Tracker project on its clip's frames (NaN where Tracker has no step)."""
+    """The tracks of a Tracker project on its clip's frames (NaN where Tracker has no step).
+
+    Parameters
+    ----------
+    project : TrackerProject
+        A project read by :mod:`locust.io.trk`.
+    names : list of str, optional
+        The tracks to take; default every point mass.
+
+    Returns
+    -------
+    TrackResult
+        Its tracks [px] with its calibration; no video.
+    """
     frames, t_s, points = project_points(project, names)
     tracks = [TrackedMarker(p.name, f"tracker:{p.tracker_name}", p.px, p.py, np.where(p.ok, 1.0, math.nan), p.ok)
               for p in points]
@@ -38,7 +51,18 @@ def project_result(project: TrackerProject, names: list[str] | None = None) -> T
 
 def tracker_export(result: TrackResult) -> TrackerExport:
     """Tracks as Tracker exports them: per track ``t``, ``x``, ``y`` in world units (m, s),
-    NaN (an empty cell) where the marker was not found."""
+    NaN (an empty cell) where the marker was not found.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+
+    Returns
+    -------
+    TrackerExport
+        One track per marker.
+    """
     tracks = {}
     for tr in result.markers:
         x, y = result.world(tr)
@@ -51,12 +75,36 @@ def tracker_export(result: TrackResult) -> TrackerExport:
 
 def tracker_text(result: TrackResult) -> str:
     """Tracker's "Export Data" layout of ``result``: a row of track names, a row of ``t x y``
-    per track, then tab-separated world values (m, s); a missing step is an empty cell."""
+    per track, then tab-separated world values (m, s); a missing step is an empty cell.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+
+    Returns
+    -------
+    str
+        The tab-separated text.
+    """
     return tracker_export_text(tracker_export(result))
 
 
 def write_tracker_text(result: TrackResult, path: Path) -> Path:
-    """Write ``result`` in Tracker's text export layout, atomically."""
+    """Write ``result`` in Tracker's text export layout, atomically.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks.
+    path : Path
+        The file to write.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     return write_tracker_export(path, tracker_export(result))
 
 
@@ -67,7 +115,29 @@ def as_project(result: TrackResult, trk_path: Path, media: str | None = None) ->
     sequence's first file) by its path relative to the project, the clip, the calibration
     (a plane's homography has none in Tracker) and a step on every frame where a marker was
     found. ``media`` overrides the video's path as written (a video inside a ``.trz``:
-    ``project.trz!/videos/a.mp4``)."""
+    ``project.trz!/videos/a.mp4``).
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks, with their video.
+    trk_path : Path
+        Where the project will be saved.
+    media : str, optional
+        The video's path as written.
+
+    Returns
+    -------
+    project : TrackerProject
+        The project.
+    video : ProjectVideo
+        The video it opens.
+
+    Raises
+    ------
+    TrackError
+        The tracks have no video.
+    """
     info = result.video
     if info is None:
         raise TrackError("these tracks have no video to open in Tracker", "track a video to write a .trk")
@@ -85,10 +155,40 @@ def as_project(result: TrackResult, trk_path: Path, media: str | None = None) ->
 
 
 def project_xml(result: TrackResult, trk_path: Path, media: str | None = None) -> str:
-    """``result`` as a Tracker 6 project's XML (:func:`locust.io.trk.project_xml` of :func:`as_project`)."""
+    """``result`` as a Tracker 6 project's XML (:func:`locust.io.trk.project_xml` of :func:`as_project`).
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks, with their video.
+    trk_path : Path
+        Where the project will be saved.
+    media : str, optional
+        The video's path as written.
+
+    Returns
+    -------
+    str
+        The XML.
+    """
     return trk_io.project_xml(*as_project(result, trk_path, media))
 
 
 def write_project(result: TrackResult, path: Path, media: str | None = None) -> Path:
-    """Write ``result`` as the Tracker project ``path``, atomically (:func:`as_project`)."""
+    """Write ``result`` as the Tracker project ``path``, atomically (:func:`as_project`).
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks, with their video.
+    path : Path
+        The ``.trk`` to write.
+    media : str, optional
+        The video's path as written.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     return trk_io.write_project(*as_project(result, path, media))

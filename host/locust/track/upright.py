@@ -26,7 +26,22 @@ TOP_SHARE = 0.5        # standing before the first move above this share of the 
 
 def standing_still(x: np.ndarray, y: np.ndarray, ok: np.ndarray, tolerance: float) -> np.ndarray:
     """Frames of the still stretch a track opens with: consecutive sightings that move under
-    ``tolerance`` until the first that moves more (or a lost frame)."""
+    ``tolerance`` until the first that moves more (or a lost frame).
+
+    Parameters
+    ----------
+    x, y : ndarray
+        Positions per frame, in the track's unit.
+    ok : ndarray of bool
+        Found per frame.
+    tolerance : float
+        Largest step from the first sighting that is still standing, in the positions' unit.
+
+    Returns
+    -------
+    ndarray
+        Indices of the still frames after the first sighting.
+    """
     idx = np.flatnonzero(ok)
     step = np.hypot(np.diff(x[idx]), np.diff(y[idx]))
     moves = (np.diff(idx) != 1) | (step > tolerance)
@@ -37,7 +52,18 @@ def standing_still(x: np.ndarray, y: np.ndarray, ok: np.ndarray, tolerance: floa
 def upside_down_warnings(result: TrackResult) -> list[str]:
     """One line when the video's heights look upside down, judged from the marker that moves
     up and down the most (in pixels) among those that stand still before their first move: a
-    marker low on a leg may dip as the leg pushes, the robot's rise decides."""
+    marker low on a leg may dip as the leg pushes, the robot's rise decides.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks, with their calibration.
+
+    Returns
+    -------
+    list of str
+        The warning, or empty.
+    """
     best = None
     for track in result.markers:
         x, y = result.world(track)

@@ -35,6 +35,22 @@ os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
 
 @dataclass(frozen=True)
 class VideoInfo:
+    """A video file or image sequence as probed.
+
+    Attributes
+    ----------
+    path : Path
+        The path probed: a video file, an image folder or a sequence's first image.
+    width_px, height_px : int
+        Frame size [px].
+    frame_count : int
+        Frames in it.
+    file_fps : float
+        The rate the file states [1/s] (0 for an image sequence, or a file that states none).
+    images : tuple of Path
+        An image sequence's files, in frame order; empty for a video file.
+    """
+
     path: Path
     width_px: int
     height_px: int
@@ -44,7 +60,23 @@ class VideoInfo:
 
 
 def check_fps(fps: float | None) -> float | None:
-    """``fps`` as given (None: the file's rate), if a camera can film at it."""
+    """``fps`` as given (None: the file's rate), if a camera can film at it.
+
+    Parameters
+    ----------
+    fps : float or None
+        The rate given [1/s].
+
+    Returns
+    -------
+    float or None
+        ``fps`` unchanged.
+
+    Raises
+    ------
+    TrackError
+        A rate outside what cameras film.
+    """
     if fps is not None and not FPS_MIN <= fps <= FPS_MAX:
         raise TrackError(f"--fps {fps:g}: a camera films {FPS_MIN:g} to {FPS_MAX:g} frames/s (times are "
                          "frame / fps: a rate outside that makes them all 0, or hours apart)",
@@ -68,6 +100,23 @@ class Clip:
     fps: float | None = None
 
     def resolved(self, info: VideoInfo) -> Clip:
+        """The clip on ``info``: ``end`` and ``fps`` filled in, every setting checked.
+
+        Parameters
+        ----------
+        info : VideoInfo
+            The probed video.
+
+        Returns
+        -------
+        Clip
+            With ``end`` and ``fps`` set.
+
+        Raises
+        ------
+        TrackError
+            A step below 1, a start or end outside the video, or no usable frame rate.
+        """
         last = info.frame_count - 1
         end = last if self.end is None else self.end
         fps = self.fps if self.fps is not None else info.file_fps
@@ -91,10 +140,29 @@ class Clip:
         return Clip(self.start, end, self.step, float(fps))
 
     def frames(self) -> range:
+        """The frame numbers of a resolved clip.
+
+        Returns
+        -------
+        range
+            From ``start`` to ``end`` inclusive, by ``step``.
+        """
         assert self.end is not None, "resolve the clip first"
         return range(self.start, self.end + 1, self.step)
 
     def time_s(self, frame: int) -> float:
+        """A frame's time in a resolved clip, zero at its first frame.
+
+        Parameters
+        ----------
+        frame : int
+            The frame number.
+
+        Returns
+        -------
+        float
+            ``(frame - start) / fps`` [s].
+        """
         assert self.fps is not None, "resolve the clip first"
         return (frame - self.start) / self.fps
 
@@ -104,7 +172,18 @@ IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".gif")
 
 def image_sequence(path: Path) -> tuple[Path, ...]:
     """The files of the image sequence ``path`` names (a folder, or the first file of a
-    numbered run), in frame order; ``()`` when ``path`` is not an image sequence."""
+    numbered run), in frame order; ``()`` when ``path`` is not an image sequence.
+
+    Parameters
+    ----------
+    path : Path
+        A folder or a file.
+
+    Returns
+    -------
+    tuple of Path
+        The frames' files.
+    """
     if path.is_dir():
         return tuple(sorted(p for p in path.iterdir() if p.is_file() and p.suffix.lower() in IMAGE_SUFFIXES))
     if path.suffix.lower() not in IMAGE_SUFFIXES:
@@ -128,7 +207,20 @@ def read_as_frame(info: VideoInfo, path: Path) -> bool:
     """Whether a file at ``path`` is a frame of the image sequence ``info``, or would be read as
     one by the next run on it: a file of its folder with an image suffix (a folder sequence), or
     its numbered name with another number (``shot07.jpg`` after ``shot00.jpg``). False for a
-    video file."""
+    video file.
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video or sequence.
+    path : Path
+        A file about to be written.
+
+    Returns
+    -------
+    bool
+        True when it would be read as a frame.
+    """
     if not info.images:
         return False
     path = Path(os.path.abspath(path))
@@ -155,7 +247,23 @@ def _probe_images(path: Path, files: tuple[Path, ...]) -> VideoInfo:
 
 def probe(path: str | os.PathLike) -> VideoInfo:
     """Open ``path`` (a video file, or an image sequence: see the module doc) and read its
-    size, frame count and rate (0 for an image sequence), or raise TrackError."""
+    size, frame count and rate (0 for an image sequence), or raise TrackError.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The video file, image folder or first image.
+
+    Returns
+    -------
+    VideoInfo
+        Its size [px], frame count and rate [1/s].
+
+    Raises
+    ------
+    TrackError
+        A missing, empty or unreadable file, a still image, or a folder without images.
+    """
     path = Path(path)
     files = image_sequence(path) if path.exists() else ()
     if files or path.is_dir():
@@ -190,6 +298,22 @@ def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8) -> Iterator[tupl
     grabbed without conversion. Decoding runs in a thread ``prefetch`` frames ahead of
     the caller (OpenCV releases the GIL while it decodes), so tracking a frame overlaps
     decoding the next ones. Raises TrackError if the file ends early.
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+    clip : Clip
+        The resolved clip.
+    prefetch : int
+        Frames decoded ahead.
+
+    Yields
+    ------
+    frame : int
+        The frame number.
+    image : ndarray
+        The frame, BGR.
     """
     out: queue.Queue = queue.Queue(maxsize=max(prefetch, 1))
     stop = threading.Event()
@@ -257,7 +381,25 @@ class _EndedEarly:
 
 
 def read_frame(info: VideoInfo, frame: int) -> np.ndarray:
-    """One decoded frame (for overlays and calibration)."""
+    """One decoded frame (for overlays and calibration).
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+    frame : int
+        The frame number.
+
+    Returns
+    -------
+    ndarray
+        The frame, BGR.
+
+    Raises
+    ------
+    TrackError
+        The frame cannot be read.
+    """
     for _, image in read_frames(info, Clip(frame, frame, 1, 1.0)):
         return image
     raise TrackError(f"{info.path}: frame {frame} could not be read")  # pragma: no cover
@@ -274,7 +416,33 @@ def _ended_early(info: VideoInfo, index: int) -> None:
 
 
 def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: str = "mp4v") -> Path:
-    """Encode ``frames`` (an iterable of BGR images) to ``path`` atomically."""
+    """Encode ``frames`` (an iterable of BGR images) to ``path`` atomically.
+
+    Parameters
+    ----------
+    path : Path
+        The video to write.
+    frames : iterable of ndarray
+        BGR images of ``size``.
+    fps : float
+        Frame rate [1/s].
+    size : tuple of int
+        (width, height) [px].
+    fourcc : str
+        The codec's four-character code.
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    TrackError
+        OpenCV cannot open an encoder for it.
+    WriteError
+        The written video does not read back whole.
+    """
     path = Path(path)
     fd, tmp = temp_beside(path, suffix=path.suffix)
     os.close(fd)
