@@ -47,7 +47,7 @@ def test_beam_json_and_write_then_ramp_and_servo(recs):
     res = run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--length-m", 0.05,
               "--json", "--write", toml)
     assert res.exit_code == 0, res.output
-    out = json.loads(res.output)
+    out = json.loads(res.stdout)
     # header truth: the seed's stiffness and damping (zeta 0.237, so only ~3 cycles ring out);
     # this recording's noise puts the fit 2.4 sigma low, still inside the 3-sigma band
     for key, truth in (("natural_frequency_hz", 7.55777), ("damping_ratio", 0.237434), ("stiffness_n_per_m", 22.55)):
@@ -88,7 +88,7 @@ def test_servo_two_loads_json(recs):
     res = run("calibrate", "servo", recs / "synthetic_servo.csv", recs / "synthetic_servo_heavy.csv",
               "--inertia-kgm2", 1.5e-5, "--inertia-kgm2", 1e-3, "--json", "--no-plot")
     assert res.exit_code == 0, res.output
-    out = json.loads(res.output)
+    out = json.loads(res.stdout)
     # header truth: stall 0.15 N*m, no-load 10.2 rad/s, delay 12 ms, clock ratio 1.002
     assert out["stall_torque_nm"]["value"] == pytest.approx(0.15, rel=0.02) and out["stall_torque_nm"]["identifiable"]
     assert out["noload_speed_rad_per_s"]["value"] == pytest.approx(10.2, rel=0.01)
@@ -105,9 +105,9 @@ def test_servo_two_loads_json(recs):
 
 def test_tracker_export_gives_the_same_fit(recs):
     a = json.loads(run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--json",
-                       "--no-plot").output)
+                       "--no-plot").stdout)
     b = json.loads(run("calibrate", "beam", recs / "synthetic_beam_tracker.txt", "--mass-kg", 0.01, "--json",
-                       "--no-plot").output)
+                       "--no-plot").stdout)
     assert b["natural_frequency_hz"]["value"] == pytest.approx(a["natural_frequency_hz"]["value"], rel=2e-3)
 
 
@@ -124,7 +124,7 @@ def test_tracker_multi_export_with_decimal_commas(tmp_path):
 def test_ramp_track_and_trials_together(recs):
     res = run("calibrate", "ramp", recs / "synthetic_ramp_track.csv", recs / "synthetic_ramp.csv", "--json",
               "--no-plot")
-    out = json.loads(res.output)
+    out = json.loads(res.stdout)
     assert out["n_trials"] == 11
     assert out["angles_deg"][0] == pytest.approx(math.degrees(math.atan(1.7)), abs=0.6)
 
@@ -178,7 +178,7 @@ def test_sim_runs_with_the_written_robot(recs):
                "--write", toml, "--no-plot").exit_code == 0
     res = run("sim", "--config", toml, "--cycles", 1, "--json")
     assert res.exit_code == 0, res.output
-    out = json.loads(res.output[res.output.index("{"):])
+    out = json.loads(res.stdout)
     assert out["robot"] == "calibrated" and out["valid"] is True
 
 

@@ -268,7 +268,7 @@ def test_cli_fits_angle_and_gyro_together_and_validates(tmp_path):
         "--inertia-kgm2", "1e-6", "--stall-torque-nm", "0.15", "--validate", str(tmp_path / "unseen.txt"),
         "--fit-kv", "--json", "--plot", str(tmp_path / "fit.png")])
     assert result.exit_code == 0, result.output
-    out = json.loads(result.output[result.output.index("{"):])
+    out = json.loads(result.stdout)
     assert out["kind"] == ["angle", "rate"]
     for name in ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "kv_nms_per_rad"):
         est = out[name]

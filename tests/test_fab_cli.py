@@ -30,7 +30,7 @@ def _run(*args):
 def test_from_robot_json_hinges(name, hinges):
     result = _run("--from-robot", name, "--json")
     assert result.exit_code == 0, result.output
-    s = json.loads(result.output)
+    s = json.loads(result.stdout)
     assert s["hinges_x_mm"] == pytest.approx(hinges, abs=1e-6)
     assert s["files"] == [] and s["out"] is None
 
@@ -38,16 +38,16 @@ def test_from_robot_json_hinges(name, hinges):
 def test_from_robot_toml_follows_its_link_lengths(tmp_path):
     robot = params.preset("seed").with_values({"geometry.ground_m": 0.045, "geometry.leg_m": 0.07})
     robot_toml.save_robot(robot, tmp_path / "robot.toml")
-    s = json.loads(_run("--from-robot", tmp_path / "robot.toml", "--json").output)
+    s = json.loads(_run("--from-robot", tmp_path / "robot.toml", "--json").stdout)
     assert s["hinges_x_mm"] == pytest.approx([45, 85, 105, 175], abs=1e-6)
     assert s["bounds_mm"]["width"] == pytest.approx(195)
     # its values are not the seed's, though the file kept the name "seed": named by the file
     assert s["source"] == "flat pattern of robot"
     robot_toml.save_robot(robot.renamed("optimize best of opt"), tmp_path / "best.toml")
-    assert json.loads(_run("--from-robot", tmp_path / "best.toml", "--json").output)["source"] == \
+    assert json.loads(_run("--from-robot", tmp_path / "best.toml", "--json").stdout)["source"] == \
         "flat pattern of optimize best of opt"
     robot_toml.save_robot(params.preset("seed"), tmp_path / "plain.toml")   # the seed itself keeps its name
-    assert json.loads(_run("--from-robot", tmp_path / "plain.toml", "--json").output)["source"] == \
+    assert json.loads(_run("--from-robot", tmp_path / "plain.toml", "--json").stdout)["source"] == \
         "flat pattern of seed"
 
 
@@ -55,7 +55,7 @@ def test_zz_out_writes_every_file_and_previews(tmp_path):
     out = tmp_path / "cut"
     result = _run(ZZ, "--out", out, "--json")
     assert result.exit_code == 0, result.output
-    s = json.loads(result.output)
+    s = json.loads(result.stdout)
     assert s["areas_mm2"]["rigid_top"] == pytest.approx(5348.86, rel=5e-4)
     assert s["areas_mm2"]["flexible"] == pytest.approx(5400.0, rel=5e-4)
     assert [row["center_x_mm"] for row in s["slots"]] == pytest.approx([40, 80, 100, 160])
@@ -115,7 +115,7 @@ def test_fold_line_drawing_with_layer_mapping_and_mirror(tmp_path):
     doc.saveas(tmp_path / "synthetic_strip.dxf")
     result = _run(tmp_path / "synthetic_strip.dxf", "--layer", "body=outline", "--layer", "hinge=creases",
                   "--hinge-width-mm", "2", "--mirror", "rigid_bottom", "--json")
-    s = json.loads(result.output)
+    s = json.loads(result.stdout)
     assert s["areas_mm2"]["rigid_top"] == pytest.approx(1200 - 40)
     assert s["areas_mm2"]["flexible"] == pytest.approx(1200)
     assert s["stack"][-1] == {"name": "rigid_bottom", "material": "rigid", "mirror": True}

@@ -51,7 +51,7 @@ def test_a_spline_over_the_limit_is_refused_before_flattening(tmp_path):
     ok = drawing(tmp_path / "ok.dxf", spline(400))    # a spline of an ordinary size is a slit
     res = fab(ok, "--json")
     assert res.exit_code == 0, res.output
-    assert json.loads(res.output)["slits"] == 1
+    assert json.loads(res.stdout)["slits"] == 1
 
 
 @pytest.mark.slow
@@ -89,7 +89,7 @@ def test_an_unknown_insunits_is_refused(tmp_path):
     assert res.exit_code == 2 and "$INSUNITS = 99 is not a drawing unit" in res.output and "--units" in res.output
     assert fab(drawing(tmp_path / "u99b.dxf", insunits=99), "--json", "--units", "mm").exit_code == 0
     res = fab(drawing(tmp_path / "u0.dxf", insunits=0), "--json")
-    assert res.exit_code == 0 and json.loads(res.output)["units"]["from"] == "assumed (no $INSUNITS)"
+    assert res.exit_code == 0 and json.loads(res.stdout)["units"]["from"] == "assumed (no $INSUNITS)"
 
 
 def test_a_cut_of_no_length_is_an_error_not_an_empty_success(tmp_path):

@@ -96,7 +96,7 @@ def test_the_command_writes_the_robot_with_the_axis_measured(tmp_path):
     res = CliRunner().invoke(cli, ["measure", "nose-load", "4.2", "--preset", "medium", "--write", str(out),
                                    "--json"])
     assert res.exit_code == 0, res.output
-    doc = json.loads(res.output)
+    doc = json.loads(res.stdout)
     assert doc["key"] == AXIS_KEY and doc["axis_before"]["sd"] == 0.003
     assert doc["axis"]["value"] == pytest.approx(0.028, abs=5e-4) and doc["axis"]["sd"] <= 0.003
     rounding = 0.001 / math.sqrt(12)        # 1 g: an error uniform over one gram

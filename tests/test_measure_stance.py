@@ -113,7 +113,7 @@ def test_measure_stance_from_two_photos_writes_the_whole_robot(stills, tmp_path)
     result = run_cli("measure", "stance", str(stills["rest"]["jpg"]), str(stills["push"]["jpg"]), "--preset", "medium",
                      "--write", str(out), "--json")
     assert result.exit_code == 0, result.output
-    got = json.loads(result.output)
+    got = json.loads(result.stdout)
     for key, tol in (("crank_start_deg", 2.0), ("ground_angle_deg", 3.0), ("servo_axis_x_m", 0.002)):
         truth = TRUTH[f"geometry.{key}"]
         assert got[key]["value"] == pytest.approx(truth, abs=tol)
@@ -125,12 +125,12 @@ def test_measure_stance_from_two_photos_writes_the_whole_robot(stills, tmp_path)
 
     params = run_cli("params", "--config", str(out), "--json")
     assert params.exit_code == 0, params.output
-    doc = json.loads(params.output)
+    doc = json.loads(params.stdout)
     text = json.dumps(doc)
     assert text.count('"measured:rest.jpg"') == 3
     sim = run_cli("sim", "--config", str(out), "--cycles", "1", "--json")
     assert sim.exit_code == 0, sim.output
-    assert json.loads(sim.output)["valid"] is True
+    assert json.loads(sim.stdout)["valid"] is True
     # the written robot is the preset but for the measured values
     again = run_cli("measure", "stance", str(stills["rest"]["jpg"]), "--preset", "medium", "--write", str(out))
     assert again.exit_code == 2 and "exists" in again.output
@@ -139,7 +139,7 @@ def test_measure_stance_from_two_photos_writes_the_whole_robot(stills, tmp_path)
 def test_one_photo_gives_the_stance_without_the_push(stills):
     result = run_cli("measure", "stance", str(stills["rest"]["jpg"]), "--preset", "medium", "--json")
     assert result.exit_code == 0, result.output
-    got = json.loads(result.output)
+    got = json.loads(result.stdout)
     assert got["push_turn_deg"] is None
     for key, tol in (("crank_start_deg", 2.0), ("ground_angle_deg", 3.0), ("servo_axis_x_m", 0.002)):
         lo, hi = got[key]["ci95"]

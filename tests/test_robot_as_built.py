@@ -43,7 +43,7 @@ def test_params_json_has_no_photo_source_a_photo_cannot_show():
 
     res = CliRunner().invoke(cli, ["params", "--preset", "medium", "--json"])
     assert res.exit_code == 0, res.output
-    values = json.loads(res.output)["values"]
+    values = json.loads(res.stdout)["values"]
     photo = {k for k, v in values.items() if v.get("source", "").startswith("photo:")}
     assert photo and photo <= IN_PLANE, sorted(photo - IN_PLANE)
     for key in ("geometry.crank_start_deg", "geometry.ground_angle_deg"):

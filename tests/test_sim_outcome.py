@@ -124,7 +124,7 @@ def test_sim_json_and_samples_give_the_outcome_and_its_shares(tmp_path):
     res = CliRunner().invoke(cli, ["sim", "--config", str(tmp_path / "r.toml"), "--cycles", "2", "--samples", "6",
                                    "--seed", "3", "--json"])
     assert res.exit_code == 0, res.output
-    out = json.loads(res.output)
+    out = json.loads(res.stdout)
     assert out["outcome"] == O.GOES_OVER
     assert out["nose_load_kg"] == pytest.approx(0.00420, abs=5e-5)
     assert out["total_mass_kg"] == pytest.approx(0.03113, abs=5e-5)
