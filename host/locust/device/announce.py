@@ -23,7 +23,20 @@ def _path(device_path: str) -> Path:
 
 
 def announce(device_path: str, source: RobotSource) -> Path:
-    """Say that this process simulates ``source`` behind ``device_path``; returns the file."""
+    """Say that this process simulates ``source`` behind ``device_path``.
+
+    Parameters
+    ----------
+    device_path : str
+        The pseudo-terminal the virtual robot listens on, e.g. ``/dev/pts/3``.
+    source : RobotSource
+        The robot it simulates (preset, robot file, leg set).
+
+    Returns
+    -------
+    Path
+        The announcement file written under ``<virtual home>/robots/``.
+    """
     path = _path(device_path)
     path.parent.mkdir(parents=True, exist_ok=True)
     return atomic_write_json(path, {"pid": os.getpid(), "device": device_path, "preset": source.preset,
@@ -31,11 +44,30 @@ def announce(device_path: str, source: RobotSource) -> Path:
 
 
 def withdraw(device_path: str) -> None:
+    """Remove the announcement for ``device_path`` (nothing happens if there is none).
+
+    Parameters
+    ----------
+    device_path : str
+        The pseudo-terminal the virtual robot listened on.
+    """
     _path(device_path).unlink(missing_ok=True)
 
 
 def announced(device_path: str) -> RobotSource | None:
-    """The robot a live ``locust virtual`` on ``device_path`` simulates, or None."""
+    """The robot a live ``locust virtual`` on ``device_path`` simulates.
+
+    Parameters
+    ----------
+    device_path : str
+        The pseudo-terminal a command was given as ``--port``.
+
+    Returns
+    -------
+    RobotSource or None
+        The announced robot; None when no file names that device, it cannot be read, or the
+        process that wrote it is gone.
+    """
     try:
         doc = json.loads(_path(device_path).read_text())
         os.kill(int(doc["pid"]), 0)

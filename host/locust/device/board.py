@@ -16,7 +16,25 @@ from .replies import check_config
 
 def read_board(link: Link, hello: dict | None = None) -> R.BoardConfig:
     """The config the firmware runs on (pins, trims, pulse ranges), its chip, and why it is
-    not the saved config.json when it is not (the firmware's ``config_problems``)."""
+    not the saved config.json when it is not (the firmware's ``config_problems``).
+
+    Parameters
+    ----------
+    link : Link
+        An open link to the board.
+    hello : dict, optional
+        The board's ``hello`` reply when already had; asked for when None.
+
+    Returns
+    -------
+    BoardConfig
+        Both servos' config with the chip, machine and config problems.
+
+    Raises
+    ------
+    DeviceError
+        The board does not answer, refuses, or answers out of shape.
+    """
     hello = hello or link.hello()
     cfg = check_config(link.call("config"), link.port)
     return R.board_config({**cfg, "chip": hello.get("chip"), "machine": hello.get("machine"),
@@ -24,14 +42,41 @@ def read_board(link: Link, hello: dict | None = None) -> R.BoardConfig:
 
 
 def write_values(link: Link, edits: list[tuple[str, float]], info=lambda msg: None) -> None:
-    """Set each ``("left.trim_deg", 2.5)`` on the board and save its config.json."""
+    """Set each ``("left.trim_deg", 2.5)`` on the board and save its config.json.
+
+    Parameters
+    ----------
+    link : Link
+        An open link to the board.
+    edits : list of (str, float)
+        Dotted config keys and their new values, in the key's own unit (``trim_deg`` in degrees).
+    info : callable, optional
+        ``info(line)`` for each value set.
+
+    Raises
+    ------
+    DeviceError
+        The board refuses a value (out of its limits, or a pin the chip cannot use).
+    """
     for key, value in edits:
         link.call("config", key=key, value=value, write=1)
         info(f"  set {key} = {value:g}")
 
 
 def table(board: R.BoardConfig) -> str:
-    """The board's config as a table for people."""
+    """The board's config as a table for people.
+
+    Parameters
+    ----------
+    board : BoardConfig
+        From :func:`read_board`.
+
+    Returns
+    -------
+    str
+        One header row and one row per servo: pin, trim [deg], direction, pulse range [us],
+        range [deg] and travel [deg].
+    """
     rows = [("servo", "pin", "trim deg", "direction", "pulse us", "range deg", "travel deg")]
     for name, s in (("left", board.left), ("right", board.right)):
         rows.append((name, str(s.pin), f"{s.trim_deg:g}", f"{s.direction:+d}",

@@ -49,7 +49,20 @@ NO_MICROPYTHON_HINT = (
 def servo_config(servo: Servo, chip: str = "esp32") -> dict:
     """The board's ``config.json`` for ``servo``: its pulse range and travel, the firmware's pins
     for ``chip``, trims and directions. The firmware keeps its own copy of the default pulse
-    range (it cannot import the host); the host always writes these from :class:`locust.params.Servo`."""
+    range (it cannot import the host); the host always writes these from :class:`locust.params.Servo`.
+
+    Parameters
+    ----------
+    servo : Servo
+        The servo parameters (pulse range [us], range and travel [deg]).
+    chip : str, default "esp32"
+        The chip whose default pins are used (``esp32``, ``s2``, ``s3`` or ``c3``).
+
+    Returns
+    -------
+    dict
+        The config, both servos.
+    """
     cfg = fw_config.default(chip)
     for name in fw_config.SERVOS:
         cfg[name].update(pulse_min_us=servo.pulse_min_us, pulse_max_us=servo.pulse_max_us,
@@ -59,6 +72,18 @@ def servo_config(servo: Servo, chip: str = "esp32") -> dict:
 
 @dataclass(frozen=True)
 class FlashedFile:
+    """One file copied to the board and checked there.
+
+    Attributes
+    ----------
+    name : str
+        Its name on the board.
+    size_bytes : int
+        Its size.
+    sha256 : str
+        Its SHA-256 in hex, the same on the board as sent.
+    """
+
     name: str
     size_bytes: int
     sha256: str
@@ -66,6 +91,28 @@ class FlashedFile:
 
 @dataclass
 class FlashResult:
+    """What ``locust flash`` did.
+
+    Attributes
+    ----------
+    port : str
+        The serial port flashed.
+    compiled : bool
+        The files were compiled to .mpy.
+    firmware_version : str
+        The version the board reports after the reset.
+    board : str
+        The board's machine string (or its platform when it names none).
+    config_written : bool
+        ``config.json`` was written.
+    files : list of FlashedFile
+        The files copied.
+    elapsed_s : float
+        Time from connecting to the handshake [s].
+    config_problems : list of str
+        Why the board runs on its default config, if it does.
+    """
+
     port: str
     compiled: bool
     firmware_version: str
@@ -77,6 +124,13 @@ class FlashResult:
 
 
 def firmware_files() -> list[Path]:
+    """The firmware's source files flashed to a board.
+
+    Returns
+    -------
+    list of Path
+        Every ``.py`` of ``locust/firmware`` but ``__init__.py``, sorted.
+    """
     return sorted(p for p in FIRMWARE_DIR.glob("*.py") if p.name not in NOT_FLASHED)
 
 
@@ -84,6 +138,21 @@ def mpy_version(header: bytes) -> int:
     """The .mpy format version of a header (bytecode-only files carry no sub-version or arch).
 
     The board reports its own in the low byte of ``sys.implementation._mpy``.
+
+    Parameters
+    ----------
+    header : bytes
+        The first bytes of a .mpy file.
+
+    Returns
+    -------
+    int
+        The format version.
+
+    Raises
+    ------
+    DeviceError
+        Not a .mpy header.
     """
     if len(header) < 3 or header[:1] != b"M":
         raise DeviceError("mpy-cross wrote an invalid .mpy file", "check the mpy-cross installation")
@@ -91,7 +160,25 @@ def mpy_version(header: bytes) -> int:
 
 
 def build(compile_mpy: bool, workdir: Path) -> list[tuple[str, bytes]]:
-    """[(name on the board, contents)] for every firmware file."""
+    """The files to flash, compiled with ``mpy-cross`` when asked (``main.py`` and ``boot.py`` stay source).
+
+    Parameters
+    ----------
+    compile_mpy : bool
+        Compile to .mpy.
+    workdir : Path
+        A folder for the compiled files.
+
+    Returns
+    -------
+    list of (str, bytes)
+        (name on the board, contents) for every firmware file.
+
+    Raises
+    ------
+    DeviceError
+        ``mpy-cross`` fails on a file.
+    """
     out = []
     for src in firmware_files():
         if not compile_mpy or src.name in KEEP_SOURCE:
@@ -147,8 +234,19 @@ def _release_console(transport, tries: int = 3) -> bool:
 
 
 def board_chip(transport) -> tuple[str, str | None]:
-    """(os.uname().machine, chip) of the board at the raw REPL; chip None if locust has no
-    pin rules for it. sys.platform is "esp32" on every chip: only the machine string tells."""
+    """The board's machine string and chip, asked at the raw REPL. ``sys.platform`` is "esp32" on
+    every chip: only the machine string tells.
+
+    Parameters
+    ----------
+    transport : SerialTransport
+        mpremote's transport, in the raw REPL.
+
+    Returns
+    -------
+    tuple
+        (``os.uname().machine``, chip); chip None if locust has no pin rules for it.
+    """
     transport.exec("import os\ntry:\n _m = os.uname().machine\nexcept Exception:\n _m = ''")
     machine = transport.eval("_m")
     return machine, fw_config.chip_of(machine)
@@ -157,7 +255,29 @@ def board_chip(transport) -> tuple[str, str | None]:
 def planned_config(board: dict | None, written: dict | None, edits: list[tuple[str, float]],
                    chip: str) -> dict:
     """The config the board will run after flashing with ``edits``, checked against ``chip``'s pin
-    rules before anything is written; DeviceError naming the bad value and the usable pins."""
+    rules before anything is written.
+
+    Parameters
+    ----------
+    board : dict or None
+        The board's own config.json (used when valid and nothing is written).
+    written : dict or None
+        The config about to be written, if any.
+    edits : list of (str, float)
+        ``("left.pin", 4)``-style edits applied on top.
+    chip : str
+        The board's chip.
+
+    Returns
+    -------
+    dict
+        The resulting config.
+
+    Raises
+    ------
+    DeviceError
+        An edit is refused for the chip, naming the bad value and the usable pins.
+    """
     cfg = written or (board if board is not None and not fw_config.problems(board, chip) else None) \
         or servo_config(Servo(), chip)
     for key, value in edits:
@@ -174,10 +294,42 @@ def planned_config(board: dict | None, written: dict | None, edits: list[tuple[s
 def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
           progress: Callable[[str], None] = lambda s: None, repl_timeout_s: float = 10.0,
           edits: list[tuple[str, float]] = (), servo: Servo | None = None) -> FlashResult:
-    """Flash the firmware; ``config`` (a whole config.json, or with ``servo`` one made from those
-    servo parameters and the chip's pins) and ``edits`` ("left.pin", 4) are
-    checked against the board's chip before any file is written (the edits themselves are
-    applied afterwards through the firmware, which checks them again)."""
+    """Flash the firmware, verify it, reset the board and complete the handshake.
+
+    ``config`` (a whole config.json, or with ``servo`` one made from those servo parameters
+    and the chip's pins) and ``edits`` are checked against the board's chip before any file is
+    written (the edits themselves are applied afterwards through the firmware, which checks
+    them again).
+
+    Parameters
+    ----------
+    port : str
+        The serial port.
+    compile_mpy : bool, default False
+        Compile the files with ``mpy-cross`` (its .mpy version must be the board's).
+    config : dict, optional
+        A whole config.json to write.
+    progress : callable, optional
+        ``progress(step)`` for each step (connecting, copying NAME, ...).
+    repl_timeout_s : float, default 10.0
+        How long to wait for the raw REPL [s].
+    edits : list of (str, float), optional
+        ``("left.pin", 4)``-style config edits checked here.
+    servo : Servo, optional
+        Servo parameters to make the config from, when ``config`` is None.
+
+    Returns
+    -------
+    FlashResult
+        The files written and the version the board reports.
+
+    Raises
+    ------
+    DeviceError
+        A bad config or edit, no MicroPython (or one older than 1.26, or a chip locust does not
+        know), a file that cannot be written or does not verify, or a board that reports another
+        version after the reset.
+    """
     from mpremote.transport import TransportError
 
     if config is not None and fw_config.problems(config):
@@ -319,7 +471,22 @@ def _write_files(transport, files: list[tuple[str, bytes]], progress: Callable[[
 
 
 def write_board_file(transport, name: str, data: bytes) -> None:
-    """Replace ``name`` on the board whole, or leave it as it was (written as NAME.part, renamed)."""
+    """Replace ``name`` on the board whole, or leave it as it was (written as NAME.part, renamed).
+
+    Parameters
+    ----------
+    transport : SerialTransport
+        mpremote's transport, in the raw REPL.
+    name : str
+        The file's name on the board.
+    data : bytes
+        Its contents.
+
+    Raises
+    ------
+    DeviceError
+        The board cannot write the file (full or failing filesystem).
+    """
     try:
         _write_part(transport, name, data)
     except BaseException:

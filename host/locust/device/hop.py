@@ -39,6 +39,37 @@ def _fetch_report(link: Link, rec: R.RunRecord) -> None:
 def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             on_phase: Callable[[R.Phase], None] = lambda p: None,
             robot: R.RobotSource | None = None) -> R.RunRecord:
+    """Run ``schedule`` on the robot, writing ``run.json`` in ``directory`` as phases arrive.
+
+    No record is written until the board answers the handshake. Whatever ends the hop
+    (Ctrl-C, a lost cable, a reboot, silence) the robot is sent to rest and the record keeps
+    what arrived, marked ``incomplete``.
+
+    Parameters
+    ----------
+    link : Link
+        An open link to the board.
+    schedule : HopSchedule
+        Cycles, push angle [deg], push and wait times [ms] and heartbeat timeout [ms].
+    directory : Path
+        The run folder ``run.json`` is written in.
+    on_phase : callable, optional
+        ``on_phase(phase)`` for each phase as it arrives.
+    robot : RobotSource, optional
+        The robot recorded in ``run.json`` (a virtual robot's preset or robot file).
+
+    Returns
+    -------
+    RunRecord
+        The record as written: ``complete`` only when every phase was reported and the
+        firmware finished the schedule (``default_config`` when it ran on its defaults).
+
+    Raises
+    ------
+    DeviceError
+        The robot refused the hop, stopped reporting, rebooted, the port was lost, or the hop
+        was interrupted; the message gives the phases recorded and the record's path.
+    """
     rec = R.RunRecord(schedule=schedule, port=link.port, message="running", robot=robot or R.RobotSource())
     # no record until the board has answered: a hop that never started (nothing flashed, the
     # wrong port, Ctrl-C at the handshake) leaves no run folder behind

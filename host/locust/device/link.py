@@ -32,8 +32,14 @@ OLD_MICROPYTHON_HINT = ("install MicroPython 1.26 or newer (docs/hardware.md, \"
 
 
 def raise_thread_priority(nice: int = -10) -> None:
-    """Best effort: this thread ahead of the machine's other work (Linux threads have their own
-    nice value; without the privilege, it stays as it is)."""
+    """Best effort: the calling thread ahead of the machine's other work (Linux threads have their
+    own nice value; without the privilege, it stays as it is).
+
+    Parameters
+    ----------
+    nice : int, default -10
+        The nice value to set (lower runs first).
+    """
     try:
         os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), nice)
     except (OSError, AttributeError):
@@ -41,6 +47,28 @@ def raise_thread_priority(nice: int = -10) -> None:
 
 
 class Link:
+    """The host end of one serial port speaking the locust protocol.
+
+    Opening it opens the port (keeping DTR and RTS asserted, so that the board is not reset)
+    and starts a reader thread: replies go to the request waiting on their id, events to
+    :attr:`events`, anything else is counted in :attr:`noise_lines`. Use it as a context
+    manager, or call :meth:`close`.
+
+    Parameters
+    ----------
+    port : str
+        The serial port, e.g. ``/dev/ttyUSB0`` or a virtual robot's ``/dev/pts/N``.
+    baud : int, default 115200
+        Baud rate [bit/s].
+    timeout_s : float, default 1.0
+        How long a request waits for its reply unless told otherwise [s].
+
+    Raises
+    ------
+    DeviceError
+        The port cannot be opened.
+    """
+
     def __init__(self, port: str, baud: int = 115200, timeout_s: float = 1.0):
         self.port = port
         self.timeout_s = timeout_s
@@ -115,6 +143,18 @@ class Link:
 
     # -- writing -------------------------------------------------------------------
     def write(self, data: bytes) -> None:
+        """Write raw bytes to the port (whole frames come from :meth:`request`).
+
+        Parameters
+        ----------
+        data : bytes
+            The bytes to send.
+
+        Raises
+        ------
+        DeviceError
+            The port is lost.
+        """
         try:
             with self._write_lock:
                 self.serial.write(data)
@@ -131,7 +171,27 @@ class Link:
             return req_id
 
     def request(self, cmd: str, timeout_s: float | None = None, **args) -> dict:
-        """Send ``cmd`` and wait for its reply (ok or not); DeviceError on timeout or lost port."""
+        """Send ``cmd`` and wait for its reply (ok or not).
+
+        Parameters
+        ----------
+        cmd : str
+            The protocol command, e.g. ``hello`` or ``hop``.
+        timeout_s : float, optional
+            How long to wait for the reply [s]; the link's ``timeout_s`` when None.
+        **args
+            The command's arguments, sent in the request frame.
+
+        Returns
+        -------
+        dict
+            The reply, with ``ok`` true or an ``error`` and ``detail``.
+
+        Raises
+        ------
+        DeviceError
+            No reply in time, or the port is lost.
+        """
         if self.error is not None:
             raise self.lost_error()
         req_id = self._new_id()
@@ -153,7 +213,27 @@ class Link:
         return msg
 
     def call(self, cmd: str, timeout_s: float | None = None, **args) -> dict:
-        """Like request(), but an error reply raises DeviceError."""
+        """Like :meth:`request`, but an error reply raises.
+
+        Parameters
+        ----------
+        cmd : str
+            The protocol command.
+        timeout_s : float, optional
+            How long to wait for the reply [s]; the link's ``timeout_s`` when None.
+        **args
+            The command's arguments.
+
+        Returns
+        -------
+        dict
+            The reply, ``ok`` true.
+
+        Raises
+        ------
+        DeviceError
+            An error reply, no reply in time, or the port is lost.
+        """
         msg = self.request(cmd, timeout_s, **args)
         if not msg.get("ok"):
             raise DeviceError(f"the robot refused {cmd!r}: {msg.get('error')}: {msg.get('detail')}",
@@ -161,6 +241,13 @@ class Link:
         return msg
 
     def lost_error(self) -> DeviceError:
+        """The error that says the port went away, with the reason.
+
+        Returns
+        -------
+        DeviceError
+            The error to raise.
+        """
         return DeviceError(f"lost the serial port {self.port}: {self.error}",
                            "check the USB cable; the robot returns to rest on its own when the host goes silent")
 
@@ -168,8 +255,25 @@ class Link:
     def hello(self, wait_s: float = 3.0, soft_reset: bool = False) -> dict:
         """The identity/version handshake, retried for ``wait_s`` (a board may be booting).
 
-        ``soft_reset``: a board found at the MicroPython REPL (mpremote leaves it there) is
-        soft-reset once, as mpremote itself does, and gets ``wait_s`` more to start main.py."""
+        Parameters
+        ----------
+        wait_s : float, default 3.0
+            How long to keep asking [s].
+        soft_reset : bool, default False
+            A board found at the MicroPython REPL (mpremote leaves it there) is soft-reset once, as
+            mpremote itself does, and gets ``wait_s`` more to start main.py.
+
+        Returns
+        -------
+        dict
+            The ``hello`` reply, checked by :func:`check_hello`.
+
+        Raises
+        ------
+        DeviceError
+            Nothing answers, the board is at the REPL, the answer is not the locust firmware, its
+            MicroPython is older than 1.26, or it speaks another protocol version.
+        """
         deadline = time.monotonic() + wait_s
         reset_sent = False
         while True:
@@ -210,17 +314,29 @@ class Link:
 
     def soft_reset(self) -> None:
         """From the MicroPython REPL back to main.py: Ctrl-C clears the line typed so far,
-        Ctrl-B leaves the raw REPL (whose own soft reset skips main.py), Ctrl-D soft-resets."""
+        Ctrl-B leaves the raw REPL (whose own soft reset skips main.py), Ctrl-D soft-resets.
+
+        Raises
+        ------
+        DeviceError
+            The port is lost.
+        """
         self.write(b"\r\x03\x02")
         time.sleep(0.05)    # the REPL redraws its prompt before the reset byte
         self.write(b"\x04")
 
     def start_heartbeat(self, interval_s: float) -> None:
-        """Ping every ``interval_s`` until stop_heartbeat(): the robot's proof the host is alive.
+        """Ping every ``interval_s`` until :meth:`stop_heartbeat`: the robot's proof the host is alive.
 
         The pings come from a thread of their own, on a fixed clock (a late beat does not push
         the next one later), at a raised priority where the system allows it, so that a busy
-        machine or a busy main thread does not silence the host."""
+        machine or a busy main thread does not silence the host.
+
+        Parameters
+        ----------
+        interval_s : float
+            Time between pings [s].
+        """
         self.stop_heartbeat()
         stop = threading.Event()
         self._heartbeat_stop = stop
@@ -242,11 +358,15 @@ class Link:
         threading.Thread(target=beat, name="locust-link-heartbeat", daemon=True).start()
 
     def stop_heartbeat(self) -> None:
+        """Stop the pings of :meth:`start_heartbeat` (nothing happens if none run)."""
         if self._heartbeat_stop is not None:
             self._heartbeat_stop.set()
             self._heartbeat_stop = None
 
     def close(self) -> None:
+        """Stop the heartbeat, release RTS then DTR (as mpremote does, so that the board is not
+        reset), close the port and wait up to 1 s for the reader thread.
+        """
         self.stop_heartbeat()
         try:
             # Release RTS before DTR (as mpremote does): DTR=1/RTS=0 only holds GPIO0 low, which a

@@ -25,28 +25,84 @@ PLANTS = ("auto", "mujoco", "record")
 
 
 class Plant(Protocol):
-    def command(self, t_s: float, left_deg: float, right_deg: float) -> None: ...
+    """What a virtual robot's servos drive: it takes horn angles over time and sums up at the end."""
 
-    def close(self, t_s: float) -> dict: ...
+    def command(self, t_s: float, left_deg: float, right_deg: float) -> None:
+        """Set both horns at ``t_s``.
+
+        Parameters
+        ----------
+        t_s : float
+            Time since the virtual robot started [s].
+        left_deg, right_deg : float
+            Horn angles in firmware units (rest 0, push negative) [deg].
+        """
+
+    def close(self, t_s: float) -> dict:
+        """End at ``t_s``.
+
+        Parameters
+        ----------
+        t_s : float
+            Time of the end since the virtual robot started [s].
+
+        Returns
+        -------
+        dict
+            The plant's summary, with its name under ``"plant"``.
+        """
 
 
 @dataclass(frozen=True)
 class ServoCommand:
+    """Both horn angles as commanded at one time.
+
+    Attributes
+    ----------
+    t_s : float
+        Time since the virtual robot started [s].
+    left_deg, right_deg : float
+        Horn angles in firmware units (rest 0, push negative) [deg].
+    """
+
     t_s: float
     left_deg: float
     right_deg: float
 
 
 class RecordingPlant:
+    """A plant that keeps every command in memory (tests and ``--plant record``)."""
+
     def __init__(self):
         self.commands: list[ServoCommand] = []
         self._lock = threading.Lock()
 
     def command(self, t_s: float, left_deg: float, right_deg: float) -> None:
+        """Keep one command.
+
+        Parameters
+        ----------
+        t_s : float
+            Time since the virtual robot started [s].
+        left_deg, right_deg : float
+            Horn angles [deg].
+        """
         with self._lock:
             self.commands.append(ServoCommand(t_s, left_deg, right_deg))
 
     def close(self, t_s: float) -> dict:
+        """The plant's summary.
+
+        Parameters
+        ----------
+        t_s : float
+            Time of the end [s] (unused).
+
+        Returns
+        -------
+        dict
+            ``{"plant": "record", "commands": N}``.
+        """
         return {"plant": "record", "commands": len(self.commands)}
 
 
@@ -56,7 +112,24 @@ HOP_REST_S = 0.5     # servos at rest this long after a push: the hop is done (o
 
 class MujocoPlant:
     """The live MuJoCo model, stepped up to each command's time (and, idle, close behind the
-    clock); ``on_hop`` gets each hop's row (:class:`locust.sim.hops.Hop`'s fields) once it is done."""
+    clock); ``on_hop`` gets each hop's row (:class:`locust.sim.hops.Hop`'s fields) once it is done.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot simulated.
+    video_path : Path, optional
+        A video to render from a fixed camera (with ``.truth.csv`` and ``.camera.json`` beside it).
+    video_fps : int, default 60
+        The video's frame rate [frames/s].
+    on_hop : callable, optional
+        ``on_hop(row)`` for each hop once it is done.
+
+    Raises
+    ------
+    DeviceError
+        The live MuJoCo model cannot be imported.
+    """
 
     def __init__(self, robot, video_path: Path | None = None, video_fps: int = 60,
                  on_hop: Callable[[dict], None] | None = None):
@@ -71,13 +144,28 @@ class MujocoPlant:
         self.films = video_path is not None   # it renders a video
 
     def command(self, t_s: float, left_deg: float, right_deg: float) -> None:
+        """Step the model up to ``t_s``, then set both servos.
+
+        Parameters
+        ----------
+        t_s : float
+            Time since the virtual robot started [s].
+        left_deg, right_deg : float
+            Horn angles in firmware units [deg].
+        """
         self.sim.advance_to(t_s)
         self.sim.set_servo_angles_deg(left_deg, right_deg)
         self._tell()
 
     def idle(self, t_s: float) -> None:
         """No command for a while: step the model up to ``IDLE_LAG_S`` before ``t_s`` (the
-        same steps a later command would take it through) and tell the hops now done."""
+        same steps a later command would take it through) and tell the hops now done.
+
+        Parameters
+        ----------
+        t_s : float
+            The virtual robot's clock now [s].
+        """
         if self.on_hop is None:
             return
         if t_s - IDLE_LAG_S > self.sim.sim_time_s:
@@ -93,6 +181,18 @@ class MujocoPlant:
         self._told = max(self._told, len(hops))
 
     def close(self, t_s: float) -> dict:
+        """Step the model up to ``t_s`` and finish the simulation (and its video).
+
+        Parameters
+        ----------
+        t_s : float
+            Time of the end since the virtual robot started [s].
+
+        Returns
+        -------
+        dict
+            ``{"plant": "mujoco", ...}`` with the live simulation's summary (its hops).
+        """
         self.sim.advance_to(t_s)
         return {"plant": "mujoco", **(self.sim.close() or {})}
 
@@ -106,6 +206,13 @@ class MujocoPlant:
 
 
 def mujoco_available() -> bool:
+    """Whether the live MuJoCo model (``locust.sim.live``) can be imported.
+
+    Returns
+    -------
+    bool
+        True when it is installed.
+    """
     import importlib.util
 
     try:
@@ -116,7 +223,32 @@ def mujoco_available() -> bool:
 
 def make_plant(kind: str, robot=None, video_path: Path | None = None, video_fps: int = 60,
                on_hop: Callable[[dict], None] | None = None) -> Plant:
-    """``auto`` is the MuJoCo model when it is installed (or a video is asked for), else a recorder."""
+    """The plant named ``kind``: ``auto`` is the MuJoCo model when it is installed (or a video is
+    asked for), else a recorder.
+
+    Parameters
+    ----------
+    kind : str
+        ``auto``, ``mujoco`` or ``record``.
+    robot : Robot, optional
+        The robot the MuJoCo plant simulates (the seed preset when None).
+    video_path : Path, optional
+        A video the MuJoCo plant renders.
+    video_fps : int, default 60
+        The video's frame rate [frames/s].
+    on_hop : callable, optional
+        ``on_hop(row)`` for each finished hop (MuJoCo plant).
+
+    Returns
+    -------
+    Plant
+        A :class:`MujocoPlant` or a :class:`RecordingPlant`.
+
+    Raises
+    ------
+    DeviceError
+        An unknown ``kind``, or MuJoCo asked for and not available.
+    """
     if kind == "auto":
         kind = "mujoco" if (video_path is not None or mujoco_available()) else "record"
     if kind == "mujoco":

@@ -24,6 +24,22 @@ ESP32_USB: dict[tuple[int, int | None], str] = {
 
 @dataclass(frozen=True)
 class PortInfo:
+    """One serial port as the operating system lists it.
+
+    Attributes
+    ----------
+    device : str
+        The port's path, e.g. ``/dev/ttyUSB0``.
+    vid, pid : int or None
+        USB vendor and product ids (None for a port that is not USB).
+    serial_number : str or None
+        The USB serial number, when the device has one.
+    description : str
+        The operating system's description of the port.
+    esp32_hint : str or None
+        Why it looks like an ESP32 (the USB bridge it is), None if it does not.
+    """
+
     device: str
     vid: int | None
     pid: int | None
@@ -33,16 +49,36 @@ class PortInfo:
 
     @property
     def vid_pid(self) -> str:
+        """The USB ids as ``VVVV:PPPP`` in hex, or ``-`` when either is unknown."""
         return f"{self.vid:04X}:{self.pid:04X}" if self.vid is not None and self.pid is not None else "-"
 
 
 def esp32_hint(vid: int | None, pid: int | None) -> str | None:
+    """Whether a USB device is a bridge ESP32 boards use.
+
+    Parameters
+    ----------
+    vid, pid : int or None
+        USB vendor and product ids.
+
+    Returns
+    -------
+    str or None
+        The bridge's name (from ``ESP32_USB``), None when the ids are not one of them.
+    """
     if vid is None:
         return None
     return ESP32_USB.get((vid, pid)) or ESP32_USB.get((vid, None))
 
 
 def list_serial_ports() -> list[PortInfo]:
+    """Every serial port on this machine, sorted by path.
+
+    Returns
+    -------
+    list of PortInfo
+        Each port with its USB ids and whether it looks like an ESP32.
+    """
     out = []
     for p in sorted(list_ports.comports(), key=lambda p: p.device):
         out.append(PortInfo(p.device, p.vid, p.pid, p.serial_number, p.description or "",
@@ -51,6 +87,23 @@ def list_serial_ports() -> list[PortInfo]:
 
 
 def autodetect(ports: list[PortInfo]) -> str:
+    """The one port that looks like an ESP32.
+
+    Parameters
+    ----------
+    ports : list of PortInfo
+        From :func:`list_serial_ports`.
+
+    Returns
+    -------
+    str
+        The device path of the only likely ESP32.
+
+    Raises
+    ------
+    DeviceError
+        No port or more than one port looks like an ESP32.
+    """
     likely = [p for p in ports if p.esp32_hint]
     if len(likely) == 1:
         return likely[0].device

@@ -19,15 +19,40 @@ DEFAULT_TRAVEL_DEG = fw_config.default()["left"]["travel_deg"]
 
 
 def limits(name: str = "left_deg") -> tuple[float, float]:
-    """The protocol's (lowest, highest) horn angle for ``pose``."""
+    """The protocol's (lowest, highest) horn angle for ``pose``.
+
+    Parameters
+    ----------
+    name : str, default "left_deg"
+        The ``pose`` argument, ``left_deg`` or ``right_deg``.
+
+    Returns
+    -------
+    tuple of float
+        (lowest, highest) horn angle [deg].
+    """
     _, lo, hi, _ = P.COMMANDS["pose"][name]
     return lo, hi
 
 
 def check_angles(left_deg: float, right_deg: float) -> tuple[float, float]:
-    """The angles as floats; DeviceError (with a hint) if the protocol refuses them.
+    """The angles as floats, checked by the protocol's own ``check_request``, so host and robot
+    cannot disagree.
 
-    The check is the protocol's own (``check_request``), so host and robot cannot disagree.
+    Parameters
+    ----------
+    left_deg, right_deg : float
+        Horn angles from rest [deg].
+
+    Returns
+    -------
+    tuple of float
+        (left_deg, right_deg) as floats [deg].
+
+    Raises
+    ------
+    DeviceError
+        The protocol refuses an angle (out of its limits, or not a number).
     """
     left_deg, right_deg = float(left_deg), float(right_deg)
     try:
@@ -56,7 +81,26 @@ def _refused(cmd: str, reply: dict) -> DeviceError:
 
 
 def pose(link: Link, left_deg: float | None, right_deg: float | None) -> tuple[float, float]:
-    """Send ``pose`` (or ``rest`` when both angles are None); the angles the robot commanded."""
+    """Send ``pose`` (or ``rest`` when both angles are None) after the handshake.
+
+    Parameters
+    ----------
+    link : Link
+        An open link to the board.
+    left_deg, right_deg : float or None
+        Horn angles from rest [deg]; both None sends the servos to rest.
+
+    Returns
+    -------
+    tuple of float
+        (left_deg, right_deg) the robot says it commanded [deg].
+
+    Raises
+    ------
+    DeviceError
+        An angle out of the protocol's limits, or the robot refuses the pose (beyond its servo
+        travel, or a hop is running).
+    """
     link.hello()
     if left_deg is None and right_deg is None:
         cmd, reply = "rest", link.request("rest")

@@ -15,12 +15,31 @@ from ..errors import DeviceError
 
 
 def mpremote_command(device: str, *args: str) -> list[str]:
-    """``mpremote connect DEVICE ARGS...`` run by this Python (the pinned mpremote beside locust)."""
+    """``mpremote connect DEVICE ARGS...`` run by this Python (the pinned mpremote beside locust).
+
+    Parameters
+    ----------
+    device : str
+        The serial port.
+    *args : str
+        mpremote's further arguments, e.g. ``repl``.
+
+    Returns
+    -------
+    list of str
+        The command line, ready for :mod:`subprocess`.
+    """
     return [sys.executable, "-m", "mpremote", "connect", device, *args]
 
 
 def require_terminal() -> None:
-    """mpremote's REPL puts its standard input in raw mode: it needs a terminal."""
+    """Check that standard input is a terminal: mpremote's REPL puts it in raw mode.
+
+    Raises
+    ------
+    DeviceError
+        Standard input is not a terminal.
+    """
     if not sys.stdin.isatty():
         raise DeviceError("`locust repl` needs a terminal (its standard input is not one)",
                           'run it in a terminal; to script the board, `mpremote connect PORT exec "CODE"` '
@@ -28,7 +47,18 @@ def require_terminal() -> None:
 
 
 def run_repl(device: str) -> None:
-    """Run mpremote's REPL on ``device`` in this terminal until the user leaves it."""
+    """Run mpremote's REPL on ``device`` in this terminal until the user leaves it.
+
+    Parameters
+    ----------
+    device : str
+        The serial port.
+
+    Raises
+    ------
+    DeviceError
+        Standard input is not a terminal, or mpremote ends with a non-zero status.
+    """
     require_terminal()
     code = subprocess.call(mpremote_command(device, "repl"))  # interrupted: mpremote is killed
     if code != 0:

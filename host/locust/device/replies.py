@@ -30,7 +30,22 @@ HINT = ("the port answers with something other than this toolkit's firmware, or 
 
 
 def malformed(port: str, what: str, msg) -> DeviceError:
-    """The error for reply or event ``msg`` whose ``what`` is out of shape, quoting the line."""
+    """The error for a reply or event whose ``what`` is out of shape, quoting the line.
+
+    Parameters
+    ----------
+    port : str
+        The serial port the line came from.
+    what : str
+        What is wrong with it, e.g. ``"protocol is not a whole number"``.
+    msg : dict
+        The decoded reply or event (quoted, cut to 300 characters).
+
+    Returns
+    -------
+    DeviceError
+        The error to raise, with a hint to flash the board again.
+    """
     line = json.dumps(msg, separators=(",", ":"), default=repr)
     shown = line if len(line) <= 300 else line[:297] + "..."
     return DeviceError(f"{port}: the board's {what}, in the line {shown}",
@@ -46,7 +61,25 @@ def _is_text(value) -> bool:
 
 
 def check_hello(msg: dict, port: str) -> dict:
-    """``msg`` if its version, protocol, chip, config problems and state have their types."""
+    """``msg`` if its version, protocol, chip, config problems and state have their types.
+
+    Parameters
+    ----------
+    msg : dict
+        The board's ``hello`` reply.
+    port : str
+        The serial port, for the message.
+
+    Returns
+    -------
+    dict
+        ``msg`` itself.
+
+    Raises
+    ------
+    DeviceError
+        A field is out of shape.
+    """
     version = msg.get("micropython")
     if version is not None and not (isinstance(version, list) and 2 <= len(version) <= 4
                                     and all(_is_int(v, 0, 10_000) for v in version)):
@@ -67,7 +100,25 @@ def check_hello(msg: dict, port: str) -> dict:
 
 
 def check_config(msg: dict, port: str) -> dict:
-    """The ``config`` object of a ``config`` reply (its servos are checked by ``board_config``)."""
+    """The ``config`` object of a ``config`` reply (its servos are checked by ``board_config``).
+
+    Parameters
+    ----------
+    msg : dict
+        The board's ``config`` reply.
+    port : str
+        The serial port, for the message.
+
+    Returns
+    -------
+    dict
+        The board's config.
+
+    Raises
+    ------
+    DeviceError
+        The reply holds no config object.
+    """
     cfg = msg.get("config")
     if not isinstance(cfg, dict):
         raise malformed(port, "config reply holds no config object", msg)
@@ -83,13 +134,50 @@ def _phase_fields(port: str, what: str, msg, cycle, name, commanded_us, measured
 
 
 def phase_event(ev: dict, port: str) -> R.Phase:
-    """The phase a ``phase`` event reports."""
+    """The phase a ``phase`` event reports.
+
+    Parameters
+    ----------
+    ev : dict
+        The event.
+    port : str
+        The serial port, for the message.
+
+    Returns
+    -------
+    Phase
+        Cycle, phase name and the commanded and measured durations [us].
+
+    Raises
+    ------
+    DeviceError
+        A field is out of shape or out of range.
+    """
     return _phase_fields(port, "phase event", ev, ev.get("cycle"), ev.get("phase"), ev.get("commanded_us"),
                          ev.get("measured_us"))
 
 
 def done_event(ev: dict, port: str) -> tuple[str, list[int] | None]:
-    """(status, ticks_us) of a ``done`` event."""
+    """The status and tick counts of a ``done`` event.
+
+    Parameters
+    ----------
+    ev : dict
+        The event.
+    port : str
+        The serial port, for the message.
+
+    Returns
+    -------
+    tuple
+        (status, ticks_us): the firmware's status text and its ``ticks_us`` at the start and
+        end of the hop [us], or None when it sent none.
+
+    Raises
+    ------
+    DeviceError
+        A field is out of shape or out of range.
+    """
     status, ticks = ev.get("status"), ev.get("ticks_us")
     if not _is_text(status):
         raise malformed(port, "done event has no status text", ev)
@@ -100,7 +188,25 @@ def done_event(ev: dict, port: str) -> tuple[str, list[int] | None]:
 
 
 def report_page(msg: dict, port: str) -> tuple[list[R.Phase], int]:
-    """(phases, total) of a ``report`` reply."""
+    """The phases and total of a ``report`` reply (one page of the firmware's own list).
+
+    Parameters
+    ----------
+    msg : dict
+        The reply.
+    port : str
+        The serial port, for the message.
+
+    Returns
+    -------
+    tuple
+        (phases, total): this page's phases and the number the firmware holds in all.
+
+    Raises
+    ------
+    DeviceError
+        A field or row is out of shape or out of range.
+    """
     rows, total = msg.get("phases"), msg.get("total")
     if not (isinstance(rows, list) and _is_int(total, 0, 2 * MAX_CYCLE)):
         raise malformed(port, "report reply has no list of phases and total", msg)
@@ -113,7 +219,25 @@ def report_page(msg: dict, port: str) -> tuple[list[R.Phase], int]:
 
 
 def pose_angles(reply: dict, port: str) -> tuple[float, float]:
-    """(left_deg, right_deg) a ``pose`` or ``rest`` reply says the servos were set to."""
+    """The angles a ``pose`` or ``rest`` reply says the servos were set to.
+
+    Parameters
+    ----------
+    reply : dict
+        The reply.
+    port : str
+        The serial port, for the message.
+
+    Returns
+    -------
+    tuple of float
+        (left_deg, right_deg) [deg].
+
+    Raises
+    ------
+    DeviceError
+        Either angle is missing, not finite, or beyond +-180 deg.
+    """
     angles = reply.get("left_deg"), reply.get("right_deg")
     if not all(isinstance(a, (int, float)) and not isinstance(a, bool) and math.isfinite(a) and abs(a) <= 180
                for a in angles):

@@ -16,9 +16,41 @@ from .ports import SIM, autodetect, list_serial_ports
 def open_port(port: str | None, plant: str = "auto", video: Path | None = None, robot=None,
               info=None, video_fps: int = 60, firmware: bool = True,
               on_close: Callable[[dict], None] | None = None) -> Iterator[str]:
-    """Yields the device path to open. ``sim`` runs a virtual robot for the ``with`` block;
-    with ``firmware`` (a command that talks to the firmware) its flash must hold one.
-    ``on_close`` gets the virtual robot's plant summary (its simulated hops) when it stops."""
+    """Resolve ``--port`` for the ``with`` block: a device path, autodetection, or ``sim``.
+
+    ``sim`` runs a virtual robot for the ``with`` block; with ``firmware`` (a command that talks
+    to the firmware) its flash must hold one. ``on_close`` gets the virtual robot's plant
+    summary (its simulated hops) when it stops.
+
+    Parameters
+    ----------
+    port : str or None
+        A device path, ``sim``, or None to autodetect the one ESP32.
+    plant : str, default "auto"
+        The virtual robot's plant (``auto``, ``mujoco`` or ``record``, :func:`make_plant`).
+    video : Path, optional
+        A video the virtual robot's MuJoCo plant renders.
+    robot : Robot, optional
+        The robot the virtual robot simulates (the seed preset when None).
+    info : callable, optional
+        ``info(line)`` for what the virtual robot is and, at the end, its simulated hops.
+    video_fps : int, default 60
+        Frame rate of ``video`` [frames/s].
+    firmware : bool, default True
+        Require firmware in the virtual robot's flash folder.
+    on_close : callable, optional
+        ``on_close(summary)`` with the virtual robot's plant summary when it stops.
+
+    Yields
+    ------
+    str
+        The device path to open.
+
+    Raises
+    ------
+    DeviceError
+        Nothing flashed on the virtual robot, an unknown plant, or no single ESP32 found.
+    """
     if port == SIM:
         from .virtual import VirtualRobot, default_flash_dir
 

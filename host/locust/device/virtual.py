@@ -83,14 +83,40 @@ CTRL_C = b"\x03"
 
 
 def virtual_home() -> Path:
+    """The virtual robot's folder: ``$LOCUST_VIRTUAL_DIR``, default ``~/.cache/locust/virtual``.
+
+    Returns
+    -------
+    Path
+        The folder (not created here).
+    """
     return Path(os.environ.get("LOCUST_VIRTUAL_DIR") or Path.home() / ".cache" / "locust" / "virtual")
 
 
 def default_flash_dir() -> Path:
+    """The virtual robot's flash folder, ``flash`` in :func:`virtual_home`.
+
+    Returns
+    -------
+    Path
+        The folder (not created here).
+    """
     return virtual_home() / "flash"
 
 
 def micropython_executable() -> str:
+    """The MicroPython unix port: the one beside this Python, else the one on ``PATH``.
+
+    Returns
+    -------
+    str
+        Its path.
+
+    Raises
+    ------
+    DeviceError
+        Neither is found.
+    """
     beside = Path(sys.executable).with_name("micropython")
     found = str(beside) if beside.exists() else shutil.which("micropython")
     if not found:
@@ -101,7 +127,23 @@ def micropython_executable() -> str:
 
 @dataclass(frozen=True)
 class PwmWrite:
-    """One duty change as the firmware wrote it, and what the virtual robot made of it."""
+    """One duty change as the firmware wrote it, and what the virtual robot made of it.
+
+    Attributes
+    ----------
+    t_written_s : float
+        When it was written, on the host clock from the firmware's ``ticks_us`` [s].
+    t_effect_s : float
+        When it takes effect: the start of the next PWM period [s].
+    pin : int
+        The GPIO number.
+    pulse_us : float
+        The pulse width [us].
+    servo : str or None
+        ``left`` or ``right`` by the firmware's config, None for a pin no servo is on.
+    horn_deg : float or None
+        The horn angle the pulse commands [deg], None for an unknown pin.
+    """
 
     t_written_s: float     # host clock, from the firmware's ticks_us
     t_effect_s: float      # start of the next PWM period
@@ -181,7 +223,18 @@ def _in_readline(pid: int) -> bool:
 
 
 def chip_env(chip: str) -> dict[str, str]:
-    """The environment that tells the machine/os shims which chip they are."""
+    """The environment that tells the machine/os shims which chip they are.
+
+    Parameters
+    ----------
+    chip : str
+        ``esp32``, ``s2``, ``s3`` or ``c3``.
+
+    Returns
+    -------
+    dict of str to str
+        ``LOCUST_MACHINE`` and the pins the chip lacks, has as input only, or wires to its flash.
+    """
     exists = fw_config.CHIPS[chip][0]
     flash = fw_config.pins_of_kind(chip, "flash")
     return {"LOCUST_MACHINE": MACHINES[chip],
@@ -192,6 +245,26 @@ def chip_env(chip: str) -> dict[str, str]:
 
 
 class VirtualRobot:
+    """The locust firmware running on the MicroPython unix port behind a pseudo-terminal, its
+    servos driving a plant (see the module's description).
+
+    Parameters
+    ----------
+    flash_dir : Path, optional
+        The virtual robot's flash folder (created if missing); :func:`default_flash_dir` when None.
+    plant : Plant, optional
+        What the servos drive; a :class:`RecordingPlant` when None.
+    log_path : Path, optional
+        A new CSV file each PWM write is logged to (never overwritten).
+    chip : str, default "esp32"
+        The chip it behaves as (``esp32``, ``s2``, ``s3`` or ``c3``).
+
+    Raises
+    ------
+    DeviceError
+        An unknown chip, or no MicroPython unix port.
+    """
+
     def __init__(self, flash_dir: Path | None = None, plant: Plant | None = None, log_path: Path | None = None,
                  chip: str = "esp32"):
         if chip not in CHIPS:
@@ -236,6 +309,13 @@ class VirtualRobot:
 
     # -- lifecycle ---------------------------------------------------------------------
     def start(self) -> VirtualRobot:
+        """Open the pseudo-terminals, boot the interpreter and start the threads.
+
+        Returns
+        -------
+        VirtualRobot
+            Itself; clients open :attr:`device_path`.
+        """
         self._ma, self._sa = os.openpty()     # the interpreter's console
         self._mb, self._sb = os.openpty()     # the clients' side: /dev/pts/N
         for fd in (self._sa, self._sb):
@@ -288,13 +368,25 @@ class VirtualRobot:
         self._next_reset_cause = RESET_SOFT  # until machine.reset() says otherwise
 
     def stop(self) -> dict:
-        """Stop the interpreter and the threads; close the plant; returns its summary.
+        """Stop the interpreter and the threads; close the plant and return its summary.
 
         A signal while stopping (TERM, Ctrl-C: an exception raised here) cancels the plant
         instead of waiting for its video: the plant thread, which owns the renderer and the
         encoder, drops the video itself, and this thread waits for that before it lets the
         exception end the process (the interpreter leaving under a thread still inside OpenGL
-        or the encoder crashed it). :attr:`video_dropped` then says so."""
+        or the encoder crashed it). :attr:`video_dropped` then says so.
+
+        Returns
+        -------
+        dict
+            The plant's summary (empty if it gave none); the same on a second call.
+
+        Raises
+        ------
+        DeviceError
+            Interrupted while stopping (the video was not kept), the simulation failed, or it did
+            not finish within ``PLANT_CLOSE_TIMEOUT_S``.
+        """
         if self._stopping.is_set():
             return self.summary or {}
         self._stopping.set()
@@ -403,6 +495,13 @@ class VirtualRobot:
         self.stop()
 
     def now_s(self) -> float:
+        """The virtual robot's clock.
+
+        Returns
+        -------
+        float
+            Time since it was made [s].
+        """
         return time.monotonic() - self._t0
 
     # -- threads -----------------------------------------------------------------------

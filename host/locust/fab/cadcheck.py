@@ -24,7 +24,17 @@ PAINT_OPS = {"S", "s", "f", "F", "f*", "B", "B*", "b", "b*"}
 
 @dataclass(frozen=True)
 class PdfDrawing:
-    """What the PDF's page content really strokes or fills (content-stream units)."""
+    """What the PDF's page content really strokes or fills (content-stream units).
+
+    Attributes
+    ----------
+    painted_paths : int
+        Paths stroked or filled.
+    segments : int
+        Line and curve segments in the painted paths.
+    bbox : tuple of float or None
+        (x0, y0, x1, y1) of the painted points [PDF units], None when nothing was painted.
+    """
 
     painted_paths: int
     segments: int                  # line and curve segments in painted paths
@@ -32,6 +42,7 @@ class PdfDrawing:
 
     @property
     def aspect(self) -> float:
+        """Width over height of :attr:`bbox` (infinite when it has no height)."""
         x0, y0, x1, y1 = self.bbox
         return (x1 - x0) / (y1 - y0) if y1 > y0 else float("inf")
 
@@ -47,7 +58,18 @@ def _streams(pdf: bytes):
 
 def pdf_drawing(pdf: bytes) -> PdfDrawing:
     """Count painted path segments in every content stream (clip paths, ended by ``n``,
-    are not drawing)."""
+    are not drawing).
+
+    Parameters
+    ----------
+    pdf : bytes
+        A PDF file's bytes (compressed streams are inflated).
+
+    Returns
+    -------
+    PdfDrawing
+        The painted paths, their segments and bounding box.
+    """
     painted = segments = 0
     xs: list[float] = []
     ys: list[float] = []
@@ -86,11 +108,36 @@ def pdf_drawing(pdf: bytes) -> PdfDrawing:
 
 
 def librecad_available() -> bool:
+    """Whether ``librecad`` is on ``PATH``.
+
+    Returns
+    -------
+    bool
+        True when it is.
+    """
     return shutil.which("librecad") is not None
 
 
 def dxf_to_pdf(dxf: str | os.PathLike, *, timeout_s: float = 60.0) -> bytes:
-    """The PDF LibreCAD draws from ``dxf``; a FabError if it fails, hangs or writes nothing."""
+    """The PDF LibreCAD draws from ``dxf`` (``librecad dxf2pdf``, headless, under a time limit).
+
+    Parameters
+    ----------
+    dxf : str or PathLike
+        The DXF file.
+    timeout_s : float, default 60.0
+        Longest LibreCAD may run [s].
+
+    Returns
+    -------
+    bytes
+        The PDF.
+
+    Raises
+    ------
+    FabError
+        LibreCAD is not installed, does not finish in time, or writes no PDF.
+    """
     exe = shutil.which("librecad")
     if exe is None:
         raise FabError("LibreCAD is not installed", "apt-get install -y librecad (Debian/Ubuntu)")
@@ -111,6 +158,25 @@ def dxf_to_pdf(dxf: str | os.PathLike, *, timeout_s: float = 60.0) -> bytes:
 
 
 def check_dxf(dxf: str | os.PathLike, *, timeout_s: float = 60.0) -> PdfDrawing:
+    """Have LibreCAD draw ``dxf`` and count what it drew.
+
+    Parameters
+    ----------
+    dxf : str or PathLike
+        The DXF file.
+    timeout_s : float, default 60.0
+        Longest LibreCAD may run [s].
+
+    Returns
+    -------
+    PdfDrawing
+        What the PDF paints.
+
+    Raises
+    ------
+    FabError
+        LibreCAD fails, hangs, writes no PDF, or draws nothing.
+    """
     drawing = pdf_drawing(dxf_to_pdf(dxf, timeout_s=timeout_s))
     if drawing.painted_paths == 0:
         raise FabError(f"LibreCAD drew nothing from {Path(dxf).name}", "open the file in a CAD program to see why")

@@ -60,7 +60,19 @@ GAP_TOL_MM = (0.0, 10.0)
 
 @dataclass(frozen=True)
 class Contour:
-    """One loop or open path of a drawing layer, in millimetres."""
+    """One loop or open path of a drawing layer, in millimetres.
+
+    Attributes
+    ----------
+    layer : str
+        The DXF layer.
+    points_mm : numpy.ndarray
+        (n, 2) vertices [mm]; a loop does not repeat its first point.
+    closed : bool
+        A loop (three or more vertices).
+    entities : tuple of str
+        The entities it came from, e.g. ``("LINE #1F", "ARC #20")``.
+    """
 
     layer: str
     points_mm: np.ndarray          # (n, 2); a loop does not repeat its first point
@@ -69,15 +81,39 @@ class Contour:
 
     @property
     def start_mm(self) -> tuple[float, float]:
+        """The first vertex (x, y) [mm]."""
         return tuple(self.points_mm[0])
 
     @property
     def end_mm(self) -> tuple[float, float]:
+        """The last vertex (x, y) [mm]."""
         return tuple(self.points_mm[-1])
 
 
 @dataclass(frozen=True)
 class Drawing:
+    """Every curve of a DXF file as contours in millimetres.
+
+    Attributes
+    ----------
+    path : Path
+        The file read.
+    units : str
+        The drawing's unit: ``mm``, ``cm``, ``in``, ...
+    mm_per_unit : float
+        Millimetres per drawing unit.
+    units_from : str
+        ``$INSUNITS``, ``--units``, or ``assumed (no $INSUNITS)``.
+    contours : tuple of Contour
+        The loops and open paths, two vertices or more.
+    skipped : dict of str to int
+        Entity types that are not curves, and how many of each.
+    recovered : int
+        Problems fixed by ezdxf's recover mode.
+    points : tuple of Contour
+        Pieces shorter than the gap tolerance, one point each (for the caller to name).
+    """
+
     path: Path
     units: str                     # "cm", "in", ...
     mm_per_unit: float
@@ -88,11 +124,36 @@ class Drawing:
     points: tuple[Contour, ...] = ()   # pieces shorter than the gap tolerance: one point each
 
     def layers(self) -> list[str]:
+        """The layers that hold contours.
+
+        Returns
+        -------
+        list of str
+            Layer names, sorted.
+        """
         return sorted({c.layer for c in self.contours})
 
 
 def open_document(path: str | Path, *, recover: bool = False):
-    """Open a DXF strictly (or with ezdxf's recover mode); any failure is a FabError."""
+    """Open a DXF strictly (or with ezdxf's recover mode); any failure is a FabError.
+
+    Parameters
+    ----------
+    path : str or Path
+        The DXF file.
+    recover : bool, default False
+        Read a damaged file with ezdxf's recover mode.
+
+    Returns
+    -------
+    tuple
+        (ezdxf document, number of problems the recover mode fixed).
+
+    Raises
+    ------
+    FabError
+        No such file, an empty file, or one ezdxf cannot read (or recover).
+    """
     import ezdxf
     from ezdxf import recover as ezrecover
 
@@ -128,6 +189,25 @@ def _short(exc: Exception, n: int = 160) -> str:
 
 
 def drawing_units(doc, override: str | None) -> tuple[str, float, str]:
+    """The drawing's unit: ``override`` if given, else ``$INSUNITS``, else millimetres assumed.
+
+    Parameters
+    ----------
+    doc : ezdxf document
+        The drawing.
+    override : str or None
+        A unit name from ``--units`` (``mm``, ``cm``, ``in``, ...).
+
+    Returns
+    -------
+    tuple
+        (unit name, millimetres per unit, where the unit came from).
+
+    Raises
+    ------
+    FabError
+        An unknown unit name, or an ``$INSUNITS`` code that is no length unit locust knows.
+    """
     if override:
         if override not in UNIT_BY_NAME:
             raise FabError(f"unknown unit {override!r}", f"use one of {', '.join(UNIT_BY_NAME)}")
@@ -152,7 +232,24 @@ def _copies(entity) -> int:
 
 def expanded_count(doc, entities, depth: int = 0, memo: dict | None = None) -> int:
     """How many entities ``entities`` become once their block references are expanded (as
-    ``_entities_by_layer`` expands them), counted from the block definitions without expanding."""
+    ``_entities_by_layer`` expands them), counted from the block definitions without expanding.
+
+    Parameters
+    ----------
+    doc : ezdxf document
+        The drawing (its block definitions).
+    entities : iterable of DXF entities
+        The entities, e.g. the model space.
+    depth : int, default 0
+        The nesting level of ``entities``.
+    memo : dict, optional
+        Counts of blocks already counted, by (name, depth).
+
+    Returns
+    -------
+    int
+        The count; it stops early once over ``MAX_EXPANDED_ENTITIES``.
+    """
     memo = {} if memo is None else memo
     total = 0
     for entity in entities:
@@ -171,7 +268,20 @@ def expanded_count(doc, entities, depth: int = 0, memo: dict | None = None) -> i
 
 
 def check_expansion(doc, path) -> None:
-    """Refuse a drawing whose block references expand into more than MAX_EXPANDED_ENTITIES."""
+    """Refuse a drawing whose block references expand into more than ``MAX_EXPANDED_ENTITIES``.
+
+    Parameters
+    ----------
+    doc : ezdxf document
+        The drawing.
+    path : str or Path
+        Its file, for the message.
+
+    Raises
+    ------
+    FabError
+        Too many entities once expanded.
+    """
     n = expanded_count(doc, doc.modelspace())
     if n > MAX_EXPANDED_ENTITIES:
         raise FabError(
@@ -312,8 +422,23 @@ def _bulge_segments(entity, sagitta: float) -> float:
 
 
 def check_entity(entity, layer: str, sagitta: float) -> None:
-    """:class:`FabError` if ``entity`` holds a number that is not finite, or an arc that would
-    flatten into more than :data:`MAX_ARC_SEGMENTS` chords at ``sagitta`` (drawing units)."""
+    """Refuse an entity that holds a number that is not finite, or an arc that would flatten into
+    more than :data:`MAX_ARC_SEGMENTS` chords.
+
+    Parameters
+    ----------
+    entity : DXF entity
+        The curve.
+    layer : str
+        Its layer, for the message.
+    sagitta : float
+        The largest distance of a chord from its arc [drawing units].
+
+    Raises
+    ------
+    FabError
+        The entity cannot be read, holds NaN or inf, or flattens into too many chords.
+    """
     try:
         numbers = _numbers(entity)
     except (TypeError, ValueError, AttributeError) as exc:
@@ -340,7 +465,32 @@ def check_entity(entity, layer: str, sagitta: float) -> None:
 
 def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm: float,
                    sagitta_mm: float) -> list[Contour]:
-    """The loops and open paths of one layer's curves."""
+    """The loops and open paths of one layer's curves: closed entities as they stand, open ones
+    chained with ezdxf's edge miner where their ends meet within the gap tolerance.
+
+    Parameters
+    ----------
+    entities : list of DXF entities
+        The layer's curves.
+    layer : str
+        The layer's name.
+    mm_per_unit : float
+        Millimetres per drawing unit.
+    gap_tol_mm : float
+        The gap two ends may leave and still be joined [mm].
+    sagitta_mm : float
+        The largest distance of a chord from its curve when flattening [mm].
+
+    Returns
+    -------
+    list of Contour
+        The contours [mm]; a piece that collapses to a point is one of a single vertex.
+
+    Raises
+    ------
+    FabError
+        An entity that cannot be read, is not finite, or is too large to flatten.
+    """
     from ezdxf import edgeminer as em
     from ezdxf import edgesmith as es
     from ezdxf import path as ezpath
@@ -403,7 +553,32 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
 
 def read_drawing(path: str | Path, *, units: str | None = None, gap_tol_mm: float = 0.01,
                  sagitta_mm: float = 0.001, recover: bool = False) -> Drawing:
-    """Read every curve of ``path`` into contours in millimetres (see the module doc)."""
+    """Read every curve of ``path`` into contours in millimetres (see the module's description).
+
+    Parameters
+    ----------
+    path : str or Path
+        The DXF file.
+    units : str, optional
+        The drawing's unit, overriding ``$INSUNITS``.
+    gap_tol_mm : float, default 0.01
+        The gap two ends may leave and still be joined, above 0 and at most 10 [mm].
+    sagitta_mm : float, default 0.001
+        The largest distance of a chord from its curve when flattening [mm].
+    recover : bool, default False
+        Read a damaged file with ezdxf's recover mode.
+
+    Returns
+    -------
+    Drawing
+        The contours by layer, the units and where they came from, what was skipped.
+
+    Raises
+    ------
+    FabError
+        A gap tolerance out of range, a file that cannot be read, an unknown unit, too many
+        block copies, or a curve that is not finite or too large.
+    """
     low, high = GAP_TOL_MM
     if not low < gap_tol_mm <= high:
         raise FabError(f"--gap-tol-mm {gap_tol_mm:g} must be above {low:g} and at most {high:g} mm: the gap two "

@@ -36,6 +36,18 @@ COLOURS = {"rigid": 1, "adhesive": 30, "flexible": 5, "outline": 7, "plate": 7, 
 
 
 def polygons(geom) -> list:
+    """The non-empty polygons of a shapely geometry.
+
+    Parameters
+    ----------
+    geom : shapely geometry
+        A Polygon, MultiPolygon or collection.
+
+    Returns
+    -------
+    list of Polygon
+        Its polygons (none for an empty geometry; lines and points are left out).
+    """
     if geom.is_empty:
         return []
     if geom.geom_type == "Polygon":
@@ -44,6 +56,20 @@ def polygons(geom) -> list:
 
 
 def rings(geom, exteriors_only: bool = False) -> list[list[tuple[float, float]]]:
+    """The rings of every polygon of ``geom``, each without its closing point.
+
+    Parameters
+    ----------
+    geom : shapely geometry
+        The geometry [mm].
+    exteriors_only : bool, default False
+        Leave out the polygons' holes.
+
+    Returns
+    -------
+    list of list of (float, float)
+        Each ring's vertices [mm].
+    """
     out = []
     for poly in polygons(geom):
         out.append(list(poly.exterior.coords)[:-1])
@@ -53,7 +79,15 @@ def rings(geom, exteriors_only: bool = False) -> list[list[tuple[float, float]]]
 
 
 class CutDocument:
-    """A new R2010 drawing in millimetres with colour-coded layers."""
+    """A new R2010 drawing in millimetres with colour-coded layers (ezdxf).
+
+    Attributes
+    ----------
+    doc : ezdxf.document.Drawing
+        The drawing.
+    msp : Modelspace
+        Its model space.
+    """
 
     def __init__(self):
         import ezdxf
@@ -66,11 +100,43 @@ class CutDocument:
         self.msp = self.doc.modelspace()
 
     def layer(self, name: str, colour: int | None = None) -> str:
+        """Add layer ``name`` if it is not there yet.
+
+        Parameters
+        ----------
+        name : str
+            The layer's name.
+        colour : int, optional
+            AutoCAD colour index; by default the one ``COLOURS`` gives the name (7 if none).
+
+        Returns
+        -------
+        str
+            ``name``.
+        """
         if name not in self.doc.layers:
             self.doc.layers.add(name, color=colour if colour is not None else COLOURS.get(name, 7))
         return name
 
     def contours(self, geom, layer: str, colour: int | None = None, exteriors_only: bool = False) -> int:
+        """Draw every ring of ``geom`` with three or more vertices as a closed LWPOLYLINE on ``layer``.
+
+        Parameters
+        ----------
+        geom : shapely geometry
+            The geometry [mm].
+        layer : str
+            The DXF layer.
+        colour : int, optional
+            The layer's AutoCAD colour index, when the layer is new.
+        exteriors_only : bool, default False
+            Leave out the polygons' holes.
+
+        Returns
+        -------
+        int
+            The number of contours drawn.
+        """
         self.layer(layer, colour)
         rs = [r for r in rings(geom, exteriors_only) if len(r) >= 3]
         for r in rs:
@@ -78,12 +144,33 @@ class CutDocument:
         return len(rs)
 
     def paths(self, lines, layer: str) -> int:
+        """Draw each line as an open LWPOLYLINE on ``layer`` (slits: single beam passes).
+
+        Parameters
+        ----------
+        lines : sequence of LineString
+            The paths [mm].
+        layer : str
+            The DXF layer.
+
+        Returns
+        -------
+        int
+            The number of paths drawn.
+        """
         self.layer(layer)
         for line in lines:
             self.msp.add_lwpolyline(list(line.coords), close=False, dxfattribs={"layer": layer})
         return len(lines)
 
     def to_bytes(self) -> bytes:
+        """The drawing as DXF.
+
+        Returns
+        -------
+        bytes
+            The DXF file, UTF-8.
+        """
         stream = io.StringIO()
         self.doc.write(stream)
         return stream.getvalue().encode("utf-8")
@@ -94,6 +181,21 @@ def _mirror_lines(lam: Laminate, lines, layer):
 
 
 def layer_file(lam: Laminate, layer) -> bytes:
+    """The DXF of one layer's sheet: ``outline``, ``cutouts``, ``alignment`` and ``slits``,
+    kerf-compensated and mirrored if the layer is.
+
+    Parameters
+    ----------
+    lam : Laminate
+        The laminate.
+    layer : LaminateLayer
+        One of its layers.
+
+    Returns
+    -------
+    bytes
+        The DXF file.
+    """
     k = lam.process.kerf_mm
     doc = CutDocument()
     doc.contours(lam.oriented(compensate_part(lam.design.body, k), layer), "outline", exteriors_only=True)
@@ -105,6 +207,19 @@ def layer_file(lam: Laminate, layer) -> bytes:
 
 
 def combined_file(lam: Laminate) -> bytes:
+    """``combined_cut_pattern.dxf``: the design overlaid on ``plate``, ``hinges``, ``holes``,
+    ``slits``, ``alignment`` and ``release``, kerf-compensated.
+
+    Parameters
+    ----------
+    lam : Laminate
+        The laminate.
+
+    Returns
+    -------
+    bytes
+        The DXF file.
+    """
     d, k = lam.design, lam.process.kerf_mm
     doc = CutDocument()
     doc.contours(compensate_part(d.body, k), "plate", exteriors_only=True)
@@ -117,6 +232,19 @@ def combined_file(lam: Laminate) -> bytes:
 
 
 def first_pass_file(lam: Laminate) -> bytes:
+    """``first_pass_cuts.dxf``: each sheet's cuts before lamination, one DXF layer per laminate
+    layer, plus ``alignment`` and ``slits``.
+
+    Parameters
+    ----------
+    lam : Laminate
+        The laminate.
+
+    Returns
+    -------
+    bytes
+        The DXF file.
+    """
     k = lam.process.kerf_mm
     doc = CutDocument()
     for layer in lam.layers:
@@ -128,13 +256,36 @@ def first_pass_file(lam: Laminate) -> bytes:
 
 
 def perimeter_file(lam: Laminate) -> bytes:
+    """``final_perimeter.dxf``: the release cut, kerf-compensated.
+
+    Parameters
+    ----------
+    lam : Laminate
+        The laminate.
+
+    Returns
+    -------
+    bytes
+        The DXF file.
+    """
     doc = CutDocument()
     doc.contours(compensate_part(lam.release, lam.process.kerf_mm), "release", exteriors_only=True)
     return doc.to_bytes()
 
 
 def cut_files(lam: Laminate) -> dict[str, bytes]:
-    """File name -> DXF bytes, every file of the job, built in memory before any is written."""
+    """Every DXF file of the job, built in memory before any is written.
+
+    Parameters
+    ----------
+    lam : Laminate
+        The laminate.
+
+    Returns
+    -------
+    dict of str to bytes
+        File name to DXF bytes: one per layer, then the combined, first-pass and perimeter files.
+    """
     files = {f"{layer.spec.name}.dxf": layer_file(lam, layer) for layer in lam.layers}
     files["combined_cut_pattern.dxf"] = combined_file(lam)
     files["first_pass_cuts.dxf"] = first_pass_file(lam)
@@ -143,7 +294,23 @@ def cut_files(lam: Laminate) -> dict[str, bytes]:
 
 
 def check_out(out_dir: str | os.PathLike) -> Path:
-    """Refuse, before any work, a destination that holds files."""
+    """Refuse, before any work, a destination that holds files.
+
+    Parameters
+    ----------
+    out_dir : str or PathLike
+        The output folder (may not exist yet).
+
+    Returns
+    -------
+    Path
+        ``out_dir`` as a Path.
+
+    Raises
+    ------
+    FabError
+        It exists and is not an empty folder.
+    """
     out = Path(out_dir)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise FabError(f"{out} already exists and is not an empty folder",
@@ -154,7 +321,25 @@ def check_out(out_dir: str | os.PathLike) -> Path:
 def publish(out_dir: str | os.PathLike, files: dict[str, bytes]) -> Path:
     """Write ``files`` into ``out_dir`` all at once: staged in a hidden sibling folder and
     renamed into place, so a failure leaves nothing behind. Never writes into a folder
-    that already holds files."""
+    that already holds files.
+
+    Parameters
+    ----------
+    out_dir : str or PathLike
+        The output folder, missing or empty.
+    files : dict of str to bytes
+        File name to contents.
+
+    Returns
+    -------
+    Path
+        The output folder.
+
+    Raises
+    ------
+    FabError
+        ``out_dir`` exists and is not an empty folder.
+    """
     out = check_out(out_dir)
     make_folder(out.parent)
     stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))

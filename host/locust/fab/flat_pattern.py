@@ -32,7 +32,21 @@ LINK_ORDER = ("ground", "crank", "coupler", "leg")
 
 @dataclass(frozen=True)
 class FlatPattern:
-    """The numbers that fix the strip, in millimetres."""
+    """The numbers that fix the strip, in millimetres.
+
+    Attributes
+    ----------
+    links_mm : tuple of float
+        Ground, crank, coupler and leg link lengths [mm].
+    width_mm : float
+        Strip width [mm].
+    glue_tab_mm : float
+        Length of the tab glued under the ground link [mm].
+    slot_width_mm, slot_length_mm : float
+        Each hinge slot's width (along the strip) and length (across it) [mm].
+    name : str
+        The robot's name, for the drawing's source.
+    """
 
     links_mm: tuple[float, float, float, float]   # ground, crank, coupler, leg
     width_mm: float = 30.0
@@ -43,13 +57,23 @@ class FlatPattern:
 
     @property
     def hinges_x_mm(self) -> tuple[float, ...]:
+        """The hinge centres along the strip, the running sums of the link lengths [mm]."""
         return tuple(round(x, 9) for x in accumulate(self.links_mm))
 
     @property
     def length_mm(self) -> float:
+        """The strip's length, links and glue tab [mm]."""
         return sum(self.links_mm) + self.glue_tab_mm
 
     def check(self) -> None:
+        """Refuse a strip that cannot be cut.
+
+        Raises
+        ------
+        FabError
+            A link no longer than a slot is wide, a slot that does not fit the strip, or a negative
+            glue tab.
+        """
         bad = [f"{n}={v:g} mm" for n, v in zip(LINK_ORDER, self.links_mm) if not v > self.slot_width_mm]
         if bad:
             raise FabError(f"flat pattern: link too short for a {self.slot_width_mm:g} mm hinge slot: {', '.join(bad)}",
@@ -63,12 +87,37 @@ class FlatPattern:
             raise FabError(f"flat pattern: negative glue tab {self.glue_tab_mm:g} mm", "give --glue-tab-mm >= 0")
 
     def slot_span_y_mm(self) -> tuple[float, float]:
+        """Where the slots lie across the strip, centred on its width.
+
+        Returns
+        -------
+        tuple of float
+            (lowest, highest) y of every slot [mm].
+        """
         c = self.width_mm / 2
         return c - self.slot_length_mm / 2, c + self.slot_length_mm / 2
 
 
 def from_robot(robot, **overrides) -> FlatPattern:
-    """The flat pattern of ``robot`` (a :class:`locust.params.Robot`), metres to mm."""
+    """The flat pattern of ``robot`` (a :class:`locust.params.Robot`), metres to mm.
+
+    Parameters
+    ----------
+    robot : Robot
+        Gives the link lengths and link width [m] and the name.
+    **overrides
+        Other :class:`FlatPattern` fields (``glue_tab_mm``, ``slot_width_mm``, ...).
+
+    Returns
+    -------
+    FlatPattern
+        The checked pattern.
+
+    Raises
+    ------
+    FabError
+        The pattern cannot be cut (:meth:`FlatPattern.check`).
+    """
     links = tuple(round(v * 1000.0, 9) for v in robot.link_lengths_m())
     fp = FlatPattern(links_mm=links, width_mm=round(robot.geometry.link_width_m * 1000.0, 9),
                      name=robot.name, **overrides)
@@ -77,12 +126,44 @@ def from_robot(robot, **overrides) -> FlatPattern:
 
 
 def stadium(x_mm: float, y0_mm: float, y1_mm: float, width_mm: float):
-    """A vertical slot with round ends spanning y0..y1 (overall), ``width_mm`` wide."""
+    """A vertical slot with round ends spanning y0..y1 (overall), ``width_mm`` wide.
+
+    Parameters
+    ----------
+    x_mm : float
+        The slot's centre line [mm].
+    y0_mm, y1_mm : float
+        Its overall ends [mm].
+    width_mm : float
+        Its width [mm].
+
+    Returns
+    -------
+    Polygon
+        The slot [mm].
+    """
     r = width_mm / 2
     return LineString([(x_mm, y0_mm + r), (x_mm, y1_mm - r)]).buffer(r, cap_style="round", quad_segs=64)
 
 
 def design(fp: FlatPattern) -> Design:
+    """The pattern as a :class:`~.design.Design`: the strip as body, a stadium slot at each hinge.
+
+    Parameters
+    ----------
+    fp : FlatPattern
+        The pattern.
+
+    Returns
+    -------
+    Design
+        The design [mm], layers ``plate`` and ``hinge_1`` ... ``hinge_4``.
+
+    Raises
+    ------
+    FabError
+        The pattern cannot be cut.
+    """
     fp.check()
     y0, y1 = fp.slot_span_y_mm()
     hinges = tuple(HingeCut(f"hinge_{i + 1}", "slot", stadium(x, y0, y1, fp.slot_width_mm))
@@ -94,7 +175,23 @@ def design(fp: FlatPattern) -> Design:
 
 def drawing_bytes(fp: FlatPattern) -> bytes:
     """The flat pattern as the seed drew it: LINE outline on ``plate``, each slot as two
-    LINEs and two ARCs on ``hinge_N``; millimetres ($INSUNITS 4)."""
+    LINEs and two ARCs on ``hinge_N``; millimetres ($INSUNITS 4).
+
+    Parameters
+    ----------
+    fp : FlatPattern
+        The pattern.
+
+    Returns
+    -------
+    bytes
+        The DXF file.
+
+    Raises
+    ------
+    FabError
+        The pattern cannot be cut.
+    """
     import io
 
     import ezdxf
@@ -124,6 +221,20 @@ def drawing_bytes(fp: FlatPattern) -> bytes:
 
 
 def write_drawing(fp: FlatPattern, path: str | Path) -> Path:
+    """Write :func:`drawing_bytes` to ``path`` atomically (:func:`locust.fileio.atomic_write_bytes`).
+
+    Parameters
+    ----------
+    fp : FlatPattern
+        The pattern.
+    path : str or Path
+        The DXF file to write.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     from ..fileio import atomic_write_bytes
 
     return atomic_write_bytes(path, drawing_bytes(fp))

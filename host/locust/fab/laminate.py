@@ -36,6 +36,18 @@ MATERIALS = ("rigid", "adhesive", "flexible")
 
 @dataclass(frozen=True)
 class LayerSpec:
+    """One sheet of the stack.
+
+    Attributes
+    ----------
+    name : str
+        Its name and file stem: ``rigid_top``, ``adhesive_top``, ...
+    material : str
+        ``rigid``, ``adhesive`` or ``flexible``.
+    mirror : bool
+        Cut mirrored about the body's vertical centre line (an adhesive cut liner side up).
+    """
+
     name: str            # file stem: rigid_top, adhesive_top, ...
     material: str        # rigid | adhesive | flexible
     mirror: bool = False
@@ -50,7 +62,19 @@ PROCESS_LIMITS_MM = {"kerf_mm": (0.0, True, 10.0), "support_width_mm": (0.0, Tru
 
 
 def check_design(design) -> None:
-    """Refuse a part no cutter can make (size, non-finite vertices) and cut-outs that are not in it."""
+    """Refuse a part no cutter can make (size, non-finite vertices) and cut-outs that are not in it.
+
+    Parameters
+    ----------
+    design : Design
+        The part, in mm.
+
+    Raises
+    ------
+    FabError
+        Non-finite vertices, a size outside ``PART_LIMITS_MM``, or a hole, slit or hinge slot
+        outside the body.
+    """
     bounds = design.body.bounds
     if design.body.is_empty or not all(math.isfinite(v) for v in bounds):
         raise FabError(f"{design.source or 'the part'}: its outline has no finite vertices (NaN or inf)",
@@ -74,7 +98,19 @@ def check_design(design) -> None:
 
 @dataclass(frozen=True)
 class Process:
-    """Cutting parameters (the seed's Config, in millimetres)."""
+    """Cutting parameters (the seed's Config, in millimetres).
+
+    Attributes
+    ----------
+    kerf_mm : float
+        Width the beam removes.
+    support_width_mm : float
+        Width of the support web the release cut leaves round the outline.
+    jig_diameter_mm : float
+        Diameter of the four alignment holes.
+    jig_spacing_mm : float
+        Distance of the alignment holes out from the body's corners, in x and in y.
+    """
 
     kerf_mm: float = 0.05
     support_width_mm: float = 2.0
@@ -82,6 +118,13 @@ class Process:
     jig_spacing_mm: float = 10.0
 
     def check(self) -> None:
+        """Refuse settings outside ``PROCESS_LIMITS_MM``, or alignment holes that would cut into the body.
+
+        Raises
+        ------
+        FabError
+            A setting out of range, naming the option to change.
+        """
         for name, (low, low_ok, high) in PROCESS_LIMITS_MM.items():
             value = getattr(self, name)
             if not (value > low or (low_ok and value == low)) or not value <= high:
@@ -98,7 +141,25 @@ SEED_STACK = ("rigid", "adhesive", "flexible", "adhesive", "rigid")
 
 def stack_from_materials(materials: tuple[str, ...] | list[str], mirror: tuple[str, ...] = ()) -> tuple[LayerSpec, ...]:
     """Name the layers of a stack: a material used once is named by it, twice gets
-    ``_top``/``_bottom``, more get ``_1``, ``_2``...; ``mirror`` lists names to mirror."""
+    ``_top``/``_bottom``, more get ``_1``, ``_2``...
+
+    Parameters
+    ----------
+    materials : sequence of str
+        Materials top to bottom (``rigid``, ``adhesive``, ``flexible``; case and blanks ignored).
+    mirror : tuple of str, optional
+        Names of the layers to cut mirrored.
+
+    Returns
+    -------
+    tuple of LayerSpec
+        The stack, top to bottom.
+
+    Raises
+    ------
+    FabError
+        An empty stack, an unknown material, no flexible layer, or a mirrored name that is no layer.
+    """
     materials = [m.strip().lower() for m in materials if m.strip()]
     bad = [m for m in materials if m not in MATERIALS]
     if bad or not materials:
@@ -120,16 +181,45 @@ def stack_from_materials(materials: tuple[str, ...] | list[str], mirror: tuple[s
 
 @dataclass(frozen=True)
 class LaminateLayer:
+    """One layer of the laminate as designed.
+
+    Attributes
+    ----------
+    spec : LayerSpec
+        Its name, material and mirroring.
+    part : Polygon or MultiPolygon
+        What is left of the sheet inside the body [mm], before mirroring and kerf compensation.
+    """
+
     spec: LayerSpec
     part: Polygon | MultiPolygon          # as designed, mm
 
     @property
     def area_mm2(self) -> float:
+        """The layer's area as designed [mm^2]."""
         return float(self.part.area)
 
 
 @dataclass(frozen=True)
 class Laminate:
+    """The layer stack cut from one design, with the cuts that make it (see the module's description).
+
+    Attributes
+    ----------
+    design : Design
+        The part.
+    process : Process
+        The cutting parameters.
+    layers : tuple of LaminateLayer
+        The stack, top to bottom.
+    alignment_holes : tuple of Polygon
+        The four alignment holes [mm].
+    release : Polygon or MultiPolygon
+        The part plus its support web: inside the release cut [mm].
+    mirror_x_mm : float
+        The vertical line mirrored layers are mirrored about: the body's centre [mm].
+    """
+
     design: Design
     process: Process
     layers: tuple[LaminateLayer, ...]
@@ -139,18 +229,57 @@ class Laminate:
 
     @property
     def support_web(self):
+        """The strip between the outline and the release cut [mm] (shapely geometry)."""
         return self.release.difference(self.design.body)
 
     def cutouts(self, layer: LaminateLayer):
-        """What the first pass removes from this layer inside the body, as designed."""
+        """What the first pass removes from this layer inside the body, as designed.
+
+        Parameters
+        ----------
+        layer : LaminateLayer
+            One of :attr:`layers`.
+
+        Returns
+        -------
+        shapely geometry
+            The cut-outs [mm].
+        """
         return self.design.body.difference(layer.part)
 
     def oriented(self, geom, layer: LaminateLayer):
+        """``geom`` as cut on ``layer``'s sheet: mirrored about :attr:`mirror_x_mm` if the layer is.
+
+        Parameters
+        ----------
+        geom : shapely geometry
+            Geometry in design coordinates [mm].
+        layer : LaminateLayer
+            The layer it is cut on.
+
+        Returns
+        -------
+        shapely geometry
+            The geometry on the sheet [mm].
+        """
         return affinity.scale(geom, -1.0, 1.0, origin=(self.mirror_x_mm, 0.0)) if layer.spec.mirror else geom
 
 
 def part_geometry(design: Design, material: str):
-    """Rigid and adhesive layers lose the hinge slots; every layer loses the holes."""
+    """A layer's part: rigid and adhesive layers lose the hinge slots; every layer loses the holes.
+
+    Parameters
+    ----------
+    design : Design
+        The part.
+    material : str
+        The layer's material.
+
+    Returns
+    -------
+    shapely geometry
+        What is left of the body [mm].
+    """
     geom = design.body
     if material != "flexible" and design.hinges:
         geom = geom.difference(design.hinge_union())
@@ -160,6 +289,20 @@ def part_geometry(design: Design, material: str):
 
 
 def alignment_holes(bounds_mm, process: Process) -> tuple[Polygon, ...]:
+    """The four alignment holes, ``jig_spacing_mm`` out from each corner of the bounds.
+
+    Parameters
+    ----------
+    bounds_mm : tuple of float
+        (x0, y0, x1, y1) of the body [mm].
+    process : Process
+        Gives the holes' diameter and spacing.
+
+    Returns
+    -------
+    tuple of Polygon
+        Circles [mm], counter-clockwise from the lower left corner.
+    """
     x0, y0, x1, y1 = bounds_mm
     s, r = process.jig_spacing_mm, process.jig_diameter_mm / 2
     corners = [(x0 - s, y0 - s), (x1 + s, y0 - s), (x1 + s, y1 + s), (x0 - s, y1 + s)]
@@ -167,6 +310,28 @@ def alignment_holes(bounds_mm, process: Process) -> tuple[Polygon, ...]:
 
 
 def build(design: Design, stack: tuple[LayerSpec, ...] | None = None, process: Process | None = None) -> Laminate:
+    """The laminate of ``design``: each layer's part, the alignment holes and the release cut.
+
+    Parameters
+    ----------
+    design : Design
+        The part [mm].
+    stack : tuple of LayerSpec, optional
+        The layers top to bottom; the seed's rigid, adhesive, flexible, adhesive, rigid when None.
+    process : Process, optional
+        Cutting parameters; the defaults when None.
+
+    Returns
+    -------
+    Laminate
+        The laminate.
+
+    Raises
+    ------
+    FabError
+        Process settings out of range, a part no cutter can make, cut-outs outside the body,
+        or a layer with nothing left.
+    """
     stack = stack or stack_from_materials(SEED_STACK)
     process = process or Process()
     process.check()
@@ -184,13 +349,44 @@ def build(design: Design, stack: tuple[LayerSpec, ...] | None = None, process: P
 
 # -- kerf compensation ----------------------------------------------------------------
 def compensate_part(geom, kerf_mm: float):
-    """Cut path around material: outer contours out by kerf/2, its holes in by kerf/2."""
+    """Cut path around material: outer contours out by kerf/2, its holes in by kerf/2.
+
+    Parameters
+    ----------
+    geom : shapely geometry
+        The material as designed [mm].
+    kerf_mm : float
+        Width the beam removes.
+
+    Returns
+    -------
+    shapely geometry
+        The cut path [mm] (mitred corners).
+    """
     return geom.buffer(kerf_mm / 2, join_style="mitre") if kerf_mm else geom
 
 
 def compensate_cutout(geom, kerf_mm: float):
     """Cut path of a hole (material removed inside): in by kerf/2. A hole narrower than
-    the kerf cannot be compensated and is an error rather than silently lost."""
+    the kerf cannot be compensated and is an error rather than silently lost.
+
+    Parameters
+    ----------
+    geom : shapely geometry
+        The cut-outs as designed [mm].
+    kerf_mm : float
+        Width the beam removes.
+
+    Returns
+    -------
+    shapely geometry
+        The cut path [mm].
+
+    Raises
+    ------
+    FabError
+        A cut-out narrower than the kerf.
+    """
     if not kerf_mm or geom.is_empty:
         return geom
     out = geom.buffer(-kerf_mm / 2, join_style="mitre")
@@ -205,9 +401,32 @@ def compensate_cutout(geom, kerf_mm: float):
 
 
 def union(geoms):
+    """The union of shapely geometries.
+
+    Parameters
+    ----------
+    geoms : iterable of shapely geometry
+        The geometries.
+
+    Returns
+    -------
+    shapely geometry
+        Their union.
+    """
     return unary_union(list(geoms))
 
 
 def sheet_bounds(lam: Laminate) -> tuple[float, float, float, float]:
-    """Everything the laser touches: release cut and alignment holes."""
+    """Everything the laser touches: release cut and alignment holes.
+
+    Parameters
+    ----------
+    lam : Laminate
+        The laminate.
+
+    Returns
+    -------
+    tuple of float
+        (x0, y0, x1, y1) [mm].
+    """
     return union([lam.release, *lam.alignment_holes, box(*lam.design.bounds_mm)]).bounds

@@ -38,6 +38,18 @@ def _frame(ax, lam: Laminate, title: str) -> None:
 
 
 def cut_pattern_png(lam: Laminate) -> bytes:
+    """The cut pattern as a PNG: body, hinge cut-outs, holes, slits, support web and alignment holes [mm].
+
+    Parameters
+    ----------
+    lam : Laminate
+        The laminate.
+
+    Returns
+    -------
+    bytes
+        The PNG file.
+    """
     plt = pyplot()
 
     d = lam.design
@@ -58,6 +70,18 @@ def cut_pattern_png(lam: Laminate) -> bytes:
 
 
 def layers_png(lam: Laminate) -> bytes:
+    """Each layer of the stack as a PNG panel, oriented as cut, with its material and area [mm^2].
+
+    Parameters
+    ----------
+    lam : Laminate
+        The laminate.
+
+    Returns
+    -------
+    bytes
+        The PNG file.
+    """
     plt = pyplot()
 
     from .laminate import sheet_bounds
@@ -81,4 +105,16 @@ def layers_png(lam: Laminate) -> bytes:
 
 
 def preview_files(lam: Laminate) -> dict[str, bytes]:
+    """Both previews by file name.
+
+    Parameters
+    ----------
+    lam : Laminate
+        The laminate.
+
+    Returns
+    -------
+    dict of str to bytes
+        ``cut_pattern.png`` and ``laminate_layers.png``.
+    """
     return {"cut_pattern.png": cut_pattern_png(lam), "laminate_layers.png": layers_png(lam)}

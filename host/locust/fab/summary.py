@@ -13,6 +13,27 @@ def _r(x: float, n: int = 4) -> float:
 
 def summary(lam: Laminate, *, hinges_x_mm: tuple[float, ...] | None = None,
             files: list[str] | None = None, out_dir: str | None = None) -> dict:
+    """The manufacturing summary of ``lam``, lengths rounded to 0.1 um.
+
+    Parameters
+    ----------
+    lam : Laminate
+        The laminate.
+    hinges_x_mm : tuple of float, optional
+        Hinge positions along the body [mm]; by default each hinge slot's centre from the
+        body's left edge.
+    files : list of str, optional
+        The files written.
+    out_dir : str, optional
+        The folder they were written to.
+
+    Returns
+    -------
+    dict
+        Source and units, bounds [mm], layer stack with areas [mm^2], support web area
+        [mm^2], hinge slots, hole and slit counts, alignment holes [mm], process settings,
+        layer roles, ignored layers, joined overlaps and files.
+    """
     d = lam.design
     x0, y0, x1, y1 = d.bounds_mm
     slots = [h.table_row() for h in d.hinges]
@@ -41,6 +62,18 @@ def summary(lam: Laminate, *, hinges_x_mm: tuple[float, ...] | None = None,
 
 
 def summary_text(s: dict) -> str:
+    """The summary as lines for people.
+
+    Parameters
+    ----------
+    s : dict
+        From :func:`summary`.
+
+    Returns
+    -------
+    str
+        The text, one fact a line.
+    """
     b = s["bounds_mm"]
     p = s["process"]
     lines = [

@@ -26,8 +26,19 @@ CM_PER_M = 100.0   # every figure draws lengths in centimetres, and says so on i
 
 
 def axis_scale(name: str) -> tuple[float, str]:
-    """(factor, axis label) to draw the sweep axis ``name``: a length (``scale``, ``*_m``) in
-    cm, anything else in its own unit, as its name says."""
+    """How to draw the sweep axis ``name``: a length (``scale``, ``*_m``) in cm, anything else in
+    its own unit, as its name says.
+
+    Parameters
+    ----------
+    name : str
+        ``scale`` or a dotted parameter name.
+
+    Returns
+    -------
+    tuple
+        (factor from the parameter's unit to the drawn one, axis label).
+    """
     if name == SCALE:
         return CM_PER_M, "added length on every link (cm)"
     return (CM_PER_M, f"{name} (cm)") if name.endswith("_m") else (1.0, name)
@@ -35,7 +46,17 @@ def axis_scale(name: str) -> tuple[float, str]:
 
 @dataclass(frozen=True)
 class Axis:
-    """``NAME=START:STOP:N``: N values from START to STOP inclusive (``numpy.linspace``)."""
+    """``NAME=START:STOP:N``: N values from START to STOP inclusive (``numpy.linspace``).
+
+    Attributes
+    ----------
+    name : str
+        ``scale`` or a dotted parameter name.
+    start, stop : float
+        The first and last value, in the parameter's unit (``scale``: m).
+    n : int
+        The number of values.
+    """
 
     name: str
     start: float
@@ -43,16 +64,42 @@ class Axis:
     n: int
 
     def values(self) -> list[float]:
+        """The axis's values.
+
+        Returns
+        -------
+        list of float
+            ``n`` values from ``start`` to ``stop``, in the parameter's unit.
+        """
         return [float(v) for v in np.linspace(self.start, self.stop, self.n)]
 
     def to_dict(self) -> dict[str, Any]:
+        """The axis as sweep.json stores it.
+
+        Returns
+        -------
+        dict
+            ``name``, ``start``, ``stop`` and ``n``.
+        """
         return {"name": self.name, "start": self.start, "stop": self.stop, "n": self.n}
 
 
 @dataclass(frozen=True)
 class Bound:
     """``NAME=LOW:HIGH`` (a range, in steps of ``step`` when given) or ``NAME=A,B,C`` (the
-    values ``choices``, a categorical) for the optimiser."""
+    values ``choices``, a categorical) for the optimiser.
+
+    Attributes
+    ----------
+    name : str
+        ``scale`` or a dotted parameter name.
+    low, high : float
+        The range, in the parameter's unit (``scale``: m); for choices, the lowest and highest.
+    step : float or None
+        The step, in the parameter's unit.
+    choices : tuple of float or None
+        The values of a categorical.
+    """
 
     name: str
     low: float
@@ -61,6 +108,13 @@ class Bound:
     choices: tuple[float, ...] | None = None
 
     def to_dict(self) -> dict[str, Any]:
+        """The bound as the optimiser's settings store it.
+
+        Returns
+        -------
+        dict
+            ``name``, ``low``, ``high``, and ``step`` or ``choices`` when set.
+        """
         out: dict[str, Any] = {"name": self.name, "low": self.low, "high": self.high}
         if self.step is not None:
             out["step"] = self.step
@@ -70,6 +124,21 @@ class Bound:
 
 
 def check_name(name: str, base: Robot) -> None:
+    """Refuse a ``--vary`` name that is not ``scale`` or a numeric robot parameter (or is
+    ``schedule.cycles``, which is ``--cycles``).
+
+    Parameters
+    ----------
+    name : str
+        The name given.
+    base : Robot
+        The robot the sweep starts from.
+
+    Raises
+    ------
+    SweepError
+        No such parameter (with the nearest names), not a number, or ``schedule.cycles``.
+    """
     if name == SCALE:
         return
     if name not in all_keys():
@@ -86,7 +155,20 @@ def check_name(name: str, base: Robot) -> None:
 
 
 def is_integer(base: Robot, name: str) -> bool:
-    """Whether the parameter ``name`` holds whole numbers (schedule.cycles, solver.iterations)."""
+    """Whether the parameter ``name`` holds whole numbers (schedule.cycles, solver.iterations).
+
+    Parameters
+    ----------
+    base : Robot
+        The robot the sweep starts from.
+    name : str
+        ``scale`` or a dotted parameter name.
+
+    Returns
+    -------
+    bool
+        True for an integer parameter (``scale`` never is).
+    """
     if name == SCALE:
         return False
     value = base.get(name)
@@ -96,7 +178,24 @@ def is_integer(base: Robot, name: str) -> bool:
 def check_range(item: str, name: str, low: float, high: float, base: Robot) -> None:
     """Both ends of a --vary range within the limits of what it changes (``scale``: the four
     links), checked before any design runs: a range outside is a unit slip (centimetres typed
-    for metres), not a sweep of invalid designs."""
+    for metres), not a sweep of invalid designs.
+
+    Parameters
+    ----------
+    item : str
+        The ``--vary`` text, for the message.
+    name : str
+        ``scale`` or a dotted parameter name.
+    low, high : float
+        The ends, in the parameter's unit (``scale``: m added to each link).
+    base : Robot
+        The robot the sweep starts from.
+
+    Raises
+    ------
+    SweepError
+        An end outside the parameter's limits.
+    """
     for end in (low, high):
         if name == SCALE:
             g = base.geometry
@@ -134,6 +233,26 @@ def _split(item: str) -> tuple[str, str]:
 
 
 def parse_axis(item: str, base: Robot) -> Axis:
+    """Read ``NAME=START:STOP:N`` for a sweep.
+
+    Parameters
+    ----------
+    item : str
+        The ``--vary`` text.
+    base : Robot
+        The robot the sweep starts from.
+
+    Returns
+    -------
+    Axis
+        The checked axis.
+
+    Raises
+    ------
+    SweepError
+        Not ``NAME=START:STOP:N``, an unknown or non-numeric name, N not a whole number >= 1,
+        ends outside the limits, or fractions for a whole-number parameter.
+    """
     name, rest = _split(item)
     check_name(name, base)
     start, stop, n = _numbers(rest, 3, "START:STOP:N", item)
@@ -155,7 +274,28 @@ def parse_axis(item: str, base: Robot) -> Axis:
 
 
 def parse_bound(item: str, base: Robot, step: float | None = None) -> Bound:
-    """``NAME=LOW:HIGH`` (with ``step``: LOW, LOW + step, ... up to HIGH) or ``NAME=A,B,C``."""
+    """Read ``NAME=LOW:HIGH`` (with ``step``: LOW, LOW + step, ... up to HIGH) or ``NAME=A,B,C``.
+
+    Parameters
+    ----------
+    item : str
+        The ``--vary`` text.
+    base : Robot
+        The robot the optimisation starts from.
+    step : float, optional
+        The step of the range, in the parameter's unit; HIGH is lowered to the last step.
+
+    Returns
+    -------
+    Bound
+        The checked bound.
+
+    Raises
+    ------
+    SweepError
+        Not in either form, an unknown or non-numeric name, LOW not below HIGH, a value given
+        twice, values outside the limits, or a step not in (0, HIGH - LOW].
+    """
     name, rest = _split(item)
     check_name(name, base)
     if "," in rest:
@@ -189,6 +329,18 @@ def design_robot(base: Robot, values: dict[str, float]) -> Robot:
     length, or a horn set on another spline step, is built no more exactly than the one it
     replaces was known, and draws of the uncertain values (``--samples``, ``--robust``) meet
     every design with the same deviates.
+
+    Parameters
+    ----------
+    base : Robot
+        The robot the sweep starts from.
+    values : dict of str to float
+        Parameter name (or ``scale``) to value, in the parameter's unit.
+
+    Returns
+    -------
+    Robot
+        The design's robot.
     """
     robot = base
     if SCALE in values:
@@ -210,6 +362,16 @@ def precheck(robot: Robot) -> str | None:
     The loop must assemble at the start angle and stay closed over every crank angle the
     schedule commands (start .. start + push): a linkage that locks part way would have the
     servo stall against its own loop.
+
+    Parameters
+    ----------
+    robot : Robot
+        The design's robot.
+
+    Returns
+    -------
+    str or None
+        The reason, or None when it can be built and driven.
     """
     g, sch = robot.geometry, robot.schedule
     try:
@@ -228,6 +390,22 @@ def precheck(robot: Robot) -> str | None:
 
 
 def invalid_row(reason: str, grashof: str = "", transmission_deg: float = math.nan) -> dict[str, Any]:
+    """The result fields of a design that is not a result.
+
+    Parameters
+    ----------
+    reason : str
+        Why.
+    grashof : str, optional
+        The linkage's Grashof class, when known.
+    transmission_deg : float, optional
+        Its worst transmission angle [deg], when known.
+
+    Returns
+    -------
+    dict
+        ``valid`` false, the reason, and NaN figures.
+    """
     nan = math.nan
     return {"valid": False, "reason": reason, "outcome": "", "flip_share": nan, "distance_m": nan,
             "max_nose_height_m": nan, "nose_apex_max_m": nan, "com_apex_max_m": nan, "hops": 0, "grashof": grashof,
@@ -243,6 +421,24 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 
     the means over that many draws of the robot file's uncertain values (:func:`sampled`), so
     designs are ranked by what they do on average over what is not known about the robot;
     ``outcome`` is the draws' most common class and ``flip_share`` the share that goes over.
+
+    Parameters
+    ----------
+    base : Robot
+        The robot the sweep starts from.
+    values : dict of str to float
+        The design's values, in each parameter's unit.
+    cycles : int
+        Hop cycles simulated.
+    samples : int, default 0
+        Draws of the uncertain values per design (0: the nominal run alone).
+
+    Returns
+    -------
+    dict
+        ``valid``, ``reason``, ``outcome``, ``flip_share``, ``distance_m``,
+        ``max_nose_height_m``, ``nose_apex_max_m``, ``com_apex_max_m``, ``hops``, ``grashof``
+        and ``transmission_deg``.
     """
     from ..sim.run import run
 
@@ -281,8 +477,23 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 
 def sampled(robot: Robot, samples: int, cycles: int) -> tuple[str, float, float, float] | None:
     """Over ``samples`` draws of the uncertain values (:func:`locust.sim.samples.sample`, seed 0:
     the same deviates for every design): the most common outcome, the share that goes over, and
-    the means of distance and highest nose point over the valid draws; None when fewer than two
-    are valid."""
+    the means of distance and highest nose point over the valid draws.
+
+    Parameters
+    ----------
+    robot : Robot
+        The design's robot.
+    samples : int
+        Number of draws.
+    cycles : int
+        Hop cycles simulated.
+
+    Returns
+    -------
+    tuple or None
+        (outcome, flip_share, distance_m [m], max_nose_height_m [m]); None when fewer than two
+        draws are valid.
+    """
     from ..sim.samples import sample
 
     spread = sample(robot, samples, cycles=cycles)

@@ -22,7 +22,19 @@ FULL_DISK = (errno.ENOSPC, errno.EDQUOT)
 
 @dataclass(frozen=True)
 class Repair:
-    """What :func:`repair` did to a journal."""
+    """What :func:`repair` did to a journal.
+
+    Attributes
+    ----------
+    path : Path
+        The journal.
+    records : int
+        Whole operations kept.
+    cut_bytes : int
+        The torn last line's bytes removed (0: the journal was whole).
+    backup : Path or None
+        The journal as it was (None: nothing was changed).
+    """
 
     path: Path
     records: int              # whole operations kept
@@ -30,7 +42,13 @@ class Repair:
     backup: Path | None       # the journal as it was (None: nothing was changed)
 
     def line(self) -> str:
-        """One line for the user."""
+        """One line for the user.
+
+        Returns
+        -------
+        str
+            What was cut and kept, and where the backup is; or that the journal is whole.
+        """
         if not self.cut_bytes:
             return f"{self.path}: the journal is whole ({self.records} operations); nothing to repair"
         return (f"repaired {self.path}: cut its torn last line ({self.cut_bytes} bytes), kept its "
@@ -49,6 +67,11 @@ def repair(path: str | os.PathLike) -> Repair:
     -------
     Repair
         What was kept and where the backup is. A whole journal is left untouched.
+
+    Raises
+    ------
+    SweepError
+        The journal cannot be read or cut, or 999 backups of it exist already.
     """
     path = Path(path)
     try:
@@ -80,7 +103,18 @@ def _backup_path(path: Path) -> Path:
 
 def full_disk(exc: BaseException) -> OSError | None:
     """The full-disk ``OSError`` behind ``exc`` (itself, or what it was raised while handling:
-    Optuna fails a second time, ``AssertionError: Should not reach.``, after its write failed)."""
+    Optuna fails a second time, ``AssertionError: Should not reach.``, after its write failed).
+
+    Parameters
+    ----------
+    exc : BaseException
+        The exception caught.
+
+    Returns
+    -------
+    OSError or None
+        The ``ENOSPC`` or ``EDQUOT`` error in its chain, None when there is none.
+    """
     seen = set()
     while exc is not None and id(exc) not in seen:
         seen.add(id(exc))

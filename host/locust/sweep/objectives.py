@@ -29,7 +29,19 @@ from ..sim.outcome import GOES_OVER, OUTCOMES
 
 @dataclass(frozen=True)
 class Objective:
-    """One objective: its command-line name, its column (with unit) and what it measures."""
+    """One objective: its command-line name, its column (with unit) and what it measures.
+
+    Attributes
+    ----------
+    name : str
+        The ``--objective`` name: ``distance``, ``nose_rise`` or ``flight``.
+    column : str
+        Its column in the trial rows, with its unit: ``distance_m``, ``nose_rise_m``, ``flight_s``.
+    label : str
+        Axis label, in the unit the plots draw it in.
+    plot_factor : float
+        Factor from the column's unit to the plotted one (1000: m to mm, s to ms).
+    """
 
     name: str
     column: str
@@ -45,7 +57,23 @@ OBJECTIVES = {
 
 
 def objectives_named(names: list[str] | tuple[str, ...]) -> list[Objective]:
-    """The objectives ``names`` in the order given; an unknown or repeated name is refused."""
+    """The objectives ``names`` in the order given; distance when none is given.
+
+    Parameters
+    ----------
+    names : list or tuple of str
+        ``--objective`` names.
+
+    Returns
+    -------
+    list of Objective
+        The objectives.
+
+    Raises
+    ------
+    SweepError
+        An unknown or repeated name.
+    """
     if not names:
         return [OBJECTIVES["distance"]]
     out = []
@@ -61,7 +89,15 @@ def objectives_named(names: list[str] | tuple[str, ...]) -> list[Objective]:
 
 @dataclass(frozen=True)
 class DrawFigures:
-    """One simulated run's outcome and its per-hop figures, by objective column."""
+    """One simulated run's outcome and its per-hop figures, by objective column.
+
+    Attributes
+    ----------
+    outcome : str
+        ``goes_over``, ``rears_and_returns`` or ``stays_low``.
+    figures : dict of str to float
+        Column (``distance_m`` [m], ``nose_rise_m`` [m], ``flight_s`` [s]) to its per-hop figure.
+    """
 
     outcome: str
     figures: dict[str, float]
@@ -73,6 +109,21 @@ class Judgement:
 
     ``figures`` holds each objective's figure optimised (the quantile over the draws, or the
     nominal run's figure), ``means`` its mean over the same draws; shares are of the valid draws.
+
+    Attributes
+    ----------
+    valid : bool
+        Enough draws passed their audit (and the design could be built).
+    reason : str
+        Why it is not valid ("" when it is).
+    figures, means : dict of str to float
+        Objective column to its figure optimised and its mean, in the column's unit.
+    flip_share : float
+        Share of the valid draws that go over.
+    outcome_shares : dict of str to float
+        Each outcome's share of the valid draws.
+    draws, draws_valid : int
+        Draws simulated, and those that passed their audit.
     """
 
     valid: bool
@@ -87,7 +138,24 @@ class Judgement:
 
 def per_hop_figures(distance_m: float, hops: list, cycles: int, outcome: str) -> DrawFigures:
     """A run's per-hop figures from its travel over the run and its hops
-    (:class:`locust.sim.hops.Hop`); every figure 0 when the run went over."""
+    (:class:`locust.sim.hops.Hop`); every figure 0 when the run went over.
+
+    Parameters
+    ----------
+    distance_m : float
+        Chassis travel over the run [m].
+    hops : list of Hop
+        The run's hops (nose apex [m], flight time [s]).
+    cycles : int
+        Hop cycles of the run.
+    outcome : str
+        The run's class.
+
+    Returns
+    -------
+    DrawFigures
+        ``distance_m`` a hop [m], mean ``nose_rise_m`` [m] and mean ``flight_s`` [s].
+    """
     if outcome == GOES_OVER:
         return DrawFigures(outcome, {o.column: 0.0 for o in OBJECTIVES.values()})
     return DrawFigures(outcome, {
@@ -116,6 +184,7 @@ def judge_draws(draws: list[DrawFigures | None], objectives: list[Objective], qu
     Returns
     -------
     Judgement
+        Valid with its figures, means and shares; or invalid with the number of failed draws.
     """
     valid = [d for d in draws if d is not None]
     n = len(draws)

@@ -44,7 +44,33 @@ FINISHED = ("COMPLETE", "PRUNED")
 def settings(base: Robot, bounds: list[Bound], cycles: int, objectives: list[Objective] | None = None,
              draws: int = 0, quantile: float | None = None, max_flip: float | None = None,
              sampler: str = "tpe") -> dict[str, Any]:
-    """What a study searches, as JSON holds it: a rerun must ask for exactly this."""
+    """What a study searches, as JSON holds it: a rerun must ask for exactly this.
+
+    Parameters
+    ----------
+    base : Robot
+        The robot every design starts from.
+    bounds : list of Bound
+        The design variables and their ranges.
+    cycles : int
+        Hop cycles each design runs.
+    objectives : list of Objective, optional
+        What is maximised.
+    draws : int, default 0
+        Draws of the uncertain values per design.
+    quantile : float, optional
+        The quantile of the draws optimised (kept only with ``draws``).
+    max_flip : float, optional
+        The largest share of draws that may go over.
+    sampler : str, default "tpe"
+        ``tpe`` or ``nsga2``.
+
+    Returns
+    -------
+    dict
+        ``base``, ``parameters``, ``vary``, ``cycles``, ``objectives``, ``robust``,
+        ``quantile``, ``max_flip`` and ``sampler``, as a JSON round trip gives them back.
+    """
     return json.loads(json.dumps({
         "base": base.name, "parameters": base.flat(), "vary": [b.to_dict() for b in bounds], "cycles": cycles,
         "objectives": [o.name for o in objectives or []], "robust": draws,
@@ -55,7 +81,22 @@ SETTING_NAMES = ("base", "vary", "cycles", "objectives", "robust", "quantile", "
 
 
 def check_settings(study, wanted: dict[str, Any], where: str) -> None:
-    """Refuse to continue a study that searches something else (or that this tool did not make)."""
+    """Refuse to continue a study that searches something else (or that this tool did not make).
+
+    Parameters
+    ----------
+    study : optuna.Study
+        The study found in the storage.
+    wanted : dict
+        :func:`settings` of this run.
+    where : str
+        The storage, for the message.
+
+    Raises
+    ------
+    SweepError
+        The study holds no settings of ours, or other ones (naming those that differ).
+    """
     held = study.user_attrs.get(SETTINGS_ATTR)
     hint = "give a new --out folder (or --storage / --study), or rerun the exact command that made it"
     if held is None:
@@ -70,7 +111,33 @@ def check_settings(study, wanted: dict[str, Any], where: str) -> None:
 
 @dataclass(frozen=True)
 class StudySpec:
-    """Everything a process needs to run one trial of the study (picklable)."""
+    """Everything a process needs to run one trial of the study (picklable).
+
+    Attributes
+    ----------
+    storage : str or None
+        The ``--storage`` URL or path; None for ``study.journal`` in ``folder``.
+    folder : Path
+        The optimisation's folder.
+    study_name : str
+        The study's name in the storage.
+    bounds : tuple of Bound
+        The design variables and their ranges.
+    integers : frozenset of str
+        The variables that are whole numbers.
+    objectives : tuple of Objective
+        What is maximised.
+    judge : callable
+        ``judge(values) -> Judgement``.
+    max_flip : float or None
+        The largest share of draws that may go over.
+    sampler : str
+        ``tpe`` or ``nsga2``.
+    seed : int
+        The sampler's base seed (each trial adds its index).
+    trials : int
+        Finished trials the study should hold.
+    """
 
     storage: str | None
     folder: Path
@@ -86,6 +153,21 @@ class StudySpec:
 
 
 def make_sampler(name: str, seed: int):
+    """The Optuna sampler ``name``: NSGA-II (population 12), or multivariate TPE with 8 random
+    start-up trials and the constant liar (trials under way elsewhere are not proposed again).
+
+    Parameters
+    ----------
+    name : str
+        ``tpe`` or ``nsga2``.
+    seed : int
+        The sampler's seed.
+
+    Returns
+    -------
+    optuna.samplers.BaseSampler
+        The sampler.
+    """
     import optuna
 
     if name == "nsga2":
@@ -95,12 +177,36 @@ def make_sampler(name: str, seed: int):
 
 
 def finished_trials(study) -> list:
+    """The study's trials that are over (complete or pruned).
+
+    Parameters
+    ----------
+    study : optuna.Study
+        The study.
+
+    Returns
+    -------
+    list of optuna.trial.FrozenTrial
+        Those trials.
+    """
     return [t for t in study.get_trials(deepcopy=False) if t.state.name in FINISHED]
 
 
 def run_trial(spec: StudySpec, index: int) -> int:
-    """Run one trial of the study (in this process or a worker): its number, or -1 when the
-    study already holds ``spec.trials`` finished trials."""
+    """Run one trial of the study (in this process or a worker).
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The study.
+    index : int
+        The trial's index in this run; the sampler's seed is ``spec.seed + index``.
+
+    Returns
+    -------
+    int
+        The trial's number, or -1 when the study already holds ``spec.trials`` finished trials.
+    """
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.ERROR)
@@ -132,6 +238,23 @@ def run_trial(spec: StudySpec, index: int) -> int:
 
 
 def suggest(trial, b: Bound, integers: frozenset[str]) -> float | int:
+    """The trial's value for one design variable: a categorical, a whole number, or a float
+    (stepped when the bound has a step).
+
+    Parameters
+    ----------
+    trial : optuna.Trial
+        The trial.
+    b : Bound
+        The variable.
+    integers : frozenset of str
+        The variables that are whole numbers.
+
+    Returns
+    -------
+    float or int
+        The suggested value, in the parameter's unit.
+    """
     if b.choices is not None:
         return trial.suggest_categorical(b.name, list(b.choices))
     if b.name in integers:
@@ -141,6 +264,30 @@ def suggest(trial, b: Bound, integers: frozenset[str]) -> float | int:
 
 @dataclass
 class OptimizeSummary:
+    """What :func:`run_optimize` left in its folder.
+
+    Attributes
+    ----------
+    study_name : str
+        The study's name.
+    trials : int
+        Trials the study holds (any state).
+    complete, pruned : int
+        Those complete, and those pruned with a reason.
+    front : list of dict
+        The Pareto front's rows (feasible trials only), by trial number.
+    picks : dict of str to dict
+        ``best-<objective>`` and ``knee`` to their rows.
+    folder : Path
+        The output folder.
+    computed : int
+        Trials this call ran.
+    interrupted : bool
+        The run was stopped by Ctrl-C (finished trials kept).
+    robots : dict of str to Path or None
+        The robot file written for each pick.
+    """
+
     study_name: str
     trials: int
     complete: int
@@ -178,6 +325,17 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
         Hop cycles each design runs.
     folder : Path
         Output folder (and the journal, unless ``storage``).
+    storage : str, optional
+        A journal file path or a database URL Optuna's RDB storage takes.
+    study_name : str, default "locust"
+        The study's name in the storage.
+    seed : int, default 0
+        The samplers' base seed.
+    jobs, scheduler : int, str
+        Trials run at once: ``jobs`` local processes, or a Dask cluster (``dask-local``,
+        ``tcp://HOST:PORT``; its workers must reach the storage).
+    progress : callable, optional
+        ``progress(n)`` as trials finish (first with those finished before this run).
     objectives : list of Objective
         What is maximised (default: distance).
     judge : callable, optional
@@ -186,15 +344,24 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
     draws : int
         0: each design's nominal run; N: N draws of its uncertain values, the figure optimised
         being the ``quantile`` over them.
+    quantile : float, default 0.1
+        The quantile of the draws optimised.
     max_flip : float, optional
         The largest share of draws that may go over (an Optuna constraint).
-    jobs, scheduler : int, str
-        Trials run at once: ``jobs`` local processes, or a Dask cluster (``dask-local``,
-        ``tcp://HOST:PORT``; its workers must reach the storage).
+    sampler : str, default "tpe"
+        ``tpe`` or ``nsga2``.
 
     Returns
     -------
     OptimizeSummary
+        The front, the picks and the robot files written; after Ctrl-C, what was finished.
+
+    Raises
+    ------
+    SweepError
+        An unknown sampler or scheduler, an unreachable Dask scheduler, a folder or storage
+        holding something else, a study with other settings, an integer range holding no whole
+        number, or a full disk.
     """
     import optuna
 
@@ -268,17 +435,52 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
 
 @dataclass(frozen=True)
 class TrialOf:
-    """A picklable ``run_trial`` of one study: what each process maps over trial indices."""
+    """A picklable ``run_trial`` of one study: what each process maps over trial indices.
+
+    Attributes
+    ----------
+    spec : StudySpec
+        The study.
+    """
 
     spec: StudySpec
 
     def __call__(self, index: int) -> int:
+        """Run trial ``index`` of the study (:func:`run_trial`).
+
+        Parameters
+        ----------
+        index : int
+            The trial's index in this run.
+
+        Returns
+        -------
+        int
+            The trial's number, or -1 when the study already holds enough finished trials.
+        """
         return run_trial(self.spec, index)
 
 
 def trial_rows(study, names: list[str], objectives: list[Objective], max_flip: float | None) -> list[dict[str, Any]]:
     """One tidy row per trial: its state, design values by dotted name, each objective's figure
-    optimised and its mean, the flip share and every outcome's share, the draws, the reason."""
+    optimised and its mean, the flip share and every outcome's share, the draws, the reason.
+
+    Parameters
+    ----------
+    study : optuna.Study
+        The study.
+    names : list of str
+        The design variables.
+    objectives : list of Objective
+        What is maximised.
+    max_flip : float or None
+        The largest share of draws that may go over.
+
+    Returns
+    -------
+    list of dict
+        The rows of trials.csv.
+    """
     rows = []
     for t in study.get_trials(deepcopy=False):
         state = t.state.name.lower()
@@ -302,7 +504,30 @@ def trial_rows(study, names: list[str], objectives: list[Objective], max_flip: f
 
 def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max_flip: float | None,
               computed: int = 0, interrupted: bool = False) -> OptimizeSummary:
-    """Write trials.csv, pareto.csv, pareto.png, optimize.json and a robot file for each pick."""
+    """Write trials.csv, pareto.csv, pareto.png, optimize.json and a robot file for each pick.
+
+    Parameters
+    ----------
+    study : optuna.Study
+        The study, loaded after the run.
+    folder : Path
+        The output folder.
+    base : Robot
+        The robot every design starts from.
+    objectives : list of Objective
+        What is maximised.
+    max_flip : float or None
+        The largest share of draws that may go over.
+    computed : int, default 0
+        Trials this run computed.
+    interrupted : bool, default False
+        The run was stopped by Ctrl-C.
+
+    Returns
+    -------
+    OptimizeSummary
+        What the folder now holds.
+    """
     held = study.user_attrs.get(SETTINGS_ATTR) or {}
     names = [v["name"] for v in held.get("vary", [])]
     rows = trial_rows(study, names, objectives, max_flip)

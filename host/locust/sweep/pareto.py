@@ -17,13 +17,39 @@ from .objectives import Objective
 
 
 def dominates(a: dict[str, Any], b: dict[str, Any], columns: list[str]) -> bool:
-    """Whether row ``a`` is at least as good as ``b`` on every column and better on one."""
+    """Whether row ``a`` is at least as good as ``b`` on every column and better on one.
+
+    Parameters
+    ----------
+    a, b : dict
+        Trial rows.
+    columns : list of str
+        The objectives' columns (all maximised).
+
+    Returns
+    -------
+    bool
+        True when ``a`` dominates ``b``.
+    """
     return all(a[c] >= b[c] for c in columns) and any(a[c] > b[c] for c in columns)
 
 
 def knee(front: list[dict[str, Any]], columns: list[str]) -> dict[str, Any]:
     """The front's knee: each objective scaled to 0..1 over the front, the row nearest the
-    point best in all (ties: the lower trial number)."""
+    point best in all (ties: the lower trial number).
+
+    Parameters
+    ----------
+    front : list of dict
+        The front's rows.
+    columns : list of str
+        The objectives' columns.
+
+    Returns
+    -------
+    dict
+        The knee's row.
+    """
     values = np.array([[r[c] for c in columns] for r in front], dtype=float)
     low, high = values.min(axis=0), values.max(axis=0)
     span = np.where(high > low, high - low, 1.0)
@@ -32,7 +58,20 @@ def knee(front: list[dict[str, Any]], columns: list[str]) -> dict[str, Any]:
 
 
 def picks(front: list[dict[str, Any]], objectives: list[Objective]) -> dict[str, dict[str, Any]]:
-    """``best-<objective>`` for each end of the front, and ``knee`` with two objectives or more."""
+    """``best-<objective>`` for each end of the front, and ``knee`` with two objectives or more.
+
+    Parameters
+    ----------
+    front : list of dict
+        The front's rows (not empty).
+    objectives : list of Objective
+        What is maximised.
+
+    Returns
+    -------
+    dict of str to dict
+        Pick name to its row (ties: the lower trial number).
+    """
     out = {f"best-{o.name}": max(front, key=lambda r, c=o.column: (r[c], -r["trial"])) for o in objectives}
     if len(objectives) > 1:
         out["knee"] = knee(front, [o.column for o in objectives])
@@ -41,7 +80,30 @@ def picks(front: list[dict[str, Any]], objectives: list[Objective]) -> dict[str,
 
 def plot_front(rows: list[dict[str, Any]], front: list[dict[str, Any]], chosen: dict[str, dict[str, Any]],
                objectives: list[Objective], max_flip: float | None, path: Path, title: str) -> Path:
-    """``pareto.png``: :func:`draw_front` on a figure of its own."""
+    """``pareto.png``: :func:`draw_front` on a figure of its own.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Every trial's row.
+    front : list of dict
+        The front's rows.
+    chosen : dict of str to dict
+        The picks (:func:`picks`).
+    objectives : list of Objective
+        What is maximised.
+    max_flip : float or None
+        The largest share of draws that may go over.
+    path : Path
+        The PNG file to write.
+    title : str
+        The plot's title.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     from ..plotting import pyplot, save_png
 
     fig, ax = pyplot().subplots(figsize=(7.5, 5))
@@ -50,14 +112,43 @@ def plot_front(rows: list[dict[str, Any]], front: list[dict[str, Any]], chosen: 
 
 
 def picks_of(front: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
-    """The picks of a front read back from ``pareto.csv`` (its ``pick`` column)."""
+    """The picks of a front read back from ``pareto.csv`` (its ``pick`` column).
+
+    Parameters
+    ----------
+    front : list of dict
+        The rows of pareto.csv.
+
+    Returns
+    -------
+    dict of str to dict
+        Pick name to its row.
+    """
     return {name: r for r in front for name in r["pick"].split()}
 
 
 def draw_front(ax, rows: list[dict[str, Any]], front: list[dict[str, Any]], chosen: dict[str, dict[str, Any]],
                objectives: list[Objective], max_flip: float | None, title: str) -> None:
     """The front against its first two objectives (one objective: against the trial number):
-    dominated trials grey, trials that go over too often marked, the front and its picks named."""
+    dominated trials grey, trials that go over too often marked, the front and its picks named.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes drawn on.
+    rows : list of dict
+        Every trial's row.
+    front : list of dict
+        The front's rows.
+    chosen : dict of str to dict
+        The picks.
+    objectives : list of Objective
+        What is maximised; figures drawn in each one's plot unit.
+    max_flip : float or None
+        The largest share of draws that may go over (for the legend).
+    title : str
+        The plot's title.
+    """
     done = [r for r in rows if r["state"] == "complete"]
     flipped = [r for r in done if not r["feasible"]]
     front_ids = {r["trial"] for r in front}
@@ -115,7 +206,22 @@ def _inside(box: tuple[float, float, float, float], x: float, y: float) -> bool:
 
 
 def describe(row: dict[str, Any], names: list[str], objectives: list[Objective]) -> str:
-    """One line: the design's values and its figures, in the units the plots use."""
+    """One line: the design's values and its figures, in the units the plots use.
+
+    Parameters
+    ----------
+    row : dict
+        A trial's row.
+    names : list of str
+        The design variables (lengths shown in cm).
+    objectives : list of Objective
+        The figures shown.
+
+    Returns
+    -------
+    str
+        The line.
+    """
     where = []
     for n in names:
         factor, _ = axis_scale(n)

@@ -109,6 +109,27 @@ def _safe(name: str) -> str:
 
 def plot_landscape(rows: list[dict[str, Any]], axes: list[Axis], best: dict | None, out: Path,
                    base: Robot) -> list[Path]:
+    """The sweep's landscape plots: a curve per axis of more than one value, a heat map per pair
+    of them; invalid designs are shown as such.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The sweep's rows.
+    axes : list of Axis
+        The sweep's axes.
+    best : dict or None
+        The best row, marked.
+    out : Path
+        The folder the PNG files go in.
+    base : Robot
+        The robot the sweep starts from (its leg sets are marked on a ``scale`` axis of the seed).
+
+    Returns
+    -------
+    list of Path
+        The files written: ``curve_<name>.png`` and ``heatmap_<a>__<b>.png``.
+    """
     out = Path(out)
     made = [_curve(rows, a, best, base, out / f"curve_{_safe(a.name)}.png") for a in axes if a.n > 1]
     for a, b in itertools.combinations([a for a in axes if a.n > 1], 2):

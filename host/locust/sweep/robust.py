@@ -20,8 +20,22 @@ from .objectives import DrawFigures, Judgement, Objective, judge_draws, per_hop_
 
 
 def draw_figures(traj, cycles: int, audited: bool = False) -> DrawFigures | None:
-    """One trajectory -> its outcome (:func:`locust.sim.outcome.classify`) and per-hop figures;
-    None when it fails its audit (``audited``: it has passed it already, or is None)."""
+    """One trajectory -> its outcome (:func:`locust.sim.outcome.classify`) and per-hop figures.
+
+    Parameters
+    ----------
+    traj : Trajectory or None
+        A rollout.
+    cycles : int
+        Hop cycles it ran.
+    audited : bool, default False
+        It has passed its audit already (or is None): not audited again.
+
+    Returns
+    -------
+    DrawFigures or None
+        The figures; None when it is None or fails its audit.
+    """
     from ..sim.audit import audit
     from ..sim.hops import summarise
     from ..sim.outcome import classify
@@ -38,6 +52,21 @@ class DesignJudge:
 
     ``draws`` 0 judges the nominal run alone (its outcome is the flip share, 0 or 1);
     otherwise each objective's figure is the ``quantile`` over the draws.
+
+    Attributes
+    ----------
+    base : Robot
+        The robot every design starts from.
+    cycles : int
+        Hop cycles each design runs.
+    objectives : tuple of Objective
+        What is judged.
+    draws : int
+        Draws of the uncertain values per design (0: the nominal run).
+    quantile : float
+        The quantile of the draws each figure is.
+    seed : int
+        Seed of the draws (the same deviates for every design).
     """
 
     base: Robot
@@ -48,6 +77,19 @@ class DesignJudge:
     seed: int = 0
 
     def __call__(self, values: dict[str, Any]) -> Judgement:
+        """Judge the design with ``values``: build it, check it, simulate it (nominal run or draws).
+
+        Parameters
+        ----------
+        values : dict
+            Parameter name (or ``scale``) to value, in the parameter's unit.
+
+        Returns
+        -------
+        Judgement
+            Its figures, or invalid with the reason (it cannot be built or driven, a value out of
+            range, the nominal run fails its audit, too few valid draws).
+        """
         try:
             robot = design_robot(self.base, values)
         except LocustError as exc:

@@ -32,7 +32,18 @@ JOURNAL_RECHECK_S = (0.0, 0.2, 0.5, 1.0)
 
 def check_folder(folder: Path) -> None:
     """Refuse a folder holding files this command did not write (a user's ``trials.csv``
-    included: a folder of ours always has ``optimize.json`` or the study's journal beside it)."""
+    included: a folder of ours always has ``optimize.json`` or the study's journal beside it).
+
+    Parameters
+    ----------
+    folder : Path
+        The ``--out`` folder (may not exist yet).
+
+    Raises
+    ------
+    SweepError
+        It is a file, or holds files ``locust optimize`` did not write.
+    """
     if not folder.exists():
         return
     if not folder.is_dir():
@@ -48,6 +59,19 @@ def check_folder(folder: Path) -> None:
 
 
 def check_storage(url: str | None) -> None:
+    """Refuse a ``--storage`` that is neither a database URL Optuna knows nor a journal file path
+    in an existing folder, or a file there that is not an Optuna journal or database.
+
+    Parameters
+    ----------
+    url : str or None
+        The ``--storage`` given (None: the folder's own journal).
+
+    Raises
+    ------
+    SweepError
+        What is wrong with it; the file is left as it is.
+    """
     if url is None or url.startswith(RDB_PREFIXES):
         if url is not None and url.startswith("sqlite:///"):
             check_sqlite_file(Path(url.removeprefix("sqlite:///")), url)
@@ -63,9 +87,23 @@ def check_storage(url: str | None) -> None:
 
 
 def check_journal_file(path: Path) -> None:
-    """Refuse (:class:`SweepError`) an existing file that is not a whole Optuna journal: one JSON
-    operation per line, the first creating a study, the last ending with its newline. Optuna
-    would append to anything (a user's notes) and cannot read a damaged one back."""
+    """Refuse an existing file that is not a whole Optuna journal: one JSON operation per line,
+    the first creating a study, the last ending with its newline. Optuna would append to
+    anything (a user's notes) and cannot read a damaged one back. A last line cut short is
+    read again for up to 1.7 s (``JOURNAL_RECHECK_S``): a process sharing the study may be
+    writing it.
+
+    Parameters
+    ----------
+    path : Path
+        The journal file (missing or empty is fine).
+
+    Raises
+    ------
+    SweepError
+        Not a file, not UTF-8, a torn last line (``--repair`` mends it), or a line that is not
+        an Optuna operation.
+    """
     if not path.exists() or (path.is_file() and path.stat().st_size == 0):
         return
     hint = "give --storage a new file path (or a new --out folder); this file is left as it is"
@@ -97,7 +135,20 @@ def check_journal_file(path: Path) -> None:
 
 def check_sqlite_file(path: Path, url: str) -> None:
     """Refuse an existing file that is not an SQLite database holding Optuna's tables (or none):
-    Optuna would add its tables to someone else's database, or fail on a text file."""
+    Optuna would add its tables to someone else's database, or fail on a text file.
+
+    Parameters
+    ----------
+    path : Path
+        The database file (missing or empty is fine).
+    url : str
+        The ``--storage`` URL, for the message.
+
+    Raises
+    ------
+    SweepError
+        The file cannot be read, is not SQLite, or holds other tables and not Optuna's.
+    """
     if not path.exists():
         return
     hint = "give a new database file (sqlite:///new.db); this file is left as it is"
@@ -124,6 +175,26 @@ def check_sqlite_file(path: Path, url: str) -> None:
 
 
 def open_storage(url: str | None, folder: Path):
+    """The Optuna storage a study lives in.
+
+    Parameters
+    ----------
+    url : str or None
+        A database URL, a journal file path (``journal:`` prefix optional), or None for
+        ``study.journal`` in ``folder``.
+    folder : Path
+        The optimisation's folder.
+
+    Returns
+    -------
+    optuna.storages.BaseStorage
+        A ``JournalStorage`` or an ``RDBStorage``.
+
+    Raises
+    ------
+    SweepError
+        The database cannot be opened.
+    """
     import optuna
     from optuna.storages import JournalStorage
     from optuna.storages.journal import JournalFileBackend

@@ -1,13 +1,14 @@
-# A `machine` module for the MicroPython unix port: the virtual robot's hardware.
-#
-# MicroPython code (it runs inside the interpreter, not on the host). It shadows the unix
-# port's own `machine` (found first on MICROPYPATH) and offers what the firmware uses:
-# Pin, PWM at a period, reset, with the modelled chip's limits: a Pin that chip lacks raises
-# ValueError, PWM on an input-only pin too, PWM on a flash pin crashes (reboots) the board, and
-# a PWM used after deinit() raises RuntimeError. Every PWM change is written as one line
-#     P <pin> <duty_ns> <ticks_us>\n
-# to the FIFO named by $LOCUST_PWM_FIFO, where the host turns it back into a horn angle
-# and feeds the plant. `reset()` writes "R" and the host reboots the interpreter.
+r"""A `machine` module for the MicroPython unix port: the virtual robot's hardware.
+
+MicroPython code (it runs inside the interpreter, not on the host). It shadows the unix
+port's own `machine` (found first on MICROPYPATH) and offers what the firmware uses:
+Pin, PWM at a period, reset, with the modelled chip's limits: a Pin that chip lacks raises
+ValueError, PWM on an input-only pin too, PWM on a flash pin crashes (reboots) the board, and
+a PWM used after deinit() raises RuntimeError. Every PWM change is written as one line
+    P <pin> <duty_ns> <ticks_us>\n
+to the FIFO named by $LOCUST_PWM_FIFO, where the host turns it back into a horn angle
+and feeds the plant. `reset()` writes "R" and the host reboots the interpreter.
+"""
 
 import os
 import time
@@ -37,6 +38,18 @@ def _emit(line):
 
 
 class Pin:
+    """A GPIO pin of the modelled chip; nothing drives it, so a pulled-up input reads 1.
+
+    Parameters
+    ----------
+    id : int
+        The GPIO number (ValueError for a pin the chip lacks).
+    mode, pull : int, optional
+        ``Pin.IN``/``Pin.OUT``/... and ``Pin.PULL_UP``/``Pin.PULL_DOWN``, as MicroPython's.
+    value : int, optional
+        The initial level, 0 or 1.
+    """
+
     IN = 1
     OUT = 3
     OPEN_DRAIN = 7
@@ -51,6 +64,18 @@ class Pin:
         self._value = value if value is not None else (1 if pull == Pin.PULL_UP else 0)
 
     def value(self, v=None):
+        """Read the pin's level, or set it.
+
+        Parameters
+        ----------
+        v : int or bool, optional
+            The level to set; read when None.
+
+        Returns
+        -------
+        int or None
+            The level, 0 or 1, when read.
+        """
         if v is None:
             return self._value
         self._value = 1 if v else 0
@@ -60,6 +85,18 @@ class Pin:
 
 
 class PWM:
+    """A PWM output whose every duty change is written to the host's FIFO with its ``ticks_us``.
+
+    Parameters
+    ----------
+    pin : Pin or int
+        The pin (ValueError for an input-only pin; a flash pin crashes the board).
+    freq : int, default 50
+        PWM frequency [Hz].
+    duty_ns, duty_u16, duty : int, optional
+        The initial duty: pulse width [ns], or a fraction of the period in 16 or 10 bits.
+    """
+
     def __init__(self, pin, freq=50, duty_ns=None, duty_u16=None, duty=None, **kw):
         self.pin = pin.id if isinstance(pin, Pin) else Pin(int(pin)).id
         if self.pin in _INPUT_ONLY:
@@ -86,6 +123,18 @@ class PWM:
             raise RuntimeError("PWM is inactive")  # the ESP32 port, after deinit()
 
     def freq(self, f=None):
+        """Read the PWM frequency, or set it (keeping the pulse width).
+
+        Parameters
+        ----------
+        f : int, optional
+            The frequency to set [Hz]; read when None.
+
+        Returns
+        -------
+        int or None
+            The frequency [Hz] when read.
+        """
         self._check()
         if f is None:
             return self._freq
@@ -93,6 +142,18 @@ class PWM:
         self.duty_ns(self._ns)
 
     def duty_ns(self, ns=None):
+        """Read the pulse width, or set it (clipped to 0..period) and tell the host.
+
+        Parameters
+        ----------
+        ns : int, optional
+            The pulse width to set [ns]; read when None.
+
+        Returns
+        -------
+        int or None
+            The pulse width [ns] when read.
+        """
         self._check()
         if ns is None:
             return self._ns
@@ -100,16 +161,41 @@ class PWM:
         _emit("P %d %d %d\n" % (self.pin, self._ns, time.ticks_us()))
 
     def duty_u16(self, v=None):
+        """Read or set the duty as a 16-bit fraction of the period.
+
+        Parameters
+        ----------
+        v : int, optional
+            The duty to set, 0..65535; read when None.
+
+        Returns
+        -------
+        int or None
+            The duty, 0..65535, when read.
+        """
         if v is None:
             return self._ns * 65535 // self._period_ns()
         self.duty_ns(int(v) * self._period_ns() // 65535)
 
     def duty(self, v=None):  # the ESP32's 10-bit duty
+        """Read or set the duty as the ESP32's 10-bit fraction of the period.
+
+        Parameters
+        ----------
+        v : int, optional
+            The duty to set, 0..1023; read when None.
+
+        Returns
+        -------
+        int or None
+            The duty, 0..1023, when read.
+        """
         if v is None:
             return self._ns * 1023 // self._period_ns()
         self.duty_ns(int(v) * self._period_ns() // 1023)
 
     def deinit(self):
+        """Stop the output (a zero pulse, told to the host); any later use raises RuntimeError."""
         if self._active:
             self._active = False
             self._ns = 0
@@ -124,25 +210,49 @@ SOFT_RESET = 5
 
 
 def reset_cause():
+    """How this boot came about, as the host says (``PWRON_RESET`` by default).
+
+    Returns
+    -------
+    int
+        ``PWRON_RESET``, ``HARD_RESET``, ``SOFT_RESET``, ...
+    """
     return int(os.getenv("LOCUST_RESET_CAUSE") or PWRON_RESET)  # the host tells how it rebooted
 
 
 def reset():
+    """Ask the host for a hard reset (it reboots the interpreter) and wait for it."""
     _emit("R\n")
     time.sleep(1)
 
 
 def soft_reset():
+    """End the interpreter (``SystemExit``): the host starts it again, as a soft reset."""
     raise SystemExit
 
 
 def unique_id():
+    """The board's id.
+
+    Returns
+    -------
+    bytes
+        ``b"virtual0"``.
+    """
     return b"virtual0"
 
 
 def freq():
+    """The CPU frequency.
+
+    Returns
+    -------
+    int
+        240000000 [Hz], a classic ESP32's.
+    """
     return 240000000
 
 
 def idle():
+    """Sleep 1 ms, the unix port's stand-in for waiting on an interrupt."""
     time.sleep_ms(1)

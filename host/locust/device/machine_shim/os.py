@@ -1,8 +1,9 @@
-# `os` with uname(), for the virtual robot (MicroPython code).
-#
-# A board's os.uname().machine names its chip ("Generic ESP32 module with ESP32", "... with
-# ESP32S3"); sys.platform is "esp32" on all of them. The unix port has no os.uname; this one
-# reports the chip the virtual robot models ($LOCUST_MACHINE).
+"""`os` with uname(), for the virtual robot (MicroPython code).
+
+A board's os.uname().machine names its chip ("Generic ESP32 module with ESP32", "... with
+ESP32S3"); sys.platform is "esp32" on all of them. The unix port has no os.uname; this one
+reports the chip the virtual robot models ($LOCUST_MACHINE).
+"""
 import uos as _os
 from uos import *  # noqa: F403
 
@@ -22,4 +23,11 @@ class _Uname:
 
 
 def uname():
+    """The board's identity; ``machine`` names the modelled chip.
+
+    Returns
+    -------
+    object
+        ``sysname``, ``nodename``, ``release``, ``version`` and ``machine`` attributes.
+    """
     return _Uname(_os.getenv("LOCUST_MACHINE") or "Generic ESP32 module with ESP32")
