@@ -43,6 +43,7 @@ import functools
 import math
 import os
 import queue
+import select
 import shutil
 import signal
 import subprocess
@@ -546,28 +547,36 @@ class VirtualRobot:
             pass  # nobody reads: dropped, like a UART's output with no listener
 
     def _bridge(self) -> None:
-        import select
-
         from .link import raise_thread_priority
 
         raise_thread_priority()   # the host's heartbeat passes through here
 
         while not self._stopping.is_set():
-            ready, _, _ = select.select([self._ma, self._mb], [], [], 0.2)
-            if self._ma in ready:
-                with self._console_lock:
-                    data = _read_pty(self._ma)
-                    if data:
-                        self._watch_console(data)
-                        self._to_client(data)
-            if self._mb in ready:
-                data = _read_pty(self._mb)
+            try:
+                self._bridge_once()
+            except (OSError, ValueError):   # a descriptor closed under it: only while stopping
+                if self._stopping.is_set():
+                    return
+                raise
+
+    def _bridge_once(self) -> None:
+        """One pass of the bridge: what the interpreter wrote to the client, what the client
+        wrote to the interpreter (Ctrl-C as a board treats it)."""
+        ready, _, _ = select.select([self._ma, self._mb], [], [], 0.2)
+        if self._ma in ready:
+            with self._console_lock:
+                data = _read_pty(self._ma)
                 if data:
-                    data = self._ctrl_c(data)
-                    try:
-                        os.write(self._ma, data)
-                    except (BlockingIOError, OSError):
-                        pass  # the interpreter is not reading: input overrun
+                    self._watch_console(data)
+                    self._to_client(data)
+        if self._mb in ready:
+            data = _read_pty(self._mb)
+            if data:
+                data = self._ctrl_c(data)
+                try:
+                    os.write(self._ma, data)
+                except (BlockingIOError, OSError):
+                    pass  # the interpreter is not reading: input overrun
 
     def _ctrl_c(self, data: bytes) -> bytes:
         """Ctrl-C as a board's console driver treats it: while the program has Ctrl-C on, the
