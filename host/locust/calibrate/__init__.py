@@ -14,8 +14,9 @@ The experiments, one fit each (numbers in, a result dataclass out, values with i
   folded hinges in the linkage, the servo on the robot's battery); :mod:`.hopmodels` sets a
   candidate's values in one compiled MuJoCo model instead of compiling each.
 
-Shared by the fits: :mod:`.fitstats` (intervals from the Jacobian, cluster-robust where
-residuals are correlated) and :mod:`.curves` (data and model for a plot). At the edges:
+Shared by the fits: :mod:`.fitparams` (each fit's values with unit, bounds and scaling, and
+the solver's vector of them), :mod:`.fitstats` (intervals from the Jacobian, cluster-robust
+where residuals are correlated) and :mod:`.curves` (data and model for a plot). At the edges:
 :mod:`.recordings` (CSV, ``locust track`` CSV, Tracker files as one table), :mod:`.gyro_log`
 (a controller's gyro log), :mod:`.inputs` (each experiment's recordings as its fit's inputs),
 :mod:`.plots` (the fit plots), :mod:`.write` (fitted values into ``robot.toml``) and

@@ -64,6 +64,40 @@ START_SAMPLES = 2048                        # the start grid looks at the window
 
 @dataclass(frozen=True)
 class BeamFit:
+    """The result of :func:`fit_beam`: the oscillator's values with their intervals, the
+    tip's stiffness and damping, and (with the beam's length) their hinge equivalents.
+
+    Attributes
+    ----------
+    source : str
+        The recording's name.
+    mass_kg, effective_mass_kg : float
+        The dropped tip mass, and the oscillating mass (tip mass plus 33/140 of the beam's).
+    length_m : float or None
+        The beam's free length (None: not given, no hinge values).
+    natural_frequency_hz, damping_ratio : Estimate
+        The oscillator's undamped natural frequency [Hz] and damping ratio (dimensionless).
+    damped_frequency_hz : float
+        ``fn * sqrt(1 - zeta^2)``.
+    stiffness_n_per_m, damping_ns_per_m : Estimate
+        The tip's stiffness ``m*wn^2`` and damping ``2*zeta*m*wn``.
+    hinge_stiffness_nm_per_rad, hinge_damping_nms_per_rad : Estimate or None
+        Their pseudo-rigid-body hinge equivalents ``k L^2`` and ``b L^2`` (None without the length).
+    amplitude_m, rms_residual_m : float
+        The oscillation's amplitude at the window's start, and the fit's RMS residual.
+    residual_autocorrelation : float
+        Lag-1 autocorrelation of the residuals (dimensionless); above ``2/sqrt(n)`` the
+        intervals are widened for it.
+    n_samples : int
+        Samples in the fit window.
+    fit_start_s, fit_end_s : float
+        The fit window, on the recording's clock.
+    mapping : str
+        The hinge mapping and its assumptions, for the report.
+    curves : Curves
+        Data and model, for the plot (displacement in mm).
+    """
+
     source: str
     mass_kg: float
     effective_mass_kg: float
@@ -85,6 +119,15 @@ class BeamFit:
     curves: Curves
 
     def summary(self) -> dict:
+        """The fit for JSON output.
+
+        Returns
+        -------
+        dict
+            ``experiment`` ("beam"), the inputs, each :class:`~.fitstats.Estimate` as its
+            :meth:`~.fitstats.Estimate.as_dict` (None when absent) and the fit's figures,
+            under the field names (units in them).
+        """
         out = {"experiment": "beam", "source": self.source, "mass_kg": self.mass_kg,
                "effective_mass_kg": self.effective_mass_kg, "length_m": self.length_m}
         for name in ("natural_frequency_hz", "damping_ratio", "stiffness_n_per_m", "damping_ns_per_m",
@@ -99,7 +142,19 @@ class BeamFit:
 
 
 def principal_displacement(x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
-    """Displacement along the direction the tip moves most (sign: towards +y, else +x)."""
+    """Displacement along the direction the tip moves most (sign: towards +y, else +x).
+
+    Parameters
+    ----------
+    x_m, y_m : array_like
+        The tip's track [m].
+
+    Returns
+    -------
+    numpy.ndarray
+        Its position along the track's first principal axis [m], measured from the track's
+        origin (so the mean is the mean position's projection).
+    """
     pts = np.column_stack([x_m - np.mean(x_m), y_m - np.mean(y_m)])
     _, _, vt = np.linalg.svd(pts, full_matrices=False)
     axis = vt[0]
@@ -111,7 +166,24 @@ def principal_displacement(x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
 def tip_swing_warning(swing_m: float, length_m: float | None, units: str = "m",
                       source: str = "beam") -> str | None:
     """A warning when the tip's peak-to-peak swing is not plausible for the beam (a 5 cm beam
-    whose tip swings 0.9 m: the track is in cm), naming the ``--units`` that would make it so."""
+    whose tip swings 0.9 m: the track is in cm), naming the ``--units`` that would make it so.
+
+    Parameters
+    ----------
+    swing_m : float
+        The tip's peak-to-peak swing [m].
+    length_m : float or None
+        The beam's free length [m] (None: judged against a desk-sized beam).
+    units : str
+        The ``--units`` the track was read in.
+    source : str
+        The recording's name, for the message.
+
+    Returns
+    -------
+    str or None
+        The warning, or None when the swing is plausible.
+    """
     if length_m is not None and length_m > 0:
         low, high, typical = (f * length_m for f in SWING_OF_LENGTH)
         beam = f"a {length_m:g} m beam"
@@ -127,6 +199,23 @@ def tip_swing_warning(swing_m: float, length_m: float | None, units: str = "m",
 
 
 def damped_oscillation(t_s: np.ndarray, p: np.ndarray, t0_s: float) -> np.ndarray:
+    """The model's tip displacement (see the module docstring).
+
+    Parameters
+    ----------
+    t_s : array_like
+        Sample times [s].
+    p : array_like, shape (5,)
+        Offset c [m], amplitudes A and B [m], natural frequency [Hz] and damping ratio
+        (dimensionless).
+    t0_s : float
+        Start of the oscillation, ``tau = t - t0`` [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        The displacement at ``t_s`` [m].
+    """
     c, a, b, fn_hz, zeta = p
     wn = 2 * np.pi * fn_hz
     wd = wn * np.sqrt(max(1.0 - zeta**2, 1e-12))
@@ -138,7 +227,36 @@ def damped_oscillation(t_s: np.ndarray, p: np.ndarray, t0_s: float) -> np.ndarra
 def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, length_m: float | None = None,
              beam_mass_kg: float = 0.0, start_s: float | None = None, end_s: float | None = None,
              source: str = "beam") -> BeamFit:
-    """Fit a damped oscillation to the tip displacement; see the module docstring."""
+    """Fit a damped oscillation to the tip displacement; see the module docstring.
+
+    Parameters
+    ----------
+    t_s : array_like
+        Sample times [s].
+    displacement_m : array_like
+        The tip's displacement along its motion [m] (:func:`principal_displacement`).
+    mass_kg : float
+        The dropped tip mass [kg].
+    length_m : float, optional
+        The beam's free length [m]: gives the hinge equivalents.
+    beam_mass_kg : float
+        The beam's own mass [kg]; 33/140 of it moves with the tip.
+    start_s, end_s : float, optional
+        The fit window [s]; by default from the drop (a release transient skipped) to the end.
+    source : str
+        The recording's name, for messages and the plot.
+
+    Returns
+    -------
+    BeamFit
+
+    Raises
+    ------
+    CalibrationError
+        A mass or length not positive, a flat signal, too few samples in the window, an
+        oscillation lost in the noise, no ring-down (damping at its bound), fewer than
+        ``MIN_CYCLES`` cycles, or fewer than ``MIN_FRAMES_PER_CYCLE`` frames a cycle.
+    """
     t, y = _checked_window(t_s, displacement_m, mass_kg, length_m, start_s, end_s, source)
     fs_hz = 1.0 / float(np.median(np.diff(t)))
     t, y, best = _past_release(t, y, fs_hz, pinned=start_s is not None)

@@ -59,6 +59,13 @@ class FitParameter:
         A held value's standard uncertainty [unit] (0: taken as exact).
     source : str
         Where a held value (or the start) comes from.
+
+    Raises
+    ------
+    CalibrationError
+        An unknown scaling, a scale not positive and finite, bounds out of order, a log-scaled
+        value without a finite nonzero reference or with bounds of the other sign, or a
+        negative ``std``.
     """
 
     name: str
@@ -104,23 +111,63 @@ class FitParameter:
         return 1.0 if self.scaling == "log" else 0.0
 
     def to_x(self, value: float) -> float:
-        """The solver's variable of ``value`` [unit]."""
+        """The solver's variable of a value.
+
+        Parameters
+        ----------
+        value : float
+            The value [unit].
+
+        Returns
+        -------
+        float
+            The solver's variable ``x`` (dimensionless).
+        """
         if self.scaling == "log":
             return math.log(value / self.origin)
         return (value - self.origin) / self.scale
 
     def to_value(self, x: float) -> float:
-        """The value [unit] of the solver's variable ``x`` (numpy's exp, as :meth:`FitParameters.from_vector`)."""
+        """The value of the solver's variable (numpy's exp, as :meth:`FitParameters.from_vector`).
+
+        Parameters
+        ----------
+        x : float
+            The solver's variable (dimensionless).
+
+        Returns
+        -------
+        float
+            The value [unit].
+        """
         if self.scaling == "log":
             return self.origin * float(np.exp(x))
         return self.origin + self.scale * x
 
     def derivative(self, x: float) -> float:
-        """d value / d x at ``x`` [unit]."""
+        """The chain rule's factor d value / d x.
+
+        Parameters
+        ----------
+        x : float
+            The solver's variable (dimensionless).
+
+        Returns
+        -------
+        float
+            d value / d x at ``x`` [unit].
+        """
         return self.origin * float(np.exp(x)) if self.scaling == "log" else self.scale
 
     def x_bounds(self) -> tuple[float, float]:
-        """The bounds in the solver's variable, (low, high)."""
+        """The bounds in the solver's variable.
+
+        Returns
+        -------
+        tuple of float
+            (low, high), dimensionless; infinite where the value is unbounded (or bounded at 0
+            when log-scaled).
+        """
         if self.scaling == "log":
             ends = [_log_or_inf(b / self.origin) for b in (self.lower, self.upper)]
             return min(ends), max(ends)
@@ -139,6 +186,11 @@ class FitParameters:
     ----------
     params : iterable of FitParameter
         The values, free and held, in the order the vector takes the free ones.
+
+    Raises
+    ------
+    CalibrationError
+        Two values share a name.
     """
 
     def __init__(self, params: Iterable[FitParameter]):
@@ -184,11 +236,43 @@ class FitParameters:
         return len(self._free)
 
     def index(self, name: str) -> int:
-        """Position of the free value ``name`` in the solver's vector."""
+        """Position of a free value in the solver's vector.
+
+        Parameters
+        ----------
+        name : str
+            The free value's name.
+
+        Returns
+        -------
+        int
+            Its index in the vector.
+
+        Raises
+        ------
+        KeyError
+            ``name`` is not a free value.
+        """
         return self._index[name]
 
     def extended(self, *more: FitParameter) -> FitParameters:
-        """These values and ``more`` after them."""
+        """These values and more after them.
+
+        Parameters
+        ----------
+        *more : FitParameter
+            The values to append.
+
+        Returns
+        -------
+        FitParameters
+            A new set; this one is unchanged.
+
+        Raises
+        ------
+        CalibrationError
+            A name of ``more`` is already taken.
+        """
         return FitParameters(self.params + more)
 
     def as_vector(self, values: Mapping[str, float] | None = None) -> np.ndarray:
@@ -202,6 +286,7 @@ class FitParameters:
         Returns
         -------
         numpy.ndarray
+            The solver's variables (dimensionless).
         """
         values = values or {}
         return np.array([p.to_x(float(values.get(p.name, p.start))) for p in self._free], dtype=float)
@@ -213,10 +298,17 @@ class FitParameters:
         Parameters
         ----------
         x : array_like, shape (size,)
+            The solver's variables (dimensionless).
 
         Returns
         -------
         dict of str to float
+            Name -> value [its unit].
+
+        Raises
+        ------
+        CalibrationError
+            ``x`` is not of the vector's length.
         """
         free = self.free_values(x)
         out = {}
@@ -225,7 +317,23 @@ class FitParameters:
         return out
 
     def free_values(self, x: np.ndarray) -> np.ndarray:
-        """The free values [their units] at ``x``, in the vector's order (size,)."""
+        """The free values at a solver's vector.
+
+        Parameters
+        ----------
+        x : array_like, shape (size,)
+            The solver's variables (dimensionless).
+
+        Returns
+        -------
+        numpy.ndarray, shape (size,)
+            The free values [their units], in the vector's order.
+
+        Raises
+        ------
+        CalibrationError
+            ``x`` is not of the vector's length.
+        """
         x = self._checked(x)
         out = self._origin + self._scale * x
         out[self._log] = self._origin[self._log] * np.exp(x[self._log])
@@ -238,46 +346,139 @@ class FitParameters:
         return x
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """The solver's bounds, (low, high), each (size,)."""
+        """The solver's bounds.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (low, high), each of shape (size,), dimensionless.
+        """
         ends = [p.x_bounds() for p in self._free]
         return np.array([e[0] for e in ends], dtype=float), np.array([e[1] for e in ends], dtype=float)
 
     def near_bound(self, x: np.ndarray, tol: float = 1e-3) -> tuple[bool, ...]:
-        """Whether each free value is within ``tol`` of a bound, in the solver's variable."""
+        """Which free values lie at a bound.
+
+        Parameters
+        ----------
+        x : array_like, shape (size,)
+            The solver's variables (dimensionless).
+        tol : float
+            Distance from a bound that counts as at it, in the solver's variable.
+
+        Returns
+        -------
+        tuple of bool
+            One per free value, in the vector's order.
+        """
         lo, hi = self.bounds()
         x = np.asarray(x, dtype=float).ravel()
         return tuple(bool(v) for v in np.minimum(x - lo, hi - x) < tol)
 
     def derivatives(self, x: np.ndarray) -> np.ndarray:
-        """d value / d x of each free value at ``x`` (size,): the diagonal of the chain rule."""
+        """The diagonal of the chain rule from the solver's vector to the free values.
+
+        Parameters
+        ----------
+        x : array_like, shape (size,)
+            The solver's variables (dimensionless).
+
+        Returns
+        -------
+        numpy.ndarray, shape (size,)
+            d value / d x of each free value at ``x`` [its unit].
+
+        Raises
+        ------
+        CalibrationError
+            ``x`` is not of the vector's length.
+        """
         x = self._checked(x)
         out = self._scale.copy()
         out[self._log] = self._origin[self._log] * np.exp(x[self._log])
         return out
 
     def gradient(self, x: np.ndarray, name: str, factor: float = 1.0) -> np.ndarray:
-        """Gradient in ``x`` of ``factor * value(name)`` (size,): for
-        :meth:`.fitstats.Covariance.estimate` on a covariance of the solver's vector."""
+        """Gradient in ``x`` of ``factor * value(name)``: for
+        :meth:`.fitstats.Covariance.estimate` on a covariance of the solver's vector.
+
+        Parameters
+        ----------
+        x : array_like, shape (size,)
+            The solver's variables (dimensionless).
+        name : str
+            A free value's name.
+        factor : float
+            Multiplies the value (a unit conversion, a sign).
+
+        Returns
+        -------
+        numpy.ndarray, shape (size,)
+            Zero but at ``name``'s position [its unit times ``factor``'s].
+
+        Raises
+        ------
+        KeyError
+            ``name`` is not a free value.
+        """
         i = self._index[name]
         grad = np.zeros(self.size)
         grad[i] = factor * self.derivatives(x)[i]
         return grad
 
     def to_values_jacobian(self, jac: np.ndarray, x: np.ndarray) -> np.ndarray:
-        """A residual Jacobian in ``x`` (n, size) as one in the free values:
-        ``d r / d value = (d r / d x) / (d value / d x)``."""
+        """A residual Jacobian in ``x`` as one in the free values:
+        ``d r / d value = (d r / d x) / (d value / d x)``.
+
+        Parameters
+        ----------
+        jac : array_like, shape (n, size)
+            d residual / d x [the residual's unit].
+        x : array_like, shape (size,)
+            The solver's variables where it was taken (dimensionless).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, size)
+            d residual / d value [the residual's unit per the value's].
+        """
         return np.asarray(jac, dtype=float) / self.derivatives(x)[None, :]
 
     def to_values_covariance(self, cov_x: np.ndarray, x: np.ndarray) -> np.ndarray:
-        """A covariance of the solver's vector (size, size) as one of the free values, to
-        first order (the delta method): ``D C D`` with ``D = diag(d value / d x)``."""
+        """A covariance of the solver's vector as one of the free values, to first order
+        (the delta method): ``D C D`` with ``D = diag(d value / d x)``.
+
+        Parameters
+        ----------
+        cov_x : array_like, shape (size, size)
+            Covariance of the solver's variables (dimensionless).
+        x : array_like, shape (size,)
+            The solver's variables at the optimum (dimensionless).
+
+        Returns
+        -------
+        numpy.ndarray, shape (size, size)
+            Covariance of the free values [products of their units].
+        """
         d = self.derivatives(x)
         return np.asarray(cov_x, dtype=float) * np.outer(d, d)
 
     def held_std(self) -> dict[str, float]:
-        """The held values that carry an uncertainty -> their standard uncertainty [unit]."""
+        """The held values that carry an uncertainty.
+
+        Returns
+        -------
+        dict of str to float
+            Name -> standard uncertainty [its unit], for each held value with ``std`` > 0.
+        """
         return {p.name: float(p.std) for p in self.params if p.held and p.std > 0}
 
     def units(self) -> dict[str, str]:
-        """Each value's unit."""
+        """Each value's unit.
+
+        Returns
+        -------
+        dict of str to str
+            Name -> unit, free and held, in the set's order.
+        """
         return {p.name: p.unit for p in self.params}

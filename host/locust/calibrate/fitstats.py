@@ -33,7 +33,21 @@ from scipy import stats
 
 @dataclass(frozen=True)
 class Estimate:
-    """One fitted quantity: value, standard error (1 sigma) and 95% interval."""
+    """One fitted quantity: value, standard error (1 sigma) and 95% interval.
+
+    Attributes
+    ----------
+    value : float
+        The estimate [the quantity's unit].
+    std : float
+        Its standard uncertainty [same unit]; inf when the data do not determine it.
+    ci95_low, ci95_high : float
+        The 95% interval [same unit].
+    std_numerical : float or None
+        The part of ``std`` from the numerics [same unit] (None: not assessed).
+    std_fixed : float or None
+        The part from the uncertainties of values held fixed [same unit] (None: none).
+    """
 
     value: float
     std: float          # one standard deviation, in the value's own unit (inf: not determined)
@@ -49,11 +63,19 @@ class Estimate:
 
     @property
     def relative_std(self) -> float:
+        """``std / |value|`` (dimensionless; inf when the value is 0)."""
         return self.std / abs(self.value) if self.value else float("inf")
 
     def as_dict(self) -> dict[str, float | list[float]]:
         """For JSON output: an undetermined std or bound stays ``inf``/``nan`` here and is
-        written ``null`` (:func:`locust.fileio.json_text`)."""
+        written ``null`` (:func:`locust.fileio.json_text`).
+
+        Returns
+        -------
+        dict
+            ``value``, ``std``, ``ci95`` ([low, high]) and, where assessed, ``std_numerical``
+            and ``std_fixed``, all in the quantity's unit.
+        """
         out = {"value": self.value, "std": self.std, "ci95": [self.ci95_low, self.ci95_high]}
         if self.std_numerical is not None:
             out["std_numerical"] = self.std_numerical
@@ -65,7 +87,22 @@ class Estimate:
 @dataclass(frozen=True)
 class Covariance:
     """Parameter covariance of a fit, the degrees of freedom of its t factor and, where
-    assessed, the numerical shift of the parameters (added as a type-B uncertainty)."""
+    assessed, the numerical shift of the parameters (added as a type-B uncertainty).
+
+    Attributes
+    ----------
+    matrix : numpy.ndarray, shape (p, p)
+        Covariance of the parameters [products of their units]; inf in the rows and columns
+        of those the data do not determine.
+    dof : int
+        Degrees of freedom of the Student-t factor.
+    shift : numpy.ndarray, shape (p,), or None
+        Systematic shift of each parameter [its unit] (e.g. the fit's time step halved).
+    method : str
+        How the covariance was computed, for the report.
+    fixed : numpy.ndarray, shape (p, p), or None
+        Covariance carried in from values held fixed (:func:`fixed_covariance`).
+    """
 
     matrix: np.ndarray
     dof: int
@@ -74,7 +111,21 @@ class Covariance:
     fixed: np.ndarray | None = None     # covariance carried in from values held fixed (fixed_covariance)
 
     def estimate(self, value: float, grad: np.ndarray) -> Estimate:
-        """A quantity ``f(params)`` with gradient ``grad`` at the optimum."""
+        """The interval of a quantity ``f(params)``, by first-order propagation.
+
+        Parameters
+        ----------
+        value : float
+            ``f`` at the optimum [its unit].
+        grad : array_like, shape (p,)
+            Its gradient in the parameters [its unit per each parameter's].
+
+        Returns
+        -------
+        Estimate
+            With ``shift`` or ``fixed`` set, their parts combined in quadrature and the t
+            factor on the Welch-Satterthwaite degrees of freedom.
+        """
         grad = np.asarray(grad, dtype=float)
         used = grad != 0
         sub = self.matrix[np.ix_(used, used)]
@@ -95,23 +146,60 @@ class Covariance:
         return Estimate(float(value), std, float(value - k * std), float(value + k * std), numerical, fixed)
 
     def parameter(self, values: np.ndarray, i: int) -> Estimate:
+        """The interval of one parameter.
+
+        Parameters
+        ----------
+        values : array_like, shape (p,)
+            The parameters at the optimum [their units].
+        i : int
+            The parameter's index.
+
+        Returns
+        -------
+        Estimate
+            As :meth:`estimate` with a unit gradient.
+        """
         grad = np.zeros(len(values))
         grad[i] = 1.0
         return self.estimate(float(values[i]), grad)
 
 
 def t95(dof: float) -> float:
-    """Two-sided 95% Student-t factor for ``dof`` degrees of freedom (the normal's when infinite)."""
+    """Two-sided 95% Student-t factor.
+
+    Parameters
+    ----------
+    dof : float
+        Degrees of freedom (below 1: taken as 1; above 1e6 or inf: the normal's).
+
+    Returns
+    -------
+    float
+        The factor k with P(|t| < k) = 0.95 (1.96 for the normal).
+    """
     if dof > 1e6:
         return float(stats.norm.ppf(0.975))
     return float(stats.t.ppf(0.975, max(float(dof), 1.0)))
 
 
 def covariance(jac: np.ndarray, residual: np.ndarray) -> Covariance:
-    """Covariance from the residual Jacobian ``jac`` (n, p) = d(residual)/d(params).
+    """Covariance ``s^2 (J^T J)^-1`` from the residual Jacobian.
 
     A parameter the data cannot determine (a zero Jacobian column, or one that loads on a
     direction with a vanishing singular value) gets infinite variance.
+
+    Parameters
+    ----------
+    jac : array_like, shape (n, p)
+        d residual / d params at the optimum [the residual's unit per each parameter's].
+    residual : array_like, shape (n,)
+        The residuals at the optimum.
+
+    Returns
+    -------
+    Covariance
+        With ``n - p`` degrees of freedom (at least 1).
     """
     jac = np.asarray(jac, dtype=float)
     residual = np.asarray(residual, dtype=float).ravel()
@@ -132,6 +220,18 @@ def serial_covariance(jac: np.ndarray, residual: np.ndarray) -> tuple[Covariance
     Where rho is above what independent residuals give (``2/sqrt(n)``, about the one-sided
     97.7 % point) the covariance is multiplied by that factor and the t factor takes
     ``n_eff - p`` degrees of freedom; otherwise it is :func:`covariance`'s.
+
+    Parameters
+    ----------
+    jac : array_like, shape (n, p)
+        d residual / d params at the optimum.
+    residual : array_like, shape (n,)
+        The residuals at the optimum, in time order.
+
+    Returns
+    -------
+    tuple of (Covariance, float)
+        The covariance and rho (dimensionless; capped at 0.99 when it is used).
     """
     base = covariance(jac, residual)
     r = np.asarray(residual, dtype=float).ravel()
@@ -154,7 +254,26 @@ def cluster_covariance(jac: np.ndarray, residual: np.ndarray, clusters: np.ndarr
     ``clusters`` (n,), independent between clusters; ``shift`` (p,): a systematic shift of
     the parameters, and ``fixed`` (p, p): the covariance carried in from values held fixed
     (:func:`fixed_covariance`), both added as type-B uncertainties. Fewer clusters than one
-    more than the parameters determine nothing: every variance is then infinite."""
+    more than the parameters determine nothing: every variance is then infinite.
+
+    Parameters
+    ----------
+    jac : array_like, shape (n, p)
+        d residual / d params at the optimum.
+    residual : array_like, shape (n,)
+        The residuals at the optimum.
+    clusters : array_like, shape (n,)
+        Each residual's cluster label.
+    shift : array_like, shape (p,), optional
+        Systematic shift of each parameter [its unit].
+    fixed : array_like, shape (p, p), optional
+        Covariance carried in from values held fixed.
+
+    Returns
+    -------
+    Covariance
+        With ``G - 1`` degrees of freedom (at least 1) for ``G`` clusters.
+    """
     jac = np.asarray(jac, dtype=float)
     residual = np.asarray(residual, dtype=float).ravel()
     clusters = np.asarray(clusters).ravel()
@@ -179,7 +298,23 @@ def fixed_covariance(jac: np.ndarray, jac_fixed: np.ndarray, std_fixed: np.ndarr
     derivative in each held value, ``std_fixed`` (q,): their standard uncertainties, taken
     as independent): the fitted values' covariance from them is ``G diag(std^2) G^T``. A
     fit that takes its other values from earlier calibrations carries their uncertainty in
-    this way instead of treating them as exact (GUM, JCGM 100:2008, 5.1)."""
+    this way instead of treating them as exact (GUM, JCGM 100:2008, 5.1).
+
+    Parameters
+    ----------
+    jac : array_like, shape (n, p)
+        d residual / d fitted values at the optimum.
+    jac_fixed : array_like, shape (n, q)
+        d residual / d held values.
+    std_fixed : array_like, shape (q,)
+        Standard uncertainties of the held values [their units].
+
+    Returns
+    -------
+    numpy.ndarray, shape (p, p)
+        Covariance of the fitted values from the held ones [products of their units]; 0 in
+        the rows of undetermined values.
+    """
     jac = np.asarray(jac, dtype=float)
     bread, undetermined = _inverse_normal(jac)
     gain = -bread @ (jac.T @ np.asarray(jac_fixed, dtype=float))
@@ -189,7 +324,20 @@ def fixed_covariance(jac: np.ndarray, jac_fixed: np.ndarray, std_fixed: np.ndarr
 
 def linear_shift(jac: np.ndarray, delta_residual: np.ndarray) -> np.ndarray:
     """The parameters' first-order (Gauss-Newton) shift when the residual changes by
-    ``delta_residual`` at fixed parameters: ``-(J^T J)^-1 J^T dr`` (0 where undetermined)."""
+    ``delta_residual`` at fixed parameters: ``-(J^T J)^-1 J^T dr`` (0 where undetermined).
+
+    Parameters
+    ----------
+    jac : array_like, shape (n, p)
+        d residual / d params at the optimum.
+    delta_residual : array_like, shape (n,)
+        The residual's change [the residual's unit].
+
+    Returns
+    -------
+    numpy.ndarray, shape (p,)
+        The shift of each parameter [its unit].
+    """
     jac = np.asarray(jac, dtype=float)
     bread, undetermined = _inverse_normal(jac)
     shift = -bread @ (jac.T @ np.asarray(delta_residual, dtype=float).ravel())

@@ -54,7 +54,20 @@ MODEL = ("I*theta'' = -k*(theta - theta0) - b*theta' - M*g*D*cos(theta) [gravity
 
 @dataclass(frozen=True)
 class HingeRig:
-    """The swinging link: inertia about the hinge, and where its weight acts."""
+    """The swinging link: inertia about the hinge, and where its weight acts.
+
+    Attributes
+    ----------
+    inertia_kgm2 : float
+        The link's moment of inertia about the hinge.
+    gravity : str
+        ``"in-plane"`` (the link swings in a vertical plane) or ``"out-of-plane"`` (the hinge
+        axis vertical: the weight has no moment).
+    mass_kg : float
+        The link's mass (in plane only).
+    com_m : float
+        Hinge to centre of mass, along the hinge-marker line (in plane only).
+    """
 
     inertia_kgm2: float
     gravity: str = "out-of-plane"          # in-plane | out-of-plane
@@ -69,6 +82,47 @@ class HingeRig:
 
 @dataclass(frozen=True)
 class HingeFit:
+    """The result of :func:`fit_hinge`: the hinge's values with their intervals, and how well
+    the swing fits.
+
+    Attributes
+    ----------
+    source : str
+        The recording's name.
+    rig : HingeRig
+        The link as given.
+    hinge_stiffness_nm_per_rad, hinge_damping_nms_per_rad, neutral_angle_deg : Estimate
+        ``k``, ``b`` and ``theta0`` (from the track's +x axis, counter-clockwise).
+    coulomb_friction_nm : Estimate or None
+        ``tau_c``, when kept (see ``coulomb_note``).
+    coulomb_note : str
+        Whether Coulomb friction was fitted and why.
+    natural_frequency_hz, damping_ratio : float
+        Of small swings about rest, gravity included (ratio dimensionless).
+    rest_angle_deg : float
+        Where spring and weight balance.
+    pivot_m : tuple of float
+        The hinge's position (x, y) in the track.
+    pivot_source : str
+        ``"given"`` (``--pivot``) or ``"fitted"`` (started at the circle fit).
+    radius_m : float
+        Hinge to marker.
+    start_angle_deg : float
+        The angle where the fit window starts (the first turning point after the release).
+    rms_residual_m, rms_residual_deg : float
+        RMS residual of the marker's position, and of its angle about the pivot.
+    n_samples : int
+        Samples in the fit window.
+    fit_start_s, fit_end_s : float
+        The fit window, on the recording's clock.
+    fit_time_s : float
+        Wall time the fit took.
+    curves : Curves
+        Data and model angle [deg], for the plot.
+    notes : list of str
+        Warnings for the report (a poorly placed pivot).
+    """
+
     source: str
     rig: HingeRig
     hinge_stiffness_nm_per_rad: Estimate
@@ -93,6 +147,15 @@ class HingeFit:
     notes: list[str] = field(default_factory=list)
 
     def summary(self) -> dict:
+        """The fit for JSON output.
+
+        Returns
+        -------
+        dict
+            ``experiment`` ("hinge"), the rig, each :class:`~.fitstats.Estimate` as its
+            :meth:`~.fitstats.Estimate.as_dict` (None when absent), the fit's figures under
+            the field names (units in them) and the model's equation.
+        """
         out = {"experiment": "hinge", "source": self.source, "inertia_kgm2": self.rig.inertia_kgm2,
                "gravity": self.rig.gravity, "mass_kg": self.rig.mass_kg or None, "com_m": self.rig.com_m or None}
         for name in ("hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad", "neutral_angle_deg",
@@ -111,8 +174,19 @@ class HingeFit:
 
 # -- geometry -----------------------------------------------------------------------
 def circle_fit(x_m: np.ndarray, y_m: np.ndarray) -> tuple[float, float, float]:
-    """Centre (x, y) and radius of the circle nearest the points: the algebraic (Kasa) fit,
-    refined by Gauss-Newton on the geometric distances."""
+    """The circle nearest the points: the algebraic (Kasa) fit, refined by Levenberg-Marquardt
+    on the geometric distances.
+
+    Parameters
+    ----------
+    x_m, y_m : array_like
+        The points [m].
+
+    Returns
+    -------
+    tuple of float
+        Centre x, centre y and radius [m].
+    """
     x, y = np.asarray(x_m, float), np.asarray(y_m, float)
     a = np.column_stack([x, y, np.ones_like(x)])
     sol, *_ = np.linalg.lstsq(a, x**2 + y**2, rcond=None)
@@ -124,7 +198,20 @@ def circle_fit(x_m: np.ndarray, y_m: np.ndarray) -> tuple[float, float, float]:
 
 
 def swing_angle(x_m: np.ndarray, y_m: np.ndarray, pivot: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
-    """The marker's angle about the pivot (rad, unwrapped, from +x, counter-clockwise) and its distance [m]."""
+    """The marker's angle about the pivot and its distance from it.
+
+    Parameters
+    ----------
+    x_m, y_m : array_like
+        The marker's track [m].
+    pivot : tuple of float
+        The pivot (x, y) [m].
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        The angle [rad] (unwrapped, from +x, counter-clockwise) and the distance [m].
+    """
     dx, dy = np.asarray(x_m) - pivot[0], np.asarray(y_m) - pivot[1]
     return np.unwrap(np.arctan2(dy, dx)), np.hypot(dx, dy)
 
@@ -132,7 +219,26 @@ def swing_angle(x_m: np.ndarray, y_m: np.ndarray, pivot: tuple[float, float]) ->
 # -- the model ----------------------------------------------------------------------
 def simulate_hinge(t_s: np.ndarray, params: np.ndarray, rig: HingeRig,
                    coulomb_width_rad_per_s: float = 0.0) -> np.ndarray:
-    """theta(t) [rad] from ``params`` = (k, b, theta0, theta_start, rate_start[, tau_c]), t from t_s[0]."""
+    """The swing's angle, integrated from ``t_s[0]`` (see the module docstring).
+
+    Parameters
+    ----------
+    t_s : array_like
+        Times [s], increasing.
+    params : array_like
+        k [N*m/rad], b [N*m*s/rad], theta0 [rad], the angle [rad] and rate [rad/s] at
+        ``t_s[0]``, and optionally tau_c [N*m].
+    rig : HingeRig
+        The link.
+    coulomb_width_rad_per_s : float
+        Rate over which the Coulomb torque turns (``tau_c * tanh(rate / width)``); must be
+        positive when tau_c is nonzero.
+
+    Returns
+    -------
+    numpy.ndarray
+        theta at ``t_s`` [rad].
+    """
     k, b, th0, th_start, w_start = (float(v) for v in params[:5])
     tau_c = float(params[5]) if len(params) > 5 else 0.0
     inv_i, mgd = 1.0 / rig.inertia_kgm2, rig.gravity_moment_nm
@@ -153,7 +259,21 @@ def simulate_hinge(t_s: np.ndarray, params: np.ndarray, rig: HingeRig,
 # -- start values --------------------------------------------------------------------
 @dataclass(frozen=True)
 class SwingShape:
-    """What the swing shows before any fit: rest angle, damped period, decay rate, amplitude."""
+    """What the swing shows before any fit: rest angle, damped period, decay rate, amplitude.
+
+    Attributes
+    ----------
+    rest_rad : float
+        The final rest angle (median of the last fifth).
+    damped_omega_rad_per_s : float
+        Damped angular frequency, from the median spacing of the rest crossings.
+    decay_per_s : float
+        Exponential decay rate of the peaks (0 with fewer than two clear peaks).
+    amplitude_rad : float
+        Largest excursion from rest.
+    crossings : int
+        Crossings of the rest angle.
+    """
 
     rest_rad: float
     damped_omega_rad_per_s: float
@@ -163,7 +283,26 @@ class SwingShape:
 
 
 def swing_shape(t_s: np.ndarray, theta: np.ndarray, source: str) -> SwingShape:
-    """From the zero crossings (about the final rest) and the peaks between them."""
+    """The swing's shape from its crossings of the final rest angle and the peaks between them.
+
+    Parameters
+    ----------
+    t_s : array_like
+        Sample times [s].
+    theta : numpy.ndarray
+        The link's angle [rad].
+    source : str
+        The recording's name, for the message.
+
+    Returns
+    -------
+    SwingShape
+
+    Raises
+    ------
+    CalibrationError
+        Fewer than ``MIN_HALF_SWINGS`` crossings.
+    """
     rest = float(np.median(theta[len(theta) * 4 // 5:]))
     u = theta - rest
     noise = angle_noise_rad(theta)
@@ -199,7 +338,24 @@ def swing_shape(t_s: np.ndarray, theta: np.ndarray, source: str) -> SwingShape:
 
 
 def start_values(t_s: np.ndarray, theta: np.ndarray, rig: HingeRig, shape: SwingShape) -> np.ndarray:
-    """(k, b, theta0, theta_start, rate_start) from the linearised swing about its rest."""
+    """Start values of the fit from the linearised swing about its rest.
+
+    Parameters
+    ----------
+    t_s : array_like
+        Sample times of the fit window [s].
+    theta : numpy.ndarray
+        The angle there [rad].
+    rig : HingeRig
+        The link.
+    shape : SwingShape
+        The swing's shape (:func:`swing_shape`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (5,)
+        k [N*m/rad], b [N*m*s/rad], theta0 [rad], the first angle [rad] and rate [rad/s].
+    """
     wn = math.hypot(shape.damped_omega_rad_per_s, shape.decay_per_s)
     stiff_total = rig.inertia_kgm2 * wn**2
     mgd = rig.gravity_moment_nm
@@ -214,7 +370,18 @@ def start_values(t_s: np.ndarray, theta: np.ndarray, rig: HingeRig, shape: Swing
 
 def angle_noise_rad(theta: np.ndarray) -> float:
     """The angle's tracking noise: from its second differences where the link is quietest (the
-    first or the last fifth of the record: held before the release, or at rest after it)."""
+    first or the last fifth of the record: held before the release, or at rest after it).
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        The angle [rad], evenly sampled.
+
+    Returns
+    -------
+    float
+        Standard deviation of one angle sample [rad] (the second difference's over sqrt(6)).
+    """
     fifth = max(len(theta) // 5, 4)
     parts = [np.diff(theta[:fifth], 2), np.diff(theta[-fifth:], 2)]
     return min(float(np.std(p)) for p in parts if len(p)) / math.sqrt(6)
@@ -230,6 +397,20 @@ def release_window(t_s: np.ndarray, theta: np.ndarray, start_s: float | None, en
     go over a few hundredths of a second, which is no free swing: the fit starts at the far
     end of that first swing, where the link turns (a drop's impact is skipped alike in
     :mod:`.beam`).
+
+    Parameters
+    ----------
+    t_s : numpy.ndarray
+        Sample times [s].
+    theta : numpy.ndarray
+        The angle [rad].
+    start_s, end_s : float or None
+        The window's ends [s] (None: found as above, and the record's end).
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        Which samples are in the window.
     """
     end = t_s[-1] if end_s is None else end_s
     if start_s is None:
@@ -264,8 +445,35 @@ def _first_turn(u: np.ndarray, release: int, band: float) -> int:
 def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, *,
               pivot: tuple[float, float] | None = None, start_s: float | None = None, end_s: float | None = None,
               coulomb: str = "auto", source: str = "hinge") -> HingeFit:
-    """Fit the swing of the marker at (x_m, y_m); see the module docstring. ``coulomb``:
-    auto (fit it when significant), off, on."""
+    """Fit the swing of the marker; see the module docstring.
+
+    Parameters
+    ----------
+    t_s : array_like
+        Sample times [s].
+    x_m, y_m : array_like
+        The marker's track [m], y up.
+    rig : HingeRig
+        The link.
+    pivot : tuple of float, optional
+        The hinge's position (x, y) [m], held; by default fitted from the circle through the arc.
+    start_s, end_s : float, optional
+        The fit window [s]; by default from the first turning point after the release to the end.
+    coulomb : str
+        ``"auto"`` (fit Coulomb friction when significant), ``"off"`` or ``"on"``.
+    source : str
+        The recording's name, for messages and the plot.
+
+    Returns
+    -------
+    HingeFit
+
+    Raises
+    ------
+    CalibrationError
+        An inertia not positive, an unknown gravity, in-plane gravity without mass and
+        centre of mass, a flat signal, too few samples in the window, or too few swings.
+    """
     clock = time.perf_counter()
     _check_rig(rig)
     t_s, x_m, y_m = (np.asarray(a, dtype=float) for a in (t_s, x_m, y_m))

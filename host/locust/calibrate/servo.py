@@ -90,7 +90,23 @@ FD_STEP = 1e-6
 
 @dataclass(frozen=True)
 class ServoRig:
-    """The test rig: load inertia about the servo axis, and its gravity moment."""
+    """The test rig: load inertia about the servo axis, and its gravity moment.
+
+    Attributes
+    ----------
+    inertia_kgm2 : float
+        The load's moment of inertia about the servo axis.
+    gravity_moment_nm : float
+        The load's weight times its lever arm with the horn horizontal (angle 0); 0: no weight
+        to lift.
+    timestep_s : float
+        The rig model's physics step.
+
+    Raises
+    ------
+    CalibrationError
+        A gravity moment beyond the stall torque's limit (a typo or a unit slip).
+    """
 
     inertia_kgm2: float
     gravity_moment_nm: float = 0.0   # load weight x lever arm, horn horizontal (angle 0)
@@ -125,7 +141,21 @@ class _Commanded:
 
 @dataclass(frozen=True)
 class StepRecording(_Commanded):
-    """An angle recording: sample times, horn angle and the firmware's command (degrees)."""
+    """An angle recording: sample times, horn angle and the firmware's command (degrees).
+
+    Attributes
+    ----------
+    t_s : numpy.ndarray
+        Sample times, on the camera's clock.
+    angle_deg : numpy.ndarray
+        The horn's angle.
+    command_deg : numpy.ndarray
+        The command sent, on the firmware's clock.
+    rig : ServoRig
+        The load it carried.
+    source : str
+        The recording's name.
+    """
 
     t_s: np.ndarray
     angle_deg: np.ndarray
@@ -140,7 +170,21 @@ class RateRecording(_Commanded):
     """A rate recording: a gyro on the horn, logged with the command on one clock. The gyro's
     unit is unknown (``rate_units``): its gain [units per rad/s] is fitted with the servo.
     Between steps the horn is at rest at the command (a level held for RATE_WINDOW_S or more);
-    each step is simulated from rest and fitted over RATE_WINDOW_S after its edge."""
+    each step is simulated from rest and fitted over RATE_WINDOW_S after its edge.
+
+    Attributes
+    ----------
+    t_s : numpy.ndarray
+        Sample times, one clock for gyro and command.
+    rate_units : numpy.ndarray
+        The gyro's reading, in its own unit.
+    command_deg : numpy.ndarray
+        The command sent.
+    rig : ServoRig
+        The load it carried.
+    source : str
+        The recording's name.
+    """
 
     t_s: np.ndarray
     rate_units: np.ndarray
@@ -150,7 +194,15 @@ class RateRecording(_Commanded):
     kind = "rate"
 
     def windows(self) -> list[tuple[int, int, int]]:
-        """(edge, first, end) sample indices of each step's fitted window."""
+        """Each step's fitted window.
+
+        Returns
+        -------
+        list of tuple of int
+            (edge, first, end) sample indices: the command's change, the window's first sample
+            (``RATE_PRE_SAMPLES`` before the edge, at rest) and one past its last (``RATE_WINDOW_S``
+            after the edge, or the next edge).
+        """
         edges = list(self.edges)
         sample_s = float(np.median(np.diff(self.t_s)))
         out = []
@@ -164,13 +216,25 @@ class RateRecording(_Commanded):
 
     def sample_weights(self) -> np.ndarray:
         """Weight of each fitted sample: each step's samples by the inverse of its peak reading
-        (relative to the mean peak), so that every step counts by its relative error."""
+        (relative to the mean peak), so that every step counts by its relative error.
+
+        Returns
+        -------
+        numpy.ndarray
+            One dimensionless weight per fitted sample, in :meth:`samples`' order.
+        """
         peaks = [max(float(np.max(np.abs(self.rate_units[e:end]))), 1.0) for e, _, end in self.windows()]
         mean = float(np.mean(peaks))
         return np.concatenate([np.full(end - first, mean / p) for (e, first, end), p in zip(self.windows(), peaks)])
 
     def samples(self) -> np.ndarray:
-        """Indices of the fitted samples (every window, in order)."""
+        """The fitted samples.
+
+        Returns
+        -------
+        numpy.ndarray of int
+            Their indices, every window's in order.
+        """
         return np.concatenate([np.arange(first, end) for _, first, end in self.windows()])
 
     @property
@@ -183,7 +247,13 @@ class RateRecording(_Commanded):
 
     def gain_guess(self) -> float:
         """|gain| [units per rad/s] from the data alone: the gyro's integral over each step
-        against the step (the horn settles at the command)."""
+        against the step (the horn settles at the command).
+
+        Returns
+        -------
+        float
+            The gain's magnitude [gyro units per rad/s]; 1 when no step moves the command.
+        """
         area, step = 0.0, 0.0
         for e, _, end in self.windows():
             area += abs(float(np.trapezoid(self.rate_units[e - 1:end], self.t_s[e - 1:end])))
@@ -198,7 +268,15 @@ Recording = StepRecording | RateRecording
 class Timing:
     """When the command reaches the servo: ``t_servo = tm + delay + (t_command - tm) * clock_ratio``,
     with ``tm`` the mean time of the recording's command edges (so that the delay is the mean
-    latency, and delay and clock ratio are nearly independent in the fit)."""
+    latency, and delay and clock ratio are nearly independent in the fit).
+
+    Attributes
+    ----------
+    delay_s : float
+        Mean latency from command to servo.
+    clock_ratio : float
+        Camera seconds per firmware second (dimensionless).
+    """
 
     delay_s: float = 0.0
     clock_ratio: float = 1.0
@@ -206,6 +284,49 @@ class Timing:
 
 @dataclass(frozen=True)
 class ServoFit:
+    """The result of :func:`fit_servo`: the servo's values with their intervals, each
+    recording's timing (and gyro gain), and how well the recordings fit.
+
+    Attributes
+    ----------
+    source : str
+        The recordings' names.
+    recordings : list of Recording
+        The recordings fitted (checked).
+    estimates : dict of str to Estimate
+        Each of ``PARAMS`` (units in the names); a held (given) one has std 0.
+    given : tuple of str
+        The ``PARAMS`` held at a given value, not fitted.
+    timings : list of Timing
+        Each recording's fitted timing.
+    timing_std : list of tuple of float
+        Their standard uncertainties: (delay [s], clock ratio).
+    gains : list of Estimate or None
+        Per recording: a rate recording's gyro gain [gyro units per rad/s] (None for an angle one).
+    identifiable : dict of str to bool
+        Whether the data tell each value (see the module docstring).
+    notes : list of str
+        Why a value is not identifiable, misfits, convergence in the time step.
+    rms_residual_deg : float or None
+        RMS residual over the angle recordings (None: there are none).
+    rms_per_recording : list of float
+        Each recording's RMS residual in its unit: deg (angle), rad/s (rate).
+    timestep_s : float
+        The rig model's physics step.
+    rms_half_step : list of float
+        The same RMS at half the step: convergence.
+    n_samples : int
+        Samples fitted.
+    iterations : int
+        Solver iterations, all runs.
+    wall_s : float
+        Wall time the fit took.
+    interval : str
+        How the intervals were computed.
+    curves : list of Curves
+        Each recording against the model, for the plots.
+    """
+
     source: str
     recordings: list[Recording] = field(repr=False)
     estimates: dict[str, Estimate]           # PARAMS -> value; a held one (given) has std 0
@@ -232,16 +353,26 @@ class ServoFit:
 
     @property
     def rms_residual_rad_per_s(self) -> float | None:
+        """RMS residual over the rate recordings [rad/s] (None: there are none)."""
         rates = [r for rec, r in zip(self.recordings, self.rms_per_recording) if rec.kind == "rate"]
         return float(np.sqrt(np.mean(np.square(rates)))) if rates else None
 
     @property
     def rate_gain(self) -> float | None:
-        """The gyro's gain of the fitted rate recordings (their mean; None without one)."""
+        """The gyro's gain of the fitted rate recordings [gyro units per rad/s] (their mean; None without one)."""
         gains = [g.value for g in self.gains if g is not None]
         return float(np.mean(gains)) if gains else None
 
     def summary(self) -> dict:
+        """The fit for JSON output.
+
+        Returns
+        -------
+        dict
+            ``experiment`` ("servo"), each recording's kind and rig, each of ``PARAMS`` as
+            its :meth:`~.fitstats.Estimate.as_dict` with ``identifiable`` (a given one without
+            interval), the timings and gains per recording, and the fit's figures.
+        """
         out = {"experiment": "servo", "source": self.source,
                "kind": [r.kind for r in self.recordings],
                "inertia_kgm2": [r.rig.inertia_kgm2 for r in self.recordings],
@@ -270,7 +401,25 @@ class ServoFit:
 
 # -- the rig model --------------------------------------------------------------------
 def rig_model(rig: ServoRig, servo: Servo | None = None) -> mujoco.MjModel:
-    """One hinge (axis -y, so positive angles lift a load hanging along +x) and the servo."""
+    """The rig as a MuJoCo model: one hinge (axis -y, so positive angles lift a load hanging
+    along +x) and the servo.
+
+    Parameters
+    ----------
+    rig : ServoRig
+        The load and the physics step.
+    servo : Servo, optional
+        The servo's values (default: :class:`~locust.params.Servo`'s).
+
+    Returns
+    -------
+    mujoco.MjModel
+
+    Raises
+    ------
+    CalibrationError
+        An inertia not positive and finite.
+    """
     if not (rig.inertia_kgm2 > 0 and math.isfinite(rig.inertia_kgm2)):
         raise CalibrationError(f"--inertia-kgm2 must be positive (got {rig.inertia_kgm2})",
                                "the load's moment of inertia about the servo axis, "
@@ -300,7 +449,20 @@ def rig_model(rig: ServoRig, servo: Servo | None = None) -> mujoco.MjModel:
 
 
 def servo_edges_s(rec: StepRecording, timing: Timing) -> np.ndarray:
-    """When each command change reaches the servo, on the camera's clock [s]."""
+    """When each command change reaches the servo.
+
+    Parameters
+    ----------
+    rec : StepRecording
+        The recording (its command edges).
+    timing : Timing
+        Its delay and clock ratio.
+
+    Returns
+    -------
+    numpy.ndarray
+        One time per edge, on the camera's clock [s].
+    """
     tm = rec.mean_edge_s
     return tm + timing.delay_s + (rec.t_s[rec.edges] - tm) * timing.clock_ratio
 
@@ -313,6 +475,26 @@ def simulate_deg(model: mujoco.MjModel, servos: list[Servo], timings: list[Timin
     edge is put on the nearest physics step and the response after it is read off shifted
     by the rounding. The simulated angle is then continuous in the timing (a saturated servo
     would otherwise not notice an edge moving inside one step), at no cost in steps.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The rig (:func:`rig_model`).
+    servos : list of Servo
+        The candidates' servos.
+    timings : list of Timing
+        The candidates' timings, one per servo.
+    rec : StepRecording
+        The recording (its times and command).
+    angle0_deg : float
+        The horn's angle at the first sample [deg].
+    t_out : array_like, optional
+        Times to read the angle at [s] (default: the recording's).
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(servos), len(t_out))
+        The angle [deg].
     """
     # candidates alike in servo and timing (a Jacobian's columns of another recording's
     # variables) share one simulation
@@ -356,7 +538,26 @@ def simulate_rate(model: mujoco.MjModel, servos: list[Servo], delays_s: list[flo
 
     Each step is simulated from rest at the previous command, the new command held from the
     moment it reaches the servo (the edge's time plus the delay): the speed is read at the
-    samples' times after that moment, so it moves continuously with the delay."""
+    samples' times after that moment, so it moves continuously with the delay.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The rig (:func:`rig_model`).
+    servos : list of Servo
+        The candidates' servos.
+    delays_s : list of float
+        The candidates' delays [s], one per servo.
+    rec : RateRecording
+        The recording (its times, command and windows).
+    t_out : list of array_like, optional
+        Per window, the times after its edge to read the speed at [s].
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(servos), samples)
+        The horn's speed [rad/s], the windows end to end.
+    """
     dt = model.opt.timestep
     wins = rec.windows()
     t, u = rec.t_s, rec.command_deg
@@ -574,7 +775,20 @@ def _solve(residual: _Residual, max_iter: int, progress: Callable[[int], None] |
 
 def progress_steps(n_recordings: int, max_iter: int = MAX_ITER) -> int:
     """Steps that :func:`fit_servo`'s ``progress`` reports in all: ``max_iter`` per solver run,
-    one per start and a polish with several recordings (see ``_solve``)."""
+    one per start and a polish with several recordings (see ``_solve``).
+
+    Parameters
+    ----------
+    n_recordings : int
+        Recordings to fit.
+    max_iter : int
+        Iterations of one solver run at most.
+
+    Returns
+    -------
+    int
+        The steps' total.
+    """
     return (STARTS + (n_recordings > 1)) * max_iter
 
 
@@ -668,7 +882,33 @@ def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None,
               kv_nms_per_rad: float | None = None, max_iter: int = MAX_ITER,
               progress: Callable[[int], None] | None = None) -> ServoFit:
     """Identify the servo from one or more recordings (angle or rate); see the module docstring.
-    ``stall_torque_nm`` and ``kv_nms_per_rad``, when given, are held at that value."""
+    ``stall_torque_nm`` and ``kv_nms_per_rad``, when given, are held at that value.
+
+    Parameters
+    ----------
+    recordings : list of Recording
+        Angle and rate recordings, fitted together.
+    stall_torque_nm : float, optional
+        The stall torque [N*m], held (a stall test, the datasheet); fitted when not given.
+    kv_nms_per_rad : float, optional
+        The servo law's velocity gain [N*m*s/rad], held; fitted when not given.
+    max_iter : int
+        Iterations of one solver run at most.
+    progress : callable, optional
+        Called with the number of steps done since its last call; they add up to
+        :func:`progress_steps`.
+
+    Returns
+    -------
+    ServoFit
+
+    Raises
+    ------
+    CalibrationError
+        No recording; a stall torque not positive or a negative kv; one load only (one
+        inertia, no weight to lift) without a stall torque; or a recording too short, without
+        a step, or with a flat signal.
+    """
     import time
 
     t_start = time.perf_counter()
@@ -878,7 +1118,27 @@ def _rms_half_step(recs: list[Recording], servo: Servo, timings: list[Timing],
 def recording_curves(model, servo: Servo, timing: Timing, gain: float | None, rec: Recording,
                      label: str = "") -> Curves:
     """The recording against the model: the angle [deg] over time, or the speed [rad/s] over
-    each step's window, the windows laid end to end."""
+    each step's window, the windows laid end to end.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The rig (:func:`rig_model`).
+    servo : Servo
+        The servo.
+    timing : Timing
+        The recording's timing.
+    gain : float or None
+        A rate recording's gyro gain [gyro units per rad/s] (None for an angle one).
+    rec : Recording
+        The recording.
+    label : str
+        Put before the recording's name in the title.
+
+    Returns
+    -------
+    Curves
+    """
     name = f"{label}{Path(rec.source).name}"
     if rec.kind == "angle":
         sim = simulate_deg(model, [servo], [timing], rec, float(rec.angle_deg[0]))[0]
@@ -902,12 +1162,24 @@ def recording_curves(model, servo: Servo, timing: Timing, gain: float | None, re
 # -- validation: predicting recordings the fit never saw ---------------------------------
 @dataclass(frozen=True)
 class StepPeak:
+    """One step's peak speed, measured and predicted.
+
+    Attributes
+    ----------
+    step_deg : float
+        The signed command change.
+    peak_speed_measured_rad_per_s, peak_speed_predicted_rad_per_s : float
+        The largest speed in the step's window; the prediction sampled at the recording's
+        own sample times.
+    """
+
     step_deg: float                            # the signed command change
     peak_speed_measured_rad_per_s: float
     peak_speed_predicted_rad_per_s: float      # sampled at the recording's own sample times
 
     @property
     def error(self) -> float:
+        """Predicted over measured peak, minus one (dimensionless)."""
         return self.peak_speed_predicted_rad_per_s / self.peak_speed_measured_rad_per_s - 1.0
 
 
@@ -916,7 +1188,25 @@ class Validation:
     """A fitted servo predicting a recording it was not fitted to; only the recording's own
     timing (delay; clock ratio for an angle recording of three edges or more) is fitted to it,
     and a rate recording's gyro gain is the fitted recordings' (the same gyro) or, without
-    one, its own integral over each step against the step."""
+    one, its own integral over each step against the step.
+
+    Attributes
+    ----------
+    source : str
+        The recording's name.
+    kind : str
+        ``"angle"`` or ``"rate"``.
+    rms : float
+        RMS of prediction minus recording: deg (angle) or rad/s (rate).
+    timing : Timing
+        The recording's timing, fitted to it.
+    gain : float or None
+        The gyro gain used [gyro units per rad/s] (None for an angle recording).
+    steps : list of StepPeak
+        Each step's peak speed.
+    curves : Curves
+        The recording against the prediction.
+    """
 
     source: str
     kind: str
@@ -927,6 +1217,13 @@ class Validation:
     curves: Curves = field(repr=False)
 
     def summary(self) -> dict:
+        """The validation for JSON output.
+
+        Returns
+        -------
+        dict
+            The fields (rms with its unit, the timing rounded, each step's peaks and error).
+        """
         return {"source": self.source, "kind": self.kind, "rms": self.rms,
                 "rms_unit": "deg" if self.kind == "angle" else "rad/s",
                 "command_delay_s": round(self.timing.delay_s, 5),
@@ -939,7 +1236,18 @@ class Validation:
 
 
 def step_windows(rec: Recording) -> list[tuple[int, int]]:
-    """(edge, end) sample indices of each step: to the next edge, at most RATE_WINDOW_S."""
+    """Each step's window: to the next edge, at most ``RATE_WINDOW_S``.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+
+    Returns
+    -------
+    list of tuple of int
+        (edge, end) sample indices, ``end`` one past the last.
+    """
     if rec.kind == "rate":
         return [(e, end) for e, _, end in rec.windows()]
     edges = list(rec.edges) + [len(rec.t_s)]
@@ -950,7 +1258,21 @@ def step_windows(rec: Recording) -> list[tuple[int, int]]:
 def peak_speeds(rec: Recording, predicted: np.ndarray, gain: float | None) -> list[StepPeak]:
     """Each step's peak speed, measured and predicted (``predicted``: the model's angle [deg]
     at every sample of an angle recording, its speed [rad/s] at the fitted samples of a rate
-    recording). An angle's speed is its change between samples over their interval."""
+    recording). An angle's speed is its change between samples over their interval.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    predicted : numpy.ndarray
+        The model's angle [deg] or speed [rad/s], as above.
+    gain : float or None
+        A rate recording's gyro gain [gyro units per rad/s] (unused for an angle one).
+
+    Returns
+    -------
+    list of StepPeak
+    """
     out = []
     if rec.kind == "rate":
         measured = rec.rate_units[rec.samples()] / gain
@@ -973,7 +1295,27 @@ def peak_speeds(rec: Recording, predicted: np.ndarray, gain: float | None) -> li
 
 
 def validate(servo: Servo, rec: Recording, gain: float | None = None) -> Validation:
-    """Predict ``rec`` with ``servo``; see :class:`Validation`."""
+    """Predict a recording with a fitted servo; see :class:`Validation`.
+
+    Parameters
+    ----------
+    servo : Servo
+        The fitted servo.
+    rec : Recording
+        A recording it was not fitted to.
+    gain : float, optional
+        The gyro's gain [gyro units per rad/s] (its sign is taken from the data); by default
+        the recording's own.
+
+    Returns
+    -------
+    Validation
+
+    Raises
+    ------
+    CalibrationError
+        A recording too short, without a step, or with a flat signal.
+    """
     rec = _checked(rec)
     if rec.kind == "rate" and gain is None:
         gain = rec.gain_sign * rec.gain_guess()
@@ -1011,5 +1353,18 @@ def validate(servo: Servo, rec: Recording, gain: float | None = None) -> Validat
 
 
 def horn_angle_deg(x_m: np.ndarray, y_m: np.ndarray, pivot_x_m: float, pivot_y_m: float) -> np.ndarray:
-    """Angle of the horn tip about the pivot, from the track's +x axis (y up), unwrapped."""
+    """Angle of the horn tip about the pivot, from the track's +x axis (y up), unwrapped.
+
+    Parameters
+    ----------
+    x_m, y_m : numpy.ndarray
+        The horn tip's track [m].
+    pivot_x_m, pivot_y_m : float
+        The servo axis in the track [m].
+
+    Returns
+    -------
+    numpy.ndarray
+        The angle [deg].
+    """
     return np.degrees(np.unwrap(np.arctan2(y_m - pivot_y_m, x_m - pivot_x_m)))

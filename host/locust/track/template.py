@@ -88,7 +88,18 @@ class Gate:
     uy: float = 0.0
 
     def ratio(self, dx, dy):
-        """Distance of the offset (dx, dy) from the prediction in gate sizes (<= 1: inside)."""
+        """Distance of the offset (dx, dy) from the prediction in gate sizes (<= 1: inside).
+
+        Parameters
+        ----------
+        dx, dy : float or ndarray
+            Offset from the predicted position [px].
+
+        Returns
+        -------
+        float or ndarray
+            The elliptical distance, in units of the gate's half-axes (dimensionless).
+        """
         along = dx * self.ux + dy * self.uy
         across = -dx * self.uy + dy * self.ux
         return np.hypot(along / self.along_px, across / self.across_px)
@@ -96,6 +107,32 @@ class Gate:
 
 @dataclass
 class TemplateMarker:
+    """A feature tracked as Tracker's autotracker does: a template cut on the key frame,
+    matched by masked square difference in a window around the predicted position (see the
+    module docstring).
+
+    Attributes
+    ----------
+    name, spec : str
+        The marker's name and its ``--marker`` spec.
+    key_x_px, key_y_px : float
+        The point picked on the key frame [px].
+    key_frame : int
+        The frame the template is cut from; earlier frames are not searched.
+    radius_px : int
+        Radius of the circular template mask [px].
+    search_half_px : int
+        Half-size of the search window around the prediction [px].
+    accept : float
+        Smallest peak height a match needs (Tracker's "automark").
+    evolve : float
+        Share of the matched patch mixed into the template on each accepted match (0..1).
+    min_likeness : float
+        Smallest zero-mean normalised correlation of a match with the template (-1..1).
+    trajectory : MarkerPath
+        Its positions so far, for the prediction.
+    """
+
     name: str
     spec: str
     key_x_px: float
@@ -112,6 +149,26 @@ class TemplateMarker:
     _offset: tuple[float, float] = (0.0, 0.0)  # key point minus template centre pixel
 
     def locate(self, frame: int, image_bgr: np.ndarray) -> Detection:
+        """Find the marker in one frame (on the key frame: cut the template there).
+
+        Parameters
+        ----------
+        frame : int
+            The frame number (frames come in order).
+        image_bgr : ndarray
+            The frame, BGR.
+
+        Returns
+        -------
+        Detection
+            Its point [px] (the key point plus the measured displacement); ``score`` is
+            Tracker's peak height (inf on the key frame, nan before it).
+
+        Raises
+        ------
+        TrackError
+            The key frame was skipped, or the template does not fit inside the image there.
+        """
         if frame < self.key_frame:
             return Detection.missing()
         if self._template is None:
