@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 from click.testing import CliRunner
 
-from locust.cli import cli
+from locust.commands import cli
 
 
 def printed(*args) -> list[str]:
