@@ -1,15 +1,15 @@
 """The simulated robot in MuJoCo: build the model, roll out the hop schedule, audit, measure,
 film.
 
-``fourbar`` solves the leg linkage; ``servo`` and ``model`` build the MuJoCo model (MjSpec);
-``schedule`` turns the hop schedule into a per-step command; ``rollout`` and ``batching`` run
-it with ``mujoco.rollout``; ``audit`` invalidates a run that breaks its own physics; ``hops``
-and ``outcome`` measure each hop and name the run's regime; ``run`` does all of that for one
-robot and returns ``result``'s :class:`~.result.SimResult`; ``samples`` and ``sensitivity``
-simulate draws and one-at-a-time moves of the uncertain values; ``statics`` finds the
-standing robot's load on its nose; ``kinematics`` poses the markers at kept states;
-``camera``, ``clip``, ``still`` and ``stickers`` render videos and stills with their
-ground truth; ``live`` steps the model as the virtual robot's servo commands arrive.
+:mod:`.fourbar` solves the leg linkage; :mod:`.servo` and :mod:`.model` build the MuJoCo model (MjSpec);
+:mod:`.schedule` turns the hop schedule into a per-step command; :mod:`.rollout` and :mod:`.batching` run
+it with ``mujoco.rollout``; :mod:`.audit` invalidates a run that breaks its own physics; :mod:`.hops`
+and :mod:`.outcome` measure each hop and name the run's regime; :mod:`.run` does all of that for one
+robot and returns :mod:`.result`'s :class:`~.result.SimResult`; :mod:`.samples` and :mod:`.sensitivity`
+simulate draws and one-at-a-time moves of the uncertain values; :mod:`.statics` finds the
+standing robot's load on its nose; :mod:`.kinematics` poses the markers at kept states;
+:mod:`.camera`, :mod:`.clip`, :mod:`.still` and :mod:`.stickers` render videos and stills with their
+ground truth; :mod:`.live` steps the model as the virtual robot's servo commands arrive.
 """
 
 import os
