@@ -1,0 +1,111 @@
+"""A step refined only where a contact arrives or leaves: what it would buy, measured.
+
+    python bench/touchdown_steps.py [--preset seed] [--cycles 3]
+
+A prototype, not a route of ``locust sim``: a Python loop of ``mj_step`` that takes the
+coarse step, and whenever a step changes the number of floor contacts, goes back to the
+state before it (``mj_getState``/``mj_setState``, warm start included) and takes the next
+``window`` at the fine step, several fine steps per coarse one. Each route's figure is the
+chassis' forward position at the end of the run (what the distance is made of), against rk4
+at 0.25 ms; "its dt/2" halves both of the route's steps. Cost: model steps taken, against
+the uniform 1 ms run's (rk4 evaluates the model 4 times a step, whichever step it takes).
+
+Last line: ``touchdown steps: <preset> best <coarse>/<fine> ms: <E> mm off, <R>x fewer steps than 1 ms``:
+the cheapest route converged by ``locust sim --check-convergence``'s rule (0.1 mm a hop or
+1 %) both against the reference and at its dt/2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+
+import mujoco
+import numpy as np
+
+from locust.params import preset
+from locust.sim.model import build
+from locust.sim.rollout import simulate
+from locust.sim.run import CONVERGED_MM, CONVERGED_REL
+from locust.sim.schedule import control_plan
+
+ROUTES = [  # (coarse step, fine step, window after a contact change) [s]
+    (2e-3, 5e-4, 0.02), (2e-3, 5e-4, 0.04), (4e-3, 5e-4, 0.02), (4e-3, 5e-4, 0.04), (4e-3, 1e-3, 0.04),
+]
+STATE = mujoco.mjtState.mjSTATE_INTEGRATION   # the full physics state and the solver's warm start
+
+
+def within(x_mm: float, other_mm: float, cycles: int) -> bool:
+    """``locust sim --check-convergence``'s rule on the distance: 0.1 mm a hop or 1 %."""
+    return abs(x_mm - other_mm) / cycles <= CONVERGED_MM or abs(x_mm - other_mm) <= CONVERGED_REL * abs(other_mm)
+
+
+def uniform(robot, dt: float, cycles: int) -> tuple[float, int]:
+    """Chassis x at the end [mm] and steps taken, of the package's own rollout at ``dt``."""
+    traj = simulate(robot.with_values({"solver.timestep_s": dt}), cycles=cycles)
+    return float(traj.final_qpos[0]) * 1000, traj.sensordata.shape[0]
+
+
+
+def refined(robot, coarse: float, fine: float, window: float, cycles: int) -> tuple[float, int]:
+    """Chassis x at the end [mm] and model steps taken, refining ``window`` after each step that
+    changes the number of contacts (the step is taken again at ``fine``)."""
+    robot = robot.with_values({"solver.timestep_s": coarse})
+    built = build(robot)
+    model, data = built.model, mujoco.MjData(built.model)
+    plan = control_plan(robot.schedule, robot.solver, cycles)
+    saved = np.empty(mujoco.mj_stateSize(model, STATE))
+    per_coarse, window_steps = int(round(coarse / fine)), int(round(window / coarse))
+    mujoco.mj_forward(model, data)
+    fine_left = steps = i = 0
+    while i < plan.nstep:
+        data.ctrl[:] = plan.ctrl_rad[i]
+        if fine_left:
+            model.opt.timestep = fine
+            for _ in range(per_coarse):
+                mujoco.mj_step(model, data)
+            steps, fine_left = steps + per_coarse, fine_left - 1
+        else:
+            mujoco.mj_getState(model, data, saved, STATE)
+            before = data.ncon
+            model.opt.timestep = coarse
+            mujoco.mj_step(model, data)
+            steps += 1
+            if data.ncon != before:     # a contact arrived or left within this step: take it again finely
+                mujoco.mj_setState(model, data, saved, STATE)
+                fine_left = window_steps
+                continue
+        i += 1
+    return float(data.qpos[0]) * 1000, steps
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--preset", default="seed")
+    ap.add_argument("--cycles", type=int, default=3)
+    args = ap.parse_args()
+    robot, cycles = preset(args.preset), args.cycles
+    ref, _ = uniform(robot, 2.5e-4, cycles)
+    print(f"{args.preset}, {cycles} hops, rk4; load average {os.getloadavg()[0]:.1f}; "
+          f"reference (uniform 0.25 ms): chassis at {ref:.3f} mm")
+    print(f"{'route':34s} {'mm off ref':>10s} {'dt/2 mm':>8s} {'steps':>6s} {'x fewer':>7s}")
+    x1, n1 = uniform(robot, 1e-3, cycles)
+    x1h, _ = uniform(robot, 5e-4, cycles)
+    print(f"{'uniform 1 ms':34s} {x1 - ref:+10.3f} {x1 - x1h:+8.3f} {n1:6d} {1.0:7.2f}")
+    best = None
+    for coarse, fine, window in ROUTES:
+        x, n = refined(robot, coarse, fine, window, cycles)
+        xh, _ = refined(robot, coarse / 2, fine / 2, window, cycles)
+        name = f"{coarse * 1e3:g} ms, {fine * 1e3:g} ms for {window * 1e3:g} ms"
+        print(f"{name:34s} {x - ref:+10.3f} {x - xh:+8.3f} {n:6d} {n1 / n:7.2f}", flush=True)
+        if within(x, ref, cycles) and within(x, xh, cycles) and (best is None or n < best[3]):
+            best = (coarse, fine, x - ref, n)
+    if best:
+        print(f"touchdown steps: {args.preset} best {best[0] * 1e3:g}/{best[1] * 1e3:g} ms: {best[2]:+.3f} mm off, "
+              f"{n1 / best[3]:.2f}x fewer steps than 1 ms")
+    else:
+        print(f"touchdown steps: {args.preset} no route converged")
+
+
+if __name__ == "__main__":
+    main()
