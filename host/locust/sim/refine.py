@@ -10,8 +10,11 @@ coarse one, the control held as the plan holds it). The record stays on the coar
 (row i at t = i*dt, every ``dt/fine_s``-th fine row), so the audit and the per-hop figures
 read it as any other trajectory.
 
-Not a route of ``locust sim`` yet (its settings are not robot parameters); measured by
-``bench/sim_speed.py`` and ``bench/touchdown_steps.py``.
+Not a route of ``locust sim`` (its settings are not robot parameters), and not yet as true
+as uniform rk4 at 1 ms on a design's draws: on medium's 32 it sends the draw nearest the
+threshold over where every uniform step has it rear and come back (docs/performance.md,
+``bench/draw_steps.py --refined``). Measured by ``bench/sim_speed.py`` and
+``bench/draw_steps.py``.
 """
 
 from __future__ import annotations
