@@ -1,14 +1,13 @@
-"""A step refined only where a contact arrives or leaves: what it would buy, measured.
+"""A step refined only where a contact arrives or leaves: what it buys, measured.
 
     python bench/touchdown_steps.py [--preset seed] [--cycles 3] [--draws 32]
 
-A prototype, not a route of ``locust sim``: a Python loop of ``mj_step`` that takes the
-coarse step, and whenever a step changes the number of floor contacts, goes back to the
-state before it (``mj_getState``/``mj_setState``, warm start included) and takes the next
-``window`` at the fine step, several fine steps per coarse one. Each route's figure is the
-chassis' forward position at the end of the run (what the distance is made of), against rk4
-at 0.25 ms; "its dt/2" halves both of the route's steps. Cost: model steps taken, against
-the uniform 1 ms run's (rk4 evaluates the model 4 times a step, whichever step it takes).
+``locust.sim.refine``'s route (the coarse step, and where a step changes the number of floor
+contacts, that step taken again from the state before it and the ``window`` after it at the
+fine step) at several settings. Each route's figure is the chassis' forward position at the
+end of the run (its free joint's x: what the distance is made of), against rk4 at 0.25 ms;
+"its dt/2" halves both of the route's steps. Cost: model steps taken, against the uniform
+1 ms run's (rk4 evaluates the model 4 times a step, whichever step it takes).
 With ``--draws N`` the same on N draws of the preset's uncertain values: how many of them
 each route converges by that figure.
 
@@ -22,11 +21,9 @@ from __future__ import annotations
 import argparse
 import os
 
-import mujoco
-import numpy as np
-
 from locust.params import preset, problems
 from locust.sim.model import build
+from locust.sim.refine import simulate_refined
 from locust.sim.rollout import simulate
 from locust.sim.run import CONVERGED_MM, CONVERGED_REL
 from locust.sim.samples import draw
@@ -35,7 +32,6 @@ from locust.sim.schedule import control_plan
 ROUTES = [  # (coarse step, fine step, window after a contact change) [s]
     (2e-3, 5e-4, 0.02), (2e-3, 5e-4, 0.04), (4e-3, 5e-4, 0.02), (4e-3, 5e-4, 0.04), (4e-3, 1e-3, 0.04),
 ]
-STATE = mujoco.mjtState.mjSTATE_INTEGRATION   # the full physics state and the solver's warm start
 
 
 def within(x_mm: float, other_mm: float, cycles: int) -> bool:
@@ -51,35 +47,10 @@ def uniform(robot, dt: float, cycles: int) -> tuple[float, int]:
 
 
 def refined(robot, coarse: float, fine: float, window: float, cycles: int) -> tuple[float, int]:
-    """Chassis x at the end [mm] and model steps taken, refining ``window`` after each step that
-    changes the number of contacts (the step is taken again at ``fine``)."""
+    """Chassis x at the end [mm] and model steps taken on ``locust.sim.refine``'s route."""
     robot = robot.with_values({"solver.timestep_s": coarse})
-    built = build(robot)
-    model, data = built.model, mujoco.MjData(built.model)
-    plan = control_plan(robot.schedule, robot.solver, cycles)
-    saved = np.empty(mujoco.mj_stateSize(model, STATE))
-    per_coarse, window_steps = int(round(coarse / fine)), int(round(window / coarse))
-    mujoco.mj_forward(model, data)
-    fine_left = steps = i = 0
-    while i < plan.nstep:
-        data.ctrl[:] = plan.ctrl_rad[i]
-        if fine_left:
-            model.opt.timestep = fine
-            for _ in range(per_coarse):
-                mujoco.mj_step(model, data)
-            steps, fine_left = steps + per_coarse, fine_left - 1
-        else:
-            mujoco.mj_getState(model, data, saved, STATE)
-            before = data.ncon
-            model.opt.timestep = coarse
-            mujoco.mj_step(model, data)
-            steps += 1
-            if data.ncon != before:     # a contact arrived or left within this step: take it again finely
-                mujoco.mj_setState(model, data, saved, STATE)
-                fine_left = window_steps
-                continue
-        i += 1
-    return float(data.qpos[0]) * 1000, steps
+    out = simulate_refined(build(robot), control_plan(robot.schedule, robot.solver, cycles), fine, window)
+    return float(out.trajectory.final_qpos[0]) * 1000, out.model_steps
 
 
 def main() -> None:
