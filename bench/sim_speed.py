@@ -8,7 +8,8 @@ Every route runs the seed design for 3 hops on one core, and then each preset (s
 medium, large) at its own default; all timings are taken in this one run, best of
 ``--repeat``. Accuracy: each route against itself at half the step (the convergence check
 ``locust sim --check-convergence`` makes) and against the converged reference (rk4 at 1/8 of
-the default step).
+the default step). The refined routes (``locust.sim.refine``: a coarse step, taken again at a
+fine one where the floor contacts change) halve both steps for their dt/2.
 
 Last line: ``sim speedup <N>x at deviation <D>% (<M> mm per hop) vs dt/2``: N is the
 notebook loop's time over the package default's, D and M the default's distance change at
@@ -27,7 +28,12 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from locust.params import preset
+from locust.sim.audit import audit
+from locust.sim.hops import summarise
+from locust.sim.model import build
+from locust.sim.refine import simulate_refined
 from locust.sim.run import run
+from locust.sim.schedule import control_plan
 from notebook_reference import notebook_run
 
 CYCLES = 3
@@ -48,6 +54,19 @@ def robot_for(overrides: dict, scale: float = 1.0):
         values["solver.timestep_s"] = dt / 10 if values.get("solver.integrator") == "implicitfast" else dt * 2
     values["solver.timestep_s"] = values.get("solver.timestep_s", dt) * scale
     return base.with_values(values)
+
+
+REFINED = [(4e-3, 5e-4, 0.04), (4e-3, 1e-3, 0.04)]   # (step, fine step, window after a contact change) [s]
+
+
+def refined_run(base, coarse: float, fine: float, window: float):
+    """Build, simulate refined, audit and summarise: what ``run`` does, on the refined route.
+    Returns (the hop summary, model steps taken)."""
+    robot = base.with_values({"solver.timestep_s": coarse})
+    out = simulate_refined(build(robot), control_plan(robot.schedule, robot.solver, CYCLES), fine, window)
+    if not audit(out.trajectory).valid:
+        raise SystemExit(f"the refined route {coarse:g}/{fine:g} s failed its audit")
+    return summarise(out.trajectory), out.model_steps
 
 
 def timed(fn, repeat: int):
@@ -86,6 +105,16 @@ def main() -> None:
         valid = "" if r.valid else "  INVALID: " + "; ".join(r.reasons)
         print(f"{name:34s} {robot.solver.timestep_s:8.1e} {t:7.3f} {nb_t / t:7.2f} {r.distance_m * 1000 / CYCLES:7.3f} "
               f"{dev_half:7.2f} {mm_half:11.3f} {dev_ref:6.2f}{valid}", flush=True)
+    # the step refined where the floor contacts change (locust.sim.refine; not a route of locust sim yet)
+    for coarse, fine, window in REFINED:
+        name = f"rk4 {coarse * 1e3:g} ms, {fine * 1e3:g} ms at contacts"
+        t, (r, steps) = timed(lambda c=coarse, f=fine, w=window: refined_run(default, c, f, w), args.repeat)
+        half, _ = refined_run(default, coarse / 2, fine / 2, window)
+        dev_half = abs(r.distance_m - half.distance_m) / abs(half.distance_m) * 100
+        mm_half = abs(r.distance_m - half.distance_m) * 1000 / CYCLES
+        dev_ref = abs(r.distance_m - ref.distance_m) / abs(ref.distance_m) * 100
+        print(f"{name:34s} {coarse:8.1e} {t:7.3f} {nb_t / t:7.2f} {r.distance_m * 1000 / CYCLES:7.3f} "
+              f"{dev_half:7.2f} {mm_half:11.3f} {dev_ref:6.2f}  ({steps} model steps)", flush=True)
     # every preset at its own default (its leg set's step), against the same notebook time
     print(f"{'preset (its default)':34s} {'dt_s':>8s} {'time_s':>7s} {'speedup':>7s} {'mm/hop':>7s} "
           f"{'dt/2 %':>7s} {'dt/2 mm/hop':>11s} {'nose dt/2 mm':>12s}")

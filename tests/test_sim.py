@@ -88,6 +88,11 @@ def test_floor_pairs_carry_each_friction_exactly(monkeypatch):
     automatic = roll_out(seed, cycles=1)
     assert automatic.built.model.npair == 0
     assert abs(paired.sensordata - automatic.sensordata).max() < 1e-12
+    # the pairs are every contact there is: no geom is left for MuJoCo's broad phase
+    model = paired.built.model
+    assert not (model.geom_contype | model.geom_conaffinity).any()
+    mutual = simulate(seed.with_values({"contact.self_collision": True}), cycles=1).built.model
+    assert (mutual.geom_contype & mutual.geom_conaffinity).any()   # the parts still collide with each other
 
 
 def test_run_keeps_the_rollout_it_was_computed_from():
