@@ -24,7 +24,7 @@ import os
 from locust.params import preset, problems
 from locust.sim.model import build
 from locust.sim.refine import simulate_refined
-from locust.sim.rollout import simulate
+from locust.sim.rollout import roll_out
 from locust.sim.run import CONVERGED_MM, CONVERGED_REL
 from locust.sim.samples import draw
 from locust.sim.schedule import control_plan
@@ -41,7 +41,7 @@ def within(x_mm: float, other_mm: float, cycles: int) -> bool:
 
 def uniform(robot, dt: float, cycles: int) -> tuple[float, int]:
     """Chassis x at the end [mm] and steps taken, of the package's own rollout at ``dt``."""
-    traj = simulate(robot.with_values({"solver.timestep_s": dt}), cycles=cycles)
+    traj = roll_out(robot.with_values({"solver.timestep_s": dt}), cycles=cycles)
     return float(traj.final_qpos[0]) * 1000, traj.sensordata.shape[0]
 
 

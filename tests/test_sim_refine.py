@@ -9,7 +9,7 @@ from locust.sim.audit import audit
 from locust.sim.hops import summarise
 from locust.sim.model import build
 from locust.sim.refine import simulate_refined
-from locust.sim.rollout import simulate
+from locust.sim.rollout import roll_out
 from locust.sim.schedule import control_plan
 
 
@@ -24,7 +24,7 @@ def test_the_seed_at_4_ms_refined_is_converged_at_fewer_steps_than_1_ms():
     0.016 mm a hop of rk4 at 0.25 ms (uniform 1 ms: 0.072 mm; uniform 2 ms: 0.215) in 2,318
     model steps against uniform 1 ms's 4,400 (docs/performance.md)."""
     seed = preset("seed")
-    truth = summarise(simulate(seed.with_values({"solver.timestep_s": 2.5e-4}), cycles=3))
+    truth = summarise(roll_out(seed.with_values({"solver.timestep_s": 2.5e-4}), cycles=3))
     out = _refined(seed, 4e-3, 5e-4, 0.04, cycles=3)
     assert audit(out.trajectory).valid
     got = summarise(out.trajectory)
@@ -39,7 +39,7 @@ def test_refined_at_its_own_step_is_the_plain_run():
     restarts the solver's warm start, so they agree to the solver's tolerance, not bit for bit)."""
     seed = preset("seed")
     built = build(seed)
-    plain = simulate(seed, cycles=1, built=built)
+    plain = roll_out(seed, cycles=1, built=built)
     out = simulate_refined(built, plain.plan, seed.solver.timestep_s, 0.04)
     s = built.sensors
     for cols in (s.chassis_pos, s.nose_pos, s.foot_pos):

@@ -3,7 +3,8 @@ film.
 
 :mod:`.fourbar` solves the leg linkage; :mod:`.servo` and :mod:`.model` build the MuJoCo model (MjSpec);
 :mod:`.schedule` turns the hop schedule into a per-step command; :mod:`.rollout` and :mod:`.batching` run
-it with ``mujoco.rollout``; :mod:`.audit` invalidates a run that breaks its own physics; :mod:`.hops`
+it with ``mujoco.rollout`` (:mod:`.refine`: a coarse step with each floor-contact change taken
+again at a fine one, for the benchmarks); :mod:`.audit` invalidates a run that breaks its own physics; :mod:`.hops`
 and :mod:`.outcome` measure each hop and name the run's regime; :mod:`.run` does all of that for one
 robot and returns :mod:`.result`'s :class:`~.result.SimResult`; :mod:`.samples` and :mod:`.sensitivity`
 simulate draws and one-at-a-time moves of the uncertain values; :mod:`.statics` finds the

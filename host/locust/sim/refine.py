@@ -37,12 +37,25 @@ CHUNK_STEPS = 25    # coarse steps a rollout call: the work thrown away after a 
 
 @dataclass(frozen=True)
 class Refined:
+    """A refined rollout: the record on the coarse grid and what it cost.
+
+    Attributes
+    ----------
+    trajectory : Trajectory
+        The record, one row per coarse step.
+    coarse_steps : int
+        Coarse steps taken, those thrown away after a contact change found in a chunk included.
+    fine_steps : int
+        Fine steps taken in the windows after each contact change.
+    """
+
     trajectory: Trajectory
     coarse_steps: int    # coarse steps taken (those thrown away after a change included)
     fine_steps: int      # fine steps taken
 
     @property
     def model_steps(self) -> int:
+        """Every step MuJoCo took, coarse and fine (the cost of the run)."""
         return self.coarse_steps + self.fine_steps
 
 
