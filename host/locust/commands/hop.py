@@ -157,8 +157,9 @@ def _video_frames(schedule: R.HopSchedule, video: Path, fps: int) -> None:
                           f"{MAX_VIDEO_FRAMES} a video of the virtual robot may hold (each is rendered on the CPU)",
                           f"lower --fps (60 is a real camera's rate) or --cycles, to at most "
                           f"{MAX_VIDEO_FRAMES // math.ceil(run_s)} frames/s for this schedule")
-    info(f"video: about {frames} frames to render ({run_s:.1f} s at {fps} frames/s); the command ends when "
-          "the last is written")
+    info(f"video: about {frames} frames for the hop ({run_s:.1f} s at {fps} frames/s), and more for the "
+         "seconds the virtual robot stands before and after it (its clock runs from its boot to the "
+         "command's end); the command ends when the last is written")
 
 
 def _note_after_hop(rec, directory: Path, exc: LocustError) -> LocustError:

@@ -205,7 +205,7 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
         dist_err = c.distance.mean - c.predicted_distance_m
         jump_err = c.jump.mean - c.predicted_jump_m
         cells = [
-            td(labels[name], left=True), td(f"+{added[name] * 1000:g}"), td(str(c.distance.n), name, "trials"),
+            td(labels[name], left=True), td(f"+{added[name] * 100:g}"), td(str(c.distance.n), name, "trials"),
             td(mm(c.predicted_distance_m), name, "predicted_distance_mm"),
             td(mm_pm(c.distance.mean, c.distance.std), name, "measured_distance_mm"),
             td(mm(dist_err), name, "distance_error_mm"), td(pct(dist_err, c.predicted_distance_m, c.resolution_m)),
@@ -219,7 +219,7 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
                left=True),
         ]
         rows.append(f'<tr{"" if valid else " class=invalid"}>{"".join(cells)}</tr>')
-    headers = ["configuration", "added (mm)", "trials", "predicted distance (mm)", "measured distance (mm)",
+    headers = ["configuration", "added (cm)", "trials", "predicted distance (mm)", "measured distance (mm)",
                "error (mm)", "error", "predicted per hop (mm)", "measured per hop (mm)",
                "predicted jump (mm)", "measured jump (mm)", "error (mm)", "error", "simulation"]
     known = [(labels[c.config], c.resolution_m) for c in comps if math.isfinite(c.resolution_m)]

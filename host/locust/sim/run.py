@@ -67,7 +67,7 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
     asm = built.assembly
     lo, hi = GOOD_TRANSMISSION_DEG
     if summary and summary.end_nose_rise_m > STAYED_UP_M:
-        notes.append(f"did not come back down: the nose ends {summary.end_nose_rise_m * 100:.1f} cm above its "
+        notes.append(f"did not come back down: the nose ends {summary.end_nose_rise_m * 1000:.0f} mm above its "
                      "standing height (it went over onto its back), so a hop's nose rise after the one that "
                      "reared is its resting height, not a hop")
     if not lo <= asm.transmission_deg <= hi:
