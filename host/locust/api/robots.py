@@ -10,13 +10,14 @@ from ..io.robot_toml import load_robot
 from ..params import PRESETS, Robot, check_robot, preset
 
 
-def robot(preset_or_path: str | Path = "seed", **overrides: Any) -> Robot:
+def robot(preset_or_path: str | Path = "small", **overrides: Any) -> Robot:
     """The robot a simulation runs on: a preset or a robot TOML, with some values changed.
 
     Parameters
     ----------
-    preset_or_path : str, path-like or Robot, default "seed"
-        A preset name (``seed``, ``small``, ``medium``, ``large``, ``seed-notebook``), the
+    preset_or_path : str, path-like or Robot, default "small"
+        A preset name (``small``, the robot as built and the commands' default; ``medium``,
+        ``large``, its other leg sets; ``seed``, the notebook's design; ``seed-notebook``), the
         path of a robot TOML (``calibration/robot.toml``, ``locust params --write``), or a
         robot to change.
     **overrides
