@@ -33,13 +33,47 @@ MAX_BATCH_BYTES = 4 * 2**30
 
 
 def batch_bytes(model: mujoco.MjModel, n_models: int, nstep: int, keep_states: bool = True) -> int:
-    """Bytes of the record of ``n_models`` copies of ``model`` over ``nstep`` steps."""
+    """Bytes of the record of ``n_models`` copies of ``model`` over ``nstep`` steps.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The model: its sensor and full-physics state sizes.
+    n_models : int
+        Models in the batch.
+    nstep : int
+        Physics steps of each.
+    keep_states : bool
+        Whether every step's state is kept beside the sensors.
+
+    Returns
+    -------
+    int
+        The record's size [bytes], 8 a number.
+    """
     nstate = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
     return 8 * n_models * nstep * (model.nsensordata + (nstate if keep_states else 0))
 
 
 def check_batch(model: mujoco.MjModel, n_models: int, nstep: int, keep_states: bool = True) -> None:
-    """:class:`SimError` when the record would be over :data:`MAX_BATCH_BYTES`."""
+    """Refuse a batch whose record would be over :data:`MAX_BATCH_BYTES`.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The model: its sensor and full-physics state sizes.
+    n_models : int
+        Models in the batch.
+    nstep : int
+        Physics steps of each.
+    keep_states : bool
+        Whether every step's state is kept beside the sensors.
+
+    Raises
+    ------
+    SimError
+        The record would be over the limit; the hint names ``--cycles`` and ``--samples``.
+    """
     need = batch_bytes(model, n_models, nstep, keep_states)
     if need > MAX_BATCH_BYTES:
         raise SimError(f"{n_models} simulation(s) of {nstep:,} steps would keep {need / 2**30:.1f} GiB of states and "
@@ -49,7 +83,21 @@ def check_batch(model: mujoco.MjModel, n_models: int, nstep: int, keep_states: b
 
 
 def chunk_bounds(nstep: int, n_models: int) -> list[tuple[int, int]]:
-    """The ``[start, stop)`` steps of each rollout call for ``n_models`` over ``nstep`` steps."""
+    """The ``[start, stop)`` steps of each rollout call for ``n_models`` over ``nstep`` steps.
+
+    Parameters
+    ----------
+    nstep : int
+        Physics steps of the run.
+    n_models : int
+        Models in the batch.
+
+    Returns
+    -------
+    list of tuple of int
+        One ``(start, stop)`` per call, covering ``0 .. nstep``: one call for a short batch of
+        several models, else at most :data:`CHUNK_MODEL_STEPS` model-steps each.
+    """
     if n_models > 1 and n_models * nstep <= SPLIT_BATCH_MODEL_STEPS:
         return [(0, nstep)]
     size = max(1, CHUNK_MODEL_STEPS // n_models)
@@ -60,9 +108,33 @@ def rollout_chunked(models: list[mujoco.MjModel], datas: list[mujoco.MjData], in
                     control: np.ndarray, keep_states: bool
                     ) -> tuple[np.ndarray | None, np.ndarray, np.ndarray, dict[str, int]]:
     """``mujoco.rollout`` of ``models`` (one or many) from ``initial_state`` under ``control``
-    (models x steps x nu) in chunks (see the module doc): (states or None, sensordata, final
-    states, MuJoCo's warnings summed over the chunks and datas). Each call counts its warnings
-    afresh, so they are added up chunk by chunk."""
+    in chunks (see the module doc). Each call counts its warnings afresh, so they are added
+    up chunk by chunk.
+
+    Parameters
+    ----------
+    models : list of mujoco.MjModel
+        The models, all of one structure.
+    datas : list of mujoco.MjData
+        One ``MjData`` per thread.
+    initial_state : ndarray
+        ``(n_models, nstate)`` full-physics start states.
+    control : ndarray
+        ``(n_models, nstep, nu)`` actuator commands for every step [rad].
+    keep_states : bool
+        Whether every step's state is returned.
+
+    Returns
+    -------
+    states : ndarray or None
+        ``(n_models, nstep, nstate)`` the state after each step, or None without ``keep_states``.
+    sensordata : ndarray
+        ``(n_models, nstep, nsensordata)`` the sensors of each step.
+    final : ndarray
+        ``(n_models, nstate)`` the state after the last step.
+    warnings : dict of str to int
+        MuJoCo's warning name -> count, summed over the chunks and datas.
+    """
     n, nstep = control.shape[0], control.shape[1]
     model_arg = models if len(models) > 1 else models[0]
     data_arg = datas if len(datas) > 1 else datas[0]

@@ -51,7 +51,28 @@ INTEGRATORS = {
 
 @dataclass(frozen=True)
 class SensorLayout:
-    """Column slices of ``sensordata`` (one row per step in a rollout)."""
+    """Column slices of ``sensordata`` (one row per step in a rollout).
+
+    Each field is the slice of one sensor's columns; the sensors' values are in SI units.
+
+    Attributes
+    ----------
+    nose_pos, foot_pos, com_pos, chassis_pos : slice
+        World position (x, y, z) of the nose site, the left foot site (the knee point, the
+        linkage's lowest point), the whole robot's centre of mass and the chassis body [m].
+    loop_a, loop_b : dict of str to slice
+        Per side (``"L"``, ``"R"``), world position of the loop's anchor on the ground link
+        and on the leg's end [m]; they coincide when the loop is closed.
+    floor_contact : slice
+        1 when any part of the robot touches the floor, else 0.
+    energy_potential, energy_kinetic : slice
+        The whole model's potential and kinetic energy [J].
+    actuator_force : slice
+        Each servo actuator's torque, (L, R): the clamped controller's, without the joint's
+        back-EMF damping [N·m].
+    actuator_velocity : slice
+        Each servo's shaft speed, (L, R) [rad/s].
+    """
 
     nose_pos: slice
     foot_pos: slice          # left foot (knee point, the lowest point of the linkage)
@@ -68,6 +89,22 @@ class SensorLayout:
 
 @dataclass(frozen=True)
 class BuiltModel:
+    """The compiled MuJoCo model of one robot, with what is needed to run and read it.
+
+    Attributes
+    ----------
+    model : mujoco.MjModel
+        The compiled model.
+    assembly : Assembly
+        The linkage in the assembled pose every body was placed in.
+    sensors : SensorLayout
+        Where each sensor is in ``sensordata``.
+    servo_actuators : tuple of int
+        The servos' actuator ids, (L, R).
+    link_lengths_m : tuple of float
+        Ground, crank, coupler and leg lengths [m].
+    """
+
     model: mujoco.MjModel
     assembly: Assembly
     sensors: SensorLayout
@@ -82,7 +119,28 @@ def _quat_euler_deg(x: float, y: float, z: float) -> np.ndarray:
 
 
 def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
-    """The model as an ``MjSpec`` (raises ``GeometryError`` for a linkage that cannot close)."""
+    """The model as an ``MjSpec``, not yet compiled.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot's parameters; the servo acts on its supply (:func:`.servo.at_supply`).
+
+    Returns
+    -------
+    spec : mujoco.MjSpec
+        The model's specification.
+    assembly : Assembly
+        The linkage in the assembled pose the bodies are placed in.
+
+    Raises
+    ------
+    GeometryError
+        The link lengths make no four-bar, or its loop cannot close at
+        ``geometry.crank_start_deg``.
+    SimError
+        ``solver.integrator`` is not one of :data:`INTEGRATORS`.
+    """
     g, sol = robot.geometry, robot.solver
     s = at_supply(robot.servo, robot.power)   # the servo on this supply (docs/servo.md, "Power")
     asm = assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, g.crank_start_deg)
@@ -227,7 +285,18 @@ def contact_solref(contact) -> list[float]:
     """MuJoCo's ``solref`` (time constant, damping ratio) for a contact of ``timeconst_s`` whose
     bounce has the coefficient of restitution ``restitution``: a damped spring loses
     ``exp(-zeta*pi/sqrt(1 - zeta^2))`` of its speed in one half-cycle, solved for zeta
-    (restitution 0: critical damping, MuJoCo's default (0.02 s, 1))."""
+    (restitution 0: critical damping, MuJoCo's default (0.02 s, 1)).
+
+    Parameters
+    ----------
+    contact : Contact
+        Its ``timeconst_s`` [s] and ``restitution`` (0..1, dimensionless).
+
+    Returns
+    -------
+    list of float
+        ``[time constant [s], damping ratio]``.
+    """
     e = contact.restitution
     if e <= 0.0:
         return [contact.timeconst_s, 1.0]
@@ -377,14 +446,52 @@ def _layout(model: mujoco.MjModel) -> SensorLayout:
 
 
 def build(robot: Robot) -> BuiltModel:
-    """Compile the robot's model. Raises ``GeometryError`` or ``SimError`` with the reason."""
+    """Compile the robot's model.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot's parameters.
+
+    Returns
+    -------
+    BuiltModel
+        The compiled model and its sensor layout.
+
+    Raises
+    ------
+    GeometryError
+        The linkage cannot close.
+    SimError
+        An unknown integrator, or MuJoCo's compiler refused a value.
+    """
     spec, asm = build_spec(robot)
     return compile_spec(spec, asm, robot)
 
 
 def compile_spec(spec: mujoco.MjSpec, asm: Assembly, robot: Robot) -> BuiltModel:
     """Compile a spec of ``robot``'s model (:func:`build_spec`, perhaps with parts added: a
-    still's stickers, a hand holding the plate) into a :class:`BuiltModel`."""
+    still's stickers, a hand holding the plate) into a :class:`BuiltModel`.
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The specification, from :func:`build_spec`.
+    asm : Assembly
+        The assembly :func:`build_spec` returned with it.
+    robot : Robot
+        The robot it was built from (its link lengths).
+
+    Returns
+    -------
+    BuiltModel
+        The compiled model.
+
+    Raises
+    ------
+    SimError
+        MuJoCo's compiler refused a value.
+    """
     try:
         model = spec.compile()
     except ValueError as exc:  # MuJoCo's compiler reports bad values this way
@@ -396,7 +503,20 @@ def compile_spec(spec: mujoco.MjSpec, asm: Assembly, robot: Robot) -> BuiltModel
 
 
 def loop_closure_error_m(model: mujoco.MjModel, data: mujoco.MjData) -> float:
-    """Largest distance between the two anchors of any loop ``connect``, after ``mj_forward``."""
+    """Largest distance between the two anchors of any loop ``connect``, after ``mj_forward``.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        A model built here (its sites ``L_loop_a`` .. ``R_loop_b``).
+    data : mujoco.MjData
+        Its data, after ``mj_forward`` or a step.
+
+    Returns
+    -------
+    float
+        The larger of the two sides' anchor distances [m].
+    """
     worst = 0.0
     for side in SIDES:
         a = data.site(f"{side}_loop_a").xpos

@@ -26,6 +26,25 @@ class Trajectory:
 
     Sensor row i is evaluated in step i's forward pass, at t = i·dt before that step
     integrates (as ``mujoco.rollout`` records it); state row i is the state after step i.
+
+    Attributes
+    ----------
+    built : BuiltModel
+        The model simulated; its ``sensors`` name the columns of ``sensordata``.
+    plan : ControlPlan
+        The servo command of every step.
+    initial_sensordata : ndarray
+        ``(nsensordata,)`` sensors after ``mj_forward`` at t = 0 (SI units: m, J, N·m, rad/s).
+    sensordata : ndarray
+        ``(nstep, nsensordata)`` sensors of every step (SI units).
+    final_qpos : ndarray
+        ``(nq,)`` joint positions after the last step (free joint: m and quaternion; hinges: rad).
+    warnings : dict of str to int
+        MuJoCo's warning name -> count over the run.
+    wall_s : float
+        Wall-clock time of the rollout call [s] (of the whole batch it ran in).
+    states : ndarray or None
+        ``(nstep, nstate)`` full-physics states, kept on request (video, traces).
     """
 
     built: BuiltModel
@@ -39,14 +58,33 @@ class Trajectory:
 
     @property
     def timestep_s(self) -> float:
+        """The physics step of the run [s]."""
         return self.plan.timestep_s
 
     def column(self, s: slice) -> np.ndarray:
+        """Columns ``s`` of the sensor record (a slice of :class:`SensorLayout`).
+
+        Parameters
+        ----------
+        s : slice
+            The columns, e.g. ``traj.built.sensors.nose_pos``.
+
+        Returns
+        -------
+        ndarray
+            ``(nstep, width)`` a view of those sensors at every step.
+        """
         return self.sensordata[:, s]
 
 
 def available_cores() -> int:
-    """The cores this process may run on (its CPU affinity), at least 1."""
+    """The cores this process may run on (its CPU affinity), at least 1.
+
+    Returns
+    -------
+    int
+        The number of cores.
+    """
     try:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:
@@ -58,7 +96,26 @@ def rollout_threads(models: list[mujoco.MjModel], initial_state: np.ndarray, con
     """One ``mujoco.rollout`` call over ``models`` (one per row of ``initial_state`` and
     ``control``) on ``threads`` threads (default: every core), none more than there are models.
 
-    Returns (state, sensordata, the MjData of each thread: their warnings)."""
+    Parameters
+    ----------
+    models : list of mujoco.MjModel
+        The models, all of one structure.
+    initial_state : ndarray
+        ``(n_models, nstate)`` full-physics start states.
+    control : ndarray
+        ``(n_models, nstep, nu)`` actuator commands for every step [rad].
+    threads : int, optional
+        Threads to run on.
+
+    Returns
+    -------
+    state : ndarray
+        ``(n_models, nstep, nstate)`` the state after each step.
+    sensordata : ndarray
+        ``(n_models, nstep, nsensordata)`` the sensors of each step.
+    datas : list of mujoco.MjData
+        The ``MjData`` of each thread (their warnings).
+    """
     n = max(1, min(threads or available_cores(), len(models)))
     datas = [mujoco.MjData(models[0]) for _ in range(n)]
     state, sensordata = mj_rollout.rollout(models if len(models) > 1 else models[0],
@@ -67,6 +124,20 @@ def rollout_threads(models: list[mujoco.MjModel], initial_state: np.ndarray, con
 
 
 def initial_state(built: BuiltModel) -> tuple[np.ndarray, np.ndarray]:
+    """The model's state and sensors at t = 0, after ``mj_forward`` in the assembled pose.
+
+    Parameters
+    ----------
+    built : BuiltModel
+        The model.
+
+    Returns
+    -------
+    state : ndarray
+        ``(nstate,)`` the full-physics state (``mjSTATE_FULLPHYSICS``).
+    sensordata : ndarray
+        ``(nsensordata,)`` the sensors (SI units).
+    """
     model = built.model
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
@@ -78,7 +149,33 @@ def initial_state(built: BuiltModel) -> tuple[np.ndarray, np.ndarray]:
 
 def roll_out(robot: Robot, cycles: int | None = None, timestep_s: float | None = None,
              built: BuiltModel | None = None, keep_states: bool = False) -> Trajectory:
-    """Simulate settle + ``cycles`` hop cycles; the model is built unless given."""
+    """Simulate settle + ``cycles`` hop cycles; the model is built unless given.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot and its hop schedule.
+    cycles : int, optional
+        Hop cycles instead of the schedule's.
+    timestep_s : float, optional
+        Physics step instead of the solver's [s].
+    built : BuiltModel, optional
+        ``robot``'s model, already built.
+    keep_states : bool
+        Keep every step's state in the trajectory (video, traces).
+
+    Returns
+    -------
+    Trajectory
+        The raw record, not yet audited.
+
+    Raises
+    ------
+    ParamsError
+        ``robot`` is outside the parameter limits or its run too long.
+    GeometryError, SimError
+        The model cannot be built, or its record would be over the memory limit.
+    """
     if timestep_s is not None:
         robot = robot.with_values({"solver.timestep_s": timestep_s})
     check_robot(robot, cycles)  # before any allocation
@@ -88,6 +185,27 @@ def roll_out(robot: Robot, cycles: int | None = None, timestep_s: float | None =
 
 
 def simulate_built(built: BuiltModel, plan: ControlPlan, keep_states: bool = False) -> Trajectory:
+    """One built model run on ``plan`` (:func:`simulate_batch` of one).
+
+    Parameters
+    ----------
+    built : BuiltModel
+        The model.
+    plan : ControlPlan
+        The servo command of every step.
+    keep_states : bool
+        Keep every step's state in the trajectory.
+
+    Returns
+    -------
+    Trajectory
+        The raw record, not yet audited.
+
+    Raises
+    ------
+    SimError
+        The record would be over the memory limit.
+    """
     return simulate_batch([built], plan, keep_states=keep_states)[0]
 
 
@@ -96,7 +214,29 @@ def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: boo
     """Several models of one structure (a fit's candidates, draws of the uncertain values) on
     one plan, in one ``mujoco.rollout`` call on ``threads`` threads (default: every core).
     MuJoCo counts its warnings per thread, not per model: when a batch raised any, each model
-    is run again alone, so that every trajectory carries its own warnings for the audit."""
+    is run again alone, so that every trajectory carries its own warnings for the audit.
+
+    Parameters
+    ----------
+    builts : list of BuiltModel
+        The models, all of one structure.
+    plan : ControlPlan
+        The servo command of every step, the same for all.
+    keep_states : bool
+        Keep every step's state in the trajectories.
+    threads : int, optional
+        Threads to run on.
+
+    Returns
+    -------
+    list of Trajectory
+        One raw record per model, in order, not yet audited.
+
+    Raises
+    ------
+    SimError
+        The batch's record would be over the memory limit.
+    """
     models = [b.model for b in builts]
     starts = [initial_state(b) for b in builts]
     control = np.zeros((len(models), plan.nstep, models[0].nu))

@@ -35,7 +35,32 @@ MIN_FRACTION = 0.1      # a positive value's draws are kept above this fraction 
 
 @dataclass(frozen=True)
 class Samples:
-    """The spread of ``n`` draws; figures over the valid ones (nan when fewer than two)."""
+    """The spread of ``n`` draws; figures over the valid ones (nan when fewer than two).
+
+    Attributes
+    ----------
+    n : int
+        Draws simulated.
+    n_valid : int
+        Draws that were built and passed their audit.
+    seed : int
+        The random generator's seed.
+    uncertain : dict of str to float
+        Robot-file key -> the standard deviation it was drawn with (in the key's own unit).
+    distance_m : list of float
+        Chassis x travelled from the start of the schedule to the end of the run, per draw
+        (nan: invalid) [m].
+    max_nose_height_m : list of float
+        Highest nose point during the run, per draw (nan: invalid) [m].
+    distance_m_mean, distance_m_sd : float
+        Mean and sample standard deviation of the valid draws' distances [m].
+    max_nose_height_m_mean, max_nose_height_m_sd : float
+        Mean and sample standard deviation of the valid draws' nose heights [m].
+    outcome : list of str or None
+        Each draw's outcome (:func:`~locust.sim.outcome.classify`; None: invalid).
+    outcomes : dict of str to OutcomeFigures
+        Each outcome's share of the valid draws and its own figures.
+    """
 
     n: int
     n_valid: int
@@ -51,11 +76,29 @@ class Samples:
     outcomes: dict[str, OutcomeFigures] = dataclasses.field(default_factory=dict)
 
     def to_json(self) -> dict:
+        """Every field as plain JSON-ready values (nested dataclasses as dicts).
+
+        Returns
+        -------
+        dict
+            Field name -> value, units as the field names say.
+        """
         return dataclasses.asdict(self)
 
 
 def uncertain_values(robot: Robot) -> dict[str, float]:
-    """Real-valued keys whose provenance gives a positive, finite uncertainty -> that uncertainty."""
+    """Real-valued keys whose provenance gives a positive, finite uncertainty -> that uncertainty.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot, its values and their provenance.
+
+    Returns
+    -------
+    dict of str to float
+        Key -> one standard deviation, in the key's own unit (keys with a finite value only).
+    """
     out = {}
     for key in real_keys():
         sd = robot.source_of(key).uncertainty
@@ -65,7 +108,22 @@ def uncertain_values(robot: Robot) -> dict[str, float]:
 
 
 def draw(robot: Robot, n: int, seed: int = 0) -> list[Robot]:
-    """``n`` robots with every uncertain value drawn about its own (see the module docstring)."""
+    """``n`` robots with every uncertain value drawn about its own (see the module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot whose uncertain values are drawn.
+    n : int
+        Draws.
+    seed : int
+        Seed of NumPy's default generator.
+
+    Returns
+    -------
+    list of Robot
+        The draws, each value's provenance ``sample``; values without uncertainty unchanged.
+    """
     sds = uncertain_values(robot)
     rng = np.random.default_rng(seed)
     keys = list(sds)
@@ -78,7 +136,31 @@ def draw(robot: Robot, n: int, seed: int = 0) -> list[Robot]:
 
 def check_draws(robot: Robot, n: int, cycles: int | None = None, keep_states: bool = False):
     """The plan of ``n`` draws of ``robot``; refused (:class:`~locust.errors.SimError`) before
-    any is drawn, built or run when their record would be over the batch's memory limit."""
+    any is drawn, built or run when their record would be over the batch's memory limit.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot at its own values.
+    n : int
+        Draws.
+    cycles : int, optional
+        Hop cycles instead of the schedule's.
+    keep_states : bool
+        Whether every step's state would be kept.
+
+    Returns
+    -------
+    ControlPlan
+        The servo command of every step, shared by all draws.
+
+    Raises
+    ------
+    ParamsError
+        ``robot`` is outside the parameter limits or its run too long.
+    GeometryError, SimError
+        ``robot``'s model cannot be built, or the draws' record would be over the memory limit.
+    """
     check_robot(robot, cycles)
     plan = control_plan(robot.schedule, robot.solver, cycles)
     check_batch(build(robot).model, n, plan.nstep, keep_states)
@@ -93,7 +175,33 @@ def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 
     or that fails its audit (as a sweep's design would be an invalid row).
 
     With ``progress``, the draws go in batches of :data:`BATCH_PER_CORE` per core, and
-    ``progress(k)`` is called as each batch of ``k`` draws is done (one call otherwise)."""
+    ``progress(k)`` is called as each batch of ``k`` draws is done (one call otherwise).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot at its own values.
+    n : int
+        Draws.
+    cycles : int, optional
+        Hop cycles instead of the schedule's.
+    seed : int
+        Seed of the draws (:func:`draw`).
+    keep_states : bool
+        Keep every step's state in the trajectories.
+    progress : callable, optional
+        Called with the number of draws just done (invalid ones first, in one call).
+
+    Returns
+    -------
+    list of Trajectory or None
+        One per draw, in order.
+
+    Raises
+    ------
+    ParamsError, GeometryError, SimError
+        As :func:`check_draws`, before anything is drawn.
+    """
     plan = check_draws(robot, n, cycles, keep_states)
     builts = []
     for r in draw(robot, n, seed):
@@ -120,7 +228,31 @@ def simulate_draws(robot: Robot, n: int, cycles: int | None = None, seed: int = 
 
 def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0,
            progress: Callable[[int], None] | None = None) -> Samples:
-    """Simulate ``n`` draws of ``robot`` in one batch; their distances and nose heights."""
+    """Simulate ``n`` draws of ``robot`` in one batch; their distances and nose heights.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot at its own values.
+    n : int
+        Draws.
+    cycles : int, optional
+        Hop cycles instead of the schedule's.
+    seed : int
+        Seed of the draws (:func:`draw`).
+    progress : callable, optional
+        As :func:`simulate_draws`.
+
+    Returns
+    -------
+    Samples
+        Each draw's figures and outcome, and their spread over the valid ones.
+
+    Raises
+    ------
+    ParamsError, GeometryError, SimError
+        As :func:`check_draws`, before anything is drawn.
+    """
     dist, nose, kind = [], [], []
     for traj in simulate_draws(robot, n, cycles, seed, progress=progress):
         summary = summarise(traj) if traj is not None else None

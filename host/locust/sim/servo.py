@@ -48,7 +48,21 @@ SERVOS_ON_SUPPLY = 2   # both legs' servos share the supply (and its resistance)
 
 def at_supply(servo: Servo, power: Power) -> Servo:
     """``servo`` as it acts on ``power``'s supply: stall torque, no-load speed and holding
-    gain scaled from its reference voltage to the voltage its terminals see (module docstring)."""
+    gain scaled from its reference voltage to the voltage its terminals see (module docstring).
+
+    Parameters
+    ----------
+    servo : Servo
+        The servo as identified at ``reference_voltage_v`` [V] on its terminals.
+    power : Power
+        The supply: its voltage [V] and source resistance [ohm], shared by both servos.
+
+    Returns
+    -------
+    Servo
+        ``servo`` itself when the supply changes nothing; else a copy with stall torque [N·m],
+        no-load speed [rad/s], ``kp`` [N·m/rad] and ``kv`` [N·m·s/rad] scaled.
+    """
     volts = power.supply_voltage_v / servo.reference_voltage_v
     sag = servo.winding_resistance_ohm / (servo.winding_resistance_ohm
                                           + SERVOS_ON_SUPPLY * power.source_resistance_ohm)
@@ -62,7 +76,18 @@ def at_supply(servo: Servo, power: Power) -> Servo:
 
 
 def back_emf_damping_nms_per_rad(servo: Servo) -> float:
-    """``b = stall / no-load speed``; 0 for a servo with no speed limit (``inf``)."""
+    """``b = stall / no-load speed``; 0 for a servo with no speed limit (``inf``).
+
+    Parameters
+    ----------
+    servo : Servo
+        Its stall torque [N·m] and no-load speed [rad/s].
+
+    Returns
+    -------
+    float
+        The back-EMF damping at the output shaft [N·m·s/rad].
+    """
     if math.isinf(servo.noload_speed_rad_per_s):
         return 0.0
     return servo.stall_torque_nm / servo.noload_speed_rad_per_s
@@ -70,8 +95,23 @@ def back_emf_damping_nms_per_rad(servo: Servo) -> float:
 
 def configure(joint: mujoco.MjsJoint, actuator: mujoco.MjsActuator, servo: Servo,
               joint_damping_nms_per_rad: float = 0.0) -> None:
-    """Make ``actuator`` (on ``joint``) the servo; ``joint_damping`` is the joint's own
-    (a flexure hinge in parallel with the servo), added to the servo's."""
+    """Make ``actuator`` (on ``joint``) the servo, in place on the spec.
+
+    Sets the joint's linear damping and armature and the actuator's position gains and
+    force range (the clamp at the stall torque).
+
+    Parameters
+    ----------
+    joint : mujoco.MjsJoint
+        The servo's hinge joint.
+    actuator : mujoco.MjsActuator
+        The actuator on ``joint``.
+    servo : Servo
+        The servo's figures (on the supply: :func:`at_supply`).
+    joint_damping_nms_per_rad : float
+        The joint's own damping (a flexure hinge in parallel with the servo), added to the
+        servo's back-EMF damping [N·m·s/rad].
+    """
     damping = list(joint.damping)   # [linear, higher-order terms]
     damping[0] = joint_damping_nms_per_rad + back_emf_damping_nms_per_rad(servo)
     joint.damping = damping
@@ -86,7 +126,27 @@ def with_servo(model: mujoco.MjModel, servo: Servo, joint_damping_nms_per_rad: f
                dof: int = 0, actuator: int = 0, scratch: mujoco.MjData | None = None) -> mujoco.MjModel:
     """A copy of a compiled ``model`` whose servo (``actuator`` on ``dof``) is ``servo``:
     the same numbers :func:`configure` gives, without recompiling (for batched fits).
-    ``scratch``: an ``MjData`` of ``model`` to work in (making one costs 4 times the rest)."""
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The compiled model; left unchanged.
+    servo : Servo
+        The servo's figures.
+    joint_damping_nms_per_rad : float
+        The joint's own damping, added to the servo's [N·m·s/rad].
+    dof : int
+        The servo joint's degree of freedom.
+    actuator : int
+        The servo's actuator id.
+    scratch : mujoco.MjData, optional
+        An ``MjData`` of ``model`` to work in (making one costs 4 times the rest).
+
+    Returns
+    -------
+    mujoco.MjModel
+        The copy, its constant mass-matrix terms recomputed for the new armature.
+    """
     m = copy.copy(model)
     kp, kv = servo.kp_nm_per_rad, servo.kv_nms_per_rad
     m.actuator_gainprm[actuator, 0] = kp
