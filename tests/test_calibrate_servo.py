@@ -300,7 +300,7 @@ JOINT_CASES = {
 
 def joint_fit_coverage(case: str, seeds: int) -> dict[str, int]:
     """SYNTHETIC: over ``seeds`` draws of both recordings, how often each 95 % interval (servo
-    values and the gyro's gain) covers the truth; each value within 5 % of it every time."""
+    values and the gyro's gain) covers the truth; each value within 10 % of it (kv 40 %)."""
     true, gyro, kv = JOINT_CASES[case]
     angle = dataclasses.replace(S.ServoTruth(), servo=true)
     names = ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad") + ("kv_nms_per_rad",) * (kv is None)
@@ -315,8 +315,9 @@ def joint_fit_coverage(case: str, seeds: int) -> dict[str, int]:
         checks = [(name, fit.estimates[name], getattr(true, name)) for name in names]
         checks.append(("gyro gain", fit.gains[1], gyro.gain_units_per_rad_per_s))
         for name, est, truth in checks:
-            if name != "kv_nms_per_rad":   # kv's own spread is 7 %
-                assert est.value == pytest.approx(truth, rel=0.05), (case, seed, name)
+            # about five standard deviations (armature 1.9 %, kv 7 % on the command line's draw):
+            # an interval made wide enough to cover anything still has its value near the truth
+            assert est.value == pytest.approx(truth, rel=0.4 if name == "kv_nms_per_rad" else 0.1), (case, seed, name)
             covered[name] += est.ci95_low <= truth <= est.ci95_high
     return covered
 
@@ -324,11 +325,12 @@ def joint_fit_coverage(case: str, seeds: int) -> dict[str, int]:
 @pytest.mark.slow
 @pytest.mark.parametrize("case", list(JOINT_CASES))
 def test_joint_fit_intervals_cover_over_seeds(case):
-    """150 draws a case (one fit is about 8 s of CPU: 20 minutes a case, too dear for the
-    default run, where the command line's test checks each value to about four of its standard
-    deviations): each of the four or five intervals covers at least coverage_floor(150,
-    intervals=5) = 132 times, which true 95 % intervals all reach with probability 0.999 and
-    an 80 % one reaches 0.7 % of the time."""
+    """150 draws a case (a fit is 3.4 s of CPU with kv held, 6.5 s with kv fitted: 8 and 16
+    minutes, too dear for the default run, where the command line's test checks each value to
+    about four of its standard deviations): each of the four or five intervals covers at least
+    coverage_floor(150, intervals=5) = 132 times, which true 95 % intervals all reach with
+    probability 0.999 and an 80 % one reaches 0.7 % of the time. Measured with kv fitted:
+    145, 150, 137, 143 and 148 of 150 (no-load speed, armature, kp, kv, gyro gain)."""
     covered = joint_fit_coverage(case, 150)
     assert min(covered.values()) >= coverage_floor(150, intervals=len(covered)), covered
 
