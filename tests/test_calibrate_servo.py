@@ -323,6 +323,7 @@ def joint_fit_coverage(case: str, seeds: int) -> dict[str, int]:
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(3600)   # 150 fits: 8 to 16 minutes of CPU, more on a shared machine
 @pytest.mark.parametrize("case", list(JOINT_CASES))
 def test_joint_fit_intervals_cover_over_seeds(case):
     """150 draws a case (a fit is 3.4 s of CPU with kv held, 6.5 s with kv fitted: 8 and 16
