@@ -27,6 +27,7 @@ from locust.fab.dxf_read import MAX_ARC_SEGMENTS
 from locust.io import run_record as R
 from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
 from probing import assert_clear_error, assert_refused_and_unchanged, invoke, tree
+from waiting import wait_for
 
 LOCUST = [sys.executable, "-m", "locust.commands"]
 
@@ -349,17 +350,12 @@ def test_kill_9_of_a_sweep_leaves_no_worker_and_no_lock_and_resumes(tmp_path):
     args = LOCUST + ["sweep", "--vary", "scale=0:0.03:40", "--cycles", "1", "--jobs", "2", "--out", "sw"]
     proc = subprocess.Popen(args, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     results = tmp_path / "sw" / "results.csv"
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        if results.exists() and len(results.read_text().splitlines()) >= 3:
-            break
-        time.sleep(0.1)
+    wait_for(lambda: len(results.read_text().splitlines()) >= 3, 60, "two rows in the sweep's results.csv")
     workers = _children(proc.pid)
     assert workers, "the sweep had no worker processes"
     proc.kill()
     proc.wait()
-    time.sleep(1.0)
-    assert not [w for w in workers if _alive(w)], "workers outlived the sweep"
+    wait_for(lambda: not [w for w in workers if _alive(w)], 10, "the workers to end with the killed sweep")
     done = len(results.read_text().splitlines()) - 1
     assert 2 <= done < 40
     again = subprocess.run(args, cwd=tmp_path, capture_output=True, text=True, timeout=120)
@@ -371,11 +367,7 @@ def test_kill_9_of_a_sweep_leaves_no_worker_and_no_lock_and_resumes(tmp_path):
 
 def _wait_for_the_first_phase(run: Path, timeout_s: float = 60.0) -> Path:
     """``run`` (a run.json) once it records a phase: the hop is under way."""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if run.exists() and '"phase"' in run.read_text():
-            break
-        time.sleep(0.1)
+    wait_for(lambda: '"phase"' in run.read_text(), timeout_s, f"a phase recorded in {run}")
     return run
 
 
@@ -390,10 +382,7 @@ def test_a_killed_hop_leaves_no_interpreter_running(env, tmp_path, sig):
     assert len(interpreters) == 1
     proc.send_signal(sig)
     _, stderr = proc.communicate(timeout=30)
-    deadline = time.monotonic() + 5
-    while time.monotonic() < deadline and _alive(interpreters[0]):
-        time.sleep(0.1)
-    assert not _alive(interpreters[0]), "the MicroPython interpreter outlived the host"
+    wait_for(lambda: not _alive(interpreters[0]), 5, "the MicroPython interpreter to end with the host")
     rec = json.loads(run.read_text())
     assert rec["status"] in ("incomplete", "running")
     if sig == signal.SIGTERM:
@@ -450,7 +439,8 @@ def test_ctrl_c_during_a_filmed_hop_finishes_the_video_and_says_so(env, tmp_path
                             cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     run = _wait_for_the_first_phase(tmp_path / "run" / "run.json")
-    time.sleep(0.5)
+    # a phase filmed in full (the video's frames follow the simulation), so the video has frames
+    wait_for(lambda: len(json.loads(run.read_text())["phases"]) >= 2, 60, "two phases in run.json")
     proc.send_signal(signal.SIGINT)
     _, stderr = proc.communicate(timeout=120)
     assert proc.returncode == 2 and "interrupted" in stderr and "hint:" in stderr and "Traceback" not in stderr
@@ -926,9 +916,8 @@ def test_a_signal_ends_a_long_simulation_within_two_seconds(tmp_path, sig):
     proc = subprocess.Popen(LOCUST + ["sim", "--cycles", "1000"], cwd=tmp_path, stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and proc.poll() is None and _cpu_s(proc.pid) < 4.0:
-        time.sleep(0.05)   # polling the CPU time it has used: past the imports and the build, into the rollout
+    # the CPU time it has used: past the imports and the build, into the rollout
+    wait_for(lambda: proc.poll() is not None or _cpu_s(proc.pid) >= 4.0, 60, "4 s of CPU in the simulation")
     assert proc.poll() is None, proc.stderr.read()
     t0 = time.monotonic()
     proc.send_signal(sig)

@@ -260,15 +260,14 @@ COVERAGE_PAIRS = (("small", "medium"), ("medium", "large"), ("small", "large"))
 def test_hidden_truths_over_leg_set_pairs(i, pair):
     """Three hidden truths x three leg-set pairs (Medium in two), each run two cycles of its own
     noise (SYNTHETIC filmings), three values fitted (one fit per test: 50-310 s each). Every
-    value within 5 % of the truth, or its interval covers it and is narrower than +-20 %
-    (issue 24's acceptance). The intervals here carry no held values' part (the seed's values
-    are exact): on truth 0, 6 of the 9 cover, the misses 0.01-2.2 % off (docs/calibrate.md)."""
+    value within 5 % of the truth (issue 24's acceptance; on truth 0 within 2.2 %), whether or
+    not its interval covers it: the intervals here carry no held values' part (the seed's
+    values are exact) and on truth 0 only 6 of the 9 cover, the misses 0.01-2.2 % off
+    (docs/calibrate.md), so one fit's coverage is not asserted."""
     truth = COVERAGE_TRUTHS[i]
     j = COVERAGE_PAIRS.index(pair)
     runs = [synthetic_run(name, truth, cycles=2, seed=10 * i + 3 * j + k) for k, name in enumerate(pair)]
     fit = H.fit_hops(runs, list(truth), max_iter=20, grid_stages=2)
     for key, value in truth.items():
         est = fit.estimates[key]
-        cover = est.ci95_low <= value <= est.ci95_high
-        near = abs(est.value - value) <= 0.05 * value
-        assert near or (cover and est.ci95_high - est.ci95_low < 0.4 * value), (key, value, est)
+        assert abs(est.value - value) <= 0.05 * value, (key, value, est)

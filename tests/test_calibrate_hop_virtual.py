@@ -60,9 +60,10 @@ def test_fit_recovers_the_hidden_values(fitted):
     for key, truth in HIDDEN.items():
         p = params[key]
         lo, hi = p["ci95"]
-        within = abs(p["value"] - truth) <= 0.05 * truth
-        covered = lo is not None and lo <= truth <= hi and (hi - lo) / 2 < 0.20 * truth
-        assert within or covered, (key, p)
+        # each on its own: within 5 % (docs/calibrate.md: within 3 % on three truths), and an
+        # interval that covers the truth (with the held values' part, as wide as +-22 %)
+        assert abs(p["value"] - truth) <= 0.05 * truth, (key, p)
+        assert lo is not None and lo <= truth <= hi, (key, p)
         # the intervals include the time step's part
         assert 0 < p["std_numerical"] <= p["std"], (key, p)
         # and the uncertainties of the values held fixed (the preset's SG90 fit, its stall torque)

@@ -13,6 +13,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from binomial import coverage_floor
 from locust.calibrate import servo as SV
 from locust.calibrate import synthetic as S
 from locust.calibrate.gyro_log import looks_like_gyro_log, parse_gyro_log, read_gyro_log
@@ -23,6 +24,7 @@ from locust.progress import Progress
 
 SG90 = S.ServoTruth().servo   # the synthetic recordings' SG90 (the AA swing's fit alone)
 PRESET = Servo()              # the presets' SG90: the AA swing and the gyro steps together
+KV_FITTED = dataclasses.replace(PRESET, kp_nm_per_rad=0.5, kv_nms_per_rad=0.004)   # a servo with kv
 
 
 def recording(truth: S.ServoTruth, seed: int) -> SV.StepRecording:
@@ -255,7 +257,7 @@ def test_cli_fits_angle_and_gyro_together_and_validates(tmp_path):
 
     from locust.commands.calibrate import calibrate
 
-    true = dataclasses.replace(PRESET, kp_nm_per_rad=0.5, kv_nms_per_rad=0.004)
+    true = KV_FITTED
     angle = dataclasses.replace(S.ServoTruth(), servo=true)
     t, a, c = S.servo_step(angle, np.random.default_rng(21))
     (tmp_path / "angle.csv").write_text("t_s,angle_deg,command_deg\n"
@@ -270,12 +272,15 @@ def test_cli_fits_angle_and_gyro_together_and_validates(tmp_path):
     assert result.exit_code == 0, result.output
     out = json.loads(result.stdout)
     assert out["kind"] == ["angle", "rate"]
-    for name in ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "kv_nms_per_rad"):
+    # each value near the truth: about four of the fit's standard deviations on these recordings
+    # (0.2, 1.9, 1.4, 7 and 0.3 %); whether such intervals cover is test_joint_fit_intervals_cover_over_seeds's
+    for name, rel in (("noload_speed_rad_per_s", 0.01), ("armature_kgm2", 0.08), ("kp_nm_per_rad", 0.06),
+                      ("kv_nms_per_rad", 0.3)):
         est = out[name]
         assert est["identifiable"], (name, out["notes"])
-        assert est["ci95"][0] <= getattr(true, name) <= est["ci95"][1], name
+        assert est["value"] == pytest.approx(getattr(true, name), rel=rel), name
     gain = out["gyro_gain_units_per_rad_per_s"][1]
-    assert gain["ci95"][0] <= gyro.gain_units_per_rad_per_s <= gain["ci95"][1]
+    assert gain["value"] == pytest.approx(gyro.gain_units_per_rad_per_s, rel=0.01)
     (val,) = out["validation"]
     assert val["source"].endswith("unseen.txt") and val["rms_unit"] == "rad/s"
     assert [s["step_deg"] for s in val["steps"]] == [20.0, -20.0, 60.0, -60.0]
@@ -285,29 +290,50 @@ def test_cli_fits_angle_and_gyro_together_and_validates(tmp_path):
     assert (tmp_path / "fit.png").is_file() and (tmp_path / "fit-validate.png").is_file()
 
 
-@pytest.mark.slow
-def test_joint_fit_intervals_cover_the_truth():
-    """SYNTHETIC, 10 seeds: an angle recording and a gyro log of one servo (kv held at 0, the
-    presets' structure); the 95% intervals of no-load speed, armature, kp and the gyro gain
-    (40 in all) cover the truth at least 36 times (binomial at 95%: 36 or more 95% of the time)."""
-    covered, total = 0, 0
-    for seed in range(10):
+# the two joint fits of an angle recording and a gyro log: the presets' structure (kv held at 0)
+# and the command line's test above (kv fitted, a stiffer kp)
+JOINT_CASES = {
+    "kv held": (PRESET, S.GyroTruth(servo=PRESET), 0.0),
+    "kv fitted": (KV_FITTED, S.GyroTruth(servo=KV_FITTED, steps_deg=(10.0, 30.0, 90.0)), None),
+}
+
+
+def joint_fit_coverage(case: str, seeds: int) -> dict[str, int]:
+    """SYNTHETIC: over ``seeds`` draws of both recordings, how often each 95 % interval (servo
+    values and the gyro's gain) covers the truth; each value within 10 % of it (kv 40 %)."""
+    true, gyro, kv = JOINT_CASES[case]
+    angle = dataclasses.replace(S.ServoTruth(), servo=true)
+    names = ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad") + ("kv_nms_per_rad",) * (kv is None)
+    covered = dict.fromkeys((*names, "gyro gain"), 0)
+    for seed in range(seeds):
         rng = np.random.default_rng(100 + seed)
-        angle = dataclasses.replace(S.ServoTruth(), servo=PRESET)
         t, a, c = S.servo_step(angle, rng)
-        gyro = S.GyroTruth(servo=PRESET)
         tg, cg, g = S.gyro_steps(gyro, rng)
         fit = SV.fit_servo([SV.StepRecording(t, a, c, SV.ServoRig(angle.inertia_kgm2)),
                             SV.RateRecording(tg, g, cg, SV.ServoRig(gyro.inertia_kgm2))],
-                           stall_torque_nm=0.15, kv_nms_per_rad=0.0)
-        checks = [(fit.estimates[n], getattr(PRESET, n)) for n in ("noload_speed_rad_per_s", "armature_kgm2",
-                                                                  "kp_nm_per_rad")]
-        checks.append((fit.gains[1], gyro.gain_units_per_rad_per_s))
-        for est, true in checks:
-            assert est.value == pytest.approx(true, rel=0.05)
-            covered += est.ci95_low <= true <= est.ci95_high
-            total += 1
-    assert covered >= 36, f"{covered}/{total}"
+                           stall_torque_nm=0.15, kv_nms_per_rad=kv)
+        checks = [(name, fit.estimates[name], getattr(true, name)) for name in names]
+        checks.append(("gyro gain", fit.gains[1], gyro.gain_units_per_rad_per_s))
+        for name, est, truth in checks:
+            # about five standard deviations (armature 1.9 %, kv 7 % on the command line's draw):
+            # an interval made wide enough to cover anything still has its value near the truth
+            assert est.value == pytest.approx(truth, rel=0.4 if name == "kv_nms_per_rad" else 0.1), (case, seed, name)
+            covered[name] += est.ci95_low <= truth <= est.ci95_high
+    return covered
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(3600)   # 150 fits: 8 to 16 minutes of CPU, more on a shared machine
+@pytest.mark.parametrize("case", list(JOINT_CASES))
+def test_joint_fit_intervals_cover_over_seeds(case):
+    """150 draws a case (a fit is 3.4 s of CPU with kv held, 6.5 s with kv fitted: 8 and 16
+    minutes, too dear for the default run, where the command line's test checks each value to
+    about four of its standard deviations): each of the four or five intervals covers at least
+    coverage_floor(150, intervals=5) = 132 times, which true 95 % intervals all reach with
+    probability 0.999 and an 80 % one reaches 0.7 % of the time. Measured with kv fitted:
+    145, 150, 137, 143 and 148 of 150 (no-load speed, armature, kp, kv, gyro gain)."""
+    covered = joint_fit_coverage(case, 150)
+    assert min(covered.values()) >= coverage_floor(150, intervals=len(covered)), covered
 
 
 # -- the two real SG90 recordings together --------------------------------------------

@@ -12,10 +12,13 @@ from pathlib import Path
 import pytest
 import serial
 
+from locust.device.link import Link
 from locust.firmware import protocol as P
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "firmware"))
 from lcg import Lcg
+
+from waiting import wait_for
 
 LOCUST = [sys.executable, "-m", "locust.commands"]
 
@@ -75,11 +78,11 @@ def test_locust_virtual_prints_each_hop_as_it_goes(env, tmp_path):
         reader.start()
         hop = _run(["hop", "--port", device, "--preset", "seed", "--cycles", "2", "--out", str(tmp_path / "run")], env)
         assert hop.returncode == 0, hop.stderr
-        deadline = time.monotonic() + 30
-        rows = []
-        while time.monotonic() < deadline and len(rows) < 2:
+        def printed_rows():
             rows = [ln.split() for ln in list(lines) if ln.split()[:1] in (["1"], ["2"])]
-            time.sleep(0.1)
+            return rows if len(rows) >= 2 else None
+
+        rows = wait_for(printed_rows, 30, "two rows printed", poll_s=0.1)
         assert proc.poll() is None               # still running: printed as it goes
         assert [r[0] for r in rows] == ["1", "2"], lines
     finally:
@@ -109,14 +112,7 @@ def test_ctrl_c_keeps_an_incomplete_record(env, tmp_path):
     out = tmp_path / "D"
     proc = subprocess.Popen(LOCUST + ["hop", "--port", "sim", "--cycles", "6", "--plant", "record", "--out", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
-    deadline = time.monotonic() + 30
-    phases = 0
-    while phases < 3 and time.monotonic() < deadline:
-        time.sleep(0.05)
-        try:
-            phases = len(json.loads((out / "run.json").read_text())["phases"])
-        except (OSError, ValueError):
-            pass
+    wait_for(lambda: len(json.loads((out / "run.json").read_text())["phases"]) >= 3, 30, "three phases in run.json")
     proc.send_signal(signal.SIGINT)
     _, stderr = proc.communicate(timeout=30)
     assert proc.returncode == 2, stderr
@@ -191,14 +187,9 @@ def test_term_while_the_video_is_finished_keeps_a_true_record(env, tmp_path):
     interpreter crashed, before). A TERM that lands as the hop returns is the hop's: the video
     is finished and kept, and the record says the hop was interrupted."""
     proc = _filmed_hop(env, tmp_path, fps=120)
-    deadline = time.monotonic() + 90
-    while time.monotonic() < deadline and proc.poll() is None:
-        try:
-            if json.loads((tmp_path / "r" / "run.json").read_text())["status"] == "complete":
-                break
-        except (OSError, ValueError, KeyError):
-            pass
-        time.sleep(0.02)
+    wait_for(lambda: proc.poll() is not None
+             or json.loads((tmp_path / "r" / "run.json").read_text())["status"] == "complete", 90,
+             "the record to say complete")
     proc.send_signal(signal.SIGTERM)
     rc, rec = _check_what_was_kept(proc, tmp_path)
     assert rec is not None and len(rec["phases"]) == 2
@@ -282,8 +273,9 @@ def test_fuzzed_virtual_robot_survives_and_then_hops(env, tmp_path, board_timing
         assert device.startswith("/dev/pts/")
         frames = _fuzz_frames(3000)
         replies = []
+        with Link(device) as link:   # the firmware booted: it answers, then idles waiting for frames
+            link.hello(wait_s=8)
         with serial.Serial(device, timeout=2) as port:
-            time.sleep(0.3)
             port.reset_input_buffer()
             reader = P.LineReader(limit=1 << 16)
             for start in range(0, len(frames), 20):

@@ -26,6 +26,7 @@ from locust.device.virtual import PWM_PERIOD_S, TICKS_LEAD_S, VirtualRobot
 from locust.errors import DeviceError
 from locust.firmware import protocol as P
 from locust.io import run_record as R
+from waiting import wait_for
 
 
 @pytest.fixture(scope="module")
@@ -88,15 +89,12 @@ def test_silent_host_leaves_servos_at_rest_within_heartbeat(robot, board_timing)
             if ev.get("ev") == P.EV_DONE and ev.get("hop") == reply["id"]:
                 done = ev
     assert done["status"] == P.HOP_HEARTBEAT and done["phases"] == 1
-    deadline = time.monotonic() + 2  # the PWM writes reach the host through a FIFO, the events a pty
-    while True:
+    def at_rest():   # the PWM writes reach the host through a FIFO, the events a pty
         last = [w for w in vr.pwm_writes if w.servo][-2:]
-        if all(abs(w.horn_deg) < 1e-6 for w in last) or time.monotonic() > deadline:
-            break
-        time.sleep(0.02)
+        return last if all(abs(w.horn_deg) < 1e-6 for w in last) else None
+
+    last = wait_for(at_rest, 2, "both servos commanded to rest")
     assert {w.servo for w in last} == {"left", "right"}
-    for w in last:
-        assert abs(w.horn_deg) < 1e-6
     # rest commanded within the timeout: 250 ms, and 5 ms for the frame's way over the pty
     board_timing([(w.t_written_s - t_last_frame - 0.250) * 1e6 for w in last], bound_us=5000,
                  what="rest command after the heartbeat")
@@ -158,9 +156,7 @@ def test_idle_robot_has_a_boards_ticks_and_soft_reset_leaves_servos_limp(robot):
     proc = subprocess.run(mpremote + ["exec", "import time; print(time.ticks_add(0, -1))"],
                           capture_output=True, text=True, timeout=60)
     assert proc.stdout.strip() == "1073741823", proc.stdout + proc.stderr
-    deadline = time.monotonic() + 5
-    while time.monotonic() < deadline and not any(w.pulse_us == 0 for w in list(vr.pwm_writes)[n:]):
-        time.sleep(0.02)
+    wait_for(lambda: any(w.pulse_us == 0 for w in list(vr.pwm_writes)[n:]), 5, "the pulses stopped")
     new = list(vr.pwm_writes)[n:]
     rest = [w for w in new if w.servo and w.pulse_us > 0]
     assert rest and all(abs(w.horn_deg) < 1e-6 for w in rest)  # Ctrl-C: to rest first
@@ -218,9 +214,9 @@ def test_ctrl_c_interrupts_running_code_and_cancels_a_line_at_the_prompt(robot):
         until(b">>> ", b"\r")
         assert b"\n42\n" not in until(b">>> ", b"12\x03")          # the line "12" is dropped...
         assert b"\n42\n" in until(b">>> ", b"6*7\r")               # ...so this is 6*7, not 126*7
-        until(b"... ", b"import time\rwhile True: time.sleep_ms(5)\r")
-        port.write(b"\r")  # runs the loop: no prompt until it is interrupted
-        time.sleep(0.3)
+        # a loop that says once that it runs (its echo reads "loop" + "ing"), then sleeps
+        until(b"... ", b"import time\rfor i in range(10**9): time.sleep_ms(5) if i else print('loop' + 'ing')\r")
+        assert b"looping" in until(b"looping", b"\r")  # runs the loop: no prompt until it is interrupted
         assert b"KeyboardInterrupt" in until(b">>> ", b"\x03")
         port.write(b"\x04")  # soft reset: the firmware again
     finally:

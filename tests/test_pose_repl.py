@@ -27,6 +27,7 @@ from locust.device.link import Link
 from locust.device.plant import RecordingPlant
 from locust.device.virtual import VirtualRobot
 from locust.firmware import protocol as P
+from waiting import wait_for
 
 LOCUST = [sys.executable, "-m", "locust.commands"]
 MPREMOTE = str(Path(sys.executable).with_name("mpremote"))
@@ -53,14 +54,12 @@ def _virtual(env, pwm_log=None, extra=()):
 
 def _horn_angles(log: Path, n_writes: int, timeout_s: float = 5.0) -> dict[str, float]:
     """The last horn angle of each servo in a --pwm-log, once it holds n_writes rows."""
-    deadline = time.monotonic() + timeout_s
-    while True:
-        rows = [line.split(",") for line in log.read_text().splitlines()[2:]]
-        if len(rows) >= n_writes or time.monotonic() > deadline:
-            break
-        time.sleep(0.05)
+    def rows():
+        found = [line.split(",") for line in log.read_text().splitlines()[2:]]
+        return found if len(found) >= n_writes else None
+
     last = {}
-    for row in rows:
+    for row in wait_for(rows, timeout_s, f"{n_writes} PWM writes in {log}"):
         if row[3] and row[5]:
             last[row[3]] = float(row[5])
     return last
@@ -189,7 +188,8 @@ def test_pose_help_explains_assembly_and_trim():
 
 def test_mpremote_exec_on_an_idle_robot_then_flash_and_hop(env, tmp_path):
     with _virtual(env) as device:
-        time.sleep(0.5)  # let the firmware boot: it is idle, waiting for frames
+        with Link(device) as link:    # the firmware booted: it answers, then idles waiting for frames
+            link.hello(wait_s=8)
         t0 = time.monotonic()
         proc = subprocess.run([MPREMOTE, "connect", device, "exec", "print(6*7)"],
                               capture_output=True, text=True, timeout=30)
@@ -266,8 +266,10 @@ def test_ctrl_c_stops_the_idle_loop_not_a_hop_and_ctrl_d_resumes(env):
     with VirtualRobot(flash_dir, RecordingPlant()) as vr, Link(vr.device_path) as link:
         link.hello(wait_s=8)
         link.start_heartbeat(0.05)
+        writes = len(vr.pwm_writes)
         hop = link.call("hop", cycles=2, push_ms=100, wait_ms=150, heartbeat_ms=500)
-        time.sleep(0.05)
+        wait_for(lambda: any(w.servo and abs(w.horn_deg) > 1 for w in list(vr.pwm_writes)[writes:]), 5,
+                 "the hop's first push")
         link.write(b"\r\x03\n")  # mid-hop: a stray Ctrl-C is a byte of a bad frame
         done = None
         while done is None:
@@ -281,16 +283,13 @@ def test_ctrl_c_stops_the_idle_loop_not_a_hop_and_ctrl_d_resumes(env):
         assert link.call("pose", left_deg=10, right_deg=10)["ok"]
         t_ctrl_c = vr.now_s()
         link.write(b"\r\x03")  # idle: the loop stops, the servos rest, the REPL has the console
-        deadline = time.monotonic() + 5
-        while not link.repl_seen and time.monotonic() < deadline:
-            link.write(b"\r\n")
-            time.sleep(0.1)
-        assert link.repl_seen
-        while time.monotonic() < deadline:  # the PWM writes reach the host through a FIFO
+        wait_for(lambda: link.write(b"\r\n") or link.repl_seen, 5, "the REPL's prompt after Ctrl-C", poll_s=0.1)
+
+        def rest_writes():   # the PWM writes reach the host through a FIFO
             rest = [w for w in vr.pwm_writes if w.servo and w.t_written_s > t_ctrl_c]
-            if len(rest) >= 2:
-                break
-            time.sleep(0.05)
+            return rest if len(rest) >= 2 else None
+
+        rest = wait_for(rest_writes, 5, "the servos' rest after Ctrl-C")
         assert {w.servo for w in rest} == {"left", "right"}
         assert all(abs(w.horn_deg) < 1e-6 for w in rest)
 
@@ -351,10 +350,7 @@ def test_locust_repl_port_sim_closed_terminal_leaves_no_interpreter(env, sig):
             proc.kill()
             proc.wait()
         os.close(master)
-    deadline = time.monotonic() + 5
-    while _interpreters_in(flash_dir) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    assert not _interpreters_in(flash_dir)
+    wait_for(lambda: not _interpreters_in(flash_dir), 5, "the MicroPython interpreters to end with the shell")
 
 
 def test_repl_help_and_no_terminal(env):

@@ -533,14 +533,18 @@ def test_a_scheduler_address_where_no_dask_answers_is_refused_promptly(tmp_path)
             server.close()
 
 
-def test_a_real_dask_scheduler_passes_the_probe():
+def test_a_real_dask_scheduler_passes_the_probe_and_its_worker_does_not():
     from dask.distributed import LocalCluster
 
     from locust.sweep.execute import probe_dask_scheduler
 
-    with LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", host="127.0.0.1",
                       dashboard_address=None) as cluster:
         probe_dask_scheduler(cluster.scheduler_address)   # raises if refused
+        # Dask's greeting is not enough: a worker's address is not a scheduler's
+        (worker,) = cluster.workers.values()
+        with pytest.raises(SweepError, match="a Dask Worker answers there"):
+            probe_dask_scheduler(worker.address)
 
 
 def test_sweep_prints_hop_figures_in_mm_like_every_table(tmp_path):

@@ -202,15 +202,18 @@ def fold_cutout(line: LineString, width_mm: float, body) -> Polygon | MultiPolyg
     return line.buffer(width_mm / 2, cap_style="flat", join_style="mitre").intersection(body)
 
 
-def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
-                        hinge_width_mm: float = 1.0, gap_tol_mm: float = 0.01) -> Design:
-    layer_map = layer_map or LayerMap()
-    roles = {layer: layer_map.role_of(layer) for layer in drawing.layers()}
+def _contours_by_role(drawing: Drawing, roles: dict[str, str | None]) -> dict[str, list[Contour]]:
+    """The drawing's contours under their layer's role (those of layers without one left out)."""
     by_role: dict[str, list[Contour]] = {r: [] for r in ROLES}
     for c in drawing.contours:
         if roles[c.layer]:
             by_role[roles[c.layer]].append(c)
+    return by_role
 
+
+def _check_closed_body_and_holes(drawing: Drawing, layer_map: LayerMap, by_role: dict[str, list[Contour]],
+                                 gap_tol_mm: float) -> None:
+    """Refuse a drawing without a body outline, or with an open body or hole outline."""
     if not by_role["body"]:
         found = ", ".join(drawing.layers()) or "none with curves"
         raise FabError(
@@ -223,13 +226,10 @@ def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
         for layer in dict.fromkeys(c.layer for c in opens):
             raise open_outline_error(layer, [c for c in opens if c.layer == layer], gap_tol_mm)
 
-    body_polys, joined = join_overlaps(by_role["body"], [_polygon(c) for c in by_role["body"]])
-    body = even_odd(body_polys)
-    if body.is_empty or body.area <= 0:
-        raise FabError(f"{drawing.path}: the body outline encloses no area", "check the body layer")
 
-    hinges: list[HingeCut] = []
-    for c in drawing.points:   # a cut that cannot be made is an error, never a cut file without it
+def _check_no_zero_length_cut(drawing: Drawing, layer_map: LayerMap, gap_tol_mm: float) -> None:
+    """A cut that cannot be made is an error, never a cut file without it."""
+    for c in drawing.points:
         role = layer_map.role_of(c.layer)
         if role in ("hinge", "cuts", "holes"):
             what = {"hinge": "hinge", "cuts": "cut", "holes": "hole"}[role]
@@ -237,21 +237,62 @@ def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
                            f"(shorter than --gap-tol-mm {gap_tol_mm:g}, or of zero radius)",
                            "draw the fold line across the body, or delete it" if role == "hinge"
                            else "draw it to its size, or delete it")
-    for c in by_role["hinge"]:
-        if c.closed:
-            poly = _polygon(c)
-            hinges.append(HingeCut(c.layer, "slot", poly))
-        else:
-            cut = fold_cutout(LineString(c.points_mm), hinge_width_mm, body)
-            if cut.is_empty or cut.area <= 0:
-                raise FabError(f"layer {c.layer!r}: hinge {', '.join(c.entities[:3])} from {_fmt(c.start_mm)} "
-                               f"to {_fmt(c.end_mm)} does not cross the body "
-                               f"(x {body.bounds[0]:.3f} to {body.bounds[2]:.3f}, "
-                               f"y {body.bounds[1]:.3f} to {body.bounds[3]:.3f} mm)",
-                               "draw the fold line across the body, or put it on another layer")
-            hinges.append(HingeCut(c.layer, "fold", cut))
-    hinges.sort(key=lambda h: (round(h.polygon.bounds[0], 6), round(h.polygon.bounds[1], 6)))
 
+
+def _hinge_cuts(contours: list[Contour], body, hinge_width_mm: float) -> list[HingeCut]:
+    """Each hinge contour as a cut: a closed one is a slot, an open one a fold line's cut-out
+    across the body (refused if it misses the body); ordered by position."""
+    hinges: list[HingeCut] = []
+    for c in contours:
+        if c.closed:
+            hinges.append(HingeCut(c.layer, "slot", _polygon(c)))
+            continue
+        cut = fold_cutout(LineString(c.points_mm), hinge_width_mm, body)
+        if cut.is_empty or cut.area <= 0:
+            raise FabError(f"layer {c.layer!r}: hinge {', '.join(c.entities[:3])} from {_fmt(c.start_mm)} "
+                           f"to {_fmt(c.end_mm)} does not cross the body "
+                           f"(x {body.bounds[0]:.3f} to {body.bounds[2]:.3f}, "
+                           f"y {body.bounds[1]:.3f} to {body.bounds[3]:.3f} mm)",
+                           "draw the fold line across the body, or put it on another layer")
+        hinges.append(HingeCut(c.layer, "fold", cut))
+    hinges.sort(key=lambda h: (round(h.polygon.bounds[0], 6), round(h.polygon.bounds[1], 6)))
+    return hinges
+
+
+def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
+                        hinge_width_mm: float = 1.0, gap_tol_mm: float = 0.01) -> Design:
+    """The design a drawing gives: its body, hinges, holes and slits, by each layer's role.
+
+    Parameters
+    ----------
+    drawing : Drawing
+        The contours read from a DXF (:func:`locust.fab.dxf_read.read_drawing`).
+    layer_map : LayerMap, optional
+        Which layer names play which role (default: :class:`LayerMap`'s patterns).
+    hinge_width_mm : float
+        The width [mm] of the cut-out a fold line becomes.
+    gap_tol_mm : float
+        The gap [mm] the reader closed ends within (said in the errors).
+
+    Returns
+    -------
+    Design
+
+    Raises
+    ------
+    FabError
+        No body; an open outline; a body of no area; a cut of no length; a hinge off the body.
+    """
+    layer_map = layer_map or LayerMap()
+    roles = {layer: layer_map.role_of(layer) for layer in drawing.layers()}
+    by_role = _contours_by_role(drawing, roles)
+    _check_closed_body_and_holes(drawing, layer_map, by_role, gap_tol_mm)
+    body_polys, joined = join_overlaps(by_role["body"], [_polygon(c) for c in by_role["body"]])
+    body = even_odd(body_polys)
+    if body.is_empty or body.area <= 0:
+        raise FabError(f"{drawing.path}: the body outline encloses no area", "check the body layer")
+    _check_no_zero_length_cut(drawing, layer_map, gap_tol_mm)
+    hinges = _hinge_cuts(by_role["hinge"], body, hinge_width_mm)
     holes = tuple(_polygon(c) for c in by_role["holes"] + by_role["cuts"] if c.closed)
     slits = tuple(LineString(c.points_mm) for c in by_role["cuts"] if not c.closed)
     return Design(

@@ -11,12 +11,13 @@ finish; only the order differs, never the numbers.
 
 from __future__ import annotations
 
+import asyncio
 import multiprocessing
 import os
 import signal
 import socket
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, ThreadPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from typing import Any
@@ -130,53 +131,71 @@ def dask_client(scheduler: str, jobs: int):
         client.close()
 
 
-# how long a scheduler's address may take to accept and greet before it is refused
+# how long a scheduler's address may take to accept, greet and say what it is before it is refused
 PROBE_TIMEOUT_S = 4.0
-# a Dask greeting: 8 bytes (little-endian) giving the length of what follows, then 8 bytes
-# giving the number of frames and 8 per frame for their lengths; it is a few dozen bytes
-_GREETING_MAX_BYTES = 1 << 16
 
 
 def probe_dask_scheduler(scheduler: str, timeout_s: float = PROBE_TIMEOUT_S) -> None:
-    """Refuse (:class:`SweepError`) an address where no Dask scheduler answers within
-    ``timeout_s``: nothing listening, a silent server, or one whose greeting is not Dask's (read
-    as Dask's, its first bytes could ask for exabytes, and the client would wait forever)."""
+    """Refuse an address where no Dask scheduler answers within ``timeout_s``.
+
+    Dask's own connection (``distributed.comm.connect``, which reads Dask's greeting) asks the
+    peer who it is; the whole exchange runs under one deadline, because a peer that is not
+    Dask (a silent server, or one whose first bytes read as a greeting of exabytes) would
+    otherwise keep a ``Client`` waiting well past its ``timeout``.
+
+    Parameters
+    ----------
+    scheduler : str
+        ``tcp://HOST:PORT``.
+    timeout_s : float
+        The deadline [s] for connecting, the greeting and the answer together.
+
+    Raises
+    ------
+    SweepError
+        Not ``tcp://HOST:PORT``; nothing listening; no answer in time; or something other than
+        a Dask scheduler answering (a worker, an HTTP or SSH server, random bytes).
+    """
     where = scheduler.removeprefix("tcp://")
     host, _, port = where.rpartition(":")
     hint = ("give the address `dask scheduler` printed (tcp://HOST:PORT, workers started with `dask worker "
             f"{scheduler}` and locust installed on them), or use --scheduler local")
     if not host or not port.isdigit() or not 0 < int(port) < 65536:
         raise SweepError(f"--scheduler {scheduler!r}: not tcp://HOST:PORT", hint)
-    try:
-        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s) as sock:
-            sock.settimeout(timeout_s)
-            head = _receive(sock, 16)
-            size = int.from_bytes(head[:8], "little")
-            frames = int.from_bytes(head[8:], "little")
-            if not 16 <= size <= _GREETING_MAX_BYTES or not 1 <= frames <= 64:
-                raise ValueError("not a Dask greeting")
-            rest = _receive(sock, size - 8)
-            lengths = [int.from_bytes(rest[8 * i:8 * i + 8], "little") for i in range(frames)]
-            if 8 + 8 * frames + sum(lengths) != size:
-                raise ValueError("not a Dask greeting")
+    no_answer = SweepError(f"cannot reach the Dask scheduler at {scheduler}: no answer in {timeout_s:g} s", hint)
+    try:   # nothing listening: said at once (Dask's connect would retry until its timeout)
+        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s).close()
     except TimeoutError:
-        raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: no answer in {timeout_s:g} s",
-                         hint) from None
-    except ValueError:
-        raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: something else answers there "
-                         "(its first bytes are not a Dask greeting)", hint) from None
+        raise no_answer from None
     except OSError as exc:
         raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: {exc.strerror or exc}", hint) from None
+    with ThreadPoolExecutor(1) as thread:   # its own event loop, also under a running one (Jupyter)
+        answer = thread.submit(asyncio.run, _identity(scheduler, timeout_s))
+        try:
+            identity = answer.result()
+        except TimeoutError:
+            raise no_answer from None
+        except Exception:   # whatever a stranger's bytes make of Dask's reader (MemoryError, ValueError, ...)
+            identity = None
+    if not isinstance(identity, dict) or identity.get("type") != "Scheduler":
+        what = f"a Dask {identity['type']}" if isinstance(identity, dict) and "type" in identity else \
+            "something else (its first bytes are not a Dask greeting)"
+        raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: {what} answers there", hint)
 
 
-def _receive(sock: socket.socket, n: int) -> bytes:
-    data = b""
-    while len(data) < n:
-        chunk = sock.recv(n - len(data))
-        if not chunk:
-            raise ValueError("closed before greeting")
-        data += chunk
-    return data
+async def _identity(address: str, timeout_s: float) -> object:
+    """What the Dask server at ``address`` says it is (its ``identity``), within ``timeout_s``."""
+    from distributed.comm import connect
+
+    async def ask() -> object:
+        comm = await connect(address, timeout=timeout_s)
+        try:
+            await comm.write({"op": "identity"})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    return await asyncio.wait_for(ask(), timeout_s)
 
 
 @contextmanager
