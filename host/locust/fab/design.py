@@ -50,9 +50,18 @@ class HingeCut:
 
     @property
     def area_mm2(self) -> float:
+        """The cut-out's area [mm²]."""
         return float(self.polygon.area)
 
     def table_row(self) -> dict:
+        """The hinge as a row of the manufacturing summary's hinge table.
+
+        Returns
+        -------
+        dict
+            ``layer``, ``kind``, and the cut-out's centre, extent and area, each in mm (mm²),
+            rounded to 0.1 µm.
+        """
         x0, y0, x1, y1 = self.polygon.bounds
         return {"layer": self.layer, "kind": self.kind,
                 "center_x_mm": round((x0 + x1) / 2, 4), "center_y_mm": round((y0 + y1) / 2, 4),
@@ -78,27 +87,78 @@ class Design:
 
     @property
     def bounds_mm(self) -> tuple[float, float, float, float]:
+        """The body's bounding box, (x min, y min, x max, y max) [mm]."""
         return tuple(float(v) for v in self.body.bounds)
 
     def hinge_union(self):
+        """Every hinge's cut-out as one shape.
+
+        Returns
+        -------
+        shapely.geometry.base.BaseGeometry
+            The union of the hinges' polygons [mm] (empty without hinges).
+        """
         return unary_union([h.polygon for h in self.hinges])
 
     def hole_union(self):
+        """Every hole as one shape.
+
+        Returns
+        -------
+        shapely.geometry.base.BaseGeometry
+            The union of the holes [mm] (empty without holes).
+        """
         return unary_union(list(self.holes))
 
 
 @dataclass(frozen=True)
 class LayerMap:
+    """Which drawing layers play which role (body, hinge, hole, slit, ignore).
+
+    Attributes
+    ----------
+    patterns : dict of str to tuple of str
+        Role -> the layer-name patterns (``fnmatch``, case-insensitive) that give it.
+    """
+
     patterns: dict[str, tuple[str, ...]] = field(default_factory=lambda: dict(DEFAULT_LAYER_MAP))
 
     def with_overrides(self, items: dict[str, list[str]]) -> LayerMap:
-        """``{"body": ["outline_a"], ...}``: these names replace the role's defaults."""
+        """The map with some roles' patterns replaced.
+
+        Parameters
+        ----------
+        items : dict of str to list of str
+            Role -> patterns, e.g. ``{"body": ["outline_a"]}``: these replace the role's defaults.
+
+        Returns
+        -------
+        LayerMap
+            The new map.
+
+        Raises
+        ------
+        locust.errors.FabError
+            An unknown role.
+        """
         for role in items:
             if role not in ROLES:
                 raise FabError(f"unknown layer role {role!r}", f"roles are {', '.join(ROLES)}")
         return LayerMap({**self.patterns, **{r: tuple(v) for r, v in items.items()}})
 
     def role_of(self, layer: str) -> str | None:
+        """The role of a drawing layer.
+
+        Parameters
+        ----------
+        layer : str
+            The layer's name in the drawing.
+
+        Returns
+        -------
+        str or None
+            The first role (in ``ROLES`` order) one of whose patterns matches, or None.
+        """
         name = layer.lower()
         for role in ROLES:
             if any(fnmatch.fnmatchcase(name, p.lower()) for p in self.patterns[role]):
@@ -199,6 +259,22 @@ def even_odd(polys: list[Polygon]):
 
 
 def fold_cutout(line: LineString, width_mm: float, body) -> Polygon | MultiPolygon:
+    """The slot a fold line makes: the line widened to ``width_mm``, flat at its ends, inside the body.
+
+    Parameters
+    ----------
+    line : shapely.geometry.LineString
+        The fold line [mm].
+    width_mm : float
+        The slot's width [mm].
+    body : shapely.geometry.Polygon or MultiPolygon
+        The part's body [mm].
+
+    Returns
+    -------
+    shapely.geometry.Polygon or MultiPolygon
+        The cut-out [mm].
+    """
     return line.buffer(width_mm / 2, cap_style="flat", join_style="mitre").intersection(body)
 
 

@@ -44,6 +44,23 @@ def plan_jobs(jobs: int | None, designs: int) -> tuple[int, str | None]:
 
 
 def check_scheduler(scheduler: str) -> str:
+    """A ``--scheduler`` value checked.
+
+    Parameters
+    ----------
+    scheduler : str
+        ``local``, ``dask-local`` or ``tcp://HOST:PORT`` of a Dask scheduler.
+
+    Returns
+    -------
+    str
+        The same value.
+
+    Raises
+    ------
+    locust.errors.SweepError
+        Any other value.
+    """
     if scheduler in ("local", "dask-local") or scheduler.startswith("tcp://"):
         return scheduler
     raise SweepError(f"--scheduler {scheduler!r}: not understood",
@@ -200,7 +217,21 @@ async def _identity(address: str, timeout_s: float) -> object:
 
 @contextmanager
 def mapper(scheduler: str, jobs: int):
-    """``with mapper(s, jobs) as run_map: for result in run_map(fn, items): ...``"""
+    """Where designs run, as a map: ``with mapper(s, jobs) as run_map: for r in run_map(fn, items): ...``.
+
+    Parameters
+    ----------
+    scheduler : str
+        ``local`` (this process, or a pool of ``jobs`` processes), ``dask-local`` or a Dask
+        scheduler's ``tcp://HOST:PORT``.
+    jobs : int
+        Workers to use.
+
+    Yields
+    ------
+    callable
+        ``run_map(fn, items)``, an iterator over the results ``fn(item)`` of the items.
+    """
     check_scheduler(scheduler)
     if scheduler == "local":
         yield (lambda fn, items: _serial(fn, items)) if jobs <= 1 else (lambda fn, items: _pool(fn, items, jobs))
