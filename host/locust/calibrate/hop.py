@@ -12,8 +12,9 @@ Before the fit each run's step is checked at the start values: halved (at most
 ``MAX_HALVINGS`` times) while halving it moves the run's markers by more than
 ``STEP_TOLERANCE_M`` (RMS over the tracked frames), so the fitted model is the converged one.
 
-Residual: the tracked markers against the same markers of the simulation, both from where
-they stood by the track's rule (the median of its frames before the first nose motion), put
+Residual: the tracked markers against the same markers of the simulation, absolute (the
+track's frame, the board's, against the world's, the standing pose included), moved by one
+offset per run shared by every marker and frame (where the board stands: :func:`alignment`), put
 on the schedule's clock by the rule the report uses (:mod:`locust.trials.measure`: the first
 nose motion of more than 3 mm, the track's start placed where the simulation's is relative
 to its first push) and then each run's clock offset fitted about it, for every candidate
@@ -21,7 +22,9 @@ to its first push) and then each run's clock offset fitted about it, for every c
 columns included, is simulated in one batched ``mujoco.rollout`` per run (in calls of
 ``CHUNK`` candidates, each set in a copy of the run's compiled model where the fitted values
 allow: :mod:`.hopmodels`); the solver is ``mujoco.minimize.least_squares`` on the logarithm
-of each positive parameter (a factor is what a friction or a stiffness is known to).
+of each positive parameter (a factor is what a friction or a stiffness is known to) and on
+an angle in degrees (:class:`Scaling`: the stance keys). A fit whose runs straddle a threshold
+between outcomes at the optimum (:func:`check_one_side`) is refused.
 Uncertainties (:mod:`.fitstats`): the frames of one hop share its errors (tracking, and a
 model that is not the robot: neighbouring residuals are correlated), so the covariance is
 cluster-robust with each hop of each run a cluster, from a central-difference Jacobian at
@@ -30,7 +33,8 @@ of freedom; the fit's own time step adds the parameters' shift when it is halved
 order, one more rollout per run), and so do the uncertainties of the values the fit holds
 fixed (from the bench calibrations: the hinge damping, the servo's armature, kp and stall
 torque), each carried through the fit's sensitivity to it (one batch per run, each held
-value one standard uncertainty either side), in quadrature. A value is *identifiable* when
+value one standard uncertainty either side), and the model's error against the plant measured
+on the virtual robot (:data:`MODEL_ERROR_RELATIVE`), in quadrature. A value is *identifiable* when
 its 95% interval is within about +-50% and it did not run to the edge of its range (a factor
 ``BOUND_FACTOR`` either side of where it started).
 """
@@ -81,7 +85,7 @@ MAX_HALVINGS = 3               # ... halved up to this many times until it is
 SHIFT_SEARCH_S = 0.05          # each run's clock offset is fitted within this of the onset rule's ...
 SHIFT_LEVELS = 101             # ... from the best of this many offsets, refined
 GRID_FACTOR = 1.6              # the starting grid spans this factor either side of the start ...
-GRID_LEVELS = {1: 9, 2: 7, 3: 5, 4: 3, 5: 3}   # ... in this many levels per fitted value
+GRID_LEVELS = {1: 9, 2: 7, 3: 3, 4: 3, 5: 3}   # ... in this many levels per fitted value
 GRID_STAGES = 3                # ... refined about its best point this many times
 # The model's error against the plant (std_model, one standard deviation, in quadrature): the
 # rollout at the measured phase times is not the virtual robot (its firmware's ticks, the
