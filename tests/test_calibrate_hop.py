@@ -286,7 +286,7 @@ def test_a_fit_across_the_outcomes_threshold_is_refused():
 
     def jacobian_at(start):
         at = H.HopRun(**{**run.__dict__, "robot": robot.with_values({key: start})})
-        return H._jacobian(H._HopResidual([at], (key,), np.array([start])), np.zeros(1))
+        return H._jacobian(H._HopResidual([at], (key,)), np.zeros(1))
 
     with pytest.raises(CalibrationError, match="straddles the threshold") as refused:
         jacobian_at(-108.46)

@@ -23,7 +23,7 @@ columns included, is simulated in one batched ``mujoco.rollout`` per run (in cal
 ``CHUNK`` candidates, each set in a copy of the run's compiled model where the fitted values
 allow: :mod:`.hopmodels`); the solver is ``mujoco.minimize.least_squares`` on the logarithm
 of each positive parameter (a factor is what a friction or a stiffness is known to) and on
-an angle in degrees (:class:`Scaling`: the stance keys). A fit whose runs straddle a threshold
+an angle in degrees (:func:`fit_parameters`: the stance keys). A fit whose runs straddle a threshold
 between outcomes at the optimum (:func:`check_one_side`) is refused.
 Uncertainties (:mod:`.fitstats`): the frames of one hop share its errors (tracking, and a
 model that is not the robot: neighbouring residuals are correlated), so the covariance is
@@ -63,6 +63,7 @@ from ..sim.schedule import ControlPlan
 from ..trials.configs import configuration
 from ..trials.measure import onset_time
 from ..trials.measured import load_trial, read_track
+from .fitparams import FitParameter, FitParameters
 from .fitstats import Estimate, cluster_covariance, fixed_covariance, linear_shift
 from .hopmodels import CandidateModels
 
@@ -388,29 +389,34 @@ def is_angle(key: str) -> bool:
     return key.endswith("_deg")
 
 
-@dataclass(frozen=True)
-class Scaling:
-    """The solver's vector ``x`` -> the fitted values: ``start * exp(x)`` for a positive
-    value (a factor is what a friction or a stiffness is known to), ``start + ANGLE_UNIT_DEG * x``
-    for an angle; each searched within ``bound`` of 0."""
+UNITS = (("_nms_per_rad", "N*m*s/rad"), ("_nm_per_rad", "N*m/rad"), ("_rad_per_s", "rad/s"), ("_kgm2", "kg*m^2"),
+         ("_nm", "N*m"), ("_deg", "deg"), ("_kg", "kg"), ("_m", "m"), ("_s", "s"))
 
-    start: np.ndarray
-    angle: np.ndarray         # per key: fitted in degrees
 
-    @classmethod
-    def of(cls, keys: tuple[str, ...], start: np.ndarray) -> Scaling:
-        return cls(np.asarray(start, dtype=float), np.array([is_angle(k) for k in keys], dtype=bool))
+def unit_of(key: str) -> str:
+    """The unit a robot key's name ends in ("1" for none: a friction coefficient)."""
+    return next((unit for suffix, unit in UNITS if key.endswith(suffix)), "1")
 
-    @property
-    def bound(self) -> np.ndarray:
-        return np.where(self.angle, ANGLE_BOUND_DEG / ANGLE_UNIT_DEG, math.log(BOUND_FACTOR))
 
-    def values(self, x: np.ndarray) -> np.ndarray:
-        return np.where(self.angle, self.start + ANGLE_UNIT_DEG * x, self.start * np.exp(x))
-
-    def slope(self, x: np.ndarray) -> np.ndarray:
-        """d value / d x."""
-        return np.where(self.angle, ANGLE_UNIT_DEG, self.start * np.exp(x))
+def fit_parameters(runs: list[HopRun], keys: tuple[str, ...]) -> FitParameters:
+    """The fit's values (:class:`.fitparams.FitParameters`): each key free from the first run's
+    value, a positive one on the logarithm of its factor from the start (a factor is what a
+    friction or a stiffness is known to) within ``BOUND_FACTOR`` either way, an angle in
+    steps of ``ANGLE_UNIT_DEG`` within ``ANGLE_BOUND_DEG``; then the values held fixed that
+    carry an uncertainty (:func:`held_uncertainties`), with it and their source."""
+    robot = runs[0].robot
+    free = []
+    for key in keys:
+        start = robot.get(key)
+        if is_angle(key):
+            free.append(FitParameter(key, "deg", start, start - ANGLE_BOUND_DEG, start + ANGLE_BOUND_DEG, "linear",
+                                     scale=ANGLE_UNIT_DEG, reference=start, source=robot.source_of(key).source))
+        else:
+            free.append(FitParameter(key, unit_of(key), start, start / BOUND_FACTOR, start * BOUND_FACTOR, "log",
+                                     reference=start, source=robot.source_of(key).source))
+    held = [FitParameter(key, unit_of(key), robot.get(key), held=True, std=sd, source=robot.source_of(key).source)
+            for key, sd in held_uncertainties(runs, keys).items()]
+    return FitParameters(free + held)
 
 
 def _converged_steps(runs: list[HopRun], tally: _Tally | None = None) -> tuple[list[HopRun], list[str], list[float]]:
@@ -457,19 +463,20 @@ def planned_simulations(runs: int, keys: int, held: int, max_iter: int, grid_sta
 
 class _HopResidual:
     """The markers' residual of every run, stacked, for candidate vectors ``x`` (columns): the
-    fitted values are ``scaling.values(x)``; ``tally`` counts the simulations it ran and
-    ``outcomes`` holds, per run, the outcome of each candidate of the last call."""
+    fitted values are ``params.free_values(x)`` (:func:`fit_parameters`); ``tally`` counts the
+    simulations it ran and ``outcomes`` holds, per run, the outcome of each candidate of the
+    last call."""
 
-    def __init__(self, runs: list[HopRun], keys: tuple[str, ...], start: np.ndarray, tally: _Tally | None = None):
-        self.runs, self.keys, self.start = runs, keys, start
-        self.scaling = Scaling.of(keys, start)
+    def __init__(self, runs: list[HopRun], keys: tuple[str, ...], tally: _Tally | None = None):
+        self.runs, self.keys = runs, keys
+        self.params = fit_parameters(runs, keys)
         self.tally = tally or _Tally()
         self.models: dict[int, CandidateModels] = {}    # per run: its candidates without the compiler
         self.outcomes: list[list[str | None]] = []
 
     def values_at(self, xs: np.ndarray) -> list[dict[str, float]]:
         """The fitted values (key -> value) at each row of ``xs``."""
-        return [dict(zip(self.keys, self.scaling.values(x).tolist())) for x in xs]
+        return [dict(zip(self.keys, self.params.free_values(x).tolist())) for x in xs]
 
     def candidates(self, run: HopRun) -> CandidateModels:
         """``run``'s compiled candidates (made at the first use)."""
@@ -544,13 +551,13 @@ def _jacobian(residual: _HopResidual, x: np.ndarray) -> tuple[np.ndarray, np.nda
     """The residual at the optimum, its Jacobian in the values (central differences, one batch
     per run) and the values' shift at half the time step: (r, jac, numerical); refused where a
     run's outcome is not the same at every point (:func:`check_one_side`)."""
-    bound = residual.scaling.bound
-    hi, lo = np.minimum(x + FD_STEP, bound), np.maximum(x - FD_STEP, -bound)
+    low, high = residual.params.bounds()
+    hi, lo = np.minimum(x + FD_STEP, high), np.maximum(x - FD_STEP, low)
     points = [x] + [np.where(np.arange(len(x)) == i, edge[i], x) for i in range(len(x)) for edge in (hi, lo)]
     rs = residual(np.array(points).T)
     check_one_side(residual, np.array(points))
     r = rs[:, 0]
-    jac = (rs[:, 1::2] - rs[:, 2::2]) / (hi - lo) / residual.scaling.slope(x)[None, :]   # d r / d p
+    jac = residual.params.to_values_jacobian((rs[:, 1::2] - rs[:, 2::2]) / (hi - lo), x)   # d r / d value
     numerical = linear_shift(jac, residual(x.reshape(-1, 1), refine=2)[:, 0] - r)
     return r, jac, numerical
 
@@ -583,8 +590,8 @@ def _said(outcome: str | None) -> str:
 def _held_covariance(residual: _HopResidual, x: np.ndarray, jac: np.ndarray) -> tuple[dict[str, float], object]:
     """The values held fixed that carry an uncertainty, and what it adds to the fitted values'
     covariance (None when there are none)."""
-    runs, keys = residual.runs, residual.keys
-    held = held_uncertainties(runs, keys)
+    runs = residual.runs
+    held = residual.params.held_std()
     if not held:
         return held, None
     # each held value one standard uncertainty either side, at the optimum: one batch per run
@@ -618,7 +625,7 @@ def _interval_text(hops: int, held: dict[str, float]) -> str:
 
 
 def _hop_estimates(cov, values: np.ndarray, x: np.ndarray, keys: tuple[str, ...], start: np.ndarray,
-                   bound: np.ndarray, hops: int, notes: list[str]) -> tuple[dict[str, Estimate], dict[str, bool]]:
+                   edge: tuple[bool, ...], hops: int, notes: list[str]) -> tuple[dict[str, Estimate], dict[str, bool]]:
     """Each value's estimate and whether the hops bound it, with a note for each that is not
     (too few hops, the edge of its range, an interval too wide)."""
     estimates, identifiable = {}, {}
@@ -630,10 +637,10 @@ def _hop_estimates(cov, values: np.ndarray, x: np.ndarray, keys: tuple[str, ...]
         estimates[key] = est
         angle = is_angle(key)
         ok = bool(np.isfinite(est.std) and (est.std <= MAX_STD_DEG if angle else est.relative_std <= MAX_RELATIVE_STD))
-        if bound[i] - abs(x[i]) < 1e-3:
+        if edge[i]:
             ok = False
-            edge = f"{ANGLE_BOUND_DEG:g} deg" if angle else f"a factor {BOUND_FACTOR:g}"
-            notes.append(f"{key} ran to the edge of its range ({est.value:.4g}, {edge} from "
+            span = f"{ANGLE_BOUND_DEG:g} deg" if angle else f"a factor {BOUND_FACTOR:g}"
+            notes.append(f"{key} ran to the edge of its range ({est.value:.4g}, {span} from "
                          f"{start[i]:.4g}): the hops do not bound it")
         elif not ok and hops > len(keys):
             wide = f"+-{2 * MAX_STD_DEG:g} deg" if angle else f"+-{200 * MAX_RELATIVE_STD:.0f}%"
@@ -674,16 +681,15 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     held_count = len(held_uncertainties(runs, keys))
     tally = _Tally(planned_simulations(len(runs), len(keys), held_count, max_iter, grid_stages), progress)
     runs, notes, step_changes = _converged_steps(runs, tally)
-    residual = _HopResidual(runs, keys, start, tally)
-    bound = residual.scaling.bound
-    bounds = [-bound, bound]
+    residual = _HopResidual(runs, keys, tally)
+    bounds = list(residual.params.bounds())
 
     x0 = grid_start(residual, len(keys), grid_stages)
     x, trace = minimize.least_squares(x0, residual, bounds=bounds, eps=FD_STEP,
                                       max_iter=max_iter, verbose=0, xtol=1e-6, gtol=1e-8)
     x = np.asarray(x, dtype=float).ravel()
     tally.planned = tally.done + len(runs) * (1 + 2 * len(keys) + 2 + 2 * held_count)   # what is left
-    values = residual.scaling.values(x)
+    values = residual.params.free_values(x)
     run_fits, clusters = _run_fits(residual, x, step_changes)
     # the optimum and its central differences in one batch per run, then the same at dt/2
     r, jac, numerical = _jacobian(residual, x)
@@ -691,7 +697,7 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     cov = replace(cluster_covariance(jac, r, np.concatenate(clusters), numerical, fixed),
                   model=np.diag(model_error(keys, values) ** 2))
     hops = len(np.unique(np.concatenate(clusters)))
-    estimates, identifiable = _hop_estimates(cov, values, x, keys, start, bound, hops, notes)
+    estimates, identifiable = _hop_estimates(cov, values, x, keys, start, residual.params.near_bound(x), hops, notes)
     return HopFit(keys=keys, start=dict(zip(keys, start.tolist())), estimates=estimates, identifiable=identifiable,
                   runs=run_fits, notes=notes, rms_m=float(np.sqrt(np.mean(r**2))), iterations=len(trace),
                   simulations=tally.done, wall_s=time.perf_counter() - t_start,
