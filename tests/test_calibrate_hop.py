@@ -295,3 +295,18 @@ def test_a_fit_across_the_outcomes_threshold_is_refused():
     assert "measure stance" in refused.value.hint
     _, jac, _ = jacobian_at(-104.0)
     assert np.all(np.isfinite(jac)) and np.abs(jac).max() > 0
+
+
+def test_the_crank_angle_at_rest_is_fitted_from_the_standing_pose():
+    """A stance key, fitted on its own scale (degrees, not factors): two Small cycles of the
+    seed at crank -88 deg (SYNTHETIC, the board 13 cm off), fitted from the seed's -90 deg on
+    the absolute markers: -87.73 deg, its interval [-89.69, -85.76] (mostly the 1 deg
+    model-error part) covering the truth."""
+    key = "geometry.crank_start_deg"
+    run = synthetic_run("small", {key: -88.0}, cycles=2)
+    fit = H.fit_hops([run], [key], max_iter=5, grid_stages=1)
+    est = fit.estimates[key]
+    assert fit.start[key] == -90.0
+    assert est.value == pytest.approx(-88.0, abs=0.5)
+    assert est.ci95_low <= -88.0 <= est.ci95_high and fit.identifiable[key]
+    assert est.std_model == pytest.approx(H.MODEL_ERROR_DEG[key])

@@ -10,8 +10,9 @@ cycles on it, filmed and tracked (the firmware under MicroPython driving the MuJ
 rendered video, colour tracking: nothing of the truth reaches the fit but pixels), and
 `locust calibrate hop` fits the three values from the seed's.
 
-The intervals' model-error part (``hop.MODEL_ERROR_RELATIVE``) was measured on other truths
-(seeds 100 and up, ``bench/hop_model_error.py``), never on these.
+The intervals' model-error part (``hop.MODEL_ERROR_RELATIVE``) was set before any of these
+ran and is not tuned to them; ``bench/hop_model_error.py`` measures it on other truths
+(seeds 100 and up, docs/calibrate.md).
 """
 
 from __future__ import annotations
