@@ -574,7 +574,7 @@ def check_one_side(residual: _HopResidual, points: np.ndarray) -> None:
     for run, outcomes in zip(residual.runs, residual.outcomes):
         at = outcomes[0]
         for point, other in zip(points[1:], outcomes[1:]):
-            if other == at:
+            if other == at or None in (other, at):      # a failed simulation is no outcome
                 continue
             moved = {k: v for k, v, d in zip(residual.keys, residual.values_at(point[None, :])[0].values(),
                                               point - points[0]) if d}
@@ -586,8 +586,8 @@ def check_one_side(residual: _HopResidual, points: np.ndarray) -> None:
                 "hold it; film a push that does not send the robot over), or fit fewer values")
 
 
-def _said(outcome: str | None) -> str:
-    return "failed" if outcome is None else outcome.replace("_", " ")
+def _said(outcome: str) -> str:
+    return outcome.replace("_", " ")
 
 
 def _held_covariance(residual: _HopResidual, x: np.ndarray, jac: np.ndarray) -> tuple[dict[str, float], object]:
