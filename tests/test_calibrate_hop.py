@@ -24,6 +24,7 @@ from locust.trials.configs import configuration
 
 CAMERA_HZ = 30.0
 NOISE_M = 1e-4
+BOARD_M = (0.13, -0.021)     # where the synthetic track's board stands in the world (x, y)
 TRUTH = {"compliance.hinge_stiffness_nm_per_rad": 0.045, "servo.noload_speed_rad_per_s": 9.0}
 
 
@@ -34,17 +35,19 @@ def seed_leg(config: str):
     return leg_set(preset("seed"), config)
 
 
-def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0) -> H.HopRun:
+def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0, plant=None) -> H.HopRun:
     """A run of ``config`` at ``truth``, "filmed" at 30 frames/s from 0.4 s before the first
-    push, camera clock 1.234 s ahead, positions with NOISE_M of noise (SYNTHETIC): leg set
-    ``config`` of the seed at ``truth`` and half its step. The run's robot (the fit's model and
-    start) is the same leg set, whose values not in ``truth`` are exact here."""
+    push, camera clock 1.234 s ahead, positions with NOISE_M of noise in a board's frame
+    BOARD_M from the world's (SYNTHETIC): leg set ``config`` of the seed (``plant``: of that
+    robot) at ``truth`` and half its step. The run's robot (the fit's model and start) is the
+    same leg set, whose values not in ``truth`` are exact here."""
     seed_robot = preset("seed")
     for key in S.uncertain_values(seed_robot):
         if key not in truth:
             seed_robot = seed_robot.with_provenance(key, Provenance(source="synthetic: exact"))
     robot = configuration(seed_robot, config).robot
-    plant = seed_leg(config).with_values({**truth, "solver.timestep_s": seed_leg(config).solver.timestep_s / 2})
+    leg = leg_set(plant or preset("seed"), config)
+    plant = leg.with_values({**truth, "solver.timestep_s": leg.solver.timestep_s / 2})
     period = robot.schedule.push_s + robot.schedule.wait_s
     phase_s = np.array([k * period + d for k in range(cycles) for d in (0.0, robot.schedule.push_s)])
     pushing = np.array([True, False] * cycles)
@@ -60,12 +63,10 @@ def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0) -> H
         t, x, y = sim[m]
         # standing where it stood before the simulation's kept lead, as the fit takes it
         at = t_cam - clock_s
-        tracks[m] = H.MarkerTrack(t_cam, np.interp(at, t, x, left=0.0) + rng.normal(0, NOISE_M, t_cam.size),
-                                  np.interp(at, t, y, left=0.0) + rng.normal(0, NOISE_M, t_cam.size))
+        tracks[m] = H.MarkerTrack(t_cam, np.interp(at, t, x) - BOARD_M[0] + rng.normal(0, NOISE_M, t_cam.size),
+                                  np.interp(at, t, y) - BOARD_M[1] + rng.normal(0, NOISE_M, t_cam.size))
     nose = tracks["nose"]
-    onset, x0, y0 = H.onset_time(nose.t_s, nose.x_m, nose.y_m)
-    tracks = {m: H.MarkerTrack(tr.t_s, tr.x_m - np.median(tr.x_m[tr.t_s < onset]),
-                               tr.y_m - np.median(tr.y_m[tr.t_s < onset])) for m, tr in tracks.items()}
+    onset, _, _ = H.onset_time(nose.t_s, nose.x_m, nose.y_m)
     return H.HopRun(source=template.source, config=config, robot=robot, phase_s=phase_s, pushing=pushing,
                     onset_s=onset, tracks=tracks)
 
@@ -271,3 +272,40 @@ def test_hidden_truths_over_leg_set_pairs(i, pair):
     for key, value in truth.items():
         est = fit.estimates[key]
         assert abs(est.value - value) <= 0.05 * value, (key, value, est)
+
+
+def test_a_fit_across_the_outcomes_threshold_is_refused():
+    """Large as built, two cycles at its 1 ms step, goes over at crank -108.465 deg and stays
+    low at -108.459 (found by bisection on this run's schedule). A fit of the crank angle whose
+    optimum sits there has central differences (0.1 deg either side) on both sides: refused,
+    naming the run and both outcomes; 4 deg away the same Jacobian is made."""
+    run = synthetic_run("large", {"geometry.crank_start_deg": -104.0}, cycles=2, plant=preset("large"))
+    robot = configuration(preset("large"), "large").robot
+    key = "geometry.crank_start_deg"
+
+    def jacobian_at(start):
+        at = H.HopRun(**{**run.__dict__, "robot": robot.with_values({key: start})})
+        return H._jacobian(H._HopResidual([at], (key,)), np.zeros(1))
+
+    with pytest.raises(CalibrationError, match="straddles the threshold") as refused:
+        jacobian_at(-108.46)
+    assert "large (synthetic-large)" in refused.value.message
+    assert "goes over" in refused.value.message and "stays low" in refused.value.message
+    assert "measure stance" in refused.value.hint
+    _, jac, _ = jacobian_at(-104.0)
+    assert np.all(np.isfinite(jac)) and np.abs(jac).max() > 0
+
+
+def test_the_crank_angle_at_rest_is_fitted_from_the_standing_pose():
+    """A stance key, fitted on its own scale (degrees, not factors): two Small cycles of the
+    seed at crank -88 deg (SYNTHETIC, the board 13 cm off), fitted from the seed's -90 deg on
+    the absolute markers: -87.73 deg, its interval [-89.69, -85.76] (mostly the 1 deg
+    model-error part) covering the truth."""
+    key = "geometry.crank_start_deg"
+    run = synthetic_run("small", {key: -88.0}, cycles=2)
+    fit = H.fit_hops([run], [key], max_iter=5, grid_stages=1)
+    est = fit.estimates[key]
+    assert fit.start[key] == -90.0
+    assert est.value == pytest.approx(-88.0, abs=0.5)
+    assert est.ci95_low <= -88.0 <= est.ci95_high and fit.identifiable[key]
+    assert est.std_model == pytest.approx(H.MODEL_ERROR_DEG[key])

@@ -78,9 +78,12 @@ def test_fit_recovers_the_hidden_values(fitted):
 
 def test_fit_leaves_little(fitted):
     for run in fitted["fit"]["runs"]:
-        # tracking noise on the virtual robot's video is under 0.1 mm; the fit leaves under 0.1 mm
-        # (0.039 and 0.050 mm on one filming, docs/calibrate.md)
-        assert run["rms_residual_m"] < 1e-4, run
+        # absolute positions (issue 33): the standing pose and where each marker's tracked face
+        # sits on the robot stay in the residual; on one filming of Small and Medium (bench/hop_model_error.py
+        # seed 100) the fit left
+        # 0.17 and 0.13 mm (the foot 0.21 and 0.16 mm, the nose 0.11 and 0.10 mm; with each
+        # marker taken from where it stood, 0.039 and 0.050 mm, docs/calibrate.md)
+        assert run["rms_residual_m"] < 2.5e-4, run
     for name in LEG_SETS:
         assert (fitted["folder"] / "plots" / f"{name}-1-hops-fit.png").stat().st_size > 10_000
         assert not (fitted["folder"] / f"{name}-1" / "hops-fit.png").exists()   # nothing into a run's folder

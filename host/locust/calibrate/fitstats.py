@@ -12,7 +12,9 @@ Miller, J. Human Resources 50, 2015), with Student's t on ``G - 1`` degrees of f
 when the step is halved) may be added as a type-B standard uncertainty: combined in
 quadrature, the t factor then takes the Welch-Satterthwaite effective degrees of freedom
 (GUM, JCGM 100:2008, G.4). So may the uncertainties of values the fit holds fixed
-(:func:`fixed_covariance`: taken from earlier calibrations, they are not exact).
+(:func:`fixed_covariance`: taken from earlier calibrations, they are not exact), and a
+model error measured apart (``Covariance.model``: what the fit's model misses of the plant,
+found by fitting recordings of known truth), each a type-B part likewise.
 
 :func:`serial_covariance`: for residuals in time order, the same inflated by the AR(1)
 factor ``(1 + rho)/(1 - rho)`` of their lag-1 autocorrelation ``rho`` when that is above
@@ -55,6 +57,7 @@ class Estimate:
     ci95_high: float
     std_numerical: float | None = None   # the part of ``std`` from the numerics (None: not assessed)
     std_fixed: float | None = None       # the part from the uncertainties of values held fixed (None: none)
+    std_model: float | None = None       # the part from a measured model error (None: none)
 
     @property
     def ci95(self) -> tuple[float, float]:
@@ -81,6 +84,8 @@ class Estimate:
             out["std_numerical"] = self.std_numerical
         if self.std_fixed is not None:
             out["std_fixed"] = self.std_fixed
+        if self.std_model is not None:
+            out["std_model"] = self.std_model
         return out
 
 
@@ -109,6 +114,7 @@ class Covariance:
     shift: np.ndarray | None = None     # systematic shift of each parameter (e.g. dt -> dt/2)
     method: str = "s^2 (J^T J)^-1, t(n-p)"
     fixed: np.ndarray | None = None     # covariance carried in from values held fixed (fixed_covariance)
+    model: np.ndarray | None = None     # covariance of a measured model error (the model is not the plant)
 
     def estimate(self, value: float, grad: np.ndarray) -> Estimate:
         """The interval of a quantity ``f(params)``, by first-order propagation.
@@ -131,19 +137,22 @@ class Covariance:
         sub = self.matrix[np.ix_(used, used)]
         var = float(grad[used] @ sub @ grad[used]) if used.any() else 0.0
         std = float(np.sqrt(max(var, 0.0))) if np.all(np.isfinite(sub)) else float("inf")
-        dof, numerical, fixed = float(self.dof), None, None
+        dof, numerical, fixed, model = float(self.dof), None, None, None
         if self.shift is not None:
             numerical = abs(float(grad[used] @ self.shift[used])) if used.any() else 0.0
         if self.fixed is not None:
             part = self.fixed[np.ix_(used, used)]
             fixed = float(np.sqrt(max(float(grad[used] @ part @ grad[used]), 0.0))) if used.any() else 0.0
-        if numerical is not None or fixed is not None:
-            combined = math.sqrt(std ** 2 + (numerical or 0.0) ** 2 + (fixed or 0.0) ** 2)
+        if self.model is not None:
+            part = self.model[np.ix_(used, used)]
+            model = float(np.sqrt(max(float(grad[used] @ part @ grad[used]), 0.0))) if used.any() else 0.0
+        if numerical is not None or fixed is not None or model is not None:
+            combined = math.sqrt(std ** 2 + (numerical or 0.0) ** 2 + (fixed or 0.0) ** 2 + (model or 0.0) ** 2)
             # Welch-Satterthwaite: a type-B part counts with infinite degrees of freedom
             dof = dof * (combined / std) ** 4 if 0 < std < math.inf else math.inf
             std = combined
         k = t95(dof)
-        return Estimate(float(value), std, float(value - k * std), float(value + k * std), numerical, fixed)
+        return Estimate(float(value), std, float(value - k * std), float(value + k * std), numerical, fixed, model)
 
     def parameter(self, values: np.ndarray, i: int) -> Estimate:
         """The interval of one parameter.
