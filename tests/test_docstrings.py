@@ -24,12 +24,6 @@ import locust
 ROOT = Path(locust.__file__).parent
 PACKAGES = ["api", "sim", "calibrate", "track", "sweep", "report", "fab", "device", "measure",
             "trials", "io", "params"]
-# files whose docstrings are still being written (issue 37), and the packages they are in
-PENDING_FILES = {"calibrate": ["hop.py", "hopmodels.py"]}
-PENDING_PACKAGES: set[str] = set()
-# package docstrings that do not yet name every module as :mod:`.name`
-PENDING_INIT: set[str] = set()
-PENDING = pytest.mark.xfail(strict=True, reason="docstrings pending")
 
 
 def modules_of(package: str) -> list[Path]:
@@ -60,21 +54,9 @@ def undocumented(path: Path) -> list[str]:
     return missing
 
 
-def parts():
-    """(package, files) to check, the pending ones marked."""
-    for package in PACKAGES:
-        pending = PENDING_FILES.get(package, [])
-        own = [p for p in modules_of(package) if p.name not in pending]
-        yield pytest.param(package, own, id=package,
-                           marks=[PENDING] if package in PENDING_PACKAGES else [])
-        if pending:
-            yield pytest.param(package, [ROOT / package / name for name in pending
-                                         if (ROOT / package / name).exists()],
-                               id=f"{package}-pending", marks=[PENDING])
-
-
-@pytest.mark.parametrize(("package", "files"), list(parts()))
-def test_public_definitions_have_docstrings(package, files):
+@pytest.mark.parametrize("package", PACKAGES)
+def test_public_definitions_have_docstrings(package):
+    files = modules_of(package)
     assert files, f"no modules found in locust.{package}"
     missing = [m for path in files for m in undocumented(path)]
     print("\n".join(missing))
@@ -128,8 +110,7 @@ def named_modules(package: str) -> set[str]:
     return set(re.findall(r":mod:`\.(\w+)`", doc))
 
 
-@pytest.mark.parametrize("package", [pytest.param(p, marks=[PENDING] if p in PENDING_INIT else [])
-                                     for p in PACKAGES])
+@pytest.mark.parametrize("package", PACKAGES)
 def test_package_docstring_names_its_modules(package):
     named = named_modules(package)
     present = {p.stem for p in modules_of(package)}

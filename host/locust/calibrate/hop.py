@@ -133,6 +133,29 @@ class HopRun:
 
 @dataclass(frozen=True)
 class RunFit:
+    """How the fitted robot follows one run's tracked markers.
+
+    Attributes
+    ----------
+    source : str
+        The run (its folder's name).
+    config : str
+        Its leg set or configuration.
+    rms_m : float
+        RMS residual over all its tracked coordinates [m].
+    rms_by_marker_m : dict of str to float
+        The same per marker [m].
+    samples : int
+        Tracked coordinates compared.
+    curves : dict
+        Marker -> (aligned time [s], tracked x, y [m], simulated time [s], simulated x, y [m]),
+        for the plots.
+    timestep_s : float
+        The step the run was fitted at [s].
+    step_change_m : float
+        RMS move of its markers at half that step, at the start values [m].
+    """
+
     source: str
     config: str
     rms_m: float                         # all tracked coordinates of the run
@@ -145,6 +168,35 @@ class RunFit:
 
 @dataclass(frozen=True)
 class HopFit:
+    """The hop fit: the fitted values with their intervals, and how each run is followed.
+
+    Attributes
+    ----------
+    keys : tuple of str
+        The fitted robot parameters, by dotted name (the unit in the name).
+    start : dict of str to float
+        Each key's starting value, in its unit.
+    estimates : dict of str to Estimate
+        Each key's value, standard deviation (numerical, held-value and model-error parts
+        included) and 95 % interval, in its unit.
+    identifiable : dict of str to bool
+        Whether the runs determine the key (its interval narrow enough).
+    runs : list of RunFit
+        Each run's residuals and curves.
+    notes : list of str
+        What a person should know about the fit.
+    rms_m : float
+        RMS residual over every run [m].
+    iterations : int
+        Solver iterations.
+    simulations : int
+        Simulations run.
+    wall_s : float
+        Wall time of the fit [s].
+    interval : str
+        What the intervals include.
+    """
+
     keys: tuple[str, ...]
     start: dict[str, float]
     estimates: dict[str, Estimate]
@@ -158,6 +210,15 @@ class HopFit:
     interval: str = ""                   # what the intervals include
 
     def summary(self) -> dict:
+        """The fit as the JSON of ``locust calibrate hop --json``.
+
+        Returns
+        -------
+        dict
+            ``parameters`` (each key's estimate, identifiability and start), ``runs`` (their
+            residuals [m] and steps [s]), the interval's wording, the RMS residual [m], the
+            solver's iterations and simulations, the wall time [s] and the notes.
+        """
         params = {k: {**self.estimates[k].as_dict(), "identifiable": self.identifiable[k], "start": self.start[k]}
                   for k in self.keys}
         return {"experiment": "hops", "source": "+".join(r.source for r in self.runs),
