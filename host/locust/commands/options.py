@@ -1,7 +1,12 @@
-"""Click parameter types every command shares: numbers that must be finite (and positive).
+"""The options several commands share, each defined once.
 
-``click``'s own ``float`` takes ``nan`` and ``inf``; an option given one of them would reach a
-fit or a drawing as nonsense, so these refuse it where the command line is read.
+- ``FiniteFloat`` (``FINITE``, ``POSITIVE``): numbers that must be finite (and positive):
+  ``click``'s own ``float`` takes ``nan`` and ``inf``, which would reach a fit or a drawing as
+  nonsense, so these refuse them where the command line is read.
+- ``robot_options``: ``--preset``, ``--config``, ``--set``, and the robot a command runs on when
+  given neither (``default_robot``: ``calibration/robot.toml`` here, else the robot as built).
+- ``import_options``: ``--units``, ``--rename``, ``--mirror`` for foreign tracks.
+- ``time_options``: ``--time-scale``, ``--clip-fps`` for slow-motion recordings.
 """
 
 from __future__ import annotations
