@@ -89,9 +89,9 @@ def test_bad_tracks_csv_names_file_and_line(tmp_path, text, words):
     assert str(path) in err.value.message and err.value.hint
 
 
-def test_track_files_are_named_beside_the_video(tmp_path):
+def test_track_files_are_named_after_the_video(tmp_path):
     video = tmp_path / "hop.mp4"
-    assert tc.tracks_csv_beside(video) == tmp_path / "hop.tracks.csv"
+    assert tc.tracks_csv_in(tmp_path / "out", video) == tmp_path / "out" / "hop.tracks.csv"   # in the output folder
     assert cam.camera_json_beside(video) == tmp_path / "hop.camera.json"
 
 

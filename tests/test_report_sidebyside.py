@@ -68,7 +68,7 @@ def report(tmp_path_factory):
     frames = {}
     for name, camera in (("nb-1", "fixed"), ("nb-2", "track")):
         frames[name] = _film(result.trajectory, robot, root / name / "hop.mp4", camera)
-        out = CliRunner().invoke(cli, ["track", str(root / name / "hop.mp4")])
+        out = CliRunner().invoke(cli, ["track", str(root / name / "hop.mp4"), "--out", str(root / name)])
         assert out.exit_code == 0, out.output
     # nb-3: the same film without its camera.json (a real camera); nb-4: a track without its video
     (root / "nb-3").mkdir()

@@ -93,7 +93,7 @@ def test_live_fixed_video_tracks_into_metres(tmp_path):
     for name in ("nose", "foot"):   # the whole run stays in the picture, clear of the edges
         assert truth[f"{name}_px"].between(10, 630).all() and truth[f"{name}_py"].between(10, 350).all()
         assert (truth[f"{name}_seen_frac"] >= 0.9).mean() >= 0.95
-    res = CliRunner().invoke(cli, ["track", str(path), "--overlay", "none"])
+    res = CliRunner().invoke(cli, ["track", str(path), "--overlay", "none", "--out", str(tmp_path)])
     assert res.exit_code == 0, res.output
     tracks = pd.read_csv(tmp_path / "live.tracks.csv")
     for name in ("nose", "foot"):

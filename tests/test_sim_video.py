@@ -145,7 +145,8 @@ def test_markers_clear_of_the_floor_and_found_by_default(clips):
         truth = pd.read_csv(info.truth_path, comment="#")
         for name in MARKER_COLOURS:
             assert (truth[f"{name}_seen_frac"] >= 0.9).mean() >= 0.95, (info.camera, name)
-        res = CliRunner().invoke(cli, ["track", str(info.video_path), "--overlay", "none"])
+        res = CliRunner().invoke(cli, ["track", str(info.video_path), "--overlay", "none", "--out",
+                                       str(info.video_path.parent)])
         assert res.exit_code == 0, res.output
         tracks = pd.read_csv(info.video_path.with_name(info.video_path.stem + ".tracks.csv"))
         for name in MARKER_COLOURS:

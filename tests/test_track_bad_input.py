@@ -23,6 +23,12 @@ from probing import assert_refused_and_unchanged, invoke
 RNG = np.random.default_rng(28)
 
 
+@pytest.fixture(autouse=True)
+def _outputs_in_tmp(tmp_path, monkeypatch):
+    """Tracks written without --out land in the current folder: each test's own."""
+    monkeypatch.chdir(tmp_path)
+
+
 @pytest.fixture(scope="module")
 def hop(tmp_path_factory):
     """A SYNTHETIC 320x180 hop clip with the default nose and foot colours, 20 frames."""

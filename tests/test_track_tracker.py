@@ -31,7 +31,7 @@ def _ball_error_px(balltoss, *args):
     """Distance (px) of each of frames 3..12 from Tracker's own step, both in OpenCV's pixels."""
     res = CliRunner().invoke(cli, ["track", "videos/BallToss_new_BallToss.mp4", *args, "--force"])
     assert res.exit_code == 0, res.output
-    got = pd.read_csv(balltoss / "videos" / "BallToss_new_BallToss.tracks.csv").set_index("frame").loc[3:12]
+    got = pd.read_csv(balltoss / "BallToss_new_BallToss.tracks.csv").set_index("frame").loc[3:12]   # the current folder
     assert got["ball_ok"].all(), "a frame is missing"
     project = trk_io.read_project(balltoss / "BallToss_BallToss.trk")      # Tracker's points, in OpenCV's pixels
     theirs = np.array([project.points["ball"][f] for f in range(3, 13)])

@@ -13,12 +13,13 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..errors import TrackError
-from ..fileio import atomic_write_json
+from ..errors import TrackError, WriteError
+from ..fileio import atomic_write_json, refuse_read_only_folder
 from ..io import trk as trk_io
 from ..io.camera_json import camera_json_beside
 from ..io.importing import ImportOptions, import_tracks, is_project, span_warnings
-from ..io.tracks_csv import tracks_csv_beside, write_tracks_csv
+from ..io.run_record import RECORD_NAME
+from ..io.tracks_csv import tracks_csv_in, write_tracks_csv
 from ..progress import progress
 from ..track import board, calib, camera, export, overlay, preview, trk
 from ..track.aruco import side_px_in_video
@@ -63,6 +64,12 @@ def track():
     `locust track video VIDEO ...`.
 
     \b
+    Every subcommand writes into one output folder, named on the first line (stderr): --out
+    (a folder, or the tracks file's path), else the run folder the input sits in (`locust hop
+    --out` made it: run.json beside the input; calibrate hop and report read its track there),
+    else the current folder; never beside an input in a folder of its own.
+
+    \b
     Examples:
       locust track hop.mp4                                 nose + foot by colour (metres from hop.camera.json)
       locust track board board.png                         print at 100 %, lay it in the plane of the hop
@@ -91,7 +98,9 @@ def video_command(video, models, pixels, start, end, step, fps, out, force, fmt,
     World columns are metres once a scale is given (--scale, --scale-aruco, --board,
     --plane-points), or through the pinhole camera of a simulated video (its
     <video>.camera.json, found beside it). A marker not found in a frame is nan with
-    <name>_ok = 0; it is never filled in. Writes <video>.tracks.csv, .json and .png.
+    <name>_ok = 0; it is never filled in. Writes <video>.tracks.csv, .json and .png into the
+    output folder named on the first line: --out, else the run folder VIDEO sits in (run.json
+    beside it), else the current folder.
 
     \b
     Examples:
@@ -155,8 +164,8 @@ def import_command(file, imports: ImportOptions, trk_names, out, force):
     if trk_names:
         raise TrackError("--track picks the tracks of a Tracker project converted as it is",
                          "leave out --rename and --mirror, or leave out --track")
+    target = _tracks_path(out, file)
     tracks = import_tracks(file, options=imports)
-    target = out if out is not None and not out.is_dir() else tracks_csv_beside(out / file.name if out else file)
     if target.exists() and target.resolve() == file.resolve():
         raise TrackError(f"--out {target} is the file being imported", "write the tracks CSV to another --out")
     _refuse_overwrite({"tracks": target}, force)
@@ -209,6 +218,7 @@ def board_command(png, board_text, force):
       locust track board small.png --board aruco:4X4_50:4x3:30:6
     """
     spec = board.parse_board(board_text)
+    _say_folder(png)
     _refuse_overwrite({"board": png}, force)
     board.write_board_png(png, spec)
     click.echo(f"wrote {png}: board {spec.text()}, {spec.width_mm:g} x {spec.height_mm:g} mm of markers "
@@ -223,8 +233,9 @@ def board_command(png, board_text, force):
 @stacked(*OUTPUT)
 def preview_command(video, frame, models, pixels, out, force):
     """Write one FRAME of VIDEO with a pixel grid, the most saturated blobs listed (colour,
-    position) and what the --marker specs find there, to <out>.preview.png: pick colours
-    and start points for `locust track video` without a GUI.
+    position) and what the --marker specs find there, to <out>.preview.png in the output
+    folder named on the first line: pick colours and start points for `locust track video`
+    without a GUI.
 
     \b
     Examples:
@@ -233,9 +244,9 @@ def preview_command(video, frame, models, pixels, out, force):
     """
     project = trk_io.read_project(video) if is_project(video) else None
     with _media(video, project) as media:
+        path = _tracks_path(out, video)
+        path = path.with_name(_stem(path) + ".preview.png")
         info = probe(media)
-        base = _base_path(out, video)
-        path = base.with_name(base.name + ".preview.png")
         _refuse_inputs({"preview": path}, [video, media])
         _refuse_overwrite({"preview": path}, force)
         blobs, found = preview.preview(info, frame, models, path)
@@ -263,8 +274,13 @@ def _media(video: Path, project):
         yield video
 
 
+def _stem(path: Path) -> str:
+    """``hop.tracks.csv`` -> ``hop.tracks``: the name the outputs share (a .csv or .txt suffix off)."""
+    return path.name[: -len(path.suffix)] if path.suffix in (".csv", ".txt") else path.name
+
+
 def _outputs(base: Path, fmt: str, overlay_kind: str) -> dict[str, Path]:
-    stem = base.name[: -len(base.suffix)] if base.suffix in (".csv", ".txt") else base.name
+    stem = _stem(base)
     folder = base.parent
     out = {"tracks": folder / f"{stem}{'.txt' if fmt == 'tracker' else '.csv'}", "sidecar": folder / f"{stem}.json"}
     if overlay_kind == "png":
@@ -297,21 +313,40 @@ def _refuse_inputs(paths: dict[str, Path], inputs: list[Path], info: VideoInfo |
                          "file the next run would read as one)", "choose an --out outside the sequence's folder")
 
 
-def _base_path(out: Path | None, source: Path) -> Path:
-    default_stem = tracks_csv_beside(source).with_suffix("").name   # hop.tracks (.csv, .json, .png)
-    if out is None:
-        return source.with_name(default_stem)
-    if out.is_dir():
-        return out / default_stem
-    if out.exists() and not out.is_file():
+def _tracks_path(out: Path | None, source: Path) -> Path:
+    """The tracks file of ``source``: ``--out`` as given, or ``<stem>.tracks.csv`` in the ``--out``
+    folder, else in :func:`_default_folder`; its folder is named on stderr as the first line."""
+    if out is not None and not out.is_dir() and out.exists() and not out.is_file():
         raise TrackError(f"--out {out} is a device or pipe, not a folder or a file name",
                          "give a folder, or the path of the tracks file to write")
-    return out
+    path = out if out is not None and not out.is_dir() else tracks_csv_in(out or _default_folder(source), source)
+    _say_folder(path)
+    return path
+
+
+def _default_folder(source: Path) -> Path:
+    """Without --out: the run folder ``source`` sits in (``locust hop --out`` made it; ``run.json``
+    beside ``source``), where ``locust calibrate hop`` and ``locust report`` read its track, unless
+    its mode says it is read-only (someone else's); else the current folder, as ``locust
+    calibrate``'s plots, never a data folder beside the input."""
+    folder = source.parent
+    if (folder / RECORD_NAME).is_file():
+        with contextlib.suppress(WriteError):
+            refuse_read_only_folder(folder)
+            return folder
+    return Path(".")
+
+
+def _say_folder(path: Path) -> None:
+    click.echo(f"output folder: {path.parent.resolve()}", err=True)
 
 
 def _track(video: Path, named: Path, project, models: list, cal: dict, clip: Clip, out, fmt, overlay_kind, force,
            trk_out) -> None:
     """Track ``video`` (``named`` on the command line: the video, or a Tracker project that opens it)."""
+    paths = _outputs(_tracks_path(out, named), fmt, overlay_kind)
+    if trk_out is not None:
+        paths["trk"] = trk_out
     info = probe(video)
     clip = clip.resolved(info)
     if cal["board_text"] or cal["plane_points"]:
@@ -327,9 +362,6 @@ def _track(video: Path, named: Path, project, models: list, cal: dict, clip: Cli
     else:
         calibration = _calibration(info, clip, cal["scale"], cal["scale_aruco"], cal["aruco_dict"], cal["origin"],
                                    cal["angle"], cal["camera_json"], cal["pixels"])
-    paths = _outputs(_base_path(out, named), fmt, overlay_kind)
-    if trk_out is not None:
-        paths["trk"] = trk_out
     _refuse_inputs(paths, [p for p in (video, named, cal["camera_json"], project and project.path) if p], info)
     _refuse_overwrite(paths, force)
 
@@ -386,9 +418,9 @@ def _write(result, paths: dict[str, Path], fmt: str) -> list[Path]:
 
 
 def _convert_trk(path: Path, names: list[str], out, fmt: str, force: bool) -> None:
+    paths = _outputs(_tracks_path(out, path), fmt, "none")
     project = trk_io.read_project(path)
     result = trk.project_result(project, names or None)
-    paths = _outputs(_base_path(out, path), fmt, "none")
     _refuse_inputs(paths, [path])
     _refuse_overwrite(paths, force)
     _report(result, _write(result, paths, fmt))

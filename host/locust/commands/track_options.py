@@ -28,7 +28,9 @@ def stacked(*options):
 
 
 OUTPUT = [click.option("--out", type=click.Path(path_type=Path),
-                       help="Output file (or folder). Default: beside the input, <input>.tracks.csv (with .json)."),
+                       help="Output file (or folder), its folder named on the first line. Default: <input>.tracks.csv "
+                            "(with .json) in the run folder the input sits in (run.json beside it), else in the "
+                            "current folder; never beside an input in a folder of its own."),
           click.option("--force", is_flag=True, help="Replace existing output files.")]
 FORMAT = [click.option("--format", "fmt", type=click.Choice(["csv", "tracker"]), default="csv", show_default=True,
                        help="csv: frame, t_s, <name>_px/_py/_x_m/_y_m/_ok. tracker: Tracker's text export layout.")]

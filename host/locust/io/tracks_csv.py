@@ -42,18 +42,23 @@ TRACKS_CSV_SUFFIX = ".tracks.csv"
 MARKER_COLUMNS = ("px", "py", "x_m", "y_m", "ok")   # per marker, in the order written
 
 
-def tracks_csv_beside(video: Path) -> Path:
-    """``hop.mp4`` -> ``hop.tracks.csv``: where ``locust track`` writes a video's tracks.
+def tracks_csv_in(folder: Path, source: Path) -> Path:
+    """``folder``, ``.../hop.mp4`` -> ``folder/hop.tracks.csv``: the name ``locust track`` gives
+    the tracks of ``source`` (a video, an image sequence's folder, a Tracker project or another
+    program's tracks) in its output folder.
 
     Parameters
     ----------
-    video : pathlib.Path
+    folder : pathlib.Path
+        The output folder.
+    source : pathlib.Path
+        What was tracked or converted.
 
     Returns
     -------
     pathlib.Path
     """
-    return video.with_name(video.stem + TRACKS_CSV_SUFFIX)
+    return folder / (source.stem + TRACKS_CSV_SUFFIX)
 
 
 @dataclass(frozen=True, eq=False)

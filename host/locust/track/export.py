@@ -78,7 +78,8 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
     src: dict = {"kind": result.source}
     if result.video is not None:
         v = result.video
-        src.update(video=str(v.path), width_px=v.width_px, height_px=v.height_px,
+        # absolute: the sidecar lands in the output folder, seldom beside the video
+        src.update(video=str(Path(v.path).resolve()), width_px=v.width_px, height_px=v.height_px,
                    frame_count=v.frame_count, file_fps=v.file_fps)
     return {
         "format": "locust.track/1",
