@@ -17,6 +17,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pandas as pd
 import pytest
@@ -26,7 +27,7 @@ from locust.commands import cli
 from locust.io import trk as trk_io
 from locust.track.synth import make_hop_video
 from locust.trials.measured import load_trial
-from probing import tree
+from probing import assert_clear_error, tree
 
 OUTPUTS = ["hop.tracks.csv", "hop.tracks.json", "hop.tracks.png"]
 SCALE = "0,0,100,0=0.1"    # 1 mm a pixel: the run folder's track in metres, as calibrate and report need
@@ -179,3 +180,43 @@ def test_an_existing_output_is_never_replaced_without_force(read_only, work, arg
     assert res.exit_code == 0, res.output
     assert all(p.stat().st_ino != written[p.name] for p in work.iterdir())   # each replaced (atomically: new file)
     assert {p.name for p in work.iterdir()} == set(written)
+
+
+@pytest.fixture()
+def frames(tmp_path) -> Path:
+    """A SYNTHETIC image sequence: a 10x10 px patch of #e8308c on black, 5 px further right each frame."""
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    for i in range(4):
+        img = np.zeros((60, 80, 3), np.uint8)
+        img[20:30, 10 + 5 * i:20 + 5 * i] = (140, 48, 232)
+        cv2.imwrite(str(folder / f"f{i:03d}.png"), img)
+    return folder
+
+
+def test_a_sequence_tracked_from_inside_its_folder_is_refused_there_and_written_with_out(frames, tmp_path,
+                                                                                         monkeypatch):
+    """`locust track .` inside the frames' folder: the outputs would land among the frames (a
+    `frames.tracks.png` the next run reads as one), so it is refused, as a clear error (it was a
+    traceback: `.` has no name); `--out ..` writes them beside the folder."""
+    monkeypatch.chdir(frames)
+    before = tree(frames)
+    args = [".", "--fps", 10, "--marker", "spot=color:#e8308c", "--pixels", "opencv"]
+    res = track(*args)
+    assert_clear_error(res, "a frame of the image sequence")
+    assert first_line(res) == f"output folder: {frames.resolve()}"
+    assert tree(frames) == before
+    res = track(*args, "--out", "..")
+    assert res.exit_code == 0, res.output
+    assert first_line(res) == f"output folder: {tmp_path.resolve()}" and tree(frames) == before
+    df = pd.read_csv(tmp_path / "frames.tracks.csv", comment="#")
+    np.testing.assert_allclose(df["spot_px"], [14.5, 19.5, 24.5, 29.5], atol=0.01)   # the patch's centres
+
+
+def test_preview_of_an_image_sequence_needs_no_frame_rate(frames, work):
+    before = tree(frames)
+    res = track("preview", frames, "--frame", 2)
+    assert res.exit_code == 0, res.output      # was: `an image sequence has no frame rate`, and no --fps to give
+    assert first_line(res) == f"output folder: {work.resolve()}"
+    assert "#e8308c" in res.stdout and "(100 px)" in res.stdout, res.stdout    # the 10x10 patch
+    assert os.listdir(work) == ["frames.tracks.preview.png"] and tree(frames) == before

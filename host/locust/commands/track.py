@@ -116,6 +116,7 @@ def video_command(video, models, pixels, start, end, step, fps, out, force, fmt,
         raise TrackError(f"--angle {calibration['angle']}: not a finite number", "give --angle as a plain number")
     if trk_out is not None and trk_out.suffix.lower() != ".trk":
         raise TrackError(f"--trk {trk_out}: a Tracker project is written as a .trk file", "e.g. --trk redo.trk")
+    video = _named(video)
     project = None
     if is_project(video):
         if calibration_from is not None:
@@ -242,6 +243,7 @@ def preview_command(video, frame, models, pixels, out, force):
       locust track preview phone.mp4                       -> phone.tracks.preview.png
       locust track preview phone.mp4 --frame 40 --marker nose=color:#e8308c@412,630
     """
+    video = _named(video)
     project = trk_io.read_project(video) if is_project(video) else None
     with _media(video, project) as media:
         path = _tracks_path(out, video)
@@ -262,6 +264,12 @@ def preview_command(video, frame, models, pixels, out, force):
             p = (p[0] - PIXEL_CONVENTIONS[pixels], p[1] - PIXEL_CONVENTIONS[pixels])
         click.echo(f"  marker {name}: " + (f"found at {p[0]:.1f},{p[1]:.1f}" if p else "not found"))
     click.echo(f"wrote {path}")
+
+
+def _named(video: Path) -> Path:
+    """``.`` (an image sequence's folder, run from inside it) by its own name, which the
+    outputs and sidecars are named after."""
+    return video.resolve() if not video.name else video
 
 
 @contextlib.contextmanager

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import TrackError
 from ..fileio import atomic_write_bytes
-from .video import Clip, read_frames
+from .video import read_frame
 
 MIN_SATURATION = 110   # OpenCV 8-bit saturation: a sticker, not a tinted wall
 MIN_VALUE = 50
@@ -141,7 +141,7 @@ def preview(info, frame: int, models: list, path: Path) -> tuple[list[Blob], dic
     """
     if not 0 <= frame < info.frame_count:
         raise TrackError(f"--frame {frame}: the video has frames 0..{info.frame_count - 1}", "pick a frame in it")
-    image = next(img for _, img in read_frames(info, Clip(frame, frame).resolved(info)))
+    image = read_frame(info, frame)   # an image sequence too: one frame needs no frame rate
     blobs = saturated_blobs(image)
     found = {}
     for m in models:
