@@ -26,10 +26,11 @@ from locust.commands import cli
 from locust.io.camera_json import read_camera_json
 from locust.markers import MARKER_COLOURS
 from locust.params import preset
-from locust.report.sidebyside import OWN_CAMERA
+from locust.report.sidebyside import OWN_CAMERA, find_video
 from locust.sim.camera import CameraView, frame_views
 from locust.sim.clip import ClipRecorder, PoseRenderer
 from locust.sim.run import run
+from locust.trials.measured import load_trial
 from test_sim_video import _frames, blob_centroid
 
 W, H, FPS = 320, 240, 30
@@ -190,3 +191,21 @@ def test_pose_renderer_takes_any_pinhole_camera():
         blob = blob_centroid(bgr, hex_colour)
         assert blob is not None
         assert np.hypot(*(np.array(blob) - odd.project(face)[0])) < 0.5, name
+
+
+def test_a_track_written_away_from_its_video_finds_it_through_its_sidecar(report, tmp_path, monkeypatch):
+    """`locust track` writes into the current folder, away from the video: the report finds
+    the video the track's sidecar records; a track without its sidecar, or whose video has
+    moved, has none."""
+    root = report["root"]
+    monkeypatch.chdir(tmp_path)
+    out = CliRunner().invoke(cli, ["track", str(root / "nb-1" / "hop.mp4")])
+    assert out.exit_code == 0, out.output
+    assert (tmp_path / "hop.tracks.csv").is_file() and not (tmp_path / "hop.mp4").exists()
+    assert find_video(load_trial(tmp_path / "hop.tracks.csv", "seed-notebook")) == (root / "nb-1" / "hop.mp4").resolve()
+    (tmp_path / "hop.tracks.json").rename(tmp_path / "kept.json")
+    assert find_video(load_trial(tmp_path / "hop.tracks.csv", "seed-notebook")) is None
+    doc = json.loads((tmp_path / "kept.json").read_text())
+    doc["source"]["video"] = str(tmp_path / "moved.mp4")
+    (tmp_path / "hop.tracks.json").write_text(json.dumps(doc))
+    assert find_video(load_trial(tmp_path / "hop.tracks.csv", "seed-notebook")) is None

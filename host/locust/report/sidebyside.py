@@ -44,6 +44,7 @@ from ..errors import ReportError, TrackError
 from ..io.camera_json import CameraFile, camera_json_beside, read_camera_json
 from ..io.tracks_csv import TRACKS_CSV_SUFFIX, TracksCsv, read_track_file
 from ..progress import progress
+from ..track.export import sidecar_video
 from ..track.video import Clip, VideoInfo, encode_video, probe, read_frames
 from .compare import Comparison, MeasuredTrial
 
@@ -212,8 +213,9 @@ def plan_side_by_side(comps: list[Comparison]) -> Plan:
 
 
 def find_video(trial) -> Path | None:
-    """The trial's filmed video: beside its track (``x.tracks.csv`` -> ``x.mp4``), else
-    ``hop.mp4`` in its folder.
+    """The trial's filmed video: beside its track (``x.tracks.csv`` -> ``x.mp4``), else the
+    one its track's sidecar records (``locust track`` writes into an output folder, often
+    away from the video), else ``hop.mp4`` in its folder.
 
     Parameters
     ----------
@@ -232,6 +234,9 @@ def find_video(trial) -> Path | None:
         for suffix in VIDEO_SUFFIXES:
             if (track.parent / (stem + suffix)).is_file():
                 return track.parent / (stem + suffix)
+        recorded = sidecar_video(track)
+        if recorded is not None:
+            return recorded
         folders.append(track.parent)
     if trial.run_path is not None:
         folders.append(trial.run_path.parent)

@@ -9,6 +9,7 @@ marker not found is ``nan`` with ok 0). This module turns a
 
 from __future__ import annotations
 
+import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -19,6 +20,7 @@ from ..io.tracks_csv import MarkerColumns, TracksCsv, tracks_csv_text, write_tra
 from ..version import __version__
 from .runner import TrackResult
 
+SIDECAR_FORMAT = "locust.track/1"   # the JSON sidecar beside a tracks CSV
 PIXEL_CONVENTION = "OpenCV: origin at the centre of the top-left pixel, x right, y down"
 
 
@@ -72,7 +74,7 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
     Returns
     -------
     dict
-        The sidecar (format ``locust.track/1``).
+        The sidecar (format :data:`SIDECAR_FORMAT`).
     """
     clip = result.clip
     src: dict = {"kind": result.source}
@@ -82,7 +84,7 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
         src.update(video=str(Path(v.path).resolve()), width_px=v.width_px, height_px=v.height_px,
                    frame_count=v.frame_count, file_fps=v.file_fps)
     return {
-        "format": "locust.track/1",
+        "format": SIDECAR_FORMAT,
         "locust_version": __version__,
         "tracks": csv_path.name,
         "pixel_convention": PIXEL_CONVENTION,
@@ -117,6 +119,32 @@ def write_tracks(result: TrackResult, csv_path: Path) -> tuple[Path, Path]:
     write_tracks_csv(csv_path, tracks_of(result))
     atomic_write_json(json_path, sidecar(result, csv_path))
     return csv_path, json_path
+
+
+def sidecar_video(csv_path: Path) -> Path | None:
+    """The video a tracks CSV was tracked from, as its sidecar (``<stem>.json`` beside it,
+    :func:`write_tracks`) records it: the sidecar often lies in an output folder away from
+    the video.
+
+    Parameters
+    ----------
+    csv_path : Path
+        The tracks CSV.
+
+    Returns
+    -------
+    Path or None
+        The recorded video where it is still a file; None without a readable locust sidecar,
+        or where the video has moved.
+    """
+    try:
+        doc = json.loads(csv_path.with_suffix(".json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(doc, dict) or doc.get("format") != SIDECAR_FORMAT:
+        return None
+    video = doc.get("source", {}).get("video")
+    return Path(video) if isinstance(video, str) and Path(video).is_file() else None
 
 
 JUMP_MIN_PX = 50.0
