@@ -28,7 +28,9 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import threading
 import time
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -82,6 +84,9 @@ HOP_TRUTH = {"contact.foot_friction": 2.0, "compliance.hinge_stiffness_nm_per_ra
              "servo.noload_speed_rad_per_s": 9.0}
 HOP_FIT_SETS = ("small", "large")   # the two leg sets farthest apart (Small + Medium: test_calibrate_hop_virtual)
 REPORT_SAMPLES = 8
+# hops filmed at once: each takes about one core (its video's rendering) while its firmware
+# paces it in real time, so two keep a 2-core machine busy without slowing the firmware's clock
+HOP_JOBS = 2
 
 
 def recording_truth(paths: list[Path]) -> dict[str, float]:
@@ -113,13 +118,18 @@ def relay_progress(lines, out) -> str:
         kept.append(line)
         if PROGRESS_MARK in line:
             text = "      " + line.strip()
-            out.write("\r\x1b[K" + text if tty else text + "\n")
-            out.flush()
+            with _OUT_LOCK:   # (commands run side by side each relay theirs)
+                out.write("\r\x1b[K" + text if tty else text + "\n")
+                out.flush()
             shown = True
     if tty and shown:
-        out.write("\n")
-        out.flush()
+        with _OUT_LOCK:
+            out.write("\n")
+            out.flush()
     return "".join(kept)
+
+
+_OUT_LOCK = threading.Lock()
 
 
 class Demo:
@@ -133,14 +143,17 @@ class Demo:
         self.stages: list[dict] = []
         self.env = {"LOCUST_VIRTUAL_DIR": str(folder / "virtual"), "PYTHONUNBUFFERED": "1"}
 
-    def call(self, args: list[str]) -> str:
+    def call(self, args: list[str], step: int | None = None) -> str:
         """``locust ARGS`` in a child process; its output goes to logs/NN-verb.log; a failure stops the demo.
 
         A child per command: each starts clean, as a user's would (one process rendering many
-        offscreen videos in turn is not what the commands are built for).
+        offscreen videos in turn is not what the commands are built for). ``step`` numbers its
+        log (default: the next).
         """
-        self.steps += 1
-        log = self.logs / f"{self.steps:02d}-{args[0]}{'-' + args[1] if args[0] == 'calibrate' else ''}.log"
+        if step is None:
+            self.steps += 1
+            step = self.steps
+        log = self.logs / f"{step:02d}-{args[0]}{'-' + args[1] if args[0] == 'calibrate' else ''}.log"
         cmd = [sys.executable, "-m", "locust.commands", *args]
         with subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                               text=True, env={**os.environ, **self.env}) as proc:
@@ -152,13 +165,34 @@ class Demo:
                               f"its whole output is in {log}")
         return output
 
-    def expect(self, *paths: Path) -> None:
-        """The files the last command should have written; a command that exits 0 without them
-        stops the demo here rather than at the next stage."""
+    def call_side_by_side(self, calls: list[tuple[list[str], tuple[Path, ...]]], jobs: int, bar) -> None:
+        """Each ``(args, expected files)`` of ``calls`` as :meth:`call`, ``jobs`` at a time, each
+        numbered in order; ``bar`` counts those done. The first failure (in order) stops the
+        demo once the others running have ended."""
+        first = self.steps
+        self.steps += len(calls)
+
+        def one(k: int) -> None:
+            args, paths = calls[k]
+            self.call(args, first + 1 + k)
+            self.expect(*paths, step=first + 1 + k)
+
+        with ThreadPoolExecutor(max_workers=max(1, min(jobs, len(calls)))) as pool:
+            futures = [pool.submit(one, k) for k in range(len(calls))]
+            for future in as_completed(futures):
+                if future.exception() is None:
+                    bar.update(1)
+        for future in futures:
+            future.result()
+
+    def expect(self, *paths: Path, step: int | None = None) -> None:
+        """The files the last command (or command ``step``) should have written; a command that
+        exits 0 without them stops the demo here rather than at the next stage."""
+        step = self.steps if step is None else step
         missing = [str(p) for p in paths if not p.is_file()]
         if missing:
-            log = sorted(self.logs.glob(f"{self.steps:02d}-*.log"))
-            raise ReportError(f"demo stopped: step {self.steps} exited 0 but did not write {', '.join(missing)}",
+            log = sorted(self.logs.glob(f"{step:02d}-*.log"))
+            raise ReportError(f"demo stopped: step {step} exited 0 but did not write {', '.join(missing)}",
                               f"its output is in {log[0] if log else self.logs}")
 
     @contextmanager
@@ -170,8 +204,8 @@ class Demo:
         self.stages.append({"stage": title, "wall_s": round(wall, 2)})
         self.say(f"      {wall:.1f} s")
 
-    def bar(self, items, label: str):
-        return progress(items, label=label, show_pos=True)
+    def bar(self, items, label: str, length: int | None = None):
+        return progress(items, length=length, label=label, show_pos=True)
 
     def say(self, msg: str) -> None:
         click.echo(msg, file=self.stderr)
@@ -185,7 +219,8 @@ class Demo:
               help="Hops filmed per leg set (repeated trials give the report its error bars).")
 @click.option("--designs", type=click.IntRange(2, 61), default=7, show_default=True,
               help="Designs in the sweep: scale from 0 to 3 cm added to every link.")
-@click.option("--jobs", type=click.IntRange(1, 64), default=None, help="Sweep workers [every local core].")
+@click.option("--jobs", type=click.IntRange(1, 64), default=None,
+              help="Sweep workers, and hops filmed at once up to 2 [every local core].")
 @click.option("--fit-hops/--no-fit-hops", default=True, show_default=True,
               help="Hide values the bench cannot reach in the virtual robot and fit them from its filmed hops.")
 def demo(out, cycles, trials, designs, jobs, fit_hops):
@@ -220,11 +255,13 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     with d.stage(1, total, "flash the firmware to the virtual robot"):
         d.call(["flash", "--port", "sim"])
     with d.stage(2, total, f"hop Small, Medium, Large x {trials} on the virtual robot, {cycles} cycles, filmed"):
-        with d.bar(trials_dirs, "hops") as bar:
-            for name, trial in bar:
-                d.call(["hop", "--port", "sim", *seed_leg_set_options(name), "--leg-set", name, *truth_sets,
-                        "--cycles", str(cycles), "--video", str(trial / "hop.mp4"), "--out", str(trial)])
-                d.expect(trial / "hop.mp4", trial / "run.json")
+        # each hop is its own virtual robot (the one flash folder, read only), the firmware paced
+        # in real time while one core renders its video: HOP_JOBS of them film at once
+        hops = [(["hop", "--port", "sim", *seed_leg_set_options(name), "--leg-set", name, *truth_sets,
+                  "--cycles", str(cycles), "--video", str(trial / "hop.mp4"), "--out", str(trial)],
+                 (trial / "hop.mp4", trial / "run.json")) for name, trial in trials_dirs]
+        with d.bar(None, "hops", length=len(hops)) as bar:
+            d.call_side_by_side(hops, min(HOP_JOBS, jobs or os.cpu_count() or 1), bar)
     with d.stage(3, total, "track nose and foot in the videos"):
         with d.bar(trials_dirs, "tracks") as bar:
             for _, trial in bar:
