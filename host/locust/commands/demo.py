@@ -204,11 +204,32 @@ class Demo:
         self.stages.append({"stage": title, "wall_s": round(wall, 2)})
         self.say(f"      {wall:.1f} s")
 
+    @contextmanager
     def bar(self, items, label: str, length: int | None = None):
-        return progress(items, length=length, label=label, show_pos=True)
+        """A stage's bar over its commands: each carries its own start-up, so the time left is
+        measured from the start; shown every ~10 s off a terminal while a long command runs."""
+        with progress(items, length=length, label=label, show_pos=True, rate_from_start=True,
+                      file=self.stderr) as bar:
+            done = threading.Event()
+            ticker = threading.Thread(target=_tick, args=(bar, done), name="locust-demo-progress", daemon=True)
+            ticker.start()
+            try:
+                yield bar
+            finally:
+                done.set()
+                ticker.join()
 
     def say(self, msg: str) -> None:
         click.echo(msg, file=self.stderr)
+
+
+def _tick(bar, done: threading.Event) -> None:
+    while not done.wait(TICK_S):
+        with _OUT_LOCK:
+            bar.tick()
+
+
+TICK_S = 1.0   # a stage's bar is looked at this often (it shows itself when due)
 
 
 @click.command()
