@@ -106,16 +106,19 @@ def recording_truth(paths: list[Path]) -> dict[str, float]:
 
 # a progress line (locust.progress) always says how long it has run
 PROGRESS_MARK = " elapsed"
+REPORT_STAGE_MARK = "report: "   # `locust report` says each of its stages so
 
 
-def relay_progress(lines, out) -> str:
+def relay_progress(lines, out, on_line=None) -> str:
     """All of a child command's output (``lines``), returned whole; its progress lines, which
     it prints every ~10 s off a terminal, shown on ``out`` as they come, indented under the
-    stage (on a terminal, redrawn in place)."""
+    stage (on a terminal, redrawn in place). ``on_line(line)`` sees every line as it comes."""
     tty = out.isatty()
     kept, shown = [], False
     for line in lines:
         kept.append(line)
+        if on_line is not None:
+            on_line(line)
         if PROGRESS_MARK in line:
             text = "      " + line.strip()
             with _OUT_LOCK:   # (commands run side by side each relay theirs)
@@ -143,12 +146,12 @@ class Demo:
         self.stages: list[dict] = []
         self.env = {"LOCUST_VIRTUAL_DIR": str(folder / "virtual"), "PYTHONUNBUFFERED": "1"}
 
-    def call(self, args: list[str], step: int | None = None) -> str:
+    def call(self, args: list[str], step: int | None = None, on_line=None) -> str:
         """``locust ARGS`` in a child process; its output goes to logs/NN-verb.log; a failure stops the demo.
 
         A child per command: each starts clean, as a user's would (one process rendering many
         offscreen videos in turn is not what the commands are built for). ``step`` numbers its
-        log (default: the next).
+        log (default: the next); ``on_line(line)`` sees its output as it comes.
         """
         if step is None:
             self.steps += 1
@@ -157,7 +160,7 @@ class Demo:
         cmd = [sys.executable, "-m", "locust.commands", *args]
         with subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                               text=True, env={**os.environ, **self.env}) as proc:
-            output = relay_progress(proc.stdout, self.stderr)
+            output = relay_progress(proc.stdout, self.stderr, on_line)
         atomic_write_text(log, f"$ locust {' '.join(args)}\n{output}")
         if proc.returncode != 0:
             tail = "\n".join("    " + ln for ln in output.strip().splitlines()[-6:])
@@ -305,8 +308,20 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
         # each trial named by its leg set: the report need not guess it from the folder name
         measured = [arg for name, trial in trials_dirs for arg in ("--measured", f"{name}={trial}")]
         closing = ["--before", str(bench_toml), "--samples", str(REPORT_SAMPLES)] if fit_hops else []
-        printed = d.call(["report", *measured, "--config", str(robot_toml), "--sweep", str(folder / "sweep"),
-                          *closing, "--out", str(folder)])
+        # its bar counts the report's own stage lines: per leg set its simulation (and its draws),
+        # then the figures; each line ends the stage before it
+        with d.bar(None, "report", length=len(LEG_SETS) * (2 if fit_hops else 1) + 1) as bar:
+            started = []
+
+            def on_line(line: str) -> None:
+                if line.startswith(REPORT_STAGE_MARK):
+                    if started:
+                        bar.update(1)
+                    started.append(line)
+
+            printed = d.call(["report", *measured, "--config", str(robot_toml), "--sweep", str(folder / "sweep"),
+                              *closing, "--out", str(folder)], on_line=on_line)
+            bar.update(max(bar.length - bar.pos, 0))
     report_path = Path(printed.strip().splitlines()[-1])
     _timings(d, folder, time.perf_counter() - t_start, {"cycles": cycles, "trials": trials, "designs": designs})
     click.echo(f"report: {report_path}")
