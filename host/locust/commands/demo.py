@@ -84,6 +84,10 @@ HOP_TRUTH = {"contact.foot_friction": 2.0, "compliance.hinge_stiffness_nm_per_ra
              "servo.noload_speed_rad_per_s": 9.0}
 HOP_FIT_SETS = ("small", "large")   # the two leg sets farthest apart (Small + Medium: test_calibrate_hop_virtual)
 REPORT_SAMPLES = 8
+# the report's figures take about as long as three of its simulation stages with draws (4.4 s
+# against 0.3 s and 2.9 s for a leg set's run and its draws, docs/performance.md): so many steps
+# on its bar keep the time left within 2x from a quarter of the stage on
+REPORT_FIGURE_STEPS = 3
 # hops filmed at once: each takes about one core (its video's rendering) while its firmware
 # paces it in real time, so two keep a 2-core machine busy without slowing the firmware's clock
 HOP_JOBS = 2
@@ -309,8 +313,8 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
         measured = [arg for name, trial in trials_dirs for arg in ("--measured", f"{name}={trial}")]
         closing = ["--before", str(bench_toml), "--samples", str(REPORT_SAMPLES)] if fit_hops else []
         # its bar counts the report's own stage lines: per leg set its simulation (and its draws),
-        # then the figures; each line ends the stage before it
-        with d.bar(None, "report", length=len(LEG_SETS) * (2 if fit_hops else 1) + 1) as bar:
+        # then the figures, worth REPORT_FIGURE_STEPS; each line ends the stage before it
+        with d.bar(None, "report", length=len(LEG_SETS) * (2 if fit_hops else 1) + REPORT_FIGURE_STEPS) as bar:
             started = []
 
             def on_line(line: str) -> None:
