@@ -13,6 +13,7 @@ import os
 import pty
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -256,3 +257,37 @@ def test_hop_without_firmware_is_a_clear_error(tmp_path):
         with pytest.raises(DeviceError, match="no locust firmware"):
             link.hello(wait_s=1.0)
         assert time.monotonic() - t0 < 3
+
+
+class LaggingPlant(RecordingPlant):
+    """A plant that falls behind the clock (as one rendering a video on a loaded machine does):
+    its idle step blocks until the test releases it."""
+
+    def __init__(self):
+        super().__init__()
+        self.busy, self.release = threading.Event(), threading.Event()
+        self.closed_at_s: float | None = None
+
+    def idle(self, t_s: float) -> None:
+        self.busy.set()
+        self.release.wait(timeout=30)
+
+    def close(self, t_s: float) -> dict:
+        self.closed_at_s = t_s
+        return super().close(t_s)
+
+
+def test_a_lagging_plant_ends_where_the_host_stopped_the_robot(tmp_path):
+    # the plant's video ends when the host stops the robot, not when its thread catches up:
+    # a second of lag used to add a second of the robot standing to the end of the video
+    plant = LaggingPlant()
+    vr = VirtualRobot(tmp_path / "flash", plant).start()
+    wait_for(plant.busy.is_set, 10, "the plant thread to go idle")
+    t_stop = vr.now_s()
+    stopping = threading.Thread(target=vr.stop)
+    stopping.start()
+    wait_for(lambda: vr.now_s() > t_stop + 1.0, 10, "a second of the robot's clock after the stop")
+    plant.release.set()
+    stopping.join(timeout=30)
+    assert not stopping.is_alive()
+    assert t_stop <= plant.closed_at_s < t_stop + 0.3

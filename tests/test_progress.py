@@ -125,3 +125,27 @@ def test_silenced_shows_nothing_and_ends_with_its_block(tty):
                     clock.t += PLAIN_EVERY_S + 1
                     bar.update(1)
         assert bool(out.getvalue()) == expect_output, (quiet, out.getvalue())
+
+
+def test_a_stage_of_long_commands_says_its_time_left_from_a_quarter_on_and_a_line_every_ten_s():
+    """The demo's hops stage: 6 commands, two at a time, each pair 20 s with its start-up. With
+    the rate measured from the start, the time left is shown from the first pair on and is the
+    true one (40 s, then 20 s); ticked every second, a line comes every 10 s between pairs."""
+    clock, out = Clock(), io.StringIO()
+    bar = Progress(length=6, label="hops", file=out, tty=False, clock=clock, rate_from_start=True)
+    start, etas = clock.t, {}
+    with bar:
+        for _ in range(3):
+            for _ in range(20):
+                clock.t += 1.0
+                bar.tick()
+            bar.update(1)
+            bar.update(1)
+            etas[bar.pos] = bar.eta_s()
+    assert etas[2] == pytest.approx(40.0) and etas[4] == pytest.approx(20.0)
+    true_left = {2: 40.0, 4: 20.0}
+    assert all(0.5 <= etas[k] / true_left[k] <= 2.0 for k in true_left)
+    lines = out.getvalue().splitlines()
+    assert len(lines) == int((clock.t - start) // PLAIN_EVERY_S)
+    assert lines[1] == "hops    0 %  0/6  0:20 elapsed"              # (the tick just before the pair ended)
+    assert lines[2] == "hops   33 %  2/6  0:30 elapsed  about 0:30 left"   # counting down through the next

@@ -10,7 +10,7 @@ import pytest
 from click.testing import CliRunner
 
 from locust.commands import cli
-from locust.device.plant import make_plant
+from locust.device.plant import VIDEO_TAIL_S, make_plant
 from locust.io.tracks_csv import MarkerColumns, TracksCsv
 from locust.params import preset
 from locust.report.page import pct
@@ -41,7 +41,7 @@ def test_mujoco_plant_films_at_the_rate_asked(tmp_path):
     plant = make_plant("mujoco", preset("seed"), path, 60)
     plant.command(0.0, 0.0, 0.0)
     out = plant.close(0.5)
-    assert out["frames"] == round((PREROLL_S + 0.5) * 60)
+    assert out["frames"] == round((PREROLL_S + 0.5 + VIDEO_TAIL_S) * 60)   # standing before and after
     info = probe(path)
     assert info.file_fps == pytest.approx(60.0)
     assert info.frame_count == out["frames"]

@@ -44,12 +44,14 @@ def format_duration(seconds: float) -> str:
 class Progress:
     """``length`` steps (or ``items``), reported on ``file`` as a bar (``tty``) or as plain lines.
 
-    ``clock`` is the time source (seconds); tests give their own.
+    ``clock`` is the time source (seconds); tests give their own. ``rate_from_start``: the
+    rate is measured from the start, and the time left shown from the first step on (steps
+    that each carry their own setup: a demo stage's commands), not from the first step finished.
     """
 
     def __init__(self, items: Iterable | None = None, length: int | None = None, label: str = "",
                  file: Any = None, tty: bool | None = None, clock: Callable[[], float] = time.monotonic,
-                 show_pos: bool = True, show_eta: bool = True, **_: Any):
+                 show_pos: bool = True, show_eta: bool = True, rate_from_start: bool = False, **_: Any):
         if length is None and items is not None:
             try:
                 length = len(items)   # type: ignore[arg-type]
@@ -61,7 +63,8 @@ class Progress:
         self.clock, self.show_pos, self.show_eta = clock, show_pos, show_eta
         self.pos = 0
         self.start = clock()
-        self._first: tuple[float, int] | None = None   # (time, pos) when the first step finished
+        self._first: tuple[float, int] | None = (self.start, 0) if rate_from_start else None
+        self._min_steps = 1 if rate_from_start else ETA_MIN_STEPS
         self._latest_s = self.start                      # when the latest step finished
         self._last_shown = self.start if not self.tty else -float("inf")
         self._drawn = False
@@ -80,7 +83,7 @@ class Progress:
             return None
         t0, p0 = self._first
         steps, spent = self.pos - p0, self._latest_s - t0
-        if steps < ETA_MIN_STEPS or spent < ETA_MIN_S:
+        if steps < self._min_steps or spent < ETA_MIN_S:
             return None
         left = max(self.length - self.pos, 0) * spent / steps - (self.clock() - self._latest_s)
         return max(left, 0.0)
@@ -123,6 +126,11 @@ class Progress:
         else:
             self.file.write(self.line() + "\n")
         self.file.flush()
+
+    def tick(self) -> None:
+        """Show the progress if it is due (a line every ~10 s off a terminal) though no step has
+        ended: for a caller whose steps are long, from a thread of its own."""
+        self._show()
 
     # -- the click.progressbar interface ------------------------------------------------
     def update(self, n_steps: int = 1, current_item: Any = None) -> None:
@@ -184,7 +192,7 @@ def progress(items: Iterable | None = None, length: int | None = None, label: st
     label : str
         Shown before the bar.
     **options
-        :class:`Progress`'s ``file``, ``tty``, ``clock``, ``show_pos``, ``show_eta``.
+        :class:`Progress`'s ``file``, ``tty``, ``clock``, ``show_pos``, ``show_eta``, ``rate_from_start``.
 
     Returns
     -------

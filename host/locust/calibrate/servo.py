@@ -40,6 +40,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -49,7 +50,7 @@ from mujoco import minimize
 
 from ..errors import CalibrationError
 from ..params import GRAVITY_M_PER_S2, LIMITS, Servo
-from ..sim.rollout import rollout_threads
+from ..sim.rollout import available_cores, rollout_threads
 from ..sim.servo import configure, with_servo
 from .curves import Curves
 from .fitparams import FitParameter, FitParameters
@@ -666,18 +667,28 @@ class _Layout:
 
 def _residual_parts(recs: list[Recording], models: list[mujoco.MjModel],
                     cands: list[tuple[Servo, list[Timing], list[float | None]]]) -> list[np.ndarray]:
-    """Per recording, (candidates, samples) residuals in its own unit: rad (angle), gyro units (rate)."""
-    parts = []
-    for k, (rec, model) in enumerate(zip(recs, models)):
-        servos = [c[0] for c in cands]
+    """Per recording, (candidates, samples) residuals in its own unit: rad (angle), gyro units (rate).
+
+    The recordings are simulated side by side, one thread each (``mujoco.rollout`` releases
+    the GIL): a line search's single candidate then uses a core per recording, and every
+    figure is the same as one after the other.
+    """
+    servos = [c[0] for c in cands]
+
+    def part(k: int) -> np.ndarray:
+        rec, model = recs[k], models[k]
         if rec.kind == "angle":
             sim = simulate_deg(model, servos, [c[1][k] for c in cands], rec, float(rec.angle_deg[0]))
-            parts.append(np.radians(sim - rec.angle_deg[None, :]))
-        else:
-            sim = simulate_rate(model, servos, [c[1][k].delay_s for c in cands], rec)
-            gains = np.array([c[2][k] for c in cands])[:, None]
-            parts.append((gains * sim - rec.rate_units[rec.samples()][None, :]) * rec.sample_weights()[None, :])
-    return parts
+            return np.radians(sim - rec.angle_deg[None, :])
+        sim = simulate_rate(model, servos, [c[1][k].delay_s for c in cands], rec)
+        gains = np.array([c[2][k] for c in cands])[:, None]
+        return (gains * sim - rec.rate_units[rec.samples()][None, :]) * rec.sample_weights()[None, :]
+
+    workers = min(len(recs), available_cores())
+    if workers < 2:
+        return [part(k) for k in range(len(recs))]
+    with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="locust-servo-fit") as pool:
+        return list(pool.map(part, range(len(recs))))
 
 
 def _rms_in_unit(rec: Recording, part: np.ndarray, gain: float | None) -> float:

@@ -28,7 +28,9 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import threading
 import time
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -82,6 +84,13 @@ HOP_TRUTH = {"contact.foot_friction": 2.0, "compliance.hinge_stiffness_nm_per_ra
              "servo.noload_speed_rad_per_s": 9.0}
 HOP_FIT_SETS = ("small", "large")   # the two leg sets farthest apart (Small + Medium: test_calibrate_hop_virtual)
 REPORT_SAMPLES = 8
+# the report's figures take about as long as three of its simulation stages with draws (4.4 s
+# against 0.3 s and 2.9 s for a leg set's run and its draws, docs/performance.md): so many steps
+# on its bar keep the time left within 2x from a quarter of the stage on
+REPORT_FIGURE_STEPS = 3
+# hops filmed at once: each takes about one core (its video's rendering) while its firmware
+# paces it in real time, so two keep a 2-core machine busy without slowing the firmware's clock
+HOP_JOBS = 2
 
 
 def recording_truth(paths: list[Path]) -> dict[str, float]:
@@ -101,25 +110,33 @@ def recording_truth(paths: list[Path]) -> dict[str, float]:
 
 # a progress line (locust.progress) always says how long it has run
 PROGRESS_MARK = " elapsed"
+REPORT_STAGE_MARK = "report: "   # `locust report` says each of its stages so
 
 
-def relay_progress(lines, out) -> str:
+def relay_progress(lines, out, on_line=None) -> str:
     """All of a child command's output (``lines``), returned whole; its progress lines, which
     it prints every ~10 s off a terminal, shown on ``out`` as they come, indented under the
-    stage (on a terminal, redrawn in place)."""
+    stage (on a terminal, redrawn in place). ``on_line(line)`` sees every line as it comes."""
     tty = out.isatty()
     kept, shown = [], False
     for line in lines:
         kept.append(line)
+        if on_line is not None:
+            on_line(line)
         if PROGRESS_MARK in line:
             text = "      " + line.strip()
-            out.write("\r\x1b[K" + text if tty else text + "\n")
-            out.flush()
+            with _OUT_LOCK:   # (commands run side by side each relay theirs)
+                out.write("\r\x1b[K" + text if tty else text + "\n")
+                out.flush()
             shown = True
     if tty and shown:
-        out.write("\n")
-        out.flush()
+        with _OUT_LOCK:
+            out.write("\n")
+            out.flush()
     return "".join(kept)
+
+
+_OUT_LOCK = threading.Lock()
 
 
 class Demo:
@@ -133,18 +150,21 @@ class Demo:
         self.stages: list[dict] = []
         self.env = {"LOCUST_VIRTUAL_DIR": str(folder / "virtual"), "PYTHONUNBUFFERED": "1"}
 
-    def call(self, args: list[str]) -> str:
+    def call(self, args: list[str], step: int | None = None, on_line=None) -> str:
         """``locust ARGS`` in a child process; its output goes to logs/NN-verb.log; a failure stops the demo.
 
         A child per command: each starts clean, as a user's would (one process rendering many
-        offscreen videos in turn is not what the commands are built for).
+        offscreen videos in turn is not what the commands are built for). ``step`` numbers its
+        log (default: the next); ``on_line(line)`` sees its output as it comes.
         """
-        self.steps += 1
-        log = self.logs / f"{self.steps:02d}-{args[0]}{'-' + args[1] if args[0] == 'calibrate' else ''}.log"
+        if step is None:
+            self.steps += 1
+            step = self.steps
+        log = self.logs / f"{step:02d}-{args[0]}{'-' + args[1] if args[0] == 'calibrate' else ''}.log"
         cmd = [sys.executable, "-m", "locust.commands", *args]
         with subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                               text=True, env={**os.environ, **self.env}) as proc:
-            output = relay_progress(proc.stdout, self.stderr)
+            output = relay_progress(proc.stdout, self.stderr, on_line)
         atomic_write_text(log, f"$ locust {' '.join(args)}\n{output}")
         if proc.returncode != 0:
             tail = "\n".join("    " + ln for ln in output.strip().splitlines()[-6:])
@@ -152,13 +172,34 @@ class Demo:
                               f"its whole output is in {log}")
         return output
 
-    def expect(self, *paths: Path) -> None:
-        """The files the last command should have written; a command that exits 0 without them
-        stops the demo here rather than at the next stage."""
+    def call_side_by_side(self, calls: list[tuple[list[str], tuple[Path, ...]]], jobs: int, bar) -> None:
+        """Each ``(args, expected files)`` of ``calls`` as :meth:`call`, ``jobs`` at a time, each
+        numbered in order; ``bar`` counts those done. The first failure (in order) stops the
+        demo once the others running have ended."""
+        first = self.steps
+        self.steps += len(calls)
+
+        def one(k: int) -> None:
+            args, paths = calls[k]
+            self.call(args, first + 1 + k)
+            self.expect(*paths, step=first + 1 + k)
+
+        with ThreadPoolExecutor(max_workers=max(1, min(jobs, len(calls)))) as pool:
+            futures = [pool.submit(one, k) for k in range(len(calls))]
+            for future in as_completed(futures):
+                if future.exception() is None:
+                    bar.update(1)
+        for future in futures:
+            future.result()
+
+    def expect(self, *paths: Path, step: int | None = None) -> None:
+        """The files the last command (or command ``step``) should have written; a command that
+        exits 0 without them stops the demo here rather than at the next stage."""
+        step = self.steps if step is None else step
         missing = [str(p) for p in paths if not p.is_file()]
         if missing:
-            log = sorted(self.logs.glob(f"{self.steps:02d}-*.log"))
-            raise ReportError(f"demo stopped: step {self.steps} exited 0 but did not write {', '.join(missing)}",
+            log = sorted(self.logs.glob(f"{step:02d}-*.log"))
+            raise ReportError(f"demo stopped: step {step} exited 0 but did not write {', '.join(missing)}",
                               f"its output is in {log[0] if log else self.logs}")
 
     @contextmanager
@@ -170,11 +211,32 @@ class Demo:
         self.stages.append({"stage": title, "wall_s": round(wall, 2)})
         self.say(f"      {wall:.1f} s")
 
-    def bar(self, items, label: str):
-        return progress(items, label=label, show_pos=True)
+    @contextmanager
+    def bar(self, items, label: str, length: int | None = None):
+        """A stage's bar over its commands: each carries its own start-up, so the time left is
+        measured from the start; shown every ~10 s off a terminal while a long command runs."""
+        with progress(items, length=length, label=label, show_pos=True, rate_from_start=True,
+                      file=self.stderr) as bar:
+            done = threading.Event()
+            ticker = threading.Thread(target=_tick, args=(bar, done), name="locust-demo-progress", daemon=True)
+            ticker.start()
+            try:
+                yield bar
+            finally:
+                done.set()
+                ticker.join()
 
     def say(self, msg: str) -> None:
         click.echo(msg, file=self.stderr)
+
+
+def _tick(bar, done: threading.Event) -> None:
+    while not done.wait(TICK_S):
+        with _OUT_LOCK:
+            bar.tick()
+
+
+TICK_S = 1.0   # a stage's bar is looked at this often (it shows itself when due)
 
 
 @click.command()
@@ -185,7 +247,8 @@ class Demo:
               help="Hops filmed per leg set (repeated trials give the report its error bars).")
 @click.option("--designs", type=click.IntRange(2, 61), default=7, show_default=True,
               help="Designs in the sweep: scale from 0 to 3 cm added to every link.")
-@click.option("--jobs", type=click.IntRange(1, 64), default=None, help="Sweep workers [every local core].")
+@click.option("--jobs", type=click.IntRange(1, 64), default=None,
+              help="Sweep workers, and hops filmed at once up to 2 [every local core].")
 @click.option("--fit-hops/--no-fit-hops", default=True, show_default=True,
               help="Hide values the bench cannot reach in the virtual robot and fit them from its filmed hops.")
 def demo(out, cycles, trials, designs, jobs, fit_hops):
@@ -220,11 +283,13 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     with d.stage(1, total, "flash the firmware to the virtual robot"):
         d.call(["flash", "--port", "sim"])
     with d.stage(2, total, f"hop Small, Medium, Large x {trials} on the virtual robot, {cycles} cycles, filmed"):
-        with d.bar(trials_dirs, "hops") as bar:
-            for name, trial in bar:
-                d.call(["hop", "--port", "sim", *seed_leg_set_options(name), "--leg-set", name, *truth_sets,
-                        "--cycles", str(cycles), "--video", str(trial / "hop.mp4"), "--out", str(trial)])
-                d.expect(trial / "hop.mp4", trial / "run.json")
+        # each hop is its own virtual robot (the one flash folder, read only), the firmware paced
+        # in real time while one core renders its video: HOP_JOBS of them film at once
+        hops = [(["hop", "--port", "sim", *seed_leg_set_options(name), "--leg-set", name, *truth_sets,
+                  "--cycles", str(cycles), "--video", str(trial / "hop.mp4"), "--out", str(trial)],
+                 (trial / "hop.mp4", trial / "run.json")) for name, trial in trials_dirs]
+        with d.bar(None, "hops", length=len(hops)) as bar:
+            d.call_side_by_side(hops, min(HOP_JOBS, jobs or os.cpu_count() or 1), bar)
     with d.stage(3, total, "track nose and foot in the videos"):
         with d.bar(trials_dirs, "tracks") as bar:
             for _, trial in bar:
@@ -247,8 +312,20 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
         # each trial named by its leg set: the report need not guess it from the folder name
         measured = [arg for name, trial in trials_dirs for arg in ("--measured", f"{name}={trial}")]
         closing = ["--before", str(bench_toml), "--samples", str(REPORT_SAMPLES)] if fit_hops else []
-        printed = d.call(["report", *measured, "--config", str(robot_toml), "--sweep", str(folder / "sweep"),
-                          *closing, "--out", str(folder)])
+        # its bar counts the report's own stage lines: per leg set its simulation (and its draws),
+        # then the figures, worth REPORT_FIGURE_STEPS; each line ends the stage before it
+        with d.bar(None, "report", length=len(LEG_SETS) * (2 if fit_hops else 1) + REPORT_FIGURE_STEPS) as bar:
+            started = []
+
+            def on_line(line: str) -> None:
+                if line.startswith(REPORT_STAGE_MARK):
+                    if started:
+                        bar.update(1)
+                    started.append(line)
+
+            printed = d.call(["report", *measured, "--config", str(robot_toml), "--sweep", str(folder / "sweep"),
+                              *closing, "--out", str(folder)], on_line=on_line)
+            bar.update(max(bar.length - bar.pos, 0))
     report_path = Path(printed.strip().splitlines()[-1])
     _timings(d, folder, time.perf_counter() - t_start, {"cycles": cycles, "trials": trials, "designs": designs})
     click.echo(f"report: {report_path}")

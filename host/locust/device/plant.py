@@ -108,6 +108,10 @@ class RecordingPlant:
 
 IDLE_LAG_S = 0.5     # idle, the model is stepped up to this long before now: no command comes that late
 HOP_REST_S = 0.5     # servos at rest this long after a push: the hop is done (or the next push starts)
+# a filmed run goes on this long after the robot is stopped, so that its clip ends, as it opens
+# (sim.live.PREROLL_S), on the robot standing: the last hop's rest is in the frames whatever the
+# host's latency, and no longer the whole time the rendering lagged behind the clock
+VIDEO_TAIL_S = 0.5
 
 
 class MujocoPlant:
@@ -181,7 +185,8 @@ class MujocoPlant:
         self._told = max(self._told, len(hops))
 
     def close(self, t_s: float) -> dict:
-        """Step the model up to ``t_s`` and finish the simulation (and its video).
+        """Step the model up to ``t_s`` (a filmed one ``VIDEO_TAIL_S`` further) and finish the
+        simulation (and its video).
 
         Parameters
         ----------
@@ -193,7 +198,7 @@ class MujocoPlant:
         dict
             ``{"plant": "mujoco", ...}`` with the live simulation's summary (its hops).
         """
-        self.sim.advance_to(t_s)
+        self.sim.advance_to(t_s + (VIDEO_TAIL_S if self.films else 0.0))
         return {"plant": "mujoco", **(self.sim.close() or {})}
 
     def abort(self) -> None:

@@ -305,6 +305,10 @@ class VirtualRobot:
         self._raw_boot_pending = False  # rebooted from the raw REPL: enter it again at the prompt
         self._pwm_pending = b""
         self.summary: dict | None = None
+        # the clock when the host stopped the robot: the plant (and its video) ends there, not
+        # when its thread gets to the end (a video rendered behind real time would otherwise
+        # go on filming the robot standing for as long as it lags)
+        self._end_s: float | None = None
         self.plant_error: BaseException | None = None   # raised by stop()
         self.video_dropped = False   # cancel(): the plant was stopped, its video not kept
 
@@ -390,6 +394,7 @@ class VirtualRobot:
         """
         if self._stopping.is_set():
             return self.summary or {}
+        self._end_s = self.now_s()
         self._stopping.set()
         plant_thread = next((t for t in self._threads if t.name.endswith("-plant")), None)
         try:
@@ -686,7 +691,7 @@ class VirtualRobot:
             try:
                 item = self._plant_queue.get(timeout=0.1 if idle else None)
             except queue.Empty:
-                idle(self.now_s())       # nothing written for 0.1 s: the plant may go on (a live model)
+                idle(self._clock_s())    # nothing written for 0.1 s: the plant may go on (a live model)
                 continue
             if item is None:
                 stopped.append(True)
@@ -709,4 +714,8 @@ class VirtualRobot:
                                 f"{'' if horn is None else format(horn, '.4f')}\n")
             if horn is not None:
                 self.plant.command(t_effect, self._last_angle["left"], self._last_angle["right"])
-        self.summary = self.plant.close(self.now_s())
+        self.summary = self.plant.close(self._clock_s())
+
+    def _clock_s(self) -> float:
+        """The virtual robot's clock, held where :meth:`stop` stopped it."""
+        return self.now_s() if self._end_s is None else min(self.now_s(), self._end_s)
