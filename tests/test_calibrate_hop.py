@@ -309,3 +309,34 @@ def test_the_crank_angle_at_rest_is_fitted_from_the_standing_pose():
     assert est.value == pytest.approx(-88.0, abs=0.5)
     assert est.ci95_low <= -88.0 <= est.ci95_high and fit.identifiable[key]
     assert est.std_model == pytest.approx(H.MODEL_ERROR_DEG[key])
+
+
+class _JaggedBowl:
+    """SYNTHETIC residual: a least-squares bowl with its minimum at TRUE, plus a staircase of
+    1e-4 in each residual (a hop's contacts make the real landscape jagged below the
+    finite-difference step); counts the candidates asked for."""
+
+    TRUE = np.array([0.3, -0.2, 0.1])
+
+    def __init__(self):
+        self.columns = 0
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        self.columns += x.shape[1]
+        d = x - self.TRUE[:, None]
+        return np.vstack([d, 0.5 * d]) + 1e-4 * np.sign(np.sin(3e3 * np.vstack([x, x])))
+
+
+def test_the_solver_stops_where_it_stalls_at_the_same_optimum():
+    """`solve` stops where a step under STALL_STEP no longer lowers the cost by STALL_REDUCTION:
+    at the optimum MuJoCo's solver reaches when left to run (within the staircase), for far
+    fewer candidates (each a simulation of every run in a real fit)."""
+    bounds = [np.full(3, -2.0), np.full(3, 2.0)]
+    stalled, left = _JaggedBowl(), _JaggedBowl()
+    x, iterations = H.solve(stalled, np.zeros(3), bounds, max_iter=30)
+    full, _ = H.minimize.least_squares(np.zeros(3), left, bounds=bounds, eps=H.FD_STEP, max_iter=30, verbose=0,
+                                       xtol=1e-6, gtol=1e-8)
+    assert np.max(np.abs(x - _JaggedBowl.TRUE)) < 5e-4            # the staircase's own scale
+    assert np.max(np.abs(x - np.ravel(full))) < 5e-4
+    assert 1 <= iterations <= 30
+    assert stalled.columns < 0.6 * left.columns, (stalled.columns, left.columns)

@@ -44,6 +44,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -77,6 +78,9 @@ ANGLE_BOUND_DEG = 30.0         # ... an angle (a key in deg: no factor, it may b
 ANGLE_UNIT_DEG = 10.0          # an angle's step in the solver's vector per unit (FD_STEP: 0.1 deg)
 MAX_STD_DEG = 2.5              # an angle is identifiable with its 95% interval within about +-5 deg
 FD_STEP = 1e-2                 # finite-difference step of the log values (1 %: over the contacts' jaggedness)
+STALL_STEP = 2e-3              # the solver has converged where a step under this (0.2 %, 0.02 deg) ...
+STALL_REDUCTION = 1e-3         # ... lowers the cost by under this part of it (a fifth of FD_STEP; the 95 %
+                               # intervals are +-8 % or wider, std_model alone being 4 %)
 MAX_RELATIVE_STD = 0.25        # identifiable: 95% interval within about +-50%
 FAILED_M = 0.1                 # residual of a candidate whose simulation failed (metres)
 THREADS = 2
@@ -291,16 +295,16 @@ def measured_plan(run: HopRun, robot: Robot) -> ControlPlan:
                        cycle_start_steps=starts)
 
 
-def simulate_markers(run: HopRun, robots: list[Robot],
-                     builts: list[BuiltModel] | None = None) -> list[dict[str, np.ndarray] | None]:
+def simulate_markers(run: HopRun, robots: list[Robot], builts: list[BuiltModel] | None = None,
+                     threads: int = THREADS) -> list[dict[str, np.ndarray] | None]:
     """Each robot's simulated markers on the schedule's clock (one batched rollout): marker ->
     (3, n) rows t, x, y in the world (x forward along the floor, y up; the standing pose
     included); ``t`` = 0 at the first push; its ``outcome`` (:func:`locust.sim.outcome.classify`).
     None: it failed. ``builts``: the robots' compiled models where the caller has them
-    (:mod:`.hopmodels`)."""
+    (:mod:`.hopmodels`); ``threads``: those the batch runs on."""
     builts = builts or [build(r) for r in robots]
     plan = measured_plan(run, robots[0])
-    trajs = simulate_batch(builts, plan, keep_states=True, threads=THREADS)
+    trajs = simulate_batch(builts, plan, keep_states=True, threads=threads)
     dt, settle = plan.timestep_s, plan.settle_steps
     rows, _ = trace_rows(dt, settle, plan.nstep)
     t = (rows + 1 - settle) * dt
@@ -558,24 +562,40 @@ class _HopResidual:
 
     def residuals_of(self, robots: Callable[[HopRun], list[Robot]],
                      builts: Callable[[HopRun], list[BuiltModel]] | None = None) -> np.ndarray:
-        """One residual column per robot ``robots(run)`` gives (one batch per run), runs stacked;
-        ``builts(run)``: their compiled models, where the caller has them."""
+        """One residual column per robot ``robots(run)`` gives, runs stacked; ``builts(run)``:
+        their compiled models, where the caller has them. The runs are simulated side by side,
+        one thread each (``mujoco.rollout`` lets go of the interpreter), so that the solver's
+        one candidate at a time still keeps every core busy; each run's batch in chunks of
+        ``CHUNK``, progress after each."""
+        workers = max(1, min(THREADS, len(self.runs)))
+        threads = max(1, THREADS // workers)
+        jobs = [(k, run, batch, builts(run) if builts else [_built_or_none(r) for r in batch])     # compiled here
+                for k, run, batch in ((k, run, robots(run)) for k, run in enumerate(self.runs))]
+        chunks = [(k, i) for k, _, batch, _ in jobs for i in range(0, len(batch), CHUNK)]
+
+        def simulate_chunk(k: int, i: int) -> list:
+            _, run, batch, models = jobs[k]
+            part = [j for j in range(i, min(i + CHUNK, len(batch))) if models[j] is not None]
+            out = dict.fromkeys(range(i, min(i + CHUNK, len(batch))))
+            try:
+                if part:
+                    out.update(zip(part, simulate_markers(run, [batch[j] for j in part], [models[j] for j in part],
+                                                          threads=threads)))
+            except (GeometryError, SimError):
+                pass
+            return list(out.values())
+
+        sims: dict[tuple[int, int], list] = {}
+        with ThreadPoolExecutor(workers) as pool:
+            futures = {pool.submit(simulate_chunk, k, i): (k, i) for k, i in chunks}
+            for future in as_completed(futures):
+                sims[futures[future]] = future.result()
+                self.tally.add(len(sims[futures[future]]))
         cols, self.outcomes = [], []
-        for run in self.runs:
-            batch = robots(run)
-            models = builts(run) if builts else [None] * len(batch)
-            col = []
-            self.outcomes.append([])
-            for k in range(0, len(batch), CHUNK):     # one rollout a chunk: progress between them
-                try:
-                    chunk = models[k:k + CHUNK]
-                    sims = simulate_markers(run, batch[k:k + CHUNK], None if chunk[0] is None else chunk)
-                except (GeometryError, SimError):
-                    sims = [None] * len(batch[k:k + CHUNK])
-                col += [aligned_residual(run, s)[0] for s in sims]
-                self.outcomes[-1] += [None if s is None else s.outcome for s in sims]
-                self.tally.add(len(sims))
-            cols.append(np.stack(col, axis=1))
+        for k, run, batch, _ in jobs:
+            done = [s for i in range(0, len(batch), CHUNK) for s in sims[(k, i)]]
+            cols.append(np.stack([aligned_residual(run, s)[0] for s in done], axis=1))
+            self.outcomes.append([None if s is None else s.outcome for s in done])
         return np.concatenate(cols, axis=0)
 
     def __call__(self, x: np.ndarray, refine: int = 1) -> np.ndarray:
@@ -585,6 +605,14 @@ class _HopResidual:
         values = self.values_at(xs)
         return self.residuals_of(lambda run: [run.robot] * len(values),
                                  lambda run: [self.candidates(run).built(v) for v in values])
+
+
+def _built_or_none(robot: Robot) -> BuiltModel | None:
+    """``robot`` compiled; None where its geometry cannot be built (a candidate that fails)."""
+    try:
+        return build(robot)
+    except GeometryError:
+        return None
 
 
 def _run_fits(residual: _HopResidual, x: np.ndarray, step_changes: list[float]) -> tuple[list[RunFit], list]:
@@ -748,10 +776,7 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     residual = _HopResidual(runs, keys, tally)
     bounds = list(residual.params.bounds())
 
-    x0 = grid_start(residual, len(keys), grid_stages)
-    x, trace = minimize.least_squares(x0, residual, bounds=bounds, eps=FD_STEP,
-                                      max_iter=max_iter, verbose=0, xtol=1e-6, gtol=1e-8)
-    x = np.asarray(x, dtype=float).ravel()
+    x, iterations = solve(residual, grid_start(residual, len(keys), grid_stages), bounds, max_iter)
     tally.planned = tally.done + len(runs) * (1 + 2 * len(keys) + 2 + 2 * held_count)   # what is left
     values = residual.params.free_values(x)
     run_fits, clusters = _run_fits(residual, x, step_changes)
@@ -763,9 +788,53 @@ def fit_hops(runs: list[HopRun], keys: list[str] | tuple[str, ...] = DEFAULT_KEY
     hops = len(np.unique(np.concatenate(clusters)))
     estimates, identifiable = _hop_estimates(cov, values, x, keys, start, residual.params.near_bound(x), hops, notes)
     return HopFit(keys=keys, start=dict(zip(keys, start.tolist())), estimates=estimates, identifiable=identifiable,
-                  runs=run_fits, notes=notes, rms_m=float(np.sqrt(np.mean(r**2))), iterations=len(trace),
+                  runs=run_fits, notes=notes, rms_m=float(np.sqrt(np.mean(r**2))), iterations=iterations,
                   simulations=tally.done, wall_s=time.perf_counter() - t_start,
                   interval=_interval_text(hops, held))
+
+
+class _Stalled(Exception):
+    """The solver's candidates no longer move the values by more than ``STALL_STEP``."""
+
+
+class _StallWatch:
+    """The residual as the solver sees it, stopping the solver where it stalls: a candidate
+    within ``STALL_STEP`` of the best point so far that lowers its cost by under
+    ``STALL_REDUCTION``. Levenberg-Marquardt meets such a candidate by growing its
+    regulariser one factor at a time, each growth a simulation of every run, until a step too
+    small to matter passes its sufficient-reduction test; there the fit has converged."""
+
+    def __init__(self, residual: _HopResidual):
+        self.residual = residual
+        self.best_cost, self.best_x = math.inf, None
+        self.jacobians = 0
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        r = self.residual(x)
+        if x.shape[1] > 1:           # the finite-difference points about the solver's point
+            self.jacobians += 1
+            return r
+        cost = float(np.sum(r ** 2))
+        stalled = (self.best_x is not None and np.linalg.norm(x[:, 0] - self.best_x) < STALL_STEP
+                   and cost > self.best_cost * (1 - STALL_REDUCTION))
+        if cost < self.best_cost:
+            self.best_cost, self.best_x = cost, x[:, 0].copy()
+        if stalled:
+            raise _Stalled
+        return r
+
+
+def solve(residual: _HopResidual, x0: np.ndarray, bounds: list[np.ndarray], max_iter: int) -> tuple[np.ndarray, int]:
+    """The least-squares optimum from ``x0`` (``mujoco.minimize.least_squares``, its Jacobian
+    by forward differences of ``FD_STEP``, each simulated as one batch), stopped where it
+    stalls (:class:`_StallWatch`): (the solver vector, its iterations)."""
+    watch = _StallWatch(residual)
+    try:
+        x, trace = minimize.least_squares(x0, watch, bounds=bounds, eps=FD_STEP, max_iter=max_iter, verbose=0,
+                                          xtol=1e-6, gtol=1e-8)
+    except _Stalled:
+        return watch.best_x, watch.jacobians
+    return np.asarray(x, dtype=float).ravel(), len(trace)
 
 
 def held_uncertainties(runs: list[HopRun], keys: tuple[str, ...]) -> dict[str, float]:
