@@ -78,6 +78,8 @@ ANGLE_BOUND_DEG = 30.0         # ... an angle (a key in deg: no factor, it may b
 ANGLE_UNIT_DEG = 10.0          # an angle's step in the solver's vector per unit (FD_STEP: 0.1 deg)
 MAX_STD_DEG = 2.5              # an angle is identifiable with its 95% interval within about +-5 deg
 FD_STEP = 1e-2                 # finite-difference step of the log values (1 %: over the contacts' jaggedness)
+MU_FACTOR = 10 ** 0.5          # the solver's regulariser grows by this a rejected step (MuJoCo's default
+                               # 10**0.1 took ~4 rejections, each a simulation of every run, an iteration)
 STALL_STEP = 2e-3              # the solver has converged where a step under this (0.2 %, 0.02 deg) ...
 STALL_REDUCTION = 1e-3         # ... lowers the cost by under this part of it (a fifth of FD_STEP; the 95 %
                                # intervals are +-8 % or wider, std_model alone being 4 %)
@@ -92,6 +94,8 @@ SHIFT_LEVELS = 101             # ... from the best of this many offsets, refined
 GRID_FACTOR = 1.6              # the starting grid spans this factor either side of the start ...
 GRID_LEVELS = {1: 9, 2: 7, 3: 3, 4: 3, 5: 3}   # ... in this many levels per fitted value
 GRID_STAGES = 3                # ... refined about its best point this many times
+GRID_COARSEN = 2               # ... and simulated at this many times the run's step (it only picks the start:
+                               # its points 12-60 % apart, the step's change a few 0.01 mm)
 # The model's error against the plant (std_model, one standard deviation, in quadrature): the
 # rollout at the measured phase times is not the virtual robot (its firmware's ticks, the
 # rendered and tracked marker faces), and the hops' own scatter does not show what that moves.
@@ -539,19 +543,27 @@ class _HopResidual:
         self.runs, self.keys = runs, keys
         self.params = fit_parameters(runs, keys)
         self.tally = tally or _Tally()
-        self.models: dict[int, CandidateModels] = {}    # per run: its candidates without the compiler
+        self.models: dict[tuple[int, int], CandidateModels] = {}    # per run and step: candidates, no compiler
         self.outcomes: list[list[str | None]] = []
 
     def values_at(self, xs: np.ndarray) -> list[dict[str, float]]:
         """The fitted values (key -> value) at each row of ``xs``."""
         return [dict(zip(self.keys, self.params.free_values(x).tolist())) for x in xs]
 
-    def candidates(self, run: HopRun) -> CandidateModels:
-        """``run``'s compiled candidates (made at the first use)."""
-        k = self.runs.index(run)
-        if k not in self.models:
-            self.models[k] = CandidateModels(run.robot, self.keys)
-        return self.models[k]
+    def candidates(self, run: HopRun, coarsen: int = 1) -> CandidateModels:
+        """``run``'s compiled candidates (made at the first use), at its step times ``coarsen``."""
+        key = (self.runs.index(run), coarsen)
+        if key not in self.models:
+            self.models[key] = CandidateModels(self.robot_of(run, coarsen), self.keys)
+        return self.models[key]
+
+    @staticmethod
+    def robot_of(run: HopRun, coarsen: int = 1) -> Robot:
+        """``run``'s robot, its step times ``coarsen``."""
+        if coarsen == 1:
+            return run.robot
+        return run.robot.with_values({"solver.timestep_s": run.robot.solver.timestep_s * coarsen},
+                                     "fit: starting grid")
 
     def robots_at(self, run: HopRun, xs: np.ndarray, refine: int = 1) -> list[Robot]:
         """``run``'s robot at each row of ``xs`` (its step divided by ``refine``)."""
@@ -598,13 +610,13 @@ class _HopResidual:
             self.outcomes.append([None if s is None else s.outcome for s in done])
         return np.concatenate(cols, axis=0)
 
-    def __call__(self, x: np.ndarray, refine: int = 1) -> np.ndarray:
+    def __call__(self, x: np.ndarray, refine: int = 1, coarsen: int = 1) -> np.ndarray:
         xs = np.atleast_2d(np.asarray(x, dtype=float).T).reshape(-1, len(self.keys))
         if refine > 1:
             return self.residuals_of(lambda run: self.robots_at(run, xs, refine))
         values = self.values_at(xs)
-        return self.residuals_of(lambda run: [run.robot] * len(values),
-                                 lambda run: [self.candidates(run).built(v) for v in values])
+        return self.residuals_of(lambda run: [self.robot_of(run, coarsen)] * len(values),
+                                 lambda run: [self.candidates(run, coarsen).built(v) for v in values])
 
 
 def _built_or_none(robot: Robot) -> BuiltModel | None:
@@ -831,7 +843,7 @@ def solve(residual: _HopResidual, x0: np.ndarray, bounds: list[np.ndarray], max_
     watch = _StallWatch(residual)
     try:
         x, trace = minimize.least_squares(x0, watch, bounds=bounds, eps=FD_STEP, max_iter=max_iter, verbose=0,
-                                          xtol=1e-6, gtol=1e-8)
+                                          xtol=1e-6, gtol=1e-8, mu_factor=MU_FACTOR)
     except _Stalled:
         return watch.best_x, watch.jacobians
     return np.asarray(x, dtype=float).ravel(), len(trace)
@@ -869,7 +881,9 @@ def grid_start(residual, n: int, stages: int = GRID_STAGES) -> np.ndarray:
     simulated in one batch about the best point so far, its span halved (in log) each time:
     a hop sits near thresholds (a foot slipping or not, a crank tip touching the floor), so
     the fit's landscape has local minima that a solver started at the robot file's values,
-    or at a coarse grid's best point, stops in."""
+    or at a coarse grid's best point, stops in. The grid only chooses where the solver
+    starts, so it is simulated at ``GRID_COARSEN`` times each run's step (half the cost);
+    every value the fit reports is simulated at the run's converged step."""
     levels = GRID_LEVELS.get(n)
     best, best_cost = np.zeros(n), math.inf
     if levels is None:
@@ -878,7 +892,7 @@ def grid_start(residual, n: int, stages: int = GRID_STAGES) -> np.ndarray:
         half = math.log(GRID_FACTOR) / 2 ** stage
         axis = np.linspace(-half, half, levels)
         xs = best[:, None] + np.array(np.meshgrid(*[axis] * n, indexing="ij")).reshape(n, -1)
-        cost = np.sum(residual(xs) ** 2, axis=0)
+        cost = np.sum(residual(xs, coarsen=GRID_COARSEN) ** 2, axis=0)
         k = int(np.argmin(cost))
         if cost[k] < best_cost:
             best, best_cost = xs[:, k].copy(), float(cost[k])
