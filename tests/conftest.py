@@ -86,28 +86,44 @@ STALL_PROBE_S = 3.0
 STALL_LIMIT_US = 1000.0
 
 
-@pytest.fixture(scope="session")
-def host_stall_us() -> float:
-    """The longest this machine stopped a spinning process over STALL_PROBE_S (microseconds)."""
+def spin_probe_us(seconds: float = STALL_PROBE_S) -> float:
+    """The longest this machine stopped a spinning process over ``seconds`` (microseconds)."""
     worst = 0.0
     t0 = last = time.perf_counter()
-    while last - t0 < STALL_PROBE_S:
+    while last - t0 < seconds:
         now = time.perf_counter()
         worst = max(worst, now - last)
         last = now
     return worst * 1e6
 
 
+@pytest.fixture(scope="session")
+def host_stall_us() -> float:
+    """The longest this machine stopped a spinning process over STALL_PROBE_S (microseconds)."""
+    return spin_probe_us()
+
+
 @pytest.fixture()
 def board_timing(host_stall_us):
     """``board_timing(errors_us)`` asserts every phase error within the board's 2 ms, or skips
-    (after the test's other checks) on a host measured to stall longer than STALL_LIMIT_US."""
+    (after the test's other checks) on a host measured to stall longer than STALL_LIMIT_US, in
+    the session's probe or, where the bound is broken, in a second probe then."""
     def check(errors_us, bound_us: float = 2000.0, what: str = "phase start error") -> None:
         errors_us = list(errors_us)
         if host_stall_us > STALL_LIMIT_US:
             pytest.skip(f"this host stopped a spinning process for {host_stall_us / 1000:.2f} ms (over "
                         f"{STALL_LIMIT_US / 1000:g} ms in a {STALL_PROBE_S:g} s probe): a {bound_us / 1000:g} ms "
                         f"timing bound cannot be tested here (worst {what} {max(map(abs, errors_us)) / 1000:.2f} ms)")
+        worst = max(map(abs, errors_us))
+        if worst > bound_us:
+            # the hypervisor's stalls come in spells: one may start after the session's probe.
+            # Probed again now: a host stalling over STALL_LIMIT_US cannot judge the bound; one
+            # that does not, can, and the firmware was late.
+            again_us = spin_probe_us()
+            if again_us > STALL_LIMIT_US:
+                pytest.skip(f"worst {what} {worst / 1000:.2f} ms over {bound_us / 1000:g} ms, and the host, probed "
+                            f"again, stopped a spinning process for {again_us / 1000:.2f} ms (over "
+                            f"{STALL_LIMIT_US / 1000:g} ms): the bound cannot be tested here")
         for e in errors_us:
             assert abs(e) <= bound_us, (what, e, errors_us)
     return check
