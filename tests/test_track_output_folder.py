@@ -117,7 +117,7 @@ def test_trackers_project_in_the_shared_data_is_converted_and_tracked_into_the_c
     assert first_line(res) == f"output folder: {work.resolve()}"
     redo = pd.read_csv(work / "redo.csv", comment="#").set_index("frame").loc[3:12]
     err = np.hypot(*(redo[["ball_px", "ball_py"]].to_numpy() - [steps[f] for f in range(3, 13)]).T)
-    assert err.max() < 0.8, err     # Tracker's autotracker (measured 0.44 px mean, 0.72 max)
+    assert err.max() < 0.8, err     # Tracker's hand-clicked points (measured 0.44 px mean, 0.72 max)
 
 
 @pytest.fixture(scope="module")
