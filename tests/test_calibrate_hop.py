@@ -46,7 +46,7 @@ def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0, plan
         if key not in truth:
             seed_robot = seed_robot.with_provenance(key, Provenance(source="synthetic: exact"))
     robot = configuration(seed_robot, config).robot
-    leg = leg_set(plant or preset("seed"), config)
+    leg = configuration(plant or preset("seed"), config).robot
     plant = leg.with_values({**truth, "solver.timestep_s": leg.solver.timestep_s / 2})
     period = robot.schedule.push_s + robot.schedule.wait_s
     phase_s = np.array([k * period + d for k in range(cycles) for d in (0.0, robot.schedule.push_s)])
@@ -275,10 +275,10 @@ def test_hidden_truths_over_leg_set_pairs(i, pair):
 
 
 def test_a_fit_across_the_outcomes_threshold_is_refused():
-    """Large as built, two cycles at its 1 ms step, goes over at crank -108.465 deg and stays
-    low at -108.459 (found by bisection on this run's schedule). A fit of the crank angle whose
-    optimum sits there has central differences (0.1 deg either side) on both sides: refused,
-    naming the run and both outcomes; 4 deg away the same Jacobian is made."""
+    """Large as built, two cycles at its 1 ms step, goes over at crank -121.169 deg and rears
+    and returns at -121.172 (found by bisection on this run's schedule). A fit of the crank
+    angle whose optimum sits there has central differences (0.1 deg either side) on both
+    sides: refused, naming the run and both outcomes; 4 deg away the same Jacobian is made."""
     run = synthetic_run("large", {"geometry.crank_start_deg": -104.0}, cycles=2, plant=preset("large"))
     robot = configuration(preset("large"), "large").robot
     key = "geometry.crank_start_deg"
@@ -288,11 +288,11 @@ def test_a_fit_across_the_outcomes_threshold_is_refused():
         return H._jacobian(H._HopResidual([at], (key,)), np.zeros(1))
 
     with pytest.raises(CalibrationError, match="straddles the threshold") as refused:
-        jacobian_at(-108.46)
+        jacobian_at(-121.17)
     assert "large (synthetic-large)" in refused.value.message
-    assert "goes over" in refused.value.message and "stays low" in refused.value.message
+    assert "goes over" in refused.value.message and "rears and returns" in refused.value.message
     assert "measure stance" in refused.value.hint
-    _, jac, _ = jacobian_at(-104.0)
+    _, jac, _ = jacobian_at(-117.17)
     assert np.all(np.isfinite(jac)) and np.abs(jac).max() > 0
 
 

@@ -15,7 +15,7 @@ from click.testing import CliRunner
 from locust.commands import cli
 from locust.errors import ReportError, TrialError
 from locust.io.sweep_store import columns as sweep_columns
-from locust.params import preset
+from locust.params import LEG_SETS, preset
 from locust.report.landscape import design_value, read_landscape
 from locust.trials.configs import configuration, name_from_path, parse_added
 from locust.trials.measure import align, measure_hops, onset_time
@@ -93,6 +93,20 @@ def test_configuration_names_and_added_lengths():
     assert parse_added(["v2=0.015"]) == {"v2": 0.015}
     with pytest.raises(TrialError):
         parse_added(["v2"])
+
+
+def test_a_leg_set_on_a_leg_set_robot_is_built_on_the_robot_as_built():
+    """`report --preset large` with a `large` trial: the trial's leg set goes on the robot as
+    built, not on top of Large's own +2 cm (it predicted 10.6 mm for a robot with 4 cm added,
+    never built, against 17.7 mm filmed); a name that is no leg set keeps the base as given."""
+    for base in LEG_SETS:
+        for name in LEG_SETS:
+            got = configuration(preset(base), name).robot
+            assert got.link_lengths_m() == pytest.approx(preset(name).link_lengths_m(), abs=1e-9), (base, name)
+            assert got.solver.timestep_s == preset(name).solver.timestep_s
+    assert configuration(preset("large"), "mine").robot.link_lengths_m() == preset("large").link_lengths_m()
+    v2 = configuration(preset("medium"), "v2", 0.015).robot        # an added length is on the base given
+    assert v2.get("geometry.crank_m") == pytest.approx(preset("medium").get("geometry.crank_m") + 0.015)
 
 
 def write_sweep(folder: Path, rows: list[str], vary="scale", cycles=3) -> Path:

@@ -64,6 +64,7 @@ def parse_servo_set(item: str, option: str = "--servo") -> tuple[str, float]:
 def hopped_robot(preset, config, sets, leg_set_name):
     """(robot, what run.json records of it): --config or --preset, the leg set on it, --set."""
     from ..params import LEG_SETS, check_robot, leg_set, parse_set_options
+    from ..trials.configs import as_built
 
     defaulted = click.get_current_context().meta.get(DEFAULTED, False)
     # a leg-set preset names the legs hopped when given; the default one (the robot as built) does not
@@ -75,7 +76,7 @@ def hopped_robot(preset, config, sets, leg_set_name):
                               f"give --preset {leg_set_name}, or --leg-set with --config robot.toml")
     robot = resolve_robot(preset, config, ())
     if leg_set_name in LEG_SETS and not preset_set:
-        robot = leg_set(robot, leg_set_name, source=f"leg-set:{leg_set_name}")
+        robot = leg_set(as_built(robot), leg_set_name, source=f"leg-set:{leg_set_name}")
     overrides = parse_set_options(sets)
     robot = check_robot(robot.with_values(overrides, "override") if overrides else robot)
     source = R.RobotSource(preset=None if config else preset, robot_file=str(config) if config else None,
