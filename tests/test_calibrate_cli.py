@@ -171,7 +171,8 @@ def test_missing_file_and_write_without_length(recs):
 
 
 def test_sim_runs_with_the_written_robot(recs):
-    """`locust sim --config <written robot.toml>` runs on the fitted values."""
+    """`locust sim --config <written robot.toml>` runs on the fitted values, on the robot every
+    command runs on when told none (small, the robot as built), never the seed's design."""
     pytest.importorskip("locust.commands.sim", reason="the simulation command is not installed")
     toml = recs / "robot.toml"
     assert run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--length-m", 0.05,
@@ -179,7 +180,11 @@ def test_sim_runs_with_the_written_robot(recs):
     res = run("sim", "--config", toml, "--cycles", 1, "--json")
     assert res.exit_code == 0, res.output
     out = json.loads(res.stdout)
-    assert out["robot"] == "calibrated" and out["valid"] is True
+    assert out["robot"] == "small" and out["valid"] is True
+    written, small = load_robot(toml), preset("small")
+    assert written.leg_set == "small"
+    assert {k: v for k, v in written.flat().items() if not k.startswith("compliance.")} == \
+        {k: v for k, v in small.flat().items() if not k.startswith("compliance.")}
 
 
 def test_plot_never_lands_in_a_read_only_data_folder(recs, tmp_path, monkeypatch):

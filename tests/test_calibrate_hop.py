@@ -228,7 +228,7 @@ def test_one_leg_set_rule_for_presets_reports_and_the_fit():
     for name, spec in LEG_SETS.items():
         robot = preset(name)                               # the robot as built with these links
         built = configuration(seed, name).robot            # the report's and the hop fit's
-        assert built == leg_set(seed, name)
+        assert built == leg_set(seed, name).renamed(name)
         assert built.solver.timestep_s == robot.solver.timestep_s == min(spec.timestep_s, seed.solver.timestep_s)
         assert built.link_lengths_m() == pytest.approx(tuple(v + spec.added_m for v in seed.link_lengths_m()))
         assert robot.link_lengths_m() == pytest.approx(built.link_lengths_m())   # the cut file's are the seed's

@@ -81,24 +81,24 @@ def test_a_preset_leg_set_is_recorded_and_a_contradicting_leg_set_refused(env, t
 
 
 def test_the_default_robot_is_the_one_as_built_or_the_calibrated_one_here(env, tmp_path):
-    """No --preset or --config: the robot as built (small, no leg set claimed) where the current
-    folder has no calibration/robot.toml, that file where it has one; the line after the output
-    folder says which."""
+    """No --preset or --config: the robot as built (small) where the current folder has no
+    calibration/robot.toml, that file where it has one; the line after the output folder says
+    which, and the record names the leg set the robot carries (the file's own, not its name's)."""
     hop = _run(["hop", "--port", "sim", *QUICK, "--out", tmp_path / "a"], env, cwd=tmp_path)
     assert hop.returncode == 0, hop.stderr
     assert hop.stderr.splitlines()[0] == f"output folder: {tmp_path / 'a'}"   # then which robot
     assert hop.stderr.splitlines()[1].startswith("robot: small, the robot as built")
-    assert R.read_run_record(tmp_path / "a" / R.RECORD_NAME).robot == R.RobotSource("small", None, None)
+    assert R.read_run_record(tmp_path / "a" / R.RECORD_NAME).robot == R.RobotSource("small", None, "small")
     (tmp_path / "calibration").mkdir()
-    save_robot(preset("large"), tmp_path / "calibration" / "robot.toml")
+    save_robot(preset("large").renamed("mine"), tmp_path / "calibration" / "robot.toml")
     hop = _run(["hop", "--port", "sim", *QUICK, "--out", tmp_path / "b"], env, cwd=tmp_path)
     assert hop.returncode == 0, hop.stderr
     assert hop.stderr.splitlines()[1].startswith("robot: calibration/robot.toml")
     assert R.read_run_record(tmp_path / "b" / R.RECORD_NAME).robot == R.RobotSource(None, "calibration/robot.toml",
-                                                                                  None)
+                                                                                  "large")
     sim = _run(["sim", "--cycles", "1", "--json"], env, cwd=tmp_path)
     assert sim.stderr.splitlines()[0].startswith("robot: calibration/robot.toml")
-    assert json.loads(sim.stdout)["robot"] == "large"
+    assert json.loads(sim.stdout)["robot"] == "mine"
 
 
 def test_a_missing_trial_folder_is_no_such_folder_not_an_unknown_configuration(tmp_path):

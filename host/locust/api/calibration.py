@@ -516,7 +516,7 @@ def robot_of_runs(runs: Sequence[PathLike]) -> tuple[Robot, str]:
     """
     from ..io.robot_toml import load_robot
     from ..io.run_record import RECORD_NAME, read_run_record
-    from ..params import LEG_SETS, preset
+    from ..params import DEFAULT_PRESET, LEG_SETS, preset
 
     seen: dict[tuple[str, str], list[str]] = {}
     for item in runs:
@@ -528,7 +528,8 @@ def robot_of_runs(runs: Sequence[PathLike]) -> tuple[Robot, str]:
         if src.robot_file:       # as given to `locust hop --config`
             key = ("file", src.robot_file)
         elif src.preset:
-            key = ("preset", "small" if src.preset in LEG_SETS else src.preset)
+            # the leg-set presets are one robot, the robot as built, with different legs on it
+            key = ("preset", DEFAULT_PRESET if src.preset in LEG_SETS else src.preset)
         else:
             continue            # an older record: it does not say
         seen.setdefault(key, []).append(str(path))
@@ -538,14 +539,15 @@ def robot_of_runs(runs: Sequence[PathLike]) -> tuple[Robot, str]:
                                "give --config ROBOT.toml (in the API: robot=) with the values the runs share, "
                                "or fit the runs of each robot apart")
     if not seen:
-        return preset("small"), "robot: small, the robot as built (the runs' run.json do not say which robot)"
+        return preset(DEFAULT_PRESET), (f"robot: {DEFAULT_PRESET}, the robot as built (the runs' run.json do not "
+                                        "say which robot)")
     ((kind, name), paths), = seen.items()
     if kind == "file":
         if not Path(name).is_file():
             raise CalibrationError(f"the runs record robot file {name}, which is not there",
                                    "give --config with that robot.toml (or the values the runs shared)")
         return load_robot(name), f"robot: {name}, as the runs' run.json record"
-    what = "the robot as built, each run's leg set on it" if name == "small" else f"preset {name}"
+    what = "the robot as built, each run's leg set on it" if name == DEFAULT_PRESET else f"preset {name}"
     return preset(name), f"robot: {name} ({what}), as the runs' run.json record"
 
 

@@ -1,7 +1,8 @@
 """Update a robot.toml with fitted values, each with its source, uncertainty and date.
 
 Only the keys given are touched; every other value, with its provenance, is kept as it
-was. A file that does not exist yet starts from the seed preset. The file is replaced
+was. A file that does not exist yet starts from the robot the command resolved (the one
+rule of ``locust.io.robot_toml.default_robot``), never from a preset picked here. The file is replaced
 atomically (a reader never sees half of it; a failed write leaves the old one).
 """
 
@@ -12,11 +13,11 @@ import math
 from pathlib import Path
 
 from ..errors import CalibrationError
-from ..io.robot_toml import update_robot
-from ..params import Provenance, Robot, preset, problems
+from ..io.robot_toml import ROBOT_FILE, update_robot
+from ..params import Provenance, Robot, problems
 from .fitstats import Estimate
 
-DEFAULT_ROBOT_TOML = Path("calibration") / "robot.toml"
+DEFAULT_ROBOT_TOML = ROBOT_FILE   # a bare --write
 
 # what a desk hopper's fitted values can be (the seed's within a few decades): a fit outside
 # came from a recording read in the wrong unit, and is not written
@@ -75,7 +76,7 @@ def check_plausible(values: dict[str, Estimate]) -> None:
 
 
 def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str | Path, *,
-                 note: str = "", date: str | None = None) -> Path:
+                 start: Robot | None = None, note: str = "", date: str | None = None) -> Path:
     """Set each dotted key in ``values`` to its fitted value, with ``fit:<recording>``; refused
     (nothing written) when a value is implausible or the robot could then not be simulated.
 
@@ -85,7 +86,10 @@ def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str |
     Parameters
     ----------
     path : path-like
-        The ``robot.toml`` (started from the seed preset when missing).
+        The ``robot.toml``.
+    start : locust.params.Robot, optional
+        The robot a file that does not exist yet starts from: the one the command resolved
+        (``locust.io.robot_toml.default_robot``). None: ``path`` must exist.
     values : dict of str to locust.calibrate.fitstats.Estimate
         Dotted name -> fitted value, in the unit its name says.
     recording : str or path-like
@@ -118,7 +122,7 @@ def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str |
                                    "(`locust params --config FILE` lists them)")
         return robot
 
-    return update_robot(path, change, start=lambda: preset("seed").renamed("calibrated"))
+    return update_robot(path, change, start=None if start is None else (lambda: start))
 
 
 def with_fitted(robot: Robot, values: dict[str, Estimate], recording: str | Path, *, note: str = "",

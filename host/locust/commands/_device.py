@@ -62,12 +62,12 @@ def parse_servo_set(item: str, option: str = "--servo") -> tuple[str, float]:
 
 
 def hopped_robot(preset, config, sets, leg_set_name):
-    """(robot, what run.json records of it): --config or --preset, the leg set on it, --set."""
+    """(robot, what run.json records of it): --config or --preset, --leg-set in place of the
+    leg set it carries, --set. The record names the leg set hopped: --leg-set's, else the robot's."""
     from ..params import LEG_SETS, check_robot, leg_set, parse_set_options
-    from ..trials.configs import as_built
 
     defaulted = click.get_current_context().meta.get(DEFAULTED, False)
-    # a leg-set preset names the legs hopped when given; the default one (the robot as built) does not
+    # a leg-set preset named on the command line is the legs hopped; --leg-set may not contradict it
     preset_set = preset if config is None and preset in LEG_SETS and not defaulted else None
     if leg_set_name is not None:
         leg_set_name = R.check_leg_set(leg_set_name)
@@ -75,12 +75,12 @@ def hopped_robot(preset, config, sets, leg_set_name):
             raise DeviceError(f"--leg-set {leg_set_name} contradicts --preset {preset}, which is the {preset} leg set",
                               f"give --preset {leg_set_name}, or --leg-set with --config robot.toml")
     robot = resolve_robot(preset, config, ())
-    if leg_set_name in LEG_SETS and not preset_set:
-        robot = leg_set(as_built(robot), leg_set_name, source=f"leg-set:{leg_set_name}")
+    if leg_set_name in LEG_SETS:
+        robot = leg_set(robot, leg_set_name, source=f"leg-set:{leg_set_name}")
     overrides = parse_set_options(sets)
     robot = check_robot(robot.with_values(overrides, "override") if overrides else robot)
     source = R.RobotSource(preset=None if config else preset, robot_file=str(config) if config else None,
-                           leg_set=leg_set_name or preset_set)
+                           leg_set=leg_set_name or robot.leg_set)
     return robot, source
 
 

@@ -19,6 +19,8 @@ from ..calibrate.write import DEFAULT_ROBOT_TOML, check_plausible, implausible, 
 from ..errors import CalibrationError
 from ..fileio import check_distinct, json_text, make_folder
 from ..io.importing import ImportOptions
+from ..io.robot_toml import default_robot, resolve_robot
+from ..params import PRESETS
 from ..plotting import check_figure_path
 from ..progress import progress
 from ..tables import estimate_line, value_line
@@ -33,8 +35,9 @@ def output_options(func):
     command = func
 
     @functools.wraps(command)
-    def wrapper(*args, **kwargs):
+    def wrapper(*args, preset, config, **kwargs):
         kwargs["write_path"] = write_target(kwargs["write_path"])
+        start_robot(kwargs["write_path"], preset, config)
         inputs = [p for name in ("tracks", "data", "validate") for p in _paths(kwargs.get(name))]
         plot = None if kwargs["no_plot"] else kwargs["plot_path"]
         check_distinct({"--plot": plot, "--write": kwargs["write_path"]}, inputs)
@@ -55,8 +58,43 @@ def output_options(func):
     func = out_option(func, "<recording>-fit.png")
     func = click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")(func)
     func = write_option(func, "Update this robot.toml with the fitted values only. Other values are kept; a new "
-                              "file starts from the seed preset.")
+                              "file starts from the robot --config or --preset names, else the one every command "
+                              "runs on (calibration/robot.toml here, else the robot as built), named on the first "
+                              "line.")
+    func = click.option("--config", type=click.Path(dir_okay=False, path_type=Path), default=None,
+                        help="With --write to a new file: the robot.toml it starts from.")(func)
+    func = click.option("--preset", type=click.Choice(list(PRESETS)), default=None,
+                        help="With --write to a new file: the preset it starts from.")(func)
     return func
+
+
+_START_KEY = "locust.calibrate.start"
+
+
+def start_robot(write_path: Path | None, preset: str | None, config: Path | None) -> None:
+    """The robot ``--write`` changes, said on the first line (stderr): the --write file when
+    it exists, else the robot a new one starts from (--config, --preset, else the one rule of
+    :func:`locust.io.robot_toml.default_robot`), kept for :func:`_finish`."""
+    if write_path is None:
+        if preset is not None or config is not None:
+            raise CalibrationError("--preset and --config name the robot a new --write file starts from",
+                                   "add --write NEW.toml, or leave them out")
+        return
+    if Path(write_path).exists():
+        if preset is not None or config is not None:
+            raise CalibrationError(f"{write_path} exists: --write updates it, and --preset/--config would not be "
+                                   "used", "leave them out, or --write a new file")
+        click.echo(f"robot: {write_path} (the --write file, updated)", err=True)
+        return
+    robot = resolve_robot(preset, config, ())
+    if config is not None:
+        line = f"robot: {config}"
+    elif preset is not None:
+        line = f"robot: {preset}"
+    else:
+        line = default_robot().line
+    click.echo(f"{line}; the new {write_path} starts from it", err=True)
+    click.get_current_context().meta[_START_KEY] = robot
 
 
 def write_option(func, help_text: str):
@@ -372,12 +410,10 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, out_dir, write
       locust calibrate hop small=runs/s1 large=runs/l1 --write calibration/robot.toml
     """
     from ..api.calibration import calibrate_hops
-    from ..io.robot_toml import resolve_robot
 
     keys = [k.strip() for k in fit_keys.split(",") if k.strip()]
     H.check_fittable(keys)
     write_path = write_target(write_path)
-    folder = out_folder(out_dir, None, no_plot, as_json)
     start_from = config or (write_path if write_path and Path(write_path).exists() else None)
     if start_from is not None:
         base = resolve_robot(None, start_from, sets)
@@ -389,7 +425,9 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, out_dir, write
         base, said = robot_of_runs(list(runs))
         overrides = parse_set_options(sets)
         base = check_robot(base.with_values(overrides, "override") if overrides else base)
-        click.echo(said, err=True)
+        new = write_path is not None and not Path(write_path).exists()
+        click.echo(said + (f"; the new {write_path} starts from it" if new else ""), err=True)
+    folder = out_folder(out_dir, None, no_plot, as_json)
     with progress(label="fitting hops: simulations") as bar:
         def done(n: int, planned: int) -> None:
             bar.length = planned
@@ -407,7 +445,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, out_dir, write
     if write_path:
         values = facade_fit.parameters
         if values:
-            write_fitted(write_path, values, H.PROVENANCE_NAME, note=facade_fit.note)
+            write_fitted(write_path, values, H.PROVENANCE_NAME, note=facade_fit.note, start=base)
         out["written"] = {"path": str(Path(write_path).resolve()), "keys": list(values)}
     if as_json:
         click.echo(json_text(out), nl=False)
@@ -458,7 +496,8 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
         check_plausible(values)
     if write_path:
         if values:
-            write_fitted(write_path, values, source_name or recording.name, note=note)
+            write_fitted(write_path, values, source_name or recording.name, note=note,
+                         start=click.get_current_context().meta.get(_START_KEY))
         out["written"] = {"path": str(Path(write_path).resolve()), "keys": list(values)}
     if as_json:
         click.echo(json_text(out), nl=False)

@@ -4,7 +4,8 @@
   ``click``'s own ``float`` takes ``nan`` and ``inf``, which would reach a fit or a drawing as
   nonsense, so these refuse them where the command line is read.
 - ``robot_options``: ``--preset``, ``--config``, ``--set``, and the robot a command runs on when
-  given neither (``default_robot``: ``calibration/robot.toml`` here, else the robot as built).
+  given neither (``locust.io.robot_toml.default_robot``: ``calibration/robot.toml`` here, else
+  the robot as built).
 - ``import_options``: ``--units``, ``--rename``, ``--mirror`` for foreign tracks.
 - ``time_options``: ``--time-scale``, ``--clip-fps`` for slow-motion recordings.
 """
@@ -20,6 +21,7 @@ import click
 from .. import params as P
 from ..calibrate.recordings import TimeOptions
 from ..io.importing import ImportOptions
+from ..io.robot_toml import ROBOT_FILE, default_robot
 
 
 class FiniteFloat(click.ParamType):
@@ -51,18 +53,7 @@ FINITE = FiniteFloat()
 POSITIVE = FiniteFloat(positive=True)
 
 
-ROBOT_FILE = Path("calibration") / "robot.toml"   # what `locust calibrate --write` makes: the robot as calibrated
-DEFAULT_PRESET = "small"                          # the robot as built, no legs added (README, "What the presets are")
 DEFAULTED = "locust.robot_defaulted"              # click context meta: no --preset or --config was given
-
-
-def default_robot() -> tuple[str | None, Path | None, str]:
-    """(preset, robot file, the line saying which) when a command is given neither: the
-    calibrated robot in the current folder, else the robot as built."""
-    if ROBOT_FILE.is_file():
-        return None, ROBOT_FILE, f"robot: {ROBOT_FILE} (found here; --preset or --config to choose another)"
-    return DEFAULT_PRESET, None, (f"robot: {DEFAULT_PRESET}, the robot as built (no {ROBOT_FILE} here; "
-                                  "--preset or --config to choose another)")
 
 
 def robot_options(func=None, *, say: bool = True):
@@ -78,7 +69,8 @@ def robot_options(func=None, *, say: bool = True):
     @functools.wraps(command)
     def wrapper(*args, preset, config, **kwargs):
         if preset is None and config is None:
-            preset, config, said = default_robot()
+            choice = default_robot()
+            preset, config, said = choice.preset, choice.robot_file, choice.line
             if say:
                 click.echo(said, err=True)
             click.get_current_context().meta[DEFAULTED] = said
@@ -91,7 +83,7 @@ def robot_options(func=None, *, say: bool = True):
                         help=f"A robot.toml (e.g. {ROBOT_FILE}); overrides --preset.")(func)
     func = click.option("--preset", type=click.Choice(list(P.PRESETS)), default=None,
                         help=f"Built-in parameter set [default: {ROBOT_FILE} when the current folder has one, "
-                             f"else {DEFAULT_PRESET}, the robot as built].")(func)
+                             f"else {P.DEFAULT_PRESET}, the robot as built].")(func)
     return func
 
 

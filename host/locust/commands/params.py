@@ -36,11 +36,14 @@ def params(preset, config, sets, as_json, write, force):
     if as_json:
         out = {k: {"value": v, **{a: b for a, b in vars(robot.source_of(k)).items() if b is not None}}
                for k, v in robot.flat().items()}
-        click.echo(json_text({"name": robot.name, "values": out,
+        click.echo(json_text({"name": robot.name, "leg_set": robot.leg_set,
+                              "leg_set_added_m": P.leg_set_spec(robot.leg_set).added_m, "values": out,
                               "nose_load_kg": load.nose_load_kg if load else None,
                               "total_mass_kg": load.total_mass_kg if load else None}), nl=False)
         return
     click.echo(f"# {robot.name}")
+    click.echo(f"# leg set: {robot.leg_set} ({P.leg_set_spec(robot.leg_set).added_m * 1000:+g} mm on every link of "
+               "the cut file's strip)")
     for key, value in robot.flat().items():
         prov = robot.source_of(key)
         unc = f" ± {prov.uncertainty:g}" if prov.uncertainty is not None else ""

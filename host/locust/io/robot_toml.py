@@ -2,9 +2,10 @@ r"""``robot.toml``: the robot's parameters with their provenance, read and writt
 
 ``load_robot`` reads and checks a file into a :class:`~locust.params.Robot`; ``save_robot``
 writes one through a real TOML writer (tomlkit) and reads each write back before it replaces
-the old file; ``update_robot`` changes a file under its lock; ``resolve_robot`` is the robot a
-command names (a preset or a file,
-with ``--set`` values on it). Given the file being replaced, it changes that document in place, so
+the old file; ``update_robot`` changes a file under its lock; ``default_robot`` is the one
+rule for the robot when none is named (this folder's ``calibration/robot.toml``, else the
+robot as built); ``resolve_robot`` is the robot a command names (a preset or a file, with
+``--set`` values on it). Given the file being replaced, it changes that document in place, so
 the comments and the layout a person gave it are kept; every string is escaped by tomlkit
 (control characters, quotes, backslashes, newlines), and a string Python holds but UTF-8
 cannot (a file name's undecodable byte, kept as a lone surrogate) is written as its ``\udcXX``
@@ -18,7 +19,7 @@ import math
 import stat
 import tomllib
 from collections.abc import Callable
-from dataclasses import fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
@@ -27,17 +28,20 @@ from tomlkit.items import InlineTable, Table
 
 from ..errors import ParamsError
 from ..fileio import atomic_write_text, locked, storable
+from ..params.legsets import LEG_SETS
 from ..params.limits import check_robot
 from ..params.model import SECTIONS, Provenance, Robot, parse_set_options, shown_value, split_key
-from ..params.presets import PRESETS, preset
+from ..params.presets import DEFAULT_PRESET, PRESETS, preset
 
 HEADER = (
-    "locust robot parameters. Each value: {value, source, uncertainty (1 sigma), date, note}.",
+    "locust robot parameters. leg_set: the filmed leg set the links carry (small, medium, large).",
+    "Each value: {value, source, uncertainty (1 sigma), date, note}.",
     "source: default | seed | photo:, cut_file:, datasheet:, data:, estimate:<what> | preset:<name>",
     "| override | fit:<recording>.",
 )
 
 PROVENANCE_KEYS = ("source", "uncertainty", "date", "note")
+TOP_KEYS = ("name", "base", "leg_set")   # the keys above the sections
 
 
 def _item(value: Any) -> Any:
@@ -64,7 +68,7 @@ def _entry(value: Any, provenance: dict[str, Any], old: Any) -> InlineTable:
 
 
 def document_text(name: str, sections: dict[str, dict[str, tuple[Any, dict[str, Any]]]],
-                  template: str | None = None) -> str:
+                  template: str | None = None, leg_set: str | None = None) -> str:
     """The TOML text of a robot.
 
     Parameters
@@ -77,6 +81,8 @@ def document_text(name: str, sections: dict[str, dict[str, tuple[Any, dict[str, 
     template : str, optional
         The TOML text of the file being replaced (valid TOML): its comments, order and layout
         are kept, its values replaced. None: a new file with the usual header.
+    leg_set : str, optional
+        The leg set the robot carries (``Robot.leg_set``), written as ``leg_set`` after the name.
 
     Returns
     -------
@@ -90,6 +96,8 @@ def document_text(name: str, sections: dict[str, dict[str, tuple[Any, dict[str, 
     else:
         doc = tomlkit.parse(template)
     doc["name"] = storable(name)
+    if leg_set is not None:
+        doc["leg_set"] = storable(leg_set)
     for section, entries in sections.items():
         table = doc.get(section)
         if not isinstance(table, Table):
@@ -103,7 +111,6 @@ def document_text(name: str, sections: dict[str, dict[str, tuple[Any, dict[str, 
 
 
 
-# Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
 # -- TOML ---------------------------------------------------------------------------
 def _uncertainty(path: Path, key: str, raw: Any) -> float | None:
     """One standard deviation, a finite number >= 0 in the value's unit, or absent."""
@@ -134,7 +141,9 @@ def _check_robot_file(path: Path) -> None:
 
 
 def load_robot(path: str | Path) -> Robot:
-    """Read a robot.toml. Missing values fall back to the seed preset's.
+    """Read a robot.toml. Missing values fall back to those of the preset its ``base`` names,
+    by default the robot as built (:data:`locust.params.DEFAULT_PRESET`); its ``leg_set``, to
+    that preset's.
 
     Parameters
     ----------
@@ -171,14 +180,19 @@ def load_robot(path: str | Path) -> Robot:
     except tomllib.TOMLDecodeError as exc:
         raise ParamsError(f"{path}: not valid TOML ({exc})",
                           "fix the file, or regenerate it with `locust params --write`") from None
-    base, name = doc.get("base", "seed"), doc.get("name", path.stem)
+    base, name = doc.get("base", DEFAULT_PRESET), doc.get("name", path.stem)
     if not isinstance(base, str) or base not in PRESETS:
         raise ParamsError(f"{path}: base = {shown_value(base)} is not a preset", f"choose one of {', '.join(PRESETS)}")
     if not isinstance(name, str):
         raise ParamsError(f"{path}: name = {shown_value(name)} is not a string", 'write it in quotes: name = "mine"')
     robot = preset(base).renamed(name)
+    legs = doc.get("leg_set", robot.leg_set)
+    if not isinstance(legs, str) or legs not in LEG_SETS:
+        raise ParamsError(f"{path}: leg_set = {shown_value(legs)} is not a leg set",
+                          f"the leg set the robot's links carry: one of {', '.join(LEG_SETS)}")
+    robot = dataclasses.replace(robot, leg_set=legs)
     for section, table in doc.items():
-        if section in ("name", "base"):
+        if section in TOP_KEYS:
             continue
         if section not in SECTIONS:
             raise ParamsError(f"{path}: unknown section [{section}]", f"sections are {', '.join(SECTIONS)}")
@@ -238,7 +252,7 @@ def to_toml(robot: Robot, template: str | None = None) -> str:
                   for f in fields(SECTIONS[section])}
         for section in SECTIONS
     }
-    return document_text(robot.name, sections, template)
+    return document_text(robot.name, sections, template, leg_set=robot.leg_set)
 
 
 def _same(a: Any, b: Any) -> bool:
@@ -260,6 +274,8 @@ def _read_back(robot: Robot, path: Path, tmp: Path) -> None:
               or dataclasses.astuple(back.source_of(key)) != dataclasses.astuple(_stored(robot.source_of(key)))]
     if back.name != storable(robot.name):
         differ.insert(0, "name")
+    if back.leg_set != robot.leg_set:
+        differ.insert(0, "leg_set")
     if differ:
         raise ParamsError(f"{path}: the robot file written reads back different ({', '.join(differ[:5])}); "
                           "the old file is kept", "report this as a bug in locust, with the command run")
@@ -332,7 +348,9 @@ def update_robot(path: str | Path, change: Callable[[Robot], Robot], *, start: C
     change : callable
         ``Robot -> Robot``, the update; it may raise to leave the file as it is.
     start : callable, optional
-        The robot when ``path`` does not exist yet (default: the seed preset).
+        The robot when ``path`` does not exist yet: the one the command resolved
+        (:func:`default_robot`, or the robot it was told), never a preset picked here. None:
+        ``path`` must exist.
     wait_s : float
         How long to wait for another process's update, seconds.
 
@@ -345,19 +363,61 @@ def update_robot(path: str | Path, change: Callable[[Robot], Robot], *, start: C
     with locked(path, wait_s) as target:
         if target.exists():
             robot, template = load_robot(target), file_text(target)
+        elif start is not None:
+            robot, template = start(), None
         else:
-            robot, template = (start or (lambda: preset("seed")))(), None
+            raise ParamsError(f"{path}: no such file", "give the path of an existing robot.toml to update")
         return save_robot(change(robot), path, template=template)
+
+
+# what `locust calibrate --write` makes and every door looks for first: the robot as calibrated here
+ROBOT_FILE = Path("calibration") / "robot.toml"
+
+
+@dataclass(frozen=True)
+class RobotChoice:
+    """Which robot a command or the API runs on, and the line that says so.
+
+    Attributes
+    ----------
+    preset : str or None
+        The preset, when no robot file is used.
+    robot_file : pathlib.Path or None
+        The robot file, when one is used.
+    line : str
+        What the command prints first (on stderr): ``robot: ...``.
+    """
+
+    preset: str | None
+    robot_file: Path | None
+    line: str
+
+
+def default_robot() -> RobotChoice:
+    """The one resolution rule, for every door (the commands, the API, the notebook, the demo,
+    ``calibrate --write`` of a new file): the robot file given (the caller's business), else
+    this folder's ``calibration/robot.toml``, else the robot as built (:data:`DEFAULT_PRESET`).
+
+    Returns
+    -------
+    RobotChoice
+    """
+    if ROBOT_FILE.is_file():
+        return RobotChoice(None, ROBOT_FILE, f"robot: {ROBOT_FILE} (found here; --preset or --config to choose "
+                                             "another)")
+    return RobotChoice(DEFAULT_PRESET, None, f"robot: {DEFAULT_PRESET}, the robot as built (no {ROBOT_FILE} here; "
+                                             "--preset or --config to choose another)")
 
 
 def resolve_robot(preset_name: str | None = None, config: str | Path | None = None,
                   sets: tuple[str, ...] | list[str] = ()) -> Robot:
-    """The robot a command runs on: ``--config`` file, else ``--preset``, then ``--set``.
+    """The robot a command runs on: ``--config`` file, else ``--preset``, else
+    :func:`default_robot`; then ``--set``.
 
     Parameters
     ----------
     preset_name : str, optional
-        A preset (default ``seed``), used when no ``config`` is given.
+        A preset, used when no ``config`` is given.
     config : path-like, optional
         A robot.toml.
     sets : sequence of str
@@ -373,8 +433,9 @@ def resolve_robot(preset_name: str | None = None, config: str | Path | None = No
         An unknown preset, a file :func:`load_robot` refuses, a bad ``--set``, or a robot that
         cannot be simulated.
     """
-    robot = load_robot(config) if config else preset(preset_name or "seed")
+    if config is None and preset_name is None:
+        choice = default_robot()
+        preset_name, config = choice.preset, choice.robot_file
+    robot = load_robot(config) if config else preset(preset_name)
     overrides = parse_set_options(sets)
     return check_robot(robot.with_values(overrides, "override") if overrides else robot)
-
-

@@ -10,7 +10,7 @@
 ``robot.toml`` is read and written by :mod:`locust.io.robot_toml`.
 """
 
-from .legsets import LEG_SETS, LegSet, leg_set, with_added_length
+from .legsets import LEG_SETS, LegSet, leg_set, leg_set_spec, with_added_length
 from .limits import LIMITS, MAX_SIM_STEPS, Limit, check_robot, outside_limits, problems
 from .model import (
     GRAVITY_M_PER_S2,
@@ -33,10 +33,11 @@ from .model import (
     real_keys,
     value_type,
 )
-from .presets import AS_BUILT, PRESETS, SG90_SOURCE, preset
+from .presets import AS_BUILT, DEFAULT_PRESET, PRESETS, SG90_SOURCE, preset
 
 __all__ = ["GRAVITY_M_PER_S2", "Geometry", "Compliance", "Servo", "Contact", "Power", "Schedule", "Solver",
            "SECTIONS", "Provenance", "Robot", "UNBOUNDED_KEYS", "all_keys", "value_type", "real_keys",
            "PHYSICAL_SECTIONS", "fittable_keys", "parse_set_options", "as_dict", "Limit", "LIMITS",
            "MAX_SIM_STEPS", "outside_limits", "problems", "check_robot", "with_added_length", "LegSet",
-           "LEG_SETS", "leg_set", "SG90_SOURCE", "AS_BUILT", "PRESETS", "preset"]
+           "LEG_SETS", "leg_set", "leg_set_spec", "SG90_SOURCE", "AS_BUILT", "DEFAULT_PRESET", "PRESETS",
+           "preset"]

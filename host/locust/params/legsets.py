@@ -4,12 +4,12 @@ and the hop fit build a leg set from.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 from ..errors import ParamsError
 from .model import Provenance, Robot
 
-# Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
 
 def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
                       note: str | None = None) -> Robot:
@@ -34,7 +34,7 @@ def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
         "geometry.coupler_m": round(g.coupler_m + added_m, 9),
         "geometry.leg_m": round(g.leg_m + added_m, 9),
     }
-    note = note or f"+{added_m * 100:g} cm on every link"
+    note = note or f"{added_m * 1000:+g} mm on every link"
     return base.with_values(values, Provenance(source=source, note=note))
 
 
@@ -58,15 +58,16 @@ LEG_SETS = {
 }
 
 
-def leg_set(base: Robot, name: str, source: str | None = None) -> Robot:
-    """The physical leg set ``name`` (small/medium/large) built on ``base``'s parameters: its
-    links, and its converged time step where ``base``'s is coarser (a finer one is kept);
-    ``source``: the provenance of what it changes (``preset:<name>``).
+def leg_set(robot: Robot, name: str, source: str | None = None) -> Robot:
+    """``robot`` with the leg set ``name`` (small/medium/large) in place of its own: every link
+    changed by ``name``'s added length less that of the leg set it carries (``robot.leg_set``),
+    so a leg set is never added on top of another; its converged time step where ``robot``'s
+    is coarser (a finer one is kept).
 
     Parameters
     ----------
-    base : Robot
-        The robot the leg set is put on.
+    robot : Robot
+        The robot the leg set is put on (its name is kept).
     name : str
         ``small``, ``medium`` or ``large``.
     source : str, optional
@@ -75,6 +76,38 @@ def leg_set(base: Robot, name: str, source: str | None = None) -> Robot:
     Returns
     -------
     Robot
+        With ``leg_set == name``.
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        An unknown leg set.
+    """
+    spec, own = leg_set_spec(name), leg_set_spec(robot.leg_set)
+    source = source or f"preset:{name}"
+    out = robot
+    if spec.added_m != own.added_m:
+        note = (f"notebook Part 3 leg set {name}: {spec.added_m * 1000:+g} mm on every link of the strip "
+                f"(in place of {robot.leg_set}'s {own.added_m * 1000:+g} mm)")
+        out = with_added_length(robot, spec.added_m - own.added_m, source=source, note=note)
+    if spec.timestep_s < out.solver.timestep_s:
+        out = out.with_values({"solver.timestep_s": spec.timestep_s},
+                              Provenance(source=source,
+                                         note=f"converged step of this leg set, {spec.step_note} (docs/servo.md)"))
+    return dataclasses.replace(out, leg_set=name)
+
+
+def leg_set_spec(name: str) -> LegSet:
+    """The leg set ``name`` of :data:`LEG_SETS`.
+
+    Parameters
+    ----------
+    name : str
+        ``small``, ``medium`` or ``large``.
+
+    Returns
+    -------
+    LegSet
 
     Raises
     ------
@@ -82,16 +115,6 @@ def leg_set(base: Robot, name: str, source: str | None = None) -> Robot:
         An unknown leg set.
     """
     try:
-        spec = LEG_SETS[name]
+        return LEG_SETS[name]
     except KeyError:
         raise ParamsError(f"unknown leg set {name!r}", f"choose one of {', '.join(LEG_SETS)}") from None
-    source = source or f"preset:{name}"
-    note = f"notebook Part 3 leg set: +{spec.added_m * 100:g} cm on every link"
-    robot = with_added_length(base, spec.added_m, source=source, note=note).renamed(name)
-    if spec.timestep_s < base.solver.timestep_s:
-        robot = robot.with_values({"solver.timestep_s": spec.timestep_s},
-                                  Provenance(source=source,
-                                             note=f"converged step of this leg set, {spec.step_note} (docs/servo.md)"))
-    return robot
-
-

@@ -11,8 +11,6 @@ from ..errors import ParamsError
 from ..firmware import protocol
 from .model import Robot
 
-# Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
-
 # -- limits -------------------------------------------------------------------------
 # The robots this toolkit is for: a desk hopper of a few grams to a kilogram, links of
 # millimetres to tens of centimetres, hobby servos. Each key's (lowest, highest, lowest

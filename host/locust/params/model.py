@@ -22,8 +22,6 @@ from typing import Any
 from ..errors import ParamsError
 
 # Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
-
-# Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
 GRAVITY_M_PER_S2 = 9.81
 
 
@@ -182,9 +180,17 @@ class Provenance:
 
 @dataclass(frozen=True)
 class Robot:
-    """A complete, named parameter set."""
+    """A complete, named parameter set.
+
+    ``leg_set`` is the filmed leg set whose links the robot carries (a key of
+    :data:`locust.params.LEG_SETS`: ``small`` is the cut file's strip as it is, ``medium`` and
+    ``large`` add 1 and 2 cm to every link); :func:`locust.params.leg_set` swaps it for
+    another, taking its own added length off first. It is part of the robot, written to and
+    read from ``robot.toml``: nothing derives it from the name.
+    """
 
     name: str = "seed"
+    leg_set: str = "small"
     geometry: Geometry = field(default_factory=Geometry)
     compliance: Compliance = field(default_factory=Compliance)
     servo: Servo = field(default_factory=Servo)

@@ -23,10 +23,8 @@ import math
 from typing import Any
 
 from ..errors import ParamsError
-from .legsets import leg_set
+from .legsets import LEG_SETS, leg_set
 from .model import Provenance, Robot
-
-# Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
 
 # -- presets ------------------------------------------------------------------------
 _SEED_SOURCE = Provenance(source="seed", note="notebook Part 2")
@@ -174,12 +172,21 @@ def _seed_notebook() -> Robot:
     ).renamed("seed-notebook")
 
 
+# the robot a command or the API runs on when told neither a robot file nor a preset, and no
+# calibration/robot.toml is at hand (locust.io.robot_toml.default_robot): the robot as built
+DEFAULT_PRESET = "small"
+
+
+def _as_built_leg_set(name: str):
+    def build() -> Robot:
+        return leg_set(_built(), name).renamed(name)
+    return build
+
+
 PRESETS = {
     "seed": _seed,
     # the filmed leg sets of the robot as built (AS_BUILT), each at its converged step
-    "small": lambda: leg_set(_built(), "small"),
-    "medium": lambda: leg_set(_built(), "medium"),
-    "large": lambda: leg_set(_built(), "large"),
+    **{name: _as_built_leg_set(name) for name in LEG_SETS},
     "seed-notebook": _seed_notebook,
 }
 

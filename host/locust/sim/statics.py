@@ -21,6 +21,9 @@ from .model import build
 from .schedule import control_plan
 
 AT_REST_REL = 0.01   # the floor's normal forces must carry the weight to 1 %: the robot is still
+# a robot whose schedule starts as it is dropped (seed-notebook: settle_s 0) still stands on the
+# floor before anyone runs it: it is settled this long at least
+MIN_SETTLE_S = 0.5
 
 
 @dataclass(frozen=True)
@@ -51,7 +54,8 @@ def _floor_normals(model: mujoco.MjModel, data: mujoco.MjData, plate: int, floor
 
 
 def standing_load(robot: Robot) -> StandingLoad:
-    """Settle ``robot`` at the 0 deg command and read the load under its nose.
+    """Settle ``robot`` at the 0 deg command (for its ``solver.settle_s``, at least
+    :data:`MIN_SETTLE_S`) and read the load under its nose.
 
     Parameters
     ----------
@@ -71,6 +75,8 @@ def standing_load(robot: Robot) -> StandingLoad:
         its weight to 1 %).
     """
     check_robot(robot, 1)
+    if robot.solver.settle_s < MIN_SETTLE_S:
+        robot = robot.with_values({"solver.settle_s": MIN_SETTLE_S}, "statics")
     built = build(robot)
     model = built.model
     data = mujoco.MjData(model)

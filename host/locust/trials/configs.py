@@ -2,9 +2,10 @@
 
 A configuration is the base robot (``--config robot.toml`` or ``--preset``) with the same
 length added to all four links: ``small`` / ``medium`` / ``large`` are the notebook's
-physical leg sets (:data:`locust.params.LEG_SETS`: +0 / +1 / +2 cm, each at its own
-converged time step, as its preset), any other name is the base as it is unless
-``--added NAME=METRES`` gives its added length (at the base's step).
+physical leg sets (:data:`locust.params.LEG_SETS`: +0 / +10 / +20 mm, each at its own
+converged time step, as its preset), put in place of the leg set the base carries
+(``Robot.leg_set``); any other name is the base as it is unless ``--added NAME=METRES``
+gives its added length (at the base's step).
 """
 
 from __future__ import annotations
@@ -68,36 +69,12 @@ def configuration(base: Robot, name: str, added_m: float | None = None) -> Confi
     """
     key = check_name(name)
     if key in LEG_SETS and (added_m is None or added_m == LEG_SETS[key].added_m):
-        robot = leg_set(as_built(base), key, source=f"leg-set:{key}")
-        return Configuration(name=key, added_m=LEG_SETS[key].added_m, robot=robot)
+        robot = leg_set(base, key, source=f"leg-set:{key}")   # in place of the leg set base carries
+        return Configuration(name=key, added_m=LEG_SETS[key].added_m, robot=robot.renamed(key))
     added_m = added_m or 0.0
-    note = f"report configuration {key}: +{added_m * 100:g} cm on every link"
+    note = f"report configuration {key}: {added_m * 1000:+g} mm on every link"
     robot = with_added_length(base, added_m, source=f"leg-set:{key}", note=note) if added_m else base
     return Configuration(name=key, added_m=float(added_m), robot=robot.renamed(key))
-
-
-def as_built(base: Robot) -> Robot:
-    """``base`` without the leg set it carries. A leg-set robot (the ``medium`` or ``large``
-    preset, or a robot file saved from one: its name is the leg set's) is that leg set on the
-    robot as built; another leg set goes on the robot as built, not on top of the first (a
-    ``large`` trial on ``--preset large`` would otherwise get +2 cm twice).
-
-    Parameters
-    ----------
-    base : locust.params.Robot
-        The robot trials are built on.
-
-    Returns
-    -------
-    locust.params.Robot
-        ``base`` itself, or ``base`` with its leg set's added length taken off every link.
-    """
-    spec = LEG_SETS.get(base.name)
-    if spec is None or not spec.added_m:
-        return base
-    return with_added_length(base, -spec.added_m, source=f"leg-set:{base.name}",
-                             note=f"the robot as built under the {base.name} leg set: "
-                                  f"-{spec.added_m * 100:g} cm on every link")
 
 
 def check_name(name: str) -> str:
