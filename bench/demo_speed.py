@@ -29,16 +29,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from locust.commands.demo import (
-    CALIBRATIONS,
-    HOP_JOBS,
-    HOP_TRUTH,
-    RECORDINGS,
-    REPORT_SAMPLES,
-    Demo,
-    recording_truth,
-    seed_leg_set_options,
-)
+from locust.commands.demo import HOP_JOBS, REPORT_SAMPLES, Demo
+from locust.demo.virtual_robot import virtual_robot
+from locust.io.robot_toml import save_robot
 from locust.params import LEG_SETS
 from locust.progress import progress
 
@@ -62,13 +55,12 @@ def hop_frames(truth_csv: Path) -> tuple[int, int]:
 def hops_stage(trials: int, cycles: int, jobs: int) -> tuple[float, float]:
     """The demo's flash and hops stages in a fresh folder, ``jobs`` hops at once; prints a row
     per hop. Returns the hops stage's wall time and the hops' real time [s]."""
-    truth = {**recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS]), **HOP_TRUTH}
-    truth_sets = [arg for key, value in truth.items() for arg in ("--set", f"{key}={value!r}")]
     with tempfile.TemporaryDirectory() as tmp, open(os.devnull, "w") as quiet:
+        truth = save_robot(virtual_robot(), Path(tmp) / "truth.toml")     # the demo's virtual robot
         d = Demo(Path(tmp), quiet)
         d.call(["flash", "--port", "sim"])
         trials_dirs = [(name, Path(tmp) / f"{name}-{k}") for name in LEG_SETS for k in range(1, trials + 1)]
-        calls = [(["hop", "--port", "sim", *seed_leg_set_options(name), "--leg-set", name, *truth_sets,
+        calls = [(["hop", "--port", "sim", "--config", str(truth), "--leg-set", name,
                    "--cycles", str(cycles), "--video", str(trial / "hop.mp4"), "--out", str(trial)],
                   (trial / "hop.mp4", trial / "run.json")) for name, trial in trials_dirs]
         t = time.perf_counter()

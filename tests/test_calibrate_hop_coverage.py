@@ -27,8 +27,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from locust.commands.demo import seed_leg_set_options
-
 pytestmark = pytest.mark.slow
 
 RANGES = {"contact.foot_friction": (1.8, 2.6), "compliance.hinge_stiffness_nm_per_rad": (0.033, 0.07),
@@ -60,7 +58,7 @@ def film_and_fit(truth: dict[str, float], folder: Path, env: dict) -> dict:
     sets = [a for k, v in truth.items() for a in ("--set", f"{k}={v!r}")]
     for name in LEG_SETS:
         run = folder / f"{name}-1"
-        locust_cli(["hop", "--port", "sim", *seed_leg_set_options(name), "--leg-set", name, *sets,
+        locust_cli(["hop", "--port", "sim", "--preset", "seed", "--leg-set", name, *sets,
                     "--cycles", str(CYCLES), "--video", str(run / "hop.mp4"), "--out", str(run)], env)
         locust_cli(["track", str(run / "hop.mp4")], env)
     t0 = time.perf_counter()

@@ -21,7 +21,6 @@ import tomllib
 
 import pytest
 
-from locust.commands.demo import seed_leg_set_options
 from locust.params import LEG_SETS as LEG_SETS_STEP
 
 pytestmark = pytest.mark.slow
@@ -44,7 +43,7 @@ def fitted(env, tmp_path_factory):
     sets = [a for k, v in HIDDEN.items() for a in ("--set", f"{k}={v}")]
     for name in LEG_SETS:
         run = folder / f"{name}-1"
-        _locust(["hop", "--port", "sim", *seed_leg_set_options(name), *sets, "--cycles", "3",
+        _locust(["hop", "--port", "sim", "--preset", "seed", "--leg-set", name, *sets, "--cycles", "3",
                  "--video", str(run / "hop.mp4"),
                  "--out", str(run)], env)
         _locust(["track", str(run / "hop.mp4")], env)

@@ -42,7 +42,7 @@ def imports_of(path: Path) -> set[str]:
     return out
 
 
-JOBS = ("sim", "calibrate", "track", "sweep", "report", "fab", "device", "measure", "trials")
+JOBS = ("sim", "calibrate", "track", "sweep", "report", "fab", "device", "measure", "trials", "demo")
 BELOW_API = (*JOBS, "io", "params", "firmware")        # packages
 SHARED = ("errors", "fileio", "progress", "tables", "plotting", "markers", "arucoboard", "orphans", "version")
 ROOT_NAMES = ("locust", "locust.__init__", "locust.__version__")

@@ -213,20 +213,3 @@ def test_measured_groups_by_name_and_folder(tmp_path):
         parse_measured([str(a), f"large={a}"])
 
 
-def test_demo_virtual_robot_carries_the_recordings_truth():
-    """The demo's virtual robot is built from the bundled recordings' '# truth:' headers,
-    which replay the seed's identified values (calibration/make_synthetic.py); the servo's
-    are those of the AA swing's fit alone (synthetic.SG90_AA_SWING)."""
-    from locust.calibrate.synthetic import SG90_AA_SWING
-    from locust.commands.demo import CALIBRATIONS, RECORDINGS, recording_truth
-    from locust.params import preset
-
-    truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])
-    assert truth == pytest.approx({
-        "compliance.hinge_stiffness_nm_per_rad": 0.056375, "compliance.hinge_damping_nms_per_rad": 0.00056375,
-        "servo.noload_speed_rad_per_s": 10.2, "servo.armature_kgm2": 3.1e-4, "servo.kp_nm_per_rad": 0.26,
-        "servo.stall_torque_nm": 0.15, "contact.foot_friction": 1.7}, rel=1e-6)
-    seed = preset("seed").with_values({f"servo.{n}": getattr(SG90_AA_SWING, n) for n in
-                                       ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad")})
-    for key, value in truth.items():
-        assert seed.get(key) == pytest.approx(value, rel=1e-6), key

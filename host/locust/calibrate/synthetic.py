@@ -10,6 +10,7 @@ about half a pixel, which at 0.6 mm/px is 0.3 mm; a horn tip 5 cm from the axis 
 
 from __future__ import annotations
 
+import io
 import math
 from dataclasses import dataclass, field
 
@@ -425,3 +426,34 @@ def hinge_swing_track(truth: HingeTruth, rng: np.random.Generator):
     x = truth.pivot_m[0] + truth.radius_m * np.cos(theta) + rng.normal(0, truth.noise_m, len(t))
     y = truth.pivot_m[1] + truth.radius_m * np.sin(theta) + rng.normal(0, truth.noise_m, len(t))
     return t, x * scale, y * scale
+
+
+def csv_text(header_lines: list[str], columns: dict[str, np.ndarray], fmt: dict[str, str]) -> str:
+    """A recording as the calibration commands read it: ``#`` header lines, a row of column
+    names, one row per sample.
+
+    Parameters
+    ----------
+    header_lines : list of str
+        Comment lines (each written after ``# ``): say SYNTHETIC and the truth.
+    columns : dict of str to numpy.ndarray
+        Column name -> values, all the same length.
+    fmt : dict of str to str
+        Column name -> format spec (default ``.6f``); a float nan is written ``nan``.
+
+    Returns
+    -------
+    str
+    """
+    out = io.StringIO()
+    for line in header_lines:
+        out.write(f"# {line}\n")
+    names = list(columns)
+    out.write(",".join(names) + "\n")
+    for i in range(len(columns[names[0]])):
+        cells = []
+        for n in names:
+            v = columns[n][i]
+            cells.append("nan" if isinstance(v, float) and np.isnan(v) else format(v, fmt.get(n, ".6f")))
+        out.write(",".join(cells) + "\n")
+    return out.getvalue()

@@ -1,26 +1,33 @@
-"""``locust demo``: the whole toolkit end to end on the virtual robot.
+"""``locust demo``: the whole toolkit end to end on the virtual robot, as a student runs it.
 
-Each stage runs the real command (``python -m locust.commands ...``, one child process each), so
-the demo exercises the same code paths a user does:
+The virtual robot is the robot as built with its uncertain values drawn once
+(:mod:`locust.demo.virtual_robot`: a draw whose Medium and Large rear and come back down, as
+the filmed robots did), hidden from everything but the virtual board. Each stage runs the real
+command (``python -m locust.commands ...``, one child process each), so the demo exercises the
+same code paths a user does:
 
 1. ``locust flash --port sim``: the firmware into the demo's own virtual flash folder;
-2. ``locust hop --port sim --preset seed --set ... --video``: Small, Medium and Large (the seed
-   robot with each leg set's links) hop on the virtual robot (the firmware under MicroPython
-   driving the MuJoCo model), filmed;
+2. ``locust hop --port sim --leg-set NAME --video``: Small, Medium and Large hop on the virtual
+   robot (the firmware under MicroPython driving the MuJoCo model), filmed;
 3. ``locust track``: nose and foot tracks from those videos;
-4. ``locust calibrate``: beam, servo and ramp fits from the bundled synthetic
-   recordings into the demo's ``robot.toml``;
-5. ``locust calibrate hop``: the hops of Small and Large fitted for what the bench cannot
-   reach (``HOP_TRUTH``: the virtual robot's friction under impact, its folded hinges, its
-   servo on the robot's own battery), written over the bench values (the bench robot is
-   kept as ``robot-bench.toml``); ``--no-fit-hops`` leaves this stage out, and the virtual
-   robot then carries the recordings' values only;
-6. ``locust sweep``: a small ``scale`` sweep of the calibrated robot;
-7. ``locust report``: the calibrated model against the measured hops, with bands from the
+4. ``locust calibrate hinge|servo|ramp``: the virtual robot's parts on the bench
+   (:mod:`locust.demo.bench`, SYNTHETIC recordings) into a new ``robot.toml``, which starts
+   from the robot as built;
+5. ``locust sim --still`` of the virtual robot, then ``locust measure stance``: the crank's
+   angle at rest, the ground link's and the servo axis' place from two side stills;
+6. ``locust sim --samples``: each leg set's outcome shares over the calibrated robot's
+   uncertainties;
+7. ``locust calibrate hop``: the filmed hops of ``HOP_FIT_SETS`` fitted for what the bench
+   cannot reach, written over the bench values (the bench robot is kept as
+   ``robot-bench.toml``); ``--no-fit-hops`` leaves this stage out;
+8. ``locust sweep``: a small ``scale`` sweep of the calibrated robot;
+9. ``locust report``: the calibrated model against the measured hops, with bands from the
    fitted uncertainties and the bench robot's prediction before the fit beside it.
 
-Every output stays under ``--out``: videos, run records, tracks, robot.toml, fit plots,
-the sweep, the report, each command's log (``logs/``) and the time each stage took.
+Every output stays under ``--out``: the virtual robot (``virtual/truth.toml``, what it hides:
+``virtual/truth.json``), its bench recordings, videos, run records, tracks, stills,
+robot.toml, fit plots, the sweep, the report, each command's log (``logs/``) and the time each
+stage took.
 """
 
 from __future__ import annotations
@@ -38,52 +45,11 @@ import click
 
 from ..errors import ReportError
 from ..fileio import atomic_write_json, atomic_write_text, unique_dir
-from ..params import LEG_SETS, leg_set, preset
+from ..params import DEFAULT_PRESET, LEG_SETS
 from ..progress import progress
 
-# The virtual robot is the seed robot with each leg set of params.LEG_SETS (the one definition:
-# its links and its converged step; what the demo's calibration models: its robot.toml's base is
-# the seed); the small/medium/large presets are the robot as built instead.
-
-
-def seed_leg_set_options(name: str) -> list[str]:
-    """``--preset seed --set ...`` for the seed robot with leg set ``name``'s links and step."""
-    robot = leg_set(preset("seed"), name)
-    keys = ("geometry.ground_m", "geometry.crank_m", "geometry.coupler_m", "geometry.leg_m", "solver.timestep_s")
-    return ["--preset", "seed", *[arg for key in keys for arg in ("--set", f"{key}={robot.get(key)!r}")]]
-
-
-RECORDINGS = Path(__file__).resolve().parents[3] / "calibration" / "recordings"
-# (subcommand, recording, its options); the servo recording is the AA swing's SG90 on a light
-# load, split with the datasheet's stall torque (no-load speed, armature and kp are written).
-CALIBRATIONS = (
-    ("beam", "synthetic_beam.csv", ["--mass-kg", "0.01", "--length-m", "0.05"]),
-    ("servo", "synthetic_servo.csv", ["--inertia-kgm2", "1.5e-5", "--stall-torque-nm", "0.15"]),
-    ("ramp", "synthetic_ramp.csv", []),
-)
-
-# The bundled recordings are SYNTHETIC, generated by calibration/make_synthetic.py from known
-# values (each file's "# truth:" header). The demo's virtual robot carries those values, so it
-# is the robot the recordings were "made on": calibration should recover what it carries, and
-# the report shows how well the calibrated model then predicts its hops.
-TRUTH_KEYS = {
-    "hinge_stiffness_nm_per_rad": "compliance.hinge_stiffness_nm_per_rad",
-    "hinge_damping_nms_per_rad": "compliance.hinge_damping_nms_per_rad",
-    "noload_speed_rad_per_s": "servo.noload_speed_rad_per_s",
-    "armature_kgm2": "servo.armature_kgm2",
-    "kp_nm_per_rad": "servo.kp_nm_per_rad",
-    "stall_torque_nm": "servo.stall_torque_nm",
-    "mu_static": "contact.foot_friction",
-}
-
-
-# What the bench experiments cannot reach, hidden in the virtual robot (unlike any preset and
-# unlike the recordings): friction under impact above the ramp's, the folded linkage's hinges
-# softer than the beam's, the servo slower on the robot's battery than on the bench.
-HOP_TRUTH = {"contact.foot_friction": 2.0, "compliance.hinge_stiffness_nm_per_rad": 0.045,
-             "servo.noload_speed_rad_per_s": 9.0}
-HOP_FIT_SETS = ("small", "large")   # the two leg sets farthest apart (Small + Medium: test_calibrate_hop_virtual)
 REPORT_SAMPLES = 8
+SHARE_DRAWS = 16     # draws of each leg set's outcome shares (stage 6)
 # the report's figures take about as long as three of its simulation stages with draws (4.4 s
 # against 0.3 s and 2.9 s for a leg set's run and its draws, docs/performance.md): so many steps
 # on its bar keep the time left within 2x from a quarter of the stage on
@@ -91,21 +57,6 @@ REPORT_FIGURE_STEPS = 3
 # hops filmed at once: each takes about one core (its video's rendering) while its firmware
 # paces it in real time, so two keep a 2-core machine busy without slowing the firmware's clock
 HOP_JOBS = 2
-
-
-def recording_truth(paths: list[Path]) -> dict[str, float]:
-    """Robot parameters named in the recordings' ``# truth:`` header lines."""
-    truth: dict[str, float] = {}
-    for path in paths:
-        for line in path.read_text().splitlines():
-            if not line.startswith("#"):
-                break
-            if line.startswith("# truth:"):
-                for token in line[len("# truth:"):].replace(";", " ").split():
-                    key, _, value = token.partition("=")
-                    if key in TRUTH_KEYS:
-                        truth[TRUTH_KEYS[key]] = float(value)
-    return truth
 
 
 # a progress line (locust.progress) always says how long it has run
@@ -246,69 +197,86 @@ TICK_S = 1.0   # a stage's bar is looked at this often (it shows itself when due
 @click.option("--trials", type=click.IntRange(1, 5), default=2, show_default=True,
               help="Hops filmed per leg set (repeated trials give the report its error bars).")
 @click.option("--designs", type=click.IntRange(2, 61), default=7, show_default=True,
-              help="Designs in the sweep: scale from 0 to 3 cm added to every link.")
+              help="Designs in the sweep: scale from 0 to 30 mm added to every link.")
 @click.option("--jobs", type=click.IntRange(1, 64), default=None,
-              help="Sweep workers, and hops filmed at once up to 2 [every local core].")
+              help=f"Sweep workers, and hops filmed at once up to {HOP_JOBS} [every local core].")
 @click.option("--fit-hops/--no-fit-hops", default=True, show_default=True,
-              help="Hide values the bench cannot reach in the virtual robot and fit them from its filmed hops.")
+              help="Fit what the bench cannot reach from the filmed hops of Medium and Large.")
 def demo(out, cycles, trials, designs, jobs, fit_hops):
     """Run the whole toolkit end to end on the virtual robot, then print where the report is.
 
-    Flash the firmware to a virtual robot, hop Small, Medium and Large on it (rendered to
-    video), track the videos, calibrate from the bundled synthetic recordings, fit what the
-    bench cannot reach from the filmed hops (hidden in the virtual robot), sweep the added
-    link length, and compare the calibrated model with the measured hops in a report (the
-    prediction before the fit beside it, bands from the fitted uncertainties).
-    Everything it makes stays under --out; each command's output is in logs/.
+    The virtual robot is the robot as built with its uncertain values drawn once (a draw whose
+    Medium and Large rear and come back down, as the filmed robots did), hidden from every
+    stage but the virtual board. Flash the firmware to it, hop Small, Medium and Large
+    (filmed), track the videos, calibrate its parts from SYNTHETIC bench recordings of them,
+    measure its stance from two side stills, say each leg set's outcome shares, fit what the
+    bench cannot reach from the filmed hops, sweep the added link length, and compare the
+    calibrated model with the measured hops in a report (the bench robot's prediction beside
+    it). Everything it makes stays under --out; each command's output is in logs/.
     """
+    from ..demo.bench import write_bench
+    from ..demo.virtual_robot import HOP_FIT_SETS
+
     stderr = sys.stderr
-    if not RECORDINGS.is_dir():
-        raise ReportError(f"the bundled calibration recordings are not at {RECORDINGS}",
-                          "run the demo from a source checkout (the recordings live in calibration/recordings)")
     t_start = time.perf_counter()
     folder = unique_dir(out, "run")
     d = Demo(folder, stderr)
     d.say(f"demo: everything goes to {folder}")
-    hops_dir, cal_dir = folder / "hops", folder / "calibration"
-    robot_toml = cal_dir / "robot.toml"
+    hops_dir, cal_dir, stills = folder / "hops", folder / "calibration", folder / "stills"
+    robot_toml, bench_toml = cal_dir / "robot.toml", cal_dir / "robot-bench.toml"
     trials_dirs = [(name, hops_dir / f"{name}-{k}") for name in LEG_SETS for k in range(1, trials + 1)]
-    total = 7 if fit_hops else 6
-    bench_toml = cal_dir / "robot-bench.toml"
+    total = 9 if fit_hops else 8
+    stage = iter(range(1, total + 1))
 
-    truth = _virtual_truth(folder, fit_hops)
-    truth_sets = [arg for key, value in truth.items() for arg in ("--set", f"{key}={value!r}")]
-    d.say("demo: the virtual robot carries the recordings' true values: "
-          + ", ".join(f"{k}={v:g}" for k, v in truth.items()))
+    truth_toml, hidden = _virtual_robot(folder)
+    d.say(f"demo: the virtual robot is a draw of the robot as built ({len(hidden)} uncertain values drawn, hidden "
+          f"in {truth_toml}): one whose Medium and Large rear and come back down, as the filmed robots did")
+    bench = write_bench(_load(truth_toml), folder / "virtual" / "bench")
 
-    with d.stage(1, total, "flash the firmware to the virtual robot"):
+    with d.stage(next(stage), total, "flash the firmware to the virtual robot"):
         d.call(["flash", "--port", "sim"])
-    with d.stage(2, total, f"hop Small, Medium, Large x {trials} on the virtual robot, {cycles} cycles, filmed"):
+    with d.stage(next(stage), total, f"hop Small, Medium, Large x {trials} on the virtual robot, {cycles} cycles, "
+                                     "filmed"):
         # each hop is its own virtual robot (the one flash folder, read only), the firmware paced
         # in real time while one core renders its video: HOP_JOBS of them film at once
-        hops = [(["hop", "--port", "sim", *seed_leg_set_options(name), "--leg-set", name, *truth_sets,
-                  "--cycles", str(cycles), "--video", str(trial / "hop.mp4"), "--out", str(trial)],
+        hops = [(["hop", "--port", "sim", "--config", str(truth_toml), "--leg-set", name, "--cycles", str(cycles),
+                  "--video", str(trial / "hop.mp4"), "--out", str(trial)],
                  (trial / "hop.mp4", trial / "run.json")) for name, trial in trials_dirs]
         with d.bar(None, "hops", length=len(hops)) as bar:
             d.call_side_by_side(hops, min(HOP_JOBS, jobs or os.cpu_count() or 1), bar)
-    with d.stage(3, total, "track nose and foot in the videos"):
+    with d.stage(next(stage), total, "track nose and foot in the videos"):
         with d.bar(trials_dirs, "tracks") as bar:
             for _, trial in bar:
                 d.call(["track", str(trial / "hop.mp4")])
                 d.expect(trial / "hop.tracks.csv")
-    with d.stage(4, total, "calibrate from the bundled synthetic recordings"):
-        with d.bar(CALIBRATIONS, "fits") as bar:
-            for kind, recording, options in bar:
-                d.call(["calibrate", kind, str(RECORDINGS / recording), *options, "--write", str(robot_toml),
-                        "--plot", str(cal_dir / f"{Path(recording).stem}-fit.png")])
+    with d.stage(next(stage), total, "calibrate the hinge, the servo and the feet' friction on the bench "
+                                     "(SYNTHETIC recordings)"):
+        with d.bar(bench, "fits") as bar:
+            for k, rec in enumerate(bar):
+                start = ["--preset", DEFAULT_PRESET] if k == 0 else []      # a new robot.toml: the robot as built
+                d.call(["calibrate", rec.experiment, *map(str, rec.paths), *rec.options, *start,
+                        "--write", str(robot_toml), "--out", str(cal_dir)])
+    with d.stage(next(stage), total, "measure the stance from two side stills of the virtual robot"):
+        d.call(["sim", "--config", str(truth_toml), "--cycles", "1", "--still", str(stills / "rest.png"),
+                "--still-push", str(stills / "push.png")])
+        d.call(["measure", "stance", str(stills / "rest.png"), str(stills / "push.png"), "--config", str(robot_toml),
+                "--write", str(robot_toml), "--force"])
+        atomic_write_text(bench_toml, robot_toml.read_text(encoding="utf-8"))
+    with d.stage(next(stage), total, f"outcome shares of each leg set over {SHARE_DRAWS} draws of the calibrated "
+                                     "robot"):
+        with d.bar(list(LEG_SETS), "leg sets") as bar:
+            for name in bar:
+                d.call(["sim", "--config", str(robot_toml), "--leg-set", name, "--cycles", str(cycles),
+                        "--samples", str(SHARE_DRAWS), "--no-sensitivity"])
     if fit_hops:
-        with d.stage(5, total, f"fit the filmed hops of {' and '.join(HOP_FIT_SETS)}: what the bench cannot reach"):
-            atomic_write_text(bench_toml, robot_toml.read_text(encoding="utf-8"))
+        with d.stage(next(stage), total, f"fit the filmed hops of {' and '.join(HOP_FIT_SETS)}: what the bench "
+                                         "cannot reach"):
             fitted = [f"{name}={hops_dir / f'{name}-1'}" for name in HOP_FIT_SETS]
             d.call(["calibrate", "hop", *fitted, "--write", str(robot_toml), "--out", str(cal_dir)])
-    with d.stage(total - 1, total, f"sweep the added link length over {designs} designs"):
+    with d.stage(next(stage), total, f"sweep the added link length over {designs} designs"):
         d.call(["sweep", "--config", str(robot_toml), "--vary", f"scale=0:0.03:{designs}", "--cycles", str(cycles),
                 "--out", str(folder / "sweep"), *(["--jobs", str(jobs)] if jobs else [])])
-    with d.stage(total, total, "report: the calibrated model against the measured hops"):
+    with d.stage(next(stage), total, "report: the calibrated model against the measured hops"):
         # each trial named by its leg set: the report need not guess it from the folder name
         measured = [arg for name, trial in trials_dirs for arg in ("--measured", f"{name}={trial}")]
         closing = ["--before", str(bench_toml), "--samples", str(REPORT_SAMPLES)] if fit_hops else []
@@ -331,18 +299,27 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     click.echo(f"report: {report_path}")
 
 
-def _virtual_truth(folder: Path, fit_hops: bool) -> dict[str, float]:
-    """The virtual robot's values: the bundled recordings' truth (and, for the hop fit, the
-    hidden HOP_TRUTH), written to virtual/truth.json."""
-    truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])
-    note = ("the virtual robot's parameters: the values the bundled SYNTHETIC calibration recordings were "
-            "generated with")
-    if fit_hops:
-        truth = {**truth, **HOP_TRUTH}
-        note += f", except {', '.join(HOP_TRUTH)}: hidden, for the hop fit to find"
-    atomic_write_json(folder / "virtual" / "truth.json", {"note": note, "values": truth,
-                                                          "hidden_for_hop_fit": HOP_TRUTH if fit_hops else {}})
-    return truth
+def _load(path: Path):
+    from ..io.robot_toml import load_robot
+
+    return load_robot(path)
+
+
+def _virtual_robot(folder: Path) -> tuple[Path, dict[str, float]]:
+    """The virtual robot written to virtual/truth.toml, and the values it hides (also written,
+    with a note, to virtual/truth.json)."""
+    from ..demo.virtual_robot import DRAW_INDEX, DRAW_SEED, HOP_FIT_SETS, hidden_values, virtual_robot
+    from ..io.robot_toml import save_robot
+
+    robot = virtual_robot()
+    path = save_robot(robot, folder / "virtual" / "truth.toml")
+    hidden = hidden_values(robot)
+    note = (f"the virtual robot: the robot as built with each uncertain value drawn (draw {DRAW_INDEX} of seed "
+            f"{DRAW_SEED}), chosen as one whose {' and '.join(HOP_FIT_SETS)} rear and come back down; hidden from "
+            "every stage but the virtual board")
+    atomic_write_json(folder / "virtual" / "truth.json", {"note": note, "values": hidden,
+                                                          "hop_fit_sets": list(HOP_FIT_SETS)})
+    return path, hidden
 
 
 def _timings(d: Demo, folder: Path, wall: float, sizes: dict[str, int]) -> None:

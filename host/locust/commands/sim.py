@@ -12,6 +12,7 @@ import click
 from ..errors import GeometryError, SimError
 from ..fileio import json_text
 from ..io.robot_toml import resolve_robot
+from ..params import LEG_SETS, check_robot, leg_set
 from ..progress import progress
 from ..tables import nose_load_line, sensitivity_lines, sim_lines, spread_lines
 from .options import robot_options
@@ -19,6 +20,9 @@ from .options import robot_options
 
 @click.command()
 @robot_options
+@click.option("--leg-set", "leg_set_name", type=click.Choice(list(LEG_SETS)), default=None,
+              help="Put this leg set on the robot in place of the one it carries (its leg_set; "
+                   "`locust params` shows it).")
 @click.option("--cycles", type=click.IntRange(1, 1000), default=None,
               help="Hop cycles to run (default: schedule.cycles of the robot).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (exit 0 even when invalid).")
@@ -46,8 +50,8 @@ from .options import robot_options
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of --samples.")
 @click.option("--verbose", "-v", is_flag=True,
               help="Also the linkage's kinematics: its Grashof class and worst transmission angle.")
-def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push, board, check_convergence, samples,
-        seed, sensitivity, verbose):
+def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, still, still_push, board, check_convergence,
+        samples, seed, sensitivity, verbose):
     """Settle the robot on the floor, then run the bang-bang hop schedule.
 
     Every run is audited (non-finite state, loop closure, energy, MuJoCo warnings). A run
@@ -63,6 +67,7 @@ def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push,
       locust sim --preset large --set servo.stall_torque_nm=0.18 --video large.mp4
       locust sim --config calibration/robot.toml --samples 16   # with its spread
       locust sim --preset medium --samples 32 --json     # outcome shares
+      locust sim --config calibration/robot.toml --leg-set large   # another leg set on it
       locust sim --preset small --still rest.png --still-push push.png   # for locust measure stance
     """
     from ..api.simulation import simulate
@@ -70,6 +75,11 @@ def sim(preset, config, sets, cycles, as_json, video, camera, still, still_push,
     from ..sim.run import invalid_result
 
     robot = resolve_robot(preset, config, sets)
+    if leg_set_name is not None:
+        if leg_set_name != robot.leg_set:
+            robot = leg_set(robot, leg_set_name, source=f"leg-set:{leg_set_name}").renamed(
+                f"{robot.name} ({leg_set_name} legs)")
+        robot = check_robot(robot)
     if video is not None:
         from ..sim.clip import check_video_path
 
