@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 
 from .compare import Comparison, TimingRow
+from .ending import trials_words, words
 
 CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
 # a backslash at a line's end joins the next line to it (no newline in the CSS)
@@ -155,7 +156,8 @@ def td(text: str, config: str | None = None, field: str | None = None, left: boo
     return f"<td{attrs}>{esc(text)}</td>"
 
 
-def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = "") -> str:
+def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = "",
+          groups: list[tuple[str, int]] | None = None) -> str:
     """A table from its headers and ready-made rows.
 
     Parameters
@@ -168,6 +170,8 @@ def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = ""
         How many leading columns' headers are left-aligned.
     id_ : str
         The table's id; none when empty.
+    groups : list of (str, int), optional
+        A header row above, each title over its number of columns.
 
     Returns
     -------
@@ -176,13 +180,16 @@ def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = ""
     """
     head = "".join(f'<th class="l">{esc(h)}</th>' if i < left_cols else f"<th>{esc(h)}</th>"
                    for i, h in enumerate(headers))
+    over = ("<tr>" + "".join(f'<th colspan="{n}">{esc(t)}</th>' for t, n in groups) + "</tr>") if groups else ""
     ident = f' id="{esc(id_)}"' if id_ else ""
-    return f"<table{ident}><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>"
+    return f"<table{ident}><thead>{over}<tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>"
 
 
 def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[str, float]) -> str:
-    """Per configuration, predicted and measured distance, distance per hop and jump, their
-    errors in mm and percent, and the simulation's status; then the tracking resolution.
+    """Per configuration: how the simulated and the filmed runs ended (:mod:`.ending`), the
+    simulation's distance (``locust sim``'s, the chassis over the run), the marker's travel
+    predicted and measured with its error, and the jump (highest marker point in a hop that came
+    back down) with its error, in mm and percent; then the tracking resolution.
 
     Parameters
     ----------
@@ -202,36 +209,46 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
     for c in comps:
         name = c.config
         valid = c.prediction.valid
-        dist_err = c.distance.mean - c.predicted_distance_m
+        ending = c.predicted_ending
+        travel_err = c.marker_travel.mean - c.predicted_marker_travel_m
         jump_err = c.jump.mean - c.predicted_jump_m
         cells = [
-            td(labels[name], left=True), td(f"+{added[name] * 100:g}"), td(str(c.distance.n), name, "trials"),
+            td(labels[name], left=True), td(f"+{added[name] * 1000:g}"), td(str(c.marker_travel.n), name, "trials"),
+            td(words(ending) if ending else "—", name, "predicted_outcome", left=True),
+            td(trials_words([m.ending for m in c.trials]), name, "measured_outcome", left=True),
             td(mm(c.predicted_distance_m), name, "predicted_distance_mm"),
-            td(mm_pm(c.distance.mean, c.distance.std), name, "measured_distance_mm"),
-            td(mm(dist_err), name, "distance_error_mm"), td(pct(dist_err, c.predicted_distance_m, c.resolution_m)),
-            td(mm(c.predicted_hop_distance_m), name, "predicted_hop_distance_mm"),
-            td(mm_pm(c.hop_distance.mean, c.hop_distance.std), name, "measured_hop_distance_mm"),
+            td(mm(c.predicted_marker_travel_m), name, "predicted_marker_travel_mm"),
+            td(mm_pm(c.marker_travel.mean, c.marker_travel.std), name, "measured_marker_travel_mm"),
+            td(mm(travel_err), name, "marker_travel_error_mm"),
+            td(pct(travel_err, c.predicted_marker_travel_m, c.resolution_m)),
             td(mm(c.predicted_jump_m), name, "predicted_jump_mm"),
             td(mm_pm(c.jump.mean, c.jump.std), name, "measured_jump_mm"),
             td(mm(jump_err), name, "jump_error_mm"), td(pct(jump_err, c.predicted_jump_m, c.resolution_m)),
-            td(f"valid, {outcome.replace('_', ' ')}" if valid and (outcome := c.prediction.result.outcome)
-               else "valid" if valid else "INVALID: " + "; ".join(c.prediction.result.reasons), name, "sim_status",
+            td("valid" if valid else "INVALID: " + "; ".join(c.prediction.result.reasons), name, "sim_status",
                left=True),
         ]
         rows.append(f'<tr{"" if valid else " class=invalid"}>{"".join(cells)}</tr>')
-    headers = ["configuration", "added (cm)", "trials", "predicted distance (mm)", "measured distance (mm)",
-               "error (mm)", "error", "predicted per hop (mm)", "measured per hop (mm)",
-               "predicted jump (mm)", "measured jump (mm)", "error (mm)", "error", "simulation"]
+    groups = [("", 3), ("how it ended", 2), ("distance (mm)", 1), ("marker travel over the run", 4),
+              ("jump: highest marker point above standing, in a hop that came back down", 4), ("", 1)]
+    headers = ["configuration", "added (mm)", "trials", "predicted", "measured", "predicted (locust sim)",
+               "predicted (mm)", "measured (mm)", "error (mm)", "error", "predicted (mm)", "measured (mm)",
+               "error (mm)", "error", "simulation"]
     known = [(labels[c.config], c.resolution_m) for c in comps if math.isfinite(c.resolution_m)]
-    note = ("" if not known else '<p class="note">Tracking resolution (one pixel at the marker): '
-            + ", ".join(f"{esc(label)} {res * 1000:.3g} mm" for label, res in known)
-            + '; an error smaller than that is not measured and reads "within 1 px".</p>')
-    return table(headers, rows, id_="summary") + note
+    note = ("<p class=\"note\">Distance: the robot's travel over the run as <code>locust sim</code> prints it (the "
+            "chassis, from the schedule's start to the run's end); the camera follows a marker, whose travel is "
+            "compared like with like. A hop that ends with the robot on its back is no jump: its marker's height is "
+            "where it lies.")
+    if known:
+        note += (" Tracking resolution (one pixel at the marker): "
+                 + ", ".join(f"{esc(label)} {res * 1000:.3g} mm" for label, res in known)
+                 + '; an error smaller than that is not measured and reads "within 1 px".')
+    return table(headers, rows, id_="summary", groups=groups) + note + "</p>"
 
 
 def outcome_table(spreads: dict, labels: dict[str, str]) -> str:
     """Each configuration's draws (``--samples``) by outcome: its share, and its own distance
-    and highest nose as mean ± sd (one sd across outcomes would hide a split).
+    (``locust sim``'s, over the run) and highest nose as mean ± sd (one sd across outcomes would
+    hide a split), as ``locust sim --samples`` prints them.
 
     Parameters
     ----------
@@ -256,12 +273,13 @@ def outcome_table(spreads: dict, labels: dict[str, str]) -> str:
                      td(mm_pm(o.max_nose_height_m.mean,
                               o.max_nose_height_m.sd if math.isfinite(o.max_nose_height_m.sd) else None))]
             rows.append(f"<tr>{''.join(cells)}</tr>")
-    headers = ["configuration", "outcome", "draws", "distance (mm)", "highest nose (mm)"]
+    headers = ["configuration", "outcome", "draws", "distance (mm)", "highest nose above the floor (mm)"]
     return table(headers, rows, left_cols=2, id_="outcomes")
 
 
 def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
-    """Every measured hop against the predicted one: distance and apex [mm], with errors.
+    """Every measured hop against the predicted one: how it ended, the marker's travel and its
+    apex [mm] (none for a hop that did not end on the robot's feet), with errors.
 
     Parameters
     ----------
@@ -281,18 +299,22 @@ def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
             key = f"{r.trial}#{r.hop}"
             rows.append("<tr>" + "".join([
                 td(labels[c.config], left=True), td(r.trial, left=True), td(str(r.hop)),
-                td(mm(r.measured_distance_m), c.config, f"hop_measured_distance_mm:{key}"),
-                td(mm(r.predicted_distance_m), c.config, f"hop_predicted_distance_mm:{key}"),
-                td(mm(r.distance_error_m)), td(pct(r.distance_error_m, r.predicted_distance_m, c.resolution_m)),
+                td(r.measured_state or "—", c.config, f"hop_measured_state:{key}", left=True),
+                td(r.predicted_state or "—", c.config, f"hop_predicted_state:{key}", left=True),
+                td(mm(r.measured_marker_travel_m), c.config, f"hop_measured_marker_travel_mm:{key}"),
+                td(mm(r.predicted_marker_travel_m), c.config, f"hop_predicted_marker_travel_mm:{key}"),
+                td(mm(r.marker_travel_error_m)),
+                td(pct(r.marker_travel_error_m, r.predicted_marker_travel_m, c.resolution_m)),
                 td(mm(r.measured_apex_m), c.config, f"hop_measured_apex_mm:{key}"),
                 td(mm(r.predicted_apex_m), c.config, f"hop_predicted_apex_mm:{key}"),
                 td(mm(r.apex_error_m)), td(pct(r.apex_error_m, r.predicted_apex_m, c.resolution_m)),
             ]) + "</tr>")
     if not rows:
         return '<p class="note">No tracks were given: nothing measured to compare hop by hop.</p>'
-    headers = ["configuration", "trial", "hop", "measured distance (mm)", "predicted (mm)", "error (mm)", "error",
-               "measured apex (mm)", "predicted (mm)", "error (mm)", "error"]
-    return table(headers, rows, left_cols=2, id_="hops")
+    groups = [("", 3), ("ended", 2), ("marker travel", 4), ("apex above standing (a hop that came back down)", 4)]
+    headers = ["configuration", "trial", "hop", "measured", "predicted", "measured (mm)", "predicted (mm)",
+               "error (mm)", "error", "measured (mm)", "predicted (mm)", "error (mm)", "error"]
+    return table(headers, rows, left_cols=2, id_="hops", groups=groups)
 
 
 def timing_table(rows: list[TimingRow], labels: dict[str, str]) -> str:
@@ -347,7 +369,8 @@ def warnings_list(notices) -> str:
 
 
 def params_table(param_rows: list[dict]) -> str:
-    """The robot's parameters with value, uncertainty (1 sd, in the parameter's unit) and source.
+    """The robot's parameters with value, uncertainty (1 sd) and source, each in the unit a
+    person reads (:func:`locust.report.build.parameter_rows`).
 
     Parameters
     ----------
@@ -361,10 +384,9 @@ def params_table(param_rows: list[dict]) -> str:
     """
     rows = []
     for p in param_rows:
-        unc = p["uncertainty"]
         rows.append("<tr>" + "".join([
             td(p["key"], left=True), td(p["value"], None, f"param:{p['key']}"),
-            td("" if unc is None else f"± {unc:.3g}"), td(p["source"], left=True), td(p["date"] or "", left=True),
+            td(p["uncertainty"]), td(p["source"], left=True), td(p["date"] or "", left=True),
             td(p["note"] or "", left=True),
         ]) + "</tr>")
     return table(["parameter", "value", "uncertainty (1 sd)", "source", "date", "note"], rows, id_="params")
