@@ -69,8 +69,8 @@ def headline(c) -> list[str]:
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=Path("reports"), show_default=True,
               help="Parent folder; the report goes into a new report/ (report-2/, ...) inside, never over another.")
 @click.option("--side-by-side", "side_by_side", is_flag=True,
-              help="Also write <trial>.side_by_side.mp4 for each trial with a video: the filmed hop beside the "
-                   "simulation from the same camera (its camera.json), on the schedule's clock.")
+              help="Also write <trial>.side_by_side.webm for each trial with a video: the filmed hop beside the "
+                   "simulation from the same camera (its camera.json), on the schedule's clock; the page plays it.")
 @click.option("--samples", type=click.IntRange(2, 256), default=None, metavar="N",
               help="Draw the robot file's uncertain values N times per configuration: bands on the predicted "
                    "curves, error bars on the predicted hops.")

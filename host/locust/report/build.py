@@ -236,15 +236,15 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
 
     timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
     warnings = notices(comps)
-    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings, spreads)
+    sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
+    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings, spreads,
+                            sbs_plan)
     doc = report_json(base, robot_source, comps, configs, timing, land, marker, warnings)
     doc["optimize"] = {"folder": str(front.folder), "front": front.front} if front is not None else None
     for entry in doc["configurations"]:
         sp, old = spreads.get(entry["name"]), befores.get(entry["name"])
         entry["predicted_spread"] = sp.to_json() if sp is not None else None
         entry["predicted_before_fit"] = old.result.to_json() if old is not None else None
-
-    sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
 
     folder = unique_dir(out, "report")
     try:
@@ -380,6 +380,13 @@ def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker:
     return "<ul class=\"note\">" + "".join(f"<li>{H.esc(i)}</li>" for i in items) + "</ul>"
 
 
+def _video_caption(job, labels: dict[str, str]) -> str:
+    """What a side-by-side video shows, and through which camera the simulation is filmed."""
+    camera = "the filmed camera" if job.camera else "its own fixed camera (the cameras differ)"
+    return (f"{labels[job.comparison.config]} {job.label}, filmed (left) beside the simulation (right) on the "
+            f"schedule's clock, the simulation through {camera}: {job.camera_note}")
+
+
 def _track_reading(t) -> str:
     """How a trial's track was read: ``metres``, ``cm -> m, mirrored``."""
     if t.track is None:
@@ -388,7 +395,7 @@ def _track_reading(t) -> str:
 
 
 def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, land, marker: str,
-                warnings: Sequence[Notice] = (), spreads: dict | None = None) -> str:
+                warnings: Sequence[Notice] = (), spreads: dict | None = None, side_by_side=None) -> str:
     """The report page.
 
     Parameters
@@ -413,6 +420,8 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
         Shown at the top, collapsed (:func:`.checks.collapsed`).
     spreads : dict of str to Spread, optional
         Per configuration, its spread over the draws; adds the outcome table.
+    side_by_side : sidebyside.Plan, optional
+        The side-by-side videos to be written beside the page: each played in it.
 
     Returns
     -------
@@ -436,6 +445,9 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
         ("Summary", H.summary_table(comps, labels, added)),
         *([("Outcome over the draws", H.outcome_table(spreads, labels))] if spreads else []),
         ("Figures", "".join(H.figure_html(f) for f in figs)),
+        *([("Side by side", H.videos_html([(j.name, _video_caption(j, labels)) for j in side_by_side.jobs],
+                                          [f"{s.trial}: {s.note}" for s in side_by_side.skipped]))]
+          if side_by_side is not None else []),
         ("Per-hop errors", H.hop_table(comps, labels)),
         ("Firmware timing", H.timing_table(timing, labels)),
         ("Parameters", f"<p class=\"note\">Robot {H.esc(base.name)} from {H.esc(robot_source)}; each configuration "
@@ -457,7 +469,8 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
     if virtual:
         meta.insert(1, f"measured trials: {len(virtual)} of {len(trials)} recorded on the virtual robot "
                        "(the simulated robot, not the physical one)")
-    return H.page("Simulation against measurement", meta, sections)
+    return H.page("Simulation against measurement", meta, sections,
+                  media=side_by_side is not None and bool(side_by_side.jobs))
 
 
 def _trial_json(t) -> dict:

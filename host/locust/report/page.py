@@ -1,5 +1,8 @@
 """The report as one self-contained HTML page: figures embedded as base64 PNG, no scripts,
-no outside resources (a Content-Security-Policy forbids them, so a browser proves it).
+no outside resources (a Content-Security-Policy forbids them, so a browser proves it). The
+side-by-side videos (``--side-by-side``) are the one exception, and not an outside one: they
+are written beside the page and played from there (``<video controls>``, a relative src; the
+policy then allows media from the page's own origin, nothing else).
 
 Every number cell carries ``data-config`` and ``data-field`` so tests and scripts can read
 the page's figures back exactly as printed.
@@ -16,6 +19,7 @@ from .compare import Comparison, TimingRow
 from .ending import trials_words, words
 
 CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
+CSP_MEDIA = CSP + "; media-src 'self'"    # with the side-by-side videos beside the page
 # a backslash at a line's end joins the next line to it (no newline in the CSS)
 STYLE = """
 body{font:14px/1.45 system-ui,-apple-system,'DejaVu Sans',sans-serif;\
@@ -24,7 +28,8 @@ h1{font-size:1.6em;margin-bottom:.2em}h2{margin-top:1.8em;border-bottom:1px soli
 table{border-collapse:collapse;margin:.6em 0;font-size:13px}\
 th,td{border:1px solid #ddd;padding:3px 8px;text-align:right}td{white-space:nowrap}td.l{white-space:normal}
 th{background:#f4f4f4}td.l,th.l{text-align:left}tr.invalid td{color:#b00020}
-figure{margin:1em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{color:#555;font-size:13px}
+figure{margin:1em 0}figure img,figure video{max-width:100%;border:1px solid #eee}\
+figcaption{color:#555;font-size:13px}
 .meta{color:#555}.note{color:#555;font-size:13px}code{background:#f6f6f6;padding:0 3px}
 ul.warn{background:#fff6e5;border:1px solid #f0c36d;padding:.6em 1em .6em 2.2em}ul.warn li{margin:.2em 0}
 """
@@ -428,7 +433,29 @@ def figure_html(fig: Figure) -> str:
             f"<figcaption><b>{esc(fig.title)}.</b> {esc(fig.caption)}</figcaption></figure>")
 
 
-def page(title: str, meta_lines: list[str], sections: list[tuple[str, str]]) -> str:
+def videos_html(videos: list[tuple[str, str]], skipped: list[str]) -> str:
+    """The side-by-side videos, each played in the page from the file beside it.
+
+    Parameters
+    ----------
+    videos : list of (str, str)
+        Each video's file name in the report's folder (the src, relative to the page) and its caption.
+    skipped : list of str
+        The trials that have none, and why.
+
+    Returns
+    -------
+    str
+        A ``<figure class="video">`` per video, then the skipped trials, HTML.
+    """
+    out = "".join(f'<figure class="video"><video controls preload="metadata" src="{esc(name)}"></video>'
+                  f"<figcaption><b>{esc(name)}</b>: {esc(caption)}.</figcaption></figure>" for name, caption in videos)
+    if skipped:
+        out += '<ul class="note">' + "".join(f"<li>{esc(s)}</li>" for s in skipped) + "</ul>"
+    return out or '<p class="note">No trial has a video.</p>'
+
+
+def page(title: str, meta_lines: list[str], sections: list[tuple[str, str]], media: bool = False) -> str:
     """The whole page: title, meta lines, then each section under its heading.
 
     Parameters
@@ -439,6 +466,9 @@ def page(title: str, meta_lines: list[str], sections: list[tuple[str, str]]) -> 
         Lines under the title, escaped.
     sections : list of (str, str)
         Heading and HTML content.
+    media : bool
+        The page plays videos beside it (:func:`videos_html`): its policy allows media from its
+        own origin.
 
     Returns
     -------
@@ -448,6 +478,6 @@ def page(title: str, meta_lines: list[str], sections: list[tuple[str, str]]) -> 
     meta = "".join(f"<div>{esc(line)}</div>" for line in meta_lines)
     body = "".join(f"<h2>{esc(h)}</h2>{content}" for h, content in sections)
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-            f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
+            f'<meta http-equiv="Content-Security-Policy" content="{CSP_MEDIA if media else CSP}">'
             f"<title>{esc(title)}</title><style>{STYLE}</style></head>"
             f"<body><h1>{esc(title)}</h1><div class=\"meta\">{meta}</div>{body}</body></html>\n")
