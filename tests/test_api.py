@@ -7,6 +7,7 @@ import importlib
 import inspect
 import json
 import os
+import re
 import subprocess
 import sys
 import types
@@ -267,6 +268,13 @@ def test_fit_and_sweep_have_tables_and_figures(tmp_path):
     fig = swept.plot()
     (ax,) = fig.axes
     assert list(ax.lines[0].get_ydata()) == pytest.approx([r["distance_m"] * 1000 for r in swept.rows if r["valid"]])
+    # the added length in mm, as locust sweep draws and prints it (it was drawn in m)
+    assert list(ax.lines[0].get_xdata()) == pytest.approx([r["scale"] * 1000 for r in swept.rows if r["valid"]])
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("added length on every link (mm)", "distance (mm)")
+    m = re.search(r"\(scale (-?[\d.]+) mm\): distance (-?[\d.]+) mm over the run", repr(swept))
+    assert m, repr(swept)
+    best = swept.best
+    assert [float(v) for v in m.groups()] == pytest.approx([best["scale"] * 1000, best["distance_m"] * 1000], abs=0.005)
 
 
 def test_help_locust_lists_every_function():

@@ -244,10 +244,11 @@ def sensitivity_lines(sens) -> list[str]:
     if not deciding:
         return [f"{INDENT}no single value at -/+{sens.k_sd:g} sd changes the outcome ({nominal})"]
     lines = [f"{INDENT}decided by (each value alone at -/+{sens.k_sd:g} sd; as given it {nominal}):"]
-    for e in deciding:
-        ends = [f"{v:.4g} {outcome_words(o) if o else 'invalid'}" for v, o in
+    for e in deciding:   # each value in the unit a person reads (a length in mm), with its unit
+        name, factor, unit = for_person(e.key)
+        ends = [f"{v * factor:.4g} {unit} {outcome_words(o) if o else 'invalid'}".replace("  ", " ") for v, o in
                 ((e.low_value, e.low_outcome), (e.high_value, e.high_outcome))]
-        lines.append(f"{INDENT * 2}{e.key} (sd {e.sd:g}): {ends[0]}; {ends[1]}")
+        lines.append(f"{INDENT * 2}{name} (sd {e.sd * factor:g} {unit}".rstrip() + f"): {ends[0]}; {ends[1]}")
     return lines
 
 
@@ -284,8 +285,9 @@ def plant_lines(summary: dict) -> list[str]:
 # -- fitted values, as `locust calibrate` prints them ------------------------------------------
 UNIT_SUFFIXES = (   # a key's unit from its name's end (longest first): _nm_ is newton-metres, never nm
     ("_nms_per_rad", "N·m·s/rad"), ("_nm_per_rad", "N·m/rad"), ("_ns_per_m", "N·s/m"), ("_n_per_m", "N/m"),
-    ("_rad_per_s", "rad/s"), ("_kgm2", "kg·m²"), ("_kg", "kg"), ("_hz", "Hz"), ("_deg", "deg"), ("_mm", "mm"),
-    ("_nm", "N·m"), ("_rad", "rad"), ("_m", "m"), ("_s", "s"),
+    ("_rad_per_s", "rad/s"), ("_kg_per_m3", "kg/m³"), ("_kgm2", "kg·m²"), ("_kg", "kg"), ("_hz", "Hz"),
+    ("_deg", "deg"), ("_mm", "mm"), ("_ms", "ms"), ("_nm", "N·m"), ("_ohm", "Ω"), ("_rad", "rad"), ("_us", "µs"),
+    ("_m", "m"), ("_s", "s"), ("_v", "V"),
 )
 
 
