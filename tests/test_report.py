@@ -237,6 +237,22 @@ def test_report_draws_an_optimize_study_s_front_and_names_its_pick(world):
     assert doc["optimize"]["front"][0]["distance_per_hop_m"] == best["distance_per_hop_m"]
 
 
+def test_a_study_made_under_the_old_objective_names_is_refused_with_the_new_ones(world, tmp_path):
+    """A study whose optimize.json maximises `distance` (the name before it said per hop) is not
+    drawn as if its figures were this locust's: error and hint, nothing simulated or written."""
+    old = tmp_path / "old-study"
+    shutil.copytree(world["root"] / "study", old)
+    meta = json.loads((old / "optimize.json").read_text())
+    meta["settings"]["objectives"] = ["distance"]
+    (old / "optimize.json").write_text(json.dumps(meta))
+    res = invoke("--measured", world["root"] / "hops" / "small-1", "--preset", "seed", "--optimize", old,
+                 "--out", tmp_path / "out")
+    assert res.exit_code == 2, res.output
+    assert "its study maximises distance, which is no objective of this locust" in res.output
+    assert "hint: rerun the study into a new --out with --objective distance_per_hop" in res.output
+    assert not (tmp_path / "out").exists()
+
+
 def test_changing_a_calibrated_stiffness_changes_the_predictions(world, tmp_path):
     """Hinge stiffness 0.056 -> 0.02 N*m/rad (as if refitted from a beam drop): run() moves Small
     by about 2 mm over two hops; the simulation is deterministic, so any difference above the
