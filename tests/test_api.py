@@ -7,6 +7,7 @@ import importlib
 import inspect
 import json
 import os
+import re
 import subprocess
 import sys
 import types
@@ -267,6 +268,13 @@ def test_fit_and_sweep_have_tables_and_figures(tmp_path):
     fig = swept.plot()
     (ax,) = fig.axes
     assert list(ax.lines[0].get_ydata()) == pytest.approx([r["distance_m"] * 1000 for r in swept.rows if r["valid"]])
+    # the added length in mm, as locust sweep draws and prints it (it was drawn in m)
+    assert list(ax.lines[0].get_xdata()) == pytest.approx([r["scale"] * 1000 for r in swept.rows if r["valid"]])
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("added length on every link (mm)", "distance (mm)")
+    m = re.search(r"\(scale (-?[\d.]+) mm\): distance (-?[\d.]+) mm over the run", repr(swept))
+    assert m, repr(swept)
+    best = swept.best
+    assert [float(v) for v in m.groups()] == pytest.approx([best["scale"] * 1000, best["distance_m"] * 1000], abs=0.005)
 
 
 def test_help_locust_lists_every_function():
@@ -280,16 +288,16 @@ def test_help_locust_lists_every_function():
 
 def test_optimize_is_the_commands_search(tmp_path):
     """locust.optimize over run_optimize: three trials of the push time of a Small whose crank
-    sits at -80 deg (it stays on its feet); the best trial's distance a hop is what simulating
-    that design gives (to 1e-12), and best-distance.toml holds the value."""
+    sits at -80 deg (it stays on its feet); the best trial's distance per hop is what simulating
+    that design gives over its one cycle (to 1e-12), and best-distance_per_hop.toml holds the value."""
     base = locust.robot("small", **{"geometry.crank_start_deg": -80.0})
     res = locust.optimize(base, {"schedule.push_s": (0.15, 0.4)}, trials=3, cycles=1, out=tmp_path / "opt")
     assert (res.trials, res.complete + res.pruned) == (3, 3)
     assert res.best is not None and 0.15 <= res.best["schedule.push_s"] <= 0.4
     again = locust.simulate(base.with_values({"schedule.push_s": res.best["schedule.push_s"]}), cycles=1)
     assert again.outcome != "goes_over"
-    assert res.best["distance_m"] == pytest.approx(again.distance_m, abs=1e-12)
-    assert locust.robot(res.robots["best-distance"]).schedule.push_s == res.best["schedule.push_s"]
+    assert res.best["distance_per_hop_m"] == pytest.approx(again.distance_m, abs=1e-12)
+    assert locust.robot(res.robots["best-distance_per_hop"]).schedule.push_s == res.best["schedule.push_s"]
     assert (tmp_path / "opt" / "trials.csv").is_file()
     with pytest.raises(LocustError, match="twice"):
         locust.optimize(base, ["scale=0:0.01", "scale=0:0.02"], trials=1, out=tmp_path / "x")

@@ -2,7 +2,8 @@
 they printed before their solver vectors became calibrate.fitparams (issue 37): each
 estimate's line, value, relative sd and 95 % interval, to the printed digit. A change in a
 fitter's packing, bounds or chain rule moves one of these digits; a deliberate change of a
-fit updates them here with its reason."""
+fit updates them here with its reason. Lengths are printed in mm (`radius`, `rms_residual`:
+they were printed in m beside the hinge's "(0.79 mm RMS)"), the JSON keeps metres."""
 
 from __future__ import annotations
 
@@ -35,16 +36,21 @@ def test_beam_fit_of_the_rubber_pendulum_prints_its_values(shared_data):
         stiffness 11.46 N/m ± 1.1 % (95 %: 11.21 … 11.72)
         damping 0.06886 N·s/m ± 9.4 % (95 %: 0.05535 … 0.08238)
         damped_frequency 3.132 Hz
-        rms_residual 0.004236 m
+        rms_residual 4.236 mm
         fit_window 0.1335, 4.705 s
     """)
 
 
 def test_hinge_fit_of_damping_test_prints_its_values(shared_data):
-    """Damping_test.trk without Coulomb friction (the fit with it: the slow test below)."""
+    """Damping_test.trk without Coulomb friction (the fit with it: the slow test below); the
+    residual is one figure in one unit where both say it: the row and the TOO NARROW flag."""
     lines = printed("hinge", shared_data / "hinge" / "Damping_test.trk", "--inertia-kgm2", 8.5e-7,
                     "--gravity", "out-of-plane", "--coulomb", "off")
     assert_printed(lines, EXPECTED["hinge_damping_nocoulomb"])
+    row = next(ln for ln in lines if ln.startswith("rms_residual") and ln.endswith(" mm"))
+    flag = next(ln for ln in lines if "TOO NARROW" in ln)
+    assert f"({float(row.split()[1]):.2f} mm RMS)" in flag
+    assert not [ln for ln in lines if ln.endswith(" m") or " m " in ln]
 
 
 @pytest.mark.slow
@@ -77,9 +83,9 @@ EXPECTED = {
         natural_frequency 2.087 Hz
         damping_ratio 0.07126
         rest_angle 95.00 deg
-        radius 0.05067 m
+        radius 50.67 mm
         start_angle 72.19 deg
-        rms_residual 7.854e-4 m
+        rms_residual 0.7854 mm
         rms_residual 0.7982 deg
     """,
     "hinge_damping": """
@@ -91,9 +97,9 @@ EXPECTED = {
         natural_frequency 2.085 Hz
         damping_ratio 0.06888
         rest_angle 94.99 deg
-        radius 0.05057 m
+        radius 50.57 mm
         start_angle 72.19 deg
-        rms_residual 7.793e-4 m
+        rms_residual 0.7793 mm
         rms_residual 0.7922 deg
     """,
     "servo_aa": """

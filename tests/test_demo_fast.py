@@ -121,7 +121,7 @@ def test_tracked_hops_match_the_truth_frames(demo):
         seen = tracks[["nose_y_m", "nose_py"]].dropna()
         px_per_m = abs(np.polyfit(seen["nose_y_m"], seen["nose_py"], 1)[0])
         quarter_px_m = 0.25 / px_per_m
-        assert hop["measured_distance_m"] == pytest.approx(float(x[-1] - x[0]), abs=quarter_px_m), label
+        assert hop["measured_marker_travel_m"] == pytest.approx(float(x[-1] - x[0]), abs=quarter_px_m), label
         assert hop["measured_apex_m"] == pytest.approx(float(z.max() - z[0]), abs=quarter_px_m), label
 
 
@@ -131,5 +131,6 @@ def test_predictions_are_run_on_the_calibrated_robot(demo):
         r = run(leg_set(calibrated, cfg["name"]), cycles=1)
         assert cfg["predicted"]["valid"] and r.valid
         assert cfg["predicted"]["distance_m"] == pytest.approx(r.distance_m, abs=1e-12)
+        assert cfg["predicted_distance_m"] == pytest.approx(r.distance_m, abs=1e-12)      # locust sim's
     rows = (demo["folder"] / "sweep" / "results.csv").read_text().splitlines()
     assert len(rows) == 3                      # header and the two designs

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import cv2
@@ -134,6 +135,27 @@ def test_measure_stance_from_two_photos_writes_the_whole_robot(stills, tmp_path)
     # the written robot is the preset but for the measured values
     again = run_cli("measure", "stance", str(stills["rest"]["jpg"]), "--preset", "medium", "--write", str(out))
     assert again.exit_code == 2 and "exists" in again.output
+
+
+def test_the_printed_stance_reads_as_a_person_reads_it(stills):
+    """Each measured value as a label and its unit, the JSON's value and interval times the
+    unit's factor, to the printed 0.01 (the servo axis in mm: it was printed as
+    `geometry.servo_axis_x_m (mm)`, a key in metres beside a value in mm)."""
+    photos = [str(stills["rest"]["jpg"]), str(stills["push"]["jpg"])]
+    got = json.loads(run_cli("measure", "stance", *photos, "--preset", "medium", "--json").stdout)
+    text = run_cli("measure", "stance", *photos, "--preset", "medium").stdout
+    rows = {m.group(1): [float(v) for v in m.group(2, 4, 5)] + [m.group(3)] for m in re.finditer(
+        r"^([a-z ]+?)\s+(-?[\d.]+) (mm|deg)\s+\[\s*(-?[\d.]+),\s*(-?[\d.]+)\]", text, re.M)}
+    for label, key, factor, unit in (("servo axis x", "servo_axis_x_m", 1000.0, "mm"),
+                                     ("crank start", "crank_start_deg", 1.0, "deg"),
+                                     ("ground angle", "ground_angle_deg", 1.0, "deg"),
+                                     ("plate pitch at rest", "rest_pitch_deg", 1.0, "deg"),
+                                     ("crank turn at the push", "push_turn_deg", 1.0, "deg")):
+        value, lo, hi, shown = rows[label]
+        assert shown == unit, label
+        want = [got[key]["value"] * factor, *(v * factor for v in got[key]["ci95"])]
+        assert [value, lo, hi] == pytest.approx(want, abs=0.005), label
+    assert "_m" not in text and "_deg" not in text and "(mm)" not in text
 
 
 def test_one_photo_gives_the_stance_without_the_push(stills):

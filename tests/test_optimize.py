@@ -17,7 +17,7 @@ from locust.sweep.optimize import run_optimize
 from probing import invoke, signalled_in_design
 
 LOCUST = [sys.executable, "-c", "from locust.commands import main; main()"]
-TWO = [OBJECTIVES["distance"], OBJECTIVES["nose_rise"]]
+TWO = [OBJECTIVES["distance_per_hop"], OBJECTIVES["nose_rise_per_hop"]]
 
 
 def read_csv(path: Path) -> list[dict[str, str]]:
@@ -35,7 +35,7 @@ TRUE_HYPERVOLUME = FRONT_X_MAX - FRONT_X_MAX ** 3 / 3
 
 def standin(values: dict[str, float]) -> Judgement:
     x, y = values["scale"], values["schedule.push_s"]
-    figures = {"distance_m": x, "nose_rise_m": (1 - x * x) * (1 - y)}
+    figures = {"distance_per_hop_m": x, "nose_rise_per_hop_m": (1 - x * x) * (1 - y)}
     flip = 1.0 if x > FRONT_X_MAX else 0.0
     return Judgement(True, "", figures, dict(figures), flip, {"goes_over": flip, "rears_and_returns": 0.0,
                                                              "stays_low": 1 - flip}, 1, 1)
@@ -67,36 +67,37 @@ def test_the_front_found_on_an_analytic_standin_is_the_known_front(tmp_path, see
     trials = read_csv(out / "trials.csv")
     assert len(trials) == 80 and len(front) == len(summary.front) >= 5
     feasible = [t for t in trials if t["feasible"] == "True"]
-    pts = [(float(r["distance_m"]), float(r["nose_rise_m"])) for r in front]
+    pts = [(float(r["distance_per_hop_m"]), float(r["nose_rise_per_hop_m"])) for r in front]
     for f1, f2 in pts:
         assert f1 <= FRONT_X_MAX                         # never a design that goes over
         assert f2 <= 1 - f1 * f1 + 1e-12                 # never better than the truth
         for t in feasible:                               # and no feasible trial dominates it
-            g1, g2 = float(t["distance_m"]), float(t["nose_rise_m"])
+            g1, g2 = float(t["distance_per_hop_m"]), float(t["nose_rise_per_hop_m"])
             assert not (g1 >= f1 and g2 >= f2 and (g1 > f1 or g2 > f2))
     assert all(float(r["flip_share"]) <= 0.05 for r in front)
     # within 8 % of the true front's hypervolume (random search over 80 trials: 76-89 %, 20 seeds)
     assert hypervolume_2d(pts) == pytest.approx(TRUE_HYPERVOLUME, rel=0.08)
     # the ends and the knee are rows of the front
     picks = {p for r in front for p in r["pick"].split()}
-    assert picks == {"best-distance", "best-nose_rise", "knee"}
-    best_d = max(front, key=lambda r: float(r["distance_m"]))
-    assert "best-distance" in best_d["pick"]
+    assert picks == {"best-distance_per_hop", "best-nose_rise_per_hop", "knee"}
+    best_d = max(front, key=lambda r: float(r["distance_per_hop_m"]))
+    assert "best-distance_per_hop" in best_d["pick"]
 
 
 # -- the figures of one design ----------------------------------------------------------
 def test_a_draw_that_goes_over_scores_zero_and_the_quantile_is_what_9_in_10_beat():
     # synthetic draws: seven on their feet at 2..8 cm a hop, one over (nose 12 cm on its back)
-    draws = [DrawFigures("rears_and_returns", {"distance_m": d / 100, "nose_rise_m": 0.05}) for d in range(2, 9)]
-    draws.append(DrawFigures("goes_over", {"distance_m": 0.0, "nose_rise_m": 0.0}))
+    draws = [DrawFigures("rears_and_returns", {"distance_per_hop_m": d / 100, "nose_rise_per_hop_m": 0.05})
+             for d in range(2, 9)]
+    draws.append(DrawFigures("goes_over", {"distance_per_hop_m": 0.0, "nose_rise_per_hop_m": 0.0}))
     j = judge_draws([*draws, None], TWO, quantile=0.1)
     assert j.valid and (j.draws, j.draws_valid) == (9, 8)
     assert j.flip_share == 1 / 8
     assert j.outcome_shares == {"goes_over": 1 / 8, "rears_and_returns": 7 / 8, "stays_low": 0.0}
     # sorted 0, 2, 3, ... 8 cm: the 0.1 quantile sits 0.7 of the way from 0 to 2 cm
-    assert j.figures["distance_m"] == pytest.approx(0.014, abs=1e-12)
-    assert j.means["distance_m"] == pytest.approx(0.35 / 8, abs=1e-12)
-    assert j.figures["nose_rise_m"] == pytest.approx(0.035, abs=1e-12)
+    assert j.figures["distance_per_hop_m"] == pytest.approx(0.014, abs=1e-12)
+    assert j.means["distance_per_hop_m"] == pytest.approx(0.35 / 8, abs=1e-12)
+    assert j.figures["nose_rise_per_hop_m"] == pytest.approx(0.035, abs=1e-12)
     # more failed audits than valid draws: no verdict
     assert not judge_draws([draws[0], None, None], TWO, quantile=0.1).valid
 
@@ -118,7 +119,7 @@ def test_every_design_meets_the_same_draws():
 # -- the command on the simulation -------------------------------------------------------
 # Medium with gentle pushes on longer links: within the flip limit in every draw of the
 # acceptance study (24 designs of 8 draws), so the front is not empty
-OPT = ["optimize", "--preset", "medium", "--objective", "distance", "--objective", "nose_rise",
+OPT = ["optimize", "--preset", "medium", "--objective", "distance_per_hop", "--objective", "nose_rise_per_hop",
        "--vary", "scale=0.01:0.02", "--vary", "schedule.push_deg=-20:-15", "--robust", "2", "--max-flip", "0.05",
        "--cycles", "1"]
 
@@ -141,7 +142,7 @@ def test_optimize_writes_the_front_resumes_after_a_kill_and_refuses_other_object
     trials = read_csv(out / "trials.csv")
     assert [t["state"] for t in trials] == ["complete", "running", "complete", "complete"]
     names = ["scale", "schedule.push_deg"]
-    objectives = ["distance_m", "nose_rise_m"]
+    objectives = ["distance_per_hop_m", "nose_rise_per_hop_m"]
     assert list(trials[0])[:2 + len(names)] == ["trial", "state", *names]
     for col in [*objectives, *(f"{c}_mean" for c in objectives), "flip_share", "share_goes_over",
                 "share_rears_and_returns", "share_stays_low"]:
@@ -161,7 +162,7 @@ def test_optimize_writes_the_front_resumes_after_a_kill_and_refuses_other_object
     again = subprocess.run(LOCUST + args, capture_output=True, text=True, timeout=300)
     assert "4 trials (0 computed now)" in again.stdout
     journal = (out / "study.journal").read_bytes()
-    other = invoke([*OPT[:3], "--objective", "flight", *OPT[5:], "--trials", "3", "--out", out])
+    other = invoke([*OPT[:3], "--objective", "flight_per_hop", *OPT[5:], "--trials", "3", "--out", out])
     assert other.exit_code == 2 and "other settings (objectives differ)" in other.output
     more = invoke([*OPT[:11], "--robust", "3", *OPT[13:], "--trials", "3", "--out", out])
     assert more.exit_code == 2 and "other settings (robust differ)" in more.output
@@ -181,15 +182,16 @@ def test_trials_run_on_local_processes_and_on_a_dask_cluster_share_one_study(tmp
     assert [int(r["trial"]) for r in rows] == list(range(6))
     # each trial's figure is its design's, whichever process judged it
     from locust.sweep.robust import DesignJudge
-    judge = DesignJudge(base, 1, (OBJECTIVES["distance"],))
+    judge = DesignJudge(base, 1, (OBJECTIVES["distance_per_hop"],))
     for r in rows[::3]:
         if r["state"] == "complete":
-            assert float(r["distance_m"]) == judge({"scale": float(r["scale"])}).figures["distance_m"]
+            assert float(r["distance_per_hop_m"]) == judge({"scale": float(r["scale"])}).figures["distance_per_hop_m"]
 
 
 @pytest.mark.parametrize("extra, words", [
-    (["--objective", "height"], ("no such objective", "distance, nose_rise, flight")),
-    (["--objective", "distance", "--objective", "distance"], ("given twice",)),
+    (["--objective", "height"], ("no such objective", "distance_per_hop, nose_rise_per_hop, flight_per_hop")),
+    (["--objective", "distance"], ("each objective is a figure per hop", "--objective distance_per_hop")),
+    (["--objective", "distance_per_hop", "--objective", "distance_per_hop"], ("given twice",)),
     (["--step", "geometry.crank_start_deg=18"], ("no --vary range of that name",)),
     (["--step", "scale=0.5"], ("a step must be above 0 and at most HIGH - LOW",)),
     (["--step", "scale"], ("not NAME=STEP",)),

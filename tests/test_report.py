@@ -129,18 +129,20 @@ def marker_distances(robot, cycles, marker="nose"):
 
 
 def test_predictions_are_the_pipelines_own(world):
-    """Distances: run()'s, to the printed 0.1 mm. Apexes: the simulated nose marker's (what
-    the camera follows), within 0.2 mm of MuJoCo's marker position at every step (the
-    report thins the trace to 240 Hz: about 0.02 mm lower at the top of the arc)."""
+    """Distance: run()'s (locust sim's), to the printed 0.1 mm; marker travel: the simulated
+    nose marker's, hop by hop. Apexes: the simulated nose marker's (what the camera follows),
+    within 0.2 mm of MuJoCo's marker position at every step (the report thins the trace to
+    240 Hz: about 0.02 mm lower at the top of the arc)."""
     cells = world["cells"].cells
     for name in ("small", "medium"):
         robot = leg_set(preset("seed"), name)
         r = run(robot, cycles=CYCLES)
         assert r.valid
         marker_hops = marker_distances(robot, CYCLES)
-        assert cells[(name, "predicted_distance_mm")] == mm(sum(marker_hops))
+        assert cells[(name, "predicted_distance_mm")] == mm(r.distance_m)
+        assert cells[(name, "predicted_marker_travel_mm")] == mm(sum(marker_hops))
         for k, d in enumerate(marker_hops, start=1):
-            assert cells[(name, f"hop_predicted_distance_mm:{name}-1#{k}")] == mm(d)
+            assert cells[(name, f"hop_predicted_marker_travel_mm:{name}-1#{k}")] == mm(d)
             # these robots stand on their feet after each hop: the nose marker travels as the chassis
             assert d == pytest.approx(r.hops[k - 1].distance_m, abs=0.0005)
         apexes = marker_apexes(robot, CYCLES)
@@ -162,14 +164,14 @@ def test_measured_hops_match_the_synthetic_truth(world):
     for label, truth in world["truth"].items():
         name = label.split("-")[0]
         for k, (d_true, a_true) in enumerate(zip(truth.hop_distance_m, truth.hop_apex_m), start=1):
-            d = float(cells[(name, f"hop_measured_distance_mm:{label}#{k}")]) / 1000
+            d = float(cells[(name, f"hop_measured_marker_travel_mm:{label}#{k}")]) / 1000
             a = float(cells[(name, f"hop_measured_apex_mm:{label}#{k}")]) / 1000
             assert d == pytest.approx(d_true, abs=0.0015), (label, k)
             assert a == pytest.approx(a_true, abs=0.005), (label, k)
             assert a <= a_true + 0.0015
     # the true robot (softer hinges) hops 2.8 mm farther than the model over the two hops: the
     # report shows that error, to the measurement's resolution
-    err = float(cells[("small", "distance_error_mm")])
+    err = float(cells[("small", "marker_travel_error_mm")])
     true_total = world["truth"]["small-1"].distance_m
     model_total = sum(marker_distances(leg_set(preset("seed"), "small"), CYCLES))
     assert (true_total - model_total) * 1000 == pytest.approx(2.76, abs=0.3)
@@ -207,14 +209,48 @@ def test_report_is_self_contained_with_named_figures(world):
     assert "fig-landscape" in text
 
 
+def test_the_page_gives_every_length_in_mm(world):
+    """docs/report.md: every length on the page in mm, each with its unit (the added length was
+    in cm, the parameters' lengths in m): no header in cm or m, the links and added lengths
+    the robots', and every parameter in mm, g or deg, its dotted name that of --set."""
+    text = world["html"].read_text(encoding="utf-8")
+    headers = re.findall(r"<th[^>]*>([^<]*)</th>", text)
+    assert headers and not [h for h in headers if re.search(r"\((c?m)\)", h)], headers
+    assert "added (mm)" in headers
+    cells = world["cells"].cells
+    seed = preset("seed")
+    assert cells[("", "param:geometry.crank_m")] == f"{seed.geometry.crank_m * 1000:.6g} mm"
+    assert cells[("", "param:geometry.body_mass_kg")] == f"{seed.geometry.body_mass_kg * 1000:.6g} g"
+    assert cells[("", "param:geometry.crank_start_deg")] == f"{seed.geometry.crank_start_deg:.6g} deg"
+    added = re.search(r'<td class="l">Medium</td><td>([^<]*)</td>', text)
+    assert added and added.group(1) == "+10"
+
+
 def test_report_draws_an_optimize_study_s_front_and_names_its_pick(world):
     text = world["html"].read_text(encoding="utf-8")
     assert "fig-pareto" in text
     best = world["study"].best     # one objective: the front is the farthest design
-    assert f"best-distance: trial {best['trial']} (scale={best['scale'] * 100:.4g} cm)" in text
+    scale = f"{best['scale'] * 1000:#.4g}".rstrip(".")
+    assert f"best-distance_per_hop: trial {best['trial']} (scale {scale} mm): distance per hop " in text
     doc = json.loads((world["html"].parent / "report.json").read_text())
     assert [r["trial"] for r in doc["optimize"]["front"]] == [best["trial"]]
-    assert doc["optimize"]["front"][0]["distance_m"] == best["distance_m"]
+    assert doc["optimize"]["front"][0]["distance_per_hop_m"] == best["distance_per_hop_m"]
+
+
+def test_a_study_made_under_the_old_objective_names_is_refused_with_the_new_ones(world, tmp_path):
+    """A study whose optimize.json maximises `distance` (the name before it said per hop) is not
+    drawn as if its figures were this locust's: error and hint, nothing simulated or written."""
+    old = tmp_path / "old-study"
+    shutil.copytree(world["root"] / "study", old)
+    meta = json.loads((old / "optimize.json").read_text())
+    meta["settings"]["objectives"] = ["distance"]
+    (old / "optimize.json").write_text(json.dumps(meta))
+    res = invoke("--measured", world["root"] / "hops" / "small-1", "--preset", "seed", "--optimize", old,
+                 "--out", tmp_path / "out")
+    assert res.exit_code == 2, res.output
+    assert "its study maximises distance, which is no objective of this locust" in res.output
+    assert "hint: rerun the study into a new --out with --objective distance_per_hop" in res.output
+    assert not (tmp_path / "out").exists()
 
 
 def test_changing_a_calibrated_stiffness_changes_the_predictions(world, tmp_path):
@@ -232,12 +268,14 @@ def test_changing_a_calibrated_stiffness_changes_the_predictions(world, tmp_path
     before = float(world["cells"].cells[("small", "predicted_distance_mm")])
     after = float(cells[("small", "predicted_distance_mm")])
     assert abs(after - before) >= 1.5
-    assert cells[("small", "predicted_distance_mm")] == mm(sum(marker_distances(leg_set(changed, "small"), CYCLES)))
-    assert cells[("", "param:compliance.hinge_stiffness_nm_per_rad")] == "0.02"
+    assert cells[("small", "predicted_distance_mm")] == mm(run(leg_set(changed, "small"), cycles=CYCLES).distance_m)
+    assert cells[("small", "predicted_marker_travel_mm")] == mm(sum(marker_distances(leg_set(changed, "small"),
+                                                                                       CYCLES)))
+    assert cells[("", "param:compliance.hinge_stiffness_nm_per_rad")] == "0.02 N·m/rad"
     # the measured side moves only with the hop windows, which the model's onset latency places
     # on the track's clock (a softer hinge starts the push later): by at most 0.3 mm here
-    a = float(cells[("small", "hop_measured_distance_mm:small-1#1")])
-    b = float(world["cells"].cells[("small", "hop_measured_distance_mm:small-1#1")])
+    a = float(cells[("small", "hop_measured_marker_travel_mm:small-1#1")])
+    b = float(world["cells"].cells[("small", "hop_measured_marker_travel_mm:small-1#1")])
     assert a == pytest.approx(b, abs=0.3)
 
 

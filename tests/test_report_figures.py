@@ -1,6 +1,7 @@
 """What the report's figures and warnings show: each warning shared by several trials once,
 with its count; legends outside the axes (never over data); captions that name only what
-is drawn; lengths in centimetres on every axis, the sweep's heat maps included.
+is drawn; lengths in millimetres on every axis, the sweep's heat maps included, and never a
+key in metres beside a value in mm.
 
 The trials are synthetic (locust.report.synthetic: the seed's leg sets simulated, with
 camera noise), written into folders whose names give their leg set."""
@@ -24,7 +25,8 @@ from locust.sweep.run import run_sweep
 from probing import invoke
 
 CYCLES = 2
-LENGTH_WORDS = ("distance", "height", "forward", "displacement", "apex", "above standing", "added length", "_m (")
+LENGTH_WORDS = ("distance", "height", "forward", "displacement", "travel", "apex", "above standing", "added length",
+                "_m (", "geometry.")
 
 
 class Captured:
@@ -99,19 +101,17 @@ def test_every_legend_stands_outside_its_axes(report):
     assert legends == 2 + 1 + 1 + 1 + 1 + 4
 
 
-def test_hop_figures_are_in_mm_and_design_lengths_in_cm(report):
-    """Hop figures (forward, height, apex, distance) in mm, as every table; a design's link
-    lengths and added length in cm, as the seed's sweep and the cut files speak of them."""
+def test_every_length_on_every_axis_is_in_mm(report):
+    """Hop figures (forward, height, apex, marker travel, distance) and a design's added length
+    in mm, as every table and every command prints them (the design in cm before)."""
     labels = [lab for fig in report["figures"] for ax in fig.axes for lab in (ax.get_xlabel(), ax.get_ylabel())
               if lab]
     lengths = [lab for lab in labels if any(w in lab for w in LENGTH_WORDS)]
-    design = [lab for lab in lengths if "added length" in lab or "_m (" in lab]
-    hop = [lab for lab in lengths if lab not in design]
     # overlay 2, jump 1, hops 2, landscape 2, dashboard 1 + 1 + 2 (its landscape)
     assert len(lengths) == 11, lengths
-    assert hop and all(lab.endswith("(mm)") for lab in hop), hop
-    assert design and all(lab.endswith("(cm)") for lab in design), design
-    assert not [lab for lab in labels if re.search(r"\(m\)$", lab)]
+    assert all(lab.endswith("(mm)") for lab in lengths), lengths
+    assert "added length on every link (mm)" in lengths
+    assert not [lab for lab in labels if re.search(r"\((c?m)\)$", lab) or "_m (" in lab]
 
 
 def _landscape(valid):
@@ -138,7 +138,7 @@ def test_the_landscape_caption_names_only_what_is_drawn(report, monkeypatch):
         assert "open circle" not in text and "square" not in text      # no design was predicted or measured
 
 
-def test_the_sweep_heat_map_draws_lengths_in_centimetres(tmp_path, monkeypatch):
+def test_the_sweep_heat_map_draws_lengths_in_mm(tmp_path, monkeypatch):
     shown = []
     monkeypatch.setattr(sweep_plot, "save_png", lambda fig, path: shown.append(fig) or Path(path))
     a, b = Axis("geometry.leg_m", 0.02, 0.04, 3), Axis("servo.kp_nm_per_rad", 1.0, 2.0, 2)
@@ -146,5 +146,5 @@ def test_the_sweep_heat_map_draws_lengths_in_centimetres(tmp_path, monkeypatch):
              "distance_m": 0.01, "max_nose_height_m": 0.002} for x in a.values() for k in b.values()]
     sweep_plot._heatmap(rows, a, b, tmp_path / "h.png")
     ax = shown[0].axes[0]
-    assert (ax.get_xlabel(), ax.get_ylabel()) == ("geometry.leg_m (cm)", "servo.kp_nm_per_rad")
-    assert ax.get_xlim() == pytest.approx((1.5, 4.5))          # 2..4 cm, half a step either side
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("geometry.leg (mm)", "servo.kp (N·m/rad)")
+    assert ax.get_xlim() == pytest.approx((15.0, 45.0))        # 20..40 mm, half a step either side

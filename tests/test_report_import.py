@@ -78,10 +78,10 @@ def test_units_mirror_rename_give_the_true_hops(trials):
                  "--preset", "seed", "--cycles", CYCLES, "--out", trials["root"] / "out-mm")
     html, cells, doc = report_of(res)
     for k, (d, a) in enumerate(zip(HOPS_M, APEX_M), start=1):
-        assert cells[("small", f"hop_measured_distance_mm:tracker#{k}")] == f"{d * 1000:.1f}"
+        assert cells[("small", f"hop_measured_marker_travel_mm:tracker#{k}")] == f"{d * 1000:.1f}"
         apex = float(cells[("small", f"hop_measured_apex_mm:tracker#{k}")]) / 1000
         assert a * (1 - 0.0278) - 1e-4 <= apex <= a + 1e-4      # 30 frames/s samples the arc's top
-    assert cells[("small", "measured_distance_mm")] == f"{sum(HOPS_M) * 1000:.1f}"
+    assert cells[("small", "measured_marker_travel_mm")] == f"{sum(HOPS_M) * 1000:.1f}"
     # given name, converted, no run record: nothing to warn about
     assert doc["warnings"] == [] and "warning" not in res.stderr and 'id="warnings"' not in html.read_text()
     (trial,) = doc["configurations"][0]["trials"]
@@ -95,13 +95,13 @@ def test_mirrored_mm_read_as_metres_is_warned_not_stopped(trials):
     html, cells, doc = report_of(res)
     kinds = {w["kind"]: w["message"] for w in doc["warnings"]}
     assert set(kinds) == {"mirrored", "units"}
-    predicted = doc["configurations"][0]["predicted_distance_m"]    # the marker's
+    predicted = doc["configurations"][0]["predicted_marker_travel_m"]    # the same marker's
     assert predicted > 0.002                                  # the seed hops forward (a few mm)
     assert kinds["mirrored"] == (f"tracker: the tracked nose travels -600 m overall where the model predicts "
                                  f"+{predicted * 1000:.1f} mm: the camera likely saw the hop mirrored (filmed "
                                  "right-to-left): give --mirror")
     # hundreds of metres a hop: 250 m read, 0.25 m in mm
-    assert [float(cells[("small", f"hop_measured_distance_mm:tracker#{k}")]) / 1000 for k in (1, 2, 3)] == \
+    assert [float(cells[("small", f"hop_measured_marker_travel_mm:tracker#{k}")]) / 1000 for k in (1, 2, 3)] == \
         pytest.approx([-200.0, -250.0, -150.0], abs=1e-4)
     assert kinds["units"] == ("tracker: 250 m in one hop is not this robot's (at most 2 m): the track is likely "
                               "in mm, not m (0.25 m then): give --units mm")
@@ -151,7 +151,7 @@ def test_guessed_leg_set_and_virtual_robot_are_said(trials):
     assert "measured trials: 1 of 1 recorded on the virtual robot (the simulated robot, not the physical one)" in text
     assert f"warning: {virtual}" in res.stderr and f"warning: {guessed}" in res.stderr
     # the warnings change no number: the staircase's hops, as measured from the tracks CSV in metres
-    assert [h["measured_distance_m"] for h in doc["configurations"][0]["hops"]] == pytest.approx(HOPS_M, abs=1e-9)
+    assert [h["measured_marker_travel_m"] for h in doc["configurations"][0]["hops"]] == pytest.approx(HOPS_M, abs=1e-9)
 
 
 @pytest.mark.parametrize("fields, where, because", [

@@ -128,8 +128,8 @@ def test_sweep_landscape_reads_and_places_designs(tmp_path):
     land = read_landscape(folder)
     assert land.names == ["scale"] and land.cycles == 3 and land.designs == 3
     assert list(land.valid) == [True, True, False]
-    assert land.hop_distance_m[:2] == pytest.approx([0.20, 0.30])
-    assert math.isnan(land.hop_distance_m[2])            # an invalid design is never a number
+    assert land.distance_per_hop_m[:2] == pytest.approx([0.20, 0.30])
+    assert math.isnan(land.distance_per_hop_m[2])            # an invalid design is never a number
     seed = preset("seed")
     assert design_value(configuration(seed, "medium"), "scale") == 0.01
     assert design_value(configuration(seed, "large"), "geometry.leg_m") == pytest.approx(0.08)

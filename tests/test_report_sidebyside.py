@@ -7,13 +7,17 @@ in the track, and render the simulation through the trial's ``camera.json``: whe
 right, the two halves show the same pixels, and the marker discs sit in the same place
 frame by frame. One trial's camera is fixed, one follows the robot (a camera pose per
 frame); one has no camera.json (the simulation's own camera, said so) and one no video.
+The page plays each video from the file beside it, in a browser too.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import re
 import shutil
+import subprocess
+from html.parser import HTMLParser
 
 import cv2
 import mujoco
@@ -90,7 +94,7 @@ def test_videos_written_with_the_filmed_size_rate_and_frames(report):
     entries, folder = report["entries"], report["folder"]
     assert set(entries) == {"nb-1", "nb-2", "nb-3", "nb-4"}
     for name in ("nb-1", "nb-2", "nb-3"):
-        path = folder / f"{name}.side_by_side.mp4"
+        path = folder / f"{name}.side_by_side.webm"
         assert entries[name]["path"] == str(path) and path.is_file()
         cap = cv2.VideoCapture(str(path))
         size = (int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT)))
@@ -121,7 +125,7 @@ def test_simulated_half_matches_the_filmed_half(report, name):
     moves in the time the report's first push is off (the onset it finds between two 30 fps
     frames; ``T0_S`` is the truth): sub-pixel standing, pushing and landed, a few pixels in
     flight. Offset by two frames, the discs are far apart: the check sees timing."""
-    left, right = _halves(report["folder"] / f"{name}.side_by_side.mp4")
+    left, right = _halves(report["folder"] / f"{name}.side_by_side.webm")
     diff = np.abs(left[:, CAPTION_ROWS:].astype(int) - right[:, CAPTION_ROWS:])
     assert diff.mean() < 1.5, f"mean |filmed - simulated| = {diff.mean():.2f} grey levels"
     clock_error_s = abs(report["entries"][name]["t0_s"] - T0_S)
@@ -153,7 +157,7 @@ def test_simulated_half_matches_the_filmed_half(report, name):
 def test_without_camera_json_the_simulations_own_camera_is_said(report):
     entry = report["entries"]["nb-3"]
     assert entry["camera"] == OWN_CAMERA and "cameras differ" in entry["note"]
-    _, right = _halves(report["folder"] / "nb-3.side_by_side.mp4")
+    _, right = _halves(report["folder"] / "nb-3.side_by_side.webm")
     for hex_colour, _ in MARKER_COLOURS.values():   # the robot is in its view in every frame
         assert all(blob_centroid(frame, hex_colour) is not None for frame in right)
 
@@ -161,8 +165,89 @@ def test_without_camera_json_the_simulations_own_camera_is_said(report):
 def test_a_trial_without_video_is_skipped_with_the_reason(report):
     entry = report["entries"]["nb-4"]
     assert entry["path"] is None and "no video" in entry["note"]
-    assert not (report["folder"] / "nb-4.side_by_side.mp4").exists()
+    assert not (report["folder"] / "nb-4.side_by_side.webm").exists()
     assert "nb-4 skipped (no video" in report["output"]
+
+
+class Videos(HTMLParser):
+    """Every <video> element's attributes, and the page's Content-Security-Policy."""
+
+    def __init__(self):
+        super().__init__()
+        self.videos: list[dict] = []
+        self.csp = ""
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag == "video":
+            self.videos.append(a)
+        if tag == "meta" and a.get("http-equiv") == "Content-Security-Policy":
+            self.csp = a["content"]
+
+
+def _page(report) -> Videos:
+    parsed = Videos()
+    parsed.feed((report["folder"] / "report.html").read_text(encoding="utf-8"))
+    return parsed
+
+
+def test_the_page_plays_each_video_from_beside_it(report):
+    """One <video controls> per written video, its src the file's name (relative: the page lies
+    beside it), none for the trial without one (listed with its reason); the policy lets media
+    come from the page's own folder and nowhere else."""
+    parsed, folder = _page(report), report["folder"]
+    srcs = [v["src"] for v in parsed.videos]
+    assert srcs == [f"{name}.side_by_side.webm" for name in ("nb-1", "nb-2", "nb-3")]
+    for v in parsed.videos:
+        assert "controls" in v and (folder / v["src"]).is_file()
+        assert "/" not in v["src"] and ":" not in v["src"]
+    assert report["entries"]["nb-1"]["path"] == str(folder / srcs[0])
+    assert "media-src 'self'" in parsed.csp and "default-src 'none'" in parsed.csp
+    assert "nb-4: no video" in (folder / "report.html").read_text(encoding="utf-8")
+
+
+VIDEO_PROBE = """<script>
+window.__errors = [];
+document.addEventListener('securitypolicyviolation', e => window.__errors.push('csp: ' + e.blockedURI));
+const vids = Array.from(document.querySelectorAll('video'));
+let left = vids.length;
+const done = () => { if (--left === 0) document.body.setAttribute('data-errors', window.__errors.join(' | ')); };
+vids.forEach((v, i) => {
+  v.addEventListener('loadeddata', () => { document.body.setAttribute('data-video-' + i,
+    v.videoWidth + 'x' + v.videoHeight + ' ' + v.duration); done(); });
+  v.addEventListener('error', () => { window.__errors.push('video ' + i + ': ' + (v.error && v.error.code)); done(); });
+  v.preload = 'auto'; v.load();
+});
+</script>"""
+
+
+def test_the_videos_play_in_headless_chromium(report):
+    """Chromium decodes every embedded video from the page's folder (file://), at twice the
+    filmed width, for as long as the film, and the page's policy blocks nothing."""
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    if not chromium:
+        pytest.skip("chromium not installed (Debian package `chromium`)")
+    folder = report["folder"]
+    text = (folder / "report.html").read_text(encoding="utf-8")
+    # the probe goes into a copy beside the page (so each src resolves as it does for the page);
+    # its policy allows inline script, nothing else changes
+    probe = text.replace("style-src 'unsafe-inline'", "style-src 'unsafe-inline'; script-src 'unsafe-inline'")
+    page = folder / "probe.html"
+    page.write_text(probe.replace("</body>", VIDEO_PROBE + "</body>"), encoding="utf-8")
+    try:
+        proc = subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--autoplay-policy="
+                               "no-user-gesture-required", "--virtual-time-budget=10000", "--dump-dom", page.as_uri()],
+                              capture_output=True, text=True, timeout=120)
+    finally:
+        page.unlink()
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    attrs = dict(re.findall(r'(data-[\w-]+)="([^"]*)"', re.search(r"<body([^>]*)>", proc.stdout).group(1)))
+    assert attrs.get("data-errors") == "", attrs
+    duration_s = report["frames"]["nb-1"] / FPS
+    for i in range(3):
+        size, duration = attrs[f"data-video-{i}"].split()
+        assert size == f"{2 * W}x{H}"
+        assert float(duration) == pytest.approx(duration_s, abs=1.5 / FPS)
 
 
 def test_pose_renderer_takes_any_pinhole_camera():

@@ -217,11 +217,11 @@ def test_optimize_prunes_invalid_designs_and_keeps_the_study(tmp_path):
     assert first.best["geometry.coupler_m"] <= 0.1166
     assert precheck(design_robot(base, {"geometry.coupler_m": first.best["geometry.coupler_m"]})) is None
     # the best design as a robot file: its values, and a name that says what it is
-    best = load_robot(tmp_path / "o" / "best-distance.toml")
-    assert best.name == f"optimize best-distance of {tmp_path / 'o'}"
+    best = load_robot(tmp_path / "o" / "best-distance_per_hop.toml")
+    assert best.name == f"optimize best-distance_per_hop of {tmp_path / 'o'}"
     assert best.geometry.coupler_m == first.best["geometry.coupler_m"]
-    # the figure optimised is the distance a hop: one cycle here
-    assert evaluate(best, {}, 1)["distance_m"] == first.best["distance_m"]
+    # the figure optimised is the distance per hop: one cycle here, so the run's distance
+    assert evaluate(best, {}, 1)["distance_m"] == first.best["distance_per_hop_m"]
     # the journal keeps the study: --trials is what it should hold, a rerun computes the rest
     again = run_optimize(base, bounds, trials=7, cycles=1, folder=tmp_path / "o", seed=4)
     assert (again.trials, again.computed) == (7, 2)
@@ -547,19 +547,50 @@ def test_a_real_dask_scheduler_passes_the_probe_and_its_worker_does_not():
             probe_dask_scheduler(worker.address)
 
 
-def test_sweep_prints_hop_figures_in_mm_like_every_table(tmp_path):
-    """Hop figures in mm (as `locust sim`, `hop` and `virtual`): the best design's line is its
-    results.csv row times 1000, to the printed 0.005 mm."""
-    import csv
+BEST = re.compile(r"best valid design (\d+) \(scale (-?[\d.]+) mm; ([\w ]+)\): distance (-?[\d.]+) mm over the "
+                  r"run \((-?[\d.]+) mm per hop\), highest nose (-?[\d.]+) mm above the floor")
 
-    res = subprocess.run(LOCUST + ["sweep", "--preset", "seed", "--vary", "scale=0:0.01:2", "--cycles", "1",
+
+def test_sweep_prints_hop_figures_in_mm_like_every_table(tmp_path):
+    """Hop figures and the added length in mm (as `locust sim`, `hop` and `virtual`): the best
+    design's line is its results.csv row times 1000, to the printed digit; `distance` is over
+    the run (locust sim's), the figure per hop says so."""
+    res = subprocess.run(LOCUST + ["sweep", "--preset", "seed", "--vary", "scale=0:0.01:2", "--cycles", "2",
                                    "--jobs", "1", "--out", str(tmp_path / "sw")], capture_output=True, text=True)
     assert res.returncode == 0, res.stderr
-    m = re.search(r"best valid design (\d+) \(scale=[^,)]+, (\w+)\): (-?[\d.]+) mm, highest nose (-?[\d.]+) mm",
-                  res.stdout)
+    m = BEST.search(res.stdout)
     assert m, res.stdout
     row = list(csv.DictReader((tmp_path / "sw" / "results.csv").open()))[int(m.group(1))]
-    assert m.group(2) == row["outcome"]
-    assert float(m.group(3)) == pytest.approx(float(row["distance_m"]) * 1000, abs=0.005)
-    assert float(m.group(4)) == pytest.approx(float(row["max_nose_height_m"]) * 1000, abs=0.005)
-    assert " cm" not in res.stdout
+    assert float(m.group(2)) == pytest.approx(float(row["scale"]) * 1000, abs=0.005)
+    assert m.group(3) == row["outcome"].replace("_", " ")
+    assert float(m.group(4)) == pytest.approx(float(row["distance_m"]) * 1000, abs=0.005)
+    assert float(m.group(5)) == pytest.approx(float(row["distance_m"]) * 1000 / 2, abs=0.005)
+    assert float(m.group(6)) == pytest.approx(float(row["max_nose_height_m"]) * 1000, abs=0.005)
+    assert " cm" not in res.stdout and "scale=0." not in res.stdout
+
+
+def test_distance_and_scale_mean_one_thing_in_sweep_and_optimize(tmp_path):
+    """The same two designs through `locust sweep` and `locust optimize` (a categorical scale,
+    so every trial is one of them): the sweep's distance is over the run, the optimiser's
+    distance per hop is that over the cycles (to 1e-12), and both print the added length in mm
+    with its unit, the same digits for the same design (before: 0.0305 against 3.05 cm)."""
+    args = ["--preset", "small", "--cycles", "2"]
+    sweep = subprocess.run(LOCUST + ["sweep", *args, "--vary", "scale=0.0305:0.031:2", "--jobs", "1",
+                                     "--out", str(tmp_path / "sw")], capture_output=True, text=True)
+    assert sweep.returncode == 0, sweep.stderr
+    opt = subprocess.run(LOCUST + ["optimize", *args, "--vary", "scale=0.0305,0.031", "--trials", "4",
+                                   "--out", str(tmp_path / "o")], capture_output=True, text=True)
+    assert opt.returncode == 0, opt.stderr
+    swept = {round(float(r["scale"]), 9): r for r in read_rows(tmp_path / "sw")}
+    trials = list(csv.DictReader((tmp_path / "o" / "trials.csv").open()))
+    assert "distance_m" not in trials[0] and "distance_per_hop_m" in trials[0]
+    for t in trials:
+        r = swept[round(float(t["scale"]), 9)]
+        if r["outcome"] != "goes_over":     # a design that goes over scores 0 per hop (not a hop)
+            assert float(t["distance_per_hop_m"]) == pytest.approx(float(r["distance_m"]) / 2, abs=1e-12)
+    best = BEST.search(sweep.stdout)
+    m = re.search(r"best-distance_per_hop: trial \d+ \(scale ([\d.]+) mm\): distance per hop (-?[\d.]+) mm",
+                  opt.stdout)
+    assert best and m, (sweep.stdout, opt.stdout)
+    assert m.group(1) == best.group(2)                 # the same design, the same printed mm
+    assert float(m.group(2)) == pytest.approx(float(best.group(5)), abs=0.005)

@@ -10,7 +10,7 @@ from click.testing import CliRunner
 from locust.commands import cli
 from locust.params import preset
 from locust.sim.run import run
-from locust.tables import mean_sd, mm, plant_lines, sim_lines, table
+from locust.tables import for_person, mean_sd, mm, plant_lines, sensitivity_lines, sim_lines, table
 
 ROUNDING_MM = 0.005     # two decimals
 
@@ -83,3 +83,20 @@ def test_plant_lines_give_the_live_runs_figures_in_mm():
 ])
 def test_mean_sd_keeps_sensible_digits(mean_m, sd_m, text):
     assert mean_sd(mean_m, sd_m) == text
+
+
+def test_sensitivity_names_each_value_in_the_unit_a_person_reads():
+    """The deciding values in mm, deg or their own unit, each with it (they were printed in the
+    key's unit with none: `geometry.servo_axis_x_m (sd 0.003): 0.022 goes over`)."""
+    from types import SimpleNamespace as E
+
+    axis = E(key="geometry.servo_axis_x_m", sd=0.003, low_value=0.022, low_outcome="goes_over",
+             high_value=0.034, high_outcome="stays_low")
+    crank = E(key="geometry.crank_start_deg", sd=10.0, low_value=-120.0, low_outcome="goes_over",
+              high_value=-80.0, high_outcome=None)
+    sens = E(nominal="goes_over", k_sd=2.0, deciding=[axis, crank])
+    assert sensitivity_lines(sens)[1:] == [
+        "    geometry.servo_axis_x (sd 3 mm): 22 mm goes over; 34 mm stays low",
+        "    geometry.crank_start (sd 10 deg): -120 deg goes over; -80 deg invalid"]
+    assert for_person("geometry.link_density_kg_per_m3") == ("geometry.link_density", 1.0, "kg/m³")
+    assert for_person("geometry.body_mass_kg") == ("geometry.body_mass", 1000.0, "g")

@@ -52,6 +52,11 @@ def test_tracker_export_in_cm_becomes_metres_with_the_new_name(tmp_path):
     res = track("import", src, "--units", "cm", "--rename", "A=nose", "--out", out)
     assert res.exit_code == 0, res.output
     assert f"wrote {out}" in res.output
+    # the span a person checks in mm (it was printed in m): the cm values times 10
+    xs, ys = [v for v in CM_X if math.isfinite(v)], [v for v in CM_Y if math.isfinite(v)]
+    span = (f"nose: 3 rows with a position; x {min(xs) * 10:.1f} .. {max(xs) * 10:.1f} mm, "
+            f"y {min(ys) * 10:.1f} .. {max(ys) * 10:.1f} mm")
+    assert span in res.output, res.output
     text = out.read_text()
     lines = text.splitlines()
     assert lines[0] == "# SYNTHETIC Tracker export in cm (written by tests/test_track_import.py)"

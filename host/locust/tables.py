@@ -1,7 +1,9 @@
-"""The short tables ``locust sim``, ``locust hop`` and ``locust virtual`` print for a person.
+"""The short tables ``locust sim``, ``locust hop`` and ``locust virtual`` print for a person,
+and the figures every command prints (:func:`for_person`, :func:`quantity`).
 
-Lengths in mm, angles in deg, times in ms or s; ``--json`` (where a command has it) stays the
-machine-readable form in SI units. Each function returns the lines; the command echoes them.
+Lengths in mm, masses in g, angles in deg, times in ms or s; ``--json`` (where a command has
+it) stays the machine-readable form in SI units. Each function returns the lines; the command
+echoes them.
 """
 
 from __future__ import annotations
@@ -242,10 +244,11 @@ def sensitivity_lines(sens) -> list[str]:
     if not deciding:
         return [f"{INDENT}no single value at -/+{sens.k_sd:g} sd changes the outcome ({nominal})"]
     lines = [f"{INDENT}decided by (each value alone at -/+{sens.k_sd:g} sd; as given it {nominal}):"]
-    for e in deciding:
-        ends = [f"{v:.4g} {outcome_words(o) if o else 'invalid'}" for v, o in
+    for e in deciding:   # each value in the unit a person reads (a length in mm), with its unit
+        name, factor, unit = for_person(e.key)
+        ends = [f"{v * factor:.4g} {unit} {outcome_words(o) if o else 'invalid'}".replace("  ", " ") for v, o in
                 ((e.low_value, e.low_outcome), (e.high_value, e.high_outcome))]
-        lines.append(f"{INDENT * 2}{e.key} (sd {e.sd:g}): {ends[0]}; {ends[1]}")
+        lines.append(f"{INDENT * 2}{name} (sd {e.sd * factor:g} {unit}".rstrip() + f"): {ends[0]}; {ends[1]}")
     return lines
 
 
@@ -282,9 +285,92 @@ def plant_lines(summary: dict) -> list[str]:
 # -- fitted values, as `locust calibrate` prints them ------------------------------------------
 UNIT_SUFFIXES = (   # a key's unit from its name's end (longest first): _nm_ is newton-metres, never nm
     ("_nms_per_rad", "N·m·s/rad"), ("_nm_per_rad", "N·m/rad"), ("_ns_per_m", "N·s/m"), ("_n_per_m", "N/m"),
-    ("_rad_per_s", "rad/s"), ("_kgm2", "kg·m²"), ("_kg", "kg"), ("_hz", "Hz"), ("_deg", "deg"), ("_mm", "mm"),
-    ("_nm", "N·m"), ("_rad", "rad"), ("_m", "m"), ("_s", "s"),
+    ("_rad_per_s", "rad/s"), ("_kg_per_m3", "kg/m³"), ("_kgm2", "kg·m²"), ("_kg", "kg"), ("_hz", "Hz"),
+    ("_deg", "deg"), ("_mm", "mm"), ("_ms", "ms"), ("_nm", "N·m"), ("_ohm", "Ω"), ("_rad", "rad"), ("_us", "µs"),
+    ("_m", "m"), ("_s", "s"), ("_v", "V"),
 )
+
+
+# what a person reads of a value in SI (its key's unit): lengths in mm, masses in g, angles in deg
+PERSON_UNITS = {"m": (1000.0, "mm"), "kg": (1000.0, "g"), "rad": (180.0 / math.pi, "deg")}
+
+
+def person_unit(unit: str) -> tuple[float, str]:
+    """The factor from an SI unit to the one a person reads it in, and that unit's name.
+
+    Parameters
+    ----------
+    unit : str
+        A unit as :func:`split_unit` names it (``m``, ``kg``, ``N·m/rad``, ...).
+
+    Returns
+    -------
+    factor, shown : float, str
+        ``(1000.0, "mm")`` for ``m``, ``(1000.0, "g")`` for ``kg``, ``(57.29..., "deg")`` for
+        ``rad``; any other unit as it is, factor 1.
+
+    Examples
+    --------
+    >>> person_unit("m"), person_unit("N·m/rad")
+    ((1000.0, 'mm'), (1.0, 'N·m/rad'))
+    """
+    return PERSON_UNITS.get(unit, (1.0, unit))
+
+
+def for_person(key: str) -> tuple[str, float, str]:
+    """A value's key as a person reads it: its name less the unit suffix, the factor from the
+    key's unit to the shown one, and the shown unit.
+
+    Parameters
+    ----------
+    key : str
+        A name with a unit suffix (``rms_residual_m``, ``geometry.crank_start_deg``).
+
+    Returns
+    -------
+    name, factor, unit : str, float, str
+
+    Examples
+    --------
+    >>> for_person("rms_residual_m")
+    ('rms_residual', 1000.0, 'mm')
+    """
+    name, unit = split_unit(key)
+    factor, shown = person_unit(unit)
+    return name, factor, shown
+
+
+def label(key: str) -> str:
+    """A dotted key's last part less its unit, in words: ``geometry.servo_axis_x_m`` -> ``servo axis x``.
+
+    Parameters
+    ----------
+    key : str
+
+    Returns
+    -------
+    str
+    """
+    return split_unit(key)[0].rpartition(".")[2].replace("_", " ")
+
+
+def quantity(key: str, value: float, digits: int = 4) -> str:
+    """``value`` (in its key's unit) to ``digits`` significant figures in the unit a person
+    reads, with the unit: ``scale_m`` 0.0305 -> ``30.50 mm``.
+
+    Parameters
+    ----------
+    key : str
+        The value's name, its unit the suffix.
+    value : float
+    digits : int
+
+    Returns
+    -------
+    str
+    """
+    _, factor, unit = for_person(key)
+    return f"{sig(value * factor, digits)} {unit}".rstrip()
 
 
 def split_unit(key: str) -> tuple[str, str]:
@@ -327,7 +413,8 @@ def sig(value: float, digits: int = 4) -> str:
 
 
 def value_line(key: str, value, unit_of_key: bool = True) -> str:
-    """A plain figure with its unit column: numbers to 4 significant figures, lists joined.
+    """A plain figure with its unit column: numbers to 4 significant figures in the unit a
+    person reads (:func:`for_person`: a key in m shown in mm, in kg in g), lists joined.
 
     Parameters
     ----------
@@ -341,11 +428,11 @@ def value_line(key: str, value, unit_of_key: bool = True) -> str:
     -------
     str
     """
-    name, unit = split_unit(key) if unit_of_key else (key, "")
+    name, factor, unit = for_person(key) if unit_of_key else (key, 1.0, "")
     if isinstance(value, (list, tuple)):
-        text = ", ".join(sig(v) if isinstance(v, float) else str(v) for v in value)
+        text = ", ".join(sig(v * factor) if isinstance(v, float) else str(v) for v in value)
     elif isinstance(value, float):
-        text = sig(value)
+        text = sig(value * factor)
     else:
         text = str(value)
     return f"{name:28s} {text:>10s}  {unit}".rstrip() if len(text) <= 10 else f"{name:28s} {text}  {unit}".rstrip()
@@ -353,7 +440,8 @@ def value_line(key: str, value, unit_of_key: bool = True) -> str:
 
 def estimate_line(key: str, value: float, std: float | None, ci95=None, note: str = "") -> str:
     """``k = 1.458e-4 N·m/rad ± 0.2 %  (95 %: 1.453e-4 … 1.463e-4)`` as a table row: the key less
-    its unit, the value, the unit, one standard deviation as a share of the value, the interval.
+    its unit, the value, the unit, one standard deviation as a share of the value, the interval;
+    in the unit a person reads (:func:`for_person`: a length in mm, a mass in g).
 
     Parameters
     ----------
@@ -371,11 +459,11 @@ def estimate_line(key: str, value: float, std: float | None, ci95=None, note: st
     -------
     str
     """
-    name, unit = split_unit(key)
-    head = f"{name:28s} {sig(value):>10s}  {unit:10s}"
+    name, k, unit = for_person(key)
+    head = f"{name:28s} {sig(value * k):>10s}  {unit:10s}"
     if std is None or not math.isfinite(std):
         return f"{head} (undetermined){note}"
     rel = 100 * std / abs(value) if value else math.inf
-    spread = f"± {rel:.1f} %" if rel < 10 else f"± {rel:.0f} %" if math.isfinite(rel) else f"± {sig(std)}"
-    interval = f"  (95 %: {sig(ci95[0])} … {sig(ci95[1])})" if ci95 and None not in ci95 else ""
+    spread = f"± {rel:.1f} %" if rel < 10 else f"± {rel:.0f} %" if math.isfinite(rel) else f"± {sig(std * k)}"
+    interval = f"  (95 %: {sig(ci95[0] * k)} … {sig(ci95[1] * k)})" if ci95 and None not in ci95 else ""
     return f"{head} {spread}{interval}{note}"

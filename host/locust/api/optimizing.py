@@ -36,7 +36,7 @@ def optimize_bounds(base: Robot, vary: Mapping[str, tuple[float, float] | str] |
 
 
 def optimize(robot: Robot, vary: Mapping[str, tuple[float, float] | str] | Sequence[str | Bound], trials: int = 50,
-             cycles: int = 3, *, out: str | Path, objectives: Sequence[str] = ("distance",), robust: int = 0,
+             cycles: int = 3, *, out: str | Path, objectives: Sequence[str] = ("distance_per_hop",), robust: int = 0,
              quantile: float = 0.1, max_flip: float | None = None, sampler: str = "tpe",
              storage: str | None = None, study_name: str = "locust", seed: int = 0, jobs: int = 1,
              progress: Callable[[int], None] | None = None) -> OptimizeSummary:
@@ -61,8 +61,9 @@ def optimize(robot: Robot, vary: Mapping[str, tuple[float, float] | str] | Seque
     out : path-like
         Folder for ``trials.csv``, ``pareto.csv``, ``pareto.png``, ``optimize.json``, the
         robot files ``best-<objective>.toml`` and ``knee.toml`` and, by default, the journal.
-    objectives : sequence of str, default ("distance",)
-        Maximised per hop: ``distance`` (m), ``nose_rise`` (m), ``flight`` (s).
+    objectives : sequence of str, default ("distance_per_hop",)
+        Maximised, each a figure per hop: ``distance_per_hop`` (m), ``nose_rise_per_hop`` (m),
+        ``flight_per_hop`` (s).
     robust : int, default 0
         Judge each design over this many draws of the robot file's uncertain values (0: its
         nominal run); the objective is then the ``quantile`` of the draws.

@@ -56,7 +56,9 @@ def make_report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str |
     -------
     locust.report.build.ReportResult
         ``html_path``, ``dashboard_path``, ``json_path``, ``comparisons`` (per configuration:
-        ``prediction.result`` the simulation, ``distance`` the measured mean and sd).
+        ``prediction.result`` the simulation, ``predicted_distance_m`` its distance as ``locust sim``
+        gives it, ``predicted_ending`` how it ended, ``marker_travel`` and ``jump`` the measured
+        means and sds, each trial's ``ending``).
     """
     from ..report.build import build_report
     from ..trials.measured import parse_measured

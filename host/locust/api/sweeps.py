@@ -39,8 +39,8 @@ class SweepResults(SweepSummary):
         return pd.DataFrame(self.rows)
 
     def plot(self, y: str = "distance_m"):
-        """``y`` of each valid design against the first varied value, in mm for lengths; the
-        best design ringed.
+        """``y`` of each valid design against the first varied value, lengths in mm on both
+        axes (as ``locust sweep``'s plots draw them); the best design ringed.
 
         Parameters
         ----------
@@ -53,18 +53,22 @@ class SweepResults(SweepSummary):
         """
         from matplotlib.figure import Figure
 
+        from ..sweep.design import axis_scale
+        from ..tables import for_person
+
         df = self.to_dataframe()
         ok = df[df["valid"].astype(bool)]
         name = self.names[0]
-        scale, unit = (1000.0, "mm") if y.endswith("_m") else (1.0, "")
+        kx, xlabel = axis_scale(name)
+        stem, scale, unit = for_person(y)
         fig = Figure(figsize=(6, 3.5), layout="constrained")
         ax = fig.subplots()
-        ax.plot(ok[name], ok[y] * scale, "o-", ms=4)
+        ax.plot(ok[name] * kx, ok[y] * scale, "o-", ms=4)
         if self.best is not None:
-            ax.plot([self.best[name]], [self.best[y] * scale], "o", mfc="none", mec="C3", ms=12, label="best")
+            ax.plot([self.best[name] * kx], [self.best[y] * scale], "o", mfc="none", mec="C3", ms=12, label="best")
             ax.legend(fontsize=8)
-        ax.set_xlabel(name + (" [m]" if name.endswith("_m") or name == "scale" else ""))
-        ax.set_ylabel(f"{y.removesuffix('_m')} [{unit}]" if unit else y)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(f"{stem} ({unit})" if unit else y)
         return fig
 
     def __repr__(self) -> str:
@@ -72,9 +76,12 @@ class SweepResults(SweepSummary):
         head = f"SweepResults: {len(self.rows)} designs of {', '.join(self.names)}, {valid} valid"
         if self.best is None:
             return head + "; no valid design"
-        where = ", ".join(f"{n}={self.best[n]:.6g}" for n in self.names)
-        return (f"{head}\n  best: design {self.best['design']} ({where}): {self.best['distance_m'] * 1000:.2f} mm, "
-                f"highest nose {self.best['max_nose_height_m'] * 1000:.2f} mm")
+        from ..sweep.design import design_text
+
+        where = ", ".join(design_text(n, self.best[n]) for n in self.names)
+        return (f"{head}\n  best: design {self.best['design']} ({where}): distance "
+                f"{self.best['distance_m'] * 1000:.2f} mm over the run, highest nose "
+                f"{self.best['max_nose_height_m'] * 1000:.2f} mm above the floor")
 
 
 def varied(base: Robot, vary: Mapping[str, tuple | str] | Sequence, parse: Callable, kind: type,

@@ -13,6 +13,7 @@ from ..errors import MeasureError
 from ..fileio import json_text
 from ..io import robot_toml
 from ..io.trk import PIXEL_CONVENTIONS
+from ..tables import for_person, label
 from .options import POSITIVE, robot_options
 
 TERMS_SHOWN = 3
@@ -127,21 +128,22 @@ def _lines(result, photos) -> list[str]:
         lines.append(f"{ph.path.name}: board {len(ph.corners_px)} corners ({ph.corner_sd_px:.2f} px); stickers by "
                      f"colour{', ' + ', '.join(given) + ' given' if given else ''}; farthest from the fit: "
                      f"{worst[0]} {worst[1]:.2f} mm")
-    units = {"geometry.crank_start_deg": (1.0, "deg"), "geometry.ground_angle_deg": (1.0, "deg"),
-             "geometry.servo_axis_x_m": (1000.0, "mm")}
-    lines.append(f"{'value':32s} {'measured':>10s}  {'95 % interval':>22s}")
-    for key, est in zip(STANCE_KEYS, result.values().values()):
-        k, unit = units[key]
+    def row(name: str, est, key: str) -> str:
+        """A value as a person reads it (a length in mm), its unit beside it and its interval."""
+        _, k, unit = for_person(key)
         lo, hi = est.ci95
-        lines.append(f"{key + ' (' + unit + ')':32s} {est.value * k:10.2f}  [{lo * k:9.2f}, {hi * k:9.2f}]")
-    est = result.rest_pitch_deg
-    lines.append(f"{'plate pitch at rest (deg)':32s} {est.value:10.2f}  [{est.ci95[0]:9.2f}, {est.ci95[1]:9.2f}]")
+        return f"{name:28s} {est.value * k:10.2f} {unit:3s}  [{lo * k:9.2f}, {hi * k:9.2f}]"
+
+    lines.append(f"{'value':28s} {'measured':>14s}  {'95 % interval':>22s}")
+    for key, est in zip(STANCE_KEYS, result.values().values()):
+        lines.append(row(label(key), est, key))
+    lines.append(row("plate pitch at rest", result.rest_pitch_deg, "rest_pitch_deg"))
     if result.push_turn_deg is not None:
         est = result.push_turn_deg
         same = (est.value < 0) == (result.push_command_deg < 0)
-        lines.append(f"{'crank turn at the push (deg)':32s} {est.value:10.2f}  [{est.ci95[0]:9.2f}, "
-                     f"{est.ci95[1]:9.2f}]  for the {result.push_command_deg:g} deg command"
-                     f"{'' if same else ': the other way than the model turns it'}")
+        lines.append(row("crank turn at the push", est, "push_turn_deg")
+                     + f"  for the {result.push_command_deg:g} deg command"
+                     + ("" if same else ": the other way than the model turns it"))
     lines.append(f"the crank stood at {result.rest_crank_seen_deg:.2f} deg in {photos[0].path.name}; the model's servo "
                  f"gives {result.servo_give_deg:.2f} deg under the robot's weight, taken off")
     lines.append(f"intervals: parametric bootstrap, {result.draws} draws (stickers {result.sticker_sd_px:.2f} px, "
@@ -196,9 +198,10 @@ def nose_load(grams, preset, config, sets, resolution_g, total_g, write, force, 
                + (f", the whole robot {total_g:g} g" if total_g is not None else ""))
     if res.plate_mass is not None:
         lo, hi = res.plate_mass.ci95
-        click.echo(f"  plate mass ({PLATE_KEY}): {res.plate_mass.value * 1000:.2f} ± {res.plate_mass.sd * 1000:.2f} g "
-                   f"(95 %: {lo * 1000:.2f} to {hi * 1000:.2f})")
-    click.echo(f"  servo axis from the plate's middle ({AXIS_KEY}), from the scale alone: {_mm(res.axis_from_scale)}")
+        click.echo(f"  plate mass: {res.plate_mass.value * 1000:.2f} ± {res.plate_mass.sd * 1000:.2f} g "
+                   f"(95 %: {lo * 1000:.2f} to {hi * 1000:.2f}; the robot's {PLATE_KEY})")
+    click.echo(f"  servo axis from the plate's middle, from the scale alone: {_mm(res.axis_from_scale)} "
+               f"(the robot's {AXIS_KEY})")
     terms = sorted(res.axis_sd_terms_m.items(), key=lambda kv: -kv[1])[:TERMS_SHOWN]
     click.echo("    its largest sd terms: " + ", ".join(f"{k} {v * 1000:.1f} mm" for k, v in terms))
     if res.axis_before is not None:

@@ -33,8 +33,10 @@ def _steps(items: tuple[str, ...]) -> dict[str, float]:
                    "Repeat for several.")
 @click.option("--step", "steps", multiple=True, metavar="NAME=STEP",
               help="Take a --vary range in steps (a horn's spline step: geometry.crank_start_deg=18).")
-@click.option("--objective", "objective_names", multiple=True, metavar="distance|nose_rise|flight",
-              help="What to maximise, per hop over the run (repeat for a Pareto front; default distance).")
+@click.option("--objective", "objective_names", multiple=True,
+              metavar="distance_per_hop|nose_rise_per_hop|flight_per_hop",
+              help="What to maximise, each a figure per hop of the run (repeat for a Pareto front; "
+                   "default distance_per_hop).")
 @click.option("--robust", "draws", type=click.IntRange(2, 256), default=None, metavar="N",
               help="Judge each design over N draws of the robot file's uncertain values (the same draws for "
                    "every design); each objective is their --quantile.")
@@ -74,11 +76,11 @@ def optimize(preset, config, sets, varies, steps, objective_names, draws, quanti
 
     \b
     Examples:
-      locust optimize --preset medium --objective distance --objective nose_rise \\
+      locust optimize --preset medium --objective distance_per_hop --objective nose_rise_per_hop \\
           --vary scale=0:0.02 --vary schedule.push_deg=-40:-15 --robust 8 --max-flip 0.05 \\
           --trials 24 --out o
       locust optimize --vary geometry.crank_start_deg=-126:-54 --step geometry.crank_start_deg=18 \\
-          --objective nose_rise --trials 20 --out horn
+          --objective nose_rise_per_hop --trials 20 --out horn
     """
     from ..sweep.design import parse_bound
     from ..sweep.objectives import objectives_named

@@ -15,6 +15,41 @@ def _stage(msg: str) -> None:
     click.echo(f"report: {msg}", err=True)
 
 
+def headline(c) -> list[str]:
+    """A configuration's result in words and mm: how the simulated and the filmed runs ended,
+    the simulation's distance (``locust sim``'s), the marker's travel on both sides and the jump.
+
+    Parameters
+    ----------
+    c : locust.report.compare.Comparison
+
+    Returns
+    -------
+    list of str
+        The predicted line, then the measured one when a trial has a track.
+    """
+    from ..report.ending import trials_words, words
+
+    def mm(value_m: float) -> str:
+        return f"{value_m * 1000:.1f} mm"
+
+    end = c.predicted_ending
+    if end is None:
+        lines = ["predicted: simulation INVALID"]
+    else:
+        jump = "" if end.over_hop == 1 else f", jump {mm(c.predicted_jump_m)}"
+        lines = [f"predicted: {words(end)}; distance {mm(c.predicted_distance_m)} (locust sim's), marker travel "
+                 f"{mm(c.predicted_marker_travel_m)}{jump}"]
+    if c.marker_travel.n:
+        n = c.marker_travel.n
+        jump = f", jump {mm(c.jump.mean)}" if c.jump.n else ""
+        lines.append(f"measured ({n} trial{'s' * (n != 1)}): {trials_words([m.ending for m in c.trials])}; "
+                     f"marker travel {mm(c.marker_travel.mean)}{jump}")
+    else:
+        lines.append("measured: no track")
+    return lines
+
+
 @click.command()
 @click.option("--measured", "measured", multiple=True, required=True, metavar="[NAME=]PATH[,PATH...]",
               help="Trials: a folder (track *.tracks.csv and/or run.json), a track file or a run.json. "
@@ -34,8 +69,8 @@ def _stage(msg: str) -> None:
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=Path("reports"), show_default=True,
               help="Parent folder; the report goes into a new report/ (report-2/, ...) inside, never over another.")
 @click.option("--side-by-side", "side_by_side", is_flag=True,
-              help="Also write <trial>.side_by_side.mp4 for each trial with a video: the filmed hop beside the "
-                   "simulation from the same camera (its camera.json), on the schedule's clock.")
+              help="Also write <trial>.side_by_side.webm for each trial with a video: the filmed hop beside the "
+                   "simulation from the same camera (its camera.json), on the schedule's clock; the page plays it.")
 @click.option("--samples", type=click.IntRange(2, 256), default=None, metavar="N",
               help="Draw the robot file's uncertain values N times per configuration: bands on the predicted "
                    "curves, error bars on the predicted hops.")
@@ -72,11 +107,8 @@ def report(measured, config, preset, sets, added, sweep, study, cycles, marker, 
                           samples=samples or 0, before=load_robot(before_path) if before_path else None,
                           imports=imports, study=study)
     for c in result.comparisons:
-        r = c.prediction.result
-        pred = f"predicted {c.predicted_distance_m * 1000:.1f} mm" if r.valid else "simulation INVALID"
-        meas = (f"measured {c.distance.mean * 1000:.1f} mm over {c.distance.n} trial(s)" if c.distance.n
-                else "no track")
-        click.echo(f"{c.config:8s} {pred}, {meas}", err=True)
+        for line in headline(c):
+            click.echo(f"{c.config:8s} {line}", err=True)
     for warning in collapsed(result.warnings):     # one line for what several trials share
         click.echo(f"warning: {warning.message}", err=True)
     click.echo(f"dashboard: {result.dashboard_path}", err=True)

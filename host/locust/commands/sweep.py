@@ -10,14 +10,18 @@ import click
 from ..fileio import json_text
 from ..io.robot_toml import resolve_robot
 from ..progress import progress
-from ..tables import mm
+from ..tables import mm, outcome_words
 from .options import robot_options
 
 
-def _describe(row: dict, names: list[str]) -> str:
-    where = ", ".join(f"{n}={row[n]:.6g}" for n in names)
-    return (f"design {row['design']} ({where}, {row['outcome']}): {mm(row['distance_m'])} mm, "
-            f"highest nose {mm(row['max_nose_height_m'])} mm, {row['hops']} airborne hops")
+def _describe(row: dict, names: list[str], cycles: int) -> str:
+    """A design's values and figures as a person reads them (lengths in mm, each with its unit)."""
+    from ..sweep.design import design_text
+
+    where = ", ".join(design_text(n, row[n]) for n in names)
+    return (f"design {row['design']} ({where}; {outcome_words(row['outcome'])}): distance {mm(row['distance_m'])} mm "
+            f"over the run ({mm(row['distance_m'] / cycles)} mm per hop), highest nose {mm(row['max_nose_height_m'])} "
+            f"mm above the floor, {row['hops']} airborne hops")
 
 
 @click.command()
@@ -35,7 +39,7 @@ def _describe(row: dict, names: list[str]) -> str:
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 @click.option("--samples", type=click.IntRange(2, 256), default=None, metavar="N",
               help="Rank designs by their mean over N draws of the robot file's uncertain values: "
-                   "distance_m and max_nose_height_m are those means.")
+                   "distance_m (over the run) and max_nose_height_m are those means.")
 def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, samples):
     """Simulate a grid of designs and report the best valid one.
 
@@ -89,7 +93,7 @@ def sweep(preset, config, sets, varies, cycles, out, jobs, scheduler, as_json, s
     if summary.best is None:
         click.echo("no valid design that stays on its feet: nothing to recommend")
     else:
-        click.echo("best valid " + _describe(summary.best, names))
+        click.echo("best valid " + _describe(summary.best, names, cycles))
     click.echo(f"results: {summary.folder / 'results.csv'}")
     for p in summary.plots:
         click.echo(f"plot: {p}")

@@ -21,6 +21,7 @@ from ..io.importing import ImportOptions, import_tracks, is_project, span_warnin
 from ..io.run_record import RECORD_NAME
 from ..io.tracks_csv import tracks_csv_in, write_tracks_csv
 from ..progress import progress
+from ..tables import mm
 from ..track import board, calib, camera, export, overlay, preview, trk
 from ..track.aruco import side_px_in_video
 from ..track.board import DEFAULT_BOARD
@@ -178,8 +179,9 @@ def import_command(file, imports: ImportOptions, trk_names, out, force):
         x, y = tracks.positions(name)
         ok = np.isfinite(x) & np.isfinite(y)
         if ok.any():
-            click.echo(f"  {name}: {int(ok.sum())} rows with a position; x {x[ok].min():.6g} .. {x[ok].max():.6g} m, "
-                       f"y {y[ok].min():.6g} .. {y[ok].max():.6g} m")
+            # the span a person checks the conversion by, in mm (the CSV keeps metres)
+            click.echo(f"  {name}: {int(ok.sum())} rows with a position; x {mm(x[ok].min(), 1)} .. "
+                       f"{mm(x[ok].max(), 1)} mm, y {mm(y[ok].min(), 1)} .. {mm(y[ok].max(), 1)} mm")
         else:
             click.echo(f"  {name}: no position")
     click.echo(f"wrote {target}")

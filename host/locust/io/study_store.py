@@ -98,7 +98,7 @@ class StudyResults:
     folder: Path
     base: str
     names: list[str]                 # the design variables, by dotted name
-    objectives: list[str]            # the objectives by name (distance, nose_rise, ...)
+    objectives: list[str]            # the objectives by name (distance_per_hop, ...)
     robust: int                      # draws a design (0: its nominal run)
     quantile: float | None
     max_flip: float | None

@@ -405,7 +405,7 @@ def _check_reach(robot: Robot, photos: list[Photo], observed: np.ndarray, p: np.
     g = robot.geometry
     raise MeasureError(
         f"{photo.path.name}: the {name} sticker is {off * 1000:.1f} mm from where any pose of this linkage puts it "
-        f"(links {g.ground_m * 100:g}/{g.crank_m * 100:g}/{g.coupler_m * 100:g}/{g.leg_m * 100:g} cm; the other "
+        f"(links {g.ground_m * 1000:g}/{g.crank_m * 1000:g}/{g.coupler_m * 1000:g}/{g.leg_m * 1000:g} mm; the other "
         f"stickers fit within {rest * 1000:.1f} mm; at most {REACH_LIMIT_M * 1000:g} mm)",
         f"check where the {name} sticker sits (docs/measure.md), the link lengths (--preset, --set geometry.*_m) "
         f"and that it was found where it is (--point {name}=X,Y gives it by hand)")

@@ -19,6 +19,7 @@ from ..errors import ReportError, WriteError
 from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, unique_dir
 from ..io.run_record import ERROR as REFUSED
 from ..params import Provenance, Robot
+from ..tables import for_person
 from ..trials.configs import Configuration, configuration
 from ..trials.measured import Trial
 from ..version import __version__
@@ -147,14 +148,20 @@ def parameter_rows(robot: Robot) -> list[dict]:
     Returns
     -------
     list of dict
-        One per dotted parameter: ``key``, ``value`` (as text, 6 significant digits), and its
-        provenance's ``uncertainty``, ``source``, ``date`` and ``note``.
+        One per dotted parameter: ``key``, ``value`` (as text, 6 significant digits, in the unit
+        a person reads with that unit: a length in mm, a mass in g), its ``uncertainty`` (as text,
+        in the same unit; "" when none), and its provenance's ``source``, ``date`` and ``note``.
     """
     rows = []
     for key, value in robot.flat().items():
         prov = robot.source_of(key)
-        rows.append({"key": key, "value": f"{value:.6g}" if isinstance(value, float) else str(value),
-                     "uncertainty": prov.uncertainty, "source": prov.source, "date": prov.date, "note": prov.note})
+        _, k, unit = for_person(key)
+        shown = (f"{value * k:.6g} {unit}".rstrip() if isinstance(value, float)
+                 else f"{value} {unit}".rstrip() if isinstance(value, int) and not isinstance(value, bool)
+                 else str(value))
+        unc = "" if prov.uncertainty is None else f"± {prov.uncertainty * k:.3g} {unit}".rstrip()
+        rows.append({"key": key, "value": shown, "uncertainty": unc, "source": prov.source, "date": prov.date,
+                     "note": prov.note})
     return rows
 
 
@@ -229,15 +236,15 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
 
     timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
     warnings = notices(comps)
-    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings, spreads)
+    sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
+    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings, spreads,
+                            sbs_plan)
     doc = report_json(base, robot_source, comps, configs, timing, land, marker, warnings)
     doc["optimize"] = {"folder": str(front.folder), "front": front.front} if front is not None else None
     for entry in doc["configurations"]:
         sp, old = spreads.get(entry["name"]), befores.get(entry["name"])
         entry["predicted_spread"] = sp.to_json() if sp is not None else None
         entry["predicted_before_fit"] = old.result.to_json() if old is not None else None
-
-    sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
 
     folder = unique_dir(out, "report")
     try:
@@ -304,19 +311,23 @@ def _figures(comps: list[Comparison], configs: dict[str, Configuration], land: L
     labels = {name: cfg.label for name, cfg in configs.items()}
     names_text = ", ".join(labels.values())
     figs = [
-        H.Figure("overlay", f"Displacement and height vs time: {names_text}",
-                 "Nose forward travel and height above standing, every measured trial (solid) and the audited "
-                 "simulation (dashed), on the schedule's clock (t = 0 at the first push; grey lines: cycle starts)."
+        H.Figure("overlay", f"Marker travel and height vs time: {names_text}",
+                 "The nose marker's forward travel from where it stood and its height above standing, in mm, every "
+                 "measured trial (solid) and the audited simulation (dashed), on the schedule's clock (t = 0 at the "
+                 "first push; grey lines: cycle starts); a run that went over onto its back says so in its "
+                 "height panel."
                  + (" Grey band: mean ± 1 sd of the simulation at draws of the robot file's uncertain values."
                     if spreads else "")
                  + (" Dotted red: the simulation on the robot before the fit." if befores else ""),
                  F.overlay_figure(comps, spreads, befores)),
         H.Figure("jump", f"Jump height, measured against predicted: {names_text}",
-                 "Highest nose point above standing; measured bars show the mean over trials with ±1 sd "
-                 "error bars where repeated trials exist; hatched bars are the simulation's.",
+                 "Highest marker point above standing in a hop that came back down, in mm; measured bars show the "
+                 "mean over trials with ±1 sd error bars where repeated trials exist; hatched bars are the "
+                 "simulation's. A run that went over in its first hop has no jump: its place says so.",
                  F.bars_figure(comps, "jump")),
         H.Figure("hops", f"Each hop, measured against predicted: {names_text}",
-                 "Per-hop distance and nose apex of every trial (dots) and the simulation (dashed).",
+                 "Per-hop marker travel and marker apex, in mm, of every trial (dots) and the simulation (dashed); "
+                 "an apex only for a hop that came back down.",
                  F.hops_figure(comps, spreads)),
     ]
     if land is not None:
@@ -330,18 +341,23 @@ def _figures(comps: list[Comparison], configs: dict[str, Configuration], land: L
 
 def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker: str) -> str:
     items = [
-        f"Predicted distances and heights are those of the model's {marker} marker in locust.sim.run.run()'s "
-        "audited rollout, cut into hops and zeroed exactly as the track is (the chassis' travel differs "
-        "from the marker's on a robot that ends on its back).",
+        "Predicted distance: locust sim's, locust.sim.run.run()'s chassis travel from the schedule's start to the "
+        "end of the run, the figure locust sim and locust sweep print. Marker travel: the model's "
+        f"{marker} marker in the same audited rollout, cut into hops and zeroed exactly as the track is, "
+        "against the track's; the two travels agree on a robot that ends each hop on its feet and differ by "
+        "centimetres on one that ends on its back.",
+        "How a run ended: the simulation's outcome is locust sim's (the plate turned more than 45 deg nose up "
+        "at the end of a cycle: on its back); a track's, where its marker rests: more than 30 mm above where it "
+        "stood at the end of a cycle is on its back. A hop that went over, and every one after it, is no jump.",
         f"Predicted heights are those of the model's {marker} marker (the disc the camera follows, where the "
         f"sticker goes), from the same rollout: a point on a pitching body rises by its own amount, so the "
         f"model's {marker} site would not be the same point.",
         f"Measured figures come from the {marker} track. The schedule's start is placed by the same rule in "
         "both: the marker's first motion of more than 3 mm from where it stood, with the simulated delay "
         "between the first push and that motion; nothing is fitted to make them agree.",
-        "Hop distance: marker x at rest at the end of a cycle minus at its start; apex: highest marker point "
-        "in the cycle above the standing height. Errors are measured minus predicted; ± is one sample "
-        "standard deviation over repeated trials.",
+        "Marker travel of a hop: marker x at rest at the end of a cycle minus at its start; apex: highest marker "
+        "point in the cycle above the standing height. Errors are measured minus predicted; ± is one sample "
+        "standard deviation over repeated trials. Every length is in mm.",
     ]
     for c in comps:
         r = c.prediction.result
@@ -350,7 +366,7 @@ def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker:
         for note in getattr(r, "notes", []):
             items.append(f"{c.config} simulation: {note}")
         for m in c.trials:
-            gaps = [h.hop for h in m.hops if not math.isfinite(h.distance_m)]
+            gaps = [h.hop for h in m.hops if not math.isfinite(h.distance_m)]   # marker travel unseen
             if gaps:
                 items.append(f"{c.config} {m.trial.label}: the track does not cover hop(s) "
                              f"{', '.join(map(str, gaps))}.")
@@ -364,6 +380,13 @@ def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker:
     return "<ul class=\"note\">" + "".join(f"<li>{H.esc(i)}</li>" for i in items) + "</ul>"
 
 
+def _video_caption(job, labels: dict[str, str]) -> str:
+    """What a side-by-side video shows, and through which camera the simulation is filmed."""
+    camera = "the filmed camera" if job.camera else "its own fixed camera (the cameras differ)"
+    return (f"{labels[job.comparison.config]} {job.label}, filmed (left) beside the simulation (right) on the "
+            f"schedule's clock, the simulation through {camera}: {job.camera_note}")
+
+
 def _track_reading(t) -> str:
     """How a trial's track was read: ``metres``, ``cm -> m, mirrored``."""
     if t.track is None:
@@ -372,7 +395,7 @@ def _track_reading(t) -> str:
 
 
 def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, land, marker: str,
-                warnings: Sequence[Notice] = (), spreads: dict | None = None) -> str:
+                warnings: Sequence[Notice] = (), spreads: dict | None = None, side_by_side=None) -> str:
     """The report page.
 
     Parameters
@@ -397,6 +420,8 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
         Shown at the top, collapsed (:func:`.checks.collapsed`).
     spreads : dict of str to Spread, optional
         Per configuration, its spread over the draws; adds the outcome table.
+    side_by_side : sidebyside.Plan, optional
+        The side-by-side videos to be written beside the page: each played in it.
 
     Returns
     -------
@@ -420,10 +445,15 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
         ("Summary", H.summary_table(comps, labels, added)),
         *([("Outcome over the draws", H.outcome_table(spreads, labels))] if spreads else []),
         ("Figures", "".join(H.figure_html(f) for f in figs)),
+        *([("Side by side", H.videos_html([(j.name, _video_caption(j, labels)) for j in side_by_side.jobs],
+                                          [f"{s.trial}: {s.note}" for s in side_by_side.skipped]))]
+          if side_by_side is not None else []),
         ("Per-hop errors", H.hop_table(comps, labels)),
         ("Firmware timing", H.timing_table(timing, labels)),
         ("Parameters", f"<p class=\"note\">Robot {H.esc(base.name)} from {H.esc(robot_source)}; each configuration "
-                       "adds its length to all four links.</p>"
+                       "adds its length to all four links. Values are shown in mm, g and deg; the dotted names are "
+                       "those of <code>--set</code> and <code>locust params</code>, whose values are in the unit "
+                       "each name ends in.</p>"
                        + H.links_table([(labels[n], c.robot.link_lengths_m()) for n, c in configs.items()])
                        + H.params_table(parameter_rows(base))),
         ("Inputs", H.table(["configuration", "trial", "track", "run record", "configuration from", "recorded on",
@@ -439,7 +469,8 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
     if virtual:
         meta.insert(1, f"measured trials: {len(virtual)} of {len(trials)} recorded on the virtual robot "
                        "(the simulated robot, not the physical one)")
-    return H.page("Simulation against measurement", meta, sections)
+    return H.page("Simulation against measurement", meta, sections,
+                  media=side_by_side is not None and bool(side_by_side.jobs))
 
 
 def _trial_json(t) -> dict:
@@ -477,8 +508,9 @@ def report_json(base: Robot, robot_source: str, comps, configs, timing, land, ma
     -------
     dict
         Robot, version, marker, sweep, warnings, and per configuration its added length
-        [m], link lengths [m], predicted and measured figures [m] and hop rows; NaN is left for
-        the writer to turn into null.
+        [m], link lengths [m], predicted and measured figures [m] (``predicted_distance_m`` is
+        ``locust sim``'s distance, ``*_marker_travel_m`` the marker's), how each run ended and
+        hop rows; NaN is left for the writer to turn into null.
     """
     out = {"robot": base.name, "robot_source": robot_source, "locust_version": __version__, "marker": marker,
            "sweep": str(land.folder) if land else None, "warnings": [w.to_json() for w in warnings],
@@ -489,13 +521,16 @@ def report_json(base: Robot, robot_source: str, comps, configs, timing, land, ma
             "name": c.config, "added_m": cfg.added_m, "cycles": c.cycles, "period_s": c.period_s,
             "link_lengths_m": list(cfg.robot.link_lengths_m()),
             "predicted": c.prediction.result.to_json(),
-            "predicted_distance_m": c.predicted_distance_m,     # the marker's, as the figure and the headline
+            "predicted_distance_m": c.predicted_distance_m,     # locust sim's: the chassis over the run
+            "predicted_outcome": ending.to_json() if (ending := c.predicted_ending) else None,
+            "predicted_marker_travel_m": c.predicted_marker_travel_m,
             "predicted_jump_m": c.predicted_jump_m,
             "predicted_marker_hops": [asdict(h) for h in c.prediction.hops],
             "onset_latency_s": c.prediction.onset_latency_s,
-            "measured": {"trials": c.distance.n, "distance_m": asdict(c.distance),
-                         "hop_distance_m": asdict(c.hop_distance), "jump_m": asdict(c.jump)},
-            "hops": [{**asdict(r), "distance_error_m": r.distance_error_m, "apex_error_m": r.apex_error_m}
+            "measured": {"trials": c.marker_travel.n, "marker_travel_m": asdict(c.marker_travel),
+                         "marker_travel_per_hop_m": asdict(c.marker_travel_per_hop), "jump_m": asdict(c.jump),
+                         "outcomes": [{"trial": m.trial.label, **m.ending.to_json()} for m in c.trials]},
+            "hops": [{**asdict(r), "marker_travel_error_m": r.marker_travel_error_m, "apex_error_m": r.apex_error_m}
                      for r in c.rows],
             "trials": [_trial_json(t) for t in c.all_trials],
         })

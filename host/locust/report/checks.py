@@ -156,7 +156,7 @@ def notices(comps: list[Comparison]) -> list[Notice]:
     for c in comps:
         for t in c.all_trials:
             out += _trial_notices(t)
-        predicted = c.predicted_distance_m if c.prediction.valid else math.nan
+        predicted = c.predicted_marker_travel_m if c.prediction.valid else math.nan   # the same marker's
         for m in c.trials:
             out += _track_notices(c, m, predicted)
     return out

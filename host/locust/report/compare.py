@@ -1,8 +1,18 @@
 """Measured against predicted: per-hop rows, per-configuration summaries, firmware timing.
 
+Two travels, each with its own name: the **distance** is ``locust sim``'s, the chassis' travel
+over the run (:attr:`Comparison.predicted_distance_m`, the very figure ``locust sim`` and
+``locust sweep`` print); the **marker travel** is the tracked marker's, from where it stood to
+where it rests after each hop, taken the same way from the track and from the simulated marker,
+so the two are compared like with like. On a robot that ends each hop on its feet they agree (to
+0.5 mm on the seed's leg sets); on one that ends on its back they differ by centimetres, and the
+camera sees only the marker's. A **jump** is the marker's highest point above standing in a hop
+that ended back on its feet (:mod:`.ending`): a hop that went over, and every one after it, is
+no jump.
+
 Across repeated trials a configuration's figure is the mean of the trials' own figures
-(mean distance per hop, highest apex, total distance) with the sample standard deviation
-(n - 1) when there are at least two trials.
+(marker travel, marker travel per hop, jump) with the sample standard deviation (n - 1) when
+there are at least two trials.
 """
 
 from __future__ import annotations
@@ -16,6 +26,7 @@ from ..errors import ReportError, TrialError
 from ..io.run_record import Jitter, jitter
 from ..trials.measure import Aligned, MeasuredHop, align, measure_hops
 from ..trials.measured import Trial, span_hint
+from .ending import ON_ITS_FEET, Ending, marker_ending, simulated_ending
 from .predict import Prediction
 
 
@@ -69,28 +80,34 @@ class HopRow:
         The trial's label.
     hop : int
         The hop (cycle) number, from 1.
-    measured_distance_m, predicted_distance_m : float
-        The marker's travel over the hop [m]; nan where the track or the simulation has none.
+    measured_marker_travel_m, predicted_marker_travel_m : float
+        The marker's travel over the hop, rest to rest [m]; nan where the track or the
+        simulation has none.
     measured_apex_m, predicted_apex_m : float
-        The marker's highest point in the hop above standing [m].
+        The marker's highest point in the hop above standing [m]; nan where the hop did not end
+        on the robot's feet (it went over, or lay on its back: no jump).
+    measured_state, predicted_state : str
+        How the hop ended: ``on its feet``, ``goes over`` or ``on its back`` (:mod:`.ending`).
     """
 
     config: str
     trial: str
     hop: int
-    measured_distance_m: float
-    predicted_distance_m: float
+    measured_marker_travel_m: float
+    predicted_marker_travel_m: float
     measured_apex_m: float
     predicted_apex_m: float
+    measured_state: str = ""
+    predicted_state: str = ""
 
     @property
-    def distance_error_m(self) -> float:
-        """Measured minus predicted hop distance [m]."""
-        return self.measured_distance_m - self.predicted_distance_m
+    def marker_travel_error_m(self) -> float:
+        """Measured minus predicted marker travel over the hop [m]."""
+        return self.measured_marker_travel_m - self.predicted_marker_travel_m
 
     @property
     def apex_error_m(self) -> float:
-        """Measured minus predicted apex [m]."""
+        """Measured minus predicted apex [m] (nan where either hop is no jump)."""
         return self.measured_apex_m - self.predicted_apex_m
 
 
@@ -113,20 +130,44 @@ class MeasuredTrial:
     hops: list[MeasuredHop]
 
     @property
-    def total_distance_m(self) -> float:
+    def ending(self) -> Ending:
+        """How the trial ended, read off its marker (:func:`.ending.marker_ending`)."""
+        return marker_ending(self.hops)
+
+    @property
+    def marker_travel_m(self) -> float:
         """The marker's travel summed over the hops [m]."""
         return float(sum(h.distance_m for h in self.hops))
 
     @property
-    def mean_hop_m(self) -> float:
-        """Mean hop distance [m]; nan without hops."""
+    def marker_travel_per_hop_m(self) -> float:
+        """The marker's mean travel per hop [m]; nan without hops."""
         return float(np.mean([h.distance_m for h in self.hops])) if self.hops else math.nan
 
     @property
     def jump_m(self) -> float:
-        """Highest apex over the hops above standing [m]; nan when none is finite."""
-        apexes = [h.apex_m for h in self.hops if math.isfinite(h.apex_m)]
-        return max(apexes) if apexes else math.nan
+        """Highest apex above standing over the hops that ended on the robot's feet [m]; nan
+        when none did (a trial that went over in its first hop has no jump)."""
+        return jump_of(self.hops, self.ending)
+
+
+def jump_of(hops: list[MeasuredHop], ending: Ending) -> float:
+    """The highest marker apex above standing over the hops that came back down [m].
+
+    Parameters
+    ----------
+    hops : list of MeasuredHop
+        A marker's hops.
+    ending : Ending
+        How the run ended (the hop it went over in).
+
+    Returns
+    -------
+    float
+        nan when no such hop has a finite apex.
+    """
+    apexes = [h.apex_m for h in hops if math.isfinite(h.apex_m) and ending.came_down(h.hop)]
+    return max(apexes) if apexes else math.nan
 
 
 @dataclass(frozen=True)
@@ -149,9 +190,9 @@ class Comparison:
         Cycles simulated.
     period_s : float
         One cycle, push plus wait [s].
-    distance, hop_distance, jump : Stat
-        Measured total distance over the cycles, mean distance per hop and highest nose apex
-        above standing [m], over the trials.
+    marker_travel, marker_travel_per_hop, jump : Stat
+        Measured marker travel over the cycles, its mean per hop, and the jump (highest marker
+        apex above standing in a hop that came back down) [m], over the trials.
     """
 
     config: str
@@ -161,14 +202,30 @@ class Comparison:
     rows: list[HopRow]
     cycles: int
     period_s: float
-    distance: Stat            # measured total distance over the cycles
-    hop_distance: Stat        # measured mean distance per hop
-    jump: Stat                # measured highest nose apex above standing
+    marker_travel: Stat             # measured marker travel over the cycles
+    marker_travel_per_hop: Stat     # its mean per hop
+    jump: Stat                      # measured highest marker apex above standing, hops that came back down
 
     @property
     def predicted_distance_m(self) -> float:
+        """``locust sim``'s distance: the chassis' travel over the run [m] (nan when invalid)."""
+        return float(self.prediction.result.distance_m) if self.prediction.valid else math.nan
+
+    @property
+    def predicted_distance_per_hop_m(self) -> float:
+        """``locust sim``'s distance over the cycles [m]: what ``locust sweep``'s landscape draws."""
+        return self.predicted_distance_m / self.cycles
+
+    @property
+    def predicted_ending(self) -> Ending | None:
+        """How the simulated run ended (:func:`.ending.simulated_ending`); None when invalid."""
+        return simulated_ending(self.prediction.result, self.prediction.hops) if self.prediction.valid else None
+
+    @property
+    def predicted_marker_travel_m(self) -> float:
         """The simulated marker's travel over the cycles, cut and zeroed as a track's hops
-        are (the chassis' travel differs from it on a robot that ends on its back)."""
+        are [m] (the chassis' travel, :attr:`predicted_distance_m`, differs from it on a robot
+        that ends on its back)."""
         hops = self.prediction.hops
         return float(sum(h.distance_m for h in hops)) if hops else math.nan
 
@@ -180,15 +237,16 @@ class Comparison:
         return max(px) if px else math.nan
 
     @property
-    def predicted_hop_distance_m(self) -> float:
+    def predicted_marker_travel_per_hop_m(self) -> float:
         """Predicted marker travel per cycle [m]."""
-        return self.predicted_distance_m / self.cycles
+        return self.predicted_marker_travel_m / self.cycles
 
     @property
     def predicted_jump_m(self) -> float:
-        """Highest apex of the tracked marker in the simulation (what a camera would see)."""
-        apexes = [h.apex_m for h in self.prediction.hops if math.isfinite(h.apex_m)]
-        return max(apexes) if apexes else math.nan
+        """Highest apex of the tracked marker in the simulation (what a camera would see) over
+        the hops that came back down [m]; nan when it went over in its first hop."""
+        ending = self.predicted_ending
+        return jump_of(self.prediction.hops, ending) if ending is not None else math.nan
 
 
 def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: float) -> Comparison:
@@ -196,7 +254,9 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
 
     Like with like: the predicted hops are the simulated marker's (the same marker as the
     track), measured by the same function from the same zero (where it stood) with the same
-    cut (the schedule's cycles, each ending at rest), never the chassis travel of ``run()``.
+    cut (the schedule's cycles, each ending at rest), never the chassis travel of ``run()``
+    (which is :attr:`Comparison.predicted_distance_m`, under its own name). A hop that did not
+    end on the robot's feet has no apex in the rows: it is no jump.
 
     Parameters
     ----------
@@ -232,18 +292,23 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
             raise ReportError(exc.message, f"{hint}; {exc.hint}" if hint else exc.hint) from None
         measured.append(MeasuredTrial(trial, trace, measure_hops(trace, period_s, trial_cycles(trial, cycles))))
     sim_hops = {h.hop: h for h in prediction.hops}            # the simulated marker's hops
+    sim_end = simulated_ending(prediction.result, prediction.hops) if prediction.valid else None
     nan = math.nan
     rows = []
     for m in measured:
+        end = m.ending
         for h in m.hops:
             p = sim_hops.get(h.hop)
-            rows.append(HopRow(prediction.config, m.trial.label, h.hop, h.distance_m,
-                               p.distance_m if p else nan, h.apex_m, p.apex_m if p else nan))
+            p_state = sim_end.state(h.hop) if p and sim_end else ""
+            rows.append(HopRow(prediction.config, m.trial.label, h.hop, h.distance_m, p.distance_m if p else nan,
+                               h.apex_m if end.came_down(h.hop) else nan,
+                               p.apex_m if p and p_state == ON_ITS_FEET else nan,
+                               end.state(h.hop) if math.isfinite(h.rest_height_m) else "", p_state))
     return Comparison(
         config=prediction.config, prediction=prediction, all_trials=list(trials), trials=measured, rows=rows,
-        cycles=cycles,
-        period_s=period_s, distance=stat([m.total_distance_m for m in measured]),
-        hop_distance=stat([m.mean_hop_m for m in measured]), jump=stat([m.jump_m for m in measured]),
+        cycles=cycles, period_s=period_s, marker_travel=stat([m.marker_travel_m for m in measured]),
+        marker_travel_per_hop=stat([m.marker_travel_per_hop_m for m in measured]),
+        jump=stat([m.jump_m for m in measured]),
     )
 
 

@@ -1,7 +1,8 @@
 """The report's figures (matplotlib, Agg), each drawn on given axes so the HTML page and the
 PNG dashboard share them. Measured: solid, coloured by configuration; predicted: dashed or
-hatched. An invalid simulation is written in its panel, never drawn as a prediction. Lengths
-are in centimetres on every axis; legends stand outside the axes, never over the data.
+hatched. An invalid simulation is written in its panel, never drawn as a prediction; a run that
+went over onto its back is written as such where its jump would be, never drawn as a jump.
+Lengths are in millimetres on every axis; legends stand outside the axes, never over the data.
 """
 
 from __future__ import annotations
@@ -13,12 +14,13 @@ import numpy as np
 from ..plotting import png_bytes, pyplot
 from ..sweep.design import axis_scale
 from ..trials.configs import Configuration
-from .compare import Comparison
+from .compare import Comparison, stat
 from .landscape import Landscape, design_value
 
 COLOURS = {"small": "#1f77b4", "medium": "#ff7f0e", "large": "#2ca02c"}   # the seed dashboard's
 OTHER = ["#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"]
 MM = 1000.0   # hop figures in mm, as every command prints them
+OVER_COLOUR = "#6a3d9a"   # a run gone over onto its back: the sweep plot's colour for it
 
 
 def colour(name: str, names: list[str]) -> str:
@@ -105,9 +107,33 @@ def draw_traces(ax, c: Comparison, names: list[str], which: str, spread=None, be
         ax.plot(p.trace.t_s, getattr(p.trace, f"{which}_m") * MM, "--", color="black", lw=1.2, label="predicted")
     else:
         _invalid_note(ax, c)
+    if which == "y":
+        _say_over(ax, c)
     for k in range(c.cycles + 1):
         ax.axvline(k * c.period_s, color="#bbbbbb", lw=0.6, zorder=0)
     ax.grid(True, ls=":", alpha=0.5)
+
+
+def _say_over(ax, c: Comparison) -> None:
+    """Write in the axes' lower right which side went over, and at which hop."""
+    said = _over_words(c)
+    if said:
+        ax.text(0.98, 0.04, said, transform=ax.transAxes, ha="right", va="bottom", fontsize=7, color=OVER_COLOUR,
+                bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 1.5})
+
+
+def _over_words(c: Comparison) -> str:
+    """Which side went over onto its back, and at which hop (empty when neither did)."""
+    said = []
+    end = c.predicted_ending
+    if end is not None and end.over_hop is not None:
+        said.append(f"predicted: goes over at hop {end.over_hop}")
+    hops = sorted({m.ending.over_hop for m in c.trials if m.ending.over_hop is not None})
+    if hops:
+        n = sum(1 for m in c.trials if m.ending.over_hop is not None)
+        said.append(f"measured: goes over at hop {', '.join(map(str, hops))}"
+                    + (f" ({n} of {len(c.trials)} trials)" if len(c.trials) > 1 else ""))
+    return "\n".join(said)
 
 
 def overlay_figure(comps: list[Comparison], spreads: dict | None = None, befores: dict | None = None) -> bytes:
@@ -134,19 +160,21 @@ def overlay_figure(comps: list[Comparison], spreads: dict | None = None, befores
     for j, c in enumerate(comps):
         for row, which in enumerate("xy"):
             draw_traces(axes[row, j], c, names, which, spreads.get(c.config), befores.get(c.config))
-        axes[0, j].set_title(f"{_label(c)}: nose displacement", loc="left", fontsize=10)
-        axes[1, j].set_title(f"{_label(c)}: nose height", loc="left", fontsize=10)
+        axes[0, j].set_title(f"{_label(c)}: marker forward travel", loc="left", fontsize=10)
+        axes[1, j].set_title(f"{_label(c)}: marker height", loc="left", fontsize=10)
         axes[1, j].set_xlabel("time since first push (s)")
         legend_outside(axes[1, j], below=True, fontsize=8)
-    axes[0, 0].set_ylabel("forward (mm)")
+    axes[0, 0].set_ylabel("forward from where it stood (mm)")
     axes[1, 0].set_ylabel("above standing (mm)")
-    fig.suptitle("Displacement and height vs time: measured (solid) and predicted (dashed)", fontsize=11)
+    fig.suptitle("Marker travel and height vs time: measured (solid) and predicted (dashed)", fontsize=11)
     fig.tight_layout()
     return png_bytes(fig)
 
 
 def draw_bars(ax, comps: list[Comparison], what: str) -> None:
-    """Measured (mean, +-1 sd across trials) beside predicted, per configuration.
+    """Measured (mean, +-1 sd across trials) beside predicted, per configuration. A jump is
+    only a hop that came back down: where every trial (or the simulation) went over in its first
+    hop, the bar's place says so instead of drawing its resting height.
 
     Parameters
     ----------
@@ -155,7 +183,8 @@ def draw_bars(ax, comps: list[Comparison], what: str) -> None:
     comps : list of Comparison
         The configurations.
     what : str
-        ``jump`` (highest nose apex) or anything else for the distance per hop.
+        ``jump`` (highest marker apex in a hop that came back down) or anything else for the
+        marker's travel per hop (both sides the marker's: like with like).
     """
     names = [c.config for c in comps]
     x = np.arange(len(comps))
@@ -164,26 +193,44 @@ def draw_bars(ax, comps: list[Comparison], what: str) -> None:
         meas = [c.jump for c in comps]
         pred = [c.predicted_jump_m for c in comps]
     else:
-        meas = [c.hop_distance for c in comps]
-        pred = [c.predicted_hop_distance_m for c in comps]
+        meas = [c.marker_travel_per_hop for c in comps]
+        pred = [c.predicted_marker_travel_per_hop_m for c in comps]
     cols = [colour(n, names) for n in names]
     heights = [s.mean * MM if s.n else 0.0 for s in meas]
     errs = [(s.std or 0.0) * MM for s in meas]
     ax.bar(x - w / 2, heights, w, color=cols, yerr=errs, capsize=4, label="measured (mean ± 1 sd)", zorder=3)
     pv = [p * MM if math.isfinite(p) else 0.0 for p in pred]
     ax.bar(x + w / 2, pv, w, color="white", edgecolor=cols, hatch="//", lw=1.2, label="predicted", zorder=3)
-    for i, (s, p) in enumerate(zip(meas, pred)):
+    for i, (c, s, p) in enumerate(zip(comps, meas, pred)):
         if s.n:
             ax.annotate(f"{s.mean * MM:.1f}" + (f"±{s.std * MM:.1f}" if s.std is not None else ""),
                         (x[i] - w / 2, heights[i]), xytext=(0, 3), textcoords="offset points",
                         ha="center", fontsize=7)
-        ax.annotate(f"{p * MM:.1f}" if math.isfinite(p) else "invalid", (x[i] + w / 2, pv[i]), xytext=(0, 3),
-                    textcoords="offset points", ha="center", fontsize=7,
-                    color="black" if math.isfinite(p) else "#b00020")
+        elif what == "jump" and c.trials:
+            ax.annotate(_over_first("measured", [m.ending.over_hop for m in c.trials]), (x[i] - w / 2, 0),
+                        xytext=(0, 3), textcoords="offset points", ha="center", va="bottom", fontsize=7,
+                        rotation=90, color=OVER_COLOUR)
+        ending = c.predicted_ending
+        if math.isfinite(p):
+            text, colour_ = f"{p * MM:.1f}", "black"
+        elif ending is None:
+            text, colour_ = "invalid", "#b00020"
+        else:
+            text, colour_ = _over_first("predicted", [ending.over_hop]), OVER_COLOUR
+        ax.annotate(text, (x[i] + w / 2, pv[i]), xytext=(0, 3), textcoords="offset points", ha="center",
+                    va="bottom", fontsize=7, color=colour_, rotation=0 if math.isfinite(p) or ending is None else 90)
     ax.set_xticks(x, [_label(c) for c in comps])
+    if not any(heights) and not any(pv):     # nothing to draw but words: give them room above zero
+        ax.set_ylim(0.0, 10.0)
     ax.axhline(0, color="black", lw=0.6)
     ax.yaxis.grid(True, ls="--", alpha=0.5, zorder=0)
     legend_outside(ax, fontsize=8)
+
+
+def _over_first(who: str, over_hops: list) -> str:
+    """What stands where a jump bar would: the run went over in its first hop (no jump)."""
+    return f"{who}: goes over at hop {min(h for h in over_hops if h is not None)}, no jump" \
+        if any(h is not None for h in over_hops) else f"{who}: no hop covered"
 
 
 def bars_figure(comps: list[Comparison], what: str) -> bytes:
@@ -205,18 +252,20 @@ def bars_figure(comps: list[Comparison], what: str) -> bytes:
     fig, ax = plt.subplots(figsize=(max(5.0, 2.2 * len(comps)), 4.0))
     draw_bars(ax, comps, what)
     if what == "jump":
-        ax.set_title("Jump height: highest nose point above standing", loc="left", fontsize=10)
+        ax.set_title("Jump: highest marker point above standing, in a hop that came back down", loc="left",
+                     fontsize=10)
         ax.set_ylabel("height (mm)")
     else:
-        ax.set_title("Distance per hop", loc="left", fontsize=10)
-        ax.set_ylabel("distance (mm)")
+        ax.set_title("Marker travel per hop", loc="left", fontsize=10)
+        ax.set_ylabel("marker travel per hop (mm)")
     fig.tight_layout()
     return png_bytes(fig)
 
 
 def hops_figure(comps: list[Comparison], spreads: dict | None = None) -> bytes:
-    """Per-hop distance and apex, every trial, against the prediction (with ±1 sd error bars
-    over the draws of a :class:`.spread.Spread`).
+    """Per-hop marker travel and apex, every trial, against the prediction (with ±1 sd error
+    bars over the draws of a :class:`.spread.Spread`); an apex only for a hop that came back
+    down (a hop that went over, and each one after it, is no jump).
 
     Parameters
     ----------
@@ -236,20 +285,26 @@ def hops_figure(comps: list[Comparison], spreads: dict | None = None) -> bytes:
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
     for c in comps:
         col = colour(c.config, names)
-        for key, ax in (("distance", axes[0]), ("apex", axes[1])):
+        ending = c.predicted_ending
+        for key, field, ax in (("distance", "marker_travel", axes[0]), ("apex", "apex", axes[1])):
             xs = [r.hop for r in c.rows]
-            ys = [getattr(r, f"measured_{key}_m") * MM for r in c.rows]
+            ys = [getattr(r, f"measured_{field}_m") * MM for r in c.rows]
             ax.plot(xs, ys, "o", color=col, ms=5, alpha=0.8, label=f"{_label(c)} measured")
-            if c.prediction.valid:
-                # the simulated marker's hops, cut as the track's are
-                px, pv = [h.hop for h in c.prediction.hops], [getattr(h, f"{key}_m") for h in c.prediction.hops]
+            if ending is not None:
+                # the simulated marker's hops, cut as the track's are; an apex only where it came back down
+                shown = [h for h in c.prediction.hops if key == "distance" or ending.came_down(h.hop)]
+                px, pv = [h.hop for h in shown], [getattr(h, f"{key}_m") for h in shown]
                 sp = spreads.get(c.config)
-                err = None if sp is None else [v * MM for v in getattr(sp, f"hop_{key}_sd_m")][:len(pv)]
+                err = None if sp is None else [getattr(sp, f"hop_{key}_sd_m")[h.hop - 1] * MM for h in shown]
                 ax.errorbar(px, [v * MM for v in pv], yerr=err, fmt="--", color=col, lw=1.2, capsize=3,
                             label=f"{_label(c)} predicted" + (" ±1 sd" if err else ""))
-    axes[0].set_title("Distance of each hop", loc="left", fontsize=10)
-    axes[1].set_title("Nose apex of each hop", loc="left", fontsize=10)
-    for ax, unit in zip(axes, ("distance (mm)", "apex above standing (mm)")):
+        _say_over(axes[1], c)
+    axes[0].set_title("Marker travel in each hop", loc="left", fontsize=10)
+    axes[1].set_title("Marker apex of each hop that came back down", loc="left", fontsize=10)
+    if not axes[1].lines:    # no hop came back down: the axes still read as hops and mm
+        axes[1].set_xlim(0.5, max(c.cycles for c in comps) + 0.5)
+        axes[1].set_ylim(0.0, 10.0)
+    for ax, unit in zip(axes, ("marker travel (mm)", "apex above standing (mm)")):
         ax.set_xlabel("hop")
         ax.set_ylabel(unit)
         ax.grid(True, ls=":", alpha=0.5)
@@ -260,8 +315,11 @@ def hops_figure(comps: list[Comparison], spreads: dict | None = None) -> bytes:
 
 
 def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[str, Configuration]) -> None:
-    """The sweep's distance per hop over its first axis (a line) or first two axes (colour),
-    with each configuration's prediction and measurement where it sits.
+    """The sweep's distance per hop (``locust sim``'s distance over the cycles) over its first
+    axis (a line) or first two axes (colour), designs that go over onto their backs marked as
+    such, with each configuration's prediction (the same figure) and measurement (its marker's
+    travel per hop, where every trial ended on its feet: then the two are the robot's travel)
+    where it sits.
 
     Parameters
     ----------
@@ -278,12 +336,16 @@ def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[s
     first = land.names[0]
     k, xlabel = axis_scale(first)
     xs = land.values[first] * k
-    hop = land.hop_distance_m * MM
+    hop = land.distance_per_hop_m * MM
+    over = land.valid & land.goes_over
     if len(land.names) == 1:
         order = np.argsort(xs)
-        ok = land.valid[order]
+        ok = (land.valid & ~land.goes_over)[order]
         ax.plot(xs[order][ok], hop[order][ok], "o-", color="#555555", ms=3.5, lw=1.0,
-                label=f"simulated designs ({land.designs})")
+                label=f"simulated designs on their feet ({int(ok.sum())})")
+        if over.any():
+            ax.plot(xs[over], hop[over], "v", color=OVER_COLOUR, mfc="none", ms=6,
+                    label=f"goes over onto its back ({int(over.sum())}): not a hop")
         bad = ~land.valid
         if bad.any():
             ax.plot(xs[bad], np.zeros(bad.sum()), "x", color="#b00020", ms=7, label="invalid (failed audit)")
@@ -292,20 +354,30 @@ def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[s
             xv = design_value(cfg, first) * k
             col = colour(c.config, names)
             ax.axvline(xv, color=col, ls=":", lw=1.0)
-            if c.prediction.valid:
-                ax.plot([xv], [c.predicted_hop_distance_m * MM], "o", mfc="white", mec=col, mew=2, ms=8)
-            if c.hop_distance.n:
-                ax.errorbar([xv], [c.hop_distance.mean * MM], yerr=[(c.hop_distance.std or 0.0) * MM], fmt="s",
-                            color=col, ms=7, capsize=4, label=f"{_label(c)}: measured ■, predicted ○")
+            ending = c.predicted_ending
+            if ending is not None:   # as the sweep's designs: a run gone over is a triangle, not a hop
+                ax.plot([xv], [c.predicted_distance_per_hop_m * MM], "v" if ending.over_hop else "o", mfc="white",
+                        mec=col, mew=2, ms=8)
+            on_feet = stat([m.marker_travel_per_hop_m for m in c.trials if m.ending.over_hop is None])
+            if on_feet.n:
+                ax.errorbar([xv], [on_feet.mean * MM], yerr=[(on_feet.std or 0.0) * MM], fmt="s",
+                            color=col, ms=7, capsize=4,
+                            label=f"{_label(c)}: measured ■, predicted {'▽' if ending and ending.over_hop else '○'}")
             else:
-                ax.plot([], [], "o", mfc="white", mec=col, label=f"{_label(c)}: predicted ○")
+                went = " (measured: goes over)" if c.trials else ""
+                mark = "▽" if ending is not None and ending.over_hop else "○"
+                ax.plot([], [], "v" if mark == "▽" else "o", mfc="white", mec=col,
+                        label=f"{_label(c)}: predicted {mark}{went}")
         ax.set_ylabel("distance per hop (mm)")
     else:
         second = land.names[1]
         k2, ylabel = axis_scale(second)
         ys = land.values[second] * k2
-        sc = ax.scatter(xs[land.valid], ys[land.valid], c=hop[land.valid], cmap="viridis", s=28)
+        feet = land.valid & ~land.goes_over
+        sc = ax.scatter(xs[feet], ys[feet], c=hop[feet], cmap="viridis", s=28)
         ax.figure.colorbar(sc, ax=ax, label="distance per hop (mm)")
+        if over.any():
+            ax.plot(xs[over], ys[over], "v", color=OVER_COLOUR, mfc="none", ms=6, label="goes over onto its back")
         bad = ~land.valid
         if bad.any():
             ax.plot(xs[bad], ys[bad], "x", color="#b00020", ms=6, label="invalid (failed audit)")
@@ -337,20 +409,25 @@ def landscape_caption(land: Landscape, comps: list[Comparison]) -> str:
         The caption.
     """
     bad = int((~land.valid).sum())
+    over = int((land.valid & land.goes_over).sum())
+    went = (f"; {over} design{'s' if over != 1 else ''} going over onto {'their' if over != 1 else 'its'} "
+            f"back{'s' if over != 1 else ''}: open triangles" if over else "")
     if len(land.names) == 1:
-        text = f"Simulated distance per hop over the sweep in {land.folder}"
-        text += (f" ({bad} invalid design{'s' if bad != 1 else ''}, failed audit: red crosses at zero)" if bad
-                 else " (every design valid)")
+        text = (f"Simulated distance per hop (locust sim's distance over the {land.cycles} cycles) over the sweep "
+                f"in {land.folder}")
+        text += (f" ({bad} invalid design{'s' if bad != 1 else ''}, failed audit: red crosses at zero{went})" if bad
+                 else f" (every design valid{went})")
         marks = []
         if any(c.prediction.valid for c in comps):
             marks.append("its prediction (open circle)")
-        if any(c.hop_distance.n for c in comps):
-            marks.append("its measurement (filled square, ±1 sd)")
+        if any(m.ending.over_hop is None for c in comps for m in c.trials):
+            marks.append("its measurement where every trial ended on its feet (the marker's travel per hop, "
+                         "filled square, ±1 sd)")
         text += ", with each physical design's position (dotted line)"
         return text + (", " + " and ".join(marks) if marks else "") + "."
     text = f"Simulated distance per hop (colour) over the sweep in {land.folder}"
-    text += (f" ({bad} invalid design{'s' if bad != 1 else ''}, failed audit: red crosses)" if bad
-             else " (every design valid)")
+    text += (f" ({bad} invalid design{'s' if bad != 1 else ''}, failed audit: red crosses{went})" if bad
+             else f" (every design valid{went})")
     return text + ", with each physical design marked by a star."
 
 
@@ -456,20 +533,21 @@ def dashboard(comps: list[Comparison], land: Landscape | None, configs: dict[str
         if c.prediction.trace is not None:
             ax.plot(c.prediction.trace.t_s, c.prediction.trace.x_m * MM, "--", color=col, lw=1.2,
                     label=f"{_label(c)} predicted")
-    ax.set_title("Longitudinal displacement (nose)", loc="left", fontsize=11)
+    ax.set_title("Forward travel of the nose marker", loc="left", fontsize=11)
     ax.set_xlabel("time since first push (s)")
-    ax.set_ylabel("displacement (mm)")
+    ax.set_ylabel("forward from where it stood (mm)")
     ax.grid(True, ls=":", alpha=0.5)
     legend_outside(ax, fontsize=8)
     draw_bars(axes[0, 1], comps, "jump")
-    axes[0, 1].set_title("Max vertical jump height (nose above standing)", loc="left", fontsize=11)
+    axes[0, 1].set_title("Jump: highest marker point above standing, hops that came back down", loc="left",
+                         fontsize=11)
     axes[0, 1].set_ylabel("height (mm)")
     if land is not None:
         draw_landscape(axes[1, 0], land, comps, configs)
     else:
-        draw_bars(axes[1, 0], comps, "distance")
-        axes[1, 0].set_title("Distance per hop", loc="left", fontsize=11)
-        axes[1, 0].set_ylabel("distance (mm)")
+        draw_bars(axes[1, 0], comps, "travel")
+        axes[1, 0].set_title("Marker travel per hop", loc="left", fontsize=11)
+        axes[1, 0].set_ylabel("marker travel per hop (mm)")
     draw_timing(axes[1, 1], comps)
     fig.suptitle("locust: simulation against measurement, " + ", ".join(_label(c) for c in comps), fontsize=13)
     fig.tight_layout()

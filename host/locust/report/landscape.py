@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import LocustError, ReportError, SweepError
 from ..io.sweep_store import read_results
+from ..sim.outcome import GOES_OVER
 from ..sweep.design import SCALE
 from ..trials.configs import Configuration
 
@@ -39,11 +40,14 @@ class Landscape:
     valid : ndarray of bool
         Whether each design's simulation passed its audit.
     distance_m : ndarray
-        Total distance over ``cycles`` [m] (nan when invalid).
+        ``locust sim``'s distance over the run of ``cycles`` [m] (nan when invalid).
     reason : list of str
         Per design, the ``reason`` column of ``results.csv`` (why an invalid one failed).
     finished : bool
         False for an interrupted sweep, some designs missing.
+    goes_over : ndarray of bool
+        Whether each design's run goes over onto its back (its ``outcome``; a sweep with
+        ``--samples``: the draws' most common outcome).
     """
 
     folder: Path
@@ -55,10 +59,15 @@ class Landscape:
     distance_m: np.ndarray            # total over ``cycles`` (nan when invalid)
     reason: list[str]
     finished: bool = True             # False: an interrupted sweep, some designs missing
+    goes_over: np.ndarray | None = None   # bool per design: its run goes over onto its back
+
+    def __post_init__(self):
+        if self.goes_over is None:
+            object.__setattr__(self, "goes_over", np.zeros_like(self.valid, dtype=bool))
 
     @property
-    def hop_distance_m(self) -> np.ndarray:
-        """Distance per cycle of each design [m]."""
+    def distance_per_hop_m(self) -> np.ndarray:
+        """Each design's distance over the run divided by its cycles [m]."""
         return self.distance_m / self.cycles
 
     @property
@@ -96,7 +105,8 @@ def read_landscape(folder: Path) -> Landscape:
     return Landscape(folder=res.folder, base=res.base, names=res.axis_names, cycles=res.cycles,
                      values={n: np.array(res.column(n), dtype=float) for n in res.axis_names},
                      valid=valid, distance_m=distance, reason=[str(r) for r in res.column("reason")],
-                     finished=res.finished)
+                     finished=res.finished,
+                     goes_over=np.array([str(o) == GOES_OVER for o in res.column("outcome")], dtype=bool))
 
 
 def design_value(config: Configuration, name: str) -> float:

@@ -1,5 +1,8 @@
 """The report as one self-contained HTML page: figures embedded as base64 PNG, no scripts,
-no outside resources (a Content-Security-Policy forbids them, so a browser proves it).
+no outside resources (a Content-Security-Policy forbids them, so a browser proves it). The
+side-by-side videos (``--side-by-side``) are the one exception, and not an outside one: they
+are written beside the page and played from there (``<video controls>``, a relative src; the
+policy then allows media from the page's own origin, nothing else).
 
 Every number cell carries ``data-config`` and ``data-field`` so tests and scripts can read
 the page's figures back exactly as printed.
@@ -13,8 +16,10 @@ import math
 from dataclasses import dataclass
 
 from .compare import Comparison, TimingRow
+from .ending import trials_words, words
 
 CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
+CSP_MEDIA = CSP + "; media-src 'self'"    # with the side-by-side videos beside the page
 # a backslash at a line's end joins the next line to it (no newline in the CSS)
 STYLE = """
 body{font:14px/1.45 system-ui,-apple-system,'DejaVu Sans',sans-serif;\
@@ -23,7 +28,8 @@ h1{font-size:1.6em;margin-bottom:.2em}h2{margin-top:1.8em;border-bottom:1px soli
 table{border-collapse:collapse;margin:.6em 0;font-size:13px}\
 th,td{border:1px solid #ddd;padding:3px 8px;text-align:right}td{white-space:nowrap}td.l{white-space:normal}
 th{background:#f4f4f4}td.l,th.l{text-align:left}tr.invalid td{color:#b00020}
-figure{margin:1em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{color:#555;font-size:13px}
+figure{margin:1em 0}figure img,figure video{max-width:100%;border:1px solid #eee}\
+figcaption{color:#555;font-size:13px}
 .meta{color:#555}.note{color:#555;font-size:13px}code{background:#f6f6f6;padding:0 3px}
 ul.warn{background:#fff6e5;border:1px solid #f0c36d;padding:.6em 1em .6em 2.2em}ul.warn li{margin:.2em 0}
 """
@@ -155,7 +161,8 @@ def td(text: str, config: str | None = None, field: str | None = None, left: boo
     return f"<td{attrs}>{esc(text)}</td>"
 
 
-def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = "") -> str:
+def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = "",
+          groups: list[tuple[str, int]] | None = None) -> str:
     """A table from its headers and ready-made rows.
 
     Parameters
@@ -168,6 +175,8 @@ def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = ""
         How many leading columns' headers are left-aligned.
     id_ : str
         The table's id; none when empty.
+    groups : list of (str, int), optional
+        A header row above, each title over its number of columns.
 
     Returns
     -------
@@ -176,13 +185,16 @@ def table(headers: list[str], rows: list[str], left_cols: int = 1, id_: str = ""
     """
     head = "".join(f'<th class="l">{esc(h)}</th>' if i < left_cols else f"<th>{esc(h)}</th>"
                    for i, h in enumerate(headers))
+    over = ("<tr>" + "".join(f'<th colspan="{n}">{esc(t)}</th>' for t, n in groups) + "</tr>") if groups else ""
     ident = f' id="{esc(id_)}"' if id_ else ""
-    return f"<table{ident}><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>"
+    return f"<table{ident}><thead>{over}<tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>"
 
 
 def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[str, float]) -> str:
-    """Per configuration, predicted and measured distance, distance per hop and jump, their
-    errors in mm and percent, and the simulation's status; then the tracking resolution.
+    """Per configuration: how the simulated and the filmed runs ended (:mod:`.ending`), the
+    simulation's distance (``locust sim``'s, the chassis over the run), the marker's travel
+    predicted and measured with its error, and the jump (highest marker point in a hop that came
+    back down) with its error, in mm and percent; then the tracking resolution.
 
     Parameters
     ----------
@@ -202,36 +214,46 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
     for c in comps:
         name = c.config
         valid = c.prediction.valid
-        dist_err = c.distance.mean - c.predicted_distance_m
+        ending = c.predicted_ending
+        travel_err = c.marker_travel.mean - c.predicted_marker_travel_m
         jump_err = c.jump.mean - c.predicted_jump_m
         cells = [
-            td(labels[name], left=True), td(f"+{added[name] * 100:g}"), td(str(c.distance.n), name, "trials"),
+            td(labels[name], left=True), td(f"+{added[name] * 1000:g}"), td(str(c.marker_travel.n), name, "trials"),
+            td(words(ending) if ending else "—", name, "predicted_outcome", left=True),
+            td(trials_words([m.ending for m in c.trials]), name, "measured_outcome", left=True),
             td(mm(c.predicted_distance_m), name, "predicted_distance_mm"),
-            td(mm_pm(c.distance.mean, c.distance.std), name, "measured_distance_mm"),
-            td(mm(dist_err), name, "distance_error_mm"), td(pct(dist_err, c.predicted_distance_m, c.resolution_m)),
-            td(mm(c.predicted_hop_distance_m), name, "predicted_hop_distance_mm"),
-            td(mm_pm(c.hop_distance.mean, c.hop_distance.std), name, "measured_hop_distance_mm"),
+            td(mm(c.predicted_marker_travel_m), name, "predicted_marker_travel_mm"),
+            td(mm_pm(c.marker_travel.mean, c.marker_travel.std), name, "measured_marker_travel_mm"),
+            td(mm(travel_err), name, "marker_travel_error_mm"),
+            td(pct(travel_err, c.predicted_marker_travel_m, c.resolution_m)),
             td(mm(c.predicted_jump_m), name, "predicted_jump_mm"),
             td(mm_pm(c.jump.mean, c.jump.std), name, "measured_jump_mm"),
             td(mm(jump_err), name, "jump_error_mm"), td(pct(jump_err, c.predicted_jump_m, c.resolution_m)),
-            td(f"valid, {outcome.replace('_', ' ')}" if valid and (outcome := c.prediction.result.outcome)
-               else "valid" if valid else "INVALID: " + "; ".join(c.prediction.result.reasons), name, "sim_status",
+            td("valid" if valid else "INVALID: " + "; ".join(c.prediction.result.reasons), name, "sim_status",
                left=True),
         ]
         rows.append(f'<tr{"" if valid else " class=invalid"}>{"".join(cells)}</tr>')
-    headers = ["configuration", "added (cm)", "trials", "predicted distance (mm)", "measured distance (mm)",
-               "error (mm)", "error", "predicted per hop (mm)", "measured per hop (mm)",
-               "predicted jump (mm)", "measured jump (mm)", "error (mm)", "error", "simulation"]
+    groups = [("", 3), ("how it ended", 2), ("distance (mm)", 1), ("marker travel over the run", 4),
+              ("jump: highest marker point above standing, in a hop that came back down", 4), ("", 1)]
+    headers = ["configuration", "added (mm)", "trials", "predicted", "measured", "predicted (locust sim)",
+               "predicted (mm)", "measured (mm)", "error (mm)", "error", "predicted (mm)", "measured (mm)",
+               "error (mm)", "error", "simulation"]
     known = [(labels[c.config], c.resolution_m) for c in comps if math.isfinite(c.resolution_m)]
-    note = ("" if not known else '<p class="note">Tracking resolution (one pixel at the marker): '
-            + ", ".join(f"{esc(label)} {res * 1000:.3g} mm" for label, res in known)
-            + '; an error smaller than that is not measured and reads "within 1 px".</p>')
-    return table(headers, rows, id_="summary") + note
+    note = ("<p class=\"note\">Distance: the robot's travel over the run as <code>locust sim</code> prints it (the "
+            "chassis, from the schedule's start to the run's end); the camera follows a marker, whose travel is "
+            "compared like with like. A hop that ends with the robot on its back is no jump: its marker's height is "
+            "where it lies.")
+    if known:
+        note += (" Tracking resolution (one pixel at the marker): "
+                 + ", ".join(f"{esc(label)} {res * 1000:.3g} mm" for label, res in known)
+                 + '; an error smaller than that is not measured and reads "within 1 px".')
+    return table(headers, rows, id_="summary", groups=groups) + note + "</p>"
 
 
 def outcome_table(spreads: dict, labels: dict[str, str]) -> str:
     """Each configuration's draws (``--samples``) by outcome: its share, and its own distance
-    and highest nose as mean ± sd (one sd across outcomes would hide a split).
+    (``locust sim``'s, over the run) and highest nose as mean ± sd (one sd across outcomes would
+    hide a split), as ``locust sim --samples`` prints them.
 
     Parameters
     ----------
@@ -256,12 +278,13 @@ def outcome_table(spreads: dict, labels: dict[str, str]) -> str:
                      td(mm_pm(o.max_nose_height_m.mean,
                               o.max_nose_height_m.sd if math.isfinite(o.max_nose_height_m.sd) else None))]
             rows.append(f"<tr>{''.join(cells)}</tr>")
-    headers = ["configuration", "outcome", "draws", "distance (mm)", "highest nose (mm)"]
+    headers = ["configuration", "outcome", "draws", "distance (mm)", "highest nose above the floor (mm)"]
     return table(headers, rows, left_cols=2, id_="outcomes")
 
 
 def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
-    """Every measured hop against the predicted one: distance and apex [mm], with errors.
+    """Every measured hop against the predicted one: how it ended, the marker's travel and its
+    apex [mm] (none for a hop that did not end on the robot's feet), with errors.
 
     Parameters
     ----------
@@ -281,18 +304,22 @@ def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
             key = f"{r.trial}#{r.hop}"
             rows.append("<tr>" + "".join([
                 td(labels[c.config], left=True), td(r.trial, left=True), td(str(r.hop)),
-                td(mm(r.measured_distance_m), c.config, f"hop_measured_distance_mm:{key}"),
-                td(mm(r.predicted_distance_m), c.config, f"hop_predicted_distance_mm:{key}"),
-                td(mm(r.distance_error_m)), td(pct(r.distance_error_m, r.predicted_distance_m, c.resolution_m)),
+                td(r.measured_state or "—", c.config, f"hop_measured_state:{key}", left=True),
+                td(r.predicted_state or "—", c.config, f"hop_predicted_state:{key}", left=True),
+                td(mm(r.measured_marker_travel_m), c.config, f"hop_measured_marker_travel_mm:{key}"),
+                td(mm(r.predicted_marker_travel_m), c.config, f"hop_predicted_marker_travel_mm:{key}"),
+                td(mm(r.marker_travel_error_m)),
+                td(pct(r.marker_travel_error_m, r.predicted_marker_travel_m, c.resolution_m)),
                 td(mm(r.measured_apex_m), c.config, f"hop_measured_apex_mm:{key}"),
                 td(mm(r.predicted_apex_m), c.config, f"hop_predicted_apex_mm:{key}"),
                 td(mm(r.apex_error_m)), td(pct(r.apex_error_m, r.predicted_apex_m, c.resolution_m)),
             ]) + "</tr>")
     if not rows:
         return '<p class="note">No tracks were given: nothing measured to compare hop by hop.</p>'
-    headers = ["configuration", "trial", "hop", "measured distance (mm)", "predicted (mm)", "error (mm)", "error",
-               "measured apex (mm)", "predicted (mm)", "error (mm)", "error"]
-    return table(headers, rows, left_cols=2, id_="hops")
+    groups = [("", 3), ("ended", 2), ("marker travel", 4), ("apex above standing (a hop that came back down)", 4)]
+    headers = ["configuration", "trial", "hop", "measured", "predicted", "measured (mm)", "predicted (mm)",
+               "error (mm)", "error", "measured (mm)", "predicted (mm)", "error (mm)", "error"]
+    return table(headers, rows, left_cols=2, id_="hops", groups=groups)
 
 
 def timing_table(rows: list[TimingRow], labels: dict[str, str]) -> str:
@@ -347,7 +374,8 @@ def warnings_list(notices) -> str:
 
 
 def params_table(param_rows: list[dict]) -> str:
-    """The robot's parameters with value, uncertainty (1 sd, in the parameter's unit) and source.
+    """The robot's parameters with value, uncertainty (1 sd) and source, each in the unit a
+    person reads (:func:`locust.report.build.parameter_rows`).
 
     Parameters
     ----------
@@ -361,10 +389,9 @@ def params_table(param_rows: list[dict]) -> str:
     """
     rows = []
     for p in param_rows:
-        unc = p["uncertainty"]
         rows.append("<tr>" + "".join([
             td(p["key"], left=True), td(p["value"], None, f"param:{p['key']}"),
-            td("" if unc is None else f"± {unc:.3g}"), td(p["source"], left=True), td(p["date"] or "", left=True),
+            td(p["uncertainty"]), td(p["source"], left=True), td(p["date"] or "", left=True),
             td(p["note"] or "", left=True),
         ]) + "</tr>")
     return table(["parameter", "value", "uncertainty (1 sd)", "source", "date", "note"], rows, id_="params")
@@ -406,7 +433,29 @@ def figure_html(fig: Figure) -> str:
             f"<figcaption><b>{esc(fig.title)}.</b> {esc(fig.caption)}</figcaption></figure>")
 
 
-def page(title: str, meta_lines: list[str], sections: list[tuple[str, str]]) -> str:
+def videos_html(videos: list[tuple[str, str]], skipped: list[str]) -> str:
+    """The side-by-side videos, each played in the page from the file beside it.
+
+    Parameters
+    ----------
+    videos : list of (str, str)
+        Each video's file name in the report's folder (the src, relative to the page) and its caption.
+    skipped : list of str
+        The trials that have none, and why.
+
+    Returns
+    -------
+    str
+        A ``<figure class="video">`` per video, then the skipped trials, HTML.
+    """
+    out = "".join(f'<figure class="video"><video controls preload="metadata" src="{esc(name)}"></video>'
+                  f"<figcaption><b>{esc(name)}</b>: {esc(caption)}.</figcaption></figure>" for name, caption in videos)
+    if skipped:
+        out += '<ul class="note">' + "".join(f"<li>{esc(s)}</li>" for s in skipped) + "</ul>"
+    return out or '<p class="note">No trial has a video.</p>'
+
+
+def page(title: str, meta_lines: list[str], sections: list[tuple[str, str]], media: bool = False) -> str:
     """The whole page: title, meta lines, then each section under its heading.
 
     Parameters
@@ -417,6 +466,9 @@ def page(title: str, meta_lines: list[str], sections: list[tuple[str, str]]) -> 
         Lines under the title, escaped.
     sections : list of (str, str)
         Heading and HTML content.
+    media : bool
+        The page plays videos beside it (:func:`videos_html`): its policy allows media from its
+        own origin.
 
     Returns
     -------
@@ -426,6 +478,6 @@ def page(title: str, meta_lines: list[str], sections: list[tuple[str, str]]) -> 
     meta = "".join(f"<div>{esc(line)}</div>" for line in meta_lines)
     body = "".join(f"<h2>{esc(h)}</h2>{content}" for h, content in sections)
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-            f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
+            f'<meta http-equiv="Content-Security-Policy" content="{CSP_MEDIA if media else CSP}">'
             f"<title>{esc(title)}</title><style>{STYLE}</style></head>"
             f"<body><h1>{esc(title)}</h1><div class=\"meta\">{meta}</div>{body}</body></html>\n")

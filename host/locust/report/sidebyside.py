@@ -2,10 +2,13 @@
 simulation of its configuration, filmed by the same camera, on the schedule's clock.
 
 For every measured trial with a video and a track the report writes
-``<trial>.side_by_side.mp4``: left the filmed frames as they are, right the configuration's
+``<trial>.side_by_side.webm``: left the filmed frames as they are, right the configuration's
 simulation rendered at the same size, one output frame per filmed frame, at the file's own
 frame rate. A caption on each half says which it is and the frame's time on the schedule's
-clock.
+clock. The page plays each beside it (``<video controls>``, a relative src): VP8 in WebM is
+what every browser decodes and this OpenCV encodes at the pace of rendering (MPEG-4 Part 2, the
+``mp4v`` of other videos here, no browser plays; VP9 in MP4 takes 60 ms to encode a
+1280x360 frame on a laptop core, three times the rendering, where VP8 takes 14 ms).
 
 - **Video**: ``<stem>.mp4`` (or .mov, .avi, .mkv, .m4v) beside the track (``hop.tracks.csv``
   -> ``hop.mp4``), else ``hop.mp4`` in the trial's folder (the track's, else the run record's).
@@ -48,7 +51,8 @@ from ..track.export import sidecar_video
 from ..track.video import Clip, VideoInfo, encode_video, probe, read_frames
 from .compare import Comparison, MeasuredTrial
 
-SUFFIX = ".side_by_side.mp4"
+SUFFIX = ".side_by_side.webm"
+FOURCC = "VP80"                      # VP8: in WebM, every browser plays it (module docstring)
 VIDEO_SUFFIXES = (".mp4", ".mov", ".avi", ".mkv", ".m4v")
 FOLDER_VIDEO = "hop.mp4"            # what `locust hop --video` is given in a trial folder (locust demo)
 OWN_CAMERA = "simulation's fixed camera"
@@ -75,6 +79,8 @@ class Job:
         The frame at t = 0 on the track's clock: ``t_track = (frame - frame0) / fps`` [frames].
     fps : float
         Frames per second of the track's clock [1/s].
+    name : str
+        The file it is written to in the report's folder (``<trial>.side_by_side.webm``).
     """
 
     comparison: Comparison
@@ -84,6 +90,7 @@ class Job:
     camera_note: str                 # where the camera comes from, or why not from the video
     frame0: float                    # track clock: t_track = (frame - frame0) / fps
     fps: float
+    name: str = ""                   # its file in the report's folder, chosen when planned
 
     @property
     def label(self) -> str:
@@ -193,6 +200,7 @@ def plan_side_by_side(comps: list[Comparison]) -> Plan:
         A video that cannot be probed, or one with no frame rate and a track without frame numbers.
     """
     jobs, skipped = [], []
+    taken: set[str] = set()
     for c in comps:
         measured = {id(m.trial): m for m in c.trials}
         for trial in c.all_trials:
@@ -208,7 +216,7 @@ def plan_side_by_side(comps: list[Comparison]) -> Plan:
             info = _probe(video)
             camera, note = filmed_camera(info)
             frame0, fps = frame_clock(m.trial.track.path, info)
-            jobs.append(Job(c, m, info, camera, note, frame0, fps))
+            jobs.append(Job(c, m, info, camera, note, frame0, fps, _name(c.config, trial.label, taken)))
     return Plan(jobs, skipped)
 
 
@@ -321,7 +329,7 @@ def frame_clock(track_path: Path, info: VideoInfo) -> tuple[float, float]:
 
 # -- rendering -----------------------------------------------------------------------
 def write_side_by_side(plan: Plan, folder: Path, say: Callable[[str], None] | None = None) -> list[SideBySide]:
-    """Render every job into ``folder`` (``<trial>.side_by_side.mp4``, never over a file);
+    """Render every job into ``folder`` (its ``name``, ``<trial>.side_by_side.webm``, never over a file);
     what became of each trial, the skipped ones (said on ``say``) last.
 
     Parameters
@@ -344,16 +352,16 @@ def write_side_by_side(plan: Plan, folder: Path, say: Callable[[str], None] | No
         A file of that name exists, or the video cannot be encoded.
     """
     say = say or (lambda msg: None)
-    taken: set[str] = set()
     out = []
     for job in plan.jobs:
-        path = folder / _name(job, taken)
+        path = folder / job.name
         if path.exists():
             raise ReportError(f"{path} exists already; not overwriting it", "write the report into a new folder")
         say(f"side by side: {job.label} ({job.video.frame_count} frames; simulation: "
             f"{job.camera_note if job.camera else OWN_CAMERA + ', ' + job.camera_note})")
         try:
-            encode_video(path, _frames(job), float(job.video.file_fps), (2 * job.video.width_px, job.video.height_px))
+            encode_video(path, _frames(job), float(job.video.file_fps), (2 * job.video.width_px, job.video.height_px),
+                         fourcc=FOURCC)
         except TrackError as exc:
             raise ReportError(exc.message, exc.hint) from None
         frames = probe(path).frame_count
@@ -365,8 +373,9 @@ def write_side_by_side(plan: Plan, folder: Path, say: Callable[[str], None] | No
     return out + plan.skipped
 
 
-def _name(job: Job, taken: set[str]) -> str:
-    stem = job.label if job.label not in taken else f"{job.comparison.config}-{job.label}"
+def _name(config: str, label: str, taken: set[str]) -> str:
+    """``<trial>.side_by_side.webm``; ``<config>-<trial>...`` when two trials share a label."""
+    stem = label if label not in taken else f"{config}-{label}"
     base, n = stem, 2
     while stem in taken:
         stem, n = f"{base}-{n}", n + 1

@@ -11,7 +11,7 @@ from pathlib import Path
 from ..errors import ReportError, SweepError
 from ..io.study_store import StudyResults, read_study
 from ..plotting import png_bytes, pyplot
-from ..sweep.objectives import OBJECTIVES
+from ..sweep.objectives import OBJECTIVES, RENAMED
 from ..sweep.pareto import describe, draw_front, picks_of
 from . import page as H
 
@@ -32,12 +32,20 @@ def read_front(folder: Path) -> StudyResults:
     Raises
     ------
     ReportError
-        The folder is not a readable study.
+        The folder is not a readable study, or one of objectives this locust does not know
+        (a study from before the objectives said ``_per_hop``).
     """
     try:
-        return read_study(folder)
+        study = read_study(folder)
     except SweepError as exc:
         raise ReportError(f"--optimize {folder}: {exc.message}", exc.hint) from None
+    unknown = [name for name in study.objectives if name not in OBJECTIVES]
+    if unknown:
+        raise ReportError(f"--optimize {folder}: its study maximises {', '.join(unknown)}, which is no objective of "
+                          f"this locust ({', '.join(OBJECTIVES)})",
+                          "rerun the study into a new --out with --objective "
+                          + " --objective ".join(RENAMED.get(n, n) for n in study.objectives))
+    return study
 
 
 def study_figure(study: StudyResults) -> H.Figure:

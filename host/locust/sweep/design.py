@@ -19,15 +19,36 @@ from ..errors import GeometryError, LocustError, SweepError
 from ..params import Provenance, Robot, all_keys, outside_limits, problems, with_added_length
 from ..sim.fourbar import assemble
 from ..sim.outcome import GOES_OVER, OUTCOMES
+from ..tables import for_person, person_unit, sig, split_unit
 
 SCALE = "scale"
 CRANK_CHECK_STEP_DEG = 1.0
-CM_PER_M = 100.0   # every figure draws lengths in centimetres, and says so on its axis
+
+
+def shown_unit(name: str) -> tuple[float, str]:
+    """The unit a person reads the design variable ``name`` in, and the factor to it from the
+    parameter's own: ``scale`` and a ``*_m`` length in mm, a ``*_kg`` mass in g, anything else in
+    its own unit, as its name says (the value stays in metres, kilograms, ... in CSV and JSON).
+
+    Parameters
+    ----------
+    name : str
+        ``scale`` or a dotted parameter name.
+
+    Returns
+    -------
+    tuple
+        (factor from the parameter's unit to the shown one, the shown unit; "" for none).
+    """
+    if name == SCALE:
+        return person_unit("m")
+    _, factor, unit = for_person(name)
+    return factor, unit
 
 
 def axis_scale(name: str) -> tuple[float, str]:
-    """How to draw the sweep axis ``name``: a length (``scale``, ``*_m``) in cm, anything else in
-    its own unit, as its name says.
+    """How to draw the sweep axis ``name``: in the unit :func:`shown_unit` gives, which its label
+    names (``geometry.leg (mm)``, never a key in metres beside a value in mm).
 
     Parameters
     ----------
@@ -39,9 +60,31 @@ def axis_scale(name: str) -> tuple[float, str]:
     tuple
         (factor from the parameter's unit to the drawn one, axis label).
     """
+    factor, unit = shown_unit(name)
     if name == SCALE:
-        return CM_PER_M, "added length on every link (cm)"
-    return (CM_PER_M, f"{name} (cm)") if name.endswith("_m") else (1.0, name)
+        return factor, f"added length on every link ({unit})"
+    stem = split_unit(name)[0]
+    return factor, f"{stem} ({unit})" if unit else name
+
+
+def design_text(name: str, value: float) -> str:
+    """One design variable as a person reads it: ``scale 30.50 mm``, ``geometry.crank_start -100.0 deg``.
+
+    Parameters
+    ----------
+    name : str
+        ``scale`` or a dotted parameter name.
+    value : float
+        In the parameter's unit (``scale``: m).
+
+    Returns
+    -------
+    str
+        The name less its unit suffix, the value to 4 significant figures, the unit.
+    """
+    factor, unit = shown_unit(name)
+    stem = name if name == SCALE else split_unit(name)[0]
+    return f"{stem} {sig(value * factor)} {unit}".rstrip()
 
 
 @dataclass(frozen=True)

@@ -1,12 +1,15 @@
 """What a design is judged by: objectives by name, per hop over the run, and their robust figure.
 
-Each objective is a figure of one simulated run, per hop (the run's figure over its cycles):
+Each objective is a figure of one simulated run per hop, as its name and its column say (the
+run's figure over its cycles; ``distance`` alone, in ``locust sim``, ``sweep`` and ``report``,
+is the travel over the whole run):
 
-- ``distance``: ``distance_m``, chassis travel over the run divided by the hop cycles (m a hop);
-- ``nose_rise``: ``nose_rise_m``, the nose's highest point above its standing height, the mean
-  over the hops (m);
-- ``flight``: ``flight_s``, the longest time with no part of the robot on the floor, the mean
-  over the hops (s).
+- ``distance_per_hop``: ``distance_per_hop_m``, the chassis' travel over the run (``locust
+  sim``'s and ``sweep``'s ``distance_m``) divided by the hop cycles (m a hop);
+- ``nose_rise_per_hop``: ``nose_rise_per_hop_m``, the nose's highest point above its standing
+  height in each hop (``locust sim``'s "nose rise"), the mean over the hops (m);
+- ``flight_per_hop``: ``flight_per_hop_s``, the longest time with no part of the robot on the
+  floor in each hop, the mean over the hops (s).
 
 All three are maximised. A draw (or a nominal run) that goes over onto its back scores 0 on
 every objective: a robot on its back does not hop again, and its nose resting high is not a
@@ -34,9 +37,10 @@ class Objective:
     Attributes
     ----------
     name : str
-        The ``--objective`` name: ``distance``, ``nose_rise`` or ``flight``.
+        The ``--objective`` name: ``distance_per_hop``, ``nose_rise_per_hop`` or ``flight_per_hop``.
     column : str
-        Its column in the trial rows, with its unit: ``distance_m``, ``nose_rise_m``, ``flight_s``.
+        Its column in the trial rows, with its unit: ``distance_per_hop_m``, ``nose_rise_per_hop_m``,
+        ``flight_per_hop_s``.
     label : str
         Axis label, in the unit the plots draw it in.
     plot_factor : float
@@ -50,14 +54,17 @@ class Objective:
 
 
 OBJECTIVES = {
-    "distance": Objective("distance", "distance_m", "distance a hop (mm)", 1000.0),
-    "nose_rise": Objective("nose_rise", "nose_rise_m", "nose rise a hop (mm)", 1000.0),
-    "flight": Objective("flight", "flight_s", "flight a hop (ms)", 1000.0),
+    "distance_per_hop": Objective("distance_per_hop", "distance_per_hop_m", "distance per hop (mm)", 1000.0),
+    "nose_rise_per_hop": Objective("nose_rise_per_hop", "nose_rise_per_hop_m", "nose rise per hop (mm)", 1000.0),
+    "flight_per_hop": Objective("flight_per_hop", "flight_per_hop_s", "flight per hop (ms)", 1000.0),
 }
+DEFAULT = "distance_per_hop"
+# the names before each said that it is a figure per hop: refused, with the name that is
+RENAMED = {"distance": "distance_per_hop", "nose_rise": "nose_rise_per_hop", "flight": "flight_per_hop"}
 
 
 def objectives_named(names: list[str] | tuple[str, ...]) -> list[Objective]:
-    """The objectives ``names`` in the order given; distance when none is given.
+    """The objectives ``names`` in the order given; ``distance_per_hop`` when none is given.
 
     Parameters
     ----------
@@ -72,12 +79,16 @@ def objectives_named(names: list[str] | tuple[str, ...]) -> list[Objective]:
     Raises
     ------
     SweepError
-        An unknown or repeated name.
+        An unknown or repeated name, or a name without the ``_per_hop`` it now has (:data:`RENAMED`).
     """
     if not names:
-        return [OBJECTIVES["distance"]]
+        return [OBJECTIVES[DEFAULT]]
     out = []
     for name in names:
+        if name in RENAMED:
+            raise SweepError(f"--objective {name!r}: each objective is a figure per hop, and says so in its name "
+                             f"(`{name}` alone is the figure over the whole run in locust sim, sweep and report)",
+                             f"give --objective {RENAMED[name]}")
         if name not in OBJECTIVES:
             raise SweepError(f"--objective {name!r}: no such objective",
                              f"choose from {', '.join(OBJECTIVES)}")
@@ -96,7 +107,8 @@ class DrawFigures:
     outcome : str
         ``goes_over``, ``rears_and_returns`` or ``stays_low``.
     figures : dict of str to float
-        Column (``distance_m`` [m], ``nose_rise_m`` [m], ``flight_s`` [s]) to its per-hop figure.
+        Column (``distance_per_hop_m`` [m], ``nose_rise_per_hop_m`` [m], ``flight_per_hop_s`` [s]) to
+        its per-hop figure.
     """
 
     outcome: str
@@ -154,14 +166,15 @@ def per_hop_figures(distance_m: float, hops: list, cycles: int, outcome: str) ->
     Returns
     -------
     DrawFigures
-        ``distance_m`` a hop [m], mean ``nose_rise_m`` [m] and mean ``flight_s`` [s].
+        ``distance_per_hop_m`` [m], the mean ``nose_rise_per_hop_m`` [m] and the mean
+        ``flight_per_hop_s`` [s].
     """
     if outcome == GOES_OVER:
         return DrawFigures(outcome, {o.column: 0.0 for o in OBJECTIVES.values()})
     return DrawFigures(outcome, {
-        "distance_m": distance_m / cycles,
-        "nose_rise_m": float(np.mean([h.nose_apex_m for h in hops])) if hops else 0.0,
-        "flight_s": float(np.mean([h.flight_s for h in hops])) if hops else 0.0,
+        "distance_per_hop_m": distance_m / cycles,
+        "nose_rise_per_hop_m": float(np.mean([h.nose_apex_m for h in hops])) if hops else 0.0,
+        "flight_per_hop_s": float(np.mean([h.flight_s for h in hops])) if hops else 0.0,
     })
 
 

@@ -32,7 +32,7 @@ from ..io.study_store import write_tables
 from ..params import Robot
 from .design import Bound, design_robot, is_integer
 from .journal import full_disk
-from .objectives import OBJECTIVES, OUTCOMES, Judgement, Objective
+from .objectives import DEFAULT, OBJECTIVES, OUTCOMES, Judgement, Objective
 from .pareto import picks, plot_front
 from .storage import SETTINGS_ATTR, check_folder, check_journal_file, check_storage, open_storage
 
@@ -337,7 +337,7 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
     progress : callable, optional
         ``progress(n)`` as trials finish (first with those finished before this run).
     objectives : list of Objective
-        What is maximised (default: distance).
+        What is maximised (default: distance_per_hop).
     judge : callable, optional
         ``judge(values) -> Judgement``; default :class:`~locust.sweep.robust.DesignJudge` of
         ``base`` with ``draws`` and ``quantile``.
@@ -369,7 +369,7 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
     from .robust import DesignJudge
 
     optuna.logging.set_verbosity(optuna.logging.ERROR)
-    objectives = objectives or [OBJECTIVES["distance"]]
+    objectives = objectives or [OBJECTIVES[DEFAULT]]
     if sampler not in SAMPLERS:
         raise SweepError(f"--sampler {sampler!r}: not one of {', '.join(SAMPLERS)}", "use tpe or nsga2")
     check_scheduler(scheduler)

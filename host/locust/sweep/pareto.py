@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from .design import axis_scale
+from .design import design_text
 from .objectives import Objective
 
 
@@ -213,7 +213,8 @@ def describe(row: dict[str, Any], names: list[str], objectives: list[Objective])
     row : dict
         A trial's row.
     names : list of str
-        The design variables (lengths shown in cm).
+        The design variables (:func:`locust.sweep.design.design_text`: lengths in mm, each with its
+        unit).
     objectives : list of Objective
         The figures shown.
 
@@ -222,11 +223,7 @@ def describe(row: dict[str, Any], names: list[str], objectives: list[Objective])
     str
         The line.
     """
-    where = []
-    for n in names:
-        factor, _ = axis_scale(n)
-        unit = " cm" if factor != 1.0 else ""
-        where.append(f"{n}={row[n] * factor:.4g}{unit}")
-    figs = ", ".join(f"{o.name} {row[o.column] * o.plot_factor:.2f} {o.label.rsplit('(', 1)[-1].rstrip(')')}"
-                     for o in objectives)
-    return f"trial {row['trial']} ({', '.join(where)}): {figs}, flip share {row['flip_share']:.2f}"
+    where = ", ".join(design_text(n, row[n]) for n in names)
+    figs = ", ".join(f"{o.label.rsplit(' (', 1)[0]} {row[o.column] * o.plot_factor:.2f} "
+                     f"{o.label.rsplit('(', 1)[-1].rstrip(')')}" for o in objectives)
+    return f"trial {row['trial']} ({where}): {figs}, flip share {row['flip_share']:.2f}"

@@ -14,7 +14,8 @@ from ..plotting import pyplot, save_png
 from ..sim.outcome import GOES_OVER
 from .design import SCALE, Axis, axis_scale
 
-METRICS = (("distance_m", "distance (mm)"), ("max_nose_height_m", "highest nose point (mm)"))   # hop figures: mm
+METRICS = (("distance_m", "distance over the run (mm)"),
+           ("max_nose_height_m", "highest nose point above the floor (mm)"))   # as `locust sim` prints them
 MM = 1000.0
 
 
@@ -59,7 +60,7 @@ def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robo
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="best")
     panels[0].set_title("distance over the run")
-    panels[1].set_title("jump height (highest nose point)")
+    panels[1].set_title("highest nose point above the floor")
     fig.suptitle(f"sweep of {base.name}", fontsize=10)
     return save_png(fig, path)
 

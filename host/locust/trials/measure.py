@@ -13,7 +13,9 @@ Per hop (schedule cycle ``k`` of period ``T``: ``[start + (k-1)T, start + kT)``)
   samples in the last ``REST_WINDOW_S`` of each cycle; the robot stands still by then, so
   nose and chassis travel agree);
 - apex: highest nose point in the cycle above the standing nose height (median before the
-  first push), the definition :mod:`locust.sim.hops` uses.
+  first push), the definition :mod:`locust.sim.hops` uses;
+- rest height: nose y at rest at the end of the cycle above where it stood (the same median
+  window as the distance): near zero on a robot back on its feet, high on one lying on its back.
 """
 
 from __future__ import annotations
@@ -54,11 +56,14 @@ class MeasuredHop:
         cover it.
     apex_m : float
         The nose's highest point in that cycle above where it stood [m]; NaN when not covered.
+    rest_height_m : float
+        The nose at rest at the end of that cycle above where it stood [m]; NaN when not covered.
     """
 
     hop: int
     distance_m: float        # nan when the track does not cover the cycle
     apex_m: float
+    rest_height_m: float = math.nan
 
 
 def onset_time(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, threshold_m: float = ONSET_M,
@@ -147,16 +152,18 @@ def measure_hops(trace: Aligned, period_s: float, cycles: int) -> list[MeasuredH
     """
     t, x, y = trace.t_s, trace.x_m, trace.y_m
     t_end = float(t[-1])
-    rest = [0.0]  # standing, by construction of the aligned trace
+    rest, rest_y = [0.0], [0.0]  # standing, by construction of the aligned trace
     for k in range(1, cycles + 1):
         b = k * period_s
         sel = (t > b - REST_WINDOW_S) & (t <= b)
-        rest.append(float(np.median(x[sel])) if sel.any() and t_end >= b - REST_WINDOW_S / 2 else math.nan)
+        seen = sel.any() and t_end >= b - REST_WINDOW_S / 2
+        rest.append(float(np.median(x[sel])) if seen else math.nan)
+        rest_y.append(float(np.median(y[sel])) if seen else math.nan)
     hops = []
     for k in range(1, cycles + 1):
         a, b = (k - 1) * period_s, k * period_s
         inside = (t >= a) & (t < b)
         covered = inside.any() and t_end >= b - REST_WINDOW_S / 2
         apex = float(y[inside].max()) if covered else math.nan
-        hops.append(MeasuredHop(hop=k, distance_m=rest[k] - rest[k - 1], apex_m=apex))
+        hops.append(MeasuredHop(hop=k, distance_m=rest[k] - rest[k - 1], apex_m=apex, rest_height_m=rest_y[k]))
     return hops
