@@ -29,11 +29,11 @@ import tempfile
 import time
 from pathlib import Path
 
+from locust.bundled import bundled_recording
 from locust.commands.demo import (
     CALIBRATIONS,
     HOP_JOBS,
     HOP_TRUTH,
-    RECORDINGS,
     REPORT_SAMPLES,
     Demo,
     recording_truth,
@@ -62,7 +62,7 @@ def hop_frames(truth_csv: Path) -> tuple[int, int]:
 def hops_stage(trials: int, cycles: int, jobs: int) -> tuple[float, float]:
     """The demo's flash and hops stages in a fresh folder, ``jobs`` hops at once; prints a row
     per hop. Returns the hops stage's wall time and the hops' real time [s]."""
-    truth = {**recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS]), **HOP_TRUTH}
+    truth = {**recording_truth([bundled_recording(rec) for _, rec, _ in CALIBRATIONS]), **HOP_TRUTH}
     truth_sets = [arg for key, value in truth.items() for arg in ("--set", f"{key}={value!r}")]
     with tempfile.TemporaryDirectory() as tmp, open(os.devnull, "w") as quiet:
         d = Demo(Path(tmp), quiet)

@@ -217,11 +217,12 @@ def test_demo_virtual_robot_carries_the_recordings_truth():
     """The demo's virtual robot is built from the bundled recordings' '# truth:' headers,
     which replay the seed's identified values (calibration/make_synthetic.py); the servo's
     are those of the AA swing's fit alone (synthetic.SG90_AA_SWING)."""
+    from locust.bundled import bundled_recording
     from locust.calibrate.synthetic import SG90_AA_SWING
-    from locust.commands.demo import CALIBRATIONS, RECORDINGS, recording_truth
+    from locust.commands.demo import CALIBRATIONS, recording_truth
     from locust.params import preset
 
-    truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])
+    truth = recording_truth([bundled_recording(rec) for _, rec, _ in CALIBRATIONS])
     assert truth == pytest.approx({
         "compliance.hinge_stiffness_nm_per_rad": 0.056375, "compliance.hinge_damping_nms_per_rad": 0.00056375,
         "servo.noload_speed_rad_per_s": 10.2, "servo.armature_kgm2": 3.1e-4, "servo.kp_nm_per_rad": 0.26,

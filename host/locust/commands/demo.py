@@ -36,6 +36,7 @@ from pathlib import Path
 
 import click
 
+from ..bundled import bundled_recording
 from ..errors import ReportError
 from ..fileio import atomic_write_json, atomic_write_text, unique_dir
 from ..params import LEG_SETS, leg_set, preset
@@ -53,9 +54,9 @@ def seed_leg_set_options(name: str) -> list[str]:
     return ["--preset", "seed", *[arg for key in keys for arg in ("--set", f"{key}={robot.get(key)!r}")]]
 
 
-RECORDINGS = Path(__file__).resolve().parents[3] / "calibration" / "recordings"
-# (subcommand, recording, its options); the servo recording is the AA swing's SG90 on a light
-# load, split with the datasheet's stall torque (no-load speed, armature and kp are written).
+# (subcommand, bundled recording, its options), each file found by locust.bundled in a checkout
+# or an installed wheel alike; the servo recording is the AA swing's SG90 on a light load, split
+# with the datasheet's stall torque (no-load speed, armature and kp are written).
 CALIBRATIONS = (
     ("beam", "synthetic_beam.csv", ["--mass-kg", "0.01", "--length-m", "0.05"]),
     ("servo", "synthetic_servo.csv", ["--inertia-kgm2", "1.5e-5", "--stall-torque-nm", "0.15"]),
@@ -262,9 +263,7 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     Everything it makes stays under --out; each command's output is in logs/.
     """
     stderr = sys.stderr
-    if not RECORDINGS.is_dir():
-        raise ReportError(f"the bundled calibration recordings are not at {RECORDINGS}",
-                          "run the demo from a source checkout (the recordings live in calibration/recordings)")
+    recordings = {recording: bundled_recording(recording) for _, recording, _ in CALIBRATIONS}
     t_start = time.perf_counter()
     folder = unique_dir(out, "run")
     d = Demo(folder, stderr)
@@ -275,7 +274,7 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     total = 7 if fit_hops else 6
     bench_toml = cal_dir / "robot-bench.toml"
 
-    truth = _virtual_truth(folder, fit_hops)
+    truth = _virtual_truth(folder, fit_hops, list(recordings.values()))
     truth_sets = [arg for key, value in truth.items() for arg in ("--set", f"{key}={value!r}")]
     d.say("demo: the virtual robot carries the recordings' true values: "
           + ", ".join(f"{k}={v:g}" for k, v in truth.items()))
@@ -298,7 +297,7 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     with d.stage(4, total, "calibrate from the bundled synthetic recordings"):
         with d.bar(CALIBRATIONS, "fits") as bar:
             for kind, recording, options in bar:
-                d.call(["calibrate", kind, str(RECORDINGS / recording), *options, "--write", str(robot_toml),
+                d.call(["calibrate", kind, str(recordings[recording]), *options, "--write", str(robot_toml),
                         "--plot", str(cal_dir / f"{Path(recording).stem}-fit.png")])
     if fit_hops:
         with d.stage(5, total, f"fit the filmed hops of {' and '.join(HOP_FIT_SETS)}: what the bench cannot reach"):
@@ -331,10 +330,10 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     click.echo(f"report: {report_path}")
 
 
-def _virtual_truth(folder: Path, fit_hops: bool) -> dict[str, float]:
-    """The virtual robot's values: the bundled recordings' truth (and, for the hop fit, the
-    hidden HOP_TRUTH), written to virtual/truth.json."""
-    truth = recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS])
+def _virtual_truth(folder: Path, fit_hops: bool, recordings: list[Path]) -> dict[str, float]:
+    """The virtual robot's values: the truth of the bundled ``recordings`` (and, for the hop
+    fit, the hidden HOP_TRUTH), written to virtual/truth.json."""
+    truth = recording_truth(recordings)
     note = ("the virtual robot's parameters: the values the bundled SYNTHETIC calibration recordings were "
             "generated with")
     if fit_hops:
