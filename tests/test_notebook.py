@@ -1,7 +1,10 @@
 """docs/python-api.ipynb: committed executed (figures, tables, an inline video, a first cell
 that installs the toolkit in Colab), run again top to bottom in a real Jupyter kernel in a
-temporary folder, and its printed figures checked against known truth and against the
-figures the committed copy shows, each at the precision it has (:func:`assert_figures_match`)."""
+temporary folder outside the checkout, twice: on the checkout's code (its host/ on the path)
+and as a user has it, in a fresh virtual environment holding only the wheel built from the
+checkout (tests/installed.py). Each run must show its figures, and the figures it prints are
+checked against known truth and against those the committed copy shows, each at the
+precision it has (:func:`assert_figures_match`)."""
 
 from __future__ import annotations
 
@@ -72,18 +75,78 @@ def test_committed_notebook_is_quiet_and_shows_no_local_path():
     assert any("Fit beam: synthetic_beam.csv" in t for t in texts)
 
 
-@pytest.fixture(scope="module")
-def printed(tmp_path_factory) -> dict[str, dict]:
-    """The JSON line each tagged cell prints, by tag, after running the notebook in a fresh kernel."""
+# a last cell, added to the run (not to the notebook): where the kernel's locust and its data came from
+WHERE = ("import json, sys\n"
+         "print(json.dumps({'locust': locust.__file__, 'beam': str(locust.bundled_recording('synthetic_beam.csv')),"
+         " 'path': sys.path}))")
+
+
+@pytest.fixture(scope="module", params=["checkout", "wheel"])
+def executed(request, tmp_path_factory):
+    """The notebook run top to bottom in a fresh kernel, in a temporary folder outside the
+    checkout: (the notebook with its outputs, what its last cell said about where locust came
+    from, which run). ``checkout``: the checkout's host/ on PYTHONPATH, in this environment's
+    kernel; ``wheel``: a kernel in a virtual environment holding only the wheel, nothing of
+    the checkout on its path."""
     nb = nbformat.read(NOTEBOOK, as_version=4)
-    folder = tmp_path_factory.mktemp("notebook")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "host"), os.environ.get("PYTHONPATH", "")]),
-               MPLBACKEND="Agg")
-    client = nbclient.NotebookClient(nb, timeout=240, kernel_name="python3",
-                                     resources={"metadata": {"path": str(folder)}})
-    client.execute(env=env, cwd=str(folder))
+    nb.cells.append(nbformat.v4.new_code_cell(WHERE))
+    folder = tmp_path_factory.mktemp(f"notebook-{request.param}")
+    resources = {"metadata": {"path": str(folder)}}
+    if request.param == "checkout":
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "host"), os.environ.get("PYTHONPATH", "")]),
+                   MPLBACKEND="Agg")
+        client = nbclient.NotebookClient(nb, timeout=240, kernel_name="python3", resources=resources)
+    else:
+        from jupyter_client.kernelspec import KernelSpecManager
+        from jupyter_client.manager import KernelManager
+
+        import installed
+
+        venv = request.getfixturevalue("wheel_venv")
+        env = venv.env(MPLBACKEND="Agg")
+        specs = KernelSpecManager(kernel_dirs=[str(venv.kernels())])
+        client = nbclient.NotebookClient(nb, timeout=240, resources=resources,
+                                         km=KernelManager(kernel_name=installed.KERNEL, kernel_spec_manager=specs))
+    client.execute(env=env, cwd=str(folder))     # a cell that raises fails it here (CellExecutionError)
     assert (folder / "python-api-out" / "large.mp4").is_file()
-    return tagged_lines(nb)
+    text = "".join(o.get("text", "") for o in nb.cells[-1].outputs if o.output_type == "stream")
+    return nb, json.loads(text), request.param
+
+
+@pytest.fixture(scope="module")
+def printed(executed) -> dict[str, dict]:
+    """The JSON line each tagged cell printed in the rerun, by tag."""
+    return tagged_lines(executed[0])
+
+
+def test_rerun_shows_its_figures_and_no_error(executed):
+    """Rerun, the notebook shows what the committed copy does: its figures (PNG), its tables,
+    the clip inline; no cell's output is an error."""
+    nb, _, _ = executed
+    outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs]
+    assert not [o for o in outputs if o.output_type == "error"]
+    data = [o.get("data", {}) for o in outputs]
+    committed = [o.get("data", {}) for c in nbformat.read(NOTEBOOK, as_version=4).cells if c.cell_type == "code"
+                 for o in c.outputs]
+    assert sum("image/png" in d for d in data) == sum("image/png" in d for d in committed) >= 3
+    assert sum("<table" in d.get("text/html", "") for d in data) >= 3
+    assert sum("<video" in d.get("text/html", "") for d in data) == 1
+
+
+def test_the_kernel_ran_the_code_it_was_meant_to(executed):
+    """The checkout's run imports locust from host/; the wheel's from its environment's
+    site-packages, its recordings from the package there, and nothing of the checkout is on
+    its path."""
+    _, where, which = executed
+    locust_file, beam = Path(where["locust"]), Path(where["beam"])
+    if which == "checkout":
+        assert locust_file == ROOT / "host" / "locust" / "__init__.py"
+        assert beam.resolve() == (ROOT / "calibration" / "recordings" / "synthetic_beam.csv").resolve()
+    else:
+        assert ROOT not in locust_file.parents and locust_file.parent.parent.name == "site-packages"
+        assert beam == locust_file.parent / "recordings" / "synthetic_beam.csv" and not beam.is_symlink()
+        assert not [p for p in where["path"] if p and Path(p).resolve().is_relative_to(ROOT)], where["path"]
+    assert beam.read_bytes() == (ROOT / "calibration" / "recordings" / "synthetic_beam.csv").read_bytes()
 
 
 def assert_figures_match(tag: str, rerun, committed) -> None:
