@@ -3,7 +3,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 PYTHON ?= python3
 # the modules whose >>> examples run in `make test`, from this folder (they read calibration/recordings)
-DOCTESTS := host/locust/api
+DOCTESTS := host/locust/api host/locust/bundled.py
 export MUJOCO_GL ?= osmesa
 export PYOPENGL_PLATFORM ?= osmesa
 

@@ -40,6 +40,19 @@ def tracker_example(shared_data, tmp_path_factory):
     return unpacked
 
 
+@pytest.fixture(scope="session")
+def wheel_venv(tmp_path_factory):
+    """This checkout as a user installs it (tests/installed.py): its wheel alone, with
+    ipykernel, in a fresh virtual environment outside the checkout; built once a session
+    (about 35 s on a quiet 2-core machine: the wheel 5 s, the environment 30 s)."""
+    import installed
+
+    folder = tmp_path_factory.mktemp("wheel")
+    assert ROOT not in folder.resolve().parents, folder
+    wheel = installed.build_wheel(folder / "build")
+    return installed.install(wheel, folder / "venv", "ipykernel")     # 0.9 GB, left to pytest's tmp_path cleanup
+
+
 @pytest.fixture(scope="module")
 def env(tmp_path_factory):
     """An environment whose virtual robot (``--port sim``) has the firmware flashed: one per

@@ -20,10 +20,10 @@ import pytest
 import locust
 import locust.sweep.run
 import locust.track.runner
+from locust.bundled import bundled_recording
 from locust.errors import LocustError, ParamsError, SimError
 
 ROOT = Path(__file__).resolve().parents[1]
-RECORDINGS = ROOT / "calibration" / "recordings"
 FACADE = ["robot", "simulate", "SimResult", "sweep_designs", "SweepResults", "track_markers", "read_tracks", "Tracks",
           "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "Fit", "make_report", "optimize",
           "make_cut_files"]
@@ -121,7 +121,7 @@ def test_sweep_errors_are_the_library_s_own():
 
 
 def test_fit_matches_the_command_line_and_applies(tmp_path):
-    data = RECORDINGS / "synthetic_ramp.csv"
+    data = bundled_recording("synthetic_ramp.csv")
     fit = locust.calibrate_ramp(data)
     proc = subprocess.run([sys.executable, "-m", "locust.commands", "calibrate", "ramp", str(data),
                            "--json", "--no-plot"],
@@ -153,14 +153,14 @@ def test_fit_matches_the_command_line_and_applies(tmp_path):
 
 def test_fit_plots_residuals_in_the_datas_unit():
     """Beam: tip displacement [mm] above, residual [mm] below; servo: rad/s both."""
-    beam = locust.calibrate_beam(RECORDINGS / "synthetic_beam.csv", mass_kg=0.01, length_m=0.05)
+    beam = locust.calibrate_beam(bundled_recording("synthetic_beam.csv"), mass_kg=0.01, length_m=0.05)
     top, bottom = beam.plot().axes
     assert (top.get_ylabel(), bottom.get_ylabel()) == ("tip displacement [mm]", "residual [mm]")
     assert bottom.get_xlabel() == "t [s]"
 
 
 def test_read_tracks_to_dataframe():
-    tracks = locust.read_tracks(RECORDINGS / "synthetic_beam.csv")
+    tracks = locust.read_tracks(bundled_recording("synthetic_beam.csv"))
     df = tracks.to_dataframe()
     assert tracks.markers == ["tip"] and len(df) == 360
     assert list(df.columns) == ["frame", "t_s", "tip_px", "tip_py", "tip_x_m", "tip_y_m", "tip_ok"]
@@ -176,8 +176,7 @@ def test_readme_python_api_runs_as_shown(tmp_path, monkeypatch, capsys):
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     section = text.split("## Python API", 1)[1]
     block = section.split("```python\n", 1)[1].split("```", 1)[0]
-    (tmp_path / "calibration").symlink_to(ROOT / "calibration")   # run "from the repository's root"
-    monkeypatch.chdir(tmp_path)
+    monkeypatch.chdir(tmp_path)      # "from any folder": the recording is the package's own
     scope: dict = {}
     exec(compile(block, "README.md", "exec"), scope)
     assert (tmp_path / "hop.mp4").is_file() and scope["result"].valid
@@ -259,7 +258,7 @@ def test_tidy_tracks_have_trackers_velocity_and_acceleration():
 
 
 def test_fit_and_sweep_have_tables_and_figures(tmp_path):
-    fit = locust.calibrate_ramp(RECORDINGS / "synthetic_ramp.csv")
+    fit = locust.calibrate_ramp(bundled_recording("synthetic_ramp.csv"))
     table = fit.to_dataframe()
     est = fit.parameters["contact.foot_friction"]
     assert table.loc["contact.foot_friction", "value"] == est.value

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from locust.bundled import bundled_recording
 from locust.fab.dxf_read import MAX_ARC_SEGMENTS
 from locust.io import run_record as R
 from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
@@ -55,8 +56,8 @@ def dxf(d: Path, name: str, body, holes=(), slits=()) -> Path:
 
 
 RECT = [(0, 0), (50, 0), (50, 30), (0, 30)]
-SERVO_CSV = Path(__file__).resolve().parents[1] / "calibration" / "recordings" / "synthetic_servo.csv"
-BEAM_CSV = Path(__file__).resolve().parents[1] / "calibration" / "recordings" / "synthetic_beam.csv"
+SERVO_CSV = bundled_recording("synthetic_servo.csv")
+BEAM_CSV = bundled_recording("synthetic_beam.csv")
 
 
 def trial(d: Path, status: str = R.COMPLETE, cycles: int = 2) -> Path:

@@ -12,13 +12,13 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from locust.bundled import bundled_recording, bundled_recordings
 from locust.calibrate.recordings import read_table
 from locust.commands import cli
 from locust.io.robot_toml import load_robot, to_toml
 from locust.params import preset
 
 ROOT = Path(__file__).resolve().parents[1]
-RECORDINGS = ROOT / "calibration" / "recordings"
 
 
 @pytest.fixture()
@@ -26,7 +26,7 @@ def recs(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)      # the fit plots' default folder is the current one
     for name in ("synthetic_beam.csv", "synthetic_beam_tracker.txt", "synthetic_servo.csv", "synthetic_servo_heavy.csv",
                  "synthetic_ramp.csv", "synthetic_ramp_track.csv"):
-        shutil.copy(RECORDINGS / name, tmp_path / name)
+        shutil.copy(bundled_recording(name), tmp_path / name)
     return tmp_path
 
 
@@ -36,9 +36,10 @@ def run(*args):
 
 
 def test_recordings_are_labelled_synthetic():
-    for path in RECORDINGS.glob("synthetic_*.csv"):
-        table = read_table(path)
-        assert path.name.startswith("synthetic_")
+    names = [n for n in bundled_recordings() if n.startswith("synthetic_") and n.endswith(".csv")]
+    assert "synthetic_beam.csv" in names
+    for name in names:
+        table = read_table(bundled_recording(name))
         assert table.comments and "SYNTHETIC" in table.comments[0]
 
 
@@ -281,8 +282,8 @@ def test_fitted_values_print_with_units_and_four_figures():
     """`k  5.587e-2  N·m/rad  ± 1.0 %  (95 %: ... … ...)`: the JSON's own value to 4 figures, its
     unit in a column (N·m, never nm), one sd as a share of the value, the 95 % interval; no
     Python lists or 12-digit floats."""
-    args = ["calibrate", "beam", str(RECORDINGS / "synthetic_beam.csv"), "--mass-kg", "0.01", "--length-m", "0.05",
-            "--no-plot"]
+    args = ["calibrate", "beam", str(bundled_recording("synthetic_beam.csv")), "--mass-kg", "0.01",
+            "--length-m", "0.05", "--no-plot"]
     text = CliRunner().invoke(cli, args).stdout
     fit = json.loads(CliRunner().invoke(cli, [*args, "--json"]).stdout)
     for key, unit in (("hinge_stiffness_nm_per_rad", "N·m/rad"), ("hinge_damping_nms_per_rad", "N·m·s/rad"),

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from locust.bundled import bundled_recording
 from locust.calibrate import hinge as H
 from locust.calibrate import synthetic as S
 from locust.calibrate.recordings import REAL_TIME, TimeOptions, clean_samples, read_table
@@ -219,12 +220,12 @@ def test_beam_reads_a_tracker_project(tmp_path):
     """`calibrate beam` on a .trk (it used to say "no numeric rows"): the shipped SYNTHETIC beam's
     fit. The project's times come from its frame rate, the CSV's are printed to a few digits:
     the frequencies agree to 1e-4."""
-    recordings = Path(__file__).resolve().parents[1] / "calibration" / "recordings"
-    table = read_table(recordings / "synthetic_beam.csv")
+    beam = bundled_recording("synthetic_beam.csv")
+    table = read_table(beam)
     t, x, y = clean_samples(Path("b"), "tip", table.time_s(), *table.marker("tip"), min_samples=20)
     trk = write_trk(tmp_path / "beam.trk", t, x, y, px_per_m=5000.0)
     args = ["--mass-kg", 0.01, "--length-m", 0.05, "--json", "--no-plot"]
-    a = json.loads(run("calibrate", "beam", recordings / "synthetic_beam.csv", *args).stdout)
+    a = json.loads(run("calibrate", "beam", beam, *args).stdout)
     b = json.loads(run("calibrate", "beam", trk, *args).stdout)
     assert b["natural_frequency_hz"]["value"] == pytest.approx(a["natural_frequency_hz"]["value"], rel=1e-4)
     assert "Tracker project" in b["input"]

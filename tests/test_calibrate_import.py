@@ -12,12 +12,11 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from locust.bundled import bundled_recording
 from locust.calibrate import beam as B
 from locust.calibrate import ramp as R
 from locust.calibrate.recordings import clean_samples, read_table
 from locust.commands import cli
-
-RECORDINGS = Path(__file__).resolve().parents[1] / "calibration" / "recordings"
 
 
 def run(*args):
@@ -31,7 +30,7 @@ def shifted(cell: str, factor: int) -> str:
 
 def beam_tracker_export(path: Path, factor: int, title: str = "tip") -> Path:
     """synthetic_beam.csv (metres) as a Tracker export in a smaller unit."""
-    lines = (RECORDINGS / "synthetic_beam.csv").read_text().splitlines()
+    lines = bundled_recording("synthetic_beam.csv").read_text().splitlines()
     head = [ln for ln in lines if not ln.startswith("#")]
     cols = head[0].split(",")
     t, x, y = cols.index("t_s"), cols.index("tip_x_m"), cols.index("tip_y_m")
@@ -51,11 +50,11 @@ def beam_json(*args):
 
 
 def test_beam_in_cm_warns_then_fits_as_metres(tmp_path):
-    metres, err = beam_json(RECORDINGS / "synthetic_beam.csv")
+    metres, err = beam_json(bundled_recording("synthetic_beam.csv"))
     assert metres["warnings"] == [] and "warning" not in err
     cm = beam_tracker_export(tmp_path / "beam_cm.txt", 100)
     # read as metres: the tip of a 5 cm beam swings over a metre; the unit that fits is named
-    table = read_table(RECORDINGS / "synthetic_beam.csv")
+    table = read_table(bundled_recording("synthetic_beam.csv"))
     t, x, y = clean_samples(Path("b"), "tip", table.time_s(), *table.marker("tip"), min_samples=20)
     swing_m = float(np.ptp(B.principal_displacement(x, y)))
     assert 0.01 < swing_m < 0.02                                  # 1.4 cm on the 5 cm beam, as filmed
@@ -79,7 +78,7 @@ def test_beam_in_cm_warns_then_fits_as_metres(tmp_path):
 
 
 def test_beam_in_metres_read_as_mm_warns_the_other_way(tmp_path):
-    res = run("calibrate", "beam", RECORDINGS / "synthetic_beam.csv", "--mass-kg", 0.01, "--length-m", 0.05,
+    res = run("calibrate", "beam", bundled_recording("synthetic_beam.csv"), "--mass-kg", 0.01, "--length-m", 0.05,
               "--units", "mm", "--no-plot")
     assert res.exit_code == 0, res.output
     assert "less than 0.0001 m is plausible for a 0.05 m beam" in res.stderr
@@ -90,7 +89,7 @@ def test_beam_in_metres_read_as_mm_warns_the_other_way(tmp_path):
 
 
 def test_ramp_track_in_mm(tmp_path):
-    lines = (RECORDINGS / "synthetic_ramp_track.csv").read_text().splitlines()
+    lines = bundled_recording("synthetic_ramp_track.csv").read_text().splitlines()
     header = next(ln for ln in lines if not ln.startswith("#"))
     cols = header.split(",")
     metric = [j for j, c in enumerate(cols) if c.endswith(("_x_m", "_y_m"))]
@@ -100,14 +99,14 @@ def test_ramp_track_in_mm(tmp_path):
         out.append(",".join(shifted(v, 1000) if j in metric else v for j, v in enumerate(f)))
     mm = tmp_path / "ramp_mm.csv"
     mm.write_text("\n".join(out) + "\n")
-    metres = json.loads(run("calibrate", "ramp", RECORDINGS / "synthetic_ramp_track.csv", RECORDINGS /
-                            "synthetic_ramp.csv", "--json", "--no-plot").stdout)
-    res = run("calibrate", "ramp", mm, RECORDINGS / "synthetic_ramp.csv", "--json", "--no-plot")
+    metres = json.loads(run("calibrate", "ramp", bundled_recording("synthetic_ramp_track.csv"),
+                            bundled_recording("synthetic_ramp.csv"), "--json", "--no-plot").stdout)
+    res = run("calibrate", "ramp", mm, bundled_recording("synthetic_ramp.csv"), "--json", "--no-plot")
     assert res.exit_code == 0, res.output
     warn = json.loads(res.stdout)["warnings"]
     assert len(warn) == 1 and "ramp's markers are 300 m apart" in warn[0] and "give --units mm" in warn[0]
-    res = run("calibrate", "ramp", mm, RECORDINGS / "synthetic_ramp.csv", "--units", "mm", "--rename", "robot=body",
-              "--robot-marker", "body", "--json", "--no-plot")
+    res = run("calibrate", "ramp", mm, bundled_recording("synthetic_ramp.csv"), "--units", "mm",
+              "--rename", "robot=body", "--robot-marker", "body", "--json", "--no-plot")
     assert res.exit_code == 0, res.output
     got = json.loads(res.stdout)
     assert got["warnings"] == [] and got["angles_deg"][0] == pytest.approx(metres["angles_deg"][0], rel=1e-9)
@@ -116,11 +115,11 @@ def test_ramp_track_in_mm(tmp_path):
 
 
 def test_import_options_need_a_track():
-    res = run("calibrate", "servo", RECORDINGS / "synthetic_servo.csv", "--inertia-kgm2", 1.5e-5, "--units", "cm")
+    res = run("calibrate", "servo", bundled_recording("synthetic_servo.csv"), "--inertia-kgm2", 1.5e-5, "--units", "cm")
     assert res.exit_code == 2 and "apply to a horn track (--pivot)" in res.output and "hint:" in res.output
-    res = run("calibrate", "ramp", RECORDINGS / "synthetic_ramp.csv", "--mirror")
+    res = run("calibrate", "ramp", bundled_recording("synthetic_ramp.csv"), "--mirror")
     assert res.exit_code == 2 and "these are angle tables" in res.output
-    res = run("calibrate", "beam", RECORDINGS / "synthetic_beam.csv", "--mass-kg", 0.01, "--units", "ft")
+    res = run("calibrate", "beam", bundled_recording("synthetic_beam.csv"), "--mass-kg", 0.01, "--units", "ft")
     assert res.exit_code == 2 and "unknown unit 'ft'" in res.output and "Traceback" not in res.output
-    res = run("calibrate", "beam", RECORDINGS / "synthetic_beam.csv", "--mass-kg", 0.01, "--rename", "nose=tip")
+    res = run("calibrate", "beam", bundled_recording("synthetic_beam.csv"), "--mass-kg", 0.01, "--rename", "nose=tip")
     assert res.exit_code == 2 and "no marker 'nose' (markers: tip)" in res.output

@@ -122,6 +122,26 @@ def test_two_loads_give_the_stall_torque(monkeypatch):
     assert_time_left_within_twice(calls, steps[0], SV.progress_steps(2))
 
 
+def test_fit_on_threads_is_the_fit_on_one(monkeypatch):
+    """The bundled light and heavy recordings fitted together, their simulations side by side
+    (a thread per recording, each candidate batch on four mujoco.rollout threads), give every
+    figure bit for bit as on one thread: a rerun under any load prints the same fit."""
+    import locust
+    import locust.sim.rollout
+
+    def fit(cores: int) -> dict:
+        monkeypatch.setattr(SV, "available_cores", lambda: cores)
+        monkeypatch.setattr(locust.sim.rollout, "available_cores", lambda: cores)
+        result = locust.calibrate_servo([locust.bundled_recording("synthetic_servo.csv"),
+                                         locust.bundled_recording("synthetic_servo_heavy.csv")], [1.5e-5, 1e-3])
+        return {key: (est.value.hex(), est.std.hex(), *(v.hex() for v in est.ci95))
+                for key, est in result.parameters.items()}
+
+    threaded = fit(4)
+    assert len(threaded) == 4        # speed, armature, kp and the stall torque: two loads split them
+    assert fit(1) == threaded
+
+
 def assert_time_left_within_twice(calls: list[tuple[float, int]], end: float, length: int) -> None:
     """A fit's progress calls (clock reading, steps), replayed on a bar and read 1000 times
     along the clock as a display would: every time left shown from a quarter of the steps on

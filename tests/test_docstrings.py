@@ -2,8 +2,8 @@
 
 - every public function, class and method (no leading underscore, not nested in a function)
   of ``locust.api`` and of each job package has a docstring; the test prints any that lack one;
-- every public function of ``locust.api`` has the numpydoc sections ``Parameters`` and
-  ``Returns``;
+- every public function of ``locust.api`` (and ``bundled_recording``, which it exports from
+  ``locust.bundled``) has the numpydoc sections ``Parameters`` and ``Returns``;
 - each package's ``__init__`` docstring names its modules as ``:mod:`.name```: every name it
   gives exists, and every module of the package is named.
 
@@ -63,11 +63,17 @@ def test_public_definitions_have_docstrings(package):
     assert missing == [], f"{len(missing)} public definitions without a docstring in locust.{package}"
 
 
+# functions the API exports as they are from the shared module that owns them: file -> names
+REEXPORTED = {"bundled.py": ("bundled_recording",)}
+
+
 def api_functions():
-    """Each public module-level function of ``locust.api``: its docstring and its arguments."""
-    for path in modules_of("api"):
+    """Each public module-level function of ``locust.api``, and each it exports from a shared
+    module (REEXPORTED): its docstring and its arguments."""
+    for path in [*modules_of("api"), *(ROOT / name for name in REEXPORTED)]:
         for node in ast.parse(path.read_text(), str(path)).body:
-            if isinstance(node, ast.FunctionDef) and not node.name.startswith("_"):
+            if isinstance(node, ast.FunctionDef) and not node.name.startswith("_") and (
+                    path.parent.name == "api" or node.name in REEXPORTED[path.name]):
                 a = node.args
                 names = [x.arg for x in a.posonlyargs + a.args + a.kwonlyargs]
                 names += [x.arg for x in (a.vararg, a.kwarg) if x is not None]
@@ -100,7 +106,7 @@ def test_every_exported_api_function_is_checked():
     from locust.api import EXPORTS
     checked = {p.id.split(".")[1] for p in api_functions()}
     functions = {name for name in EXPORTS if name[0].islower()}
-    assert len(functions) == 13
+    assert len(functions) == 14
     assert sorted(functions - checked) == []
 
 

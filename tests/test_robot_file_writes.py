@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from locust.bundled import bundled_recording
 from locust.calibrate.fitstats import Estimate
 from locust.calibrate.write import write_fitted
 from locust.commands import cli
@@ -26,7 +27,7 @@ from locust.io.robot_toml import load_robot, save_robot, update_robot
 from locust.params import Provenance, parse_set_options, preset
 
 ROOT = Path(__file__).resolve().parents[1]
-RAMP = ROOT / "calibration" / "recordings" / "synthetic_ramp.csv"
+RAMP = bundled_recording("synthetic_ramp.csv")
 NASTY = [chr(c) for c in range(0x20)] + ["\x7f", '"', "'", "\\", '\\"', '"""', "'''", "\n\n", "\r\n", "é",
                                           "日本", "\u2028", "\ufeff", "\U0001f600", "\udcff", "\udc80", "#", "=",
                                           "[x]", "{", "}"]

@@ -17,6 +17,7 @@ Functions (each with a numpydoc docstring: ``help(locust.simulate)``):
   one row per marker per frame with velocity and acceleration, ``.plot()``, ``.write()``).
 - ``calibrate_beam/hinge/servo/ramp/hops(...)``: a ``Fit`` (``.parameters``, ``.to_dataframe()``,
   ``.plot()``, ``.apply(robot)``).
+- ``bundled_recording(name)``: the path of a SYNTHETIC recording the toolkit ships (``synthetic_beam.csv``, ...).
 - ``make_report(robot, measured)``: the HTML comparison of simulation and filmed hops.
 - ``optimize(robot, vary, trials, out=...)``: Optuna's search for the farthest valid hop.
 - ``make_cut_files(robot_or_dxf, out=...)``: the laminate's cut files and their summary.
@@ -30,7 +31,7 @@ from .version import __version__
 
 __all__ = ["robot", "simulate", "SimResult", "sweep_designs", "SweepResults", "track_markers", "read_tracks", "Tracks",
            "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "calibrate_hops", "Fit",
-           "make_report", "optimize", "make_cut_files", "Robot", "LocustError", "__version__"]
+           "bundled_recording", "make_report", "optimize", "make_cut_files", "Robot", "LocustError", "__version__"]
 
 
 def __getattr__(name: str):

@@ -14,6 +14,9 @@ function              module                    returns
 ``make_cut_files``    :mod:`.fabrication`       dict (the manufacturing summary)
 ====================  ========================  =====================================================
 
+``bundled_recording(name)`` (:mod:`.calibration`, from :mod:`locust.bundled`) is the path of a
+recording the toolkit ships, in a checkout or an installed wheel alike.
+
 The command line calls the same functions (``locust sim``, ``sweep``, ``report``, ``fab``,
 ``calibrate beam|hinge|servo|ramp``). Every name is also at the package top: ``locust.simulate``.
 """
@@ -30,6 +33,7 @@ EXPORTS = {
     "track_markers": "tracking", "read_tracks": "tracking", "Tracks": "tracking",
     "calibrate_beam": "calibration", "calibrate_hinge": "calibration", "calibrate_ramp": "calibration",
     "calibrate_servo": "calibration", "calibrate_hops": "calibration", "Fit": "calibration",
+    "bundled_recording": "calibration",
     "make_report": "reports",
     "optimize": "optimizing", "make_cut_files": "fabrication",
 }

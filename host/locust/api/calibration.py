@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..bundled import bundled_recording
 from ..calibrate.fitstats import Estimate
 from ..calibrate.ramp import READING_RESOLUTION_DEG
 from ..calibrate.recordings import REAL_TIME, TimeOptions
@@ -567,5 +568,5 @@ def _tuple(value) -> tuple[float, ...]:
     return tuple(float(v) for v in value) if isinstance(value, Sequence) else (float(value),)
 
 
-__all__ = ["Fit", "calibrate_beam", "calibrate_hinge", "calibrate_hops", "calibrate_ramp", "calibrate_servo",
-           "fit_servo_recordings"]
+__all__ = ["Fit", "bundled_recording", "calibrate_beam", "calibrate_hinge", "calibrate_hops", "calibrate_ramp",
+           "calibrate_servo", "fit_servo_recordings"]
