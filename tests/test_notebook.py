@@ -72,7 +72,7 @@ def test_committed_notebook_is_quiet_and_shows_no_local_path():
     texts = ["".join(o.get("text", "")) + "".join(v for k, v in o.get("data", {}).items() if k.startswith("text/"))
              for o in outputs]
     assert not [t for t in texts if str(ROOT) in t or "/home/" in t or "/tmp/" in t or "/work/" in t]
-    assert any("Fit beam: synthetic_beam.csv" in t for t in texts)
+    assert any("Fit hinge: hinge_swing.csv" in t for t in texts)
 
 
 # a last cell, added to the run (not to the notebook): where the kernel's locust and its data came from
@@ -238,13 +238,17 @@ def test_trace_gives_the_summary_figures(printed):
 
 
 def test_sweep_rows_and_best(printed):
+    """The crank's angle at rest decides the robot as built: it goes over up to -90 deg and stays
+    on its feet from -85 deg; the best is the farthest of those that stay on their feet."""
     import locust
 
     s = printed["sweep"]
-    assert (s["designs"], s["valid"]) == (5, 5)
-    assert s["distance_m"][s["best_design"]] == max(s["distance_m"])
-    # design 0 adds nothing: the seed itself, simulated here in this process
-    assert s["distance_m"][0] == locust.simulate(locust.robot("seed"), cycles=2).distance_m
+    assert (s["designs"], s["valid"]) == (7, 7)
+    assert s["outcome"] == ["goes_over"] * 5 + ["stays_low"] * 2
+    on_feet = [d for d, o in zip(s["distance_m"], s["outcome"]) if o != "goes_over"]
+    assert s["distance_m"][s["best_design"]] == max(on_feet)
+    # design 2 is -100 deg, the robot as built itself, simulated here in this process
+    assert s["distance_m"][2] == locust.simulate(locust.robot("small"), cycles=2).distance_m
 
 
 def test_tracked_hop_against_the_rendered_truth(printed):
@@ -256,16 +260,20 @@ def test_tracked_hop_against_the_rendered_truth(printed):
     assert t["nose_max_mm"] < 0.5
 
 
-def test_calibrations_recover_the_synthetic_truth(printed):
+def test_calibrations_recover_the_virtual_robots_values(printed):
+    """The bench recordings are SYNTHETIC, made from the demo's virtual robot (locust.demo): each
+    fit's 95 % interval covers the value it was made from."""
+    from locust.demo.virtual_robot import virtual_robot
+
+    hidden = virtual_robot()
     fits = printed["calibrate"]
     assert set(fits) == {"compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s",
-                         "contact.foot_friction"}
+                         "servo.stall_torque_nm", "contact.foot_friction"}
     for key, f in fits.items():
-        assert f["covered"], key
-    # the bundled recordings are fixed files: their fits are fixed numbers
-    assert fits["contact.foot_friction"]["value"] == pytest.approx(1.7112949, rel=1e-6)
-    assert fits["compliance.hinge_stiffness_nm_per_rad"]["value"] == pytest.approx(0.0558676, rel=1e-4)
-    assert fits["servo.noload_speed_rad_per_s"]["value"] == pytest.approx(10.2075, rel=1e-3)
+        assert f["truth"] == pytest.approx(hidden.get(key), rel=1e-12), key
+        assert f["covered"] and f["ci95"][0] <= hidden.get(key) <= f["ci95"][1], key
+    # the film hinge's scale (1.46e-4 N*m/rad), not a cardstock beam's 0.056
+    assert fits["compliance.hinge_stiffness_nm_per_rad"]["value"] == pytest.approx(1.46e-4, rel=0.01)
 
 
 def test_same_call_twice(printed):
