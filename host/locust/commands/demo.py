@@ -45,6 +45,7 @@ import click
 
 from ..errors import ReportError
 from ..fileio import atomic_write_json, atomic_write_text, unique_dir
+from ..orphans import die_with_parent
 from ..params import DEFAULT_PRESET, LEG_SETS
 from ..progress import progress
 
@@ -100,6 +101,10 @@ class Demo:
         self.steps = 0
         self.stages: list[dict] = []
         self.env = {"LOCUST_VIRTUAL_DIR": str(folder / "virtual"), "PYTHONUNBUFFERED": "1"}
+        self.running: set[subprocess.Popen] = set()   # the children now running (side by side: several)
+        self.stopping = threading.Event()              # set once the demo is stopped: start nothing more
+        self._lock = threading.Lock()
+        self.stages_started: list[str] = []
 
     def call(self, args: list[str], step: int | None = None, on_line=None) -> str:
         """``locust ARGS`` in a child process; its output goes to logs/NN-verb.log; a failure stops the demo.
@@ -113,10 +118,28 @@ class Demo:
             step = self.steps
         log = self.logs / f"{step:02d}-{args[0]}{'-' + args[1] if args[0] == 'calibrate' else ''}.log"
         cmd = [sys.executable, "-m", "locust.commands", *args]
+        if self.stopping.is_set():
+            raise DemoStopped("the demo is stopping")
+        parent = os.getpid()
         with subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                              text=True, env={**os.environ, **self.env}) as proc:
-            output = relay_progress(proc.stdout, self.stderr, on_line)
-        atomic_write_text(log, f"$ locust {' '.join(args)}\n{output}")
+                              text=True, env={**os.environ, **self.env},
+                              preexec_fn=lambda: die_with_parent(parent)) as proc:   # a kill -9 takes it too
+            with self._lock:
+                self.running.add(proc)
+            try:
+                output = relay_progress(proc.stdout, self.stderr, on_line)
+            except BaseException:          # Ctrl-C or a TERM here: the command ends with the demo
+                _end(proc)
+                raise
+            finally:
+                if self.stopping.is_set():
+                    _end(proc)
+                proc.wait()
+                with self._lock:
+                    self.running.discard(proc)
+        atomic_write_text(log, f"$ locust {' '.join(args)}\n{output}")   # (a stopped command's too)
+        if self.stopping.is_set():
+            raise DemoStopped(f"`locust {args[0]}` was stopped")
         if proc.returncode != 0:
             tail = "\n".join("    " + ln for ln in output.strip().splitlines()[-6:])
             raise ReportError(f"demo stopped: `locust {' '.join(args)}` failed (exit {proc.returncode}):\n{tail}",
@@ -135,13 +158,43 @@ class Demo:
             self.call(args, first + 1 + k)
             self.expect(*paths, step=first + 1 + k)
 
-        with ThreadPoolExecutor(max_workers=max(1, min(jobs, len(calls)))) as pool:
+        pool = ThreadPoolExecutor(max_workers=max(1, min(jobs, len(calls))))
+        try:
             futures = [pool.submit(one, k) for k in range(len(calls))]
             for future in as_completed(futures):
                 if future.exception() is None:
                     bar.update(1)
+        except BaseException:
+            self.stop()       # the queued commands never start, the running ones end now
+            raise
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
         for future in futures:
             future.result()
+
+    @contextmanager
+    def stoppable(self):
+        """Ctrl-C, a TERM or a HUP while the demo runs: no command more starts, the running ones
+        end (:meth:`stop`), and the demo ends with an error saying where it stopped."""
+        try:
+            yield
+        except (KeyboardInterrupt, SystemExit, DemoStopped) as exc:
+            self.stop()
+            what = {130: "Ctrl-C", 143: "a TERM signal", 129: "a HUP signal"}.get(
+                getattr(exc, "code", 130) if not isinstance(exc, DemoStopped) else 0, "a signal")
+            stage = self.stages_started[-1] if self.stages_started else "before its first stage"
+            raise ReportError(f"demo stopped by {what} during {stage}; every command it ran has ended",
+                              f"what it made so far is in {self.folder} (each command's output in "
+                              f"{self.logs}); run `locust demo` again for a whole run") from None
+
+    def stop(self) -> None:
+        """Start no command more and end those running: each is sent TERM (it unwinds, leaving
+        no temporary file), and killed if it has not ended within :data:`STOP_GRACE_S`."""
+        self.stopping.set()
+        with self._lock:
+            running = list(self.running)
+        for proc in running:
+            _end(proc)
 
     def expect(self, *paths: Path, step: int | None = None) -> None:
         """The files the last command (or command ``step``) should have written; a command that
@@ -156,6 +209,7 @@ class Demo:
     @contextmanager
     def stage(self, number: int, total: int, title: str):
         self.say(f"[{number}/{total}] {title}")
+        self.stages_started.append(f"stage {number}/{total} ({title})")
         t0 = time.perf_counter()
         yield
         wall = time.perf_counter() - t0
@@ -179,6 +233,25 @@ class Demo:
 
     def say(self, msg: str) -> None:
         click.echo(msg, file=self.stderr)
+
+
+class DemoStopped(Exception):
+    """A command the demo ran was ended because the demo is being stopped."""
+
+
+STOP_GRACE_S = 0.5   # a child sent TERM has this long to unwind before it is killed
+
+
+def _end(proc: subprocess.Popen) -> None:
+    """End ``proc``: TERM, then KILL after :data:`STOP_GRACE_S` (nothing when it has ended)."""
+    if proc.poll() is not None:
+        return
+    proc.terminate()
+    try:
+        proc.wait(timeout=STOP_GRACE_S)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
 
 
 def _tick(bar, done: threading.Event) -> None:
@@ -228,74 +301,75 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     total = 9 if fit_hops else 8
     stage = iter(range(1, total + 1))
 
-    truth_toml, hidden = _virtual_robot(folder)
-    d.say(f"demo: the virtual robot is a draw of the robot as built ({len(hidden)} uncertain values drawn, hidden "
-          f"in {truth_toml}): one whose Medium and Large rear and come back down, as the filmed robots did")
-    bench = write_bench(_load(truth_toml), folder / "virtual" / "bench")
+    with d.stoppable():
+        truth_toml, hidden = _virtual_robot(folder)
+        d.say(f"demo: the virtual robot is a draw of the robot as built ({len(hidden)} uncertain values drawn, hidden "
+              f"in {truth_toml}): one whose Medium and Large rear and come back down, as the filmed robots did")
+        bench = write_bench(_load(truth_toml), folder / "virtual" / "bench")
 
-    with d.stage(next(stage), total, "flash the firmware to the virtual robot"):
-        d.call(["flash", "--port", "sim"])
-    with d.stage(next(stage), total, f"hop Small, Medium, Large x {trials} on the virtual robot, {cycles} cycles, "
-                                     "filmed"):
-        # each hop is its own virtual robot (the one flash folder, read only), the firmware paced
-        # in real time while one core renders its video: HOP_JOBS of them film at once
-        hops = [(["hop", "--port", "sim", "--config", str(truth_toml), "--leg-set", name, "--cycles", str(cycles),
-                  "--video", str(trial / "hop.mp4"), "--out", str(trial)],
-                 (trial / "hop.mp4", trial / "run.json")) for name, trial in trials_dirs]
-        with d.bar(None, "hops", length=len(hops)) as bar:
-            d.call_side_by_side(hops, min(HOP_JOBS, jobs or os.cpu_count() or 1), bar)
-    with d.stage(next(stage), total, "track nose and foot in the videos"):
-        with d.bar(trials_dirs, "tracks") as bar:
-            for _, trial in bar:
-                d.call(["track", str(trial / "hop.mp4")])
-                d.expect(trial / "hop.tracks.csv")
-    with d.stage(next(stage), total, "calibrate the hinge, the servo and the feet' friction on the bench "
-                                     "(SYNTHETIC recordings)"):
-        with d.bar(bench, "fits") as bar:
-            for k, rec in enumerate(bar):
-                start = ["--preset", DEFAULT_PRESET] if k == 0 else []      # a new robot.toml: the robot as built
-                d.call(["calibrate", rec.experiment, *map(str, rec.paths), *rec.options, *start,
-                        "--write", str(robot_toml), "--out", str(cal_dir)])
-    with d.stage(next(stage), total, "measure the stance from two side stills of the virtual robot"):
-        d.call(["sim", "--config", str(truth_toml), "--cycles", "1", "--still", str(stills / "rest.png"),
-                "--still-push", str(stills / "push.png")])
-        d.call(["measure", "stance", str(stills / "rest.png"), str(stills / "push.png"), "--config", str(robot_toml),
-                "--write", str(robot_toml), "--force"])
-        atomic_write_text(bench_toml, robot_toml.read_text(encoding="utf-8"))
-    with d.stage(next(stage), total, f"outcome shares of each leg set over {SHARE_DRAWS} draws of the calibrated "
-                                     "robot"):
-        with d.bar(list(LEG_SETS), "leg sets") as bar:
-            for name in bar:
-                d.call(["sim", "--config", str(robot_toml), "--leg-set", name, "--cycles", str(cycles),
-                        "--samples", str(SHARE_DRAWS), "--no-sensitivity"])
-    if fit_hops:
-        with d.stage(next(stage), total, f"fit the filmed hops of {' and '.join(HOP_FIT_SETS)}: what the bench "
-                                         "cannot reach"):
-            fitted = [f"{name}={hops_dir / f'{name}-1'}" for name in HOP_FIT_SETS]
-            d.call(["calibrate", "hop", *fitted, "--write", str(robot_toml), "--out", str(cal_dir)])
-    with d.stage(next(stage), total, f"sweep the added link length over {designs} designs"):
-        d.call(["sweep", "--config", str(robot_toml), "--vary", f"scale=0:0.03:{designs}", "--cycles", str(cycles),
-                "--out", str(folder / "sweep"), *(["--jobs", str(jobs)] if jobs else [])])
-    with d.stage(next(stage), total, "report: the calibrated model against the measured hops"):
-        # each trial named by its leg set: the report need not guess it from the folder name
-        measured = [arg for name, trial in trials_dirs for arg in ("--measured", f"{name}={trial}")]
-        closing = ["--before", str(bench_toml), "--samples", str(REPORT_SAMPLES)] if fit_hops else []
-        # its bar counts the report's own stage lines: per leg set its simulation (and its draws),
-        # then the figures, worth REPORT_FIGURE_STEPS; each line ends the stage before it
-        with d.bar(None, "report", length=len(LEG_SETS) * (2 if fit_hops else 1) + REPORT_FIGURE_STEPS) as bar:
-            started = []
+        with d.stage(next(stage), total, "flash the firmware to the virtual robot"):
+            d.call(["flash", "--port", "sim"])
+        with d.stage(next(stage), total, f"hop Small, Medium, Large x {trials} on the virtual robot, {cycles} cycles, "
+                                         "filmed"):
+            # each hop is its own virtual robot (the one flash folder, read only), the firmware paced
+            # in real time while one core renders its video: HOP_JOBS of them film at once
+            hops = [(["hop", "--port", "sim", "--config", str(truth_toml), "--leg-set", name, "--cycles", str(cycles),
+                      "--video", str(trial / "hop.mp4"), "--out", str(trial)],
+                     (trial / "hop.mp4", trial / "run.json")) for name, trial in trials_dirs]
+            with d.bar(None, "hops", length=len(hops)) as bar:
+                d.call_side_by_side(hops, min(HOP_JOBS, jobs or os.cpu_count() or 1), bar)
+        with d.stage(next(stage), total, "track nose and foot in the videos"):
+            with d.bar(trials_dirs, "tracks") as bar:
+                for _, trial in bar:
+                    d.call(["track", str(trial / "hop.mp4")])
+                    d.expect(trial / "hop.tracks.csv")
+        with d.stage(next(stage), total, "calibrate the hinge, the servo and the feet' friction on the bench "
+                                         "(SYNTHETIC recordings)"):
+            with d.bar(bench, "fits") as bar:
+                for k, rec in enumerate(bar):
+                    start = ["--preset", DEFAULT_PRESET] if k == 0 else []      # a new robot.toml: the robot as built
+                    d.call(["calibrate", rec.experiment, *map(str, rec.paths), *rec.options, *start,
+                            "--write", str(robot_toml), "--out", str(cal_dir)])
+        with d.stage(next(stage), total, "measure the stance from two side stills of the virtual robot"):
+            d.call(["sim", "--config", str(truth_toml), "--cycles", "1", "--still", str(stills / "rest.png"),
+                    "--still-push", str(stills / "push.png")])
+            d.call(["measure", "stance", str(stills / "rest.png"), str(stills / "push.png"),
+                    "--config", str(robot_toml), "--write", str(robot_toml), "--force"])
+            atomic_write_text(bench_toml, robot_toml.read_text(encoding="utf-8"))
+        with d.stage(next(stage), total, f"outcome shares of each leg set over {SHARE_DRAWS} draws of the calibrated "
+                                         "robot"):
+            with d.bar(list(LEG_SETS), "leg sets") as bar:
+                for name in bar:
+                    d.call(["sim", "--config", str(robot_toml), "--leg-set", name, "--cycles", str(cycles),
+                            "--samples", str(SHARE_DRAWS), "--no-sensitivity"])
+        if fit_hops:
+            with d.stage(next(stage), total, f"fit the filmed hops of {' and '.join(HOP_FIT_SETS)}: what the bench "
+                                             "cannot reach"):
+                fitted = [f"{name}={hops_dir / f'{name}-1'}" for name in HOP_FIT_SETS]
+                d.call(["calibrate", "hop", *fitted, "--write", str(robot_toml), "--out", str(cal_dir)])
+        with d.stage(next(stage), total, f"sweep the added link length over {designs} designs"):
+            d.call(["sweep", "--config", str(robot_toml), "--vary", f"scale=0:0.03:{designs}", "--cycles", str(cycles),
+                    "--out", str(folder / "sweep"), *(["--jobs", str(jobs)] if jobs else [])])
+        with d.stage(next(stage), total, "report: the calibrated model against the measured hops"):
+            # each trial named by its leg set: the report need not guess it from the folder name
+            measured = [arg for name, trial in trials_dirs for arg in ("--measured", f"{name}={trial}")]
+            closing = ["--before", str(bench_toml), "--samples", str(REPORT_SAMPLES)] if fit_hops else []
+            # its bar counts the report's own stage lines: per leg set its simulation (and its draws),
+            # then the figures, worth REPORT_FIGURE_STEPS; each line ends the stage before it
+            with d.bar(None, "report", length=len(LEG_SETS) * (2 if fit_hops else 1) + REPORT_FIGURE_STEPS) as bar:
+                started = []
 
-            def on_line(line: str) -> None:
-                if line.startswith(REPORT_STAGE_MARK):
-                    if started:
-                        bar.update(1)
-                    started.append(line)
+                def on_line(line: str) -> None:
+                    if line.startswith(REPORT_STAGE_MARK):
+                        if started:
+                            bar.update(1)
+                        started.append(line)
 
-            printed = d.call(["report", *measured, "--config", str(robot_toml), "--sweep", str(folder / "sweep"),
-                              *closing, "--out", str(folder)], on_line=on_line)
-            bar.update(max(bar.length - bar.pos, 0))
-    report_path = Path(printed.strip().splitlines()[-1])
-    _timings(d, folder, time.perf_counter() - t_start, {"cycles": cycles, "trials": trials, "designs": designs})
+                printed = d.call(["report", *measured, "--config", str(robot_toml), "--sweep", str(folder / "sweep"),
+                                  *closing, "--out", str(folder)], on_line=on_line)
+                bar.update(max(bar.length - bar.pos, 0))
+        report_path = Path(printed.strip().splitlines()[-1])
+        _timings(d, folder, time.perf_counter() - t_start, {"cycles": cycles, "trials": trials, "designs": designs})
     click.echo(f"report: {report_path}")
 
 
