@@ -26,10 +26,10 @@ sysdeps:
 demo: install sysdeps
 	$(VENV)/bin/locust demo --out demo-out
 
-# Lint, then the fast tests (the default, well under 15 minutes). pytest exits 5 when it
-# collects nothing.
+# Lint everything from the root (firmware/ too: ruff does not follow the host/locust/firmware link),
+# then the fast tests (the default, well under 15 minutes). pytest exits 5 when it collects nothing.
 test: install sysdeps
-	$(VENV)/bin/ruff check host tests bench
+	$(VENV)/bin/ruff check .
 	$(PY) -m pytest -q; rc=$$?; [ $$rc -eq 5 ] && { echo "no tests collected"; exit 0; }; exit $$rc
 	$(PY) -m pytest -q --doctest-modules $(DOCTESTS); rc=$$?; [ $$rc -eq 5 ] && { echo "no doctests collected"; exit 0; }; exit $$rc
 

@@ -53,6 +53,7 @@ def seed_damping_ratio(truth: S.BeamTruth) -> float:
 
 
 def beam(out: Path) -> None:
+    """Write the beam-drop recording (locust track layout and Tracker's text export) into ``out``."""
     # the notebook's beam test, replayed: the seed's identified stiffness and damping
     truth = S.BeamTruth()
     truth = dataclasses.replace(truth, damping_ratio=round(seed_damping_ratio(truth), 6))
@@ -74,6 +75,7 @@ def beam(out: Path) -> None:
 
 
 def servo(out: Path) -> None:
+    """Write the servo step recordings (a light load, a heavy one, a stall) into ``out``."""
     heavy = dataclasses.replace(S.ServoTruth(), inertia_kgm2=1e-3, half_period_s=1.2)
     for name, truth, seed, what in (
         ("synthetic_servo.csv", S.ServoTruth(), 6002, "the SG90 of the AA swing alone, a 1.5e-5 kg*m^2 load"),
@@ -97,6 +99,7 @@ def servo(out: Path) -> None:
 
 
 def ramp(out: Path) -> None:
+    """Write the ramp trials and a filmed ramp tilt into ``out``."""
     truth = S.RampTruth()
     angles = S.ramp_angles(truth, np.random.default_rng(6004))
     head = [
@@ -117,6 +120,7 @@ def ramp(out: Path) -> None:
 
 
 def main() -> None:
+    """Write every recording into ``--out``."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "recordings")
     args = ap.parse_args()

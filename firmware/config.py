@@ -38,7 +38,8 @@ LIMITS = {
 # (pins, kind, reason): kind "input" cannot drive a pulse, "flash" takes the module's flash
 # or PSRAM with it (the board crashes), "console" the USB serial link, "strap" the boot mode.
 _ESP32_RESERVED = (
-    ((0, 2, 5, 12, 15), "strap", "a boot strapping pin (a servo's pull can change how the chip boots; 12 sets the flash voltage)"),
+    ((0, 2, 5, 12, 15), "strap",
+     "a boot strapping pin (a servo's pull can change how the chip boots; 12 sets the flash voltage)"),
     ((1, 3), "console", "the console UART (TX 1, RX 3): the USB serial link to the host"),
     ((6, 7, 8, 9, 10, 11), "flash", "wired to the module's SPI flash (driving it crashes the board)"),
     ((16, 17), "flash", "wired to the PSRAM on WROVER modules (not a Pin in the SPIRAM build)"),

@@ -100,7 +100,7 @@ def crc_hex(body):
         value = _crc32(body) & 0xFFFFFFFF
     else:
         value = _crc32_pure(body)
-    return "{:08x}".format(value)
+    return f"{value:08x}"
 
 
 def _crc32_pure(data):
@@ -134,13 +134,13 @@ def decode(line, limit=MAX_FRAME):
     try:
         given = line[star + 1:].decode()
     except Exception:
-        raise ProtocolError(E_FRAME, "checksum is not ASCII")
+        raise ProtocolError(E_FRAME, "checksum is not ASCII") from None
     if given.lower() != crc_hex(body):
         raise ProtocolError(E_CHECKSUM, "crc32 mismatch")
     try:
         obj = json.loads(body.decode())
     except Exception:
-        raise ProtocolError(E_JSON, "body is not valid JSON")
+        raise ProtocolError(E_JSON, "body is not valid JSON") from None
     if type(obj) is not dict:
         raise ProtocolError(E_JSON, "body is not a JSON object")
     return obj
@@ -181,7 +181,8 @@ def check_request(obj):
         else:
             ok = type(value) is int or (kind == "num" and type(value) is float)
             if not ok:
-                raise ProtocolError(E_REQUEST, "%s must be %s" % (key, "an integer" if kind == "int" else "a number"), req_id)
+                wanted = "an integer" if kind == "int" else "a number"
+                raise ProtocolError(E_REQUEST, "%s must be %s" % (key, wanted), req_id)
             if not _finite(value) or not lo <= value <= hi:
                 raise ProtocolError(E_RANGE, "%s=%s outside %s..%s" % (key, _short(str(value)), lo, hi), req_id)
         args[key] = value

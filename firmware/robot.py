@@ -53,8 +53,9 @@ class Console:
     """
 
     def __init__(self):
-        import micropython
         import select
+
+        import micropython
         self._in = sys.stdin.buffer
         self._out = sys.stdout.buffer
         self._pollin = select.POLLIN
@@ -261,7 +262,7 @@ class Controller:
                 # reach config.json, where it would be tried at every boot
                 new = config.with_value(self.cfg, key, args["value"], self.chip)
             except ValueError as e:
-                raise P.ProtocolError(P.E_RANGE, str(e)[:160], req_id)
+                raise P.ProtocolError(P.E_RANGE, str(e)[:160], req_id) from None
             self._apply(req_id, new)
         if not key:
             return P.reply(req_id, config=self.cfg)
@@ -280,14 +281,14 @@ class Controller:
             servos = self.make_servos(new)
         except Exception as e:  # e.g. ValueError("invalid pin") from machine.Pin
             self.servos = self.make_servos(self.cfg)  # the old pins worked: they still do
-            raise P.ProtocolError(P.E_RANGE, ("the board refused the new config: " + repr(e))[:160], req_id)
+            raise P.ProtocolError(P.E_RANGE, ("the board refused the new config: " + repr(e))[:160], req_id) from None
         try:
             config.save(new, self.cfg_path, self.chip)
         except Exception as e:  # a full or failing filesystem
             servos.rest()
             servos.deinit()
             self.servos = self.make_servos(self.cfg)
-            raise P.ProtocolError(P.E_INTERNAL, ("config.json not saved: " + repr(e))[:160], req_id)
+            raise P.ProtocolError(P.E_INTERNAL, ("config.json not saved: " + repr(e))[:160], req_id) from None
         self.servos = servos
         self.cfg = new
         self.cfg_problems = []

@@ -15,6 +15,8 @@ OUR_SUMMARY = "Firmware-plus-host toolkit for a foldable four-bar hopping robot"
 
 
 def main() -> int:
+    """1 (saying why) when the load-testing tool "locust" is installed here; 0 otherwise, after
+    removing an earlier install of this toolkit under that name."""
     venv = sys.argv[1] if len(sys.argv) > 1 else "this environment"
     try:
         meta = md.metadata("locust")

@@ -24,6 +24,7 @@ SLOT_W_CM = 0.1
 
 
 def build() -> ezdxf.document.Drawing:
+    """The seed's zz.dxf as its notebook describes it: the plate and its four hinge slots."""
     doc = ezdxf.new("R2010", units=5)            # centimetres, like the seed
     doc.header["$MEASUREMENT"] = 1
     doc.header["$PSVPSCALE"] = 1.0               # ezdxf's 0 makes LibreCAD print nothing
@@ -45,6 +46,7 @@ def build() -> ezdxf.document.Drawing:
 
 
 def main(out: str | None = None) -> Path:
+    """Write the drawing to ``out`` (default: zz.dxf beside this script), the same bytes every run."""
     path = Path(out) if out else Path(__file__).with_name("zz.dxf")
     ezdxf.options.write_fixed_meta_data_for_testing = True    # fixed dates and GUIDs:
     doc = build()                                              # the same bytes every run
