@@ -115,7 +115,8 @@ TARGETS = [
                "commanded_us": WRONG_TYPES + [HUGE, -HUGE, -INF, NAN, 1.5, -1],
                "measured_us": WRONG_TYPES + [HUGE, -HUGE, -INF, NAN, 1.5, -1]}, ["hop"]),
     ("done", {"status": [MISSING, 5, HUGE, INF, [], {}, True, None, 1.5, "x" * 500],
-              "ticks_us": ["x", 5, HUGE, INF, [], {}, [1], True, 1.5, [HUGE, 0], [1, INF]]}, ["hop"]),
+              "ticks_us": ["x", 5, HUGE, INF, [], {}, [1], True, 1.5, [HUGE, 0], [1, INF]],
+              "rest_us": ["x", HUGE, -HUGE, INF, NAN, [], {}, True, 1.5, -1]}, ["hop"]),
     ("hop", {"id": ["x", HUGE, INF, [], {}, [1], None, 1.5, True]}, ["hop"]),   # then no reply to this request
     ("pose", {"left_deg": WRONG_TYPES + [HUGE, -INF, NAN, "micropython", 1e6],
               "right_deg": WRONG_TYPES + [HUGE, -INF, NAN, "micropython", 1e6]}, ["pose"]),
@@ -172,4 +173,7 @@ def test_the_double_answers_as_the_firmware_does(tmp_path, command):
         board.close()
     assert res.exit_code == 0, res.output
     if command == "hop":
-        assert '"status": "complete"' in (tmp_path / "run" / "run.json").read_text()
+        saved = (tmp_path / "run" / "run.json").read_text()
+        assert '"status": "complete"' in saved
+        # a board's own clock times its phases: no host to stall it (not applicable)
+        assert '"host_stall_max_s": null' in saved and "host stall" not in res.stderr

@@ -4,7 +4,9 @@ The firmware times the phases itself (``ticks_us``) and reports each one live; t
 sends a heartbeat all along, so that a host that dies or a cable that is pulled leaves the
 robot at rest within the heartbeat timeout. Whatever happens, ``run.json`` holds what
 arrived, with status ``complete`` only when every phase was reported and the firmware
-finished the schedule.
+finished the schedule. On a virtual robot each phase also gets its host stall (the time the
+host held the interpreter off while it was due, :mod:`locust.device.stalls`), so the record
+can say when the timing is the host's rather than the firmware's.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from ..io import run_record as R
 from .board import read_board
 from .link import CLOSED, Link
 from .replies import done_event, phase_event, report_page
+from .stalls import StallWatch
 
 RECORD_EVERY_S = 0.25  # run.json is rewritten at most this often during a hop
 
@@ -38,7 +41,7 @@ def _fetch_report(link: Link, rec: R.RunRecord) -> None:
 
 def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             on_phase: Callable[[R.Phase], None] = lambda p: None,
-            robot: R.RobotSource | None = None) -> R.RunRecord:
+            robot: R.RobotSource | None = None, stalls: StallWatch | None = None) -> R.RunRecord:
     """Run ``schedule`` on the robot, writing ``run.json`` in ``directory`` as phases arrive.
 
     No record is written until the board answers the handshake. Whatever ends the hop
@@ -57,6 +60,10 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
         ``on_phase(phase)`` for each phase as it arrives.
     robot : RobotSource, optional
         The robot recorded in ``run.json`` (a virtual robot's preset or robot file).
+    stalls : StallWatch, optional
+        A virtual robot's watch on its interpreter (:attr:`VirtualRobot.stalls`): each phase
+        gets its host stall, and the record says when the timing is the host's. None for a
+        real board (not applicable).
 
     Returns
     -------
@@ -88,6 +95,8 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
         while not link.events.empty():  # a boot event from before we connected is old news
             link.events.get_nowait()
         link.start_heartbeat(schedule.heartbeat_ms / 8000.0)  # 8 beats in each timeout
+        if stalls is not None:
+            stalls.start()
         reply = link.request("hop", cycles=schedule.cycles, push_deg=schedule.push_deg,
                              push_ms=schedule.push_ms, wait_ms=schedule.wait_ms,
                              heartbeat_ms=schedule.heartbeat_ms)
@@ -126,11 +135,15 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
                     last_write = time.monotonic()
                 on_phase(phase)
             elif ev.get("ev") == P.EV_DONE:
-                rec.firmware_status, rec.firmware_ticks_us = done_event(ev, link.port)
+                rec.firmware_status, rec.firmware_ticks_us, end_us = done_event(ev, link.port)
                 break
         link.stop_heartbeat()
         if len(rec.phases) < schedule.phases:
             _fetch_report(link, rec)
+        if stalls is not None:
+            stalls.stop()
+            if rec.firmware_ticks_us and end_us is not None:
+                rec.set_host_stalls(stalls.phase_stalls_us(rec.firmware_ticks_us[1], end_us, rec.phases))
     except KeyboardInterrupt:
         _stop_quietly(link)
         rec.status, rec.message = R.INCOMPLETE, "interrupted (Ctrl-C or a kill); the robot was sent to rest"
@@ -147,6 +160,8 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
                           f"partial record in {directory / R.RECORD_NAME})", exc.hint) from None
     finally:
         link.stop_heartbeat()
+        if stalls is not None:
+            stalls.stop()
     complete = rec.firmware_status == P.HOP_COMPLETE and len(rec.phases) == schedule.phases
     rec.status = R.COMPLETE if complete else R.INCOMPLETE
     rec.message = None if complete else f"firmware ended the hop: {rec.firmware_status}"

@@ -157,8 +157,8 @@ def phase_event(ev: dict, port: str) -> R.Phase:
                          ev.get("measured_us"))
 
 
-def done_event(ev: dict, port: str) -> tuple[str, list[int] | None]:
-    """The status and tick counts of a ``done`` event.
+def done_event(ev: dict, port: str) -> tuple[str, list[int] | None, int | None]:
+    """The status, tick counts and length of a ``done`` event.
 
     Parameters
     ----------
@@ -170,21 +170,24 @@ def done_event(ev: dict, port: str) -> tuple[str, list[int] | None]:
     Returns
     -------
     tuple
-        (status, ticks_us): the firmware's status text and its ``ticks_us`` at the start and
-        end of the hop [us], or None when it sent none.
+        (status, ticks_us, rest_us): the firmware's status text, its ``ticks_us`` at the start
+        and end of the hop [us] (None when it sent none), and the hop's length on its clock at
+        that end [us] (None when it sent none).
 
     Raises
     ------
     DeviceError
         A field is out of shape or out of range.
     """
-    status, ticks = ev.get("status"), ev.get("ticks_us")
+    status, ticks, rest = ev.get("status"), ev.get("ticks_us"), ev.get("rest_us")
     if not _is_text(status):
         raise malformed(port, "done event has no status text", ev)
     if ticks is not None and not (isinstance(ticks, list) and len(ticks) == 2
                                   and all(_is_int(t, 0, TICKS_US_MAX) for t in ticks)):
         raise malformed(port, "done event's ticks_us is not two whole numbers 0 to 2^30", ev)
-    return status, ticks
+    if rest is not None and not _is_int(rest, 0, MAX_PHASE_US):
+        raise malformed(port, f"done event's rest_us is not a whole number 0 to {MAX_PHASE_US:,} us", ev)
+    return status, ticks, rest
 
 
 def report_page(msg: dict, port: str) -> tuple[list[R.Phase], int]:
