@@ -186,9 +186,12 @@ def _child_setup(host_pid: int) -> None:  # runs in the child before exec
     _raise_priority()
 
 
+REALTIME_PRIORITY = 10   # the interpreter's SCHED_FIFO priority, when the host allows one
+
+
 def _raise_priority() -> None:
     try:
-        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(10))
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(REALTIME_PRIORITY))
         return
     except (PermissionError, OSError, AttributeError):
         pass
@@ -196,6 +199,26 @@ def _raise_priority() -> None:
         os.nice(-10)
     except (PermissionError, OSError):
         pass
+
+
+def realtime_scheduling_allowed() -> bool:
+    """Whether a virtual robot started by this process gets real-time scheduling.
+
+    Asked of the kernel itself (the calling thread is set to the interpreter's real-time
+    priority and straight back), so root, ``CAP_SYS_NICE``, an ``RLIMIT_RTPRIO`` and a cgroup
+    without real-time time all answer as they would for the interpreter.
+
+    Returns
+    -------
+    bool
+    """
+    try:
+        policy, param = os.sched_getscheduler(0), os.sched_getparam(0)
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(REALTIME_PRIORITY))
+    except (PermissionError, OSError, AttributeError):
+        return False
+    os.sched_setscheduler(0, policy, param)
+    return True
 
 
 def _catches_sigint(pid: int) -> bool:
