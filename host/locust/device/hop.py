@@ -21,19 +21,21 @@ from ..firmware import protocol as P
 from ..io import run_record as R
 from .board import read_board
 from .link import CLOSED, Link
-from .replies import done_event, phase_event, report_page
+from .replies import check_scheduled, done_event, phase_event, report_page
 from .stalls import StallWatch
 
 RECORD_EVERY_S = 0.25  # run.json is rewritten at most this often during a hop
+LATE_END_S = 3.0       # past the schedule's end, a hop whose board has not said it ended is given up
 
 
 def _fetch_report(link: Link, rec: R.RunRecord) -> None:
     """Ask for the firmware's own list of phases: fills any event lost on the line."""
     start = 0
     while True:
-        phases, total = report_page(link.call("report", start=start), link.port)
+        page = link.call("report", start=start)
+        phases, total = report_page(page, link.port)
         for phase in phases:
-            rec.add_phase(phase)
+            rec.add_phase(check_scheduled(phase, rec.schedule, link.port, page))
         start += len(phases)
         if not phases or start >= total:
             return
@@ -107,8 +109,14 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
                               "see `locust hop --help` and docs/protocol.md for the limits")
         hop_id = reply["id"]   # the id of our request: the reply was matched by it
         last_write = 0.0
-        deadline = time.monotonic() + schedule.duration_s + 3.0
+        last: R.Phase | None = None
+        deadline = time.monotonic() + schedule.duration_s + LATE_END_S
         while True:
+            if time.monotonic() > deadline:   # (a board that reports on and on never ends the hop)
+                raise DeviceError(f"the robot had not ended the hop {LATE_END_S:g} s after its "
+                                  f"{schedule.duration_s:g} s schedule",
+                                  "the board's firmware is not this toolkit's, or it is damaged: flash it again "
+                                  "with `locust flash`")
             try:
                 ev = link.events.get(timeout=max(0.1, deadline - time.monotonic()))
             except queue.Empty:
@@ -125,7 +133,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             if ev.get("hop") != hop_id:
                 continue
             if ev.get("ev") == P.EV_PHASE:
-                phase = phase_event(ev, link.port)
+                phase = last = check_scheduled(phase_event(ev, link.port), schedule, link.port, ev, last)
                 rec.add_phase(phase)
                 # rewriting the whole record at each of 2000 phases costs more than the phases
                 # last: a host that falls behind stops reading, the board's output blocks and its
