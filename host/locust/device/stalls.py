@@ -3,7 +3,7 @@
 The virtual robot's firmware times its phases on the host's clock: a host that does not run
 the interpreter when a phase is due makes that phase late, and the run record would show it
 as the firmware's lateness. :class:`StallWatch` samples the interpreter's own scheduling
-accounting every millisecond while a hop runs:
+accounting while a hop runs, every millisecond while it is awake (every 5 ms while it sleeps):
 
 - ``/proc/PID/schedstat``: the time it has run on a CPU, the time it has waited on a run
   queue, and how many times it was put on a CPU;
