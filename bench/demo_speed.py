@@ -6,7 +6,7 @@ while the MuJoCo plant steps the model and renders the video. A hop cannot take 
 the firmware's schedule; everything above it is start-up (the command's imports, the
 interpreter's boot, the handshake) and the plant's rendering when it lags behind the clock.
 This runs the stage as the demo does (the same commands, a fresh virtual robot folder), once
-with one hop at a time and once with the demo's ``HOP_JOBS`` at once, and prints per hop the
+with one hop at a time and once with as many at once as the demo films (``hop_jobs``), and prints per hop the
 video's frames, the share of them that film the hop (the foot away from where it stood and
 from where it comes to rest), the firmware's worst phase start error, and the stage's wall
 time against the hops' real time:
@@ -29,7 +29,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from locust.commands.demo import HOP_JOBS, REPORT_SAMPLES, Demo
+from locust.commands.demo import REPORT_SAMPLES, Demo, hop_jobs
 from locust.demo.virtual_robot import virtual_robot
 from locust.io.robot_toml import save_robot
 from locust.params import LEG_SETS
@@ -86,7 +86,8 @@ def main() -> None:
     args = ap.parse_args()
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     walls = {}
-    for jobs in (1, HOP_JOBS):
+    at_once = hop_jobs(os.cpu_count() or 1)
+    for jobs in (1, at_once):
         print(f"hops stage, {jobs} at a time:")
         walls[jobs], real = hops_stage(args.trials, args.cycles, jobs)
         print(f"  {walls[jobs]:.1f} s, {walls[jobs] / real:.2f}x the hops' real time ({real:.1f} s); "
@@ -102,8 +103,8 @@ def main() -> None:
                                          "--sweep", str(run / "sweep"), "--before", str(cal / "robot-bench.toml"),
                                          "--samples", str(REPORT_SAMPLES), "--out", tmp])
             print(f"report stage: {time.perf_counter() - t:.1f} s; load average {os.getloadavg()[0]:.2f}")
-    print(f"hops stage: {walls[1]:.1f} s one at a time, {walls[HOP_JOBS]:.1f} s {HOP_JOBS} at once "
-          f"({walls[1] / walls[HOP_JOBS]:.2f}x); {real:.1f} s of hops")
+    print(f"hops stage: {walls[1]:.1f} s one at a time, {walls[at_once]:.1f} s {at_once} at once "
+          f"({walls[1] / walls[at_once]:.2f}x); {real:.1f} s of hops")
 
 
 if __name__ == "__main__":

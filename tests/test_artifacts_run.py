@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import html
 import json
 
 import click
@@ -12,6 +13,7 @@ from locust.errors import DeviceError, TrialError
 from locust.firmware import protocol as P
 from locust.io import run_record as R
 from locust.report.compare import timing_rows, trial_cycles
+from locust.report.page import timing_table
 from locust.trials.measured import load_trial
 
 
@@ -44,6 +46,48 @@ def test_a_partial_record_reads_back_equal_too(tmp_path):
     assert R.read_run_record(tmp_path / R.RECORD_NAME) == rec
 
 
+def test_a_virtual_robots_host_stalls_read_back_equal(tmp_path):
+    """Each phase's host stall (us) is data; the longest (s) and the note follow from it."""
+    rec = _record()
+    rec.phases[2] = R.Phase(2, "push", 1_150_000, 1_238_500)    # 88.5 ms late
+    rec.set_host_stalls([0, 12, 88_400, 3])
+    path = R.write(rec, tmp_path)
+    doc = json.loads(path.read_text())
+    back = R.read_run_record(path)
+    assert back == rec and back.to_dict() == doc
+    assert [p["host_stall_us"] for p in doc["phases"]] == [0, 12, 88_400, 3]
+    assert doc["phases"][2]["host_stall_ms"] == 88.4
+    assert doc["host_stall_max_s"] == 0.0884
+    assert doc["timing_note"] == ("timing not representative: the host stalled 88.4 ms while cycle 2's push "
+                                  "was due (it started 88.5 ms late)")
+    doc["host_stall_max_s"], doc["timing_note"] = 1.0, "derived"     # derived: not read
+    path.write_text(json.dumps(doc))
+    assert R.read_run_record(path) == rec
+
+
+def test_a_real_boards_record_has_no_host_stall(tmp_path):
+    doc = R.write(_record(), tmp_path).read_text()
+    assert '"host_stall_max_s": null' in doc and '"timing_note": null' in doc
+    assert all(p.host_stall_us is None for p in R.read_run_record(tmp_path / R.RECORD_NAME).phases)
+
+
+@pytest.mark.parametrize("error_us, stall_us, note", [
+    (88_500, 88_400, "the host stalled 88.4 ms while cycle 1's push was due (it started 88.5 ms late)"),
+    (3_000, 1_500, "the host stalled 1.5 ms"),     # 1.5 ms of 3 late: the firmware's own 1.5 is in the bound
+    (1_500, 1_500, None),                          # within the bound, whoever caused it
+    (50_000, 500, None),                           # 49.5 ms the firmware's own: its timing, shown as such
+    (2_100, 2_050, "the host stalled 2.0 ms"),     # over the bound
+    (4_100, 2_000, None),                          # the firmware's own 2.1 ms is over the bound
+])
+def test_the_timing_note_says_when_the_lateness_is_the_hosts(error_us, stall_us, note):
+    phases = [R.Phase(1, "push", 0, error_us, stall_us), R.Phase(1, "wait", 300_000, 300_050, 0)]
+    got = R.timing_note(phases)
+    if note is None:
+        assert got is None
+    else:
+        assert got.startswith("timing not representative: " + note), got
+
+
 def test_phase_times_stay_in_microseconds_and_convert_in_one_place():
     p = R.Phase(1, "wait", 300_000, 300_040)
     assert (p.commanded_ms, p.measured_ms, p.error_ms) == (300.0, 300.04, R.us_to_ms(40))
@@ -69,6 +113,9 @@ def test_derived_fields_are_not_read(tmp_path):
     ({"schedule": {"cycles": 2, "push_deg": -30, "push_ms": 300.5, "wait_ms": 1000}, "phases": []}, "whole number"),
     ({"schedule": {"cycles": 2, "push_deg": -30, "push_ms": 300, "wait_ms": 1000},
       "phases": [{"cycle": 1, "phase": "push", "commanded_us": 0}]}, "phase 1"),
+    ({"schedule": {"cycles": 1, "push_deg": -30, "push_ms": 300, "wait_ms": 1000},
+      "phases": [{"cycle": 1, "phase": "push", "commanded_us": 0, "measured_us": 9, "host_stall_us": -5}]},
+     "phase 1's host_stall_us"),
 ])
 def test_bad_records_are_named(tmp_path, doc, message):
     path = tmp_path / R.RECORD_NAME
@@ -98,7 +145,13 @@ def test_the_report_reads_run_json_through_the_record(tmp_path):
     assert trial_cycles(trial, 6) == 2
     (row,) = timing_rows("small", [trial])
     assert (row.status, row.phases, row.phases_expected, row.firmware) == ("complete", 4, 4, "0.1.0")
-    assert row.jitter == R.jitter(rec.phases)
+    assert row.jitter == R.jitter(rec.phases) and row.timing_note is None
+    rec.set_host_stalls([0, 0, 25_000, 0])
+    R.write(rec, tmp_path / "small-2")
+    (row,) = timing_rows("small", [load_trial(tmp_path / "small-2", "small")])
+    assert row.timing_note == R.timing_note(rec.phases) and "stalled 25.0 ms" in row.timing_note
+    status = f'data-config="small" data-field="status:small-2">complete; {html.escape(row.timing_note)}</td>'
+    assert status in timing_table([row], {"small": "Small"})     # where the report shows the firmware's timing
     (tmp_path / "bad").mkdir()
     (tmp_path / "bad" / R.RECORD_NAME).write_text("[]")
     with pytest.raises(TrialError, match="not a run record"):

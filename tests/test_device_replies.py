@@ -115,7 +115,8 @@ TARGETS = [
                "commanded_us": WRONG_TYPES + [HUGE, -HUGE, -INF, NAN, 1.5, -1],
                "measured_us": WRONG_TYPES + [HUGE, -HUGE, -INF, NAN, 1.5, -1]}, ["hop"]),
     ("done", {"status": [MISSING, 5, HUGE, INF, [], {}, True, None, 1.5, "x" * 500],
-              "ticks_us": ["x", 5, HUGE, INF, [], {}, [1], True, 1.5, [HUGE, 0], [1, INF]]}, ["hop"]),
+              "ticks_us": ["x", 5, HUGE, INF, [], {}, [1], True, 1.5, [HUGE, 0], [1, INF]],
+              "rest_us": ["x", HUGE, -HUGE, INF, NAN, [], {}, True, 1.5, -1]}, ["hop"]),
     ("hop", {"id": ["x", HUGE, INF, [], {}, [1], None, 1.5, True]}, ["hop"]),   # then no reply to this request
     ("pose", {"left_deg": WRONG_TYPES + [HUGE, -INF, NAN, "micropython", 1e6],
               "right_deg": WRONG_TYPES + [HUGE, -INF, NAN, "micropython", 1e6]}, ["pose"]),
@@ -172,4 +173,110 @@ def test_the_double_answers_as_the_firmware_does(tmp_path, command):
         board.close()
     assert res.exit_code == 0, res.output
     if command == "hop":
-        assert '"status": "complete"' in (tmp_path / "run" / "run.json").read_text()
+        saved = (tmp_path / "run" / "run.json").read_text()
+        assert '"status": "complete"' in saved
+        # a board's own clock times its phases: no host to stall it (not applicable)
+        assert '"host_stall_max_s": null' in saved and "host stall" not in res.stderr
+
+
+# -- phases that are not the schedule's, a hop that never ends, a config out of the firmware's limits --
+
+def _phases(change):
+    """A spoil that passes each phase event (by its index ``i``) through ``change(i, event)``."""
+    return lambda what, msg: change(msg["i"], dict(msg)) if what == "phase" else msg
+
+
+def _set(**by_index):
+    """``change`` setting, for phase ``i``, each field to ``by_index[field][i]``."""
+    def change(i, msg):
+        for key, values in by_index.items():
+            msg[key] = values[i]
+        return msg
+    return change
+
+
+# the hop of _args: 1 cycle, push 50 ms then wait 50 ms: commanded at 0 and 50,000 us
+NOT_THE_SCHEDULES = {
+    "a clock that runs backwards": (_set(measured_us=[60_000, 50_100]), "its clock ran backwards"),
+    "cycle 0": (_set(cycle=[0, 0]), "not a phase of the 1 cycles sent"),
+    "cycles 998 and 997": (_set(cycle=[998, 997]), "not a phase of the 1 cycles sent"),
+    "every commanded start 0": (_set(commanded_us=[0, 0]), "not at the schedule's 50,000 us"),
+    "a phase started early": (_set(measured_us=[150, 49_000]), "before it was due"),
+    "a wait reported before its push": (_set(phase=["wait", "push"], commanded_us=[50_000, 0],
+                                             measured_us=[50_150, 50_300]), "came after cycle 1's wait"),
+}
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("case", list(NOT_THE_SCHEDULES))
+def test_a_phase_that_is_not_the_schedules_is_a_clear_error(tmp_path, monkeypatch, case):
+    change, words = NOT_THE_SCHEDULES[case]
+    board = FakeBoard(_phases(change))
+    monkeypatch.chdir(tmp_path)
+    try:
+        res = invoke(_args("hop", board.port, tmp_path))
+    finally:
+        board.close()
+    assert_clear_error(res, "the board's", "in the line {", words)
+    assert '"status": "incomplete"' in (tmp_path / "run" / "run.json").read_text()
+
+
+class RepeatingBoard(FakeBoard):
+    """Answers the hop, then sends one event every millisecond and never ends the hop: the
+    hop's first phase again and again, or (``other_hop``) a phase of another hop."""
+
+    def __init__(self, other_hop: bool):
+        self.other_hop = other_hop
+        super().__init__()
+
+    def _answer(self, req):
+        if req.get("cmd") != "hop":
+            return super()._answer(req)
+        self._send("hop", P.reply(req["id"]))
+        ev = P.event(P.EV_PHASE, hop=req["id"] + 1000 * self.other_hop, i=0, cycle=1, phase="push",
+                     commanded_us=0, measured_us=150)
+
+        def repeat():
+            while not self.stopped.is_set():
+                try:
+                    os.write(self.master, P.encode(ev))
+                except OSError:
+                    return
+                time.sleep(0.001)
+        threading.Thread(target=repeat, daemon=True).start()
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("other_hop, words", [(False, ["came after cycle 1's push", "the board's"]),
+                                              (True, ["had not ended the hop 3 s after its 0.1 s schedule"])])
+def test_a_board_that_reports_on_and_on_is_given_up_by_the_schedules_end(tmp_path, monkeypatch, other_hop, words):
+    board = RepeatingBoard(other_hop)
+    monkeypatch.chdir(tmp_path)
+    try:
+        t0 = time.monotonic()
+        res = invoke(_args("hop", board.port, tmp_path))
+        seconds = time.monotonic() - t0
+    finally:
+        board.close()
+    assert_clear_error(res, *words)
+    assert seconds < 0.1 + 3.0 + 5.0    # the schedule, the 3 s of grace, the handshake on a loaded host
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("field, value", [("pin", 99999), ("trim_deg", 1e308), ("travel_deg", -5)])
+@pytest.mark.parametrize("command", ["config", "hop"])
+def test_a_config_outside_the_firmwares_own_limits_is_not_in_use(tmp_path, monkeypatch, field, value, command):
+    def spoil(what, msg):
+        if what == "config":
+            msg = dict(msg, config=fw_config.default("esp32"))
+            msg["config"]["left"] = dict(msg["config"]["left"], **{field: value})
+        return msg
+
+    board = FakeBoard(spoil)
+    monkeypatch.chdir(tmp_path)
+    try:
+        res = invoke(_args(command, board.port, tmp_path))
+    finally:
+        board.close()
+    assert_clear_error(res, "the board's config reply holds a config the firmware refuses", f"left.{field}=")
+    assert "in use" not in res.output

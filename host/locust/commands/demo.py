@@ -55,9 +55,20 @@ SHARE_DRAWS = 16     # draws of each leg set's outcome shares (stage 6)
 # against 0.3 s and 2.9 s for a leg set's run and its draws, docs/performance.md): so many steps
 # on its bar keep the time left within 2x from a quarter of the stage on
 REPORT_FIGURE_STEPS = 3
-# hops filmed at once: each takes about one core (its video's rendering) while its firmware
-# paces it in real time, so two keep a 2-core machine busy without slowing the firmware's clock
+# Hops filmed at once: each takes about one core (its video's rendering) while its firmware
+# paces it in real time. With real-time scheduling the interpreters run ahead of the renders:
+# two at once on 2 cores keep every phase within 0.12 ms, as one at a time does (12 hops
+# each, bench/hop_timing.py). Without it the renders starve them: two filmed at once put
+# phases 238 ms late, one at a time 59 ms (the run records say the host stalled that long).
 HOP_JOBS = 2
+
+
+def hop_jobs(cores: int) -> int:
+    """Hops filmed at once on ``cores`` cores: up to HOP_JOBS where the virtual robot gets
+    real-time scheduling, else one (a phase late only by the host is still not the firmware's)."""
+    from ..device.virtual import realtime_scheduling_allowed
+
+    return max(1, min(HOP_JOBS, cores)) if realtime_scheduling_allowed() else 1
 
 
 # a progress line (locust.progress) always says how long it has run
@@ -272,7 +283,8 @@ TICK_S = 1.0   # a stage's bar is looked at this often (it shows itself when due
 @click.option("--designs", type=click.IntRange(2, 61), default=7, show_default=True,
               help="Designs in the sweep: scale from 0 to 30 mm added to every link.")
 @click.option("--jobs", type=click.IntRange(1, 64), default=None,
-              help=f"Sweep workers, and hops filmed at once up to {HOP_JOBS} [every local core].")
+              help="Sweep workers, and hops filmed at once up to 2 (1 where the virtual robot gets no "
+                   "real-time scheduling: its phases would be late) [every local core].")
 @click.option("--fit-hops/--no-fit-hops", default=True, show_default=True,
               help="Fit what the bench cannot reach from the filmed hops of Medium and Large.")
 def demo(out, cycles, trials, designs, jobs, fit_hops):
@@ -312,12 +324,12 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
         with d.stage(next(stage), total, f"hop Small, Medium, Large x {trials} on the virtual robot, {cycles} cycles, "
                                          "filmed"):
             # each hop is its own virtual robot (the one flash folder, read only), the firmware paced
-            # in real time while one core renders its video: HOP_JOBS of them film at once
+            # in real time while one core renders its video: hop_jobs() of them film at once
             hops = [(["hop", "--port", "sim", "--config", str(truth_toml), "--leg-set", name, "--cycles", str(cycles),
                       "--video", str(trial / "hop.mp4"), "--out", str(trial)],
                      (trial / "hop.mp4", trial / "run.json")) for name, trial in trials_dirs]
             with d.bar(None, "hops", length=len(hops)) as bar:
-                d.call_side_by_side(hops, min(HOP_JOBS, jobs or os.cpu_count() or 1), bar)
+                d.call_side_by_side(hops, hop_jobs(jobs or os.cpu_count() or 1), bar)
         with d.stage(next(stage), total, "track nose and foot in the videos"):
             with d.bar(trials_dirs, "tracks") as bar:
                 for _, trial in bar:

@@ -84,15 +84,16 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     previous = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
     rec = None
     simulated: dict = {}     # the virtual robot's simulated hops (--port sim)
+    virtual: list = []       # the virtual robot (--port sim): its host's stalls go in the record
     try:
         with open_port(port, plant=plant, video=video, robot=robot, info=info, video_fps=video_fps,
-                       on_close=simulated.update) as device:
+                       on_close=simulated.update, on_open=virtual.append) as device:
             with Link(device) as link:
                 with progress(length=schedule.phases, label="hop") as bar:
                     rec = run_hop(link, schedule, directory,
                                   on_phase=lambda p: (bar.update(1),
                                                       setattr(bar, "label", f"cycle {p.cycle} {p.phase}")),
-                                  robot=source)
+                                  robot=source, stalls=virtual[0].stalls if virtual else None)
     except BaseException as exc:
         reported = _note_after_hop(rec, directory, exc) if isinstance(exc, LocustError) else exc
         if isinstance(exc, KeyboardInterrupt) and not (directory / R.RECORD_NAME).exists():
@@ -112,10 +113,14 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
         if simulated.get("plant") == "mujoco":
             doc["simulated"] = simulated      # what the virtual robot's simulation did, SI units
         click.echo(json_text(doc), nl=False)
-    j = R.jitter(rec.phases)
+    j, stall_s = R.jitter(rec.phases), R.host_stall_max_s(rec.phases)
     info(f"{rec.status}: {len(rec.phases)}/{schedule.phases} phases"
           + (f", start error max {j.max_abs_ms:.3f} ms (mean {j.mean_ms:.3f}, sd {j.std_ms:.3f})" if j else "")
+          + (f", host stall max {stall_s * 1000:.2f} ms" if stall_s is not None else "")
           + f"; record {path}")
+    note = R.timing_note(rec.phases)
+    if note:
+        info(f"{note}; that lateness is the host's, not the firmware's: hop again with less running beside it")
     if rec.status == R.DEFAULT_CONFIG:
         raise DeviceError(f"every phase ran, but {rec.message}",
                           f"{R.CONFIG_FIX_HINT}; then hop again (this record, {path}, says {R.DEFAULT_CONFIG})")

@@ -10,6 +10,7 @@
   and keep ``run.json`` up to date; :mod:`.repl`: mpremote's REPL on the port.
 - :mod:`.virtual`: the real firmware on the MicroPython unix port behind a pseudo-terminal,
   with the ``machine_shim`` modules as its hardware; :mod:`.plant`: what its servos drive
-  (a recorder or the live MuJoCo model); :mod:`.announce`: which robot a running
+  (a recorder or the live MuJoCo model); :mod:`.stalls`: how long the host held its
+  interpreter off the CPU while a phase was due; :mod:`.announce`: which robot a running
   ``locust virtual`` simulates.
 """

@@ -36,7 +36,7 @@ def read_board(link: Link, hello: dict | None = None) -> R.BoardConfig:
         The board does not answer, refuses, or answers out of shape.
     """
     hello = hello or link.hello()
-    cfg = check_config(link.call("config"), link.port)
+    cfg = check_config(link.call("config"), link.port, hello.get("chip"))
     return R.board_config({**cfg, "chip": hello.get("chip"), "machine": hello.get("machine"),
                            "config_problems": hello.get("config_problems") or []}, f"the board on {link.port}")
 

@@ -4,7 +4,9 @@ The firmware times the phases itself (``ticks_us``) and reports each one live; t
 sends a heartbeat all along, so that a host that dies or a cable that is pulled leaves the
 robot at rest within the heartbeat timeout. Whatever happens, ``run.json`` holds what
 arrived, with status ``complete`` only when every phase was reported and the firmware
-finished the schedule.
+finished the schedule. On a virtual robot each phase also gets its host stall (the time the
+host held the interpreter off while it was due, :mod:`locust.device.stalls`), so the record
+can say when the timing is the host's rather than the firmware's.
 """
 
 from __future__ import annotations
@@ -19,18 +21,21 @@ from ..firmware import protocol as P
 from ..io import run_record as R
 from .board import read_board
 from .link import CLOSED, Link
-from .replies import done_event, phase_event, report_page
+from .replies import check_scheduled, done_event, phase_event, report_page
+from .stalls import StallWatch
 
 RECORD_EVERY_S = 0.25  # run.json is rewritten at most this often during a hop
+LATE_END_S = 3.0       # past the schedule's end, a hop whose board has not said it ended is given up
 
 
 def _fetch_report(link: Link, rec: R.RunRecord) -> None:
     """Ask for the firmware's own list of phases: fills any event lost on the line."""
     start = 0
     while True:
-        phases, total = report_page(link.call("report", start=start), link.port)
+        page = link.call("report", start=start)
+        phases, total = report_page(page, link.port)
         for phase in phases:
-            rec.add_phase(phase)
+            rec.add_phase(check_scheduled(phase, rec.schedule, link.port, page))
         start += len(phases)
         if not phases or start >= total:
             return
@@ -38,7 +43,7 @@ def _fetch_report(link: Link, rec: R.RunRecord) -> None:
 
 def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             on_phase: Callable[[R.Phase], None] = lambda p: None,
-            robot: R.RobotSource | None = None) -> R.RunRecord:
+            robot: R.RobotSource | None = None, stalls: StallWatch | None = None) -> R.RunRecord:
     """Run ``schedule`` on the robot, writing ``run.json`` in ``directory`` as phases arrive.
 
     No record is written until the board answers the handshake. Whatever ends the hop
@@ -57,6 +62,10 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
         ``on_phase(phase)`` for each phase as it arrives.
     robot : RobotSource, optional
         The robot recorded in ``run.json`` (a virtual robot's preset or robot file).
+    stalls : StallWatch, optional
+        A virtual robot's watch on its interpreter (:attr:`VirtualRobot.stalls`): each phase
+        gets its host stall, and the record says when the timing is the host's. None for a
+        real board (not applicable).
 
     Returns
     -------
@@ -88,6 +97,8 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
         while not link.events.empty():  # a boot event from before we connected is old news
             link.events.get_nowait()
         link.start_heartbeat(schedule.heartbeat_ms / 8000.0)  # 8 beats in each timeout
+        if stalls is not None:
+            stalls.start()
         reply = link.request("hop", cycles=schedule.cycles, push_deg=schedule.push_deg,
                              push_ms=schedule.push_ms, wait_ms=schedule.wait_ms,
                              heartbeat_ms=schedule.heartbeat_ms)
@@ -98,8 +109,14 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
                               "see `locust hop --help` and docs/protocol.md for the limits")
         hop_id = reply["id"]   # the id of our request: the reply was matched by it
         last_write = 0.0
-        deadline = time.monotonic() + schedule.duration_s + 3.0
+        last: R.Phase | None = None
+        deadline = time.monotonic() + schedule.duration_s + LATE_END_S
         while True:
+            if time.monotonic() > deadline:   # (a board that reports on and on never ends the hop)
+                raise DeviceError(f"the robot had not ended the hop {LATE_END_S:g} s after its "
+                                  f"{schedule.duration_s:g} s schedule",
+                                  "the board's firmware is not this toolkit's, or it is damaged: flash it again "
+                                  "with `locust flash`")
             try:
                 ev = link.events.get(timeout=max(0.1, deadline - time.monotonic()))
             except queue.Empty:
@@ -116,7 +133,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
             if ev.get("hop") != hop_id:
                 continue
             if ev.get("ev") == P.EV_PHASE:
-                phase = phase_event(ev, link.port)
+                phase = last = check_scheduled(phase_event(ev, link.port), schedule, link.port, ev, last)
                 rec.add_phase(phase)
                 # rewriting the whole record at each of 2000 phases costs more than the phases
                 # last: a host that falls behind stops reading, the board's output blocks and its
@@ -126,11 +143,15 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
                     last_write = time.monotonic()
                 on_phase(phase)
             elif ev.get("ev") == P.EV_DONE:
-                rec.firmware_status, rec.firmware_ticks_us = done_event(ev, link.port)
+                rec.firmware_status, rec.firmware_ticks_us, end_us = done_event(ev, link.port)
                 break
         link.stop_heartbeat()
         if len(rec.phases) < schedule.phases:
             _fetch_report(link, rec)
+        if stalls is not None:
+            stalls.stop()
+            if rec.firmware_ticks_us and end_us is not None:
+                rec.set_host_stalls(stalls.phase_stalls_us(rec.firmware_ticks_us[1], end_us, rec.phases))
     except KeyboardInterrupt:
         _stop_quietly(link)
         rec.status, rec.message = R.INCOMPLETE, "interrupted (Ctrl-C or a kill); the robot was sent to rest"
@@ -147,6 +168,8 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
                           f"partial record in {directory / R.RECORD_NAME})", exc.hint) from None
     finally:
         link.stop_heartbeat()
+        if stalls is not None:
+            stalls.stop()
     complete = rec.firmware_status == P.HOP_COMPLETE and len(rec.phases) == schedule.phases
     rec.status = R.COMPLETE if complete else R.INCOMPLETE
     rec.message = None if complete else f"firmware ended the hop: {rec.firmware_status}"

@@ -13,7 +13,9 @@ import math
 import re
 
 from ..errors import DeviceError
+from ..firmware import config as fw_config
 from ..firmware import protocol as P
+from ..firmware import schedule as fw_schedule
 from ..io import run_record as R
 
 _HOP = P.COMMANDS["hop"]
@@ -99,8 +101,12 @@ def check_hello(msg: dict, port: str) -> dict:
     return msg
 
 
-def check_config(msg: dict, port: str) -> dict:
-    """The ``config`` object of a ``config`` reply (its servos are checked by ``board_config``).
+def check_config(msg: dict, port: str, chip: str | None = None) -> dict:
+    """The ``config`` object of a ``config`` reply, within the firmware's own limits.
+
+    The firmware runs only on a config that passes its own checks (``config.problems``: each
+    value's limits, and ``chip``'s pin rules), its saved config.json or else its default: a
+    reply outside them is not what it runs on.
 
     Parameters
     ----------
@@ -108,6 +114,8 @@ def check_config(msg: dict, port: str) -> dict:
         The board's ``config`` reply.
     port : str
         The serial port, for the message.
+    chip : str, optional
+        The chip the board says it is (its ``hello``), whose pins are checked too.
 
     Returns
     -------
@@ -117,11 +125,14 @@ def check_config(msg: dict, port: str) -> dict:
     Raises
     ------
     DeviceError
-        The reply holds no config object.
+        The reply holds no config object, or one the firmware would refuse.
     """
     cfg = msg.get("config")
     if not isinstance(cfg, dict):
         raise malformed(port, "config reply holds no config object", msg)
+    problems = fw_config.problems(cfg, chip if chip in fw_config.CHIPS else None)
+    if problems:
+        raise malformed(port, f"config reply holds a config the firmware refuses to run on ({problems[0]})", msg)
     return cfg
 
 
@@ -157,8 +168,60 @@ def phase_event(ev: dict, port: str) -> R.Phase:
                          ev.get("measured_us"))
 
 
-def done_event(ev: dict, port: str) -> tuple[str, list[int] | None]:
-    """The status and tick counts of a ``done`` event.
+def check_scheduled(phase: R.Phase, schedule: R.HopSchedule, port: str, msg, after: R.Phase | None = None) -> R.Phase:
+    """``phase`` if it is one the hop's schedule commands, and may follow ``after``.
+
+    The firmware reports the phases of the schedule it was sent, in order, each started when
+    it was due or later (it spins until then), on a clock that never runs backwards.
+
+    Parameters
+    ----------
+    phase : Phase
+        A phase the board reported.
+    schedule : HopSchedule
+        The schedule sent.
+    port : str
+        The serial port, for the message.
+    msg : dict
+        The event or reply it came in (quoted).
+    after : Phase, optional
+        The phase the board reported before it, in the same stream of events.
+
+    Returns
+    -------
+    Phase
+        ``phase`` itself.
+
+    Raises
+    ------
+    DeviceError
+        Not a phase of the schedule, not its commanded start, started early, out of order, or
+        measured before the phase before it.
+    """
+    i = 2 * (phase.cycle - 1) + (phase.phase == "wait")
+    if not 0 <= i < schedule.phases:
+        raise malformed(port, f"phase is cycle {phase.cycle}'s {phase.phase}, not a phase of the {schedule.cycles} "
+                              "cycles sent", msg)
+    start_us = fw_schedule.phase(i, schedule.push_deg, schedule.push_ms, schedule.wait_ms)[2]
+    if phase.commanded_us != start_us:
+        raise malformed(port, f"phase says cycle {phase.cycle}'s {phase.phase} was commanded at "
+                              f"{phase.commanded_us:,} us, not at the schedule's {start_us:,} us", msg)
+    if phase.measured_us < phase.commanded_us:
+        raise malformed(port, f"phase started {phase.commanded_us - phase.measured_us:,} us before it was due "
+                              "(the firmware waits for each phase's start)", msg)
+    if after is not None:
+        before = 2 * (after.cycle - 1) + (after.phase == "wait")
+        if i <= before:
+            raise malformed(port, f"phase cycle {phase.cycle}'s {phase.phase} came after cycle {after.cycle}'s "
+                                  f"{after.phase} (the firmware reports them in order, once each)", msg)
+        if phase.measured_us < after.measured_us:
+            raise malformed(port, f"phase was measured {after.measured_us - phase.measured_us:,} us before the one "
+                                  "before it: its clock ran backwards", msg)
+    return phase
+
+
+def done_event(ev: dict, port: str) -> tuple[str, list[int] | None, int | None]:
+    """The status, tick counts and length of a ``done`` event.
 
     Parameters
     ----------
@@ -170,21 +233,24 @@ def done_event(ev: dict, port: str) -> tuple[str, list[int] | None]:
     Returns
     -------
     tuple
-        (status, ticks_us): the firmware's status text and its ``ticks_us`` at the start and
-        end of the hop [us], or None when it sent none.
+        (status, ticks_us, rest_us): the firmware's status text, its ``ticks_us`` at the start
+        and end of the hop [us] (None when it sent none), and the hop's length on its clock at
+        that end [us] (None when it sent none).
 
     Raises
     ------
     DeviceError
         A field is out of shape or out of range.
     """
-    status, ticks = ev.get("status"), ev.get("ticks_us")
+    status, ticks, rest = ev.get("status"), ev.get("ticks_us"), ev.get("rest_us")
     if not _is_text(status):
         raise malformed(port, "done event has no status text", ev)
     if ticks is not None and not (isinstance(ticks, list) and len(ticks) == 2
                                   and all(_is_int(t, 0, TICKS_US_MAX) for t in ticks)):
         raise malformed(port, "done event's ticks_us is not two whole numbers 0 to 2^30", ev)
-    return status, ticks
+    if rest is not None and not _is_int(rest, 0, MAX_PHASE_US):
+        raise malformed(port, f"done event's rest_us is not a whole number 0 to {MAX_PHASE_US:,} us", ev)
+    return status, ticks, rest
 
 
 def report_page(msg: dict, port: str) -> tuple[list[R.Phase], int]:

@@ -15,7 +15,8 @@ from .ports import SIM, autodetect, list_serial_ports
 @contextlib.contextmanager
 def open_port(port: str | None, plant: str = "auto", video: Path | None = None, robot=None,
               info=None, video_fps: int = 60, firmware: bool = True,
-              on_close: Callable[[dict], None] | None = None) -> Iterator[str]:
+              on_close: Callable[[dict], None] | None = None,
+              on_open: Callable[[object], None] | None = None) -> Iterator[str]:
     """Resolve ``--port`` for the ``with`` block: a device path, autodetection, or ``sim``.
 
     ``sim`` runs a virtual robot for the ``with`` block; with ``firmware`` (a command that talks
@@ -40,6 +41,8 @@ def open_port(port: str | None, plant: str = "auto", video: Path | None = None, 
         Require firmware in the virtual robot's flash folder.
     on_close : callable, optional
         ``on_close(summary)`` with the virtual robot's plant summary when it stops.
+    on_open : callable, optional
+        ``on_open(robot)`` with the :class:`VirtualRobot` once it runs (not called for a real port).
 
     Yields
     ------
@@ -71,6 +74,8 @@ def open_port(port: str | None, plant: str = "auto", video: Path | None = None, 
         try:
             if info:
                 info(f"virtual robot on {vr.device_path} (flash {vr.flash_dir}, {vr.scheduling} scheduling)")
+            if on_open is not None:
+                on_open(vr)
             yield vr.device_path
         finally:
             summary = vr.stop()

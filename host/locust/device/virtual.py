@@ -22,7 +22,9 @@ What runs where:
   is read off what the interpreter prints (the raw REPL's banner, the ``>>>`` prompt).
 
 The interpreter runs with real-time scheduling when the host allows it (otherwise at a raised
-or normal priority): an MCU does not share its core with a compiler and a browser.
+or normal priority): an MCU does not share its core with a compiler and a browser. Where the
+host still holds it off while a phase is due, :attr:`VirtualRobot.stalls` measures how long
+(``locust.device.stalls``), and the run record says the timing is the host's.
 
 It has a board's limits, by default those of a classic ESP32 without PSRAM (``chip`` picks
 esp32, s2, s3 or c3): ``time``'s ticks are 30-bit and start ``TICKS_LEAD_S`` before a wrap at
@@ -61,6 +63,7 @@ from ..fileio import DISK_HINT
 from ..firmware import config as fw_config
 from ..orphans import die_with_parent
 from .plant import Plant, RecordingPlant
+from .stalls import StallWatch
 
 SHIM_DIR = Path(__file__).resolve().parent / "machine_shim"
 PWM_PERIOD_S = 0.020
@@ -183,9 +186,12 @@ def _child_setup(host_pid: int) -> None:  # runs in the child before exec
     _raise_priority()
 
 
+REALTIME_PRIORITY = 10   # the interpreter's SCHED_FIFO priority, when the host allows one
+
+
 def _raise_priority() -> None:
     try:
-        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(10))
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(REALTIME_PRIORITY))
         return
     except (PermissionError, OSError, AttributeError):
         pass
@@ -193,6 +199,26 @@ def _raise_priority() -> None:
         os.nice(-10)
     except (PermissionError, OSError):
         pass
+
+
+def realtime_scheduling_allowed() -> bool:
+    """Whether a virtual robot started by this process gets real-time scheduling.
+
+    Asked of the kernel itself (the calling thread is set to the interpreter's real-time
+    priority and straight back), so root, ``CAP_SYS_NICE``, an ``RLIMIT_RTPRIO`` and a cgroup
+    without real-time time all answer as they would for the interpreter.
+
+    Returns
+    -------
+    bool
+    """
+    try:
+        policy, param = os.sched_getscheduler(0), os.sched_getparam(0)
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(REALTIME_PRIORITY))
+    except (PermissionError, OSError, AttributeError):
+        return False
+    os.sched_setscheduler(0, policy, param)
+    return True
 
 
 def _catches_sigint(pid: int) -> bool:
@@ -311,6 +337,9 @@ class VirtualRobot:
         self._end_s: float | None = None
         self.plant_error: BaseException | None = None   # raised by stop()
         self.video_dropped = False   # cancel(): the plant was stopped, its video not kept
+        # how long this host holds the interpreter off the CPU while a phase is due (a hop
+        # starts and stops it: locust.device.hop.run_hop)
+        self.stalls = StallWatch(lambda: self.interpreter_pid, self.clock_of_ticks)
 
     # -- lifecycle ---------------------------------------------------------------------
     def start(self) -> VirtualRobot:
@@ -426,6 +455,7 @@ class VirtualRobot:
 
     def _stop_interpreter(self) -> None:
         """End MicroPython and every thread but the plant's, and hand the plant its last writes."""
+        self.stalls.stop()
         with self._proc_lock:
             proc = self._proc
         if proc and proc.poll() is None:
@@ -499,6 +529,29 @@ class VirtualRobot:
 
     def __exit__(self, *exc) -> None:
         self.stop()
+
+    @property
+    def interpreter_pid(self) -> int | None:
+        """The process id of the MicroPython interpreter running now (a reboot starts another)."""
+        with self._proc_lock:
+            return self._proc.pid if self._proc is not None else None
+
+    def clock_of_ticks(self, ticks_us: int) -> float:
+        """When the firmware's ``time.ticks_us()`` last read ``ticks_us``, this boot.
+
+        Parameters
+        ----------
+        ticks_us : int
+            A reading of the board's 30-bit ticks [us].
+
+        Returns
+        -------
+        float
+            The latest instant at or before now with those ticks, ``time.monotonic()`` [s]
+            (the ticks wrap every 2^30 us: 17.9 min).
+        """
+        now_us = int(time.monotonic() * 1e6)
+        return (now_us - ((now_us + self._ticks_offset_us - ticks_us) % TICKS_PERIOD)) / 1e6
 
     def now_s(self) -> float:
         """The virtual robot's clock.

@@ -18,7 +18,7 @@ import math
 import os
 import re
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 from ..errors import DeviceError
@@ -34,6 +34,10 @@ DEFAULT_CONFIG = "default_config"
 CONFIG_FIX_HINT = ("write a valid config: `locust config --port PORT --set left.trim_deg=0` (any key; the "
                    "board saves the whole config), or `locust flash --port PORT --reset-config`")
 RECORD_NAME = "run.json"
+# a board starts each phase within 2 ms of its time (its firmware spins the last 12 ms before
+# one); a virtual robot's host that held the interpreter off longer than this while a phase
+# was due, or long enough to make a phase late past it, says the run's timing is the host's
+TIMING_BOUND_US = 2000
 READ_HINT = "give the run.json that `locust hop` wrote"
 DAMAGED_HINT = "the record is damaged; rerun the hop"
 
@@ -125,6 +129,9 @@ class Phase:
     phase: str            # "push" or "wait"
     commanded_us: int     # commanded start, from the start of the hop (firmware clock)
     measured_us: int      # measured start: when the new PWM duty was written
+    # a virtual robot's: how long its host held the interpreter off the CPU between the
+    # commanded and the measured start (None: not watched, a real board)
+    host_stall_us: int | None = None
 
     @property
     def error_us(self) -> int:
@@ -161,6 +168,8 @@ class Phase:
             "error_ms": self.error_ms,
             "commanded_us": self.commanded_us,
             "measured_us": self.measured_us,
+            "host_stall_ms": None if self.host_stall_us is None else us_to_ms(self.host_stall_us),
+            "host_stall_us": self.host_stall_us,
         }
 
 
@@ -196,6 +205,52 @@ def jitter(phases: list[Phase]) -> Jitter | None:
     return Jitter(n=len(errs), mean_ms=round(mean, 4), std_ms=round(std, 4),
                   max_abs_ms=round(max(abs(e) for e in errs), 4),
                   max_late_ms=round(max(max(errs), 0.0), 4), max_early_ms=round(max(-min(errs), 0.0), 4))
+
+
+def host_stall_max_s(phases: list[Phase]) -> float | None:
+    """The longest a virtual robot's host held its interpreter off while a phase was due.
+
+    Parameters
+    ----------
+    phases : list of Phase
+
+    Returns
+    -------
+    float or None
+        [s]; None when no phase was watched (a real board: not applicable).
+    """
+    stalls = [p.host_stall_us for p in phases if p.host_stall_us is not None]
+    return max(stalls) / 1e6 if stalls else None
+
+
+def timing_note(phases: list[Phase]) -> str | None:
+    """Why the phases' start errors are not the firmware's own, in plain words, or None.
+
+    A phase is held up by the host when the host held the interpreter off longer than
+    :data:`TIMING_BOUND_US` while it was due, or long enough that without it the phase would
+    have started within the bound.
+
+    Parameters
+    ----------
+    phases : list of Phase
+
+    Returns
+    -------
+    str or None
+        ``timing not representative: the host stalled ...``, naming the phase held up longest;
+        None when no phase was held up (and for a real board).
+    """
+    held = [p for p in phases if p.host_stall_us is not None and (
+        p.host_stall_us > TIMING_BOUND_US
+        or (p.error_us > TIMING_BOUND_US and p.error_us - p.host_stall_us <= TIMING_BOUND_US))]
+    if not held:
+        return None
+    worst = max(held, key=lambda p: p.host_stall_us)
+    note = (f"timing not representative: the host stalled {us_to_ms(worst.host_stall_us):.1f} ms while "
+            f"cycle {worst.cycle}'s {worst.phase} was due (it started {worst.error_ms:.1f} ms late)")
+    if len(held) > 1:
+        note += f"; {len(held)} phases were held up by the host"
+    return note
 
 
 _LEG_SET_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_+-]*$")
@@ -341,8 +396,18 @@ class RunRecord:
             self.phases.append(phase)
             self.phases.sort(key=lambda p: p.commanded_us)
 
+    def set_host_stalls(self, stalls_us: list[int]) -> None:
+        """Give each phase, in order, its host stall (a virtual robot's).
+
+        Parameters
+        ----------
+        stalls_us : list of int
+            [us], one per phase of :attr:`phases`.
+        """
+        self.phases = [replace(p, host_stall_us=s) for p, s in zip(self.phases, stalls_us, strict=True)]
+
     def to_dict(self) -> dict:
-        """The record as ``run.json`` holds it, with the phases' jitter.
+        """The record as ``run.json`` holds it, with the phases' jitter and the host's stalls.
 
         Returns
         -------
@@ -362,6 +427,8 @@ class RunRecord:
             "phases_expected": self.schedule.phases,
             "phases": [p.to_dict() for p in self.phases],
             "jitter": asdict(j) if j else None,
+            "host_stall_max_s": host_stall_max_s(self.phases),
+            "timing_note": timing_note(self.phases),
             "firmware_ticks_us": self.firmware_ticks_us,
             "ticks_wrapped": (None if not self.firmware_ticks_us
                               else self.firmware_ticks_us[1] < self.firmware_ticks_us[0]),
@@ -461,8 +528,9 @@ def write(record: RunRecord, directory: Path) -> Path:
 def read_run_record(path: Path) -> RunRecord:
     """A ``run.json`` back as the :class:`RunRecord` that :func:`write` wrote.
 
-    Phase times are read in their native microseconds; the derived fields (each phase's
-    milliseconds, ``phases_expected``, ``jitter``) are not read, they follow from the rest.
+    Phase times and host stalls are read in their native microseconds; the derived fields (each
+    phase's milliseconds, ``phases_expected``, ``jitter``, ``host_stall_max_s``, ``timing_note``)
+    are not read, they follow from the rest.
     A file that is not a run record, or a damaged one, raises :class:`DeviceError` naming
     the file and the field.
 
@@ -506,9 +574,11 @@ def read_run_record(path: Path) -> RunRecord:
     for i, ph in enumerate(doc["phases"]):
         if not isinstance(ph, dict) or not all(_is_int(ph.get(k)) for k in ("commanded_us", "measured_us")):
             raise DeviceError(f"{path}: phase {i + 1} has no commanded_us/measured_us integers", DAMAGED_HINT)
-        cycle = ph.get("cycle")
+        cycle, stall = ph.get("cycle"), ph.get("host_stall_us")
+        if stall is not None and not (_is_int(stall) and stall >= 0):
+            raise DeviceError(f"{path}: phase {i + 1}'s host_stall_us is not a whole number of us", DAMAGED_HINT)
         phases.append(Phase(cycle if _is_int(cycle) else 0, str(ph.get("phase", "?")),
-                            ph["commanded_us"], ph["measured_us"]))
+                            ph["commanded_us"], ph["measured_us"], stall))
     return RunRecord(
         schedule=HopSchedule(**values), port=str(doc.get("port") or ""), status=str(doc.get("status") or INCOMPLETE),
         firmware_version=_text(doc.get("firmware_version")), firmware_status=_text(doc.get("firmware_status")),

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ReportError, TrialError
-from ..io.run_record import Jitter, jitter
+from ..io.run_record import Jitter, jitter, timing_note
 from ..trials.measure import Aligned, MeasuredHop, align, measure_hops
 from ..trials.measured import Trial, span_hint
 from .ending import ON_ITS_FEET, Ending, marker_ending, simulated_ending
@@ -348,6 +348,8 @@ class TimingRow:
         The firmware version (``?`` when unrecorded).
     jitter : Jitter or None
         Phase start errors, measured minus commanded [ms].
+    timing_note : str or None
+        Why those errors are not the firmware's (a virtual robot's host that stalled), or None.
     """
 
     config: str
@@ -357,6 +359,7 @@ class TimingRow:
     phases_expected: int
     firmware: str
     jitter: Jitter | None        # start errors, ms
+    timing_note: str | None = None
 
 
 def timing_rows(config: str, trials: list[Trial]) -> list[TimingRow]:
@@ -385,5 +388,6 @@ def timing_rows(config: str, trials: list[Trial]) -> list[TimingRow]:
         rows.append(TimingRow(
             config=config, trial=t.label, status=rec.status, phases=len(rec.phases),
             phases_expected=rec.schedule.phases, firmware=rec.firmware_version or "?", jitter=jitter(rec.phases),
+            timing_note=timing_note(rec.phases),
         ))
     return rows

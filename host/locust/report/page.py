@@ -345,7 +345,9 @@ def timing_table(rows: list[TimingRow], labels: dict[str, str]) -> str:
             return f"{getattr(j, attr):.3f}" if j is not None else "—"
 
         out.append("<tr>" + "".join([
-            td(labels[r.config], left=True), td(r.trial, left=True), td(r.status, left=True), td(r.firmware),
+            td(labels[r.config], left=True), td(r.trial, left=True),
+            td(f"{r.status}; {r.timing_note}" if r.timing_note else r.status, r.config, f"status:{r.trial}", left=True),
+            td(r.firmware),
             td(f"{r.phases}/{r.phases_expected}"), td(ms("mean_ms"), r.config, f"jitter_mean_ms:{r.trial}"),
             td(ms("std_ms")), td(ms("max_abs_ms"), r.config, f"jitter_max_abs_ms:{r.trial}"),
             td(ms("max_late_ms")), td(ms("max_early_ms")),
