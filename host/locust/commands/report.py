@@ -81,7 +81,7 @@ def report(measured, config, preset, sets, added, sweep, study, cycles, marker, 
            imports):
     """Compare simulation and measurement for each configuration in one self-contained HTML page.
 
-    Each configuration (Small/Medium/Large: the --config/--preset robot with +0/+1/+2 cm on
+    Each configuration (Small/Medium/Large: the --config/--preset robot with +0/+10/+20 mm on
     all four links) is simulated with those parameters, audited, and compared with its tracks:
     displacement and height against time, jump height (± 1 sd over repeated trials), per-hop
     errors, the parameters with their source and uncertainty, the sweep landscape with the

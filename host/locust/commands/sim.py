@@ -57,7 +57,7 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
     Every run is audited (non-finite state, loop closure, energy, MuJoCo warnings). A run
     that fails its audit is reported invalid with the reasons, and exits 1 unless --json.
     A valid run's outcome is one of: goes over (ends on its back), rears and returns (nose
-    above 3 cm and back down, every hop), stays low. The standing robot's weight on its nose
+    above 30 mm and back down, every hop), stays low. The standing robot's weight on its nose
     (a kitchen scale under the nose: `locust measure nose-load`) is printed with it.
 
     \b

@@ -12,7 +12,7 @@ The four-bar is folded from one strip of laminate. The rule (the seed's ``zz.dxf
 - the strip is ``link_width_m`` wide (seed 30 mm); each hinge is a stadium slot
   ``slot_width_mm`` x ``slot_length_mm`` (seed 1 x 13 mm) centred on the strip's width.
 
-So the Medium (+1 cm a link) and Large (+2 cm) leg sets have hinges at 50, 100, 130,
+So the Medium (+10 mm a link) and Large (+20 mm) leg sets have hinges at 50, 100, 130,
 200 mm and 60, 120, 160, 240 mm, on 220 and 260 mm strips.
 """
 

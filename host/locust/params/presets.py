@@ -9,7 +9,7 @@ Presets:
   from), a time step at which the hop has converged (docs/servo.md), audited.
 - ``small`` / ``medium`` / ``large``: the seed team's robot as built (``AS_BUILT``: its
   photos, cut file and the SG90's datasheet, each value with its source) with the leg sets
-  of Part 3, +0 / +1 / +2 cm on every link of the cut file's strip, each at the time step
+  of Part 3, +0 / +10 / +20 mm on every link of the cut file's strip, each at the time step
   its hop needs (``LEG_SETS``, the one table that presets, reports and the hop fit build a
   leg set from).
 - ``seed-notebook``: the notebook's Part 2 simulation exactly (dropped from 8 cm with the
