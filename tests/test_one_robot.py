@@ -120,3 +120,17 @@ def test_a_calibration_written_to_a_new_file_is_the_default_robot_with_the_fit(s
     # the real recordings' fit (docs/servo.md): no-load speed 10.31 rad/s, kp 0.377 N*m/rad
     assert written["values"]["servo.noload_speed_rad_per_s"]["value"] == pytest.approx(10.31, abs=0.05)
     assert written["values"]["servo.kp_nm_per_rad"]["value"] == pytest.approx(0.377, abs=0.005)
+
+
+@pytest.mark.parametrize("named", [[], ["--preset", "medium"]])
+def test_a_command_writing_a_robot_file_says_first_which_robot_it_starts_from(tmp_path, named):
+    for args in (["params", *named, "--write", "a.toml"],
+                 ["measure", "nose-load", "4.2" if named else "7.4", *named, "--write", "b.toml"]):
+        done = locust_cli(*args, cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        first = done.stderr.splitlines()[0]
+        assert first == (f"robot: medium; {args[-1]} is written from it" if named else
+                         "robot: small, the robot as built (no calibration/robot.toml here; --preset or --config to "
+                         "choose another)"), first
+        written = load_robot(tmp_path / args[-1])
+        assert written.leg_set == ("medium" if named else "small")

@@ -14,7 +14,7 @@ from ..fileio import json_text
 from ..io import robot_toml
 from ..io.trk import PIXEL_CONVENTIONS
 from ..tables import for_person, label
-from .options import POSITIVE, robot_options
+from .options import POSITIVE, robot_options, say_written_from
 
 TERMS_SHOWN = 3
 
@@ -86,6 +86,7 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
     from ..params import Provenance
 
     robot = resolve_robot(preset, config, sets)
+    say_written_from(preset, config, write)
     spec = parse_board(board or DEFAULT_BOARD)
     if write is not None:
         if write.exists() and not force:
@@ -184,6 +185,7 @@ def nose_load(grams, preset, config, sets, resolution_g, total_g, write, force, 
     from ..measure.nose_load import AXIS_KEY, PLATE_KEY, measure_nose_load
 
     robot = robot_toml.resolve_robot(preset, config, sets)
+    say_written_from(preset, config, write)
     if write is not None and write.exists() and not force:
         raise MeasureError(f"{write} exists", "choose another path, or add --force to overwrite it")
     res = measure_nose_load(robot, grams / 1000, resolution_g / 1000, None if total_g is None else total_g / 1000)

@@ -87,6 +87,15 @@ def robot_options(func=None, *, say: bool = True):
     return func
 
 
+def say_written_from(preset: str | None, config: Path | None, write: Path | None) -> None:
+    """A command that writes a robot file says, first (stderr), which robot it starts from:
+    the default robot's line (:func:`robot_options`) has said it already; a robot named on the
+    command line is said here."""
+    if write is None or click.get_current_context().meta.get(DEFAULTED):
+        return
+    click.echo(f"robot: {config if config is not None else preset}; {write} is written from it", err=True)
+
+
 def import_options(func):
     """``--units``, ``--rename``, ``--mirror`` on a click command; the command gets them as one
     checked :class:`ImportOptions` argument, ``imports`` (a bad value is a TrackError)."""

@@ -11,7 +11,7 @@ from .. import params as P
 from ..errors import ParamsError
 from ..fileio import json_text, locked
 from ..io import robot_toml
-from .options import robot_options
+from .options import robot_options, say_written_from
 
 
 @click.command()
@@ -28,6 +28,7 @@ def params(preset, config, sets, as_json, write, force):
     nose_load_kg; `locust measure nose-load` takes the scale's reading back).
     """
     robot = robot_toml.resolve_robot(preset, config, sets)
+    say_written_from(preset, config, write)
     if write:
         _write(robot, write, force, config, sets)
         click.echo(f"wrote {write}")
