@@ -45,6 +45,7 @@ from .camera import (
     pinhole_from_scene,
     set_scene_pinhole,
 )
+from .gl import check_renderer
 from .rollout import Trajectory, roll_out
 
 MARKERS = tuple(MARKER_COLOURS)           # ("nose", "foot"): geoms "marker_<name>"
@@ -73,6 +74,7 @@ class PoseRenderer:
         model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
         model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
         self.data = mujoco.MjData(model)
+        check_renderer()
         try:
             self.renderer = mujoco.Renderer(model, height=height, width=width)
         except Exception as exc:
