@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import TrackError
 from ..fileio import check_encoded, temp_beside
+from ..io.delimited import MAX_LINES
 from ..io.trk import FPS_MAX, FPS_MIN
 
 # FFmpeg's own log lines ("moov atom not found" ...) are noise next to our error
@@ -137,6 +138,12 @@ class Clip:
             raise TrackError(f"{info.path.name} has no usable frame rate ({fps!r}; a camera films "
                              f"{FPS_MIN:g} to {FPS_MAX:g} frames/s)",
                              "give the real frame rate with --fps, e.g. --fps 240")
+        frames = len(range(self.start, end + 1, self.step))
+        if frames > MAX_LINES:
+            raise TrackError(f"frames {self.start}..{end} step {self.step} of {info.path.name} are {frames:,} frames, "
+                             f"more than a track file holds ({MAX_LINES:,} rows: 14 minutes at 240 frames/s)",
+                             "track the part of the clip the hops are in (--start, --end), or every few frames "
+                             "(--step)")
         return Clip(self.start, end, self.step, float(fps))
 
     def frames(self) -> range:
