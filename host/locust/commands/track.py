@@ -14,7 +14,7 @@ import click
 import numpy as np
 
 from ..errors import TrackError, WriteError
-from ..fileio import atomic_write_json, refuse_read_only_folder
+from ..fileio import atomic_write_json, refuse_read_only_folder, write_target
 from ..io import trk as trk_io
 from ..io.camera_json import camera_json_beside
 from ..io.importing import ImportOptions, import_tracks, is_project, span_warnings
@@ -301,6 +301,8 @@ def _outputs(base: Path, fmt: str, overlay_kind: str) -> dict[str, Path]:
 
 
 def _refuse_overwrite(paths: dict[str, Path], force: bool) -> None:
+    for p in paths.values():   # before any work: what no write may replace, nor reach through a link
+        write_target(p)
     taken = [str(p) for p in paths.values() if p.exists()]
     if taken and not force:
         raise TrackError(f"output exists: {', '.join(taken)}", "choose another --out, or add --force to replace it")

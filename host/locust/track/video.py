@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 
 from ..errors import TrackError
-from ..fileio import check_encoded, temp_beside
+from ..fileio import check_encoded, opencv_path, temp_beside, write_target
 from ..io.delimited import MAX_LINES
 from ..io.trk import FPS_MAX, FPS_MIN
 
@@ -240,12 +240,18 @@ def read_as_frame(info: VideoInfo, path: Path) -> bool:
                 and re.fullmatch(re.escape(m[1]) + r"\d+", path.stem))
 
 
+def _imread(path: Path) -> np.ndarray | None:
+    """One image, BGR (None: not readable as one), by a name OpenCV can take."""
+    with opencv_path(path) as name:
+        return cv2.imread(name, cv2.IMREAD_COLOR)
+
+
 def _probe_images(path: Path, files: tuple[Path, ...]) -> VideoInfo:
     if len(files) < 2:
         raise TrackError(f"{path}: a single image, not a video or an image sequence",
                          "give a video file, a folder of frames, or the first file of a numbered run "
                          "(shot00.jpg, shot01.jpg, ...)")
-    first = cv2.imread(str(files[0]), cv2.IMREAD_COLOR)
+    first = _imread(files[0])
     if first is None:
         raise TrackError(f"{files[0]}: not a readable image", "check the file opens in an image viewer")
     h, w = first.shape[:2]
@@ -281,7 +287,8 @@ def probe(path: str | os.PathLike) -> VideoInfo:
         raise TrackError(f"{path}: no such file", "check the path of the video")
     if path.stat().st_size == 0:
         raise TrackError(f"{path}: the file is empty", "copy the video again from the camera")
-    cap = cv2.VideoCapture(str(path))
+    with opencv_path(path) as name:
+        cap = cv2.VideoCapture(name)
     try:
         if not cap.isOpened():
             raise TrackError(f"{path}: not a readable video (FFmpeg could not open it; "
@@ -336,7 +343,7 @@ def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8) -> Iterator[tupl
 
     def decode_images() -> None:
         for frame in clip.frames():
-            image = cv2.imread(str(info.images[frame]), cv2.IMREAD_COLOR) if frame < len(info.images) else None
+            image = _imread(info.images[frame]) if frame < len(info.images) else None
             if image is None or image.shape[:2] != (info.height_px, info.width_px):
                 put(_EndedEarly(frame))
                 return
@@ -347,7 +354,8 @@ def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8) -> Iterator[tupl
     def decode() -> None:
         if info.images:
             return decode_images()
-        cap = cv2.VideoCapture(str(info.path))
+        with opencv_path(info.path) as name:
+            cap = cv2.VideoCapture(name)
         try:
             index = 0
             for frame in clip.frames():
@@ -451,9 +459,11 @@ def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: 
         The written video does not read back whole.
     """
     path = Path(path)
-    fd, tmp = temp_beside(path, suffix=path.suffix)
+    target = write_target(path)   # a link in the folder: its target; one out of it: refused
+    fd, tmp = temp_beside(target, suffix=path.suffix)
     os.close(fd)
-    writer = cv2.VideoWriter(tmp, cv2.VideoWriter_fourcc(*fourcc), fps, size)
+    with opencv_path(tmp) as name:
+        writer = cv2.VideoWriter(name, cv2.VideoWriter_fourcc(*fourcc), fps, size)
     if fourcc == "MJPG":
         writer.set(cv2.VIDEOWRITER_PROP_QUALITY, 90)
     try:
@@ -466,7 +476,7 @@ def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: 
             written += 1
         writer.release()
         check_encoded(tmp, written, path)
-        os.replace(tmp, path)
+        os.replace(tmp, target)
     except BaseException:
         writer.release()
         Path(tmp).unlink(missing_ok=True)
