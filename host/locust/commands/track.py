@@ -384,6 +384,8 @@ def _track(video: Path, named: Path, project, models: list, cal: dict, clip: Cli
         result.source = f"locust track of the video in {named}"
     for warning in upside_down_warnings(result):
         click.echo(f"warning: {warning}", err=True)
+    if trk_out is not None:
+        trk.check_even_times(result)   # before anything is written
     written = _write(result, paths, fmt)
     if trk_out is not None:
         media = trk_io.media_in_zip(project, trk_out) if project is not None and is_project(named) else None
