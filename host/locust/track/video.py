@@ -26,6 +26,7 @@ import os
 import queue
 import re
 import threading
+import zipfile
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -394,6 +395,10 @@ def probe(path: str | os.PathLike) -> VideoInfo:
         cap = cv2.VideoCapture(name)
     try:
         if not cap.isOpened():
+            if zipfile.is_zipfile(path):   # (a Tracker project zip is opened as a project, before this)
+                raise TrackError(f"{path}: a zip archive, not a video, and not a Tracker project (no .trk in it)",
+                                 f"unpack it (unzip {path.name} -d frames) and give the video in it, or the folder "
+                                 "of its frames with --fps")
             raise TrackError(f"{path}: not a readable video (FFmpeg could not open it; "
                              "it is not a video, or a damaged or truncated one)",
                              "check the file plays in a video player; re-copy it from the camera")
