@@ -12,7 +12,7 @@ import stat
 import tempfile
 import time
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any
 
@@ -24,8 +24,50 @@ DISK_HINT = "check that the folder exists and is writable and that the disk has 
 def write_target(path: str | os.PathLike) -> Path:
     """The file a write to ``path`` lands on: a symlink's target (the link is kept), else ``path``.
 
-    Refuses (:class:`WriteError`) what a write must never replace: a device, a folder, a pipe or
-    any other non-regular file, and a file its owner made read-only.
+    A write never leaves the folder it was given through a link: a symlink is followed only
+    to a target in its own folder or below it (:func:`link_target`); one pointing anywhere
+    else, there or not (a dangling link), is refused. Refuses too (:class:`WriteError`) what a
+    write must never replace: a device, a folder, a pipe or any other non-regular file, and a
+    file its owner made read-only.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    locust.errors.WriteError
+    """
+    path = link_target(path)
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        return path
+    except OSError as exc:
+        raise WriteError(f"{path}: cannot inspect it ({exc.strerror})", DISK_HINT) from None
+    if not stat.S_ISREG(st.st_mode):
+        raise WriteError(f"{path} is not a regular file (a device, folder or pipe); refusing to replace it",
+                         "write to a new file path")
+    if not os.access(path, os.W_OK) or not st.st_mode & 0o222:  # (root may write anything: ask the mode)
+        raise WriteError(f"{path} is read-only; refusing to replace it",
+                         "write to another path, or make it writable (chmod u+w) if you mean to replace it")
+    return path
+
+
+def link_target(path: str | os.PathLike) -> Path:
+    """``path``, or the file its symlink points to when that lies in the link's own folder or
+    below it; :class:`WriteError` for a link pointing out of it.
+
+    The folder a command is given (``--out``, the folder of a file named) is where its writes
+    land: a link left there, by a person or a program, must not carry a write to a file
+    elsewhere (``out/hop.tracks.csv -> ../../victim.csv``), whether that file exists or not.
+    A link within the folder (``robot.toml -> robots/small.toml``) has its target updated.
+    Only the last component is a link looked at: a folder named through a link is the folder
+    chosen.
 
     Parameters
     ----------
@@ -40,21 +82,16 @@ def write_target(path: str | os.PathLike) -> Path:
     locust.errors.WriteError
     """
     path = Path(path)
-    if path.is_symlink():
-        path = Path(os.path.realpath(path))
-    try:
-        st = os.stat(path)
-    except FileNotFoundError:
+    if not path.is_symlink():
         return path
-    except OSError as exc:
-        raise WriteError(f"{path}: cannot inspect it ({exc.strerror})", DISK_HINT) from None
-    if not stat.S_ISREG(st.st_mode):
-        raise WriteError(f"{path} is not a regular file (a device, folder or pipe); refusing to replace it",
-                         "write to a new file path")
-    if not os.access(path, os.W_OK) or not st.st_mode & 0o222:  # (root may write anything: ask the mode)
-        raise WriteError(f"{path} is read-only; refusing to replace it",
-                         "write to another path, or make it writable (chmod u+w) if you mean to replace it")
-    return path
+    target = Path(os.path.realpath(path))
+    folder = os.path.realpath(path.parent)
+    if os.path.commonpath([folder, target]) != folder:
+        there = "" if target.exists() else " (not there yet)"
+        raise WriteError(f"{path} is a link to {target}{there}, outside the folder {folder}: a write never leaves "
+                         "the folder it is given through a link; refusing to write it",
+                         f"remove the link (rm {path}) or write to {target} itself")
+    return target
 
 
 def refuse_read_only_folder(folder: Path) -> None:
@@ -205,6 +242,61 @@ def unwind_on_termination() -> None:
             signal.signal(sig, unwind)
 
 
+@contextmanager
+def opencv_path(path: str | os.PathLike) -> Iterator[str]:
+    """A name OpenCV can open ``path`` by, for the duration of the ``with``: ``path`` itself, or,
+    where it is not UTF-8 text, a link to it in a private temporary folder.
+
+    OpenCV takes a file name as UTF-8 text; a name with bytes that are not UTF-8 (a folder
+    copied from an old camera or another system: Python keeps those bytes as lone
+    surrogates) crashes it with a segmentation fault, in its reader and its writer alike. The
+    link (``media`` plus the name's suffix, which OpenCV's writer chooses the container by)
+    reaches the same file, to read or to write through. A capture or writer opens its file as
+    it is made, so the link may go once it is.
+
+    Parameters
+    ----------
+    path : path-like
+        The file to read or write (a writer's file may not exist yet).
+
+    Yields
+    ------
+    str
+        A UTF-8 name of the same file.
+
+    Raises
+    ------
+    locust.errors.WriteError
+        No private folder can be made for the link.
+    """
+    name = os.fspath(path)
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError:
+        pass
+    else:
+        yield name
+        return
+    suffix = Path(name).suffix
+    try:
+        suffix.encode("utf-8")
+    except UnicodeEncodeError:
+        suffix = ""
+    try:
+        folder = tempfile.mkdtemp(prefix="locust-name-")
+    except OSError as exc:
+        raise WriteError(f"cannot make a temporary folder ({exc.strerror})", DISK_HINT) from None
+    link = os.path.join(folder, "media" + suffix)
+    try:
+        os.symlink(os.path.abspath(name), link)
+        yield link
+    finally:
+        with suppress(OSError):
+            os.unlink(link)
+        with suppress(OSError):
+            os.rmdir(folder)
+
+
 def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
     """Raise :class:`WriteError` unless the video just encoded at ``tmp`` (for ``path``) reads
     back with its ``frames`` frames: OpenCV's writer ignores a failed write (a full disk) and
@@ -227,11 +319,12 @@ def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
         return
     import cv2
 
-    cap = cv2.VideoCapture(str(tmp))
-    try:
-        count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
-    finally:
-        cap.release()
+    with opencv_path(tmp) as name:
+        cap = cv2.VideoCapture(name)
+        try:
+            count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
+        finally:
+            cap.release()
     if count != frames:
         raise WriteError(f"{path}: the video could not be written completely ({count} of {frames} frames read "
                          "back); the disk may be full", DISK_HINT)

@@ -49,11 +49,11 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
-from mujoco import minimize
 from scipy import optimize
 
 from ..errors import CalibrationError, GeometryError, ParamsError, SimError, TrialError
 from ..params import Provenance, Robot, fittable_keys, value_type
+from ..sim.gl import minimize  # MuJoCo's solver, as locust.sim imports MuJoCo (its OpenGL checked first)
 from ..sim.hops import summarise
 from ..sim.kinematics import geom_positions, marker_geoms, trace_rows
 from ..sim.model import BuiltModel, build

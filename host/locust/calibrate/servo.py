@@ -44,12 +44,11 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-import mujoco
 import numpy as np
-from mujoco import minimize
 
 from ..errors import CalibrationError
 from ..params import GRAVITY_M_PER_S2, LIMITS, Servo
+from ..sim.gl import minimize, mujoco  # MuJoCo as locust.sim imports it (its OpenGL checked first)
 from ..sim.rollout import available_cores, rollout_threads
 from ..sim.servo import configure, with_servo
 from .curves import Curves

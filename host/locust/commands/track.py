@@ -14,7 +14,7 @@ import click
 import numpy as np
 
 from ..errors import TrackError, WriteError
-from ..fileio import atomic_write_json, refuse_read_only_folder
+from ..fileio import atomic_write_json, refuse_read_only_folder, write_target
 from ..io import trk as trk_io
 from ..io.camera_json import camera_json_beside
 from ..io.importing import ImportOptions, import_tracks, is_project, span_warnings
@@ -301,6 +301,8 @@ def _outputs(base: Path, fmt: str, overlay_kind: str) -> dict[str, Path]:
 
 
 def _refuse_overwrite(paths: dict[str, Path], force: bool) -> None:
+    for p in paths.values():   # before any work: what no write may replace, nor reach through a link
+        write_target(p)
     taken = [str(p) for p in paths.values() if p.exists()]
     if taken and not force:
         raise TrackError(f"output exists: {', '.join(taken)}", "choose another --out, or add --force to replace it")
@@ -382,6 +384,8 @@ def _track(video: Path, named: Path, project, models: list, cal: dict, clip: Cli
         result.source = f"locust track of the video in {named}"
     for warning in upside_down_warnings(result):
         click.echo(f"warning: {warning}", err=True)
+    if trk_out is not None:
+        trk.check_even_times(result)   # before anything is written
     written = _write(result, paths, fmt)
     if trk_out is not None:
         media = trk_io.media_in_zip(project, trk_out) if project is not None and is_project(named) else None

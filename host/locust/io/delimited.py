@@ -17,6 +17,12 @@ gives the columns their meaning.
 
 Every problem is a :class:`~locust.errors.TrackError` naming the file, and the line or
 column, with a hint.
+
+A file read is a regular file of at most :data:`MAX_BYTES` and :data:`MAX_LINES` lines (``#``
+comments aside), refused before it is read (its size) or split (its lines): a track of a clip
+holds a line a frame, and beyond these it is no longer one experiment (nor would its rows fit a
+laptop's memory: about 1.3 kB of Python objects a row while split). The writers of these
+formats refuse what this reader would (:func:`check_text`).
 """
 
 from __future__ import annotations
@@ -31,6 +37,13 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import TrackError
+
+# A track (a line a frame) of 14 minutes at 240 frames/s, or of nearly two hours at 30; a hop
+# experiment is seconds to minutes.
+MAX_LINES = 200_000
+MAX_BYTES = 64 * 2**20
+SIZE_HINT = ("cut the file to the experiment (keep its header and the rows you need, e.g. head -n 10000), or "
+             "track a shorter part of the clip (--start, --end, --step)")
 
 _TRUE = {"true", "yes", "1"}
 _FALSE = {"false", "no", "0"}
@@ -98,18 +111,84 @@ def read_text(path: str | Path) -> str:
     Raises
     ------
     locust.errors.TrackError
-        No such file, not a regular file, or not text.
+        No such file, not a regular file, over :data:`MAX_BYTES` (refused before it is read) or
+        :data:`MAX_LINES` lines (before it is split), or not text.
     """
     path = Path(path)
     try:
-        if not stat.S_ISREG(path.stat().st_mode):   # a pipe blocks, a device never ends: not opened
+        info = path.stat()
+        if not stat.S_ISREG(info.st_mode):   # a pipe blocks, a device never ends: not opened
             raise TrackError(f"{path}: not a regular file (a pipe, device or folder)",
                              "give the path of a recording file (a CSV or a Tracker text export)")
-        return path.read_text(encoding="utf-8-sig")
+        check_size(path, info.st_size)
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_BYTES + 1)   # (a file growing as it is read stops at the limit too)
+        check_size(path, len(data), _lines(data))
+        return data.decode("utf-8-sig")
     except FileNotFoundError:
         raise TrackError(f"{path}: no such file", "check the path of the recording") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise TrackError(f"{path}: cannot be read as text ({exc})", "give a CSV or a Tracker text export") from None
+
+
+def check_size(path: str | Path, n_bytes: int, n_lines: int = 0, writing: bool = False) -> None:
+    """Refuse a delimited file of more than :data:`MAX_BYTES` or :data:`MAX_LINES` lines, read or
+    about to be written.
+
+    Parameters
+    ----------
+    path : path-like
+        For messages.
+    n_bytes : int
+        Its size [bytes].
+    n_lines : int
+        Its lines but its ``#`` comments, where known.
+    writing : bool
+        The file is about to be written (the message says so).
+
+    Raises
+    ------
+    locust.errors.TrackError
+        Over either limit.
+    """
+    what = "would be" if writing else "is"
+    if n_bytes > MAX_BYTES:
+        raise TrackError(f"{path} {what} {n_bytes / 2**20:,.0f} MB, over the {MAX_BYTES / 2**20:.0f} MB a track or "
+                         f"recording file may hold ({MAX_LINES:,} lines: 14 minutes at 240 frames/s); "
+                         f"{'nothing was written' if writing else 'not read'}", SIZE_HINT)
+    if n_lines > MAX_LINES:
+        raise TrackError(f"{path} {what} {n_lines:,} lines, over the {MAX_LINES:,} a track or recording file may "
+                         f"hold (14 minutes at 240 frames/s); {'nothing was written' if writing else 'not read'}",
+                         SIZE_HINT)
+
+
+def check_text(path: str | Path, text: str) -> str:
+    """``text``, to be written to ``path``, if this module would read it back (:func:`check_size`).
+
+    Parameters
+    ----------
+    path : path-like
+    text : str
+
+    Returns
+    -------
+    str
+        ``text``.
+
+    Raises
+    ------
+    locust.errors.TrackError
+        Over either limit.
+    """
+    data = text.encode("utf-8")
+    check_size(path, len(data), _lines(data), writing=True)
+    return text
+
+
+def _lines(data: bytes) -> int:
+    """The lines of ``data`` but its ``#`` comments (a converted file may say where it came from
+    in more comments than its source had, and still be read back)."""
+    return data.count(b"\n") - data.count(b"\n#") - data.startswith(b"#")
 
 
 def split_text(text: str, path: str | Path) -> DelimitedText:

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 import re
+import zipfile
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -229,7 +230,9 @@ PROJECT_SUFFIXES = (".trk", ".trz")
 
 
 def is_project(path: str | Path) -> bool:
-    """Whether ``path`` names a Tracker project (``.trk``, or a ``.trz`` zip holding one).
+    """Whether ``path`` names a Tracker project: a ``.trk``, a ``.trz`` zip holding one, or a
+    ``.zip`` holding one (Tracker's own examples are handed out so, e.g. ``CupsClips.zip``:
+    the frames and the ``.trk``; only the zip's list of members is read here).
 
     Parameters
     ----------
@@ -239,7 +242,16 @@ def is_project(path: str | Path) -> bool:
     -------
     bool
     """
-    return Path(path).suffix.lower() in PROJECT_SUFFIXES
+    path = Path(path)
+    if path.suffix.lower() in PROJECT_SUFFIXES:
+        return True
+    if path.suffix.lower() != ".zip" or not path.is_file():
+        return False
+    try:
+        with zipfile.ZipFile(path) as z:
+            return any(name.lower().endswith(".trk") for name in z.namelist())
+    except (zipfile.BadZipFile, EOFError, ValueError, OSError):
+        return False   # not a readable zip: whoever reads it says so
 
 
 def import_project(path: str | Path, options: ImportOptions = AS_IS) -> TracksCsv:

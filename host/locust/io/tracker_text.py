@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import TrackError
 from ..fileio import atomic_write_text
-from .delimited import DelimitedText, check_names, read_text, split_text
+from .delimited import DelimitedText, check_names, check_text, read_text, split_text
 from .tracks_csv import missing_time, no_marker, same_array
 
 DEFAULT_TRACK = "track"   # the name of columns no title or names row claims
@@ -286,10 +286,12 @@ def write_tracker_export(path: Path, export: TrackerExport) -> Path:
 
     Raises
     ------
+    locust.errors.TrackError
+        More rows than a track file may hold (:func:`.delimited.check_size`).
     locust.errors.WriteError
         The file cannot be written.
     """
-    return atomic_write_text(path, tracker_export_text(export))
+    return atomic_write_text(path, check_text(path, tracker_export_text(export)))
 
 
 def parse_tracker_export(text: str, path: str | Path) -> TrackerExport:

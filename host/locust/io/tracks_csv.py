@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import TrackError
 from ..fileio import atomic_write_text
-from .delimited import DelimitedText, check_names, read_text, split_text
+from .delimited import DelimitedText, check_names, check_text, read_text, split_text
 
 if TYPE_CHECKING:
     from .tracker_text import TrackerExport
@@ -294,10 +294,12 @@ def write_tracks_csv(path: Path, tracks: TracksCsv) -> Path:
 
     Raises
     ------
+    locust.errors.TrackError
+        More rows than a track file may hold (:func:`.delimited.check_size`).
     locust.errors.WriteError
         The file cannot be written.
     """
-    return atomic_write_text(path, tracks_csv_text(tracks))
+    return atomic_write_text(path, check_text(path, tracks_csv_text(tracks)))
 
 
 def parse_tracks_csv(text: str, path: str | Path) -> TracksCsv:

@@ -110,7 +110,7 @@ def _plate_from_weight(robot: Robot, total_kg: float, resolution_kg: float) -> G
     from ..sim.model import build
 
     def mass(r: Robot) -> float:
-        import mujoco
+        from ..sim.gl import mujoco
 
         model = build(r).model
         return float(model.body_subtreemass[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "chassis")])

@@ -34,6 +34,7 @@ from scipy.optimize import least_squares
 from ..arucoboard import BoardSpec
 from ..calibrate.fitstats import Estimate
 from ..errors import GeometryError, MeasureError
+from ..fileio import opencv_path
 from ..params import Robot
 from ..sim.stickers import STICKERS, plate_points, to_view
 
@@ -235,7 +236,8 @@ def read_photo(path: Path, spec: BoardSpec, given: dict[str, tuple[float, float]
     locust.errors.MeasureError
         Not a readable image, no board, or a sticker not found.
     """
-    image = cv2.imread(str(path), cv2.IMREAD_COLOR)
+    with opencv_path(path) as name:
+        image = cv2.imread(name, cv2.IMREAD_COLOR)
     if image is None:
         raise MeasureError(f"{path}: not a readable image", "give a photo or a video frame as PNG or JPEG")
     corners_px, corners_m, corner_sd = board_corners(spec, image, path)

@@ -10,24 +10,26 @@ robot and returns :mod:`.result`'s :class:`~.result.SimResult`; :mod:`.samples` 
 simulate draws and one-at-a-time moves of the uncertain values; :mod:`.statics` finds the
 standing robot's load on its nose; :mod:`.kinematics` poses the markers at kept states;
 :mod:`.camera`, :mod:`.clip`, :mod:`.still` and :mod:`.stickers` render videos and stills with their
-ground truth; :mod:`.live` steps the model as the virtual robot's servo commands arrive.
+ground truth (:mod:`.gl`: the OpenGL MuJoCo renders with, checked before MuJoCo is imported);
+:mod:`.live` steps the model as the virtual robot's servo commands arrive.
 """
 
 import os
 
 # MuJoCo picks its GL backend when first imported: offscreen rendering needs no display.
-# Set here, once, before any submodule imports MuJoCo.
+# Set here, once, before any submodule imports MuJoCo (through .gl, which checks it first).
 os.environ.setdefault("MUJOCO_GL", "osmesa")
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 
 
 def _quiet_mujoco() -> None:
-    """MuJoCo's own warnings (an unstable simulation: "Nan, Inf or huge value in QACC") go to
+    """MuJoCo imported (:mod:`.gl`: with rendering off where its OpenGL cannot be had), its own
+    warnings (an unstable simulation: "Nan, Inf or huge value in QACC") going to
     this package's logger, not to stdout and a ``MUJOCO_LOG.TXT`` in the user's folder: each
     is counted in ``MjData.warning``, which the audit reads (:mod:`locust.sim.audit`)."""
     import logging
 
-    import mujoco
+    from .gl import mujoco
 
     log = logging.getLogger("locust.sim")
     mujoco.set_mju_user_warning(lambda message: log.debug("MuJoCo: %s", message))

@@ -30,7 +30,7 @@ import mujoco
 import numpy as np
 
 from ..errors import SimError
-from ..fileio import atomic_write_text, check_encoded, temp_beside
+from ..fileio import atomic_write_text, check_encoded, opencv_path, temp_beside
 from ..io.camera_json import CameraFile, MarkerPlane, camera_json_beside, write_camera_json
 from ..markers import MARKER_COLOURS
 from ..params import Robot
@@ -45,6 +45,7 @@ from .camera import (
     pinhole_from_scene,
     set_scene_pinhole,
 )
+from .gl import check_renderer
 from .rollout import Trajectory, roll_out
 
 MARKERS = tuple(MARKER_COLOURS)           # ("nose", "foot"): geoms "marker_<name>"
@@ -73,6 +74,7 @@ class PoseRenderer:
         model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
         model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
         self.data = mujoco.MjData(model)
+        check_renderer()
         try:
             self.renderer = mujoco.Renderer(model, height=height, width=width)
         except Exception as exc:
@@ -278,8 +280,10 @@ def check_video_path(path: str | os.PathLike) -> Path:
     if path.suffix.lower() != ".mp4":
         raise SimError(f"video path {path} does not end in .mp4", "name the video <something>.mp4")
     for p in (path, *sidecar_paths(path)):
-        if p.exists():
-            raise SimError(f"{p} exists already; not overwriting it", "choose another video name, or move it away")
+        if p.exists() or p.is_symlink():   # (a link pointing nowhere yet is there too)
+            link = f" (a link to {os.readlink(p)})" if p.is_symlink() else ""
+            raise SimError(f"{p} exists already{link}; not overwriting it",
+                           "choose another video name, or move it away")
     if path.parent.exists() and not path.parent.is_dir():
         raise SimError(f"{path.parent} is not a folder", "choose a video path inside a folder")
     return path
@@ -324,8 +328,9 @@ class ClipRecorder:
         self.data = self.poser.data
         fd, self.tmp_path = temp_beside(self.path, suffix=".mp4")
         os.close(fd)
-        self.writer = cv2.VideoWriter(self.tmp_path, cv2.VideoWriter_fourcc(*"mp4v"), float(self.fps),
-                                      (self.width, self.height))
+        with opencv_path(self.tmp_path) as name:
+            self.writer = cv2.VideoWriter(name, cv2.VideoWriter_fourcc(*"mp4v"), float(self.fps),
+                                          (self.width, self.height))
         if not self.writer.isOpened():
             self.abort()
             raise SimError(f"OpenCV cannot write an MP4 at {self.path}",

@@ -19,6 +19,7 @@ from ..fileio import atomic_write_json
 from ..io.tracks_csv import MarkerColumns, TracksCsv, tracks_csv_text, write_tracks_csv
 from ..version import __version__
 from .runner import TrackResult
+from .video import TIMES_FROM_FILE
 
 SIDECAR_FORMAT = "locust.track/1"   # the JSON sidecar beside a tracks CSV
 PIXEL_CONVENTION = "OpenCV: origin at the centre of the top-left pixel, x right, y down"
@@ -89,8 +90,7 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
         "tracks": csv_path.name,
         "pixel_convention": PIXEL_CONVENTION,
         "source": src,
-        "clip": {"start": clip.start, "end": clip.end, "step": clip.step, "fps": clip.fps,
-                 "time": "t_s = (frame - start) / fps"},
+        "clip": {"start": clip.start, "end": clip.end, "step": clip.step, "fps": clip.fps, "time": result.times},
         "calibration": result.calibration.as_dict(),
         "markers": [{"name": t.name, "spec": t.spec, "frames": len(t.ok), "found": t.found(),
                      **asdict(track_events(t.px, t.py, t.ok)),
@@ -217,6 +217,10 @@ def summary_lines(result: TrackResult) -> list[str]:
         line += (f"; {ev.gaps} gap(s), longest {ev.longest_gap} frames, {ev.reacquired} re-acquisition(s), "
                  f"{ev.jumps} jump(s)")
         lines.append(line)
+    if result.times == TIMES_FROM_FILE and len(result.t_s) > 1:
+        gaps_ms = np.diff(result.t_s) / np.diff(result.frames) * 1000
+        lines.append(f"times: the video's own timestamps, its frames {gaps_ms.min():.1f} to {gaps_ms.max():.1f} ms "
+                     f"apart (a variable frame rate), not frame / {result.clip.fps:g} frames/s")
     lines.append(result.calibration.summary())
     return lines
 

@@ -11,7 +11,7 @@ from ..errors import TrackError
 from .calib import Calibration
 from .camera import PlaneCalibration
 from .color import FrameHSV
-from .video import Clip, VideoInfo, read_frames
+from .video import TIMES_EVEN, Clip, VideoInfo, frame_times_s, read_frames
 
 
 @dataclass
@@ -59,6 +59,7 @@ class TrackResult:
     markers: list[TrackedMarker]
     calibration: Calibration | PlaneCalibration
     source: str = "locust track"
+    times: str = TIMES_EVEN        # how ``t_s`` was found (:func:`.video.frame_times_s`)
 
     def world(self, track: TrackedMarker) -> tuple[np.ndarray, np.ndarray]:
         """A marker's track in world metres through the result's calibration.
@@ -81,7 +82,8 @@ def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibrat
     """Run every marker model over a resolved ``clip`` of the video ``info``.
 
     ``progress(1)`` is called after each frame. With ``require_found`` a marker that was
-    never found anywhere in the clip raises TrackError (nothing is written then).
+    never found anywhere in the clip raises TrackError (nothing is written then). The
+    frames' times are the video file's (:func:`.video.frame_times_s`).
 
     Parameters
     ----------
@@ -121,7 +123,8 @@ def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibrat
         if hasattr(model, "frame_hsv"):
             model.frame_hsv = frame_hsv
     cols = {m.name: (np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan), np.zeros(n, bool)) for m in models}
-    for i, (frame, image) in enumerate(read_frames(info, clip)):
+    stamps_s: dict[int, float] = {}
+    for i, (frame, image) in enumerate(read_frames(info, clip, stamps_s=stamps_s)):
         for model in models:
             det = model.locate(frame, image)
             px, py, score, ok = cols[model.name]
@@ -139,5 +142,5 @@ def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibrat
                 "colour's chroma (no sticker of that colour in the picture: nothing): `locust track preview VIDEO` "
                 "lists the coloured patches of a frame; else check --color-tol, the template point and frame, or "
                 "the ArUco id; --marker NAME=SPEC replaces the default nose/foot colours")
-    t_s = np.array([clip.time_s(int(f)) for f in frames])
-    return TrackResult(info, clip, frames, t_s, tracks, calibration)
+    times = frame_times_s(info, clip, frames, stamps_s)
+    return TrackResult(info, clip, frames, times.t_s, tracks, calibration, times=times.rule)

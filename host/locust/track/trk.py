@@ -21,7 +21,7 @@ from ..io.tracker_text import TrackerExport, TrackerTrack, tracker_export_text, 
 from ..io.trk import ProjectVideo, TrackerClip, TrackerProject, project_points
 from .calib import Calibration
 from .runner import TrackedMarker, TrackResult
-from .video import Clip
+from .video import TIMES_FROM_FILE, Clip
 
 
 def project_result(project: TrackerProject, names: list[str] | None = None) -> TrackResult:
@@ -110,6 +110,26 @@ def write_tracker_text(result: TrackResult, path: Path) -> Path:
 
 # --- A Tracker project (the format itself: :mod:`locust.io.trk`) ------------------------
 
+def check_even_times(result: TrackResult) -> None:
+    """Refuse to write ``result`` as a Tracker project when its frames are not evenly spaced: a
+    project times every frame as ``frame x delta_t``, which would contradict the video's own
+    timestamps (:func:`.video.frame_times_s`).
+
+    Parameters
+    ----------
+    result : TrackResult
+
+    Raises
+    ------
+    TrackError
+        The times are the video file's uneven timestamps.
+    """
+    if result.times == TIMES_FROM_FILE:
+        raise TrackError(f"{result.video.path if result.video else 'these tracks'}: its frames are not evenly spaced "
+                         "(a variable frame rate), and a Tracker project times every frame as frame x delta_t; "
+                         "nothing was written", "leave out --trk: the tracks CSV has each frame's own time")
+
+
 def as_project(result: TrackResult, trk_path: Path, media: str | None = None) -> tuple[TrackerProject, ProjectVideo]:
     """``result`` as the Tracker project saved at ``trk_path``: the video (or the image
     sequence's first file) by its path relative to the project, the clip, the calibration
@@ -136,11 +156,12 @@ def as_project(result: TrackResult, trk_path: Path, media: str | None = None) ->
     Raises
     ------
     TrackError
-        The tracks have no video.
+        The tracks have no video, or frames not evenly spaced (:func:`check_even_times`).
     """
     info = result.video
     if info is None:
         raise TrackError("these tracks have no video to open in Tracker", "track a video to write a .trk")
+    check_even_times(result)
     clip = result.clip
     rel = media or Path(os.path.relpath((info.images[0] if info.images else info.path).resolve(),
                                         Path(trk_path).resolve().parent)).as_posix()

@@ -9,6 +9,15 @@ An image sequence is a video too, as Tracker and ffmpeg take it: a folder of ima
 (sorted by name), or the first file of a numbered run (``shot00.jpg``, ``shot01.jpg``, ...:
 the same name with the number counting up by one, as many as follow without a gap).
 It has no frame rate of its own: give ``--fps`` (or the ``.trk``'s frame interval).
+
+A frame's time is the video file's own: phones record at a variable frame rate (frames 15 to
+50 ms apart in one clip), and their files say when each frame was taken. Each frame's
+timestamp is read as it is decoded (:func:`read_frames`, OpenCV's ``CAP_PROP_POS_MSEC``: the
+container's presentation time) and :func:`frame_times_s` keeps ``(frame - start) / fps`` where
+the timestamps agree with it (a constant-rate file: the stamps are those times rounded to the
+file's time base), else takes the timestamps. A rate given with ``--fps`` (or a Tracker
+project's frame interval) spaces the frames evenly, so it is refused for a file whose own
+frames are not evenly spaced.
 """
 
 from __future__ import annotations
@@ -17,6 +26,7 @@ import os
 import queue
 import re
 import threading
+import zipfile
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,7 +35,8 @@ import cv2
 import numpy as np
 
 from ..errors import TrackError
-from ..fileio import check_encoded, temp_beside
+from ..fileio import check_encoded, opencv_path, temp_beside, write_target
+from ..io.delimited import MAX_LINES
 from ..io.trk import FPS_MAX, FPS_MIN
 
 # FFmpeg's own log lines ("moov atom not found" ...) are noise next to our error
@@ -91,13 +102,15 @@ class Clip:
     ``end`` is inclusive (like Tracker's end frame); ``None`` means the last frame.
     ``fps`` overrides the file's rate (slow-motion footage is often stored at 30 fps
     while filmed at 240 fps). Time is ``t_s = (frame - start) / fps``, zero at the
-    clip's first frame, as in Tracker.
+    clip's first frame, as in Tracker, where the video's own timestamps agree
+    (:func:`frame_times_s`); ``fps_given`` (set by :meth:`resolved`) says the rate was given.
     """
 
     start: int = 0
     end: int | None = None
     step: int = 1
     fps: float | None = None
+    fps_given: bool = False
 
     def resolved(self, info: VideoInfo) -> Clip:
         """The clip on ``info``: ``end`` and ``fps`` filled in, every setting checked.
@@ -137,7 +150,13 @@ class Clip:
             raise TrackError(f"{info.path.name} has no usable frame rate ({fps!r}; a camera films "
                              f"{FPS_MIN:g} to {FPS_MAX:g} frames/s)",
                              "give the real frame rate with --fps, e.g. --fps 240")
-        return Clip(self.start, end, self.step, float(fps))
+        frames = len(range(self.start, end + 1, self.step))
+        if frames > MAX_LINES:
+            raise TrackError(f"frames {self.start}..{end} step {self.step} of {info.path.name} are {frames:,} frames, "
+                             f"more than a track file holds ({MAX_LINES:,} rows: 14 minutes at 240 frames/s)",
+                             "track the part of the clip the hops are in (--start, --end), or every few frames "
+                             "(--step)")
+        return Clip(self.start, end, self.step, float(fps), self.fps_given or self.fps is not None)
 
     def frames(self) -> range:
         """The frame numbers of a resolved clip.
@@ -165,6 +184,98 @@ class Clip:
         """
         assert self.fps is not None, "resolve the clip first"
         return (frame - self.start) / self.fps
+
+
+# Timestamps within a quarter of a frame of (frame - start) / fps are that rate's, rounded to the
+# file's time base (a millisecond in Matroska is a quarter of a frame at 240 frames/s); more is
+# a frame taken at another time.
+EVEN_WITHIN_FRAMES = 0.25
+TIMES_EVEN = "t_s = (frame - start) / fps"
+TIMES_FROM_FILE = ("t_s = the frame's timestamp in the video file less the start frame's (its frames are not "
+                   "evenly spaced: a variable frame rate)")
+
+
+@dataclass(frozen=True)
+class FrameTimes:
+    """The times of a clip's frames, and the rule that gave them.
+
+    Attributes
+    ----------
+    t_s : ndarray
+        One per frame of the clip, zero at its first [s].
+    rule : str
+        :data:`TIMES_EVEN` or :data:`TIMES_FROM_FILE`.
+    """
+
+    t_s: np.ndarray
+    rule: str
+
+    @property
+    def from_file(self) -> bool:
+        """Whether the times are the video file's timestamps (its frames not evenly spaced)."""
+        return self.rule == TIMES_FROM_FILE
+
+
+def frame_times_s(info: VideoInfo, clip: Clip, frames, stamps_s: dict[int, float]) -> FrameTimes:
+    """The times of ``frames`` of a resolved ``clip`` of ``info``, zero at the clip's start,
+    as the video file states them (see the module doc).
+
+    Parameters
+    ----------
+    info : VideoInfo
+        The probed video.
+    clip : Clip
+        The resolved clip.
+    frames : sequence of int
+        Its frames, in order (the first is ``clip.start``).
+    stamps_s : dict of int to float
+        Each frame's timestamp in the file [s], as :func:`read_frames` reads it (empty for an
+        image sequence, which has none).
+
+    Returns
+    -------
+    FrameTimes
+        ``(frame - start) / fps`` where the file's timestamps agree within
+        :data:`EVEN_WITHIN_FRAMES` of a frame, else the timestamps.
+
+    Raises
+    ------
+    TrackError
+        Timestamps that do not increase (a damaged file), or a rate given (``--fps``, a
+        Tracker project's) for a file whose frames are not evenly spaced.
+    """
+    frames = np.asarray(frames, dtype=int)
+    even = FrameTimes((frames - clip.start) / clip.fps, TIMES_EVEN)
+    if info.images or len(frames) < 2 or any(int(f) not in stamps_s for f in frames):
+        return even
+    stamps = np.array([stamps_s[int(f)] for f in frames])
+    if np.all(stamps == stamps[0]):
+        return even   # the file states no times (every frame at 0): frame / fps is all there is
+    back = np.flatnonzero(np.diff(stamps) <= 0)
+    if back.size:
+        k = int(back[0])
+        raise TrackError(f"{info.path}: frame {frames[k + 1]} is stamped {stamps[k + 1]:.4f} s, not after frame "
+                         f"{frames[k]} ({stamps[k]:.4f} s): the file's clock is damaged, so no frame's time can be "
+                         "trusted", "re-copy the video from the camera, or convert it to a constant frame rate "
+                         "(e.g. ffmpeg -i IN.mp4 -vf fps=60 OUT.mp4) and track that")
+    stamped = stamps - stamps[0]
+    if not clip.fps_given:
+        off = np.abs(stamped - even.t_s)
+        return even if off.max() <= EVEN_WITHIN_FRAMES / clip.fps else FrameTimes(stamped, TIMES_FROM_FILE)
+    # a given rate spaces the frames evenly: the file's own must be, at whatever rate it states
+    own = (frames - frames[0]) * (stamped[-1] / (frames[-1] - frames[0]))
+    off = np.abs(stamped - own)
+    interval_s = stamped[-1] / (frames[-1] - frames[0])
+    if off.max() > EVEN_WITHIN_FRAMES * interval_s:
+        k = int(np.argmax(off))
+        gaps_ms = np.diff(stamped) / (np.diff(frames)) * 1000
+        raise TrackError(f"{info.path}: a rate of {clip.fps:g} frames/s (--fps, or the Tracker project's frame "
+                         "interval) spaces the frames evenly, but the file's own are not: they are "
+                         f"{gaps_ms.min():.1f} to {gaps_ms.max():.1f} ms apart, frame {frames[k]} stamped "
+                         f"{stamped[k]:.3f} s after frame {frames[0]}, {off[k] * 1000:.0f} ms off even spacing "
+                         "(a variable frame rate, as phones record)",
+                         "leave out --fps: the file's own timestamps are then the frames' times")
+    return even
 
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".gif")
@@ -233,12 +344,18 @@ def read_as_frame(info: VideoInfo, path: Path) -> bool:
                 and re.fullmatch(re.escape(m[1]) + r"\d+", path.stem))
 
 
+def _imread(path: Path) -> np.ndarray | None:
+    """One image, BGR (None: not readable as one), by a name OpenCV can take."""
+    with opencv_path(path) as name:
+        return cv2.imread(name, cv2.IMREAD_COLOR)
+
+
 def _probe_images(path: Path, files: tuple[Path, ...]) -> VideoInfo:
     if len(files) < 2:
         raise TrackError(f"{path}: a single image, not a video or an image sequence",
                          "give a video file, a folder of frames, or the first file of a numbered run "
                          "(shot00.jpg, shot01.jpg, ...)")
-    first = cv2.imread(str(files[0]), cv2.IMREAD_COLOR)
+    first = _imread(files[0])
     if first is None:
         raise TrackError(f"{files[0]}: not a readable image", "check the file opens in an image viewer")
     h, w = first.shape[:2]
@@ -274,9 +391,14 @@ def probe(path: str | os.PathLike) -> VideoInfo:
         raise TrackError(f"{path}: no such file", "check the path of the video")
     if path.stat().st_size == 0:
         raise TrackError(f"{path}: the file is empty", "copy the video again from the camera")
-    cap = cv2.VideoCapture(str(path))
+    with opencv_path(path) as name:
+        cap = cv2.VideoCapture(name)
     try:
         if not cap.isOpened():
+            if zipfile.is_zipfile(path):   # (a Tracker project zip is opened as a project, before this)
+                raise TrackError(f"{path}: a zip archive, not a video, and not a Tracker project (no .trk in it)",
+                                 f"unpack it (unzip {path.name} -d frames) and give the video in it, or the folder "
+                                 "of its frames with --fps")
             raise TrackError(f"{path}: not a readable video (FFmpeg could not open it; "
                              "it is not a video, or a damaged or truncated one)",
                              "check the file plays in a video player; re-copy it from the camera")
@@ -291,7 +413,8 @@ def probe(path: str | os.PathLike) -> VideoInfo:
     return info
 
 
-def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8) -> Iterator[tuple[int, np.ndarray]]:
+def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8,
+                stamps_s: dict[int, float] | None = None) -> Iterator[tuple[int, np.ndarray]]:
     """Yield ``(frame_index, bgr_image)`` for every frame of a resolved ``clip``.
 
     Frames are decoded in order (seeking is inexact in many codecs); skipped frames are
@@ -307,6 +430,10 @@ def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8) -> Iterator[tupl
         The resolved clip.
     prefetch : int
         Frames decoded ahead.
+    stamps_s : dict of int to float, optional
+        Filled, frame by frame before each is yielded, with its timestamp in the video file
+        [s] (a video file's presentation time; an image sequence has none): what
+        :func:`frame_times_s` takes.
 
     Yields
     ------
@@ -329,7 +456,7 @@ def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8) -> Iterator[tupl
 
     def decode_images() -> None:
         for frame in clip.frames():
-            image = cv2.imread(str(info.images[frame]), cv2.IMREAD_COLOR) if frame < len(info.images) else None
+            image = _imread(info.images[frame]) if frame < len(info.images) else None
             if image is None or image.shape[:2] != (info.height_px, info.width_px):
                 put(_EndedEarly(frame))
                 return
@@ -340,7 +467,8 @@ def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8) -> Iterator[tupl
     def decode() -> None:
         if info.images:
             return decode_images()
-        cap = cv2.VideoCapture(str(info.path))
+        with opencv_path(info.path) as name:
+            cap = cv2.VideoCapture(name)
         try:
             index = 0
             for frame in clip.frames():
@@ -354,6 +482,8 @@ def read_frames(info: VideoInfo, clip: Clip, prefetch: int = 8) -> Iterator[tupl
                     put(_EndedEarly(index))
                     return
                 index += 1
+                if stamps_s is not None:
+                    stamps_s[frame] = cap.get(cv2.CAP_PROP_POS_MSEC) / 1000.0
                 if not put((frame, image)):
                     return
             put(None)
@@ -444,9 +574,11 @@ def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: 
         The written video does not read back whole.
     """
     path = Path(path)
-    fd, tmp = temp_beside(path, suffix=path.suffix)
+    target = write_target(path)   # a link in the folder: its target; one out of it: refused
+    fd, tmp = temp_beside(target, suffix=path.suffix)
     os.close(fd)
-    writer = cv2.VideoWriter(tmp, cv2.VideoWriter_fourcc(*fourcc), fps, size)
+    with opencv_path(tmp) as name:
+        writer = cv2.VideoWriter(name, cv2.VideoWriter_fourcc(*fourcc), fps, size)
     if fourcc == "MJPG":
         writer.set(cv2.VIDEOWRITER_PROP_QUALITY, 90)
     try:
@@ -459,7 +591,7 @@ def encode_video(path: Path, frames, fps: float, size: tuple[int, int], fourcc: 
             written += 1
         writer.release()
         check_encoded(tmp, written, path)
-        os.replace(tmp, path)
+        os.replace(tmp, target)
     except BaseException:
         writer.release()
         Path(tmp).unlink(missing_ok=True)
