@@ -83,6 +83,9 @@ def test_calibration_recovers_the_virtual_robots_values(demo):
         assert robot.get(key) == pytest.approx(truth.get(key), rel=0.04, abs=0.3), key
     assert {"compliance.hinge_stiffness_nm_per_rad", "servo.stall_torque_nm", "servo.noload_speed_rad_per_s",
             "contact.foot_friction", "geometry.crank_start_deg", "geometry.ground_angle_deg"} <= set(checked)
+    # the plate on a 0.1 g kitchen scale, given by hand (--set)
+    assert robot.source_of("geometry.body_mass_kg").source == "override"
+    assert robot.geometry.body_mass_kg == pytest.approx(truth.geometry.body_mass_kg, abs=0.05e-3)
 
 
 def test_outcome_shares_are_said_for_each_leg_set(demo):

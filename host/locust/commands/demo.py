@@ -299,7 +299,7 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
     calibrated model with the measured hops in a report (the bench robot's prediction beside
     it). Everything it makes stays under --out; each command's output is in logs/.
     """
-    from ..demo.bench import write_bench
+    from ..demo.bench import plate_on_a_scale, write_bench
     from ..demo.virtual_robot import HOP_FIT_SETS
 
     stderr = sys.stderr
@@ -342,7 +342,11 @@ def demo(out, cycles, trials, designs, jobs, fit_hops):
                     start = ["--preset", DEFAULT_PRESET] if k == 0 else []      # a new robot.toml: the robot as built
                     d.call(["calibrate", rec.experiment, *map(str, rec.paths), *rec.options, *start,
                             "--write", str(robot_toml), "--out", str(cal_dir)])
-        with d.stage(next(stage), total, "measure the stance from two side stills of the virtual robot"):
+        with d.stage(next(stage), total, "measure the virtual robot: its plate on a kitchen scale, its stance from "
+                                         "two side stills"):
+            plate_g = plate_on_a_scale(_load(truth_toml))
+            d.call(["params", "--config", str(robot_toml), "--set", f"geometry.body_mass_kg={plate_g / 1000!r}",
+                    "--write", str(robot_toml), "--force"])
             d.call(["sim", "--config", str(truth_toml), "--cycles", "1", "--still", str(stills / "rest.png"),
                     "--still-push", str(stills / "push.png")])
             d.call(["measure", "stance", str(stills / "rest.png"), str(stills / "push.png"),

@@ -6,7 +6,9 @@ written as SYNTHETIC recordings (each file's header says so, and gives the truth
 - a servo step with a light load and a stall against a weight too heavy for it (the servo
   experiment, ``locust calibrate servo``: the stall sets the torque, the step the speed, gain
   and rotor inertia);
-- ramp trials: the robot on a tilted board until its feet slide (``locust calibrate ramp``).
+- ramp trials: the robot on a tilted board until its feet slide (``locust calibrate ramp``);
+- its plate on a kitchen scale before the legs go on (:func:`plate_on_a_scale`, what the
+  robot file's estimate asks for: "weigh yours").
 
 Each is made from the robot's own values by :mod:`locust.calibrate.synthetic` (not the fits'
 own models), with the noise a phone camera or an inclinometer gives.
@@ -25,6 +27,23 @@ from ..fileio import atomic_write_text
 from ..params import Robot
 
 SEED = 7001      # the noise's random generator (one seed a recording, from here on)
+SCALE_RESOLUTION_G = 0.1     # a kitchen scale's last digit
+
+
+def plate_on_a_scale(robot: Robot) -> float:
+    """What a kitchen scale of :data:`SCALE_RESOLUTION_G` reads with ``robot``'s plate on it [g].
+
+    Parameters
+    ----------
+    robot : locust.params.Robot
+
+    Returns
+    -------
+    float
+        The reading, to the scale's last digit.
+    """
+    grams = robot.geometry.body_mass_kg * 1000
+    return round(round(grams / SCALE_RESOLUTION_G) * SCALE_RESOLUTION_G, 6)
 
 
 @dataclass(frozen=True)
