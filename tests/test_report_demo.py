@@ -133,7 +133,14 @@ def test_demo_closes_the_loop(demo):
     for key in written:
         assert fitted.source_of(key).source == "fit:hops", key
         assert bench.source_of(key).source != "fit:hops", key
-    assert "compliance.hinge_stiffness_nm_per_rad is not identifiable" in log   # a film hinge: the hops cannot see it
+    doc = json.loads((demo["report"].parent / "report.json").read_text())
+    for cfg in doc["configurations"]:     # the fitted model ends each leg set's hops as the virtual robot did
+        ends = {t["outcome"] for t in cfg["measured"]["outcomes"]}
+        assert ends == {cfg["predicted_outcome"]["outcome"]}, cfg["name"]
+    assert {c["name"]: c["predicted_outcome"]["outcome"] for c in doc["configurations"]} == {
+        "small": "stays_low", "medium": "rears_and_returns", "large": "rears_and_returns"}
+    for row in doc["timing"]:             # the firmware's clock, as the demo films two hops at once
+        assert row["jitter"]["max_late_ms"] <= 2.0 or row["timing_note"], row
     doc = json.loads((demo["report"].parent / "report.json").read_text())
     for cfg in doc["configurations"]:
         assert cfg["predicted_before_fit"]["valid"]
