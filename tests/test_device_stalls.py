@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import STALL_LIMIT_US, spin_probe_us
+from host_probe import STALL_LIMIT_US, spin_probe_us
 from locust.device.hop import run_hop
 from locust.device.link import Link
 from locust.device.plant import RecordingPlant
