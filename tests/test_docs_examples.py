@@ -69,8 +69,8 @@ OUTPUT_OPTIONS = {"--video", "--still", "--still-push", "--out", "--trk", "--wri
 STAND_INS = {
     "step.csv": ("the AA-battery swing the servo protocol films (../shared/data)",
                  SHARED / "data" / "servo" / "sg90_aa_battery_step.csv", False),
-    "trials.csv": ("ramp trials: the bundled synthetic ones", ROOT / "calibration" / "recordings" / "synthetic_ramp.csv",
-                   False),
+    "trials.csv": ("ramp trials: the bundled synthetic ones",
+                   ROOT / "calibration" / "recordings" / "synthetic_ramp.csv", False),
     "hop.mp4": ("a filmed hop: one cycle of the virtual seed robot, fixed camera, with its sidecars", None, True),
 }
 # what an option needs of the machine, skipped without it
@@ -92,10 +92,15 @@ def _big_sweep(argv: list[str]) -> bool:
     return argv[:1] == ["sweep"] and designs * max([1, *map(int, _option(argv, "--samples"))]) >= 30
 
 
+def _big_study(argv: list[str]) -> bool:
+    trials = math.prod(int(n) for n in _option(argv, "--trials") or ["50"])     # (optimize's default trials)
+    return argv[:1] == ["optimize"] and trials * max([1, *map(int, _option(argv, "--robust"))]) >= 30
+
+
 # (why it is slow, is it): each over about 20 s on a busy 2-core machine
 SLOW = (
     ("the whole toolkit, minutes", lambda argv: argv[:1] == ["demo"]),
-    ("an optimisation of many robust trials", lambda argv: argv[:1] == ["optimize"]),
+    ("an optimisation of 30 trials or more", _big_study),
     ("a hop fit", lambda argv: argv[:2] == ["calibrate", "hop"]),
     ("a servo fit", lambda argv: argv[:2] == ["calibrate", "servo"]),
     ("32 or more draws", _slow_samples),
