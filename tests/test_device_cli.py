@@ -108,6 +108,35 @@ def test_flash_refuses_a_pin_the_chip_cannot_drive_and_writes_nothing(env, tmp_p
     assert hop.returncode == 0, hop.stderr
 
 
+@pytest.fixture()
+def flash_config(env):
+    """The virtual board's config.json; put back as flashed after the test."""
+    path = Path(env["LOCUST_VIRTUAL_DIR"]) / "flash" / "config.json"
+    saved = path.read_bytes()
+    yield path
+    path.write_bytes(saved)
+
+
+def test_flash_refuses_a_travel_beyond_the_trim_with_a_hint_about_the_two(env, flash_config):
+    """A 2.5 deg trim leaves 87.5 deg of travel on a 180 deg pulse range: a travel of 90 is
+    refused with the trim and travel in the hint (not the pins, which are fine), nothing is
+    written; the trim set to 0 first in the same flash lets the travel go to 90."""
+    flash_dir = flash_config.parent
+    trimmed = _run(["config", "--port", "sim", "--set", "left.trim_deg=2.5"], env)
+    assert trimmed.returncode == 0, trimmed.stderr
+    before = {p.name: p.read_bytes() for p in flash_dir.iterdir()}
+    proc = _run(["flash", "--port", "sim", "--servo", "left.travel_deg=90"], env)
+    assert proc.returncode == 2, proc.stderr
+    assert "error: --servo left.travel_deg=90 refused for the ESP32: left: travel plus trim exceed" in proc.stderr
+    assert "hint: left has trim 2.5 deg and travel 45 deg; travel plus |trim| may be at most 90 deg" in proc.stderr
+    assert "pins" not in proc.stderr and "Traceback" not in proc.stderr
+    assert {p.name: p.read_bytes() for p in flash_dir.iterdir()} == before
+    done = _run(["flash", "--port", "sim", "--servo", "left.trim_deg=0", "--servo", "left.travel_deg=90"], env)
+    assert done.returncode == 0, done.stderr
+    saved = json.loads(flash_config.read_text())["left"]
+    assert (saved["trim_deg"], saved["travel_deg"]) == (0, 90)
+
+
 def test_ctrl_c_keeps_an_incomplete_record(env, tmp_path):
     out = tmp_path / "D"
     proc = subprocess.Popen(LOCUST + ["hop", "--port", "sim", "--cycles", "6", "--plant", "record", "--out", str(out)],

@@ -284,11 +284,26 @@ def planned_config(board: dict | None, written: dict | None, edits: list[tuple[s
         try:
             cfg = fw_config.with_value(cfg, key, value, chip)
         except ValueError as exc:
-            pins = ", ".join(str(p) for p in fw_config.usable_pins(chip))
             raise DeviceError(f"--servo {key}={value:g} refused for the {fw_config.chip_name(chip)}: {exc}",
-                              f"the {fw_config.chip_name(chip)}'s pins that can drive a servo: {pins}; "
-                              "nothing was written to the board") from None
+                              _refusal_hint(key, cfg, chip)) from None
     return cfg
+
+
+def _refusal_hint(key: str, cfg: dict, chip: str) -> str:
+    """What to do about a refused ``--servo`` value: the usable pins for a pin; for the travel
+    or trim, the two together against half the pulse range (each value is checked in the
+    order given, on the values before it)."""
+    if key.endswith(".pin"):
+        pins = ", ".join(str(p) for p in fw_config.usable_pins(chip))
+        return (f"the {fw_config.chip_name(chip)}'s pins that can drive a servo: {pins}; "
+                "nothing was written to the board")
+    name = key.partition(".")[0]
+    servo = cfg.get(name, {}) if isinstance(cfg, dict) else {}
+    if key.endswith((".travel_deg", ".trim_deg")) and {"trim_deg", "travel_deg", "range_deg"} <= set(servo):
+        return (f"{name} has trim {servo['trim_deg']:g} deg and travel {servo['travel_deg']:g} deg; travel plus |trim| "
+                f"may be at most {servo['range_deg'] / 2:g} deg, and each --servo value is checked in the order given "
+                f"(e.g. --servo {name}.trim_deg=0 before a larger travel); nothing was written to the board")
+    return "see docs/hardware.md for each value's limits; nothing was written to the board"
 
 
 def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
