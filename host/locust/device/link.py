@@ -10,6 +10,7 @@ and dropped.
 from __future__ import annotations
 
 import collections
+import errno
 import os
 import queue
 import threading
@@ -19,6 +20,7 @@ import serial
 
 from ..errors import DeviceError
 from ..firmware import protocol as P
+from .holders import check_free, in_use_error, port_holders
 from .replies import check_hello
 
 REPLY_LIMIT = 64 * 1024         # longest reply or event line read (requests are held to P.MAX_FRAME)
@@ -94,12 +96,22 @@ class Link:
         # MicroPython sends nothing (or drops bursts) while DTR is low. So keep pyserial's
         # default, both asserted, as mpremote does on POSIX: open() re-asserts what the kernel
         # already asserted (TIOCMBIS only) and the lines never move.
+        # Two readers of one port split the board's bytes between them (holders.py): the port is
+        # locked (pyserial's flock, which mpremote takes too) and refused while another program
+        # has it open, rather than a hop losing its replies to it.
+        ser.exclusive = True
         try:
             ser.open()
         except (serial.SerialException, OSError) as exc:
+            if exc.errno in (errno.EAGAIN, errno.EWOULDBLOCK):   # the flock: another locust or mpremote
+                raise in_use_error(port, port_holders(port)) from None
             raise DeviceError(f"cannot open serial port {port}: {exc}",
-                              "check the cable and the port name (`locust ports`), and that no other "
-                              "program (a serial monitor, mpremote) holds the port") from None
+                              "check the cable and the port name (`locust ports`)") from None
+        try:
+            check_free(port)
+        except DeviceError:
+            ser.close()
+            raise
         ser.reset_input_buffer()
         self.serial = ser
         self._reader = threading.Thread(target=self._read_loop, name="locust-link-reader", daemon=True)
@@ -160,9 +172,7 @@ class Link:
                 self.serial.write(data)
         except (serial.SerialException, OSError) as exc:
             self.error = self.error or exc
-            raise DeviceError(f"lost the serial port {self.port}: {exc}",
-                              "check the USB cable; "
-                              "the robot returns to rest on its own when the host goes silent") from None
+            raise self.lost_error() from None
 
     def _new_id(self) -> int:
         with self._lock:
@@ -204,6 +214,9 @@ class Link:
         except queue.Empty:
             with self._lock:
                 self._pending.pop(req_id, None)
+            other = self.other_program_error()
+            if other is not None:
+                raise other from None
             raise DeviceError(f"no reply to {cmd!r} from {self.port} within "
                               f"{self.timeout_s if timeout_s is None else timeout_s:g} s",
                               "is the locust firmware running? run `locust flash --port "
@@ -241,15 +254,36 @@ class Link:
         return msg
 
     def lost_error(self) -> DeviceError:
-        """The error that says the port went away, with the reason.
+        """The error that says the port went away, with the reason, and what the robot does now.
 
         Returns
         -------
         DeviceError
-            The error to raise.
+            The error to raise: "port in use by another program" when another program has
+            opened the port since (its reads take the board's bytes away from this one).
         """
+        other = self.other_program_error()
+        if other is not None:
+            return other
+        if self._heartbeat_stop is not None:   # the robot's own watch on the host's pings is armed
+            after = "the robot returns to rest on its own once the host has been silent for the hop's heartbeat timeout"
+        else:   # pose, config, hello: nothing on the robot notices that the host went away
+            after = ("nothing tells the robot to rest: the servos keep the last pose they were given until the "
+                     "board is reset or powered off")
         return DeviceError(f"lost the serial port {self.port}: {self.error}",
-                           "check the USB cable; the robot returns to rest on its own when the host goes silent")
+                           f"check the USB cable and the port (`locust ports`), re-plug the board and run the "
+                           f"command again; {after}")
+
+    def other_program_error(self) -> DeviceError | None:
+        """The "port in use" error when another program has the port open now (one that opened
+        it after this link did, without a lock: a serial monitor), else None.
+
+        Returns
+        -------
+        DeviceError or None
+        """
+        holders = port_holders(self.port)
+        return in_use_error(self.port, holders) if holders else None
 
     # -- handshake and heartbeat -----------------------------------------------------
     def hello(self, wait_s: float = 3.0, soft_reset: bool = False) -> dict:
@@ -294,7 +328,12 @@ class Link:
                                       f"restart the firmware: Ctrl-D at the >>> prompt of `locust repl --port {port}` "
                                       f"(a soft reset runs main.py), `mpremote connect {port} reset`, "
                                       f"or `locust flash --port {port}` (which also installs it)") from None
-                if self.error is not None or time.monotonic() >= deadline:
+                if self.error is not None:
+                    raise self.lost_error() from None
+                if time.monotonic() >= deadline:
+                    other = self.other_program_error()
+                    if other is not None:
+                        raise other from None
                     raise DeviceError(f"no locust firmware answered on {self.port}",
                                       "flash it with `locust flash --port "
                                       f"{self.port}` (a board without MicroPython needs that first: see "
