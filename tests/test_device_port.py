@@ -1,5 +1,5 @@
-"""The robot's serial port: one program at a time, and a port that goes away (a pulled cable)
-named as such.
+"""The robot's serial port: one program at a time, a heartbeat that has stopped before the port
+closes, and a port that goes away (a pulled cable) named as such.
 
 A second program on the port (mpremote's REPL, a serial monitor, another locust command) takes
 pieces of the board's replies; each command refuses a port another program holds, naming it.
@@ -22,6 +22,10 @@ import threading
 import tty
 from pathlib import Path
 
+import serial.serialposix as SP
+from serial.serialutil import to_bytes
+
+from locust.device.link import Link
 from locust.firmware import config as fw_config
 from locust.firmware import protocol as P
 from waiting import wait_for
@@ -135,6 +139,60 @@ def test_a_second_locust_command_is_refused_while_a_hop_runs_and_the_hop_complet
     assert hop.returncode == 0, stderr
     rec = json.loads(stdout)
     assert rec["status"] == "complete" and len(rec["phases"]) == 16
+
+
+# -- the heartbeat and the port's close -------------------------------------------------------
+
+
+def test_no_heartbeat_write_is_in_progress_when_the_port_closes(monkeypatch):
+    """A ping already past pyserial's is-open check (its thread preempted there) when the link
+    closes: close() waits for it, so the port never closes under a write (Ctrl-C in a long
+    `hop --port sim` printed the heartbeat thread's TypeError from pyserial's write, the port
+    closed under it, before the clean error)."""
+    ping = P.encode({"id": 0, "cmd": "ping"})
+    inside = threading.Event()       # the held ping is inside pyserial's write
+    closing = threading.Event()
+    writing = []                     # writes in progress
+    seen = {"closed_during_write": False}
+    errors = []
+    monkeypatch.setattr(threading, "excepthook", lambda args: errors.append(args.exc_value))
+
+    def held(data):      # pyserial's write calls this right after its is_open check
+        if bytes(data) == ping and not inside.is_set():
+            inside.set()
+            closing.wait(timeout=0.2)   # preempted here until the port starts to close (or 0.2 s)
+        return to_bytes(data)
+
+    real_write, real_close = SP.Serial.write, SP.Serial.close
+
+    def write(self, data):
+        writing.append(data)
+        try:
+            return real_write(self, data)
+        finally:
+            writing.remove(data)
+
+    def close(self):
+        seen["closed_during_write"] = seen["closed_during_write"] or bool(writing)
+        closing.set()
+        real_close(self)
+
+    monkeypatch.setattr(SP, "to_bytes", held)
+    monkeypatch.setattr(SP.Serial, "write", write)
+    monkeypatch.setattr(SP.Serial, "close", close)
+    master, slave = pty.openpty()
+    try:
+        link = Link(os.ttyname(slave))
+        link.start_heartbeat(0.005)
+        assert inside.wait(5)
+        link.close()
+        beats = [t for t in threading.enumerate() if t.name == "locust-link-heartbeat"]
+        assert not [t for t in beats if t.is_alive()]          # it had ended before close() returned
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert not seen["closed_during_write"]
+    assert errors == []
 
 
 # -- a port that goes away ------------------------------------------------------------------

@@ -23,6 +23,7 @@ from ..firmware import protocol as P
 from .holders import check_free, in_use_error, port_holders
 from .replies import check_hello
 
+STOP_WAIT_S = 1.0               # closing waits this long for the heartbeat thread, then for a write
 REPLY_LIMIT = 64 * 1024         # longest reply or event line read (requests are held to P.MAX_FRAME)
 CLOSED = {"ev": "link_closed"}  # put on the event queue when the port goes away
 REPL_PROMPT = b">>> "           # the friendly REPL echoing a frame: `>>> ${"id":...`
@@ -83,7 +84,7 @@ class Link:
         self._lock = threading.Lock()
         self._write_lock = threading.Lock()
         self._next_id = 1
-        self._heartbeat_stop: threading.Event | None = None
+        self._heartbeat: tuple[threading.Event, threading.Thread] | None = None
         ser = serial.Serial()
         ser.port = port
         ser.baudrate = baud
@@ -167,12 +168,16 @@ class Link:
         DeviceError
             The port is lost.
         """
-        try:
-            with self._write_lock:
+        with self._write_lock:
+            if not self.serial.is_open:   # close() ran: nothing more goes out
+                raise DeviceError(f"the serial port {self.port} is closed", "open a new Link") from None
+            try:
                 self.serial.write(data)
-        except (serial.SerialException, OSError) as exc:
-            self.error = self.error or exc
-            raise self.lost_error() from None
+            except (serial.SerialException, OSError) as exc:
+                self.error = self.error or exc
+                raise self.lost_error() from None
+            except (TypeError, AttributeError, ValueError):   # closed under it (close() gave up waiting)
+                raise DeviceError(f"the serial port {self.port} is closed", "open a new Link") from None
 
     def _new_id(self) -> int:
         with self._lock:
@@ -265,7 +270,7 @@ class Link:
         other = self.other_program_error()
         if other is not None:
             return other
-        if self._heartbeat_stop is not None:   # the robot's own watch on the host's pings is armed
+        if self._heartbeat is not None:   # the robot's own watch on the host's pings is armed
             after = "the robot returns to rest on its own once the host has been silent for the hop's heartbeat timeout"
         else:   # pose, config, hello: nothing on the robot notices that the host went away
             after = ("nothing tells the robot to rest: the servos keep the last pose they were given until the "
@@ -378,7 +383,6 @@ class Link:
         """
         self.stop_heartbeat()
         stop = threading.Event()
-        self._heartbeat_stop = stop
         frame = P.encode({"id": 0, "cmd": "ping"})
 
         def beat() -> None:
@@ -394,17 +398,25 @@ class Link:
                 except DeviceError:
                     return
 
-        threading.Thread(target=beat, name="locust-link-heartbeat", daemon=True).start()
+        thread = threading.Thread(target=beat, name="locust-link-heartbeat", daemon=True)
+        self._heartbeat = (stop, thread)
+        thread.start()
 
     def stop_heartbeat(self) -> None:
-        """Stop the pings of :meth:`start_heartbeat` (nothing happens if none run)."""
-        if self._heartbeat_stop is not None:
-            self._heartbeat_stop.set()
-            self._heartbeat_stop = None
+        """Stop the pings of :meth:`start_heartbeat` and wait for their thread to end (up to
+        ``STOP_WAIT_S``): no ping is sent after this returns (nothing happens if none run)."""
+        if self._heartbeat is not None:
+            stop, thread = self._heartbeat
+            self._heartbeat = None
+            stop.set()
+            if thread is not threading.current_thread():
+                thread.join(timeout=STOP_WAIT_S)
 
     def close(self) -> None:
-        """Stop the heartbeat, release RTS then DTR (as mpremote does, so that the board is not
-        reset), close the port and wait up to 1 s for the reader thread.
+        """Stop the heartbeat (its thread ended first: a ping written while the port closes
+        under it fails inside pyserial), release RTS then DTR (as mpremote does, so that the
+        board is not reset), close the port once no write is in progress, and wait up to 1 s
+        for the reader thread.
         """
         self.stop_heartbeat()
         try:
@@ -415,10 +427,16 @@ class Link:
             self.serial.dtr = False
         except (serial.SerialException, OSError):
             pass  # a pseudo-terminal (the virtual robot) has no modem lines
+        # a write still in progress (one blocked on a port that stopped draining) is given
+        # STOP_WAIT_S, then the port closes anyway: a hung board must not hang the host
+        locked = self._write_lock.acquire(timeout=STOP_WAIT_S)
         try:
             self.serial.close()
         except (serial.SerialException, OSError):
             pass
+        finally:
+            if locked:
+                self._write_lock.release()
         self._reader.join(timeout=1.0)
 
     def __enter__(self) -> Link:
