@@ -167,6 +167,52 @@ def _last_new(buf: bytes, marker: bytes, seen: int) -> int:
     return i if i >= 0 and i + len(marker) > seen else -1
 
 
+class ConsoleLines:
+    """A board's console line endings for what the unix port writes with a bare LF.
+
+    On a board, MicroPython writes its text (the REPL's echo and prompt, ``print``, a
+    traceback) through ``mp_hal_stdout_tx_strn_cooked``, which sends each LF as CR LF; the
+    unix port leaves that to its terminal's ``onlcr``, which the virtual robot's raw
+    pseudo-terminals do not do, so mpremote's REPL and a serial monitor showed a staircase.
+    ``onlcr`` itself would be wrong: it doubles the CR of what a board sends as CR LF already
+    (the raw REPL's banner, which mpremote waits for byte for byte). So only a bare LF becomes
+    CR LF, and not at the end of a protocol frame (a line that starts with ``$``), which the
+    firmware writes through ``sys.stdout.buffer``, raw on a board as well. Binary a program
+    writes through ``sys.stdout.buffer`` (mpremote's ``mount``) gets a CR before each LF
+    here, as under any terminal; a board sends it as it is.
+    """
+
+    def __init__(self):
+        self._line = b""        # the current line's first byte (b"" at the start of a line)
+        self._last = b"\n"      # the last byte passed on
+
+    def feed(self, data: bytes) -> bytes:
+        """What the client receives for ``data`` written by the interpreter.
+
+        Parameters
+        ----------
+        data : bytes
+            The next bytes of the interpreter's output.
+
+        Returns
+        -------
+        bytes
+            The same, each bare LF outside a frame written CR LF.
+        """
+        *lines, tail = data.split(b"\n")
+        out = bytearray()
+        for seg in lines:
+            first = self._line or seg[:1]
+            before = seg[-1:] or self._last
+            out += seg + (b"\n" if first == b"$" or before == b"\r" else b"\r\n")
+            self._line, self._last = b"", b"\n"
+        if tail:
+            self._line = self._line or tail[:1]
+            self._last = tail[-1:]
+            out += tail
+        return bytes(out)
+
+
 def _read_pty(fd: int) -> bytes:
     """What a pseudo-terminal's master holds now (b"" if nothing, or no process on the other side)."""
     try:
@@ -330,6 +376,7 @@ class VirtualRobot:
         self._console_tail = b""
         self._raw_boot_pending = False  # rebooted from the raw REPL: enter it again at the prompt
         self._pwm_pending = b""
+        self._console_lines = ConsoleLines()   # a board's CR LF for the REPL's text
         self.summary: dict | None = None
         # the clock when the host stopped the robot: the plant (and its video) ends there, not
         # when its thread gets to the end (a video rendered behind real time would otherwise
@@ -582,7 +629,8 @@ class VirtualRobot:
             for pin in sorted(self._active_pins):
                 self._plant_queue.put((t_s, pin, 0.0))
             self._active_pins.clear()
-            self._to_client(b"\r\nMPY: soft reboot\r\n")
+            with self._console_lock:   # (through the console's lines: the next line is a new one)
+                self._to_client(self._console_lines.feed(b"\r\nMPY: soft reboot\r\n"))
             time.sleep(0.05)
             self._boot(raw_repl=self._raw_repl)
 
@@ -626,7 +674,7 @@ class VirtualRobot:
                 data = _read_pty(self._ma)
                 if data:
                     self._watch_console(data)
-                    self._to_client(data)
+                    self._to_client(self._console_lines.feed(data))
         if self._mb in ready:
             data = _read_pty(self._mb)
             if data:
