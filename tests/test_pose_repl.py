@@ -148,13 +148,16 @@ def test_pose_moves_and_holds_the_horns_on_the_virtual_robot(env, tmp_path):
 
 
 def test_pose_port_sim(env, monkeypatch):
-    """`--port sim`: the command's own virtual robot, whose plant shows the horn angles."""
+    """`--port sim`: the command's own virtual robot, whose plant shows the horn angles; it
+    stops with the command, so the pose is said not to be held (it said "held")."""
     plant = RecordingPlant()
     monkeypatch.setenv("LOCUST_VIRTUAL_DIR", env["LOCUST_VIRTUAL_DIR"])
     monkeypatch.setattr("locust.device.session.make_plant", lambda *a, **k: plant)
     result = CliRunner().invoke(cli, ["pose", "--port", "sim", "-20", "10"])
     assert result.exit_code == 0, result.output
     assert "pose: left -20 deg, right 10 deg" in result.output
+    assert "on sim; not held: this command's virtual robot stopped with it" in result.output
+    assert "locust virtual" in result.output and "held until" not in result.output
     last = plant.commands[-1]
     assert (last.left_deg, last.right_deg) == (pytest.approx(-20.0, abs=1e-3), pytest.approx(10.0, abs=1e-3))
 
@@ -286,8 +289,11 @@ def test_a_hop_the_board_never_answered_leaves_no_run_folder(tmp_path):
         os.close(master)
         os.close(slave)
     assert res.returncode == 2, res.stderr
-    assert res.stderr.splitlines()[0].startswith("output folder: data/runs/"), res.stderr
+    first = res.stderr.splitlines()[0]
+    assert first.startswith("output folder: data/runs/"), res.stderr
     assert "error: no locust firmware answered" in res.stderr
+    # the error says what became of the folder the first line named (it said nothing of it)
+    assert f"no run record was written, so {first.split(': ', 1)[1]} was not kept" in res.stderr
     assert list(tmp_path.iterdir()) == []      # not data/, not data/runs/, not the timestamp folder
 
 
