@@ -172,10 +172,14 @@ def _video_frames(schedule: R.HopSchedule, video: Path, fps: int) -> None:
 def _note_after_hop(rec, directory: Path, exc: LocustError) -> LocustError:
     """The run record says what a failure after the phases cost (the virtual robot's video onto
     a full disk, or interrupted while it was finished), and every phase is kept. Returns the
-    error to report: both failures, when the hop had failed first."""
-    from ..device.virtual import VIDEO_NOT_KEPT
+    error to report: both failures, when the hop had failed first. A signal that came once the
+    video was finished all the same (``VIDEO_KEPT``) cost nothing the record describes: it
+    stays as the hop left it, beside its video."""
+    from ..device.virtual import VIDEO_KEPT, VIDEO_NOT_KEPT
 
     path = directory / R.RECORD_NAME
+    if exc.message == VIDEO_KEPT:
+        return _after_first(exc)
     if rec is None and exc.message == VIDEO_NOT_KEPT and path.is_file():
         rec = R.read_run_record(path)   # (the hop's own failure wrote it, or a signal came as it returned)
     if rec is None:
@@ -187,6 +191,11 @@ def _note_after_hop(rec, directory: Path, exc: LocustError) -> LocustError:
     else:
         return exc
     R.write(rec, directory)
+    return _after_first(exc)
+
+
+def _after_first(exc: LocustError) -> LocustError:
+    """``exc`` after the hop's own error it was raised during, when there was one (both said)."""
     first = exc.__context__   # (the signal, raised while the hop's own error unwound)
     while first is not None and not isinstance(first, LocustError):
         first = first.__context__

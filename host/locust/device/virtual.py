@@ -68,6 +68,7 @@ from .stalls import StallWatch
 SHIM_DIR = Path(__file__).resolve().parent / "machine_shim"
 PWM_PERIOD_S = 0.020
 VIDEO_NOT_KEPT = "interrupted while the virtual robot's video was being finished: the video was not kept"
+VIDEO_KEPT = "interrupted as the virtual robot stopped, once its video was finished: the video was kept"
 PLANT_CANCEL_TIMEOUT_S = 30.0  # a cancelled plant stops within a frame or a step; this long at the most
 PLANT_CLOSE_TIMEOUT_S = 600.0  # the simulation may still be rendering its video when the hop ends
 TICKS_PERIOD = 1 << 30  # an ESP32's ticks_us() wraps at 2**30 us
@@ -465,8 +466,9 @@ class VirtualRobot:
         Raises
         ------
         DeviceError
-            Interrupted while stopping (the video was not kept), the simulation failed, or it did
-            not finish within ``PLANT_CLOSE_TIMEOUT_S``.
+            Interrupted while stopping (``VIDEO_NOT_KEPT``, or ``VIDEO_KEPT`` when the plant had
+            finished its video all the same), the simulation failed, or it did not finish within
+            ``PLANT_CLOSE_TIMEOUT_S``.
         """
         if self._stopping.is_set():
             return self.summary or {}
@@ -485,6 +487,13 @@ class VirtualRobot:
                 self._wait_plant(PLANT_CANCEL_TIMEOUT_S, cancel=True)
             self._end_quietly()
             self._release()
+            # what the plant did decides, not the cancel: one already writing its video's last
+            # frames and index (sim.live's close) does not look at the cancel and keeps the video
+            if self.summary is not None and self.plant_error is None:
+                self.video_dropped = False
+                if getattr(self.plant, "films", False) and self.summary.get("video_path"):
+                    raise DeviceError(VIDEO_KEPT, "what the command had written is whole; only what it prints "
+                                                  "at its end was not printed") from None
             raise self._dropped() from None
         self._release()
         if self.video_dropped:
