@@ -213,8 +213,8 @@ def test_ctrl_c_interrupts_running_code_and_cancels_a_line_at_the_prompt(robot):
                 seen += port.read(256)
             return seen
         until(b">>> ", b"\r")
-        assert b"\n42\n" not in until(b">>> ", b"12\x03")          # the line "12" is dropped...
-        assert b"\n42\n" in until(b">>> ", b"6*7\r")               # ...so this is 6*7, not 126*7
+        assert b"\n42\r\n" not in until(b">>> ", b"12\x03")        # the line "12" is dropped...
+        assert b"\n42\r\n" in until(b">>> ", b"6*7\r")             # ...so this is 6*7, not 126*7
         # a loop that says once that it runs (its echo reads "loop" + "ing"), then sleeps
         until(b"... ", b"import time\rfor i in range(10**9): time.sleep_ms(5) if i else print('loop' + 'ing')\r")
         assert b"looping" in until(b"looping", b"\r")  # runs the loop: no prompt until it is interrupted

@@ -148,13 +148,16 @@ def test_pose_moves_and_holds_the_horns_on_the_virtual_robot(env, tmp_path):
 
 
 def test_pose_port_sim(env, monkeypatch):
-    """`--port sim`: the command's own virtual robot, whose plant shows the horn angles."""
+    """`--port sim`: the command's own virtual robot, whose plant shows the horn angles; it
+    stops with the command, so the pose is said not to be held (it said "held")."""
     plant = RecordingPlant()
     monkeypatch.setenv("LOCUST_VIRTUAL_DIR", env["LOCUST_VIRTUAL_DIR"])
     monkeypatch.setattr("locust.device.session.make_plant", lambda *a, **k: plant)
     result = CliRunner().invoke(cli, ["pose", "--port", "sim", "-20", "10"])
     assert result.exit_code == 0, result.output
     assert "pose: left -20 deg, right 10 deg" in result.output
+    assert "on sim; not held: this command's virtual robot stopped with it" in result.output
+    assert "locust virtual" in result.output and "held until" not in result.output
     last = plant.commands[-1]
     assert (last.left_deg, last.right_deg) == (pytest.approx(-20.0, abs=1e-3), pytest.approx(10.0, abs=1e-3))
 
@@ -219,6 +222,36 @@ def test_mpremote_exec_on_an_idle_robot_then_flash_and_hop(env, tmp_path):
         assert rec["status"] == "complete" and len(rec["phases"]) == 2
 
 
+def test_mpremote_sees_a_boards_line_ends_and_file_sizes_on_the_virtual_robot(env):
+    """mpremote on the virtual robot as on a board: `exec` output ends its lines CR LF (bare LF
+    before: a staircase in a terminal), `fs ls` gives each flashed file its size in bytes (0
+    before: the unix port's ilistdir has no size), and the firmware's frames still end in a
+    bare LF, as a board sends them through sys.stdout.buffer."""
+    flash_dir = Path(env["LOCUST_VIRTUAL_DIR"]) / "flash"
+    with _virtual(env) as device:
+        with serial.Serial(device, timeout=0.2) as port:
+            port.write(P.encode({"id": 7, "cmd": "ping"}))
+            seen = b""
+            deadline = time.monotonic() + 10
+            while not (b'"id":7' in seen and seen.endswith(b"\n")) and time.monotonic() < deadline:
+                seen += port.read(256)
+        at = seen.find(b'"id":7')
+        start, end = seen.rfind(b"$", 0, at), seen.find(b"\n", at)
+        reply = seen[start:end + 1]
+        assert P.decode(reply[:-1])["id"] == 7 and reply[-2:-1] != b"\r", seen
+
+        out = subprocess.run([MPREMOTE, "connect", device, "exec", "print(1); print(2)"], capture_output=True,
+                             timeout=30)
+        assert out.returncode == 0, out.stderr
+        assert out.stdout == b"1\r\n2\r\n"
+
+        ls = subprocess.run([MPREMOTE, "connect", device, "fs", "ls"], capture_output=True, text=True, timeout=30)
+        assert ls.returncode == 0, ls.stderr
+        listed = {name: int(size) for size, name in (line.split() for line in ls.stdout.splitlines()[1:])}
+        assert listed == {p.name: p.stat().st_size for p in flash_dir.iterdir() if p.is_file()}
+        assert min(listed.values()) > 0
+
+
 def test_a_hop_on_locust_virtual_records_the_robot_it_simulates(env, tmp_path):
     """`locust virtual --preset medium`, then `hop --port /dev/pts/N`: run.json records medium
     (the virtual robot's), not the hop's own default."""
@@ -256,8 +289,11 @@ def test_a_hop_the_board_never_answered_leaves_no_run_folder(tmp_path):
         os.close(master)
         os.close(slave)
     assert res.returncode == 2, res.stderr
-    assert res.stderr.splitlines()[0].startswith("output folder: data/runs/"), res.stderr
+    first = res.stderr.splitlines()[0]
+    assert first.startswith("output folder: data/runs/"), res.stderr
     assert "error: no locust firmware answered" in res.stderr
+    # the error says what became of the folder the first line named (it said nothing of it)
+    assert f"no run record was written, so {first.split(': ', 1)[1]} was not kept" in res.stderr
     assert list(tmp_path.iterdir()) == []      # not data/, not data/runs/, not the timestamp folder
 
 
@@ -305,7 +341,7 @@ def test_locust_repl_in_a_terminal(env):
         code, seen = _interact(["repl", "--port", device], env, [
             (b"", b"exit this shell"),  # mpremote's banner
             (b"\x03", b">>> "),  # Ctrl-C: out of the command loop
-            (b"print(6*7)\r", b"42"),
+            (b"print(6*7)\r", b"42\r\n>>> "),    # a board's line end: no staircase in the terminal
             (b"\x1d", b""),  # Ctrl-]: leave
         ])
         assert code == 0, seen[-2000:]

@@ -75,9 +75,9 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
     if video is not None and port == "sim":
         try:
             _video_frames(schedule, video, video_fps)
-        except LocustError:
+        except LocustError as exc:
             _remove_empty(directory, made)
-            raise
+            raise _unrecorded(exc, directory) from None
     held = R.claim(directory)   # a second hop into the same --out is refused (the folder is the other's)
     # a kill (SIGTERM) or a closed terminal (SIGHUP) ends the hop as Ctrl-C does: the robot to
     # rest, the record says so, a --port sim virtual robot stops
@@ -96,10 +96,12 @@ def hop(port, cycles, push_deg, push_ms, wait_ms, heartbeat_ms, out, as_json, le
                                   robot=source, stalls=virtual[0].stalls if virtual else None)
     except BaseException as exc:
         reported = _note_after_hop(rec, directory, exc) if isinstance(exc, LocustError) else exc
-        if isinstance(exc, KeyboardInterrupt) and not (directory / R.RECORD_NAME).exists():
-            reported = DeviceError("interrupted before the hop began: no run record was written",
-                                   "run the hop again when ready")
+        never_began = not (directory / R.RECORD_NAME).exists()
+        if isinstance(exc, KeyboardInterrupt) and never_began:
+            reported = DeviceError("interrupted before the hop began", "run the hop again when ready")
         _remove_empty(directory, made)   # a hop that never started leaves no folder
+        if never_began and isinstance(reported, LocustError):
+            reported = _unrecorded(reported, directory)   # (the first line named the folder)
         if reported is not exc:
             raise reported from None
         raise
@@ -170,10 +172,14 @@ def _video_frames(schedule: R.HopSchedule, video: Path, fps: int) -> None:
 def _note_after_hop(rec, directory: Path, exc: LocustError) -> LocustError:
     """The run record says what a failure after the phases cost (the virtual robot's video onto
     a full disk, or interrupted while it was finished), and every phase is kept. Returns the
-    error to report: both failures, when the hop had failed first."""
-    from ..device.virtual import VIDEO_NOT_KEPT
+    error to report: both failures, when the hop had failed first. A signal that came once the
+    video was finished all the same (``VIDEO_KEPT``) cost nothing the record describes: it
+    stays as the hop left it, beside its video."""
+    from ..device.virtual import VIDEO_KEPT, VIDEO_NOT_KEPT
 
     path = directory / R.RECORD_NAME
+    if exc.message == VIDEO_KEPT:
+        return _after_first(exc)
     if rec is None and exc.message == VIDEO_NOT_KEPT and path.is_file():
         rec = R.read_run_record(path)   # (the hop's own failure wrote it, or a signal came as it returned)
     if rec is None:
@@ -185,10 +191,23 @@ def _note_after_hop(rec, directory: Path, exc: LocustError) -> LocustError:
     else:
         return exc
     R.write(rec, directory)
+    return _after_first(exc)
+
+
+def _after_first(exc: LocustError) -> LocustError:
+    """``exc`` after the hop's own error it was raised during, when there was one (both said)."""
     first = exc.__context__   # (the signal, raised while the hop's own error unwound)
     while first is not None and not isinstance(first, LocustError):
         first = first.__context__
     return DeviceError(f"{first.message}; {exc.message}", first.hint) if first is not None else exc
+
+
+def _unrecorded(exc: LocustError, directory: Path) -> DeviceError:
+    """``exc`` saying that no record was written and what became of the output folder the
+    command's first line named (a hop that never began removes the folder it made)."""
+    note = (f"no run record was written, so {directory} was not kept" if not directory.exists()
+            else f"no run record was written in {directory}")
+    return DeviceError(f"{exc.message}; {note}", exc.hint)
 
 
 def _first_missing(path: Path) -> Path | None:

@@ -38,6 +38,7 @@ def pose(left_deg, right_deg, rest, port):
     and its /dev/pts/N to watch a pose there.
     """
     from ..device.link import Link
+    from ..device.ports import SIM
     from ..device.pose import check_angles
     from ..device.pose import pose as do_pose
     from ..device.session import open_port
@@ -53,5 +54,10 @@ def pose(left_deg, right_deg, rest, port):
     with open_port(port, plant="record", info=info) as device:
         with Link(device) as link:
             left, right = do_pose(link, None if rest else left_deg, None if rest else right_deg)
+    if port == SIM:   # its virtual robot has just stopped with the command: nothing holds the pose
+        held = ("not held: this command's virtual robot stopped with it (to hold a pose, start `locust virtual` "
+                "and pass its /dev/pts/N as --port)")
+    else:
+        held = "held until another command moves the servos or a reset"
     click.echo(f"{'rest' if rest else 'pose'}: left {left:g} deg, right {right:g} deg (horn, from rest) "
-               f"on {port or device}; held until another command moves the servos or a reset")
+               f"on {port or device}; {held}")

@@ -3,7 +3,8 @@
 - :mod:`.ports`: list the serial ports, mark the likely ESP32, pick one for ``--port``;
   :mod:`.session`: resolve ``--port`` (a path, autodetection, or ``sim``, a virtual robot).
 - :mod:`.link`: the protocol's host end (framed requests, replies, events, heartbeat);
-  :mod:`.replies`: the board's replies and events checked like input files.
+  :mod:`.replies`: the board's replies and events checked like input files; :mod:`.holders`:
+  who else has the port open (a second reader takes the board's bytes).
 - :mod:`.flash`: copy the firmware to a board with mpremote, verify it, reset, shake hands.
 - :mod:`.board`: the board's servo config read and changed (``locust config``);
   :mod:`.pose`: hold the servos at an angle (``locust pose``); :mod:`.hop`: run the hop schedule

@@ -27,10 +27,13 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import serial
+
 from ..errors import DeviceError
 from ..firmware import config as fw_config
 from ..firmware import protocol as P
 from ..params import Servo
+from .holders import check_free, in_use_error, port_holders
 from .link import MIN_MICROPYTHON, OLD_MICROPYTHON_HINT, REPLY_LIMIT, Link
 
 FIRMWARE_DIR = Path(P.__file__).resolve().parent
@@ -194,14 +197,84 @@ def build(compile_mpy: bool, workdir: Path) -> list[tuple[str, bytes]]:
     return out
 
 
+LOST_HINT = ("check the USB cable and the port (`locust ports`), re-plug the board and run `locust flash` again "
+             "(the files are renamed into place only once every one has verified, so a cable pulled while "
+             "they were copied leaves the board's firmware as it was)")
+
+
+class GuardedPort:
+    """mpremote's serial port, whose reads and writes raise :class:`DeviceError` when the port
+    fails (a pulled cable): pyserial raises an ``OSError`` there, which mpremote's own
+    ``except OSError`` takes for a missing file on the board (``fs_exists``) and which the
+    command line would take for a disk error. Everything else passes through to the port.
+
+    Parameters
+    ----------
+    port : serial.Serial
+        The port mpremote opened.
+    name : str
+        Its path, for the message.
+    """
+
+    GUARDED = ("read", "write", "inWaiting", "read_all", "flush", "reset_input_buffer")
+
+    def __init__(self, port, name: str):
+        self.__dict__.update(_port=port, _name=name, step="connecting")
+
+    def __getattr__(self, attr: str):
+        value = getattr(self._port, attr)
+        if attr in self.GUARDED:
+            return lambda *args, **kwargs: self._guarded(value, *args, **kwargs)
+        return value
+
+    def __setattr__(self, attr: str, value) -> None:
+        if attr == "step":
+            self.__dict__["step"] = value
+        else:
+            setattr(self._port, attr, value)
+
+    @property
+    def in_waiting(self) -> int:
+        """Bytes waiting to be read (pyserial's ``in_waiting``, guarded)."""
+        return self._guarded(lambda: self._port.in_waiting)
+
+    def _guarded(self, call, *args, **kwargs):
+        try:
+            return call(*args, **kwargs)
+        except (serial.SerialException, OSError, TypeError) as exc:   # (TypeError: pyserial closed it under us)
+            raise DeviceError(f"lost the serial port {self._name} while flashing ({self.step}): {exc}",
+                              LOST_HINT) from None
+
+
 def _transport(port: str):
     from mpremote.transport import TransportError
     from mpremote.transport_serial import SerialTransport
 
     try:
-        return SerialTransport(port, baudrate=115200)
+        transport = SerialTransport(port, baudrate=115200)   # (exclusive: mpremote's flock, as the Link's)
     except TransportError as exc:
+        holders = port_holders(port)
+        if holders:
+            raise in_use_error(port, holders) from None
         raise DeviceError(f"cannot open {port}: {exc}", "check the cable and `locust ports`") from None
+    try:
+        check_free(port)   # a program that takes no lock (a serial monitor) would take the board's replies
+    except DeviceError:
+        transport.close()
+        raise
+    transport.serial = GuardedPort(transport.serial, port)
+    return transport
+
+
+def _close(transport) -> None:
+    """Close mpremote's transport; on a port that is gone, its line changes fail: close the port anyway."""
+    try:
+        transport.close()
+    except (OSError, DeviceError):
+        try:
+            transport.serial.close()
+        except (OSError, DeviceError):
+            pass
 
 
 def _release_console(transport, tries: int = 3) -> bool:
@@ -353,8 +426,13 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
     t_start = time.monotonic()
     transport = _transport(port)
     in_raw_repl = False
+
+    def step(what: str) -> None:    # (named in the error if the port goes away during it)
+        transport.serial.step = what
+        progress(what)
+
     try:
-        progress("connecting")
+        step("connecting")
         _release_console(transport)
         # mpremote reads a pty with blocking reads: bound them while a silent port is possible
         transport.serial.timeout = 1.0
@@ -369,12 +447,12 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
         files = _firmware_files(compile_mpy, board_mpy)
         result = FlashResult(port=port, compiled=compile_mpy, firmware_version="", board=machine or platform,
                              config_written=False)
-        _write_files(transport, files, progress, result)
+        _write_files(transport, files, step, result)
         if config is not None or not transport.fs_exists(fw_config.FILE):
-            progress(f"writing {fw_config.FILE}")
+            step(f"writing {fw_config.FILE}")
             write_board_file(transport, fw_config.FILE, json.dumps(config or servo_config(Servo(), chip)).encode())
             result.config_written = True
-        progress("resetting")
+        step("resetting")
         transport.exit_raw_repl()
         in_raw_repl = False
         transport.serial.write(b"\x04")  # soft reset from the friendly REPL: runs main.py
@@ -385,9 +463,9 @@ def flash(port: str, compile_mpy: bool = False, config: dict | None = None,
             try:
                 transport.exit_raw_repl()
                 transport.serial.write(b"\x04")
-            except (TransportError, OSError):
+            except (TransportError, OSError, DeviceError):
                 pass
-        transport.close()
+        _close(transport)
     progress("handshake")
     with Link(port) as link:
         hello = link.hello(wait_s=8.0)
@@ -529,5 +607,5 @@ def _remove_parts(transport, names: list[str]) -> None:
         try:
             if transport.fs_exists(name + PART):
                 transport.fs_rmfile(name + PART)
-        except (TransportError, OSError):
+        except (TransportError, OSError, DeviceError):   # (the port lost too: the first error is reported)
             pass

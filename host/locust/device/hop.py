@@ -85,7 +85,7 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
     try:
         hello = link.hello(soft_reset=True)    # mpremote leaves a board at the REPL
     except KeyboardInterrupt:
-        raise DeviceError("interrupted before the board answered; no hop ran, nothing was recorded",
+        raise DeviceError("interrupted before the board answered: no hop ran",
                           "run the hop again when ready") from None
     rec.firmware_version = hello.get("version")
     R.write(rec, directory)

@@ -10,6 +10,7 @@ and dropped.
 from __future__ import annotations
 
 import collections
+import errno
 import os
 import queue
 import threading
@@ -19,8 +20,10 @@ import serial
 
 from ..errors import DeviceError
 from ..firmware import protocol as P
+from .holders import check_free, in_use_error, port_holders
 from .replies import check_hello
 
+STOP_WAIT_S = 1.0               # closing waits this long for the heartbeat thread, then for a write
 REPLY_LIMIT = 64 * 1024         # longest reply or event line read (requests are held to P.MAX_FRAME)
 CLOSED = {"ev": "link_closed"}  # put on the event queue when the port goes away
 REPL_PROMPT = b">>> "           # the friendly REPL echoing a frame: `>>> ${"id":...`
@@ -81,7 +84,7 @@ class Link:
         self._lock = threading.Lock()
         self._write_lock = threading.Lock()
         self._next_id = 1
-        self._heartbeat_stop: threading.Event | None = None
+        self._heartbeat: tuple[threading.Event, threading.Thread] | None = None
         ser = serial.Serial()
         ser.port = port
         ser.baudrate = baud
@@ -94,12 +97,22 @@ class Link:
         # MicroPython sends nothing (or drops bursts) while DTR is low. So keep pyserial's
         # default, both asserted, as mpremote does on POSIX: open() re-asserts what the kernel
         # already asserted (TIOCMBIS only) and the lines never move.
+        # Two readers of one port split the board's bytes between them (holders.py): the port is
+        # locked (pyserial's flock, which mpremote takes too) and refused while another program
+        # has it open, rather than a hop losing its replies to it.
+        ser.exclusive = True
         try:
             ser.open()
         except (serial.SerialException, OSError) as exc:
+            if exc.errno in (errno.EAGAIN, errno.EWOULDBLOCK):   # the flock: another locust or mpremote
+                raise in_use_error(port, port_holders(port)) from None
             raise DeviceError(f"cannot open serial port {port}: {exc}",
-                              "check the cable and the port name (`locust ports`), and that no other "
-                              "program (a serial monitor, mpremote) holds the port") from None
+                              "check the cable and the port name (`locust ports`)") from None
+        try:
+            check_free(port)
+        except DeviceError:
+            ser.close()
+            raise
         ser.reset_input_buffer()
         self.serial = ser
         self._reader = threading.Thread(target=self._read_loop, name="locust-link-reader", daemon=True)
@@ -155,14 +168,16 @@ class Link:
         DeviceError
             The port is lost.
         """
-        try:
-            with self._write_lock:
+        with self._write_lock:
+            if not self.serial.is_open:   # close() ran: nothing more goes out
+                raise DeviceError(f"the serial port {self.port} is closed", "open a new Link") from None
+            try:
                 self.serial.write(data)
-        except (serial.SerialException, OSError) as exc:
-            self.error = self.error or exc
-            raise DeviceError(f"lost the serial port {self.port}: {exc}",
-                              "check the USB cable; "
-                              "the robot returns to rest on its own when the host goes silent") from None
+            except (serial.SerialException, OSError) as exc:
+                self.error = self.error or exc
+                raise self.lost_error() from None
+            except (TypeError, AttributeError, ValueError):   # closed under it (close() gave up waiting)
+                raise DeviceError(f"the serial port {self.port} is closed", "open a new Link") from None
 
     def _new_id(self) -> int:
         with self._lock:
@@ -204,6 +219,9 @@ class Link:
         except queue.Empty:
             with self._lock:
                 self._pending.pop(req_id, None)
+            other = self.other_program_error()
+            if other is not None:
+                raise other from None
             raise DeviceError(f"no reply to {cmd!r} from {self.port} within "
                               f"{self.timeout_s if timeout_s is None else timeout_s:g} s",
                               "is the locust firmware running? run `locust flash --port "
@@ -241,15 +259,36 @@ class Link:
         return msg
 
     def lost_error(self) -> DeviceError:
-        """The error that says the port went away, with the reason.
+        """The error that says the port went away, with the reason, and what the robot does now.
 
         Returns
         -------
         DeviceError
-            The error to raise.
+            The error to raise: "port in use by another program" when another program has
+            opened the port since (its reads take the board's bytes away from this one).
         """
+        other = self.other_program_error()
+        if other is not None:
+            return other
+        if self._heartbeat is not None:   # the robot's own watch on the host's pings is armed
+            after = "the robot returns to rest on its own once the host has been silent for the hop's heartbeat timeout"
+        else:   # pose, config, hello: nothing on the robot notices that the host went away
+            after = ("nothing tells the robot to rest: the servos keep the last pose they were given until the "
+                     "board is reset or powered off")
         return DeviceError(f"lost the serial port {self.port}: {self.error}",
-                           "check the USB cable; the robot returns to rest on its own when the host goes silent")
+                           f"check the USB cable and the port (`locust ports`), re-plug the board and run the "
+                           f"command again; {after}")
+
+    def other_program_error(self) -> DeviceError | None:
+        """The "port in use" error when another program has the port open now (one that opened
+        it after this link did, without a lock: a serial monitor), else None.
+
+        Returns
+        -------
+        DeviceError or None
+        """
+        holders = port_holders(self.port)
+        return in_use_error(self.port, holders) if holders else None
 
     # -- handshake and heartbeat -----------------------------------------------------
     def hello(self, wait_s: float = 3.0, soft_reset: bool = False) -> dict:
@@ -294,7 +333,12 @@ class Link:
                                       f"restart the firmware: Ctrl-D at the >>> prompt of `locust repl --port {port}` "
                                       f"(a soft reset runs main.py), `mpremote connect {port} reset`, "
                                       f"or `locust flash --port {port}` (which also installs it)") from None
-                if self.error is not None or time.monotonic() >= deadline:
+                if self.error is not None:
+                    raise self.lost_error() from None
+                if time.monotonic() >= deadline:
+                    other = self.other_program_error()
+                    if other is not None:
+                        raise other from None
                     raise DeviceError(f"no locust firmware answered on {self.port}",
                                       "flash it with `locust flash --port "
                                       f"{self.port}` (a board without MicroPython needs that first: see "
@@ -339,7 +383,6 @@ class Link:
         """
         self.stop_heartbeat()
         stop = threading.Event()
-        self._heartbeat_stop = stop
         frame = P.encode({"id": 0, "cmd": "ping"})
 
         def beat() -> None:
@@ -355,17 +398,25 @@ class Link:
                 except DeviceError:
                     return
 
-        threading.Thread(target=beat, name="locust-link-heartbeat", daemon=True).start()
+        thread = threading.Thread(target=beat, name="locust-link-heartbeat", daemon=True)
+        self._heartbeat = (stop, thread)
+        thread.start()
 
     def stop_heartbeat(self) -> None:
-        """Stop the pings of :meth:`start_heartbeat` (nothing happens if none run)."""
-        if self._heartbeat_stop is not None:
-            self._heartbeat_stop.set()
-            self._heartbeat_stop = None
+        """Stop the pings of :meth:`start_heartbeat` and wait for their thread to end (up to
+        ``STOP_WAIT_S``): no ping is sent after this returns (nothing happens if none run)."""
+        if self._heartbeat is not None:
+            stop, thread = self._heartbeat
+            self._heartbeat = None
+            stop.set()
+            if thread is not threading.current_thread():
+                thread.join(timeout=STOP_WAIT_S)
 
     def close(self) -> None:
-        """Stop the heartbeat, release RTS then DTR (as mpremote does, so that the board is not
-        reset), close the port and wait up to 1 s for the reader thread.
+        """Stop the heartbeat (its thread ended first: a ping written while the port closes
+        under it fails inside pyserial), release RTS then DTR (as mpremote does, so that the
+        board is not reset), close the port once no write is in progress, and wait up to 1 s
+        for the reader thread.
         """
         self.stop_heartbeat()
         try:
@@ -376,10 +427,16 @@ class Link:
             self.serial.dtr = False
         except (serial.SerialException, OSError):
             pass  # a pseudo-terminal (the virtual robot) has no modem lines
+        # a write still in progress (one blocked on a port that stopped draining) is given
+        # STOP_WAIT_S, then the port closes anyway: a hung board must not hang the host
+        locked = self._write_lock.acquire(timeout=STOP_WAIT_S)
         try:
             self.serial.close()
         except (serial.SerialException, OSError):
             pass
+        finally:
+            if locked:
+                self._write_lock.release()
         self._reader.join(timeout=1.0)
 
     def __enter__(self) -> Link:

@@ -12,6 +12,7 @@ import subprocess
 import sys
 
 from ..errors import DeviceError
+from .holders import check_free
 
 
 def mpremote_command(device: str, *args: str) -> list[str]:
@@ -57,9 +58,11 @@ def run_repl(device: str) -> None:
     Raises
     ------
     DeviceError
-        Standard input is not a terminal, or mpremote ends with a non-zero status.
+        Standard input is not a terminal, another program has the port open, or mpremote ends
+        with a non-zero status.
     """
     require_terminal()
+    check_free(device)   # (mpremote says only "failed to access" a port another program holds)
     code = subprocess.call(mpremote_command(device, "repl"))  # interrupted: mpremote is killed
     if code != 0:
         raise DeviceError(f"mpremote's REPL on {device} ended with status {code}",

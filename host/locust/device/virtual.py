@@ -68,6 +68,7 @@ from .stalls import StallWatch
 SHIM_DIR = Path(__file__).resolve().parent / "machine_shim"
 PWM_PERIOD_S = 0.020
 VIDEO_NOT_KEPT = "interrupted while the virtual robot's video was being finished: the video was not kept"
+VIDEO_KEPT = "interrupted as the virtual robot stopped, once its video was finished: the video was kept"
 PLANT_CANCEL_TIMEOUT_S = 30.0  # a cancelled plant stops within a frame or a step; this long at the most
 PLANT_CLOSE_TIMEOUT_S = 600.0  # the simulation may still be rendering its video when the hop ends
 TICKS_PERIOD = 1 << 30  # an ESP32's ticks_us() wraps at 2**30 us
@@ -165,6 +166,52 @@ def _last_new(buf: bytes, marker: bytes, seen: int) -> int:
     """Where ``marker`` last occurs in ``buf`` ending past ``buf[:seen]`` (already searched), or -1."""
     i = buf.rfind(marker)
     return i if i >= 0 and i + len(marker) > seen else -1
+
+
+class ConsoleLines:
+    """A board's console line endings for what the unix port writes with a bare LF.
+
+    On a board, MicroPython writes its text (the REPL's echo and prompt, ``print``, a
+    traceback) through ``mp_hal_stdout_tx_strn_cooked``, which sends each LF as CR LF; the
+    unix port leaves that to its terminal's ``onlcr``, which the virtual robot's raw
+    pseudo-terminals do not do, so mpremote's REPL and a serial monitor showed a staircase.
+    ``onlcr`` itself would be wrong: it doubles the CR of what a board sends as CR LF already
+    (the raw REPL's banner, which mpremote waits for byte for byte). So only a bare LF becomes
+    CR LF, and not at the end of a protocol frame (a line that starts with ``$``), which the
+    firmware writes through ``sys.stdout.buffer``, raw on a board as well. Binary a program
+    writes through ``sys.stdout.buffer`` (mpremote's ``mount``) gets a CR before each LF
+    here, as under any terminal; a board sends it as it is.
+    """
+
+    def __init__(self):
+        self._line = b""        # the current line's first byte (b"" at the start of a line)
+        self._last = b"\n"      # the last byte passed on
+
+    def feed(self, data: bytes) -> bytes:
+        """What the client receives for ``data`` written by the interpreter.
+
+        Parameters
+        ----------
+        data : bytes
+            The next bytes of the interpreter's output.
+
+        Returns
+        -------
+        bytes
+            The same, each bare LF outside a frame written CR LF.
+        """
+        *lines, tail = data.split(b"\n")
+        out = bytearray()
+        for seg in lines:
+            first = self._line or seg[:1]
+            before = seg[-1:] or self._last
+            out += seg + (b"\n" if first == b"$" or before == b"\r" else b"\r\n")
+            self._line, self._last = b"", b"\n"
+        if tail:
+            self._line = self._line or tail[:1]
+            self._last = tail[-1:]
+            out += tail
+        return bytes(out)
 
 
 def _read_pty(fd: int) -> bytes:
@@ -330,6 +377,7 @@ class VirtualRobot:
         self._console_tail = b""
         self._raw_boot_pending = False  # rebooted from the raw REPL: enter it again at the prompt
         self._pwm_pending = b""
+        self._console_lines = ConsoleLines()   # a board's CR LF for the REPL's text
         self.summary: dict | None = None
         # the clock when the host stopped the robot: the plant (and its video) ends there, not
         # when its thread gets to the end (a video rendered behind real time would otherwise
@@ -418,8 +466,9 @@ class VirtualRobot:
         Raises
         ------
         DeviceError
-            Interrupted while stopping (the video was not kept), the simulation failed, or it did
-            not finish within ``PLANT_CLOSE_TIMEOUT_S``.
+            Interrupted while stopping (``VIDEO_NOT_KEPT``, or ``VIDEO_KEPT`` when the plant had
+            finished its video all the same), the simulation failed, or it did not finish within
+            ``PLANT_CLOSE_TIMEOUT_S``.
         """
         if self._stopping.is_set():
             return self.summary or {}
@@ -438,6 +487,13 @@ class VirtualRobot:
                 self._wait_plant(PLANT_CANCEL_TIMEOUT_S, cancel=True)
             self._end_quietly()
             self._release()
+            # what the plant did decides, not the cancel: one already writing its video's last
+            # frames and index (sim.live's close) does not look at the cancel and keeps the video
+            if self.summary is not None and self.plant_error is None:
+                self.video_dropped = False
+                if getattr(self.plant, "films", False) and self.summary.get("video_path"):
+                    raise DeviceError(VIDEO_KEPT, "what the command had written is whole; only what it prints "
+                                                  "at its end was not printed") from None
             raise self._dropped() from None
         self._release()
         if self.video_dropped:
@@ -582,7 +638,8 @@ class VirtualRobot:
             for pin in sorted(self._active_pins):
                 self._plant_queue.put((t_s, pin, 0.0))
             self._active_pins.clear()
-            self._to_client(b"\r\nMPY: soft reboot\r\n")
+            with self._console_lock:   # (through the console's lines: the next line is a new one)
+                self._to_client(self._console_lines.feed(b"\r\nMPY: soft reboot\r\n"))
             time.sleep(0.05)
             self._boot(raw_repl=self._raw_repl)
 
@@ -626,7 +683,7 @@ class VirtualRobot:
                 data = _read_pty(self._ma)
                 if data:
                     self._watch_console(data)
-                    self._to_client(data)
+                    self._to_client(self._console_lines.feed(data))
         if self._mb in ready:
             data = _read_pty(self._mb)
             if data:
