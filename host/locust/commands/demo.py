@@ -204,8 +204,7 @@ class Demo:
         self.stopping.set()
         with self._lock:
             running = list(self.running)
-        for proc in running:
-            _end(proc)
+        _end(*running)
 
     def expect(self, *paths: Path, step: int | None = None) -> None:
         """The files the last command (or command ``step``) should have written; a command that
@@ -253,16 +252,19 @@ class DemoStopped(Exception):
 STOP_GRACE_S = 0.5   # a child sent TERM has this long to unwind before it is killed
 
 
-def _end(proc: subprocess.Popen) -> None:
-    """End ``proc``: TERM, then KILL after :data:`STOP_GRACE_S` (nothing when it has ended)."""
-    if proc.poll() is not None:
-        return
-    proc.terminate()
-    try:
-        proc.wait(timeout=STOP_GRACE_S)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait()
+def _end(*procs: subprocess.Popen) -> None:
+    """End ``procs`` together: TERM to each, then KILL to those not ended within
+    :data:`STOP_GRACE_S` of it (nothing to one that has ended)."""
+    live = [p for p in procs if p.poll() is None]
+    for p in live:
+        p.terminate()
+    deadline = time.monotonic() + STOP_GRACE_S
+    for p in live:
+        try:
+            p.wait(timeout=max(0.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
 
 
 def _tick(bar, done: threading.Event) -> None:
