@@ -142,18 +142,6 @@ class PrintCheck:
                        f"{math.tan(math.radians(self.tilt_deg)):.1f}; photograph it from straight above")
         return out
 
-    def as_dict(self) -> dict:
-        """The check as JSON holds it (SI and plain ratios).
-
-        Returns
-        -------
-        dict
-        """
-        return {"photo": str(self.photo), "board": self.board, "print_scale": self.scale,
-                "print_scale_interval": [self.scale_low, self.scale_high], "interval": INTERVAL,
-                "card_long_m": self.card_mm[0] / 1000, "card_short_m": self.card_mm[1] / 1000,
-                "markers": self.markers, "tilt_deg": self.tilt_deg}
-
 
 # -- the board ----------------------------------------------------------------------------
 def _homography(img_px: np.ndarray, board_mm: np.ndarray) -> np.ndarray:
@@ -168,13 +156,11 @@ def _apply(H: np.ndarray, pts: np.ndarray) -> np.ndarray:
     return v[:, :2] / v[:, 2:]
 
 
-def tilt_deg(spec: BoardSpec, img_px: np.ndarray, board_mm: np.ndarray, size_px: tuple[int, int]) -> float:
+def tilt_deg(img_px: np.ndarray, board_mm: np.ndarray, size_px: tuple[int, int]) -> float:
     """The camera's axis from the board's normal, from the board's pose in this one view.
 
     Parameters
     ----------
-    spec : BoardSpec
-        The board.
     img_px : ndarray
         (N, 2) its detected corners [px].
     board_mm : ndarray
@@ -420,6 +406,6 @@ def check_print(photo: Path, spec: BoardSpec, draws: int = DRAWS, seed: int = 0)
         true = [CARD_MM[j] + rng.uniform(-1, 1) * CARD_TOLERANCE_MM[j] for j in (0, 1)]
         scales[i] = (true[0] + true[1]) / (lm + sm)
     low, high = np.quantile(scales, [(1 - INTERVAL) / 2, (1 + INTERVAL) / 2])
-    tilt = tilt_deg(spec, img_px, board_mm, (image.shape[1], image.shape[0]))
+    tilt = tilt_deg(img_px, board_mm, (image.shape[1], image.shape[0]))
     return PrintCheck(photo, spec.text(), float(scale), float(low), float(high), (long_mm, short_mm),
                       len(img_px) // 4, tilt)
