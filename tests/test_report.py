@@ -237,6 +237,21 @@ def test_report_draws_an_optimize_study_s_front_and_names_its_pick(world):
     assert doc["optimize"]["front"][0]["distance_per_hop_m"] == best["distance_per_hop_m"]
 
 
+def test_report_writes_optuna_s_views_of_the_study_beside_the_page(world):
+    """--optimize: study.html beside report.html, drawn from the study's journal (its three
+    trials), linked from the front's caption; one objective, so a history and importances and a
+    note in place of a front."""
+    folder = world["html"].parent
+    text = world["html"].read_text(encoding="utf-8")
+    assert '<a href="study.html">Optuna&#x27;s own views of the study' in text
+    views = (folder / "study.html").read_text(encoding="utf-8")
+    assert "3 trials in " in views and str(world["root"] / "study" / "study.journal") in views
+    assert views.count('data-view="history"') == 1 and views.count('data-view="front"') == 0
+    assert "one objective: the study has no front" in views
+    doc = json.loads((folder / "report.json").read_text())
+    assert doc["optimize"]["views"] == "study.html"
+
+
 def test_a_study_made_under_the_old_objective_names_is_refused_with_the_new_ones(world, tmp_path):
     """A study whose optimize.json maximises `distance` (the name before it said per hop) is not
     drawn as if its figures were this locust's: error and hint, nothing simulated or written."""

@@ -48,8 +48,8 @@ def _steps(items: tuple[str, ...]) -> dict[str, float]:
               help="Finished trials the study should hold; a rerun computes only those missing.")
 @click.option("--cycles", type=click.IntRange(1, 100), default=3, show_default=True)
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
-              help="Folder for pareto.csv, pareto.png, trials.csv, optimize.json, best-*.toml "
-                   "(and the journal by default).")
+              help="Folder for pareto.csv, pareto.png, study.html (Optuna's history, importances and "
+                   "interactive front), trials.csv, optimize.json, best-*.toml (and the journal by default).")
 @click.option("--storage", default=None, metavar="URL",
               help="Optuna storage: a journal file path (default OUT/study.journal) or an RDB URL "
                    "such as sqlite:///study.db to share a study between machines.")
@@ -116,6 +116,8 @@ def _report(summary, bounds, objectives, out: Path) -> None:
         click.echo(f"{pick}: " + describe(row, names, objectives))
         click.echo(f"  as a robot file: {summary.robots[pick]}")
     click.echo(f"results: {out / 'pareto.csv'}, {out / 'pareto.png'}, {out / 'trials.csv'}, {out / 'optimize.json'}")
+    if summary.complete:
+        click.echo(f"Optuna's views (history, importances, interactive front): {out / 'study.html'}")
     if summary.interrupted:
         kept = summary.complete + summary.pruned
         click.echo(f"interrupted: {kept} finished trial{'s' * (kept != 1)} kept in the study and the files above "

@@ -74,6 +74,7 @@ def track():
     Examples:
       locust track hop.mp4                                 nose + foot by colour (metres from hop.camera.json)
       locust track board board.png                         print at 100 %, lay it in the plane of the hop
+      locust track board --check photo.jpg                 was it printed at 100 %? (a bank card beside it)
       locust track preview phone.mp4                       pick colours and start points from phone.preview.png
       locust track video phone.mp4 --marker nose=color:#e8308c@412,630 --board aruco:4X4_50:5x4:40:10
       locust track from-trk experiment.trz --format tracker
@@ -205,28 +206,58 @@ def from_trk_command(project, trk_names, out, force, fmt):
     _convert_trk(project, list(trk_names), out, fmt, force)
 
 
-@track.command("board", short_help="Write a printable ArUco calibration board (PNG).")
-@click.argument("png", type=click.Path(dir_okay=False, path_type=Path))
+@track.command("board", short_help="Write a printable ArUco board (PNG and PDF), or check a print of one.")
+@click.argument("png", required=False, type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--board", "board_text", default=DEFAULT_BOARD, show_default=True,
-              metavar="aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM", help="The ArUco grid board to draw.")
-@click.option("--force", is_flag=True, help="Replace an existing PNG.")
-def board_command(png, board_text, force):
-    """Write an ArUco grid board as PNG at 300 DPI, to print at 100 % and lay flat in the
-    plane of motion; `locust track video VIDEO --board SPEC` then gives metres with the
-    perspective corrected.
+              metavar="aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM", help="The ArUco grid board.")
+@click.option("--check", "photo", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Measure PHOTO, the printed board with an ID-1 card (a bank or ID card, 85.60 x 53.98 mm) lying "
+                   "flat beside it, and say by how much the printer scaled the board.")
+@click.option("--force", is_flag=True, help="Replace an existing PNG and PDF.")
+def board_command(png, board_text, photo, force):
+    """Write an ArUco grid board as PNG (300 DPI) and PDF (its page the sheet's size), to print
+    at 100 % and lay flat in the plane of motion; `locust track video VIDEO --board SPEC` then
+    gives metres with the perspective corrected. Beside the markers the sheet carries a 100 mm
+    scale bar and the board's spec and sizes.
+
+    \b
+    --check PHOTO measures a photo of the print instead: lay a bank or ID card (ISO/IEC 7810
+    ID-1, 85.60 x 53.98 mm) flat on the table beside the sheet, its whole outline in view, and
+    photograph both from above. A photo alone cannot tell a smaller print from a farther
+    camera: the card, at its true size, can. Or lay a ruler along the printed 100 mm bar.
 
     \b
     Examples:
-      locust track board board.png
+      locust track board board.png                         also writes board.pdf
       locust track board small.png --board aruco:4X4_50:4x3:30:6
+      locust track board --check photo.jpg                 the print's scale, from the card beside it
     """
+    from ..track import boardcheck, boardsheet
+
     spec = board.parse_board(board_text)
+    if photo is not None:
+        if png is not None:
+            raise TrackError("give PNG (write a board) or --check PHOTO (measure a print), not both",
+                             "e.g. locust track board --check photo.jpg")
+        result = boardcheck.check_print(photo, spec)
+        for line in result.lines(spec):
+            click.echo(line, err=line.startswith("warning:"))
+        return
+    if png is None:
+        raise TrackError("give the PNG to write, or --check PHOTO", "e.g. locust track board board.png")
+    if png.suffix.lower() not in (".png", ".pdf"):
+        raise TrackError(f"{png}: the board is written as a .png, with a .pdf beside it",
+                         f"e.g. locust track board {png.with_suffix('.png').name}")
+    png = png.with_suffix(".png") if png.suffix.lower() == ".pdf" else png
+    pdf = boardsheet.pdf_beside(png)
     _say_folder(png)
-    _refuse_overwrite({"board": png}, force)
-    board.write_board_png(png, spec)
-    click.echo(f"wrote {png}: board {spec.text()}, {spec.width_mm:g} x {spec.height_mm:g} mm of markers "
-               f"at {board.BOARD_DPI} DPI; print at 100 % (no fit to page), check one marker is "
-               f"{spec.marker_mm:g} mm, lay it flat in the plane of motion")
+    _refuse_overwrite({"board": png, "pdf": pdf}, force)
+    boardsheet.write_board_sheet(png, spec)
+    lay = boardsheet.layout(spec)
+    click.echo(f"wrote {png} ({boardsheet.SHEET_DPI} DPI) and {pdf} ({lay.width_mm:.1f} x {lay.height_mm:.1f} mm "
+               f"page): board {spec.text()}, {spec.width_mm:g} x {spec.height_mm:g} mm of markers; print at 100 % "
+               f"(no fit to page), check the scale bar is 100 mm (or `locust track board --check PHOTO`), lay it "
+               f"flat in the plane of motion")
 
 
 @track.command("preview", short_help="One frame with a pixel grid, its coloured blobs listed.")

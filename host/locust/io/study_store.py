@@ -104,6 +104,7 @@ class StudyResults:
     max_flip: float | None
     trials: list[dict[str, Any]]
     front: list[dict[str, Any]]
+    study: str = "locust"            # the study's name in its storage
 
 
 def read_study(folder: Path) -> StudyResults:
@@ -128,7 +129,8 @@ def read_study(folder: Path) -> StudyResults:
         if not (folder / name).is_file():
             raise SweepError(f"{folder}: no {name}", hint)
     try:
-        held = json.loads((folder / META).read_text(encoding="utf-8"))["settings"]
+        meta = json.loads((folder / META).read_text(encoding="utf-8"))
+        held = meta["settings"]
         names = [str(v["name"]) for v in held["vary"]]
         objectives = [str(o) for o in held["objectives"]]
     except (OSError, ValueError, KeyError, TypeError) as exc:
@@ -141,4 +143,4 @@ def read_study(folder: Path) -> StudyResults:
         except (OSError, ValueError, TypeError) as exc:
             raise SweepError(f"{folder / name}: not a `locust optimize` table ({exc})", hint) from None
     return StudyResults(folder, str(held.get("base", "?")), names, objectives, int(held.get("robust") or 0),
-                        held.get("quantile"), held.get("max_flip"), *tables)
+                        held.get("quantile"), held.get("max_flip"), *tables, study=str(meta.get("study", "locust")))

@@ -19,6 +19,7 @@ from ..errors import ReportError, WriteError
 from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, unique_dir
 from ..io.run_record import ERROR as REFUSED
 from ..params import Provenance, Robot
+from ..sweep.views import STUDY_PAGE
 from ..tables import for_person
 from ..trials.configs import Configuration, configuration
 from ..trials.measured import Trial
@@ -31,7 +32,7 @@ from .landscape import Landscape, read_landscape
 from .predict import predict
 from .sidebyside import plan_side_by_side, write_side_by_side
 from .spread import spread
-from .study import read_front, study_figure
+from .study import read_front, study_figure, views_page
 
 REPORT_NAME = "report.html"
 DASHBOARD_NAME = "dashboard.png"
@@ -223,6 +224,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
                           f"configurations given: {', '.join(measured)}")
     land = read_landscape(sweep) if sweep is not None else None   # fail early on a bad sweep folder
     front = read_front(study) if study is not None else None
+    views = views_page(front) if front is not None else None
     t0 = time.perf_counter()
 
     configs, comps, spreads, befores = _simulate(base, measured, added, cycles, marker, progress, side_by_side,
@@ -231,7 +233,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     progress("drawing figures")
     figs = _figures(comps, configs, land, spreads, befores)
     if front is not None:
-        figs.insert(-1, study_figure(front))
+        figs.insert(-1, study_figure(front, views is not None))
     dash = F.dashboard(comps, land, configs)
 
     timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
@@ -240,7 +242,8 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings, spreads,
                             sbs_plan)
     doc = report_json(base, robot_source, comps, configs, timing, land, marker, warnings)
-    doc["optimize"] = {"folder": str(front.folder), "front": front.front} if front is not None else None
+    doc["optimize"] = {"folder": str(front.folder), "front": front.front,
+                       "views": STUDY_PAGE if views is not None else None} if front is not None else None
     for entry in doc["configurations"]:
         sp, old = spreads.get(entry["name"]), befores.get(entry["name"])
         entry["predicted_spread"] = sp.to_json() if sp is not None else None
@@ -250,6 +253,8 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     try:
         html_path = atomic_write_text(folder / REPORT_NAME, html_text)
         dash_path = atomic_write_bytes(folder / DASHBOARD_NAME, dash)
+        if views is not None:
+            atomic_write_text(folder / STUDY_PAGE, views)
         videos = write_side_by_side(sbs_plan, folder, progress) if sbs_plan is not None else []
         if sbs_plan is not None:
             doc["side_by_side"] = [v.to_json() for v in videos]

@@ -47,12 +47,15 @@ class Figure:
         Its title and caption.
     png : bytes
         The image, PNG.
+    link : tuple of str, optional
+        ``(href, text)``: a page beside the report the caption links to ("" for none).
     """
 
     key: str
     title: str
     caption: str
     png: bytes
+    link: tuple[str, str] | None = None
 
 
 def esc(value) -> str:
@@ -431,8 +434,9 @@ def figure_html(fig: Figure) -> str:
         The ``<figure id="fig-<key>">`` element.
     """
     data = base64.b64encode(fig.png).decode("ascii")
+    link = f' <a href="{esc(fig.link[0])}">{esc(fig.link[1])}</a>' if fig.link else ""
     return (f'<figure id="fig-{esc(fig.key)}"><img src="data:image/png;base64,{data}" alt="{esc(fig.title)}">'
-            f"<figcaption><b>{esc(fig.title)}.</b> {esc(fig.caption)}</figcaption></figure>")
+            f"<figcaption><b>{esc(fig.title)}.</b> {esc(fig.caption)}{link}</figcaption></figure>")
 
 
 def videos_html(videos: list[tuple[str, str]], skipped: list[str]) -> str:

@@ -1,7 +1,11 @@
-"""A ``locust optimize`` study in the report: its Pareto front and the designs it picks.
+"""A ``locust optimize`` study in the report: its Pareto front and the designs it picks, and
+Optuna's own views of it.
 
 The folder is read by its owner (:func:`locust.io.study_store.read_study`); the front is drawn
-as ``pareto.png`` draws it (:func:`locust.sweep.pareto.draw_front`).
+as ``pareto.png`` draws it (:func:`locust.sweep.pareto.draw_front`). Optuna's views (history,
+importances, interactive front: :mod:`locust.sweep.views`) are drawn from the study's journal
+in that folder, as it is when the report is made, into ``study.html`` beside the report; a
+study kept in a database (``--storage``) is shown by the ``study.html`` its folder holds.
 """
 
 from __future__ import annotations
@@ -13,7 +17,10 @@ from ..io.study_store import StudyResults, read_study
 from ..plotting import png_bytes, pyplot
 from ..sweep.objectives import OBJECTIVES, RENAMED
 from ..sweep.pareto import describe, draw_front, picks_of
+from ..sweep.views import STUDY_PAGE
 from . import page as H
+
+JOURNAL = "study.journal"
 
 
 def read_front(folder: Path) -> StudyResults:
@@ -48,13 +55,62 @@ def read_front(folder: Path) -> StudyResults:
     return study
 
 
-def study_figure(study: StudyResults) -> H.Figure:
+def views_page(study: StudyResults) -> str | None:
+    """``study.html``'s text: Optuna's views of the study, from the journal in its folder (else
+    the page its folder holds; None when it holds neither).
+
+    Parameters
+    ----------
+    study : StudyResults
+        The study, from :func:`read_front`.
+
+    Returns
+    -------
+    str or None
+        The page.
+
+    Raises
+    ------
+    ReportError
+        The journal is not one, or holds no study of the folder's name.
+    """
+    import optuna
+
+    from ..sweep.storage import check_journal_file, open_storage
+    from ..sweep.views import page_html, study_views
+
+    journal = study.folder / JOURNAL
+    if not journal.is_file():
+        page = study.folder / STUDY_PAGE
+        return page.read_text(encoding="utf-8") if page.is_file() else None
+    try:
+        check_journal_file(journal)
+        optuna.logging.set_verbosity(optuna.logging.ERROR)
+        held = optuna.load_study(study_name=study.study, storage=open_storage(None, study.folder))
+    except SweepError as exc:
+        raise ReportError(f"--optimize {study.folder}: {exc.message}", exc.hint) from None
+    except KeyError:
+        raise ReportError(f"--optimize {study.folder}: its journal holds no study {study.study!r}, which its "
+                          "optimize.json names", "give the --out folder of one `locust optimize` run") from None
+    trials = held.get_trials(deepcopy=False)
+    lines = [f"{len(trials)} trials in {journal} when this report was made: "
+             f"{sum(t.state.name == 'COMPLETE' for t in trials)} complete, "
+             f"{sum(t.state.name == 'PRUNED' for t in trials)} pruned as invalid designs; every objective is "
+             "maximised. Pruned trials are in no view; a design over the flip limit is drawn as infeasible on "
+             "the front."]
+    return page_html(study_views(held, [OBJECTIVES[n] for n in study.objectives]),
+                     f"Study {held.study_name}: Optuna's views", lines)
+
+
+def study_figure(study: StudyResults, views: bool = False) -> H.Figure:
     """The front, its ends and knee, with a caption saying how each design was judged.
 
     Parameters
     ----------
     study : StudyResults
         The study, from :func:`read_front`.
+    views : bool
+        ``study.html`` (:func:`views_page`) is written beside the report: the caption links it.
 
     Returns
     -------
@@ -75,4 +131,6 @@ def study_figure(study: StudyResults) -> H.Figure:
     caption = (f"Pareto front of the study in {study.folder}: each objective per hop, {judged}{limit}; a run "
                f"that goes over onto its back scores 0. Grey: dominated designs; red crosses: over the flip "
                f"limit. {picked or 'No feasible design.'}")
-    return H.Figure("pareto", "Designs that hop far and high without going over", caption, png_bytes(fig))
+    link = (STUDY_PAGE, "Optuna's own views of the study: history, importances, interactive front.") if views \
+        else None
+    return H.Figure("pareto", "Designs that hop far and high without going over", caption, png_bytes(fig), link)

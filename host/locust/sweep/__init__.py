@@ -9,6 +9,7 @@
 - :mod:`.optimize`: the Optuna study of the designs that hop farthest and highest without going
   over; :mod:`.objectives`: what a design is judged by; :mod:`.robust`: a design judged on its
   nominal run or over draws of its uncertain values; :mod:`.pareto`: the front, its ends and
-  knee, ``pareto.png``; :mod:`.storage`: the study's journal or database, checked before Optuna
+  knee, ``pareto.png``; :mod:`.views`: Optuna's own history, importances and interactive front,
+  ``study.html``; :mod:`.storage`: the study's journal or database, checked before Optuna
   touches it; :mod:`.journal`: a journal torn by a full disk, and its repair.
 """

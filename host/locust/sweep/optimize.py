@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +36,7 @@ from .journal import full_disk
 from .objectives import DEFAULT, OBJECTIVES, OUTCOMES, Judgement, Objective
 from .pareto import picks, plot_front
 from .storage import SETTINGS_ATTR, check_folder, check_journal_file, check_storage, open_storage
+from .views import STUDY_PAGE, write_study_page
 
 SAMPLERS = ("tpe", "nsga2")
 # states of a trial that is over: the study holds its result (or its reason)
@@ -399,6 +401,10 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
                                 directions=["maximize"] * len(objectives))
     if held is None:
         study.set_user_attr(SETTINGS_ATTR, wanted)
+        # the columns' names, units included: what Optuna's views and optuna-dashboard label
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)   # stable since Optuna 3.2
+            study.set_metric_names([o.column for o in objectives])
     before = len(study.trials)
     left = max(0, trials - len(finished_trials(study)))
     judge = judge or DesignJudge(base, cycles, tuple(objectives), draws, quantile)
@@ -504,7 +510,8 @@ def trial_rows(study, names: list[str], objectives: list[Objective], max_flip: f
 
 def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max_flip: float | None,
               computed: int = 0, interrupted: bool = False) -> OptimizeSummary:
-    """Write trials.csv, pareto.csv, pareto.png, optimize.json and a robot file for each pick.
+    """Write trials.csv, pareto.csv, pareto.png, study.html (Optuna's own views of the study),
+    optimize.json and a robot file for each pick.
 
     Parameters
     ----------
@@ -553,5 +560,6 @@ def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max
         if held.get("robust"):
             title += f" (quantile {held['quantile']:g} of {held['robust']} draws)"
         plot_front(rows, front, chosen, objectives, max_flip, folder / "pareto.png", title)
+        write_study_page(study, objectives, folder / STUDY_PAGE)
     return OptimizeSummary(study.study_name, len(rows), len(done), len(pruned), front, chosen, folder, computed,
                            interrupted, robots)

@@ -16,8 +16,8 @@ from ..errors import SweepError
 
 RDB_PREFIXES = ("sqlite:", "postgresql", "mysql", "oracle", "mssql")
 # what run_optimize writes in its folder; anything else there is someone else's
-OWN_FILES = frozenset({"trials.csv", "pareto.csv", "optimize.json", "pareto.png", "knee.toml", "study.journal",
-                       "study.journal.lock"})
+OWN_FILES = frozenset({"trials.csv", "pareto.csv", "optimize.json", "pareto.png", "study.html", "knee.toml",
+                       "study.journal", "study.journal.lock"})
 # and a robot file for each end of the front: best-<objective>.toml
 OWN_PREFIX, OWN_SUFFIX = "best-", ".toml"
 # a journal saved by --repair before its torn line was cut (sweep/journal.py)

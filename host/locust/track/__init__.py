@@ -16,6 +16,9 @@ Modules, one job each:
 - :mod:`.calib`     pixel -> metre calibration (stick or ArUco size), origin, axes
 - :mod:`.camera`    pixel -> plane metres through the pinhole camera of a ``camera.json``
 - :mod:`.board`     pixel -> plane metres through a homography: ArUco grid board or four points
+- :mod:`.boardsheet` the board to print (PNG and a PDF of its size), a 100 mm bar, its spec
+- :mod:`.boardcheck` a print's scale, from a photo of it with a bank card beside it
+- :mod:`.boardphoto` synthetic photos of a board printed at a known scale, with a card
 - :mod:`.preview`   one frame with a pixel grid and the saturated blobs, for picking colours
 - :mod:`.runner`    the frame loop that ties video, markers and calibration together
 - :mod:`.export`    a result as the tracks CSV + JSON sidecar

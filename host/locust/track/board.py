@@ -13,17 +13,16 @@ the bottom-left marker), x along the board's bottom edge, y up the board. A homo
 exact for points *in* the plane; a marker in front of it (a sticker on a robot 2 cm
 nearer the camera) reads a little off, by its distance over the camera's distance.
 
-``locust track board FILE.png`` writes the board at 300 DPI (the PNG records it):
-print it at 100 % ("actual size", no "fit to page"), then measure one marker with a ruler.
+``locust track board FILE.png`` writes the board to print (:mod:`locust.track.boardsheet`: a
+PNG at 300 DPI and a PDF of the sheet's size, with a 100 mm scale bar and the board's spec);
+``--check PHOTO`` measures a print's scale (:mod:`locust.track.boardcheck`).
 """
 
 from __future__ import annotations
 
-import io
 import math
 import re
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import cv2
 import numpy as np
@@ -31,39 +30,13 @@ import numpy as np
 # the board itself is defined once, beside the simulation's stills and the photo measurement
 from ..arucoboard import DEFAULT_BOARD, MIN_BOARD_MARKERS, BoardSpec, parse_board  # noqa: F401
 from ..errors import TrackError
-from ..fileio import atomic_write_bytes
 from .calib import NUM, PIXEL_CONVENTIONS
 from .video import read_frames
 
-BOARD_DPI = 300
 DETECT_FRAMES = 30       # frames searched for the board at the start of the clip
 # --plane-points span an area: their narrowest spread at least this fraction of their widest
 # (a sheet's corners seen at 80 deg from square still span 0.17); below it the map is a guess
 MIN_POINT_SPREAD = 0.01
-
-
-def write_board_png(path: Path, spec: BoardSpec, dpi: int = BOARD_DPI) -> Path:
-    """Write the board at ``dpi`` (recorded in the PNG) for printing at 100 %.
-
-    Parameters
-    ----------
-    path : Path
-        The PNG to write (atomically).
-    spec : BoardSpec
-        The board.
-    dpi : int
-        Print resolution [dots/inch].
-
-    Returns
-    -------
-    Path
-        The file written.
-    """
-    from PIL import Image
-
-    buf = io.BytesIO()
-    Image.fromarray(spec.image(dpi / 25.4)).save(buf, format="PNG", dpi=(dpi, dpi))
-    return atomic_write_bytes(path, buf.getvalue())
 
 
 @dataclass(frozen=True)
