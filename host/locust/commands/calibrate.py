@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import time
+from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 
@@ -22,7 +25,7 @@ from ..io.importing import ImportOptions
 from ..io.robot_toml import default_robot, resolve_robot
 from ..params import PRESETS
 from ..plotting import check_figure_path
-from ..progress import progress
+from ..progress import format_duration, progress
 from ..tables import estimate_line, value_line
 from .options import FINITE, POSITIVE, import_options, time_options
 
@@ -246,13 +249,33 @@ def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s,
     from ..api.calibration import calibrate_hinge
 
     centre = tuple(inputs.parse_floats(pivot, 2, "--pivot", "X,Y in metres, e.g. --pivot 0.0,0.0")) if pivot else None
-    with progress(length=1, label="fitting hinge swing") as bar:
+    with (progress(label=HINGE_LABEL.format(stage="reading")) as bar,
+          interruptible("the hinge fit", "run it again; a long recording fits sooner in a window of it "
+                                         "(--start-s, --end-s)")):
+        def told(stage: str, evaluations: int) -> None:
+            bar.label = HINGE_LABEL.format(stage=stage)
+            bar.update(evaluations - bar.pos)
+
         fit = calibrate_hinge(tracks, inertia_kgm2, gravity, mass_kg=mass_kg, com_m=com_m, pivot=centre,
                               marker=marker, start_s=start_s, end_s=end_s, coulomb=coulomb, imports=imports,
-                              timing=timing)
-        bar.update(1)
+                              timing=timing, progress=told)
     _finish(fit.result, tracks, fit.parameters, fit.note, write_path, as_json, plot_path, no_plot, force,
             subtitle=fit.subtitle, input_note=fit.input_note)
+
+
+HINGE_LABEL = "fitting hinge swing ({stage}): evaluations of the swing"
+
+
+@contextlib.contextmanager
+def interruptible(what: str, hint: str = "run it again") -> Iterator[None]:
+    """Ctrl-C during a fit: one clear error (exit 2) saying nothing was written, not click's
+    bare ``Aborted!``."""
+    started = time.monotonic()
+    try:
+        yield
+    except KeyboardInterrupt:
+        raise CalibrationError(f"interrupted: {what} stopped after {format_duration(time.monotonic() - started)}; "
+                               "nothing was fitted or written", hint) from None
 
 
 @calibrate.command()
@@ -324,7 +347,8 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
                                "leave them out for t_s,angle_deg,command_deg recordings and gyro logs")
     from ..api.calibration import fit_servo_recordings
 
-    with progress(length=S.progress_steps(len(recordings)), label="fitting servo") as bar:
+    with (progress(length=S.progress_steps(len(recordings)), label="fitting servo") as bar,
+          interruptible("the servo fit")):
         facade_fit = fit_servo_recordings(recordings, stall_torque_nm, kv_nms_per_rad=kv_nms_per_rad, fit_kv=fit_kv,
                                           progress=bar.update)
     fit = facade_fit.result
@@ -428,7 +452,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, out_dir, write
         new = write_path is not None and not Path(write_path).exists()
         click.echo(said + (f"; the new {write_path} starts from it" if new else ""), err=True)
     folder = out_folder(out_dir, None, no_plot, as_json)
-    with progress(label="fitting hops: simulations") as bar:
+    with progress(label="fitting hops: simulations") as bar, interruptible("the hop fit"):
         def done(n: int, planned: int) -> None:
             bar.length = planned
             bar.update(n - bar.pos)
@@ -520,7 +544,7 @@ def _print_text(out: dict) -> None:
                    "validation_plot", "gyro_gain_units_per_rad_per_s"):
             continue
         if isinstance(val, dict) and "value" in val:
-            _print_text_value(key, val, narrow if key.startswith("hinge_") else "")
+            _print_text_value(key, val, narrow if key.startswith("hinge_") and val.get("identifiable", True) else "")
         elif val is not None:
             click.echo(value_line(key, val))
     for k, gain in enumerate(out.get("gyro_gain_units_per_rad_per_s") or []):
