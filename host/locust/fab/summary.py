@@ -32,7 +32,8 @@ def summary(lam: Laminate, *, hinges_x_mm: tuple[float, ...] | None = None,
     dict
         Source and units, bounds [mm], layer stack with areas [mm^2], support web area
         [mm^2], hinge slots, hole and slit counts, alignment holes [mm], process settings,
-        layer roles, ignored layers, joined overlaps and files.
+        layer roles, ignored layers, joined overlaps, notes on how the layers were read and
+        files.
     """
     d = lam.design
     x0, y0, x1, y1 = d.bounds_mm
@@ -56,6 +57,7 @@ def summary(lam: Laminate, *, hinges_x_mm: tuple[float, ...] | None = None,
         "layer_roles": d.layer_roles,
         "ignored_layers": list(d.ignored_layers),
         "joined_overlaps": list(d.joined),
+        "notes": list(d.notes),
         "out": out_dir,
         "files": files or [],
     }
@@ -99,6 +101,8 @@ def summary_text(s: dict) -> str:
         lines.append(f"ignored layers (no role): {', '.join(s['ignored_layers'])}")
     for note in s["joined_overlaps"]:
         lines.append(f"overlapping outlines joined (union): {note}")
+    for note in s.get("notes", []):
+        lines.append(f"note: {note}")
     if s["files"]:
         lines.append(f"wrote {len(s['files'])} files to {s['out']}: {', '.join(s['files'])}")
     return "\n".join(lines)
