@@ -55,10 +55,10 @@ def output_options(func):
                         help="Replace an existing file at --plot that is not a figure this toolkit wrote.")(func)
     func = click.option("--no-plot", is_flag=True, help="Do not draw the fit plot.")(func)
     func = click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-                        help="Fit plot (data, model, residuals; .png, .svg or .pdf) [default: <recording>-fit.png "
-                             "in --out]. An existing file is replaced only when it is a figure this toolkit "
-                             "wrote.")(func)
-    func = out_option(func, "<recording>-fit.png")
+                        help="Fit plot (data, model, residuals; .png, .svg or .pdf) [default: "
+                             "<recording>-<experiment>-fit.png in --out]. An existing file is replaced only "
+                             "when it is a figure this toolkit wrote.")(func)
+    func = out_option(func, "<recording>-<experiment>-fit.png")
     func = click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")(func)
     func = write_option(func, "Update this robot.toml with the fitted values only. Other values are kept; a new "
                               "file starts from the robot --config or --preset names, else the one every command "
@@ -368,7 +368,7 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
         extra["validation"] = [v.summary() for v in validations]
         if not no_plot:
             target = plot_path.with_name(plot_path.stem + "-validate.png") if plot_path else \
-                default_plot_path(validate[0]).with_name(f"{validate[0].stem}-validate.png")
+                default_plot_path(validate[0], "servo").with_name(f"{validate[0].stem}-validate.png")
             extra["validation_plot"] = str(plot_fit([v.curves for v in validations], target,
                                                     "predicted by the fitted servo (not fitted to it)", force))
     _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot, force,
@@ -400,7 +400,7 @@ def ramp(data, ramp_markers, robot_marker, into, resolution_deg, imports, timing
     fit = calibrate_ramp(list(data), into=into, ramp_markers=ramp_markers, robot_marker=robot_marker,
                          imports=imports, timing=timing, resolution_deg=resolution_deg)
     _finish(fit.result, data[0], fit.parameters, fit.note, write_path, as_json, plot_path, no_plot, force,
-            subtitle=fit.subtitle, recording_name=Path(fit.source) if len(data) == 1 else Path("ramp"),
+            subtitle=fit.subtitle, recording_name=Path(fit.source), several=len(data) > 1,
             source_name=Path(fit.source).name, warnings=fit.warnings)
 
 
@@ -490,16 +490,19 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, out_dir, write
                    else f"nothing written to {out['written']['path']}: no value was identifiable")
 
 
-def default_plot_path(recording: Path, recording_name: Path | None = None) -> Path:
-    """``<recording>-fit.png`` in the command's output folder (:func:`out_folder`), never beside
-    the recording (a data folder, maybe someone else's)."""
+def default_plot_path(recording: Path | None, experiment: str) -> Path:
+    """``<recording>-<experiment>-fit.png`` (``<experiment>-fit.png`` for several recordings) in
+    the command's output folder (:func:`out_folder`), never beside the recording (a data
+    folder, maybe someone else's): each experiment's own name, so a beam fit and a hinge fit of
+    one recording keep both plots."""
     folder = make_folder(click.get_current_context().meta.get(_OUT_KEY, Path(".")))
-    return folder / f"{Path(recording_name or recording).stem}-fit.png"
+    return folder / (f"{Path(recording).stem}-{experiment}-fit.png" if recording is not None
+                     else f"{experiment}-fit.png")
 
 
 def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_path: Path | None,
             as_json: bool, plot_path: Path | None, no_plot: bool, force: bool, *, subtitle: str,
-            recording_name: Path | None = None, source_name: str | None = None,
+            recording_name: Path | None = None, several: bool = False, source_name: str | None = None,
             warnings: list[str] | None = None, extra: dict | None = None, input_note: str = "") -> None:
     recording_name = recording_name or recording
     out = {**fit.summary(), **(extra or {})}
@@ -510,7 +513,7 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
     for warning in out["warnings"]:
         click.echo(f"warning: {warning}", err=True)
     if not no_plot:
-        plot_path = plot_path or default_plot_path(recording, recording_name)
+        plot_path = plot_path or default_plot_path(None if several else recording_name, out["experiment"])
         out["plot"] = str(plot_fit(fit.curves, plot_path, subtitle, force))
     if write_path and odd:   # show the fit, then refuse to write it
         if as_json:
