@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from ..errors import ReportError, WriteError
-from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, unique_dir
+from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, check_can_make, unique_dir
 from ..io.run_record import ERROR as REFUSED
 from ..params import Provenance, Robot
 from ..tables import for_person
@@ -213,8 +213,10 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
         A bad input (unknown ``added`` name, bad sweep or study folder, refused or mixed runs,
         ``cycles`` beyond the runs'); nothing is written then.
     WriteError
-        The files could not be written; the new folder is removed.
+        ``out`` cannot be made (a file in the way, a read-only folder: refused before any
+        simulation), or the files could not be written (the new folder is removed).
     """
+    check_can_make(out)            # before any simulation: a folder it cannot write fails now, not after the work
     progress = progress or (lambda msg: None)
     added = added or {}
     unknown = sorted(set(added) - set(measured))
