@@ -240,7 +240,9 @@ def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s,
     I*theta'' = -k*(theta - theta0) - b*theta' [- M*g*D*cos(theta)] [- tau_c*sign(theta')].
     Prints k [N*m/rad], b [N*m*s/rad] with 95% intervals, the RMS residual of the marker
     position [m]; --write sets compliance.hinge_stiffness_nm_per_rad and
-    compliance.hinge_damping_nms_per_rad.
+    compliance.hinge_damping_nms_per_rad, those the swing determines (a value NOT
+    IDENTIFIABLE, or any where the model does not follow the swing, is never written). With
+    --gravity in-plane, --inertia-kgm2 is at least --mass-kg x --com-m^2.
 
     \b
     Example (the course's film hinge, the link clamped with its hinge axis vertical):
