@@ -201,7 +201,7 @@ def test_plot_never_lands_in_a_read_only_data_folder(recs, tmp_path, monkeypatch
         res = run("calibrate", "ramp", data / "ramp.csv")
         assert res.exit_code == 0, res.output
         assert sorted(p.name for p in data.iterdir()) == ["ramp.csv"]
-        assert (work / "ramp-fit.png").stat().st_size > 1000
+        assert (work / "ramp-ramp-fit.png").stat().st_size > 1000
     finally:
         data.chmod(0o755)
 
@@ -220,12 +220,12 @@ def test_plots_go_to_the_out_folder_named_first_never_beside_the_data(recs, tmp_
     assert res.exit_code == 0, res.output
     assert res.stderr.splitlines()[0] == f"output folder: {work / 'results' / 'beam'}"
     assert sorted(p.name for p in data.iterdir()) == ["beam.csv"]
-    assert (work / "results" / "beam" / "beam-fit.png").stat().st_size > 1000
-    assert f"plot: {Path('results/beam/beam-fit.png')}" in res.stdout
+    assert (work / "results" / "beam" / "beam-beam-fit.png").stat().st_size > 1000
+    assert f"plot: {Path('results/beam/beam-beam-fit.png')}" in res.stdout
     res = CliRunner().invoke(cli, ["calibrate", "ramp", str(recs / "synthetic_ramp.csv"), "--json"])
     assert res.exit_code == 0, res.output
-    assert json.loads(res.stdout)["plot"] == "synthetic_ramp-fit.png"     # the current folder
-    assert (work / "synthetic_ramp-fit.png").is_file() and not (recs / "synthetic_ramp-fit.png").exists()
+    assert json.loads(res.stdout)["plot"] == "synthetic_ramp-ramp-fit.png"     # the current folder
+    assert (work / "synthetic_ramp-ramp-fit.png").is_file() and not (recs / "synthetic_ramp-ramp-fit.png").exists()
 
 
 # -- calibrate hop starts from the robot its runs record ---------------------------------------
@@ -309,3 +309,21 @@ def test_the_hinge_interval_is_flagged_where_its_residual_is_model_error(shared_
     flagged = [ln for ln in res.stdout.splitlines() if "TOO NARROW" in ln]
     assert [ln.split()[0] for ln in flagged] == ["hinge_stiffness", "hinge_damping"]
     assert "0.79 mm RMS" in flagged[0]
+
+
+def test_two_experiments_on_one_recording_keep_both_plots(shared_data, tmp_path, monkeypatch):
+    """The rubber pendulum fitted as a beam, then as a hinge (both fit it): each experiment
+    draws its own `<recording>-<experiment>-fit.png`, and the hinge fit leaves the beam's plot as
+    it was (both were `<recording>-fit.png`: the second replaced the first)."""
+    monkeypatch.chdir(tmp_path)
+    rec = shared_data / "hinge" / "pendulum_rubber_60fps_m.csv"
+    beam = CliRunner().invoke(cli, ["calibrate", "beam", str(rec), "--mass-kg", "0.0295", "--json"])
+    assert beam.exit_code == 0, beam.output
+    assert json.loads(beam.stdout)["plot"] == "pendulum_rubber_60fps_m-beam-fit.png"
+    drawn = (tmp_path / "pendulum_rubber_60fps_m-beam-fit.png").read_bytes()
+    hinge = CliRunner().invoke(cli, ["calibrate", "hinge", str(rec), "--inertia-kgm2", "1e-4", "--gravity",
+                                     "out-of-plane", "--json"])
+    assert hinge.exit_code == 0, hinge.output
+    assert json.loads(hinge.stdout)["plot"] == "pendulum_rubber_60fps_m-hinge-fit.png"
+    assert (tmp_path / "pendulum_rubber_60fps_m-beam-fit.png").read_bytes() == drawn
+    assert (tmp_path / "pendulum_rubber_60fps_m-hinge-fit.png").stat().st_size > 10_000

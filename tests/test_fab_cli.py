@@ -51,6 +51,34 @@ def test_from_robot_toml_follows_its_link_lengths(tmp_path):
         "flat pattern of seed"
 
 
+def test_from_robot_carries_the_designs_crank_angle_servo_axis_and_push(tmp_path):
+    """docs/sweep.md's knee of the front: links +36 mm, crank at rest -82 deg, push -26 deg, as
+    `locust optimize` writes knee.toml. The strip holds the links; the crank's angle (the horn's
+    spline position), the servo axis and the push are in the summary, its text and
+    summary.json, to the value in the file (they were dropped: a knee built from the cut files
+    alone got the robot as built's -100 deg and -30 deg)."""
+    small = params.preset("small")
+    g = small.geometry
+    knee = small.with_values({"geometry.ground_m": g.ground_m + 0.036, "geometry.crank_m": g.crank_m + 0.036,
+                              "geometry.coupler_m": g.coupler_m + 0.036, "geometry.leg_m": g.leg_m + 0.036,
+                              "geometry.crank_start_deg": -82.0, "schedule.push_deg": -26.0},
+                             "optimize").renamed("optimize knee of opt")
+    robot_toml.save_robot(knee, tmp_path / "knee.toml")
+    out = tmp_path / "cut"
+    s = json.loads(_run("--from-robot", tmp_path / "knee.toml", "--out", out, "--no-preview", "--json").stdout)
+    assert s["assembly"] == {"robot": "optimize knee of opt",
+                             "links_mm": {"ground": 76.0, "crank": 76.0, "coupler": 56.0, "leg": 96.0},
+                             "link_width_mm": 30.0, "crank_start_deg": -82.0,
+                             "servo_axis_x_mm": pytest.approx(1000 * g.servo_axis_x_m), "push_deg": -26.0,
+                             "push_s": small.schedule.push_s}
+    assert s["hinges_x_mm"] == pytest.approx([76, 152, 208, 304], abs=1e-6)
+    assert json.loads((out / "summary.json").read_text())["assembly"] == s["assembly"]
+    text = _run("--from-robot", tmp_path / "knee.toml").stdout
+    assert "assemble: the crank at rest at -82.0 deg from the ground link" in text
+    assert "hop: push -26.0 deg for 300 ms" in text and "--push-deg -26 --push-ms 300" in text
+    assert "assembly" not in json.loads(_run(ZZ, "--json").stdout)          # a drawing has no robot
+
+
 def test_zz_out_writes_every_file_and_previews(tmp_path):
     out = tmp_path / "cut"
     result = _run(ZZ, "--out", out, "--json")

@@ -200,5 +200,5 @@ def test_a_recording_named_with_an_undecodable_byte_is_written_and_plotted(tmp_p
                           str(tmp_path / name), "--write", str(tmp_path / "r.toml"), "--out", str(tmp_path)],
                          capture_output=True, timeout=120)
     assert res.returncode == 0 and b"Traceback" not in res.stderr, res.stderr[-3000:]
-    assert (tmp_path / os.fsdecode(b"ramp\xff-fit.png")).stat().st_size > 10_000
+    assert (tmp_path / os.fsdecode(b"ramp\xff-ramp-fit.png")).stat().st_size > 10_000
     assert load_robot(tmp_path / "r.toml").source_of("contact.foot_friction").source == "fit:ramp\\udcff.csv"

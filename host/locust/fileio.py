@@ -133,17 +133,35 @@ def make_folder(folder: str | os.PathLike) -> Path:
         A file in the way, a read-only ancestor, or an OS error.
     """
     folder = Path(folder)
+    check_can_make(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WriteError(f"cannot make the folder {folder} ({exc.strerror})", DISK_HINT) from None
+    return folder
+
+
+def check_can_make(folder: str | os.PathLike) -> None:
+    """Refuse now, making nothing, what :func:`make_folder` would refuse: for a command that
+    writes its folder only after minutes of work (a report), so that a path it cannot use
+    fails before the work.
+
+    Parameters
+    ----------
+    folder : path-like
+
+    Raises
+    ------
+    locust.errors.WriteError
+        A file in the way or a read-only ancestor (the nearest that exists decides).
+    """
+    folder = Path(folder)
     existing = folder
     while not existing.exists() and existing.parent != existing:
         existing = existing.parent
     if not existing.is_dir():
         raise WriteError(f"cannot make {folder}: {existing} is a file", "choose a folder path")
     refuse_read_only_folder(existing)
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise WriteError(f"cannot make the folder {folder} ({exc.strerror})", DISK_HINT) from None
-    return folder
 
 
 def temp_beside(path: str | os.PathLike, suffix: str = ".tmp") -> tuple[int, str]:

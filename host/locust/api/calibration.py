@@ -231,7 +231,7 @@ def calibrate_hinge(tracks: PathLike, inertia_kgm2: float, gravity: str, *, mass
                     com_m: float | None = None, pivot: tuple[float, float] | None = None, marker: str | None = None,
                     start_s: float | None = None, end_s: float | None = None, coulomb: str = "auto",
                     units: str = "m", imports: ImportOptions | None = None,
-                    timing: TimeOptions = REAL_TIME) -> Fit:
+                    timing: TimeOptions = REAL_TIME, progress=None) -> Fit:
     """Fit a link's free swing on a flexure hinge: stiffness, damping, neutral angle.
 
     Parameters
@@ -258,11 +258,15 @@ def calibrate_hinge(tracks: PathLike, inertia_kgm2: float, gravity: str, *, mass
         The track's options already parsed (instead of ``units``).
     timing : locust.calibrate.recordings.TimeOptions
         The slow-motion time scale.
+    progress : callable, optional
+        ``progress(stage, evaluations)``: the fit's stage and the evaluations of the swing done.
 
     Returns
     -------
     Fit
-        ``compliance.hinge_stiffness_nm_per_rad`` and ``compliance.hinge_damping_nms_per_rad``.
+        ``compliance.hinge_stiffness_nm_per_rad`` and ``compliance.hinge_damping_nms_per_rad``,
+        those the swing determines (never one not identifiable, nor any where the model does
+        not follow the swing).
     """
     from ..calibrate import hinge as HG
     from ..calibrate.recordings import clean_samples, read_table
@@ -271,12 +275,13 @@ def calibrate_hinge(tracks: PathLike, inertia_kgm2: float, gravity: str, *, mass
         raise CalibrationError("--mass-kg and --com-m act with --gravity in-plane only",
                                "leave them out, or give --gravity in-plane if the link swings in a vertical plane")
     rig = HG.HingeRig(inertia_kgm2, gravity, mass_kg or 0.0, com_m or 0.0)
+    HG.check_rig(rig)              # before the recording is read: an impossible rig is no fit's question
     table = read_table(tracks, _imports(imports, units), timing)
     x, y = table.marker(marker)
     t, x, y = clean_samples(tracks, "the link's marker", table.time_s(), x, y, min_samples=HG.MIN_SAMPLES)
-    fit = HG.fit_hinge(t, x, y, rig, pivot=pivot, start_s=start_s, end_s=end_s, coulomb=coulomb, source=str(tracks))
-    values = {"compliance.hinge_stiffness_nm_per_rad": fit.hinge_stiffness_nm_per_rad,
-              "compliance.hinge_damping_nms_per_rad": fit.hinge_damping_nms_per_rad}
+    fit = HG.fit_hinge(t, x, y, rig, pivot=pivot, start_s=start_s, end_s=end_s, coulomb=coulomb, source=str(tracks),
+                       progress=progress)
+    values = {f"compliance.{key}": getattr(fit, key) for key, ok in fit.identifiable.items() if ok}
     note = (f"hinge swing, I={inertia_kgm2:g} kg*m^2, gravity {gravity}"
             + (f", M={mass_kg:g} kg, D={com_m:g} m" if gravity == "in-plane" else "")
             + f", pivot {fit.pivot_source}; Coulomb friction {fit.coulomb_note}")

@@ -51,7 +51,8 @@ def make_cut_files(source: Robot | str | Path, *, out: str | Path | None = None,
     -------
     dict
         The manufacturing summary (``summary.json``'s content): the layer stack, areas in mm²,
-        the hinges' positions in mm, the files written.
+        the hinges' positions in mm, the files written; from a robot also its ``assembly``
+        (the crank's angle at rest, the servo axis, the push: what the cut files do not hold).
 
     Raises
     ------
@@ -95,7 +96,8 @@ def make_cut_files(source: Robot | str | Path, *, out: str | Path | None = None,
             files.update(preview.preview_files(lam))
     names = sorted(files) + (["summary.json"] if out is not None else [])
     result = summary(lam, hinges_x_mm=fp.hinges_x_mm if fp is not None else None, files=names,
-                     out_dir=str(out) if out else None)
+                     out_dir=str(out) if out else None,
+                     assembly=flat_pattern.assembly(source) if fp is not None else None)
     if out is not None:
         files["summary.json"] = json_text(result).encode()
         export.publish(out, files)

@@ -16,21 +16,26 @@ plane), the swing obeys, at any angle::
 - ``tau_c`` [N*m] Coulomb friction, fitted only when the data show it: kept when it lowers
   the residual beyond chance (F test, p < 0.001) and its 95 % interval excludes zero.
 
-The swing is integrated (LSODA, relative tolerance 1e-10) from the start of the fit window,
-its initial angle and rate fitted with ``k``, ``b``, ``theta0``. The residual is the
+The swing starts at the fit window's start, its initial angle and rate fitted with ``k``,
+``b``, ``theta0``: in closed form where the equation is linear (no weight's moment, no
+Coulomb term), else integrated (LSODA, relative tolerance 1e-10) with its variational
+equations for the Jacobian (one integration gives every column). The residual is the
 marker's position, x and y [m], against ``pivot + R*(cos theta, sin theta)``: the distance
 ``R`` from the hinge to the marker is fitted too, and so is the pivot unless ``--pivot``
 gives it (its start: the centre of the circle fitted to the marker's arc), so its
 uncertainty is in the intervals of ``k`` and ``b``. Intervals come from the residual Jacobian
 (:mod:`.fitstats`). Start values come from the swing itself: the period from its zero
 crossings, the decay from its successive peaks (never a spectral peak, which can lock onto
-the record length).
+the record length). A rig no link can be is refused (:func:`check_rig`: in plane, ``I``
+below ``M*D^2``), and a value the swing does not determine is not identifiable
+(:func:`identifiable`: every one where the model does not follow the swing).
 """
 
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -48,6 +53,13 @@ MIN_SAMPLES = 20
 MIN_HALF_SWINGS = 3              # zero crossings needed for a period
 COULOMB_P_VALUE = 1e-3
 SMALL_ARC_DEG = 20.0             # a circle fit over less arc than this places the pivot poorly
+MAX_RELATIVE_STD = 0.25          # identifiable: 95% interval within about +-50% of the value
+AT_BOUND = 1e-6                  # a value below this share of its start has run to its bound, 0
+# the model follows the swing when its residual is at most this share of the swing's own RMS
+# (it explains three quarters of the swing's variance or more): the course's film hinge, whose
+# model error is the largest seen in a real swing, leaves 0.15; a rig whose inertia, mass or
+# centre of mass is wrong gives a model that cannot swing at the data's rate, 0.98 and more
+FOLLOWS_SHARE = 0.5
 MODEL = ("I*theta'' = -k*(theta - theta0) - b*theta' - M*g*D*cos(theta) [gravity in plane] "
          "- tau_c*sign(theta') [Coulomb, when significant]")
 
@@ -120,7 +132,11 @@ class HingeFit:
     curves : Curves
         Data and model angle [deg], for the plot.
     notes : list of str
-        Warnings for the report (a poorly placed pivot).
+        Warnings for the report (a poorly placed pivot, a value the swing does not determine,
+        a model that does not follow the swing).
+    identifiable : dict of str to bool
+        Whether the swing determines ``hinge_stiffness_nm_per_rad`` and
+        ``hinge_damping_nms_per_rad`` (:func:`identifiable`); only those are written.
     """
 
     source: str
@@ -145,6 +161,7 @@ class HingeFit:
     fit_time_s: float
     curves: Curves
     notes: list[str] = field(default_factory=list)
+    identifiable: dict[str, bool] = field(default_factory=dict)
 
     def summary(self) -> dict:
         """The fit for JSON output.
@@ -162,6 +179,8 @@ class HingeFit:
                      "coulomb_friction_nm"):
             est = getattr(self, name)
             out[name] = None if est is None else est.as_dict()
+            if name in self.identifiable:
+                out[name]["identifiable"] = self.identifiable[name]
         out.update(coulomb_friction=self.coulomb_note, natural_frequency_hz=self.natural_frequency_hz,
                    damping_ratio=self.damping_ratio, rest_angle_deg=self.rest_angle_deg,
                    pivot_m=list(self.pivot_m), pivot=self.pivot_source, radius_m=self.radius_m,
@@ -217,9 +236,15 @@ def swing_angle(x_m: np.ndarray, y_m: np.ndarray, pivot: tuple[float, float]) ->
 
 
 # -- the model ----------------------------------------------------------------------
+RTOL = 1e-10          # LSODA's relative tolerance on the swing (its angle and rate)
+ATOL = 1e-12          # ... and absolute [rad, rad/s]
+LINEAR_FD_STEP = 1e-6  # the closed form's central differences, per unit of the solver's variable
+
+
 def simulate_hinge(t_s: np.ndarray, params: np.ndarray, rig: HingeRig,
                    coulomb_width_rad_per_s: float = 0.0) -> np.ndarray:
-    """The swing's angle, integrated from ``t_s[0]`` (see the module docstring).
+    """The swing's angle from ``t_s[0]`` (see the module docstring): in closed form where the
+    model is linear (no weight's moment, no Coulomb term), else integrated (LSODA).
 
     Parameters
     ----------
@@ -239,21 +264,150 @@ def simulate_hinge(t_s: np.ndarray, params: np.ndarray, rig: HingeRig,
     numpy.ndarray
         theta at ``t_s`` [rad].
     """
+    t = np.asarray(t_s, dtype=float) - t_s[0]
+    if is_linear(params, rig):
+        return linear_swing(t, params, rig.inertia_kgm2)
+    return _integrate(t, params, rig, coulomb_width_rad_per_s, sensitivities=False)[:, 0]
+
+
+def is_linear(params: np.ndarray, rig: HingeRig) -> bool:
+    """Whether the swing equation is linear (no weight's moment, no Coulomb term): it then has
+    a closed form.
+
+    Parameters
+    ----------
+    params : array_like
+        As :func:`simulate_hinge` takes them.
+    rig : HingeRig
+
+    Returns
+    -------
+    bool
+    """
+    return rig.gravity_moment_nm == 0 and len(params) == 5
+
+
+def linear_swing(t: np.ndarray, params: np.ndarray, inertia_kgm2: float) -> np.ndarray:
+    """The linear swing ``I*theta'' = -k*(theta - theta0) - b*theta'`` in closed form: under-,
+    critically or over-damped, from the angle and rate at ``t = 0``.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Times from the start [s].
+    params : array_like
+        k [N*m/rad], b [N*m*s/rad], theta0 [rad], the start angle [rad] and rate [rad/s].
+    inertia_kgm2 : float
+
+    Returns
+    -------
+    numpy.ndarray
+        theta at ``t`` [rad].
+    """
+    k, b, th0, th_start, w_start = (float(v) for v in params[:5])
+    alpha = b / (2 * inertia_kgm2)
+    wd2 = k / inertia_kgm2 - alpha * alpha
+    u0 = th_start - th0
+    v0 = w_start + alpha * u0
+    decay = np.exp(-alpha * t)
+    if wd2 > 0:
+        wd = math.sqrt(wd2)
+        u = decay * (u0 * np.cos(wd * t) + v0 * np.sin(wd * t) / wd)
+    elif wd2 < 0:
+        g = math.sqrt(-wd2)
+        # e^(-alpha t) cosh(g t) and sinh(g t)/g without overflow (g t large) or cancellation (small)
+        fast, slow = np.exp((g - alpha) * t), np.exp(-(g + alpha) * t)
+        near = g * t < 1.0
+        cosh_part = np.where(near, decay * np.cosh(np.where(near, g * t, 0.0)), (fast + slow) / 2)
+        sinh_part = np.where(near, decay * np.sinh(np.where(near, g * t, 0.0)) / g, (fast - slow) / (2 * g))
+        u = u0 * cosh_part + v0 * sinh_part
+    else:
+        u = decay * (u0 + v0 * t)
+    return th0 + u
+
+
+def swing_sensitivities(t_s: np.ndarray, params: np.ndarray, rig: HingeRig,
+                        coulomb_width_rad_per_s: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """The swing's angle and its derivative in each of ``params``, integrated together: the
+    swing equation and its variational equations in one LSODA run, the step chosen by the
+    swing's own tolerance (the derivatives follow the same steps). One integration gives
+    every column of the fit's Jacobian, exact to the integrator's tolerance; finite
+    differences would take one integration a column, each carrying the tolerance divided by
+    the step (the step 3e-5: 2e-4 of the column, where these agree with wide central
+    differences to 4e-6).
+
+    Parameters
+    ----------
+    t_s : array_like
+        Times [s], increasing.
+    params : array_like
+        As :func:`simulate_hinge` takes them (5, or 6 with tau_c).
+    rig : HingeRig
+    coulomb_width_rad_per_s : float
+        As :func:`simulate_hinge`.
+
+    Returns
+    -------
+    theta : numpy.ndarray, shape (n,)
+        [rad].
+    dtheta : numpy.ndarray, shape (n, len(params))
+        d theta / d param, in rad per the parameter's unit.
+    """
+    t = np.asarray(t_s, dtype=float) - t_s[0]
+    sol = _integrate(t, params, rig, coulomb_width_rad_per_s, sensitivities=True)
+    return sol[:, 0], sol[:, 2:2 + len(params)]
+
+
+def _integrate(t: np.ndarray, params: np.ndarray, rig: HingeRig, eps: float, *, sensitivities: bool) -> np.ndarray:
+    """LSODA of the swing (columns theta, rate), with ``sensitivities`` its variational
+    equations after them (d theta / d p for each p, then d rate / d p)."""
     k, b, th0, th_start, w_start = (float(v) for v in params[:5])
     tau_c = float(params[5]) if len(params) > 5 else 0.0
+    n = len(params)
     inv_i, mgd = 1.0 / rig.inertia_kgm2, rig.gravity_moment_nm
-    eps = coulomb_width_rad_per_s
 
     def rhs(_t, s):
-        th, w = s
+        th, w = s[0], s[1]
         torque = -k * (th - th0) - b * w - mgd * math.cos(th)
         if tau_c:
             torque -= tau_c * math.tanh(w / eps)
         return [w, torque * inv_i]
 
-    sol = integrate.odeint(rhs, [th_start, w_start], np.asarray(t_s) - t_s[0], tfirst=True, rtol=1e-10,
-                           atol=1e-12, mxstep=50000)
-    return sol[:, 0]
+    # the variational equations: d/dt (d theta / dp) = d rate / dp, and
+    # d/dt (d rate / dp) = (d torque/d theta * d theta/dp + d torque/d rate * d rate/dp + d torque/dp) / I,
+    # written out for the five values and for the six (with tau_c): LSODA calls this some
+    # 10^4 times a swing, and a loop or a numpy array here costs it more than the arithmetic
+    cos, sin, tanh = math.cos, math.sin, math.tanh
+
+    def rhs5(_t, s):
+        th, w, a1, a2, a3, a4, a5, r1, r2, r3, r4, r5 = s.tolist()
+        torque = -k * (th - th0) - b * w - mgd * cos(th)
+        ba, br = (-k + mgd * sin(th)) * inv_i, -b * inv_i
+        return [w, torque * inv_i, r1, r2, r3, r4, r5,
+                ba * a1 + br * r1 + (th0 - th) * inv_i, ba * a2 + br * r2 - w * inv_i,
+                ba * a3 + br * r3 + k * inv_i, ba * a4 + br * r4, ba * a5 + br * r5]
+
+    def rhs6(_t, s):
+        th, w, a1, a2, a3, a4, a5, a6, r1, r2, r3, r4, r5, r6 = s.tolist()
+        turn = tanh(w / eps)
+        torque = -k * (th - th0) - b * w - mgd * cos(th) - tau_c * turn
+        ba = (-k + mgd * sin(th)) * inv_i
+        br = (-b - tau_c * (1.0 - turn * turn) / eps) * inv_i
+        return [w, torque * inv_i, r1, r2, r3, r4, r5, r6,
+                ba * a1 + br * r1 + (th0 - th) * inv_i, ba * a2 + br * r2 - w * inv_i,
+                ba * a3 + br * r3 + k * inv_i, ba * a4 + br * r4, ba * a5 + br * r5,
+                ba * a6 + br * r6 - turn * inv_i]
+
+    if not sensitivities:
+        return integrate.odeint(rhs, [th_start, w_start], t, tfirst=True, rtol=RTOL, atol=ATOL, mxstep=50000)
+    start = np.zeros(2 + 2 * n)
+    start[:2] = th_start, w_start
+    start[2 + 3] = 1.0           # d theta / d start angle at the start
+    start[2 + n + 4] = 1.0       # d rate / d start rate at the start
+    # the step is the swing's: its two states carry the tolerance, the derivatives none of it
+    rtol = np.r_[RTOL, RTOL, np.full(2 * n, RTOL)]
+    atol = np.r_[ATOL, ATOL, np.full(2 * n, 1e300)]
+    return integrate.odeint(rhs5 if n == 5 else rhs6, start, t, tfirst=True, rtol=rtol, atol=atol, mxstep=50000)
 
 
 # -- start values --------------------------------------------------------------------
@@ -444,7 +598,8 @@ def _first_turn(u: np.ndarray, release: int, band: float) -> int:
 # -- the fit ------------------------------------------------------------------------
 def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, *,
               pivot: tuple[float, float] | None = None, start_s: float | None = None, end_s: float | None = None,
-              coulomb: str = "auto", source: str = "hinge") -> HingeFit:
+              coulomb: str = "auto", source: str = "hinge",
+              progress: Callable[[str, int], None] | None = None) -> HingeFit:
     """Fit the swing of the marker; see the module docstring.
 
     Parameters
@@ -463,6 +618,10 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
         ``"auto"`` (fit Coulomb friction when significant), ``"off"`` or ``"on"``.
     source : str
         The recording's name, for messages and the plot.
+    progress : callable, optional
+        ``progress(stage, evaluations)`` after each evaluation of the swing (an integration,
+        or the closed form where the model is linear): the fit's stage (``viscous fit``,
+        ``Coulomb test``, ``Coulomb fit``) and the evaluations done so far.
 
     Returns
     -------
@@ -471,11 +630,11 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
     Raises
     ------
     CalibrationError
-        An inertia not positive, an unknown gravity, in-plane gravity without mass and
-        centre of mass, a flat signal, too few samples in the window, or too few swings.
+        A rig no link can be (:func:`check_rig`), a flat signal, too few samples in the
+        window, or too few swings.
     """
     clock = time.perf_counter()
-    _check_rig(rig)
+    check_rig(rig)
     t_s, x_m, y_m = (np.asarray(a, dtype=float) for a in (t_s, x_m, y_m))
     notes = []
     centre = pivot if pivot is not None else circle_fit(x_m, y_m)[:2]
@@ -495,12 +654,15 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
         notes.append(f"the swing covers {arc_deg:.3g} deg: the fitted pivot is poorly placed; give --pivot")
     shape = swing_shape(t, theta, source)
     p0 = start_values(t, theta, rig, shape)
-    problem = _Swing(t, x, y, rig, p0, shape, float(np.median(radius_all[window])), centre, fit_pivot=pivot is None)
+    problem = _Swing(t, x, y, rig, p0, shape, float(np.median(radius_all[window])), centre, fit_pivot=pivot is None,
+                     progress=progress)
     base = problem.solve(problem.start())
     chosen, coulomb_note = base, "not fitted (--coulomb off)"
     if coulomb != "off":
+        problem.stage = "Coulomb test"
         p_value = problem.coulomb_score_p(base)
         if coulomb == "on" or p_value < COULOMB_P_VALUE:
+            problem.stage = "Coulomb fit"
             with_c = problem.solve(np.append(base.x, 1.0))
             tau = problem.estimates(with_c)["coulomb_friction_nm"]
             if coulomb == "on" or tau.ci95_low > 0:
@@ -522,6 +684,7 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
     zeta = b / (2 * math.sqrt(max(stiff_total, 1e-300) * rig.inertia_kgm2))
     measured = swing_angle(x, y, (px, py))[0]
     measured += 2 * math.pi * np.round((model[0] - measured[0]) / (2 * math.pi))
+    flags = identifiable(est, p0, measured, model, Path(source).name, notes)
     fine_t = np.linspace(t[0], t[-1], max(10 * len(t), 2000))
     curves = Curves(x=t, data=np.degrees(measured), model=np.degrees(model), x_label="t [s]",
                     y_label="link angle about the hinge [deg]", title=f"hinge: {Path(source).name}",
@@ -537,7 +700,56 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
         rms_residual_m=float(np.sqrt(np.mean(rx**2 + ry**2))),
         rms_residual_deg=math.degrees(float(np.sqrt(np.mean((measured - model) ** 2)))), n_samples=len(t),
         fit_start_s=float(t[0]), fit_end_s=float(t[-1]), fit_time_s=time.perf_counter() - clock,
-        curves=curves, notes=notes)
+        curves=curves, notes=notes, identifiable=flags)
+
+
+def identifiable(est: dict[str, Estimate], start: np.ndarray, measured: np.ndarray, model: np.ndarray,
+                 name: str, notes: list[str]) -> dict[str, bool]:
+    """Whether the swing determines ``k`` and ``b``, with a note for each it does not: every
+    value untrustworthy where the model does not follow the swing (its residual above
+    ``FOLLOWS_SHARE`` of the swing's RMS, the note first: the servo fit's rule), else each one
+    that ran to its bound (0) or whose 95 % interval is wider than about +-50 %.
+
+    Parameters
+    ----------
+    est : dict of str to Estimate
+        The fit's estimates, by name.
+    start : numpy.ndarray
+        The fit's start values (k and b first).
+    measured, model : numpy.ndarray
+        The angle about the pivot, measured and fitted, over the window [rad].
+    name : str
+        The recording's name, for the notes.
+    notes : list of str
+        Appended to.
+
+    Returns
+    -------
+    dict of str to bool
+        ``hinge_stiffness_nm_per_rad`` and ``hinge_damping_nms_per_rad`` -> identifiable.
+    """
+    keys = ("hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad")
+    residual = float(np.sqrt(np.mean((measured - model) ** 2)))
+    swing = float(np.sqrt(np.mean((measured - np.mean(measured)) ** 2)))
+    if residual > FOLLOWS_SHARE * swing:
+        notes.insert(0, f"the model does not follow {name} (RMS {math.degrees(residual):.3g} deg about a swing of "
+                        f"{math.degrees(swing):.3g} deg RMS): no value is trustworthy; check --inertia-kgm2, "
+                        "--gravity, --mass-kg and --com-m (calibration/protocols/hinge.md)")
+        return dict.fromkeys(keys, False)
+    flags = {}
+    for key, first in zip(keys, start[:2]):
+        e = est[key]
+        if e.value < AT_BOUND * first:
+            notes.append(f"{key} ran to the edge of its range ({e.value:.3g}, its bound 0): the swing does not "
+                         "bound it")
+            flags[key] = False
+        elif not (math.isfinite(e.std) and e.relative_std <= MAX_RELATIVE_STD):
+            notes.append(f"{key} is not identifiable from this swing (its 95% interval is wider than about "
+                         f"+-{200 * MAX_RELATIVE_STD:.0f}%)")
+            flags[key] = False
+        else:
+            flags[key] = True
+    return flags
 
 
 class _Swing:
@@ -553,8 +765,9 @@ class _Swing:
     DYNAMIC = 5
 
     def __init__(self, t, x, y, rig: HingeRig, p0: np.ndarray, shape: SwingShape, radius_m: float,
-                 centre, *, fit_pivot: bool):
+                 centre, *, fit_pivot: bool, progress: Callable[[str, int], None] | None = None):
         self.t, self.x, self.y, self.rig = t, x, y, rig
+        self.progress, self.stage, self.evaluations = progress, "viscous fit", 0
         self.p0, self.radius0, self.fit_pivot = p0, radius_m, fit_pivot
         self.centre = (float(centre[0]), float(centre[1]))
         self.width = 0.002 * max(shape.amplitude_rad, 1e-3) * shape.damped_omega_rad_per_s   # sign(rate), smoothed
@@ -593,7 +806,38 @@ class _Swing:
         return p, v["radius_m"], (v["pivot_x_m"], v["pivot_y_m"])
 
     def angle(self, q: np.ndarray) -> np.ndarray:
+        self._counted()
         return simulate_hinge(self.t, self.split(q)[0], self.rig, self.width)
+
+    def _counted(self) -> None:
+        """One more evaluation of the swing (an integration, or the closed form), told to ``progress``."""
+        self.evaluations += 1
+        if self.progress is not None:
+            self.progress(self.stage, self.evaluations)
+
+    def angle_derivatives(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[int]]:
+        """The angle at ``q`` and its derivatives in the dynamic values (k, b, theta0, the start
+        angle and rate, and tau_c when fitted), in the solver's variables: (theta, d theta / d q
+        of those columns, their indices in ``q``). Where the swing has a closed form, by central
+        differences of it (``LINEAR_FD_STEP``: exact to about 1e-9); elsewhere from the
+        variational equations, one integration (:func:`swing_sensitivities`)."""
+        p = self.split(q)[0]
+        dynamic = list(range(self.DYNAMIC)) + ([len(q) - 1] if len(q) > self.DYNAMIC + self.n_geo else [])
+        params = self.parameters(q)
+        by_q = np.array([params[params.free[i]].derivative(q[i]) for i in dynamic])   # d value / d q
+        if is_linear(p, self.rig):
+            th = self.angle(q)
+            cols = []
+            for i in dynamic:
+                h = LINEAR_FD_STEP * max(1.0, abs(q[i]))
+                up, down = q.copy(), q.copy()
+                up[i] += h
+                down[i] -= h
+                cols.append((self.angle(up) - self.angle(down)) / (2 * h))
+            return th, np.column_stack(cols), dynamic
+        self._counted()
+        th, d_p = swing_sensitivities(self.t, p, self.rig, self.width)
+        return th, d_p * by_q, dynamic
 
     def residual(self, q: np.ndarray, theta: np.ndarray | None = None) -> np.ndarray:
         _, radius, (px, py) = self.split(q)
@@ -601,20 +845,15 @@ class _Swing:
         return np.concatenate([px + radius * np.cos(th) - self.x, py + radius * np.sin(th) - self.y])
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
-        """The dynamic columns by forward differences of 3e-5 (far above the integrator's
-        relative tolerance of 1e-10), the radius and pivot columns exactly."""
+        """The dynamic columns from the swing's derivatives (:meth:`angle_derivatives`), the
+        radius and pivot columns exactly."""
         _, radius, _ = self.split(q)
-        th = self.angle(q)
+        th, d_th, dynamic = self.angle_derivatives(q)
         cos, sin = np.cos(th), np.sin(th)
         n = len(th)
         jac = np.zeros((2 * n, len(q)))
-        dynamic = list(range(self.DYNAMIC)) + ([len(q) - 1] if len(q) > self.DYNAMIC + self.n_geo else [])
-        for i in dynamic:
-            h = 3e-5 * max(1.0, abs(q[i]))
-            step = q.copy()
-            step[i] += h
-            dth = (self.angle(step) - th) / h
-            jac[:n, i], jac[n:, i] = -radius * sin * dth, radius * cos * dth
+        for col, i in enumerate(dynamic):
+            jac[:n, i], jac[n:, i] = -radius * sin * d_th[:, col], radius * cos * d_th[:, col]
         jac[:n, self.DYNAMIC], jac[n:, self.DYNAMIC] = self.radius0 * cos, self.radius0 * sin
         if self.fit_pivot:
             jac[:n, self.DYNAMIC + 1] = self.radius0
@@ -667,6 +906,31 @@ def _rest_angle(p: np.ndarray, rig: HingeRig) -> float:
         return th0
     root = optimize.least_squares(lambda th: k * (th - th0) + mgd * np.cos(th), [th0]).x[0]
     return float(root)
+
+
+def check_rig(rig: HingeRig) -> None:
+    """Refuse a rig no link can be: an inertia not positive, an unknown gravity, in-plane
+    gravity without the weight's moment, or an inertia about the hinge below ``M*D^2`` (the
+    parallel-axis theorem: the link's own inertia about its centre of mass is never negative).
+
+    Parameters
+    ----------
+    rig : HingeRig
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Naming the values and what a link of them would be.
+    """
+    _check_rig(rig)
+    least = rig.mass_kg * rig.com_m ** 2
+    if rig.gravity == "in-plane" and rig.inertia_kgm2 < least * (1 - 1e-9):
+        raise CalibrationError(
+            f"--inertia-kgm2 {rig.inertia_kgm2:g} is below --mass-kg x --com-m^2 = {rig.mass_kg:g} x "
+            f"{rig.com_m:g}^2 = {least:.3g} kg*m^2: no link has less inertia about its hinge than its mass "
+            "has at its centre of mass",
+            "check the three (calibration/protocols/hinge.md): a uniform bar of mass M and length L hinged "
+            "at one end has D = L/2 and I = M*L^2/3 = 4/3 M*D^2")
 
 
 def _check_rig(rig: HingeRig) -> None:

@@ -52,6 +52,7 @@ import numpy as np
 from scipy import optimize
 
 from ..errors import CalibrationError, GeometryError, ParamsError, SimError, TrialError
+from ..io.run_record import COMPLETE, CONFIG_FIX_HINT, DEFAULT_CONFIG, RunRecord
 from ..params import Provenance, Robot, fittable_keys, value_type
 from ..sim.gl import minimize  # MuJoCo's solver, as locust.sim imports MuJoCo (its OpenGL checked first)
 from ..sim.hops import summarise
@@ -248,6 +249,7 @@ def load_run(path: Path, config: str, base: Robot) -> HopRun:
         raise CalibrationError(f"{path}: a hop fit needs the run's run.json and the track of its video",
                                "give the folder `locust hop --out` wrote, after `locust track` on its video")
     record = trial.record
+    check_record(record, trial.run_path)
     phases = sorted(record.phases, key=lambda p: p.measured_us)
     pushes = [p for p in phases if p.phase == "push"]
     if not pushes:
@@ -275,6 +277,39 @@ def load_run(path: Path, config: str, base: Robot) -> HopRun:
     return HopRun(source=Path(path), config=config, robot=robot,
                   phase_s=np.array([(p.measured_us - t0_us) * 1e-6 for p in phases]),
                   pushing=np.array([p.phase == "push" for p in phases]), onset_s=float(onset), tracks=tracks)
+
+
+def check_record(record: RunRecord, path: Path) -> None:
+    """Refuse a run record the fit cannot simulate truly: a run that did not finish its
+    schedule (``incomplete``: a cable pulled, an interrupt; ``error``: refused by the board),
+    one the board ran on its default config (the trims and pulse range the robot's angles rest
+    on were not used), and one whose measured phase starts contradict the commanded order.
+
+    Parameters
+    ----------
+    record : locust.io.run_record.RunRecord
+    path : pathlib.Path
+        Its ``run.json``, for the message.
+
+    Raises
+    ------
+    locust.errors.CalibrationError
+        Naming the run, what is wrong with it and what to do.
+    """
+    leave_out = f"rerun the hop, or leave {path.parent} out of the fit"
+    if record.status == DEFAULT_CONFIG:
+        raise CalibrationError(f"{path}: the board ran this hop on its default config, not its config.json "
+                               f"({record.message}): the crank angles it made are not the ones simulated",
+                               f"{CONFIG_FIX_HINT}; then {leave_out}")
+    if record.status != COMPLETE:
+        said = f" ({record.message})" if record.message else ""
+        raise CalibrationError(f"{path}: the run is {record.status}{said}, {len(record.phases)} of "
+                               f"{record.schedule.phases} phases recorded: a fit needs the whole schedule the "
+                               "robot ran", leave_out)
+    problem = record.order_problem()
+    if problem:
+        raise CalibrationError(f"{path}: {problem}: the record's phase times are not a hop's",
+                               f"check the board's clock (`locust hop` again); {leave_out}")
 
 
 def _until(track: MarkerTrack, last_s: float) -> MarkerTrack:

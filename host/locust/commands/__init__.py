@@ -39,6 +39,33 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
 }
 
 
+# An error is a line or two a person reads: the longest the toolkit writes on purpose is a hint
+# listing every fittable key (1,144 characters). Beyond this a message quotes what it was given
+# (a 60,000-character cell of a CSV, a robot.toml string, a results.csv header of 10,000
+# columns) and is cut in its middle: what and where come first, the reason last.
+MAX_ERROR_CHARS = 1200
+
+
+def bounded(text: str, limit: int = MAX_ERROR_CHARS) -> str:
+    """``text`` whole when it has at most ``limit`` characters; else its start and its end with
+    how many characters were left out between them.
+
+    Parameters
+    ----------
+    text : str
+    limit : int
+
+    Returns
+    -------
+    str
+        At most about ``limit`` characters.
+    """
+    if len(text) <= limit:
+        return text
+    head, tail = limit * 3 // 4, limit // 5
+    return f"{text[:head]} … [{len(text) - head - tail:,} characters left out] … {text[-tail:]}"
+
+
 class LazyGroup(click.Group):
     def list_commands(self, ctx: click.Context) -> list[str]:
         return [name for name in COMMANDS if _available(name)]
@@ -65,17 +92,17 @@ class LazyGroup(click.Group):
             return super().invoke(ctx)
         except click.UsageError as exc:   # a bad option value, a missing argument: the same two lines
             sub = exc.ctx.command_path if exc.ctx else "locust"
-            click.secho(f"error: {exc.format_message()}", fg="red", err=True)
+            click.secho(f"error: {bounded(exc.format_message())}", fg="red", err=True)
             click.echo(f"  hint: see `{sub} --help`", err=True)
             ctx.exit(exc.exit_code)
         except LocustError as exc:
-            click.secho(f"error: {exc.message}", fg="red", err=True)
+            click.secho(f"error: {bounded(exc.message)}", fg="red", err=True)
             if exc.hint:
-                click.echo(f"  hint: {exc.hint}", err=True)
+                click.echo(f"  hint: {bounded(exc.hint)}", err=True)
             ctx.exit(exc.exit_code)
         except OSError as exc:  # a file or folder the job's own checks did not foresee
             where = f"{exc.filename}: " if exc.filename else ""
-            click.secho(f"error: {where}{exc.strerror or exc}", fg="red", err=True)
+            click.secho(f"error: {bounded(f'{where}{exc.strerror or exc}')}", fg="red", err=True)
             click.echo("  hint: check that the path exists and is readable, that the output folder is "
                        "writable and that the disk has space", err=True)
             ctx.exit(2)

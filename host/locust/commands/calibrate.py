@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import time
+from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 
@@ -22,7 +25,7 @@ from ..io.importing import ImportOptions
 from ..io.robot_toml import default_robot, resolve_robot
 from ..params import PRESETS
 from ..plotting import check_figure_path
-from ..progress import progress
+from ..progress import format_duration, progress
 from ..tables import estimate_line, value_line
 from .options import FINITE, POSITIVE, import_options, time_options
 
@@ -52,10 +55,10 @@ def output_options(func):
                         help="Replace an existing file at --plot that is not a figure this toolkit wrote.")(func)
     func = click.option("--no-plot", is_flag=True, help="Do not draw the fit plot.")(func)
     func = click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-                        help="Fit plot (data, model, residuals; .png, .svg or .pdf) [default: <recording>-fit.png "
-                             "in --out]. An existing file is replaced only when it is a figure this toolkit "
-                             "wrote.")(func)
-    func = out_option(func, "<recording>-fit.png")
+                        help="Fit plot (data, model, residuals; .png, .svg or .pdf) [default: "
+                             "<recording>-<experiment>-fit.png in --out]. An existing file is replaced only "
+                             "when it is a figure this toolkit wrote.")(func)
+    func = out_option(func, "<recording>-<experiment>-fit.png")
     func = click.option("--json", "as_json", is_flag=True, help="Print the results as JSON.")(func)
     func = write_option(func, "Update this robot.toml with the fitted values only. Other values are kept; a new "
                               "file starts from the robot --config or --preset names, else the one every command "
@@ -237,7 +240,9 @@ def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s,
     I*theta'' = -k*(theta - theta0) - b*theta' [- M*g*D*cos(theta)] [- tau_c*sign(theta')].
     Prints k [N*m/rad], b [N*m*s/rad] with 95% intervals, the RMS residual of the marker
     position [m]; --write sets compliance.hinge_stiffness_nm_per_rad and
-    compliance.hinge_damping_nms_per_rad.
+    compliance.hinge_damping_nms_per_rad, those the swing determines (a value NOT
+    IDENTIFIABLE, or any where the model does not follow the swing, is never written). With
+    --gravity in-plane, --inertia-kgm2 is at least --mass-kg x --com-m^2.
 
     \b
     Example (the course's film hinge, the link clamped with its hinge axis vertical):
@@ -246,13 +251,33 @@ def hinge(tracks, inertia_kgm2, gravity, mass_kg, com_m, pivot, marker, start_s,
     from ..api.calibration import calibrate_hinge
 
     centre = tuple(inputs.parse_floats(pivot, 2, "--pivot", "X,Y in metres, e.g. --pivot 0.0,0.0")) if pivot else None
-    with progress(length=1, label="fitting hinge swing") as bar:
+    with (progress(label=HINGE_LABEL.format(stage="reading")) as bar,
+          interruptible("the hinge fit", "run it again; a long recording fits sooner in a window of it "
+                                         "(--start-s, --end-s)")):
+        def told(stage: str, evaluations: int) -> None:
+            bar.label = HINGE_LABEL.format(stage=stage)
+            bar.update(evaluations - bar.pos)
+
         fit = calibrate_hinge(tracks, inertia_kgm2, gravity, mass_kg=mass_kg, com_m=com_m, pivot=centre,
                               marker=marker, start_s=start_s, end_s=end_s, coulomb=coulomb, imports=imports,
-                              timing=timing)
-        bar.update(1)
+                              timing=timing, progress=told)
     _finish(fit.result, tracks, fit.parameters, fit.note, write_path, as_json, plot_path, no_plot, force,
             subtitle=fit.subtitle, input_note=fit.input_note)
+
+
+HINGE_LABEL = "fitting hinge swing ({stage}): evaluations of the swing"
+
+
+@contextlib.contextmanager
+def interruptible(what: str, hint: str = "run it again") -> Iterator[None]:
+    """Ctrl-C during a fit: one clear error (exit 2) saying nothing was written, not click's
+    bare ``Aborted!``."""
+    started = time.monotonic()
+    try:
+        yield
+    except KeyboardInterrupt:
+        raise CalibrationError(f"interrupted: {what} stopped after {format_duration(time.monotonic() - started)}; "
+                               "nothing was fitted or written", hint) from None
 
 
 @calibrate.command()
@@ -324,7 +349,8 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
                                "leave them out for t_s,angle_deg,command_deg recordings and gyro logs")
     from ..api.calibration import fit_servo_recordings
 
-    with progress(length=S.progress_steps(len(recordings)), label="fitting servo") as bar:
+    with (progress(length=S.progress_steps(len(recordings)), label="fitting servo") as bar,
+          interruptible("the servo fit")):
         facade_fit = fit_servo_recordings(recordings, stall_torque_nm, kv_nms_per_rad=kv_nms_per_rad, fit_kv=fit_kv,
                                           progress=bar.update)
     fit = facade_fit.result
@@ -344,7 +370,7 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
         extra["validation"] = [v.summary() for v in validations]
         if not no_plot:
             target = plot_path.with_name(plot_path.stem + "-validate.png") if plot_path else \
-                default_plot_path(validate[0]).with_name(f"{validate[0].stem}-validate.png")
+                default_plot_path(validate[0], "servo").with_name(f"{validate[0].stem}-validate.png")
             extra["validation_plot"] = str(plot_fit([v.curves for v in validations], target,
                                                     "predicted by the fitted servo (not fitted to it)", force))
     _finish(fit, data[0], values, note, write_path, as_json, plot_path, no_plot, force,
@@ -376,7 +402,7 @@ def ramp(data, ramp_markers, robot_marker, into, resolution_deg, imports, timing
     fit = calibrate_ramp(list(data), into=into, ramp_markers=ramp_markers, robot_marker=robot_marker,
                          imports=imports, timing=timing, resolution_deg=resolution_deg)
     _finish(fit.result, data[0], fit.parameters, fit.note, write_path, as_json, plot_path, no_plot, force,
-            subtitle=fit.subtitle, recording_name=Path(fit.source) if len(data) == 1 else Path("ramp"),
+            subtitle=fit.subtitle, recording_name=Path(fit.source), several=len(data) > 1,
             source_name=Path(fit.source).name, warnings=fit.warnings)
 
 
@@ -428,7 +454,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, out_dir, write
         new = write_path is not None and not Path(write_path).exists()
         click.echo(said + (f"; the new {write_path} starts from it" if new else ""), err=True)
     folder = out_folder(out_dir, None, no_plot, as_json)
-    with progress(label="fitting hops: simulations") as bar:
+    with progress(label="fitting hops: simulations") as bar, interruptible("the hop fit"):
         def done(n: int, planned: int) -> None:
             bar.length = planned
             bar.update(n - bar.pos)
@@ -466,16 +492,19 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, out_dir, write
                    else f"nothing written to {out['written']['path']}: no value was identifiable")
 
 
-def default_plot_path(recording: Path, recording_name: Path | None = None) -> Path:
-    """``<recording>-fit.png`` in the command's output folder (:func:`out_folder`), never beside
-    the recording (a data folder, maybe someone else's)."""
+def default_plot_path(recording: Path | None, experiment: str) -> Path:
+    """``<recording>-<experiment>-fit.png`` (``<experiment>-fit.png`` for several recordings) in
+    the command's output folder (:func:`out_folder`), never beside the recording (a data
+    folder, maybe someone else's): each experiment's own name, so a beam fit and a hinge fit of
+    one recording keep both plots."""
     folder = make_folder(click.get_current_context().meta.get(_OUT_KEY, Path(".")))
-    return folder / f"{Path(recording_name or recording).stem}-fit.png"
+    return folder / (f"{Path(recording).stem}-{experiment}-fit.png" if recording is not None
+                     else f"{experiment}-fit.png")
 
 
 def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_path: Path | None,
             as_json: bool, plot_path: Path | None, no_plot: bool, force: bool, *, subtitle: str,
-            recording_name: Path | None = None, source_name: str | None = None,
+            recording_name: Path | None = None, several: bool = False, source_name: str | None = None,
             warnings: list[str] | None = None, extra: dict | None = None, input_note: str = "") -> None:
     recording_name = recording_name or recording
     out = {**fit.summary(), **(extra or {})}
@@ -486,7 +515,7 @@ def _finish(fit, recording: Path, values: dict[str, Estimate], note: str, write_
     for warning in out["warnings"]:
         click.echo(f"warning: {warning}", err=True)
     if not no_plot:
-        plot_path = plot_path or default_plot_path(recording, recording_name)
+        plot_path = plot_path or default_plot_path(None if several else recording_name, out["experiment"])
         out["plot"] = str(plot_fit(fit.curves, plot_path, subtitle, force))
     if write_path and odd:   # show the fit, then refuse to write it
         if as_json:
@@ -520,7 +549,7 @@ def _print_text(out: dict) -> None:
                    "validation_plot", "gyro_gain_units_per_rad_per_s"):
             continue
         if isinstance(val, dict) and "value" in val:
-            _print_text_value(key, val, narrow if key.startswith("hinge_") else "")
+            _print_text_value(key, val, narrow if key.startswith("hinge_") and val.get("identifiable", True) else "")
         elif val is not None:
             click.echo(value_line(key, val))
     for k, gain in enumerate(out.get("gyro_gain_units_per_rad_per_s") or []):

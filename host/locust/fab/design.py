@@ -13,7 +13,15 @@ seed's ``plate`` / ``hinge_N`` and the course files' ``body`` / ``joints`` /
   body or has no length is an error that names its position.
 - holes: closed outlines cut through every layer.
 - cuts: closed outlines cut through every layer; open paths are slits (a single pass of
-  the beam, zero width as designed).
+  the beam, zero width as designed). One drawing reads them otherwise: the seed notebook's
+  own combined cut pattern (its Part 4's ``combined_cut_pattern.dxf``) holds the outline on
+  ``plate`` and the hinge slots on ``cuts``, with no hinge layer, and its ``flexible.dxf`` has
+  none of them: in a drawing of that shape (:func:`seed_combined_pattern`) the closed
+  outlines on ``cuts`` are hinge slots, cut from the rigid and adhesive layers only, and the
+  summary says so.
+
+A drawing with no hinge at all cuts the flexible layer as the others; the summary says that
+too (a laminate's flexible layer is there to be its hinges).
 """
 
 from __future__ import annotations
@@ -84,6 +92,7 @@ class Design:
     layer_roles: dict[str, str] = field(default_factory=dict)    # drawing layer -> role
     ignored_layers: tuple[str, ...] = ()
     joined: tuple[str, ...] = ()                   # overlapping body outlines joined, and where
+    notes: tuple[str, ...] = ()                    # how the layers were read, where a person should know
 
     @property
     def bounds_mm(self) -> tuple[float, float, float, float]:
@@ -145,6 +154,19 @@ class LayerMap:
             if role not in ROLES:
                 raise FabError(f"unknown layer role {role!r}", f"roles are {', '.join(ROLES)}")
         return LayerMap({**self.patterns, **{r: tuple(v) for r, v in items.items()}})
+
+    def is_default(self, role: str) -> bool:
+        """Whether ``role`` keeps its default layer names (no ``--layer`` for it).
+
+        Parameters
+        ----------
+        role : str
+
+        Returns
+        -------
+        bool
+        """
+        return self.patterns[role] == DEFAULT_LAYER_MAP[role]
 
     def role_of(self, layer: str) -> str | None:
         """The role of a drawing layer.
@@ -335,6 +357,34 @@ def _hinge_cuts(contours: list[Contour], body, hinge_width_mm: float) -> list[Hi
     return hinges
 
 
+def seed_combined_pattern(drawing: Drawing, layer_map: LayerMap, roles: dict[str, str | None]) -> list[str]:
+    """The ``cuts`` layers that hold hinge slots, in the seed notebook's combined cut pattern:
+    a drawing whose body is on ``plate`` (the seed's name for it), with no hinge layer, whose
+    ``cuts`` layers hold closed outlines only, read with the default layer names (a
+    ``--layer`` for hinge or cuts reads it as given).
+
+    Parameters
+    ----------
+    drawing : Drawing
+    layer_map : LayerMap
+    roles : dict of str to str or None
+        Each layer's role by its name.
+
+    Returns
+    -------
+    list of str
+        Those layers (none when the drawing is not of that shape).
+    """
+    if not (layer_map.is_default("hinge") and layer_map.is_default("cuts")) or "hinge" in roles.values():
+        return []
+    if not any(role == "body" and layer.lower() == "plate" for layer, role in roles.items()):
+        return []
+    cuts = [layer for layer, role in roles.items() if role == "cuts"]
+    if not cuts or any(not c.closed for c in drawing.contours if c.layer in cuts):
+        return []
+    return cuts
+
+
 def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
                         hinge_width_mm: float = 1.0, gap_tol_mm: float = 0.01) -> Design:
     """The design a drawing gives: its body, hinges, holes and slits, by each layer's role.
@@ -361,6 +411,13 @@ def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
     """
     layer_map = layer_map or LayerMap()
     roles = {layer: layer_map.role_of(layer) for layer in drawing.layers()}
+    notes = []
+    seed_slots = seed_combined_pattern(drawing, layer_map, roles)
+    for layer in seed_slots:
+        roles[layer] = "hinge"
+        notes.append(f"layer {layer!r} read as the hinge slots, cut from the rigid and adhesive layers only: the "
+                     "seed's combined cut pattern (outline on 'plate', slots on 'cuts', no hinge layer; its own "
+                     "flexible.dxf has none of them); give --layer cuts=cuts to cut them through every layer")
     by_role = _contours_by_role(drawing, roles)
     _check_closed_body_and_holes(drawing, layer_map, by_role, gap_tol_mm)
     body_polys, joined = join_overlaps(by_role["body"], [_polygon(c) for c in by_role["body"]])
@@ -371,9 +428,13 @@ def design_from_drawing(drawing: Drawing, layer_map: LayerMap | None = None, *,
     hinges = _hinge_cuts(by_role["hinge"], body, hinge_width_mm)
     holes = tuple(_polygon(c) for c in by_role["holes"] + by_role["cuts"] if c.closed)
     slits = tuple(LineString(c.points_mm) for c in by_role["cuts"] if not c.closed)
+    if not hinges:
+        notes.append("no hinge in the drawing (no layer named like "
+                     f"{', '.join(layer_map.patterns['hinge'][:4])}, ...): the flexible layer is cut as the others; "
+                     "give --layer hinge=NAME for the layer that holds the hinges")
     return Design(
         body=body, hinges=tuple(hinges), holes=holes, slits=slits, source=str(drawing.path),
         units=drawing.units, units_from=drawing.units_from,
         layer_roles={k: v for k, v in roles.items() if v},
-        ignored_layers=tuple(k for k, v in roles.items() if not v), joined=joined,
+        ignored_layers=tuple(k for k, v in roles.items() if not v), joined=joined, notes=tuple(notes),
     )

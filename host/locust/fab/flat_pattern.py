@@ -125,6 +125,30 @@ def from_robot(robot, **overrides) -> FlatPattern:
     return fp
 
 
+def assembly(robot) -> dict:
+    """What the cut files do not hold of ``robot``'s design, and its building and hopping need:
+    the crank's angle at rest (the servo horn goes onto its spline there: docs/hardware.md),
+    where the servo axis sits on the plate, and the push the design was chosen with (a
+    ``locust optimize`` design varies these beside its links).
+
+    Parameters
+    ----------
+    robot : Robot
+
+    Returns
+    -------
+    dict
+        ``robot`` (its name), ``links_mm`` (ground, crank, coupler, leg [mm]), ``link_width_mm``,
+        ``crank_start_deg``, ``servo_axis_x_mm`` (from the plate's centre), ``push_deg`` and
+        ``push_s``.
+    """
+    g, s = robot.geometry, robot.schedule
+    return {"robot": robot.name,
+            "links_mm": {name: round(v * 1000.0, 6) for name, v in zip(LINK_ORDER, robot.link_lengths_m())},
+            "link_width_mm": round(g.link_width_m * 1000.0, 6), "crank_start_deg": g.crank_start_deg,
+            "servo_axis_x_mm": round(g.servo_axis_x_m * 1000.0, 6), "push_deg": s.push_deg, "push_s": s.push_s}
+
+
 def stadium(x_mm: float, y0_mm: float, y1_mm: float, width_mm: float):
     """A vertical slot with round ends spanning y0..y1 (overall), ``width_mm`` wide.
 

@@ -12,7 +12,7 @@ def _r(x: float, n: int = 4) -> float:
 
 
 def summary(lam: Laminate, *, hinges_x_mm: tuple[float, ...] | None = None,
-            files: list[str] | None = None, out_dir: str | None = None) -> dict:
+            files: list[str] | None = None, out_dir: str | None = None, assembly: dict | None = None) -> dict:
     """The manufacturing summary of ``lam``, lengths rounded to 0.1 um.
 
     Parameters
@@ -26,13 +26,17 @@ def summary(lam: Laminate, *, hinges_x_mm: tuple[float, ...] | None = None,
         The files written.
     out_dir : str, optional
         The folder they were written to.
+    assembly : dict, optional
+        From a robot: its design's figures the cut files do not hold
+        (:func:`locust.fab.flat_pattern.assembly`).
 
     Returns
     -------
     dict
         Source and units, bounds [mm], layer stack with areas [mm^2], support web area
         [mm^2], hinge slots, hole and slit counts, alignment holes [mm], process settings,
-        layer roles, ignored layers, joined overlaps and files.
+        layer roles, ignored layers, joined overlaps, notes on how the layers were read and
+        files.
     """
     d = lam.design
     x0, y0, x1, y1 = d.bounds_mm
@@ -56,8 +60,10 @@ def summary(lam: Laminate, *, hinges_x_mm: tuple[float, ...] | None = None,
         "layer_roles": d.layer_roles,
         "ignored_layers": list(d.ignored_layers),
         "joined_overlaps": list(d.joined),
+        "notes": list(d.notes),
         "out": out_dir,
         "files": files or [],
+        **({"assembly": assembly} if assembly is not None else {}),
     }
 
 
@@ -99,6 +105,17 @@ def summary_text(s: dict) -> str:
         lines.append(f"ignored layers (no role): {', '.join(s['ignored_layers'])}")
     for note in s["joined_overlaps"]:
         lines.append(f"overlapping outlines joined (union): {note}")
+    for note in s.get("notes", []):
+        lines.append(f"note: {note}")
+    if "assembly" in s:
+        a = s["assembly"]
+        links = ", ".join(f"{k} {v:.1f}" for k, v in a["links_mm"].items())
+        lines += [f"design: {a['robot']}: links {links} mm on a {a['link_width_mm']:.1f} mm strip",
+                  f"assemble: the crank at rest at {a['crank_start_deg']:.1f} deg from the ground link (its servo "
+                  f"horn on the spline there at the 0 deg command: docs/hardware.md), the servo axis "
+                  f"{a['servo_axis_x_mm']:.1f} mm from the plate's centre",
+                  f"hop: push {a['push_deg']:.1f} deg for {a['push_s'] * 1000:.0f} ms (`locust hop --config` with "
+                  f"this robot file, or --push-deg {a['push_deg']:g} --push-ms {a['push_s'] * 1000:g})"]
     if s["files"]:
         lines.append(f"wrote {len(s['files'])} files to {s['out']}: {', '.join(s['files'])}")
     return "\n".join(lines)

@@ -406,6 +406,23 @@ class RunRecord:
         """
         self.phases = [replace(p, host_stall_us=s) for p, s in zip(self.phases, stalls_us, strict=True)]
 
+    def order_problem(self) -> str | None:
+        """Where the measured starts contradict the commanded order (a push measured after the
+        wait commanded after it): a board's clock or a damaged record, never a hop.
+
+        Returns
+        -------
+        str or None
+            The first pair of phases out of order, in words; None when every measured start
+            follows the one commanded before it.
+        """
+        ordered = sorted(self.phases, key=lambda p: p.commanded_us)
+        for before, after in zip(ordered, ordered[1:]):
+            if after.measured_us <= before.measured_us:
+                return (f"cycle {after.cycle}'s {after.phase} is measured at {after.measured_ms:.3f} ms, not after "
+                        f"cycle {before.cycle}'s {before.phase} (commanded before it) at {before.measured_ms:.3f} ms")
+        return None
+
     def to_dict(self) -> dict:
         """The record as ``run.json`` holds it, with the phases' jitter and the host's stalls.
 

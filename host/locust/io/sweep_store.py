@@ -10,6 +10,7 @@ the same whatever ran it. Floats are written with ``repr``: they read back bit f
 from __future__ import annotations
 
 import csv
+import fcntl
 import io
 import json
 import math
@@ -128,7 +129,9 @@ class StoredSweep:
     axis_names: list[str]              # varied names, in order
     cycles: int
     rows: list[dict[str, Any]]         # typed rows (see :func:`read_rows`), in file order
-    finished: bool                     # False: an interrupted sweep, some designs missing
+    finished: bool                     # False: still running, or interrupted with designs missing
+    planned: int | None = None         # the designs the sweep plans (None: a folder that does not say)
+    running: bool = False              # another process holds the folder's lock: it is writing it now
 
     def column(self, name: str) -> list[Any]:
         """One column's values over the rows, in file order.
@@ -146,6 +149,10 @@ class StoredSweep:
 
 def read_results(folder: Path) -> StoredSweep:
     """Read a ``locust sweep --out`` folder (``sweep.json`` and ``results.csv``).
+
+    It is finished only when no sweep holds its lock now (one being written holds it until
+    its last row), its ``sweep.json`` does not say it stopped short, and its rows cover every
+    design it plans (a sweep killed outright says nothing more than that).
 
     Parameters
     ----------
@@ -175,8 +182,42 @@ def read_results(folder: Path) -> StoredSweep:
         raise SweepError(f"{meta_path}: not a sweep description ({exc})", hint) from None
     if not names or cycles < 1:
         raise SweepError(f"{meta_path}: no varied parameter or no cycles", hint)
+    planned = meta.get("designs")
+    if planned is not None and (not isinstance(planned, int) or isinstance(planned, bool) or planned < 1):
+        raise SweepError(f"{meta_path}: designs = {planned!r} is not a count of designs", hint)
+    running = is_running(folder)
+    rows = read_rows(csv_path, names)
+    finished = (not running and meta.get("finished", True) is True
+                and (planned is None or len({row["design"] for row in rows}) >= planned))
     return StoredSweep(folder=folder, base=str(req.get("base", "?")), axis_names=names, cycles=cycles,
-                        rows=read_rows(csv_path, names), finished=bool(meta.get("finished", True)))
+                        rows=rows, finished=finished, planned=planned, running=running)
+
+
+def is_running(folder: Path) -> bool:
+    """Whether a sweep is writing ``folder`` now: another open description holds its lock
+    (:meth:`SweepStore.open` takes it before its first row and keeps it to the last; a process
+    that dies lets go of it). Reading makes no file: a folder without the lock file is not
+    being written.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+
+    Returns
+    -------
+    bool
+    """
+    try:
+        fd = os.open(Path(folder) / LOCK, os.O_RDONLY | os.O_CLOEXEC)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return True
+    finally:
+        os.close(fd)
+    return False
 
 
 @dataclass

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from ..errors import ReportError, WriteError
-from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, unique_dir
+from ..fileio import atomic_write_bytes, atomic_write_json, atomic_write_text, check_can_make, unique_dir
 from ..io.run_record import ERROR as REFUSED
 from ..params import Provenance, Robot
 from ..sweep.views import STUDY_PAGE
@@ -214,8 +214,10 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
         A bad input (unknown ``added`` name, bad sweep or study folder, refused or mixed runs,
         ``cycles`` beyond the runs'); nothing is written then.
     WriteError
-        The files could not be written; the new folder is removed.
+        ``out`` cannot be made (a file in the way, a read-only folder: refused before any
+        simulation), or the files could not be written (the new folder is removed).
     """
+    check_can_make(out)            # before any simulation: a folder it cannot write fails now, not after the work
     progress = progress or (lambda msg: None)
     added = added or {}
     unknown = sorted(set(added) - set(measured))
@@ -237,7 +239,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     dash = F.dashboard(comps, land, configs)
 
     timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
-    warnings = notices(comps)
+    warnings = notices(comps) + sweep_notices(land)
     sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
     html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings, spreads,
                             sbs_plan)
@@ -377,12 +379,32 @@ def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker:
                              f"{', '.join(map(str, gaps))}.")
         if not c.trials:
             items.append(f"{c.config}: no track given, prediction only.")
-    if land is not None and not land.finished:
-        items.append(f"The sweep in {land.folder} did not finish: the landscape shows {land.designs} designs only.")
     if land is not None and land.base != base.name:
         items.append(f"The sweep's base robot is {land.base!r}, the report's is {base.name!r}: the landscape "
                      "may not be the same robot.")
     return "<ul class=\"note\">" + "".join(f"<li>{H.esc(i)}</li>" for i in items) + "</ul>"
+
+
+def sweep_notices(land: Landscape | None) -> list[Notice]:
+    """A warning when the sweep's landscape is not all of it: the sweep is still being written
+    (read as it stood), or it stopped short.
+
+    Parameters
+    ----------
+    land : Landscape or None
+
+    Returns
+    -------
+    list of Notice
+        None or one, of kind ``sweep-unfinished``.
+    """
+    if land is None or land.finished:
+        return []
+    state = ("is still running (read as it stood; report again when it ends)" if land.running
+             else "did not finish (rerun the same `locust sweep` to resume it)")
+    of = f"{land.designs} of the {land.planned} designs it plans" if land.planned else f"{land.designs} designs"
+    text = f"the sweep in {land.folder} {state}: the landscape shows only {of}"
+    return [Notice("sweep-unfinished", "", "", text, text)]
 
 
 def _video_caption(job, labels: dict[str, str]) -> str:

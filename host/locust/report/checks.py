@@ -49,7 +49,8 @@ class Notice:
     Attributes
     ----------
     kind : str
-        ``configuration-guessed``, ``virtual-robot``, ``mirrored`` or ``units``.
+        ``configuration-guessed``, ``virtual-robot``, ``mirrored``, ``units`` or
+        ``sweep-unfinished`` (of the report's ``--sweep``, no configuration or trial).
     config : str
         The configuration (leg set) it concerns.
     trial : str
@@ -60,7 +61,7 @@ class Notice:
         The same warning without this trial's details: notices sharing it are shown as one line.
     """
 
-    kind: str            # configuration-guessed | virtual-robot | mirrored | units
+    kind: str            # configuration-guessed | virtual-robot | mirrored | units | sweep-unfinished
     config: str
     trial: str
     message: str

@@ -44,10 +44,14 @@ class Landscape:
     reason : list of str
         Per design, the ``reason`` column of ``results.csv`` (why an invalid one failed).
     finished : bool
-        False for an interrupted sweep, some designs missing.
+        False for a sweep still running or interrupted, some designs missing.
     goes_over : ndarray of bool
         Whether each design's run goes over onto its back (its ``outcome``; a sweep with
         ``--samples``: the draws' most common outcome).
+    planned : int or None
+        The designs the sweep plans (None: its folder does not say).
+    running : bool
+        A sweep was writing the folder when it was read.
     """
 
     folder: Path
@@ -60,6 +64,8 @@ class Landscape:
     reason: list[str]
     finished: bool = True             # False: an interrupted sweep, some designs missing
     goes_over: np.ndarray | None = None   # bool per design: its run goes over onto its back
+    planned: int | None = None        # the designs the sweep plans
+    running: bool = False             # a sweep was writing the folder when it was read
 
     def __post_init__(self):
         if self.goes_over is None:
@@ -105,7 +111,7 @@ def read_landscape(folder: Path) -> Landscape:
     return Landscape(folder=res.folder, base=res.base, names=res.axis_names, cycles=res.cycles,
                      values={n: np.array(res.column(n), dtype=float) for n in res.axis_names},
                      valid=valid, distance_m=distance, reason=[str(r) for r in res.column("reason")],
-                     finished=res.finished,
+                     finished=res.finished, planned=res.planned, running=res.running,
                      goes_over=np.array([str(o) == GOES_OVER for o in res.column("outcome")], dtype=bool))
 
 
