@@ -429,6 +429,15 @@ def test_the_heartbeat_keeps_its_clock_beside_a_busy_thread():
         os.close(master)
         os.close(slave)
     gaps = [b - a for a, b in zip(arrivals, arrivals[1:])]
+    if len(arrivals) < 0.8 * 2.0 / interval_s or max(gaps) >= 2 * interval_s:
+        # a host that stops this process for long (a busy shared machine) cannot judge the
+        # heartbeat's clock; probed now, one that does not stop it can, and the beat was late
+        from host_probe import STALL_LIMIT_US, spin_probe_us
+
+        again_us = spin_probe_us()
+        if again_us > STALL_LIMIT_US:
+            pytest.skip(f"worst gap between beats {max(gaps, default=0) * 1000:.0f} ms, and the host stopped a "
+                        f"spinning process for {again_us / 1000:.2f} ms: the heartbeat's clock cannot be judged here")
     assert len(arrivals) >= 0.8 * 2.0 / interval_s
     # a beat may be late by a few scheduler slices, never by a good part of the timeout
     assert max(gaps) < 2 * interval_s, gaps
