@@ -54,7 +54,7 @@ def velocity(t_s: np.ndarray, x: np.ndarray) -> np.ndarray:
         return out
     span = t[2:] - t[:-2]
     seen = np.isfinite(x[2:]) & np.isfinite(x[1:-1]) & np.isfinite(x[:-2]) & (span > 0)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):   # (a value beyond any track's: inf)
         out[1:-1] = np.where(seen, (x[2:] - x[:-2]) / span, np.nan)
     return out
 
@@ -88,14 +88,15 @@ def acceleration(t_s: np.ndarray, x: np.ndarray) -> np.ndarray:
     if not seen.any():
         return out
     tw, xw = tw[seen], xw[seen]
-    step = (tw[:, 4] - tw[:, 0]) / 4.0                       # the window's mean step: u is about -2..2
-    u = (tw - tw[:, 2:3]) / step[:, None]
-    y = xw - xw[:, 2:3]                                      # about the middle sample: no cancellation
-    basis = np.stack([np.ones_like(u), u, u * u], axis=-1)   # (m, 5, 3): p + q u + c u^2
-    normal = np.einsum("mki,mkj->mij", basis, basis)
-    rhs = np.einsum("mki,mk->mi", basis, y)
-    coef = np.linalg.solve(normal, rhs[..., None])[..., 0]
-    out[2:n - 2][seen] = 2.0 * coef[:, 2] / step**2
+    with np.errstate(invalid="ignore", over="ignore"):          # (a value beyond any track's: inf or nan)
+        step = (tw[:, 4] - tw[:, 0]) / 4.0                       # the window's mean step: u is about -2..2
+        u = (tw - tw[:, 2:3]) / step[:, None]
+        y = xw - xw[:, 2:3]                                      # about the middle sample: no cancellation
+        basis = np.stack([np.ones_like(u), u, u * u], axis=-1)   # (m, 5, 3): p + q u + c u^2
+        normal = np.einsum("mki,mkj->mij", basis, basis)
+        rhs = np.einsum("mki,mk->mi", basis, y)
+        coef = np.linalg.solve(normal, rhs[..., None])[..., 0]
+        out[2:n - 2][seen] = 2.0 * coef[:, 2] / step**2
     return out
 
 
