@@ -68,7 +68,7 @@ def test_the_course_deflection_test(shared_data):
     trk = shared_data / "hinge" / "Deflection_test.trk"
     fit = locust.calibrate_beam(trk, MASS_KG, length_m=LENGTH_M, static=True)
     r = fit.result
-    assert fit.parameters == {} and fit.experiment == "static beam"
+    assert fit.parameters == {} and fit.experiment == "static-beam"
     for est, value, low, high in ((r.deflection_m, 5.555e-3, 5.332e-3, 5.778e-3),
                                   (r.stiffness_n_per_m, 167.8, 161.0, 174.5)):
         tolerance = 0.05 * (high - low) / 2
@@ -97,7 +97,7 @@ def test_the_command_prints_the_figures_and_writes_nothing(shared_data, tmp_path
     assert "stiffness                         167.8  N/m" in res.stdout
     assert "note: nothing written to robot.toml" in res.stdout and "the tip still creeps" in res.stdout
     doc = json.loads(invoke([*args, "--json"]).stdout)
-    assert doc["experiment"] == "static beam" and doc["stiffness_n_per_m"]["value"] == pytest.approx(167.8, abs=0.35)
+    assert doc["experiment"] == "static-beam" and doc["stiffness_n_per_m"]["value"] == pytest.approx(167.8, abs=0.35)
     assert doc["load_n"] == pytest.approx(0.095 * 9.81) and "written" not in doc
 
 

@@ -30,7 +30,7 @@ class Fit:
     Attributes
     ----------
     experiment : str
-        ``beam``, ``static beam``, ``hinge``, ``servo``, ``ramp`` or ``hops``.
+        ``beam``, ``static-beam``, ``hinge``, ``servo``, ``ramp`` or ``hops``.
     source : str
         The recording(s) fitted, ``+``-joined; the values' provenance ``fit:<source>``.
     parameters : dict of str to locust.calibrate.fitstats.Estimate
@@ -284,7 +284,7 @@ def _static_beam(tracks: PathLike, table, x, y, mass_kg: float, length_m: float 
         scale, scale_note = 0.0, "taken as exact: the track names no calibration stick (--scale-std-pct to give one)"
     fit = BS.fit_static_beam(t, x, y, mass_kg, scale_relative_std=scale, scale_note=scale_note, length_m=length_m,
                              rest_s=rest_s, settled_s=settled_s, source=str(tracks))
-    return Fit("static beam", str(tracks), {}, fit, note=f"static beam L={length_m} m, m={mass_kg} kg; {BS.MAPPING}",
+    return Fit("static-beam", str(tracks), {}, fit, note=f"static beam L={length_m} m, m={mass_kg} kg; {BS.MAPPING}",
                subtitle=f"deflection {fit.deflection_m.value * 1000:.3f} mm, k {fit.stiffness_n_per_m.value:.4g} N/m",
                input_note=table.input_note)
 

@@ -156,11 +156,12 @@ class StaticBeamFit:
         Returns
         -------
         dict
-            ``experiment`` ("static beam"), the inputs, each :class:`~.fitstats.Estimate` as its
-            :meth:`~.fitstats.Estimate.as_dict` (None when absent), the windows and the scale's
+            ``experiment`` ("static-beam": it names the plot, which has no space), the inputs,
+            each :class:`~.fitstats.Estimate` as its :meth:`~.fitstats.Estimate.as_dict` (None
+            when absent), the windows and the scale's
             uncertainty, under the field names (units in them).
         """
-        out = {"experiment": "static beam", "source": self.source, "mass_kg": self.mass_kg, "load_n": self.load_n,
+        out = {"experiment": "static-beam", "source": self.source, "mass_kg": self.mass_kg, "load_n": self.load_n,
                "length_m": self.length_m}
         for name in ("deflection_m", "stiffness_n_per_m", "bending_stiffness_nm2", "creep_m_per_s"):
             est = getattr(self, name)
