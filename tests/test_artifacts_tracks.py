@@ -49,9 +49,13 @@ def test_tracks_csv_round_trip_keeps_lost_frames_and_notes(tmp_path):
     tracks = _tracks()
     path = tc.write_tracks_csv(tmp_path / "hop.tracks.csv", tracks)
     text = path.read_text()
-    header = "frame,t_s,nose_px,nose_py,nose_x_m,nose_y_m,nose_ok,foot_px,foot_py,foot_x_m,foot_y_m,foot_ok"
+    derived = "vx_m_per_s,{0}_vy_m_per_s,{0}_ax_m_per_s2,{0}_ay_m_per_s2"
+    header = (f"frame,t_s,nose_px,nose_py,nose_x_m,nose_y_m,nose_ok,nose_{derived.format('nose')},"
+              f"foot_px,foot_py,foot_x_m,foot_y_m,foot_ok,foot_{derived.format('foot')}")
     assert text.splitlines()[:3] == ["# synthetic: four frames", "# truth: none", header]
-    assert text.splitlines()[5] == "5,0.066667,nan,nan,nan,nan,0,6.0000,220.0000,nan,nan,1"
+    # the nose lost on frame 5 has no velocity next to it; the foot has no metres, so none
+    assert text.splitlines()[5] == ("5,0.066667,nan,nan,nan,nan,0,nan,nan,nan,nan,"
+                                    "6.0000,220.0000,nan,nan,1,nan,nan,nan,nan")
     back = tc.read_tracks_csv(path)
     t_written = np.round(tracks.t_s, 6)
     assert back == tc.TracksCsv(tracks.frame, t_written, tracks.markers, tracks.comments)

@@ -139,7 +139,7 @@ def test_creeping_tip_is_refused():
     y = 0.0053 * (1 - np.exp(-np.clip(t - 0.5, 0, None) / 0.8)) + rng.normal(0, 1e-4, len(t))
     with pytest.raises(CalibrationError, match="no ring-down") as err:
         B.fit_beam(t, y, 0.095, length_m=0.048)
-    assert "static deflection" in err.value.hint
+    assert "add --static to read its static deflection" in err.value.hint
 
 
 # Ring-downs with a release transient at the drop (a finger leaving the mass, a higher mode

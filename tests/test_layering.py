@@ -1,7 +1,7 @@
 """The package layering (docs/architecture.md), from the bottom up:
 
 - the shared modules at the root (errors, fileio, progress, tables, plotting, markers,
-  arucoboard, orphans, version, bundled) and ``params``, the robot's parameters;
+  arucoboard, orphans, version, bundled, derivatives) and ``params``, the robot's parameters;
 - ``io``, the file formats, which imports no job package;
 - the job packages (sim, calibrate, track, sweep, report, fab, device, measure, trials);
 - ``api``, the functions a notebook calls;
@@ -45,7 +45,7 @@ def imports_of(path: Path) -> set[str]:
 JOBS = ("sim", "calibrate", "track", "sweep", "report", "fab", "device", "measure", "trials", "demo")
 BELOW_API = (*JOBS, "io", "params", "firmware")        # packages
 SHARED = ("errors", "fileio", "progress", "tables", "plotting", "markers", "arucoboard", "orphans", "version",
-          "bundled")
+          "bundled", "derivatives")
 ROOT_NAMES = ("locust", "locust.__init__", "locust.__version__")
 
 

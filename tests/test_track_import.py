@@ -62,12 +62,13 @@ def test_tracker_export_in_cm_becomes_metres_with_the_new_name(tmp_path):
     assert lines[0] == "# SYNTHETIC Tracker export in cm (written by tests/test_track_import.py)"
     assert lines[1] == ("# imported from export.txt (Tracker text export): positions in cm -> m, renamed A -> nose; "
                         "not imported: A v")
-    assert lines[2] == "frame,t_s,nose_px,nose_py,nose_x_m,nose_y_m,nose_ok"
-    # the cells are the cm values / 100, digit for digit
-    assert lines[3] == "0,0.000000,nan,nan,0.123456,-0.035000,1"
-    assert lines[4] == "1,0.033333,nan,nan,0.130625,-0.027500,1"
-    assert lines[5] == "2,0.066667,nan,nan,nan,nan,0"            # a step Tracker does not have: lost
-    assert lines[6] == "3,0.100000,nan,nan,0.158750,0.001250,1"
+    assert lines[2] == ("frame,t_s,nose_px,nose_py,nose_x_m,nose_y_m,nose_ok,"
+                        "nose_vx_m_per_s,nose_vy_m_per_s,nose_ax_m_per_s2,nose_ay_m_per_s2")
+    # the cells are the cm values / 100, digit for digit (no velocity: a neighbour is lost or missing)
+    assert lines[3] == "0,0.000000,nan,nan,0.123456,-0.035000,1,nan,nan,nan,nan"
+    assert lines[4] == "1,0.033333,nan,nan,0.130625,-0.027500,1,nan,nan,nan,nan"
+    assert lines[5] == "2,0.066667,nan,nan,nan,nan,0,nan,nan,nan,nan"            # a step Tracker does not have: lost
+    assert lines[6] == "3,0.100000,nan,nan,0.158750,0.001250,1,nan,nan,nan,nan"
     back = tc.read_tracks_csv(out)
     x, y = back.positions("nose")
     np.testing.assert_array_equal(x, np.array(CM_X) / 100)       # exactly the cm value / 100
@@ -118,7 +119,8 @@ def test_tracks_csv_in_mm_keeps_pixels_and_renames_columns(tmp_path):
     res = track("import", src, "--units", "mm", "--rename", "A=nose", "--out", out)
     assert res.exit_code == 0, res.output
     back = tc.read_tracks_csv(out)
-    assert back.columns == ("frame", "t_s", "nose_px", "nose_py", "nose_x_m", "nose_y_m", "nose_ok")
+    assert back.columns == ("frame", "t_s", "nose_px", "nose_py", "nose_x_m", "nose_y_m", "nose_ok", "nose_vx_m_per_s",
+                            "nose_vy_m_per_s", "nose_ax_m_per_s2", "nose_ay_m_per_s2")
     nose = back.markers["nose"]
     assert list(back.frame) == [5, 6] and nose.px[0] == 100.5 and nose.py[0] == 200.25   # pixels stay pixels
     assert nose.x_m[0] == 0.125 and nose.y_m[0] == 0.04 and not nose.ok[1]

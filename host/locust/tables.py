@@ -285,14 +285,14 @@ def plant_lines(summary: dict) -> list[str]:
 # -- fitted values, as `locust calibrate` prints them ------------------------------------------
 UNIT_SUFFIXES = (   # a key's unit from its name's end (longest first): _nm_ is newton-metres, never nm
     ("_nms_per_rad", "N·m·s/rad"), ("_nm_per_rad", "N·m/rad"), ("_ns_per_m", "N·s/m"), ("_n_per_m", "N/m"),
-    ("_rad_per_s", "rad/s"), ("_kg_per_m3", "kg/m³"), ("_kgm2", "kg·m²"), ("_kg", "kg"), ("_hz", "Hz"),
-    ("_deg", "deg"), ("_mm", "mm"), ("_ms", "ms"), ("_nm", "N·m"), ("_ohm", "Ω"), ("_rad", "rad"), ("_us", "µs"),
-    ("_m", "m"), ("_s", "s"), ("_v", "V"),
+    ("_rad_per_s", "rad/s"), ("_m_per_s", "m/s"), ("_kg_per_m3", "kg/m³"), ("_kgm2", "kg·m²"), ("_nm2", "N·m²"),
+    ("_kg", "kg"), ("_hz", "Hz"), ("_deg", "deg"), ("_mm", "mm"), ("_ms", "ms"), ("_nm", "N·m"), ("_ohm", "Ω"),
+    ("_rad", "rad"), ("_us", "µs"), ("_m", "m"), ("_n", "N"), ("_s", "s"), ("_v", "V"),
 )
 
 
 # what a person reads of a value in SI (its key's unit): lengths in mm, masses in g, angles in deg
-PERSON_UNITS = {"m": (1000.0, "mm"), "kg": (1000.0, "g"), "rad": (180.0 / math.pi, "deg")}
+PERSON_UNITS = {"m": (1000.0, "mm"), "m/s": (1000.0, "mm/s"), "kg": (1000.0, "g"), "rad": (180.0 / math.pi, "deg")}
 
 
 def person_unit(unit: str) -> tuple[float, str]:

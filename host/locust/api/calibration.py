@@ -30,7 +30,7 @@ class Fit:
     Attributes
     ----------
     experiment : str
-        ``beam``, ``hinge``, ``servo``, ``ramp`` or ``hops``.
+        ``beam``, ``static-beam``, ``hinge``, ``servo``, ``ramp`` or ``hops``.
     source : str
         The recording(s) fitted, ``+``-joined; the values' provenance ``fit:<source>``.
     parameters : dict of str to locust.calibrate.fitstats.Estimate
@@ -147,6 +147,9 @@ class Fit:
         if self.subtitle:
             lines.append(f"  {self.subtitle}")
         lines += ["  " + estimate_line(k, e.value, e.std, e.ci95) for k, e in self.parameters.items()]
+        figures = getattr(self.result, "figures", None)
+        if figures is not None:         # a fit of no robot value: its own figures
+            lines += ["  " + estimate_line(k, e.value, e.std, e.ci95) for k, e in figures().items()]
         if not self.parameters:
             lines.append("  no robot value determined")
         lines += [f"  warning: {w}" for w in self.warnings]
@@ -168,8 +171,11 @@ def _imports(imports: ImportOptions | None, units: str) -> ImportOptions:
 def calibrate_beam(tracks: PathLike, mass_kg: float, *, length_m: float | None = None, beam_mass_kg: float = 0.0,
                    marker: str | None = None, start_s: float | None = None, end_s: float | None = None,
                    units: str = "m", imports: ImportOptions | None = None,
-                   timing: TimeOptions = REAL_TIME) -> Fit:
-    """Fit a cantilever's damped oscillation after a tip mass is dropped on it.
+                   timing: TimeOptions = REAL_TIME, static: bool = False,
+                   rest_s: tuple[float, float] | None = None, settled_s: tuple[float, float] | None = None,
+                   scale_std_pct: float | None = None) -> Fit:
+    """Fit a cantilever's damped oscillation after a tip mass is dropped on it; with
+    ``static``, read its static deflection under the mass instead.
 
     Parameters
     ----------
@@ -191,12 +197,23 @@ def calibrate_beam(tracks: PathLike, mass_kg: float, *, length_m: float | None =
         ``--units``, ``--rename``, ``--mirror`` already parsed (instead of ``units``).
     timing : locust.calibrate.recordings.TimeOptions
         ``--time-scale`` / ``--clip-fps``: a slow-motion recording back on real time.
+    static : bool, default False
+        The track is of the tip at rest, loaded by hand, and settled (no ring-down):
+        :mod:`locust.calibrate.beam_static` reads the deflection from rest to settled, the
+        stiffness ``m*g/delta`` and, with ``length_m``, the bending stiffness ``k*L^3/3``.
+    rest_s, settled_s : (float, float), optional
+        With ``static``: the rest and settled windows [s] (default: found from the track).
+    scale_std_pct : float, optional
+        With ``static``: the scale's standard uncertainty [%] (default: from a Tracker
+        project's calibration stick, its ends placed to 0.25 px; else the scale taken as exact).
 
     Returns
     -------
     Fit
         ``compliance.hinge_stiffness_nm_per_rad`` and ``compliance.hinge_damping_nms_per_rad``
-        (with ``length_m``); ``.result`` has the frequency, damping ratio and stiffness.
+        (with ``length_m``); ``.result`` has the frequency, damping ratio and stiffness. With
+        ``static``: no robot value (a cardstock beam's bending is no hinge's stiffness), and
+        ``.result`` a :class:`locust.calibrate.beam_static.StaticBeamFit`.
 
     Examples
     --------
@@ -211,8 +228,11 @@ def calibrate_beam(tracks: PathLike, mass_kg: float, *, length_m: float | None =
     from ..calibrate.recordings import clean_samples, read_table
 
     imports = _imports(imports, units)
+    _check_beam_options(static, beam_mass_kg, start_s, end_s, rest_s, settled_s, scale_std_pct)
     table = read_table(tracks, imports, timing)
     x, y = table.marker(marker)
+    if static:
+        return _static_beam(tracks, table, x, y, mass_kg, length_m, rest_s, settled_s, scale_std_pct)
     t, x, y = clean_samples(tracks, "the beam tip", table.time_s(), x, y, min_samples=B.MIN_SAMPLES)
     displacement = B.principal_displacement(x, y)
     warning = B.tip_swing_warning(float(np.ptp(displacement)), length_m, imports.units, source=str(tracks))
@@ -225,6 +245,48 @@ def calibrate_beam(tracks: PathLike, mass_kg: float, *, length_m: float | None =
     return Fit("beam", str(tracks), values, fit, note=f"beam L={length_m} m, m={mass_kg} kg; {B.MAPPING}",
                subtitle=f"fn {fit.natural_frequency_hz.value:.4g} Hz, zeta {fit.damping_ratio.value:.3g}",
                warnings=[warning] if warning else [], input_note=table.input_note)
+
+
+def _check_beam_options(static: bool, beam_mass_kg: float, start_s, end_s, rest_s, settled_s, scale_std_pct) -> None:
+    """Each mode's options only: the ring-down's window and beam mass, or the static windows and scale."""
+    if static:
+        given = [name for name, v in (("--beam-mass-kg", beam_mass_kg or None), ("--start-s", start_s),
+                                      ("--end-s", end_s)) if v is not None]
+        if given:
+            raise CalibrationError(f"{', '.join(given)}: the ring-down's, not a static deflection's",
+                                   "with --static give --rest-s A,B and --settled-s A,B (or leave them out)")
+    else:
+        given = [name for name, v in (("--rest-s", rest_s), ("--settled-s", settled_s),
+                                      ("--scale-std-pct", scale_std_pct)) if v is not None]
+        if given:
+            raise CalibrationError(f"{', '.join(given)}: a static deflection's (--static), not a ring-down's",
+                                   "add --static for a tip loaded and left to settle, or leave them out")
+
+
+def _static_beam(tracks: PathLike, table, x, y, mass_kg: float, length_m: float | None, rest_s, settled_s,
+                 scale_std_pct: float | None) -> Fit:
+    """``calibrate_beam(static=True)``: the deflection, stiffness and bending stiffness."""
+    from ..calibrate import beam_static as BS
+    from ..calibrate.recordings import clean_samples
+    from ..io.importing import is_project
+    from ..io.trk import read_project
+
+    t, x, y = clean_samples(tracks, "the beam tip", table.time_s(), x, y, min_samples=2 * BS.MIN_WINDOW)
+    stick = read_project(tracks).stick if is_project(Path(tracks)) else None
+    if scale_std_pct is not None:
+        scale, scale_note = scale_std_pct / 100, f"{scale_std_pct:g} % (--scale-std-pct)"
+    elif stick is not None:
+        scale = BS.stick_scale_std(stick.length_px)
+        scale_note = (f"{scale * 100:.2g} %, from Tracker's {stick.name!r} ({stick.length_px:.2f} px for "
+                      f"{stick.length_m * 1000:g} mm), each end placed by hand to {BS.CLICK_SD_PX:g} px; its "
+                      f"{stick.length_m * 1000:g} mm taken as exact (--scale-std-pct to say otherwise)")
+    else:
+        scale, scale_note = 0.0, "taken as exact: the track names no calibration stick (--scale-std-pct to give one)"
+    fit = BS.fit_static_beam(t, x, y, mass_kg, scale_relative_std=scale, scale_note=scale_note, length_m=length_m,
+                             rest_s=rest_s, settled_s=settled_s, source=str(tracks))
+    return Fit("static-beam", str(tracks), {}, fit, note=f"static beam L={length_m} m, m={mass_kg} kg; {BS.MAPPING}",
+               subtitle=f"deflection {fit.deflection_m.value * 1000:.3f} mm, k {fit.stiffness_n_per_m.value:.4g} N/m",
+               input_note=table.input_note)
 
 
 def calibrate_hinge(tracks: PathLike, inertia_kgm2: float, gravity: str, *, mass_kg: float | None = None,

@@ -54,8 +54,12 @@ class Tracks:
         -------
         pandas.DataFrame
             ``frame``, ``t_s``, then per marker ``<name>_px``, ``<name>_py`` (pixels, OpenCV
-            convention), ``<name>_x_m``, ``<name>_y_m`` (world metres, NaN without a scale) and
-            ``<name>_ok`` (found in that frame), as in a tracks CSV.
+            convention), ``<name>_x_m``, ``<name>_y_m`` (world metres, NaN without a scale),
+            ``<name>_ok`` (found in that frame) and its velocity and acceleration
+            ``<name>_vx_m_per_s``, ``<name>_vy_m_per_s``, ``<name>_ax_m_per_s2``,
+            ``<name>_ay_m_per_s2`` (Tracker's finite differences, :mod:`locust.derivatives`;
+            NaN where a neighbour they need is missing), as in a tracks CSV. A file written
+            without the velocity columns has them too, after its own.
         """
         import pandas as pd
 
@@ -65,15 +69,20 @@ class Tracks:
         for name in t.markers:
             if f"{name}_ok" in cols:
                 cols[f"{name}_ok"] = t.markers[name].ok.copy()
+        for name in t.markers_with_positions():
+            for kind, values in t.derived(name).items():
+                cols.setdefault(f"{name}_{kind}", values)
         return pd.DataFrame(cols)
 
     def tidy(self):
         """One row per marker per frame (trackpy's habit), with velocity and acceleration.
 
-        Velocity and acceleration are Tracker's finite differences on the world metres:
-        ``v[i] = (x[i+1] - x[i-1]) / (t[i+1] - t[i-1])`` and, at a steady frame rate,
-        ``a[i] = (x[i+2] - 2 x[i] + x[i-2]) / (4 dt²)`` (central differences of the central
-        differences); NaN at the ends of the clip and next to a frame where the marker is lost.
+        Velocity and acceleration are Tracker's finite differences on the world metres
+        (:mod:`locust.derivatives`, the tracks CSV's own columns): ``v[i] = (x[i+1] - x[i-1])
+        / (t[i+1] - t[i-1])`` and ``a[i]`` twice the quadratic coefficient of the parabola of
+        least squares through frames ``i-2 .. i+2``, at a steady frame rate ``(2 x[i-2] -
+        x[i-1] - 2 x[i] - x[i+1] + 2 x[i+2]) / (7 dt²)``; NaN at the ends of the clip and
+        wherever a frame they read (the frame itself included) lost the marker.
 
         Returns
         -------
@@ -84,13 +93,12 @@ class Tracks:
         import pandas as pd
 
         t, parts = self.tracks.t_s, []
-        for name, m in self.tracks.markers.items():
+        for name in self.tracks.markers_with_positions():
+            m = self.tracks.markers[name]
             x, y = self.tracks.positions(name)
-            v = [_central(t, c) for c in (x, y)]
-            a = [_central(t, c) for c in v]
             parts.append(pd.DataFrame({
                 "frame": self.tracks.frame, "t_s": t, "marker": name, "x_px": m.px, "y_px": m.py, "x_m": x, "y_m": y,
-                "ok": m.ok, "vx_m_per_s": v[0], "vy_m_per_s": v[1], "ax_m_per_s2": a[0], "ay_m_per_s2": a[1]}))
+                "ok": m.ok, **self.tracks.derived(name)}))
         if not parts:
             return pd.DataFrame(columns=["frame", "t_s", "marker", "x_px", "y_px", "x_m", "y_m", "ok", "vx_m_per_s",
                                          "vy_m_per_s", "ax_m_per_s2", "ay_m_per_s2"])
@@ -151,14 +159,6 @@ class Tracks:
         for name, m in t.markers.items():
             lines.append(f"  {name}: found in {int(np.count_nonzero(m.ok))} of {len(m.ok)} frames")
         return "\n".join(lines)
-
-
-def _central(t: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Central differences dv/dt, NaN at both ends (Tracker leaves them blank)."""
-    out = np.full(len(v), np.nan)
-    if len(v) >= 3:
-        out[1:-1] = (v[2:] - v[:-2]) / (t[2:] - t[:-2])
-    return out
 
 
 def _marker_specs(markers: Mapping[str, str] | Sequence[str] | None) -> list[str]:

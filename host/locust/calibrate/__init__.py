@@ -5,6 +5,9 @@ The experiments, one fit each (numbers in, a result dataclass out, values with i
 - :mod:`.beam`: a cardstock cantilever with a dropped tip mass -> the tip's stiffness [N/m] and
   damping [N·s/m]; with the beam's length, their pseudo-rigid-body hinge equivalents (k L², b L²),
   which hold for the robot only if its hinge is of the same material and width.
+- :mod:`.beam_static`: the same cantilever loaded by hand and left to settle -> its static
+  deflection, stiffness m g / delta and bending stiffness E I = k L³ / 3 (no robot value: the
+  model's links are rigid and its hinges are folds).
 - :mod:`.hinge`: a link ringing down on a flexure hinge -> the hinge's stiffness, damping and
   neutral angle.
 - :mod:`.servo`: a servo stepped while carrying a load (filmed horn or rate gyro) -> no-load

@@ -398,7 +398,7 @@ def _checked_oscillation(p: np.ndarray, r: np.ndarray, t: np.ndarray, fs_hz: flo
         )
     fn, zeta = float(p[3]), float(p[4])
     creep = ("a tip that creeps to its new rest without ringing (a mass lowered by hand) has no oscillation "
-             "to fit: read its static deflection, k = m*g/deflection")
+             "to fit: add --static to read its static deflection (k = m*g/deflection)")
     if zeta >= 0.999 * ZETA_BOUNDS[1]:
         raise CalibrationError(f"{source}: no ring-down, the fitted damping ratio is at its bound {ZETA_BOUNDS[1]} "
                                f"({fn:.3g} Hz)", creep)

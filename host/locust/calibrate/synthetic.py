@@ -119,6 +119,82 @@ def beam_tip_track(truth: BeamTruth, rng: np.random.Generator, tilt_deg: float =
     return t, x_m, y_m
 
 
+@dataclass(frozen=True)
+class StaticBeamTruth:
+    """A cardstock cantilever loaded at its tip by hand and filmed at rest before and after
+    (SYNTHETIC truth for the static beam fit; the course's test: 0.095 kg on 48 mm, 60 frames/s).
+
+    Attributes
+    ----------
+    stiffness_n_per_m : float
+        The tip's stiffness [N/m].
+    rest_s, load_s, settled_s : float
+        How long the tip is filmed at rest, being loaded (a smooth ramp to its deflection) and
+        settled [s].
+    scatter_m, scatter_rho : float
+        The track's scatter about the tip, one standard deviation per axis [m], and its
+        frame-to-frame correlation (AR(1): a hand-clicked or tracked tip wanders).
+    scale_relative_std : float
+        How well the track's scale is known: each track's metres are off by a factor drawn
+        from N(1, this) (no unit).
+    """
+
+    mass_kg: float = 0.095
+    length_m: float = 0.048
+    stiffness_n_per_m: float = 169.0
+    fps: float = 60.0
+    rest_s: float = 2.0
+    load_s: float = 1.5
+    settled_s: float = 1.5
+    scatter_m: float = 5e-5
+    scatter_rho: float = 0.8
+    scale_relative_std: float = 0.009
+
+    @property
+    def deflection_m(self) -> float:
+        """The tip's static deflection, m*g/k [m]."""
+        return self.mass_kg * GRAVITY_M_PER_S2 / self.stiffness_n_per_m
+
+
+def static_beam_track(truth: StaticBeamTruth, rng: np.random.Generator, tilt_deg: float = 3.0):
+    """(t_s, x_m, y_m) of the tip: at rest, lowered to its deflection (smoothstep), settled.
+
+    Each axis carries AR(1) scatter of ``scatter_m`` and ``scatter_rho``; the whole track is
+    scaled by a factor drawn from ``N(1, scale_relative_std)`` (the scale's own error, which
+    the fit is told of, not of its draw); the camera is tilted by ``tilt_deg``.
+
+    Parameters
+    ----------
+    truth : StaticBeamTruth
+    rng : numpy.random.Generator
+        The scatter's and the scale's source.
+    tilt_deg : float, default 3
+        The camera's tilt [deg].
+
+    Returns
+    -------
+    t_s, x_m, y_m : numpy.ndarray
+        Time [s] and the tip's position in the camera's frame [m] (SYNTHETIC).
+    """
+    n = int(round((truth.rest_s + truth.load_s + truth.settled_s) * truth.fps))
+    t = np.arange(n) / truth.fps
+    u = np.clip((t - truth.rest_s) / truth.load_s, 0.0, 1.0)
+    y = -truth.deflection_m * u * u * (3 - 2 * u)
+    tilt = math.radians(tilt_deg)
+
+    def wander() -> np.ndarray:
+        e = rng.normal(0.0, truth.scatter_m * math.sqrt(1 - truth.scatter_rho ** 2), n)
+        e[0] = rng.normal(0.0, truth.scatter_m)
+        for i in range(1, n):
+            e[i] += truth.scatter_rho * e[i - 1]
+        return e
+
+    scale = 1.0 + rng.normal(0.0, truth.scale_relative_std)
+    x_m = scale * (0.05 - math.sin(tilt) * y + wander())
+    y_m = scale * (0.12 + math.cos(tilt) * y + wander())
+    return t, x_m, y_m
+
+
 SG90_AA_SWING = Servo(kp_nm_per_rad=0.26, stall_torque_nm=0.15, noload_speed_rad_per_s=10.2, armature_kgm2=3.1e-4,
                       kv_nms_per_rad=0.0)
 """The SG90 fitted to the course's AA-battery swing alone (kv held at 0): the servo of the

@@ -171,31 +171,85 @@ def calibrate() -> None:
     """
 
 
+_STATIC_WRITE_KEY = "locust.calibrate.static_write"
+
+
+def static_writes_nothing(func):
+    """``beam --static --write``: robot.toml holds no value a cardstock beam's bending gives (the
+    model's links are rigid, its hinges are folds: docs/servo.md, "Hinges and links"), so the
+    write is taken out before the robot line that would name a file to update, and the
+    command says at its end that nothing was written."""
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        if kwargs.get("static") and kwargs.get("write_path") is not None:
+            given = kwargs["write_path"]
+            click.get_current_context().meta[_STATIC_WRITE_KEY] = DEFAULT_ROBOT_TOML if str(given) == _BARE_WRITE \
+                else given
+            kwargs["write_path"] = None
+        return func(*args, **kwargs)
+
+    return wrapper
+
+
+def _window_option(value: str | None, option: str) -> tuple[float, float] | None:
+    return tuple(inputs.parse_floats(value, 2, option, f"two times in s, e.g. {option} 0,1.5")) if value else None
+
+
 @calibrate.command()
 @click.argument("tracks", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--mass-kg", type=POSITIVE, required=True, help="Dropped tip mass [kg].")
+@click.option("--mass-kg", type=POSITIVE, required=True, help="Dropped tip mass [kg] (with --static: the tip load).")
 @click.option("--marker", default=None, help="Marker of the beam tip in the track [default: the only one].")
 @click.option("--length-m", type=POSITIVE, default=None,
-              help="Free length of the beam, clamp to mass [m]; needed for the hinge values (k*L^2, b*L^2).")
+              help="Free length of the beam, clamp to mass [m]; needed for the hinge values (k*L^2, b*L^2), "
+                   "with --static for the bending stiffness E*I = k*L^3/3.")
 @click.option("--beam-mass-kg", type=FINITE, default=0.0, show_default=True,
               help="The beam's own mass [kg]; 33/140 of it is added to the oscillating mass.")
 @click.option("--start-s", type=FINITE, default=None,
               help="Fit from this time [default: the first swing after the drop].")
 @click.option("--end-s", type=FINITE, default=None, help="Fit up to this time [default: end of the track].")
+@click.option("--static", is_flag=True,
+              help="A static deflection test, not a ring-down: the tip at rest, loaded, and settled; the "
+                   "deflection from rest to settled, the stiffness m*g/deflection and (with --length-m) the "
+                   "bending stiffness, each with a 95% interval. Nothing of it goes into robot.toml.")
+@click.option("--rest-s", default=None, metavar="A,B",
+              help="With --static: the rest window [s] [default: the start to where the loading begins].")
+@click.option("--settled-s", default=None, metavar="A,B",
+              help="With --static: the settled window [s] [default: where the loading ends to the end].")
+@click.option("--scale-std-pct", type=FINITE, default=None, metavar="P",
+              help="With --static: the scale's standard uncertainty [%] [default: a Tracker project's "
+                   "calibration stick, its two ends placed to 0.25 px; else the scale taken as exact].")
 @import_options
 @time_options
+@static_writes_nothing
 @output_options
-def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, imports, timing, write_path, as_json,
-         plot_path, no_plot, force):
+def beam(tracks, mass_kg, marker, length_m, beam_mass_kg, start_s, end_s, static, rest_s, settled_s, scale_std_pct,
+         imports, timing, write_path, as_json, plot_path, no_plot, force):
     """Fit the beam tip's damped oscillation: stiffness, damping, and the model's hinge values.
 
     TRACKS is a `locust track` CSV, a Tracker project (.trk, .trz) or text export, or a
-    t,x,y CSV of the beam tip (metres, or --units cm|mm).
+    t,x,y CSV of the beam tip (metres, or --units cm|mm). With --static, read the tip's
+    static deflection under the load instead (the course's deflection test):
+
+    \b
+      locust calibrate beam Deflection_test.trk --static --mass-kg 0.095 --length-m 0.048
     """
     from ..api.calibration import calibrate_beam
 
     fit = calibrate_beam(tracks, mass_kg, length_m=length_m, beam_mass_kg=beam_mass_kg, marker=marker,
-                         start_s=start_s, end_s=end_s, imports=imports, timing=timing)
+                         start_s=start_s, end_s=end_s, imports=imports, timing=timing, static=static,
+                         rest_s=_window_option(rest_s, "--rest-s"), settled_s=_window_option(settled_s, "--settled-s"),
+                         scale_std_pct=scale_std_pct)
+    if static:
+        notes = fit.result.notes()
+        unwritten = click.get_current_context().meta.get(_STATIC_WRITE_KEY)
+        if unwritten is not None:
+            notes.append(f"nothing written to {unwritten}: no value of a robot file holds a cardstock beam's "
+                         "stiffness (the model's links are rigid and its hinges are folds, whose stiffness "
+                         "`locust calibrate hinge` measures: docs/servo.md, Hinges and links)")
+        _finish(fit.result, tracks, {}, fit.note, None, as_json, plot_path, no_plot, force, subtitle=fit.subtitle,
+                warnings=fit.warnings, input_note=fit.input_note, extra={"notes": notes})
+        return
     if not fit.parameters and write_path:
         raise CalibrationError("--write needs --length-m: the hinge values are k*L^2 and b*L^2",
                                "measure the beam's free length from the clamp to the mass")

@@ -6,13 +6,21 @@
 Layout: ``#`` comment lines (the file's own notes, e.g. ``# synthetic: ...``), then one
 header line and one row per frame::
 
-    frame,t_s,<m>_px,<m>_py,<m>_x_m,<m>_y_m,<m>_ok        (the last five once per marker)
+    frame,t_s,<m>_px,<m>_py,<m>_x_m,<m>_y_m,<m>_ok,<m>_vx_m_per_s,<m>_vy_m_per_s,<m>_ax_m_per_s2,<m>_ay_m_per_s2
+                                                          (all but the first two once per marker)
 
 - ``frame``: video frame index; ``t_s``: seconds since the clip's first frame (6 decimals);
 - ``<m>_px``, ``<m>_py``: pixels in OpenCV's convention, origin at the centre of the
   top-left pixel, x right, y down (4 decimals);
 - ``<m>_x_m``, ``<m>_y_m``: world metres, y up (6 decimals); ``nan`` without a calibration;
-- ``<m>_ok``: 1 where the marker was found, 0 where not; its cells are then ``nan``.
+- ``<m>_ok``: 1 where the marker was found, 0 where not; its cells are then ``nan``;
+- ``<m>_vx_m_per_s``, ``<m>_vy_m_per_s`` (4 decimals), ``<m>_ax_m_per_s2``,
+  ``<m>_ay_m_per_s2`` (3 decimals): velocity and acceleration by Tracker's finite
+  differences (:mod:`locust.derivatives`), ``nan`` where a neighbour they need is missing.
+  They are derived columns: computed from the time and world columns *as written* (so the
+  file's own numbers give them back), and on reading computed again from the columns read,
+  never taken from the file (a file written before they existed reads as it did, and
+  one converted to another unit or mirrored cannot keep a stale velocity).
 
 The reader also takes what other programs make of the file (the tokenizer is
 :mod:`.delimited`): ``true``/``false`` in ``_ok``, ``;`` or tab delimiters with decimal
@@ -31,6 +39,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..derivatives import acceleration, velocity
 from ..errors import TrackError
 from ..fileio import atomic_write_text
 from .delimited import DelimitedText, check_names, check_text, read_text, split_text
@@ -40,6 +49,9 @@ if TYPE_CHECKING:
 
 TRACKS_CSV_SUFFIX = ".tracks.csv"
 MARKER_COLUMNS = ("px", "py", "x_m", "y_m", "ok")   # per marker, in the order written
+# per marker after those: computed from the time and world columns, never stored (see above)
+DERIVED_COLUMNS = ("vx_m_per_s", "vy_m_per_s", "ax_m_per_s2", "ay_m_per_s2")
+_DERIVED_DIGITS = (4, 4, 3, 3)
 
 
 def tracks_csv_in(folder: Path, source: Path) -> Path:
@@ -115,7 +127,8 @@ class TracksCsv:
         """The file's columns: as read, or the layout :func:`tracks_csv_text` writes."""
         if self.header is not None:
             return self.header
-        return ("frame", "t_s", *(f"{m}_{c}" for m in self.markers for c in MARKER_COLUMNS), *self.other)
+        return ("frame", "t_s", *(f"{m}_{c}" for m in self.markers for c in (*MARKER_COLUMNS, *DERIVED_COLUMNS)),
+                *self.other)
 
     def column(self, name: str) -> np.ndarray:
         """One column by its name in the file, as floats (``_ok`` as 1.0/0.0).
@@ -128,7 +141,8 @@ class TracksCsv:
         Returns
         -------
         numpy.ndarray
-            In the column's unit (px, m, s).
+            In the column's unit (px, m, s; m/s and m/s² for the derived columns, computed
+            from the positions whether the file had them or not).
 
         Raises
         ------
@@ -143,6 +157,8 @@ class TracksCsv:
             return self.other[name]
         marker, kind = _marker_column(name) or ("", "")
         if marker in self.markers:
+            if kind in DERIVED_COLUMNS:
+                return self.derived(marker)[kind]
             return getattr(self.markers[marker], kind).astype(float)
         raise KeyError(name)
 
@@ -188,6 +204,28 @@ class TracksCsv:
             raise no_marker(self.path, marker, self.markers_with_positions())
         m = self.markers[marker]
         return np.where(m.ok, m.x_m, np.nan), np.where(m.ok, m.y_m, np.nan)
+
+    def derived(self, marker: str) -> dict[str, np.ndarray]:
+        """``marker``'s velocity and acceleration (Tracker's finite differences on the world
+        metres, :mod:`locust.derivatives`), NaN where a neighbour they need was lost.
+
+        Parameters
+        ----------
+        marker : str
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            :data:`DERIVED_COLUMNS`: ``vx_m_per_s``, ``vy_m_per_s`` [m/s], ``ax_m_per_s2``,
+            ``ay_m_per_s2`` [m/s²].
+
+        Raises
+        ------
+        locust.errors.TrackError
+            No such marker (the message names those there are).
+        """
+        x, y = self.positions(marker)
+        return _derived(self.t_s, x, y)
 
     def has_pixels(self, marker: str) -> bool:
         """Whether ``marker`` has a finite pixel position anywhere (tracked, even if not in metres).
@@ -238,7 +276,7 @@ class TracksCsv:
             split = _marker_column(name)
             if split is None:
                 other[name] = values
-            else:
+            elif split[1] not in DERIVED_COLUMNS:       # derived: computed again from the positions
                 markers.setdefault(split[0], {})[split[1]] = values
         nan = np.full(n, np.nan)
         return cls(frame=frame.astype(int), t_s=cols.get("t_s", nan.copy()),
@@ -264,18 +302,22 @@ def tracks_csv_text(tracks: TracksCsv) -> str:
     for line in tracks.comments:
         out.write(f"# {line}\n")
     head = ["frame", "t_s"]
-    cols: list[tuple[np.ndarray, int]] = []       # values, decimals (-1: the 0/1 of ok)
+    t_text = _cells(tracks.t_s, 6)
+    cols = [[str(int(f)) for f in np.asarray(tracks.frame).tolist()], t_text]
+    t_written = _parsed(t_text)
     for m in tracks.markers.values():
-        head += [f"{m.name}_{c}" for c in MARKER_COLUMNS]
-        cols += [(m.px, 4), (m.py, 4), (m.x_m, 6), (m.y_m, 6), (m.ok, -1)]
+        head += [f"{m.name}_{c}" for c in (*MARKER_COLUMNS, *DERIVED_COLUMNS)]
+        x_text, y_text = _cells(m.x_m, 6), _cells(m.y_m, 6)
+        ok = ["1" if v else "0" for v in np.asarray(m.ok).tolist()]
+        cols += [_cells(m.px, 4), _cells(m.py, 4), x_text, y_text, ok]
+        # from the positions as written, so that reading the file gives these very numbers back
+        x, y = (np.where(m.ok, _parsed(c), np.nan) for c in (x_text, y_text))
+        cols += [_cells(v, digits) for v, digits in zip(_derived(t_written, x, y).values(), _DERIVED_DIGITS)]
     for name, values in tracks.other.items():
         head.append(name)
-        cols.append((values, 6))
+        cols.append(_cells(values, 6))
     out.write(",".join(head) + "\n")
-    for i, frame in enumerate(tracks.frame):
-        row = [str(int(frame)), _fmt(tracks.t_s[i], 6)]
-        row += [str(int(bool(v[i]))) if digits < 0 else _fmt(v[i], digits) for v, digits in cols]
-        out.write(",".join(row) + "\n")
+    out.writelines(",".join(row) + "\n" for row in zip(*cols))
     return out.getvalue()
 
 
@@ -415,8 +457,23 @@ def no_marker(path: Path | None, marker: str, names: list[str]) -> TrackError:
                       "check the name given with --marker")
 
 
+def _derived(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray) -> dict[str, np.ndarray]:
+    return dict(zip(DERIVED_COLUMNS, (velocity(t_s, x_m), velocity(t_s, y_m),
+                                      acceleration(t_s, x_m), acceleration(t_s, y_m))))
+
+
+def _cells(values: np.ndarray, digits: int) -> list[str]:
+    """A column's cells: ``digits`` decimals, ``nan`` for a value that is not finite."""
+    return [f"{v:.{digits}f}" if math.isfinite(v) else "nan" for v in np.asarray(values, dtype=float).tolist()]
+
+
+def _parsed(cells: list[str]) -> np.ndarray:
+    """A column as the reader gets it back from its cells."""
+    return np.array([float(c) for c in cells], dtype=float)
+
+
 def _marker_column(name: str) -> tuple[str, str] | None:
-    for kind in ("x_m", "y_m", "px", "py", "ok"):
+    for kind in (*DERIVED_COLUMNS, "x_m", "y_m", "px", "py", "ok"):
         if name.endswith("_" + kind) and len(name) > len(kind) + 1:
             return name[: -len(kind) - 1], kind
     return None
@@ -440,7 +497,3 @@ def same_array(a: np.ndarray | None, b: np.ndarray | None) -> bool:
     if a.dtype.kind in "fc" or b.dtype.kind in "fc":
         return a.shape == b.shape and bool(np.array_equal(a, b, equal_nan=True))
     return bool(np.array_equal(a, b))
-
-
-def _fmt(value: float, digits: int) -> str:
-    return "nan" if not math.isfinite(value) else f"{value:.{digits}f}"

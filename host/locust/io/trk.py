@@ -139,6 +139,29 @@ class TrackerClip:
     fps: float
 
 
+@dataclass(frozen=True)
+class ScaleStick:
+    """The calibration stick a project's scale was set from: its two ends as placed by hand
+    and the length typed for it (Tracker's ``TapeMeasure`` in stick mode).
+
+    Attributes
+    ----------
+    name : str
+        The stick's name in Tracker (``calibration stick A``).
+    length_px : float
+        Its length on the image [px].
+    length_m : float
+        The world length given it [m].
+    """
+
+    name: str
+    length_px: float
+    length_m: float
+
+
+STICK_AGREES = 1e-3    # a stick whose px per m is this far from the axes' scale is not the one that set it
+
+
 @dataclass
 class TrackerProject:
     """A Tracker project (``.trk``) as read or to be written.
@@ -156,6 +179,8 @@ class TrackerProject:
         Track name -> frame -> (px, py) in pixels, OpenCV's convention.
     descriptions : dict of str to str
         Track name -> its description in Tracker.
+    stick : ScaleStick or None
+        The calibration stick that set the scale, as read (None: none, or not the one that set it).
     """
 
     path: Path
@@ -164,6 +189,7 @@ class TrackerProject:
     calibration: Calibration | None   # None: written without a Tracker calibration (a plane's homography)
     points: dict[str, dict[int, tuple[float, float]]]  # name -> frame -> (px, py), OpenCV convention
     descriptions: dict[str, str] = field(default_factory=dict)   # name -> the track's description in Tracker
+    stick: ScaleStick | None = None   # the calibration stick the scale came from, as read
 
 
 def read_project(path: str | Path) -> TrackerProject:
@@ -276,8 +302,11 @@ def _project(path: Path, root: ET.Element) -> TrackerProject:
 
     points: dict[str, dict[int, tuple[float, float]]] = {}
     tracks = _prop(root, "tracks")
+    stick = None
     for item in (tracks.findall("property") if tracks is not None else []):
         obj = item.find("object")
+        if obj is not None and stick is None and (obj.get("class") or "").endswith(".TapeMeasure"):
+            stick = _stick(obj, unit, calibration.m_per_px)
         if obj is None or not (obj.get("class") or "").endswith(POINT_CLASSES):
             continue
         name = _value(obj, "name", str, f"track{len(points) + 1}")
@@ -307,7 +336,26 @@ def _project(path: Path, root: ET.Element) -> TrackerProject:
                          "and times are frame x delta_t",
                          "set the clip's frame rate in Tracker (Video > Clip Settings) and save the project again")
     fps = 1000.0 / dt_ms if dt_ms else math.nan
-    return TrackerProject(path, video_path, TrackerClip(start, end, step, fps), calibration, points)
+    return TrackerProject(path, video_path, TrackerClip(start, end, step, fps), calibration, points, stick=stick)
+
+
+def _stick(obj: ET.Element, unit_m: float, m_per_px: float) -> ScaleStick | None:
+    """A tape in stick mode whose first step's ends and world length give the axes' scale
+    (to :data:`STICK_AGREES`); None for a measuring tape, or a stick the scale was not set from."""
+    if _value(obj, "stickmode", str, "false") != "true":
+        return None
+    fd = _prop(obj, "framedata")
+    first = _object(fd.find("property")) if fd is not None and fd.find("property") is not None else None
+    ends = [_value(first, k) for k in ("x1", "y1", "x2", "y2")]
+    lengths = _prop(obj, "worldlengths")
+    typed = _value(lengths, "[0]") if lengths is not None else None
+    if None in ends or typed is None or not (typed > 0 and math.isfinite(m_per_px)):
+        return None
+    length_px = math.hypot(ends[2] - ends[0], ends[3] - ends[1])
+    length_m = typed * unit_m
+    if not (length_px > 0 and abs(length_m / length_px / m_per_px - 1) <= STICK_AGREES):
+        return None
+    return ScaleStick(_value(obj, "name", str, "calibration stick"), length_px, length_m)
 
 
 def _finite(path: Path, obj, name: str) -> float:

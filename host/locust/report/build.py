@@ -363,8 +363,9 @@ def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker:
         "both: the marker's first motion of more than 3 mm from where it stood, with the simulated delay "
         "between the first push and that motion; nothing is fitted to make them agree.",
         "Marker travel of a hop: marker x at rest at the end of a cycle minus at its start; apex: highest marker "
-        "point in the cycle above the standing height. Errors are measured minus predicted; ± is one sample "
-        "standard deviation over repeated trials. Every length is in mm.",
+        "point in the cycle above the standing height; take-off speed: the marker's highest speed from the "
+        "cycle's start to its apex (Tracker's central difference), in m/s. Errors are measured minus predicted; "
+        "± is one sample standard deviation over repeated trials. Every length is in mm.",
     ]
     for c in comps:
         r = c.prediction.result

@@ -88,6 +88,9 @@ class HopRow:
         on the robot's feet (it went over, or lay on its back: no jump).
     measured_state, predicted_state : str
         How the hop ended: ``on its feet``, ``goes over`` or ``on its back`` (:mod:`.ending`).
+    measured_takeoff_speed_m_per_s, predicted_takeoff_speed_m_per_s : float
+        The marker's highest speed from the hop's start to its apex [m/s]
+        (:func:`locust.trials.measure.measure_hops`); nan where the track or the simulation has none.
     """
 
     config: str
@@ -99,6 +102,8 @@ class HopRow:
     predicted_apex_m: float
     measured_state: str = ""
     predicted_state: str = ""
+    measured_takeoff_speed_m_per_s: float = math.nan
+    predicted_takeoff_speed_m_per_s: float = math.nan
 
     @property
     def marker_travel_error_m(self) -> float:
@@ -303,7 +308,8 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
             rows.append(HopRow(prediction.config, m.trial.label, h.hop, h.distance_m, p.distance_m if p else nan,
                                h.apex_m if end.came_down(h.hop) else nan,
                                p.apex_m if p and p_state == ON_ITS_FEET else nan,
-                               end.state(h.hop) if math.isfinite(h.rest_height_m) else "", p_state))
+                               end.state(h.hop) if math.isfinite(h.rest_height_m) else "", p_state,
+                               h.takeoff_speed_m_per_s, p.takeoff_speed_m_per_s if p else nan))
     return Comparison(
         config=prediction.config, prediction=prediction, all_trials=list(trials), trials=measured, rows=rows,
         cycles=cycles, period_s=period_s, marker_travel=stat([m.marker_travel_m for m in measured]),

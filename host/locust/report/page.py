@@ -112,6 +112,21 @@ def mm_pm(mean: float, std: float | None) -> str:
     return mm(mean) + (f" ± {std * 1000:.1f}" if std is not None else "")
 
 
+def speed(value_m_per_s: float) -> str:
+    """A speed in m/s to 0.01 m/s (``—`` when not finite).
+
+    Parameters
+    ----------
+    value_m_per_s : float
+        [m/s].
+
+    Returns
+    -------
+    str
+    """
+    return f"{value_m_per_s:.2f}" if math.isfinite(value_m_per_s) else "—"
+
+
 def pct(err: float, ref: float, resolution_m: float = math.nan) -> str:
     """The error in percent of ``ref``; "within 1 px" when it is smaller than the tracking
     resolution (one pixel, in metres), which no percentage of a small jump can beat.
@@ -287,7 +302,8 @@ def outcome_table(spreads: dict, labels: dict[str, str]) -> str:
 
 def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
     """Every measured hop against the predicted one: how it ended, the marker's travel and its
-    apex [mm] (none for a hop that did not end on the robot's feet), with errors.
+    apex [mm] (none for a hop that did not end on the robot's feet), with errors, and its
+    take-off speed [m/s].
 
     Parameters
     ----------
@@ -316,12 +332,17 @@ def hop_table(comps: list[Comparison], labels: dict[str, str]) -> str:
                 td(mm(r.measured_apex_m), c.config, f"hop_measured_apex_mm:{key}"),
                 td(mm(r.predicted_apex_m), c.config, f"hop_predicted_apex_mm:{key}"),
                 td(mm(r.apex_error_m)), td(pct(r.apex_error_m, r.predicted_apex_m, c.resolution_m)),
+                # take-off speed: the marker's fastest from the hop's start to its apex (Tracker's v)
+                td(speed(r.measured_takeoff_speed_m_per_s), c.config, f"hop_measured_takeoff_speed_m_per_s:{key}"),
+                td(speed(r.predicted_takeoff_speed_m_per_s), c.config, f"hop_predicted_takeoff_speed_m_per_s:{key}"),
             ]) + "</tr>")
     if not rows:
         return '<p class="note">No tracks were given: nothing measured to compare hop by hop.</p>'
-    groups = [("", 3), ("ended", 2), ("marker travel", 4), ("apex above standing (a hop that came back down)", 4)]
+    groups = [("", 3), ("ended", 2), ("marker travel", 4), ("apex above standing (a hop that came back down)", 4),
+              ("take-off speed", 2)]
     headers = ["configuration", "trial", "hop", "measured", "predicted", "measured (mm)", "predicted (mm)",
-               "error (mm)", "error", "measured (mm)", "predicted (mm)", "error (mm)", "error"]
+               "error (mm)", "error", "measured (mm)", "predicted (mm)", "error (mm)", "error",
+               "measured (m/s)", "predicted (m/s)"]
     return table(headers, rows, left_cols=2, id_="hops", groups=groups)
 
 

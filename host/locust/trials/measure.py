@@ -15,7 +15,12 @@ Per hop (schedule cycle ``k`` of period ``T``: ``[start + (k-1)T, start + kT)``)
 - apex: highest nose point in the cycle above the standing nose height (median before the
   first push), the definition :mod:`locust.sim.hops` uses;
 - rest height: nose y at rest at the end of the cycle above where it stood (the same median
-  window as the distance): near zero on a robot back on its feet, high on one lying on its back.
+  window as the distance): near zero on a robot back on its feet, high on one lying on its back;
+- take-off speed: the nose's highest speed from the cycle's start to its apex, the speed it
+  leaves the floor with (it gains speed while the legs push and loses it in flight), by
+  Tracker's finite difference (:mod:`locust.derivatives`, what a student reads off Tracker's
+  ``v`` column); none beside a lost frame (the trace holds the frames found only: a step more
+  than half again the usual is a frame lost there).
 """
 
 from __future__ import annotations
@@ -25,11 +30,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..derivatives import velocity
 from ..errors import TrialError
 
 ONSET_M = 0.003          # nose motion that counts as the first push (camera noise is ~0.5 mm)
 REST_WINDOW_S = 0.2      # end of a cycle averaged as the rest position
 MIN_STANDING_SAMPLES = 2   # frames before the first motion: the standing pose
+LOST_STEP = 1.5          # a step this many times the usual one has a lost frame in it
 
 
 @dataclass(frozen=True)
@@ -58,12 +65,15 @@ class MeasuredHop:
         The nose's highest point in that cycle above where it stood [m]; NaN when not covered.
     rest_height_m : float
         The nose at rest at the end of that cycle above where it stood [m]; NaN when not covered.
+    takeoff_speed_m_per_s : float
+        The nose's highest speed from the cycle's start to its apex [m/s]; NaN when not covered.
     """
 
     hop: int
     distance_m: float        # nan when the track does not cover the cycle
     apex_m: float
     rest_height_m: float = math.nan
+    takeoff_speed_m_per_s: float = math.nan
 
 
 def onset_time(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, threshold_m: float = ONSET_M,
@@ -151,6 +161,7 @@ def measure_hops(trace: Aligned, period_s: float, cycles: int) -> list[MeasuredH
     list of MeasuredHop
     """
     t, x, y = trace.t_s, trace.x_m, trace.y_m
+    speed = nose_speed(t, x, y)
     t_end = float(t[-1])
     rest, rest_y = [0.0], [0.0]  # standing, by construction of the aligned trace
     for k in range(1, cycles + 1):
@@ -165,5 +176,33 @@ def measure_hops(trace: Aligned, period_s: float, cycles: int) -> list[MeasuredH
         inside = (t >= a) & (t < b)
         covered = inside.any() and t_end >= b - REST_WINDOW_S / 2
         apex = float(y[inside].max()) if covered else math.nan
-        hops.append(MeasuredHop(hop=k, distance_m=rest[k] - rest[k - 1], apex_m=apex, rest_height_m=rest_y[k]))
+        takeoff = math.nan
+        if covered:
+            rising = np.flatnonzero(inside)[:int(np.argmax(y[inside])) + 1]    # the cycle's start to its apex
+            seen = speed[rising][np.isfinite(speed[rising])]
+            takeoff = float(seen.max()) if seen.size else math.nan
+        hops.append(MeasuredHop(hop=k, distance_m=rest[k] - rest[k - 1], apex_m=apex, rest_height_m=rest_y[k],
+                                takeoff_speed_m_per_s=takeoff))
     return hops
+
+
+def nose_speed(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
+    """The nose's speed at each sample by Tracker's central difference, NaN beside a lost frame.
+
+    Parameters
+    ----------
+    t_s, x_m, y_m : numpy.ndarray
+        A trace of the frames found: time [s], forward and up [m].
+
+    Returns
+    -------
+    numpy.ndarray
+        [m/s]; NaN at the ends and where the step before or after a sample is more than
+        :data:`LOST_STEP` times the usual (a frame lost there, as Tracker leaves it blank).
+    """
+    speed = np.hypot(velocity(t_s, x_m), velocity(t_s, y_m))
+    if len(t_s) > 2:
+        step = np.diff(t_s)
+        gap = step > LOST_STEP * float(np.median(step))
+        speed[np.r_[False, gap] | np.r_[gap, False]] = np.nan
+    return speed
