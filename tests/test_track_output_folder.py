@@ -220,3 +220,39 @@ def test_preview_of_an_image_sequence_needs_no_frame_rate(frames, work):
     assert first_line(res) == f"output folder: {work.resolve()}"
     assert "#e8308c" in res.stdout and "(100 px)" in res.stdout, res.stdout    # the 10x10 patch
     assert os.listdir(work) == ["frames.tracks.preview.png"] and tree(frames) == before
+
+
+def test_out_naming_a_folder_not_there_yet_makes_it(tmp_path, monkeypatch):
+    """`--out newdir/` (or `--out newdir`, no .csv/.txt): the folder, made, the tracks in it;
+    it was a file `newdir.csv` in the current folder."""
+    make_hop_video(tmp_path / "hop.mp4", width=320, height=180, n_frames=20, seed=1)
+    monkeypatch.chdir(tmp_path)
+    for out in ("newdir/", "other"):
+        res = track(tmp_path / "hop.mp4", "--out", out)
+        assert res.exit_code == 0, res.output
+        folder = tmp_path / out.rstrip("/")
+        assert folder.is_dir() and (folder / "hop.tracks.csv").is_file()
+        assert first_line(res) == f"output folder: {folder}"
+        assert not (tmp_path / f"{out.rstrip('/')}.csv").exists()
+
+
+def test_a_track_onto_a_name_another_track_is_writing_is_refused(tmp_path):
+    """Two `locust track --out same` at once: the names are claimed before tracking (the lock
+    the first holds while it tracks and writes, held here by the test), so the second is refused
+    at once and writes nothing (both used to exit 0, one replacing the other)."""
+    from locust.fileio import locked
+
+    video = tmp_path / "hop.mp4"
+    make_hop_video(video, width=320, height=180, n_frames=20, seed=2)
+    out = tmp_path / "same"
+    out.mkdir()
+    with locked(out / "hop.tracks.csv", wait_s=0):
+        res = subprocess.run([sys.executable, "-m", "locust.commands", "track", str(video), "--out", str(out)],
+                             capture_output=True, text=True, timeout=120)
+        assert res.returncode == 2, res.stderr
+        assert f"error: {out / 'hop.tracks.csv'} is being written by another `locust track` now" in res.stderr
+        assert "hint:" in res.stderr and "Traceback" not in res.stderr
+        assert [p.name for p in out.iterdir()] == [".hop.tracks.csv.lock"]     # nothing of its own
+    done = track(video, "--out", out)
+    assert done.exit_code == 0, done.output                                       # once the name is free
+    assert (out / "hop.tracks.csv").is_file() and not (out / ".hop.tracks.csv.lock").exists()

@@ -14,7 +14,7 @@ import click
 import numpy as np
 
 from ..errors import TrackError, WriteError
-from ..fileio import atomic_write_json, refuse_read_only_folder, write_target
+from ..fileio import atomic_write_json, locked, make_folder, refuse_read_only_folder, write_target
 from ..io import trk as trk_io
 from ..io.camera_json import camera_json_beside
 from ..io.importing import ImportOptions, import_tracks, is_project, span_warnings
@@ -362,6 +362,8 @@ def _tracks_path(out: Path | None, source: Path) -> Path:
     if out is not None and not out.is_dir() and out.exists() and not out.is_file():
         raise TrackError(f"--out {out} is a device or pipe, not a folder or a file name",
                          "give a folder, or the path of the tracks file to write")
+    if out is not None and not out.exists() and out.suffix.lower() not in (".csv", ".txt"):
+        out = make_folder(out)     # `--out newdir/` (or `--out newdir`): a folder to make, not a file name
     path = out if out is not None and not out.is_dir() else tracks_csv_in(out or _default_folder(source), source)
     _say_folder(path)
     return path
@@ -406,8 +408,22 @@ def _track(video: Path, named: Path, project, models: list, cal: dict, clip: Cli
         calibration = _calibration(info, clip, cal["scale"], cal["scale_aruco"], cal["aruco_dict"], cal["origin"],
                                    cal["angle"], cal["camera_json"], cal["pixels"])
     _refuse_inputs(paths, [p for p in (video, named, cal["camera_json"], project and project.path) if p], info)
-    _refuse_overwrite(paths, force)
+    try:        # the outputs' names claimed for this run: a second `locust track` onto them now is refused
+        with locked(paths["tracks"], wait_s=0):
+            _refuse_overwrite(paths, force)
+            _track_and_write(video, named, project, models, calibration, info, clip, paths, fmt, overlay_kind,
+                             trk_out)
+    except WriteError as exc:
+        if ".lock beside" not in exc.message:
+            raise
+        raise TrackError(f"{paths['tracks']} is being written by another `locust track` now",
+                         "wait for it to finish (then --force replaces what it wrote), or give this run another "
+                         "--out") from None
 
+
+def _track_and_write(video, named, project, models, calibration, info, clip, paths, fmt, overlay_kind,
+                     trk_out) -> None:
+    """Track ``video`` and write ``paths``: what :func:`_track` runs once the names are its own."""
     n = len(clip.frames())
     with progress(length=n, label=f"tracking {video.name}") as bar:
         result = track_video(info, clip, models, calibration, progress=bar.update)
