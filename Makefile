@@ -27,10 +27,11 @@ demo: install sysdeps
 	$(VENV)/bin/locust demo --out demo-out
 
 # Lint everything from the root (firmware/ too: ruff does not follow the host/locust/firmware link),
-# then the fast tests (the default, well under 15 minutes). pytest exits 5 when it collects nothing.
+# then the fast tests (the default, well under 15 minutes) on every core, each test file on one
+# worker (its module fixtures made once). pytest exits 5 when it collects nothing.
 test: install sysdeps
 	$(VENV)/bin/ruff check .
-	$(PY) -m pytest -q; rc=$$?; [ $$rc -eq 5 ] && { echo "no tests collected"; exit 0; }; exit $$rc
+	$(PY) -m pytest -q -n auto --dist loadfile; rc=$$?; [ $$rc -eq 5 ] && { echo "no tests collected"; exit 0; }; exit $$rc
 	$(PY) -m pytest -q --doctest-modules $(DOCTESTS); rc=$$?; [ $$rc -eq 5 ] && { echo "no doctests collected"; exit 0; }; exit $$rc
 
 # Everything, including the slow system tests.
