@@ -223,17 +223,19 @@ def test_preview_of_an_image_sequence_needs_no_frame_rate(frames, work):
 
 
 def test_out_naming_a_folder_not_there_yet_makes_it(tmp_path, monkeypatch):
-    """`--out newdir/` (or `--out newdir`, no .csv/.txt): the folder, made, the tracks in it;
-    it was a file `newdir.csv` in the current folder."""
+    """`--out newdir/`: the folder, made, the tracks in it (it was a file `newdir.csv` in the
+    current folder); `--out name` without the slash stays the outputs' name."""
     make_hop_video(tmp_path / "hop.mp4", width=320, height=180, n_frames=20, seed=1)
     monkeypatch.chdir(tmp_path)
-    for out in ("newdir/", "other"):
-        res = track(tmp_path / "hop.mp4", "--out", out)
-        assert res.exit_code == 0, res.output
-        folder = tmp_path / out.rstrip("/")
-        assert folder.is_dir() and (folder / "hop.tracks.csv").is_file()
-        assert first_line(res) == f"output folder: {folder}"
-        assert not (tmp_path / f"{out.rstrip('/')}.csv").exists()
+    res = track(tmp_path / "hop.mp4", "--out", "newdir/")
+    assert res.exit_code == 0, res.output
+    folder = tmp_path / "newdir"
+    assert folder.is_dir() and (folder / "hop.tracks.csv").is_file()
+    assert first_line(res) == f"output folder: {folder}"
+    assert not (tmp_path / "newdir.csv").exists()
+    res = track(tmp_path / "hop.mp4", "--out", "named")
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "named.csv").is_file() and not (tmp_path / "named").exists()
 
 
 def test_a_track_onto_a_name_another_track_is_writing_is_refused(tmp_path):

@@ -14,7 +14,7 @@ import click
 import numpy as np
 
 from ..errors import TrackError, WriteError
-from ..fileio import atomic_write_json, locked, make_folder, refuse_read_only_folder, write_target
+from ..fileio import atomic_write_json, locked, refuse_read_only_folder, write_target
 from ..io import trk as trk_io
 from ..io.camera_json import camera_json_beside
 from ..io.importing import ImportOptions, import_tracks, is_project, span_warnings
@@ -362,8 +362,6 @@ def _tracks_path(out: Path | None, source: Path) -> Path:
     if out is not None and not out.is_dir() and out.exists() and not out.is_file():
         raise TrackError(f"--out {out} is a device or pipe, not a folder or a file name",
                          "give a folder, or the path of the tracks file to write")
-    if out is not None and not out.exists() and out.suffix.lower() not in (".csv", ".txt"):
-        out = make_folder(out)     # `--out newdir/` (or `--out newdir`): a folder to make, not a file name
     path = out if out is not None and not out.is_dir() else tracks_csv_in(out or _default_folder(source), source)
     _say_folder(path)
     return path

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import math
+import os
 from pathlib import Path
 
 import click
@@ -27,8 +28,22 @@ def stacked(*options):
     return decorate
 
 
-OUTPUT = [click.option("--out", type=click.Path(path_type=Path),
-                       help="Output file (or folder), its folder named on the first line. Default: <input>.tracks.csv "
+def _out_path(ctx, param, value: str | None) -> Path | None:
+    """``--out``: a name ending in ``/`` is a folder, made if it is not there yet (a ``Path``
+    would drop the slash and name a file ``newdir.csv`` here instead)."""
+    if value is None:
+        return None
+    path = Path(value)
+    if value.endswith(("/", os.sep)) and not path.exists():
+        from ..fileio import make_folder
+
+        make_folder(path)
+    return path
+
+
+OUTPUT = [click.option("--out", type=click.Path(path_type=str), callback=_out_path,
+                       help="Output file, or folder (ending in /: made if missing), its folder named on the first "
+                            "line. Default: <input>.tracks.csv "
                             "(with .json) in the run folder the input sits in (run.json beside it), else in the "
                             "current folder; never beside an input in a folder of its own."),
           click.option("--force", is_flag=True, help="Replace existing output files.")]
