@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import math
 import os
+import threading
+import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -75,8 +77,11 @@ class PoseRenderer:
         model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
         self.data = mujoco.MjData(model)
         check_renderer()
+        _close_orphans()
         try:
             self.renderer = mujoco.Renderer(model, height=height, width=width)
+            _LIVE[id(self)] = (self.renderer, threading.get_ident())
+            weakref.finalize(self, _orphaned, id(self))
         except Exception as exc:
             raise SimError(f"cannot open an offscreen OpenGL context ({type(exc).__name__}: {exc})",
                            "install OSMesa (apt-get install libosmesa6) and run with MUJOCO_GL=osmesa, "
@@ -137,8 +142,36 @@ class PoseRenderer:
     def close(self) -> None:
         """Free the offscreen renderer; closing twice is harmless."""
         if getattr(self, "renderer", None) is not None:
+            _LIVE.pop(id(self), None)
             self.renderer.close()
             self.renderer = None
+
+
+# A renderer's OpenGL context may only be freed on the thread it is current on: MuJoCo's own
+# finalizer frees it wherever the garbage collector happens to run, and an OSMesa context
+# freed from another thread leaves the next one made current on its own thread to crash
+# (SIGSEGV in OSMesaMakeCurrent). So every renderer is held here until it is closed; one whose
+# PoseRenderer was dropped unclosed is closed by the next PoseRenderer made on its thread.
+_LIVE: dict[int, tuple[mujoco.Renderer, int]] = {}
+_ORPHANS: list[tuple[mujoco.Renderer, int]] = []
+_ORPHANS_LOCK = threading.Lock()
+
+
+def _orphaned(key: int) -> None:
+    entry = _LIVE.pop(key, None)
+    if entry is not None:
+        with _ORPHANS_LOCK:
+            _ORPHANS.append(entry)
+
+
+def _close_orphans() -> None:
+    """Close the dropped renderers of this thread (each on the thread its context is current on)."""
+    me = threading.get_ident()
+    with _ORPHANS_LOCK:
+        mine = [e for e in _ORPHANS if e[1] == me]
+        _ORPHANS[:] = [e for e in _ORPHANS if e[1] != me]
+    for renderer, _ in mine:
+        renderer.close()
 
 
 def face_centre_m(model: mujoco.MjModel, data: mujoco.MjData, geom_id: int) -> np.ndarray:
