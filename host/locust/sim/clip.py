@@ -22,8 +22,6 @@ from __future__ import annotations
 
 import math
 import os
-import threading
-import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -77,11 +75,9 @@ class PoseRenderer:
         model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
         self.data = mujoco.MjData(model)
         check_renderer()
-        _close_orphans()
         try:
             self.renderer = mujoco.Renderer(model, height=height, width=width)
-            _LIVE[id(self)] = (self.renderer, threading.get_ident())
-            weakref.finalize(self, _orphaned, id(self))
+            release_context(self.renderer)
         except Exception as exc:
             raise SimError(f"cannot open an offscreen OpenGL context ({type(exc).__name__}: {exc})",
                            "install OSMesa (apt-get install libosmesa6) and run with MUJOCO_GL=osmesa, "
@@ -137,41 +133,50 @@ class PoseRenderer:
         self.renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
         self.renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = int(self.shadows)
         cam = pinhole_from_scene(self.renderer.scene, self.width, self.height)
-        return self.renderer.render(), cam
+        try:
+            return self.renderer.render(), cam
+        finally:
+            release_context(self.renderer)
 
     def close(self) -> None:
         """Free the offscreen renderer; closing twice is harmless."""
         if getattr(self, "renderer", None) is not None:
-            _LIVE.pop(id(self), None)
             self.renderer.close()
             self.renderer = None
 
 
-# A renderer's OpenGL context may only be freed on the thread it is current on: MuJoCo's own
-# finalizer frees it wherever the garbage collector happens to run, and an OSMesa context
-# freed from another thread leaves the next one made current on its own thread to crash
-# (SIGSEGV in OSMesaMakeCurrent). So every renderer is held here until it is closed; one whose
-# PoseRenderer was dropped unclosed is closed by the next PoseRenderer made on its thread.
-_LIVE: dict[int, tuple[mujoco.Renderer, int]] = {}
-_ORPHANS: list[tuple[mujoco.Renderer, int]] = []
-_ORPHANS_LOCK = threading.Lock()
+# An OpenGL context is current per thread, and MuJoCo's Renderer leaves its own current on the
+# thread that made or last used it. A clip is rendered on two threads (the virtual robot's first
+# frames on the caller's, the rest on its plant thread), and a renderer may be closed, or
+# collected, on any thread: a context freed while it is still current on another thread leaves
+# that thread pointing at freed memory, and the next context made current there crashes
+# (SIGSEGV in OSMesaMakeCurrent). So a renderer's context is current only while it renders:
+# released after each frame, it can be used and freed on any thread.
+def release_context(renderer: mujoco.Renderer) -> None:
+    """Leave no OpenGL context current on this thread (after ``renderer`` made its own current).
 
+    Parameters
+    ----------
+    renderer : mujoco.Renderer
+        The renderer whose context was made current (on OSMesa, EGL or GLFW).
+    """
+    gl = getattr(renderer, "_gl_context", None)
+    backend = next((k.__module__ for k in type(gl).__mro__ if k.__module__.startswith("mujoco.")
+                    and k.__module__.split(".")[1] in ("osmesa", "egl", "glfw")), "") if gl else ""
+    if backend == "mujoco.osmesa":
+        from OpenGL import GL, osmesa
 
-def _orphaned(key: int) -> None:
-    entry = _LIVE.pop(key, None)
-    if entry is not None:
-        with _ORPHANS_LOCK:
-            _ORPHANS.append(entry)
+        osmesa.OSMesaMakeCurrent(None, None, GL.GL_FLOAT, 0, 0)
+    elif backend == "mujoco.egl":
+        from mujoco import egl
 
+        if egl.EGL_DISPLAY is not None:
+            egl.EGL.eglMakeCurrent(egl.EGL_DISPLAY, egl.EGL.EGL_NO_SURFACE, egl.EGL.EGL_NO_SURFACE,
+                                   egl.EGL.EGL_NO_CONTEXT)
+    elif backend == "mujoco.glfw":
+        import glfw
 
-def _close_orphans() -> None:
-    """Close the dropped renderers of this thread (each on the thread its context is current on)."""
-    me = threading.get_ident()
-    with _ORPHANS_LOCK:
-        mine = [e for e in _ORPHANS if e[1] == me]
-        _ORPHANS[:] = [e for e in _ORPHANS if e[1] != me]
-    for renderer, _ in mine:
-        renderer.close()
+        glfw.make_context_current(None)
 
 
 def face_centre_m(model: mujoco.MjModel, data: mujoco.MjData, geom_id: int) -> np.ndarray:
