@@ -138,6 +138,10 @@ class OptimizeSummary:
         The run was stopped by Ctrl-C (finished trials kept).
     robots : dict of str to Path or None
         The robot file written for each pick.
+    names : tuple of str
+        The design variables, by dotted name, in the order searched (the rows' columns).
+    objectives : tuple of Objective
+        What is maximised, in order.
     """
 
     study_name: str
@@ -150,6 +154,8 @@ class OptimizeSummary:
     computed: int = 0
     interrupted: bool = False
     robots: dict[str, Path] | None = None     # best-<objective>.toml, knee.toml
+    names: tuple[str, ...] = ()
+    objectives: tuple[Objective, ...] = ()
 
     @property
     def best(self) -> dict[str, Any] | None:
@@ -187,7 +193,8 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
         Trials run at once: ``jobs`` local processes, or a Dask cluster (``dask-local``,
         ``tcp://HOST:PORT``; its workers must reach the storage).
     progress : callable, optional
-        ``progress(n)`` as trials finish (first with those finished before this run).
+        ``progress(n)`` as trials finish: first, as they begin, with those finished before this
+        run (0 for a new study), then 1 a trial.
     objectives : list of Objective
         What is maximised (default: distance_per_hop).
     judge : callable, optional
@@ -232,8 +239,8 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
     judge = judge or DesignJudge(base, cycles, tuple(objectives), draws, quantile)
     spec = StudySpec(storage, folder, study_name, tuple(bounds), integers, tuple(objectives), judge, max_flip,
                      sampler, seed, trials)
-    if progress and trials > left:
-        progress(trials - left)   # finished before this run
+    if progress:
+        progress(trials - left)   # finished before this run: the trials begin
     # a resumed study must not draw its first samples again: each trial's sampler seed moves on
     # with the trials the study held before it
     computed, interrupted = run_trials(spec, [before + k for k in range(left)], scheduler, jobs, progress, where)
@@ -486,4 +493,4 @@ def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max
         plot_front(rows, front, chosen, objectives, max_flip, folder / "pareto.png", title)
         write_study_page(study, objectives, folder / STUDY_PAGE)
     return OptimizeSummary(study.study_name, len(rows), len(done), len(pruned), front, chosen, folder, computed,
-                           interrupted, robots)
+                           interrupted, robots, tuple(names), tuple(objectives))
