@@ -19,9 +19,8 @@ from click.testing import CliRunner
 
 from locust.arucoboard import DEFAULT_BOARD
 from locust.commands import cli
-from locust.commands.measure import _points
 from locust.io.camera_json import read_camera_json
-from locust.measure.stance import find_stickers, fit_points
+from locust.measure.stance import find_stickers, fit_points, given_points
 from locust.params import preset
 from locust.sim.stickers import STICKERS
 
@@ -175,8 +174,8 @@ def test_a_still_never_overwrites(stills):
 
 
 def test_pixels_given_in_trackers_convention_are_half_a_pixel_from_opencvs():
-    assert _points(("knee=10,20",), "tracker", "--point") == {"knee": (9.5, 19.5)}
-    assert _points(("knee=10,20",), "opencv", "--point") == {"knee": (10.0, 20.0)}
+    assert given_points(("knee=10,20",), "tracker", "--point") == {"knee": (9.5, 19.5)}
+    assert given_points(("knee=10,20",), "opencv", "--point") == {"knee": (10.0, 20.0)}
 
 
 def test_an_unknown_sticker_name_is_refused(stills):

@@ -221,3 +221,57 @@ def test_stepped_and_categorical_design_variables(tmp_path):
     assert {float(r["geometry.crank_start_deg"]) for r in rows} <= {-136.0, -118.0, -100.0, -82.0, -64.0}
     assert {float(r["geometry.leg_m"]) for r in rows} <= {0.06, 0.07, 0.08}
     assert len({float(r["geometry.crank_start_deg"]) for r in rows}) >= 3
+
+
+# -- one study job behind the command and the API ------------------------------------------
+HOST = Path(__file__).resolve().parents[1] / "host" / "locust"
+
+
+def called_names(path: Path) -> set[str]:
+    """The names ``path``'s code calls (``f(...)`` and ``module.f(...)``)."""
+    import ast
+
+    calls = [n.func for n in ast.walk(ast.parse(path.read_text())) if isinstance(n, ast.Call)]
+    return {c.id if isinstance(c, ast.Name) else c.attr for c in calls if isinstance(c, (ast.Name, ast.Attribute))}
+
+
+def test_the_command_and_the_api_run_one_study_job(tmp_path):
+    """`locust optimize` and locust.optimize both call sweep.study.optimize_study, and the same
+    study through each (three trials of a stepped push time on a Small that stays on its feet,
+    seed 2) writes the same trials, figures and front, byte for byte."""
+    import locust
+
+    assert "optimize_study" in called_names(HOST / "commands" / "optimize.py")
+    assert "optimize_study" in called_names(HOST / "api" / "optimizing.py")
+    assert "run_optimize" not in called_names(HOST / "commands" / "optimize.py") | \
+        called_names(HOST / "api" / "optimizing.py")
+    res = invoke(["optimize", "--preset", "small", "--set", "geometry.crank_start_deg=-80", "--vary",
+                  "schedule.push_s=0.15:0.4", "--step", "schedule.push_s=0.05", "--trials", "3", "--cycles", "1",
+                  "--seed", "2", "--out", tmp_path / "cli"])
+    assert res.exit_code == 0, res.output
+    robot = locust.robot("small", **{"geometry.crank_start_deg": -80.0})
+    api = locust.optimize(robot, {"schedule.push_s": (0.15, 0.4)}, steps={"schedule.push_s": 0.05}, trials=3,
+                          cycles=1, seed=2, out=tmp_path / "api")
+    for name in ("trials.csv", "pareto.csv"):
+        assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "api" / name).read_bytes(), name
+    trials = read_csv(tmp_path / "cli" / "trials.csv")
+    assert [t["state"] for t in trials] == ["complete"] * 3
+    # every value drawn is a step of the range: 0.15, 0.20, ... 0.40 s
+    assert all(round((float(t["schedule.push_s"]) - 0.15) / 0.05, 9).is_integer() for t in trials)
+    best = max(trials, key=lambda t: float(t["distance_per_hop_m"]))
+    assert api.best["trial"] == int(best["trial"])
+    assert api.best["distance_per_hop_m"] == float(best["distance_per_hop_m"])
+    assert f"best-distance_per_hop: trial {best['trial']} " in res.output
+
+
+def test_the_api_takes_every_option_of_the_command():
+    """Each option of `locust optimize` (its robot aside: locust.robot makes it) is a parameter
+    of locust.optimize, under the option's own name but for three the API has always spelt its way."""
+    import inspect
+
+    import locust
+    from locust.commands.optimize import optimize
+
+    api_name = {"varies": "vary", "objective_names": "objectives", "draws": "robust"}
+    options = {p.name for p in optimize.params} - {"preset", "config", "sets"}
+    assert set(inspect.signature(locust.optimize).parameters) >= {api_name.get(o, o) for o in options}

@@ -139,3 +139,54 @@ def test_a_robot_still_falling_when_the_schedule_starts_is_invalid(settle_s, val
     res = run(preset("seed").with_values({"solver.settle_s": settle_s}), cycles=1)
     assert res.valid is valid, res.reasons
     assert any("not at rest when the schedule started" in r for r in res.reasons) is not valid
+
+
+def test_the_command_and_the_api_run_one_simulation_job():
+    """`locust sim` and locust.simulate both call sim.job.run_simulation, which alone runs the
+    dt/2 check and the stills; a Small with Medium legs through each gives the same figures and
+    the same convergence check, to the last bit."""
+    import ast
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    import locust
+    from locust.commands import cli
+
+    host = Path(__file__).resolve().parents[1] / "host" / "locust"
+    for module in ("commands/sim.py", "api/simulation.py"):
+        tree = ast.parse((host / module).read_text())
+        called = {n.func.id if isinstance(n.func, ast.Name) else getattr(n.func, "attr", "")
+                  for n in ast.walk(tree) if isinstance(n, ast.Call)}
+        assert "run_simulation" in called and not {"check_convergence", "render_stills", "run"} & called, module
+    res = CliRunner().invoke(cli, ["sim", "--preset", "small", "--leg-set", "medium", "--cycles", "1",
+                                   "--check-convergence", "--json"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    api = locust.simulate(locust.robot("small"), cycles=1, leg_set="medium", check_convergence=True)
+    assert doc["robot"] == api.robot == "small (medium legs)"
+    assert doc["valid"] and api.valid
+    for key in ("distance_m", "max_nose_height_m", "nose_load_kg", "timestep_s"):
+        assert doc[key] == getattr(api, key), key
+    assert doc["convergence"] == api.convergence
+    assert api.convergence["half_timestep_s"] == api.timestep_s / 2
+
+
+def test_the_draws_bar_is_drawn_when_the_draws_begin_and_ended_at_the_last():
+    """`locust sim --samples N`'s bar on a terminal: nothing before the draws begin (a refusal
+    prints alone), and its line ended at the last draw, so the video's own bar that follows
+    starts on a line of its own; a step after that draws nothing."""
+    import io
+
+    from locust.commands.options import JobBar
+
+    out = io.StringIO()
+    with JobBar(4, "4 draws", file=out, tty=True, clock=lambda: 0.0) as bar:
+        assert out.getvalue() == ""
+        bar.update(0)
+        assert out.getvalue().endswith("4 draws  [------------------------------]    0 %  0/4  0:00 elapsed")
+        bar.update(4)
+        ended = out.getvalue()
+        assert ended.endswith("4 draws  [##############################]  100 %  4/4  0:00 elapsed\n")
+        bar.update(1)
+    assert out.getvalue() == ended

@@ -6,10 +6,10 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 from ..params import Robot
-from ..sweep.design import Bound, parse_bound
-from ..sweep.objectives import objectives_named
-from ..sweep.optimize import OptimizeSummary, run_optimize
-from .sweeps import varied
+from ..sweep.design import Bound
+from ..sweep.optimize import OptimizeSummary
+from ..sweep.study import OptimizeOptions, optimize_study, parse_steps, study_bounds
+from .sweeps import vary_texts
 
 
 def optimize_bounds(base: Robot, vary: Mapping[str, tuple[float, float] | str] | Sequence[str | Bound]) -> list[Bound]:
@@ -32,14 +32,16 @@ def optimize_bounds(base: Robot, vary: Mapping[str, tuple[float, float] | str] |
     locust.errors.SweepError
         Nothing varied, a name given twice, or a range that cannot be read.
     """
-    return varied(base, vary, parse_bound, Bound, '{"geometry.leg_m": (0.05, 0.09)}')
+    return study_bounds(base, vary_texts(vary), {})
 
 
 def optimize(robot: Robot, vary: Mapping[str, tuple[float, float] | str] | Sequence[str | Bound], trials: int = 50,
              cycles: int = 3, *, out: str | Path, objectives: Sequence[str] = ("distance_per_hop",), robust: int = 0,
              quantile: float = 0.1, max_flip: float | None = None, sampler: str = "tpe",
              storage: str | None = None, study_name: str = "locust", seed: int = 0, jobs: int = 1,
-             progress: Callable[[int], None] | None = None) -> OptimizeSummary:
+             steps: Mapping[str, float] | Sequence[str] | None = None, scheduler: str = "local",
+             repair: bool = False, progress: Callable[[int], None] | None = None,
+             say: Callable[[str], None] | None = None) -> OptimizeSummary:
     """Search design ranges for the hops that go farthest and highest without going over, as
     ``locust optimize`` does (Optuna; a Pareto front with two objectives or more).
 
@@ -52,8 +54,9 @@ def optimize(robot: Robot, vary: Mapping[str, tuple[float, float] | str] | Seque
     robot : Robot
         The base design (:func:`locust.robot`).
     vary : dict or list of str
-        Name -> ``(low, high)`` (or ``"low:high"``): a numeric parameter's dotted name or
-        ``scale`` (metres added to all four links); integer parameters draw whole numbers.
+        Name -> ``(low, high)`` (or ``"low:high"``, or ``"a,b,c"``: those values alone): a
+        numeric parameter's dotted name or ``scale`` (metres added to all four links); integer
+        parameters draw whole numbers. A list holds ``--vary`` texts (``"scale=0:0.02"``).
     trials : int, default 50
         Finished trials the study should hold (a resumed study computes the rest).
     cycles : int, default 3
@@ -80,9 +83,21 @@ def optimize(robot: Robot, vary: Mapping[str, tuple[float, float] | str] | Seque
     seed : int, default 0
         The sampler's seed.
     jobs : int, default 1
-        Trials run at once, each in its own process.
+        Trials run at once, each in its own process (or Dask worker).
+    steps : dict or list of str, optional
+        A range's step by its name (``{"geometry.crank_start_deg": 18}``, or ``--step`` texts
+        ``"NAME=STEP"``): the values low, low + step, ... up to high.
+    scheduler : str, default "local"
+        ``local`` (``jobs`` processes), ``dask-local`` or ``tcp://HOST:PORT`` of a Dask
+        scheduler (its workers must reach ``storage``).
+    repair : bool, default False
+        First cut the torn last line of the study's journal, a full disk's (the file saved as
+        ``study.journal.torn-N`` beside it; every whole trial kept).
     progress : callable, optional
-        Called with 1 as each trial finishes.
+        Called as the trials begin with those finished before (0 for a new study), then with 1
+        as each trial finishes.
+    say : callable, optional
+        Told, as a line of text, what ``repair`` did.
 
     Returns
     -------
@@ -100,7 +115,12 @@ def optimize(robot: Robot, vary: Mapping[str, tuple[float, float] | str] | Seque
     >>> res.trials, res.complete, res.pruned
     (3, 3, 0)
     """
-    bounds = optimize_bounds(robot, vary)
-    return run_optimize(robot, bounds, trials, cycles, Path(out), storage=storage, study_name=study_name,
-                        seed=seed, jobs=jobs, progress=progress, objectives=objectives_named(list(objectives)),
-                        draws=robust, quantile=quantile, max_flip=max_flip, sampler=sampler)
+    if steps is None or isinstance(steps, Mapping):
+        steps = {name: float(step) for name, step in (steps or {}).items()}
+    else:
+        steps = parse_steps(list(steps))
+    options = OptimizeOptions(out=Path(out), vary=tuple(vary_texts(vary)), steps=steps,
+                              objectives=tuple(objectives), robust=robust, quantile=quantile, max_flip=max_flip,
+                              trials=trials, cycles=cycles, storage=storage, study_name=study_name, sampler=sampler,
+                              seed=seed, jobs=jobs, scheduler=scheduler, repair=repair)
+    return optimize_study(robot, options, progress=progress, say=say)

@@ -2,15 +2,19 @@
 
 from __future__ import annotations
 
-import dataclasses
+import os
+from pathlib import Path
 
 from ..params import Robot
-from ..sim import run as _run
+from ..sim.job import SimOptions, run_simulation
 from ..sim.result import SimResult
 
 
 def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: int = 0,
-             keep_states: bool = True, progress=None, sensitivity: bool | None = None) -> SimResult:
+             keep_states: bool = True, progress=None, sensitivity: bool | None = None, *,
+             leg_set: str | None = None, check_convergence: bool = False, video: str | os.PathLike | None = None,
+             camera: str = "track", still: str | os.PathLike | None = None,
+             still_push: str | os.PathLike | None = None, board: str | None = None) -> SimResult:
     """Settle the robot on the floor, run its hop schedule, audit the run and measure the hops.
 
     Parameters
@@ -31,12 +35,31 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
         Keep every step's state for ``trace()`` and ``video()`` (False: the figures only, for
         runs of many cycles).
     progress : callable, optional
-        ``progress(k)`` as each batch of ``k`` draws is done (``samples``).
+        ``progress(0)`` as the draws begin, then ``progress(k)`` as each batch of ``k`` draws
+        is done (``samples``).
     sensitivity : bool, optional
         Which measured values decide the outcome: each uncertain value alone at -/+ 2 sd
         (``result.sensitivity``, :func:`locust.sim.sensitivity.outcome_sensitivity`). True:
         always; False: never; None (default): when the draws of ``samples`` split between
         outcomes.
+    leg_set : {"small", "medium", "large"}, optional
+        Put this leg set on the robot in place of the one it carries (``robot.leg_set``).
+    check_convergence : bool, default False
+        Rerun at half the time step: ``result.convergence``, the relative changes and whether
+        each is within 1 % or 0.1 mm.
+    video : path-like, optional
+        Render the run to this MP4 (offscreen) with its true marker pixels beside it
+        (``<video>.truth.csv``), as ``result.video(video, camera=camera)`` does; noted in
+        ``result.notes``.
+    camera : {"track", "fixed"}, default "track"
+        For ``video``: follow the robot, or hold still.
+    still : path-like, optional
+        Render a side photo (PNG) of the robot settled at the 0 deg command, with the board and
+        the stickers ``locust measure stance`` reads, and their true pixels beside it.
+    still_push : path-like, optional
+        The same of the robot held up at the push command (the same camera).
+    board : str, optional
+        For the stills: the board beside the robot (default ``aruco:4X4_50:5x4:40:10``).
 
     Returns
     -------
@@ -52,6 +75,8 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
         The linkage cannot be assembled.
     locust.errors.ParamsError
         A value out of range for simulating.
+    locust.errors.SimError
+        A video or still path that cannot be written, or a render asked of an invalid run.
 
     Examples
     --------
@@ -62,26 +87,12 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
     >>> r.trace().columns[:3].tolist()
     ['t_s', 'nose_x_m', 'nose_z_m']
     """
-    if samples:
-        from ..sim.samples import check_draws
-
-        check_draws(robot, samples, cycles)   # before the robot's own run
-    result = dataclasses.replace(_run.run(robot, cycles=cycles, keep_states=keep_states), params=robot)
-    if result.valid:
-        from ..sim.statics import standing_load
-
-        load = standing_load(robot)
-        result.nose_load_kg, result.total_mass_kg = load.nose_load_kg, load.total_mass_kg
-    if samples and result.valid:
-        from ..sim.samples import sample
-
-        result.spread = sample(robot, samples, cycles=cycles, seed=seed, progress=progress)
-    mixed = result.spread is not None and max(o.share for o in result.spread.outcomes.values()) < 1.0
-    if result.valid and (sensitivity or (sensitivity is None and mixed)):
-        from ..sim.sensitivity import outcome_sensitivity
-
-        result.sensitivity = outcome_sensitivity(robot, cycles=cycles)
-    return result
+    options = SimOptions(cycles=cycles, leg_set=leg_set, samples=samples, seed=seed, sensitivity=sensitivity,
+                         keep_states=keep_states, check_convergence=check_convergence,
+                         video=None if video is None else Path(video), camera=camera,
+                         still=None if still is None else Path(still),
+                         still_push=None if still_push is None else Path(still_push), board=board)
+    return run_simulation(robot, options, progress=progress)
 
 
 __all__ = ["SimResult", "simulate"]

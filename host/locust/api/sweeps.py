@@ -114,16 +114,33 @@ def varied(base: Robot, vary: Mapping[str, tuple | str] | Sequence, parse: Calla
     locust.errors.SweepError
         Nothing varied, a name given twice, or a value ``parse`` refuses.
     """
-    if isinstance(vary, Mapping):
-        items = [v if isinstance(v, str) else ":".join(repr(x) for x in v) for v in vary.values()]
-        vary = [f"{name}={spec}" for name, spec in zip(vary, items)]
-    parsed = [v if isinstance(v, kind) else parse(v, base) for v in vary]
+    parsed = [v if isinstance(v, kind) else parse(v, base) for v in vary_texts(vary)]
     names = [p.name for p in parsed]
     if not names:
         raise SweepError("nothing to vary", f"e.g. vary={example}")
     if len(set(names)) != len(names):
         raise SweepError(f"--vary names a parameter twice: {', '.join(names)}", "give each parameter one --vary")
     return parsed
+
+
+def vary_texts(vary: Mapping[str, tuple | str] | Sequence) -> list:
+    """``vary`` as the command line's ``--vary NAME=...`` texts: a dict's items (name -> a tuple
+    of numbers, written exactly, or their text) made ``NAME=a:b[:n]``; a sequence as it is.
+
+    Parameters
+    ----------
+    vary : mapping or sequence
+        Name -> tuple of numbers or text, or texts (and parsed objects) already.
+
+    Returns
+    -------
+    list
+        The texts (and any parsed objects), in the order given.
+    """
+    if not isinstance(vary, Mapping):
+        return list(vary)
+    items = [v if isinstance(v, str) else ":".join(repr(x) for x in v) for v in vary.values()]
+    return [f"{name}={spec}" for name, spec in zip(vary, items)]
 
 
 def sweep_axes(base: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis]) -> list[Axis]:

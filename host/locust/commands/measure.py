@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-import datetime
-import re
 from pathlib import Path
 
 import click
@@ -23,25 +21,6 @@ TERMS_SHOWN = 3
 def measure():
     """Measure the robot as built: its stance from photos (docs/measure.md), its nose load on
     a kitchen scale (docs/hardware.md)."""
-
-
-def _points(items: tuple[str, ...], convention: str, option: str) -> dict[str, tuple[float, float]]:
-    """``NAME=X,Y`` -> OpenCV pixels (Tracker's are half a pixel further right and down)."""
-    from ..sim.stickers import STICKERS
-
-    shift = PIXEL_CONVENTIONS[convention]
-    out = {}
-    for item in items:
-        m = re.fullmatch(r"\s*(\w+)\s*=\s*([-+]?[\d.]+)\s*,\s*([-+]?[\d.]+)\s*", item)
-        if not m or m.group(1) not in STICKERS:
-            raise MeasureError(f"{option} {item!r} is not NAME=X,Y with NAME one of {', '.join(STICKERS)}",
-                               f"e.g. {option} knee=412.5,633")
-        try:
-            out[m.group(1)] = (float(m.group(2)) + shift, float(m.group(3)) + shift)
-        except ValueError:
-            raise MeasureError(f"{option} {item!r}: X and Y must be numbers of pixels",
-                               f"e.g. {option} knee=412.5,633") from None
-    return out
 
 
 @measure.command()
@@ -82,8 +61,7 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
     from ..arucoboard import DEFAULT_BOARD, parse_board
     from ..fileio import check_distinct
     from ..io.robot_toml import resolve_robot, save_robot
-    from ..measure.stance import fit_stance, model_servo_give, read_photo
-    from ..params import Provenance
+    from ..measure.stance import fit_stance, given_points, model_servo_give, read_photo, with_stance
 
     robot = resolve_robot(preset, config, sets)
     say_written_from(preset, config, write)
@@ -94,20 +72,13 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
         check_distinct({"--write": write}, inputs=[p for p in (rest, push) if p is not None])
     if push_points and push is None:
         raise MeasureError("--push-point without a PUSH photo", "give the PUSH photo after REST")
-    photos = [read_photo(rest, spec, _points(points, pixels, "--point"))]
+    photos = [read_photo(rest, spec, given_points(points, pixels, "--point"))]
     if push is not None:
-        photos.append(read_photo(push, spec, _points(push_points, pixels, "--push-point")))
+        photos.append(read_photo(push, spec, given_points(push_points, pixels, "--push-point")))
     result = fit_stance(robot, photos, model_servo_give(robot), draws=draws, seed=seed)
 
     if write is not None:
-        today = datetime.date.today().isoformat()
-        for key, est in result.values().items():
-            lo, hi = est.ci95
-            robot = robot.with_values({key: est.value}, Provenance(
-                source=f"measured:{rest.name}", uncertainty=est.std, date=today,
-                note=f"95% interval [{lo:.5g}, {hi:.5g}], parametric bootstrap of the pixel noise and the board's "
-                     f"pose ({result.draws} draws); locust measure stance"))
-        save_robot(robot, write)
+        save_robot(with_stance(robot, result, rest), write)
     if as_json:
         out = result.to_json()
         out["wrote"] = None if write is None else str(write)

@@ -7,23 +7,8 @@ from pathlib import Path
 
 import click
 
-from ..errors import SweepError
 from ..io.robot_toml import resolve_robot
-from ..progress import progress
-from .options import robot_options
-
-
-def _steps(items: tuple[str, ...]) -> dict[str, float]:
-    out = {}
-    for item in items:
-        name, sep, text = item.partition("=")
-        try:
-            out[name.strip()] = float(text)
-        except ValueError:
-            raise SweepError(f"--step {item!r} is not NAME=STEP", "e.g. --step geometry.crank_start_deg=18") from None
-        if not sep:
-            raise SweepError(f"--step {item!r} is not NAME=STEP", "e.g. --step geometry.crank_start_deg=18")
-    return out
+from .options import JobBar, robot_options
 
 
 @click.command()
@@ -82,38 +67,27 @@ def optimize(preset, config, sets, varies, steps, objective_names, draws, quanti
       locust optimize --vary geometry.crank_start_deg=-126:-54 --step geometry.crank_start_deg=18 \\
           --objective nose_rise_per_hop --trials 20 --out horn
     """
-    from ..sweep.design import parse_bound
-    from ..sweep.objectives import objectives_named
-    from ..sweep.optimize import run_optimize
+    from ..sweep.study import OptimizeOptions, optimize_study, parse_steps
 
-    base = resolve_robot(preset, config, sets)
-    step_of = _steps(steps)
-    bounds = [parse_bound(v, base, step_of.get(v.partition("=")[0].strip())) for v in varies]
-    if len({b.name for b in bounds}) != len(bounds):
-        raise SweepError("--vary names a parameter twice", "give each parameter one --vary")
-    unknown = sorted(set(step_of) - {b.name for b in bounds})
-    if unknown:
-        raise SweepError(f"--step {unknown[0]}: no --vary range of that name", "give --vary NAME=LOW:HIGH with it")
-    objectives = objectives_named(list(objective_names))
-    if repair:
-        _repair(storage, out)
-    with progress(length=trials, label="optimize", show_pos=True, show_eta=True) as bar:
-        summary = run_optimize(base, bounds, trials, cycles, out, storage=storage, study_name=study_name,
-                               seed=seed, jobs=jobs, progress=bar.update, objectives=objectives, draws=draws or 0,
-                               quantile=quantile, max_flip=max_flip, sampler=sampler, scheduler=scheduler)
-    _report(summary, bounds, objectives, out)
+    robot = resolve_robot(preset, config, sets)
+    options = OptimizeOptions(out=out, vary=varies, steps=parse_steps(steps), objectives=objective_names,
+                              robust=draws or 0, quantile=quantile, max_flip=max_flip, trials=trials, cycles=cycles,
+                              storage=storage, study_name=study_name, sampler=sampler, seed=seed, jobs=jobs,
+                              scheduler=scheduler, repair=repair)
+    with JobBar(trials, "optimize", show_pos=True, show_eta=True) as bar:
+        summary = optimize_study(robot, options, progress=bar.update, say=bar.say)
+    _report(summary, out)
 
 
-def _report(summary, bounds, objectives, out: Path) -> None:
+def _report(summary, out: Path) -> None:
     from ..sweep.pareto import describe
 
     click.echo(f"study {summary.study_name!r}: {summary.trials} trials ({summary.computed} computed now), "
                f"{summary.complete} valid, {summary.pruned} pruned as invalid; {len(summary.front)} on the front")
     if not summary.picks:
         click.echo("no valid design within the flip limit yet")
-    names = [b.name for b in bounds]
     for pick, row in summary.picks.items():
-        click.echo(f"{pick}: " + describe(row, names, objectives))
+        click.echo(f"{pick}: " + describe(row, list(summary.names), list(summary.objectives)))
         click.echo(f"  as a robot file: {summary.robots[pick]}")
     click.echo(f"results: {out / 'pareto.csv'}, {out / 'pareto.png'}, {out / 'trials.csv'}, {out / 'optimize.json'}")
     if summary.complete:
@@ -123,17 +97,3 @@ def _report(summary, bounds, objectives, out: Path) -> None:
         click.echo(f"interrupted: {kept} finished trial{'s' * (kept != 1)} kept in the study and the files above "
                    "(a trial under way is not); rerun the same command to continue", err=True)
         sys.exit(130)
-
-
-def _repair(storage: str | None, out: Path) -> None:
-    """--repair: cut the torn last line of the study's journal file (saved beside it first)."""
-    from ..sweep.journal import repair
-    from ..sweep.storage import RDB_PREFIXES
-
-    if storage is not None and storage.startswith(RDB_PREFIXES):
-        raise SweepError(f"--repair mends a journal file; --storage {storage} is a database",
-                         "leave --repair off (a database is not torn by a full disk)")
-    journal = Path(storage.removeprefix("journal:")) if storage else out / "study.journal"
-    if not journal.is_file():
-        raise SweepError(f"--repair: there is no journal {journal}", "give the --out (or --storage) of the study")
-    click.echo(repair(journal).line(), err=True)

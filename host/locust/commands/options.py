@@ -8,6 +8,7 @@
   the robot as built).
 - ``import_options``: ``--units``, ``--rename``, ``--mirror`` for foreign tracks.
 - ``time_options``: ``--time-scale``, ``--clip-fps`` for slow-motion recordings.
+- ``JobBar``: a job's progress bar, fed by the job's ``progress`` and ``say`` callbacks.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from .. import params as P
 from ..calibrate.recordings import TimeOptions
 from ..io.importing import ImportOptions
 from ..io.robot_toml import ROBOT_FILE, default_robot
+from ..progress import Progress, progress
 
 
 class FiniteFloat(click.ParamType):
@@ -130,3 +132,66 @@ def time_options(func):
                            help="Slow motion: real time = the file's time * S [-], e.g. 0.125 for a 240 "
                                 "frames/s clip exported at 30 [default: 1, times as they are].")(wrapper)
     return wrapper
+
+
+class JobBar:
+    """A job's progress bar on stderr (:func:`locust.progress.progress`), fed by the job's callbacks.
+
+    The bar is drawn from the job's first ``update`` (a job reports ``update(0)`` as its long
+    part begins), so what the job refuses before it starts is printed alone, and it is closed at
+    its last step, so a bar the job draws next (a video's rendering) has a line of its own.
+    ``say`` prints a line of the job's on stderr, on a line of its own beside the bar.
+
+    Parameters
+    ----------
+    length : int
+        The steps.
+    label : str
+        Shown before the bar.
+    **options
+        :func:`locust.progress.progress`'s options.
+    """
+
+    def __init__(self, length: int, label: str, **options):
+        self.length, self.label, self.options = length, label, options
+        self.bar: Progress | None = None
+        self.done = False
+
+    def __enter__(self) -> JobBar:
+        return self
+
+    def __exit__(self, *exc) -> bool:
+        self.close()
+        return False
+
+    def update(self, n_steps: int = 1) -> None:
+        """Count ``n_steps`` more steps done (0: the work begins), drawing the bar first.
+
+        Parameters
+        ----------
+        n_steps : int
+        """
+        if self.done:
+            return
+        if self.bar is None:
+            self.bar = progress(length=self.length, label=self.label, **self.options).__enter__()
+        self.bar.update(n_steps)
+        if self.bar.pos >= self.length:
+            self.close()
+
+    def say(self, line: str) -> None:
+        """Print ``line`` on stderr, clearing the bar's line first on a terminal (the next step draws it again).
+
+        Parameters
+        ----------
+        line : str
+        """
+        if self.bar is not None and not self.done and self.bar.tty:
+            self.bar.file.write("\r\x1b[K")
+        click.echo(line, err=True)
+
+    def close(self) -> None:
+        """End the bar (its last state and a new line, on a terminal), if it was drawn."""
+        if self.bar is not None and not self.done:
+            self.bar.__exit__(None, None, None)
+        self.done = True

@@ -2,20 +2,17 @@
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 from contextlib import nullcontext
 from pathlib import Path
 
 import click
 
-from ..errors import GeometryError, SimError
 from ..fileio import json_text
 from ..io.robot_toml import resolve_robot
-from ..params import LEG_SETS, check_robot, leg_set
-from ..progress import progress
+from ..params import LEG_SETS
 from ..tables import nose_load_line, sensitivity_lines, sim_lines, spread_lines
-from .options import robot_options
+from .options import JobBar, robot_options
 
 
 @click.command()
@@ -70,57 +67,14 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
       locust sim --config calibration/robot.toml --leg-set large   # another leg set on it
       locust sim --preset small --still rest.png --still-push push.png   # for locust measure stance
     """
-    from ..api.simulation import simulate
-    from ..sim.run import check_convergence as converge
-    from ..sim.run import invalid_result
+    from ..sim.job import SimOptions, run_simulation
 
     robot = resolve_robot(preset, config, sets)
-    if leg_set_name is not None:
-        if leg_set_name != robot.leg_set:
-            robot = leg_set(robot, leg_set_name, source=f"leg-set:{leg_set_name}").renamed(
-                f"{robot.name} ({leg_set_name} legs)")
-        robot = check_robot(robot)
-    if video is not None:
-        from ..sim.clip import check_video_path
-
-        check_video_path(video)  # fail before simulating, not after
-    if still is not None or still_push is not None:
-        from ..arucoboard import DEFAULT_BOARD, parse_board
-        from ..sim.still import check_still_path
-
-        for path in (still, still_push):
-            if path is not None:
-                check_still_path(path)
-        board = parse_board(board or DEFAULT_BOARD)
-    try:
-        with progress(length=samples, label=f"{samples} draws") if samples else nullcontext() as bar:
-            result = simulate(robot, cycles=cycles, samples=samples or 0, seed=seed,
-                              keep_states=video is not None,  # the video reuses the rollout
-                              progress=bar.update if bar else None,
-                              sensitivity=sensitivity)
-    except GeometryError as exc:
-        if not as_json:
-            raise
-        bad = invalid_result(robot, exc.message + (f" ({exc.hint})" if exc.hint else ""), cycles)
-        result = dataclasses.replace(bad, params=robot)
-    if check_convergence and result.valid:
-        result.convergence = converge(robot, result, cycles=cycles)
-    if video is not None:
-        if not result.valid:
-            raise SimError("not rendering an invalid simulation", "fix the reasons listed above first")
-        info = result.video(video, camera=camera)
-        result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
-
-    if still is not None or still_push is not None:
-        from ..sim.still import render_stills
-
-        if not result.valid:
-            raise SimError("not rendering stills of an invalid robot", "fix the reasons listed above first")
-
-        for info in render_stills(robot, still, still_push, board=board):
-            result.notes.append(f"still: {info.path} ({info.pose.kind}, crank {info.pose.crank_deg:.2f} deg from the "
-                                f"ground link); truth: {info.truth_path}")
-    spread, sens = getattr(result, "spread", None), getattr(result, "sensitivity", None)
+    options = SimOptions(cycles=cycles, leg_set=leg_set_name, samples=samples or 0, seed=seed, sensitivity=sensitivity,
+                         keep_states=False, check_convergence=check_convergence, video=video, camera=camera,
+                         still=still, still_push=still_push, board=board, invalid_linkage_result=as_json)
+    with JobBar(samples, f"{samples} draws") if samples else nullcontext() as bar:
+        result = run_simulation(robot, options, progress=bar.update if bar else None)
     if as_json:
         click.echo(json_text(result.to_json()), nl=False)
         return
@@ -128,8 +82,8 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
         click.echo(line)
     if result.valid:
         click.echo(nose_load_line(result.nose_load_kg, result.total_mass_kg))
+    spread, sens = getattr(result, "spread", None), getattr(result, "sensitivity", None)
     for line in (spread_lines(spread) if spread is not None else []) + (sensitivity_lines(sens) if sens else []):
         click.echo(line)
     if not result.valid:
         sys.exit(1)
-

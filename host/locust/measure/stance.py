@@ -23,7 +23,10 @@ are the 95 % interval.
 
 from __future__ import annotations
 
+import datetime
 import math
+import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,7 +38,8 @@ from ..arucoboard import BoardSpec
 from ..calibrate.fitstats import Estimate
 from ..errors import GeometryError, MeasureError
 from ..fileio import opencv_path
-from ..params import Robot
+from ..io.trk import PIXEL_CONVENTIONS
+from ..params import Provenance, Robot
 from ..sim.stickers import STICKERS, plate_points, to_view
 
 OBLIQUE_LIMIT = 0.05          # the board's scale may differ this much between opposite edges
@@ -494,5 +498,72 @@ def fit_stance(robot: Robot, photos: list[Photo], servo_give_deg, draws: int = B
         residual_mm=residual, sticker_sd_px=sticker_sd, corner_sd_px=corner_sd, draws=draws, mirrored=mirrored)
 
 
+def given_points(items: Sequence[str], convention: str, option: str) -> dict[str, tuple[float, float]]:
+    """Stickers' pixels given as ``NAME=X,Y`` (``--point``), in OpenCV's convention (Tracker's
+    pixels are half a pixel further right and down).
+
+    Parameters
+    ----------
+    items : sequence of str
+        The ``NAME=X,Y`` texts.
+    convention : str
+        A key of :data:`locust.io.trk.PIXEL_CONVENTIONS`: ``tracker`` or ``opencv``.
+    option : str
+        The option they were given with, for messages.
+
+    Returns
+    -------
+    dict of str to (float, float)
+        Each sticker's pixel [px], OpenCV's convention.
+
+    Raises
+    ------
+    MeasureError
+        A text not of the form, or a name that is not a sticker's.
+    """
+    shift = PIXEL_CONVENTIONS[convention]
+    out = {}
+    for item in items:
+        m = re.fullmatch(r"\s*(\w+)\s*=\s*([-+]?[\d.]+)\s*,\s*([-+]?[\d.]+)\s*", item)
+        if not m or m.group(1) not in STICKERS:
+            raise MeasureError(f"{option} {item!r} is not NAME=X,Y with NAME one of {', '.join(STICKERS)}",
+                               f"e.g. {option} knee=412.5,633")
+        try:
+            out[m.group(1)] = (float(m.group(2)) + shift, float(m.group(3)) + shift)
+        except ValueError:
+            raise MeasureError(f"{option} {item!r}: X and Y must be numbers of pixels",
+                               f"e.g. {option} knee=412.5,633") from None
+    return out
+
+
+def with_stance(robot: Robot, result: StanceResult, rest: Path) -> Robot:
+    """``robot`` with the values the photos determine in place, each with its interval and
+    where it came from (the rest photo, today).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot measured.
+    result : StanceResult
+        The fit.
+    rest : Path
+        The rest photo.
+
+    Returns
+    -------
+    Robot
+        The robot as measured.
+    """
+    today = datetime.date.today().isoformat()
+    for key, est in result.values().items():
+        lo, hi = est.ci95
+        robot = robot.with_values({key: est.value}, Provenance(
+            source=f"measured:{rest.name}", uncertainty=est.std, date=today,
+            note=f"95% interval [{lo:.5g}, {hi:.5g}], parametric bootstrap of the pixel noise and the board's "
+                 f"pose ({result.draws} draws); locust measure stance"))
+    return robot
+
+
 __all__ = ["BOOTSTRAP_DRAWS", "OBLIQUE_LIMIT", "Photo", "REACH_LIMIT_M", "STANCE_KEYS", "StanceResult",
-           "board_corners", "find_stickers", "fit_points", "fit_stance", "model_servo_give", "read_photo", "to_plane"]
+           "board_corners", "find_stickers", "fit_points", "fit_stance", "given_points", "model_servo_give",
+           "read_photo", "to_plane", "with_stance"]

@@ -6,7 +6,8 @@ film.
 it with ``mujoco.rollout`` (:mod:`.refine`: a coarse step with each floor-contact change taken
 again at a fine one, for the benchmarks); :mod:`.audit` invalidates a run that breaks its own physics; :mod:`.hops`
 and :mod:`.outcome` measure each hop and name the run's regime; :mod:`.run` does all of that for one
-robot and returns :mod:`.result`'s :class:`~.result.SimResult`; :mod:`.samples` and :mod:`.sensitivity`
+robot and returns :mod:`.result`'s :class:`~.result.SimResult` (:mod:`.job`: ``locust sim``'s whole run,
+which :func:`locust.simulate` shares); :mod:`.samples` and :mod:`.sensitivity`
 simulate draws and one-at-a-time moves of the uncertain values; :mod:`.statics` finds the
 standing robot's load on its nose; :mod:`.kinematics` poses the markers at kept states;
 :mod:`.camera`, :mod:`.clip`, :mod:`.still` and :mod:`.stickers` render videos and stills with their

@@ -122,21 +122,6 @@ class PinholeCamera:
         return np.column_stack([self.fx_px * pc[:, 0] / pc[:, 2] + self.cx_px,
                                 self.fy_px * pc[:, 1] / pc[:, 2] + self.cy_px])
 
-    def m_per_px_at_depth(self, depth_m: float) -> float:
-        """The size of one pixel on a plane facing the camera.
-
-        Parameters
-        ----------
-        depth_m : float
-            The plane's distance along the optical axis [m].
-
-        Returns
-        -------
-        float
-            Metres per pixel (horizontally) at that depth [m/px].
-        """
-        return depth_m / self.fx_px
-
     def intrinsics(self) -> dict:
         """The intrinsics as a JSON object.
 

@@ -14,6 +14,10 @@ processes may share it), or in any database Optuna's RDB storage takes (``sqlite
 draws, quantile, flip limit) as its user attribute ``locust``: a rerun with other settings is
 refused. ``trials`` is the number of finished trials the study should hold: a rerun computes
 only those missing, so a study killed part way resumes where it stopped.
+
+:func:`run_optimize` checks the request, opens the study, maps its trials (:mod:`.trial`, one
+a task) over local processes or a Dask cluster and writes what the study holds
+(:func:`summarise`).
 """
 
 from __future__ import annotations
@@ -36,11 +40,10 @@ from .journal import full_disk
 from .objectives import DEFAULT, OBJECTIVES, OUTCOMES, Judgement, Objective
 from .pareto import picks, plot_front
 from .storage import SETTINGS_ATTR, check_folder, check_journal_file, check_storage, open_storage
+from .trial import StudySpec, TrialOf, finished_trials
 from .views import STUDY_PAGE, write_study_page
 
 SAMPLERS = ("tpe", "nsga2")
-# states of a trial that is over: the study holds its result (or its reason)
-FINISHED = ("COMPLETE", "PRUNED")
 
 
 def settings(base: Robot, bounds: list[Bound], cycles: int, objectives: list[Objective] | None = None,
@@ -111,159 +114,6 @@ def check_settings(study, wanted: dict[str, Any], where: str) -> None:
                          "differ); its trials cannot be ranked against these", hint)
 
 
-@dataclass(frozen=True)
-class StudySpec:
-    """Everything a process needs to run one trial of the study (picklable).
-
-    Attributes
-    ----------
-    storage : str or None
-        The ``--storage`` URL or path; None for ``study.journal`` in ``folder``.
-    folder : Path
-        The optimisation's folder.
-    study_name : str
-        The study's name in the storage.
-    bounds : tuple of Bound
-        The design variables and their ranges.
-    integers : frozenset of str
-        The variables that are whole numbers.
-    objectives : tuple of Objective
-        What is maximised.
-    judge : callable
-        ``judge(values) -> Judgement``.
-    max_flip : float or None
-        The largest share of draws that may go over.
-    sampler : str
-        ``tpe`` or ``nsga2``.
-    seed : int
-        The sampler's base seed (each trial adds its index).
-    trials : int
-        Finished trials the study should hold.
-    """
-
-    storage: str | None
-    folder: Path
-    study_name: str
-    bounds: tuple[Bound, ...]
-    integers: frozenset[str]
-    objectives: tuple[Objective, ...]
-    judge: Callable[[dict[str, Any]], Judgement]
-    max_flip: float | None
-    sampler: str
-    seed: int
-    trials: int
-
-
-def make_sampler(name: str, seed: int):
-    """The Optuna sampler ``name``: NSGA-II (population 12), or multivariate TPE with 8 random
-    start-up trials and the constant liar (trials under way elsewhere are not proposed again).
-
-    Parameters
-    ----------
-    name : str
-        ``tpe`` or ``nsga2``.
-    seed : int
-        The sampler's seed.
-
-    Returns
-    -------
-    optuna.samplers.BaseSampler
-        The sampler.
-    """
-    import optuna
-
-    if name == "nsga2":
-        return optuna.samplers.NSGAIISampler(seed=seed, population_size=12)
-    # constant_liar: trials under way in other processes are not proposed again
-    return optuna.samplers.TPESampler(seed=seed, n_startup_trials=8, multivariate=True, constant_liar=True)
-
-
-def finished_trials(study) -> list:
-    """The study's trials that are over (complete or pruned).
-
-    Parameters
-    ----------
-    study : optuna.Study
-        The study.
-
-    Returns
-    -------
-    list of optuna.trial.FrozenTrial
-        Those trials.
-    """
-    return [t for t in study.get_trials(deepcopy=False) if t.state.name in FINISHED]
-
-
-def run_trial(spec: StudySpec, index: int) -> int:
-    """Run one trial of the study (in this process or a worker).
-
-    Parameters
-    ----------
-    spec : StudySpec
-        The study.
-    index : int
-        The trial's index in this run; the sampler's seed is ``spec.seed + index``.
-
-    Returns
-    -------
-    int
-        The trial's number, or -1 when the study already holds ``spec.trials`` finished trials.
-    """
-    import optuna
-
-    optuna.logging.set_verbosity(optuna.logging.ERROR)
-    storage = open_storage(spec.storage, spec.folder)
-    sampler = make_sampler(spec.sampler, spec.seed + index)
-    study = optuna.load_study(study_name=spec.study_name, storage=storage, sampler=sampler)
-    if len(finished_trials(study)) >= spec.trials:
-        return -1
-    numbers = []
-
-    def objective(trial: optuna.Trial) -> list[float]:
-        numbers.append(trial.number)
-        values = {b.name: suggest(trial, b, spec.integers) for b in spec.bounds}
-        judged = spec.judge(values)
-        trial.set_user_attr("draws", judged.draws)
-        trial.set_user_attr("draws_valid", judged.draws_valid)
-        if not judged.valid:
-            trial.set_user_attr("reason", judged.reason)
-            raise optuna.TrialPruned(judged.reason)
-        trial.set_user_attr("means", judged.means)
-        trial.set_user_attr("outcome_shares", judged.outcome_shares)
-        trial.set_user_attr("flip_share", judged.flip_share)
-        if spec.max_flip is not None:
-            trial.set_constraint("flip_share", judged.flip_share - spec.max_flip)
-        return [judged.figures[o.column] for o in spec.objectives]
-
-    study.optimize(objective, n_trials=1, catch=())
-    return numbers[0] if numbers else -1
-
-
-def suggest(trial, b: Bound, integers: frozenset[str]) -> float | int:
-    """The trial's value for one design variable: a categorical, a whole number, or a float
-    (stepped when the bound has a step).
-
-    Parameters
-    ----------
-    trial : optuna.Trial
-        The trial.
-    b : Bound
-        The variable.
-    integers : frozenset of str
-        The variables that are whole numbers.
-
-    Returns
-    -------
-    float or int
-        The suggested value, in the parameter's unit.
-    """
-    if b.choices is not None:
-        return trial.suggest_categorical(b.name, list(b.choices))
-    if b.name in integers:
-        return trial.suggest_int(b.name, math.ceil(b.low), math.floor(b.high))
-    return trial.suggest_float(b.name, b.low, b.high, step=b.step)
-
-
 @dataclass
 class OptimizeSummary:
     """What :func:`run_optimize` left in its folder.
@@ -288,6 +138,10 @@ class OptimizeSummary:
         The run was stopped by Ctrl-C (finished trials kept).
     robots : dict of str to Path or None
         The robot file written for each pick.
+    names : tuple of str
+        The design variables, by dotted name, in the order searched (the rows' columns).
+    objectives : tuple of Objective
+        What is maximised, in order.
     """
 
     study_name: str
@@ -300,6 +154,8 @@ class OptimizeSummary:
     computed: int = 0
     interrupted: bool = False
     robots: dict[str, Path] | None = None     # best-<objective>.toml, knee.toml
+    names: tuple[str, ...] = ()
+    objectives: tuple[Objective, ...] = ()
 
     @property
     def best(self) -> dict[str, Any] | None:
@@ -337,7 +193,8 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
         Trials run at once: ``jobs`` local processes, or a Dask cluster (``dask-local``,
         ``tcp://HOST:PORT``; its workers must reach the storage).
     progress : callable, optional
-        ``progress(n)`` as trials finish (first with those finished before this run).
+        ``progress(n)`` as trials finish: first, as they begin, with those finished before this
+        run (0 for a new study), then 1 a trial.
     objectives : list of Objective
         What is maximised (default: distance_per_hop).
     judge : callable, optional
@@ -367,11 +224,61 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
     """
     import optuna
 
-    from .execute import check_scheduler, mapper, plan_jobs, probe_dask_scheduler
     from .robust import DesignJudge
 
     optuna.logging.set_verbosity(optuna.logging.ERROR)
     objectives = objectives or [OBJECTIVES[DEFAULT]]
+    integers = check_request(base, bounds, folder, storage, sampler, scheduler)
+    make_folder(folder)
+    storage_obj = open_storage(storage, folder)
+    where = storage or str(folder / "study.journal")
+    study = open_study(storage_obj, study_name, settings(base, bounds, cycles, objectives, draws, quantile, max_flip,
+                                                         sampler), where, objectives)
+    before = len(study.trials)
+    left = max(0, trials - len(finished_trials(study)))
+    judge = judge or DesignJudge(base, cycles, tuple(objectives), draws, quantile)
+    spec = StudySpec(storage, folder, study_name, tuple(bounds), integers, tuple(objectives), judge, max_flip,
+                     sampler, seed, trials)
+    if progress:
+        progress(trials - left)   # finished before this run: the trials begin
+    # a resumed study must not draw its first samples again: each trial's sampler seed moves on
+    # with the trials the study held before it
+    computed, interrupted = run_trials(spec, [before + k for k in range(left)], scheduler, jobs, progress, where)
+    return summarise(optuna.load_study(study_name=study_name, storage=storage_obj), folder, base, objectives,
+                     max_flip, computed, interrupted=interrupted)
+
+
+def check_request(base: Robot, bounds: list[Bound], folder: Path, storage: str | None, sampler: str,
+                  scheduler: str) -> frozenset[str]:
+    """Refuse, before anything is written, a study that cannot run: an unknown sampler or
+    scheduler, an unreachable Dask scheduler, a folder or storage holding something else, an
+    integer range holding no whole number.
+
+    Parameters
+    ----------
+    base : Robot
+        The robot every design starts from.
+    bounds : list of Bound
+        The design variables and their ranges.
+    folder : Path
+        Output folder (and the journal, unless ``storage``).
+    storage : str or None
+        A journal file path or a database URL.
+    sampler, scheduler : str
+        As :func:`run_optimize` takes them.
+
+    Returns
+    -------
+    frozenset of str
+        The design variables that are whole numbers.
+
+    Raises
+    ------
+    SweepError
+        Any of the above.
+    """
+    from .execute import check_scheduler, probe_dask_scheduler
+
     if sampler not in SAMPLERS:
         raise SweepError(f"--sampler {sampler!r}: not one of {', '.join(SAMPLERS)}", "use tpe or nsga2")
     check_scheduler(scheduler)
@@ -387,17 +294,45 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
             raise SweepError(f"--vary {b.name}={b.low:g}:{b.high:g} holds no whole number, and {b.name} is one",
                              f"give a range with at least one integer, e.g. {b.name}={math.floor(b.low)}:"
                              f"{math.floor(b.low) + 2}")
-    make_folder(folder)
-    storage_obj = open_storage(storage, folder)
-    wanted = settings(base, bounds, cycles, objectives, draws, quantile, max_flip, sampler)
-    where = storage or str(folder / "study.journal")
+    return integers
+
+
+def open_study(storage, study_name: str, wanted: dict[str, Any], where: str, objectives: list[Objective]):
+    """The study in ``storage``, checked to search ``wanted``; a new one, recording ``wanted``
+    and its objectives' column names, when there is none.
+
+    Parameters
+    ----------
+    storage : optuna.storages.BaseStorage
+        The opened storage.
+    study_name : str
+        The study's name in it.
+    wanted : dict
+        :func:`settings` of this run.
+    where : str
+        The storage, for messages.
+    objectives : list of Objective
+        What is maximised.
+
+    Returns
+    -------
+    optuna.Study
+        The study, every objective maximised.
+
+    Raises
+    ------
+    SweepError
+        A study of that name searching other settings (:func:`check_settings`).
+    """
+    import optuna
+
     try:
-        held = optuna.load_study(study_name=study_name, storage=storage_obj)
+        held = optuna.load_study(study_name=study_name, storage=storage)
     except KeyError:
         held = None
     if held is not None:
         check_settings(held, wanted, where)
-    study = optuna.create_study(study_name=study_name, storage=storage_obj, load_if_exists=True,
+    study = optuna.create_study(study_name=study_name, storage=storage, load_if_exists=True,
                                 directions=["maximize"] * len(objectives))
     if held is None:
         study.set_user_attr(SETTINGS_ATTR, wanted)
@@ -405,19 +340,45 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)   # stable since Optuna 3.2
             study.set_metric_names([o.column for o in objectives])
-    before = len(study.trials)
-    left = max(0, trials - len(finished_trials(study)))
-    judge = judge or DesignJudge(base, cycles, tuple(objectives), draws, quantile)
-    spec = StudySpec(storage, folder, study_name, tuple(bounds), integers, tuple(objectives), judge, max_flip,
-                     sampler, seed, trials)
-    # a resumed study must not draw its first samples again: each trial's sampler seed moves on
-    # with the trials the study held before it
-    items = [before + k for k in range(left)]
+    return study
+
+
+def run_trials(spec: StudySpec, items: list[int], scheduler: str, jobs: int,
+               progress: Callable[[int], None] | None, where: str) -> tuple[int, bool]:
+    """Run the trials ``items`` on the scheduler's workers.
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The study.
+    items : list of int
+        The trials' indices (each seeds its sampler).
+    scheduler : str
+        ``local`` (``jobs`` processes, no more than the trials), ``dask-local`` or ``tcp://HOST:PORT``.
+    jobs : int
+        Trials run at once.
+    progress : callable, optional
+        ``progress(1)`` as each trial finishes.
+    where : str
+        The storage, for messages.
+
+    Returns
+    -------
+    computed : int
+        Trials this call ran.
+    interrupted : bool
+        Ctrl-C stopped the run (the trial under way is dropped; every finished one is kept).
+
+    Raises
+    ------
+    SweepError
+        The disk filled up while the study was written.
+    """
+    from .execute import mapper, plan_jobs
+
     if not scheduler.startswith("tcp://"):
         jobs, _ = plan_jobs(jobs, len(items))
     computed = 0
-    if progress and trials > left:
-        progress(trials - left)   # finished before this run
     try:
         with mapper(scheduler, jobs) as run_map:
             for number in run_map(TrialOf(spec), items):
@@ -433,38 +394,8 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
                          "free some space on that disk, then rerun the same command with --repair (it saves the "
                          "study as it is and cuts a line the full disk left torn)") from None
     except KeyboardInterrupt:   # the trial under way is dropped (FAIL); every finished one is kept
-        return summarise(optuna.load_study(study_name=study_name, storage=storage_obj), folder, base, objectives,
-                         max_flip, computed, interrupted=True)
-    return summarise(optuna.load_study(study_name=study_name, storage=storage_obj), folder, base, objectives,
-                     max_flip, computed)
-
-
-@dataclass(frozen=True)
-class TrialOf:
-    """A picklable ``run_trial`` of one study: what each process maps over trial indices.
-
-    Attributes
-    ----------
-    spec : StudySpec
-        The study.
-    """
-
-    spec: StudySpec
-
-    def __call__(self, index: int) -> int:
-        """Run trial ``index`` of the study (:func:`run_trial`).
-
-        Parameters
-        ----------
-        index : int
-            The trial's index in this run.
-
-        Returns
-        -------
-        int
-            The trial's number, or -1 when the study already holds enough finished trials.
-        """
-        return run_trial(self.spec, index)
+        return computed, True
+    return computed, False
 
 
 def trial_rows(study, names: list[str], objectives: list[Objective], max_flip: float | None) -> list[dict[str, Any]]:
@@ -562,4 +493,4 @@ def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max
         plot_front(rows, front, chosen, objectives, max_flip, folder / "pareto.png", title)
         write_study_page(study, objectives, folder / STUDY_PAGE)
     return OptimizeSummary(study.study_name, len(rows), len(done), len(pruned), front, chosen, folder, computed,
-                           interrupted, robots)
+                           interrupted, robots, tuple(names), tuple(objectives))

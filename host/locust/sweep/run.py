@@ -199,11 +199,6 @@ class SweepSummary:
     finished: bool
     plots: list[Path]
 
-    @property
-    def designs_per_s(self) -> float:
-        """Designs computed per second of wall time [1/s] (NaN when no time passed)."""
-        return self.computed / self.wall_s if self.wall_s > 0 else float("nan")
-
 
 def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: str = "local",
               jobs: int | None = None, progress: Callable[[int], None] | None = None,

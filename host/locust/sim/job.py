@@ -1,0 +1,245 @@
+"""The simulation job: what ``locust sim`` and :func:`locust.simulate` both run.
+
+:class:`SimOptions` holds every setting of ``locust sim`` but the robot and how the result is
+printed; :func:`run_simulation` checks the files it will write (before simulating, not after),
+runs the audited simulation with its standing load, its draws and their sensitivity, then the
+dt/2 convergence check, the video and the stills asked for, each noted in the result.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import GeometryError, SimError
+from ..params import Robot, check_robot, leg_set
+from . import run as _run
+from .result import SimResult
+
+
+@dataclass(frozen=True, kw_only=True)
+class SimOptions:
+    """The settings of one simulation, as ``locust sim`` takes them (its robot aside).
+
+    Attributes
+    ----------
+    cycles : int or None
+        Hop cycles to run (None: the robot's ``schedule.cycles``).
+    leg_set : str or None
+        Put this leg set (small, medium, large) on the robot in place of the one it carries.
+    samples : int
+        With N >= 2, also N draws of the values that carry an uncertainty (``result.spread``).
+    seed : int
+        Random seed of the draws.
+    sensitivity : bool or None
+        Each uncertain value alone at -/+ 2 sd (True: always; None: when the draws split).
+    keep_states : bool
+        Keep every step's state (a video keeps them whatever this says).
+    check_convergence : bool
+        Rerun at half the time step (``result.convergence``).
+    video : Path or None
+        Render the run to this MP4, with its truth sidecars.
+    camera : str
+        For ``video``: ``track`` (follow the robot) or ``fixed``.
+    still, still_push : Path or None
+        Render side stills of the robot settled at the 0 deg command, and held up at the push
+        command, with their truth sidecars.
+    board : str or None
+        For the stills: the board beside the robot (None: the default board).
+    invalid_linkage_result : bool
+        A linkage that cannot be assembled is an invalid result with its reason, not an error.
+    """
+
+    cycles: int | None = None
+    leg_set: str | None = None
+    samples: int = 0
+    seed: int = 0
+    sensitivity: bool | None = None
+    keep_states: bool = True
+    check_convergence: bool = False
+    video: Path | None = None
+    camera: str = "track"
+    still: Path | None = None
+    still_push: Path | None = None
+    board: str | None = None
+    invalid_linkage_result: bool = False
+
+
+def prepared(robot: Robot, options: SimOptions):
+    """The robot simulated (with ``options.leg_set`` on it), the outputs' paths checked, and
+    the stills' board read: refused before anything is simulated.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot as given.
+    options : SimOptions
+        The settings.
+
+    Returns
+    -------
+    robot : Robot
+        The robot to simulate.
+    board : locust.arucoboard.BoardSpec or None
+        The stills' board (None without stills).
+
+    Raises
+    ------
+    ParamsError
+        The robot with the leg set is out of range.
+    SimError
+        A video or still path that cannot be written.
+    TrackError
+        A board that cannot be read.
+    """
+    if options.leg_set is not None:
+        if options.leg_set != robot.leg_set:
+            robot = leg_set(robot, options.leg_set, source=f"leg-set:{options.leg_set}").renamed(
+                f"{robot.name} ({options.leg_set} legs)")
+        robot = check_robot(robot)
+    if options.video is not None:
+        from .clip import check_video_path
+
+        check_video_path(options.video)
+    if options.still is None and options.still_push is None:
+        return robot, None
+    from ..arucoboard import DEFAULT_BOARD, parse_board
+    from .still import check_still_path
+
+    for path in (options.still, options.still_push):
+        if path is not None:
+            check_still_path(path)
+    return robot, parse_board(options.board or DEFAULT_BOARD)
+
+
+def simulated(robot: Robot, options: SimOptions, progress: Callable[[int], None] | None = None) -> SimResult:
+    """The audited run, its standing load, its draws and which values decide its outcome.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot.
+    options : SimOptions
+        ``cycles``, ``samples``, ``seed``, ``sensitivity``, ``keep_states`` (and ``video``,
+        which keeps the states).
+    progress : callable, optional
+        ``progress(0)`` as the draws begin, then ``progress(k)`` as each batch of ``k`` is done.
+
+    Returns
+    -------
+    SimResult
+        With its robot (``params``).
+
+    Raises
+    ------
+    GeometryError
+        The linkage cannot be assembled.
+    ParamsError
+        A value out of range for simulating.
+    """
+    cycles = options.cycles
+    if options.samples:
+        from .samples import check_draws
+
+        check_draws(robot, options.samples, cycles)   # before the robot's own run
+    keep = options.keep_states or options.video is not None   # the video reuses the rollout
+    result = dataclasses.replace(_run.run(robot, cycles=cycles, keep_states=keep), params=robot)
+    if result.valid:
+        from .statics import standing_load
+
+        load = standing_load(robot)
+        result.nose_load_kg, result.total_mass_kg = load.nose_load_kg, load.total_mass_kg
+    if options.samples and result.valid:
+        from .samples import sample
+
+        if progress:
+            progress(0)
+        result.spread = sample(robot, options.samples, cycles=cycles, seed=options.seed, progress=progress)
+    mixed = result.spread is not None and max(o.share for o in result.spread.outcomes.values()) < 1.0
+    if result.valid and (options.sensitivity or (options.sensitivity is None and mixed)):
+        from .sensitivity import outcome_sensitivity
+
+        result.sensitivity = outcome_sensitivity(robot, cycles=cycles)
+    return result
+
+
+def rendered(result: SimResult, robot: Robot, options: SimOptions, board) -> None:
+    """Render the video and the stills asked for, each noted in ``result.notes``.
+
+    Parameters
+    ----------
+    result : SimResult
+        The run (its rollout kept when a video is asked for).
+    robot : Robot
+        The robot simulated.
+    options : SimOptions
+        ``video``, ``camera``, ``still``, ``still_push``.
+    board : locust.arucoboard.BoardSpec or None
+        The stills' board.
+
+    Raises
+    ------
+    SimError
+        The run is invalid, or a render fails.
+    """
+    if options.video is not None:
+        if not result.valid:
+            raise SimError("not rendering an invalid simulation", "fix the reasons listed above first")
+        info = result.video(options.video, camera=options.camera)
+        result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
+    if options.still is None and options.still_push is None:
+        return
+    from .still import render_stills
+
+    if not result.valid:
+        raise SimError("not rendering stills of an invalid robot", "fix the reasons listed above first")
+    for still in render_stills(robot, options.still, options.still_push, board=board):
+        result.notes.append(f"still: {still.path} ({still.pose.kind}, crank {still.pose.crank_deg:.2f} deg from the "
+                            f"ground link); truth: {still.truth_path}")
+
+
+def run_simulation(robot: Robot, options: SimOptions, progress: Callable[[int], None] | None = None) -> SimResult:
+    """Simulate ``robot`` as ``options`` say: checks, the audited run and its draws, the
+    convergence check, the video and the stills.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot (:func:`locust.robot`).
+    options : SimOptions
+        The settings.
+    progress : callable, optional
+        ``progress(0)`` as the draws begin, then ``progress(k)`` as each batch of ``k`` is done.
+
+    Returns
+    -------
+    SimResult
+        The result with its robot, spread, sensitivity and convergence as asked, and a note for
+        each file rendered.
+
+    Raises
+    ------
+    GeometryError
+        The linkage cannot be assembled (unless ``options.invalid_linkage_result``).
+    ParamsError
+        A value out of range for simulating.
+    SimError
+        A path that cannot be written, or a render asked of an invalid run.
+    """
+    robot, board = prepared(robot, options)
+    try:
+        result = simulated(robot, options, progress)
+    except GeometryError as exc:
+        if not options.invalid_linkage_result:
+            raise
+        reason = exc.message + (f" ({exc.hint})" if exc.hint else "")
+        result = dataclasses.replace(_run.invalid_result(robot, reason, options.cycles), params=robot)
+    if options.check_convergence and result.valid:
+        result.convergence = _run.check_convergence(robot, result, cycles=options.cycles)
+    rendered(result, robot, options, board)
+    return result
+
+
+__all__ = ["SimOptions", "prepared", "rendered", "run_simulation", "simulated"]
