@@ -11,6 +11,8 @@ Modules, one job each:
 - :mod:`.predict`   Tracker's constant-acceleration look-ahead for search windows
 - :mod:`.color`     coloured stickers: colour-picked, coverage-weighted centroid
 - :mod:`.template`  Tracker's autotracker: evolving template, Gaussian sub-pixel peak
+- :mod:`.blobs`     a colour mask's blobs: their labels, boxes and shapes
+- :mod:`.coverage`  a sticker's centre from the share of each pixel it covers
 - :mod:`.aruco`     ArUco markers (``cv2.aruco``) with sub-pixel corners
 - :mod:`.spec`      ``--marker NAME=SPEC`` parsing and the default marker set
 - :mod:`.calib`     pixel -> metre calibration (stick or ArUco size), origin, axes
