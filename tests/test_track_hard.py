@@ -184,8 +184,8 @@ def test_usual_blob_shortcut_changes_nothing_on_a_hard_clip(tmp_path, monkeypatc
     def positions():
         shapes.clear()
         markers = [parse_marker("s=color:#ff00ff")]
-        (t,) = track_video(info, Clip().resolved(info), markers, build(info.height_px)).markers
-        return np.stack([t.px, t.py]), int(t.ok.sum()), len(shapes)
+        t = track_video(info, Clip().resolved(info), markers, build(info.height_px)).tracks
+        return np.stack([t.px["s"], t.py["s"]]), int(t.ok["s"].sum()), len(shapes)
 
     shortcut, found, judged = positions()
     monkeypatch.setattr(color, "JUDGE_EVERY", 1)

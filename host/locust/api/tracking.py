@@ -25,7 +25,7 @@ class Tracks:
     """
 
     tracks: TracksCsv
-    result: object | None = None     # locust.track.runner.TrackResult
+    result: object | None = None     # locust.track.runner.TrackResult: the job's, with the files it wrote
 
     @property
     def markers(self) -> list[str]:
@@ -68,7 +68,7 @@ class Tracks:
         cols["frame"] = t.frame.copy()
         for name in t.markers:
             if f"{name}_ok" in cols:
-                cols[f"{name}_ok"] = t.markers[name].ok.copy()
+                cols[f"{name}_ok"] = t.ok[name].copy()
         for name in t.markers_with_positions():
             for kind, values in t.derived(name).items():
                 cols.setdefault(f"{name}_{kind}", values)
@@ -93,12 +93,12 @@ class Tracks:
         import pandas as pd
 
         t, parts = self.tracks.t_s, []
-        for name in self.tracks.markers_with_positions():
-            m = self.tracks.markers[name]
-            x, y = self.tracks.positions(name)
+        tr = self.tracks
+        for name in tr.markers_with_positions():
+            x, y = tr.positions(name)
             parts.append(pd.DataFrame({
-                "frame": self.tracks.frame, "t_s": t, "marker": name, "x_px": m.px, "y_px": m.py, "x_m": x, "y_m": y,
-                "ok": m.ok, **self.tracks.derived(name)}))
+                "frame": tr.frame, "t_s": t, "marker": name, "x_px": tr.px[name], "y_px": tr.py[name], "x_m": x,
+                "y_m": y, "ok": tr.ok[name], **tr.derived(name)}))
         if not parts:
             return pd.DataFrame(columns=["frame", "t_s", "marker", "x_px", "y_px", "x_m", "y_m", "ok", "vx_m_per_s",
                                          "vy_m_per_s", "ax_m_per_s2", "ay_m_per_s2"])
@@ -156,8 +156,8 @@ class Tracks:
     def __repr__(self) -> str:
         t = self.tracks
         lines = [f"Tracks: {t.n_rows} frames, markers {', '.join(t.markers) or 'none'}"]
-        for name, m in t.markers.items():
-            lines.append(f"  {name}: found in {int(np.count_nonzero(m.ok))} of {len(m.ok)} frames")
+        for name, ok in t.ok.items():
+            lines.append(f"  {name}: found in {int(np.count_nonzero(ok))} of {len(ok)} frames")
         return "\n".join(lines)
 
 
@@ -251,7 +251,6 @@ def track_markers(video: str | Path, markers: Mapping[str, str] | Sequence[str] 
     >>> hop.video("hop.mp4", overwrite=True, camera="fixed", width=320, height=240)  # doctest: +SKIP
     >>> locust.track_markers("hop.mp4").to_dataframe()[["t_s", "nose_x_m", "nose_y_m"]]  # doctest: +SKIP
     """
-    from ..track.export import tracks_of
     from ..track.runner import track_video
     from ..track.spec import ModelOptions, parse_markers
     from ..track.video import Clip, probe
@@ -275,7 +274,7 @@ def track_markers(video: str | Path, markers: Mapping[str, str] | Sequence[str] 
             from ..track.trk import write_project
 
             write_project(result, trk, trk_io.media_in_zip(project, trk) if media != video else None)
-    return Tracks(tracks_of(result), result)
+    return Tracks(result.tracks, result)
 
 
 def _project(video: Path, calibration_from, scale, origin, camera_json):

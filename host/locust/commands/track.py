@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import click
@@ -426,7 +427,7 @@ def _track_and_write(video, named, project, models, calibration, info, clip, pat
     with progress(length=n, label=f"tracking {video.name}") as bar:
         result = track_video(info, clip, models, calibration, progress=bar.update)
     if named != video:   # a Tracker project's video, unpacked from it for this run
-        result.source = f"locust track of the video in {named}"
+        result = replace(result, source=f"locust track of the video in {named}")
     for warning in upside_down_warnings(result):
         click.echo(f"warning: {warning}", err=True)
     if trk_out is not None:
@@ -488,8 +489,9 @@ def _convert_trk(path: Path, names: list[str], out, fmt: str, force: bool) -> No
 def _report(result, written: list[Path]) -> None:
     for line in export.summary_lines(result):
         click.echo(line)
-    lost = [t.name for t in result.markers
-            if t.spec.startswith("template:") and t.ok.any() and not t.ok[int(np.argmax(t.ok)):].all()]
+    ok = result.tracks.ok
+    lost = [m for m in result.tracks.markers
+            if result.specs[m].startswith("template:") and ok[m].any() and not ok[m][int(np.argmax(ok[m])):].all()]
     if lost:
         click.echo(f"hint: {', '.join(lost)}: lost (nan) where the match looked unlike the template (--likeness, "
                    "--accept) or left the path its track predicts, e.g. out of view; check the overlay, and pick "
