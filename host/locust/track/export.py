@@ -191,3 +191,28 @@ def summary_lines(result: TrackResult) -> list[str]:
     lines.append(result.calibration.summary())
     return lines
 
+
+
+def report_lines(result: TrackResult) -> list[str]:
+    """What a job that wrote ``result`` prints: :func:`summary_lines`, a hint where a template
+    marker was lost after it was found, and each file written.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks, with the files written.
+
+    Returns
+    -------
+    list of str
+        The lines to print.
+    """
+    lines = summary_lines(result)
+    ok = result.tracks.ok
+    lost = [m for m in result.tracks.markers
+            if result.specs[m].startswith("template:") and ok[m].any() and not ok[m][int(np.argmax(ok[m])):].all()]
+    if lost:
+        lines.append(f"hint: {', '.join(lost)}: lost (nan) where the match looked unlike the template (--likeness, "
+                     "--accept) or left the path its track predicts, e.g. out of view; check the overlay, and pick "
+                     "a point with texture that stays in view, or a --template-radius about the feature's size")
+    return [*lines, *(f"wrote {p}" for p in result.written)]
