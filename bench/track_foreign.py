@@ -440,15 +440,14 @@ def score(truth: Truth, tracks_path: Path, clip: Path | None = None, marker: str
     from locust.io.tracks_csv import read_tracks_csv
 
     tracks = read_tracks_csv(tracks_path)
-    m = tracks.markers[marker]
     n = len(truth.t_s)
     frame = tracks.frame.astype(int)
     ok = np.zeros(n, bool)
     px, py, xm, ym = (np.full(n, np.nan) for _ in range(4))
     sel = (frame >= 0) & (frame < n)
-    ok[frame[sel]] = m.ok[sel].astype(bool)
-    px[frame[sel]], py[frame[sel]] = m.px[sel], m.py[sel]
-    xm[frame[sel]], ym[frame[sel]] = m.x_m[sel] * 1000, m.y_m[sel] * 1000
+    ok[frame[sel]] = tracks.ok[marker][sel].astype(bool)
+    px[frame[sel]], py[frame[sel]] = tracks.px[marker][sel], tracks.py[marker][sel]
+    xm[frame[sel]], ym[frame[sel]] = tracks.x_m[marker][sel] * 1000, tracks.y_m[marker][sel] * 1000
     err = np.hypot(px - truth.px, py - truth.py)
     err_mm = np.hypot(xm - truth.x_mm, ym - truth.y_mm)
     full, out = truth.full, truth.out

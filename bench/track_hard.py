@@ -68,6 +68,9 @@ def main() -> None:
     ap.add_argument("--before", default="2ef6642",
                     help="git revision whose tracking package runs beside the current one ('none': skip)")
     args = ap.parse_args()
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from track_speed import load_before, marker_pixels
+
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "hard_synthetic.mp4"
         t = time.perf_counter()
@@ -81,20 +84,18 @@ def main() -> None:
         print(f"  {plane.summary()}")
         spec = [f"sticker=color:{truth.sticker_hex}"]
         t = time.perf_counter()
-        m = track_video(info, clip, parse_markers(spec), build(info.height_px), require_found=False).markers[0]
+        m = marker_pixels(track_video(info, clip, parse_markers(spec), build(info.height_px), require_found=False))
         now_s = time.perf_counter() - t
         if args.before != "none":
-            sys.path.insert(0, str(Path(__file__).resolve().parent))
-            from track_speed import load_before
-
             (Path(tmp) / "before").mkdir()
             before = load_before(args.before, Path(tmp) / "before")
             if before is not None:
-                b = before.runner.track_video(before.video.probe(path), before.video.Clip().resolved(info),
-                                              before.spec.parse_markers(spec), before.calib.build(info.height_px),
-                                              require_found=False).markers[0]
-                print(line("before", figures(truth, b.px, b.py, b.ok, plane)) + f"  ({args.before})")
-        print(line("now", figures(truth, m.px, m.py, m.ok, plane)) + f"  ({len(m.ok) / now_s:.0f} frames/s)")
+                b = marker_pixels(before.runner.track_video(
+                    before.video.probe(path), before.video.Clip().resolved(info), before.spec.parse_markers(spec),
+                    before.calib.build(info.height_px), require_found=False))
+                print(line("before", figures(truth, *b["sticker"], plane)) + f"  ({args.before})")
+        px, py, ok = m["sticker"]
+        print(line("now", figures(truth, px, py, ok, plane)) + f"  ({len(ok) / now_s:.0f} frames/s)")
 
 
 if __name__ == "__main__":

@@ -68,6 +68,15 @@ class _Package:
         self.calib = importlib.import_module(f"{name}.calib")
 
 
+def marker_pixels(result) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per marker its pixels and found flags, from this checkout's result (its tracks file's
+    columns) or an older copy's (a list of tracked markers)."""
+    if hasattr(result, "tracks"):
+        t = result.tracks
+        return {m: (t.px[m], t.py[m], t.ok[m]) for m in t.markers}
+    return {tr.name: (tr.px, tr.py, tr.ok) for tr in result.markers}
+
+
 def load_before(rev: str, folder: Path):
     """``host/locust/track`` as it was at git revision ``rev``, imported as ``locust.track_before``."""
     root = Path(__file__).resolve().parents[1]
@@ -137,12 +146,12 @@ def measure(path: Path, truth, repeats: int, before=None) -> tuple[float, float]
         if k in best:
             print(f"  {label:26s} {best[k]:7.3f} s  {n / best[k]:7.1f} frames/s  (best of {repeats})")
     for kind, result in results.items():
-        for tr in result.markers:
-            vis = truth.visible[tr.name]
-            err = np.hypot(tr.px - truth.px[tr.name], tr.py - truth.py[tr.name])[vis]
-            hidden_ok = bool((~tr.ok[~vis]).all())
-            print(f"  {kind:6s} {tr.name:5s} RMS error {np.sqrt(np.nanmean(err ** 2)):.3f} px, "
-                  f"max {np.nanmax(err):.3f} px, found {int(tr.ok[vis].sum())}/{int(vis.sum())} visible, "
+        for name, (px, py, ok) in marker_pixels(result).items():
+            vis = truth.visible[name]
+            err = np.hypot(px - truth.px[name], py - truth.py[name])[vis]
+            hidden_ok = bool((~ok[~vis]).all())
+            print(f"  {kind:6s} {name:5s} RMS error {np.sqrt(np.nanmean(err ** 2)):.3f} px, "
+                  f"max {np.nanmax(err):.3f} px, found {int(ok[vis].sum())}/{int(vis.sum())} visible, "
                   f"{int((~vis).sum())} occluded frames nan: {hidden_ok}")
     return best["decode"] / best["track"], best["decode"] / best["before"] if "before" in best else float("nan")
 

@@ -237,17 +237,18 @@ def test_tidy_tracks_have_trackers_velocity_and_acceleration():
     NaN (Tracker's blank cell) wherever one is not: the lost frame itself has no velocity, and
     no acceleration within two frames of it."""
     from locust.api.tracking import Tracks
-    from locust.io.tracks_csv import MarkerColumns, TracksCsv
+    from locust.io.tracks_csv import TracksCsv
 
     t = np.arange(20) / 30.0
     x, y = 0.1 + 1.5 * t, 0.2 + 2.0 * t - 9.81 / 2 * t ** 2
     ok = np.ones(20, dtype=bool)
     ok[10] = False
     nan = np.full(20, np.nan)
-    tracks = Tracks(TracksCsv(frame=np.arange(20), t_s=t, markers={
-        "ball": MarkerColumns("ball", px=nan, py=nan, x_m=np.where(ok, x, np.nan), y_m=np.where(ok, y, np.nan), ok=ok),
-        "still": MarkerColumns("still", px=nan, py=nan, x_m=np.zeros(20), y_m=np.zeros(20), ok=np.ones(20, bool))},
-        comments=("synthetic",)))
+    tracks = Tracks(TracksCsv(
+        frame=np.arange(20), t_s=t, px={"ball": nan, "still": nan}, py={"ball": nan, "still": nan},
+        x_m={"ball": np.where(ok, x, np.nan), "still": np.zeros(20)},
+        y_m={"ball": np.where(ok, y, np.nan), "still": np.zeros(20)},
+        ok={"ball": ok, "still": np.ones(20, bool)}, comments=("synthetic",)))
     df = tracks.tidy()
     assert list(df.columns[:7]) == ["frame", "t_s", "marker", "x_px", "y_px", "x_m", "y_m"]
     assert len(df) == 40 and list(df.marker[:2]) == ["ball", "still"] and list(df.frame[:2]) == [0, 0]

@@ -28,8 +28,7 @@ from locust.io import tracks_csv as tc
 from locust.io import trk as trk_io
 from locust.track import camera as track_camera
 from locust.track import trk
-from locust.track.export import tracks_of
-from locust.track.runner import TrackedMarker, TrackResult
+from locust.track.runner import TrackResult
 from locust.track.video import Clip, VideoInfo
 
 NAN = math.nan
@@ -37,12 +36,12 @@ NAN = math.nan
 
 def _tracks() -> tc.TracksCsv:
     ok = np.array([True, True, False, True])
-    nose = tc.MarkerColumns("nose", np.array([10.5, 11.25, NAN, 13.0]), np.array([200.0, 199.5, NAN, 197.125]),
-                            np.array([0.1, 0.105, NAN, 0.115]), np.array([0.02, 0.025, NAN, 0.03]), ok)
-    foot = tc.MarkerColumns("foot", np.array([5.0, 5.5, 6.0, 6.5]), np.array([220.0] * 4),
-                            np.full(4, NAN), np.full(4, NAN), np.ones(4, bool))      # pixels only: no scale
     return tc.TracksCsv(frame=np.array([3, 4, 5, 6]), t_s=np.array([0.0, 1 / 30, 2 / 30, 0.1]),
-                        markers={"nose": nose, "foot": foot}, comments=("synthetic: four frames", "truth: none"))
+                        px={"nose": np.array([10.5, 11.25, NAN, 13.0]), "foot": np.array([5.0, 5.5, 6.0, 6.5])},
+                        py={"nose": np.array([200.0, 199.5, NAN, 197.125]), "foot": np.array([220.0] * 4)},
+                        x_m={"nose": np.array([0.1, 0.105, NAN, 0.115]), "foot": np.full(4, NAN)},  # foot: no scale
+                        y_m={"nose": np.array([0.02, 0.025, NAN, 0.03]), "foot": np.full(4, NAN)},
+                        ok={"nose": ok, "foot": np.ones(4, bool)}, comments=("synthetic: four frames", "truth: none"))
 
 
 def test_tracks_csv_round_trip_keeps_lost_frames_and_notes(tmp_path):
@@ -58,7 +57,8 @@ def test_tracks_csv_round_trip_keeps_lost_frames_and_notes(tmp_path):
                                     "6.0000,220.0000,nan,nan,1,nan,nan,nan,nan")
     back = tc.read_tracks_csv(path)
     t_written = np.round(tracks.t_s, 6)
-    assert back == tc.TracksCsv(tracks.frame, t_written, tracks.markers, tracks.comments)
+    assert back == tc.TracksCsv(tracks.frame, t_written, tracks.px, tracks.py, tracks.x_m, tracks.y_m, tracks.ok,
+                                tracks.comments)
     assert back.path == path and back.columns == tuple(text.splitlines()[2].split(","))
     assert tc.tracks_csv_text(back) == text                               # and the text again, byte for byte
     x, y = back.positions("nose")
@@ -74,7 +74,7 @@ def test_tracks_csv_reader_takes_what_other_programs_write(tmp_path):
     assert tc.parse_tracks_csv(theirs, "theirs.csv") == tc.parse_tracks_csv(ours, "ours.csv")
     # columns left out are NaN, no _ok counts every row as found, columns of no marker are kept
     part = tc.parse_tracks_csv("t_s,tip_x_m,tip_y_m,temp_c\n0,1,2,20.5\n", "part.csv")
-    assert list(part.frame) == [0] and np.isnan(part.markers["tip"].px).all() and part.markers["tip"].ok.all()
+    assert list(part.frame) == [0] and np.isnan(part.px["tip"]).all() and part.ok["tip"].all()
     assert part.other["temp_c"][0] == 20.5 and part.columns == ("t_s", "tip_x_m", "tip_y_m", "temp_c")
     assert tc.parse_tracks_csv(tc.tracks_csv_text(part), "again.csv") == part
 
@@ -106,17 +106,17 @@ def test_report_synthetic_track_is_what_the_owner_writes(tmp_path):
 
     truth = write_synthetic_trial(tmp_path, preset("seed"), 1, lost_frames=3)
     tracks = tc.read_tracks_csv(truth.track_path)
-    assert tracks.comments[0].startswith("synthetic:") and int((~tracks.markers["nose"].ok).sum()) == 3
+    assert tracks.comments[0].startswith("synthetic:") and int((~tracks.ok["nose"]).sum()) == 3
     assert tc.tracks_csv_text(tracks) == truth.track_path.read_text()
 
 
 def _export() -> tt.TrackerExport:
     # row 4: a frame where no track has a step (a row of empty cells in the file)
-    ball = tt.TrackerTrack("ball", np.array([NAN, 0.05, 0.1, NAN]), np.array([NAN, 0.125, 0.25, NAN]),
-                           np.array([NAN, 1.5, 1.25, NAN]))
-    cup = tt.TrackerTrack("cup 3", np.array([0.0, 0.05, NAN, NAN]), np.array([1.0, 1.5, NAN, NAN]),
-                          np.array([2.0, 2.5, NAN, NAN]), {"v": np.array([3.0, NAN, NAN, NAN])})
-    return tt.TrackerExport({"ball": ball, "cup_3": cup})
+    return tt.TrackerExport(names={"ball": "ball", "cup_3": "cup 3"},
+                            t_s={"ball": np.array([NAN, 0.05, 0.1, NAN]), "cup_3": np.array([0.0, 0.05, NAN, NAN])},
+                            x_m={"ball": np.array([NAN, 0.125, 0.25, NAN]), "cup_3": np.array([1.0, 1.5, NAN, NAN])},
+                            y_m={"ball": np.array([NAN, 1.5, 1.25, NAN]), "cup_3": np.array([2.0, 2.5, NAN, NAN])},
+                            other={"cup_3": {"v": np.array([3.0, NAN, NAN, NAN])}})
 
 
 def test_tracker_text_round_trip_keeps_missing_steps_and_empty_frames(tmp_path):
@@ -138,11 +138,11 @@ def test_tracker_text_round_trip_keeps_missing_steps_and_empty_frames(tmp_path):
 def test_tracker_6_multi_export_shares_one_time_column():
     text = "#multi:\n\tcm A\t\tcm B\t\nt\tx\ty\tx\ty\n0,0\t1,5\t2,0\t3,0\t4,0\n0,1\t1,6\t\t3,1\t4,1\n"
     export = tt.parse_tracker_export(text, "multi.txt")
-    assert list(export.tracks) == ["cm_A", "cm_B"] and export.tracks["cm_A"].name == "cm A"
-    assert export.tracks["cm_A"].t_s is export.tracks["cm_B"].t_s
-    np.testing.assert_array_equal(export.tracks["cm_A"].y_m, [2.0, NAN])
+    assert export.markers == ("cm_A", "cm_B") and export.names["cm_A"] == "cm A"
+    assert export.t_s["cm_A"] is export.t_s["cm_B"]
+    np.testing.assert_array_equal(export.y_m["cm_A"], [2.0, NAN])
     titled = tt.parse_tracker_export("tip\nt\tx\ty\n0\t1\t2\n", "tip.txt")
-    assert list(titled.tracks) == ["tip"] and titled.tracks["tip"].x_m[0] == 1.0
+    assert titled.markers == ("tip",) and titled.x_m["tip"][0] == 1.0
     with pytest.raises(TrackError, match="times disagree in data row 1"):
         tt.parse_tracker_export("a\t\t\tb\t\t\nt\tx\ty\tt\tx\ty\n0\t1\t2\t0.5\t3\t4\n", "x.txt").time_s()
 
@@ -210,11 +210,11 @@ def test_tracker_project_round_trip(tmp_path):
     ok = np.array([True, True, False, True, True, True])
     px = np.where(ok, 100.0 + 4.25 * (frames - 2), NAN)
     py = np.where(ok, 300.0 - 2.5 * (frames - 2), NAN)
-    nose = TrackedMarker("nose", "colour:pink", px, py, np.where(ok, 1.0, NAN), ok)
     cal = trk_io.Calibration(m_per_px=1 / 2048, origin_x_px=12.5, origin_y_px=350.25, angle_deg=2.5, source="stick")
     clip = Clip(2, 7, 1, 30.0)
     video = VideoInfo(tmp_path / "hop.mp4", 640, 360, 12, 30.0)
-    result = TrackResult(video, clip, frames, (frames - 2) / 30.0, [nose], cal)
+    result = TrackResult.from_pixels(frames, (frames - 2) / 30.0, {"nose": px}, {"nose": py}, {"nose": ok},
+                                     {"nose": "colour:pink"}, {"nose": np.where(ok, 1.0, NAN)}, cal, clip, video=video)
     path = trk.write_project(result, tmp_path / "hop.trk")
 
     back = trk_io.read_project(path)
@@ -225,9 +225,8 @@ def test_tracker_project_round_trip(tmp_path):
     c = back.calibration
     assert (c.origin_x_px, c.origin_y_px, c.angle_deg) == (12.5, 350.25, 2.5)
     assert c.m_per_px == pytest.approx(1 / 2048, rel=1e-12)
-    mine, theirs = tracks_of(result), trk_io.project_tracks(back)
+    mine, theirs = result.tracks, trk_io.project_tracks(back)
     np.testing.assert_array_equal(theirs.frame, mine.frame)
     np.testing.assert_allclose(theirs.t_s, mine.t_s, rtol=1e-12)
     for col in ("px", "py", "x_m", "y_m", "ok"):
-        np.testing.assert_allclose(getattr(theirs.markers["nose"], col), getattr(mine.markers["nose"], col),
-                                   rtol=1e-12, atol=0)
+        np.testing.assert_allclose(getattr(theirs, col)["nose"], getattr(mine, col)["nose"], rtol=1e-12, atol=0)

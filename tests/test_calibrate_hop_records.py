@@ -19,7 +19,7 @@ from locust.calibrate import hop as H
 from locust.commands import cli
 from locust.errors import CalibrationError
 from locust.io import run_record as R
-from locust.io.tracks_csv import MarkerColumns, TracksCsv, write_tracks_csv
+from locust.io.tracks_csv import TracksCsv, write_tracks_csv
 from locust.params import preset
 
 SCHEDULE = R.HopSchedule(cycles=2)
@@ -53,9 +53,10 @@ def run_folder(folder, status=R.COMPLETE, message=None, phases=None):
     lift = np.where((into >= 0) & (into % period_s < SCHEDULE.push_ms / 1000),
                     0.02 * np.sin(np.pi * (into % period_s) / (SCHEDULE.push_ms / 1000)), 0.0)
     n = t.size
-    nose = MarkerColumns("nose", np.full(n, 300.0), 400.0 - 5000 * lift, np.full(n, 0.046), 0.02 + lift,
-                         np.ones(n, dtype=bool))
-    write_tracks_csv(folder / "hop.tracks.csv", TracksCsv(frame=np.arange(n), t_s=t, markers={"nose": nose}))
+    nose = {"px": np.full(n, 300.0), "py": 400.0 - 5000 * lift, "x_m": np.full(n, 0.046), "y_m": 0.02 + lift,
+            "ok": np.ones(n, dtype=bool)}
+    write_tracks_csv(folder / "hop.tracks.csv",
+                     TracksCsv(frame=np.arange(n), t_s=t, **{kind: {"nose": c} for kind, c in nose.items()}))
     return folder
 
 

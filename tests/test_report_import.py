@@ -20,7 +20,7 @@ from click.testing import CliRunner
 from locust.commands import cli
 from locust.io.run_record import HopSchedule, Phase, RunRecord
 from locust.io.run_record import write as write_record
-from locust.io.tracks_csv import MarkerColumns, TracksCsv, write_tracks_csv
+from locust.io.tracks_csv import TracksCsv, write_tracks_csv
 from locust.report.checks import ROBOT, SYNTHETIC, VIRTUAL, recorded_on
 from test_report import parse
 from test_report_inputs import staircase
@@ -56,7 +56,8 @@ def trials(tmp_path_factory):
     ok = np.ones(t.size, bool)
     nan = np.full(t.size, np.nan)
     write_tracks_csv(folder / "hop.tracks.csv", TracksCsv(
-        frame=np.arange(t.size), t_s=t, markers={"nose": MarkerColumns("nose", nan, nan, x, y, ok)},
+        frame=np.arange(t.size), t_s=t, px={"nose": nan}, py={"nose": nan}, x_m={"nose": x}, y_m={"nose": y},
+        ok={"nose": ok},
         comments=("synthetic: staircase nose (tests/test_report_import.py)",)))
     record = RunRecord(schedule=HopSchedule(cycles=CYCLES, push_deg=-30.0, push_ms=300, wait_ms=1000),
                        port="/dev/pts/7", status="complete", firmware_version="0.3.0", firmware_status="complete")

@@ -14,7 +14,7 @@ import pytest
 
 from locust.io.trk import MAX_CLIP_FRAMES
 from locust.track.calib import build
-from locust.track.runner import TrackedMarker, TrackResult
+from locust.track.runner import TrackResult
 from locust.track.synth import make_hop_video, paint_dot
 from locust.track.trk import project_xml
 from locust.track.video import Clip, VideoInfo, encode_video, probe
@@ -59,9 +59,10 @@ def test_fps_edges_are_accepted(hop):
 def _project_text(tmp_path, delta_t: str) -> str:
     n = 10
     frames = np.arange(n)
-    track = TrackedMarker("nose", "color:#ff00ff", 100 + 2.0 * frames, 200 - 1.0 * frames, np.ones(n), np.ones(n, bool))
-    result = TrackResult(VideoInfo(tmp_path / "hop.mp4", 640, 360, n, 30.0), Clip(0, n - 1, 1, 30.0), frames,
-                         frames / 30.0, [track], build(360, 0.001, None, 0.0, "stick 0.001 m/px"))
+    result = TrackResult.from_pixels(frames, frames / 30.0, {"nose": 100 + 2.0 * frames}, {"nose": 200 - 1.0 * frames},
+                                     {"nose": np.ones(n, bool)}, {"nose": "color:#ff00ff"}, {"nose": np.ones(n)},
+                                     build(360, 0.001, None, 0.0, "stick 0.001 m/px"), Clip(0, n - 1, 1, 30.0),
+                                     video=VideoInfo(tmp_path / "hop.mp4", 640, 360, n, 30.0))
     text = project_xml(result, tmp_path / "p.trk", None)
     assert text.count('name="delta_t" type="double">') == 1     # the clip control's
     return re.sub(r'(name="delta_t" type="double">)[^<]*', rf"\g<1>{delta_t}", text)

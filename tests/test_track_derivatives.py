@@ -23,7 +23,7 @@ from click.testing import CliRunner
 import locust
 from locust.commands import cli
 from locust.io import delimited
-from locust.io.tracks_csv import MarkerColumns, TracksCsv, read_tracks_csv, write_tracks_csv
+from locust.io.tracks_csv import TracksCsv, read_tracks_csv, write_tracks_csv
 
 G = 9.81
 
@@ -126,7 +126,8 @@ def test_uneven_frame_times_keep_each_frames_own_time():
     t = np.cumsum(np.r_[0.0, (1 + rng.uniform(-0.2, 0.2, 29)) / 30])
     y = 2.0 * t - G / 2 * t ** 2
     nan = np.full(30, np.nan)
-    tracks = TracksCsv(np.arange(30), t, {"ball": MarkerColumns("ball", nan, nan, 0.5 * t, y, np.ones(30, bool))})
+    tracks = TracksCsv(np.arange(30), t, px={"ball": nan}, py={"ball": nan}, x_m={"ball": 0.5 * t}, y_m={"ball": y},
+                       ok={"ball": np.ones(30, bool)})
     d = tracks.derived("ball")
     assert d["ay_m_per_s2"][2:-2] == pytest.approx(np.full(26, -G), abs=1e-9)
     assert d["ax_m_per_s2"][2:-2] == pytest.approx(np.zeros(26), abs=1e-9)
@@ -146,8 +147,9 @@ def test_the_csv_gives_its_own_velocity_back_and_old_files_still_read(tmp_path):
     x, y = 0.1 + 1.234567891 * t, 0.05 + 1.5 * t - G / 2 * t ** 2 + rng.normal(0, 2e-4, n)
     ok = np.ones(n, bool)
     ok[17] = False
-    m = MarkerColumns("nose", rng.uniform(0, 1920, n), rng.uniform(0, 1080, n), x, y, ok)
-    path = write_tracks_csv(tmp_path / "a.tracks.csv", TracksCsv(np.arange(n), t, {"nose": m}))
+    m = TracksCsv(np.arange(n), t, px={"nose": rng.uniform(0, 1920, n)}, py={"nose": rng.uniform(0, 1080, n)},
+                  x_m={"nose": x}, y_m={"nose": y}, ok={"nose": ok})
+    path = write_tracks_csv(tmp_path / "a.tracks.csv", m)
     text = path.read_text()
     back = read_tracks_csv(path)
     rows = pd.read_csv(path)
@@ -167,8 +169,9 @@ def test_the_csv_gives_its_own_velocity_back_and_old_files_still_read(tmp_path):
     rows_max = delimited.MAX_LINES - 1                       # the header is the other line
     t = np.arange(rows_max) / 240.0 + 100.0                  # 14 minutes at 240 frames/s
     swing = -1.1 - 0.1 * np.sin(2 * np.pi * t)               # 4-digit pixels, a metre off the origin
-    marker = {name: MarkerColumns(name, 1919.1234 + 0 * t, 1079.1234 + 0 * t, swing, swing, np.ones(rows_max, bool))
-              for name in ("nose", "foot")}
-    tracks = TracksCsv(np.arange(rows_max) + 10 ** 5, t, marker)
+    both = ("nose", "foot")
+    tracks = TracksCsv(np.arange(rows_max) + 10 ** 5, t, px={m: 1919.1234 + 0 * t for m in both},
+                       py={m: 1079.1234 + 0 * t for m in both}, x_m={m: swing for m in both},
+                       y_m={m: swing for m in both}, ok={m: np.ones(rows_max, bool) for m in both})
     full = write_tracks_csv(tmp_path / "full.tracks.csv", tracks)     # refused were it over a limit
     assert full.stat().st_size == pytest.approx(30.1 * 2**20, rel=0.01)  # 158 bytes a row: 47 % of the 64 MB

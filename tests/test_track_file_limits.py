@@ -18,7 +18,7 @@ import pytest
 
 from locust.errors import TrackError
 from locust.io import delimited
-from locust.io.tracks_csv import MarkerColumns, TracksCsv, read_tracks_csv, write_tracks_csv
+from locust.io.tracks_csv import TracksCsv, read_tracks_csv, write_tracks_csv
 from locust.track.video import Clip, VideoInfo
 from probing import assert_clear_error, invoke, tree
 
@@ -79,8 +79,8 @@ def test_a_track_file_of_more_lines_than_the_limit_is_refused_and_one_at_it_read
 def test_tracks_a_reader_would_refuse_are_not_written(tmp_path):
     n = delimited.MAX_LINES          # with the header, one line over
     ones = np.ones(n)
-    tracks = TracksCsv(np.arange(n), np.arange(n) / 240.0, {"nose": MarkerColumns("nose", ones, ones, ones, ones,
-                                                                                  ones.astype(bool))})
+    tracks = TracksCsv(np.arange(n), np.arange(n) / 240.0, px={"nose": ones}, py={"nose": ones}, x_m={"nose": ones},
+                       y_m={"nose": ones}, ok={"nose": ones.astype(bool)})
     with pytest.raises(TrackError, match=f"would be {n + 1:,} lines, over the {delimited.MAX_LINES:,}"):
         write_tracks_csv(tmp_path / "t.csv", tracks)
     assert list(tmp_path.iterdir()) == []

@@ -15,7 +15,7 @@ from locust.errors import TrackError
 from locust.track.board import BoardSpec, board_points, parse_board, parse_plane_points
 from locust.track.export import track_events
 from locust.track.hardclip import STICKER_HEX, make_hard_video, read_truth_csv
-from locust.track.predict import MarkerPath
+from locust.track.predict import MotionFit
 from locust.track.spec import ModelOptions, parse_marker
 
 W, H, N = 960, 540, 100
@@ -135,7 +135,7 @@ def test_board_and_marker_spec_errors():
 
 
 def test_trajectory_extrapolates_a_parabola():
-    tr = MarkerPath()
+    tr = MotionFit()
     f = np.arange(10, 15)
     for k in f:
         tr.add(int(k), (3.0 * k, 0.5 * k ** 2 - 4 * k))
@@ -178,14 +178,14 @@ def test_usual_blob_shortcut_changes_nothing_on_a_hard_clip(tmp_path, monkeypatc
     truth = make_hard_video(path, W, H, N, seed=3, sticker_hex="#ff00ff")
     info = probe(path)
     shapes = []
-    measure = color._blob_shape
-    monkeypatch.setattr(color, "_blob_shape", lambda blob, area: shapes.append(area) or measure(blob, area))
+    measure = color.blob_shape
+    monkeypatch.setattr(color, "blob_shape", lambda blob, area: shapes.append(area) or measure(blob, area))
 
     def positions():
         shapes.clear()
         markers = [parse_marker("s=color:#ff00ff")]
-        (t,) = track_video(info, Clip().resolved(info), markers, build(info.height_px)).markers
-        return np.stack([t.px, t.py]), int(t.ok.sum()), len(shapes)
+        t = track_video(info, Clip().resolved(info), markers, build(info.height_px)).tracks
+        return np.stack([t.px["s"], t.py["s"]]), int(t.ok["s"].sum()), len(shapes)
 
     shortcut, found, judged = positions()
     monkeypatch.setattr(color, "JUDGE_EVERY", 1)

@@ -121,9 +121,8 @@ def test_tracks_csv_in_mm_keeps_pixels_and_renames_columns(tmp_path):
     back = tc.read_tracks_csv(out)
     assert back.columns == ("frame", "t_s", "nose_px", "nose_py", "nose_x_m", "nose_y_m", "nose_ok", "nose_vx_m_per_s",
                             "nose_vy_m_per_s", "nose_ax_m_per_s2", "nose_ay_m_per_s2")
-    nose = back.markers["nose"]
-    assert list(back.frame) == [5, 6] and nose.px[0] == 100.5 and nose.py[0] == 200.25   # pixels stay pixels
-    assert nose.x_m[0] == 0.125 and nose.y_m[0] == 0.04 and not nose.ok[1]
+    assert list(back.frame) == [5, 6] and back.px["nose"][0] == 100.5 and back.py["nose"][0] == 200.25   # pixels stay
+    assert back.x_m["nose"][0] == 0.125 and back.y_m["nose"][0] == 0.04 and not back.ok["nose"][1]
     assert back.comments[0] == "synthetic: two frames in mm"
     # the identity returns the file as read
     assert import_tracks(src) == tc.read_tracks_csv(src)
@@ -206,13 +205,12 @@ def test_an_import_spanning_more_than_a_desk_warns(tmp_path):
 def _real_export_in_cm(project, names: dict[str, str]) -> tt.TrackerExport:
     """Tracker's own world points (metres) as Tracker would export them calibrated in cm."""
     result = trk.project_result(project)
-    tracks = {}
-    for m in result.markers:
-        x, y = result.world(m)
-        ok = m.ok
-        t = np.where(ok, result.t_s, np.nan)
-        tracks[m.name] = tt.TrackerTrack(names[m.name], t, np.where(ok, x * 100, np.nan), np.where(ok, y * 100, np.nan))
-    return tt.TrackerExport(tracks), result
+    tr = result.tracks
+    cm = {kind: {m: np.where(tr.ok[m], column[m] * 100, np.nan) for m in tr.markers}
+          for kind, column in (("x_m", tr.x_m), ("y_m", tr.y_m))}
+    export = tt.TrackerExport({m: names[m] for m in tr.markers},
+                              {m: np.where(tr.ok[m], tr.t_s, np.nan) for m in tr.markers}, **cm)
+    return export, result
 
 
 def test_real_balltoss_exported_in_cm_gives_trackers_metres_and_g(shared_data, tmp_path):
@@ -227,10 +225,8 @@ def test_real_balltoss_exported_in_cm_gives_trackers_metres_and_g(shared_data, t
     assert res.exit_code == 0, res.output
     back = tc.read_tracks_csv(out)
     x, y = back.positions("nose")
-    ball = result.markers[0]
-    wx, wy = result.world(ball)
-    ok = ball.ok
-    assert int(back.markers["nose"].ok.sum()) == int(ok.sum()) == 11
+    wx, wy, ok = result.tracks.x_m["ball"], result.tracks.y_m["ball"], result.tracks.ok["ball"]
+    assert int(back.ok["nose"].sum()) == int(ok.sum()) == 11
     # each cell: the export's cm text / 100, and Tracker's metres to the export's 6 significant digits
     cells = [line.split("\t") for line in src.read_text().splitlines()[2:]]
     for i in np.flatnonzero(ok):
@@ -250,12 +246,12 @@ def test_real_cupsclips_renamed_by_trackers_own_names(shared_data, tmp_path):
     assert src.read_text().splitlines()[0].split("\t")[0] == "cup 3"     # Tracker's name, with its space
     tracks = import_tracks(src, "cm", ["cup 3=nose", "cup 7=foot"], mirror=True)
     assert list(tracks.markers) == ["nose", "foot"]
-    for marker, m in zip(("nose", "foot"), result.markers):
-        wx, wy = result.world(m)
+    for marker, m in zip(("nose", "foot"), result.tracks.markers):
+        wx, wy, ok = result.tracks.x_m[m], result.tracks.y_m[m], result.tracks.ok[m]
         x, y = tracks.positions(marker)
-        assert np.isfinite(x).sum() == int(m.ok.sum()) == 9
-        np.testing.assert_allclose(-x[m.ok], wx[m.ok], rtol=5e-6, atol=1e-7)      # mirrored
-        np.testing.assert_allclose(y[m.ok], wy[m.ok], rtol=5e-6, atol=1e-7)
+        assert np.isfinite(x).sum() == int(ok.sum()) == 9
+        np.testing.assert_allclose(-x[ok], wx[ok], rtol=5e-6, atol=1e-7)      # mirrored
+        np.testing.assert_allclose(y[ok], wy[ok], rtol=5e-6, atol=1e-7)
     with pytest.raises(TrackError, match=r"no marker 'cup 9' \(markers: cup_3 \('cup 3' in Tracker\)"):
         import_tracks(src, "cm", ["cup 9=nose"])
 

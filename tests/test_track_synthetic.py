@@ -114,7 +114,7 @@ def test_marker_found_as_usual_is_judged_every_few_frames(hop, monkeypatch):
     path, _ = hop
     info = probe(path)
     shapes = []
-    measure = color._blob_shape
+    measure = color.blob_shape
 
     def counted(blob, area):
         shapes.append(area)
@@ -123,9 +123,10 @@ def test_marker_found_as_usual_is_judged_every_few_frames(hop, monkeypatch):
     def positions():
         shapes.clear()
         result = track_video(info, Clip().resolved(info), parse_markers([]), build(info.height_px))
-        return np.stack([np.stack([t.px, t.py]) for t in result.markers]), len(shapes)
+        t = result.tracks
+        return np.stack([np.stack([t.px[m], t.py[m]]) for m in t.markers]), len(shapes)
 
-    monkeypatch.setattr(color, "_blob_shape", counted)
+    monkeypatch.setattr(color, "blob_shape", counted)
     every_few, judged = positions()
     monkeypatch.setattr(color, "JUDGE_EVERY", 1)
     every_frame, judged_all = positions()

@@ -62,11 +62,10 @@ def test_trk_reader_reproduces_trackers_world_data(shared_data):
     assert project.points["ball"][3] == pytest.approx((176.10010427528672 - 0.5, 154.66110531803963 - 0.5))
     assert project.clip.fps == pytest.approx(1000 / 66.0)
     result = trk.project_result(project)
-    ball = result.markers[0]
-    x, y = result.world(ball)
+    x, y, ok = result.tracks.x_m["ball"], result.tracks.y_m["ball"], result.tracks.ok["ball"]
     assert (x[2], y[2]) == pytest.approx((0.0, 0.0), abs=1e-12)  # the axes origin sits on the first step
     # published figure (shared/data/README): a parabola through Tracker's data gives g ~ 10.3 m/s^2
-    c = np.polyfit(result.t_s[ball.ok], y[ball.ok], 2)
+    c = np.polyfit(result.tracks.t_s[ok], y[ok], 2)
     assert -2 * c[0] == pytest.approx(10.3, abs=0.1)
 
 
@@ -75,16 +74,15 @@ def test_from_trk_cli_writes_trackers_text_layout(shared_data, tmp_path):
     res = CliRunner().invoke(cli, ["track", "from-trk", str(shared_data / "tracker" / "BallToss.trz"),
                                    "--format", "tracker", "--out", str(out)])
     assert res.exit_code == 0, res.output
-    table = read_tracker_export(out).tracks["ball"]
+    table = read_tracker_export(out)
     project = trk_io.read_project(shared_data / "tracker" / "BallToss.trz")
-    result = trk.project_result(project)
-    x, y = result.world(result.markers[0])
-    ok = result.markers[0].ok
-    assert len(table.x_m) == len(result.frames)           # frames without a step are rows of empty cells
-    assert np.isnan(table.x_m[~ok]).all()
-    np.testing.assert_allclose(table.t_s[ok], result.t_s[ok], atol=1e-6)
-    np.testing.assert_allclose(table.x_m[ok], x[ok], atol=1e-5)
-    np.testing.assert_allclose(table.y_m[ok], y[ok], atol=1e-5)
+    tracks = trk.project_result(project).tracks
+    x, y, ok = tracks.x_m["ball"], tracks.y_m["ball"], tracks.ok["ball"]
+    assert len(table.x_m["ball"]) == len(tracks.frame)    # frames without a step are rows of empty cells
+    assert np.isnan(table.x_m["ball"][~ok]).all()
+    np.testing.assert_allclose(table.t_s["ball"][ok], tracks.t_s[ok], atol=1e-6)
+    np.testing.assert_allclose(table.x_m["ball"][ok], x[ok], atol=1e-5)
+    np.testing.assert_allclose(table.y_m["ball"][ok], y[ok], atol=1e-5)
     assert (tmp_path / "balltoss.json").is_file()
 
 
@@ -133,8 +131,8 @@ def test_python_api_reuses_a_projects_calibration_and_writes_a_trk(balltoss, sha
     redo = tmp_path / "redo.trk"
     tracks = locust.track_markers(shared_data / "tracker" / "BallToss.trz", ball, trk=redo)
     project = trk_io.read_project(shared_data / "tracker" / "BallToss.trz")
-    truth = trk.project_result(project)
-    tx, ty = truth.world(truth.markers[0])
+    truth = trk.project_result(project).tracks
+    tx, ty = truth.x_m["ball"], truth.y_m["ball"]
     x, y = tracks.positions("ball")
     frames = list(range(3, 13))
     err_px = np.hypot(x[frames] - tx[frames], y[frames] - ty[frames]) / project.calibration.m_per_px

@@ -182,10 +182,10 @@ def test_calibration_from_trk_gives_trackers_metres(balltoss, tmp_path):
     assert res.exit_code == 0, res.output
     df = pd.read_csv(tmp_path / "ball.csv")
     theirs = trk.project_result(trk_io.read_project(balltoss / "BallToss_BallToss.trk"))
-    x, y = theirs.world(theirs.markers[0])
+    x, y = theirs.tracks.x_m["ball"], theirs.tracks.y_m["ball"]
     ok = df["ball_ok"].astype(bool).to_numpy()
     assert ok[2:].all() and not ok[:2].any()                       # Tracker's steps: frames 2..12
-    assert np.abs(df["t_s"] - theirs.t_s).max() < 1e-9             # the project's 66 ms frame interval
+    assert np.abs(df["t_s"] - theirs.tracks.t_s).max() < 1e-9             # the project's 66 ms frame interval
     err_mm = 1000 * np.hypot(df["ball_x_m"] - x, df["ball_y_m"] - y)[ok]
     assert err_mm.max() <= 2.5, err_mm                              # acceptance 5 mm; measured 1.8, mean 1.0
     written = trk_io.read_project(tmp_path / "ball.trk")

@@ -28,7 +28,7 @@ import pytest
 
 from locust.io import trz
 from locust.track.calib import build
-from locust.track.runner import TrackedMarker, TrackResult
+from locust.track.runner import TrackResult
 from locust.track.synth import make_hop_video
 from locust.track.trk import project_xml
 from locust.track.video import Clip, VideoInfo
@@ -46,9 +46,10 @@ def members(tmp_path_factory) -> dict[str, bytes]:
     make_hop_video(folder / "hop.mp4", width=160, height=90, n_frames=10, seed=3)
     n = 10
     frames = np.arange(n)
-    track = TrackedMarker("nose", "color:#ff00ff", 80 + 2.0 * frames, 60 - 1.0 * frames, np.ones(n), np.ones(n, bool))
-    result = TrackResult(VideoInfo(folder / "hop.mp4", 160, 90, n, 30.0), Clip(0, n - 1, 1, 30.0), frames,
-                         frames / 30.0, [track], build(90, 0.001, None, 0.0, "stick 0.001 m/px"))
+    result = TrackResult.from_pixels(frames, frames / 30.0, {"nose": 80 + 2.0 * frames}, {"nose": 60 - 1.0 * frames},
+                                     {"nose": np.ones(n, bool)}, {"nose": "color:#ff00ff"}, {"nose": np.ones(n)},
+                                     build(90, 0.001, None, 0.0, "stick 0.001 m/px"), Clip(0, n - 1, 1, 30.0),
+                                     video=VideoInfo(folder / "hop.mp4", 160, 90, n, 30.0))
     return {"p.trk": project_xml(result, folder / "p.trk", VIDEO).encode(),
             VIDEO: (folder / "hop.mp4").read_bytes()}
 

@@ -11,7 +11,7 @@ from click.testing import CliRunner
 
 from locust.commands import cli
 from locust.device.plant import VIDEO_TAIL_S, make_plant
-from locust.io.tracks_csv import MarkerColumns, TracksCsv
+from locust.io.tracks_csv import TracksCsv
 from locust.params import preset
 from locust.report.page import pct
 from locust.sim.live import PREROLL_S
@@ -50,8 +50,8 @@ def test_mujoco_plant_films_at_the_rate_asked(tmp_path):
 def _tracks(px, x_m):
     px, x_m = np.asarray(px, float), np.asarray(x_m, float)
     zero = np.zeros_like(px)
-    col = MarkerColumns("nose", px, zero, x_m, zero, np.ones(px.size, bool))
-    return TracksCsv(frame=np.arange(px.size), t_s=np.arange(px.size) / 60, markers={"nose": col})
+    return TracksCsv(frame=np.arange(px.size), t_s=np.arange(px.size) / 60, px={"nose": px}, py={"nose": zero},
+                     x_m={"nose": x_m}, y_m={"nose": zero}, ok={"nose": np.ones(px.size, bool)})
 
 
 def test_resolution_is_the_tracks_own_metres_per_pixel():

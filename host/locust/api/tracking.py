@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -11,8 +10,6 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import TrackError
-from ..io import trk as trk_io
-from ..io.importing import is_project
 from ..io.tracks_csv import TracksCsv
 
 
@@ -25,7 +22,7 @@ class Tracks:
     """
 
     tracks: TracksCsv
-    result: object | None = None     # locust.track.runner.TrackResult
+    result: object | None = None     # locust.track.runner.TrackResult: the job's, with the files it wrote
 
     @property
     def markers(self) -> list[str]:
@@ -68,7 +65,7 @@ class Tracks:
         cols["frame"] = t.frame.copy()
         for name in t.markers:
             if f"{name}_ok" in cols:
-                cols[f"{name}_ok"] = t.markers[name].ok.copy()
+                cols[f"{name}_ok"] = t.ok[name].copy()
         for name in t.markers_with_positions():
             for kind, values in t.derived(name).items():
                 cols.setdefault(f"{name}_{kind}", values)
@@ -93,12 +90,12 @@ class Tracks:
         import pandas as pd
 
         t, parts = self.tracks.t_s, []
-        for name in self.tracks.markers_with_positions():
-            m = self.tracks.markers[name]
-            x, y = self.tracks.positions(name)
+        tr = self.tracks
+        for name in tr.markers_with_positions():
+            x, y = tr.positions(name)
             parts.append(pd.DataFrame({
-                "frame": self.tracks.frame, "t_s": t, "marker": name, "x_px": m.px, "y_px": m.py, "x_m": x, "y_m": y,
-                "ok": m.ok, **self.tracks.derived(name)}))
+                "frame": tr.frame, "t_s": t, "marker": name, "x_px": tr.px[name], "y_px": tr.py[name], "x_m": x,
+                "y_m": y, "ok": tr.ok[name], **tr.derived(name)}))
         if not parts:
             return pd.DataFrame(columns=["frame", "t_s", "marker", "x_px", "y_px", "x_m", "y_m", "ok", "vx_m_per_s",
                                          "vy_m_per_s", "ax_m_per_s2", "ay_m_per_s2"])
@@ -156,91 +153,151 @@ class Tracks:
     def __repr__(self) -> str:
         t = self.tracks
         lines = [f"Tracks: {t.n_rows} frames, markers {', '.join(t.markers) or 'none'}"]
-        for name, m in t.markers.items():
-            lines.append(f"  {name}: found in {int(np.count_nonzero(m.ok))} of {len(m.ok)} frames")
+        for name, ok in t.ok.items():
+            lines.append(f"  {name}: found in {int(np.count_nonzero(ok))} of {len(ok)} frames")
         return "\n".join(lines)
 
 
-def _marker_specs(markers: Mapping[str, str] | Sequence[str] | None) -> list[str]:
-    from ..track.spec import default_specs
-
+def _marker_specs(markers: Mapping[str, str] | Sequence[str] | None) -> tuple[str, ...]:
     if markers is None:
-        return default_specs()
+        return ()   # the robot's nose and foot colours
     if isinstance(markers, Mapping):
-        return [f"{name}={spec}" for name, spec in markers.items()]
-    return list(markers)
+        return tuple(f"{name}={spec}" for name, spec in markers.items())
+    return tuple(markers)
 
 
-def _calibration(info, scale, origin, angle_deg: float, camera_json, pixels: str = "tracker"):
-    from ..io.camera_json import camera_json_beside
-    from ..track import calib, camera
+def _numbers(values: Sequence[float]) -> str:
+    """Numbers as the command line writes them (``1.5,2.0``), each exactly (a float's repr)."""
+    return ",".join(repr(float(v)) for v in values)
 
-    if camera_json is not None and (scale or origin):
-        raise TrackError("give camera_json or scale/origin, not both", "one calibration per run")
-    if camera_json is not None:
-        return camera.load(camera_json, info.width_px, info.height_px)
-    beside = camera_json_beside(info.path)
-    if scale is None and origin is None and beside.is_file():
-        return camera.load(beside, info.width_px, info.height_px)
-    m_per_px, source = float("nan"), "none"
-    if scale is not None:
-        x1, y1, x2, y2, length_m = (float(v) for v in scale)
-        m_per_px, source = calib.m_per_px_from_stick(x1, y1, x2, y2, length_m), f"stick {tuple(scale)}"
-    return calib.build(info.height_px, m_per_px, calib.typed_px(*origin, pixels) if origin is not None else None,
-                       angle_deg, source)
+
+def _scale_text(scale) -> str | None:
+    if scale is None or isinstance(scale, str):
+        return scale
+    *ends, length_m = scale
+    return f"{_numbers(ends)}={_numbers([length_m])}"
+
+
+def _aruco_text(scale_aruco) -> str | None:
+    if scale_aruco is None or isinstance(scale_aruco, str):
+        return scale_aruco
+    marker_id, side_m = scale_aruco
+    return f"{int(marker_id)}={_numbers([side_m])}"
+
+
+def _point_text(point) -> str | None:
+    return point if point is None or isinstance(point, str) else _numbers(point)
+
+
+def _plane_text(points) -> str | None:
+    if points is None or isinstance(points, str):
+        return points
+    return ";".join(f"{_numbers(px)}={_numbers(xy_m)}" for px, xy_m in points)
+
+
+def _path(value: str | Path | None) -> Path | None:
+    return None if value is None else Path(value)
 
 
 def track_markers(video: str | Path, markers: Mapping[str, str] | Sequence[str] | None = None, *,
-          scale: tuple[float, float, float, float, float] | None = None, origin: tuple[float, float] | None = None,
-          angle_deg: float = 0.0, camera_json: str | Path | None = None, start: int = 0, end: int | None = None,
-          step: int = 1, fps: float | None = None, color_tol: int = 80, search_px: int = 40,
-          pixels: str = "tracker", calibration_from: str | Path | None = None, trk: str | Path | None = None,
-          overwrite: bool = False, progress: Callable[[int], None] | None = None) -> Tracks:
+                  scale: tuple[float, float, float, float, float] | str | None = None,
+                  scale_aruco: tuple[int, float] | str | None = None, aruco_dict: str | None = None,
+                  board: str | None = None,
+                  plane_points: Sequence[tuple[tuple[float, float], tuple[float, float]]] | str | None = None,
+                  origin: tuple[float, float] | str | None = None, angle_deg: float = 0.0,
+                  camera_json: str | Path | None = None, calibration_from: str | Path | None = None,
+                  start: int = 0, end: int | None = None, step: int = 1, fps: float | None = None,
+                  color_tol: int = 80, search_px: int = 40, template_radius_px: int = 8, accept: float = 0.5,
+                  likeness: float = 0.5, evolve_percent: float = 20.0, pixels: str = "tracker",
+                  out: str | Path | None = None, fmt: str = "csv", overlay: str = "png",
+                  trk: str | Path | None = None, overwrite: bool = False,
+                  progress: Callable[[int], None] | None = None) -> Tracks:
     """Find markers in every frame of a video (or an image sequence), as Tracker's autotracker would.
+
+    The same job as ``locust track video`` (:func:`locust.track.pipeline.track_job`), with the
+    same options: with ``out`` it writes the same files (the tracks CSV, its JSON sidecar and
+    the overlay); without, only the tracks are returned (and ``trk`` written, if given).
 
     Parameters
     ----------
     video : path-like
-        An MP4 (or the first image of a numbered sequence), or a Tracker project (``.trk``,
-        ``.trz``) that opens one: its calibration and frame rate are then used.
-    markers : dict, optional
-        Name -> spec: ``color:#RRGGBB[@X,Y]``, ``template:X,Y@FRAME`` or ``aruco:ID``.
-        Default: the robot's nose (``#ff00ff``) and foot (``#00ffff``) colours.
-    scale : (x1, y1, x2, y2, length_m), optional
-        A calibration stick: two pixels and the distance between them in metres.
-    origin : (x, y), optional
+        An MP4 (or the first image of a numbered sequence, or its folder), or a Tracker project
+        (``.trk``, ``.trz``) that opens one: its calibration and frame rate are then used.
+    markers : dict or sequence of str, optional
+        Name -> spec (or ``"NAME=SPEC"`` strings, as ``--marker``): ``color:#RRGGBB[@X,Y]``,
+        ``template:X,Y@FRAME`` or ``aruco:ID[@DICT]``. Default: the robot's nose (``#ff00ff``)
+        and foot (``#00ffff``) colours.
+    scale : (x1, y1, x2, y2, length_m) or str, optional
+        A calibration stick: two pixels and the distance between them in metres
+        (``--scale``; the text ``"X1,Y1,X2,Y2=LENGTH_M"`` too).
+    scale_aruco : (id, side_m) or str, optional
+        An ArUco marker's printed side length [m], measured where it first appears
+        (``--scale-aruco``, ``"ID=SIDE_M"``).
+    aruco_dict : str, optional
+        The ArUco dictionary of ``scale_aruco``; default ``DICT_4X4_50`` (``--aruco-dict``'s).
+    board : str, optional
+        An ArUco grid board lying in the plane of motion, ``aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM``
+        (``--board``; :func:`locust.track.boardsheet.make_board` prints one): world metres in
+        that plane, origin at its bottom-left corner, perspective corrected.
+    plane_points : sequence of ((px, py), (x_m, y_m)) or str, optional
+        Instead of a board: four or more pixels with their measured plane coordinates [m]
+        (``--plane-points``, ``"PX,PY=X_M,Y_M;..."``).
+    origin : (x, y) or str, optional
         The world origin in pixels (default the centre of the bottom-left pixel).
     angle_deg : float, default 0
         Direction of the world x axis, degrees counter-clockwise from the image's.
     camera_json : path-like, optional
         The pinhole camera of a simulated video; default ``<video>.camera.json`` beside it,
-        used when no scale or origin is given (world metres through each marker's plane).
+        used when no scale, ArUco scale or origin is given (world metres through each marker's plane).
+    calibration_from : path-like, optional
+        A Tracker project (``.trk``/``.trz``) of the same camera: its calibration (scale,
+        origin, axes) and frame rate are used, as ``locust track video --calibration-from``.
     start, end, step : int
         The frames tracked (``end`` inclusive, default the last).
     fps : float, optional
         The true frame rate, for slow-motion footage; default the file's.
-    color_tol, search_px : int
-        Colour tolerance (0-255) and the search window's half size (px).
+    color_tol : int, default 80
+        Colour markers: largest per-channel difference (0-255) still counted as the marker.
+    search_px : int, default 40
+        Half-size of the search window around each predicted position [px].
+    template_radius_px : int, default 8
+        Template markers: radius of the circular template [px].
+    accept : float, default 0.5
+        Template markers: least peak height of a match.
+    likeness : float, default 0.5
+        Template markers: least correlation of a match with the template (-1 to 1).
+    evolve_percent : float, default 20
+        Template markers: percent of each accepted match blended into the template.
     pixels : {"tracker", "opencv"}, default "tracker"
-        Convention of the pixel positions given in ``markers``, ``scale`` and ``origin``:
+        Convention of the pixel positions given in ``markers``, ``scale``, ``origin`` and ``plane_points``:
         Tracker's (origin at the image's top-left corner, as Tracker's table shows them) or
         OpenCV's (origin at the top-left pixel's centre, 0.5 px from Tracker's). The returned
         pixel columns are OpenCV's.
-    calibration_from : path-like, optional
-        A Tracker project (``.trk``/``.trz``) of the same camera: its calibration (scale,
-        origin, axes) and frame rate are used, as ``locust track video --calibration-from``.
+    out : path-like, optional
+        Write the tracks file here (a file name, or a folder: ``<video>.tracks.csv`` in it; a
+        name ending in ``/`` is a folder, made if missing), with its sidecar and overlay.
+    fmt : {"csv", "tracker"}, default "csv"
+        The layout of the tracks file written to ``out`` (``--format``).
+    overlay : {"png", "video", "none"}, default "png"
+        The tracks drawn on the last frame, or on the whole clip, written beside ``out``.
     trk : path-like, optional
         Also write the tracks as a Tracker project (``.trk``) that opens the video with the
         clip's timing and calibration, one point mass per marker (``--trk`` of the command).
     overwrite : bool, default False
-        Replace an existing ``trk`` file; otherwise it is refused.
+        Replace existing outputs (``--force``); otherwise they are refused.
     progress : callable, optional
-        Called with 1 after each frame.
+        Called with 1 after each frame tracked (and each frame drawn, for an overlay video).
 
     Returns
     -------
     Tracks
-        ``.to_dataframe()``, ``.positions(marker)``, ``.write(path)``.
+        ``.to_dataframe()``, ``.positions(marker)``, ``.write(path)``; ``.result.written``: the
+        files written.
+
+    Raises
+    ------
+    locust.errors.TrackError
+        Bad input or options, a marker never found, or an output that may not be written.
 
     Examples
     --------
@@ -251,58 +308,30 @@ def track_markers(video: str | Path, markers: Mapping[str, str] | Sequence[str] 
     >>> hop.video("hop.mp4", overwrite=True, camera="fixed", width=320, height=240)  # doctest: +SKIP
     >>> locust.track_markers("hop.mp4").to_dataframe()[["t_s", "nose_x_m", "nose_y_m"]]  # doctest: +SKIP
     """
-    from ..track.export import tracks_of
-    from ..track.runner import track_video
-    from ..track.spec import ModelOptions, parse_markers
-    from ..track.video import Clip, probe
+    from ..track.aruco import DEFAULT_DICTIONARY
+    from ..track.outputs import out_path
+    from ..track.pipeline import TrackOptions, track_job
+    from ..track.spec import ModelOptions
 
-    video = Path(video)
-    project = _project(video, calibration_from, scale, origin, camera_json)
-    if project is not None and fps is None and math.isfinite(project.clip.fps):
-        fps = project.clip.fps
-    trk = _trk_target(trk, overwrite)
-    models = parse_markers(_marker_specs(markers),
-                           ModelOptions(color_tol=color_tol, search_half_px=search_px, pixels=pixels))
-    opened = trk_io.project_media(project) if project is not None and is_project(video) \
-        else contextlib.nullcontext(video)
-    with opened as media:
-        info = probe(Path(media))
-        clip = Clip(start, end, step, fps).resolved(info)
-        calibration = project.calibration if project is not None else \
-            _calibration(info, scale, origin, angle_deg, camera_json, pixels)
-        result = track_video(info, clip, models, calibration, progress=progress)
-        if trk is not None:
-            from ..track.trk import write_project
-
-            write_project(result, trk, trk_io.media_in_zip(project, trk) if media != video else None)
-    return Tracks(tracks_of(result), result)
+    model = ModelOptions(color_tol, search_px, template_radius_px, accept, evolve_percent / 100.0, likeness, pixels)
+    options = TrackOptions(
+        markers=_marker_specs(markers), model=model, start=start, end=end, step=step, fps=fps,
+        scale=_scale_text(scale), scale_aruco=_aruco_text(scale_aruco), aruco_dict=aruco_dict or DEFAULT_DICTIONARY,
+        board=board, plane_points=_plane_text(plane_points), camera_json=_path(camera_json), origin=_point_text(origin),
+        angle_deg=angle_deg, calibration_from=_path(calibration_from), out=out_path(out), files=out is not None,
+        force=overwrite, fmt=fmt, overlay=overlay, trk=_path(trk))
+    result = track_job(video, options, bars=_callback_bars(progress))
+    return Tracks(result.tracks, result)
 
 
-def _project(video: Path, calibration_from, scale, origin, camera_json):
-    """The Tracker project whose calibration is used: ``video`` itself when it is one, else
-    ``calibration_from``; refused beside another calibration."""
-    if is_project(video):
-        if calibration_from is not None:
-            raise TrackError("the video is a Tracker project: its calibration is used, leave out calibration_from",
-                             "or give the video itself")
-        project = trk_io.read_project(video)
-    else:
-        project = trk_io.read_project(calibration_from) if calibration_from is not None else None
-    if project is not None and (scale is not None or origin is not None or camera_json is not None):
-        raise TrackError("a Tracker project's calibration, or scale/origin/camera_json, not both",
-                         "one calibration per run")
-    return project
+def _callback_bars(progress: Callable[[int], None] | None):
+    """The job's progress as ``progress(steps)`` calls, whatever the stage."""
 
+    @contextlib.contextmanager
+    def bars(length: int, label: str):
+        yield progress or (lambda steps: None)
 
-def _trk_target(trk: str | Path | None, overwrite: bool) -> Path | None:
-    if trk is None:
-        return None
-    trk = Path(trk)
-    if trk.suffix.lower() != ".trk":
-        raise TrackError(f"trk={str(trk)!r}: a Tracker project is written as a .trk file", "e.g. trk='redo.trk'")
-    if trk.exists() and not overwrite:
-        raise TrackError(f"{trk} exists", "give another trk path, or overwrite=True to replace it")
-    return trk
+    return bars
 
 
 def read_tracks(path: str | Path, units: str = "m", rename: Mapping[str, str] | Sequence[str] = (),

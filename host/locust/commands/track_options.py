@@ -1,19 +1,19 @@
 """The options of ``locust track``'s subcommands, each defined once: the markers and their
-settings, the calibration, the clip, the output."""
+settings, the calibration, the clip, the output. ``locust track video``'s are named as the
+fields of :class:`locust.track.pipeline.TrackOptions`, which the command builds from them."""
 
 from __future__ import annotations
 
 import functools
-import math
-import os
 from pathlib import Path
 
 import click
 
-from ..errors import TrackError
 from ..track.aruco import DEFAULT_DICTIONARY
+from ..track.board import DEFAULT_BOARD
 from ..track.calib import PIXEL_CONVENTIONS, PIXELS_HELP
-from ..track.spec import ModelOptions, parse_markers
+from ..track.outputs import out_path
+from ..track.spec import ModelOptions
 from ..track.video import check_fps
 
 
@@ -28,20 +28,7 @@ def stacked(*options):
     return decorate
 
 
-def _out_path(ctx, param, value: str | None) -> Path | None:
-    """``--out``: a name ending in ``/`` is a folder, made if it is not there yet (a ``Path``
-    would drop the slash and name a file ``newdir.csv`` here instead)."""
-    if value is None:
-        return None
-    path = Path(value)
-    if value.endswith(("/", os.sep)) and not path.exists():
-        from ..fileio import make_folder
-
-        make_folder(path)
-    return path
-
-
-OUTPUT = [click.option("--out", type=click.Path(path_type=str), callback=_out_path,
+OUTPUT = [click.option("--out", type=click.Path(path_type=str), callback=lambda ctx, param, value: out_path(value),
                        help="Output file, or folder (ending in /: made if missing), its folder named on the first "
                             "line. Default: <input>.tracks.csv "
                             "(with .json) in the run folder the input sits in (run.json beside it), else in the "
@@ -52,15 +39,14 @@ FORMAT = [click.option("--format", "fmt", type=click.Choice(["csv", "tracker"]),
 
 
 def marker_options(func):
-    """``--marker``, ``--pixels`` and the matching settings; the command gets the markers as
-    ``models`` and the convention of typed pixel positions as ``pixels``."""
+    """``--marker``, ``--pixels`` and the matching settings; the command gets the ``NAME=SPEC``
+    strings as ``markers`` and the models' settings (the convention of typed pixel positions
+    among them) as ``model``, a :class:`~locust.track.spec.ModelOptions`."""
 
     @functools.wraps(func)
     def wrapper(*args, markers, color_tol, search_px, template_radius, accept, likeness, evolve, pixels, **kwargs):
-        if not math.isfinite(accept):
-            raise TrackError(f"--accept {accept}: not a finite number", "give --accept as a plain number, see --help")
-        options = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0, likeness, pixels)
-        return func(*args, models=parse_markers(list(markers), options), pixels=pixels, **kwargs)
+        model = ModelOptions(color_tol, search_px, template_radius, accept, evolve / 100.0, likeness, pixels)
+        return func(*args, markers=tuple(markers), model=model, **kwargs)
 
     return stacked(
         click.option("--marker", "markers", multiple=True, metavar="NAME=SPEC",
@@ -96,7 +82,7 @@ CALIBRATION = [
                  help="Calibrate from an ArUco marker's printed side length (m), measured where it first appears."),
     click.option("--aruco-dict", default=DEFAULT_DICTIONARY, show_default=True,
                  help="ArUco dictionary for --scale-aruco."),
-    click.option("--board", "board_text", metavar="aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM",
+    click.option("--board", metavar="aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM",
                  help="An ArUco grid board lying in the plane of motion (see `locust track board`): world x_m/y_m "
                       "in that plane, origin at the board's bottom-left corner, y up, with perspective corrected. "
                       "E.g. aruco:4X4_50:5x4:40:10."),
@@ -107,7 +93,7 @@ CALIBRATION = [
                       "Default: <video>.camera.json beside the video, "
                       "used when no --scale/--scale-aruco/--origin is given."),
     click.option("--origin", metavar="X,Y", help="World origin in pixels. Default: centre of the bottom-left pixel."),
-    click.option("--angle", default=0.0, show_default=True, type=float,
+    click.option("--angle", "angle_deg", default=0.0, show_default=True, type=float,
                  help="Direction of the world x axis, degrees counter-clockwise from the image x axis (as Tracker)."),
     click.option("--calibration-from", type=click.Path(dir_okay=False, path_type=Path),
                  help="Track in the coordinates of a Tracker project (.trk or .trz): its scale, origin and axes, and "
@@ -121,3 +107,24 @@ CLIP = [
                  help="True frame rate (1 to 10000 frames/s), for slow-motion footage whose file rate is wrong. "
                       "Default: the file's rate."),
 ]
+VIDEO = [*CALIBRATION, *CLIP, *OUTPUT, *FORMAT,
+    click.option("--overlay", type=click.Choice(["png", "video", "none"]), default="png", show_default=True,
+                 help="Draw the tracks on the last frame (png) or on the whole clip (video)."),
+    click.option("--trk", type=click.Path(dir_okay=False, path_type=Path),
+                 help="Also write the tracks as a Tracker project (.trk) that opens the video or image sequence with "
+                      "the clip's timing and calibration, one point mass per marker: correct frames by hand in "
+                      "Tracker."),
+]
+IMPORT = [click.option("--track", "trk_names", multiple=True, metavar="NAME",
+                       help="A Tracker project converted as it is: only these of its tracks (repeatable)."), *OUTPUT]
+FROM_TRK = [click.option("--track", "trk_names", multiple=True, metavar="NAME",
+                         help="Only these Tracker tracks (repeatable). Default: all point masses."), *OUTPUT, *FORMAT]
+BOARD = [
+    click.option("--board", "board_text", default=DEFAULT_BOARD, show_default=True,
+                 metavar="aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM", help="The ArUco grid board."),
+    click.option("--check", "photo", type=click.Path(dir_okay=False, path_type=Path), default=None,
+                 help="Measure PHOTO, the printed board with an ID-1 card (a bank or ID card, 85.60 x 53.98 mm) lying "
+                      "flat beside it, and say by how much the printer scaled the board."),
+    click.option("--force", is_flag=True, help="Replace an existing PNG and PDF."),
+]
+PREVIEW_FRAME = click.option("--frame", default=0, show_default=True, type=int, help="The frame to show.")

@@ -47,7 +47,7 @@ import numpy as np
 from ..errors import TrackError
 from .delimited import DelimitedText, check_names, read_text, split_text
 from .tracker_text import DEFAULT_TRACK, TrackerExport
-from .tracks_csv import MarkerColumns, TracksCsv, _marker_column, is_tracks_header
+from .tracks_csv import TracksCsv, _marker_column, is_tracks_header
 
 UNITS: dict[str, int] = {"m": 1, "cm": 100, "mm": 1000}   # the file's unit -> that many to a metre
 UNNAMED = "nose"                                          # the marker of a track with no name
@@ -353,8 +353,7 @@ def tracks_from_delimited(doc: DelimitedText, options: ImportOptions = AS_IS) ->
     note = f"imported from {doc.path.name} ({LAYOUT_NAMES['txy' if plain else layout]}): {options.describe()}"
     if dropped:
         note += f"; not imported: {', '.join(dropped)}"
-    return TracksCsv(frame=np.arange(len(t_s)), t_s=t_s, markers=markers, comments=(*doc.comments, note),
-                     path=doc.path)
+    return TracksCsv(frame=np.arange(len(t_s)), t_s=t_s, **markers, comments=(*doc.comments, note), path=doc.path)
 
 
 def check_times(doc: DelimitedText, t_s) -> None:
@@ -399,13 +398,13 @@ def _tracker_markers(doc: DelimitedText):
     export = TrackerExport.from_delimited(doc)
     written_names = {c.strip() for c in (doc.names_row or [])}
     columns, dropped = [], []
-    for key, track in export.tracks.items():
-        if track.x_m is None or track.y_m is None:
-            dropped.append(f"{track.name} (no x and y)")
+    for key, name in export.names.items():
+        if export.x_m[key] is None or export.y_m[key] is None:
+            dropped.append(f"{name} (no x and y)")
             continue
-        unnamed = track.name == DEFAULT_TRACK and DEFAULT_TRACK not in written_names
-        columns.append((UNNAMED if unnamed else key, None if unnamed else track.name, track.x_m, track.y_m))
-        dropped += [f"{track.name} {h}" for h in track.other]
+        unnamed = name == DEFAULT_TRACK and DEFAULT_TRACK not in written_names
+        columns.append((UNNAMED if unnamed else key, None if unnamed else name, export.x_m[key], export.y_m[key]))
+        dropped += [f"{name} {h}" for h in export.other[key]]
     return ([export.time_s(), *columns] if columns else []), dropped
 
 
@@ -445,14 +444,15 @@ def _renames(path: Path, names: list[tuple[str, str | None]], options: ImportOpt
     return final
 
 
-def _apply(path: Path, columns: list, options: ImportOptions) -> dict[str, MarkerColumns]:
+def _apply(path: Path, columns: list, options: ImportOptions) -> dict[str, dict[str, np.ndarray]]:
+    """The markers' columns (px, py, x_m, y_m, ok: :class:`.tracks_csv.TracksCsv`'s), renamed, in metres."""
     final = _renames(path, [(name, written) for name, written, _, _ in columns], options)
-    out: dict[str, MarkerColumns] = {}
+    out: dict[str, dict[str, np.ndarray]] = {"px": {}, "py": {}, "x_m": {}, "y_m": {}, "ok": {}}
     for new, (_, _, x, y) in zip(final, columns):
         x_m, y_m = _to_metres(x, options), np.asarray(y, dtype=float) / options.divisor
-        ok = np.isfinite(x_m) | np.isfinite(y_m)        # a step with either value, as Tracker wrote it
-        nan = np.full(len(x_m), np.nan)
-        out[new] = MarkerColumns(new, nan, nan.copy(), x_m, y_m, ok)
+        out["px"][new], out["py"][new] = np.full(len(x_m), np.nan), np.full(len(x_m), np.nan)
+        out["x_m"][new], out["y_m"][new] = x_m, y_m
+        out["ok"][new] = np.isfinite(x_m) | np.isfinite(y_m)        # a step with either value, as Tracker wrote it
     return out
 
 
@@ -464,13 +464,15 @@ def _to_metres(x, options: ImportOptions) -> np.ndarray:
 def _convert_tracks_csv(tracks: TracksCsv, options: ImportOptions) -> TracksCsv:
     names = list(tracks.markers)
     final = dict(zip(names, _renames(tracks.path, [(n, None) for n in names], options)))
-    markers = {final[n]: replace(m, name=final[n], x_m=_to_metres(m.x_m, options), y_m=m.y_m / options.divisor)
-               for n, m in tracks.markers.items()}
+    renamed = {kind: {final[n]: column for n, column in getattr(tracks, kind).items()}
+               for kind in ("px", "py", "ok")}
+    renamed["x_m"] = {final[n]: _to_metres(x, options) for n, x in tracks.x_m.items()}
+    renamed["y_m"] = {final[n]: y / options.divisor for n, y in tracks.y_m.items()}
     header = None
     if tracks.header is not None:
         header = tuple(f"{final[mk[0]]}_{mk[1]}" if (mk := _marker_column(h)) and mk[0] in final else h
                        for h in tracks.header)
-    return replace(tracks, markers=markers, header=header,
+    return replace(tracks, **renamed, header=header,
                    comments=(*tracks.comments, f"converted from {tracks.path.name if tracks.path else 'tracks'}: "
                                                f"{options.describe()}"))
 

@@ -35,54 +35,55 @@ DEFAULT_TRACK = "track"   # the name of columns no title or names row claims
 
 
 @dataclass(frozen=True, eq=False)
-class TrackerTrack:
-    """One track of an export: its name as Tracker wrote it and its columns (NaN where empty).
-
-    ``t_s`` is the track's own ``t`` column, or the table's shared one; a column the export
-    does not have is None. ``other`` holds further columns (``v``, ``vx``, ``theta`` ...)
-    under Tracker's header names.
-    """
-
-    name: str
-    t_s: np.ndarray | None
-    x_m: np.ndarray | None
-    y_m: np.ndarray | None
-    other: dict[str, np.ndarray] = field(default_factory=dict)
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, TrackerTrack):
-            return NotImplemented
-        return (self.name == other.name
-                and all(same_array(getattr(self, c), getattr(other, c)) for c in ("t_s", "x_m", "y_m"))
-                and self.other.keys() == other.other.keys()
-                and all(same_array(v, other.other[k]) for k, v in self.other.items()))
-
-    __hash__ = None  # type: ignore[assignment]
-
-
-@dataclass(frozen=True, eq=False)
 class TrackerExport:
     """A Tracker text export: its tracks by marker name, and its ``#`` comment lines.
 
-    Equality compares the contents (NaN equal to NaN), not ``path``.
+    A track's columns are held by kind, each a dict over the same marker names in the file's
+    order: ``names`` its name as Tracker wrote it (``cup 3`` for the marker ``cup_3``),
+    ``t_s`` its own ``t`` column or the table's shared one, ``x_m``, ``y_m`` (NaN where
+    empty; None for a column the export does not have), and ``other`` its further columns
+    (``v``, ``vx``, ``theta`` ...) under Tracker's header names. Equality compares the
+    contents (NaN equal to NaN), not ``path``.
     """
 
-    tracks: dict[str, TrackerTrack]
+    names: dict[str, str]
+    t_s: dict[str, np.ndarray | None]
+    x_m: dict[str, np.ndarray | None]
+    y_m: dict[str, np.ndarray | None]
+    other: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
     comments: tuple[str, ...] = ()
     path: Path | None = None
+
+    def __post_init__(self) -> None:
+        markers = list(self.names)
+        if any(list(kind) != markers for kind in (self.t_s, self.x_m, self.y_m)) or \
+                not set(self.other) <= set(markers):
+            raise TrackError("a Tracker export's names, t_s, x_m and y_m name different tracks",
+                             "give each track its name and its t, x and y (None for a column it has not)")
+        object.__setattr__(self, "other", {m: dict(self.other.get(m, {})) for m in markers})   # one per track
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, TrackerExport):
             return NotImplemented
-        return self.tracks == other.tracks and self.comments == other.comments
+        return (self.names == other.names and self.comments == other.comments
+                and all(same_array(getattr(self, kind)[m], getattr(other, kind)[m])
+                        for kind in ("t_s", "x_m", "y_m") for m in self.names)
+                and all(self.other[m].keys() == other.other[m].keys()
+                        and all(same_array(v, other.other[m][k]) for k, v in self.other[m].items())
+                        for m in self.names))
 
     __hash__ = None  # type: ignore[assignment]
 
     @property
+    def markers(self) -> tuple[str, ...]:
+        """The tracks' marker names, in the file's order."""
+        return tuple(self.names)
+
+    @property
     def n_rows(self) -> int:
         """The longest track's number of rows."""
-        lengths = [len(a) for t in self.tracks.values() for a in (t.t_s, t.x_m, t.y_m, *t.other.values())
-                   if a is not None]
+        lengths = [len(a) for m in self.names
+                   for a in (self.t_s[m], self.x_m[m], self.y_m[m], *self.other[m].values()) if a is not None]
         return max(lengths, default=0)
 
     @property
@@ -111,7 +112,7 @@ class TrackerExport:
         -------
         list of str
         """
-        return [m for m, t in self.tracks.items() if t.x_m is not None and t.y_m is not None]
+        return [m for m in self.names if self.x_m[m] is not None and self.y_m[m] is not None]
 
     def time_s(self) -> np.ndarray:
         """The time of each row: the tracks' ``t`` columns as one, which must agree where
@@ -123,9 +124,9 @@ class TrackerExport:
             [s].
         """
         times: list[np.ndarray] = []
-        for t in self.tracks.values():
-            if t.t_s is not None and not any(t.t_s is s for s in times):
-                times.append(t.t_s)
+        for t in self.t_s.values():
+            if t is not None and not any(t is s for s in times):
+                times.append(t)
         if not times:
             raise missing_time(self.path, self.columns)
         out = times[0].copy()
@@ -155,10 +156,9 @@ class TrackerExport:
         locust.errors.TrackError
             No such marker.
         """
-        track = self.tracks.get(marker)
-        if track is None or track.x_m is None or track.y_m is None:
+        if marker not in self.markers_with_positions():
             raise no_marker(self.path, marker, self.markers_with_positions())
-        return track.x_m.copy(), track.y_m.copy()
+        return self.x_m[marker].copy(), self.y_m[marker].copy()
 
     def has_pixels(self, marker: str) -> bool:
         """Always False: a text export holds world values only.
@@ -175,14 +175,14 @@ class TrackerExport:
 
     def _labelled(self) -> dict[str, np.ndarray]:
         out: dict[str, np.ndarray] = {}
-        if any(t.t_s is not None for t in self.tracks.values()):
+        if any(t is not None for t in self.t_s.values()):
             out["t_s"] = self.time_s()
-        for marker, t in self.tracks.items():
-            if t.x_m is not None:
-                out[f"{marker}_x_m"] = t.x_m
-            if t.y_m is not None:
-                out[f"{marker}_y_m"] = t.y_m
-            out.update({f"{marker}_{marker_name(h)}": v for h, v in t.other.items()})
+        for marker in self.names:
+            if self.x_m[marker] is not None:
+                out[f"{marker}_x_m"] = self.x_m[marker]
+            if self.y_m[marker] is not None:
+                out[f"{marker}_y_m"] = self.y_m[marker]
+            out.update({f"{marker}_{marker_name(h)}": v for h, v in self.other[marker].items()})
         return out
 
     @classmethod
@@ -225,9 +225,10 @@ class TrackerExport:
                 g[h] = data[:, j]
             else:
                 g["other"][h] = data[:, j]
-        tracks = {m: TrackerTrack(g["name"], g.get("t", shared), g.get("x"), g.get("y"), g["other"])
-                  for m, g in groups.items() if "x" in g or "y" in g or g["other"]}   # not a lone shared t
-        return cls(tracks=tracks, comments=doc.comments, path=doc.path)
+        kept = [m for m, g in groups.items() if "x" in g or "y" in g or g["other"]]   # not a lone shared t
+        return cls(names={m: groups[m]["name"] for m in kept}, t_s={m: groups[m].get("t", shared) for m in kept},
+                   x_m={m: groups[m].get("x") for m in kept}, y_m={m: groups[m].get("y") for m in kept},
+                   other={m: groups[m]["other"] for m in kept}, comments=doc.comments, path=doc.path)
 
 
 def marker_name(name: str) -> str:
@@ -259,10 +260,10 @@ def tracker_export_text(export: TrackerExport) -> str:
     names: list[str] = []
     heads: list[str] = []
     cols: list[np.ndarray] = []
-    for track in export.tracks.values():
-        parts = [(h, v) for h, v in (("t", track.t_s), ("x", track.x_m), ("y", track.y_m), *track.other.items())
-                 if v is not None]
-        names += [track.name] + [""] * (len(parts) - 1)
+    for m, name in export.names.items():
+        parts = [(h, v) for h, v in (("t", export.t_s[m]), ("x", export.x_m[m]), ("y", export.y_m[m]),
+                                     *export.other[m].items()) if v is not None]
+        names += [name] + [""] * (len(parts) - 1)
         heads += [h for h, _ in parts]
         cols += [np.asarray(v, dtype=float) for _, v in parts]
     lines = [f"# {c}" for c in export.comments] + ["\t".join(names), "\t".join(heads)]

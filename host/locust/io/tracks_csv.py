@@ -74,48 +74,49 @@ def tracks_csv_in(folder: Path, source: Path) -> Path:
 
 
 @dataclass(frozen=True, eq=False)
-class MarkerColumns:
-    """One marker's columns: pixels (OpenCV convention), world metres (y up), found or not."""
-
-    name: str
-    px: np.ndarray
-    py: np.ndarray
-    x_m: np.ndarray
-    y_m: np.ndarray
-    ok: np.ndarray          # bool: found in that frame
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, MarkerColumns):
-            return NotImplemented
-        return self.name == other.name and all(same_array(getattr(self, c), getattr(other, c)) for c in MARKER_COLUMNS)
-
-    __hash__ = None  # type: ignore[assignment]
-
-
-@dataclass(frozen=True, eq=False)
 class TracksCsv:
     """A tracks CSV: per frame its index and time, per marker its columns, and the file's notes.
 
-    Equality compares the contents (NaN equal to NaN), not ``path`` or ``header``.
+    A marker's columns are held by kind, as the file names them (``nose_x_m`` is
+    ``x_m["nose"]``): ``px``, ``py`` in pixels (OpenCV convention), ``x_m``, ``y_m`` in world
+    metres (y up) and ``ok`` (bool: found in that frame), each a dict over the same markers in
+    the file's order. Equality compares the contents (NaN equal to NaN), not ``path`` or ``header``.
     """
 
     frame: np.ndarray                                       # int, video frame index
     t_s: np.ndarray                                         # seconds since the clip's first frame
-    markers: dict[str, MarkerColumns]
+    px: dict[str, np.ndarray] = field(default_factory=dict)
+    py: dict[str, np.ndarray] = field(default_factory=dict)
+    x_m: dict[str, np.ndarray] = field(default_factory=dict)
+    y_m: dict[str, np.ndarray] = field(default_factory=dict)
+    ok: dict[str, np.ndarray] = field(default_factory=dict)
     comments: tuple[str, ...] = ()                          # the ``#`` lines, without the ``#``
     other: dict[str, np.ndarray] = field(default_factory=dict)   # columns of no marker, as read
     path: Path | None = None                                # where it was read from
     header: tuple[str, ...] | None = None                   # the columns as read (None: as written)
 
+    def __post_init__(self) -> None:
+        names = list(self.ok)
+        if any(list(getattr(self, kind)) != names for kind in MARKER_COLUMNS):
+            raise TrackError("a tracks CSV's px, py, x_m, y_m and ok name different markers",
+                             "give each marker all five columns, in one order")
+
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, TracksCsv):
             return NotImplemented
         return (same_array(self.frame, other.frame) and same_array(self.t_s, other.t_s)
-                and self.markers == other.markers and self.comments == other.comments
+                and set(self.markers) == set(other.markers) and self.comments == other.comments
+                and all(same_array(getattr(self, kind)[m], getattr(other, kind)[m])
+                        for kind in MARKER_COLUMNS for m in self.markers)
                 and self.other.keys() == other.other.keys()
                 and all(same_array(v, other.other[k]) for k, v in self.other.items()))
 
     __hash__ = None  # type: ignore[assignment]
+
+    @property
+    def markers(self) -> tuple[str, ...]:
+        """The markers' names, in the file's order."""
+        return tuple(self.ok)
 
     @property
     def n_rows(self) -> int:
@@ -159,7 +160,7 @@ class TracksCsv:
         if marker in self.markers:
             if kind in DERIVED_COLUMNS:
                 return self.derived(marker)[kind]
-            return getattr(self.markers[marker], kind).astype(float)
+            return getattr(self, kind)[marker].astype(float)
         raise KeyError(name)
 
     def markers_with_positions(self) -> list[str]:
@@ -202,8 +203,8 @@ class TracksCsv:
         """
         if marker not in self.markers_with_positions():
             raise no_marker(self.path, marker, self.markers_with_positions())
-        m = self.markers[marker]
-        return np.where(m.ok, m.x_m, np.nan), np.where(m.ok, m.y_m, np.nan)
+        ok = self.ok[marker]
+        return np.where(ok, self.x_m[marker], np.nan), np.where(ok, self.y_m[marker], np.nan)
 
     def derived(self, marker: str) -> dict[str, np.ndarray]:
         """``marker``'s velocity and acceleration (Tracker's finite differences on the world
@@ -238,8 +239,7 @@ class TracksCsv:
         -------
         bool
         """
-        m = self.markers.get(marker)
-        return m is not None and bool(np.isfinite(m.px).any())
+        return marker in self.px and bool(np.isfinite(self.px[marker]).any())
 
     @classmethod
     def from_delimited(cls, doc: DelimitedText) -> TracksCsv:
@@ -279,11 +279,9 @@ class TracksCsv:
             elif split[1] not in DERIVED_COLUMNS:       # derived: computed again from the positions
                 markers.setdefault(split[0], {})[split[1]] = values
         nan = np.full(n, np.nan)
-        return cls(frame=frame.astype(int), t_s=cols.get("t_s", nan.copy()),
-                   markers={m: MarkerColumns(m, c.get("px", nan.copy()), c.get("py", nan.copy()),
-                                             c.get("x_m", nan.copy()), c.get("y_m", nan.copy()),
-                                             c["ok"] > 0.5 if "ok" in c else np.ones(n, bool))
-                            for m, c in markers.items()},
+        kinds = {kind: {m: c.get(kind, nan.copy()) for m, c in markers.items()} for kind in ("px", "py", "x_m", "y_m")}
+        ok = {m: c["ok"] > 0.5 if "ok" in c else np.ones(n, bool) for m, c in markers.items()}
+        return cls(frame=frame.astype(int), t_s=cols.get("t_s", nan.copy()), **kinds, ok=ok,
                    comments=doc.comments, other=other, path=doc.path, header=tuple(names))
 
 
@@ -305,13 +303,13 @@ def tracks_csv_text(tracks: TracksCsv) -> str:
     t_text = _cells(tracks.t_s, 6)
     cols = [[str(int(f)) for f in np.asarray(tracks.frame).tolist()], t_text]
     t_written = _parsed(t_text)
-    for m in tracks.markers.values():
-        head += [f"{m.name}_{c}" for c in (*MARKER_COLUMNS, *DERIVED_COLUMNS)]
-        x_text, y_text = _cells(m.x_m, 6), _cells(m.y_m, 6)
-        ok = ["1" if v else "0" for v in np.asarray(m.ok).tolist()]
-        cols += [_cells(m.px, 4), _cells(m.py, 4), x_text, y_text, ok]
+    for m in tracks.markers:
+        head += [f"{m}_{c}" for c in (*MARKER_COLUMNS, *DERIVED_COLUMNS)]
+        x_text, y_text = _cells(tracks.x_m[m], 6), _cells(tracks.y_m[m], 6)
+        ok = ["1" if v else "0" for v in np.asarray(tracks.ok[m]).tolist()]
+        cols += [_cells(tracks.px[m], 4), _cells(tracks.py[m], 4), x_text, y_text, ok]
         # from the positions as written, so that reading the file gives these very numbers back
-        x, y = (np.where(m.ok, _parsed(c), np.nan) for c in (x_text, y_text))
+        x, y = (np.where(tracks.ok[m], _parsed(c), np.nan) for c in (x_text, y_text))
         cols += [_cells(v, digits) for v, digits in zip(_derived(t_written, x, y).values(), _DERIVED_DIGITS)]
     for name, values in tracks.other.items():
         head.append(name)

@@ -37,7 +37,7 @@ import numpy as np
 
 from ..errors import TrackError
 from ..fileio import atomic_write_text
-from .tracks_csv import MarkerColumns, TracksCsv
+from .tracks_csv import TracksCsv
 from .trz import MAX_TRK_BYTES, open_trz, read_member, unpack_members
 
 TRACKER_TO_OPENCV_PX = -0.5
@@ -458,11 +458,10 @@ def project_tracks(project: TrackerProject, names: list[str] | None = None) -> T
         A name the project does not hold.
     """
     frames, t_s, tracks = project_points(project, names)
-    markers = {}
-    for tr in tracks:
-        x_m, y_m = project.calibration.to_world(tr.px, tr.py)
-        markers[tr.name] = MarkerColumns(tr.name, tr.px, tr.py, x_m, y_m, tr.ok)
-    return TracksCsv(frame=frames, t_s=t_s, markers=markers)
+    world = {tr.name: project.calibration.to_world(tr.px, tr.py) for tr in tracks}
+    return TracksCsv(frame=frames, t_s=t_s, px={tr.name: tr.px for tr in tracks}, py={tr.name: tr.py for tr in tracks},
+                     x_m={m: w[0] for m, w in world.items()}, y_m={m: w[1] for m, w in world.items()},
+                     ok={tr.name: tr.ok for tr in tracks})
 
 
 def _safe_name(name: str) -> str:

@@ -112,7 +112,7 @@ def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int 
     """
     from ..io.run_record import COMPLETE, HopSchedule, Phase, RunRecord
     from ..io.run_record import write as write_record
-    from ..io.tracks_csv import MarkerColumns, TracksCsv, write_tracks_csv
+    from ..io.tracks_csv import TracksCsv, write_tracks_csv
 
     result, trace = truth or simulated_nose(robot, cycles)
     rng = np.random.default_rng(seed)
@@ -125,8 +125,8 @@ def write_synthetic_trial(folder: Path, robot: Robot, cycles: int, *, seed: int 
     nan = np.full(t_sched.size, np.nan)
     tracks = TracksCsv(
         frame=np.arange(t_sched.size), t_s=np.arange(t_sched.size) / fps,
-        markers={"nose": MarkerColumns("nose", px=nan, py=nan, x_m=np.where(ok, x, np.nan),
-                                       y_m=np.where(ok, y, np.nan), ok=ok)},
+        px={"nose": nan}, py={"nose": nan}, x_m={"nose": np.where(ok, x, np.nan)},
+        y_m={"nose": np.where(ok, y, np.nan)}, ok={"nose": ok},
         comments=(f"synthetic: simulated nose of robot {robot.name!r}, {cycles} cycles, {fps:g} frames/s, "
                   f"noise {noise_m * 1000:g} mm sd, seed {seed}",))
     folder = Path(folder)

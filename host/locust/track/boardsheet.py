@@ -20,8 +20,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..arucoboard import BOARD_MARGIN_MM, BoardSpec
+from ..errors import TrackError
 from ..fileio import atomic_write_bytes
 from ..plotting import CREATOR, pyplot
+from .outputs import Say, quiet, refuse_overwrite, say_folder
 
 SHEET_DPI = 300
 BAR_MM = 100.0
@@ -202,3 +204,45 @@ def pdf_beside(png: Path) -> Path:
     Path
     """
     return png.with_suffix(".pdf")
+
+
+def make_board(png: Path | None, spec: BoardSpec, force: bool = False, say: Say = quiet) -> str:
+    """``locust track board PNG``: write the sheet as ``png`` and the PDF beside it, never over
+    an existing file without ``force``.
+
+    Parameters
+    ----------
+    png : Path or None
+        The PNG to write (a ``.pdf`` names the PDF: the PNG goes beside it); None is refused.
+    spec : BoardSpec
+        The board.
+    force : bool
+        Replace an existing PNG and PDF.
+    say : callable
+        Told the output folder.
+
+    Returns
+    -------
+    str
+        What to print: the files written, the sheet's size and how to print it.
+
+    Raises
+    ------
+    locust.errors.TrackError
+        No PNG, a name that is neither .png nor .pdf, or an existing output without ``force``.
+    """
+    if png is None:
+        raise TrackError("give the PNG to write, or --check PHOTO", "e.g. locust track board board.png")
+    if png.suffix.lower() not in (".png", ".pdf"):
+        raise TrackError(f"{png}: the board is written as a .png, with a .pdf beside it",
+                         f"e.g. locust track board {png.with_suffix('.png').name}")
+    png = png.with_suffix(".png") if png.suffix.lower() == ".pdf" else png
+    pdf = pdf_beside(png)
+    say_folder(png, say)
+    refuse_overwrite({"board": png, "pdf": pdf}, force)
+    write_board_sheet(png, spec)
+    lay = layout(spec)
+    return (f"wrote {png} ({SHEET_DPI} DPI) and {pdf} ({lay.width_mm:.1f} x {lay.height_mm:.1f} mm "
+            f"page): board {spec.text()}, {spec.width_mm:g} x {spec.height_mm:g} mm of markers; print at 100 % "
+            f"(no fit to page), check the scale bar is 100 mm (or `locust track board --check PHOTO`), lay it "
+            f"flat in the plane of motion")

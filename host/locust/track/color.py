@@ -4,8 +4,8 @@ Colour picks the marker and locates it. Pixels within ``tolerance`` of the marke
 (largest channel difference, 0-255) form the core; the marker is the connected core blob
 nearest the predicted position (the largest one when there is no prediction). Its centre
 is the centroid of each pixel's *coverage* -- the fraction of the pixel the sticker
-covers -- over the blob grown by two pixels, so anti-aliased edge pixels count by the
-share they hold. Coverage is estimated from luma, which codecs keep at full resolution
+covers -- over the blob grown by two pixels (:mod:`.coverage`), so anti-aliased edge pixels
+count by the share they hold. Coverage is estimated from luma, which codecs keep at full resolution
 (4:2:0 halves the colour planes), where the surround is uniform; around a textured surround
 (a ruler's marks) from chroma (the pixel's colour less its grey level) between the local
 background's and the sticker's, so the texture weighs nothing.
@@ -23,14 +23,30 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, field
-from typing import NamedTuple
 
 import cv2
 import numpy as np
 
 from ..errors import TrackError
+from .blobs import (
+    BlobShape,
+    along,
+    blob_shape,
+    contours,
+    every,
+    filled,
+    labelled_blobs,
+    median_of,
+    on_image_border,
+    touches_edge,
+)
+from .coverage import RING_PX, coverage_centroid
 from .detection import Detection, window
-from .predict import MarkerPath
+from .predict import MotionFit
+
+JUDGE_EVERY = 4   # a marker found as usual has its shape and colour judged every this many frames
+FIRST_SIGHTING_MIN_PX = 3.0   # least width of a first sighting: a 2 x 2 speck (2.3 px) is noise, not a sticker
+DISC_FILL = 0.65  # least share of its box a blob taken as usual fills (a disc: pi/4, 0.79)
 
 
 def parse_hex(colour: str) -> tuple[int, int, int]:
@@ -117,7 +133,7 @@ class ColorMarker:
         Where to look for the sticker until it is first seen [px]; None: the whole frame.
     hue_tol_deg : float
         Largest hue difference from the marker's colour [deg].
-    track : MarkerPath
+    motion : MotionFit
         Its positions so far, for the prediction.
     frame_hsv : FrameHSV
         The frame's HSV picture, shared by the markers of one run.
@@ -132,7 +148,7 @@ class ColorMarker:
     partial_fraction: float = 0.6  # below this share of the usual area: partly hidden
     start_px: tuple[float, float] | None = None
     hue_tol_deg: float = 16.0
-    track: MarkerPath = field(default_factory=MarkerPath)
+    motion: MotionFit = field(default_factory=MotionFit)
     _areas: deque = field(default_factory=lambda: deque(maxlen=15))
     _widths: deque = field(default_factory=lambda: deque(maxlen=15))
     _usual_area: float = 0.0       # median of _areas (round, whole blobs), kept up to date
@@ -179,9 +195,9 @@ class ColorMarker:
             sightings).
         """
         det = self._find(frame, image_bgr) or Detection.missing(0.0)
-        if det.ok and self.track.last_frame is None:
+        if det.ok and self.motion.last_frame is None:
             self._note_distractors(image_bgr, det)
-        self.track.add(frame, det.point())
+        self.motion.add(frame, det.point())
         return det
 
     def _note_distractors(self, image: np.ndarray, marker: Detection) -> None:
@@ -197,18 +213,18 @@ class ColorMarker:
         h, w = image.shape[:2]
         seen = set()
         hsv = self.frame_hsv.of(self._frame, image, 2)
-        for c in _contours(self._widest(every(image, 2) if self._hsv is None else None, hsv)):
+        for c in contours(self._widest(every(image, 2) if self._hsv is None else None, hsv)):
             x, y, bw, bh = cv2.boundingRect(c)
             x0, y0, x1, y1 = max(2 * x - 2, 0), max(2 * y - 2, 0), min(2 * (x + bw) + 2, w), min(2 * (y + bh) + 2, h)
             roi = image[y0:y1, x0:x1]
-            for piece in _contours(self._widest(roi)):
+            for piece in contours(self._widest(roi)):
                 bx, by, bw, bh = cv2.boundingRect(piece)
                 box = (bx + x0, by + y0, bw, bh)
                 if box in seen:
                     continue
                 seen.add(box)
                 if bw * bh >= self.min_area_px and not self._in_zone(box, marker.px, marker.py) \
-                        and self._has_own_colour(self._blob_hs(roi, _filled(piece, (bx, by, bw, bh)), bx, by)):
+                        and self._has_own_colour(self._blob_hs(roi, filled(piece, (bx, by, bw, bh)), bx, by)):
                     self._distractors.append(box)
 
     def _widest(self, roi: np.ndarray | None, hsv: np.ndarray | None = None) -> np.ndarray:
@@ -227,11 +243,11 @@ class ColorMarker:
                 return self._locate_in(image, (0, 0, image.shape[1], image.shape[0]), None)
             return self._locate_in(image, window(self.start_px, 2 * self.search_half_px * self._tries, image.shape),
                                    self.start_px)
-        centre, self._velocity = self.track.predict_motion(frame)
-        lost = self._lost = self.track.frames_lost(frame)
+        centre, self._velocity = self.motion.predict_motion(frame)
+        lost = self._lost = self.motion.frames_lost(frame)
         self._speed = math.hypot(*self._velocity)
         if lost:
-            self._speed = max(self._speed, self.track.max_speed_px)
+            self._speed = max(self._speed, self.motion.max_speed_px)
         if lost == 0:
             # a tight window first (three radii around the prediction): cheap, and the
             # blob must lie wholly inside it; otherwise the full search window
@@ -243,10 +259,10 @@ class ColorMarker:
         # the search window: at least five marker diameters (a hop starts from rest within a
         # frame); lost, it grows by its own size each frame around the extrapolated path
         half = int(max(self.search_half_px, 5 * self._usual_width)) * (1 + lost)
-        if self.track.stretch == 1:   # no velocity yet (first sighting, or re-acquired): twice as far, as Tracker does
+        if self.motion.stretch == 1:   # no velocity yet (first sighting, or re-acquired): twice as far, as Tracker does
             half *= 2
         if not lost:   # it may stop dead (a landing) as it starts from rest: reach back to where it was
-            half = max(half, int(math.dist(centre, self.track.last_point) + self._usual_width))
+            half = max(half, int(math.dist(centre, self.motion.last_point) + self._usual_width))
         h, w = image.shape[:2]
         box = window((min(max(centre[0], 0), w - 1), min(max(centre[1], 0), h - 1)), half, image.shape)
         return self._locate_in(image, box, centre)
@@ -297,7 +313,7 @@ class ColorMarker:
         colours = self._colours
         sin = sum([c[4] for c in colours])
         cos = sum([c[3] for c in colours])
-        return (math.degrees(math.atan2(sin, cos)) / 2 % 180, _median_of([c[1] for c in colours]),
+        return (math.degrees(math.atan2(sin, cos)) / 2 % 180, median_of([c[1] for c in colours]),
                 max([c[2] for c in colours]))
 
     def _own_mask(self, roi: np.ndarray, hsv: np.ndarray) -> np.ndarray:
@@ -393,75 +409,67 @@ class ColorMarker:
 
     def _locate_core(self, image, roi, core, box, centre, whole_inside: bool, hue_checked: bool,
                      tight: bool) -> Detection | None:
+        """The marker among the blobs of ``core`` (one colour test over the window ``box``),
+        tried nearest ``centre`` first; ``whole_inside``, ``tight``: as :meth:`_locate_in`."""
         x0, y0 = box[:2]
-        # only the box of the set pixels is labelled (the same components, at an offset): an
-        # empty frame (a hidden marker) is not labelled at all, a window or the whole picture
-        # holding one sticker costs the sticker's box
-        rect = cv2.boundingRect(core)
-        lx, ly, lw, lh = rect
-        if lw == 0:   # a hidden marker: nothing to label
-            return None
-        part = core[ly:ly + lh, lx:lx + lw]
-        n, labels = cv2.connectedComponents(part, connectivity=8)
-        if n <= 1:
-            return None
-        if n == 2:   # one blob (the usual case): the core is its mask; its statistics cost less than OpenCV's
-            blobs = [((*rect, cv2.countNonZero(part)), core, 255)]
-        else:
-            stats, cents = _component_stats(part, labels, n)
-            stats[:, 0] += lx
-            stats[:, 1] += ly
-            cents += (lx, ly)
-            labels = cv2.copyMakeBorder(labels, ly, core.shape[0] - ly - lh, lx, core.shape[1] - lx - lw,
-                                        cv2.BORDER_CONSTANT, value=0)
-            order = np.arange(1, n)
-            if centre is None:   # largest first
-                order = order[np.argsort(-stats[order, cv2.CC_STAT_AREA], kind="stable")]
-            else:                # nearest the prediction first
-                order = order[np.argsort(np.hypot(cents[order, 0] + x0 - centre[0], cents[order, 1] + y0 - centre[1]),
-                                         kind="stable")]
-            blobs = ((stats[i].tolist(), labels, i) for i in order.tolist())
+        n, blobs = labelled_blobs(core, (x0, y0), centre)
         for stat, mask, label in blobs:
             bx, by, bw, bh, area = stat
             if area < self.min_area_px:
                 continue
-            if _touches_edge(stat, roi.shape, box, image.shape):
+            if touches_edge(stat, roi.shape, box, image.shape):
                 if whole_inside:
                     return None
-                # the window cut the blob (the prediction was off): look again around what it saw;
-                # if that is not the marker, the other blobs in the window still may be
-                seen_at = (x0 + bx + bw / 2, y0 + by + bh / 2)
-                radius = math.sqrt(self._usual_area / math.pi) if self._areas else max(bw, bh)
-                half = int(3 * radius + max(bw, bh) / 2) + 6
-                det = self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
-                if det is not None:
-                    return det
-                continue
-            if _on_image_border(stat, box, image.shape):
+                det = self._look_again(image, box, stat)
+            elif on_image_border(stat, box, image.shape):
                 continue   # cut by the picture's edge: its centroid is not the marker's
-            at = (x0 + bx + bw / 2, y0 + by + bh / 2)
-            if tight and n == 2 and hue_checked and self._as_usual(area, bw, bh):
-                if self._near_distractor(*at):
-                    return None
-                self._unjudged += 1
-                return self._measure(roi, mask, stat, label, None, x0, y0, None, n == 2)
-            blob = mask[by:by + bh, bx:bx + bw]
-            if n > 2:   # with one blob the core is its mask
-                blob = (blob == label).view(np.uint8)
-            shape = _blob_shape(blob, area)
-            if not self._fits(shape, at):
-                continue
-            # the blob's mean colour (hue, saturation, chroma), for the checks and to learn from
-            hs = self._blob_hs(roi, blob, bx, by) if self._hsv is not None else None
-            if not (hue_checked or self._has_hue(hs)):
-                continue
-            if not self._has_own_colour(hs):
-                continue   # taken only on a blob of the colour it has shown
-            if self._near_distractor(*at):
-                continue   # a look-alike seen at the start is never taken
-            self._unjudged = 0
-            return self._measure(roi, mask, stat, label, shape, x0, y0, hs, n == 2)
+            elif tight and n == 2 and hue_checked and self._as_usual(area, bw, bh):
+                return self._as_before(roi, mask, stat, label, box)
+            else:
+                det = self._judged(roi, mask, stat, label, box, n == 2, hue_checked)
+            if det is not None:
+                return det
         return None
+
+    def _look_again(self, image, box, stat) -> Detection | None:
+        """The window cut the blob (the prediction was off): look again around what it saw; if
+        that is not the marker, the other blobs in the window still may be (None)."""
+        bx, by, bw, bh = stat[:4]
+        seen_at = (box[0] + bx + bw / 2, box[1] + by + bh / 2)
+        radius = math.sqrt(self._usual_area / math.pi) if self._areas else max(bw, bh)
+        half = int(3 * radius + max(bw, bh) / 2) + 6
+        return self._locate_in(image, window(seen_at, half, image.shape), seen_at, True)
+
+    def _as_before(self, roi, mask, stat, label, box) -> Detection | None:
+        """A blob alone in the tight window, as the marker has been seen (:meth:`_as_usual`):
+        taken without judging its shape and colour, unless it lies on a look-alike."""
+        bx, by, bw, bh = stat[:4]
+        if self._near_distractor(box[0] + bx + bw / 2, box[1] + by + bh / 2):
+            return None
+        self._unjudged += 1
+        return self._measure(roi, mask, stat, label, None, box[0], box[1], None, True)
+
+    def _judged(self, roi, mask, stat, label, box, alone: bool, hue_checked: bool) -> Detection | None:
+        """The blob, if its shape, its colour and its place say it is the marker; else None.
+        ``alone``: ``mask`` is the colour mask itself, one blob in it."""
+        bx, by, bw, bh, area = stat
+        at = (box[0] + bx + bw / 2, box[1] + by + bh / 2)
+        blob = mask[by:by + bh, bx:bx + bw]
+        if not alone:   # with one blob the core is its mask
+            blob = (blob == label).view(np.uint8)
+        shape = blob_shape(blob, area)
+        if not self._fits(shape, at):
+            return None
+        # the blob's mean colour (hue, saturation, chroma), for the checks and to learn from
+        hs = self._blob_hs(roi, blob, bx, by) if self._hsv is not None else None
+        if not (hue_checked or self._has_hue(hs)):
+            return None
+        if not self._has_own_colour(hs):
+            return None   # taken only on a blob of the colour it has shown
+        if self._near_distractor(*at):
+            return None   # a look-alike seen at the start is never taken
+        self._unjudged = 0
+        return self._measure(roi, mask, stat, label, shape, box[0], box[1], hs, alone)
 
     def _as_usual(self, area: int, width: int, height: int) -> bool:
         """True if a blob, alone in the tight window around the prediction and within the RGB
@@ -503,8 +511,8 @@ class ColorMarker:
         if shape.area_px < self.partial_fraction * self._usual_area:
             return False
         d = self._usual_width
-        last = self.track.last_point
-        gap = self.track.frames_lost(self._frame) + 1
+        last = self.motion.last_point
+        gap = self.motion.frames_lost(self._frame) + 1
         moved = ((at[0] - last[0]) / gap, (at[1] - last[1]) / gap)
         streak = 1.2 * max(self._speed, math.hypot(*moved)) + 2.0
         if shape.area_px > 1.6 * self._usual_area + d * streak:
@@ -514,11 +522,11 @@ class ColorMarker:
         if not (0.6 * d <= shape.minor_px <= 1.5 * d and shape.major_px <= 1.5 * d + streak):
             return False
         if shape.major_px > 1.4 * shape.minor_px:   # a blur streak lies along the motion
-            if self._lost > self.track.stretch:
+            if self._lost > self.motion.stretch:
                 # lost for longer than the fit's own span: its extrapolated direction is a guess
                 # (a few pixels of error in the curvature turn it by tens of degrees)
                 return self._speed >= 0.3 * d
-            return _along(shape.angle_rad, self._velocity, d) or _along(shape.angle_rad, moved, d)
+            return along(shape.angle_rad, self._velocity, d) or along(shape.angle_rad, moved, d)
         return True
 
     def _measure(self, roi, labels, stat, best: int, shape: BlobShape | None, x0: int, y0: int,
@@ -533,241 +541,16 @@ class ColorMarker:
         blob = labels[cy0:cy1, cx0:cx1]
         blob = blob.astype(bool) if alone else blob == best
         near = roi[cy0:cy1, cx0:cx1]
-        px, py = _coverage_centroid(near, blob)
+        px, py = coverage_centroid(near, blob)
         area = float(stat[4])
         score = area / self._usual_area if self._areas else 1.0
         if shape is not None and shape.minor_px >= 0.75 * shape.major_px:   # round and whole: learn its size
             self._areas.append(area)
             self._widths.append(shape.minor_px)
-            self._usual_area = _median_of(self._areas)
-            self._usual_width = _median_of(self._widths)
+            self._usual_area = median_of(self._areas)
+            self._usual_width = median_of(self._widths)
             if hs is not None:   # the blob's mean colour
                 turn = math.radians(2 * hs[0])   # hue is an angle: its mean is the mean direction
                 self._colours.append((*hs, math.cos(turn), math.sin(turn)))
                 self._own = None
         return Detection(px + x0 + cx0, py + y0 + cy0, score, True)
-
-
-def every(image: np.ndarray, step: int) -> np.ndarray:
-    """``image[::step, ::step]`` as a contiguous picture. OpenCV's nearest-pixel resize to
-    1/step takes exactly those pixels where the sizes divide by ``step``, ten times faster
-    than NumPy's copy of a strided view (a 1280x720 frame at step 2: 0.26 ms against 2.9 ms);
-    a last row or column past a whole number of steps is copied on its own.
-
-    Parameters
-    ----------
-    image : ndarray
-        An image.
-    step : int
-        Sampling step [px].
-
-    Returns
-    -------
-    ndarray
-        The sampled image, contiguous.
-    """
-    h, w = image.shape[:2]
-    hq, wq = h // step, w // step
-    if step == 1 or hq == 0 or wq == 0:
-        return np.ascontiguousarray(image[::step, ::step])
-    main = cv2.resize(image[:hq * step, :wq * step], (wq, hq), interpolation=cv2.INTER_NEAREST)
-    main = main.reshape((hq, wq) + image.shape[2:])   # OpenCV drops a single channel's axis
-    if h == hq * step and w == wq * step:
-        return main
-    out = np.empty((-(-h // step), -(-w // step)) + image.shape[2:], image.dtype)
-    out[:hq, :wq] = main
-    if h > hq * step:
-        out[hq] = image[hq * step, ::step]
-    if w > wq * step:
-        out[:, wq] = image[::step, wq * step]
-    return out
-
-
-def _contours(mask: np.ndarray) -> list:
-    """Outer contours of the blobs of ``mask``."""
-    return cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)[0]
-
-
-def _filled(contour: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
-    """0/1 mask of the blob ``contour`` outlines, over its bounding ``box`` (x, y, w, h)."""
-    x, y, w, h = box
-    mask = np.zeros((h, w), np.uint8)
-    cv2.drawContours(mask, [contour], -1, 1, cv2.FILLED, offset=(-x, -y))
-    return mask
-
-
-def _median_of(values) -> float:
-    """``statistics.median`` of a few floats, without its type checks."""
-    s = sorted(values)
-    k = len(s) // 2
-    return s[k] if len(s) % 2 else (s[k - 1] + s[k]) / 2
-
-
-def _component_stats(core: np.ndarray, labels: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """``cv2.connectedComponentsWithStats``'s stats and centroids from the labels, computed
-    over the set pixels only (OpenCV's pass over a whole sparse 720p image costs ~8 ms)."""
-    pts = cv2.findNonZero(core).reshape(-1, 2)
-    xs, ys = pts[:, 0], pts[:, 1]
-    lab = labels[ys, xs]
-    area = np.bincount(lab, minlength=n)
-    x0, y0 = np.full(n, labels.shape[1]), np.full(n, labels.shape[0])
-    x1, y1 = np.full(n, -1), np.full(n, -1)
-    np.minimum.at(x0, lab, xs)
-    np.minimum.at(y0, lab, ys)
-    np.maximum.at(x1, lab, xs)
-    np.maximum.at(y1, lab, ys)
-    stats = np.stack([x0, y0, x1 - x0 + 1, y1 - y0 + 1, area], axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cents = np.stack([np.bincount(lab, xs, n) / area, np.bincount(lab, ys, n) / area], axis=1)
-    return stats, cents
-
-
-def _along(angle_rad: float, velocity: tuple[float, float], diameter_px: float) -> bool:
-    """True if a streak at ``angle_rad`` lies within 30 degrees of a motion of ``velocity``
-    px/frame, fast enough to smear a marker of ``diameter_px`` visibly."""
-    vx, vy = velocity
-    speed = math.hypot(vx, vy)
-    if speed < 0.3 * diameter_px:
-        return False
-    return abs(vx * math.cos(angle_rad) + vy * math.sin(angle_rad)) / speed >= math.cos(math.radians(30))
-
-
-class BlobShape(NamedTuple):   # a tuple: one is made per blob looked at, every frame
-    """A blob's area and equivalent ellipse.
-
-    Attributes
-    ----------
-    area_px : float
-        Area [px²].
-    major_px, minor_px : float
-        Full lengths of the equivalent ellipse's axes (4 sigma): a disc's diameter [px].
-    angle_rad : float
-        Direction of the major axis, image x right, y down [rad].
-    """
-
-    area_px: float
-    major_px: float     # full lengths of the equivalent ellipse (4 sigma): a disc's diameter
-    minor_px: float
-    angle_rad: float = 0.0   # direction of the major axis (image x right, y down)
-
-
-def _blob_shape(blob: np.ndarray, area: int) -> BlobShape:
-    """Area and equivalent ellipse of a blob given as a mask (nonzero in the blob)."""
-    m = cv2.moments(blob)   # 0/1 or 0/255: the same shape
-    a, b, c = m["mu20"] / m["m00"], m["mu11"] / m["m00"], m["mu02"] / m["m00"]
-    root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
-    # + 1/12 per axis: a pixel is a square, not a point
-    lam1, lam2 = (a + c) / 2 + root + 1 / 12, (a + c) / 2 - root + 1 / 12
-    return BlobShape(float(area), 4 * math.sqrt(lam1), 4 * math.sqrt(max(lam2, 0.0)), 0.5 * math.atan2(2 * b, a - c))
-
-
-def _on_image_border(stat: list[int], box, image_shape) -> bool:
-    x, y, w, h = stat[:4]
-    x0, y0 = box[0] + x, box[1] + y
-    return x0 <= 0 or y0 <= 0 or x0 + w >= image_shape[1] or y0 + h >= image_shape[0]
-
-
-RING_PX = 4
-JUDGE_EVERY = 4   # a marker found as usual has its shape and colour judged every this many frames
-FIRST_SIGHTING_MIN_PX = 3.0   # least width of a first sighting: a 2 x 2 speck (2.3 px) is noise, not a sticker
-DISC_FILL = 0.65  # least share of its box a blob taken as usual fills (a disc: pi/4, 0.79)
-_KERNEL_9 = np.ones((9, 9), np.uint8)    # two 5x5 dilations in one
-_KERNEL_5 = np.ones((5, 5), np.uint8)
-_KERNEL_3 = np.ones((3, 3), np.uint8)
-
-
-UNIFORM_SHARE = 0.1      # a surround varying by less than this share of the sticker's luma contrast is uniform
-CHROMA_CONTRAST = 40.0   # least sticker-to-background chroma difference (0-255 scale) to weigh by colour
-
-
-def _coverage_centroid(roi: np.ndarray, blob: np.ndarray) -> tuple[float, float]:
-    """Centroid of per-pixel coverage over ``blob`` (a boolean mask) grown by two pixels.
-
-    Coverage comes from luma (full resolution under 4:2:0, so the least noisy) when the
-    surround is uniform: the luma of the two-pixel ring around the grown blob varies (standard
-    deviation) by less than ``UNIFORM_SHARE`` of the sticker-to-surround luma contrast, so no
-    surround pixel passes for more than a tenth of sticker. A textured surround (a ruler's
-    marks, a checker floor's edges) would: then coverage comes from chroma
-    (``_chroma_centroid``), where grey texture weighs nothing. A pale sticker (too little
-    chroma contrast) stays with luma; a sticker as bright as its surround with the colour core.
-
-    ``roi`` must hold the blob and the ``RING_PX`` pixels around it (or the image edge).
-    """
-    blob_u8 = blob.view(np.uint8)
-    grown = cv2.dilate(blob_u8, _KERNEL_5)
-    luma = cv2.cvtColor(roi.astype(np.float32), cv2.COLOR_BGR2GRAY)   # BT.601: 0.114 B + 0.587 G + 0.299 R
-    inner_u8 = cv2.erode(blob_u8, _KERNEL_3)
-    inner = luma[inner_u8.view(bool)]
-    level = float(_median(inner if inner.size else luma[blob]))
-    ring_u8 = (cv2.dilate(blob_u8, _KERNEL_9) > grown).view(np.uint8)   # the two pixels around the grown blob
-    ring = luma[ring_u8.view(bool)]
-    if not ring.size:
-        return _moments_centroid(blob_u8)
-    background = float(_median(ring))
-    contrast = abs(level - background)
-    ring -= background
-    if contrast < 20 or float(np.dot(ring, ring)) >= (UNIFORM_SHARE * contrast) ** 2 * ring.size:
-        at = _chroma_centroid(roi, blob_u8, grown, ring_u8, inner_u8)
-        if at is not None:
-            return at
-    if contrast < 20:   # sticker as bright as its surround: the colour core alone
-        return _moments_centroid(blob_u8)
-    cover = luma   # in place: luma is not needed any more
-    cover -= background
-    cover /= level - background
-    np.maximum(cover, 0.0, out=cover)
-    np.minimum(cover, 1.0, out=cover)
-    cover *= grown
-    return _moments_centroid(cover)
-
-
-def _moments_centroid(weights: np.ndarray) -> tuple[float, float]:
-    m = cv2.moments(weights)
-    return m["m10"] / m["m00"], m["m01"] / m["m00"]
-
-
-def _chroma_centroid(roi: np.ndarray, blob_u8: np.ndarray, grown: np.ndarray, ring_u8: np.ndarray,
-                     inner_u8: np.ndarray) -> tuple[float, float] | None:
-    """Centroid of per-pixel coverage estimated from colour, not brightness: each pixel's
-    chroma (its colour less its grey level) is projected on the line from the local
-    background's chroma to the sticker's. A textured grey surround (a ruler's marks, a
-    picture frame's edge) then weighs nothing, however bright or dark, where luma coverage
-    takes its dark or bright pixels for part of the sticker. ``None`` when the sticker's
-    chroma differs too little from its surround's (a pale sticker): then luma decides.
-    """
-    pixels = roi.astype(np.float32)
-    chroma = pixels - pixels.mean(axis=2, keepdims=True)
-    core = inner_u8 if inner_u8.any() else blob_u8
-    sticker = np.median(chroma[core.view(bool)], axis=0)
-    background = np.median(chroma[ring_u8.view(bool)], axis=0)
-    axis = sticker - background
-    contrast = float(np.linalg.norm(axis))
-    if contrast < CHROMA_CONTRAST:
-        return None
-    w = axis / contrast ** 2
-    cover = cv2.transform(chroma, w.reshape(1, 3)) - float(background @ w)
-    np.clip(cover, 0.0, 1.0, out=cover)
-    cover *= grown
-    return _moments_centroid(cover)
-
-
-def _median(values: np.ndarray) -> np.floating:
-    """``np.median`` of a 1-D float32 array, without its general-purpose overhead; ``values``
-    is a scratch copy (a masked selection): it is partitioned in place."""
-    n = values.size
-    k = n // 2
-    if n % 2:
-        values.partition(k)
-        return values[k]
-    values.partition((k - 1, k))
-    return (values[k - 1] + values[k]) / np.float32(2)
-
-
-def _touches_edge(stat: list[int], roi_shape, box, image_shape) -> bool:
-    """True if a blob reaches a window edge that is not also the image edge."""
-    x, y, w, h = stat[:4]
-    x0, y0, x1, y1 = box
-    margin = 3  # the coverage ring needs room too
-    return ((x < margin and x0 > 0) or (y < margin and y0 > 0)
-            or (x + w > roi_shape[1] - margin and x1 < image_shape[1])
-            or (y + h > roi_shape[0] - margin and y1 < image_shape[0]))

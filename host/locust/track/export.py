@@ -3,8 +3,9 @@
 The CSV's layout, writer and reader are :mod:`locust.io.tracks_csv`'s (columns ``frame``, ``t_s``,
 then per marker ``<name>_px``, ``<name>_py`` in pixels, OpenCV convention, ``<name>_x_m``,
 ``<name>_y_m`` in world metres, y up, ``nan`` without a scale, and ``<name>_ok`` 1/0; a
-marker not found is ``nan`` with ok 0). This module turns a
-:class:`~.runner.TrackResult` into one, and writes the sidecar beside it.
+marker not found is ``nan`` with ok 0). A
+:class:`~.runner.TrackResult` holds one (``result.tracks``); this module writes it, and the
+sidecar beside it.
 """
 
 from __future__ import annotations
@@ -16,49 +17,13 @@ from pathlib import Path
 import numpy as np
 
 from ..fileio import atomic_write_json
-from ..io.tracks_csv import MarkerColumns, TracksCsv, tracks_csv_text, write_tracks_csv
+from ..io.tracks_csv import write_tracks_csv
 from ..version import __version__
 from .runner import TrackResult
 from .video import TIMES_FROM_FILE
 
 SIDECAR_FORMAT = "locust.track/1"   # the JSON sidecar beside a tracks CSV
 PIXEL_CONVENTION = "OpenCV: origin at the centre of the top-left pixel, x right, y down"
-
-
-def tracks_of(result: TrackResult) -> TracksCsv:
-    """The tracks CSV of ``result``: pixels, world metres through its calibration, found or not.
-
-    Parameters
-    ----------
-    result : TrackResult
-        The tracks.
-
-    Returns
-    -------
-    TracksCsv
-        Frames, times [s] and per marker pixels [px], positions [m] and found flags.
-    """
-    markers = {}
-    for tr in result.markers:
-        xm, ym = result.world(tr)
-        markers[tr.name] = MarkerColumns(tr.name, tr.px, tr.py, xm, ym, np.asarray(tr.ok, dtype=bool))
-    return TracksCsv(frame=np.asarray(result.frames, dtype=int), t_s=result.t_s, markers=markers)
-
-
-def csv_text(result: TrackResult) -> str:
-    """The text of ``result``'s tracks CSV.
-
-    Parameters
-    ----------
-    result : TrackResult
-        The tracks.
-
-    Returns
-    -------
-    str
-        The CSV.
-    """
-    return tracks_csv_text(tracks_of(result))
 
 
 def sidecar(result: TrackResult, csv_path: Path) -> dict:
@@ -77,7 +42,7 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
     dict
         The sidecar (format :data:`SIDECAR_FORMAT`).
     """
-    clip = result.clip
+    clip, t = result.clip, result.tracks
     src: dict = {"kind": result.source}
     if result.video is not None:
         v = result.video
@@ -92,11 +57,11 @@ def sidecar(result: TrackResult, csv_path: Path) -> dict:
         "source": src,
         "clip": {"start": clip.start, "end": clip.end, "step": clip.step, "fps": clip.fps, "time": result.times},
         "calibration": result.calibration.as_dict(),
-        "markers": [{"name": t.name, "spec": t.spec, "frames": len(t.ok), "found": t.found(),
-                     **asdict(track_events(t.px, t.py, t.ok)),
-                     "missing_frames": [int(f) for f in result.frames[~t.ok]]} for t in result.markers],
-        "scores": {"frame": [int(f) for f in result.frames],
-                   **{t.name: [float(s) for s in t.score] for t in result.markers}},
+        "markers": [{"name": m, "spec": result.specs[m], "frames": len(t.ok[m]), "found": result.found(m),
+                     **asdict(track_events(t.px[m], t.py[m], t.ok[m])),
+                     "missing_frames": [int(f) for f in t.frame[~t.ok[m]]]} for m in t.markers],
+        "scores": {"frame": [int(f) for f in t.frame],
+                   **{m: [float(s) for s in result.scores[m]] for m in t.markers}},
     }
 
 
@@ -116,7 +81,7 @@ def write_tracks(result: TrackResult, csv_path: Path) -> tuple[Path, Path]:
         The files written.
     """
     json_path = csv_path.with_suffix(".json")
-    write_tracks_csv(csv_path, tracks_of(result))
+    write_tracks_csv(csv_path, result.tracks)
     atomic_write_json(json_path, sidecar(result, csv_path))
     return csv_path, json_path
 
@@ -203,24 +168,51 @@ def summary_lines(result: TrackResult) -> list[str]:
         The lines to print.
     """
     lines = []
-    n = len(result.frames)
-    for t in result.markers:
-        line = f"{t.name:10s} {t.found():5d}/{n} frames found"
-        finite = t.score[np.isfinite(t.score) & t.ok]
+    t = result.tracks
+    n = len(t.frame)
+    for m in t.markers:
+        line = f"{m:10s} {result.found(m):5d}/{n} frames found"
+        score = result.scores[m]
+        finite = score[np.isfinite(score) & t.ok[m]]
         if finite.size:
             line += f", score median {np.median(finite):.3g}"
-        missing = result.frames[~t.ok]
+        missing = t.frame[~t.ok[m]]
         if missing.size:
             shown = ", ".join(str(int(f)) for f in missing[:8]) + (" ..." if missing.size > 8 else "")
             line += f"; missing frames {shown}"
-        ev = track_events(t.px, t.py, t.ok)
+        ev = track_events(t.px[m], t.py[m], t.ok[m])
         line += (f"; {ev.gaps} gap(s), longest {ev.longest_gap} frames, {ev.reacquired} re-acquisition(s), "
                  f"{ev.jumps} jump(s)")
         lines.append(line)
-    if result.times == TIMES_FROM_FILE and len(result.t_s) > 1:
-        gaps_ms = np.diff(result.t_s) / np.diff(result.frames) * 1000
+    if result.times == TIMES_FROM_FILE and len(t.t_s) > 1:
+        gaps_ms = np.diff(t.t_s) / np.diff(t.frame) * 1000
         lines.append(f"times: the video's own timestamps, its frames {gaps_ms.min():.1f} to {gaps_ms.max():.1f} ms "
                      f"apart (a variable frame rate), not frame / {result.clip.fps:g} frames/s")
     lines.append(result.calibration.summary())
     return lines
 
+
+
+def report_lines(result: TrackResult) -> list[str]:
+    """What a job that wrote ``result`` prints: :func:`summary_lines`, a hint where a template
+    marker was lost after it was found, and each file written.
+
+    Parameters
+    ----------
+    result : TrackResult
+        The tracks, with the files written.
+
+    Returns
+    -------
+    list of str
+        The lines to print.
+    """
+    lines = summary_lines(result)
+    ok = result.tracks.ok
+    lost = [m for m in result.tracks.markers
+            if result.specs[m].startswith("template:") and ok[m].any() and not ok[m][int(np.argmax(ok[m])):].all()]
+    if lost:
+        lines.append(f"hint: {', '.join(lost)}: lost (nan) where the match looked unlike the template (--likeness, "
+                     "--accept) or left the path its track predicts, e.g. out of view; check the overlay, and pick "
+                     "a point with texture that stays in view, or a --template-radius about the feature's size")
+    return [*lines, *(f"wrote {p}" for p in result.written)]

@@ -34,7 +34,6 @@ from .synth import SUPERSAMPLE, camera, dot_coverage, write_video
 
 HARD_BOARD = BoardSpec("DICT_4X4_50", 5, 3, 40.0, 10.0)   # 240 x 140 mm
 STICKER_HEX = "#e8308c"          # a pink sticker, and a pen cap of the very same colour
-STICKER_DIAMETER_M = 0.020
 GRAVITY_M_S2 = 9.81
 TRUTH_HEADER = "frame,t_s,px,py,in_picture,whole_in_picture,x_m,y_m"
 

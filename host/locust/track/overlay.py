@@ -10,15 +10,15 @@ import numpy as np
 
 from ..errors import TrackError
 from ..fileio import atomic_write_bytes
-from .runner import TrackedMarker, TrackResult
+from .runner import TrackResult
 from .video import encode_video, read_frame, read_frames
 
 PALETTE_BGR = [(255, 0, 255), (255, 255, 0), (0, 255, 255), (0, 128, 255), (255, 128, 0), (128, 255, 0)]
 
 
-def _colour(track: TrackedMarker, k: int) -> tuple[int, int, int]:
-    if track.spec.lower().startswith(("color:#", "colour:#")):
-        h = track.spec.split("#", 1)[1]
+def _colour(spec: str, k: int) -> tuple[int, int, int]:
+    if spec.lower().startswith(("color:#", "colour:#")):
+        h = spec.split("#", 1)[1]
         return int(h[4:6], 16), int(h[2:4], 16), int(h[0:2], 16)
     return PALETTE_BGR[k % len(PALETTE_BGR)]
 
@@ -49,13 +49,14 @@ def draw_tracks(image: np.ndarray, result: TrackResult, upto: int | None = None,
         The annotated copy.
     """
     out = image.copy()
-    n = len(result.frames) if upto is None else upto + 1
+    t = result.tracks
+    n = len(t.frame) if upto is None else upto + 1
     first = 0 if trail is None else max(n - trail, 0)
     shift = 4  # sub-pixel drawing: coordinates in 1/16 px
-    for k, tr in enumerate(result.markers):
-        colour = _colour(tr, k)
-        pts = np.stack([tr.px[:n], tr.py[:n]], axis=1)
-        good = tr.ok[:n].copy()
+    for k, name in enumerate(t.markers):
+        colour = _colour(result.specs[name], k)
+        pts = np.stack([t.px[name][:n], t.py[name][:n]], axis=1)
+        good = t.ok[name][:n].copy()
         good[:first] = False
         # break the path where the marker was missing
         for seg in np.split(np.arange(n), np.flatnonzero(~good) + 1):
@@ -67,7 +68,7 @@ def draw_tracks(image: np.ndarray, result: TrackResult, upto: int | None = None,
             c = tuple(int(v) for v in np.round(pts[i] * (1 << shift)))
             cv2.circle(out, c, 3 << shift, colour, 1, cv2.LINE_AA, shift)
         if upto is not None and not good[n - 1]:
-            cv2.putText(out, f"{tr.name}: lost", (8, 20 + 18 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1,
+            cv2.putText(out, f"{name}: lost", (8, 20 + 18 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1,
                         cv2.LINE_AA)
             continue
         last = np.flatnonzero(good)
@@ -76,7 +77,7 @@ def draw_tracks(image: np.ndarray, result: TrackResult, upto: int | None = None,
             if upto is not None:
                 c = tuple(int(v) for v in np.round(pts[n - 1] * (1 << shift)))
                 cv2.circle(out, c, 8 << shift, colour, 2, cv2.LINE_AA, shift)
-            cv2.putText(out, tr.name, (int(x) + 8, int(y) - 8), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv2.LINE_AA)
+            cv2.putText(out, name, (int(x) + 8, int(y) - 8), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv2.LINE_AA)
     origin, x_dir, y_dir = result.calibration.axes_px()
     o = (int(round(origin[0])), int(round(origin[1])))
     for direction, colour in ((x_dir, (0, 0, 255)), (y_dir, (0, 255, 0))):
@@ -106,7 +107,7 @@ def write_png(result: TrackResult, path: Path) -> Path:
     """
     if result.video is None:
         raise TrackError("no video to draw on", "give the video to draw tracks on")
-    image = read_frame(result.video, int(result.frames[-1]))
+    image = read_frame(result.video, int(result.tracks.frame[-1]))
     ok, png = cv2.imencode(".png", draw_tracks(image, result))
     return atomic_write_bytes(path, png.tobytes())
 

@@ -84,16 +84,6 @@ class MotionHistory:
         if point is not None:
             self.last_found = point
 
-    def has_velocity(self) -> bool:
-        """True when the last two positions are both known.
-
-        Returns
-        -------
-        bool
-            Whether a velocity can be taken.
-        """
-        return len(self._points) >= 2 and self._points[-1] is not None and self._points[-2] is not None
-
     def search_centre(self) -> Point | None:
         """The look-ahead prediction, or the last position seen when there is none.
 
@@ -116,8 +106,9 @@ def _fit_matrix(offsets: tuple[int, ...]) -> list[list[float]]:
 _NO_GAP = {n: tuple(range(1 - n, 1)) for n in range(1, 9)}
 
 
-class MarkerPath:
-    """Where a marker should be on a given frame, also across frames it was not seen.
+class MotionFit:
+    """Where a marker should be on a given frame, also across frames it was not seen: the
+    centre of the window it is searched in (not its track: only the last ``keep`` sightings).
 
     A least-squares constant-acceleration fit (per axis, over the frame number) to the last
     ``keep`` positions found; with two positions constant velocity, with one the position

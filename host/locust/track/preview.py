@@ -16,7 +16,12 @@ import numpy as np
 
 from ..errors import TrackError
 from ..fileio import atomic_write_bytes
-from .video import read_frame
+from ..io import trk as trk_io
+from ..io.importing import is_project
+from .calib import PIXEL_CONVENTIONS
+from .outputs import Say, media, named, quiet, refuse_inputs, refuse_overwrite, stem, tracks_path
+from .spec import ModelOptions, parse_markers
+from .video import probe, read_frame
 
 MIN_SATURATION = 110   # OpenCV 8-bit saturation: a sticker, not a tinted wall
 MIN_VALUE = 50
@@ -165,3 +170,57 @@ def preview(info, frame: int, models: list, path: Path) -> tuple[list[Blob], dic
     ok, png = cv2.imencode(".png", out)
     atomic_write_bytes(path, png.tobytes())
     return blobs, found
+
+
+def preview_video(video: Path, frame: int, markers: tuple[str, ...] = (), model: ModelOptions | None = None,
+                  out: Path | None = None, force: bool = False, say: Say = quiet) -> list[str]:
+    """``locust track preview``: write the annotated ``frame`` of ``video`` (a video, an image
+    sequence or a Tracker project that opens one) to ``<out>.preview.png`` in the output folder.
+
+    Parameters
+    ----------
+    video : Path
+        What to preview.
+    frame : int
+        The frame to show.
+    markers : tuple of str
+        ``NAME=SPEC`` of the markers to try on it; empty: the robot's nose and foot colours.
+    model : ModelOptions, optional
+        Their settings, and the convention their positions are typed (and printed) in.
+    out : Path, optional
+        ``--out``.
+    force : bool
+        Replace an existing preview.
+    say : callable
+        Told the output folder.
+
+    Returns
+    -------
+    list of str
+        What to print: the blobs, where each marker was found, the file written.
+
+    Raises
+    ------
+    TrackError
+        A frame outside the video, or a preview that may not be written.
+    """
+    model = model or ModelOptions()
+    models, pixels = parse_markers(list(markers), model), model.pixels
+    video = named(video)
+    project = trk_io.read_project(video) if is_project(video) else None
+    with media(video, project) as path:
+        png = tracks_path(out, video, say)
+        png = png.with_name(stem(png) + ".preview.png")
+        info = probe(path)
+        refuse_inputs({"preview": png}, [video, path])
+        refuse_overwrite({"preview": png}, force)
+        blobs, found = preview(info, frame, models, png)
+    lines = [f"frame {frame} of {info.path.name} ({info.width_px}x{info.height_px}): most saturated blobs"]
+    lines += [b.line(k) for k, b in enumerate(blobs, 1)] or ["  none (no strongly coloured patch in this frame)"]
+    if found:
+        lines.append(f"markers ({pixels}'s pixels, as --marker takes them):")
+    for name, p in found.items():
+        if p:   # found in OpenCV's pixels: shown in the convention the specs are typed in
+            p = (p[0] - PIXEL_CONVENTIONS[pixels], p[1] - PIXEL_CONVENTIONS[pixels])
+        lines.append(f"  marker {name}: " + (f"found at {p[0]:.1f},{p[1]:.1f}" if p else "not found"))
+    return [*lines, f"wrote {png}"]

@@ -4,77 +4,103 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import TrackError
+from ..io.tracks_csv import TracksCsv
 from .calib import Calibration
 from .camera import PlaneCalibration
 from .color import FrameHSV
 from .video import TIMES_EVEN, Clip, VideoInfo, frame_times_s, read_frames
 
 
-@dataclass
-class TrackedMarker:
-    """One marker's track over a clip.
+@dataclass(frozen=True)
+class TrackResult:
+    """What a tracking run found: the tracks file's contents and how they were made.
+
+    ``video`` is None for tracks read from a Tracker project.
 
     Attributes
     ----------
-    name, spec : str
-        The marker's name and its spec.
-    px, py : ndarray
-        Position per frame, OpenCV convention [px]; nan where not found.
-    score : ndarray
-        The model's score per frame (its meaning is the model's).
-    ok : ndarray of bool
-        Whether it was found on each frame.
+    tracks : TracksCsv
+        Per frame its number and time, per marker its pixels (OpenCV convention), world
+        metres (through ``calibration``) and whether it was found: what the tracks CSV holds.
+    specs : dict of str to str
+        Per marker, its spec (``color:#ff00ff``, ``tracker:<name>`` ...).
+    scores : dict of str to ndarray
+        Per marker, its model's score per frame (its meaning is the model's).
+    calibration : Calibration or PlaneCalibration
+        Pixels to metres.
+    clip : Clip
+        The frames tracked.
+    video : VideoInfo or None
+        The video tracked.
+    source : str
+        What made the tracks, for the sidecar.
+    times : str
+        How ``tracks.t_s`` was found (:func:`.video.frame_times_s`).
+    written : tuple of Path
+        The files the job wrote, in order (empty until written).
     """
 
-    name: str
-    spec: str
-    px: np.ndarray
-    py: np.ndarray
-    score: np.ndarray
-    ok: np.ndarray
+    tracks: TracksCsv
+    specs: dict[str, str]
+    scores: dict[str, np.ndarray]
+    calibration: Calibration | PlaneCalibration
+    clip: Clip
+    video: VideoInfo | None = None
+    source: str = "locust track"
+    times: str = TIMES_EVEN
+    written: tuple[Path, ...] = ()
 
-    def found(self) -> int:
-        """Number of frames the marker was found on.
+    @classmethod
+    def from_pixels(cls, frames: np.ndarray, t_s: np.ndarray, px: dict[str, np.ndarray], py: dict[str, np.ndarray],
+                    ok: dict[str, np.ndarray], specs: dict[str, str], scores: dict[str, np.ndarray],
+                    calibration: Calibration | PlaneCalibration, clip: Clip, video: VideoInfo | None = None,
+                    source: str = "locust track", times: str = TIMES_EVEN) -> TrackResult:
+        """A result from the markers' pixels, their world metres through ``calibration``.
+
+        Parameters
+        ----------
+        frames : ndarray
+            The frames' numbers.
+        t_s : ndarray
+            Their times [s].
+        px, py : dict of str to ndarray
+            Per marker, its position per frame, OpenCV convention [px]; nan where not found.
+        ok : dict of str to ndarray
+            Per marker, whether it was found on each frame.
+        specs, scores, calibration, clip, video, source, times
+            As the attributes.
+
+        Returns
+        -------
+        TrackResult
+            Its tracks in pixels and world metres.
+        """
+        frames = np.asarray(frames, dtype=int)
+        world = {m: calibration.to_world(px[m], py[m], m, frames) for m in px}
+        tracks = TracksCsv(frame=frames, t_s=t_s, px=px, py=py, x_m={m: w[0] for m, w in world.items()},
+                           y_m={m: w[1] for m, w in world.items()},
+                           ok={m: np.asarray(ok[m], dtype=bool) for m in px})
+        return cls(tracks, specs, scores, calibration, clip, video, source, times)
+
+    def found(self, marker: str) -> int:
+        """Number of frames ``marker`` was found on.
+
+        Parameters
+        ----------
+        marker : str
+            One of ``tracks.markers``.
 
         Returns
         -------
         int
             The count.
         """
-        return int(self.ok.sum())
-
-
-@dataclass
-class TrackResult:
-    """Tracks of one clip. ``video`` is None for tracks read from a Tracker project."""
-
-    video: VideoInfo | None
-    clip: Clip
-    frames: np.ndarray
-    t_s: np.ndarray
-    markers: list[TrackedMarker]
-    calibration: Calibration | PlaneCalibration
-    source: str = "locust track"
-    times: str = TIMES_EVEN        # how ``t_s`` was found (:func:`.video.frame_times_s`)
-
-    def world(self, track: TrackedMarker) -> tuple[np.ndarray, np.ndarray]:
-        """A marker's track in world metres through the result's calibration.
-
-        Parameters
-        ----------
-        track : TrackedMarker
-            One of the result's markers.
-
-        Returns
-        -------
-        x_m, y_m : ndarray
-            Position per frame, y up [m].
-        """
-        return self.calibration.to_world(track.px, track.py, track.name, self.frames)
+        return int(self.tracks.ok[marker].sum())
 
 
 def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibration | PlaneCalibration,
@@ -131,16 +157,17 @@ def track_video(info: VideoInfo, clip: Clip, models: list, calibration: Calibrat
             px[i], py[i], score[i], ok[i] = det.px, det.py, det.score, det.ok
         if progress:
             progress(1)
-    tracks = [TrackedMarker(m.name, m.spec, *cols[m.name]) for m in models]
     if require_found:
-        lost = [t for t in tracks if t.found() == 0]
+        lost = [m for m in models if not cols[m.name][3].any()]
         if lost:
             raise TrackError(
                 f"marker(s) never found in frames {clip.start}..{clip.end} of {info.path.name}: "
-                + ", ".join(f"{t.name} ({t.spec})" for t in lost),
+                + ", ".join(f"{m.name} ({m.spec})" for m in lost),
                 "a colour marker is first taken on a round patch at least 3 px across with at least 0.3 of its "
                 "colour's chroma (no sticker of that colour in the picture: nothing): `locust track preview VIDEO` "
                 "lists the coloured patches of a frame; else check --color-tol, the template point and frame, or "
                 "the ArUco id; --marker NAME=SPEC replaces the default nose/foot colours")
     times = frame_times_s(info, clip, frames, stamps_s)
-    return TrackResult(info, clip, frames, times.t_s, tracks, calibration, times=times.rule)
+    px, py, scores, ok = ({m: c[k] for m, c in cols.items()} for k in range(4))
+    return TrackResult.from_pixels(frames, times.t_s, px, py, ok, {m.name: m.spec for m in models}, scores,
+                                   calibration, clip, video=info, times=times.rule)

@@ -19,13 +19,14 @@ renders too.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
 from ..errors import TrackError
 from ..markers import MARKER_COLOURS
 from .aruco import DEFAULT_DICTIONARY, ArucoMarker
-from .calib import typed_px
+from .calib import PIXEL_CONVENTIONS, typed_px
 from .color import ColorMarker, parse_hex
 from .template import TemplateMarker
 
@@ -44,6 +45,13 @@ class ModelOptions:
     evolve: float = 0.2
     likeness: float = 0.5
     pixels: str = "tracker"
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.accept):
+            raise TrackError(f"--accept {self.accept}: not a finite number",
+                             "give --accept as a plain number, see --help")
+        if self.pixels not in PIXEL_CONVENTIONS:
+            raise TrackError(f"pixel convention {self.pixels!r} is not known", "give tracker or opencv")
 
 
 def default_specs() -> list[str]:

@@ -6,7 +6,7 @@ The same steps as Tracker's ``TemplateMatcher`` / ``AutoTracker`` (Open Source P
    default mask is 16 px across) around (X, Y).
 2. On each later frame, the search window (+-``search_half_px``, Tracker's 40) is
    centred on where the track's motion puts the marker: a constant-acceleration fit to
-   its last positions (:class:`.predict.MarkerPath`), extrapolated across frames where it
+   its last positions (:class:`.predict.MotionFit`), extrapolated across frames where it
    was lost. Until two positions give a velocity the window is twice as large: Tracker's
    own BallToss ball moves 70 px between its first two steps.
 3. The match is the position of least RGB square difference (masked) in the window.
@@ -69,7 +69,7 @@ import numpy as np
 
 from ..errors import TrackError
 from .detection import Detection, window
-from .predict import MarkerPath
+from .predict import MotionFit
 
 AMBIGUITY = 1.5            # matches within this factor of the best square difference are look-alikes
 AMBIGUITY_IN_GATE = 3.0    # ... and within this factor, inside the motion gate
@@ -136,7 +136,7 @@ class TemplateMarker:
         Share of the matched patch mixed into the template on each accepted match (0..1).
     min_likeness : float
         Smallest zero-mean normalised correlation of a match with the template (-1..1).
-    trajectory : MarkerPath
+    motion : MotionFit
         Its positions so far, for the prediction.
     """
 
@@ -150,7 +150,7 @@ class TemplateMarker:
     accept: float = 0.5
     evolve: float = 0.2
     min_likeness: float = 0.5
-    trajectory: MarkerPath = field(default_factory=MarkerPath)
+    motion: MotionFit = field(default_factory=MotionFit)
     _template: np.ndarray | None = None
     _mask: np.ndarray | None = None
     _offset: tuple[float, float] = (0.0, 0.0)  # key point minus template centre pixel
@@ -184,7 +184,7 @@ class TemplateMarker:
                                  f"start the clip at or before frame {self.key_frame} with a step that reaches it")
             return self._start(frame, image_bgr)
         det = self._match(frame, image_bgr)
-        self.trajectory.add(frame, det.point())
+        self.motion.add(frame, det.point())
         return det
 
     def _start(self, frame: int, image: np.ndarray) -> Detection:
@@ -199,12 +199,12 @@ class TemplateMarker:
         cv2.circle(self._mask, (r, r), r, 1, -1)
         self._mask = np.repeat(self._mask[:, :, None], 3, axis=2).astype(np.float32)
         self._offset = (self.key_x_px - cx, self.key_y_px - cy)
-        self.trajectory.add(frame, (self.key_x_px, self.key_y_px))
+        self.motion.add(frame, (self.key_x_px, self.key_y_px))
         return Detection(self.key_x_px, self.key_y_px, math.inf, True)
 
     def _prediction(self, frame: int) -> tuple[tuple[float, float], float, Gate]:
         """Predicted point, search half-size (px) and gate for ``frame``."""
-        traj = self.trajectory
+        traj = self.motion
         lost = traj.frames_lost(frame)
         growth = min(1.0 + LOST_GROWTH * lost, LOST_GROWTH_MAX)
         if traj.stretch < 2:
@@ -237,7 +237,7 @@ class TemplateMarker:
         if roi.shape[0] < 2 * r + 3 or roi.shape[1] < 2 * r + 3:
             return Detection.missing()
         diff = np.maximum(cv2.matchTemplate(roi, self._template, cv2.TM_SQDIFF, mask=self._mask), 0.0)
-        lost = self.trajectory.frames_lost(frame)
+        lost = self.motion.frames_lost(frame)
         iy, ix = _nearest_lookalike(diff, px - ox - x0 - r, py - oy - y0 - r,
                                     gate if lost == 0 else Gate(math.inf, math.inf))
         best = float(diff[iy, ix])
@@ -251,7 +251,7 @@ class TemplateMarker:
         off = float(gate.ratio(mx - px, my - py))
         if lost > 0:   # lost: where it was last seen is as good a guess, the gate not grown
             growth = min(1.0 + LOST_GROWTH * lost, LOST_GROWTH_MAX)
-            lx, ly = self.trajectory.last_point
+            lx, ly = self.motion.last_point
             off = min(off, math.hypot(mx - lx, my - ly) * growth / gate.along_px)
         like = self._likeness(image, x0 + ix + r, y0 + iy + r)
         if not height > self.accept:
@@ -262,7 +262,7 @@ class TemplateMarker:
             return Detection.missing(height)   # coming back takes a match that stands out in its window
         if off > 1.0:   # off its path
             return Detection.missing(height)
-        if self.trajectory.stretch < 3 and math.hypot(mx - px, my - py) > GATE_MIN_PX and _has_lookalike(diff, iy, ix):
+        if self.motion.stretch < 3 and math.hypot(mx - px, my - py) > GATE_MIN_PX and _has_lookalike(diff, iy, ix):
             return Detection.missing(height)   # no path yet to tell the marker from its look-alikes
         if like < self.min_likeness:
             return Detection.missing(height)

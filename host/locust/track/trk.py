@@ -17,10 +17,10 @@ import numpy as np
 
 from ..errors import TrackError
 from ..io import trk as trk_io
-from ..io.tracker_text import TrackerExport, TrackerTrack, tracker_export_text, write_tracker_export
+from ..io.tracker_text import TrackerExport, tracker_export_text, write_tracker_export
 from ..io.trk import ProjectVideo, TrackerClip, TrackerProject, project_points
 from .calib import Calibration
-from .runner import TrackedMarker, TrackResult
+from .runner import TrackResult
 from .video import TIMES_FROM_FILE, Clip
 
 
@@ -40,11 +40,12 @@ def project_result(project: TrackerProject, names: list[str] | None = None) -> T
         Its tracks [px] with its calibration; no video.
     """
     frames, t_s, points = project_points(project, names)
-    tracks = [TrackedMarker(p.name, f"tracker:{p.tracker_name}", p.px, p.py, np.where(p.ok, 1.0, math.nan), p.ok)
-              for p in points]
     c = project.clip
-    return TrackResult(None, Clip(c.start, c.end, c.step, c.fps), frames, t_s, tracks, project.calibration,
-                       source=f"tracker project {project.path}")
+    specs = {p.name: f"tracker:{p.tracker_name}" for p in points}
+    return TrackResult.from_pixels(frames, t_s, {p.name: p.px for p in points}, {p.name: p.py for p in points},
+                                   {p.name: p.ok for p in points}, specs,
+                                   {p.name: np.where(p.ok, 1.0, math.nan) for p in points}, project.calibration,
+                                   Clip(c.start, c.end, c.step, c.fps), source=f"tracker project {project.path}")
 
 
 # --- Tracker's text export (the format itself: :mod:`locust.io.tracker_text`) --------
@@ -63,14 +64,11 @@ def tracker_export(result: TrackResult) -> TrackerExport:
     TrackerExport
         One track per marker.
     """
-    tracks = {}
-    for tr in result.markers:
-        x, y = result.world(tr)
-        if not np.isfinite(result.calibration.m_per_px):
-            x, y = tr.px, tr.py  # no scale: Tracker exports pixels then, too
-        tracks[tr.name] = TrackerTrack(tr.name, np.where(tr.ok, result.t_s, np.nan), np.where(tr.ok, x, np.nan),
-                                       np.where(tr.ok, y, np.nan))
-    return TrackerExport(tracks)
+    t = result.tracks
+    scaled = np.isfinite(result.calibration.m_per_px)   # no scale: Tracker exports pixels then, too
+    x = {m: np.where(t.ok[m], t.x_m[m] if scaled else t.px[m], np.nan) for m in t.markers}
+    y = {m: np.where(t.ok[m], t.y_m[m] if scaled else t.py[m], np.nan) for m in t.markers}
+    return TrackerExport({m: m for m in t.markers}, {m: np.where(t.ok[m], t.t_s, np.nan) for m in t.markers}, x, y)
 
 
 def tracker_text(result: TrackResult) -> str:
@@ -165,13 +163,14 @@ def as_project(result: TrackResult, trk_path: Path, media: str | None = None) ->
     clip = result.clip
     rel = media or Path(os.path.relpath((info.images[0] if info.images else info.path).resolve(),
                                         Path(trk_path).resolve().parent)).as_posix()
-    frames = [int(f) for f in result.frames]
+    t = result.tracks
+    frames = [int(f) for f in t.frame]
     end = frames[-1] if frames else clip.start - clip.step
-    points = {tr.name: {int(f): (float(x), float(y)) for f, x, y, ok in zip(result.frames, tr.px, tr.py, tr.ok) if ok}
-              for tr in result.markers}
+    points = {m: {int(f): (float(x), float(y)) for f, x, y, ok in zip(t.frame, t.px[m], t.py[m], t.ok[m]) if ok}
+              for m in t.markers}
     cal = result.calibration if isinstance(result.calibration, Calibration) else None
     project = TrackerProject(Path(trk_path), rel, TrackerClip(clip.start, end, clip.step, clip.fps), cal, points,
-                             {tr.name: f"locust track: {tr.spec}" for tr in result.markers})
+                             {m: f"locust track: {result.specs[m]}" for m in t.markers})
     return project, ProjectVideo(rel, bool(info.images), info.width_px, info.height_px, info.frame_count)
 
 

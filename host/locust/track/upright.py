@@ -65,10 +65,11 @@ def upside_down_warnings(result: TrackResult) -> list[str]:
         The warning, or empty.
     """
     best = None
-    for track in result.markers:
-        x, y = result.world(track)
-        ok = track.ok & np.isfinite(y) & np.isfinite(track.py)
-        if ok.sum() < 2 * MIN_STILL or np.ptp(track.py[ok]) < MIN_RISE_PX:
+    t = result.tracks
+    for name in t.markers:
+        x, y, py = t.x_m[name], t.y_m[name], t.py[name]
+        ok = t.ok[name] & np.isfinite(y) & np.isfinite(py)
+        if ok.sum() < 2 * MIN_STILL or np.ptp(py[ok]) < MIN_RISE_PX:
             continue
         low, high = np.percentile(y[ok], [1, 99])
         if not high > low:
@@ -76,9 +77,9 @@ def upside_down_warnings(result: TrackResult) -> list[str]:
         still = standing_still(x, y, ok, STILL_SHARE * (high - low))
         if still.size < MIN_STILL:
             continue
-        rise_px = float(np.ptp(track.py[ok]))
+        rise_px = float(np.ptp(py[ok]))
         if best is None or rise_px > best[0]:
-            best = (rise_px, track.name, still.size, float(np.median(y[still])), low, high)
+            best = (rise_px, name, still.size, float(np.median(y[still])), low, high)
     if best is None:
         return []
     _, name, n_still, rest, low, high = best

@@ -300,11 +300,10 @@ def metres_per_pixel(tracks, marker: str) -> float:
     float
         [m/px].
     """
-    columns = getattr(tracks, "markers", {}).get(marker)
-    if columns is None or not hasattr(columns, "px"):
+    if marker not in getattr(tracks, "px", {}):   # a Tracker export has no pixel columns
         return math.nan
-    step_px = np.hypot(np.diff(columns.px), np.diff(columns.py))
-    step_m = np.hypot(np.diff(columns.x_m), np.diff(columns.y_m))
+    step_px = np.hypot(np.diff(tracks.px[marker]), np.diff(tracks.py[marker]))
+    step_m = np.hypot(np.diff(tracks.x_m[marker]), np.diff(tracks.y_m[marker]))
     use = np.isfinite(step_px) & np.isfinite(step_m) & (step_px >= 1.0)
     return float(np.median(step_m[use] / step_px[use])) if use.any() else math.nan
 
