@@ -26,6 +26,10 @@ more command edges, the ratio of the two clocks. A gyro log has one clock: a del
 Both are fitted and reported; neither is a property of the servo, and neither is written
 to ``robot.toml``.
 
+The fitted values are named by their robot keys (``servo.noload_speed_rad_per_s``, ...:
+``KEYS``); a recording's own values (``command_delay_s[k]``, ``command_clock_error[k]``,
+``gyro_gain_units_per_rad_per_s[k]``) are named by what they are and written nowhere.
+
 All candidates of a solver iteration are simulated at once (``mujoco.rollout``, one model
 per candidate, on every core) and the error, each recording's divided by its own RMS, is minimised with
 MuJoCo's own least-squares solver (``mujoco.minimize.least_squares``) from the best few
@@ -48,6 +52,7 @@ import numpy as np
 
 from ..errors import CalibrationError
 from ..params import GRAVITY_M_PER_S2, LIMITS, Servo
+from ..params.model import split_key
 from ..sim.gl import minimize, mujoco  # MuJoCo as locust.sim imports it (its OpenGL checked first)
 from ..sim.rollout import available_cores, rollout_threads
 from ..sim.servo import configure, with_servo
@@ -55,14 +60,15 @@ from .curves import Curves
 from .fitparams import FitParameter, FitParameters
 from .fitstats import Estimate, cluster_covariance, covariance, linear_shift
 
-PARAMS = ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "kv_nms_per_rad", "stall_torque_nm")
-UNITS = {"noload_speed_rad_per_s": "rad/s", "armature_kgm2": "kg*m^2", "kp_nm_per_rad": "N*m/rad",
-         "kv_nms_per_rad": "N*m*s/rad", "stall_torque_nm": "N*m"}
+KEYS = ("servo.noload_speed_rad_per_s", "servo.armature_kgm2", "servo.kp_nm_per_rad", "servo.kv_nms_per_rad",
+        "servo.stall_torque_nm")
+UNITS = {"servo.noload_speed_rad_per_s": "rad/s", "servo.armature_kgm2": "kg*m^2", "servo.kp_nm_per_rad": "N*m/rad",
+         "servo.kv_nms_per_rad": "N*m*s/rad", "servo.stall_torque_nm": "N*m"}
 # search box of the physical parameters (wide: an SG90 sits well inside it)
-LOWER = {"noload_speed_rad_per_s": 0.5, "armature_kgm2": 1e-8, "kp_nm_per_rad": 1e-3, "kv_nms_per_rad": 1e-6,
-         "stall_torque_nm": 1e-3}
-UPPER = {"noload_speed_rad_per_s": 200.0, "armature_kgm2": 1e-1, "kp_nm_per_rad": 1e3, "kv_nms_per_rad": 10.0,
-         "stall_torque_nm": 50.0}
+LOWER = {"servo.noload_speed_rad_per_s": 0.5, "servo.armature_kgm2": 1e-8, "servo.kp_nm_per_rad": 1e-3,
+         "servo.kv_nms_per_rad": 1e-6, "servo.stall_torque_nm": 1e-3}
+UPPER = {"servo.noload_speed_rad_per_s": 200.0, "servo.armature_kgm2": 1e-1, "servo.kp_nm_per_rad": 1e3,
+         "servo.kv_nms_per_rad": 10.0, "servo.stall_torque_nm": 50.0}
 DELAY_SCALE_S = 0.01          # the solver works in delay / 10 ms and (clock ratio - 1) / 1e-3
 CLOCK_SCALE = 1e-3
 MAX_DELAY_S = 0.2
@@ -86,6 +92,37 @@ EXPECTED_ITERATIONS = 15  # what a run takes, for progress until one has run (bo
 # of CPU)
 MU_FACTOR = 10 ** 0.5
 FD_STEP = 1e-6
+
+
+def servo_of(values) -> Servo:
+    """The servo of the fit's values.
+
+    Parameters
+    ----------
+    values : mapping of str to float
+        At least each of ``KEYS``, by its robot key.
+
+    Returns
+    -------
+    locust.params.Servo
+        Those values, its other fields at their defaults.
+    """
+    return Servo(**{split_key(key)[1]: values[key] for key in KEYS})
+
+
+def values_of(servo: Servo) -> dict[str, float]:
+    """A servo's values of ``KEYS``, by their robot keys (the inverse of :func:`servo_of`).
+
+    Parameters
+    ----------
+    servo : locust.params.Servo
+        The servo.
+
+    Returns
+    -------
+    dict of str to float
+    """
+    return {key: getattr(servo, split_key(key)[1]) for key in KEYS}
 
 
 @dataclass(frozen=True)
@@ -294,9 +331,9 @@ class ServoFit:
     recordings : list of Recording
         The recordings fitted (checked).
     estimates : dict of str to Estimate
-        Each of ``PARAMS`` (units in the names); a held (given) one has std 0.
+        Each of ``KEYS`` by its robot key (units in the names); a held (given) one has std 0.
     given : tuple of str
-        The ``PARAMS`` held at a given value, not fitted.
+        The ``KEYS`` held at a given value, not fitted.
     timings : list of Timing
         Each recording's fitted timing.
     timing_std : list of tuple of float
@@ -304,7 +341,7 @@ class ServoFit:
     gains : list of Estimate or None
         Per recording: a rate recording's gyro gain [gyro units per rad/s] (None for an angle one).
     identifiable : dict of str to bool
-        Whether the data tell each value (see the module docstring).
+        Whether the data tell each value (see the module docstring), by its robot key.
     notes : list of str
         Why a value is not identifiable, misfits, convergence in the time step.
     rms_residual_deg : float or None
@@ -329,8 +366,8 @@ class ServoFit:
 
     source: str
     recordings: list[Recording] = field(repr=False)
-    estimates: dict[str, Estimate]           # PARAMS -> value; a held one (given) has std 0
-    given: tuple[str, ...]                   # the PARAMS held at a given value, not fitted
+    estimates: dict[str, Estimate]           # KEYS -> value; a held one (given) has std 0
+    given: tuple[str, ...]                   # the KEYS held at a given value, not fitted
     timings: list[Timing]
     timing_std: list[tuple[float, float]]
     gains: list[Estimate | None]             # per recording: the gyro gain [units per rad/s] of a rate recording
@@ -349,7 +386,7 @@ class ServoFit:
     @property
     def servo(self) -> Servo:
         """The fitted servo (other fields at their defaults)."""
-        return Servo(**{name: self.estimates[name].value for name in PARAMS})
+        return servo_of({key: self.estimates[key].value for key in KEYS})
 
     @property
     def rms_residual_rad_per_s(self) -> float | None:
@@ -369,21 +406,22 @@ class ServoFit:
         Returns
         -------
         dict
-            ``experiment`` ("servo"), each recording's kind and rig, each of ``PARAMS`` as
-            its :meth:`~.fitstats.Estimate.as_dict` with ``identifiable`` (a given one without
-            interval), the timings and gains per recording, and the fit's figures.
+            ``experiment`` ("servo"), each recording's kind and rig, each of ``KEYS`` (by its
+            robot key) as its :meth:`~.fitstats.Estimate.as_dict` with ``identifiable`` (a
+            given one without interval), the timings and gains per recording, and the fit's
+            figures.
         """
         out = {"experiment": "servo", "source": self.source,
                "kind": [r.kind for r in self.recordings],
                "inertia_kgm2": [r.rig.inertia_kgm2 for r in self.recordings],
                "gravity_moment_nm": [r.rig.gravity_moment_nm for r in self.recordings]}
-        for name in PARAMS:
-            est = self.estimates[name]
-            entry = {**est.as_dict(), "identifiable": self.identifiable[name]}
-            if name in self.given:
+        for key in KEYS:
+            est = self.estimates[key]
+            entry = {**est.as_dict(), "identifiable": self.identifiable[key]}
+            if key in self.given:
                 entry = {"value": est.value, "std": None, "ci95": [None, None], "identifiable": True,
                          "given": True}
-            out[name] = entry
+            out[key] = entry
         out["interval"] = self.interval
         out["command_delay_s"] = [round(t.delay_s, 5) for t in self.timings]
         out["command_delay_std_s"] = [round(s[0], 5) for s in self.timing_std]
@@ -615,27 +653,28 @@ class _Layout:
                  signs: tuple[float, ...] = ()):
         self.clock, self.gain = clock, gain
         params = []
-        for name in PARAMS:
-            value = held.get(name)
+        for key in KEYS:
+            value = held.get(key)
             # a fitted one's nominal: the middle of its box in log (the grid's starts replace it)
-            nominal = math.sqrt(LOWER[name] * UPPER[name]) if value is None else value
-            params.append(FitParameter(name, UNITS[name], nominal, LOWER[name], UPPER[name], scaling="log",
+            nominal = math.sqrt(LOWER[key] * UPPER[key]) if value is None else value
+            params.append(FitParameter(key, UNITS[key], nominal, LOWER[key], UPPER[key], scaling="log",
                                        held=value is not None, source="given" if value is not None else ""))
         self._nuisance = []
         for k, (has_clock, has_gain) in enumerate(zip(clock, gain)):
-            params.append(FitParameter(f"delay_s[{k}]", "s", 0.0, -MAX_DELAY_S, MAX_DELAY_S, scale=DELAY_SCALE_S))
+            params.append(FitParameter(f"command_delay_s[{k}]", "s", 0.0, -MAX_DELAY_S, MAX_DELAY_S,
+                                       scale=DELAY_SCALE_S))
             self._nuisance.append((k, "delay"))
             if has_clock:
-                params.append(FitParameter(f"clock_error[{k}]", "1", 0.0, -MAX_CLOCK_ERROR, MAX_CLOCK_ERROR,
+                params.append(FitParameter(f"command_clock_error[{k}]", "1", 0.0, -MAX_CLOCK_ERROR, MAX_CLOCK_ERROR,
                                            scale=CLOCK_SCALE))
                 self._nuisance.append((k, "clock"))
             if has_gain:
                 sign = signs[k]
-                params.append(FitParameter(f"gyro_gain[{k}]", "units per rad/s", sign, sign * 1e-9, sign * 1e9,
-                                           scaling="log", reference=sign))
+                params.append(FitParameter(f"gyro_gain_units_per_rad_per_s[{k}]", "units per rad/s", sign,
+                                           sign * 1e-9, sign * 1e9, scaling="log", reference=sign))
                 self._nuisance.append((k, "gain"))
         self.params = FitParameters(params)
-        self.fitted = tuple(n for n in PARAMS if n in self.params.free)
+        self.fitted = tuple(key for key in KEYS if key in self.params.free)
 
     @property
     def size(self) -> int:
@@ -644,17 +683,17 @@ class _Layout:
     @property
     def stall_given(self) -> float | None:
         """The stall torque [N*m] when held, else None."""
-        stall = self.params["stall_torque_nm"]
+        stall = self.params["servo.stall_torque_nm"]
         return stall.start if stall.held else None
 
     def unpack(self, x: np.ndarray) -> tuple[Servo, list[Timing], list[float | None]]:
         values = self.params.from_vector(x)
         timings, gains = [], []
         for k, (has_clock, has_gain) in enumerate(zip(self.clock, self.gain)):
-            ratio = 1.0 + values[f"clock_error[{k}]"] if has_clock else 1.0
-            timings.append(Timing(values[f"delay_s[{k}]"], ratio))
-            gains.append(values[f"gyro_gain[{k}]"] if has_gain else None)
-        return Servo(**{n: values[n] for n in PARAMS}), timings, gains
+            ratio = 1.0 + values[f"command_clock_error[{k}]"] if has_clock else 1.0
+            timings.append(Timing(values[f"command_delay_s[{k}]"], ratio))
+            gains.append(values[f"gyro_gain_units_per_rad_per_s[{k}]"] if has_gain else None)
+        return servo_of(values), timings, gains
 
     def nuisance(self) -> list[tuple[int, str]]:
         """(recording, what) of each variable after the physical ones, in order."""
@@ -923,7 +962,7 @@ def fit_servo(recordings: list[Recording], stall_torque_nm: float | None = None,
 
     t_start = time.perf_counter()
     recs = _checked_inputs(recordings, stall_torque_nm, kv_nms_per_rad)
-    held = {"stall_torque_nm": stall_torque_nm, "kv_nms_per_rad": kv_nms_per_rad}
+    held = {"servo.stall_torque_nm": stall_torque_nm, "servo.kv_nms_per_rad": kv_nms_per_rad}
     layout = _Layout(held, tuple(r.kind == "angle" and len(r.edges) >= MIN_EDGES_FOR_CLOCK for r in recs),
                      tuple(r.kind == "rate" for r in recs),
                      tuple(r.gain_sign if r.kind == "rate" else 1.0 for r in recs))
@@ -1017,22 +1056,23 @@ def _grid_starts(recs, layout: _Layout, residual, bounds) -> list[np.ndarray]:
     for noload in (seen_speed, 1.5 * seen_speed, 2.5 * seen_speed):
         timing = [_timing_guess(rec, noload) for rec in recs]
         for tau_s in (0.002, 0.01, 0.03):                        # mechanical time constant (J+Ja)/b
-            armature = max(tau_s * stall / noload - j, LOWER["armature_kgm2"] * 10)
+            armature = max(tau_s * stall / noload - j, LOWER["servo.armature_kgm2"] * 10)
             for linear_deg in (3.0, 10.0, 25.0):
-                kv_shares = (0.01, 0.3, 1.0) if "kv_nms_per_rad" in layout.fitted else (None,)
+                kv_shares = (0.01, 0.3, 1.0) if "servo.kv_nms_per_rad" in layout.fitted else (None,)
                 for kv_share in kv_shares:                       # kv against the back-EMF's stall/noload
                     for delay_frames in (-1.0, -0.5, 0.0, 0.5):
-                        phys = {"noload_speed_rad_per_s": noload, "armature_kgm2": armature,
-                                "kp_nm_per_rad": stall / math.radians(linear_deg), "stall_torque_nm": stall,
-                                "kv_nms_per_rad": (kv_share or 0.0) * stall / noload}
+                        phys = {"servo.noload_speed_rad_per_s": noload, "servo.armature_kgm2": armature,
+                                "servo.kp_nm_per_rad": stall / math.radians(linear_deg),
+                                "servo.stall_torque_nm": stall,
+                                "servo.kv_nms_per_rad": (kv_share or 0.0) * stall / noload}
                         values = dict(phys)
                         for k, rec in enumerate(recs):
                             delay_s, ratio = timing[k]
                             lag = tau_s if rec.kind == "angle" else 0.0
-                            values[f"delay_s[{k}]"] = delay_s - lag + delay_frames * frame_s[k]
-                            values[f"clock_error[{k}]"] = ratio - 1.0      # used where the clock is fitted
+                            values[f"command_delay_s[{k}]"] = delay_s - lag + delay_frames * frame_s[k]
+                            values[f"command_clock_error[{k}]"] = ratio - 1.0      # used where the clock is fitted
                             if rec.kind == "rate":
-                                values[f"gyro_gain[{k}]"] = rec.gain_sign * rec.gain_guess()
+                                values[f"gyro_gain_units_per_rad_per_s[{k}]"] = rec.gain_sign * rec.gain_guess()
                         cands.append(layout.params.as_vector(values))
     lo, hi = bounds
     xs = np.clip(np.array(cands), lo + 1e-6, hi - 1e-6)
@@ -1332,7 +1372,7 @@ def validate(servo: Servo, rec: Recording, gain: float | None = None) -> Validat
     elif rec.kind == "rate":
         gain = rec.gain_sign * abs(gain)
     has_clock = rec.kind == "angle" and len(rec.edges) >= MIN_EDGES_FOR_CLOCK
-    layout = _Layout({n: getattr(servo, n) for n in PARAMS}, (has_clock,), (False,))
+    layout = _Layout(values_of(servo), (has_clock,), (False,))
     model = rig_model(rec.rig)
 
     def residual(x: np.ndarray) -> np.ndarray:
@@ -1344,7 +1384,8 @@ def validate(servo: Servo, rec: Recording, gain: float | None = None) -> Validat
     noload = servo.noload_speed_rad_per_s if math.isfinite(servo.noload_speed_rad_per_s) else 10.0
     delay_s, ratio = _timing_guess(rec, noload)
     frame_s = float(np.median(np.diff(rec.t_s)))
-    starts = [layout.params.as_vector({"delay_s[0]": delay_s + f * frame_s, "clock_error[0]": ratio - 1.0})
+    starts = [layout.params.as_vector({"command_delay_s[0]": delay_s + f * frame_s,
+                                         "command_clock_error[0]": ratio - 1.0})
               for f in (-1.5, -1.0, -0.5, 0.0, 0.5)]
     bounds = layout.bounds()
     lo, hi = bounds
