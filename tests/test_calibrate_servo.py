@@ -18,7 +18,9 @@ from locust.calibrate import servo as SV
 from locust.calibrate import synthetic as S
 from locust.calibrate.gyro_log import looks_like_gyro_log, parse_gyro_log, read_gyro_log
 from locust.calibrate.recordings import read_table
-from locust.errors import CalibrationError
+from locust.calibrate.servo import rig as servo_rig
+from locust.calibrate.servo.layout import Layout
+from locust.errors import CalibrationError, ParamsError
 from locust.params import Robot, Servo
 from locust.progress import Progress
 from locust.sim.servo import with_servo
@@ -55,6 +57,33 @@ def test_rig_model_is_the_hobby_servo():
     copy = with_servo(SV.rig_model(SV.ServoRig(4e-4, 0.03)), servo)
     for name in ("actuator_gainprm", "actuator_biasprm", "actuator_forcerange", "dof_damping", "dof_armature"):
         assert np.array_equal(getattr(copy, name), getattr(model, name)), name
+
+
+def test_the_fits_table_names_each_servo_value_by_its_robot_key():
+    """The fit's table holds the servo's values under the robot's own keys, so a fitted value
+    goes to robot.toml under its name as it is; a recording's delay, clock error and gyro
+    gain are no robot key (never written). A vector of the AA swing's SG90 (kp 0.26, 10.2
+    rad/s, 3.1e-4 kg*m^2), the stall torque and kv held at 0.15 and 0, unpacks to that servo."""
+    layout = Layout({"servo.stall_torque_nm": 0.15, "servo.kv_nms_per_rad": 0.0}, clock=(True,), gain=(True,),
+                    signs=(1.0,))
+    assert layout.fitted == ("servo.noload_speed_rad_per_s", "servo.armature_kgm2", "servo.kp_nm_per_rad")
+    assert layout.params.held == ("servo.kv_nms_per_rad", "servo.stall_torque_nm")
+    # each a key the robot reads: the presets' SG90 under them
+    assert [Robot().get(key) for key in SV.KEYS] == [10.31, 4.65e-4, 0.377, 0.0, 0.15]
+    assert set(SV.KEYS) == {*layout.fitted, *layout.params.held}
+    own = [name for name in layout.params.free if name not in layout.fitted]
+    assert own == ["command_delay_s[0]", "command_clock_error[0]", "gyro_gain_units_per_rad_per_s[0]"]
+    for name in own:
+        with pytest.raises(ParamsError):
+            Robot().get(name)
+    x = layout.params.as_vector({**SV.values_of(SG90), "command_delay_s[0]": 0.012, "command_clock_error[0]": 0.002,
+                                 "gyro_gain_units_per_rad_per_s[0]": 8.5})
+    servo, (timing,), (gain,) = layout.unpack(x)
+    assert servo.kp_nm_per_rad == pytest.approx(0.26, rel=1e-12)
+    assert servo.noload_speed_rad_per_s == pytest.approx(10.2, rel=1e-12)
+    assert servo.armature_kgm2 == pytest.approx(3.1e-4, rel=1e-12)
+    assert (servo.stall_torque_nm, servo.kv_nms_per_rad) == (0.15, 0.0)
+    assert (timing.delay_s, timing.clock_ratio, gain) == pytest.approx((0.012, 1.002, 8.5), rel=1e-12)
 
 
 def test_saturated_servo_slews_at_its_noload_speed():
@@ -109,13 +138,13 @@ def test_two_loads_give_the_stall_torque(monkeypatch):
     light = S.ServoTruth()
     heavy = dataclasses.replace(light, inertia_kgm2=1e-3, half_period_s=1.2)
     steps = [0.0]
-    simulate = SV.rollout_threads
+    simulate = servo_rig.rollout_threads
 
     def counted(models, state, control, threads=None):
         steps[0] += control.shape[0] * control.shape[1]
         return simulate(models, state, control, threads)
 
-    monkeypatch.setattr(SV, "rollout_threads", counted)
+    monkeypatch.setattr(servo_rig, "rollout_threads", counted)
     calls: list[tuple[float, int]] = []
     fit = SV.fit_servo([recording(light, 4), recording(heavy, 5)], kv_nms_per_rad=0.0,
                        progress=lambda n: calls.append((steps[0], n)))
@@ -136,7 +165,7 @@ def test_fit_on_threads_is_the_fit_on_one(monkeypatch):
     import locust.sim.rollout
 
     def fit(cores: int) -> dict:
-        monkeypatch.setattr(SV, "available_cores", lambda: cores)
+        monkeypatch.setattr(servo_rig, "available_cores", lambda: cores)
         monkeypatch.setattr(locust.sim.rollout, "available_cores", lambda: cores)
         result = locust.calibrate_servo([locust.bundled_recording("synthetic_servo.csv"),
                                          locust.bundled_recording("synthetic_servo_heavy.csv")], [1.5e-5, 1e-3])
