@@ -91,8 +91,9 @@ def test_servo_two_loads_json(recs):
     assert res.exit_code == 0, res.output
     out = json.loads(res.stdout)
     # header truth: stall 0.15 N*m, no-load 10.2 rad/s, delay 12 ms, clock ratio 1.002
-    assert out["stall_torque_nm"]["value"] == pytest.approx(0.15, rel=0.02) and out["stall_torque_nm"]["identifiable"]
-    assert out["noload_speed_rad_per_s"]["value"] == pytest.approx(10.2, rel=0.01)
+    stall = out["servo.stall_torque_nm"]
+    assert stall["value"] == pytest.approx(0.15, rel=0.02) and stall["identifiable"]
+    assert out["servo.noload_speed_rad_per_s"]["value"] == pytest.approx(10.2, rel=0.01)
     assert out["command_delay_s"] == pytest.approx([0.012, 0.012], abs=0.002)
     assert out["command_clock_ratio"] == pytest.approx([1.002, 1.002], abs=3e-4)
     assert len(out["rms_per_recording"]) == 2 and out["rms_unit"] == ["deg", "deg"]

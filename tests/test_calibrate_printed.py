@@ -107,9 +107,9 @@ EXPECTED = {
         rms_residual 0.7922 deg
     """,
     "servo_aa": """
-        noload_speed 10.23 rad/s ± 0.6 % (95 %: 10.12 … 10.35)
-        armature 3.130e-4 kg·m² ± 11 % (95 %: 2.466e-4 … 3.794e-4)
-        kp 0.2592 N·m/rad ± 7.4 % (95 %: 0.2212 … 0.2973)
+        servo.noload_speed 10.23 rad/s ± 0.6 % (95 %: 10.12 … 10.35)
+        servo.armature 3.130e-4 kg·m² ± 11 % (95 %: 2.466e-4 … 3.794e-4)
+        servo.kp 0.2592 N·m/rad ± 7.4 % (95 %: 0.2212 … 0.2973)
         command_delay -0.03854 s
         command_delay_std 0.001920 s
         command_clock_ratio 0.9954
@@ -119,9 +119,9 @@ EXPECTED = {
         rms_half_step 1.473
     """,
     "servo_gyro": """
-        noload_speed 10.53 rad/s ± 1.7 % (95 %: 10.17 … 10.89)
-        armature 4.879e-4 kg·m² ± 5.1 % (95 %: 4.375e-4 … 5.384e-4)
-        kp 0.3767 N·m/rad ± 4.0 % (95 %: 0.3457 … 0.4077)
+        servo.noload_speed 10.53 rad/s ± 1.7 % (95 %: 10.17 … 10.89)
+        servo.armature 4.879e-4 kg·m² ± 5.1 % (95 %: 4.375e-4 … 5.384e-4)
+        servo.kp 0.3767 N·m/rad ± 4.0 % (95 %: 0.3457 … 0.4077)
         command_delay 0.02864 s
         command_delay_std 0.001500 s
         command_clock_ratio 1.000
@@ -132,9 +132,9 @@ EXPECTED = {
         gyro_gain_units_per_rad_per_s[0] 7.796 ± 1.1 % (95 %: 7.624 … 7.968)
     """,
     "servo_both": """
-        noload_speed 10.31 rad/s ± 1.1 % (95 %: 10.08 … 10.53)
-        armature 4.646e-4 kg·m² ± 5.4 % (95 %: 4.141e-4 … 5.150e-4)
-        kp 0.3771 N·m/rad ± 3.6 % (95 %: 0.3493 … 0.4050)
+        servo.noload_speed 10.31 rad/s ± 1.1 % (95 %: 10.08 … 10.53)
+        servo.armature 4.646e-4 kg·m² ± 5.4 % (95 %: 4.141e-4 … 5.150e-4)
+        servo.kp 0.3771 N·m/rad ± 3.6 % (95 %: 0.3493 … 0.4050)
         command_delay -0.04664, 0.02954 s
         command_delay_std 0.001950, 0.001430 s
         command_clock_ratio 0.9954, 1.000

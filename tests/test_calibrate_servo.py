@@ -18,13 +18,21 @@ from locust.calibrate import servo as SV
 from locust.calibrate import synthetic as S
 from locust.calibrate.gyro_log import looks_like_gyro_log, parse_gyro_log, read_gyro_log
 from locust.calibrate.recordings import read_table
-from locust.errors import CalibrationError
-from locust.params import Servo
+from locust.calibrate.servo import rig as servo_rig
+from locust.calibrate.servo.layout import Layout
+from locust.errors import CalibrationError, ParamsError
+from locust.params import Robot, Servo
 from locust.progress import Progress
+from locust.sim.servo import with_servo
 
 SG90 = S.ServoTruth().servo   # the synthetic recordings' SG90 (the AA swing's fit alone)
 PRESET = Servo()              # the presets' SG90: the AA swing and the gyro steps together
 KV_FITTED = dataclasses.replace(PRESET, kp_nm_per_rad=0.5, kv_nms_per_rad=0.004)   # a servo with kv
+
+
+def value_of(servo: Servo, key: str) -> float:
+    """A servo's value by its robot key (``servo.kp_nm_per_rad``), as the robot reads it."""
+    return Robot(servo=servo).get(key)
 
 
 def recording(truth: S.ServoTruth, seed: int) -> SV.StepRecording:
@@ -46,9 +54,36 @@ def test_rig_model_is_the_hobby_servo():
     assert data.M[0] == pytest.approx(4e-4 + 2e-4, rel=1e-9)           # load + reflected rotor
     assert -data.qfrc_bias[0] == pytest.approx(-0.03, rel=1e-6)         # gravity moment at angle 0
     # the same servo put on a compiled model without recompiling
-    copy = SV.with_servo(SV.rig_model(SV.ServoRig(4e-4, 0.03)), servo)
+    copy = with_servo(SV.rig_model(SV.ServoRig(4e-4, 0.03)), servo)
     for name in ("actuator_gainprm", "actuator_biasprm", "actuator_forcerange", "dof_damping", "dof_armature"):
         assert np.array_equal(getattr(copy, name), getattr(model, name)), name
+
+
+def test_the_fits_table_names_each_servo_value_by_its_robot_key():
+    """The fit's table holds the servo's values under the robot's own keys, so a fitted value
+    goes to robot.toml under its name as it is; a recording's delay, clock error and gyro
+    gain are no robot key (never written). A vector of the AA swing's SG90 (kp 0.26, 10.2
+    rad/s, 3.1e-4 kg*m^2), the stall torque and kv held at 0.15 and 0, unpacks to that servo."""
+    layout = Layout({"servo.stall_torque_nm": 0.15, "servo.kv_nms_per_rad": 0.0}, clock=(True,), gain=(True,),
+                    signs=(1.0,))
+    assert layout.fitted == ("servo.noload_speed_rad_per_s", "servo.armature_kgm2", "servo.kp_nm_per_rad")
+    assert layout.params.held == ("servo.kv_nms_per_rad", "servo.stall_torque_nm")
+    # each a key the robot reads: the presets' SG90 under them
+    assert [Robot().get(key) for key in SV.KEYS] == [10.31, 4.65e-4, 0.377, 0.0, 0.15]
+    assert set(SV.KEYS) == {*layout.fitted, *layout.params.held}
+    own = [name for name in layout.params.free if name not in layout.fitted]
+    assert own == ["command_delay_s[0]", "command_clock_error[0]", "gyro_gain_units_per_rad_per_s[0]"]
+    for name in own:
+        with pytest.raises(ParamsError):
+            Robot().get(name)
+    x = layout.params.as_vector({**SV.values_of(SG90), "command_delay_s[0]": 0.012, "command_clock_error[0]": 0.002,
+                                 "gyro_gain_units_per_rad_per_s[0]": 8.5})
+    servo, (timing,), (gain,) = layout.unpack(x)
+    assert servo.kp_nm_per_rad == pytest.approx(0.26, rel=1e-12)
+    assert servo.noload_speed_rad_per_s == pytest.approx(10.2, rel=1e-12)
+    assert servo.armature_kgm2 == pytest.approx(3.1e-4, rel=1e-12)
+    assert (servo.stall_torque_nm, servo.kv_nms_per_rad) == (0.15, 0.0)
+    assert (timing.delay_s, timing.clock_ratio, gain) == pytest.approx((0.012, 1.002, 8.5), rel=1e-12)
 
 
 def test_saturated_servo_slews_at_its_noload_speed():
@@ -86,9 +121,9 @@ def test_synthetic_step_other_load_and_frame_rate_is_recovered():
                                 delay_s=0.02, clock_ratio=0.998)
     fit = SV.fit_servo([recording(truth, 11)], stall_torque_nm=0.15, kv_nms_per_rad=0.0)
     est = fit.estimates
-    assert est["noload_speed_rad_per_s"].value == pytest.approx(SG90.noload_speed_rad_per_s, rel=0.05)
-    assert est["armature_kgm2"].value == pytest.approx(SG90.armature_kgm2, rel=0.15)
-    assert est["kp_nm_per_rad"].value == pytest.approx(SG90.kp_nm_per_rad, rel=0.30)
+    assert est["servo.noload_speed_rad_per_s"].value == pytest.approx(SG90.noload_speed_rad_per_s, rel=0.05)
+    assert est["servo.armature_kgm2"].value == pytest.approx(SG90.armature_kgm2, rel=0.15)
+    assert est["servo.kp_nm_per_rad"].value == pytest.approx(SG90.kp_nm_per_rad, rel=0.30)
     assert all(fit.identifiable.values()), fit.notes
     assert fit.rms_residual_deg == pytest.approx(truth.noise_deg, rel=0.15)
     assert fit.timings[0].delay_s == pytest.approx(0.02, abs=0.002)
@@ -103,19 +138,19 @@ def test_two_loads_give_the_stall_torque(monkeypatch):
     light = S.ServoTruth()
     heavy = dataclasses.replace(light, inertia_kgm2=1e-3, half_period_s=1.2)
     steps = [0.0]
-    simulate = SV.rollout_threads
+    simulate = servo_rig.rollout_threads
 
     def counted(models, state, control, threads=None):
         steps[0] += control.shape[0] * control.shape[1]
         return simulate(models, state, control, threads)
 
-    monkeypatch.setattr(SV, "rollout_threads", counted)
+    monkeypatch.setattr(servo_rig, "rollout_threads", counted)
     calls: list[tuple[float, int]] = []
     fit = SV.fit_servo([recording(light, 4), recording(heavy, 5)], kv_nms_per_rad=0.0,
                        progress=lambda n: calls.append((steps[0], n)))
     assert all(fit.identifiable.values()), fit.notes
-    for name in ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad", "stall_torque_nm"):
-        true = getattr(SG90, name)
+    for name in ("servo.noload_speed_rad_per_s", "servo.armature_kgm2", "servo.kp_nm_per_rad", "servo.stall_torque_nm"):
+        true = value_of(SG90, name)
         est = fit.estimates[name]
         assert est.value == pytest.approx(true, rel=0.05), name
         assert abs(est.value - true) < 4 * est.std, name
@@ -130,7 +165,7 @@ def test_fit_on_threads_is_the_fit_on_one(monkeypatch):
     import locust.sim.rollout
 
     def fit(cores: int) -> dict:
-        monkeypatch.setattr(SV, "available_cores", lambda: cores)
+        monkeypatch.setattr(servo_rig, "available_cores", lambda: cores)
         monkeypatch.setattr(locust.sim.rollout, "available_cores", lambda: cores)
         result = locust.calibrate_servo([locust.bundled_recording("synthetic_servo.csv"),
                                          locust.bundled_recording("synthetic_servo_heavy.csv")], [1.5e-5, 1e-3])
@@ -167,9 +202,9 @@ def test_stalled_servo_gives_stall_torque_not_kp():
     """SYNTHETIC: a weight too heavy to lift: the horn stalls where M*cos(angle) = stall."""
     truth = S.STALL_SERVO
     fit = SV.fit_servo([recording(truth, 12)], kv_nms_per_rad=0.0)
-    assert fit.estimates["stall_torque_nm"].value == pytest.approx(0.15, rel=0.01)
-    assert fit.identifiable["stall_torque_nm"] and not fit.identifiable["kp_nm_per_rad"]
-    assert any("kp_nm_per_rad is not identifiable" in n for n in fit.notes)
+    assert fit.estimates["servo.stall_torque_nm"].value == pytest.approx(0.15, rel=0.01)
+    assert fit.identifiable["servo.stall_torque_nm"] and not fit.identifiable["servo.kp_nm_per_rad"]
+    assert any("servo.kp_nm_per_rad is not identifiable" in n for n in fit.notes)
 
 
 def test_one_load_without_stall_torque_is_refused():
@@ -194,14 +229,14 @@ def test_real_sg90_recording_is_followed(shared_data):
     kv held at 0: one large swing cannot tell kp from kv (the gyro steps can)."""
     fit = SV.fit_servo([aa_recording(shared_data)], stall_torque_nm=0.15, kv_nms_per_rad=0.0)
     assert fit.rms_residual_deg <= 2.5
-    assert 8.0 <= fit.estimates["noload_speed_rad_per_s"].value <= 13.0
-    assert 5e-5 <= fit.estimates["armature_kgm2"].value <= 2e-3
+    assert 8.0 <= fit.estimates["servo.noload_speed_rad_per_s"].value <= 13.0
+    assert 5e-5 <= fit.estimates["servo.armature_kgm2"].value <= 2e-3
     assert all(fit.identifiable.values()), fit.notes
     # the synthetic recordings' SG90 is this fit, to its stated uncertainty
-    for name in ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad"):
-        assert fit.estimates[name].value == pytest.approx(getattr(SG90, name), abs=2 * fit.estimates[name].std), name
+    for name in ("servo.noload_speed_rad_per_s", "servo.armature_kgm2", "servo.kp_nm_per_rad"):
+        assert fit.estimates[name].value == pytest.approx(value_of(SG90, name), abs=2 * fit.estimates[name].std), name
     # the presets' top speed (both recordings) agrees with the swing's alone
-    assert fit.estimates["noload_speed_rad_per_s"].value == pytest.approx(PRESET.noload_speed_rad_per_s, rel=0.03)
+    assert fit.estimates["servo.noload_speed_rad_per_s"].value == pytest.approx(PRESET.noload_speed_rad_per_s, rel=0.03)
 
 
 def test_horn_angle_from_track():
@@ -294,11 +329,11 @@ def test_cli_fits_angle_and_gyro_together_and_validates(tmp_path):
     assert out["kind"] == ["angle", "rate"]
     # each value near the truth: about four of the fit's standard deviations on these recordings
     # (0.2, 1.9, 1.4, 7 and 0.3 %); whether such intervals cover is test_joint_fit_intervals_cover_over_seeds's
-    for name, rel in (("noload_speed_rad_per_s", 0.01), ("armature_kgm2", 0.08), ("kp_nm_per_rad", 0.06),
-                      ("kv_nms_per_rad", 0.3)):
+    for name, rel in (("servo.noload_speed_rad_per_s", 0.01), ("servo.armature_kgm2", 0.08),
+                      ("servo.kp_nm_per_rad", 0.06), ("servo.kv_nms_per_rad", 0.3)):
         est = out[name]
         assert est["identifiable"], (name, out["notes"])
-        assert est["value"] == pytest.approx(getattr(true, name), rel=rel), name
+        assert est["value"] == pytest.approx(value_of(true, name), rel=rel), name
     gain = out["gyro_gain_units_per_rad_per_s"][1]
     assert gain["value"] == pytest.approx(gyro.gain_units_per_rad_per_s, rel=0.01)
     (val,) = out["validation"]
@@ -323,7 +358,8 @@ def joint_fit_coverage(case: str, seeds: int) -> dict[str, int]:
     values and the gyro's gain) covers the truth; each value within 10 % of it (kv 40 %)."""
     true, gyro, kv = JOINT_CASES[case]
     angle = dataclasses.replace(S.ServoTruth(), servo=true)
-    names = ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad") + ("kv_nms_per_rad",) * (kv is None)
+    names = (("servo.noload_speed_rad_per_s", "servo.armature_kgm2", "servo.kp_nm_per_rad")
+             + ("servo.kv_nms_per_rad",) * (kv is None))
     covered = dict.fromkeys((*names, "gyro gain"), 0)
     for seed in range(seeds):
         rng = np.random.default_rng(100 + seed)
@@ -332,12 +368,13 @@ def joint_fit_coverage(case: str, seeds: int) -> dict[str, int]:
         fit = SV.fit_servo([SV.StepRecording(t, a, c, SV.ServoRig(angle.inertia_kgm2)),
                             SV.RateRecording(tg, g, cg, SV.ServoRig(gyro.inertia_kgm2))],
                            stall_torque_nm=0.15, kv_nms_per_rad=kv)
-        checks = [(name, fit.estimates[name], getattr(true, name)) for name in names]
+        checks = [(name, fit.estimates[name], value_of(true, name)) for name in names]
         checks.append(("gyro gain", fit.gains[1], gyro.gain_units_per_rad_per_s))
         for name, est, truth in checks:
             # about five standard deviations (armature 1.9 %, kv 7 % on the command line's draw):
             # an interval made wide enough to cover anything still has its value near the truth
-            assert est.value == pytest.approx(truth, rel=0.4 if name == "kv_nms_per_rad" else 0.1), (case, seed, name)
+            rel = 0.4 if name == "servo.kv_nms_per_rad" else 0.1
+            assert est.value == pytest.approx(truth, rel=rel), (case, seed, name)
             covered[name] += est.ci95_low <= truth <= est.ci95_high
     return covered
 
@@ -408,8 +445,8 @@ def test_real_sg90s_together_are_the_preset(shared_data):
                        stall_torque_nm=0.15, kv_nms_per_rad=0.0)
     assert all(fit.identifiable.values()), fit.notes
     assert fit.rms_per_recording[0] <= 2.5 and fit.rms_per_recording[1] <= 0.7
-    for name in ("noload_speed_rad_per_s", "armature_kgm2", "kp_nm_per_rad"):
+    for name in ("servo.noload_speed_rad_per_s", "servo.armature_kgm2", "servo.kp_nm_per_rad"):
         est = fit.estimates[name]
-        assert est.value == pytest.approx(getattr(PRESET, name), abs=0.5 * est.std), name
+        assert est.value == pytest.approx(value_of(PRESET, name), abs=0.5 * est.std), name
     # the data README's integral: 0.148 units*s per commanded degree, i.e. 8.48 units per rad/s
     assert fit.rate_gain == pytest.approx(math.degrees(0.148), rel=0.10)

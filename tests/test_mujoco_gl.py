@@ -126,9 +126,9 @@ def test_calibrate_servo_runs_with_a_value_mujoco_does_not_know(tmp_path):
     assert proc.returncode == 0, proc.stderr
     fit = json.loads(proc.stdout)
     # header truth: the AA swing's SG90 (noload 10.2 rad/s, armature 3.1e-4 kg*m^2, kp 0.26 N*m/rad)
-    assert fit["noload_speed_rad_per_s"]["value"] == pytest.approx(10.2, rel=0.01)
-    assert fit["armature_kgm2"]["value"] == pytest.approx(3.1e-4, rel=0.05)
-    assert fit["kp_nm_per_rad"]["value"] == pytest.approx(0.26, rel=0.05)
+    assert fit["servo.noload_speed_rad_per_s"]["value"] == pytest.approx(10.2, rel=0.01)
+    assert fit["servo.armature_kgm2"]["value"] == pytest.approx(3.1e-4, rel=0.05)
+    assert fit["servo.kp_nm_per_rad"]["value"] == pytest.approx(0.26, rel=0.05)
 
 
 @pytest.fixture()

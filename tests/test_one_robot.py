@@ -114,8 +114,7 @@ def test_a_calibration_written_to_a_new_file_is_the_default_robot_with_the_fit(s
     assert written["leg_set"] == default["leg_set"] == "small"
     assert {k: written["values"][k]["value"] for k in GEOMETRY} == {k: default["values"][k]["value"] for k in GEOMETRY}
     for key in SERVO_FITTED:
-        name = key.split(".")[1]
-        assert written["values"][key]["value"] == fitted[name]["value"]
+        assert written["values"][key]["value"] == fitted[key]["value"]
         assert written["values"][key]["source"].startswith("fit:sg90_aa_battery_step.csv")
     # the real recordings' fit (docs/servo.md): no-load speed 10.31 rad/s, kp 0.377 N*m/rad
     assert written["values"]["servo.noload_speed_rad_per_s"]["value"] == pytest.approx(10.31, abs=0.05)

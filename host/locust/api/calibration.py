@@ -393,13 +393,13 @@ def calibrate_servo(recordings: PathLike | Sequence[PathLike], inertia_kgm2: flo
     ...                              stall_torque_nm=0.15)            # doctest: +SKIP
     >>> fit.parameters["servo.noload_speed_rad_per_s"].value          # doctest: +SKIP
     """
-    from ..calibrate import servo as S
     from ..calibrate.inputs import per_recording, servo_recording
+    from ..calibrate.servo import ServoRig
 
     paths = [Path(recordings)] if isinstance(recordings, (str, Path)) else [Path(p) for p in recordings]
     inertias = per_recording(_tuple(inertia_kgm2), len(paths), "--inertia-kgm2")
     moments = per_recording(_tuple(gravity_moment_nm), len(paths), "--gravity-moment-nm")
-    recs = [servo_recording(path, S.ServoRig(inertia, moment), None, None, None, ImportOptions(), timing)
+    recs = [servo_recording(path, ServoRig(inertia, moment), None, None, None, ImportOptions(), timing)
             for path, inertia, moment in zip(paths, inertias, moments)]
     return fit_servo_recordings(recs, stall_torque_nm, kv_nms_per_rad=kv_nms_per_rad, fit_kv=fit_kv,
                                 progress=progress)
@@ -428,12 +428,12 @@ def fit_servo_recordings(recs: list, stall_torque_nm: float | None = None, *, kv
     Fit
         The ``servo.*`` values the recordings determine (never those not identifiable).
     """
-    from ..calibrate import servo as S
+    from ..calibrate.servo import KEYS, fit_servo
 
     inertias = [r.rig.inertia_kgm2 for r in recs]
     moments = [r.rig.gravity_moment_nm for r in recs]
-    fit = S.fit_servo(recs, stall_torque_nm, kv_nms_per_rad=None if fit_kv else kv_nms_per_rad, progress=progress)
-    values = {f"servo.{n}": fit.estimates[n] for n in S.PARAMS if fit.identifiable[n] and n not in fit.given}
+    fit = fit_servo(recs, stall_torque_nm, kv_nms_per_rad=None if fit_kv else kv_nms_per_rad, progress=progress)
+    values = {key: fit.estimates[key] for key in KEYS if fit.identifiable[key] and key not in fit.given}
     kinds = ",".join(r.kind for r in recs)
     note = (f"servo steps ({kinds}), J={','.join(map(str, inertias))} kg*m^2, M={','.join(map(str, moments))} N*m"
             + (f", stall torque {stall_torque_nm} N*m given" if stall_torque_nm else "")
