@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 from locust.bundled import bundled_recording
-from locust.fab.dxf_read import MAX_ARC_SEGMENTS
+from locust.fab.dxf_limits import MAX_ARC_SEGMENTS
 from locust.io import run_record as R
 from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
 from probing import assert_clear_error, assert_refused_and_unchanged, invoke, tree
