@@ -10,7 +10,7 @@ import pytest
 
 from locust.commands import hop as hop_command
 from locust.errors import DeviceError, TrialError
-from locust.firmware import protocol as P
+from locust.firmware import protocol
 from locust.io import run_record as R
 from locust.report.compare import timing_rows, trial_cycles
 from locust.report.page import timing_table
@@ -132,7 +132,7 @@ def test_a_minimal_record_takes_the_protocol_defaults(tmp_path):
     path.write_text(json.dumps({"schedule": {"cycles": 2, "push_deg": -30, "push_ms": 300, "wait_ms": 1000},
                                 "phases": []}))
     rec = R.read_run_record(path)
-    assert rec.schedule.heartbeat_ms == P.COMMANDS["hop"]["heartbeat_ms"][3]
+    assert rec.schedule.heartbeat_ms == protocol.COMMANDS["hop"]["heartbeat_ms"][3]
     assert (rec.status, rec.firmware_version, rec.phases) == (R.INCOMPLETE, None, [])
 
 
@@ -159,7 +159,7 @@ def test_the_report_reads_run_json_through_the_record(tmp_path):
 
 
 def test_schedule_limits_and_defaults_are_the_protocols():
-    hop = P.COMMANDS["hop"]
+    hop = protocol.COMMANDS["hop"]
     sched = R.HopSchedule()
     for name in ("cycles", "push_deg", "push_ms", "wait_ms", "heartbeat_ms"):
         assert getattr(sched, name) == hop[name][3]

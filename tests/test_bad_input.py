@@ -400,10 +400,10 @@ def test_the_heartbeat_keeps_its_clock_beside_a_busy_thread():
     import threading
 
     from locust.device.link import Link
-    from locust.firmware import protocol as P
+    from locust.firmware import protocol
 
     master, slave = pty.openpty()
-    interval_s = P.COMMANDS["hop"]["heartbeat_ms"][3] / 8000.0
+    interval_s = protocol.COMMANDS["hop"]["heartbeat_ms"][3] / 8000.0
     stop = threading.Event()
 
     def busy():
