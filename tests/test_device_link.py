@@ -26,7 +26,7 @@ from locust.device.plant import RecordingPlant
 from locust.device.virtual import PWM_PERIOD_S, TICKS_LEAD_S, VirtualRobot
 from locust.errors import DeviceError
 from locust.firmware import protocol
-from locust.io import run_record as R
+from locust.io import run_record
 from waiting import wait_for
 
 
@@ -51,11 +51,11 @@ def test_flash_copies_verifies_and_shakes_hands(robot):
 
 def test_hop_phases_on_time_and_servos_follow(robot, tmp_path, board_timing):
     vr, plant, _ = robot
-    schedule = R.HopSchedule(cycles=2, push_deg=-30.0, push_ms=100, wait_ms=150)
+    schedule = run_record.HopSchedule(cycles=2, push_deg=-30.0, push_ms=100, wait_ms=150)
     t_start = vr.now_s()
     with Link(vr.device_path) as link:
         rec = run_hop(link, schedule, tmp_path)
-    assert rec.status == R.COMPLETE and len(rec.phases) == 4
+    assert rec.status == run_record.COMPLETE and len(rec.phases) == 4
     assert [p.commanded_us for p in rec.phases] == [0, 100_000, 250_000, 350_000]
     assert all(p.error_us >= 0 for p in rec.phases)     # never early
     pushes = [c for c in plant.commands if c.t_s > t_start and c.left_deg < -1]
@@ -136,12 +136,12 @@ def test_hop_across_a_ticks_wrap_stays_on_time(robot, tmp_path, board_timing):
         _reboot_into_firmware(link)
         before = link.call("ping")["t_us"]
         assert (1 << 30) - before < TICKS_LEAD_S * 1e6  # the wrap is ahead
-        rec = run_hop(link, R.HopSchedule(cycles=6, push_ms=300, wait_ms=1000), tmp_path)
+        rec = run_hop(link, run_record.HopSchedule(cycles=6, push_ms=300, wait_ms=1000), tmp_path)
         after = link.call("ping")["t_us"]
     assert after < before  # wrapped during the hop
     start, end = rec.firmware_ticks_us
     assert before < start < (1 << 30) and end < after and rec.to_dict()["ticks_wrapped"]
-    assert rec.status == R.COMPLETE and len(rec.phases) == 12
+    assert rec.status == run_record.COMPLETE and len(rec.phases) == 12
     assert [p.commanded_us for p in rec.phases][-1] == 5 * 1_300_000 + 300_000
     assert all(p.error_us >= 0 for p in rec.phases)     # never early
     board_timing([p.error_us for p in rec.phases])
