@@ -8,14 +8,13 @@ import numpy as np
 import pytest
 
 from binomial import coverage_floor
-from locust.calibrate import ramp
-from locust.calibrate import synthetic as S
+from locust.calibrate import ramp, synthetic
 from locust.errors import CalibrationError
 
 
 def test_mu_is_tan_of_mean_angle():
-    truth = S.RampTruth()
-    angles = S.ramp_angles(truth, np.random.default_rng(21))
+    truth = synthetic.RampTruth()
+    angles = synthetic.ramp_angles(truth, np.random.default_rng(21))
     fit = ramp.fit_ramp(angles)
     assert fit.mu_static.value == pytest.approx(math.tan(math.radians(np.mean(angles))), rel=0.01)
     assert fit.mu_static.value == pytest.approx(truth.mu_static, rel=0.03)
@@ -27,10 +26,10 @@ RAMP_DRAWS = 400      # 0.3 s in all
 def test_ramp_intervals_cover_over_seeds():
     """SYNTHETIC: 400 sets of ten trials (0.8 deg scatter, read to 0.5 deg): the 95 % interval
     covers the truth at least coverage_floor(400) = 365 times (an 80 % interval: never, 6e-10)."""
-    truth = S.RampTruth()
+    truth = synthetic.RampTruth()
     covered = 0
     for seed in range(RAMP_DRAWS):
-        mu = ramp.fit_ramp(S.ramp_angles(truth, np.random.default_rng(seed))).mu_static
+        mu = ramp.fit_ramp(synthetic.ramp_angles(truth, np.random.default_rng(seed))).mu_static
         covered += mu.ci95_low <= truth.mu_static <= mu.ci95_high
     assert covered >= coverage_floor(RAMP_DRAWS), covered
 
@@ -63,9 +62,9 @@ def test_identical_readings_give_the_resolutions_interval_not_a_point():
 
 
 def test_critical_angle_from_tilt_track():
-    truth = S.RampTruth()
+    truth = synthetic.RampTruth()
     for seed in (1, 2):
-        t, markers, crit = S.ramp_tilt_track(truth, np.random.default_rng(seed), fps=30.0, rate_deg_per_s=6.0)
+        t, markers, crit = synthetic.ramp_tilt_track(truth, np.random.default_rng(seed), fps=30.0, rate_deg_per_s=6.0)
         onset = ramp.critical_angle_from_track(t, markers["ramp_a"], markers["ramp_b"], markers["robot"])
         assert onset.critical_angle_deg == pytest.approx(crit, abs=0.6)
 
