@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from locust.calibrate import hinge as H
+from locust.calibrate import hinge as hinge_fit
 from locust.calibrate.recordings import REAL_TIME, clean_samples, read_table
 from locust.io.importing import ImportOptions
 
@@ -36,18 +36,18 @@ def forward_differences(self, q):
     return th, np.column_stack(cols), dynamic
 
 
-def fit(path: Path, units: str, rig: H.HingeRig, coulomb: str, old: bool):
+def fit(path: Path, units: str, rig: hinge_fit.HingeRig, coulomb: str, old: bool):
     table = read_table(path, ImportOptions.parse(units), REAL_TIME)
     t, x, y = clean_samples(path, "marker", table.time_s(), *table.marker(), min_samples=20)
-    saved = H._Swing.angle_derivatives, H.is_linear
+    saved = hinge_fit._Swing.angle_derivatives, hinge_fit.is_linear
     if old:
-        H._Swing.angle_derivatives, H.is_linear = forward_differences, lambda params, rig: False
+        hinge_fit._Swing.angle_derivatives, hinge_fit.is_linear = forward_differences, lambda params, rig: False
     try:
         start = time.perf_counter()
-        result = H.fit_hinge(t, x, y, rig, coulomb=coulomb, source=str(path))
+        result = hinge_fit.fit_hinge(t, x, y, rig, coulomb=coulomb, source=str(path))
         return time.perf_counter() - start, result
     finally:
-        H._Swing.angle_derivatives, H.is_linear = saved
+        hinge_fit._Swing.angle_derivatives, hinge_fit.is_linear = saved
 
 
 def main() -> None:
@@ -56,12 +56,12 @@ def main() -> None:
     args = parser.parse_args()
     hinge = args.shared / "hinge"
     cases = [
-        ("Damping_test.trk, coulomb off", hinge / "Damping_test.trk", "m", H.HingeRig(8.5e-7), "off"),
-        ("Damping_test.trk, coulomb auto", hinge / "Damping_test.trk", "m", H.HingeRig(8.5e-7), "auto"),
+        ("Damping_test.trk, coulomb off", hinge / "Damping_test.trk", "m", hinge_fit.HingeRig(8.5e-7), "off"),
+        ("Damping_test.trk, coulomb auto", hinge / "Damping_test.trk", "m", hinge_fit.HingeRig(8.5e-7), "auto"),
         ("film pendulum, in plane, 1e-4 kg*m^2", hinge / "pendulum_transparency_film.csv", "mm",
-         H.HingeRig(1e-4, "in-plane", 0.002, 0.08), "auto"),
+         hinge_fit.HingeRig(1e-4, "in-plane", 0.002, 0.08), "auto"),
         ("film pendulum, the help's example rig", hinge / "pendulum_transparency_film.csv", "m",
-         H.HingeRig(8.5e-7), "auto"),
+         hinge_fit.HingeRig(8.5e-7), "auto"),
     ]
     print(f"load average {os.getloadavg()[0]:.2f}")
     for name, path, units, rig, coulomb in cases:

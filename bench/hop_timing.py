@@ -28,11 +28,11 @@ import tempfile
 from pathlib import Path
 
 from locust.commands.demo import CALIBRATIONS, HOP_TRUTH, RECORDINGS, Demo, recording_truth, seed_leg_set_options
-from locust.io import run_record as R
+from locust.io import run_record
 from locust.params import LEG_SETS
 from locust.progress import progress
 
-BOUND_MS = R.TIMING_BOUND_US / 1000
+BOUND_MS = run_record.TIMING_BOUND_US / 1000
 SCHEDULING = re.compile(r"(\w+) scheduling\)")
 
 
@@ -57,10 +57,10 @@ def hops(trials: int, cycles: int, jobs: int, video: bool) -> dict:
         worst_err = worst_stall = 0.0
         over = 0
         for trial in trials_dirs:
-            rec = R.read_run_record(trial / "run.json")
+            rec = run_record.read_run_record(trial / "run.json")
             err = max(abs(p.error_ms) for p in rec.phases)
             worst_err = max(worst_err, err)
-            worst_stall = max(worst_stall, (R.host_stall_max_s(rec.phases) or 0.0) * 1000)
+            worst_stall = max(worst_stall, (run_record.host_stall_max_s(rec.phases) or 0.0) * 1000)
             over += err > BOUND_MS
     return {"error_ms": worst_err, "stall_ms": worst_stall, "over": over, "hops": len(calls),
             "scheduling": "/".join(sorted(scheduling))}

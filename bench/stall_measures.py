@@ -40,7 +40,7 @@ from locust.device.hop import run_hop
 from locust.device.link import Link
 from locust.device.plant import RecordingPlant, make_plant
 from locust.device.virtual import VirtualRobot
-from locust.io import run_record as R
+from locust.io import run_record
 from locust.params import preset
 
 
@@ -78,7 +78,7 @@ def main() -> None:
     ap.add_argument("--hogs", type=int, default=0, help="CPU-bound processes beside the hop")
     ap.add_argument("--stop", type=float, default=0.0, help="SIGSTOP the interpreter this long [ms]")
     args = ap.parse_args()
-    schedule = R.HopSchedule(cycles=args.cycles, push_deg=-30.0, push_ms=300, wait_ms=1000, heartbeat_ms=2000)
+    schedule = run_record.HopSchedule(cycles=args.cycles, push_deg=-30.0, push_ms=300, wait_ms=1000, heartbeat_ms=2000)
     hogs = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(args.hogs)]
     try:
         with tempfile.TemporaryDirectory() as tmp:
@@ -91,7 +91,7 @@ def main() -> None:
                 sampler = Sampler(vr)
                 sampler.start()
 
-                def on_phase(p: R.Phase) -> None:
+                def on_phase(p: run_record.Phase) -> None:
                     if args.stop and (p.cycle, p.phase) == (2, "push"):
                         start_s = time.monotonic() + (schedule.push_ms * 1000 - p.error_us) / 1e6 - 0.020
 

@@ -18,28 +18,78 @@ import pandas as pd
 import pytest
 
 import locust
+import locust.api
 import locust.sweep.run
 import locust.track.runner
+from locust.api import EXPORTS, module_of
 from locust.bundled import bundled_recording
 from locust.errors import LocustError, ParamsError, SimError
+from locust.params import Robot
 
 ROOT = Path(__file__).resolve().parents[1]
-FACADE = ["robot", "simulate", "SimResult", "sweep_designs", "SweepResults", "track_markers", "read_tracks", "Tracks",
-          "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "Fit", "make_report", "optimize",
-          "make_cut_files"]
 
 
-def test_all_lists_the_facade():
-    assert set(FACADE) <= set(locust.__all__)
-    assert set(FACADE) <= set(dir(locust))
-    for name in FACADE:
-        assert callable(getattr(locust, name)), name
+def test_all_is_the_api_list():
+    """locust.__all__ is locust.api.EXPORTS (the one list of the public names) and the version;
+    every name is at the package top and in locust.api alike, callable."""
+    assert locust.__all__ == [*EXPORTS, "__version__"]
+    assert set(locust.__all__) <= set(dir(locust))
+    assert {"Robot", "LocustError", "simulate", "calibrate_hops"} <= set(EXPORTS)
+    for name in EXPORTS:
+        value = getattr(locust, name)
+        assert callable(value), name
+        assert value is getattr(locust.api, name) is getattr(importlib.import_module(module_of(name)), name)
+    assert (locust.Robot, locust.LocustError) == (Robot, LocustError)
+    with pytest.raises(AttributeError, match="no attribute 'EXPORTS'"):
+        locust.EXPORTS   # noqa: B018 (the list is locust.api's, not a name of the API)
     # the API's names are not the subpackages' (sweep, track, report, fab stay plain modules)
     for package in ("sweep", "track", "report", "fab"):
         assert isinstance(importlib.import_module(f"locust.{package}"), types.ModuleType)
         assert not callable(importlib.import_module(f"locust.{package}")), package
     assert "vary" in inspect.signature(locust.sweep_designs).parameters
     assert "Parameters" in locust.sweep_designs.__doc__
+
+
+def called_names(text: str) -> set[str]:
+    """The names ``text`` writes as calls between backquotes: ``simulate(robot)``, and
+    ``calibrate_beam/hinge(...)`` for two (the names after the first take its prefix)."""
+    names = set()
+    for group in re.findall(r"`(\w+(?:/\w+)*)\(", text):
+        first, *rest = group.split("/")
+        names |= {first, *(f"{first.rpartition('_')[0]}_{name}" for name in rest)}
+    return names
+
+
+def test_called_names_reads_the_short_form():
+    assert called_names("``calibrate_beam/hinge/hops(...)``, `robot(x)`, ``.plot()``, plain(x)") == {
+        "calibrate_beam", "calibrate_hinge", "calibrate_hops", "robot"}
+
+
+FUNCTIONS = {name for name in EXPORTS if name[0].islower()}
+CLASSES = set(EXPORTS) - FUNCTIONS
+
+
+def test_the_api_docstring_table_is_the_list():
+    """locust.api's table has one row a name of EXPORTS, with the module EXPORTS gives it."""
+    rows = re.findall(r"^``(\w+)``\s+:mod:`\.?([\w.]+)`", locust.api.__doc__, re.M)
+    assert dict(rows) == EXPORTS
+    assert len(rows) == len(EXPORTS)
+
+
+def test_the_package_docstring_names_the_list():
+    """``help(locust)``'s list of functions names exactly the functions of EXPORTS, and names
+    each of its classes."""
+    bullets = [line.partition("``:")[0] for line in locust.__doc__.splitlines() if line.startswith("- ``")]
+    assert called_names("\n".join(bullets)) == FUNCTIONS
+    assert sorted(c for c in CLASSES if not re.search(rf"\b{c}\b", locust.__doc__)) == []
+
+
+def test_the_architecture_table_names_the_list():
+    """docs/architecture.md's table of the Python API names exactly the functions of EXPORTS."""
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    section = text.split("## The Python API", 1)[1].split("\n## ", 1)[0]
+    first_cells = [line.split("|")[1] for line in section.splitlines() if line.startswith("| `")]
+    assert called_names("\n".join(first_cells)) == FUNCTIONS
 
 
 def test_notebook_session(tmp_path):

@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 
 from locust.bundled import bundled_recording
-from locust.fab.dxf_read import MAX_ARC_SEGMENTS
-from locust.io import run_record as R
+from locust.fab.dxf_limits import MAX_ARC_SEGMENTS
+from locust.io import run_record
 from locust.params import LIMITS, MAX_SIM_STEPS, check_robot, preset, problems
 from probing import assert_clear_error, assert_refused_and_unchanged, invoke, tree
 from waiting import wait_for
@@ -60,7 +60,7 @@ SERVO_CSV = bundled_recording("synthetic_servo.csv")
 BEAM_CSV = bundled_recording("synthetic_beam.csv")
 
 
-def trial(d: Path, status: str = R.COMPLETE, cycles: int = 2) -> Path:
+def trial(d: Path, status: str = run_record.COMPLETE, cycles: int = 2) -> Path:
     """A measured trial: a staircase nose track (synthetic) and its run record."""
     folder = d / "small-1"
     folder.mkdir()
@@ -69,10 +69,10 @@ def trial(d: Path, status: str = R.COMPLETE, cycles: int = 2) -> Path:
         t = i / 30
         rows.append(f"{i},{t:.6f},{0.1 + 0.02 * min(int(t / 1.3), cycles):.6f},0.05")
     (folder / "hop.tracks.csv").write_text("\n".join(rows) + "\n")
-    sched = R.HopSchedule(cycles=cycles, push_deg=-30.0, push_ms=300, wait_ms=1000)
-    rec = R.RunRecord(schedule=sched, port="/dev/ttyUSB0", status=status,
-                      message="out_of_range: push_deg" if status == R.ERROR else None)
-    R.write(rec, folder)
+    sched = run_record.HopSchedule(cycles=cycles, push_deg=-30.0, push_ms=300, wait_ms=1000)
+    rec = run_record.RunRecord(schedule=sched, port="/dev/ttyUSB0", status=status,
+                               message="out_of_range: push_deg" if status == run_record.ERROR else None)
+    run_record.write(rec, folder)
     return folder
 
 
@@ -200,8 +200,8 @@ CASES = [
     # report
     ("report-cycles-beyond-record", lambda d: ["report", "--measured", f"small={trial(d)}", "--cycles", "5",
                                                "--out", d / "rep"], ["recorded only 2 cycles"]),
-    ("report-refused-hop", lambda d: ["report", "--measured", f"small={trial(d, R.ERROR)}", "--out", d / "rep"],
-     ["refused by the robot"]),
+    ("report-refused-hop", lambda d: ["report", "--measured", f"small={trial(d, run_record.ERROR)}",
+                                      "--out", d / "rep"], ["refused by the robot"]),
     # the robot's command line
     ("hop-heartbeat-0", lambda d: ["hop", "--port", "sim", "--heartbeat-ms", "0", "--out", d / "run"],
      ["--heartbeat-ms"]),
@@ -400,10 +400,10 @@ def test_the_heartbeat_keeps_its_clock_beside_a_busy_thread():
     import threading
 
     from locust.device.link import Link
-    from locust.firmware import protocol as P
+    from locust.firmware import protocol
 
     master, slave = pty.openpty()
-    interval_s = P.COMMANDS["hop"]["heartbeat_ms"][3] / 8000.0
+    interval_s = protocol.COMMANDS["hop"]["heartbeat_ms"][3] / 8000.0
     stop = threading.Event()
 
     def busy():

@@ -9,14 +9,14 @@ import pytest
 from scipy import signal
 
 from locust.calibrate import beam as B
-from locust.calibrate import synthetic as S
+from locust.calibrate import synthetic
 from locust.errors import CalibrationError
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_beam_fit_recovers_truth(seed):
-    truth = S.BeamTruth()
-    t, x, y = S.beam_tip_track(truth, np.random.default_rng(seed))
+    truth = synthetic.BeamTruth()
+    t, x, y = synthetic.beam_tip_track(truth, np.random.default_rng(seed))
     fit = B.fit_beam(t, B.principal_displacement(x, y), truth.mass_kg, length_m=truth.length_m)
     assert fit.natural_frequency_hz.value == pytest.approx(truth.natural_frequency_hz, rel=0.01)
     assert fit.damping_ratio.value == pytest.approx(truth.damping_ratio, rel=0.05)
@@ -31,16 +31,16 @@ def test_beam_fit_recovers_truth(seed):
 
 def test_heavily_damped_seed_beam():
     """The seed's damping (stiffness/100 s) on this beam is zeta ~ 0.24: still fitted within 5%."""
-    truth = dataclasses.replace(S.BeamTruth(), damping_ratio=0.2374)
-    t, x, y = S.beam_tip_track(truth, np.random.default_rng(7))
+    truth = dataclasses.replace(synthetic.BeamTruth(), damping_ratio=0.2374)
+    t, x, y = synthetic.beam_tip_track(truth, np.random.default_rng(7))
     fit = B.fit_beam(t, B.principal_displacement(x, y), truth.mass_kg, length_m=truth.length_m)
     assert fit.damping_ratio.value == pytest.approx(0.2374, rel=0.05)
     assert fit.natural_frequency_hz.value == pytest.approx(truth.natural_frequency_hz, rel=0.02)
 
 
 def test_beam_mass_adds_rayleigh_share():
-    truth = S.BeamTruth()
-    t, x, y = S.beam_tip_track(truth, np.random.default_rng(4))
+    truth = synthetic.BeamTruth()
+    t, x, y = synthetic.beam_tip_track(truth, np.random.default_rng(4))
     d = B.principal_displacement(x, y)
     plain = B.fit_beam(t, d, 0.010)
     with_beam = B.fit_beam(t, d, 0.010, beam_mass_kg=0.0014)
@@ -59,8 +59,8 @@ def test_flat_beam_signal_is_refused():
 
 
 def test_too_few_beam_samples_are_refused():
-    truth = S.BeamTruth()
-    t, x, y = S.beam_tip_track(truth, np.random.default_rng(0))
+    truth = synthetic.BeamTruth()
+    t, x, y = synthetic.beam_tip_track(truth, np.random.default_rng(0))
     with pytest.raises(CalibrationError, match="samples in the fit window"):
         B.fit_beam(t, B.principal_displacement(x, y), 0.01, start_s=0.2, end_s=0.25)
 
@@ -75,15 +75,15 @@ COVERAGE_MASS_KG = {30.0: 0.04}
 COVERAGE_NOISE_M = (0.0003, 0.0006)
 
 
-def _coverage_runs(zeta: float) -> list[tuple[S.BeamTruth, B.BeamFit]]:
+def _coverage_runs(zeta: float) -> list[tuple[synthetic.BeamTruth, B.BeamFit]]:
     """(truth, fit) of ``COVERAGE_SEEDS`` ring-downs at damping ratio ``zeta``."""
     runs = []
     for seed in range(COVERAGE_SEEDS):
         fps = COVERAGE_FPS[seed % len(COVERAGE_FPS)]
         noise = COVERAGE_NOISE_M[seed // len(COVERAGE_FPS) % len(COVERAGE_NOISE_M)]
-        truth = dataclasses.replace(S.BeamTruth(), damping_ratio=zeta, fps=fps, noise_m=noise,
-                                    mass_kg=COVERAGE_MASS_KG.get(fps, S.BeamTruth.mass_kg))
-        t, x, y = S.beam_tip_track(truth, np.random.default_rng(9000 + seed))
+        truth = dataclasses.replace(synthetic.BeamTruth(), damping_ratio=zeta, fps=fps, noise_m=noise,
+                                    mass_kg=COVERAGE_MASS_KG.get(fps, synthetic.BeamTruth.mass_kg))
+        t, x, y = synthetic.beam_tip_track(truth, np.random.default_rng(9000 + seed))
         runs.append((truth, B.fit_beam(t, B.principal_displacement(x, y), truth.mass_kg)))
     return runs
 
@@ -116,11 +116,11 @@ def test_beam_intervals_hold_with_correlated_tracking_noise():
     """A tracker whose error wanders from frame to frame (AR(1), lag-1 correlation 0.8, 0.3 mm):
     the residuals' autocorrelation widens the intervals (s^2 (J^T J)^-1 alone covered the
     truth in 32 of these 50 ring-downs); SYNTHETIC."""
-    truth = dataclasses.replace(S.BeamTruth(), damping_ratio=0.1, noise_m=0.0)
+    truth = dataclasses.replace(synthetic.BeamTruth(), damping_ratio=0.1, noise_m=0.0)
     rho, covered, fitted_rho = 0.8, 0, []
     for seed in range(50):
         rng = np.random.default_rng(300 + seed)
-        t, x, y = S.beam_tip_track(truth, rng)
+        t, x, y = synthetic.beam_tip_track(truth, rng)
         noise = signal.lfilter([1.0], [1.0, -rho], rng.normal(0, 3e-4 * np.sqrt(1 - rho**2), len(t) + 200))[200:]
         fit = B.fit_beam(t, B.principal_displacement(x, y) + noise, truth.mass_kg)
         est = fit.natural_frequency_hz
@@ -146,11 +146,11 @@ def test_creeping_tip_is_refused():
 # of the strip): extra tip displacement of 30-100 % of the swing, of either sign, gone within
 # 3-10 ms, a decaying offset or a ringing at the strip's second-mode ratio (6.27 x fn); the
 # drop lands anywhere between two frames; 30-240 frames/s; all SYNTHETIC.
-def _transient_truth(zeta: float, seed: int) -> tuple[S.BeamTruth, np.random.Generator]:
+def _transient_truth(zeta: float, seed: int) -> tuple[synthetic.BeamTruth, np.random.Generator]:
     rng = np.random.default_rng(5000 + seed)
     fps = COVERAGE_FPS[seed % len(COVERAGE_FPS)]
-    base = dataclasses.replace(S.BeamTruth(), damping_ratio=zeta, fps=fps,
-                               mass_kg=COVERAGE_MASS_KG.get(fps, S.BeamTruth.mass_kg),
+    base = dataclasses.replace(synthetic.BeamTruth(), damping_ratio=zeta, fps=fps,
+                               mass_kg=COVERAGE_MASS_KG.get(fps, synthetic.BeamTruth.mass_kg),
                                noise_m=COVERAGE_NOISE_M[seed // len(COVERAGE_FPS) % len(COVERAGE_NOISE_M)])
     wn = 2 * np.pi * base.natural_frequency_hz
     swing = np.hypot(base.mass_kg * 9.81 / base.stiffness_n_per_m, np.sqrt(2 * 9.81 * base.drop_height_m) / wn)
@@ -166,9 +166,9 @@ def test_release_transient_is_skipped(sign):
     (zeta 0.24): the window starts after it and the fit holds the truth; a window pinned at
     the drop (--start-s) keeps it, and its interval widens for it (zeta 0.28 [0.20, 0.36] for
     a push along the motion); SYNTHETIC."""
-    truth = dataclasses.replace(S.BeamTruth(), damping_ratio=0.24, transient_m=sign * 0.008, transient_s=0.006)
+    truth = dataclasses.replace(synthetic.BeamTruth(), damping_ratio=0.24, transient_m=sign * 0.008, transient_s=0.006)
     for seed in range(3):
-        t, x, y = S.beam_tip_track(truth, np.random.default_rng(seed))
+        t, x, y = synthetic.beam_tip_track(truth, np.random.default_rng(seed))
         d = B.principal_displacement(x, y)
         fit = B.fit_beam(t, d, truth.mass_kg)
         assert fit.fit_start_s > truth.drop_at_s + 0.008        # two frames after the drop at least
@@ -190,7 +190,7 @@ def test_release_transient_intervals_cover_over_seeds(zeta):
     covered = {"natural_frequency_hz": 0, "damping_ratio": 0}
     for seed in range(90):
         truth, rng = _transient_truth(zeta, seed)
-        t, x, y = S.beam_tip_track(truth, rng)
+        t, x, y = synthetic.beam_tip_track(truth, rng)
         fit = B.fit_beam(t, B.principal_displacement(x, y), truth.mass_kg)
         for name, true in (("natural_frequency_hz", truth.natural_frequency_hz), ("damping_ratio", zeta)):
             est = getattr(fit, name)

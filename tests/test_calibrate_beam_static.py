@@ -19,7 +19,7 @@ import pytest
 import locust
 from binomial import chance_to_pass, coverage_floor
 from locust.calibrate import beam_static as BS
-from locust.calibrate import synthetic as S
+from locust.calibrate import synthetic
 from locust.errors import CalibrationError
 from locust.io.trk import read_project
 from probing import assert_clear_error, invoke
@@ -40,10 +40,10 @@ def test_intervals_cover_the_true_stiffness():
     deflection = stiffness = 0
     errors = []
     for k in range(DRAWS):
-        truth = dataclasses.replace(S.StaticBeamTruth(), scatter_rho=(0.0, 0.5, 0.8)[k % 3],
+        truth = dataclasses.replace(synthetic.StaticBeamTruth(), scatter_rho=(0.0, 0.5, 0.8)[k % 3],
                                     scale_relative_std=(0.0, 0.009, 0.02)[(k // 3) % 3])
         rng = np.random.default_rng(k)
-        t, x, y = S.static_beam_track(truth, rng, tilt_deg=rng.uniform(-5, 5))
+        t, x, y = synthetic.static_beam_track(truth, rng, tilt_deg=rng.uniform(-5, 5))
         fit = BS.fit_static_beam(t, x, y, truth.mass_kg, scale_relative_std=truth.scale_relative_std,
                                  length_m=truth.length_m)
         lo, hi = fit.deflection_m.ci95
@@ -108,11 +108,11 @@ def test_a_ring_down_options_and_a_static_track_without_rest_are_refused(shared_
     assert_clear_error(invoke([*base, "--rest-s", "0,1"]), "--rest-s: a static deflection's", "--static")
     assert_clear_error(invoke([*base, "--static", "--rest-s", "9,10"]), "lies outside the track")
     assert_clear_error(invoke([*base, "--static", "--settled-s", "1"]), "expected 2 numbers")
-    truth = S.StaticBeamTruth(rest_s=0.1)
-    t, x, y = S.static_beam_track(truth, np.random.default_rng(0))
+    truth = synthetic.StaticBeamTruth(rest_s=0.1)
+    t, x, y = synthetic.static_beam_track(truth, np.random.default_rng(0))
     with pytest.raises(CalibrationError, match="not at rest before the loading: it moves 0.696 mm"):
         BS.fit_static_beam(t, x, y, MASS_KG)
-    still = S.StaticBeamTruth(stiffness_n_per_m=1e6)      # a tip that does not move for the scatter
-    t, x, y = S.static_beam_track(still, np.random.default_rng(0))
+    still = synthetic.StaticBeamTruth(stiffness_n_per_m=1e6)      # a tip that does not move for the scatter
+    t, x, y = synthetic.static_beam_track(still, np.random.default_rng(0))
     with pytest.raises(CalibrationError, match="times its scatter|samples in the"):
         BS.fit_static_beam(t, x, y, MASS_KG)

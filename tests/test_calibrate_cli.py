@@ -232,12 +232,13 @@ def test_plots_go_to_the_out_folder_named_first_never_beside_the_data(recs, tmp_
 # -- calibrate hop starts from the robot its runs record ---------------------------------------
 def _recorded_run(folder, preset_name=None, robot_file=None, leg=None):
     """A run.json (no track) recording which robot was hopped, as `locust hop` writes it."""
-    from locust.io import run_record as R
+    from locust.io import run_record
 
-    rec = R.RunRecord(schedule=R.HopSchedule(cycles=1, push_deg=-30, push_ms=300, wait_ms=1000), port="sim",
-                      status=R.COMPLETE, robot=R.RobotSource(preset=preset_name, robot_file=robot_file, leg_set=leg))
+    rec = run_record.RunRecord(schedule=run_record.HopSchedule(cycles=1, push_deg=-30, push_ms=300, wait_ms=1000),
+                               port="sim", status=run_record.COMPLETE,
+                               robot=run_record.RobotSource(preset=preset_name, robot_file=robot_file, leg_set=leg))
     folder.mkdir(parents=True)
-    R.write(rec, folder)
+    run_record.write(rec, folder)
     return folder
 
 

@@ -18,8 +18,7 @@ import pytest
 from click.testing import CliRunner
 
 from locust.bundled import bundled_recording
-from locust.calibrate import hinge as H
-from locust.calibrate import synthetic as S
+from locust.calibrate import hinge, synthetic
 from locust.calibrate.recordings import REAL_TIME, TimeOptions, clean_samples, read_table
 from locust.commands import cli
 from locust.io.importing import ImportOptions
@@ -27,8 +26,8 @@ from locust.io.importing import ImportOptions
 POINT = "org.opensourcephysics.cabrillo.tracker.PointMass"
 FRAME = "org.opensourcephysics.media.core.ImageCoordSystem$FrameData"
 
-OUT_OF_PLANE = S.HingeTruth()
-IN_PLANE = S.IN_PLANE_HINGE
+OUT_OF_PLANE = synthetic.HingeTruth()
+IN_PLANE = synthetic.IN_PLANE_HINGE
 CASES = {   # the four combinations of the acceptance: gravity in / out of plane, 60 / 240 frames/s, m / mm
     "out-of-plane 60 fps m": OUT_OF_PLANE,
     "out-of-plane 240 fps mm": dataclasses.replace(OUT_OF_PLANE, fps=240.0, duration_s=4.0, units="mm"),
@@ -42,8 +41,8 @@ def run(*args):
     return CliRunner().invoke(cli, list(map(str, args)))
 
 
-def rig_of(truth: S.HingeTruth) -> H.HingeRig:
-    return H.HingeRig(truth.inertia_kgm2, truth.gravity, truth.mass_kg, truth.com_m)
+def rig_of(truth: synthetic.HingeTruth) -> hinge.HingeRig:
+    return hinge.HingeRig(truth.inertia_kgm2, truth.gravity, truth.mass_kg, truth.com_m)
 
 
 def write_txy(path: Path, t, x, y, *, title: str | None = None) -> Path:
@@ -93,10 +92,11 @@ def write_trk(path: Path, t, x_m, y_m, *, px_per_m: float = 7200.0, origin=(960.
     return path
 
 
-def fit_file(path: Path, truth: S.HingeTruth, units: str = "m", timing: TimeOptions = REAL_TIME) -> H.HingeFit:
+def fit_file(path: Path, truth: synthetic.HingeTruth, units: str = "m",
+             timing: TimeOptions = REAL_TIME) -> hinge.HingeFit:
     table = read_table(path, ImportOptions.parse(units), timing)
     t, x, y = clean_samples(path, "marker", table.time_s(), *table.marker(), min_samples=20)
-    return H.fit_hinge(t, x, y, rig_of(truth), source=str(path))
+    return hinge.fit_hinge(t, x, y, rig_of(truth), source=str(path))
 
 
 def acceptable(est, truth: float) -> bool:
@@ -111,7 +111,7 @@ def test_hinge_fit_is_accurate_and_its_intervals_cover_over_seeds(case, tmp_path
     covered = {"k": 0, "b": 0}
     coulomb_fitted = 0
     for seed in range(SEEDS):
-        t, x, y = S.hinge_swing_track(truth, np.random.default_rng(1000 + seed))
+        t, x, y = synthetic.hinge_swing_track(truth, np.random.default_rng(1000 + seed))
         fit = fit_file(write_txy(tmp_path / f"swing{seed}.csv", t, x, y), truth, truth.units)
         for key, est, true in (("k", fit.hinge_stiffness_nm_per_rad, truth.hinge_stiffness_nm_per_rad),
                                ("b", fit.hinge_damping_nms_per_rad, truth.hinge_damping_nms_per_rad)):
@@ -131,7 +131,7 @@ def test_hinge_fit_is_accurate_and_its_intervals_cover_over_seeds(case, tmp_path
 def test_coulomb_friction_is_fitted_when_the_swing_shows_it(tmp_path):
     truth = dataclasses.replace(OUT_OF_PLANE, coulomb_nm=1.5e-6)
     for seed in range(2):
-        t, x, y = S.hinge_swing_track(truth, np.random.default_rng(seed))
+        t, x, y = synthetic.hinge_swing_track(truth, np.random.default_rng(seed))
         fit = fit_file(write_txy(tmp_path / "swing.csv", t, x, y), truth)
         assert fit.coulomb_friction_nm is not None, fit.coulomb_note
         # the fit smooths sign(rate) over 0.2 % of the peak rate: a few per cent high
@@ -145,7 +145,7 @@ def test_every_track_format_gives_the_same_fit(tmp_path):
     """.trk, .trz, Tracker's export with a mass_A title line (mm), a t,x,y CSV (m), a slow-motion
     export (240 frames/s played at 30) with --time-scale or --clip-fps: one fit, to its digits."""
     truth = dataclasses.replace(OUT_OF_PLANE, fps=60.0, duration_s=6.0)
-    t, x, y = S.hinge_swing_track(truth, np.random.default_rng(7))
+    t, x, y = synthetic.hinge_swing_track(truth, np.random.default_rng(7))
     ref = fit_file(write_txy(tmp_path / "m.csv", t, x, y), truth)
     fits = {
         "trk": fit_file(write_trk(tmp_path / "swing.trk", t, x, y), truth),
@@ -166,7 +166,7 @@ def test_every_track_format_gives_the_same_fit(tmp_path):
 
 def test_cli_hinge_json_write_and_trk_note(tmp_path):
     truth = OUT_OF_PLANE
-    t, x, y = S.hinge_swing_track(truth, np.random.default_rng(3))
+    t, x, y = synthetic.hinge_swing_track(truth, np.random.default_rng(3))
     trk = write_trk(tmp_path / "swing.trk", t, x, y)
     robot = tmp_path / "robot.toml"
     res = run("calibrate", "hinge", trk, "--inertia-kgm2", truth.inertia_kgm2, "--gravity", "out-of-plane",
@@ -188,7 +188,7 @@ def test_cli_hinge_json_write_and_trk_note(tmp_path):
     assert given["pivot"] == "given"
     table = read_table(trk, ImportOptions.parse("m"), REAL_TIME)
     samples = clean_samples(trk, "marker", table.time_s(), *table.marker(), min_samples=20)
-    assert _reported(given) == _reported_fit(H.fit_hinge(*samples, rig_of(truth), pivot=(px, py)))
+    assert _reported(given) == _reported_fit(hinge.fit_hinge(*samples, rig_of(truth), pivot=(px, py)))
 
 
 def _reported(out: dict) -> list:
@@ -197,13 +197,13 @@ def _reported(out: dict) -> list:
             for key in ("hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad")]
 
 
-def _reported_fit(fit: H.HingeFit) -> list:
+def _reported_fit(fit: hinge.HingeFit) -> list:
     return [[e.value, e.std, e.ci95_low, e.ci95_high]
             for e in (fit.hinge_stiffness_nm_per_rad, fit.hinge_damping_nms_per_rad)]
 
 
 def test_cli_hinge_refuses_what_it_cannot_fit(tmp_path):
-    t, x, y = S.hinge_swing_track(IN_PLANE, np.random.default_rng(0))
+    t, x, y = synthetic.hinge_swing_track(IN_PLANE, np.random.default_rng(0))
     path = write_txy(tmp_path / "s.csv", t, x, y)
     res = run("calibrate", "hinge", path, "--inertia-kgm2", 4.2e-7, "--gravity", "in-plane", "--no-plot")
     assert res.exit_code == 2 and "--mass-kg and --com-m" in res.output
@@ -261,7 +261,7 @@ def test_times_printed_to_three_digits_are_rebuilt_from_the_rows(tmp_path):
     10.5, 10.6 at 30 frames/s): the rows give them back, and the fit is the one of the full
     times; a time that truly steps back stays an error."""
     truth = dataclasses.replace(OUT_OF_PLANE, fps=30.0, duration_s=16.0, hold_s=9.0)
-    t, x, y = S.hinge_swing_track(truth, np.random.default_rng(5))
+    t, x, y = synthetic.hinge_swing_track(truth, np.random.default_rng(5))
     ref = fit_file(write_txy(tmp_path / "full.csv", t, x, y), truth)
     coarse = np.array([float(f"{v:.3g}") for v in t])
     path = write_txy(tmp_path / "coarse.csv", coarse, x, y)
@@ -279,7 +279,7 @@ def test_times_printed_to_three_digits_are_rebuilt_from_the_rows(tmp_path):
 
 def test_track_import_reads_a_tracker_project(tmp_path):
     """`locust track import` goes through the same reader: a .trk's metres, renamed."""
-    t, x, y = S.hinge_swing_track(dataclasses.replace(OUT_OF_PLANE, duration_s=2.0), np.random.default_rng(1))
+    t, x, y = synthetic.hinge_swing_track(dataclasses.replace(OUT_OF_PLANE, duration_s=2.0), np.random.default_rng(1))
     trk = write_trk(tmp_path / "swing.trk", t, x, y)
     res = run("track", "import", trk, "--rename", "mass_A=tip", "--out", tmp_path / "swing.tracks.csv")
     assert res.exit_code == 0, res.output

@@ -16,10 +16,10 @@ import math
 import numpy as np
 import pytest
 
-from locust.calibrate import hop as H
+from locust.calibrate import hop
 from locust.errors import CalibrationError
 from locust.params import LEG_SETS, Provenance, leg_set, preset
-from locust.sim import samples as S
+from locust.sim import samples
 from locust.trials.configs import configuration
 
 CAMERA_HZ = 30.0
@@ -35,14 +35,14 @@ def seed_leg(config: str):
     return leg_set(preset("seed"), config)
 
 
-def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0, plant=None) -> H.HopRun:
+def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0, plant=None) -> hop.HopRun:
     """A run of ``config`` at ``truth``, "filmed" at 30 frames/s from 0.4 s before the first
     push, camera clock 1.234 s ahead, positions with NOISE_M of noise in a board's frame
     BOARD_M from the world's (SYNTHETIC): leg set ``config`` of the seed (``plant``: of that
     robot) at ``truth`` and half its step. The run's robot (the fit's model and start) is the
     same leg set, whose values not in ``truth`` are exact here."""
     seed_robot = preset("seed")
-    for key in S.uncertain_values(seed_robot):
+    for key in samples.uncertain_values(seed_robot):
         if key not in truth:
             seed_robot = seed_robot.with_provenance(key, Provenance(source="synthetic: exact"))
     robot = configuration(seed_robot, config).robot
@@ -53,29 +53,29 @@ def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0, plan
     pushing = np.array([True, False] * cycles)
     clock_s = 1.234
     t_cam = np.arange(clock_s - 0.4, clock_s + cycles * period, 1 / CAMERA_HZ)
-    blank = H.MarkerTrack(t_cam, np.zeros_like(t_cam), np.zeros_like(t_cam))
-    template = H.HopRun(source=H.Path(f"synthetic-{config}"), config=config, robot=robot, phase_s=phase_s,
-                        pushing=pushing, onset_s=clock_s, tracks={"nose": blank, "foot": blank})
-    sim = H.simulate_markers(template, [plant])[0]
+    blank = hop.MarkerTrack(t_cam, np.zeros_like(t_cam), np.zeros_like(t_cam))
+    template = hop.HopRun(source=hop.Path(f"synthetic-{config}"), config=config, robot=robot, phase_s=phase_s,
+                          pushing=pushing, onset_s=clock_s, tracks={"nose": blank, "foot": blank})
+    sim = hop.simulate_markers(template, [plant])[0]
     rng = np.random.default_rng(seed)
     tracks = {}
     for m in ("nose", "foot"):
         t, x, y = sim[m]
         # standing where it stood before the simulation's kept lead, as the fit takes it
         at = t_cam - clock_s
-        tracks[m] = H.MarkerTrack(t_cam, np.interp(at, t, x) - BOARD_M[0] + rng.normal(0, NOISE_M, t_cam.size),
-                                  np.interp(at, t, y) - BOARD_M[1] + rng.normal(0, NOISE_M, t_cam.size))
+        tracks[m] = hop.MarkerTrack(t_cam, np.interp(at, t, x) - BOARD_M[0] + rng.normal(0, NOISE_M, t_cam.size),
+                                    np.interp(at, t, y) - BOARD_M[1] + rng.normal(0, NOISE_M, t_cam.size))
     nose = tracks["nose"]
-    onset, _, _ = H.onset_time(nose.t_s, nose.x_m, nose.y_m)
-    return H.HopRun(source=template.source, config=config, robot=robot, phase_s=phase_s, pushing=pushing,
-                    onset_s=onset, tracks=tracks)
+    onset, _, _ = hop.onset_time(nose.t_s, nose.x_m, nose.y_m)
+    return hop.HopRun(source=template.source, config=config, robot=robot, phase_s=phase_s, pushing=pushing,
+                      onset_s=onset, tracks=tracks)
 
 
 @pytest.fixture(scope="module")
 def small_fit():
     run = synthetic_run("small", TRUTH)      # three hops: a cluster-robust interval on two values needs three
     calls = []
-    fit = H.fit_hops([run], list(TRUTH), max_iter=20, grid_stages=2, progress=lambda done, planned: calls.append(
+    fit = hop.fit_hops([run], list(TRUTH), max_iter=20, grid_stages=2, progress=lambda done, planned: calls.append(
         (done, planned)))
     small_fit_progress.extend(calls)
     return run, fit
@@ -92,11 +92,11 @@ def test_fit_reports_its_simulations_done_and_planned(small_fit):
     _, fit = small_fit
     done = [d for d, _ in small_fit_progress]
     assert all(b > a for a, b in zip(done, done[1:])) and done[-1] == fit.simulations
-    first_plan = H.planned_simulations(1, 2, 0, 20, 2)
+    first_plan = hop.planned_simulations(1, 2, 0, 20, 2)
     assert fit.simulations / 2 <= first_plan <= 2 * fit.simulations
     assert small_fit_progress[-1] == (fit.simulations, fit.simulations)
     # every rollout call holds at most CHUNK candidates, so the count moves while a batch runs
-    assert max(b - a for a, b in zip([0, *done], done)) <= H.CHUNK
+    assert max(b - a for a, b in zip([0, *done], done)) <= hop.CHUNK
 
 
 def test_fit_recovers_the_values_the_traces_were_made_with(small_fit):
@@ -140,9 +140,9 @@ def test_fit_residual_is_the_noise_it_was_given(small_fit):
 
 def test_measured_phase_times_drive_the_command():
     run = synthetic_run("small", TRUTH, cycles=1)
-    late = H.HopRun(**{**run.__dict__, "phase_s": np.array([0.0, 0.4])})   # a push measured 100 ms long
+    late = hop.HopRun(**{**run.__dict__, "phase_s": np.array([0.0, 0.4])})   # a push measured 100 ms long
     dt = run.robot.solver.timestep_s
-    plan, plan_late = H.measured_plan(run, run.robot), H.measured_plan(late, run.robot)
+    plan, plan_late = hop.measured_plan(run, run.robot), hop.measured_plan(late, run.robot)
     push = math.radians(run.robot.schedule.push_deg)
     assert np.sum(plan.ctrl_rad == push) * dt == pytest.approx(0.3, abs=dt)
     assert np.sum(plan_late.ctrl_rad == push) * dt == pytest.approx(0.4, abs=dt)
@@ -152,17 +152,17 @@ def test_measured_phase_times_drive_the_command():
 def test_keys_that_cannot_be_fitted_are_refused():
     run = synthetic_run("small", TRUTH, cycles=1)
     with pytest.raises(CalibrationError, match="real-valued"):
-        H.check_keys(["schedule.cycles"], [run])
+        hop.check_keys(["schedule.cycles"], [run])
     with pytest.raises(CalibrationError, match="unknown robot parameter"):
-        H.check_keys(["contact.foot_frict"], [run])
-    large = H.HopRun(**{**run.__dict__, "robot": seed_leg("large")})
+        hop.check_keys(["contact.foot_frict"], [run])
+    large = hop.HopRun(**{**run.__dict__, "robot": seed_leg("large")})
     with pytest.raises(CalibrationError, match="leg sets differ"):
-        H.check_keys(["geometry.leg_m"], [run, large])
+        hop.check_keys(["geometry.leg_m"], [run, large])
 
 
 def test_samples_spread_comes_from_the_uncertainties():
     robot = seed_leg("small")
-    spread = S.sample(robot, 8, cycles=2)
+    spread = samples.sample(robot, 8, cycles=2)
     # the seed's servo values carry the SG90 fit's uncertainties
     assert "servo.noload_speed_rad_per_s" in spread.uncertain
     assert spread.n_valid == 8 and spread.distance_m_sd > 0 and spread.max_nose_height_m_sd > 0
@@ -170,7 +170,7 @@ def test_samples_spread_comes_from_the_uncertainties():
     bare = robot
     for key in spread.uncertain:
         bare = bare.with_provenance(key, Provenance(source="test"))
-    none = S.sample(bare, 3, cycles=2)
+    none = samples.sample(bare, 3, cycles=2)
     # (the draws share each thread's MjData, so the constraint solver's warm start differs: the
     # same run to within a few 1e-18 m)
     assert none.uncertain == {} and none.distance_m_sd < 1e-12
@@ -184,8 +184,8 @@ def test_draws_follow_the_written_uncertainties():
              .with_provenance("contact.foot_friction", Provenance(source="test", uncertainty=0.05))
              .with_provenance("compliance.hinge_stiffness_nm_per_rad", Provenance(source="test", uncertainty=0.004)))
     keys = ["contact.foot_friction", "compliance.hinge_stiffness_nm_per_rad", "servo.noload_speed_rad_per_s"]
-    sds = S.uncertain_values(robot)
-    drawn = np.array([[r.get(k) for k in keys] for r in S.draw(robot, 4000, seed=11)])
+    sds = samples.uncertain_values(robot)
+    drawn = np.array([[r.get(k) for k in keys] for r in samples.draw(robot, 4000, seed=11)])
     for i, key in enumerate(keys):
         sd = sds[key]
         assert sd > 0, key
@@ -201,7 +201,7 @@ def test_sweep_ranks_designs_by_the_mean_over_draws():
     base = preset("seed")
     plain = evaluate(base, {"scale": 0.0}, 1)
     mean = evaluate(base, {"scale": 0.0}, 1, samples=4)
-    spread = S.sample(base, 4, cycles=1)
+    spread = samples.sample(base, 4, cycles=1)
     assert mean["distance_m"] == pytest.approx(spread.distance_m_mean, abs=1e-12)
     assert mean["max_nose_height_m"] == pytest.approx(spread.max_nose_height_m_mean, abs=1e-12)
     # the mean of the draws is not the nominal run's (the seed's servo values are uncertain)
@@ -211,12 +211,12 @@ def test_sweep_ranks_designs_by_the_mean_over_draws():
 def test_draws_outside_the_limits_are_invalid_not_simulated():
     """A push drawn beyond the servo's 45 deg travel is refused as `locust sim` would refuse it."""
     robot = seed_leg("small").with_provenance("schedule.push_deg", Provenance(source="test", uncertainty=20.0))
-    drawn = [r.get("schedule.push_deg") for r in S.draw(robot, 12, seed=3)]
+    drawn = [r.get("schedule.push_deg") for r in samples.draw(robot, 12, seed=3)]
     outside = [abs(v) > robot.get("servo.travel_deg") for v in drawn]
     assert 0 < sum(outside) < 12                               # the seed gives some of each
-    trajs = S.simulate_draws(robot, 12, cycles=1, seed=3)
+    trajs = samples.simulate_draws(robot, 12, cycles=1, seed=3)
     assert [t is None for t in trajs] == outside
-    spread = S.sample(robot, 12, cycles=1, seed=3)
+    spread = samples.sample(robot, 12, cycles=1, seed=3)
     assert spread.n_valid == 12 - sum(outside)
     assert [math.isnan(d) for d in spread.distance_m] == outside
 
@@ -241,12 +241,12 @@ def test_the_fit_halves_a_step_that_has_not_converged():
     """Small at 5 ms: halving the step moves its markers by more than the fit's tolerance at the
     seed's values (0.1 mm RMS), so the fit refines it; at its own step (LEG_SETS) it is kept."""
     run = synthetic_run("small", {}, cycles=1)
-    coarse = H.HopRun(**{**run.__dict__, "robot": run.robot.with_values({"solver.timestep_s": 5e-3})})
-    refined, change = H.converged_step(coarse)
-    assert refined.robot.solver.timestep_s < 5e-3 and change <= H.STEP_TOLERANCE_M
+    coarse = hop.HopRun(**{**run.__dict__, "robot": run.robot.with_values({"solver.timestep_s": 5e-3})})
+    refined, change = hop.converged_step(coarse)
+    assert refined.robot.solver.timestep_s < 5e-3 and change <= hop.STEP_TOLERANCE_M
     assert refined.robot.source_of("solver.timestep_s").source == "fit: time step check"
-    kept, change = H.converged_step(run)
-    assert kept.robot.solver.timestep_s == LEG_SETS["small"].timestep_s and change <= H.STEP_TOLERANCE_M
+    kept, change = hop.converged_step(run)
+    assert kept.robot.solver.timestep_s == LEG_SETS["small"].timestep_s and change <= hop.STEP_TOLERANCE_M
 
 
 # hidden values unlike any preset, friction above the floor's 1.6 (below it acts on nothing)
@@ -268,7 +268,7 @@ def test_hidden_truths_over_leg_set_pairs(i, pair):
     truth = COVERAGE_TRUTHS[i]
     j = COVERAGE_PAIRS.index(pair)
     runs = [synthetic_run(name, truth, cycles=2, seed=10 * i + 3 * j + k) for k, name in enumerate(pair)]
-    fit = H.fit_hops(runs, list(truth), max_iter=20, grid_stages=2)
+    fit = hop.fit_hops(runs, list(truth), max_iter=20, grid_stages=2)
     for key, value in truth.items():
         est = fit.estimates[key]
         assert abs(est.value - value) <= 0.05 * value, (key, value, est)
@@ -284,8 +284,8 @@ def test_a_fit_across_the_outcomes_threshold_is_refused():
     key = "geometry.crank_start_deg"
 
     def jacobian_at(start):
-        at = H.HopRun(**{**run.__dict__, "robot": robot.with_values({key: start})})
-        return H._jacobian(H._HopResidual([at], (key,)), np.zeros(1))
+        at = hop.HopRun(**{**run.__dict__, "robot": robot.with_values({key: start})})
+        return hop._jacobian(hop._HopResidual([at], (key,)), np.zeros(1))
 
     with pytest.raises(CalibrationError, match="straddles the threshold") as refused:
         jacobian_at(-121.17)
@@ -303,12 +303,12 @@ def test_the_crank_angle_at_rest_is_fitted_from_the_standing_pose():
     model-error part) covering the truth."""
     key = "geometry.crank_start_deg"
     run = synthetic_run("small", {key: -88.0}, cycles=2)
-    fit = H.fit_hops([run], [key], max_iter=5, grid_stages=1)
+    fit = hop.fit_hops([run], [key], max_iter=5, grid_stages=1)
     est = fit.estimates[key]
     assert fit.start[key] == -90.0
     assert est.value == pytest.approx(-88.0, abs=0.5)
     assert est.ci95_low <= -88.0 <= est.ci95_high and fit.identifiable[key]
-    assert est.std_model == pytest.approx(H.MODEL_ERROR_DEG[key])
+    assert est.std_model == pytest.approx(hop.MODEL_ERROR_DEG[key])
 
 
 class _JaggedBowl:
@@ -333,9 +333,9 @@ def test_the_solver_stops_where_it_stalls_at_the_same_optimum():
     fewer candidates (each a simulation of every run in a real fit)."""
     bounds = [np.full(3, -2.0), np.full(3, 2.0)]
     stalled, left = _JaggedBowl(), _JaggedBowl()
-    x, iterations = H.solve(stalled, np.zeros(3), bounds, max_iter=30)
-    full, _ = H.minimize.least_squares(np.zeros(3), left, bounds=bounds, eps=H.FD_STEP, max_iter=30, verbose=0,
-                                       xtol=1e-6, gtol=1e-8)
+    x, iterations = hop.solve(stalled, np.zeros(3), bounds, max_iter=30)
+    full, _ = hop.minimize.least_squares(np.zeros(3), left, bounds=bounds, eps=hop.FD_STEP, max_iter=30, verbose=0,
+                                         xtol=1e-6, gtol=1e-8)
     assert np.max(np.abs(x - _JaggedBowl.TRUE)) < 5e-4            # the staircase's own scale
     assert np.max(np.abs(x - np.ravel(full))) < 5e-4
     assert 1 <= iterations <= 30

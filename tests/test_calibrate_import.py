@@ -14,7 +14,7 @@ from click.testing import CliRunner
 
 from locust.bundled import bundled_recording
 from locust.calibrate import beam as B
-from locust.calibrate import ramp as R
+from locust.calibrate import ramp
 from locust.calibrate.recordings import clean_samples, read_table
 from locust.commands import cli
 
@@ -111,7 +111,7 @@ def test_ramp_track_in_mm(tmp_path):
     got = json.loads(res.stdout)
     assert got["warnings"] == [] and got["angles_deg"][0] == pytest.approx(metres["angles_deg"][0], rel=1e-9)
     assert got["mu_static"]["value"] == pytest.approx(metres["mu_static"]["value"], rel=1e-9)
-    assert R.board_length_warning(0.3) is None
+    assert ramp.board_length_warning(0.3) is None
 
 
 def test_import_options_need_a_track():

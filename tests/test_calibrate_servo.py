@@ -15,7 +15,7 @@ import pytest
 
 from binomial import coverage_floor
 from locust.calibrate import servo as SV
-from locust.calibrate import synthetic as S
+from locust.calibrate import synthetic
 from locust.calibrate.gyro_log import looks_like_gyro_log, parse_gyro_log, read_gyro_log
 from locust.calibrate.recordings import read_table
 from locust.calibrate.servo import rig as servo_rig
@@ -25,7 +25,7 @@ from locust.params import Robot, Servo
 from locust.progress import Progress
 from locust.sim.servo import with_servo
 
-SG90 = S.ServoTruth().servo   # the synthetic recordings' SG90 (the AA swing's fit alone)
+SG90 = synthetic.ServoTruth().servo   # the synthetic recordings' SG90 (the AA swing's fit alone)
 PRESET = Servo()              # the presets' SG90: the AA swing and the gyro steps together
 KV_FITTED = dataclasses.replace(PRESET, kp_nm_per_rad=0.5, kv_nms_per_rad=0.004)   # a servo with kv
 
@@ -35,8 +35,8 @@ def value_of(servo: Servo, key: str) -> float:
     return Robot(servo=servo).get(key)
 
 
-def recording(truth: S.ServoTruth, seed: int) -> SV.StepRecording:
-    t, angle, command = S.servo_step(truth, np.random.default_rng(seed))
+def recording(truth: synthetic.ServoTruth, seed: int) -> SV.StepRecording:
+    t, angle, command = synthetic.servo_step(truth, np.random.default_rng(seed))
     return SV.StepRecording(t, angle, command, SV.ServoRig(truth.inertia_kgm2, truth.gravity_moment_nm),
                             source=f"synthetic seed {seed}")
 
@@ -104,7 +104,7 @@ def test_saturated_servo_slews_at_its_noload_speed():
 def test_simulated_angle_moves_smoothly_with_the_delay():
     """Moving the command edge by 0.1 ms moves the slewing horn's angle by 0.1 ms of its speed,
     although the physics step is 1 ms (a fit needs this derivative)."""
-    truth = S.ServoTruth(edges=1)
+    truth = synthetic.ServoTruth(edges=1)
     rec = recording(truth, 0)
     model = SV.rig_model(SV.ServoRig(truth.inertia_kgm2))
     a, b = SV.simulate_deg(model, [SG90, SG90], [SV.Timing(0.0100), SV.Timing(0.0101)], rec, 0.0)
@@ -117,7 +117,7 @@ def test_simulated_angle_moves_smoothly_with_the_delay():
 def test_synthetic_step_other_load_and_frame_rate_is_recovered():
     """SYNTHETIC: the preset SG90 on a 6e-5 kg*m^2 load filmed at 120 frames/s (the bundled
     recording: 1.5e-5 at 60, the real one 3.3e-6 at 30), stall torque given."""
-    truth = dataclasses.replace(S.ServoTruth(), inertia_kgm2=6e-5, fps=120.0, edges=4, target_deg=90.0,
+    truth = dataclasses.replace(synthetic.ServoTruth(), inertia_kgm2=6e-5, fps=120.0, edges=4, target_deg=90.0,
                                 delay_s=0.02, clock_ratio=0.998)
     fit = SV.fit_servo([recording(truth, 11)], stall_torque_nm=0.15, kv_nms_per_rad=0.0)
     est = fit.estimates
@@ -135,7 +135,7 @@ def test_two_loads_give_the_stall_torque(monkeypatch):
     """SYNTHETIC: the same SG90 on two loads; no stall torque given, all four identified. Its
     progress, on a clock that counts the physics steps simulated (the fit's work, whatever
     the machine's load), gives a time left within a factor of 2 from a quarter on."""
-    light = S.ServoTruth()
+    light = synthetic.ServoTruth()
     heavy = dataclasses.replace(light, inertia_kgm2=1e-3, half_period_s=1.2)
     steps = [0.0]
     simulate = servo_rig.rollout_threads
@@ -200,7 +200,7 @@ def assert_time_left_within_twice(calls: list[tuple[float, int]], end: float, le
 
 def test_stalled_servo_gives_stall_torque_not_kp():
     """SYNTHETIC: a weight too heavy to lift: the horn stalls where M*cos(angle) = stall."""
-    truth = S.STALL_SERVO
+    truth = synthetic.STALL_SERVO
     fit = SV.fit_servo([recording(truth, 12)], kv_nms_per_rad=0.0)
     assert fit.estimates["servo.stall_torque_nm"].value == pytest.approx(0.15, rel=0.01)
     assert fit.identifiable["servo.stall_torque_nm"] and not fit.identifiable["servo.kp_nm_per_rad"]
@@ -209,7 +209,7 @@ def test_stalled_servo_gives_stall_torque_not_kp():
 
 def test_one_load_without_stall_torque_is_refused():
     with pytest.raises(CalibrationError, match="stall torque is needed"):
-        SV.fit_servo([recording(S.ServoTruth(), 1)])
+        SV.fit_servo([recording(synthetic.ServoTruth(), 1)])
 
 
 def aa_recording(shared_data) -> SV.StepRecording:
@@ -279,15 +279,15 @@ def test_bad_gyro_log_is_refused(text, match):
         parse_gyro_log(text, "log.txt")
 
 
-def gyro_synthetic(truth: S.GyroTruth, seed: int) -> SV.RateRecording:
-    t, command, rate = S.gyro_steps(truth, np.random.default_rng(seed))
+def gyro_synthetic(truth: synthetic.GyroTruth, seed: int) -> SV.RateRecording:
+    t, command, rate = synthetic.gyro_steps(truth, np.random.default_rng(seed))
     return SV.RateRecording(t, rate, command, SV.ServoRig(truth.inertia_kgm2), source=f"synthetic gyro {seed}")
 
 
 def test_validation_of_the_true_servo_reports_each_step():
     """SYNTHETIC: the true servo predicting its own gyro log: each step's signed size, peak
     speeds measured and predicted alike (the gyro's noise is 0.5 of 8 units per rad/s)."""
-    truth = S.GyroTruth()
+    truth = synthetic.GyroTruth()
     v = SV.validate(truth.servo, gyro_synthetic(truth, 3), gain=truth.gain_units_per_rad_per_s)
     assert [p.step_deg for p in v.steps] == [15.0, -15.0, 45.0, -45.0, 100.0, -100.0]
     for p in v.steps:
@@ -297,8 +297,8 @@ def test_validation_of_the_true_servo_reports_each_step():
     assert v.rms == pytest.approx(math.hypot(0.5, 1 / math.sqrt(12)) / 8, rel=0.25)  # noise and rounding
 
 
-def write_gyro_log(path, truth: S.GyroTruth, seed: int) -> None:
-    t, command, rate = S.gyro_steps(truth, np.random.default_rng(seed))
+def write_gyro_log(path, truth: synthetic.GyroTruth, seed: int) -> None:
+    t, command, rate = synthetic.gyro_steps(truth, np.random.default_rng(seed))
     path.write_text("".join(f"{round(1000 * ti)},{c:g},{g:g}\n" for ti, c, g in zip(t, command, rate)))
 
 
@@ -313,11 +313,11 @@ def test_cli_fits_angle_and_gyro_together_and_validates(tmp_path):
     from locust.commands.calibrate import calibrate
 
     true = KV_FITTED
-    angle = dataclasses.replace(S.ServoTruth(), servo=true)
-    t, a, c = S.servo_step(angle, np.random.default_rng(21))
+    angle = dataclasses.replace(synthetic.ServoTruth(), servo=true)
+    t, a, c = synthetic.servo_step(angle, np.random.default_rng(21))
     (tmp_path / "angle.csv").write_text("t_s,angle_deg,command_deg\n"
                                         + "".join(f"{ti},{ai},{ci}\n" for ti, ai, ci in zip(t, a, c)))
-    gyro = S.GyroTruth(servo=true, steps_deg=(10.0, 30.0, 90.0))
+    gyro = synthetic.GyroTruth(servo=true, steps_deg=(10.0, 30.0, 90.0))
     write_gyro_log(tmp_path / "gyro.txt", gyro, 22)
     write_gyro_log(tmp_path / "unseen.txt", dataclasses.replace(gyro, steps_deg=(20.0, 60.0)), 23)
     result = CliRunner().invoke(calibrate, [
@@ -348,8 +348,8 @@ def test_cli_fits_angle_and_gyro_together_and_validates(tmp_path):
 # the two joint fits of an angle recording and a gyro log: the presets' structure (kv held at 0)
 # and the command line's test above (kv fitted, a stiffer kp)
 JOINT_CASES = {
-    "kv held": (PRESET, S.GyroTruth(servo=PRESET), 0.0),
-    "kv fitted": (KV_FITTED, S.GyroTruth(servo=KV_FITTED, steps_deg=(10.0, 30.0, 90.0)), None),
+    "kv held": (PRESET, synthetic.GyroTruth(servo=PRESET), 0.0),
+    "kv fitted": (KV_FITTED, synthetic.GyroTruth(servo=KV_FITTED, steps_deg=(10.0, 30.0, 90.0)), None),
 }
 
 
@@ -357,14 +357,14 @@ def joint_fit_coverage(case: str, seeds: int) -> dict[str, int]:
     """SYNTHETIC: over ``seeds`` draws of both recordings, how often each 95 % interval (servo
     values and the gyro's gain) covers the truth; each value within 10 % of it (kv 40 %)."""
     true, gyro, kv = JOINT_CASES[case]
-    angle = dataclasses.replace(S.ServoTruth(), servo=true)
+    angle = dataclasses.replace(synthetic.ServoTruth(), servo=true)
     names = (("servo.noload_speed_rad_per_s", "servo.armature_kgm2", "servo.kp_nm_per_rad")
              + ("servo.kv_nms_per_rad",) * (kv is None))
     covered = dict.fromkeys((*names, "gyro gain"), 0)
     for seed in range(seeds):
         rng = np.random.default_rng(100 + seed)
-        t, a, c = S.servo_step(angle, rng)
-        tg, cg, g = S.gyro_steps(gyro, rng)
+        t, a, c = synthetic.servo_step(angle, rng)
+        tg, cg, g = synthetic.gyro_steps(gyro, rng)
         fit = SV.fit_servo([SV.StepRecording(t, a, c, SV.ServoRig(angle.inertia_kgm2)),
                             SV.RateRecording(tg, g, cg, SV.ServoRig(gyro.inertia_kgm2))],
                            stall_torque_nm=0.15, kv_nms_per_rad=kv)

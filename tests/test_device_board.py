@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from locust.firmware import config as fw_config
-from locust.io import run_record as R
+from locust.io import run_record
 from locust.io.robot_toml import save_robot
 from locust.params import preset
 from locust.trials.measured import config_of
@@ -43,7 +43,7 @@ def test_config_reads_the_board_back_and_sets_a_trim_without_flashing(env, flash
     firmware = {p.name: p.read_bytes() for p in flash.iterdir() if p.name != fw_config.FILE}
     shown = _run(["config", "--port", "sim", "--json"], env)
     assert shown.returncode == 0, shown.stderr
-    board = R.board_config(json.loads(shown.stdout))
+    board = run_record.board_config(json.loads(shown.stdout))
     assert (board.chip, board.left.pin, board.right.pin) == ("esp32", 18, 19)      # the ESP32's default pins
     assert (board.left.trim_deg, board.right.direction, board.problems) == (0.0, -1, ())
 
@@ -59,20 +59,21 @@ def test_config_reads_the_board_back_and_sets_a_trim_without_flashing(env, flash
     out = tmp_path / "run"            # a folder name that names no leg set
     hop = _run(["hop", "--port", "sim", *QUICK, "--preset", "seed", "--leg-set", "Large", "--out", out], env)
     assert hop.returncode == 0, hop.stderr
-    rec = R.read_run_record(out / R.RECORD_NAME)
-    assert rec.status == R.COMPLETE
-    assert rec.robot == R.RobotSource(preset="seed", robot_file=None, leg_set="large")
+    rec = run_record.read_run_record(out / run_record.RECORD_NAME)
+    assert rec.status == run_record.COMPLETE
+    assert rec.robot == run_record.RobotSource(preset="seed", robot_file=None, leg_set="large")
     assert (rec.board.left.pin, rec.board.left.trim_deg, rec.board.right.trim_deg) == (18, 1.25, -2.5)
     # the report takes the configuration from the record, not the folder's name
     assert config_of(out) == ("large", "run record")
-    assert config_of(out / R.RECORD_NAME) == ("large", "run record")
+    assert config_of(out / run_record.RECORD_NAME) == ("large", "run record")
 
 
 def test_a_preset_leg_set_is_recorded_and_a_contradicting_leg_set_refused(env, tmp_path):
     out = tmp_path / "trial-7"
     hop = _run(["hop", "--port", "sim", *QUICK, "--preset", "medium", "--out", out], env)
     assert hop.returncode == 0, hop.stderr
-    assert R.read_run_record(out / R.RECORD_NAME).robot == R.RobotSource("medium", None, "medium")
+    assert run_record.read_run_record(out / run_record.RECORD_NAME).robot == run_record.RobotSource(
+        "medium", None, "medium")
     assert config_of(out) == ("medium", "run record")
     assert_refused_and_unchanged(tmp_path, ["hop", "--port", "sim", "--preset", "small", "--leg-set", "large",
                                             "--out", tmp_path / "x"], "contradicts --preset small")
@@ -88,14 +89,15 @@ def test_the_default_robot_is_the_one_as_built_or_the_calibrated_one_here(env, t
     assert hop.returncode == 0, hop.stderr
     assert hop.stderr.splitlines()[0] == f"output folder: {tmp_path / 'a'}"   # then which robot
     assert hop.stderr.splitlines()[1].startswith("robot: small, the robot as built")
-    assert R.read_run_record(tmp_path / "a" / R.RECORD_NAME).robot == R.RobotSource("small", None, "small")
+    assert run_record.read_run_record(tmp_path / "a" / run_record.RECORD_NAME).robot == run_record.RobotSource(
+        "small", None, "small")
     (tmp_path / "calibration").mkdir()
     save_robot(preset("large").renamed("mine"), tmp_path / "calibration" / "robot.toml")
     hop = _run(["hop", "--port", "sim", *QUICK, "--out", tmp_path / "b"], env, cwd=tmp_path)
     assert hop.returncode == 0, hop.stderr
     assert hop.stderr.splitlines()[1].startswith("robot: calibration/robot.toml")
-    assert R.read_run_record(tmp_path / "b" / R.RECORD_NAME).robot == R.RobotSource(None, "calibration/robot.toml",
-                                                                                  "large")
+    assert run_record.read_run_record(tmp_path / "b" / run_record.RECORD_NAME).robot == run_record.RobotSource(
+        None, "calibration/robot.toml", "large")
     sim = _run(["sim", "--cycles", "1", "--json"], env, cwd=tmp_path)
     assert sim.stderr.splitlines()[0].startswith("robot: calibration/robot.toml")
     assert json.loads(sim.stdout)["robot"] == "mine"
@@ -127,8 +129,8 @@ def test_a_corrupt_board_config_is_recorded_and_never_complete(env, flash_config
     assert hop.returncode == 2, hop.stderr
     assert "error: every phase ran, but the board ran on its default config" in hop.stderr
     assert "hint:" in hop.stderr and "locust config --port PORT --set" in hop.stderr and "Traceback" not in hop.stderr
-    rec = R.read_run_record(out / R.RECORD_NAME)
-    assert rec.status == R.DEFAULT_CONFIG and len(rec.phases) == 2
+    rec = run_record.read_run_record(out / run_record.RECORD_NAME)
+    assert rec.status == run_record.DEFAULT_CONFIG and len(rec.phases) == 2
     assert rec.board.problems == ("config.json is not valid JSON; using defaults",)
 
     reflashed = _run(["flash", "--port", "sim"], env)        # keeps the board's config.json, and says it is unused
@@ -142,26 +144,28 @@ def test_a_corrupt_board_config_is_recorded_and_never_complete(env, flash_config
     assert fw_config.problems(json.loads(flash_config.read_text()), "esp32") == []
     again = _run(["hop", "--port", "sim", *QUICK, "--out", tmp_path / "small-2"], env)
     assert again.returncode == 0, again.stderr
-    assert R.read_run_record(tmp_path / "small-2" / R.RECORD_NAME).status == R.COMPLETE
+    assert run_record.read_run_record(tmp_path / "small-2" / run_record.RECORD_NAME).status == run_record.COMPLETE
 
 
 def test_robot_and_board_read_back_equal_and_a_damaged_board_entry_is_named(tmp_path):
     servo = dict(fw_config.default()["left"], trim_deg=2.5)
-    board = R.board_config({"chip": "s3", "machine": "Generic ESP32S3 module with ESP32S3", "left": servo,
-                            "right": fw_config.default()["right"],
-                            "config_problems": ["config.json is not valid JSON"]})
-    rec = R.RunRecord(schedule=R.HopSchedule(cycles=1), port="/dev/ttyACM0", status=R.DEFAULT_CONFIG,
-                      robot=R.RobotSource(None, "calibration/robot.toml", "v2"), board=board)
-    path = R.write(rec, tmp_path)
-    assert R.read_run_record(path) == rec and R.read_run_record(path).board.on_defaults
+    board = run_record.board_config({"chip": "s3", "machine": "Generic ESP32S3 module with ESP32S3", "left": servo,
+                                     "right": fw_config.default()["right"],
+                                     "config_problems": ["config.json is not valid JSON"]})
+    rec = run_record.RunRecord(schedule=run_record.HopSchedule(cycles=1), port="/dev/ttyACM0",
+                               status=run_record.DEFAULT_CONFIG,
+                               robot=run_record.RobotSource(None, "calibration/robot.toml", "v2"), board=board)
+    path = run_record.write(rec, tmp_path)
+    assert run_record.read_run_record(path) == rec and run_record.read_run_record(path).board.on_defaults
     doc = json.loads(path.read_text())
     doc["board"]["left"]["pin"] = "eighteen"
     path.write_text(json.dumps(doc))
-    with pytest.raises(R.DeviceError, match="board left.pin is missing or not a number"):
-        R.read_run_record(path)
+    with pytest.raises(run_record.DeviceError, match="board left.pin is missing or not a number"):
+        run_record.read_run_record(path)
     del doc["board"], doc["robot"]                # a record from before they were recorded
     path.write_text(json.dumps(doc))
-    assert R.read_run_record(path).robot == R.RobotSource() and R.read_run_record(path).board is None
+    back = run_record.read_run_record(path)
+    assert back.robot == run_record.RobotSource() and back.board is None
 
 
 def test_every_torn_or_out_of_limits_config_is_reported_and_never_used(tmp_path):

@@ -13,7 +13,7 @@ import pytest
 import serial
 
 from locust.device.link import Link
-from locust.firmware import protocol as P
+from locust.firmware import protocol
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "firmware"))
 from lcg import Lcg
@@ -34,7 +34,7 @@ def test_flash_then_hop_six_cycles_on_time(env, tmp_path, board_timing):
                  "--out", str(tmp_path / "run")], env)
     assert proc.returncode == 0, proc.stderr
     rec = json.loads(proc.stdout)
-    assert rec["status"] == "complete" and rec["firmware_version"] == P.VERSION
+    assert rec["status"] == "complete" and rec["firmware_version"] == protocol.VERSION
     assert len(rec["phases"]) == 12
     assert [(p["cycle"], p["phase"]) for p in rec["phases"][:2]] == [(1, "push"), (1, "wait")]
     assert rec["phases"][-1]["commanded_ms"] == 5 * 1300 + 300
@@ -324,22 +324,22 @@ def _fuzz_frames(n, seed=4):
         if kind == 0:
             line = rng.bytes(1 + rng.below(200))
         elif kind == 1:  # a valid frame with one flipped bit
-            good = bytearray(P.encode({"id": i, "cmd": "pose", "left_deg": 1, "right_deg": 1})[:-1])
+            good = bytearray(protocol.encode({"id": i, "cmd": "pose", "left_deg": 1, "right_deg": 1})[:-1])
             good[1 + rng.below(len(good) - 2)] ^= 1 << rng.below(7)
             line = bytes(good)
         elif kind == 2:
             body = rng.bytes(rng.below(80))
-            line = b"$" + body + b"*" + P.crc_hex(body).encode()
+            line = b"$" + body + b"*" + protocol.crc_hex(body).encode()
         elif kind == 3:
             line = b"$" + rng.bytes(300 + rng.below(2000))
         elif kind == 4:
-            line = P.encode({"id": i, "cmd": "pose", "left_deg": rng.below(400) - 200,
-                             "right_deg": rng.below(400) - 200})[:-1]
+            line = protocol.encode({"id": i, "cmd": "pose", "left_deg": rng.below(400) - 200,
+                                    "right_deg": rng.below(400) - 200})[:-1]
         elif kind == 5:
-            line = P.encode({"id": i, "cmd": ["hop", "fly", "config", "report"][rng.below(4)],
-                             "cycles": rng.below(5) - 1, "key": "left.travel_deg", "value": 200})[:-1]
+            line = protocol.encode({"id": i, "cmd": ["hop", "fly", "config", "report"][rng.below(4)],
+                                    "cycles": rng.below(5) - 1, "key": "left.travel_deg", "value": 200})[:-1]
         elif kind == 6:
-            line = P.encode({"id": rng.next(), "cmd": "pose", "left_deg": 1e308 * 10, "right_deg": "x"})[:-1]
+            line = protocol.encode({"id": rng.next(), "cmd": "pose", "left_deg": 1e308 * 10, "right_deg": "x"})[:-1]
         else:
             line = bytes([4, 1, 2, 5, 0x1B]) + rng.bytes(8)  # the REPL's other control characters
         line = line.replace(b"\n", b"").replace(b"\r", b"").replace(b"\x03", b"?") or b"?"
@@ -360,18 +360,18 @@ def test_fuzzed_virtual_robot_survives_and_then_hops(env, tmp_path, board_timing
             link.hello(wait_s=8)
         with serial.Serial(device, timeout=2) as port:
             port.reset_input_buffer()
-            reader = P.LineReader(limit=1 << 16)
+            reader = protocol.LineReader(limit=1 << 16)
             for start in range(0, len(frames), 20):
                 batch = frames[start:start + 20]
                 port.write(b"".join(batch))
                 while len(replies) < start + len(batch):
                     data = port.read(max(1, port.in_waiting))
                     assert data, f"no reply after {len(replies)} of {len(frames)} frames"
-                    replies += [P.decode(line) for line in reader.feed(data) if line]
+                    replies += [protocol.decode(line) for line in reader.feed(data) if line]
         assert len(replies) == len(frames)  # one reply each: nothing crashed, nothing dropped
-        assert not [r for r in replies if r.get("error") == P.E_INTERNAL]
-        assert sum(r.get("error") == P.E_CHECKSUM for r in replies) >= 375
-        assert sum(r.get("error") == P.E_TOO_LONG for r in replies) == 375
+        assert not [r for r in replies if r.get("error") == protocol.E_INTERNAL]
+        assert sum(r.get("error") == protocol.E_CHECKSUM for r in replies) >= 375
+        assert sum(r.get("error") == protocol.E_TOO_LONG for r in replies) == 375
         moved = sum(1 for r in replies if r.get("ok") and "left_deg" in r)
         assert moved > 0
         hop = _run(["hop", "--port", device, "--cycles", "1", "--json", "--out", str(tmp_path / "after")], env)

@@ -25,8 +25,8 @@ from locust.device.link import Link
 from locust.device.plant import RecordingPlant
 from locust.device.virtual import PWM_PERIOD_S, TICKS_LEAD_S, VirtualRobot
 from locust.errors import DeviceError
-from locust.firmware import protocol as P
-from locust.io import run_record as R
+from locust.firmware import protocol
+from locust.io import run_record
 from waiting import wait_for
 
 
@@ -41,7 +41,7 @@ def robot(tmp_path_factory):
 
 def test_flash_copies_verifies_and_shakes_hands(robot):
     vr, _, result = robot
-    assert result.firmware_version == P.VERSION
+    assert result.firmware_version == protocol.VERSION
     assert sorted(f.name for f in result.files) == sorted(p.name for p in firmware_files())
     for f in result.files:  # what landed in the flash folder is byte-identical
         assert hashlib.sha256((vr.flash_dir / f.name).read_bytes()).hexdigest() == f.sha256
@@ -51,11 +51,11 @@ def test_flash_copies_verifies_and_shakes_hands(robot):
 
 def test_hop_phases_on_time_and_servos_follow(robot, tmp_path, board_timing):
     vr, plant, _ = robot
-    schedule = R.HopSchedule(cycles=2, push_deg=-30.0, push_ms=100, wait_ms=150)
+    schedule = run_record.HopSchedule(cycles=2, push_deg=-30.0, push_ms=100, wait_ms=150)
     t_start = vr.now_s()
     with Link(vr.device_path) as link:
         rec = run_hop(link, schedule, tmp_path)
-    assert rec.status == R.COMPLETE and len(rec.phases) == 4
+    assert rec.status == run_record.COMPLETE and len(rec.phases) == 4
     assert [p.commanded_us for p in rec.phases] == [0, 100_000, 250_000, 350_000]
     assert all(p.error_us >= 0 for p in rec.phases)     # never early
     pushes = [c for c in plant.commands if c.t_s > t_start and c.left_deg < -1]
@@ -87,9 +87,9 @@ def test_silent_host_leaves_servos_at_rest_within_heartbeat(robot, board_timing)
         done = None
         while done is None:
             ev = link.events.get(timeout=5)
-            if ev.get("ev") == P.EV_DONE and ev.get("hop") == reply["id"]:
+            if ev.get("ev") == protocol.EV_DONE and ev.get("hop") == reply["id"]:
                 done = ev
-    assert done["status"] == P.HOP_HEARTBEAT and done["phases"] == 1
+    assert done["status"] == protocol.HOP_HEARTBEAT and done["phases"] == 1
     def at_rest():   # the PWM writes reach the host through a FIFO, the events a pty
         last = [w for w in vr.pwm_writes if w.servo][-2:]
         return last if all(abs(w.horn_deg) < 1e-6 for w in last) else None
@@ -104,13 +104,13 @@ def test_silent_host_leaves_servos_at_rest_within_heartbeat(robot, board_timing)
 def test_errors_over_the_wire_and_busy(robot):
     vr, _, _ = robot
     with Link(vr.device_path) as link:
-        assert link.request("pose", left_deg=80, right_deg=0)["error"] == P.E_RANGE
-        assert link.request("warp")["error"] == P.E_UNKNOWN
+        assert link.request("pose", left_deg=80, right_deg=0)["error"] == protocol.E_RANGE
+        assert link.request("warp")["error"] == protocol.E_UNKNOWN
         link.write(b"$not json*00000000\n")
-        link.write(P.encode({"id": 77, "cmd": "ping"}).replace(b"ping", b"pong"))
+        link.write(protocol.encode({"id": 77, "cmd": "ping"}).replace(b"ping", b"pong"))
         assert link.call("ping")["ok"]
         errors = [m["error"] for m in link.unsolicited]
-        assert P.E_CHECKSUM in errors
+        assert protocol.E_CHECKSUM in errors
         bad_id = link.request("pose", left_deg=10, right_deg=-10)
         assert bad_id["ok"] and (bad_id["left_deg"], bad_id["right_deg"]) == (10, -10)
         assert link.call("rest")["ok"]
@@ -122,7 +122,7 @@ def _reboot_into_firmware(link):
     link.write(b"\x04")
     deadline = time.monotonic() + 10
     while time.monotonic() < deadline:
-        if link.events.get(timeout=deadline - time.monotonic()).get("ev") == P.EV_BOOT:
+        if link.events.get(timeout=deadline - time.monotonic()).get("ev") == protocol.EV_BOOT:
             return
     raise AssertionError("no boot event")
 
@@ -136,12 +136,12 @@ def test_hop_across_a_ticks_wrap_stays_on_time(robot, tmp_path, board_timing):
         _reboot_into_firmware(link)
         before = link.call("ping")["t_us"]
         assert (1 << 30) - before < TICKS_LEAD_S * 1e6  # the wrap is ahead
-        rec = run_hop(link, R.HopSchedule(cycles=6, push_ms=300, wait_ms=1000), tmp_path)
+        rec = run_hop(link, run_record.HopSchedule(cycles=6, push_ms=300, wait_ms=1000), tmp_path)
         after = link.call("ping")["t_us"]
     assert after < before  # wrapped during the hop
     start, end = rec.firmware_ticks_us
     assert before < start < (1 << 30) and end < after and rec.to_dict()["ticks_wrapped"]
-    assert rec.status == R.COMPLETE and len(rec.phases) == 12
+    assert rec.status == run_record.COMPLETE and len(rec.phases) == 12
     assert [p.commanded_us for p in rec.phases][-1] == 5 * 1_300_000 + 300_000
     assert all(p.error_us >= 0 for p in rec.phases)     # never early
     board_timing([p.error_us for p in rec.phases])
@@ -235,7 +235,7 @@ def test_flash_stops_a_running_hop_instead_of_calling_the_board_blank(robot):
         link.call("hop", cycles=20, push_ms=300, wait_ms=1000, heartbeat_ms=10000)
     # the hop runs on, silent host or not, for 10 s: past the 3 s the raw REPL is given
     result = flash(vr.device_path, repl_timeout_s=3.0)
-    assert result.firmware_version == P.VERSION
+    assert result.firmware_version == protocol.VERSION
 
 
 def test_flash_on_a_port_without_micropython_names_the_installer():

@@ -27,7 +27,7 @@ from serial.serialutil import to_bytes
 
 from locust.device.link import Link
 from locust.firmware import config as fw_config
-from locust.firmware import protocol as P
+from locust.firmware import protocol
 from waiting import wait_for
 
 LOCUST = [sys.executable, "-m", "locust.commands"]
@@ -149,7 +149,7 @@ def test_no_heartbeat_write_is_in_progress_when_the_port_closes(monkeypatch):
     closes: close() waits for it, so the port never closes under a write (Ctrl-C in a long
     `hop --port sim` printed the heartbeat thread's TypeError from pyserial's write, the port
     closed under it, before the clean error)."""
-    ping = P.encode({"id": 0, "cmd": "ping"})
+    ping = protocol.encode({"id": 0, "cmd": "ping"})
     inside = threading.Event()       # the held ping is inside pyserial's write
     closing = threading.Event()
     writing = []                     # writes in progress
@@ -216,32 +216,33 @@ class PulledBoard:
         if cmd == self.pull:
             return True
         if cmd == "hello":
-            msg = P.reply(rid, name=P.NAME, version=P.VERSION, protocol=P.PROTOCOL, platform="esp32",
-                          micropython=[1, 26, 0], machine="ESP32 module", chip="esp32", reset="power_on",
-                          config_problems=[], hopping=False)
+            msg = protocol.reply(rid, name=protocol.NAME, version=protocol.VERSION, protocol=protocol.PROTOCOL,
+                                 platform="esp32", micropython=[1, 26, 0], machine="ESP32 module", chip="esp32",
+                                 reset="power_on", config_problems=[], hopping=False)
         elif cmd == "config":
-            msg = P.reply(rid, config=fw_config.default("esp32"))
+            msg = protocol.reply(rid, config=fw_config.default("esp32"))
         elif cmd == "hop":
-            os.write(self.master, P.encode(P.reply(rid)))
-            msg = P.event(P.EV_PHASE, hop=rid, i=0, cycle=1, phase="push", commanded_us=0, measured_us=150)
+            os.write(self.master, protocol.encode(protocol.reply(rid)))
+            msg = protocol.event(protocol.EV_PHASE, hop=rid, i=0, cycle=1, phase="push", commanded_us=0,
+                                 measured_us=150)
             if self.pull == "phase":
-                os.write(self.master, P.encode(msg))
+                os.write(self.master, protocol.encode(msg))
                 return True
         else:
-            msg = P.reply(rid)
-        os.write(self.master, P.encode(msg))
+            msg = protocol.reply(rid)
+        os.write(self.master, protocol.encode(msg))
         return False
 
     def _serve(self) -> None:
-        lines = P.LineReader()
+        lines = protocol.LineReader()
         while True:
             if not select.select([self.master], [], [], 30)[0]:
                 break
             pulled = False
             for line in lines.feed(os.read(self.master, 4096)):
                 try:
-                    pulled = pulled or self._answer(P.decode(line))
-                except (P.ProtocolError, TypeError):
+                    pulled = pulled or self._answer(protocol.decode(line))
+                except (protocol.ProtocolError, TypeError):
                     continue
             if pulled:
                 break

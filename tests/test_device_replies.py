@@ -20,7 +20,7 @@ import tty
 import pytest
 
 from locust.firmware import config as fw_config
-from locust.firmware import protocol as P
+from locust.firmware import protocol
 from probing import assert_clear_error, invoke, tree
 
 MISSING = object()
@@ -41,34 +41,37 @@ class FakeBoard:
 
     def _send(self, what: str, msg: dict) -> None:
         msg = self.spoil(what, msg)
-        os.write(self.master, P.encode(msg))   # json.dumps writes inf as Infinity, as a board's JSON may
+        os.write(self.master, protocol.encode(msg))   # json.dumps writes inf as Infinity, as a board's JSON may
 
     def _answer(self, req: dict) -> None:
         cmd, rid = req.get("cmd"), req.get("id")
         if cmd == "hello":
-            self._send("hello", P.reply(rid, name=P.NAME, version=P.VERSION, protocol=P.PROTOCOL, platform="esp32",
-                                        micropython=[1, 26, 0], machine="ESP32 module", chip="esp32",
-                                        reset="power_on", config_problems=[], hopping=False))
+            self._send("hello", protocol.reply(rid, name=protocol.NAME, version=protocol.VERSION,
+                                               protocol=protocol.PROTOCOL, platform="esp32", micropython=[1, 26, 0],
+                                               machine="ESP32 module", chip="esp32", reset="power_on",
+                                               config_problems=[], hopping=False))
         elif cmd == "config":
-            self._send("config", P.reply(rid, config=fw_config.default("esp32")))
+            self._send("config", protocol.reply(rid, config=fw_config.default("esp32")))
         elif cmd == "hop":
-            self._send("hop", P.reply(rid))
+            self._send("hop", protocol.reply(rid))
             push, wait = req["push_ms"] * 1000, req["wait_ms"] * 1000
             for i in range(2 * req["cycles"]):
                 c, start = i // 2 + 1, (i // 2) * (push + wait) + (push if i % 2 else 0)
-                self._send("phase", P.event(P.EV_PHASE, hop=rid, i=i, cycle=c, phase="wait" if i % 2 else "push",
-                                            commanded_us=start, measured_us=start + 150))
-            self._send("done", P.event(P.EV_DONE, hop=rid, status=P.HOP_COMPLETE, phases=2 * req["cycles"],
-                                       total=2 * req["cycles"], max_err_us=150, rest_us=0, ticks_us=[100, 900]))
+                self._send("phase", protocol.event(protocol.EV_PHASE, hop=rid, i=i, cycle=c,
+                                                   phase="wait" if i % 2 else "push", commanded_us=start,
+                                                   measured_us=start + 150))
+            self._send("done", protocol.event(protocol.EV_DONE, hop=rid, status=protocol.HOP_COMPLETE,
+                                              phases=2 * req["cycles"], total=2 * req["cycles"], max_err_us=150,
+                                              rest_us=0, ticks_us=[100, 900]))
         elif cmd in ("pose", "rest"):
-            self._send(cmd, P.reply(rid, left_deg=req.get("left_deg", 0.0), right_deg=req.get("right_deg", 0.0)))
+            self._send(cmd, protocol.reply(rid, left_deg=req.get("left_deg", 0.0), right_deg=req.get("right_deg", 0.0)))
         elif cmd == "report":
-            self._send("report", P.reply(rid, status=P.HOP_COMPLETE, total=0, start=0, phases=[]))
+            self._send("report", protocol.reply(rid, status=protocol.HOP_COMPLETE, total=0, start=0, phases=[]))
         else:   # ping, stop
-            self._send(cmd, P.reply(rid))
+            self._send(cmd, protocol.reply(rid))
 
     def _serve(self) -> None:
-        lines = P.LineReader()
+        lines = protocol.LineReader()
         while not self.stopped.is_set():
             try:
                 data = os.read(self.master, 4096)
@@ -76,8 +79,8 @@ class FakeBoard:
                 return
             for line in lines.feed(data):
                 try:
-                    self._answer(P.decode(line))
-                except (P.ProtocolError, TypeError):
+                    self._answer(protocol.decode(line))
+                except (protocol.ProtocolError, TypeError):
                     continue
 
     def close(self) -> None:
@@ -232,14 +235,14 @@ class RepeatingBoard(FakeBoard):
     def _answer(self, req):
         if req.get("cmd") != "hop":
             return super()._answer(req)
-        self._send("hop", P.reply(req["id"]))
-        ev = P.event(P.EV_PHASE, hop=req["id"] + 1000 * self.other_hop, i=0, cycle=1, phase="push",
-                     commanded_us=0, measured_us=150)
+        self._send("hop", protocol.reply(req["id"]))
+        ev = protocol.event(protocol.EV_PHASE, hop=req["id"] + 1000 * self.other_hop, i=0, cycle=1, phase="push",
+                            commanded_us=0, measured_us=150)
 
         def repeat():
             while not self.stopped.is_set():
                 try:
-                    os.write(self.master, P.encode(ev))
+                    os.write(self.master, protocol.encode(ev))
                 except OSError:
                     return
                 time.sleep(0.001)

@@ -28,7 +28,7 @@ from locust.device.link import Link
 from locust.device.plant import RecordingPlant
 from locust.device.stalls import ASLEEP_PERIOD_S, SAMPLE_PERIOD_S, HeldOff, Sample
 from locust.device.virtual import VirtualRobot
-from locust.io import run_record as R
+from locust.io import run_record
 from waiting import wait_for
 
 MS = 1e-3
@@ -109,7 +109,7 @@ def test_a_process_whose_virtual_cpu_the_hypervisor_took_is_held_off():
 
 # -- a real hop on the virtual robot, held up for a known time ------------------------------
 
-SCHEDULE = R.HopSchedule(cycles=3, push_deg=-30.0, push_ms=200, wait_ms=300, heartbeat_ms=2000)
+SCHEDULE = run_record.HopSchedule(cycles=3, push_deg=-30.0, push_ms=200, wait_ms=300, heartbeat_ms=2000)
 HELD = (2, "wait")   # the phase held up: its start is due 700 ms into the hop
 HOLD_S = 0.200       # how long the interpreter is held
 # the hold is set to begin this long before that phase is due (the firmware sleeps then): the
@@ -124,7 +124,7 @@ def robot(env):
         yield vr
 
 
-def _hop_held_up(vr: VirtualRobot, directory: Path, hold) -> tuple[R.RunRecord, float, float]:
+def _hop_held_up(vr: VirtualRobot, directory: Path, hold) -> tuple[run_record.RunRecord, float, float]:
     """A hop of SCHEDULE during which ``hold(pid, start_s)`` holds the interpreter up from
     LEAD_S before HELD is due (set up from the hop's first phase on, so a process it starts
     is ready by then); returns the record, and when the hold began and ended from HELD's
@@ -132,7 +132,7 @@ def _hop_held_up(vr: VirtualRobot, directory: Path, hold) -> tuple[R.RunRecord, 
     held: dict = {}
     due_us = (HELD[0] - 1) * (SCHEDULE.push_ms + SCHEDULE.wait_ms) * 1000 + SCHEDULE.push_ms * 1000
 
-    def on_phase(p: R.Phase) -> None:
+    def on_phase(p: run_record.Phase) -> None:
         if (p.cycle, p.phase) == (1, "push"):
             start_s = time.monotonic() + (due_us - p.error_us) / 1e6 - LEAD_S
             threading.Thread(target=lambda: held.update(span=hold(vr.interpreter_pid, start_s)), daemon=True).start()
@@ -185,10 +185,10 @@ def _hog(pid: int, start_s: float) -> tuple[float, float]:
     return began_s, ended_s
 
 
-def _check_held_up(rec: R.RunRecord, hold_ms: float) -> None:
+def _check_held_up(rec: run_record.RunRecord, hold_ms: float) -> None:
     phase = next(p for p in rec.phases if (p.cycle, p.phase) == HELD)
     stall_ms = phase.host_stall_us / 1e3
-    assert rec.status == R.COMPLETE
+    assert rec.status == run_record.COMPLETE
     explained = (phase.error_ms - stall_ms <= TOLERANCE_MS and stall_ms >= hold_ms - TOLERANCE_MS
                  and stall_ms <= phase.error_ms + 1e-3)
     if not explained:
@@ -200,8 +200,8 @@ def _check_held_up(rec: R.RunRecord, hold_ms: float) -> None:
                         f"late, and the host stopped a spinning process for {again_us / 1000:.2f} ms: not judged here")
     assert phase.error_ms - stall_ms <= TOLERANCE_MS, (phase, hold_ms)     # the host explains the lateness
     assert hold_ms - TOLERANCE_MS <= stall_ms <= phase.error_ms + 1e-3, (phase, hold_ms)
-    assert R.host_stall_max_s(rec.phases) == pytest.approx(stall_ms / 1e3, abs=1e-6)
-    note = R.timing_note(rec.phases)
+    assert run_record.host_stall_max_s(rec.phases) == pytest.approx(stall_ms / 1e3, abs=1e-6)
+    note = run_record.timing_note(rec.phases)
     assert note.startswith(f"timing not representative: the host stalled {stall_ms:.1f} ms while "
                            f"cycle {HELD[0]}'s {HELD[1]} was due"), note
     assert rec.to_dict()["timing_note"] == note
@@ -214,7 +214,7 @@ def test_a_stopped_interpreter_is_the_hosts_stall_not_the_firmwares(robot, tmp_p
     rec, began_ms, hold_ms = _hop_held_up(robot, tmp_path, _stop)
     assert began_ms < 0 < hold_ms     # the hold covered the phase's start
     _check_held_up(rec, hold_ms)
-    saved = json.loads((tmp_path / R.RECORD_NAME).read_text())
+    saved = json.loads((tmp_path / run_record.RECORD_NAME).read_text())
     assert saved["host_stall_max_s"] == pytest.approx(rec.to_dict()["host_stall_max_s"], abs=1e-9)
 
 
@@ -232,11 +232,11 @@ def test_a_cpu_bound_process_holding_the_interpreter_off_is_measured(robot, tmp_
 def test_a_quiet_hop_claims_no_stall_over_the_bound(robot, tmp_path, board_timing):
     with Link(robot.device_path) as link:
         rec = run_hop(link, SCHEDULE, tmp_path, stalls=robot.stalls)
-    assert rec.status == R.COMPLETE and robot.stalls.samples >= SCHEDULE.duration_s / ASLEEP_PERIOD_S / 2
+    assert rec.status == run_record.COMPLETE and robot.stalls.samples >= SCHEDULE.duration_s / ASLEEP_PERIOD_S / 2
     stalls = [p.host_stall_us for p in rec.phases]
     assert all(0 <= s <= max(p.error_us, 0) + 1 for s, p in zip(stalls, rec.phases))   # never more than the lateness
-    board_timing(stalls, bound_us=R.TIMING_BOUND_US, what="host stall")
-    if R.timing_note(rec.phases) is None:
+    board_timing(stalls, bound_us=run_record.TIMING_BOUND_US, what="host stall")
+    if run_record.timing_note(rec.phases) is None:
         assert rec.to_dict()["timing_note"] is None
 
 
@@ -262,7 +262,8 @@ def test_locust_hop_on_the_virtual_robot_prints_and_records_the_hosts_stall(env,
                              "--json", "--out", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
-        wait_for(lambda: (out / R.RECORD_NAME).is_file(), 60, "the board to answer")   # after the handshake's reboot
+        # after the handshake's reboot
+        wait_for(lambda: (out / run_record.RECORD_NAME).is_file(), 60, "the board to answer")
         time.sleep(0.5)
         pid = _interpreter_of(proc.pid)
         os.kill(pid, signal.SIGSTOP)
@@ -281,7 +282,7 @@ def test_locust_hop_on_the_virtual_robot_prints_and_records_the_hosts_stall(env,
     assert rec["timing_note"].startswith(f"timing not representative: the host stalled {worst['host_stall_ms']:.1f} ms")
     assert rec["timing_note"] in stderr
     assert f"host stall max {worst['host_stall_ms']:.2f} ms" in stderr
-    assert json.loads((out / R.RECORD_NAME).read_text()) == rec
+    assert json.loads((out / run_record.RECORD_NAME).read_text()) == rec
 
 
 def test_the_demo_films_two_hops_at_once_only_where_the_interpreter_runs_in_real_time(robot):

@@ -11,7 +11,8 @@ from ezdxf.math import rational_bspline_from_arc
 
 from locust.errors import FabError
 from locust.fab.design import LayerMap, design_from_drawing, parse_layer_options
-from locust.fab.dxf_read import MAX_EXPANDED_ENTITIES, expanded_count, read_drawing
+from locust.fab.dxf_limits import MAX_EXPANDED_ENTITIES, expanded_count
+from locust.fab.dxf_read import read_drawing
 from probing import assert_refused_and_unchanged, invoke
 
 

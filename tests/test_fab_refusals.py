@@ -18,7 +18,8 @@ import pytest
 from click.testing import CliRunner
 
 from locust.commands import cli
-from locust.fab.dxf_read import MAX_SPLINE_POINTS, read_drawing
+from locust.fab.dxf_limits import MAX_SPLINE_POINTS
+from locust.fab.dxf_read import read_drawing
 
 
 def drawing(path: Path, cut=None, insunits: int = 4, square=((20, 10), (30, 10), (30, 20), (20, 20))) -> Path:

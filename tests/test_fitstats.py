@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from locust.calibrate import fitstats as F
+from locust.calibrate import fitstats
 
 CLUSTERS, PER_CLUSTER, TRIALS = 8, 40, 2000
 
@@ -26,7 +26,7 @@ def _coverage(method: str, seed: int = 1) -> float:
         y = truth[0] + truth[1] * t + shared[labels, 0] + shared[labels, 1] * t + rng.normal(0, 0.02, t.size)
         fit = np.linalg.lstsq(-jac, y, rcond=None)[0]
         r = y + jac @ fit
-        cov = F.cluster_covariance(jac, r, labels) if method == "cluster" else F.covariance(jac, r)
+        cov = fitstats.cluster_covariance(jac, r, labels) if method == "cluster" else fitstats.covariance(jac, r)
         est = cov.parameter(fit, 1)
         hits += est.ci95_low <= truth[1] <= est.ci95_high
     return hits / TRIALS
@@ -44,12 +44,12 @@ def test_intervals_that_assume_independent_residuals_do_not():
 
 def test_too_few_clusters_determine_nothing():
     jac = np.column_stack([np.ones(6), np.arange(6.0)])
-    cov = F.cluster_covariance(jac, np.arange(6.0) % 2 - 0.5, np.array([0, 0, 0, 1, 1, 1]))
+    cov = fitstats.cluster_covariance(jac, np.arange(6.0) % 2 - 0.5, np.array([0, 0, 0, 1, 1, 1]))
     assert np.all(np.isinf(cov.matrix))
 
 
 def test_a_numerical_shift_adds_in_quadrature_with_welch_satterthwaite_dof():
-    cov = F.Covariance(np.diag([0.03**2, 1.0]), dof=5, shift=np.array([0.04, 0.0]))
+    cov = fitstats.Covariance(np.diag([0.03**2, 1.0]), dof=5, shift=np.array([0.04, 0.0]))
     est = cov.parameter(np.array([2.0, 1.0]), 0)
     assert est.std == pytest.approx(0.05) and est.std_numerical == pytest.approx(0.04)
     # nu_eff = 5 (0.05 / 0.03)^4 = 38.6 -> t = 2.0225
@@ -57,7 +57,7 @@ def test_a_numerical_shift_adds_in_quadrature_with_welch_satterthwaite_dof():
     assert "std_numerical" in est.as_dict()
     # the shift as a linear change of the data: the Gauss-Newton step of a line fit
     jac = -np.column_stack([np.ones(5), np.arange(5.0)])
-    assert F.linear_shift(jac, np.full(5, 0.1)) == pytest.approx([0.1, 0.0])
+    assert fitstats.linear_shift(jac, np.full(5, 0.1)) == pytest.approx([0.1, 0.0])
 
 
 def test_values_held_fixed_carry_their_uncertainty_into_the_fit():
@@ -75,13 +75,13 @@ def test_values_held_fixed_carry_their_uncertainty_into_the_fit():
     a = fit_a(b_held)
     r = y - a * x - b_held * z
     jac, jac_b = -x[:, None], -z[:, None]             # d residual / d a, d residual / d b
-    fixed = F.fixed_covariance(jac, jac_b, np.array([sd_b]))
+    fixed = fitstats.fixed_covariance(jac, jac_b, np.array([sd_b]))
     moved = (fit_a(b_held + sd_b) - fit_a(b_held - sd_b)) / 2
     assert np.sqrt(fixed[0, 0]) == pytest.approx(abs(moved), rel=1e-12)
     assert np.sqrt(fixed[0, 0]) == pytest.approx(abs(x @ z / (x @ x)) * sd_b, rel=1e-12)
     clusters = np.arange(40) // 4
-    plain = F.cluster_covariance(jac, r, clusters).parameter(np.array([a]), 0)
-    est = F.cluster_covariance(jac, r, clusters, fixed=fixed).parameter(np.array([a]), 0)
+    plain = fitstats.cluster_covariance(jac, r, clusters).parameter(np.array([a]), 0)
+    est = fitstats.cluster_covariance(jac, r, clusters, fixed=fixed).parameter(np.array([a]), 0)
     assert est.std_fixed == pytest.approx(np.sqrt(fixed[0, 0]), rel=1e-12)
     assert est.std == pytest.approx(np.hypot(plain.std, est.std_fixed), rel=1e-12)
     assert est.std_numerical is None and "std_fixed" in est.as_dict()

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from locust import params as P
+from locust import params
 from locust.commands import cli
 from locust.io import robot_toml
 from locust.measure.nose_load import AXIS_KEY, PLATE_KEY, measure_nose_load
@@ -24,12 +24,12 @@ MEASURED = {"geometry.crank_start_deg": 1.0, "geometry.ground_angle_deg": 1.5, "
             PLATE_KEY: 0.001}
 
 
-def robot_with(uncertain: dict[str, float]) -> P.Robot:
+def robot_with(uncertain: dict[str, float]) -> params.Robot:
     """Medium with only ``uncertain`` (key -> sd) carrying an uncertainty; the axis none."""
-    base = P.preset("medium")
-    robot = base.with_values({k: base.get(k) for k in uncertain_values(base)}, P.Provenance("test"))
+    base = params.preset("medium")
+    robot = base.with_values({k: base.get(k) for k in uncertain_values(base)}, params.Provenance("test"))
     for key, sd in uncertain.items():
-        robot = robot.with_values({key: robot.get(key)}, P.Provenance("estimate", uncertainty=sd))
+        robot = robot.with_values({key: robot.get(key)}, params.Provenance("estimate", uncertainty=sd))
     return robot
 
 
@@ -37,7 +37,7 @@ def test_the_nose_carries_more_as_the_servos_move_toward_it():
     """Medium standing at rest: the floor carries its 31.1 g, 4.2 g of it under the nose;
     moving the servos (18 g of it) 5 mm toward the nose at a time raises the nose's share
     each time, by 0.3-0.7 g, and the centre of mass moves toward the nose by about 4.4 mm."""
-    loads = [standing_load(P.preset("medium").with_values({AXIS_KEY: a}))
+    loads = [standing_load(params.preset("medium").with_values({AXIS_KEY: a}))
              for a in (0.043, 0.038, 0.033, 0.028, 0.023, 0.018, 0.013)]
     assert loads[3].nose_load_kg == pytest.approx(0.00420, abs=2e-5)
     assert loads[3].total_mass_kg == pytest.approx(0.03113, abs=2e-5)

@@ -2,21 +2,21 @@
 
 import pytest
 
-from locust import params as P
+from locust import params
 from locust.errors import ParamsError
 from locust.io import robot_toml
 
 
 def test_presets_add_one_and_two_cm_to_every_link():
-    seed = P.preset("seed").link_lengths_m()
+    seed = params.preset("seed").link_lengths_m()
     for name, added in (("small", 0.0), ("medium", 0.01), ("large", 0.02)):
-        got = P.preset(name).link_lengths_m()
+        got = params.preset(name).link_lengths_m()
         assert got == pytest.approx(tuple(v + added for v in seed), abs=1e-12)
     assert seed == (0.04, 0.04, 0.02, 0.06)
 
 
 def test_seed_notebook_runs_the_notebook_way():
-    nb = P.preset("seed-notebook")
+    nb = params.preset("seed-notebook")
     assert (nb.solver.timestep_s, nb.solver.control_hz, nb.solver.settle_s) == (1e-4, 60.0, 0.0)
     assert nb.source_of("servo.kp_nm_per_rad").source == "seed"
 
@@ -40,9 +40,9 @@ def test_bad_set_options(item, fragment):
 
 
 def test_toml_round_trip_keeps_values_and_uncertainty(tmp_path):
-    fitted = P.preset("medium").with_values(
+    fitted = params.preset("medium").with_values(
         {"compliance.hinge_stiffness_nm_per_rad": 0.061},
-        P.Provenance(source="fit:beam.csv", uncertainty=0.002, date="2026-11-21"))
+        params.Provenance(source="fit:beam.csv", uncertainty=0.002, date="2026-11-21"))
     path = robot_toml.save_robot(fitted, tmp_path / "robot.toml")
     back = robot_toml.load_robot(path)
     assert back.flat() == fitted.flat()

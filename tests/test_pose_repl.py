@@ -26,7 +26,7 @@ from locust.commands import cli
 from locust.device.link import Link
 from locust.device.plant import RecordingPlant
 from locust.device.virtual import VirtualRobot
-from locust.firmware import protocol as P
+from locust.firmware import protocol
 from waiting import wait_for
 
 LOCUST = [sys.executable, "-m", "locust.commands"]
@@ -230,7 +230,7 @@ def test_mpremote_sees_a_boards_line_ends_and_file_sizes_on_the_virtual_robot(en
     flash_dir = Path(env["LOCUST_VIRTUAL_DIR"]) / "flash"
     with _virtual(env) as device:
         with serial.Serial(device, timeout=0.2) as port:
-            port.write(P.encode({"id": 7, "cmd": "ping"}))
+            port.write(protocol.encode({"id": 7, "cmd": "ping"}))
             seen = b""
             deadline = time.monotonic() + 10
             while not (b'"id":7' in seen and seen.endswith(b"\n")) and time.monotonic() < deadline:
@@ -238,7 +238,7 @@ def test_mpremote_sees_a_boards_line_ends_and_file_sizes_on_the_virtual_robot(en
         at = seen.find(b'"id":7')
         start, end = seen.rfind(b"$", 0, at), seen.find(b"\n", at)
         reply = seen[start:end + 1]
-        assert P.decode(reply[:-1])["id"] == 7 and reply[-2:-1] != b"\r", seen
+        assert protocol.decode(reply[:-1])["id"] == 7 and reply[-2:-1] != b"\r", seen
 
         out = subprocess.run([MPREMOTE, "connect", device, "exec", "print(1); print(2)"], capture_output=True,
                              timeout=30)
@@ -310,11 +310,11 @@ def test_ctrl_c_stops_the_idle_loop_not_a_hop_and_ctrl_d_resumes(env):
         done = None
         while done is None:
             ev = link.events.get(timeout=5)
-            if ev.get("ev") == P.EV_DONE and ev.get("hop") == hop["id"]:
+            if ev.get("ev") == protocol.EV_DONE and ev.get("hop") == hop["id"]:
                 done = ev
         link.stop_heartbeat()
-        assert done["status"] == P.HOP_COMPLETE and done["phases"] == 4
-        assert P.E_FRAME in [m.get("error") for m in link.unsolicited]
+        assert done["status"] == protocol.HOP_COMPLETE and done["phases"] == 4
+        assert protocol.E_FRAME in [m.get("error") for m in link.unsolicited]
 
         assert link.call("pose", left_deg=10, right_deg=10)["ok"]
         t_ctrl_c = vr.now_s()

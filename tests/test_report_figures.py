@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from locust.params import leg_set, preset
-from locust.report import figures as F
+from locust.report import figures
 from locust.report.checks import Notice, collapsed
 from locust.report.landscape import Landscape
 from locust.report.synthetic import simulated_nose, write_synthetic_trial
@@ -52,7 +52,7 @@ def report(tmp_path_factory):
     run_sweep(seed, [Axis("scale", 0.0, 0.01, 2)], CYCLES, root / "sweep", jobs=1, plots=False)
     captured = Captured()
     mp = pytest.MonkeyPatch()
-    mp.setattr(F, "png_bytes", captured)
+    mp.setattr(figures, "png_bytes", captured)
     try:
         trials = [a for t in ("small-1", "small-2", "medium-1") for a in ("--measured", root / "hops" / t)]
         res = invoke(["report", *trials, "--preset", "seed", "--sweep", root / "sweep", "--out", root / "out"])
@@ -125,14 +125,14 @@ def test_the_landscape_caption_names_only_what_is_drawn(report, monkeypatch):
     caption = re.search(r'<figure id="fig-landscape">.*?<figcaption>(.*?)</figcaption>', report["html"], re.S)
     assert caption and "every design valid" in caption.group(1) and "cross" not in caption.group(1)
     captured = Captured()
-    monkeypatch.setattr(F, "png_bytes", captured)
+    monkeypatch.setattr(figures, "png_bytes", captured)
     for valid, crosses in (([True, True, True], 0), ([True, False, False], 2)):
         land = _landscape(valid)
-        F.landscape_figure(land, [], {})
+        figures.landscape_figure(land, [], {})
         drawn = [line for line in captured.figures[-1].axes[0].lines if line.get_marker() == "x"]
         assert sum(len(line.get_xdata()) for line in drawn) == crosses
         assert all(np.all(line.get_ydata() == 0) for line in drawn)
-        text = F.landscape_caption(land, [])
+        text = figures.landscape_caption(land, [])
         assert ("2 invalid designs, failed audit: red crosses at zero" in text) == bool(crosses)
         assert ("cross" in text) == bool(crosses)
         assert "open circle" not in text and "square" not in text      # no design was predicted or measured

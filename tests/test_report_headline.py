@@ -149,14 +149,14 @@ def test_the_jump_bars_say_a_run_went_over(tmp_path):
     resting height, 87 mm on Small, stood before) and writes that it went over instead."""
     import locust
     from locust.plotting import pyplot
-    from locust.report import figures as F
+    from locust.report import figures
 
     robot = preset("small")
     write_synthetic_trial(tmp_path / "small-1", robot, CYCLES, fps=60.0, noise_m=0.0, lost_frames=0)
     res = locust.make_report(robot, {"over": [tmp_path / "small-1"]}, out=tmp_path / "out")
     (c,) = res.comparisons
     fig, ax = pyplot().subplots()
-    F.draw_bars(ax, [c], "jump")
+    figures.draw_bars(ax, [c], "jump")
     assert [p.get_height() for p in ax.patches] == [0.0, 0.0]
     texts = [t.get_text() for t in ax.texts]
     assert texts == ["measured: goes over at hop 1, no jump", "predicted: goes over at hop 1, no jump"]

@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from locust import params as P
+from locust import params
 from locust.sim import servo as SV
 from locust.sim.model import build, contact_solref
 from locust.sim.run import run
@@ -15,15 +15,15 @@ from locust.sim.run import run
 
 def test_every_as_built_value_names_a_measurement_and_none_a_hop_fit():
     for name in ("small", "medium", "large"):
-        robot = P.preset(name)
-        for key in P.AS_BUILT:
+        robot = params.preset(name)
+        for key in params.AS_BUILT:
             source = robot.source_of(key).source
             # a bench recording's fit (fit:<recording>) is a measurement; a hop fit is not
             assert source.split(":")[0] in {"photo", "cut_file", "datasheet", "data", "estimate", "preset",
                                             "fit"}, key
-        assert not [k for k in P.all_keys() if "hop" in robot.source_of(k).source], name
+        assert not [k for k in params.all_keys() if "hop" in robot.source_of(k).source], name
     # the leg sets' lengths are the cut file's plus the notebook's added centimetres
-    assert P.preset("large").link_lengths_m() == pytest.approx((0.06, 0.06, 0.04, 0.08), abs=1e-12)
+    assert params.preset("large").link_lengths_m() == pytest.approx((0.06, 0.06, 0.04, 0.08), abs=1e-12)
 
 
 # what a photo of the robot from above can show: lengths in the plate's plane
@@ -57,7 +57,7 @@ def test_params_json_has_no_photo_source_a_photo_cannot_show():
 def test_the_supply_scales_the_servo_as_a_dc_motor():
     """4.2 V through 0.5 ohm to two servos of 10 ohm: stall torque 0.15 * 4.2/5 * 10/11, no-load
     speed 10.2 * 4.2/5 (no current at no load, no sag), the holding gain with the torque."""
-    robot = P.preset("medium").with_values({"power.supply_voltage_v": 4.2, "power.source_resistance_ohm": 0.5})
+    robot = params.preset("medium").with_values({"power.supply_voltage_v": 4.2, "power.source_resistance_ohm": 0.5})
     s = SV.at_supply(robot.servo, robot.power)
     torque = 4.2 / 5.0 * 10.0 / 11.0
     stall, noload, kp = robot.servo.stall_torque_nm, robot.servo.noload_speed_rad_per_s, robot.servo.kp_nm_per_rad
@@ -75,24 +75,24 @@ def test_the_supply_scales_the_servo_as_a_dc_motor():
     hinge = robot.compliance.hinge_damping_nms_per_rad
     assert model.dof_damping[dof] == pytest.approx(hinge + back_emf, rel=1e-12)
     # on the voltage it was identified at, with no source resistance, the servo is unchanged
-    bare = P.preset("medium").with_values({"power.source_resistance_ohm": 0.0})
+    bare = params.preset("medium").with_values({"power.source_resistance_ohm": 0.0})
     assert SV.at_supply(bare.servo, bare.power) is bare.servo
 
 
 @pytest.mark.parametrize("restitution", [0.0, 0.2, 0.5, 0.9])
 def test_contact_softness_gives_the_drop_tests_restitution(restitution):
-    contact = P.Contact(timeconst_s=0.01, restitution=restitution)
+    contact = params.Contact(timeconst_s=0.01, restitution=restitution)
     timeconst, zeta = contact_solref(contact)
     assert timeconst == 0.01
     bounce = 0.0 if zeta >= 1.0 else math.exp(-zeta * math.pi / math.sqrt(1.0 - zeta**2))
     assert bounce == pytest.approx(restitution, abs=1e-12)
     # restitution 0 is MuJoCo's default contact (critically damped)
-    assert contact_solref(P.Contact()) == [0.02, 1.0]
+    assert contact_solref(params.Contact()) == [0.02, 1.0]
 
 
 @pytest.fixture(scope="module")
 def leg_sets():
-    return {name: run(P.preset(name), cycles=6) for name in ("small", "medium", "large")}
+    return {name: run(params.preset(name), cycles=6) for name in ("small", "medium", "large")}
 
 
 def test_as_built_leg_sets_rear_onto_their_legs_and_stay(leg_sets):
@@ -118,7 +118,7 @@ def test_large_falls_back_each_hop_one_sigma_away():
     Large with its crank at -90 deg at rest instead of -100 (the estimate's one standard
     deviation, 10 deg) pitches its nose up 9-12 cm and falls back every hop, moving 7.4-8.2 mm
     toward its nose each time (docs/servo.md has the table)."""
-    r = run(P.preset("large").with_values({"geometry.crank_start_deg": -90.0}), cycles=6)
+    r = run(params.preset("large").with_values({"geometry.crank_start_deg": -90.0}), cycles=6)
     assert r.valid, r.reasons
     assert all(0.007 < h.distance_m < 0.0085 for h in r.hops), [h.distance_m for h in r.hops]
     assert all(0.09 < h.nose_apex_m < 0.12 for h in r.hops), [h.nose_apex_m for h in r.hops]

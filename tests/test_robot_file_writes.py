@@ -114,13 +114,13 @@ def test_calibrate_write_after_a_robot_file_with_escapes_reads_back(tmp_path):
 
 
 def test_a_write_that_does_not_read_back_keeps_the_old_file(tmp_path, monkeypatch):
-    import locust.io.robot_toml as P
+    import locust.io.robot_toml as robot_toml
 
     path = tmp_path / "r.toml"
     save_robot(preset("seed"), path)
     before = path.read_bytes()
-    monkeypatch.setattr(P, "to_toml", lambda robot, template=None: 'name = "x\n"\n')   # not TOML
-    with pytest.raises(P.ParamsError, match="does not read back"):
+    monkeypatch.setattr(robot_toml, "to_toml", lambda robot, template=None: 'name = "x\n"\n')   # not TOML
+    with pytest.raises(robot_toml.ParamsError, match="does not read back"):
         save_robot(preset("small"), path)
     assert path.read_bytes() == before
     assert [p.name for p in tmp_path.iterdir()] == ["r.toml"]   # no temporary left

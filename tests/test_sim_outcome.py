@@ -9,7 +9,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from locust import params as P
+from locust import params
 from locust.io import robot_toml
 from locust.sim import outcome as O
 from locust.sim.run import run
@@ -51,7 +51,7 @@ KNOWN = [
 
 @pytest.mark.parametrize("preset, values, expected, nose_cm", KNOWN)
 def test_simulated_runs_of_known_regime(preset, values, expected, nose_cm):
-    r = run(P.preset(preset).with_values(values), cycles=6)
+    r = run(params.preset(preset).with_values(values), cycles=6)
     assert r.valid, r.reasons
     assert O.classify(r.hops) == expected
     lo, hi = nose_cm
@@ -86,9 +86,9 @@ def only_uncertain(robot, uncertain: dict[str, float]):
     """``robot`` with every uncertainty removed but those given (key -> sd)."""
     from locust.sim.samples import uncertain_values
 
-    bare = robot.with_values({k: robot.get(k) for k in uncertain_values(robot)}, P.Provenance("test"))
+    bare = robot.with_values({k: robot.get(k) for k in uncertain_values(robot)}, params.Provenance("test"))
     for key, sd in uncertain.items():
-        bare = bare.with_values({key: bare.get(key)}, P.Provenance("estimate", uncertainty=sd))
+        bare = bare.with_values({key: bare.get(key)}, params.Provenance("estimate", uncertainty=sd))
     return bare
 
 
@@ -97,7 +97,8 @@ def test_sensitivity_names_the_value_that_decides_the_regime():
     goes over; the servo mass at -/+2 sd (8 and 10 g) does not change it."""
     from locust.sim.sensitivity import outcome_sensitivity
 
-    robot = only_uncertain(P.preset("medium"), {"geometry.crank_start_deg": 10.0, "geometry.servo_mass_kg": 0.0005})
+    robot = only_uncertain(params.preset("medium"),
+                           {"geometry.crank_start_deg": 10.0, "geometry.servo_mass_kg": 0.0005})
     sens = outcome_sensitivity(robot, cycles=2)
     assert sens.nominal == O.GOES_OVER
     crank, mass = sens.effects
@@ -119,7 +120,7 @@ def test_sim_json_and_samples_give_the_outcome_and_its_shares(tmp_path):
 
     from locust.commands import cli
 
-    robot = only_uncertain(P.preset("medium"), {"geometry.crank_start_deg": 10.0})
+    robot = only_uncertain(params.preset("medium"), {"geometry.crank_start_deg": 10.0})
     robot_toml.save_robot(robot, tmp_path / "r.toml")
     res = CliRunner().invoke(cli, ["sim", "--config", str(tmp_path / "r.toml"), "--cycles", "2", "--samples", "6",
                                    "--seed", "3", "--json"])
@@ -148,7 +149,7 @@ def test_the_report_shows_each_outcomes_share_of_the_draws():
     from locust.report.spread import spread
     from locust.sim.samples import sample
 
-    robot = only_uncertain(P.preset("medium"), {"geometry.crank_start_deg": 10.0})
+    robot = only_uncertain(params.preset("medium"), {"geometry.crank_start_deg": 10.0})
     sp = spread(robot, 2, "nose", 6, seed=3)
     ref = sample(robot, 6, cycles=2, seed=3)
     assert {k: v.n for k, v in sp.outcomes.items()} == {k: v.n for k, v in ref.outcomes.items()}
@@ -164,7 +165,7 @@ def test_the_api_shows_the_outcome_shares_as_the_command_does():
     the same split, shown in its table, and ``sensitivity=False`` leaves it out."""
     import locust
 
-    robot = only_uncertain(P.preset("medium"), {"geometry.crank_start_deg": 10.0})
+    robot = only_uncertain(params.preset("medium"), {"geometry.crank_start_deg": 10.0})
     r = locust.simulate(robot, cycles=2, samples=6, seed=3, keep_states=False, sensitivity=False)
     assert r.outcome == O.GOES_OVER and r.sensitivity is None
     over = r.spread.outcomes[O.GOES_OVER]

@@ -6,16 +6,16 @@ from __future__ import annotations
 import numpy as np
 
 from locust.params import preset
-from locust.sim import samples as S
+from locust.sim import samples
 from locust.sim.rollout import available_cores
 
 
 def test_draws_in_batches_with_progress_are_the_same_draws():
     robot = preset("small")
-    n = S.BATCH_PER_CORE * available_cores() + 3          # one full batch and a part
-    whole = S.sample(robot, n, cycles=1, seed=5)
+    n = samples.BATCH_PER_CORE * available_cores() + 3          # one full batch and a part
+    whole = samples.sample(robot, n, cycles=1, seed=5)
     calls: list[int] = []
-    batched = S.sample(robot, n, cycles=1, seed=5, progress=calls.append)
+    batched = samples.sample(robot, n, cycles=1, seed=5, progress=calls.append)
     assert sum(calls) == n and len(calls) >= 2
     for key in ("distance_m", "max_nose_height_m"):   # bit for bit, failed draws (nan) alike
         assert np.array_equal(getattr(batched, key), getattr(whole, key), equal_nan=True), key

@@ -8,7 +8,8 @@ The Python API (:mod:`locust.api`), for notebooks and scripts::
     r.video("hop.mp4", overwrite=True)
     locust.sweep_designs(locust.robot("seed"), vary={"scale": (0.0, 0.05, 30)}, cycles=3).to_dataframe()
 
-Functions (each with a numpydoc docstring: ``help(locust.simulate)``):
+Functions (each with a numpydoc docstring: ``help(locust.simulate)``), named once in
+:data:`locust.api.EXPORTS`:
 
 - ``robot(preset_or_path, **values)``: a :class:`Robot` (presets seed, small, medium, large).
 - ``simulate(robot, cycles)``: a ``SimResult`` (``.trace()``, ``.video()``, ``.plot()``).
@@ -27,24 +28,16 @@ Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
 
 import importlib as _importlib
 
+from .api import EXPORTS as _EXPORTS
 from .version import __version__
 
-__all__ = ["robot", "simulate", "SimResult", "sweep_designs", "SweepResults", "track_markers", "read_tracks", "Tracks",
-           "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "calibrate_hops", "Fit",
-           "bundled_recording", "make_report", "optimize", "make_cut_files", "Robot", "LocustError", "__version__"]
+# the API's names (locust.api.EXPORTS, the one list), and the version
+__all__ = [*_EXPORTS, "__version__"]
 
 
 def __getattr__(name: str):
     """The API's names, imported on first use (``import locust`` stays quick for the command line)."""
-    if name == "Robot":
-        from .params import Robot
-
-        return Robot
-    if name == "LocustError":
-        from .errors import LocustError
-
-        return LocustError
-    if name in __all__:
+    if name in _EXPORTS:
         return getattr(_importlib.import_module("locust.api"), name)
     raise AttributeError(f"module 'locust' has no attribute {name!r}")
 

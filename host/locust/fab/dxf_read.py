@@ -8,13 +8,13 @@ returned open, with the entities it came from, so the caller can say where the g
 
 Units come from ``$INSUNITS`` (``units`` overrides them); a unitless drawing is read as
 millimetres and says so. Geometry leaves this module in millimetres and nowhere else
-is a unit converted.
+is a unit converted. What a drawing may hold (block copies, spline points, arc chords, finite
+numbers) is checked by :mod:`.dxf_limits` before it is expanded or flattened.
 """
 
 from __future__ import annotations
 
 import contextlib
-import math
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +22,15 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FabError
+from .dxf_limits import (
+    MAX_CURVE_VERTICES,
+    MAX_INSERT_DEPTH,
+    check_entity,
+    check_expansion,
+    check_spline,
+    entity_label,
+    reason,
+)
 
 # $INSUNITS code -> (name, millimetres per unit). Exact factors: ezdxf's own table
 # carries float noise (25.4000000001 mm per inch).
@@ -35,24 +44,6 @@ UNIT_BY_NAME: dict[str, tuple[int, float]] = {name: (code, mm) for code, (name, 
 
 CURVES = {"LINE", "ARC", "LWPOLYLINE", "POLYLINE", "CIRCLE", "ELLIPSE", "SPLINE"}
 
-# Block references are expanded this many levels deep, into at most this many entities: an
-# outline for a laser is thousands of curves (50,000 circles read in about 9 s), and nested
-# blocks multiply (8 levels of 10 references each are 10^8 copies, hours of expansion), so
-# they are counted before any is expanded.
-MAX_INSERT_DEPTH = 8
-MAX_EXPANDED_ENTITIES = 50_000
-# A SPLINE of more control or fit points than this is refused before it is flattened, and no
-# curve is flattened into more vertices than MAX_CURVE_VERTICES: a laser outline's spline has
-# tens to hundreds of points (500 flatten into about 2,000 vertices), while one of 200,000
-# control points grew memory by 300 MB/s for minutes.
-MAX_SPLINE_POINTS = 20_000
-MAX_CURVE_VERTICES = 200_000
-
-
-# An arc is flattened into chords no further than the sagitta from it: a circle of 10 m at
-# 1 um is 7,000 chords. An arc needing more (a radius of 10^12 mm, a bulge of 1e300) is no
-# outline for a laser and would take hours, so it is refused by its count before flattening.
-MAX_ARC_SEGMENTS = 100_000
 # The gap two ends may leave and still be joined: above 0 (0 joins nothing, below 0 is no
 # distance) and at most 10 mm (a laminate part is millimetres to centimetres).
 GAP_TOL_MM = (0.0, 10.0)
@@ -177,15 +168,10 @@ def open_document(path: str | Path, *, recover: bool = False):
         raise
     except Exception as exc:  # ezdxf raises many types on garbage (structure, decode, value)
         raise FabError(
-            f"{path}: not a readable DXF ({type(exc).__name__}: {_short(exc)})",
+            f"{path}: not a readable DXF ({type(exc).__name__}: {reason(exc)})",
             "export the drawing again; if it is truncated, --recover reads what is left",
         ) from None
     return doc, fixed
-
-
-def _short(exc: Exception, n: int = 160) -> str:
-    text = " ".join(str(exc).split()).removeprefix(f"{type(exc).__name__}: ")
-    return text if len(text) <= n else text[: n - 1] + "…"
 
 
 def drawing_units(doc, override: str | None) -> tuple[str, float, str]:
@@ -223,75 +209,6 @@ def drawing_units(doc, override: str | None) -> tuple[str, float, str]:
     return "mm", 1.0, "assumed (no $INSUNITS)"
 
 
-def _copies(entity) -> int:
-    """How many times an INSERT places its block (a MINSERT is rows x columns)."""
-    rows = max(int(entity.dxf.get("row_count", 1) or 1), 1)
-    cols = max(int(entity.dxf.get("column_count", 1) or 1), 1)
-    return rows * cols
-
-
-def expanded_count(doc, entities, depth: int = 0, memo: dict | None = None) -> int:
-    """How many entities ``entities`` become once their block references are expanded (as
-    ``_entities_by_layer`` expands them), counted from the block definitions without expanding.
-
-    Parameters
-    ----------
-    doc : ezdxf document
-        The drawing (its block definitions).
-    entities : iterable of DXF entities
-        The entities, e.g. the model space.
-    depth : int, default 0
-        The nesting level of ``entities``.
-    memo : dict, optional
-        Counts of blocks already counted, by (name, depth).
-
-    Returns
-    -------
-    int
-        The count; it stops early once over ``MAX_EXPANDED_ENTITIES``.
-    """
-    memo = {} if memo is None else memo
-    total = 0
-    for entity in entities:
-        total += 1
-        if entity.dxftype() != "INSERT" or depth >= MAX_INSERT_DEPTH:
-            continue
-        name = entity.dxf.get("name")
-        key = (name, depth + 1)
-        if key not in memo:
-            block = doc.blocks.get(name) if name else None
-            memo[key] = 0 if block is None else expanded_count(doc, block, depth + 1, memo)
-        total += _copies(entity) * memo[key]
-        if total > MAX_EXPANDED_ENTITIES:
-            return total
-    return total
-
-
-def check_expansion(doc, path) -> None:
-    """Refuse a drawing whose block references expand into more than ``MAX_EXPANDED_ENTITIES``.
-
-    Parameters
-    ----------
-    doc : ezdxf document
-        The drawing.
-    path : str or Path
-        Its file, for the message.
-
-    Raises
-    ------
-    FabError
-        Too many entities once expanded.
-    """
-    n = expanded_count(doc, doc.modelspace())
-    if n > MAX_EXPANDED_ENTITIES:
-        raise FabError(
-            f"{path}: its block references expand into more than {MAX_EXPANDED_ENTITIES:,} entities "
-            f"(blocks nested in blocks multiply; counted before expanding)",
-            "explode the blocks in the CAD program and keep only the outline for the laser, "
-            "or remove the repeated blocks",
-        )
-
-
 def _entities_by_layer(msp) -> tuple[dict[str, list], Counter]:
     """Model-space curves grouped by layer; block references are expanded in place."""
     by_layer: dict[str, list] = defaultdict(list)
@@ -307,7 +224,7 @@ def _entities_by_layer(msp) -> tuple[dict[str, list], Counter]:
                 visit(sub, layer, depth + 1)
         elif kind in CURVES:
             if kind == "SPLINE":
-                _check_spline(entity, layer)
+                check_spline(entity, layer)
             by_layer[layer].append(entity)
         else:
             skipped[kind] += 1
@@ -315,19 +232,6 @@ def _entities_by_layer(msp) -> tuple[dict[str, list], Counter]:
     for entity in msp:
         visit(entity, None, 0)
     return by_layer, skipped
-
-
-def _label(entity) -> str:
-    handle = entity.dxf.get("handle")
-    return f"{entity.dxftype()} #{handle}" if handle else entity.dxftype()
-
-
-def _check_spline(entity, layer: str) -> None:
-    n = max(entity.control_point_count(), entity.fit_point_count())
-    if n > MAX_SPLINE_POINTS:
-        raise FabError(f"layer {layer!r}: {_label(entity)} has {n:,} points, over the {MAX_SPLINE_POINTS:,} a cut "
-                       "outline's spline may have (refused before flattening it)",
-                       "simplify the curve in the CAD program (fewer control points), or draw it as a polyline")
 
 
 def _flat(path, sagitta: float, layer: str, labels: tuple[str, ...]) -> np.ndarray:
@@ -377,92 +281,6 @@ def _anchor(entity) -> np.ndarray | None:
     return None
 
 
-def _numbers(entity) -> list[float]:
-    """Every coordinate, radius, bulge, ratio and knot ``entity`` is drawn from, as stored."""
-    dxf, kind = entity.dxf, entity.dxftype()
-    out: list[float] = []
-    for attr in ("start", "end", "center", "major_axis", "radius", "ratio", "start_angle", "end_angle",
-                 "start_param", "end_param"):
-        value = dxf.get(attr) if dxf.is_supported(attr) else None
-        if value is not None:
-            out += list(value) if hasattr(value, "__iter__") else [value]
-    if kind == "LWPOLYLINE":
-        out += [v for point in entity.get_points("xyb") for v in point]
-    elif kind == "POLYLINE":
-        for v in entity.vertices:
-            out += [*v.dxf.location, v.dxf.get("bulge", 0.0)]
-    elif kind == "SPLINE":
-        out += [c for p in (*entity.control_points, *entity.fit_points) for c in p] + list(entity.knots)
-    return [float(v) for v in out]
-
-
-def _arc_segments(radius: float, angle_rad: float, sagitta: float) -> float:
-    """Chords an arc of ``radius`` through ``angle_rad`` takes to stay within ``sagitta``."""
-    if not radius > sagitta:
-        return 1.0
-    x = sagitta / radius
-    step = 2.0 * (math.acos(1.0 - x) if x > 1e-8 else math.sqrt(2.0 * x))   # acos(1 - x) ~ sqrt(2x)
-    return abs(angle_rad) / step if step > 0 else math.inf
-
-
-def _bulge_segments(entity, sagitta: float) -> float:
-    """The most chords any bulged segment of a polyline takes."""
-    if entity.dxftype() == "LWPOLYLINE":
-        pts = [(x, y, b) for x, y, b in entity.get_points("xyb")]
-    else:
-        pts = [(v.dxf.location[0], v.dxf.location[1], v.dxf.get("bulge", 0.0)) for v in entity.vertices]
-    most = 0.0
-    for (x0, y0, b), (x1, y1, _) in zip(pts, pts[1:] + pts[:1]):
-        chord = math.hypot(x1 - x0, y1 - y0)
-        if b and chord > 0:
-            angle = 4.0 * math.atan(abs(b))
-            radius = chord / (2.0 * math.sin(angle / 2.0)) if math.sin(angle / 2.0) > 0 else math.inf
-            most = max(most, _arc_segments(radius, angle, sagitta) if math.isfinite(radius) else math.inf)
-    return most
-
-
-def check_entity(entity, layer: str, sagitta: float) -> None:
-    """Refuse an entity that holds a number that is not finite, or an arc that would flatten into
-    more than :data:`MAX_ARC_SEGMENTS` chords.
-
-    Parameters
-    ----------
-    entity : DXF entity
-        The curve.
-    layer : str
-        Its layer, for the message.
-    sagitta : float
-        The largest distance of a chord from its arc [drawing units].
-
-    Raises
-    ------
-    FabError
-        The entity cannot be read, holds NaN or inf, or flattens into too many chords.
-    """
-    try:
-        numbers = _numbers(entity)
-    except (TypeError, ValueError, AttributeError) as exc:
-        raise FabError(f"layer {layer!r}: {_label(entity)} cannot be read ({_short(exc)})",
-                       "fix the drawing in the CAD program, or redraw that entity") from None
-    if not all(math.isfinite(v) for v in numbers):
-        raise FabError(f"layer {layer!r}: {_label(entity)} has a coordinate, radius or bulge that is not a finite "
-                       "number (NaN or inf)", "fix the drawing in the CAD program, or redraw that entity")
-    kind = entity.dxftype()
-    if kind in ("ARC", "CIRCLE"):
-        segments = _arc_segments(abs(entity.dxf.radius), 2 * math.pi, sagitta)
-    elif kind == "ELLIPSE":
-        axis = entity.dxf.major_axis
-        segments = _arc_segments(math.hypot(axis[0], axis[1]), 2 * math.pi, sagitta)
-    elif kind in ("LWPOLYLINE", "POLYLINE"):
-        segments = _bulge_segments(entity, sagitta)
-    else:
-        segments = 0.0
-    if segments > MAX_ARC_SEGMENTS:
-        raise FabError(f"layer {layer!r}: {_label(entity)} is an arc that flattens into {segments:.3g} chords, over "
-                       f"the limit of {MAX_ARC_SEGMENTS:,} (a radius or bulge far beyond a laminate part's)",
-                       "check the drawing's units and that arc's radius (or the polyline's bulge), and redraw it")
-
-
 def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm: float,
                    sagitta_mm: float) -> list[Contour]:
     """The loops and open paths of one layer's curves: closed entities as they stand, open ones
@@ -491,64 +309,93 @@ def layer_contours(entities: list, layer: str, *, mm_per_unit: float, gap_tol_mm
     FabError
         An entity that cannot be read, is not finite, or is too large to flatten.
     """
-    from ezdxf import edgeminer as em
+    gap, sag = gap_tol_mm / mm_per_unit, sagitta_mm / mm_per_unit
+    pieces, open_entities = _closed_pieces(entities, layer, sag)
+    edges, points = _open_edges(open_entities, gap)
+    pieces += points + _chains(edges, layer, gap, sag)
+    contours = (_contour(layer, piece, gap, mm_per_unit) for piece in pieces)
+    return [c for c in contours if c is not None]
+
+
+# a piece of a layer before it is a Contour: vertices [drawing units], closed, where it came from
+_Piece = tuple[np.ndarray, bool, tuple[str, ...]]
+
+
+def _closed_pieces(entities: list, layer: str, sag: float) -> tuple[list[_Piece], list]:
+    """Each closed entity flattened, and each degenerate one (zero radius, no vertices) as its
+    point, in the layer's order; the open entities apart, for the edge miner."""
     from ezdxf import edgesmith as es
     from ezdxf import path as ezpath
 
-    gap = gap_tol_mm / mm_per_unit
-    sag = sagitta_mm / mm_per_unit
-    out: list[Contour] = []
-
-    def emit(pts: np.ndarray, closed: bool, labels: tuple[str, ...]) -> None:
-        if closed and len(pts) > 2 and np.hypot(*(pts[0] - pts[-1])) <= gap:
-            pts = pts[:-1]
-        closed = closed and len(pts) >= 3     # a "loop" of two points is a line there and back
-        if len(pts) >= 2:
-            out.append(Contour(layer, pts * mm_per_unit, closed, labels))
-        elif len(pts):                    # collapsed to a point: kept so the caller can name it
-            out.append(Contour(layer, pts[:1] * mm_per_unit, False, labels))
-
-    open_pieces = []
+    pieces, open_entities = [], []
     for entity in entities:
         check_entity(entity, layer, sag)
+        labels = (entity_label(entity),)
         try:
             closed = es.is_closed_entity(entity)
         except MemoryError:
-            raise FabError(f"layer {layer!r}: {_label(entity)} is too large to read",
+            raise FabError(f"layer {layer!r}: {labels[0]} is too large to read",
                            "simplify it in the CAD program") from None
         except Exception:  # degenerate entity (zero radius, no vertices): a point the caller names
             point = _anchor(entity)
             if point is not None:
-                emit(point, False, (_label(entity),))
+                pieces.append((point, False, labels))
             continue
         if closed:
-            emit(_flat(ezpath.make_path(entity), sag, layer, (_label(entity),)), True, (_label(entity),))
+            pieces.append((_flat(ezpath.make_path(entity), sag, layer, labels), True, labels))
         else:
-            open_pieces.append(entity)
+            open_entities.append(entity)
+    return pieces, open_entities
 
-    edges = []
-    seen: set = set()
-    for ent in open_pieces:
-        edge = es.make_edge_2d(ent, gap_tol=gap)
-        if edge is not None:
-            # an entity drawn twice over itself (same ends, same middle) is one cut: chaining every
-            # copy multiplies the chains the edge miner tries (10,000 stacked lines ran for minutes)
-            key = _trace_key(ent, edge, gap)
-            if key not in seen:
-                seen.add(key)
-                edges.append(edge)
-        else:                             # shorter than the gap tolerance (or of zero radius)
-            point = _anchor(ent)
+
+def _open_edges(open_entities: list, gap: float) -> tuple[list, list[_Piece]]:
+    """The open entities as the edge miner's edges, each trace once, and those shorter than the
+    gap tolerance (or of zero radius) as their points."""
+    from ezdxf import edgesmith as es
+
+    edges, points, seen = [], [], set()
+    for entity in open_entities:
+        edge = es.make_edge_2d(entity, gap_tol=gap)
+        if edge is None:                  # shorter than the gap tolerance (or of zero radius)
+            point = _anchor(entity)
             if point is not None:
-                emit(point, False, (_label(ent),))
+                points.append((point, False, (entity_label(entity),)))
+            continue
+        # an entity drawn twice over itself (same ends, same middle) is one cut: chaining every
+        # copy multiplies the chains the edge miner tries (10,000 stacked lines ran for minutes)
+        key = _trace_key(entity, edge, gap)
+        if key not in seen:
+            seen.add(key)
+            edges.append(edge)
+    return edges, points
+
+
+def _chains(edges: list, layer: str, gap: float, sag: float) -> list[_Piece]:
+    """The edges chained where their ends meet within ``gap``, each chain flattened."""
+    from ezdxf import edgeminer as em
+    from ezdxf import edgesmith as es
+
     if not edges:
-        return out
-    deposit = em.Deposit(edges, gap_tol=gap)
-    for chain in em.find_all_simple_chains(deposit):
-        labels = tuple(_label(e.payload) for e in chain)
-        pts = _flat(es.path2d_from_chain(chain), sag, layer, labels)
-        emit(pts, em.is_loop(chain, gap_tol=gap), labels)
-    return out
+        return []
+    chains = []
+    for chain in em.find_all_simple_chains(em.Deposit(edges, gap_tol=gap)):
+        labels = tuple(entity_label(e.payload) for e in chain)
+        chains.append((_flat(es.path2d_from_chain(chain), sag, layer, labels), em.is_loop(chain, gap_tol=gap), labels))
+    return chains
+
+
+def _contour(layer: str, piece: _Piece, gap: float, mm_per_unit: float) -> Contour | None:
+    """A piece in millimetres: a loop without its closing repeat; a "loop" of two points is a
+    line there and back, open; a piece collapsed to a point is kept for the caller to name."""
+    pts, closed, labels = piece
+    if closed and len(pts) > 2 and np.hypot(*(pts[0] - pts[-1])) <= gap:
+        pts = pts[:-1]
+    closed = closed and len(pts) >= 3
+    if len(pts) >= 2:
+        return Contour(layer, pts * mm_per_unit, closed, labels)
+    if len(pts):
+        return Contour(layer, pts[:1] * mm_per_unit, False, labels)
+    return None
 
 
 def read_drawing(path: str | Path, *, units: str | None = None, gap_tol_mm: float = 0.01,

@@ -28,8 +28,6 @@ from ..errors import FabError
 from ..fileio import make_folder
 from .laminate import Laminate, compensate_cutout, compensate_part, union
 
-DXF_NAMES = ("combined_cut_pattern", "first_pass_cuts", "final_perimeter")
-
 # AutoCAD colour index per DXF layer
 COLOURS = {"rigid": 1, "adhesive": 30, "flexible": 5, "outline": 7, "plate": 7, "cutouts": 1,
            "hinges": 1, "holes": 5, "slits": 6, "alignment": 3, "release": 4}

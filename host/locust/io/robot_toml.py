@@ -18,7 +18,7 @@ import dataclasses
 import math
 import stat
 import tomllib
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
@@ -161,9 +161,22 @@ def load_robot(path: str | Path) -> Robot:
         or out of its limits.
     """
     path = Path(path)
+    doc = _document(path)
+    robot = _top(path, doc)
+    for key, entry in _entries(path, doc):
+        value, prov = _value(path, key, entry)
+        try:
+            robot = robot.with_values({key: value}, prov)
+        except ParamsError as exc:
+            raise ParamsError(f"{path}: {exc.message}", exc.hint) from None
+    return robot
+
+
+def _document(path: Path) -> dict[str, Any]:
+    """The TOML document ``path`` holds; each way it cannot be read is a ParamsError."""
     try:
         _check_robot_file(path)
-        doc = tomllib.loads(path.read_bytes().decode("utf-8"))
+        return tomllib.loads(path.read_bytes().decode("utf-8"))
     except RecursionError:
         raise ParamsError(f"{path}: not a robot.toml: its tables or lists are nested too deep to read",
                           "a robot.toml has sections of key = value (or {value = ..., source = ...}) and no "
@@ -180,6 +193,10 @@ def load_robot(path: str | Path) -> Robot:
     except tomllib.TOMLDecodeError as exc:
         raise ParamsError(f"{path}: not valid TOML ({exc})",
                           "fix the file, or regenerate it with `locust params --write`") from None
+
+
+def _top(path: Path, doc: dict[str, Any]) -> Robot:
+    """The robot the keys above the sections make: the ``base`` preset, named, on its ``leg_set``."""
     base, name = doc.get("base", DEFAULT_PRESET), doc.get("name", path.stem)
     if not isinstance(base, str) or base not in PRESETS:
         raise ParamsError(f"{path}: base = {shown_value(base)} is not a preset", f"choose one of {', '.join(PRESETS)}")
@@ -190,7 +207,12 @@ def load_robot(path: str | Path) -> Robot:
     if not isinstance(legs, str) or legs not in LEG_SETS:
         raise ParamsError(f"{path}: leg_set = {shown_value(legs)} is not a leg set",
                           f"the leg set the robot's links carry: one of {', '.join(LEG_SETS)}")
-    robot = dataclasses.replace(robot, leg_set=legs)
+    return dataclasses.replace(robot, leg_set=legs)
+
+
+def _entries(path: Path, doc: dict[str, Any]) -> Iterator[tuple[str, Any]]:
+    """Each value's dotted key and its entry as written, in the file's order, the sections and
+    keys checked as they come."""
     for section, table in doc.items():
         if section in TOP_KEYS:
             continue
@@ -206,31 +228,33 @@ def load_robot(path: str | Path) -> Robot:
                 split_key(key)
             except ParamsError as exc:
                 raise ParamsError(f"{path}: {exc.message}", exc.hint) from None
-            if isinstance(entry, dict):
-                if "value" not in entry:
-                    raise ParamsError(f"{path}: {key} has no 'value'", "write it as {value = ..., source = \"...\"}")
-                for field in ("source", "date", "note"):
-                    if isinstance(entry.get(field), (dict, list)):
-                        raise ParamsError(f"{path}: {key} has {field} = {shown_value(entry[field])}, not a string",
-                                          f'write it in quotes: {field} = "..."')
-                prov = Provenance(
-                    source=str(entry.get("source", "default")),
-                    uncertainty=_uncertainty(path, key, entry.get("uncertainty")),
-                    date=None if entry.get("date") is None else str(entry["date"]),
-                    note=None if entry.get("note") is None else str(entry["note"]),
-                )
-                value = entry["value"]
-            else:
-                prov, value = Provenance(source=f"file:{path.name}"), entry
-            if isinstance(value, (dict, list)):
-                raise ParamsError(f"{path}: {key} = {shown_value(value)}, where a number belongs",
-                                  f"write one value: {key.split('.')[1]} = 0.05, or "
-                                  '{value = 0.05, source = "..."}')
-            try:
-                robot = robot.with_values({key: value}, prov)
-            except ParamsError as exc:
-                raise ParamsError(f"{path}: {exc.message}", exc.hint) from None
-    return robot
+            yield key, entry
+
+
+def _value(path: Path, key: str, entry: Any) -> tuple[Any, Provenance]:
+    """An entry's value and provenance: ``{value = ..., source = "..."}``, or a bare value
+    (its source the file)."""
+    if isinstance(entry, dict):
+        if "value" not in entry:
+            raise ParamsError(f"{path}: {key} has no 'value'", "write it as {value = ..., source = \"...\"}")
+        for field in ("source", "date", "note"):
+            if isinstance(entry.get(field), (dict, list)):
+                raise ParamsError(f"{path}: {key} has {field} = {shown_value(entry[field])}, not a string",
+                                  f'write it in quotes: {field} = "..."')
+        prov = Provenance(
+            source=str(entry.get("source", "default")),
+            uncertainty=_uncertainty(path, key, entry.get("uncertainty")),
+            date=None if entry.get("date") is None else str(entry["date"]),
+            note=None if entry.get("note") is None else str(entry["note"]),
+        )
+        value = entry["value"]
+    else:
+        prov, value = Provenance(source=f"file:{path.name}"), entry
+    if isinstance(value, (dict, list)):
+        raise ParamsError(f"{path}: {key} = {shown_value(value)}, where a number belongs",
+                          f"write one value: {key.split('.')[1]} = 0.05, or "
+                          '{value = 0.05, source = "..."}')
+    return value, prov
 
 
 def to_toml(robot: Robot, template: str | None = None) -> str:

@@ -21,7 +21,8 @@ from typing import Any
 
 from ..errors import ParamsError
 
-# Standard gravity, m/s^2: the world's, not the robot's, but every model and fit uses this one.
+# Standard gravity, m/s^2 (9.80665 by definition, 3rd CGPM 1901), to the three figures of MuJoCo's
+# default option.gravity: the world's, not the robot's, but every model and fit uses this one.
 GRAVITY_M_PER_S2 = 9.81
 
 
@@ -410,33 +411,44 @@ def fittable_keys() -> list[str]:
     return [key for key in real_keys() if key.partition(".")[0] in PHYSICAL_SECTIONS]
 
 
+def _as_bool(key: str, raw: Any) -> bool:
+    if isinstance(raw, bool):
+        return raw
+    text = str(raw).strip().lower()
+    if text in ("1", "true", "yes", "on"):
+        return True
+    if text in ("0", "false", "no", "off"):
+        return False
+    raise ValueError("not true/false")
+
+
+def _as_float(key: str, raw: Any) -> float:
+    value = float(raw)
+    if key in UNBOUNDED_KEYS and value == math.inf:
+        return value
+    if not math.isfinite(value):
+        raise ValueError("not finite")
+    return value
+
+
+def _as_int(key: str, raw: Any) -> int:
+    value = float(raw)
+    if not math.isfinite(value) or value != int(value):
+        raise ValueError("not a whole number")
+    return int(value)
+
+
+# a field's type -> how a value given for it (a number, or the text of --set) becomes one
+_CONVERT = {"bool": _as_bool, "float": _as_float, "int": _as_int}
+
+
 def _coerce(key: str, raw: Any) -> Any:
     ftype = value_type(key)
     try:
-        if ftype == "bool":
-            if isinstance(raw, bool):
-                return raw
-            text = str(raw).strip().lower()
-            if text in ("1", "true", "yes", "on"):
-                return True
-            if text in ("0", "false", "no", "off"):
-                return False
-            raise ValueError("not true/false")
         if isinstance(raw, bool) and ftype in ("float", "int"):
             raise ValueError("true/false is not a number")
-        if ftype == "float":
-            value = float(raw)
-            if key in UNBOUNDED_KEYS and value == math.inf:
-                return value
-            if not math.isfinite(value):
-                raise ValueError("not finite")
-            return value
-        if ftype == "int":
-            value = float(raw)
-            if not math.isfinite(value) or value != int(value):
-                raise ValueError("not a whole number")
-            return int(value)
-        return str(raw)
+        convert = _CONVERT.get(ftype)
+        return str(raw) if convert is None else convert(key, raw)
     except OverflowError:
         raise ParamsError(f"bad value {shown_value(raw)} for {key}: too large for a number", f"{key} takes a {ftype}") \
             from None

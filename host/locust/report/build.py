@@ -24,8 +24,7 @@ from ..tables import for_person
 from ..trials.configs import Configuration, configuration
 from ..trials.measured import Trial
 from ..version import __version__
-from . import figures as F
-from . import page as H
+from . import figures, page
 from .checks import VIRTUAL, Notice, collapsed, notices, recorded_on
 from .compare import Comparison, compare, timing_rows
 from .landscape import Landscape, read_landscape
@@ -236,7 +235,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     figs = _figures(comps, configs, land, spreads, befores)
     if front is not None:
         figs.insert(-1, study_figure(front, views is not None))
-    dash = F.dashboard(comps, land, configs)
+    dash = figures.dashboard(comps, land, configs)
 
     timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
     warnings = notices(comps) + sweep_notices(land)
@@ -312,37 +311,38 @@ def _run_configuration(base: Robot, name: str, trials: list[Trial], added_m: flo
 
 
 def _figures(comps: list[Comparison], configs: dict[str, Configuration], land: Landscape | None,
-             spreads: dict, befores: dict) -> list[H.Figure]:
+             spreads: dict, befores: dict) -> list[page.Figure]:
     """The page's figures with their captions: overlay, jump, hops, the sweep landscape (with
     a sweep) and the firmware timing."""
     labels = {name: cfg.label for name, cfg in configs.items()}
     names_text = ", ".join(labels.values())
     figs = [
-        H.Figure("overlay", f"Marker travel and height vs time: {names_text}",
-                 "The nose marker's forward travel from where it stood and its height above standing, in mm, every "
-                 "measured trial (solid) and the audited simulation (dashed), on the schedule's clock (t = 0 at the "
-                 "first push; grey lines: cycle starts); a run that went over onto its back says so in its "
-                 "height panel."
-                 + (" Grey band: mean ± 1 sd of the simulation at draws of the robot file's uncertain values."
-                    if spreads else "")
-                 + (" Dotted red: the simulation on the robot before the fit." if befores else ""),
-                 F.overlay_figure(comps, spreads, befores)),
-        H.Figure("jump", f"Jump height, measured against predicted: {names_text}",
-                 "Highest marker point above standing in a hop that came back down, in mm; measured bars show the "
-                 "mean over trials with ±1 sd error bars where repeated trials exist; hatched bars are the "
-                 "simulation's. A run that went over in its first hop has no jump: its place says so.",
-                 F.bars_figure(comps, "jump")),
-        H.Figure("hops", f"Each hop, measured against predicted: {names_text}",
-                 "Per-hop marker travel and marker apex, in mm, of every trial (dots) and the simulation (dashed); "
-                 "an apex only for a hop that came back down.",
-                 F.hops_figure(comps, spreads)),
+        page.Figure("overlay", f"Marker travel and height vs time: {names_text}",
+                    "The nose marker's forward travel from where it stood and its height above standing, in mm, every "
+                    "measured trial (solid) and the audited simulation (dashed), on the schedule's clock (t = 0 at the "
+                    "first push; grey lines: cycle starts); a run that went over onto its back says so in its "
+                    "height panel."
+                    + (" Grey band: mean ± 1 sd of the simulation at draws of the robot file's uncertain values."
+                       if spreads else "")
+                    + (" Dotted red: the simulation on the robot before the fit." if befores else ""),
+                    figures.overlay_figure(comps, spreads, befores)),
+        page.Figure("jump", f"Jump height, measured against predicted: {names_text}",
+                    "Highest marker point above standing in a hop that came back down, in mm; measured bars show the "
+                    "mean over trials with ±1 sd error bars where repeated trials exist; hatched bars are the "
+                    "simulation's. A run that went over in its first hop has no jump: its place says so.",
+                    figures.bars_figure(comps, "jump")),
+        page.Figure("hops", f"Each hop, measured against predicted: {names_text}",
+                    "Per-hop marker travel and marker apex, in mm, of every trial (dots) and the simulation (dashed); "
+                    "an apex only for a hop that came back down.",
+                    figures.hops_figure(comps, spreads)),
     ]
     if land is not None:
-        figs.append(H.Figure("landscape", f"Sweep landscape with {names_text} marked",
-                             F.landscape_caption(land, comps), F.landscape_figure(land, comps, configs)))
-    figs.append(H.Figure("timing", f"Firmware timing of the runs: {names_text}",
-                         "Start of every phase as the firmware measured it, minus the commanded start.",
-                         F.timing_figure(comps)))
+        figs.append(page.Figure("landscape", f"Sweep landscape with {names_text} marked",
+                                figures.landscape_caption(land, comps),
+                                figures.landscape_figure(land, comps, configs)))
+    figs.append(page.Figure("timing", f"Firmware timing of the runs: {names_text}",
+                            "Start of every phase as the firmware measured it, minus the commanded start.",
+                            figures.timing_figure(comps)))
     return figs
 
 
@@ -383,7 +383,7 @@ def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker:
     if land is not None and land.base != base.name:
         items.append(f"The sweep's base robot is {land.base!r}, the report's is {base.name!r}: the landscape "
                      "may not be the same robot.")
-    return "<ul class=\"note\">" + "".join(f"<li>{H.esc(i)}</li>" for i in items) + "</ul>"
+    return "<ul class=\"note\">" + "".join(f"<li>{page.esc(i)}</li>" for i in items) + "</ul>"
 
 
 def sweep_notices(land: Landscape | None) -> list[Notice]:
@@ -462,30 +462,30 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
     for c in comps:
         for t in c.all_trials:
             where, why = recorded_on(t.record)
-            inputs.append("<tr>" + H.td(labels[c.config], left=True) + H.td(t.label, left=True)
-                          + H.td(str(t.track.path) if t.track else "—", left=True)
-                          + H.td(str(t.run_path) if t.run_path else "—", left=True)
-                          + H.td(t.config_from, c.config, f"config_from:{t.label}", left=True)
-                          + H.td(where or "—", c.config, f"recorded_on:{t.label}", left=True)
-                          + H.td(_track_reading(t), left=True) + "</tr>")
-    sections = [("Warnings", H.warnings_list(collapsed(warnings)))] if warnings else []
+            inputs.append("<tr>" + page.td(labels[c.config], left=True) + page.td(t.label, left=True)
+                          + page.td(str(t.track.path) if t.track else "—", left=True)
+                          + page.td(str(t.run_path) if t.run_path else "—", left=True)
+                          + page.td(t.config_from, c.config, f"config_from:{t.label}", left=True)
+                          + page.td(where or "—", c.config, f"recorded_on:{t.label}", left=True)
+                          + page.td(_track_reading(t), left=True) + "</tr>")
+    sections = [("Warnings", page.warnings_list(collapsed(warnings)))] if warnings else []
     sections += [
-        ("Summary", H.summary_table(comps, labels, added)),
-        *([("Outcome over the draws", H.outcome_table(spreads, labels))] if spreads else []),
-        ("Figures", "".join(H.figure_html(f) for f in figs)),
-        *([("Side by side", H.videos_html([(j.name, _video_caption(j, labels)) for j in side_by_side.jobs],
-                                          [f"{s.trial}: {s.note}" for s in side_by_side.skipped]))]
+        ("Summary", page.summary_table(comps, labels, added)),
+        *([("Outcome over the draws", page.outcome_table(spreads, labels))] if spreads else []),
+        ("Figures", "".join(page.figure_html(f) for f in figs)),
+        *([("Side by side", page.videos_html([(j.name, _video_caption(j, labels)) for j in side_by_side.jobs],
+                                             [f"{s.trial}: {s.note}" for s in side_by_side.skipped]))]
           if side_by_side is not None else []),
-        ("Per-hop errors", H.hop_table(comps, labels)),
-        ("Firmware timing", H.timing_table(timing, labels)),
-        ("Parameters", f"<p class=\"note\">Robot {H.esc(base.name)} from {H.esc(robot_source)}; each configuration "
-                       "adds its length to all four links. Values are shown in mm, g and deg; the dotted names are "
-                       "those of <code>--set</code> and <code>locust params</code>, whose values are in the unit "
-                       "each name ends in.</p>"
-                       + H.links_table([(labels[n], c.robot.link_lengths_m()) for n, c in configs.items()])
-                       + H.params_table(parameter_rows(base))),
-        ("Inputs", H.table(["configuration", "trial", "track", "run record", "configuration from", "recorded on",
-                            "track read in"], inputs, left_cols=7, id_="inputs")),
+        ("Per-hop errors", page.hop_table(comps, labels)),
+        ("Firmware timing", page.timing_table(timing, labels)),
+        ("Parameters", f"<p class=\"note\">Robot {page.esc(base.name)} from {page.esc(robot_source)}; each "
+                       "configuration adds its length to all four links. Values are shown in mm, g and deg; the "
+                       "dotted names are those of <code>--set</code> and <code>locust params</code>, whose values are "
+                       "in the unit each name ends in.</p>"
+                       + page.links_table([(labels[n], c.robot.link_lengths_m()) for n, c in configs.items()])
+                       + page.params_table(parameter_rows(base))),
+        ("Inputs", page.table(["configuration", "trial", "track", "run record", "configuration from", "recorded on",
+                               "track read in"], inputs, left_cols=7, id_="inputs")),
         ("How the numbers are made", _notes(comps, land, base, marker)),
     ]
     meta = [f"robot: {base.name} ({robot_source})",
@@ -497,8 +497,8 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
     if virtual:
         meta.insert(1, f"measured trials: {len(virtual)} of {len(trials)} recorded on the virtual robot "
                        "(the simulated robot, not the physical one)")
-    return H.page("Simulation against measurement", meta, sections,
-                  media=side_by_side is not None and bool(side_by_side.jobs))
+    return page.page("Simulation against measurement", meta, sections,
+                     media=side_by_side is not None and bool(side_by_side.jobs))
 
 
 def _trial_json(t) -> dict:

@@ -18,7 +18,7 @@ from ..plotting import png_bytes, pyplot
 from ..sweep.objectives import OBJECTIVES, RENAMED
 from ..sweep.pareto import describe, draw_front, picks_of
 from ..sweep.views import STUDY_PAGE
-from . import page as H
+from .page import Figure
 
 JOURNAL = "study.journal"
 
@@ -102,7 +102,7 @@ def views_page(study: StudyResults) -> str | None:
                      f"Study {held.study_name}: Optuna's views", lines)
 
 
-def study_figure(study: StudyResults, views: bool = False) -> H.Figure:
+def study_figure(study: StudyResults, views: bool = False) -> Figure:
     """The front, its ends and knee, with a caption saying how each design was judged.
 
     Parameters
@@ -133,4 +133,4 @@ def study_figure(study: StudyResults, views: bool = False) -> H.Figure:
                f"limit. {picked or 'No feasible design.'}")
     link = (STUDY_PAGE, "Optuna's own views of the study: history, importances, interactive front.") if views \
         else None
-    return H.Figure("pareto", "Designs that hop far and high without going over", caption, png_bytes(fig), link)
+    return Figure("pareto", "Designs that hop far and high without going over", caption, png_bytes(fig), link)

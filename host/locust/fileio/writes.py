@@ -1,22 +1,20 @@
-"""Atomic writes and never-overwrite helpers shared by every part."""
+"""Where a write lands and how: atomic writes through a temporary beside the file, folders
+made and never reused, strict JSON; shared by every part."""
 
 from __future__ import annotations
 
 import errno
-import fcntl
 import json
 import os
 import re
 import signal
 import stat
 import tempfile
-import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager, suppress
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from .errors import WriteError
+from ..errors import WriteError
 
 DISK_HINT = "check that the folder exists and is writable and that the disk has space, or write elsewhere"
 
@@ -260,94 +258,6 @@ def unwind_on_termination() -> None:
             signal.signal(sig, unwind)
 
 
-@contextmanager
-def opencv_path(path: str | os.PathLike) -> Iterator[str]:
-    """A name OpenCV can open ``path`` by, for the duration of the ``with``: ``path`` itself, or,
-    where it is not UTF-8 text, a link to it in a private temporary folder.
-
-    OpenCV takes a file name as UTF-8 text; a name with bytes that are not UTF-8 (a folder
-    copied from an old camera or another system: Python keeps those bytes as lone
-    surrogates) crashes it with a segmentation fault, in its reader and its writer alike. The
-    link (``media`` plus the name's suffix, which OpenCV's writer chooses the container by)
-    reaches the same file, to read or to write through. A capture or writer opens its file as
-    it is made, so the link may go once it is.
-
-    Parameters
-    ----------
-    path : path-like
-        The file to read or write (a writer's file may not exist yet).
-
-    Yields
-    ------
-    str
-        A UTF-8 name of the same file.
-
-    Raises
-    ------
-    locust.errors.WriteError
-        No private folder can be made for the link.
-    """
-    name = os.fspath(path)
-    try:
-        name.encode("utf-8")
-    except UnicodeEncodeError:
-        pass
-    else:
-        yield name
-        return
-    suffix = Path(name).suffix
-    try:
-        suffix.encode("utf-8")
-    except UnicodeEncodeError:
-        suffix = ""
-    try:
-        folder = tempfile.mkdtemp(prefix="locust-name-")
-    except OSError as exc:
-        raise WriteError(f"cannot make a temporary folder ({exc.strerror})", DISK_HINT) from None
-    link = os.path.join(folder, "media" + suffix)
-    try:
-        os.symlink(os.path.abspath(name), link)
-        yield link
-    finally:
-        with suppress(OSError):
-            os.unlink(link)
-        with suppress(OSError):
-            os.rmdir(folder)
-
-
-def check_encoded(tmp: str | os.PathLike, frames: int, path: Path) -> None:
-    """Raise :class:`WriteError` unless the video just encoded at ``tmp`` (for ``path``) reads
-    back with its ``frames`` frames: OpenCV's writer ignores a failed write (a full disk) and
-    leaves a truncated file no player opens.
-
-    Parameters
-    ----------
-    tmp : path-like
-        The encoded video.
-    frames : int
-        The frames written.
-    path : pathlib.Path
-        The video's final path, for the message.
-
-    Raises
-    ------
-    locust.errors.WriteError
-    """
-    if frames == 0:
-        return
-    import cv2
-
-    with opencv_path(tmp) as name:
-        cap = cv2.VideoCapture(name)
-        try:
-            count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
-        finally:
-            cap.release()
-    if count != frames:
-        raise WriteError(f"{path}: the video could not be written completely ({count} of {frames} frames read "
-                         "back); the disk may be full", DISK_HINT)
-
-
 def storable(text: str) -> str:
     r"""``text`` as UTF-8 (and a font) can hold it: a lone surrogate (an undecodable byte of a
     file name, as Python keeps it) becomes its backslash escape, ``\udcff``; every other
@@ -437,124 +347,6 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes, *,
             raise write_error(path, exc) from None
         raise
     return path
-
-
-@contextmanager
-def locked(path: str | os.PathLike, wait_s: float = 60.0) -> Iterator[Path]:
-    """Hold an exclusive lock for updating ``path`` (read, change, write back) while the block runs.
-
-    The lock is ``fcntl.flock`` on ``.NAME.lock`` beside ``path`` (the file itself is replaced
-    by every atomic write, so a lock on it would not outlive the first update). Another process
-    (or another lock in this one) updating the same ``path`` waits until this block ends; after
-    ``wait_s`` seconds of waiting it is :class:`WriteError`. What :func:`write_target` refuses
-    is refused first, before any lock file is made. The lock file is removed as the lock is
-    released; a waiter that then holds the removed file's lock sees so and locks the new one.
-
-    Parameters
-    ----------
-    path : path-like
-    wait_s : float
-        How long to wait for another holder [s].
-
-    Yields
-    ------
-    pathlib.Path
-        The file a write to ``path`` lands on (:func:`write_target`).
-
-    Raises
-    ------
-    locust.errors.WriteError
-        Waited ``wait_s`` in vain, or a target :func:`write_target` refuses.
-    """
-    path = write_target(path)
-    make_folder(path.parent)
-    lock_path = path.parent / f".{path.name}.lock"
-    deadline = time.monotonic() + wait_s
-    while True:
-        try:
-            fd = os.open(lock_path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
-        except OSError as exc:
-            raise write_error(lock_path, exc) from None
-        try:
-            _flock_until(fd, deadline, path, wait_s)
-            held = os.fstat(fd)
-            try:
-                now = os.stat(lock_path)
-            except FileNotFoundError:
-                now = None
-        except BaseException:
-            os.close(fd)
-            raise
-        if now is not None and (now.st_dev, now.st_ino) == (held.st_dev, held.st_ino):
-            break
-        os.close(fd)   # its holder removed it as it let go: lock the one there now
-    try:
-        yield path
-    finally:
-        try:
-            os.unlink(lock_path)   # (still held: no one can lock it between this and the close)
-        except OSError:
-            pass
-        os.close(fd)
-
-
-def _flock_until(fd: int, deadline: float, path: Path, wait_s: float) -> None:
-    while True:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            return
-        except BlockingIOError:
-            if time.monotonic() > deadline:
-                raise WriteError(f"{path} is being updated by another process (it holds .{path.name}.lock beside "
-                                 f"it) and has been for over {wait_s:g} s",
-                                 "wait for that command to finish, then run this one again") from None
-            time.sleep(0.02)
-
-
-def try_lock(path: str | os.PathLike) -> int | None:
-    """An open descriptor of ``path`` (a folder, or a lock file made if missing) holding an
-    exclusive ``flock`` on it; None at once when another process holds one. Close the
-    descriptor to release it (a process that dies releases it too).
-
-    Parameters
-    ----------
-    path : path-like
-
-    Returns
-    -------
-    int or None
-    """
-    flags = os.O_RDONLY | os.O_DIRECTORY if os.path.isdir(path) else os.O_RDWR | os.O_CREAT
-    fd = os.open(path, flags | os.O_CLOEXEC, 0o644)
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        os.close(fd)
-        return None
-    return fd
-
-
-def claim_folder(folder: str | os.PathLike) -> int:
-    """:func:`try_lock` of ``folder``, or :class:`WriteError` when another process writes there now.
-
-    Parameters
-    ----------
-    folder : path-like
-
-    Returns
-    -------
-    int
-        The lock's descriptor.
-
-    Raises
-    ------
-    locust.errors.WriteError
-    """
-    fd = try_lock(folder)
-    if fd is None:
-        raise WriteError(f"another process is writing in {folder} now; refusing to share it",
-                         "give this command a folder of its own")
-    return fd
 
 
 def atomic_write_text(path: str | os.PathLike, text: str, **kwargs) -> Path:
