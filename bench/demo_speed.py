@@ -29,7 +29,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from locust.commands.demo import REPORT_SAMPLES, Demo, hop_jobs
+from locust.demo.runner import Demo
+from locust.demo.story import REPORT_SAMPLES, hop_jobs
 from locust.demo.virtual_robot import virtual_robot
 from locust.io.robot_toml import save_robot
 from locust.params import LEG_SETS

@@ -27,8 +27,10 @@ import re
 import tempfile
 from pathlib import Path
 
-from locust.commands.demo import CALIBRATIONS, HOP_TRUTH, RECORDINGS, Demo, recording_truth, seed_leg_set_options
+from locust.demo.runner import Demo
+from locust.demo.virtual_robot import virtual_robot
 from locust.io import run_record
+from locust.io.robot_toml import save_robot
 from locust.params import LEG_SETS
 from locust.progress import progress
 
@@ -39,16 +41,14 @@ SCHEDULING = re.compile(r"(\w+) scheduling\)")
 def hops(trials: int, cycles: int, jobs: int, video: bool) -> dict:
     """The demo's hops in a fresh virtual robot folder, ``jobs`` at once; their worst phase start
     error [ms], worst host stall [ms], the hops over the bound, and the scheduling they had."""
-    truth = {**recording_truth([RECORDINGS / rec for _, rec, _ in CALIBRATIONS]), **HOP_TRUTH}
-    truth_sets = [arg for key, value in truth.items() for arg in ("--set", f"{key}={value!r}")]
     with tempfile.TemporaryDirectory() as tmp, open(os.devnull, "w") as quiet:
+        truth = save_robot(virtual_robot(), Path(tmp) / "truth.toml")     # the demo's virtual robot
         d = Demo(Path(tmp), quiet)
         d.call(["flash", "--port", "sim"])
-        trials_dirs = [Path(tmp) / f"{name}-{k}" for name in LEG_SETS for k in range(1, trials + 1)]
-        calls = [(["hop", "--port", "sim", *seed_leg_set_options(trial.name.rsplit("-", 1)[0]),
-                   "--leg-set", trial.name.rsplit("-", 1)[0], *truth_sets, "--cycles", str(cycles), "--out", str(trial),
-                   *(["--video", str(trial / "hop.mp4")] if video else ["--plant", "mujoco"])],
-                  (trial / "run.json",)) for trial in trials_dirs]
+        trials_dirs = [(name, Path(tmp) / f"{name}-{k}") for name in LEG_SETS for k in range(1, trials + 1)]
+        calls = [(["hop", "--port", "sim", "--config", str(truth), "--leg-set", name, "--cycles", str(cycles),
+                   "--out", str(trial), *(["--video", str(trial / "hop.mp4")] if video else ["--plant", "mujoco"])],
+                  (trial / "run.json",)) for name, trial in trials_dirs]
         with progress(length=len(calls), file=quiet) as bar:
             d.call_side_by_side(calls, jobs, bar)
         scheduling = set()
@@ -56,7 +56,7 @@ def hops(trials: int, cycles: int, jobs: int, video: bool) -> dict:
             scheduling.update(SCHEDULING.findall(log.read_text()))
         worst_err = worst_stall = 0.0
         over = 0
-        for trial in trials_dirs:
+        for _, trial in trials_dirs:
             rec = run_record.read_run_record(trial / "run.json")
             err = max(abs(p.error_ms) for p in rec.phases)
             worst_err = max(worst_err, err)

@@ -7,7 +7,7 @@ import io
 
 import pytest
 
-from locust.commands.demo import Demo
+from locust.demo.runner import Demo
 from locust.errors import ReportError
 from locust.progress import progress
 

@@ -288,7 +288,7 @@ def test_locust_hop_on_the_virtual_robot_prints_and_records_the_hosts_stall(env,
 def test_the_demo_films_two_hops_at_once_only_where_the_interpreter_runs_in_real_time(robot):
     """Two filmed at once keep phases within 0.12 ms with real-time scheduling and put them 238 ms
     late without (bench/hop_timing.py): the demo asks the kernel what the interpreter got."""
-    from locust.commands.demo import hop_jobs
+    from locust.demo.story import hop_jobs
     from locust.device.virtual import realtime_scheduling_allowed
 
     realtime = robot.scheduling == "realtime"
@@ -298,6 +298,6 @@ def test_the_demo_films_two_hops_at_once_only_where_the_interpreter_runs_in_real
     if realtime and shutil.which("capsh"):
         # the same machine for a user without the privilege: one at a time
         done = subprocess.run(["capsh", "--drop=cap_sys_nice", "--", "-c",
-                               f"{sys.executable} -c 'from locust.commands.demo import hop_jobs; print(hop_jobs(2))'"],
+                               f"{sys.executable} -c 'from locust.demo.story import hop_jobs; print(hop_jobs(2))'"],
                               capture_output=True, text=True, timeout=60)
         assert done.stdout.strip() == "1", done.stderr

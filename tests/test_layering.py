@@ -47,7 +47,7 @@ def imports_of(path: Path) -> set[str]:
 # docs/architecture.md draws
 ARROWS = {
     "calibrate": ("sim", "trials"),
-    "demo": ("calibrate", "sim"),
+    "demo": ("calibrate", "device", "sim"),
     "device": ("sim",),
     "fab": (),
     "measure": ("calibrate", "sim", "track"),

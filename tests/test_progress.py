@@ -94,7 +94,7 @@ class _Out(io.StringIO):
 def test_the_demo_shows_a_childs_progress_and_keeps_all_its_output(tty):
     """A demo stage's command runs in a child whose output goes to a log: its progress lines
     (every ~10 s, a pipe being no terminal) are shown as they come, nothing else is."""
-    from locust.commands.demo import relay_progress
+    from locust.demo.runner import relay_progress
 
     clock, child = Clock(), io.StringIO()
     with Progress(length=30, label="fitting hops", file=child, tty=False, clock=clock) as bar:

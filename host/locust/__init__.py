@@ -22,6 +22,7 @@ Functions (each with a numpydoc docstring: ``help(locust.simulate)``), named onc
 - ``make_report(robot, measured)``: the HTML comparison of simulation and filmed hops.
 - ``optimize(robot, vary, trials, out=...)``: Optuna's search for the farthest valid hop.
 - ``make_cut_files(robot_or_dxf, out=...)``: the laminate's cut files and their summary.
+- ``run_demo(out, cycles, trials, designs)``: ``locust demo``, the toolkit end to end on the virtual robot.
 
 Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
 """

@@ -24,12 +24,13 @@ name                   module                     what it is
 ``make_report``        :mod:`.reports`            :class:`locust.report.build.ReportResult`
 ``optimize``           :mod:`.optimizing`         :class:`locust.sweep.optimize.OptimizeSummary`
 ``make_cut_files``     :mod:`.fabrication`        dict (the manufacturing summary)
+``run_demo``           :mod:`.demos`              the toolkit end to end on the virtual robot
 ``Robot``              :mod:`locust.params`       the robot's parameters, each with its provenance
 ``LocustError``        :mod:`locust.errors`       every error the toolkit raises (message, hint)
 =====================  =========================  ====================================================
 
 The command line calls the same functions (``locust sim``, ``sweep``, ``report``, ``fab``,
-``calibrate beam|hinge|servo|ramp``). Every name is also at the package top: ``locust.simulate``.
+``calibrate beam|hinge|servo|ramp``, ``demo``). Every name is also at the package top: ``locust.simulate``.
 """
 
 from __future__ import annotations
@@ -57,6 +58,7 @@ EXPORTS = {
     "make_report": "reports",
     "optimize": "optimizing",
     "make_cut_files": "fabrication",
+    "run_demo": "demos",
     "Robot": "locust.params",
     "LocustError": "locust.errors",
 }

@@ -14,7 +14,10 @@ its hops finds nothing. Its hinge is the film hinge's (``fit:Damping_test.trk``,
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
+from ..fileio import atomic_write_json
+from ..io.robot_toml import save_robot
 from ..params import DEFAULT_PRESET, Provenance, Robot, preset
 from ..sim.samples import draw
 
@@ -56,3 +59,30 @@ def hidden_values(robot: Robot) -> dict[str, float]:
         Key -> value, in the unit its name says.
     """
     return {k: robot.get(k) for k, p in robot.provenance.items() if p.source == "demo-draw"}
+
+
+def write_truth(folder: Path) -> tuple[Path, dict[str, float]]:
+    """Write the virtual robot to ``folder/virtual/truth.toml``, and what it hides, with a note
+    saying how it was drawn and chosen, to ``folder/virtual/truth.json``.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        The demo's run folder.
+
+    Returns
+    -------
+    path : pathlib.Path
+        The robot file the virtual board reads.
+    hidden : dict of str to float
+        Its drawn values (:func:`hidden_values`).
+    """
+    robot = virtual_robot()
+    path = save_robot(robot, folder / "virtual" / "truth.toml")
+    hidden = hidden_values(robot)
+    note = (f"the virtual robot: the robot as built with each uncertain value drawn (draw {DRAW_INDEX} of seed "
+            f"{DRAW_SEED}), chosen as one whose {' and '.join(HOP_FIT_SETS)} rear and come back down; hidden from "
+            "every stage but the virtual board")
+    atomic_write_json(folder / "virtual" / "truth.json", {"note": note, "values": hidden,
+                                                          "hop_fit_sets": list(HOP_FIT_SETS)})
+    return path, hidden
