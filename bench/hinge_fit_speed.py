@@ -67,10 +67,10 @@ def main() -> None:
     for name, path, units, rig, coulomb in cases:
         old_s, old = fit(path, units, rig, coulomb, old=True)
         new_s, new = fit(path, units, rig, coulomb, old=False)
-        print(f"{name}: forward differences {old_s:.2f} s (k {old.hinge_stiffness_nm_per_rad.value:.6g}, "
-              f"b {old.hinge_damping_nms_per_rad.value:.6g}); variational equations / closed form {new_s:.2f} s "
-              f"(k {new.hinge_stiffness_nm_per_rad.value:.6g}, b {new.hinge_damping_nms_per_rad.value:.6g}); "
-              f"{old_s / new_s:.1f}x")
+        (k_old, b_old), (k_new, b_new) = ([f.estimates[key].value for key in (H.STIFFNESS, H.DAMPING)]
+                                          for f in (old, new))
+        print(f"{name}: forward differences {old_s:.2f} s (k {k_old:.6g}, b {b_old:.6g}); variational equations / "
+              f"closed form {new_s:.2f} s (k {k_new:.6g}, b {b_new:.6g}); {old_s / new_s:.1f}x")
 
 
 if __name__ == "__main__":

@@ -177,7 +177,7 @@ def test_fit_matches_the_command_line_and_applies(tmp_path):
                            "--json", "--no-plot"],
                           capture_output=True, text=True, check=True, timeout=120,
                           env=dict(os.environ, PYTHONPATH=str(ROOT / "host")))
-    cli = json.loads(proc.stdout)["mu_static"]
+    cli = json.loads(proc.stdout)["contact.foot_friction"]
     est = fit.parameters["contact.foot_friction"]
     assert (est.value, est.std, list(est.ci95)) == (cli["value"], cli["std"], cli["ci95"])
     # the truth the synthetic file was made from (its header): mu 1.7

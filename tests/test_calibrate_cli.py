@@ -288,8 +288,8 @@ def test_fitted_values_print_with_units_and_four_figures():
             "--length-m", "0.05", "--no-plot"]
     text = CliRunner().invoke(cli, args).stdout
     fit = json.loads(CliRunner().invoke(cli, [*args, "--json"]).stdout)
-    for key, unit in (("hinge_stiffness_nm_per_rad", "N·m/rad"), ("hinge_damping_nms_per_rad", "N·m·s/rad"),
-                      ("natural_frequency_hz", "Hz")):
+    for key, unit in (("compliance.hinge_stiffness_nm_per_rad", "N·m/rad"),
+                      ("compliance.hinge_damping_nms_per_rad", "N·m·s/rad"), ("natural_frequency_hz", "Hz")):
         v = fit[key]
         line = next(ln for ln in text.splitlines() if ln.split()[0] == key.split("_n")[0].split("_hz")[0])
         m = re.fullmatch(r"(\S+)\s+(\S+)\s+(\S+)\s+± (\S+) %\s+\(95 %: (\S+) … (\S+)\)", line)
@@ -309,7 +309,7 @@ def test_the_hinge_interval_is_flagged_where_its_residual_is_model_error(shared_
                                    "--no-plot"])
     assert res.exit_code == 0, res.output
     flagged = [ln for ln in res.stdout.splitlines() if "TOO NARROW" in ln]
-    assert [ln.split()[0] for ln in flagged] == ["hinge_stiffness", "hinge_damping"]
+    assert [ln.split()[0] for ln in flagged] == ["compliance.hinge_stiffness", "compliance.hinge_damping"]
     assert "0.79 mm RMS" in flagged[0]
 
 
@@ -329,3 +329,40 @@ def test_two_experiments_on_one_recording_keep_both_plots(shared_data, tmp_path,
     assert json.loads(hinge.stdout)["plot"] == "pendulum_rubber_60fps_m-hinge-fit.png"
     assert (tmp_path / "pendulum_rubber_60fps_m-beam-fit.png").read_bytes() == drawn
     assert (tmp_path / "pendulum_rubber_60fps_m-hinge-fit.png").stat().st_size > 10_000
+
+
+# -- one job behind both doors ------------------------------------------------------------------
+def test_the_command_and_the_api_run_the_same_job(recs, monkeypatch):
+    """Each experiment's work is one function of locust.calibrate.jobs, which `locust calibrate`
+    and locust.calibrate_* both call: each door calls it once, and both give the same figures
+    (the beam's hinge stiffness within 4 % of its header's 0.056375 N*m/rad, the ramp's interval
+    holding its header's friction 1.7); a hop fit's empty run folder is refused in it for both."""
+    import locust
+    from locust.calibrate import jobs
+    from locust.errors import LocustError
+
+    calls = []
+
+    def counted(name):
+        job = getattr(jobs, name)
+        return lambda *args, **kwargs: calls.append(name) or job(*args, **kwargs)
+
+    for name in ("beam", "ramp", "hops"):
+        monkeypatch.setattr(jobs, name, counted(name))
+    key = "compliance.hinge_stiffness_nm_per_rad"
+    cli_beam = json.loads(run("calibrate", "beam", recs / "synthetic_beam.csv", "--mass-kg", 0.01, "--length-m", 0.05,
+                              "--json", "--no-plot").stdout)[key]
+    api_beam = locust.calibrate_beam(recs / "synthetic_beam.csv", 0.01, length_m=0.05).parameters[key]
+    assert (cli_beam["value"], cli_beam["std"], cli_beam["ci95"]) == (api_beam.value, api_beam.std, list(api_beam.ci95))
+    assert api_beam.value == pytest.approx(0.056375, rel=0.04)
+    key = "contact.foot_friction"
+    cli_ramp = json.loads(run("calibrate", "ramp", recs / "synthetic_ramp.csv", "--json", "--no-plot").stdout)[key]
+    api_ramp = locust.calibrate_ramp(recs / "synthetic_ramp.csv").parameters[key]
+    assert (cli_ramp["value"], cli_ramp["ci95"]) == (api_ramp.value, list(api_ramp.ci95))
+    assert api_ramp.ci95[0] <= 1.7 <= api_ramp.ci95[1]
+    (recs / "small-1").mkdir()
+    refused = run("calibrate", "hop", "small=small-1", "--no-plot")
+    assert refused.exit_code == 2 and "no run.json" in refused.output
+    with pytest.raises(LocustError, match="no run.json"):
+        locust.calibrate_hops(locust.robot("seed"), {"small": recs / "small-1"})
+    assert calls == ["beam", "beam", "ramp", "ramp", "hops", "hops"]

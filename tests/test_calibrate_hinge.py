@@ -19,6 +19,7 @@ from click.testing import CliRunner
 
 from locust.bundled import bundled_recording
 from locust.calibrate import hinge, synthetic
+from locust.calibrate.hingeswing import HingeRig
 from locust.calibrate.recordings import REAL_TIME, TimeOptions, clean_samples, read_table
 from locust.commands import cli
 from locust.io.importing import ImportOptions
@@ -35,14 +36,15 @@ CASES = {   # the four combinations of the acceptance: gravity in / out of plane
     "in-plane 60 fps m": dataclasses.replace(IN_PLANE, fps=60.0),
 }
 SEEDS = 20
+K, B = "compliance.hinge_stiffness_nm_per_rad", "compliance.hinge_damping_nms_per_rad"   # the robot keys fitted
 
 
 def run(*args):
     return CliRunner().invoke(cli, list(map(str, args)))
 
 
-def rig_of(truth: synthetic.HingeTruth) -> hinge.HingeRig:
-    return hinge.HingeRig(truth.inertia_kgm2, truth.gravity, truth.mass_kg, truth.com_m)
+def rig_of(truth: synthetic.HingeTruth) -> HingeRig:
+    return HingeRig(truth.inertia_kgm2, truth.gravity, truth.mass_kg, truth.com_m)
 
 
 def write_txy(path: Path, t, x, y, *, title: str | None = None) -> Path:
@@ -113,8 +115,8 @@ def test_hinge_fit_is_accurate_and_its_intervals_cover_over_seeds(case, tmp_path
     for seed in range(SEEDS):
         t, x, y = synthetic.hinge_swing_track(truth, np.random.default_rng(1000 + seed))
         fit = fit_file(write_txy(tmp_path / f"swing{seed}.csv", t, x, y), truth, truth.units)
-        for key, est, true in (("k", fit.hinge_stiffness_nm_per_rad, truth.hinge_stiffness_nm_per_rad),
-                               ("b", fit.hinge_damping_nms_per_rad, truth.hinge_damping_nms_per_rad)):
+        for key, est, true in (("k", fit.estimates[K], truth.hinge_stiffness_nm_per_rad),
+                               ("b", fit.estimates[B], truth.hinge_damping_nms_per_rad)):
             assert acceptable(est, true), (case, seed, key, est, true)
             covered[key] += est.ci95_low <= true <= est.ci95_high
         coulomb_fitted += fit.coulomb_friction_nm is not None
@@ -136,8 +138,8 @@ def test_coulomb_friction_is_fitted_when_the_swing_shows_it(tmp_path):
         assert fit.coulomb_friction_nm is not None, fit.coulomb_note
         # the fit smooths sign(rate) over 0.2 % of the peak rate: a few per cent high
         assert fit.coulomb_friction_nm.value == pytest.approx(truth.coulomb_nm, rel=0.08)
-        for est, true in ((fit.hinge_stiffness_nm_per_rad, truth.hinge_stiffness_nm_per_rad),
-                          (fit.hinge_damping_nms_per_rad, truth.hinge_damping_nms_per_rad)):
+        for est, true in ((fit.estimates[K], truth.hinge_stiffness_nm_per_rad),
+                          (fit.estimates[B], truth.hinge_damping_nms_per_rad)):
             assert acceptable(est, true), (seed, est, true)
 
 
@@ -156,11 +158,11 @@ def test_every_track_format_gives_the_same_fit(tmp_path):
         "clip-fps": fit_file(write_txy(tmp_path / "slow2.csv", t * 4, x, y), truth,
                              timing=TimeOptions(clip_fps=truth.fps)),
     }
-    k0 = ref.hinge_stiffness_nm_per_rad.value
+    k0 = ref.estimates[K].value
     for name, fit in fits.items():
         # the same samples to 1e-9: the fits agree to the solver's own convergence (about 1e-5)
-        assert fit.hinge_stiffness_nm_per_rad.value == pytest.approx(k0, rel=1e-4), name
-        assert fit.hinge_damping_nms_per_rad.value == pytest.approx(ref.hinge_damping_nms_per_rad.value, rel=1e-4), name
+        assert fit.estimates[K].value == pytest.approx(k0, rel=1e-4), name
+        assert fit.estimates[B].value == pytest.approx(ref.estimates[B].value, rel=1e-4), name
         assert fit.rms_residual_m == pytest.approx(ref.rms_residual_m, rel=1e-4), name
 
 
@@ -194,12 +196,12 @@ def test_cli_hinge_json_write_and_trk_note(tmp_path):
 def _reported(out: dict) -> list:
     """Stiffness and damping as `locust calibrate hinge --json` prints them: value, std, ci95."""
     return [[out[key]["value"], out[key]["std"], *out[key]["ci95"]]
-            for key in ("hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad")]
+            for key in (K, B)]
 
 
 def _reported_fit(fit: hinge.HingeFit) -> list:
     return [[e.value, e.std, e.ci95_low, e.ci95_high]
-            for e in (fit.hinge_stiffness_nm_per_rad, fit.hinge_damping_nms_per_rad)]
+            for e in (fit.estimates[K], fit.estimates[B])]
 
 
 def test_cli_hinge_refuses_what_it_cannot_fit(tmp_path):
@@ -252,7 +254,7 @@ def test_damping_test_trk_rings_at_its_recorded_frequency(shared_data):
     assert 2.0 < fd < 2.2
     zeta = out["damping_ratio"]
     k_ring = 8.5e-7 * (2 * math.pi * fd) ** 2 / (1 - zeta**2)
-    assert out["hinge_stiffness_nm_per_rad"]["value"] == pytest.approx(k_ring, rel=0.05)
+    assert out[K]["value"] == pytest.approx(k_ring, rel=0.05)
     assert out["rms_residual_m"] < 1e-3
 
 
@@ -269,7 +271,7 @@ def test_times_printed_to_three_digits_are_rebuilt_from_the_rows(tmp_path):
     assert "times rebuilt from the row order at 30" in table.input_note
     assert np.max(np.abs(table.time_s() - t)) < 1e-4       # a line through 480 rounded times: 0.3 % of a frame
     fit = fit_file(path, truth)
-    assert fit.hinge_stiffness_nm_per_rad.value == pytest.approx(ref.hinge_stiffness_nm_per_rad.value, rel=1e-4)
+    assert fit.estimates[K].value == pytest.approx(ref.estimates[K].value, rel=1e-4)
     back = coarse.copy()
     back[200] = back[199] - 0.5
     res = run("calibrate", "hinge", write_txy(tmp_path / "back.csv", back, x, y), "--inertia-kgm2", 8.5e-7,

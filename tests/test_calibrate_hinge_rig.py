@@ -24,13 +24,14 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from locust.calibrate import hinge, synthetic
+from locust.calibrate import hinge, hingeswing, synthetic
 from locust.commands import cli
 from locust.errors import CalibrationError
 
 FILM = ("hinge", "pendulum_transparency_film.csv")
 # the issue's link: 2 g with its centre of mass 80 mm from the hinge, so at least 1.28e-5 kg*m^2
 MASS = ("--gravity", "in-plane", "--mass-kg", "0.002", "--com-m", "0.08")
+K, B = "compliance.hinge_stiffness_nm_per_rad", "compliance.hinge_damping_nms_per_rad"   # the robot keys fitted
 
 
 def run(*args):
@@ -47,9 +48,9 @@ def test_an_inertia_below_m_d_squared_is_refused_before_the_recording_is_read(tm
             in res.stderr)
     assert "I = M*L^2/3" in res.stderr and "nowhere" not in res.stderr
     with pytest.raises(CalibrationError, match="below --mass-kg"):
-        hinge.check_rig(hinge.HingeRig(1.279e-5, "in-plane", 0.002, 0.08))
-    hinge.check_rig(hinge.HingeRig(1.28e-5, "in-plane", 0.002, 0.08))      # a point mass: the least there is
-    hinge.check_rig(hinge.HingeRig(1e-6, "out-of-plane"))                  # no weight's moment, no M or D to check
+        hingeswing.check_rig(hingeswing.HingeRig(1.279e-5, "in-plane", 0.002, 0.08))
+    hingeswing.check_rig(hingeswing.HingeRig(1.28e-5, "in-plane", 0.002, 0.08))      # a point mass: the least there is
+    hingeswing.check_rig(hingeswing.HingeRig(1e-6, "out-of-plane"))   # no weight's moment, no M or D to check
 
 
 def test_a_fit_that_does_not_follow_its_swing_writes_nothing(shared_data, tmp_path):
@@ -64,14 +65,14 @@ def test_a_fit_that_does_not_follow_its_swing_writes_nothing(shared_data, tmp_pa
     res = run(*args, "--write", robot)
     assert res.exit_code == 0, res.output
     lines = res.stdout.splitlines()
-    for key in ("hinge_stiffness", "hinge_damping"):
+    for key in ("compliance.hinge_stiffness", "compliance.hinge_damping"):
         line = next(ln for ln in lines if ln.startswith(key + " "))
         assert line.endswith("NOT IDENTIFIABLE") and "TOO NARROW" not in line, line
     assert any(ln.startswith("note: the model does not follow pendulum_transparency_film.csv") for ln in lines)
     assert "nothing written" in res.stdout and not robot.exists()
     out = json.loads(run(*args, "--json").stdout)
-    assert out["hinge_stiffness_nm_per_rad"]["identifiable"] is False
-    assert out["hinge_damping_nms_per_rad"]["identifiable"] is False
+    assert out[K]["identifiable"] is False
+    assert out[B]["identifiable"] is False
     said = re.search(r"RMS (\S+) deg about a swing of (\S+) deg", out["notes"][0])
     residual, swing = float(said.group(1)), float(said.group(2))
     assert residual > hinge.FOLLOWS_SHARE * swing
@@ -84,8 +85,8 @@ def test_the_same_film_on_a_rig_that_swings_at_its_rate_is_fitted(shared_data):
               "--end-s", "20", "--no-plot", "--json")
     assert res.exit_code == 0, res.output
     out = json.loads(res.stdout)
-    assert out["hinge_stiffness_nm_per_rad"]["identifiable"] and out["hinge_damping_nms_per_rad"]["identifiable"]
-    assert out["hinge_stiffness_nm_per_rad"]["value"] == pytest.approx(1.255e-4, rel=0.01)
+    assert out[K]["identifiable"] and out[B]["identifiable"]
+    assert out[K]["value"] == pytest.approx(1.255e-4, rel=0.01)
     assert out["rms_residual_deg"] < 1.5 and not out["notes"]
 
 
@@ -94,10 +95,10 @@ def test_a_value_run_to_its_bound_is_not_identifiable():
     1.5e-6) fitted with Coulomb friction: b runs to its bound, 0, and is not written; k is."""
     truth = synthetic.HingeTruth(hinge_damping_nms_per_rad=1e-12, coulomb_nm=1.5e-6)
     t, x, y = synthetic.hinge_swing_track(truth, np.random.default_rng(2))
-    fit = hinge.fit_hinge(t, x, y, hinge.HingeRig(truth.inertia_kgm2), coulomb="on")
-    assert fit.identifiable == {"hinge_stiffness_nm_per_rad": True, "hinge_damping_nms_per_rad": False}
-    assert any(n.startswith("hinge_damping_nms_per_rad ran to the edge of its range") for n in fit.notes)
-    assert fit.hinge_stiffness_nm_per_rad.value == pytest.approx(truth.hinge_stiffness_nm_per_rad, rel=0.02)
+    fit = hinge.fit_hinge(t, x, y, hingeswing.HingeRig(truth.inertia_kgm2), coulomb="on")
+    assert fit.identifiable == {K: True, B: False}
+    assert any(n.startswith(f"{B} ran to the edge of its range") for n in fit.notes)
+    assert fit.estimates[K].value == pytest.approx(truth.hinge_stiffness_nm_per_rad, rel=0.02)
 
 
 # -- the swing's derivatives and closed form ------------------------------------------------
@@ -107,19 +108,19 @@ def test_the_jacobian_is_the_swings_own_from_its_variational_equations():
     own error about 1e-6): within 2e-5 of each column's size. The forward differences of 3e-5
     they replace were 2e-4 off."""
     truth = synthetic.IN_PLANE_HINGE
-    rig = hinge.HingeRig(truth.inertia_kgm2, truth.gravity, truth.mass_kg, truth.com_m)
+    rig = hingeswing.HingeRig(truth.inertia_kgm2, truth.gravity, truth.mass_kg, truth.com_m)
     t = np.arange(0.0, 1.2, 1 / 240)
     p = np.array([9.9e-4, 8.2e-6, math.radians(-80.0), math.radians(-150.0), 0.0, 2e-6])
     width = 0.05
-    theta, d = hinge.swing_sensitivities(t, p, rig, width)
+    theta, d = hingeswing.swing_sensitivities(t, p, rig, width)
     try:
-        hinge.RTOL, hinge.ATOL = 1e-12, 1e-14
-        ref = np.column_stack([(hinge.simulate_hinge(t, p + np.eye(6)[i] * h, rig, width)
-                                - hinge.simulate_hinge(t, p - np.eye(6)[i] * h, rig, width)) / (2 * h)
+        hingeswing.RTOL, hingeswing.ATOL = 1e-12, 1e-14
+        ref = np.column_stack([(hingeswing.simulate_hinge(t, p + np.eye(6)[i] * h, rig, width)
+                                - hingeswing.simulate_hinge(t, p - np.eye(6)[i] * h, rig, width)) / (2 * h)
                                for i, h in enumerate(1e-3 * np.maximum(np.abs(p), [0, 0, 1, 1, 1, 0]))])
-        exact = hinge.simulate_hinge(t, p, rig, width)
+        exact = hingeswing.simulate_hinge(t, p, rig, width)
     finally:
-        hinge.RTOL, hinge.ATOL = 1e-10, 1e-12
+        hingeswing.RTOL, hingeswing.ATOL = 1e-10, 1e-12
     assert np.max(np.abs(theta - exact)) < 1e-8
     err = np.linalg.norm(d - ref, axis=0) / np.linalg.norm(ref, axis=0)
     assert np.all(err < 2e-5), err
@@ -130,16 +131,16 @@ def test_the_jacobian_is_the_swings_own_from_its_variational_equations():
 def test_the_linear_swing_in_closed_form_is_the_integrated_one(k, b):
     """Out of plane and without Coulomb friction the swing is linear: its closed form agrees with
     LSODA at a relative tolerance of 1e-12 within 1e-9 rad, whatever its damping."""
-    rig = hinge.HingeRig(8.5e-7)
+    rig = hingeswing.HingeRig(8.5e-7)
     t = np.linspace(0.0, 8.0, 481)
     p = np.array([k, b, math.radians(95.0), math.radians(130.0), -0.3])
-    assert hinge.is_linear(p, rig)
+    assert hingeswing.is_linear(p, rig)
     try:
-        hinge.RTOL, hinge.ATOL = 1e-12, 1e-14
-        integrated = hinge._integrate(t, p, rig, 0.0, sensitivities=False)[:, 0]
+        hingeswing.RTOL, hingeswing.ATOL = 1e-12, 1e-14
+        integrated = hingeswing._integrate(t, p, rig, 0.0, sensitivities=False)[:, 0]
     finally:
-        hinge.RTOL, hinge.ATOL = 1e-10, 1e-12
-    assert np.max(np.abs(hinge.linear_swing(t, p, rig.inertia_kgm2) - integrated)) < 1e-9
+        hingeswing.RTOL, hingeswing.ATOL = 1e-10, 1e-12
+    assert np.max(np.abs(hingeswing.linear_swing(t, p, rig.inertia_kgm2) - integrated)) < 1e-9
 
 
 def test_a_jacobian_of_the_integrated_swing_is_one_integration(monkeypatch):
@@ -151,12 +152,12 @@ def test_a_jacobian_of_the_integrated_swing_is_one_integration(monkeypatch):
     solved = []
     solve = hinge._Swing.solve
     monkeypatch.setattr(hinge._Swing, "solve", lambda self, q0: solved.append((self, q0)) or solve(self, q0))
-    rig = hinge.HingeRig(truth.inertia_kgm2, truth.gravity, truth.mass_kg, truth.com_m)
-    hinge.fit_hinge(t, x, y, rig, coulomb="off")
+    hinge.fit_hinge(t, x, y, hingeswing.HingeRig(truth.inertia_kgm2, truth.gravity, truth.mass_kg, truth.com_m),
+                    coulomb="off")
     problem, q0 = solved[0]
     calls = []
-    odeint = hinge.integrate.odeint
-    monkeypatch.setattr(hinge.integrate, "odeint", lambda *a, **k: calls.append(a[1].size) or odeint(*a, **k))
+    odeint = hingeswing.integrate.odeint
+    monkeypatch.setattr(hingeswing.integrate, "odeint", lambda *a, **k: calls.append(a[1].size) or odeint(*a, **k))
     jac = problem.jacobian(q0)
     assert calls == [2 + 2 * 5]               # the swing and its derivatives in k, b, theta0, start angle, rate
     assert jac.shape == (2 * len(problem.t), len(q0)) and np.all(np.isfinite(jac))

@@ -12,15 +12,19 @@ system test on the virtual robot's own videos is in test_calibrate_hop_virtual.p
 from __future__ import annotations
 
 import math
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from locust.calibrate import hop
+from locust.calibrate import hop, hopresidual, hopruns
 from locust.errors import CalibrationError
 from locust.params import LEG_SETS, Provenance, leg_set, preset
 from locust.sim import samples
 from locust.trials.configs import configuration
+from locust.trials.measure import onset_time
+from locust.trials.measured import Track, Trial
 
 CAMERA_HZ = 30.0
 NOISE_M = 1e-4
@@ -35,7 +39,7 @@ def seed_leg(config: str):
     return leg_set(preset("seed"), config)
 
 
-def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0, plant=None) -> hop.HopRun:
+def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0, plant=None) -> Trial:
     """A run of ``config`` at ``truth``, "filmed" at 30 frames/s from 0.4 s before the first
     push, camera clock 1.234 s ahead, positions with NOISE_M of noise in a board's frame
     BOARD_M from the world's (SYNTHETIC): leg set ``config`` of the seed (``plant``: of that
@@ -53,22 +57,21 @@ def synthetic_run(config: str, truth: dict, cycles: int = 3, seed: int = 0, plan
     pushing = np.array([True, False] * cycles)
     clock_s = 1.234
     t_cam = np.arange(clock_s - 0.4, clock_s + cycles * period, 1 / CAMERA_HZ)
-    blank = hop.MarkerTrack(t_cam, np.zeros_like(t_cam), np.zeros_like(t_cam))
-    template = hop.HopRun(source=hop.Path(f"synthetic-{config}"), config=config, robot=robot, phase_s=phase_s,
-                          pushing=pushing, onset_s=clock_s, tracks={"nose": blank, "foot": blank})
-    sim = hop.simulate_markers(template, [plant])[0]
+    blank = Track(t_cam, np.zeros_like(t_cam), np.zeros_like(t_cam))
+    template = Trial(config=config, label=f"synthetic-{config}", source=Path(f"synthetic-{config}"), robot=robot,
+                     phase_s=phase_s, pushing=pushing, onset_s=clock_s, tracks={"nose": blank, "foot": blank})
+    sim = hopruns.simulate_markers(template, [plant])[0]
     rng = np.random.default_rng(seed)
     tracks = {}
     for m in ("nose", "foot"):
         t, x, y = sim[m]
         # standing where it stood before the simulation's kept lead, as the fit takes it
         at = t_cam - clock_s
-        tracks[m] = hop.MarkerTrack(t_cam, np.interp(at, t, x) - BOARD_M[0] + rng.normal(0, NOISE_M, t_cam.size),
-                                    np.interp(at, t, y) - BOARD_M[1] + rng.normal(0, NOISE_M, t_cam.size))
+        tracks[m] = Track(t_cam, np.interp(at, t, x) - BOARD_M[0] + rng.normal(0, NOISE_M, t_cam.size),
+                          np.interp(at, t, y) - BOARD_M[1] + rng.normal(0, NOISE_M, t_cam.size), marker=m)
     nose = tracks["nose"]
-    onset, _, _ = hop.onset_time(nose.t_s, nose.x_m, nose.y_m)
-    return hop.HopRun(source=template.source, config=config, robot=robot, phase_s=phase_s, pushing=pushing,
-                      onset_s=onset, tracks=tracks)
+    onset, _, _ = onset_time(nose.t_s, nose.x_m, nose.y_m)
+    return replace(template, onset_s=onset, tracks=tracks)
 
 
 @pytest.fixture(scope="module")
@@ -96,7 +99,7 @@ def test_fit_reports_its_simulations_done_and_planned(small_fit):
     assert fit.simulations / 2 <= first_plan <= 2 * fit.simulations
     assert small_fit_progress[-1] == (fit.simulations, fit.simulations)
     # every rollout call holds at most CHUNK candidates, so the count moves while a batch runs
-    assert max(b - a for a, b in zip([0, *done], done)) <= hop.CHUNK
+    assert max(b - a for a, b in zip([0, *done], done)) <= hopresidual.CHUNK
 
 
 def test_fit_recovers_the_values_the_traces_were_made_with(small_fit):
@@ -140,9 +143,9 @@ def test_fit_residual_is_the_noise_it_was_given(small_fit):
 
 def test_measured_phase_times_drive_the_command():
     run = synthetic_run("small", TRUTH, cycles=1)
-    late = hop.HopRun(**{**run.__dict__, "phase_s": np.array([0.0, 0.4])})   # a push measured 100 ms long
+    late = replace(run, phase_s=np.array([0.0, 0.4]))   # a push measured 100 ms long
     dt = run.robot.solver.timestep_s
-    plan, plan_late = hop.measured_plan(run, run.robot), hop.measured_plan(late, run.robot)
+    plan, plan_late = hopruns.measured_plan(run, run.robot), hopruns.measured_plan(late, run.robot)
     push = math.radians(run.robot.schedule.push_deg)
     assert np.sum(plan.ctrl_rad == push) * dt == pytest.approx(0.3, abs=dt)
     assert np.sum(plan_late.ctrl_rad == push) * dt == pytest.approx(0.4, abs=dt)
@@ -155,7 +158,7 @@ def test_keys_that_cannot_be_fitted_are_refused():
         hop.check_keys(["schedule.cycles"], [run])
     with pytest.raises(CalibrationError, match="unknown robot parameter"):
         hop.check_keys(["contact.foot_frict"], [run])
-    large = hop.HopRun(**{**run.__dict__, "robot": seed_leg("large")})
+    large = replace(run, robot=seed_leg("large"))
     with pytest.raises(CalibrationError, match="leg sets differ"):
         hop.check_keys(["geometry.leg_m"], [run, large])
 
@@ -241,12 +244,12 @@ def test_the_fit_halves_a_step_that_has_not_converged():
     """Small at 5 ms: halving the step moves its markers by more than the fit's tolerance at the
     seed's values (0.1 mm RMS), so the fit refines it; at its own step (LEG_SETS) it is kept."""
     run = synthetic_run("small", {}, cycles=1)
-    coarse = hop.HopRun(**{**run.__dict__, "robot": run.robot.with_values({"solver.timestep_s": 5e-3})})
-    refined, change = hop.converged_step(coarse)
-    assert refined.robot.solver.timestep_s < 5e-3 and change <= hop.STEP_TOLERANCE_M
+    coarse = replace(run, robot=run.robot.with_values({"solver.timestep_s": 5e-3}))
+    refined, change = hopruns.converged_step(coarse)
+    assert refined.robot.solver.timestep_s < 5e-3 and change <= hopruns.STEP_TOLERANCE_M
     assert refined.robot.source_of("solver.timestep_s").source == "fit: time step check"
-    kept, change = hop.converged_step(run)
-    assert kept.robot.solver.timestep_s == LEG_SETS["small"].timestep_s and change <= hop.STEP_TOLERANCE_M
+    kept, change = hopruns.converged_step(run)
+    assert kept.robot.solver.timestep_s == LEG_SETS["small"].timestep_s and change <= hopruns.STEP_TOLERANCE_M
 
 
 # hidden values unlike any preset, friction above the floor's 1.6 (below it acts on nothing)
@@ -284,8 +287,8 @@ def test_a_fit_across_the_outcomes_threshold_is_refused():
     key = "geometry.crank_start_deg"
 
     def jacobian_at(start):
-        at = hop.HopRun(**{**run.__dict__, "robot": robot.with_values({key: start})})
-        return hop._jacobian(hop._HopResidual([at], (key,)), np.zeros(1))
+        at = replace(run, robot=robot.with_values({key: start}))
+        return hopresidual.optimum_jacobian(hopresidual.HopResidual([at], (key,)), np.zeros(1))
 
     with pytest.raises(CalibrationError, match="straddles the threshold") as refused:
         jacobian_at(-121.17)

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from locust.calibrate import hop
+from locust.calibrate.hopruns import load_run
 from locust.commands import cli
 from locust.errors import CalibrationError
 from locust.io import run_record
@@ -64,7 +64,7 @@ def run_folder(folder, status=run_record.COMPLETE, message=None, phases=None):
 def test_a_complete_run_loads_on_its_measured_phase_times(tmp_path):
     """The control: the same folder with a complete record is a run of the fit, each phase
     starting at its measured time from the first push (45 µs late each, so 0 from the first)."""
-    run = hop.load_run(run_folder(tmp_path / "small-1"), "small", preset("small"))
+    run = load_run(run_folder(tmp_path / "small-1"), "small", preset("small"))
     assert run.phase_s == pytest.approx([0.0, 0.3, 1.3, 1.6], abs=1e-9)
     assert run.pushing.tolist() == [True, False, True, False]
     assert run.onset_s == pytest.approx(ONSET_S, abs=1 / FPS)
@@ -81,7 +81,7 @@ def test_a_complete_run_loads_on_its_measured_phase_times(tmp_path):
 def test_a_run_that_did_not_run_its_schedule_is_refused(tmp_path, status, message, phases, said):
     folder = run_folder(tmp_path / "small-1", status, message, phases)
     with pytest.raises(CalibrationError) as exc:
-        hop.load_run(folder, "small", preset("small"))
+        load_run(folder, "small", preset("small"))
     assert exc.value.message.startswith(f"{folder / 'run.json'}: {said}")
     assert f"leave {folder} out of the fit" in exc.value.hint
 
@@ -92,7 +92,7 @@ def test_a_push_measured_after_its_wait_is_refused(tmp_path):
     doc = json.loads((folder / "run.json").read_text())
     assert [p["phase"] for p in doc["phases"]][:2] == ["push", "wait"]      # the record keeps commanded order
     with pytest.raises(CalibrationError) as exc:
-        hop.load_run(folder, "small", preset("small"))
+        load_run(folder, "small", preset("small"))
     assert exc.value.message == (f"{folder / 'run.json'}: cycle 1's wait is measured at 300.045 ms, not after "
                                  "cycle 1's push (commanded before it) at 305.045 ms: the record's phase times "
                                  "are not a hop's")

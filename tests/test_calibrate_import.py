@@ -68,7 +68,8 @@ def test_beam_in_cm_warns_then_fits_as_metres(tmp_path):
     assert wrong["amplitude_m"] == pytest.approx(100 * metres["amplitude_m"], rel=1e-6)
     right, err = beam_json(cm, "--units", "cm")
     assert right["warnings"] == [] and "warning" not in err
-    for key in ("natural_frequency_hz", "damping_ratio", "stiffness_n_per_m", "hinge_stiffness_nm_per_rad"):
+    for key in ("natural_frequency_hz", "damping_ratio", "stiffness_n_per_m",
+                "compliance.hinge_stiffness_nm_per_rad"):
         assert right[key]["value"] == pytest.approx(metres[key]["value"], rel=1e-7), key   # the fit's own tolerance
     assert right["amplitude_m"] == pytest.approx(metres["amplitude_m"], rel=1e-7)
     # mirrored and renamed: the same beam
@@ -110,7 +111,7 @@ def test_ramp_track_in_mm(tmp_path):
     assert res.exit_code == 0, res.output
     got = json.loads(res.stdout)
     assert got["warnings"] == [] and got["angles_deg"][0] == pytest.approx(metres["angles_deg"][0], rel=1e-9)
-    assert got["mu_static"]["value"] == pytest.approx(metres["mu_static"]["value"], rel=1e-9)
+    assert got["contact.foot_friction"]["value"] == pytest.approx(metres["contact.foot_friction"]["value"], rel=1e-9)
     assert ramp.board_length_warning(0.3) is None
 
 

@@ -76,8 +76,8 @@ def test_servo_fits_of_the_real_sg90s_print_their_values(shared_data, name, file
 
 EXPECTED = {
     "hinge_damping_nocoulomb": """
-        hinge_stiffness 1.461e-4 N·m/rad ± 0.2 % (95 %: 1.456e-4 … 1.466e-4) TOO NARROW: the residual (0.79 mm RMS)
-        hinge_damping 1.588e-6 N·m·s/rad ± 1.1 % (95 %: 1.553e-6 … 1.623e-6) TOO NARROW: the residual (0.79 mm RMS)
+        compliance.hinge_stiffness 1.461e-4 N·m/rad ± 0.2 % (95 %: 1.456e-4 … 1.466e-4) TOO NARROW: the residual (0.79
+        compliance.hinge_damping 1.588e-6 N·m·s/rad ± 1.1 % (95 %: 1.553e-6 … 1.623e-6) TOO NARROW: the residual (0.79
         neutral_angle 95.00 deg ± 0.3 % (95 %: 94.35 … 95.65)
         coulomb_friction not fitted (--coulomb off)
         natural_frequency 2.087 Hz
@@ -93,8 +93,8 @@ EXPECTED = {
     # forward differences it replaced (3e-5 of a column against 3e-4), which had these at
     # 1.587e-6 and 7.192e-8 [1.468e-8, 1.292e-7] (a thousandth of a standard deviation away)
     "hinge_damping": """
-        hinge_stiffness 1.458e-4 N·m/rad ± 0.2 % (95 %: 1.453e-4 … 1.463e-4) TOO NARROW: the residual (0.78 mm RMS)
-        hinge_damping 1.534e-6 N·m·s/rad ± 1.8 % (95 %: 1.480e-6 … 1.588e-6) TOO NARROW: the residual (0.78 mm RMS)
+        compliance.hinge_stiffness 1.458e-4 N·m/rad ± 0.2 % (95 %: 1.453e-4 … 1.463e-4) TOO NARROW: the residual (0.78
+        compliance.hinge_damping 1.534e-6 N·m·s/rad ± 1.8 % (95 %: 1.480e-6 … 1.588e-6) TOO NARROW: the residual (0.78
         neutral_angle 94.99 deg ± 0.3 % (95 %: 94.35 … 95.64)
         coulomb_friction 7.190e-8 N·m ± 41 % (95 %: 1.466e-8 … 1.291e-7)
         coulomb_friction fitted: significant (score test p = 1.7e-05)

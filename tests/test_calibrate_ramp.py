@@ -16,8 +16,9 @@ def test_mu_is_tan_of_mean_angle():
     truth = synthetic.RampTruth()
     angles = synthetic.ramp_angles(truth, np.random.default_rng(21))
     fit = ramp.fit_ramp(angles)
-    assert fit.mu_static.value == pytest.approx(math.tan(math.radians(np.mean(angles))), rel=0.01)
-    assert fit.mu_static.value == pytest.approx(truth.mu_static, rel=0.03)
+    mu = fit.estimates["contact.foot_friction"]
+    assert mu.value == pytest.approx(math.tan(math.radians(np.mean(angles))), rel=0.01)
+    assert mu.value == pytest.approx(truth.mu_static, rel=0.03)
 
 
 RAMP_DRAWS = 400      # 0.3 s in all
@@ -29,7 +30,7 @@ def test_ramp_intervals_cover_over_seeds():
     truth = synthetic.RampTruth()
     covered = 0
     for seed in range(RAMP_DRAWS):
-        mu = ramp.fit_ramp(synthetic.ramp_angles(truth, np.random.default_rng(seed))).mu_static
+        mu = ramp.fit_ramp(synthetic.ramp_angles(truth, np.random.default_rng(seed))).estimates["contact.foot_friction"]
         covered += mu.ci95_low <= truth.mu_static <= mu.ci95_high
     assert covered >= coverage_floor(RAMP_DRAWS), covered
 
@@ -38,9 +39,10 @@ def test_interval_by_hand():
     """Three trials 40, 41, 42 deg: mean 41, s = 1, t(0.975, 2) = 4.303."""
     fit = ramp.fit_ramp(np.array([40.0, 41.0, 42.0]))
     half = 4.302653 * 1 / math.sqrt(3)
-    assert fit.mu_static.ci95_low == pytest.approx(math.tan(math.radians(41 - half)), rel=1e-6)
-    assert fit.mu_static.ci95_high == pytest.approx(math.tan(math.radians(41 + half)), rel=1e-6)
-    assert fit.mu_static.std == pytest.approx(math.radians(1 / math.sqrt(3)) / math.cos(math.radians(41)) ** 2)
+    mu = fit.estimates["contact.foot_friction"]
+    assert mu.ci95_low == pytest.approx(math.tan(math.radians(41 - half)), rel=1e-6)
+    assert mu.ci95_high == pytest.approx(math.tan(math.radians(41 + half)), rel=1e-6)
+    assert mu.std == pytest.approx(math.radians(1 / math.sqrt(3)) / math.cos(math.radians(41)) ** 2)
 
 
 def test_identical_readings_give_the_resolutions_interval_not_a_point():
@@ -49,9 +51,10 @@ def test_identical_readings_give_the_resolutions_interval_not_a_point():
     tan(30 +- 4.303 * 0.2887 / sqrt(3)) = [0.5608, 0.5942], never [0.5774, 0.5774]."""
     fit = ramp.fit_ramp(np.array([30.0, 30.0, 30.0]))
     half = 4.302653 * (1 / math.sqrt(12)) / math.sqrt(3)
-    assert fit.mu_static.ci95_low == pytest.approx(math.tan(math.radians(30 - half)), rel=1e-6)
-    assert fit.mu_static.ci95_high == pytest.approx(math.tan(math.radians(30 + half)), rel=1e-6)
-    assert fit.mu_static.ci95_low == pytest.approx(0.5608, abs=1e-4)
+    mu = fit.estimates["contact.foot_friction"]
+    assert mu.ci95_low == pytest.approx(math.tan(math.radians(30 - half)), rel=1e-6)
+    assert mu.ci95_high == pytest.approx(math.tan(math.radians(30 + half)), rel=1e-6)
+    assert mu.ci95_low == pytest.approx(0.5608, abs=1e-4)
     assert fit.std_angle_deg == pytest.approx(0.288675, rel=1e-5) and "reading resolution" in fit.notes[0]
     # a finer reading (0.1 deg) narrows it tenfold; spread above the floor is the trials' own
     fine = ramp.fit_ramp(np.array([30.0, 30.0, 30.0]), resolution_deg=0.1)

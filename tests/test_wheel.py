@@ -55,7 +55,7 @@ def test_installed_command_fits_a_bundled_recording_from_an_empty_folder(wheel_v
     fit = run_installed(wheel_venv, [wheel_venv.bin / "locust", "calibrate", "ramp", ramp, "--json", "--no-plot"],
                         folder)
     assert fit.returncode == 0, fit.stderr
-    assert json.loads(fit.stdout)["mu_static"]["value"] == pytest.approx(1.7112949, rel=1e-6)
+    assert json.loads(fit.stdout)["contact.foot_friction"]["value"] == pytest.approx(1.7112949, rel=1e-6)
     assert list(folder.iterdir()) == []       # --no-plot: nothing written where it ran
 
 

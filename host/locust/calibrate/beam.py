@@ -21,7 +21,11 @@ Hinge mapping for the model (pseudo-rigid-body, one lumped hinge at the clamp): 
 is a rigid bar of length L on a torsional spring, the mass at its tip, small angles
 (tip displacement = L*theta). Equal tip force for equal deflection gives
 
-    k_rot = k*L^2 [N*m/rad],  b_rot = b*L^2 [N*m*s/rad].
+    k_rot = k*L^2 [N*m/rad],  b_rot = b*L^2 [N*m*s/rad],
+
+the robot's ``compliance.hinge_stiffness_nm_per_rad`` and ``compliance.hinge_damping_nms_per_rad``,
+named so in the fit (:attr:`BeamFit.estimates`); the oscillator's own values keep names of
+their own and are never written to a robot.
 
 Assumptions: small deflection (tip motion << L), mass concentrated at the tip, linear
 viscous damping, the clamp rigid, the cardstock hinge of the robot made of the same
@@ -60,6 +64,8 @@ START_COUNT = 3                             # starts refined by least squares: t
 RELEASE_S = 0.015                           # a release transient dies out within this of the drop ...
 RELEASE_Z = 4.0                             # ... and leaves residuals above this many noise sigmas
 START_SAMPLES = 2048                        # the start grid looks at the window's first samples (the ring-down)
+STIFFNESS = "compliance.hinge_stiffness_nm_per_rad"   # the robot values the hinge mapping gives
+DAMPING = "compliance.hinge_damping_nms_per_rad"
 
 
 @dataclass(frozen=True)
@@ -81,8 +87,10 @@ class BeamFit:
         ``fn * sqrt(1 - zeta^2)``.
     stiffness_n_per_m, damping_ns_per_m : Estimate
         The tip's stiffness ``m*wn^2`` and damping ``2*zeta*m*wn``.
-    hinge_stiffness_nm_per_rad, hinge_damping_nms_per_rad : Estimate or None
-        Their pseudo-rigid-body hinge equivalents ``k L^2`` and ``b L^2`` (None without the length).
+    estimates : dict of str to Estimate
+        Their pseudo-rigid-body hinge equivalents ``k L^2`` and ``b L^2``, the robot's
+        ``compliance.hinge_stiffness_nm_per_rad`` and ``compliance.hinge_damping_nms_per_rad``
+        (empty without the length).
     amplitude_m, rms_residual_m : float
         The oscillation's amplitude at the window's start, and the fit's RMS residual.
     residual_autocorrelation : float
@@ -107,8 +115,7 @@ class BeamFit:
     damped_frequency_hz: float
     stiffness_n_per_m: Estimate
     damping_ns_per_m: Estimate
-    hinge_stiffness_nm_per_rad: Estimate | None
-    hinge_damping_nms_per_rad: Estimate | None
+    estimates: dict[str, Estimate]
     amplitude_m: float
     rms_residual_m: float
     residual_autocorrelation: float     # lag-1; above 2/sqrt(n) the intervals are widened for it
@@ -125,15 +132,15 @@ class BeamFit:
         -------
         dict
             ``experiment`` ("beam"), the inputs, each :class:`~.fitstats.Estimate` as its
-            :meth:`~.fitstats.Estimate.as_dict` (None when absent) and the fit's figures,
-            under the field names (units in them).
+            :meth:`~.fitstats.Estimate.as_dict` (the robot's values under their keys, None
+            without the length) and the fit's figures, under the field names (units in them).
         """
         out = {"experiment": "beam", "source": self.source, "mass_kg": self.mass_kg,
                "effective_mass_kg": self.effective_mass_kg, "length_m": self.length_m}
-        for name in ("natural_frequency_hz", "damping_ratio", "stiffness_n_per_m", "damping_ns_per_m",
-                     "hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad"):
-            est = getattr(self, name)
-            out[name] = None if est is None else est.as_dict()
+        for name in ("natural_frequency_hz", "damping_ratio", "stiffness_n_per_m", "damping_ns_per_m"):
+            out[name] = getattr(self, name).as_dict()
+        for key in (STIFFNESS, DAMPING):
+            out[key] = self.estimates[key].as_dict() if key in self.estimates else None
         out.update(damped_frequency_hz=self.damped_frequency_hz, amplitude_m=self.amplitude_m,
                    rms_residual_m=self.rms_residual_m, residual_autocorrelation=self.residual_autocorrelation,
                    n_samples=self.n_samples,
@@ -274,10 +281,10 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
     b = 2 * zeta * m * wn
     grad_k = grad_fn * 2 * k / fn
     grad_b = 2 * m * 2 * np.pi * (zeta * grad_fn + fn * grad_zeta)
-    hinge_k = hinge_b = None
+    hinge = {}
     if length_m is not None:
-        hinge_k = cov.estimate(k * length_m**2, grad_k * length_m**2)
-        hinge_b = cov.estimate(b * length_m**2, grad_b * length_m**2)
+        hinge = {STIFFNESS: cov.estimate(k * length_m**2, grad_k * length_m**2),
+                 DAMPING: cov.estimate(b * length_m**2, grad_b * length_m**2)}
     fine_t = np.linspace(t[0], t[-1], max(20 * len(t), 2000))
     curves = Curves(x=t, data=y * 1e3, model=(y - r) * 1e3, x_label="t [s]",
                     y_label="tip displacement [mm]", title=f"beam: {Path(source).name}",
@@ -287,7 +294,7 @@ def fit_beam(t_s: np.ndarray, displacement_m: np.ndarray, mass_kg: float, *, len
         natural_frequency_hz=cov.estimate(fn, grad_fn), damping_ratio=cov.estimate(zeta, grad_zeta),
         damped_frequency_hz=fn * float(np.sqrt(1 - zeta**2)),
         stiffness_n_per_m=cov.estimate(k, grad_k), damping_ns_per_m=cov.estimate(b, grad_b),
-        hinge_stiffness_nm_per_rad=hinge_k, hinge_damping_nms_per_rad=hinge_b, amplitude_m=amp,
+        estimates=hinge, amplitude_m=amp,
         rms_residual_m=rms, residual_autocorrelation=rho, n_samples=len(t), fit_start_s=float(t[0]),
         fit_end_s=float(t[-1]),
         mapping=MAPPING, curves=curves,

@@ -16,15 +16,19 @@ plane), the swing obeys, at any angle::
 - ``tau_c`` [N*m] Coulomb friction, fitted only when the data show it: kept when it lowers
   the residual beyond chance (F test, p < 0.001) and its 95 % interval excludes zero.
 
+``k`` and ``b`` are the robot's ``compliance.hinge_stiffness_nm_per_rad`` and
+``compliance.hinge_damping_nms_per_rad``, named so in the fit; ``theta0``, ``tau_c`` and the
+rest are the rig's, under names of their own, and never written to a robot.
+
 The swing starts at the fit window's start, its initial angle and rate fitted with ``k``,
 ``b``, ``theta0``: in closed form where the equation is linear (no weight's moment, no
 Coulomb term), else integrated (LSODA, relative tolerance 1e-10) with its variational
-equations for the Jacobian (one integration gives every column). The residual is the
+equations for the Jacobian (one integration gives every column; :mod:`.hingeswing`). The residual is the
 marker's position, x and y [m], against ``pivot + R*(cos theta, sin theta)``: the distance
 ``R`` from the hinge to the marker is fitted too, and so is the pivot unless ``--pivot``
 gives it (its start: the centre of the circle fitted to the marker's arc), so its
 uncertainty is in the intervals of ``k`` and ``b``. Intervals come from the residual Jacobian
-(:mod:`.fitstats`). Start values come from the swing itself: the period from its zero
+(:mod:`.fitstats`). Start values come from the swing itself (:mod:`.hingestart`): the period from its zero
 crossings, the decay from its successive peaks (never a spectral peak, which can lock onto
 the record length). A rig no link can be is refused (:func:`check_rig`: in plane, ``I``
 below ``M*D^2``), and a value the swing does not determine is not identifiable
@@ -40,17 +44,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy import integrate, optimize, stats
+from scipy import optimize, stats
 
 from ..errors import CalibrationError
-from ..params import GRAVITY_M_PER_S2
 from .curves import Curves
 from .fitparams import FitParameter, FitParameters
 from .fitstats import Estimate, covariance
+from .hingestart import SwingShape, angle_noise_rad, circle_fit, release_window, start_values, swing_angle, swing_shape
+from .hingeswing import HingeRig, check_rig, is_linear, simulate_hinge, swing_sensitivities
 
-GRAVITY_CHOICES = ("in-plane", "out-of-plane")
+STIFFNESS = "compliance.hinge_stiffness_nm_per_rad"   # the robot values a swing determines
+DAMPING = "compliance.hinge_damping_nms_per_rad"
 MIN_SAMPLES = 20
-MIN_HALF_SWINGS = 3              # zero crossings needed for a period
 COULOMB_P_VALUE = 1e-3
 SMALL_ARC_DEG = 20.0             # a circle fit over less arc than this places the pivot poorly
 MAX_RELATIVE_STD = 0.25          # identifiable: 95% interval within about +-50% of the value
@@ -62,34 +67,8 @@ AT_BOUND = 1e-6                  # a value below this share of its start has run
 FOLLOWS_SHARE = 0.5
 MODEL = ("I*theta'' = -k*(theta - theta0) - b*theta' - M*g*D*cos(theta) [gravity in plane] "
          "- tau_c*sign(theta') [Coulomb, when significant]")
+LINEAR_FD_STEP = 1e-6  # the closed form's central differences, per unit of the solver's variable
 
-
-@dataclass(frozen=True)
-class HingeRig:
-    """The swinging link: inertia about the hinge, and where its weight acts.
-
-    Attributes
-    ----------
-    inertia_kgm2 : float
-        The link's moment of inertia about the hinge.
-    gravity : str
-        ``"in-plane"`` (the link swings in a vertical plane) or ``"out-of-plane"`` (the hinge
-        axis vertical: the weight has no moment).
-    mass_kg : float
-        The link's mass (in plane only).
-    com_m : float
-        Hinge to centre of mass, along the hinge-marker line (in plane only).
-    """
-
-    inertia_kgm2: float
-    gravity: str = "out-of-plane"          # in-plane | out-of-plane
-    mass_kg: float = 0.0
-    com_m: float = 0.0                     # hinge to centre of mass [m], along the hinge-marker line
-
-    @property
-    def gravity_moment_nm(self) -> float:
-        """M*g*D: the weight's largest moment about the hinge (0 out of plane)."""
-        return self.mass_kg * GRAVITY_M_PER_S2 * self.com_m if self.gravity == "in-plane" else 0.0
 
 
 @dataclass(frozen=True)
@@ -103,8 +82,12 @@ class HingeFit:
         The recording's name.
     rig : HingeRig
         The link as given.
-    hinge_stiffness_nm_per_rad, hinge_damping_nms_per_rad, neutral_angle_deg : Estimate
-        ``k``, ``b`` and ``theta0`` (from the track's +x axis, counter-clockwise).
+    estimates : dict of str to Estimate
+        The robot's values the swing measures, by their keys: ``k`` as
+        ``compliance.hinge_stiffness_nm_per_rad`` and ``b`` as
+        ``compliance.hinge_damping_nms_per_rad``.
+    neutral_angle_deg : Estimate
+        ``theta0`` (from the track's +x axis, counter-clockwise): the rig's, no robot value.
     coulomb_friction_nm : Estimate or None
         ``tau_c``, when kept (see ``coulomb_note``).
     coulomb_note : str
@@ -135,14 +118,13 @@ class HingeFit:
         Warnings for the report (a poorly placed pivot, a value the swing does not determine,
         a model that does not follow the swing).
     identifiable : dict of str to bool
-        Whether the swing determines ``hinge_stiffness_nm_per_rad`` and
-        ``hinge_damping_nms_per_rad`` (:func:`identifiable`); only those are written.
+        Whether the swing determines each of :attr:`estimates` (:func:`identifiable`); only
+        those are written.
     """
 
     source: str
     rig: HingeRig
-    hinge_stiffness_nm_per_rad: Estimate
-    hinge_damping_nms_per_rad: Estimate
+    estimates: dict[str, Estimate]
     neutral_angle_deg: Estimate
     coulomb_friction_nm: Estimate | None
     coulomb_note: str
@@ -170,14 +152,14 @@ class HingeFit:
         -------
         dict
             ``experiment`` ("hinge"), the rig, each :class:`~.fitstats.Estimate` as its
-            :meth:`~.fitstats.Estimate.as_dict` (None when absent), the fit's figures under
-            the field names (units in them) and the model's equation.
+            :meth:`~.fitstats.Estimate.as_dict` (None when absent; the robot's values under
+            their keys), the fit's figures under the field names (units in them) and the
+            model's equation.
         """
         out = {"experiment": "hinge", "source": self.source, "inertia_kgm2": self.rig.inertia_kgm2,
                "gravity": self.rig.gravity, "mass_kg": self.rig.mass_kg or None, "com_m": self.rig.com_m or None}
-        for name in ("hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad", "neutral_angle_deg",
-                     "coulomb_friction_nm"):
-            est = getattr(self, name)
+        for name, est in (*self.estimates.items(), ("neutral_angle_deg", self.neutral_angle_deg),
+                          ("coulomb_friction_nm", self.coulomb_friction_nm)):
             out[name] = None if est is None else est.as_dict()
             if name in self.identifiable:
                 out[name]["identifiable"] = self.identifiable[name]
@@ -189,410 +171,6 @@ class HingeFit:
                    fit_window_s=[self.fit_start_s, self.fit_end_s], fit_time_s=self.fit_time_s, model=MODEL,
                    notes=list(self.notes))
         return out
-
-
-# -- geometry -----------------------------------------------------------------------
-def circle_fit(x_m: np.ndarray, y_m: np.ndarray) -> tuple[float, float, float]:
-    """The circle nearest the points: the algebraic (Kasa) fit, refined by Levenberg-Marquardt
-    on the geometric distances.
-
-    Parameters
-    ----------
-    x_m, y_m : array_like
-        The points [m].
-
-    Returns
-    -------
-    tuple of float
-        Centre x, centre y and radius [m].
-    """
-    x, y = np.asarray(x_m, float), np.asarray(y_m, float)
-    a = np.column_stack([x, y, np.ones_like(x)])
-    sol, *_ = np.linalg.lstsq(a, x**2 + y**2, rcond=None)
-    cx, cy = sol[0] / 2, sol[1] / 2
-    r = math.sqrt(max(sol[2] + cx**2 + cy**2, 0.0))
-    res = optimize.least_squares(lambda p: np.hypot(x - p[0], y - p[1]) - p[2], [cx, cy, r], method="lm")
-    cx, cy, r = res.x
-    return float(cx), float(cy), float(abs(r))
-
-
-def swing_angle(x_m: np.ndarray, y_m: np.ndarray, pivot: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
-    """The marker's angle about the pivot and its distance from it.
-
-    Parameters
-    ----------
-    x_m, y_m : array_like
-        The marker's track [m].
-    pivot : tuple of float
-        The pivot (x, y) [m].
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        The angle [rad] (unwrapped, from +x, counter-clockwise) and the distance [m].
-    """
-    dx, dy = np.asarray(x_m) - pivot[0], np.asarray(y_m) - pivot[1]
-    return np.unwrap(np.arctan2(dy, dx)), np.hypot(dx, dy)
-
-
-# -- the model ----------------------------------------------------------------------
-RTOL = 1e-10          # LSODA's relative tolerance on the swing (its angle and rate)
-ATOL = 1e-12          # ... and absolute [rad, rad/s]
-LINEAR_FD_STEP = 1e-6  # the closed form's central differences, per unit of the solver's variable
-
-
-def simulate_hinge(t_s: np.ndarray, params: np.ndarray, rig: HingeRig,
-                   coulomb_width_rad_per_s: float = 0.0) -> np.ndarray:
-    """The swing's angle from ``t_s[0]`` (see the module docstring): in closed form where the
-    model is linear (no weight's moment, no Coulomb term), else integrated (LSODA).
-
-    Parameters
-    ----------
-    t_s : array_like
-        Times [s], increasing.
-    params : array_like
-        k [N*m/rad], b [N*m*s/rad], theta0 [rad], the angle [rad] and rate [rad/s] at
-        ``t_s[0]``, and optionally tau_c [N*m].
-    rig : HingeRig
-        The link.
-    coulomb_width_rad_per_s : float
-        Rate over which the Coulomb torque turns (``tau_c * tanh(rate / width)``); must be
-        positive when tau_c is nonzero.
-
-    Returns
-    -------
-    numpy.ndarray
-        theta at ``t_s`` [rad].
-    """
-    t = np.asarray(t_s, dtype=float) - t_s[0]
-    if is_linear(params, rig):
-        return linear_swing(t, params, rig.inertia_kgm2)
-    return _integrate(t, params, rig, coulomb_width_rad_per_s, sensitivities=False)[:, 0]
-
-
-def is_linear(params: np.ndarray, rig: HingeRig) -> bool:
-    """Whether the swing equation is linear (no weight's moment, no Coulomb term): it then has
-    a closed form.
-
-    Parameters
-    ----------
-    params : array_like
-        As :func:`simulate_hinge` takes them.
-    rig : HingeRig
-
-    Returns
-    -------
-    bool
-    """
-    return rig.gravity_moment_nm == 0 and len(params) == 5
-
-
-def linear_swing(t: np.ndarray, params: np.ndarray, inertia_kgm2: float) -> np.ndarray:
-    """The linear swing ``I*theta'' = -k*(theta - theta0) - b*theta'`` in closed form: under-,
-    critically or over-damped, from the angle and rate at ``t = 0``.
-
-    Parameters
-    ----------
-    t : numpy.ndarray
-        Times from the start [s].
-    params : array_like
-        k [N*m/rad], b [N*m*s/rad], theta0 [rad], the start angle [rad] and rate [rad/s].
-    inertia_kgm2 : float
-
-    Returns
-    -------
-    numpy.ndarray
-        theta at ``t`` [rad].
-    """
-    k, b, th0, th_start, w_start = (float(v) for v in params[:5])
-    alpha = b / (2 * inertia_kgm2)
-    wd2 = k / inertia_kgm2 - alpha * alpha
-    u0 = th_start - th0
-    v0 = w_start + alpha * u0
-    decay = np.exp(-alpha * t)
-    if wd2 > 0:
-        wd = math.sqrt(wd2)
-        u = decay * (u0 * np.cos(wd * t) + v0 * np.sin(wd * t) / wd)
-    elif wd2 < 0:
-        g = math.sqrt(-wd2)
-        # e^(-alpha t) cosh(g t) and sinh(g t)/g without overflow (g t large) or cancellation (small)
-        fast, slow = np.exp((g - alpha) * t), np.exp(-(g + alpha) * t)
-        near = g * t < 1.0
-        cosh_part = np.where(near, decay * np.cosh(np.where(near, g * t, 0.0)), (fast + slow) / 2)
-        sinh_part = np.where(near, decay * np.sinh(np.where(near, g * t, 0.0)) / g, (fast - slow) / (2 * g))
-        u = u0 * cosh_part + v0 * sinh_part
-    else:
-        u = decay * (u0 + v0 * t)
-    return th0 + u
-
-
-def swing_sensitivities(t_s: np.ndarray, params: np.ndarray, rig: HingeRig,
-                        coulomb_width_rad_per_s: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """The swing's angle and its derivative in each of ``params``, integrated together: the
-    swing equation and its variational equations in one LSODA run, the step chosen by the
-    swing's own tolerance (the derivatives follow the same steps). One integration gives
-    every column of the fit's Jacobian, exact to the integrator's tolerance; finite
-    differences would take one integration a column, each carrying the tolerance divided by
-    the step (the step 3e-5: 2e-4 of the column, where these agree with wide central
-    differences to 4e-6).
-
-    Parameters
-    ----------
-    t_s : array_like
-        Times [s], increasing.
-    params : array_like
-        As :func:`simulate_hinge` takes them (5, or 6 with tau_c).
-    rig : HingeRig
-    coulomb_width_rad_per_s : float
-        As :func:`simulate_hinge`.
-
-    Returns
-    -------
-    theta : numpy.ndarray, shape (n,)
-        [rad].
-    dtheta : numpy.ndarray, shape (n, len(params))
-        d theta / d param, in rad per the parameter's unit.
-    """
-    t = np.asarray(t_s, dtype=float) - t_s[0]
-    sol = _integrate(t, params, rig, coulomb_width_rad_per_s, sensitivities=True)
-    return sol[:, 0], sol[:, 2:2 + len(params)]
-
-
-def _integrate(t: np.ndarray, params: np.ndarray, rig: HingeRig, eps: float, *, sensitivities: bool) -> np.ndarray:
-    """LSODA of the swing (columns theta, rate), with ``sensitivities`` its variational
-    equations after them (d theta / d p for each p, then d rate / d p)."""
-    k, b, th0, th_start, w_start = (float(v) for v in params[:5])
-    tau_c = float(params[5]) if len(params) > 5 else 0.0
-    n = len(params)
-    inv_i, mgd = 1.0 / rig.inertia_kgm2, rig.gravity_moment_nm
-
-    def rhs(_t, s):
-        th, w = s[0], s[1]
-        torque = -k * (th - th0) - b * w - mgd * math.cos(th)
-        if tau_c:
-            torque -= tau_c * math.tanh(w / eps)
-        return [w, torque * inv_i]
-
-    # the variational equations: d/dt (d theta / dp) = d rate / dp, and
-    # d/dt (d rate / dp) = (d torque/d theta * d theta/dp + d torque/d rate * d rate/dp + d torque/dp) / I,
-    # written out for the five values and for the six (with tau_c): LSODA calls this some
-    # 10^4 times a swing, and a loop or a numpy array here costs it more than the arithmetic
-    cos, sin, tanh = math.cos, math.sin, math.tanh
-
-    def rhs5(_t, s):
-        th, w, a1, a2, a3, a4, a5, r1, r2, r3, r4, r5 = s.tolist()
-        torque = -k * (th - th0) - b * w - mgd * cos(th)
-        ba, br = (-k + mgd * sin(th)) * inv_i, -b * inv_i
-        return [w, torque * inv_i, r1, r2, r3, r4, r5,
-                ba * a1 + br * r1 + (th0 - th) * inv_i, ba * a2 + br * r2 - w * inv_i,
-                ba * a3 + br * r3 + k * inv_i, ba * a4 + br * r4, ba * a5 + br * r5]
-
-    def rhs6(_t, s):
-        th, w, a1, a2, a3, a4, a5, a6, r1, r2, r3, r4, r5, r6 = s.tolist()
-        turn = tanh(w / eps)
-        torque = -k * (th - th0) - b * w - mgd * cos(th) - tau_c * turn
-        ba = (-k + mgd * sin(th)) * inv_i
-        br = (-b - tau_c * (1.0 - turn * turn) / eps) * inv_i
-        return [w, torque * inv_i, r1, r2, r3, r4, r5, r6,
-                ba * a1 + br * r1 + (th0 - th) * inv_i, ba * a2 + br * r2 - w * inv_i,
-                ba * a3 + br * r3 + k * inv_i, ba * a4 + br * r4, ba * a5 + br * r5,
-                ba * a6 + br * r6 - turn * inv_i]
-
-    if not sensitivities:
-        return integrate.odeint(rhs, [th_start, w_start], t, tfirst=True, rtol=RTOL, atol=ATOL, mxstep=50000)
-    start = np.zeros(2 + 2 * n)
-    start[:2] = th_start, w_start
-    start[2 + 3] = 1.0           # d theta / d start angle at the start
-    start[2 + n + 4] = 1.0       # d rate / d start rate at the start
-    # the step is the swing's: its two states carry the tolerance, the derivatives none of it
-    rtol = np.r_[RTOL, RTOL, np.full(2 * n, RTOL)]
-    atol = np.r_[ATOL, ATOL, np.full(2 * n, 1e300)]
-    return integrate.odeint(rhs5 if n == 5 else rhs6, start, t, tfirst=True, rtol=rtol, atol=atol, mxstep=50000)
-
-
-# -- start values --------------------------------------------------------------------
-@dataclass(frozen=True)
-class SwingShape:
-    """What the swing shows before any fit: rest angle, damped period, decay rate, amplitude.
-
-    Attributes
-    ----------
-    rest_rad : float
-        The final rest angle (median of the last fifth).
-    damped_omega_rad_per_s : float
-        Damped angular frequency, from the median spacing of the rest crossings.
-    decay_per_s : float
-        Exponential decay rate of the peaks (0 with fewer than two clear peaks).
-    amplitude_rad : float
-        Largest excursion from rest.
-    crossings : int
-        Crossings of the rest angle.
-    """
-
-    rest_rad: float
-    damped_omega_rad_per_s: float
-    decay_per_s: float
-    amplitude_rad: float
-    crossings: int
-
-
-def swing_shape(t_s: np.ndarray, theta: np.ndarray, source: str) -> SwingShape:
-    """The swing's shape from its crossings of the final rest angle and the peaks between them.
-
-    Parameters
-    ----------
-    t_s : array_like
-        Sample times [s].
-    theta : numpy.ndarray
-        The link's angle [rad].
-    source : str
-        The recording's name, for the message.
-
-    Returns
-    -------
-    SwingShape
-
-    Raises
-    ------
-    CalibrationError
-        Fewer than ``MIN_HALF_SWINGS`` crossings.
-    """
-    rest = float(np.median(theta[len(theta) * 4 // 5:]))
-    u = theta - rest
-    noise = angle_noise_rad(theta)
-    amp = float(np.max(np.abs(u)))
-    band = max(3 * noise, 0.02 * amp)                             # hysteresis: noise at rest is no crossing
-    crossings, peaks, side, last = [], [], 0, 0
-    for i, v in enumerate(u):
-        s = 1 if v > band else -1 if v < -band else 0
-        if s == 0:
-            continue
-        if side and s != side:
-            j = max(k for k in range(last, i) if np.sign(u[k]) == side)   # the last sample on the old side
-            tc = t_s[j] + (t_s[j + 1] - t_s[j]) * u[j] / (u[j] - u[j + 1]) if u[j] != u[j + 1] else t_s[j]
-            crossings.append(float(tc))
-            seg = np.abs(u[last:i])
-            peaks.append((float(t_s[last + int(np.argmax(seg))]), float(seg.max())))
-        if s != side:
-            last = i
-        side = s
-    if len(crossings) < MIN_HALF_SWINGS:
-        raise CalibrationError(f"{source}: the link crosses its rest angle {len(crossings)} times in the fit window "
-                               f"(need {MIN_HALF_SWINGS})",
-                               "film until the swing has died out, or widen --start-s/--end-s; "
-                               "see calibration/protocols/hinge.md")
-    half = float(np.median(np.diff(crossings)))
-    wd = math.pi / half
-    decay = 0.0
-    big = [(tp, a) for tp, a in peaks if a > 3 * band]
-    if len(big) >= 2:
-        slope = np.polyfit([p[0] for p in big], np.log([p[1] for p in big]), 1)[0]
-        decay = max(-float(slope), 0.0)
-    return SwingShape(rest, wd, decay, amp, len(crossings))
-
-
-def start_values(t_s: np.ndarray, theta: np.ndarray, rig: HingeRig, shape: SwingShape) -> np.ndarray:
-    """Start values of the fit from the linearised swing about its rest.
-
-    Parameters
-    ----------
-    t_s : array_like
-        Sample times of the fit window [s].
-    theta : numpy.ndarray
-        The angle there [rad].
-    rig : HingeRig
-        The link.
-    shape : SwingShape
-        The swing's shape (:func:`swing_shape`).
-
-    Returns
-    -------
-    numpy.ndarray, shape (5,)
-        k [N*m/rad], b [N*m*s/rad], theta0 [rad], the first angle [rad] and rate [rad/s].
-    """
-    wn = math.hypot(shape.damped_omega_rad_per_s, shape.decay_per_s)
-    stiff_total = rig.inertia_kgm2 * wn**2
-    mgd = rig.gravity_moment_nm
-    k0 = stiff_total + mgd * math.sin(shape.rest_rad)
-    k0 = max(k0, 0.05 * stiff_total)
-    b0 = max(2 * shape.decay_per_s * rig.inertia_kgm2, 1e-3 * 2 * rig.inertia_kgm2 * wn)
-    th0 = shape.rest_rad + mgd * math.cos(shape.rest_rad) / k0
-    n = min(5, len(t_s))
-    rate = float(np.polyfit(t_s[:n] - t_s[0], theta[:n], 2)[1]) if n >= 3 else 0.0
-    return np.array([k0, b0, th0, float(theta[0]), rate])
-
-
-def angle_noise_rad(theta: np.ndarray) -> float:
-    """The angle's tracking noise: from its second differences where the link is quietest (the
-    first or the last fifth of the record: held before the release, or at rest after it).
-
-    Parameters
-    ----------
-    theta : numpy.ndarray
-        The angle [rad], evenly sampled.
-
-    Returns
-    -------
-    float
-        Standard deviation of one angle sample [rad] (the second difference's over sqrt(6)).
-    """
-    fifth = max(len(theta) // 5, 4)
-    parts = [np.diff(theta[:fifth], 2), np.diff(theta[-fifth:], 2)]
-    return min(float(np.std(p)) for p in parts if len(p)) / math.sqrt(6)
-
-
-def release_window(t_s: np.ndarray, theta: np.ndarray, start_s: float | None, end_s: float | None) -> np.ndarray:
-    """Samples to fit: the free swing from the first turning point after the release (or from
-    ``start_s``) to ``end_s``.
-
-    The release is the last moment the link is held at its largest excursion from the final
-    rest in the first half of the record: the last sample, before the link has swung a tenth
-    of the way back, within three noise deviations of the level it was held at. A hand lets
-    go over a few hundredths of a second, which is no free swing: the fit starts at the far
-    end of that first swing, where the link turns (a drop's impact is skipped alike in
-    :mod:`.beam`).
-
-    Parameters
-    ----------
-    t_s : numpy.ndarray
-        Sample times [s].
-    theta : numpy.ndarray
-        The angle [rad].
-    start_s, end_s : float or None
-        The window's ends [s] (None: found as above, and the record's end).
-
-    Returns
-    -------
-    numpy.ndarray of bool
-        Which samples are in the window.
-    """
-    end = t_s[-1] if end_s is None else end_s
-    if start_s is None:
-        rest = np.median(theta[len(theta) * 4 // 5:])
-        signed = theta - rest
-        u = np.abs(signed)
-        noise = angle_noise_rad(theta)
-        i = int(np.argmax(u[:max(len(u) // 2, 1)]))
-        leaving = np.nonzero(u[i:] < u[i] - max(0.1 * u[i], 6 * noise))[0]
-        j = i + (int(leaving[0]) if len(leaving) else len(u) - i)
-        level = float(np.median(u[i:j]))
-        release = i + int(np.nonzero(u[i:j] >= level - 3 * noise)[0][-1])
-        start_s = t_s[_first_turn(signed, release, max(3 * noise, 0.02 * u[i]))]
-    return (t_s >= start_s) & (t_s <= end)
-
-
-def _first_turn(u: np.ndarray, release: int, band: float) -> int:
-    """The far extreme of the first swing after ``release`` (``release`` itself without one)."""
-    side = np.sign(u[release])
-    over = np.nonzero(u[release:] * -side > band)[0]
-    if not len(over):
-        return release
-    c1 = release + int(over[0])
-    back = np.nonzero(u[c1:] * side > band)[0]
-    if not len(back):
-        return release
-    c2 = c1 + int(back[0])
-    return c1 + int(np.argmax(np.abs(u[c1:c2])))
 
 
 # -- the fit ------------------------------------------------------------------------
@@ -691,8 +269,8 @@ def fit_hinge(t_s: np.ndarray, x_m: np.ndarray, y_m: np.ndarray, rig: HingeRig, 
                     model_x=fine_t, model_fine=np.degrees(simulate_hinge(fine_t, p, rig, problem.width)))
     rx, ry = np.split(chosen.fun, 2)
     return HingeFit(
-        source=source, rig=rig, hinge_stiffness_nm_per_rad=est["hinge_stiffness_nm_per_rad"],
-        hinge_damping_nms_per_rad=est["hinge_damping_nms_per_rad"], neutral_angle_deg=est["neutral_angle_deg"],
+        source=source, rig=rig, estimates={key: est[key] for key in (STIFFNESS, DAMPING)},
+        neutral_angle_deg=est["neutral_angle_deg"],
         coulomb_friction_nm=est.get("coulomb_friction_nm"), coulomb_note=coulomb_note,
         natural_frequency_hz=wn / (2 * math.pi), damping_ratio=zeta, rest_angle_deg=math.degrees(rest),
         pivot_m=(px, py), pivot_source="given" if pivot is not None else "fitted",
@@ -726,9 +304,10 @@ def identifiable(est: dict[str, Estimate], start: np.ndarray, measured: np.ndarr
     Returns
     -------
     dict of str to bool
-        ``hinge_stiffness_nm_per_rad`` and ``hinge_damping_nms_per_rad`` -> identifiable.
+        ``compliance.hinge_stiffness_nm_per_rad`` and ``compliance.hinge_damping_nms_per_rad``
+        -> identifiable.
     """
-    keys = ("hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad")
+    keys = (STIFFNESS, DAMPING)
     residual = float(np.sqrt(np.mean((measured - model) ** 2)))
     swing = float(np.sqrt(np.mean((measured - np.mean(measured)) ** 2)))
     if residual > FOLLOWS_SHARE * swing:
@@ -777,8 +356,8 @@ class _Swing:
         held = not fit_pivot
         k0, b0, th0, th_start, rate0 = (float(v) for v in p0)
         self.params = FitParameters([
-            FitParameter("hinge_stiffness_nm_per_rad", "N*m/rad", k0, 0.0, scale=self.dyn_scale[0]),
-            FitParameter("hinge_damping_nms_per_rad", "N*m*s/rad", b0, 0.0, scale=self.dyn_scale[1]),
+            FitParameter(STIFFNESS, "N*m/rad", k0, 0.0, scale=self.dyn_scale[0]),
+            FitParameter(DAMPING, "N*m*s/rad", b0, 0.0, scale=self.dyn_scale[1]),
             FitParameter("neutral_angle_rad", "rad", th0),
             FitParameter("start_angle_rad", "rad", th_start),
             FitParameter("start_rate_rad_per_s", "rad/s", rate0, scale=self.dyn_scale[4]),
@@ -872,8 +451,7 @@ class _Swing:
         q = result.x
         params = self.parameters(q)
         v = params.from_vector(q)
-        out = {name: cov.estimate(v[name], params.gradient(q, name))
-               for name in ("hinge_stiffness_nm_per_rad", "hinge_damping_nms_per_rad")}
+        out = {name: cov.estimate(v[name], params.gradient(q, name)) for name in (STIFFNESS, DAMPING)}
         out["neutral_angle_deg"] = cov.estimate(math.degrees(v["neutral_angle_rad"]),
                                                 params.gradient(q, "neutral_angle_rad", math.degrees(1.0)))
         if "coulomb_friction_nm" in v:
@@ -907,43 +485,4 @@ def _rest_angle(p: np.ndarray, rig: HingeRig) -> float:
     root = optimize.least_squares(lambda th: k * (th - th0) + mgd * np.cos(th), [th0]).x[0]
     return float(root)
 
-
-def check_rig(rig: HingeRig) -> None:
-    """Refuse a rig no link can be: an inertia not positive, an unknown gravity, in-plane
-    gravity without the weight's moment, or an inertia about the hinge below ``M*D^2`` (the
-    parallel-axis theorem: the link's own inertia about its centre of mass is never negative).
-
-    Parameters
-    ----------
-    rig : HingeRig
-
-    Raises
-    ------
-    locust.errors.CalibrationError
-        Naming the values and what a link of them would be.
-    """
-    _check_rig(rig)
-    least = rig.mass_kg * rig.com_m ** 2
-    if rig.gravity == "in-plane" and rig.inertia_kgm2 < least * (1 - 1e-9):
-        raise CalibrationError(
-            f"--inertia-kgm2 {rig.inertia_kgm2:g} is below --mass-kg x --com-m^2 = {rig.mass_kg:g} x "
-            f"{rig.com_m:g}^2 = {least:.3g} kg*m^2: no link has less inertia about its hinge than its mass "
-            "has at its centre of mass",
-            "check the three (calibration/protocols/hinge.md): a uniform bar of mass M and length L hinged "
-            "at one end has D = L/2 and I = M*L^2/3 = 4/3 M*D^2")
-
-
-def _check_rig(rig: HingeRig) -> None:
-    if not rig.inertia_kgm2 > 0:
-        raise CalibrationError(f"--inertia-kgm2 must be positive (got {rig.inertia_kgm2})",
-                               "the link's moment of inertia about the hinge, in kg*m^2 "
-                               "(calibration/protocols/hinge.md)")
-    if rig.gravity not in GRAVITY_CHOICES:
-        raise CalibrationError(f"--gravity {rig.gravity!r}: expected in-plane or out-of-plane",
-                               "in-plane: the link swings in a vertical plane; "
-                               "out-of-plane: the hinge axis is vertical")
-    if rig.gravity == "in-plane" and not (rig.mass_kg > 0 and rig.com_m > 0):
-        raise CalibrationError("--gravity in-plane needs --mass-kg and --com-m (the weight's moment M*g*D)",
-                               "weigh the link and measure the hinge-to-centre-of-mass distance "
-                               "(calibration/protocols/hinge.md)")
 

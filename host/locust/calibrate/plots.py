@@ -1,13 +1,18 @@
 """Fit plots: data and model above, residuals below (one such pair per recording), written
-atomically (PNG, SVG or PDF by the path's suffix)."""
+atomically (PNG, SVG or PDF by the path's suffix); and a hop fit's run, its tracked markers
+against the fitted simulation."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..fileio import storable
 from ..plotting import save_png
 from .curves import Curves
+
+if TYPE_CHECKING:
+    from .hopresidual import RunFit
 
 
 def plot_fit(curves: Curves | list[Curves], path: str | Path, subtitle: str = "", force: bool = False) -> Path:
@@ -79,5 +84,35 @@ def fit_figure(curves: Curves | list[Curves], subtitle: str = ""):
         if discrete:      # numbered trials (the ramp's): ticks on whole trials only
             bottom.xaxis.set_major_locator(MaxNLocator(integer=True))
         bottom.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def plot_run(fit: RunFit, path: Path, subtitle: str = "") -> Path:
+    """Tracked markers against the fitted simulation, x and y of each, on the schedule's clock."""
+    return save_png(run_figure(fit, subtitle), path, dpi=110)
+
+
+def run_figure(fit: RunFit, subtitle: str = ""):
+    """The figure :func:`plot_run` writes (a ``matplotlib.figure.Figure``, no display needed)."""
+    from matplotlib.figure import Figure
+
+    markers = list(fit.curves)
+    fig = Figure(figsize=(5.2 * max(len(markers), 1), 5.5))
+    axes = fig.subplots(2, max(len(markers), 1), squeeze=False, sharex=True)
+    for col, m in enumerate(markers):
+        t, x, y, ts, xs, ys = fit.curves[m]
+        lo, hi = float(t[0]), float(t[-1])
+        keep = (ts >= lo) & (ts <= hi)
+        for row, (data, model, label) in enumerate(((x, xs, "x forward"), (y, ys, "y up"))):
+            ax = axes[row, col]
+            ax.plot(t, 1000 * data, ".", ms=3, color="#1f77b4", label="tracked")
+            ax.plot(ts[keep], 1000 * model[keep], "-", lw=1.2, color="#d62728", label="fitted simulation")
+            ax.set_ylabel(f"{m} {label} [mm]")
+            ax.grid(alpha=0.3)
+        axes[0, col].set_title(f"{m}: RMS {1000 * fit.rms_by_marker_m[m]:.2f} mm", fontsize=10)
+        axes[1, col].set_xlabel("t from the first push [s]")
+    axes[0, 0].legend(loc="best", fontsize=8)
+    fig.suptitle(f"{fit.config}: {Path(fit.source).name}" + (f"\n{subtitle}" if subtitle else ""), fontsize=10)
     fig.tight_layout()
     return fig

@@ -7,6 +7,9 @@ trials' spread ``s`` is never taken below what the angle's reading resolution le
 unknown, ``resolution / sqrt(12)`` (a protractor's 1 deg graduation: 0.29 deg): trials read
 alike are alike to the graduation, not identical, and give an interval of that width.
 
+The estimate is the robot's friction the command names (``contact.foot_friction`` by default,
+``contact.nose_friction`` for a robot sliding on its nose), under that key.
+
 A trial can also come from a side-view track of the ramp (markers at both ends of the
 board) and the robot: the ramp angle is that of the board, and the robot starts to slide
 when its distance along the board leaves its resting value. The onset is located by
@@ -30,6 +33,7 @@ from .fitstats import Estimate, t95
 MIN_TRIALS = 2
 READING_RESOLUTION_DEG = 1.0   # a protractor's graduation: the angle is read to the nearest degree
 BOARD_M = (0.05, 3.0, 0.3)     # (least, most, typical) length between the ramp's two markers
+FRICTIONS = ("contact.foot_friction", "contact.nose_friction")   # the robot values a ramp measures
 
 
 @dataclass(frozen=True)
@@ -40,8 +44,9 @@ class RampFit:
     ----------
     source : str
         The recording(s).
-    mu_static : locust.calibrate.fitstats.Estimate
-        ``tan(mean angle)`` (no unit) with its 95% interval.
+    estimates : dict of str to locust.calibrate.fitstats.Estimate
+        ``tan(mean angle)`` (no unit) with its 95% interval, under the friction's robot key
+        (one of :data:`FRICTIONS`).
     mean_angle_deg, std_angle_deg : float
         The trials' mean and standard deviation [deg] (at least the reading's resolution / sqrt(12)).
     n_trials : int
@@ -55,7 +60,7 @@ class RampFit:
     """
 
     source: str
-    mu_static: Estimate
+    estimates: dict[str, Estimate]
     mean_angle_deg: float
     std_angle_deg: float
     n_trials: int
@@ -71,14 +76,14 @@ class RampFit:
         -------
         dict
         """
-        return {"experiment": "ramp", "source": self.source, "mu_static": self.mu_static.as_dict(),
+        return {"experiment": "ramp", "source": self.source, **{k: e.as_dict() for k, e in self.estimates.items()},
                 "mean_angle_deg": self.mean_angle_deg, "std_angle_deg": self.std_angle_deg,
                 "n_trials": self.n_trials, "angles_deg": self.angles_deg, "resolution_deg": self.resolution_deg,
                 "notes": self.notes}
 
 
 def fit_ramp(angles_deg: np.ndarray, source: str = "ramp",
-             resolution_deg: float = READING_RESOLUTION_DEG) -> RampFit:
+             resolution_deg: float = READING_RESOLUTION_DEG, key: str = FRICTIONS[0]) -> RampFit:
     """Static friction ``mu = tan(mean critical angle)`` with a Student-t 95% interval.
 
     Parameters
@@ -90,6 +95,8 @@ def fit_ramp(angles_deg: np.ndarray, source: str = "ramp",
     resolution_deg : float, default 1.0
         How finely each angle was read [deg]; the trials' spread is taken as at least
         ``resolution_deg / sqrt(12)`` (see the module docstring).
+    key : str, default "contact.foot_friction"
+        The robot's friction the estimate is (one of :data:`FRICTIONS`).
 
     Returns
     -------
@@ -98,8 +105,11 @@ def fit_ramp(angles_deg: np.ndarray, source: str = "ramp",
     Raises
     ------
     locust.errors.CalibrationError
-        Fewer than two trials, an angle outside 0..90 deg, or a resolution that is not positive.
+        Fewer than two trials, an angle outside 0..90 deg, a resolution that is not positive, or
+        a key that is no friction of the model.
     """
+    if key not in FRICTIONS:
+        raise CalibrationError(f"{key!r}: not a friction of the model", "choose " + " or ".join(FRICTIONS))
     if not (math.isfinite(resolution_deg) and resolution_deg > 0):
         raise CalibrationError(f"--resolution-deg {resolution_deg:g} must be a finite number above 0",
                                "the angle's reading resolution, e.g. 1 for a protractor read to the degree")
@@ -126,7 +136,7 @@ def fit_ramp(angles_deg: np.ndarray, source: str = "ramp",
     trials = np.arange(1, n + 1, dtype=float)
     curves = Curves(x=trials, data=np.tan(np.radians(a)), model=np.full(n, mu), x_label="trial",
                     y_label="tan(critical angle)", title=f"ramp: {source}")
-    return RampFit(source=source, mu_static=Estimate(mu, std, lo, hi), mean_angle_deg=mean, std_angle_deg=sd,
+    return RampFit(source=source, estimates={key: Estimate(mu, std, lo, hi)}, mean_angle_deg=mean, std_angle_deg=sd,
                    n_trials=n, angles_deg=[float(x) for x in a], curves=curves, resolution_deg=resolution_deg,
                    notes=notes)
 

@@ -28,6 +28,7 @@ def headline(c) -> list[str]:
     list of str
         The predicted line, then the measured one when a trial has a track.
     """
+    from ..report.compare import ending_of
     from ..report.ending import trials_words, words
 
     def mm(value_m: float) -> str:
@@ -43,7 +44,7 @@ def headline(c) -> list[str]:
     if c.marker_travel.n:
         n = c.marker_travel.n
         jump = f", jump {mm(c.jump.mean)}" if c.jump.n else ""
-        lines.append(f"measured ({n} trial{'s' * (n != 1)}): {trials_words([m.ending for m in c.trials])}; "
+        lines.append(f"measured ({n} trial{'s' * (n != 1)}): {trials_words([ending_of(m) for m in c.trials])}; "
                      f"marker travel {mm(c.marker_travel.mean)}{jump}")
     else:
         lines.append("measured: no track")

@@ -26,7 +26,7 @@ from ..trials.measured import Trial
 from ..version import __version__
 from . import figures, page
 from .checks import VIRTUAL, Notice, collapsed, notices, recorded_on
-from .compare import Comparison, compare, timing_rows
+from .compare import Comparison, compare, ending_of, timing_rows
 from .landscape import Landscape, read_landscape
 from .predict import predict
 from .sidebyside import plan_side_by_side, write_side_by_side
@@ -376,7 +376,7 @@ def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker:
         for m in c.trials:
             gaps = [h.hop for h in m.hops if not math.isfinite(h.distance_m)]   # marker travel unseen
             if gaps:
-                items.append(f"{c.config} {m.trial.label}: the track does not cover hop(s) "
+                items.append(f"{c.config} {m.label}: the track does not cover hop(s) "
                              f"{', '.join(map(str, gaps))}.")
         if not c.trials:
             items.append(f"{c.config}: no track given, prediction only.")
@@ -557,7 +557,7 @@ def report_json(base: Robot, robot_source: str, comps, configs, timing, land, ma
             "onset_latency_s": c.prediction.onset_latency_s,
             "measured": {"trials": c.marker_travel.n, "marker_travel_m": asdict(c.marker_travel),
                          "marker_travel_per_hop_m": asdict(c.marker_travel_per_hop), "jump_m": asdict(c.jump),
-                         "outcomes": [{"trial": m.trial.label, **m.ending.to_json()} for m in c.trials]},
+                         "outcomes": [{"trial": m.label, **ending_of(m).to_json()} for m in c.trials]},
             "hops": [{**asdict(r), "marker_travel_error_m": r.marker_travel_error_m, "apex_error_m": r.apex_error_m}
                      for r in c.rows],
             "trials": [_trial_json(t) for t in c.all_trials],

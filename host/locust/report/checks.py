@@ -25,7 +25,7 @@ import numpy as np
 from ..io.importing import units_hint
 from ..io.run_record import RunRecord
 from ..trials.measured import CONFIG_FROM_RECORD, CONFIG_GIVEN, Trial, span_hint
-from .compare import Comparison, MeasuredTrial
+from .compare import Comparison
 
 ROBOT = "robot"
 VIRTUAL = "virtual robot"
@@ -182,9 +182,9 @@ def _trial_notices(t: Trial) -> list[Notice]:
     return out
 
 
-def _track_notices(c: Comparison, m: MeasuredTrial, predicted_m: float) -> list[Notice]:
+def _track_notices(c: Comparison, m: Trial, predicted_m: float) -> list[Notice]:
     out = []
-    track, label = m.trial.track, m.trial.label
+    track, label = m.track, m.label
     travel = float(np.median(m.trace.x_m[-END_SAMPLES:]))           # from where it stood to where it ended
     marker = f"tracked {track.marker}"
     if math.isfinite(predicted_m) and abs(predicted_m) >= MIN_TRAVEL_M and abs(travel) >= MIN_TRAVEL_M \

@@ -18,13 +18,13 @@ there are at least two trials.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..errors import ReportError, TrialError
 from ..io.run_record import Jitter, jitter, timing_note
-from ..trials.measure import Aligned, MeasuredHop, align, measure_hops
+from ..trials.measure import MeasuredHop, align, measure_hops
 from ..trials.measured import Trial, span_hint
 from .ending import ON_ITS_FEET, Ending, marker_ending, simulated_ending
 from .predict import Prediction
@@ -116,44 +116,35 @@ class HopRow:
         return self.measured_apex_m - self.predicted_apex_m
 
 
-@dataclass(frozen=True)
-class MeasuredTrial:
-    """A trial's track on the prediction's clock, cut into hops.
+def ending_of(trial: Trial) -> Ending:
+    """How a measured trial ended, read off its marker's hops (:func:`.ending.marker_ending`).
 
-    Attributes
+    Parameters
     ----------
     trial : Trial
-        The trial.
-    trace : Aligned
-        Its marker trace, t = 0 at the first push [s], from where it stood [m].
-    hops : list of MeasuredHop
-        Its hops, cut at the schedule's cycles.
+        A trial measured on the prediction's clock (:func:`compare`).
+
+    Returns
+    -------
+    Ending
     """
+    return marker_ending(trial.hops)
 
-    trial: Trial
-    trace: Aligned
-    hops: list[MeasuredHop]
 
-    @property
-    def ending(self) -> Ending:
-        """How the trial ended, read off its marker (:func:`.ending.marker_ending`)."""
-        return marker_ending(self.hops)
+def trial_jump_m(trial: Trial) -> float:
+    """A measured trial's jump: the highest apex above standing over its hops that ended on the
+    robot's feet [m]; nan when none did (a trial that went over in its first hop has no jump).
 
-    @property
-    def marker_travel_m(self) -> float:
-        """The marker's travel summed over the hops [m]."""
-        return float(sum(h.distance_m for h in self.hops))
+    Parameters
+    ----------
+    trial : Trial
+        A trial measured on the prediction's clock.
 
-    @property
-    def marker_travel_per_hop_m(self) -> float:
-        """The marker's mean travel per hop [m]; nan without hops."""
-        return float(np.mean([h.distance_m for h in self.hops])) if self.hops else math.nan
-
-    @property
-    def jump_m(self) -> float:
-        """Highest apex above standing over the hops that ended on the robot's feet [m]; nan
-        when none did (a trial that went over in its first hop has no jump)."""
-        return jump_of(self.hops, self.ending)
+    Returns
+    -------
+    float
+    """
+    return jump_of(trial.hops, ending_of(trial))
 
 
 def jump_of(hops: list[MeasuredHop], ending: Ending) -> float:
@@ -186,9 +177,11 @@ class Comparison:
     prediction : Prediction
         What the simulation predicts.
     all_trials : list of Trial
-        Every trial given, with or without a track.
-    trials : list of MeasuredTrial
-        The trials with a track, measured.
+        Every trial given, with or without a track; those with one measured (the same
+        objects as :attr:`trials`).
+    trials : list of Trial
+        The trials with a track, measured: each with its ``trace`` on the prediction's clock and
+        its ``hops``.
     rows : list of HopRow
         Every measured hop against the predicted one.
     cycles : int
@@ -203,7 +196,7 @@ class Comparison:
     config: str
     prediction: Prediction
     all_trials: list[Trial]   # every trial given, with or without a track
-    trials: list[MeasuredTrial]
+    trials: list[Trial]       # those with a track, measured
     rows: list[HopRow]
     cycles: int
     period_s: float
@@ -238,7 +231,7 @@ class Comparison:
     def resolution_m(self) -> float:
         """One pixel of the coarsest track, in metres: a difference below it is not measured
         (nan when no track has pixel columns)."""
-        px = [m.trial.track.m_per_px for m in self.trials if math.isfinite(m.trial.track.m_per_px)]
+        px = [m.track.m_per_px for m in self.trials if math.isfinite(m.track.m_per_px)]
         return max(px) if px else math.nan
 
     @property
@@ -285,37 +278,62 @@ def compare(prediction: Prediction, trials: list[Trial], cycles: int, period_s: 
         A track whose start cannot be found (with a units hint where it looks misread).
     """
     latency = prediction.onset_latency_s if prediction.valid else 0.0
-    measured = []
-    for trial in trials:
-        if trial.track is None:
-            continue
-        tr = trial.track
-        try:
-            trace = align(tr.t_s, tr.x_m, tr.y_m, latency, where=str(tr.path))
-        except TrialError as exc:
-            hint = span_hint(tr)        # noise in mm read as metres looks like a robot already moving
-            raise ReportError(exc.message, f"{hint}; {exc.hint}" if hint else exc.hint) from None
-        measured.append(MeasuredTrial(trial, trace, measure_hops(trace, period_s, trial_cycles(trial, cycles))))
+    every = [trial if trial.track is None else measured(trial, latency, period_s, cycles) for trial in trials]
+    measured_trials = [t for t in every if t.track is not None]
     sim_hops = {h.hop: h for h in prediction.hops}            # the simulated marker's hops
     sim_end = simulated_ending(prediction.result, prediction.hops) if prediction.valid else None
     nan = math.nan
     rows = []
-    for m in measured:
-        end = m.ending
+    for m in measured_trials:
+        end = ending_of(m)
         for h in m.hops:
             p = sim_hops.get(h.hop)
             p_state = sim_end.state(h.hop) if p and sim_end else ""
-            rows.append(HopRow(prediction.config, m.trial.label, h.hop, h.distance_m, p.distance_m if p else nan,
+            rows.append(HopRow(prediction.config, m.label, h.hop, h.distance_m, p.distance_m if p else nan,
                                h.apex_m if end.came_down(h.hop) else nan,
                                p.apex_m if p and p_state == ON_ITS_FEET else nan,
                                end.state(h.hop) if math.isfinite(h.rest_height_m) else "", p_state,
                                h.takeoff_speed_m_per_s, p.takeoff_speed_m_per_s if p else nan))
     return Comparison(
-        config=prediction.config, prediction=prediction, all_trials=list(trials), trials=measured, rows=rows,
-        cycles=cycles, period_s=period_s, marker_travel=stat([m.marker_travel_m for m in measured]),
-        marker_travel_per_hop=stat([m.marker_travel_per_hop_m for m in measured]),
-        jump=stat([m.jump_m for m in measured]),
+        config=prediction.config, prediction=prediction, all_trials=every, trials=measured_trials, rows=rows,
+        cycles=cycles, period_s=period_s, marker_travel=stat([m.marker_travel_m for m in measured_trials]),
+        marker_travel_per_hop=stat([m.marker_travel_per_hop_m for m in measured_trials]),
+        jump=stat([trial_jump_m(m) for m in measured_trials]),
     )
+
+
+def measured(trial: Trial, latency_s: float, period_s: float, cycles: int) -> Trial:
+    """``trial`` on the prediction's clock: its marker's trace from its first push (placed
+    ``latency_s`` before its first motion, as the prediction's) and its hops cut at the cycles.
+
+    Parameters
+    ----------
+    trial : Trial
+        A trial with a track.
+    latency_s : float
+        The prediction's delay from the schedule's start to the marker's first motion [s].
+    period_s : float
+        One cycle, push plus wait [s].
+    cycles : int
+        Cycles simulated (a trial with a run record is cut at its own commanded cycles).
+
+    Returns
+    -------
+    Trial
+        A copy with ``trace`` and ``hops``.
+
+    Raises
+    ------
+    ReportError
+        A track whose start cannot be found (with a units hint where it looks misread).
+    """
+    tr = trial.track
+    try:
+        trace = align(tr.t_s, tr.x_m, tr.y_m, latency_s, where=str(tr.path))
+    except TrialError as exc:
+        hint = span_hint(tr)        # noise in mm read as metres looks like a robot already moving
+        raise ReportError(exc.message, f"{hint}; {exc.hint}" if hint else exc.hint) from None
+    return replace(trial, trace=trace, hops=tuple(measure_hops(trace, period_s, trial_cycles(trial, cycles))))
 
 
 def trial_cycles(trial: Trial, default: int) -> int:

@@ -14,7 +14,7 @@ import numpy as np
 from ..plotting import png_bytes, pyplot
 from ..sweep.design import axis_scale
 from ..trials.configs import Configuration
-from .compare import Comparison, stat
+from .compare import Comparison, ending_of, stat
 from .landscape import Landscape, design_value
 
 COLOURS = {"small": "#1f77b4", "medium": "#ff7f0e", "large": "#2ca02c"}   # the seed dashboard's
@@ -128,9 +128,9 @@ def _over_words(c: Comparison) -> str:
     end = c.predicted_ending
     if end is not None and end.over_hop is not None:
         said.append(f"predicted: goes over at hop {end.over_hop}")
-    hops = sorted({m.ending.over_hop for m in c.trials if m.ending.over_hop is not None})
+    hops = sorted({ending_of(m).over_hop for m in c.trials if ending_of(m).over_hop is not None})
     if hops:
-        n = sum(1 for m in c.trials if m.ending.over_hop is not None)
+        n = sum(1 for m in c.trials if ending_of(m).over_hop is not None)
         said.append(f"measured: goes over at hop {', '.join(map(str, hops))}"
                     + (f" ({n} of {len(c.trials)} trials)" if len(c.trials) > 1 else ""))
     return "\n".join(said)
@@ -207,7 +207,7 @@ def draw_bars(ax, comps: list[Comparison], what: str) -> None:
                         (x[i] - w / 2, heights[i]), xytext=(0, 3), textcoords="offset points",
                         ha="center", fontsize=7)
         elif what == "jump" and c.trials:
-            ax.annotate(_over_first("measured", [m.ending.over_hop for m in c.trials]), (x[i] - w / 2, 0),
+            ax.annotate(_over_first("measured", [ending_of(m).over_hop for m in c.trials]), (x[i] - w / 2, 0),
                         xytext=(0, 3), textcoords="offset points", ha="center", va="bottom", fontsize=7,
                         rotation=90, color=OVER_COLOUR)
         ending = c.predicted_ending
@@ -358,7 +358,7 @@ def draw_landscape(ax, land: Landscape, comps: list[Comparison], configs: dict[s
             if ending is not None:   # as the sweep's designs: a run gone over is a triangle, not a hop
                 ax.plot([xv], [c.predicted_distance_per_hop_m * MM], "v" if ending.over_hop else "o", mfc="white",
                         mec=col, mew=2, ms=8)
-            on_feet = stat([m.marker_travel_per_hop_m for m in c.trials if m.ending.over_hop is None])
+            on_feet = stat([m.marker_travel_per_hop_m for m in c.trials if ending_of(m).over_hop is None])
             if on_feet.n:
                 ax.errorbar([xv], [on_feet.mean * MM], yerr=[(on_feet.std or 0.0) * MM], fmt="s",
                             color=col, ms=7, capsize=4,
@@ -420,7 +420,7 @@ def landscape_caption(land: Landscape, comps: list[Comparison]) -> str:
         marks = []
         if any(c.prediction.valid for c in comps):
             marks.append("its prediction (open circle)")
-        if any(m.ending.over_hop is None for c in comps for m in c.trials):
+        if any(ending_of(m).over_hop is None for c in comps for m in c.trials):
             marks.append("its measurement where every trial ended on its feet (the marker's travel per hop, "
                          "filled square, ±1 sd)")
         text += ", with each physical design's position (dotted line)"

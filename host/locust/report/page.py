@@ -15,7 +15,7 @@ import html
 import math
 from dataclasses import dataclass
 
-from .compare import Comparison, TimingRow
+from .compare import Comparison, TimingRow, ending_of
 from .ending import trials_words, words
 
 CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
@@ -238,7 +238,7 @@ def summary_table(comps: list[Comparison], labels: dict[str, str], added: dict[s
         cells = [
             td(labels[name], left=True), td(f"+{added[name] * 1000:g}"), td(str(c.marker_travel.n), name, "trials"),
             td(words(ending) if ending else "—", name, "predicted_outcome", left=True),
-            td(trials_words([m.ending for m in c.trials]), name, "measured_outcome", left=True),
+            td(trials_words([ending_of(m) for m in c.trials]), name, "measured_outcome", left=True),
             td(mm(c.predicted_distance_m), name, "predicted_distance_mm"),
             td(mm(c.predicted_marker_travel_m), name, "predicted_marker_travel_mm"),
             td(mm_pm(c.marker_travel.mean, c.marker_travel.std), name, "measured_marker_travel_mm"),

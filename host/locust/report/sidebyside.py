@@ -49,7 +49,8 @@ from ..io.tracks_csv import TRACKS_CSV_SUFFIX, TracksCsv, read_track_file
 from ..progress import progress
 from ..track.export import sidecar_video
 from ..track.video import Clip, VideoInfo, encode_video, probe, read_frames
-from .compare import Comparison, MeasuredTrial
+from ..trials.measured import Trial
+from .compare import Comparison
 
 SUFFIX = ".side_by_side.webm"
 FOURCC = "VP80"                      # VP8: in WebM, every browser plays it (module docstring)
@@ -67,7 +68,7 @@ class Job:
     ----------
     comparison : Comparison
         The trial's configuration.
-    measured : MeasuredTrial
+    measured : Trial
         The trial, its track aligned to the schedule.
     video : VideoInfo
         The filmed video.
@@ -84,7 +85,7 @@ class Job:
     """
 
     comparison: Comparison
-    measured: MeasuredTrial
+    measured: Trial
     video: VideoInfo
     camera: CameraFile | None        # the filmed camera; None: the simulation's own
     camera_note: str                 # where the camera comes from, or why not from the video
@@ -95,7 +96,7 @@ class Job:
     @property
     def label(self) -> str:
         """The trial's label."""
-        return self.measured.trial.label
+        return self.measured.label
 
     def t_s(self, frame: int) -> float:
         """Frame ``frame``'s time on the schedule's clock (t = 0 at the first push).
@@ -202,7 +203,7 @@ def plan_side_by_side(comps: list[Comparison]) -> Plan:
     jobs, skipped = [], []
     taken: set[str] = set()
     for c in comps:
-        measured = {id(m.trial): m for m in c.trials}
+        measured = {id(m): m for m in c.trials}
         for trial in c.all_trials:
             m = measured.get(id(trial))
             video = find_video(trial)
@@ -215,7 +216,7 @@ def plan_side_by_side(comps: list[Comparison]) -> Plan:
                 continue
             info = _probe(video)
             camera, note = filmed_camera(info)
-            frame0, fps = frame_clock(m.trial.track.path, info)
+            frame0, fps = frame_clock(m.track.path, info)
             jobs.append(Job(c, m, info, camera, note, frame0, fps, _name(c.config, trial.label, taken)))
     return Plan(jobs, skipped)
 

@@ -1,5 +1,11 @@
 """Measured inputs of a report or a hop fit: marker tracks and run records, grouped by configuration.
 
+A filmed run is a :class:`Trial` (its tracks, each a :class:`Track`, and its run record): the
+one type of a run as measured, beside its file's :class:`~locust.io.run_record.RunRecord`. The
+hop fit fills in the robot it simulates a trial on and its phase times
+(:func:`locust.calibrate.hopruns.load_run`), the report its trace on a prediction's clock and
+its hops (:func:`locust.report.compare.measured`).
+
 ``--measured`` takes ``NAME=PATH[,PATH...]`` or plain paths. Each path is one trial:
 
 - a folder holding a track (``*.tracks.csv``, or one CSV/Tracker export with marker columns)
@@ -20,7 +26,7 @@ a tracks CSV, a Tracker text export or a ``t,x,y`` CSV, with ``--units``, ``--re
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +36,9 @@ from ..io.importing import AS_IS, DESK_SPAN_M, TYPICAL_SPAN_M, ImportOptions, im
 from ..io.run_record import RECORD_NAME as RUN_NAME
 from ..io.run_record import RunRecord, read_run_record
 from ..io.tracks_csv import TRACKS_CSV_SUFFIX
+from ..params import Robot
 from .configs import check_name, name_from_path, sort_key
+from .measure import Aligned, MeasuredHop
 
 TRACK_GLOB = f"*{TRACKS_CSV_SUFFIX}"
 CONFIG_GIVEN = "given"                   # --measured NAME=PATH
@@ -40,22 +48,61 @@ CONFIG_FROM_RECORD = "run record"        # the leg set run.json names
 
 @dataclass(frozen=True)
 class Track:
-    """One marker's positions, lost frames removed: time (s), x forward and y up (m)."""
+    """One marker's positions, lost frames removed: time (s), x forward and y up (m).
 
-    path: Path
-    marker: str
+    Attributes
+    ----------
+    t_s : numpy.ndarray
+        The frames' times [s], on the camera's clock.
+    x_m, y_m : numpy.ndarray
+        The marker forward and up [m], in the track's frame (the board's, or the world's for
+        a virtual robot's camera.json).
+    marker : str
+        The marker's name ("" for a track made, not read).
+    path : pathlib.Path or None
+        The file it was read from (None: made, not read).
+    frames : int
+        Rows in the file, lost ones included (0: not read from a file).
+    units : str
+        The unit the file's positions were in (``--units``).
+    mirrored : bool
+        Read with ``--mirror``.
+    m_per_px : float
+        Tracking resolution: one pixel at the marker [m] (nan: no pixels).
+    """
+
     t_s: np.ndarray
     x_m: np.ndarray
     y_m: np.ndarray
-    frames: int          # rows in the file, lost ones included
+    marker: str = ""
+    path: Path | None = None
+    frames: int = 0      # rows in the file, lost ones included
     units: str = "m"     # the unit the file's positions were in (--units)
     mirrored: bool = False
     m_per_px: float = math.nan   # tracking resolution: one pixel at the marker, in metres (nan: no pixels)
 
+    def until(self, last_s: float) -> Track:
+        """The frames up to camera time ``last_s``.
 
-@dataclass(frozen=True)
+        Parameters
+        ----------
+        last_s : float
+            The last time kept [s], on the track's clock.
+
+        Returns
+        -------
+        Track
+        """
+        keep = self.t_s <= last_s
+        return replace(self, t_s=self.t_s[keep], x_m=self.x_m[keep], y_m=self.y_m[keep])
+
+
+@dataclass(frozen=True, eq=False)
 class Trial:
-    """One filmed trial: its configuration, its track and its run record.
+    """One filmed run as measured: its configuration, its marker tracks and its run record,
+    and, once put on a clock, when its phases started and where its hops went. The one type
+    a run has beside its file's :class:`~locust.io.run_record.RunRecord`: the hop fit
+    simulates it, the report measures it against a prediction.
 
     Attributes
     ----------
@@ -63,22 +110,66 @@ class Trial:
         The configuration's key (a leg set's name).
     label : str
         The short name tables show: the trial's folder.
-    track : Track or None
-        The nose's positions; None for a run without a track.
+    tracks : dict of str to Track
+        Marker -> its positions; the first is the marker the trial was read for (the nose by
+        default); empty for a run without a track.
     run_path : pathlib.Path or None
         Its ``run.json``.
     record : locust.io.run_record.RunRecord or None
         The run record read.
     config_from : str
         How the configuration was known: given, from the run record, or from the folder's name.
+    source : pathlib.Path or None
+        The path it was given as: a run folder, its ``run.json`` or a track file.
+    robot : locust.params.Robot or None
+        The robot it is simulated on (the hop fit's: its leg set on the robot being fitted, at
+        the run's own push angle); None where none is chosen.
+    phase_s : numpy.ndarray or None
+        The start of each phase as the firmware measured it, seconds from the first push.
+    pushing : numpy.ndarray or None
+        Per phase: a push (True) or a wait.
+    onset_s : float
+        The measured marker's first motion on the camera's clock [s] (nan: not found).
+    trace : locust.trials.measure.Aligned or None
+        The measured marker on a prediction's clock (t = 0 at the first push), from where it
+        stood; None until it is put there.
+    hops : tuple of locust.trials.measure.MeasuredHop
+        Its hops on that clock, cut at the schedule's cycles.
     """
 
     config: str
     label: str                       # short name shown in tables: the trial's folder
-    track: Track | None
-    run_path: Path | None
-    record: RunRecord | None = field(default=None, compare=False)
+    tracks: dict[str, Track] = field(default_factory=dict)
+    run_path: Path | None = None
+    record: RunRecord | None = None
     config_from: str = CONFIG_GIVEN      # how its configuration was known: given, its run record, or its folder
+    source: Path | None = None
+    robot: Robot | None = None
+    phase_s: np.ndarray | None = None
+    pushing: np.ndarray | None = None
+    onset_s: float = math.nan
+    trace: Aligned | None = None
+    hops: tuple[MeasuredHop, ...] = ()
+
+    @property
+    def track(self) -> Track | None:
+        """The marker the trial was read for (the first of :attr:`tracks`); None without a track."""
+        return next(iter(self.tracks.values()), None)
+
+    @property
+    def end_s(self) -> float:
+        """The last frame of any track, seconds after :attr:`onset_s`."""
+        return max(float(tr.t_s[-1]) for tr in self.tracks.values()) - self.onset_s
+
+    @property
+    def marker_travel_m(self) -> float:
+        """The marker's travel summed over :attr:`hops` [m]."""
+        return float(sum(h.distance_m for h in self.hops))
+
+    @property
+    def marker_travel_per_hop_m(self) -> float:
+        """The marker's mean travel per hop [m]; nan without hops."""
+        return float(np.mean([h.distance_m for h in self.hops])) if self.hops else math.nan
 
 
 def parse_measured(items: tuple[str, ...] | list[str], marker: str = "nose",
@@ -222,8 +313,9 @@ def load_trial(path: Path, config: str, marker: str = "nose", imports: ImportOpt
     else:
         track_path, label = path, path.parent.name or path.stem
     record = read_run(run_path) if run_path else None
-    track = read_track(track_path, marker, imports) if track_path else None
-    return Trial(config=config, label=label, track=track, run_path=run_path, record=record, config_from=config_from)
+    tracks = {marker: read_track(track_path, marker, imports)} if track_path else {}
+    return Trial(config=config, label=label, tracks=tracks, run_path=run_path, record=record, config_from=config_from,
+                 source=path)
 
 
 def _one_track(folder: Path, required: bool) -> Path | None:
@@ -281,7 +373,7 @@ def read_track(path: Path, marker: str = "nose", imports: ImportOptions = AS_IS)
     if np.any(np.diff(tt) <= 0):
         raise TrialError(f"{path}: repeated time stamps in t_s",
                           "export the track again; each frame needs its own time")
-    return Track(path=path, marker=marker, t_s=tt, x_m=x[ok][order], y_m=y[ok][order], frames=tracks.n_rows,
+    return Track(t_s=tt, x_m=x[ok][order], y_m=y[ok][order], marker=marker, path=path, frames=tracks.n_rows,
                  units=imports.units, mirrored=imports.mirror, m_per_px=metres_per_pixel(tracks, marker))
 
 
