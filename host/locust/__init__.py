@@ -21,6 +21,7 @@ Functions (each with a numpydoc docstring: ``help(locust.simulate)``):
 - ``make_report(robot, measured)``: the HTML comparison of simulation and filmed hops.
 - ``optimize(robot, vary, trials, out=...)``: Optuna's search for the farthest valid hop.
 - ``make_cut_files(robot_or_dxf, out=...)``: the laminate's cut files and their summary.
+- ``hop(port, cycles, ...)``: the hop schedule on the robot or the virtual robot (``port="sim"``), its ``RunRecord``.
 
 Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
 """
@@ -31,7 +32,8 @@ from .version import __version__
 
 __all__ = ["robot", "simulate", "SimResult", "sweep_designs", "SweepResults", "track_markers", "read_tracks", "Tracks",
            "calibrate_beam", "calibrate_hinge", "calibrate_ramp", "calibrate_servo", "calibrate_hops", "Fit",
-           "bundled_recording", "make_report", "optimize", "make_cut_files", "Robot", "LocustError", "__version__"]
+           "bundled_recording", "make_report", "optimize", "make_cut_files", "hop", "Robot", "LocustError",
+           "__version__"]
 
 
 def __getattr__(name: str):

@@ -12,13 +12,14 @@ function              module                    returns
 ``make_report``       :mod:`.reports`           :class:`locust.report.build.ReportResult`
 ``optimize``          :mod:`.optimizing`        :class:`locust.sweep.optimize.OptimizeSummary`
 ``make_cut_files``    :mod:`.fabrication`       dict (the manufacturing summary)
+``hop``               :mod:`.hopping`           :class:`locust.io.run_record.RunRecord` (run.json)
 ====================  ========================  =====================================================
 
 ``bundled_recording(name)`` (:mod:`.calibration`, from :mod:`locust.bundled`) is the path of a
 recording the toolkit ships, in a checkout or an installed wheel alike.
 
 The command line calls the same functions (``locust sim``, ``sweep``, ``report``, ``fab``,
-``calibrate beam|hinge|servo|ramp``). Every name is also at the package top: ``locust.simulate``.
+``calibrate beam|hinge|servo|ramp``, ``hop``). Every name is also at the package top: ``locust.simulate``.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ EXPORTS = {
     "bundled_recording": "calibration",
     "make_report": "reports",
     "optimize": "optimizing", "make_cut_files": "fabrication",
+    "hop": "hopping",
 }
 
 __all__ = list(EXPORTS)
