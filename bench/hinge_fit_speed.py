@@ -67,7 +67,7 @@ def main() -> None:
     for name, path, units, rig, coulomb in cases:
         old_s, old = fit(path, units, rig, coulomb, old=True)
         new_s, new = fit(path, units, rig, coulomb, old=False)
-        (k_old, b_old), (k_new, b_new) = ([f.estimates[key].value for key in (H.STIFFNESS, H.DAMPING)]
+        (k_old, b_old), (k_new, b_new) = ([f.estimates[key].value for key in (hinge_fit.STIFFNESS, hinge_fit.DAMPING)]
                                           for f in (old, new))
         print(f"{name}: forward differences {old_s:.2f} s (k {k_old:.6g}, b {b_old:.6g}); variational equations / "
               f"closed form {new_s:.2f} s (k {k_new:.6g}, b {b_new:.6g}); {old_s / new_s:.1f}x")

@@ -48,9 +48,6 @@ HOP_COMPLETE = "complete"
 HOP_STOPPED = "stopped"
 HOP_HEARTBEAT = "heartbeat_lost"
 
-PUSH = "push"
-WAIT = "wait"
-
 MAX_ID = 0x7FFFFFFF
 REPORT_PAGE = 8                   # phases per `report` reply
 

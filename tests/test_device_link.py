@@ -23,7 +23,8 @@ from locust.device.flash import firmware_files, flash
 from locust.device.hop import run_hop
 from locust.device.link import Link
 from locust.device.plant import RecordingPlant
-from locust.device.virtual import PWM_PERIOD_S, TICKS_LEAD_S, VirtualRobot
+from locust.device.pwm import PWM_PERIOD_S
+from locust.device.virtual import TICKS_LEAD_S, VirtualRobot
 from locust.errors import DeviceError
 from locust.firmware import protocol
 from locust.io import run_record

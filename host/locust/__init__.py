@@ -23,6 +23,7 @@ Functions (each with a numpydoc docstring: ``help(locust.simulate)``), named onc
 - ``optimize(robot, vary, trials, out=...)``: Optuna's search for the farthest valid hop.
 - ``make_cut_files(robot_or_dxf, out=...)``: the laminate's cut files and their summary.
 - ``run_demo(out, cycles, trials, designs)``: ``locust demo``, the toolkit end to end on the virtual robot.
+- ``hop(port, cycles, ...)``: the hop schedule on the robot or the virtual robot (``port="sim"``), its ``RunRecord``.
 
 Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
 """

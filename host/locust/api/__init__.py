@@ -25,12 +25,13 @@ name                   module                     what it is
 ``optimize``           :mod:`.optimizing`         :class:`locust.sweep.optimize.OptimizeSummary`
 ``make_cut_files``     :mod:`.fabrication`        dict (the manufacturing summary)
 ``run_demo``           :mod:`.demos`              the toolkit end to end on the virtual robot
+``hop``                :mod:`.hopping`            the hop schedule on a robot: its run.json's ``RunRecord``
 ``Robot``              :mod:`locust.params`       the robot's parameters, each with its provenance
 ``LocustError``        :mod:`locust.errors`       every error the toolkit raises (message, hint)
 =====================  =========================  ====================================================
 
 The command line calls the same functions (``locust sim``, ``sweep``, ``report``, ``fab``,
-``calibrate beam|hinge|servo|ramp``, ``demo``). Every name is also at the package top: ``locust.simulate``.
+``calibrate beam|hinge|servo|ramp``, ``demo``, ``hop``). Every name is also at the package top: ``locust.simulate``.
 """
 
 from __future__ import annotations
@@ -59,6 +60,7 @@ EXPORTS = {
     "optimize": "optimizing",
     "make_cut_files": "fabrication",
     "run_demo": "demos",
+    "hop": "hopping",
     "Robot": "locust.params",
     "LocustError": "locust.errors",
 }

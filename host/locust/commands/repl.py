@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import signal
-
 import click
 
-from ._device import PORT_HELP, info, interrupt
+from ._device import PORT_HELP, info
 
 
 @click.command()
@@ -30,17 +28,13 @@ def repl(port):
     session; to use the same virtual robot with other commands too, start `locust virtual`
     and pass its /dev/pts/N as --port.
     """
+    from ..device.interrupts import signals_interrupt
     from ..device.repl import require_terminal, run_repl
     from ..device.session import open_port
 
     require_terminal()  # before a virtual robot is started for nothing
     # a closed terminal (SIGHUP) or a kill (SIGTERM) must still stop a --port sim virtual robot
-    previous = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
-    try:
-        with open_port(port, plant="record", info=info, firmware=False) as device:
-            info(f"mpremote REPL on {device}: Ctrl-C for the >>> prompt, Ctrl-D there restarts the firmware, "
-                  "Ctrl-] or Ctrl-X leaves")
-            run_repl(device)
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+    with signals_interrupt(), open_port(port, plant="record", info=info, firmware=False) as device:
+        info(f"mpremote REPL on {device}: Ctrl-C for the >>> prompt, Ctrl-D there restarts the firmware, "
+             "Ctrl-] or Ctrl-X leaves")
+        run_repl(device)

@@ -10,8 +10,8 @@ import click
 
 from ..errors import DeviceError
 from ..tables import hop_table, plant_lines
-from ._device import CHIPS, hopped_robot, info, interrupt, plant_options
-from .options import robot_options
+from ._device import CHIPS, info, plant_options
+from .options import DEFAULTED, robot_options
 
 
 @click.command()
@@ -35,6 +35,8 @@ def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, s
     boot, poll timeouts on a 10 ms tick, the chip's pin rules, a heap like a board without
     PSRAM, servos limp after a soft reset, Ctrl-C that interrupts anywhere while idle.
     """
+    from ..device.hop_job import hopped_robot
+    from ..device.interrupts import interrupt
     from ..device.plant import make_plant
     from ..device.virtual import VirtualRobot
 
@@ -42,7 +44,8 @@ def virtual(flash_dir, pwm_log, chip, plant, video, video_fps, preset, config, s
         raise DeviceError(f"{pwm_log} exists; a log is never overwritten", "choose another --pwm-log path")
     from ..device.announce import announce, withdraw
 
-    robot, source = hopped_robot(preset, config, sets, None)
+    robot, source = hopped_robot(preset, config, sets, None,
+                                 defaulted=bool(click.get_current_context().meta.get(DEFAULTED)))
     shown = []
 
     def show_hop(hop: dict) -> None:       # each hop as it is done, the rows `locust sim` prints

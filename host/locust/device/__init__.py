@@ -8,9 +8,12 @@
 - :mod:`.flash`: copy the firmware to a board with mpremote, verify it, reset, shake hands.
 - :mod:`.board`: the board's servo config read and changed (``locust config``);
   :mod:`.pose`: hold the servos at an angle (``locust pose``); :mod:`.hop`: run the hop schedule
-  and keep ``run.json`` up to date; :mod:`.repl`: mpremote's REPL on the port.
+  and keep ``run.json`` up to date; :mod:`.hop_job`: the hop as a job, from options to the
+  record (``locust hop`` and ``locust.hop``); :mod:`.repl`: mpremote's REPL on the port;
+  :mod:`.interrupts`: a TERM or HUP ends a command as Ctrl-C does.
 - :mod:`.virtual`: the real firmware on the MicroPython unix port behind a pseudo-terminal,
-  with the ``machine_shim`` modules as its hardware; :mod:`.plant`: what its servos drive
+  with the ``machine_shim`` modules as its hardware; :mod:`.console`: the bridge between its
+  pseudo-terminals; :mod:`.pwm`: its PWM writes as horn angles; :mod:`.plant`: what its servos drive
   (a recorder or the live MuJoCo model); :mod:`.stalls`: how long the host held its
   interpreter off the CPU while a phase was due; :mod:`.announce`: which robot a running
   ``locust virtual`` simulates.

@@ -90,94 +90,138 @@ def run_hop(link: Link, schedule: R.HopSchedule, directory: Path,
     rec.firmware_version = hello.get("version")
     R.write(rec, directory)
     try:
-        if hello.get("hopping"):
-            link.call("stop")
-        rec.board = read_board(link, hello)
-        R.write(rec, directory)
-        while not link.events.empty():  # a boot event from before we connected is old news
-            link.events.get_nowait()
-        link.start_heartbeat(schedule.heartbeat_ms / 8000.0)  # 8 beats in each timeout
-        if stalls is not None:
-            stalls.start()
-        reply = link.request("hop", cycles=schedule.cycles, push_deg=schedule.push_deg,
-                             push_ms=schedule.push_ms, wait_ms=schedule.wait_ms,
-                             heartbeat_ms=schedule.heartbeat_ms)
-        if not reply.get("ok"):
-            rec.status, rec.message = R.ERROR, f"{reply.get('error')}: {reply.get('detail')}"
-            R.write(rec, directory)
-            raise DeviceError(f"the robot refused the hop: {rec.message}",
-                              "see `locust hop --help` and docs/protocol.md for the limits")
-        hop_id = reply["id"]   # the id of our request: the reply was matched by it
-        last_write = 0.0
-        last: R.Phase | None = None
-        deadline = time.monotonic() + schedule.duration_s + LATE_END_S
-        while True:
-            if time.monotonic() > deadline:   # (a board that reports on and on never ends the hop)
-                raise DeviceError(f"the robot had not ended the hop {LATE_END_S:g} s after its "
-                                  f"{schedule.duration_s:g} s schedule",
-                                  "the board's firmware is not this toolkit's, or it is damaged: flash it again "
-                                  "with `locust flash`")
-            try:
-                ev = link.events.get(timeout=max(0.1, deadline - time.monotonic()))
-            except queue.Empty:
-                raise DeviceError("the robot stopped reporting mid-hop",
-                                  "check the cable and the power; the record keeps what arrived") from None
-            if ev is CLOSED:
-                raise link.lost_error()
-            if ev.get("ev") == P.EV_BOOT:
-                cause = ev.get("reset", "unknown")
-                what = ("a brown-out (MicroPython reports it as a power-on reset)" if cause == "power_on"
-                        else f"a {cause} reset")
-                raise DeviceError(f"the robot rebooted mid-hop: {what}",
-                                  "check the servo power supply: two servos pushing can sag the ESP32's supply")
-            if ev.get("hop") != hop_id:
-                continue
-            if ev.get("ev") == P.EV_PHASE:
-                phase = last = check_scheduled(phase_event(ev, link.port), schedule, link.port, ev, last)
-                rec.add_phase(phase)
-                # rewriting the whole record at each of 2000 phases costs more than the phases
-                # last: a host that falls behind stops reading, the board's output blocks and its
-                # phases start late. So at most every RECORD_EVERY_S while phases stream in.
-                if time.monotonic() - last_write >= RECORD_EVERY_S:
-                    R.write(rec, directory)
-                    last_write = time.monotonic()
-                on_phase(phase)
-            elif ev.get("ev") == P.EV_DONE:
-                rec.firmware_status, rec.firmware_ticks_us, end_us = done_event(ev, link.port)
-                break
-        link.stop_heartbeat()
-        if len(rec.phases) < schedule.phases:
-            _fetch_report(link, rec)
-        if stalls is not None:
-            stalls.stop()
-            if rec.firmware_ticks_us and end_us is not None:
-                rec.set_host_stalls(stalls.phase_stalls_us(rec.firmware_ticks_us[1], end_us, rec.phases))
+        _hop(link, rec, directory, hello, on_phase, stalls)
     except KeyboardInterrupt:
-        _stop_quietly(link)
-        rec.status, rec.message = R.INCOMPLETE, "interrupted (Ctrl-C or a kill); the robot was sent to rest"
-        R.write(rec, directory)
-        raise DeviceError(f"hop interrupted after {len(rec.phases)} of {schedule.phases} phases; "
-                          f"partial record in {directory / R.RECORD_NAME}",
-                          "the robot is at rest; run the hop again when ready") from None
+        raise _interrupted(link, rec, directory) from None
     except DeviceError as exc:
-        _stop_quietly(link)
-        if rec.status != R.ERROR:
-            rec.status, rec.message = R.INCOMPLETE, exc.message
-        R.write(rec, directory)
-        raise DeviceError(f"{exc.message} (after {len(rec.phases)} of {schedule.phases} phases; "
-                          f"partial record in {directory / R.RECORD_NAME})", exc.hint) from None
+        raise _failed(link, rec, directory, exc) from None
     finally:
         link.stop_heartbeat()
         if stalls is not None:
             stalls.stop()
-    complete = rec.firmware_status == P.HOP_COMPLETE and len(rec.phases) == schedule.phases
+    _judge(rec)
+    R.write(rec, directory)
+    return rec
+
+
+def _hop(link: Link, rec: R.RunRecord, directory: Path, hello: dict, on_phase: Callable[[R.Phase], None],
+         stalls: StallWatch | None) -> None:
+    """The hop itself, once the board has answered: its config read, the schedule sent, the
+    phases followed to the board's end, any phase lost on the line asked for again."""
+    schedule = rec.schedule
+    if hello.get("hopping"):
+        link.call("stop")
+    rec.board = read_board(link, hello)
+    R.write(rec, directory)
+    while not link.events.empty():  # a boot event from before we connected is old news
+        link.events.get_nowait()
+    link.start_heartbeat(schedule.heartbeat_ms / 8000.0)  # 8 beats in each timeout
+    if stalls is not None:
+        stalls.start()
+    end_us = _follow(link, rec, directory, _start(link, rec, directory), on_phase)
+    link.stop_heartbeat()
+    if len(rec.phases) < schedule.phases:
+        _fetch_report(link, rec)
+    if stalls is not None:
+        stalls.stop()
+        if rec.firmware_ticks_us and end_us is not None:
+            rec.set_host_stalls(stalls.phase_stalls_us(rec.firmware_ticks_us[1], end_us, rec.phases))
+
+
+def _start(link: Link, rec: R.RunRecord, directory: Path) -> int:
+    """Send the schedule; the id the board's events of this hop carry (a refusal is recorded)."""
+    s = rec.schedule
+    reply = link.request("hop", cycles=s.cycles, push_deg=s.push_deg, push_ms=s.push_ms, wait_ms=s.wait_ms,
+                         heartbeat_ms=s.heartbeat_ms)
+    if not reply.get("ok"):
+        rec.status, rec.message = R.ERROR, f"{reply.get('error')}: {reply.get('detail')}"
+        R.write(rec, directory)
+        raise DeviceError(f"the robot refused the hop: {rec.message}",
+                          "see `locust hop --help` and docs/protocol.md for the limits")
+    return reply["id"]   # the id of our request: the reply was matched by it
+
+
+def _follow(link: Link, rec: R.RunRecord, directory: Path, hop_id: int,
+            on_phase: Callable[[R.Phase], None]) -> int | None:
+    """Record each phase of hop ``hop_id`` as the board reports it, until its ``done`` event;
+    the board's ticks at the end [us] (None if it gave none)."""
+    schedule = rec.schedule
+    last_write = 0.0
+    last: R.Phase | None = None
+    deadline = time.monotonic() + schedule.duration_s + LATE_END_S
+    while True:
+        ev = _next_event(link, schedule, deadline)
+        if ev.get("hop") != hop_id:
+            continue
+        if ev.get("ev") == P.EV_PHASE:
+            phase = last = check_scheduled(phase_event(ev, link.port), schedule, link.port, ev, last)
+            rec.add_phase(phase)
+            # rewriting the whole record at each of 2000 phases costs more than the phases
+            # last: a host that falls behind stops reading, the board's output blocks and its
+            # phases start late. So at most every RECORD_EVERY_S while phases stream in.
+            if time.monotonic() - last_write >= RECORD_EVERY_S:
+                R.write(rec, directory)
+                last_write = time.monotonic()
+            on_phase(phase)
+        elif ev.get("ev") == P.EV_DONE:
+            rec.firmware_status, rec.firmware_ticks_us, end_us = done_event(ev, link.port)
+            return end_us
+
+
+def _next_event(link: Link, schedule: R.HopSchedule, deadline: float) -> dict:
+    """The board's next event during the hop; silence, a lost port, a reboot or a hop that
+    goes on past ``deadline`` (``time.monotonic()``) are errors."""
+    if time.monotonic() > deadline:   # (a board that reports on and on never ends the hop)
+        raise DeviceError(f"the robot had not ended the hop {LATE_END_S:g} s after its "
+                          f"{schedule.duration_s:g} s schedule",
+                          "the board's firmware is not this toolkit's, or it is damaged: flash it again "
+                          "with `locust flash`")
+    try:
+        ev = link.events.get(timeout=max(0.1, deadline - time.monotonic()))
+    except queue.Empty:
+        raise DeviceError("the robot stopped reporting mid-hop",
+                          "check the cable and the power; the record keeps what arrived") from None
+    if ev is CLOSED:
+        raise link.lost_error()
+    if ev.get("ev") == P.EV_BOOT:
+        cause = ev.get("reset", "unknown")
+        what = ("a brown-out (MicroPython reports it as a power-on reset)" if cause == "power_on"
+                else f"a {cause} reset")
+        raise DeviceError(f"the robot rebooted mid-hop: {what}",
+                          "check the servo power supply: two servos pushing can sag the ESP32's supply")
+    return ev
+
+
+def _interrupted(link: Link, rec: R.RunRecord, directory: Path) -> DeviceError:
+    """Ctrl-C or a kill mid-hop: the robot to rest, the record kept as ``incomplete``."""
+    _stop_quietly(link)
+    rec.status, rec.message = R.INCOMPLETE, "interrupted (Ctrl-C or a kill); the robot was sent to rest"
+    R.write(rec, directory)
+    return DeviceError(f"hop interrupted after {len(rec.phases)} of {rec.schedule.phases} phases; "
+                       f"partial record in {directory / R.RECORD_NAME}",
+                       "the robot is at rest; run the hop again when ready")
+
+
+def _failed(link: Link, rec: R.RunRecord, directory: Path, exc: DeviceError) -> DeviceError:
+    """A hop that failed mid-way: the robot to rest, the record kept (``incomplete``, or the
+    board's refusal as ``error``), the error saying how far it got."""
+    _stop_quietly(link)
+    if rec.status != R.ERROR:
+        rec.status, rec.message = R.INCOMPLETE, exc.message
+    R.write(rec, directory)
+    return DeviceError(f"{exc.message} (after {len(rec.phases)} of {rec.schedule.phases} phases; "
+                       f"partial record in {directory / R.RECORD_NAME})", exc.hint)
+
+
+def _judge(rec: R.RunRecord) -> None:
+    """The verdict of a hop the board ended: ``complete`` only with every phase reported and
+    the firmware's own ``complete`` (``default_config`` when it ran on its defaults)."""
+    complete = rec.firmware_status == P.HOP_COMPLETE and len(rec.phases) == rec.schedule.phases
     rec.status = R.COMPLETE if complete else R.INCOMPLETE
     rec.message = None if complete else f"firmware ended the hop: {rec.firmware_status}"
     if complete and rec.board is not None and rec.board.on_defaults:
         rec.status = R.DEFAULT_CONFIG
         rec.message = "the board ran on its default config, not its config.json: " + "; ".join(rec.board.problems)
-    R.write(rec, directory)
-    return rec
 
 
 def _stop_quietly(link: Link) -> None:

@@ -22,6 +22,8 @@ from typing import Protocol
 from ..errors import DeviceError
 
 PLANTS = ("auto", "mujoco", "record")
+VIDEO_FPS = 60    # the virtual robot's camera [frames/s], as docs/hardware.md asks of a real one
+FPS_RANGE = (1, 1000)    # the rates its video may be rendered at [frames/s]
 
 
 class Plant(Protocol):
