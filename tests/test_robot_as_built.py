@@ -8,7 +8,7 @@ import math
 import pytest
 
 from locust import params
-from locust.sim import servo as SV
+from locust.sim import servo as sim_servo
 from locust.sim.model import build, contact_solref
 from locust.sim.run import run
 
@@ -58,7 +58,7 @@ def test_the_supply_scales_the_servo_as_a_dc_motor():
     """4.2 V through 0.5 ohm to two servos of 10 ohm: stall torque 0.15 * 4.2/5 * 10/11, no-load
     speed 10.2 * 4.2/5 (no current at no load, no sag), the holding gain with the torque."""
     robot = params.preset("medium").with_values({"power.supply_voltage_v": 4.2, "power.source_resistance_ohm": 0.5})
-    s = SV.at_supply(robot.servo, robot.power)
+    s = sim_servo.at_supply(robot.servo, robot.power)
     torque = 4.2 / 5.0 * 10.0 / 11.0
     stall, noload, kp = robot.servo.stall_torque_nm, robot.servo.noload_speed_rad_per_s, robot.servo.kp_nm_per_rad
     assert robot.servo.reference_voltage_v == 5.0 and robot.servo.winding_resistance_ohm == 10.0
@@ -76,7 +76,7 @@ def test_the_supply_scales_the_servo_as_a_dc_motor():
     assert model.dof_damping[dof] == pytest.approx(hinge + back_emf, rel=1e-12)
     # on the voltage it was identified at, with no source resistance, the servo is unchanged
     bare = params.preset("medium").with_values({"power.source_resistance_ohm": 0.0})
-    assert SV.at_supply(bare.servo, bare.power) is bare.servo
+    assert sim_servo.at_supply(bare.servo, bare.power) is bare.servo
 
 
 @pytest.mark.parametrize("restitution", [0.0, 0.2, 0.5, 0.9])

@@ -11,8 +11,8 @@ import numpy as np
 
 from ..errors import CalibrationError
 from ..io.importing import ImportOptions
-from . import ramp as R
-from . import servo as S
+from . import ramp
+from . import servo as servo_fit
 from .gyro_log import looks_like_gyro_log, parse_gyro_log
 from .recordings import REAL_TIME, TimeOptions, clean_samples, read_recording_text, read_table
 
@@ -51,9 +51,9 @@ def servo_recording(path: Path, rig, pivot, step, marker, imports: ImportOptions
                 "leave out --pivot and --step for a gyro log",
             )
         log = parse_gyro_log(text, path)
-        return S.RateRecording(log.t_s, log.rate_units, log.command_deg, rig, source=str(path))
+        return servo_fit.RateRecording(log.t_s, log.rate_units, log.command_deg, rig, source=str(path))
     t, angle, command = servo_series(path, pivot, step, marker, imports, timing)
-    return S.StepRecording(t, angle, command, rig, source=str(path))
+    return servo_fit.StepRecording(t, angle, command, rig, source=str(path))
 
 
 def per_recording(values: tuple[float, ...], n: int, option: str) -> list[float]:
@@ -125,7 +125,7 @@ def servo_series(
     table = read_table(data, imports, timing)
     if pivot is None:
         t, angle, command = table.require("t_s", "angle_deg", "command_deg", purpose="a servo step")
-        return clean_samples(data, "the servo angle", t, angle, command, min_samples=S.MIN_SAMPLES)
+        return clean_samples(data, "the servo angle", t, angle, command, min_samples=servo_fit.MIN_SAMPLES)
     px, py = parse_floats(pivot, 2, "--pivot", "X,Y in metres, e.g. --pivot 0.10,0.05")
     if step is None:
         raise CalibrationError(
@@ -134,8 +134,8 @@ def servo_series(
         )
     a_from, a_to, at_s = parse_floats(step, 3, "--step", "FROM,TO,AT_S, e.g. --step 0,180,0.05")
     x, y = table.marker(marker)
-    t, x, y = clean_samples(data, "the horn tip", table.time_s(), x, y, min_samples=S.MIN_SAMPLES)
-    return t, S.horn_angle_deg(x, y, px, py), np.where(t < at_s, a_from, a_to)
+    t, x, y = clean_samples(data, "the horn tip", table.time_s(), x, y, min_samples=servo_fit.MIN_SAMPLES)
+    return t, servo_fit.horn_angle_deg(x, y, px, py), np.where(t < at_s, a_from, a_to)
 
 
 def ramp_angles(
@@ -175,10 +175,10 @@ def ramp_angles(
     if len(names) != 2 or not table.markers():
         table.require("angle_deg", purpose="ramp trials (or a track with ramp and robot markers)")
     a, b = table.marker(names[0]), table.marker(names[1])
-    onset = R.critical_angle_from_track(table.time_s(), a, b, table.marker(robot_marker), source=str(path))
+    onset = ramp.critical_angle_from_track(table.time_s(), a, b, table.marker(robot_marker), source=str(path))
     board = np.hypot(b[0] - a[0], b[1] - a[1])
     board_m = float(np.median(board[np.isfinite(board)])) if np.isfinite(board).any() else float("nan")
-    return [onset.critical_angle_deg], R.board_length_warning(board_m, imports.units, str(path)), True
+    return [onset.critical_angle_deg], ramp.board_length_warning(board_m, imports.units, str(path)), True
 
 
 def parse_floats(text: str, n: int, option: str, hint: str) -> list[float]:

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import click
 
-from .. import params as P
+from .. import params as robot_params
 from ..calibrate.recordings import TimeOptions
 from ..io.importing import ImportOptions
 from ..io.robot_toml import ROBOT_FILE, default_robot
@@ -83,9 +83,9 @@ def robot_options(func=None, *, say: bool = True):
                              "e.g. --set servo.kp_nm_per_rad=0.4. Repeatable.")(wrapper)
     func = click.option("--config", type=click.Path(dir_okay=False, path_type=Path), default=None,
                         help=f"A robot.toml (e.g. {ROBOT_FILE}); overrides --preset.")(func)
-    func = click.option("--preset", type=click.Choice(list(P.PRESETS)), default=None,
+    func = click.option("--preset", type=click.Choice(list(robot_params.PRESETS)), default=None,
                         help=f"Built-in parameter set [default: {ROBOT_FILE} when the current folder has one, "
-                             f"else {P.DEFAULT_PRESET}, the robot as built].")(func)
+                             f"else {robot_params.DEFAULT_PRESET}, the robot as built].")(func)
     return func
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from .. import params as P
+from .. import params as robot_params
 from ..errors import ParamsError
 from ..fileio import json_text, locked
 from ..io import robot_toml
@@ -38,12 +38,13 @@ def params(preset, config, sets, as_json, write, force):
         out = {k: {"value": v, **{a: b for a, b in vars(robot.source_of(k)).items() if b is not None}}
                for k, v in robot.flat().items()}
         click.echo(json_text({"name": robot.name, "leg_set": robot.leg_set,
-                              "leg_set_added_m": P.leg_set_spec(robot.leg_set).added_m, "values": out,
+                              "leg_set_added_m": robot_params.leg_set_spec(robot.leg_set).added_m, "values": out,
                               "nose_load_kg": load.nose_load_kg if load else None,
                               "total_mass_kg": load.total_mass_kg if load else None}), nl=False)
         return
     click.echo(f"# {robot.name}")
-    click.echo(f"# leg set: {robot.leg_set} ({P.leg_set_spec(robot.leg_set).added_m * 1000:+g} mm on every link of "
+    added_mm = robot_params.leg_set_spec(robot.leg_set).added_m * 1000
+    click.echo(f"# leg set: {robot.leg_set} ({added_mm:+g} mm on every link of "
                "the cut file's strip)")
     for key, value in robot.flat().items():
         prov = robot.source_of(key)
@@ -54,7 +55,7 @@ def params(preset, config, sets, as_json, write, force):
                f"# standing at rest: no nose load ({why})")
 
 
-def _standing(robot: P.Robot):
+def _standing(robot: robot_params.Robot):
     """The model's standing load (:func:`locust.sim.statics.standing_load`), or None and why not."""
     from ..errors import LocustError
     from ..sim.statics import standing_load
@@ -65,7 +66,7 @@ def _standing(robot: P.Robot):
         return None, exc.message
 
 
-def _write(robot: P.Robot, write: Path, force: bool, config: Path | None, sets) -> None:
+def _write(robot: robot_params.Robot, write: Path, force: bool, config: Path | None, sets) -> None:
     """--write: a new file is created exclusively (a file another command made a moment ago is
     not replaced); --force replaces one under its lock; ``--config F --set ... --write F
     --force`` updates F as it is now (another process's update kept), its comments kept.
@@ -76,9 +77,9 @@ def _write(robot: P.Robot, write: Path, force: bool, config: Path | None, sets) 
         robot_toml.save_robot(robot, write, template=robot_toml.file_text(config) if config else None, exclusive=True)
         return
     if config is not None and os.path.realpath(config) == os.path.realpath(write):
-        overrides = P.parse_set_options(sets)
+        overrides = robot_params.parse_set_options(sets)
         robot_toml.update_robot(
-            write, lambda now: P.check_robot(now.with_values(overrides, "override") if overrides else now))
+            write, lambda now: robot_params.check_robot(now.with_values(overrides, "override") if overrides else now))
         return
     with locked(write):   # replaced by this robot: the layout of its --config, if any
         robot_toml.save_robot(robot, write, template=robot_toml.file_text(config) if config else None)

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..calibrate import synthetic as S
+from ..calibrate import synthetic
 from ..fileio import atomic_write_text
 from ..params import Robot
 
@@ -65,7 +65,7 @@ class BenchRecording:
     options: tuple[str, ...]
 
 
-def _servo_head(what: str, truth: S.ServoTruth) -> list[str]:
+def _servo_head(what: str, truth: synthetic.ServoTruth) -> list[str]:
     s = truth.servo
     return [f"SYNTHETIC servo recording ({what}) of the demo's virtual robot, made by locust.demo.bench",
             f"truth: noload_speed_rad_per_s={s.noload_speed_rad_per_s:.6g} armature_kgm2={s.armature_kgm2:.6g} "
@@ -90,37 +90,38 @@ def write_bench(robot: Robot, folder: Path) -> list[BenchRecording]:
         In the order a student would do them: hinge, servo, ramp.
     """
     c, k = robot.compliance, SEED
-    hinge = dataclasses.replace(S.HingeTruth(), hinge_stiffness_nm_per_rad=c.hinge_stiffness_nm_per_rad,
+    hinge = dataclasses.replace(synthetic.HingeTruth(), hinge_stiffness_nm_per_rad=c.hinge_stiffness_nm_per_rad,
                                 hinge_damping_nms_per_rad=c.hinge_damping_nms_per_rad)
-    t, x, y = S.hinge_swing_track(hinge, np.random.default_rng(k))
+    t, x, y = synthetic.hinge_swing_track(hinge, np.random.default_rng(k))
     head = ["SYNTHETIC hinge swing (t in s, x and y in m) of the demo's virtual robot, made by locust.demo.bench",
             f"truth: hinge_stiffness_nm_per_rad={hinge.hinge_stiffness_nm_per_rad:.6g} "
             f"hinge_damping_nms_per_rad={hinge.hinge_damping_nms_per_rad:.6g}",
             f"rig: inertia_kgm2={hinge.inertia_kgm2:g}, gravity {hinge.gravity}; {hinge.fps:g} frames/s, "
             f"marker noise {hinge.noise_m * 1000:g} mm (1 sigma)"]
     hinge_path = folder / "hinge_swing.csv"
-    atomic_write_text(hinge_path, S.csv_text(head, {"t": t, "x": x, "y": y}, {"t": ".6f", "x": ".7f", "y": ".7f"}))
+    columns = {"t": t, "x": x, "y": y}
+    atomic_write_text(hinge_path, synthetic.csv_text(head, columns, {"t": ".6f", "x": ".7f", "y": ".7f"}))
 
-    step = dataclasses.replace(S.ServoTruth(), servo=robot.servo)
-    stall = dataclasses.replace(S.STALL_SERVO, servo=robot.servo)
+    step = dataclasses.replace(synthetic.ServoTruth(), servo=robot.servo)
+    stall = dataclasses.replace(synthetic.STALL_SERVO, servo=robot.servo)
     servo_paths = []
     for name, truth, seed, what in (("servo_step.csv", step, k + 1, "a light load stepped 0 <-> 120 deg"),
                                     ("servo_stall.csv", stall, k + 2, "a weight too heavy: the horn stalls")):
-        t, angle, command = S.servo_step(truth, np.random.default_rng(seed))
+        t, angle, command = synthetic.servo_step(truth, np.random.default_rng(seed))
         path = folder / name
-        atomic_write_text(path, S.csv_text(_servo_head(what, truth),
-                                           {"t_s": t, "angle_deg": angle, "command_deg": command},
-                                           {"t_s": ".6f", "angle_deg": ".3f", "command_deg": ".1f"}))
+        atomic_write_text(path, synthetic.csv_text(_servo_head(what, truth),
+                                                   {"t_s": t, "angle_deg": angle, "command_deg": command},
+                                                   {"t_s": ".6f", "angle_deg": ".3f", "command_deg": ".1f"}))
         servo_paths.append(path)
 
-    ramp = S.RampTruth(mu_static=robot.contact.foot_friction)
-    angles = S.ramp_angles(ramp, np.random.default_rng(k + 3))
+    ramp = synthetic.RampTruth(mu_static=robot.contact.foot_friction)
+    angles = synthetic.ramp_angles(ramp, np.random.default_rng(k + 3))
     head = ["SYNTHETIC ramp trials of the demo's virtual robot, made by locust.demo.bench",
             f"truth: mu_static={ramp.mu_static:.6g} (critical angle {ramp.critical_angle_deg:.4f} deg); trial scatter "
             f"{ramp.scatter_deg} deg, reading error {ramp.reading_deg} deg, read to 0.1 deg"]
     ramp_path = folder / "ramp.csv"
-    atomic_write_text(ramp_path, S.csv_text(head, {"trial": np.arange(1, len(angles) + 1), "angle_deg": angles},
-                                            {"trial": "d", "angle_deg": ".1f"}))
+    atomic_write_text(ramp_path, synthetic.csv_text(head, {"trial": np.arange(1, len(angles) + 1), "angle_deg": angles},
+                                                    {"trial": "d", "angle_deg": ".1f"}))
     return [
         BenchRecording("hinge", (hinge_path,),
                        ("--inertia-kgm2", f"{hinge.inertia_kgm2!r}", "--gravity", hinge.gravity)),

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from ...calibrate import inputs
-from ...calibrate import servo as S
+from ...calibrate import servo as servo_fit
 from ...calibrate.plots import plot_fit
 from ...errors import CalibrationError
 from ...io.importing import ImportOptions
@@ -80,14 +80,15 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
     moments = inputs.per_recording(gravity_moment_nm or (0.0,), len(data), "--gravity-moment-nm")
     if pivot is not None and len(data) > 1:
         raise CalibrationError("--pivot takes one horn track", "fit tracks one at a time, or give angle CSVs")
-    recordings = [inputs.servo_recording(path, S.ServoRig(inertia, moment), pivot, step, marker, imports, timing)
+    recordings = [inputs.servo_recording(path, servo_fit.ServoRig(inertia, moment), pivot, step, marker, imports,
+                                         timing)
                   for path, inertia, moment in zip(data, inertias, moments)]
     if pivot is None and not imports.identity:
         raise CalibrationError("--units, --rename and --mirror apply to a horn track (--pivot), not to angles",
                                "leave them out for t_s,angle_deg,command_deg recordings and gyro logs")
     from ...api.calibration import fit_servo_recordings
 
-    with (progress(length=S.progress_steps(len(recordings)), label="fitting servo") as bar,
+    with (progress(length=servo_fit.progress_steps(len(recordings)), label="fitting servo") as bar,
           interruptible("the servo fit")):
         facade_fit = fit_servo_recordings(recordings, stall_torque_nm, kv_nms_per_rad=kv_nms_per_rad, fit_kv=fit_kv,
                                           progress=bar.update)
@@ -97,11 +98,12 @@ def servo(data, inertia_kgm2, stall_torque_nm, kv_nms_per_rad, fit_kv, gravity_m
         v_inertias = inputs.per_recording(validate_inertia_kgm2, len(validate), "--validate-inertia-kgm2") \
             if validate_inertia_kgm2 else [None] * len(validate)
         for path, inertia in zip(validate, v_inertias):
-            rec = inputs.servo_recording(path, S.ServoRig(inertias[0]), None, None, None, ImportOptions(), timing)
+            rec = inputs.servo_recording(path, servo_fit.ServoRig(inertias[0]), None, None, None, ImportOptions(),
+                                         timing)
             if inertia is None:
                 inertia = next((r.rig.inertia_kgm2 for r in recordings if r.kind == rec.kind), inertias[0])
-            rec = replace(rec, rig=S.ServoRig(inertia))
-            validations.append(S.validate(fit.servo, rec, gain=fit.rate_gain))
+            rec = replace(rec, rig=servo_fit.ServoRig(inertia))
+            validations.append(servo_fit.validate(fit.servo, rec, gain=fit.rate_gain))
     extra = {}
     if validations:
         extra["validation"] = [v.summary() for v in validations]
