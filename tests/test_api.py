@@ -93,7 +93,7 @@ def test_the_architecture_table_names_the_list():
 
 
 def test_notebook_session(tmp_path):
-    """The session of the issue: robot, simulate, .trace(), .video(..., overwrite=True) twice,
+    """A notebook session: robot, simulate, .trace(), .video(..., overwrite=True) twice,
     sweep .to_dataframe()."""
     robot = locust.robot("small", **{"servo.kp_nm_per_rad": 0.4})
     assert robot.get("servo.kp_nm_per_rad") == 0.4

@@ -29,7 +29,7 @@ from locust.commands import cli
 from locust.errors import CalibrationError
 
 FILM = ("hinge", "pendulum_transparency_film.csv")
-# the issue's link: 2 g with its centre of mass 80 mm from the hinge, so at least 1.28e-5 kg*m^2
+# a link of 2 g with its centre of mass 80 mm from the hinge, so at least 1.28e-5 kg*m^2
 MASS = ("--gravity", "in-plane", "--mass-kg", "0.002", "--com-m", "0.08")
 K, B = "compliance.hinge_stiffness_nm_per_rad", "compliance.hinge_damping_nms_per_rad"   # the robot keys fitted
 
@@ -54,7 +54,7 @@ def test_an_inertia_below_m_d_squared_is_refused_before_the_recording_is_read(tm
 
 
 def test_a_fit_that_does_not_follow_its_swing_writes_nothing(shared_data, tmp_path):
-    """The issue's rig at 1.5e-5 kg*m^2: allowed, yet gravity alone swings it faster than the
+    """The 2 g link's rig at 1.5e-5 kg*m^2: allowed, yet gravity alone swings it faster than the
     film's 1.6 s period and a hinge cannot slow it, so the model does not follow the swing (its
     residual about the size of the swing): every value NOT IDENTIFIABLE (was: k 2.8e-24 +-
     7.7e21 % printed TOO NARROW), the note says why, --write writes nothing, exit 0 as the

@@ -264,7 +264,7 @@ COVERAGE_PAIRS = (("small", "medium"), ("medium", "large"), ("small", "large"))
 def test_hidden_truths_over_leg_set_pairs(i, pair):
     """Three hidden truths x three leg-set pairs (Medium in two), each run two cycles of its own
     noise (SYNTHETIC filmings), three values fitted (one fit per test: 50-310 s each). Every
-    value within 5 % of the truth (issue 24's acceptance; on truth 0 within 2.2 %), whether or
+    value within 5 % of the truth (on truth 0 within 2.2 %), whether or
     not its interval covers it: the intervals here carry no held values' part (the seed's
     values are exact) and on truth 0 only 6 of the 9 cover, the misses 0.01-2.2 % off
     (docs/calibrate.md), so one fit's coverage is not asserted."""

@@ -1,6 +1,6 @@
 """`locust calibrate hop` on the virtual robot: do its 95 % intervals cover hidden truths? (slow)
 
-Issue 33's acceptance: over at least 10 hidden truths, each key's 95 % interval covers the
+Over at least 10 hidden truths, each key's 95 % interval covers the
 truth in at least 8 of 10. Each truth is drawn (seeded, :func:`hidden_truth`) log-uniformly
 within the ranges the hop fit is meant for on the seed robot (the demo's virtual robot):
 foot friction 1.8-2.6 (above the floor's 1.6, where it acts), hinge stiffness 0.033-0.07

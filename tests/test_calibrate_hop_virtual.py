@@ -77,7 +77,7 @@ def test_fit_recovers_the_hidden_values(fitted):
 
 def test_fit_leaves_little(fitted):
     for run in fitted["fit"]["runs"]:
-        # absolute positions (issue 33): the standing pose and where each marker's tracked face
+        # absolute positions: the standing pose and where each marker's tracked face
         # sits on the robot stay in the residual; on one filming of Small and Medium (bench/hop_model_error.py
         # seed 100) the fit left
         # 0.17 and 0.13 mm (the foot 0.21 and 0.16 mm, the nose 0.11 and 0.10 mm; with each

@@ -1,5 +1,5 @@
 """The beam, hinge and servo fits of the REAL recordings in ../shared/data print the values
-they printed before their solver vectors became calibrate.fitparams (issue 37): each
+they printed before their solver vectors became calibrate.fitparams: each
 estimate's line, value, relative sd and 95 % interval, to the printed digit. A change in a
 fitter's packing, bounds or chain rule moves one of these digits; a deliberate change of a
 fit updates them here with its reason. Lengths are printed in mm (`radius`, `rms_residual`:

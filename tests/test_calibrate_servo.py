@@ -420,8 +420,8 @@ def split_gyro_log(source, folder, amplitudes) -> Path:
 def test_real_sg90s_predict_step_sizes_they_never_saw(shared_data, tmp_path):
     """REAL, cross-validated: fitted on the AA swing and the gyro log's steps of 10, 30, ...,
     130 deg, the servo predicts the peak speeds of the 20, 40, ..., 120 deg steps, and the
-    reverse: every one within 20 %, the median within 8 % (the issue's acceptance on its
-    withheld 15-135 deg steps)."""
+    reverse: every one within 20 %, the median within 8 % (the bounds for
+    withheld steps of 15-135 deg)."""
     log = shared_data / "servo" / "sg90_unloaded_gyro_steps.txt"
     odd = split_gyro_log(log, tmp_path, set(range(10, 140, 20)))
     even = split_gyro_log(log, tmp_path, set(range(20, 130, 20)))

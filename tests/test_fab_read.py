@@ -1,5 +1,5 @@
 """The DXF reader on synthetic drawings of known area (written here with ezdxf), one per
-entity kind the issue names, plus units, chaining, gaps, layers and damaged files."""
+entity kind it reads, plus units, chaining, gaps, layers and damaged files."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""`locust fab` refuses what it cannot make rather than succeed without it (issue 39, items 6
-and 8): a spline too large to flatten (within seconds, in bounded memory), a cut of no length,
+"""`locust fab` refuses what it cannot make rather than succeed without it:
+a spline too large to flatten (within seconds, in bounded memory), a cut of no length,
 a NaN vertex, an unknown $INSUNITS, a hinge width that is no width. The drawings are
 synthetic, made here with ezdxf."""
 
@@ -57,7 +57,7 @@ def test_a_spline_over_the_limit_is_refused_before_flattening(tmp_path):
 
 @pytest.mark.slow
 def test_the_200k_point_spline_is_refused_within_seconds_in_bounded_memory(tmp_path):
-    """The issue's drawing: 200,000 control points on `cuts` (13 MB). It grew memory by 300 MB/s
+    """A drawing of 200,000 control points on `cuts` (13 MB). It grew memory by 300 MB/s
     to an OOM kill, or under a 4 GB limit made cut files with `slits: 0`. Now: exit 2 under a
     1.5 GB address-space limit (about 10 s to read the file on a loaded 2-core machine)."""
     path = drawing(tmp_path / "huge.dxf", spline(200_000))

@@ -1,5 +1,5 @@
-"""A full disk (a real 64 kB tmpfs, tests/conftest.py) under `flash --port sim` and `sweep`
-(issue 39, item 7): an error that says the disk is full, the board's firmware files as they
+"""A full disk (a real 64 kB tmpfs, tests/conftest.py) under `flash --port sim` and `sweep`:
+an error that says the disk is full, the board's firmware files as they
 were (no torn config.py), and a sweep folder its rerun resumes."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""`locust optimize` on a disk that fills up mid-trial (issue 39, item 3): the command ends with
+"""`locust optimize` on a disk that fills up mid-trial: the command ends with
 error:/hint:, and the journal it tore is mended by `--repair` (saved beside it first), every
 whole trial kept. The full disk is a real one: a 64 kB tmpfs (mounting needs root; the test is
 skipped, saying so, where mounting is not allowed)."""

@@ -374,7 +374,7 @@ def test_report_loads_in_headless_chromium(world, tmp_path):
 
 def test_a_full_disk_leaves_no_half_report(world, small_disk):
     """A report onto a real full disk (a 64 kB tmpfs): error:/hint:, and no report/ folder left
-    (an empty one was, issue 39 item 7)."""
+    (an earlier version left an empty one)."""
     disk, fill = small_disk
     fill(free=8192)
     res = invoke("--measured", world["root"] / "hops" / "small-1", "--preset", "seed", "--out", disk / "out")

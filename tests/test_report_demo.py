@@ -1,4 +1,4 @@
-"""`locust demo` end to end (slow): the acceptance items of the report issue.
+"""`locust demo` end to end (slow), checked against what its report must show.
 
 The virtual robot (a draw of the robot as built; firmware under MicroPython, MuJoCo plant,
 rendered video) hops Small, Medium and Large; the videos are tracked, its SYNTHETIC bench

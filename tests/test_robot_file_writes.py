@@ -1,5 +1,5 @@
 """Every writer of a robot.toml writes TOML that reads back, keeps the user's comments, and
-loses no update when two processes write one file at once (issue 39, items 1 and 2).
+loses no update when two processes write one file at once.
 
 The strings written are generated: every control character, quotes, backslashes, newlines,
 non-ASCII text and a file name's undecodable byte (a lone surrogate)."""
@@ -101,7 +101,7 @@ def test_params_write_keeps_comments_of_the_config(tmp_path):
 
 
 def test_calibrate_write_after_a_robot_file_with_escapes_reads_back(tmp_path):
-    """The issue's reproduction: a note with a newline escape, then `calibrate ramp --write`."""
+    """A note with a newline escape, then `calibrate ramp --write`: the file reads back."""
     path = tmp_path / "r.toml"
     path.write_text('# mine\nname = "r"\n[geometry]\n'
                     'leg_m = { value = 0.06, source = "seed", note = "x\\ny\\u0001\\u007f" }\n')
@@ -176,7 +176,7 @@ def test_update_robot_waits_for_the_lock_then_says_who_holds_it(tmp_path):
 
 @pytest.mark.slow
 def test_two_concurrent_calibrate_writes_both_land_20_of_20(tmp_path):
-    """The issue's reproduction, 20 times: `calibrate ramp --into foot` and `--into nose` onto
+    """Two writers at once, 20 times: `calibrate ramp --into foot` and `--into nose` onto
     one file at once; both fitted values are in it every time (about 90 s)."""
     landed = 0
     for k in range(20):

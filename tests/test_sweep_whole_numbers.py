@@ -1,5 +1,5 @@
 """`sweep --vary` of a whole-number parameter refuses a range whose steps are not whole before
-any design runs (issue 39, item 8: `solver.iterations=1:10.5:3` ran and marked 5.75 and 10.5
+any design runs (an earlier version ran `solver.iterations=1:10.5:3` and marked 5.75 and 10.5
 invalid)."""
 
 from __future__ import annotations

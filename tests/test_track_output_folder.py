@@ -1,4 +1,4 @@
-"""Where `locust track` writes (issue 36, item 11): into one output folder, named on the
+"""Where `locust track` writes: into one output folder, named on the
 first stderr line as `output folder: <absolute path>`. An input in a folder of its own (a
 read-only data folder) is tracked into the current folder, never beside it; a video copied
 into a `locust hop --out` run folder is tracked into that folder, where `locust calibrate hop`

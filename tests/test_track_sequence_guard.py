@@ -1,5 +1,5 @@
 """`locust track video` never writes onto a frame of an image sequence, nor a file the next
-run would read as one of its frames, --force or not (issue 39, item 4), and never writes
+run would read as one of its frames, --force or not, and never writes
 beside a device (`--out /dev/null`). The frames are synthetic: a magenta patch on black."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""`locust track from-trk` refuses a clip or scale Tracker would not save (issue 39, item 8):
+"""`locust track from-trk` refuses a clip or scale Tracker would not save:
 a step of -1 (times counting down), a step count of -5 (an empty CSV, exit 0 before), a
 negative scale (every position mirrored). The projects are SYNTHETIC (tests/test_calibrate_hinge.py)."""
 

@@ -1,7 +1,7 @@
 """What the virtual robot's servos drive: a plant that takes horn angles over time.
 
 - ``RecordingPlant`` keeps every command in memory; tests and ``--plant record`` use it.
-- ``MujocoPlant`` drives the simulation engineer's live MuJoCo model
+- ``MujocoPlant`` drives the simulation's live MuJoCo model
   (``locust.sim.live.LiveSim``), so a hop on the virtual robot moves the simulated robot.
   Its video has a fixed camera framed on the robot's planned schedule (``robot.schedule``:
   ``locust hop`` puts its own options there), with ``.truth.csv`` and ``.camera.json``

@@ -22,7 +22,7 @@ its wait) less its standing pitch, nose up positive, counted through the vertica
 
 The thresholds and why:
 
-- :data:`REAR_M` = 3 cm of nose rise: the height issue 33 names for a rear; the filmed
+- :data:`REAR_M` = 3 cm of nose rise: the height that counts as a rear; the filmed
   "several centimetres" of a hop are above it, a robot shuffling on its feet is well below.
 - :data:`OVER_TURN_DEG` = 45 deg: a robot that has come back down stands within a degree
   of its start (0.0 deg measured on every returning hop of the presets' near-threshold
