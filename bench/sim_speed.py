@@ -59,11 +59,11 @@ def robot_for(overrides: dict, scale: float = 1.0):
 REFINED = [(4e-3, 5e-4, 0.04), (4e-3, 1e-3, 0.04)]   # (step, fine step, window after a contact change) [s]
 
 
-def refined_run(base, coarse: float, fine: float, window: float):
+def refined_run(robot, coarse: float, fine: float, window: float):
     """Build, simulate refined, audit and summarise: what ``run`` does, on the refined route.
     Returns (the hop summary, model steps taken)."""
-    robot = base.with_values({"solver.timestep_s": coarse})
-    out = simulate_refined(build(robot), control_plan(robot.schedule, robot.solver, CYCLES), fine, window)
+    stepped = robot.with_values({"solver.timestep_s": coarse})
+    out = simulate_refined(build(stepped), control_plan(stepped.schedule, stepped.solver, CYCLES), fine, window)
     if not audit(out.trajectory).valid:
         raise SystemExit(f"the refined route {coarse:g}/{fine:g} s failed its audit")
     return summarise(out.trajectory), out.model_steps

@@ -142,7 +142,7 @@ def test_repr_is_a_short_table_in_mm():
     assert repr(r.distance_m) not in text and len(text.splitlines()) < 12
     assert "<table>" in r._repr_html_() and f"{r.hops[0].distance_m * 1000:.2f}" in r._repr_html_()
     # the CLI's JSON is the simulation's own figures and the standing load: nothing else of the facade
-    facade = ("params", "spread", "sensitivity", "nose_load_kg", "total_mass_kg")
+    facade = ("robot", "spread", "sensitivity", "nose_load_kg", "total_mass_kg")
     assert set(r.to_json()) == set(locust.sim.result.SimResult(**{k: v for k, v in vars(r).items()
                                                                if k not in facade}).to_json()) | set(facade[3:])
     assert f"nose load        {r.nose_load_kg * 1000:.1f} g" in text

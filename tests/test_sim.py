@@ -164,7 +164,7 @@ def test_the_command_and_the_api_run_one_simulation_job():
     assert res.exit_code == 0, res.output
     doc = json.loads(res.stdout)
     api = locust.simulate(locust.robot("small"), cycles=1, leg_set="medium", check_convergence=True)
-    assert doc["robot"] == api.robot == "small (medium legs)"
+    assert doc["robot"] == api.robot_name == "small (medium legs)"
     assert doc["valid"] and api.valid
     for key in ("distance_m", "max_nose_height_m", "nose_load_kg", "timestep_s"):
         assert doc[key] == getattr(api, key), key

@@ -94,7 +94,7 @@ def sim_lines(r, verbose: bool = False) -> list[str]:
     list of str
     """
     said = f"{verdict(r.valid)}, {outcome_words(r.outcome)}" if r.outcome else verdict(r.valid)
-    lines = [f"{r.robot}: {said} ({r.cycles} cycle{'' if r.cycles == 1 else 's'}, "
+    lines = [f"{r.robot_name}: {said} ({r.cycles} cycle{'' if r.cycles == 1 else 's'}, "
              f"time step {r.timestep_s:g} s, "
              f"{r.wall_s:.1f} s wall)"]
     lines += [f"{INDENT}reason: {reason}" for reason in r.reasons]

@@ -13,7 +13,7 @@ from ..fileio import json_text
 from ..params import Robot
 
 
-def make_cut_files(source: Robot | str | Path, *, out: str | Path | None = None,
+def make_cut_files(robot_or_dxf: Robot | str | Path, *, out: str | Path | None = None,
         layers: Mapping[str, Sequence[str]] | None = None, units: str | None = None, gap_tol_mm: float = 0.01,
         recover: bool = False, hinge_width_mm: float = 1.0, stack: Sequence[str] = laminate.SEED_STACK,
         mirror: Sequence[str] = (), kerf_mm: float = 0.05, support_width_mm: float = 2.0,
@@ -23,7 +23,7 @@ def make_cut_files(source: Robot | str | Path, *, out: str | Path | None = None,
 
     Parameters
     ----------
-    source : Robot or path-like
+    robot_or_dxf : Robot or path-like
         A robot (:func:`locust.robot`): the leg's flat pattern from its four link lengths; or
         an outline DXF (layers plate/body = outline, hinge_*/joints = hinges, holes, cuts).
     out : path-like, optional
@@ -73,12 +73,12 @@ def make_cut_files(source: Robot | str | Path, *, out: str | Path | None = None,
     if out is not None:
         export.check_out(out)
     fp = None
-    if isinstance(source, Robot):
-        fp = flat_pattern.from_robot(source, glue_tab_mm=glue_tab_mm, slot_width_mm=slot_width_mm,
+    if isinstance(robot_or_dxf, Robot):
+        fp = flat_pattern.from_robot(robot_or_dxf, glue_tab_mm=glue_tab_mm, slot_width_mm=slot_width_mm,
                                      slot_length_mm=slot_length_mm)
         design = flat_pattern.design(fp)
     else:
-        drawing = read_drawing(source, units=units, gap_tol_mm=gap_tol_mm, recover=recover)
+        drawing = read_drawing(robot_or_dxf, units=units, gap_tol_mm=gap_tol_mm, recover=recover)
         layer_map = LayerMap().with_overrides({k: list(v) for k, v in (layers or {}).items()})
         design = design_from_drawing(drawing, layer_map, hinge_width_mm=hinge_width_mm, gap_tol_mm=gap_tol_mm)
     specs = laminate.stack_from_materials(list(stack), tuple(mirror))
@@ -97,7 +97,7 @@ def make_cut_files(source: Robot | str | Path, *, out: str | Path | None = None,
     names = sorted(files) + (["summary.json"] if out is not None else [])
     result = summary(lam, hinges_x_mm=fp.hinges_x_mm if fp is not None else None, files=names,
                      out_dir=str(out) if out else None,
-                     assembly=flat_pattern.assembly(source) if fp is not None else None)
+                     assembly=flat_pattern.assembly(robot_or_dxf) if fp is not None else None)
     if out is not None:
         files["summary.json"] = json_text(result).encode()
         export.publish(out, files)

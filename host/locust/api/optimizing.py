@@ -12,13 +12,13 @@ from ..sweep.study import OptimizeOptions, optimize_study, parse_steps, study_bo
 from .sweeps import vary_texts
 
 
-def optimize_bounds(base: Robot, vary: Mapping[str, tuple[float, float] | str] | Sequence[str | Bound]) -> list[Bound]:
+def optimize_bounds(robot: Robot, vary: Mapping[str, tuple[float, float] | str] | Sequence[str | Bound]) -> list[Bound]:
     """The searched ranges: ``{"geometry.leg_m": (0.05, 0.09)}``, ``{"schedule.push_s": "0.15:0.4"}``
     or ``["geometry.leg_m=0.05:0.09", ...]`` (the command line's ``--vary``), each name once.
 
     Parameters
     ----------
-    base : locust.params.Robot
+    robot : locust.params.Robot
         The robot optimised.
     vary : mapping or sequence
         Name -> (low, high) in the parameter's unit, or the same as text.
@@ -32,7 +32,7 @@ def optimize_bounds(base: Robot, vary: Mapping[str, tuple[float, float] | str] |
     locust.errors.SweepError
         Nothing varied, a name given twice, or a range that cannot be read.
     """
-    return study_bounds(base, vary_texts(vary), {})
+    return study_bounds(robot, vary_texts(vary), {})
 
 
 def optimize(robot: Robot, vary: Mapping[str, tuple[float, float] | str] | Sequence[str | Bound], trials: int = 50,

@@ -84,7 +84,7 @@ class SweepResults(SweepSummary):
                 f"{self.best['max_nose_height_m'] * 1000:.2f} mm above the floor")
 
 
-def varied(base: Robot, vary: Mapping[str, tuple | str] | Sequence, parse: Callable, kind: type,
+def varied(robot: Robot, vary: Mapping[str, tuple | str] | Sequence, parse: Callable, kind: type,
            example: str) -> list:
     """``vary`` as a dict (name -> a tuple of numbers or their ``"a:b"`` text) or as the command
     line's ``--vary NAME=...`` strings, each parsed by ``parse(text, base)`` unless it already is
@@ -92,7 +92,7 @@ def varied(base: Robot, vary: Mapping[str, tuple | str] | Sequence, parse: Calla
 
     Parameters
     ----------
-    base : locust.params.Robot
+    robot : locust.params.Robot
         The robot whose parameters are varied (names are checked against it).
     vary : mapping or sequence
         Name -> tuple of numbers or ``"a:b[:n]"`` text, or ``NAME=a:b[:n]`` strings or ``kind`` objects;
@@ -114,7 +114,7 @@ def varied(base: Robot, vary: Mapping[str, tuple | str] | Sequence, parse: Calla
     locust.errors.SweepError
         Nothing varied, a name given twice, or a value ``parse`` refuses.
     """
-    parsed = [v if isinstance(v, kind) else parse(v, base) for v in vary_texts(vary)]
+    parsed = [v if isinstance(v, kind) else parse(v, robot) for v in vary_texts(vary)]
     names = [p.name for p in parsed]
     if not names:
         raise SweepError("nothing to vary", f"e.g. vary={example}")
@@ -143,13 +143,13 @@ def vary_texts(vary: Mapping[str, tuple | str] | Sequence) -> list:
     return [f"{name}={spec}" for name, spec in zip(vary, items)]
 
 
-def sweep_axes(base: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis]) -> list[Axis]:
+def sweep_axes(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis]) -> list[Axis]:
     """The grid's axes: ``{"scale": (0.0, 0.05, 30)}``, ``{"geometry.leg_m": "0.04:0.1:7"}`` or
     ``["scale=0:0.05:30", ...]`` (the command line's ``--vary``), each name checked once.
 
     Parameters
     ----------
-    base : locust.params.Robot
+    robot : locust.params.Robot
         The robot swept.
     vary : mapping or sequence
         Name -> (low, high, count) in the parameter's unit, or the same as text.
@@ -163,7 +163,7 @@ def sweep_axes(base: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axi
     locust.errors.SweepError
         Nothing varied, a name given twice, or a range that cannot be read.
     """
-    return varied(base, vary, parse_axis, Axis, '{"scale": (0.0, 0.05, 30)}')
+    return varied(robot, vary, parse_axis, Axis, '{"scale": (0.0, 0.05, 30)}')
 
 
 def sweep_designs(robot: Robot, vary: Mapping[str, RANGE | str] | Sequence[str | Axis], cycles: int = 3, *,

@@ -53,7 +53,7 @@ SHIFT_LEVELS = 101             # ... from the best of this many offsets, refined
 
 
 # -- reading runs ------------------------------------------------------------------------
-def load_run(path: Path, config: str, base: Robot) -> Trial:
+def load_run(path: Path, config: str, robot: Robot) -> Trial:
     """A ``locust hop --out`` folder (its run.json and tracks) as the trial the fit simulates.
 
     Parameters
@@ -62,13 +62,13 @@ def load_run(path: Path, config: str, base: Robot) -> Trial:
         The run folder.
     config : str
         Its leg set.
-    base : locust.params.Robot
+    robot : locust.params.Robot
         The robot being fitted, on which the leg set is built.
 
     Returns
     -------
     locust.trials.measured.Trial
-        With its robot (the leg set on ``base``, at the run's own push angle), its phase
+        With its robot (the leg set on ``robot``, at the run's own push angle), its phase
         times from the first push, its nose's onset on the camera's clock, and its tracks
         (nose, and foot where it was tracked standing) up to ``REST_KEPT_S`` after the last phase.
 
@@ -106,10 +106,10 @@ def load_run(path: Path, config: str, base: Robot) -> Trial:
     end_s = (last.measured_us - t0_us) * 1e-6 + (record.schedule.push_ms if last.phase == "push"
                                                   else record.schedule.wait_ms) * 1e-3
     tracks = {m: tr.until(onset + end_s + REST_KEPT_S) for m, tr in tracks.items()}
-    robot = configuration(base, config).robot
-    if not math.isclose(robot.schedule.push_deg, record.schedule.push_deg):
-        robot = robot.with_values({"schedule.push_deg": record.schedule.push_deg}, f"run:{trial.run_path}")
-    return replace(trial, source=Path(path), robot=robot, tracks=tracks,
+    run_robot = configuration(robot, config).robot
+    if not math.isclose(run_robot.schedule.push_deg, record.schedule.push_deg):
+        run_robot = run_robot.with_values({"schedule.push_deg": record.schedule.push_deg}, f"run:{trial.run_path}")
+    return replace(trial, source=Path(path), robot=run_robot, tracks=tracks,
                    phase_s=np.array([(p.measured_us - t0_us) * 1e-6 for p in phases]),
                    pushing=np.array([p.phase == "push" for p in phases]), onset_s=float(onset))
 

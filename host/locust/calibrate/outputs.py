@@ -36,7 +36,7 @@ class Saved:
     refused: CalibrationError | None = None
 
 
-def save(fit: Fit, *, plot_path: Path | None = None, write_path: Path | None = None, start: Robot | None = None,
+def save(fit: Fit, *, plot_path: Path | None = None, write_path: Path | None = None, robot: Robot | None = None,
          force: bool = False, extra: dict | None = None) -> Saved:
     """Draw ``fit``'s plot and write its values into a robot.toml.
 
@@ -48,7 +48,7 @@ def save(fit: Fit, *, plot_path: Path | None = None, write_path: Path | None = N
         The fit plot (None: none drawn).
     write_path : pathlib.Path, optional
         The robot.toml the values go to (None: none written).
-    start : locust.params.Robot, optional
+    robot : locust.params.Robot, optional
         The robot a new ``write_path`` starts from.
     force : bool, default False
         Replace a file at ``plot_path`` that is not one of this toolkit's figures.
@@ -69,12 +69,12 @@ def save(fit: Fit, *, plot_path: Path | None = None, write_path: Path | None = N
     if write_path and odd:
         return Saved(out, CalibrationError("; ".join(odd) + "; not written", UNIT_HINT))
     if write_path:
-        _write(fit, out, write_path, start, Path(fit.source).name)
+        _write(fit, out, write_path, robot, Path(fit.source).name)
     return Saved(out)
 
 
 def save_hops(fit: Fit, *, plot_folder: Path | None = None, write_path: Path | None = None,
-              start: Robot | None = None) -> dict:
+              robot: Robot | None = None) -> dict:
     """Draw each run's plot of a hop fit (``<run>-hops-fit.png``) and write its values.
 
     Parameters
@@ -85,7 +85,7 @@ def save_hops(fit: Fit, *, plot_folder: Path | None = None, write_path: Path | N
         Where the plots go, made if missing (None: none drawn).
     write_path : pathlib.Path, optional
         The robot.toml the identifiable values go to, source ``fit:hops``.
-    start : locust.params.Robot, optional
+    robot : locust.params.Robot, optional
         The robot a new ``write_path`` starts from.
 
     Returns
@@ -106,12 +106,12 @@ def save_hops(fit: Fit, *, plot_folder: Path | None = None, write_path: Path | N
                 plot = make_folder(plot_folder) / f"{Path(run.source).name}-hops-fit.png"
                 out["plots"].append(str(plot_run(run, plot, f"RMS {1000 * run.rms_m:.2f} mm")))
     if write_path:
-        _write(fit, out, write_path, start, fit.source)
+        _write(fit, out, write_path, robot, fit.source)
     return out
 
 
-def _write(fit: Fit, out: dict, write_path: Path, start: Robot | None, recording: str) -> None:
+def _write(fit: Fit, out: dict, write_path: Path, robot: Robot | None, recording: str) -> None:
     """The fitted values into ``write_path`` (none to write: the file is left alone), said in ``out``."""
     if fit.parameters:
-        write_fitted(write_path, fit.parameters, recording, note=fit.note, start=start)
+        write_fitted(write_path, fit.parameters, recording, note=fit.note, robot=robot)
     out["written"] = {"path": str(Path(write_path).resolve()), "keys": list(fit.parameters)}

@@ -76,7 +76,7 @@ def check_plausible(values: dict[str, Estimate]) -> None:
 
 
 def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str | Path, *,
-                 start: Robot | None = None, note: str = "", date: str | None = None) -> Path:
+                 robot: Robot | None = None, note: str = "", date: str | None = None) -> Path:
     """Set each dotted key in ``values`` to its fitted value, with ``fit:<recording>``; refused
     (nothing written) when a value is implausible or the robot could then not be simulated.
 
@@ -87,7 +87,7 @@ def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str |
     ----------
     path : path-like
         The ``robot.toml``.
-    start : locust.params.Robot, optional
+    robot : locust.params.Robot, optional
         The robot a file that does not exist yet starts from: the one the command resolved
         (``locust.io.robot_toml.default_robot``). None: ``path`` must exist.
     values : dict of str to locust.calibrate.fitstats.Estimate
@@ -122,7 +122,7 @@ def write_fitted(path: str | Path, values: dict[str, Estimate], recording: str |
                                    "(`locust params --config FILE` lists them)")
         return robot
 
-    return update_robot(path, change, start=None if start is None else (lambda: start))
+    return update_robot(path, change, start=None if robot is None else (lambda: robot))
 
 
 def with_fitted(robot: Robot, values: dict[str, Estimate], recording: str | Path, *, note: str = "",

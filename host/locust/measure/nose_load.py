@@ -109,10 +109,10 @@ def _plate_from_weight(robot: Robot, total_kg: float, resolution_kg: float) -> G
     part; its sd from the resolution and the other parts' own uncertainties."""
     from ..sim.model import build
 
-    def mass(r: Robot) -> float:
+    def mass(robot: Robot) -> float:
         from ..sim.gl import mujoco
 
-        model = build(r).model
+        model = build(robot).model
         return float(model.body_subtreemass[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "chassis")])
 
     plate0 = robot.get(PLATE_KEY)

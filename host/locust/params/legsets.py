@@ -11,13 +11,13 @@ from ..errors import ParamsError
 from .model import Provenance, Robot
 
 
-def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
+def with_added_length(robot: Robot, added_m: float, source: str = "sweep:scale",
                       note: str | None = None) -> Robot:
-    """``base`` with the same length added to all four links (the seed's ``scale`` variable).
+    """``robot`` with the same length added to all four links (the seed's ``scale`` variable).
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
     added_m : float
         The length added to each link [m] (may be negative).
     source, note : str
@@ -27,7 +27,7 @@ def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
     -------
     Robot
     """
-    g = base.geometry
+    g = robot.geometry
     values = {
         "geometry.ground_m": round(g.ground_m + added_m, 9),
         "geometry.crank_m": round(g.crank_m + added_m, 9),
@@ -35,7 +35,7 @@ def with_added_length(base: Robot, added_m: float, source: str = "sweep:scale",
         "geometry.leg_m": round(g.leg_m + added_m, 9),
     }
     note = note or f"{added_m * 1000:+g} mm on every link"
-    return base.with_values(values, Provenance(source=source, note=note))
+    return robot.with_values(values, Provenance(source=source, note=note))
 
 
 @dataclass(frozen=True)

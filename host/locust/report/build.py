@@ -165,7 +165,7 @@ def parameter_rows(robot: Robot) -> list[dict]:
     return rows
 
 
-def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, robot_source: str,
+def build_report(robot: Robot, measured: dict[str, list[Trial]], out: Path, *, robot_source: str,
                  cycles: int | None = None, sweep: Path | None = None, added: dict[str, float] | None = None,
                  marker: str = "nose", progress: Callable[[str], None] | None = None,
                  side_by_side: bool = False, samples: int = 0, before: Robot | None = None,
@@ -174,14 +174,14 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The robot whose leg sets are the configurations.
     measured : dict of str to list of Trial
         Per configuration (leg-set name), its trials; an empty list predicts only.
     out : Path
         Where the new ``report`` folder is made (never an existing one).
     robot_source : str
-        Where ``base`` came from, as the page names it.
+        Where ``robot`` came from, as the page names it.
     cycles : int, optional
         Cycles to simulate; default the runs' recorded cycles, else the robot's schedule.
     sweep : Path, optional
@@ -228,7 +228,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     views = views_page(front) if front is not None else None
     t0 = time.perf_counter()
 
-    configs, comps, spreads, befores = _simulate(base, measured, added, cycles, marker, progress, side_by_side,
+    configs, comps, spreads, befores = _simulate(robot, measured, added, cycles, marker, progress, side_by_side,
                                                  samples, before)
 
     progress("drawing figures")
@@ -240,9 +240,9 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
     timing = [row for c in comps for row in timing_rows(c.config, c.all_trials)]
     warnings = notices(comps) + sweep_notices(land)
     sbs_plan = plan_side_by_side(comps) if side_by_side else None   # videos probed, cameras read: before any write
-    html_text = render_html(base, robot_source, comps, configs, figs, timing, land, marker, warnings, spreads,
+    html_text = render_html(robot, robot_source, comps, configs, figs, timing, land, marker, warnings, spreads,
                             sbs_plan)
-    doc = report_json(base, robot_source, comps, configs, timing, land, marker, warnings)
+    doc = report_json(robot, robot_source, comps, configs, timing, land, marker, warnings)
     doc["optimize"] = {"folder": str(front.folder), "front": front.front,
                        "views": STUDY_PAGE if views is not None else None} if front is not None else None
     for entry in doc["configurations"]:
@@ -271,7 +271,7 @@ def build_report(base: Robot, measured: dict[str, list[Trial]], out: Path, *, ro
                         warnings=warnings, side_by_side=videos)
 
 
-def _simulate(base: Robot, measured: dict[str, list[Trial]], added: dict[str, float], cycles: int | None,
+def _simulate(robot: Robot, measured: dict[str, list[Trial]], added: dict[str, float], cycles: int | None,
               marker: str, progress: Callable[[str], None], side_by_side: bool, samples: int,
               before: Robot | None) -> tuple[dict[str, Configuration], list[Comparison], dict, dict]:
     """Each configuration simulated on its runs' schedule and compared with its trials; with
@@ -281,7 +281,7 @@ def _simulate(base: Robot, measured: dict[str, list[Trial]], added: dict[str, fl
     comps: list[Comparison] = []
     spreads, befores = {}, {}
     for name, trials in measured.items():
-        cfg, sched, n_cycles = _run_configuration(base, name, trials, added.get(name), cycles)
+        cfg, sched, n_cycles = _run_configuration(robot, name, trials, added.get(name), cycles)
         configs[name] = cfg
         period = cfg.robot.schedule.push_s + cfg.robot.schedule.wait_s
         progress(f"simulating {cfg.label} ({n_cycles} cycles)")
@@ -296,11 +296,11 @@ def _simulate(base: Robot, measured: dict[str, list[Trial]], added: dict[str, fl
     return configs, comps, spreads, befores
 
 
-def _run_configuration(base: Robot, name: str, trials: list[Trial], added_m: float | None,
+def _run_configuration(robot: Robot, name: str, trials: list[Trial], added_m: float | None,
                        cycles: int | None) -> tuple[Configuration, dict | None, int]:
     """Configuration ``name`` on the schedule its trials ran, that schedule, and the cycles to
     simulate (``cycles``, else the runs', else the robot's; never more than the runs recorded)."""
-    cfg = configuration(base, name, added_m)
+    cfg = configuration(robot, name, added_m)
     sched = run_schedule(name, trials)
     cfg = Configuration(cfg.name, cfg.added_m, with_run_schedule(cfg.robot, sched))
     if cycles and sched and cycles > sched["cycles"]:
@@ -346,7 +346,7 @@ def _figures(comps: list[Comparison], configs: dict[str, Configuration], land: L
     return figs
 
 
-def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker: str) -> str:
+def _notes(comps: list[Comparison], land: Landscape | None, robot: Robot, marker: str) -> str:
     items = [
         "Predicted distance: locust sim's, locust.sim.run.run()'s chassis travel from the schedule's start to the "
         "end of the run, the figure locust sim and locust sweep print. Marker travel: the model's "
@@ -380,8 +380,8 @@ def _notes(comps: list[Comparison], land: Landscape | None, base: Robot, marker:
                              f"{', '.join(map(str, gaps))}.")
         if not c.trials:
             items.append(f"{c.config}: no track given, prediction only.")
-    if land is not None and land.base != base.name:
-        items.append(f"The sweep's base robot is {land.base!r}, the report's is {base.name!r}: the landscape "
+    if land is not None and land.base != robot.name:
+        items.append(f"The sweep's base robot is {land.base!r}, the report's is {robot.name!r}: the landscape "
                      "may not be the same robot.")
     return "<ul class=\"note\">" + "".join(f"<li>{page.esc(i)}</li>" for i in items) + "</ul>"
 
@@ -422,13 +422,13 @@ def _track_reading(t) -> str:
     return ("metres" if t.track.units == "m" else f"{t.track.units} -> m") + (", mirrored" if t.track.mirrored else "")
 
 
-def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, land, marker: str,
+def render_html(robot: Robot, robot_source: str, comps, configs, figs, timing, land, marker: str,
                 warnings: Sequence[Notice] = (), spreads: dict | None = None, side_by_side=None) -> str:
     """The report page.
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The report's base robot.
     robot_source : str
         Where it came from.
@@ -478,17 +478,17 @@ def render_html(base: Robot, robot_source: str, comps, configs, figs, timing, la
           if side_by_side is not None else []),
         ("Per-hop errors", page.hop_table(comps, labels)),
         ("Firmware timing", page.timing_table(timing, labels)),
-        ("Parameters", f"<p class=\"note\">Robot {page.esc(base.name)} from {page.esc(robot_source)}; each "
+        ("Parameters", f"<p class=\"note\">Robot {page.esc(robot.name)} from {page.esc(robot_source)}; each "
                        "configuration adds its length to all four links. Values are shown in mm, g and deg; the "
                        "dotted names are those of <code>--set</code> and <code>locust params</code>, whose values are "
                        "in the unit each name ends in.</p>"
                        + page.links_table([(labels[n], c.robot.link_lengths_m()) for n, c in configs.items()])
-                       + page.params_table(parameter_rows(base))),
+                       + page.params_table(parameter_rows(robot))),
         ("Inputs", page.table(["configuration", "trial", "track", "run record", "configuration from", "recorded on",
                                "track read in"], inputs, left_cols=7, id_="inputs")),
-        ("How the numbers are made", _notes(comps, land, base, marker)),
+        ("How the numbers are made", _notes(comps, land, robot, marker)),
     ]
-    meta = [f"robot: {base.name} ({robot_source})",
+    meta = [f"robot: {robot.name} ({robot_source})",
             f"configurations: {', '.join(labels.values())}; cycles: "
             + ", ".join(f"{labels[c.config]} {c.cycles}" for c in comps),
             f"generated {time.strftime('%Y-%m-%d %H:%M:%S %z')} by locust {__version__}"]
@@ -509,13 +509,13 @@ def _trial_json(t) -> dict:
             "track_units": t.track.units if t.track else None, "track_mirrored": t.track.mirrored if t.track else None}
 
 
-def report_json(base: Robot, robot_source: str, comps, configs, timing, land, marker: str,
+def report_json(robot: Robot, robot_source: str, comps, configs, timing, land, marker: str,
                 warnings: Sequence[Notice] = ()) -> dict:
     """The content of ``report.json`` (without its ``wall_s``).
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The report's base robot.
     robot_source : str
         Where it came from.
@@ -540,7 +540,7 @@ def report_json(base: Robot, robot_source: str, comps, configs, timing, land, ma
         ``locust sim``'s distance, ``*_marker_travel_m`` the marker's), how each run ended and
         hop rows; NaN is left for the writer to turn into null.
     """
-    out = {"robot": base.name, "robot_source": robot_source, "locust_version": __version__, "marker": marker,
+    out = {"robot": robot.name, "robot_source": robot_source, "locust_version": __version__, "marker": marker,
            "sweep": str(land.folder) if land else None, "warnings": [w.to_json() for w in warnings],
            "configurations": []}
     for c in comps:

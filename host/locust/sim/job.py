@@ -130,7 +130,7 @@ def simulated(robot: Robot, options: SimOptions, progress: Callable[[int], None]
     Returns
     -------
     SimResult
-        With its robot (``params``).
+        With its robot (``robot``).
 
     Raises
     ------
@@ -145,7 +145,7 @@ def simulated(robot: Robot, options: SimOptions, progress: Callable[[int], None]
 
         check_draws(robot, options.samples, cycles)   # before the robot's own run
     keep = options.keep_states or options.video is not None   # the video reuses the rollout
-    result = dataclasses.replace(_run.run(robot, cycles=cycles, keep_states=keep), params=robot)
+    result = dataclasses.replace(_run.run(robot, cycles=cycles, keep_states=keep), robot=robot)
     if result.valid:
         from .statics import standing_load
 
@@ -235,7 +235,7 @@ def run_simulation(robot: Robot, options: SimOptions, progress: Callable[[int], 
         if not options.invalid_linkage_result:
             raise
         reason = exc.message + (f" ({exc.hint})" if exc.hint else "")
-        result = dataclasses.replace(_run.invalid_result(robot, reason, options.cycles), params=robot)
+        result = dataclasses.replace(_run.invalid_result(robot, reason, options.cycles), robot=robot)
     if options.check_convergence and result.valid:
         result.convergence = _run.check_convergence(robot, result, cycles=options.cycles)
     rendered(result, robot, options, board)

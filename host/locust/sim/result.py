@@ -25,15 +25,15 @@ from .rollout import Trajectory
 class SimResult:
     """One audited simulation (:func:`locust.sim.run.run`; :func:`locust.simulate` adds the rest):
     its figures (``valid``, ``reasons``, ``distance_m``, ``max_nose_height_m``, ``hops``, ``notes`` ...),
-    the robot they belong to (``params``), the rollout (``trajectory``, every step's state),
-    and, with ``samples``, the spread over draws of the uncertain values (``spread``). The
+    the robot they belong to (``robot``, named ``robot_name``), the rollout (``trajectory``,
+    every step's state), and, with ``samples``, the spread over draws of the uncertain values (``spread``). The
     standing robot's weight on its nose, as a kitchen scale under it reads, is
     ``nose_load_kg`` (of ``total_mass_kg``; :mod:`locust.sim.statics`).
 
     ``repr`` is a short table in mm and degrees; in a notebook it is an HTML table.
     """
 
-    robot: str
+    robot_name: str
     valid: bool
     reasons: list[str]
     distance_m: float
@@ -59,7 +59,7 @@ class SimResult:
     trajectory: Trajectory | None = field(default=None, repr=False, compare=False)
 
 
-    params: Robot | None = field(default=None, repr=False, compare=False)
+    robot: Robot | None = field(default=None, repr=False, compare=False)
     spread: object | None = field(default=None, repr=False, compare=False)   # locust.sim.samples.Samples
     nose_load_kg: float = float("nan")     # standing at the 0 deg command, the nose's share of the weight
     total_mass_kg: float = float("nan")
@@ -76,10 +76,11 @@ class SimResult:
         dict
             The figures by name, in SI units as the field names say.
         """
-        out = dataclasses.asdict(dataclasses.replace(self, trajectory=None, params=None, spread=None, sensitivity=None))
-        for key in ("trajectory", "params", "spread", "sensitivity"):
+        out = dataclasses.asdict(dataclasses.replace(self, trajectory=None, robot=None, spread=None, sensitivity=None))
+        for key in ("trajectory", "robot", "spread", "sensitivity"):
             del out[key]
-        if self.params is None:   # a bare run (not locust.simulate's): no standing load was asked for
+        out = {"robot": out.pop("robot_name"), **out}   # the JSON names the robot by its name
+        if self.robot is None:   # a bare run (not locust.simulate's): no standing load was asked for
             del out["nose_load_kg"], out["total_mass_kg"]
         if self.spread is not None:
             sp = self.spread.to_json()
@@ -190,13 +191,13 @@ class SimResult:
         traj = self._trajectory()
         targets = (path, *sidecar_paths(path))
         if not overwrite or not any(p.exists() or p.is_symlink() for p in targets):
-            return render_video(self.params, path, camera=camera, fps=fps, width=width, height=height,
+            return render_video(self.robot, path, camera=camera, fps=fps, width=width, height=height,
                                 trajectory=traj)
         if path.suffix.lower() != ".mp4":
             raise SimError(f"video path {path} does not end in .mp4", "name the video <something>.mp4")
         landing = [write_target(p) for p in targets]   # refuses folders, devices and read-only files
         with tempfile.TemporaryDirectory(prefix=f".{path.stem}.", dir=path.parent) as tmp:
-            info = render_video(self.params, Path(tmp) / path.name, camera=camera, fps=fps, width=width,
+            info = render_video(self.robot, Path(tmp) / path.name, camera=camera, fps=fps, width=width,
                                 height=height, trajectory=traj)
             for src, dst in zip((info.video_path, info.truth_path, info.camera_path), landing):
                 os.replace(src, dst)
@@ -222,8 +223,8 @@ class SimResult:
         ax_x.set_ylabel("forward from the start [mm]")
         ax_x.set_xlabel("time from the first push [s]")
         ax_z.legend(loc="upper right")
-        fig.suptitle(f"{self.robot}: {self.distance_m * 1000:.1f} mm in {self.cycles} cycles, highest nose "
-                     f"{self.max_nose_height_m * 1000:.1f} mm" if self.valid else f"{self.robot}: INVALID")
+        fig.suptitle(f"{self.robot_name}: {self.distance_m * 1000:.1f} mm in {self.cycles} cycles, highest nose "
+                     f"{self.max_nose_height_m * 1000:.1f} mm" if self.valid else f"{self.robot_name}: INVALID")
         return fig
 
     def _trajectory(self):
@@ -260,7 +261,7 @@ class SimResult:
     HOP_HEAD = ("hop", "distance mm", "nose apex mm", "com apex mm", "flight ms")
 
     def __repr__(self) -> str:
-        lines = [f"SimResult {self.robot}"] + [f"  {k:16s} {v}" for k, v in self._rows()]
+        lines = [f"SimResult {self.robot_name}"] + [f"  {k:16s} {v}" for k, v in self._rows()]
         if self.hops:
             widths = [max(len(c), *(len(r[i]) for r in self._hop_rows())) for i, c in enumerate(self.HOP_HEAD)]
             lines.append("  " + "  ".join(c.rjust(w) for c, w in zip(self.HOP_HEAD, widths)))
@@ -270,7 +271,7 @@ class SimResult:
 
     def _repr_html_(self) -> str:
         esc = html.escape
-        out = [f"<b>SimResult {esc(self.robot)}</b><table>"]
+        out = [f"<b>SimResult {esc(self.robot_name)}</b><table>"]
         out += [f"<tr><th style='text-align:left'>{esc(k)}</th><td>{esc(v)}</td></tr>" for k, v in self._rows()]
         out.append("</table>")
         if self.hops:
@@ -299,7 +300,7 @@ def invalid_result(robot: Robot, reason: str, cycles: int | None = None) -> SimR
         ``valid`` False, no hops, zero duration.
     """
     nan = float("nan")
-    return SimResult(robot=robot.name, valid=False, reasons=[reason], distance_m=nan, max_nose_height_m=nan,
+    return SimResult(robot_name=robot.name, valid=False, reasons=[reason], distance_m=nan, max_nose_height_m=nan,
                      hops=[], cycles=cycles or robot.schedule.cycles, timestep_s=robot.solver.timestep_s,
                      duration_s=0.0, wall_s=0.0, loop_residual_max_m=nan, energy_surplus_max_j=nan,
                      servo_work_j=nan)

@@ -73,7 +73,7 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
     if not lo <= asm.transmission_deg <= hi:
         notes.append(f"poor transmission angle {asm.transmission_deg:.0f} deg at the start (outside {lo:g}-{hi:g})")
     return SimResult(
-        robot=robot.name, valid=verdict.valid, reasons=verdict.reasons,
+        robot_name=robot.name, valid=verdict.valid, reasons=verdict.reasons,
         distance_m=summary.distance_m if summary else nan,
         max_nose_height_m=summary.max_nose_height_m if summary else nan,
         hops=summary.hops if summary else [],

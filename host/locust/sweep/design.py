@@ -166,7 +166,7 @@ class Bound:
         return out
 
 
-def check_name(name: str, base: Robot) -> None:
+def check_name(name: str, robot: Robot) -> None:
     """Refuse a ``--vary`` name that is not ``scale`` or a numeric robot parameter (or is
     ``schedule.cycles``, which is ``--cycles``).
 
@@ -174,7 +174,7 @@ def check_name(name: str, base: Robot) -> None:
     ----------
     name : str
         The name given.
-    base : Robot
+    robot : Robot
         The robot the sweep starts from.
 
     Raises
@@ -188,7 +188,7 @@ def check_name(name: str, base: Robot) -> None:
         close = [k for k in all_keys() if name.split(".")[-1] in k][:4]
         hint = f"did you mean {', '.join(close)}?" if close else "use `scale` or a dotted name from `locust params`"
         raise SweepError(f"--vary {name!r}: no such robot parameter", hint)
-    value = base.get(name)
+    value = robot.get(name)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise SweepError(f"--vary {name!r}: the parameter is not a number ({value!r})",
                          "vary a numeric parameter, e.g. geometry.leg_m or schedule.push_deg")
@@ -197,12 +197,12 @@ def check_name(name: str, base: Robot) -> None:
                          "give --cycles N instead (one run per number of hops, each with its own --out)")
 
 
-def is_integer(base: Robot, name: str) -> bool:
+def is_integer(robot: Robot, name: str) -> bool:
     """Whether the parameter ``name`` holds whole numbers (schedule.cycles, solver.iterations).
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The robot the sweep starts from.
     name : str
         ``scale`` or a dotted parameter name.
@@ -214,11 +214,11 @@ def is_integer(base: Robot, name: str) -> bool:
     """
     if name == SCALE:
         return False
-    value = base.get(name)
+    value = robot.get(name)
     return isinstance(value, int) and not isinstance(value, bool)
 
 
-def check_range(item: str, name: str, low: float, high: float, base: Robot) -> None:
+def check_range(item: str, name: str, low: float, high: float, robot: Robot) -> None:
     """Both ends of a --vary range within the limits of what it changes (``scale``: the four
     links), checked before any design runs: a range outside is a unit slip (centimetres typed
     for metres), not a sweep of invalid designs.
@@ -231,7 +231,7 @@ def check_range(item: str, name: str, low: float, high: float, base: Robot) -> N
         ``scale`` or a dotted parameter name.
     low, high : float
         The ends, in the parameter's unit (``scale``: m added to each link).
-    base : Robot
+    robot : Robot
         The robot the sweep starts from.
 
     Raises
@@ -241,7 +241,7 @@ def check_range(item: str, name: str, low: float, high: float, base: Robot) -> N
     """
     for end in (low, high):
         if name == SCALE:
-            g = base.geometry
+            g = robot.geometry
             changed = {f"geometry.{k}": getattr(g, k) + end for k in ("ground_m", "crank_m", "coupler_m", "leg_m")}
         else:
             changed = {name: end}
@@ -275,14 +275,14 @@ def _split(item: str) -> tuple[str, str]:
     return name.strip(), rest.strip()
 
 
-def parse_axis(item: str, base: Robot) -> Axis:
+def parse_axis(item: str, robot: Robot) -> Axis:
     """Read ``NAME=START:STOP:N`` for a sweep.
 
     Parameters
     ----------
     item : str
         The ``--vary`` text.
-    base : Robot
+    robot : Robot
         The robot the sweep starts from.
 
     Returns
@@ -297,16 +297,16 @@ def parse_axis(item: str, base: Robot) -> Axis:
         ends outside the limits, or fractions for a whole-number parameter.
     """
     name, rest = _split(item)
-    check_name(name, base)
+    check_name(name, robot)
     start, stop, n = _numbers(rest, 3, "START:STOP:N", item)
     if n != int(n) or n < 1:
         raise SweepError(f"--vary {item!r}: N = {n:g} must be a whole number of designs >= 1",
                          "e.g. --vary scale=0:0.05:30")
     if int(n) == 1 and start != stop:
         raise SweepError(f"--vary {item!r}: one design cannot span {start:g}..{stop:g}", "use N >= 2")
-    check_range(item, name, start, stop, base)
+    check_range(item, name, start, stop, robot)
     axis = Axis(name, start, stop, int(n))
-    if is_integer(base, name):
+    if is_integer(robot, name):
         fractions = [v for v in axis.values() if v != round(v)]
         if fractions:
             raise SweepError(f"--vary {item!r}: {name} is a whole number, and this range gives "
@@ -316,14 +316,14 @@ def parse_axis(item: str, base: Robot) -> Axis:
     return axis
 
 
-def parse_bound(item: str, base: Robot, step: float | None = None) -> Bound:
+def parse_bound(item: str, robot: Robot, step: float | None = None) -> Bound:
     """Read ``NAME=LOW:HIGH`` (with ``step``: LOW, LOW + step, ... up to HIGH) or ``NAME=A,B,C``.
 
     Parameters
     ----------
     item : str
         The ``--vary`` text.
-    base : Robot
+    robot : Robot
         The robot the optimisation starts from.
     step : float, optional
         The step of the range, in the parameter's unit; HIGH is lowered to the last step.
@@ -340,19 +340,19 @@ def parse_bound(item: str, base: Robot, step: float | None = None) -> Bound:
         twice, values outside the limits, or a step not in (0, HIGH - LOW].
     """
     name, rest = _split(item)
-    check_name(name, base)
+    check_name(name, robot)
     if "," in rest:
         choices = _numbers(rest.replace(",", ":"), rest.count(",") + 1, "A,B,C", item)
         if len(set(choices)) != len(choices):
             raise SweepError(f"--vary {item!r}: a value is given twice", "give each value once")
         for v in choices:
-            check_range(item, name, v, v, base)
+            check_range(item, name, v, v, robot)
         return Bound(name, min(choices), max(choices), choices=tuple(choices))
     low, high = _numbers(rest, 2, "LOW:HIGH", item)
     if not low < high:
         raise SweepError(f"--vary {item!r}: LOW {low:g} must be below HIGH {high:g}",
                          "e.g. --vary geometry.leg_m=0.05:0.09")
-    check_range(item, name, low, high, base)
+    check_range(item, name, low, high, robot)
     if step is not None:
         if not (math.isfinite(step) and 0 < step <= high - low):
             raise SweepError(f"--step {name}={step:g}: a step must be above 0 and at most HIGH - LOW "
@@ -365,8 +365,8 @@ def parse_bound(item: str, base: Robot, step: float | None = None) -> Bound:
 LINKS = tuple(f"geometry.{k}" for k in ("ground_m", "crank_m", "coupler_m", "leg_m"))
 
 
-def design_robot(base: Robot, values: dict[str, float]) -> Robot:
-    """``base`` with the design's values; ``scale`` first, named parameters over it.
+def design_robot(robot: Robot, values: dict[str, float]) -> Robot:
+    """``robot`` with the design's values; ``scale`` first, named parameters over it.
 
     A value the design sets keeps the uncertainty of the value it replaces: a link cut to a new
     length, or a horn set on another spline step, is built no more exactly than the one it
@@ -375,7 +375,7 @@ def design_robot(base: Robot, values: dict[str, float]) -> Robot:
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The robot the sweep starts from.
     values : dict of str to float
         Parameter name (or ``scale``) to value, in the parameter's unit.
@@ -385,18 +385,18 @@ def design_robot(base: Robot, values: dict[str, float]) -> Robot:
     Robot
         The design's robot.
     """
-    robot = base
+    design = robot
     if SCALE in values:
-        robot = with_added_length(robot, values[SCALE])
+        design = with_added_length(design, values[SCALE])
     named = {k: v for k, v in values.items() if k != SCALE}
     if named:
-        robot = robot.with_values(named, Provenance(source="sweep"))
+        design = design.with_values(named, Provenance(source="sweep"))
     changed = (LINKS if SCALE in values else ()) + tuple(named)
     for key in changed:
-        sd = base.source_of(key).uncertainty
-        if sd is not None and robot.source_of(key).uncertainty is None:
-            robot = robot.with_provenance(key, replace(robot.source_of(key), uncertainty=sd))
-    return robot
+        sd = robot.source_of(key).uncertainty
+        if sd is not None and design.source_of(key).uncertainty is None:
+            design = design.with_provenance(key, replace(design.source_of(key), uncertainty=sd))
+    return design
 
 
 def precheck(robot: Robot) -> str | None:
@@ -455,7 +455,7 @@ def invalid_row(reason: str, grashof: str = "", transmission_deg: float = math.n
             "transmission_deg": transmission_deg}
 
 
-def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 0) -> dict[str, Any]:
+def evaluate(robot: Robot, values: dict[str, float], cycles: int, samples: int = 0) -> dict[str, Any]:
     """Check, simulate and audit one design -> the result fields of its row.
 
     A pure function of its arguments: whichever process or machine runs it, the row is the same.
@@ -467,7 +467,7 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The robot the sweep starts from.
     values : dict of str to float
         The design's values, in each parameter's unit.
@@ -486,14 +486,14 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 
     from ..sim.run import run
 
     try:
-        robot = design_robot(base, values)
+        design = design_robot(robot, values)
     except LocustError as exc:
         return invalid_row(str(exc))
-    reason = "; ".join(problems(robot, cycles)) or precheck(robot)
+    reason = "; ".join(problems(design, cycles)) or precheck(design)
     if reason:
         return invalid_row(reason)
     try:
-        result = run(robot, cycles=cycles)
+        result = run(design, cycles=cycles)
     except LocustError as exc:
         return invalid_row(str(exc))
     if not result.valid:
@@ -502,7 +502,7 @@ def evaluate(base: Robot, values: dict[str, float], cycles: int, samples: int = 
     outcome = result.outcome
     distance_m, nose_m, flip = result.distance_m, result.max_nose_height_m, float(outcome == GOES_OVER)
     if samples:
-        spread = sampled(robot, samples, cycles)
+        spread = sampled(design, samples, cycles)
         if spread is None:
             return invalid_row(f"fewer than two of {samples} draws of the uncertain values are valid",
                                result.grashof, result.transmission_deg)

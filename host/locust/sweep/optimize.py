@@ -46,14 +46,14 @@ from .views import STUDY_PAGE, write_study_page
 SAMPLERS = ("tpe", "nsga2")
 
 
-def settings(base: Robot, bounds: list[Bound], cycles: int, objectives: list[Objective] | None = None,
+def settings(robot: Robot, bounds: list[Bound], cycles: int, objectives: list[Objective] | None = None,
              draws: int = 0, quantile: float | None = None, max_flip: float | None = None,
              sampler: str = "tpe") -> dict[str, Any]:
     """What a study searches, as JSON holds it: a rerun must ask for exactly this.
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The robot every design starts from.
     bounds : list of Bound
         The design variables and their ranges.
@@ -73,11 +73,11 @@ def settings(base: Robot, bounds: list[Bound], cycles: int, objectives: list[Obj
     Returns
     -------
     dict
-        ``base``, ``parameters``, ``vary``, ``cycles``, ``objectives``, ``robust``,
+        ``robot``, ``parameters``, ``vary``, ``cycles``, ``objectives``, ``robust``,
         ``quantile``, ``max_flip`` and ``sampler``, as a JSON round trip gives them back.
     """
     return json.loads(json.dumps({
-        "base": base.name, "parameters": base.flat(), "vary": [b.to_dict() for b in bounds], "cycles": cycles,
+        "base": robot.name, "parameters": robot.flat(), "vary": [b.to_dict() for b in bounds], "cycles": cycles,
         "objectives": [o.name for o in objectives or []], "robust": draws,
         "quantile": quantile if draws else None, "max_flip": max_flip, "sampler": sampler}))
 
@@ -163,7 +163,7 @@ class OptimizeSummary:
         return next(iter(self.picks.values()), None)
 
 
-def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, folder: Path,
+def run_optimize(robot: Robot, bounds: list[Bound], trials: int, cycles: int, folder: Path,
                  storage: str | None = None, study_name: str = "locust", seed: int = 0, jobs: int = 1,
                  progress: Callable[[int], None] | None = None, objectives: list[Objective] | None = None,
                  judge: Callable[[dict[str, Any]], Judgement] | None = None, draws: int = 0,
@@ -173,7 +173,7 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The robot every design starts from.
     bounds : list of Bound
         The design variables and their ranges.
@@ -199,7 +199,7 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
         What is maximised (default: distance_per_hop).
     judge : callable, optional
         ``judge(values) -> Judgement``; default :class:`~locust.sweep.robust.DesignJudge` of
-        ``base`` with ``draws`` and ``quantile``.
+        ``robot`` with ``draws`` and ``quantile``.
     draws : int
         0: each design's nominal run; N: N draws of its uncertain values, the figure optimised
         being the ``quantile`` over them.
@@ -228,15 +228,15 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
 
     optuna.logging.set_verbosity(optuna.logging.ERROR)
     objectives = objectives or [OBJECTIVES[DEFAULT]]
-    integers = check_request(base, bounds, folder, storage, sampler, scheduler)
+    integers = check_request(robot, bounds, folder, storage, sampler, scheduler)
     make_folder(folder)
     storage_obj = open_storage(storage, folder)
     where = storage or str(folder / "study.journal")
-    study = open_study(storage_obj, study_name, settings(base, bounds, cycles, objectives, draws, quantile, max_flip,
+    study = open_study(storage_obj, study_name, settings(robot, bounds, cycles, objectives, draws, quantile, max_flip,
                                                          sampler), where, objectives)
     before = len(study.trials)
     left = max(0, trials - len(finished_trials(study)))
-    judge = judge or DesignJudge(base, cycles, tuple(objectives), draws, quantile)
+    judge = judge or DesignJudge(robot, cycles, tuple(objectives), draws, quantile)
     spec = StudySpec(storage, folder, study_name, tuple(bounds), integers, tuple(objectives), judge, max_flip,
                      sampler, seed, trials)
     if progress:
@@ -244,11 +244,11 @@ def run_optimize(base: Robot, bounds: list[Bound], trials: int, cycles: int, fol
     # a resumed study must not draw its first samples again: each trial's sampler seed moves on
     # with the trials the study held before it
     computed, interrupted = run_trials(spec, [before + k for k in range(left)], scheduler, jobs, progress, where)
-    return summarise(optuna.load_study(study_name=study_name, storage=storage_obj), folder, base, objectives,
+    return summarise(optuna.load_study(study_name=study_name, storage=storage_obj), folder, robot, objectives,
                      max_flip, computed, interrupted=interrupted)
 
 
-def check_request(base: Robot, bounds: list[Bound], folder: Path, storage: str | None, sampler: str,
+def check_request(robot: Robot, bounds: list[Bound], folder: Path, storage: str | None, sampler: str,
                   scheduler: str) -> frozenset[str]:
     """Refuse, before anything is written, a study that cannot run: an unknown sampler or
     scheduler, an unreachable Dask scheduler, a folder or storage holding something else, an
@@ -256,7 +256,7 @@ def check_request(base: Robot, bounds: list[Bound], folder: Path, storage: str |
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The robot every design starts from.
     bounds : list of Bound
         The design variables and their ranges.
@@ -288,7 +288,7 @@ def check_request(base: Robot, bounds: list[Bound], folder: Path, storage: str |
     if storage is None:
         check_journal_file(folder / "study.journal")
     check_storage(storage)
-    integers = frozenset(b.name for b in bounds if is_integer(base, b.name))
+    integers = frozenset(b.name for b in bounds if is_integer(robot, b.name))
     for b in bounds:
         if b.name in integers and math.floor(b.high) < math.ceil(b.low):
             raise SweepError(f"--vary {b.name}={b.low:g}:{b.high:g} holds no whole number, and {b.name} is one",
@@ -439,7 +439,7 @@ def trial_rows(study, names: list[str], objectives: list[Objective], max_flip: f
     return rows
 
 
-def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max_flip: float | None,
+def summarise(study, folder: Path, robot: Robot, objectives: list[Objective], max_flip: float | None,
               computed: int = 0, interrupted: bool = False) -> OptimizeSummary:
     """Write trials.csv, pareto.csv, pareto.png, study.html (Optuna's own views of the study),
     optimize.json and a robot file for each pick.
@@ -450,7 +450,7 @@ def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max
         The study, loaded after the run.
     folder : Path
         The output folder.
-    base : Robot
+    robot : Robot
         The robot every design starts from.
     objectives : list of Objective
         What is maximised.
@@ -477,8 +477,8 @@ def summarise(study, folder: Path, base: Robot, objectives: list[Objective], max
     write_tables(folder, rows, [{**r, "pick": " ".join(k for k, c in chosen.items() if c is r)} for r in front])
     robots = {}
     for pick, r in chosen.items():
-        robot = design_robot(base, {n: r[n] for n in names}).renamed(f"optimize {pick} of {folder}")
-        robots[pick] = save_robot(robot, folder / f"{pick}.toml")
+        design = design_robot(robot, {n: r[n] for n in names}).renamed(f"optimize {pick} of {folder}")
+        robots[pick] = save_robot(design, folder / f"{pick}.toml")
     done = [r for r in rows if r["state"] == "complete"]
     pruned = [r for r in rows if r["state"] == "pruned"]
     atomic_write_json(folder / "optimize.json", {

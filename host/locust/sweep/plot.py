@@ -19,16 +19,16 @@ METRICS = (("distance_m", "distance over the run (mm)"),
 MM = 1000.0
 
 
-def _leg_set_marks(axis: Axis, base: Robot) -> list[tuple[str, float]]:
+def _leg_set_marks(axis: Axis, robot: Robot) -> list[tuple[str, float]]:
     """Where the physical Small/Medium/Large leg sets sit on a ``scale`` axis of the seed."""
-    if axis.name != SCALE or base.link_lengths_m() != preset("seed").link_lengths_m():
+    if axis.name != SCALE or robot.link_lengths_m() != preset("seed").link_lengths_m():
         return []
     lo, hi = sorted((axis.start, axis.stop))
     return [(name.capitalize(), leg.added_m) for name, leg in LEG_SETS.items()
             if lo - 1e-12 <= leg.added_m <= hi + 1e-12]
 
 
-def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robot, path: Path) -> Path:
+def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, robot: Robot, path: Path) -> Path:
     plt = pyplot()
     x_scale, label = axis_scale(axis.name)
     fig, panels = plt.subplots(1, 2, figsize=(11, 4.2))
@@ -52,7 +52,7 @@ def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robo
         if best is not None:
             ax.plot(best[axis.name] * x_scale, best[key] * MM, "*", ms=14, color="#ff7f0e",
                     label="best valid (distance)")
-        for name, v in _leg_set_marks(axis, base):
+        for name, v in _leg_set_marks(axis, robot):
             ax.axvline(v * x_scale, color="0.4", ls=":", lw=1)
             ax.text(v * x_scale, ax.get_ylim()[1], f" {name}", rotation=90, va="top", fontsize=8, color="0.3")
         ax.set_xlabel(label)
@@ -61,7 +61,7 @@ def _curve(rows: list[dict[str, Any]], axis: Axis, best: dict | None, base: Robo
         ax.legend(fontsize=8, loc="best")
     panels[0].set_title("distance over the run")
     panels[1].set_title("highest nose point above the floor")
-    fig.suptitle(f"sweep of {base.name}", fontsize=10)
+    fig.suptitle(f"sweep of {robot.name}", fontsize=10)
     return save_png(fig, path)
 
 
@@ -109,7 +109,7 @@ def _safe(name: str) -> str:
 
 
 def plot_landscape(rows: list[dict[str, Any]], axes: list[Axis], best: dict | None, out: Path,
-                   base: Robot) -> list[Path]:
+                   robot: Robot) -> list[Path]:
     """The sweep's landscape plots: a curve per axis of more than one value, a heat map per pair
     of them; invalid designs are shown as such.
 
@@ -123,7 +123,7 @@ def plot_landscape(rows: list[dict[str, Any]], axes: list[Axis], best: dict | No
         The best row, marked.
     out : Path
         The folder the PNG files go in.
-    base : Robot
+    robot : Robot
         The robot the sweep starts from (its leg sets are marked on a ``scale`` axis of the seed).
 
     Returns
@@ -132,7 +132,7 @@ def plot_landscape(rows: list[dict[str, Any]], axes: list[Axis], best: dict | No
         The files written: ``curve_<name>.png`` and ``heatmap_<a>__<b>.png``.
     """
     out = Path(out)
-    made = [_curve(rows, a, best, base, out / f"curve_{_safe(a.name)}.png") for a in axes if a.n > 1]
+    made = [_curve(rows, a, best, robot, out / f"curve_{_safe(a.name)}.png") for a in axes if a.n > 1]
     for a, b in itertools.combinations([a for a in axes if a.n > 1], 2):
         made.append(_heatmap(rows, a, b, out / f"heatmap_{_safe(a.name)}__{_safe(b.name)}.png"))
     return made

@@ -141,12 +141,12 @@ def best_row(rows: list[dict[str, Any]]) -> dict[str, Any] | None:
     return max(valid, key=lambda r: (r["distance_m"], -r["design"])) if valid else None
 
 
-def request(base: Robot, axes: list[Axis], cycles: int, samples: int = 0) -> dict[str, Any]:
+def request(robot: Robot, axes: list[Axis], cycles: int, samples: int = 0) -> dict[str, Any]:
     """What the sweep was asked, as sweep.json stores it.
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The robot the sweep starts from.
     axes : list of Axis
         The sweep's axes.
@@ -158,9 +158,9 @@ def request(base: Robot, axes: list[Axis], cycles: int, samples: int = 0) -> dic
     Returns
     -------
     dict
-        ``base``, ``parameters``, ``vary``, ``cycles`` and, when given, ``samples``.
+        ``robot``, ``parameters``, ``vary``, ``cycles`` and, when given, ``samples``.
     """
-    out = {"base": base.name, "parameters": base.flat(), "vary": [a.to_dict() for a in axes], "cycles": cycles}
+    out = {"base": robot.name, "parameters": robot.flat(), "vary": [a.to_dict() for a in axes], "cycles": cycles}
     if samples:    # only when asked: the folders of plain sweeps keep their request as it was
         out["samples"] = samples
     return out
@@ -200,7 +200,7 @@ class SweepSummary:
     plots: list[Path]
 
 
-def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: str = "local",
+def run_sweep(robot: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: str = "local",
               jobs: int | None = None, progress: Callable[[int], None] | None = None,
               plots: bool = True, samples: int = 0, say: Callable[[str], None] | None = None) -> SweepSummary:
     """Run (or resume) the sweep into ``out``.
@@ -211,7 +211,7 @@ def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: 
 
     Parameters
     ----------
-    base : Robot
+    robot : Robot
         The robot the sweep starts from.
     axes : list of Axis
         The sweep's axes.
@@ -246,13 +246,13 @@ def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: 
     """
     designs = grid(axes)
     names = [a.name for a in axes]
-    meta = {"request": request(base, axes, cycles, samples), "designs": len(designs), "scheduler": scheduler,
+    meta = {"request": request(robot, axes, cycles, samples), "designs": len(designs), "scheduler": scheduler,
             "jobs": jobs or default_jobs()}
     if scheduler.startswith("tcp://"):
         probe_dask_scheduler(scheduler)   # before the folder is touched
     store = SweepStore.open(out, meta, names)
     resumed = len(store.done)
-    todo = [Task(base, i, tuple(v.items()), cycles, samples) for i, v in enumerate(designs) if i not in store.done]
+    todo = [Task(robot, i, tuple(v.items()), cycles, samples) for i, v in enumerate(designs) if i not in store.done]
     if not scheduler.startswith("tcp://"):   # a cluster's workers are its own
         jobs, why = plan_jobs(jobs, len(todo))
         if why and say and todo:
@@ -277,5 +277,5 @@ def run_sweep(base: Robot, axes: list[Axis], cycles: int, out: Path, scheduler: 
     if plots and rows:
         from .plot import plot_landscape
 
-        made = plot_landscape(rows, axes, best, out, base)
+        made = plot_landscape(rows, axes, best, out, robot)
     return SweepSummary(Path(out), rows, best, len(rows) - resumed, resumed, wall, finished, made)

@@ -46,12 +46,12 @@ class Configuration:
         return self.name[:1].upper() + self.name[1:]
 
 
-def configuration(base: Robot, name: str, added_m: float | None = None) -> Configuration:
-    """The configuration ``name`` on ``base``: a known leg set, or ``base`` plus ``added_m``.
+def configuration(robot: Robot, name: str, added_m: float | None = None) -> Configuration:
+    """The configuration ``name`` on ``robot``: a known leg set, or ``robot`` plus ``added_m``.
 
     Parameters
     ----------
-    base : locust.params.Robot
+    robot : locust.params.Robot
         The robot the leg set is built on.
     name : str
         A leg set's name (``small``, ``medium``, ``large``) or the user's own.
@@ -69,12 +69,12 @@ def configuration(base: Robot, name: str, added_m: float | None = None) -> Confi
     """
     key = check_name(name)
     if key in LEG_SETS and (added_m is None or added_m == LEG_SETS[key].added_m):
-        robot = leg_set(base, key, source=f"leg-set:{key}")   # in place of the leg set base carries
-        return Configuration(name=key, added_m=LEG_SETS[key].added_m, robot=robot.renamed(key))
+        built = leg_set(robot, key, source=f"leg-set:{key}")   # in place of the leg set robot carries
+        return Configuration(name=key, added_m=LEG_SETS[key].added_m, robot=built.renamed(key))
     added_m = added_m or 0.0
     note = f"report configuration {key}: {added_m * 1000:+g} mm on every link"
-    robot = with_added_length(base, added_m, source=f"leg-set:{key}", note=note) if added_m else base
-    return Configuration(name=key, added_m=float(added_m), robot=robot.renamed(key))
+    built = with_added_length(robot, added_m, source=f"leg-set:{key}", note=note) if added_m else robot
+    return Configuration(name=key, added_m=float(added_m), robot=built.renamed(key))
 
 
 def check_name(name: str) -> str:

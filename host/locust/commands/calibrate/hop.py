@@ -56,7 +56,7 @@ def hop(runs, fit_keys, config, sets, max_iter, as_json, no_plot, out_dir, write
             bar.update(n - bar.pos)
 
         fit = jobs.hops(base, list(runs), keys, max_iter=max_iter, progress=done)
-    out = save_hops(fit, plot_folder=folder, write_path=write_path, start=base)
+    out = save_hops(fit, plot_folder=folder, write_path=write_path, robot=base)
     if as_json:
         show(out, as_json)
     else:

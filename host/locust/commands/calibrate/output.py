@@ -42,7 +42,7 @@ def finish(fit: Fit, recording: Path | None, write_path: Path | None, as_json: b
         plot_path = plot_path or default_plot_path(recording, fit.experiment)
     for warning in [*fit.warnings, *implausible(fit.parameters)]:
         click.echo(f"warning: {warning}", err=True)
-    saved = save(fit, plot_path=None if no_plot else plot_path, write_path=write_path, start=start_of_write(),
+    saved = save(fit, plot_path=None if no_plot else plot_path, write_path=write_path, robot=start_of_write(),
                  force=force, extra=extra)
     show(saved.summary, as_json)
     if saved.refused is not None:     # shown, then refused
