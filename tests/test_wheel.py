@@ -62,21 +62,25 @@ def test_installed_command_fits_a_bundled_recording_from_an_empty_folder(wheel_v
 @pytest.mark.slow
 def test_installed_demo_runs_from_an_empty_folder(wheel_venv, tmp_path):
     """`locust demo --out demo-out` of the installed wheel, from an empty folder outside the
-    checkout: every stage runs, its calibration fits the bundled recordings (their names in
-    the fitted values' sources), and its virtual robot carries their truth."""
+    checkout: every one of its nine stages runs, its bench fits the SYNTHETIC recordings of the
+    virtual robot (their names in the fitted values' sources), and its virtual robot is the
+    draw of the robot as built that the checkout's own code makes."""
+    from locust.demo.story import DemoOptions, stage_titles
+    from locust.demo.virtual_robot import hidden_values, virtual_robot
+
     folder = tmp_path / "empty"
     folder.mkdir()
     proc = run_installed(wheel_venv, [wheel_venv.bin / "locust", "demo", "--out", "demo-out"], folder, timeout=900)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
-    for n in range(1, 8):
-        assert f"[{n}/7]" in proc.stderr
+    titles = stage_titles(DemoOptions())
+    assert len(titles) == 9
+    for n, title in enumerate(titles, 1):
+        assert f"[{n}/9] {title}" in proc.stderr, title
     run = folder / "demo-out" / "run"
     report = Path(proc.stdout.strip().splitlines()[-1].removeprefix("report: "))
     assert (folder / report).resolve().is_file() and (folder / report).resolve().is_relative_to(run.resolve())
     bench = (run / "calibration" / "robot-bench.toml").read_text()
-    for name in ("synthetic_beam.csv", "synthetic_servo.csv", "synthetic_ramp.csv"):
+    for name in ("hinge_swing.csv", "servo_step.csv", "ramp.csv"):
         assert f"fit:{name}" in bench, name
     truth = json.loads((run / "virtual" / "truth.json").read_text())["values"]
-    # the recordings' "# truth:" headers (those the hop fit does not hide)
-    assert truth["servo.armature_kgm2"] == 0.00031 and truth["servo.kp_nm_per_rad"] == 0.26
-    assert truth["servo.stall_torque_nm"] == 0.15
+    assert truth == hidden_values(virtual_robot())

@@ -180,6 +180,21 @@ def _stages(options: DemoOptions) -> list[tuple[str, Callable[[_Run], None]]]:
             ("report: the calibrated model against the measured hops", _report)]
 
 
+def stage_titles(options: DemoOptions) -> list[str]:
+    """The stages the demo runs with ``options``, as it announces them (``[n/N] title``).
+
+    Parameters
+    ----------
+    options : DemoOptions
+
+    Returns
+    -------
+    list of str
+        The stages' titles, in order.
+    """
+    return [title for title, _ in _stages(options)]
+
+
 def _flash(run: _Run) -> None:
     run.d.call(["flash", "--port", "sim"])
 
