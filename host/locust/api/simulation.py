@@ -14,7 +14,8 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
              keep_states: bool = True, progress=None, sensitivity: bool | None = None, *,
              leg_set: str | None = None, check_convergence: bool = False, video: str | os.PathLike | None = None,
              camera: str = "track", still: str | os.PathLike | None = None,
-             still_push: str | os.PathLike | None = None, board: str | None = None) -> SimResult:
+             still_push: str | os.PathLike | None = None, board: str | None = None,
+             explain: bool = False) -> SimResult:
     """Settle the robot on the floor, run its hop schedule, audit the run and measure the hops.
 
     Parameters
@@ -36,7 +37,7 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
         runs of many cycles).
     progress : callable, optional
         ``progress(0)`` as the draws begin, then ``progress(k)`` as each batch of ``k`` draws
-        is done (``samples``).
+        is done (``samples``), then of ``k`` runs of the explanation (``explain``).
     sensitivity : bool, optional
         Which measured values decide the outcome: each uncertain value alone at -/+ 2 sd
         (``result.sensitivity``, :func:`locust.sim.sensitivity.outcome_sensitivity`). True:
@@ -60,6 +61,14 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
         The same of the robot held up at the push command (the same camera).
     board : str, optional
         For the stills: the board beside the robot (default ``aruco:4X4_50:5x4:40:10``).
+    explain : bool, default False
+        Why the robot does what it does (``result.explanation``,
+        :class:`locust.sim.explain.Explanation`): how it went over (when, on what, the centre
+        of mass's distance behind its supports, the servo torque), or how close it came; for
+        every uncertain and design value, how far the outcome's threshold is (in its unit and
+        its sd); the tornado of each uncertain value's -/+2 sd effect on nose rise and
+        distance; and it in plain words (``result.explanation.words``). Some 300 runs of the
+        robot: ``progress`` counts them.
 
     Returns
     -------
@@ -91,7 +100,8 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
                          keep_states=keep_states, check_convergence=check_convergence,
                          video=None if video is None else Path(video), camera=camera,
                          still=None if still is None else Path(still),
-                         still_push=None if still_push is None else Path(still_push), board=board)
+                         still_push=None if still_push is None else Path(still_push), board=board,
+                         explain=explain)
     return run_simulation(robot, options, progress=progress)
 
 

@@ -11,7 +11,7 @@ import click
 from ..fileio import json_text
 from ..io.robot_toml import resolve_robot
 from ..params import LEG_SETS
-from ..tables import nose_load_line, sensitivity_lines, sim_lines, spread_lines
+from ..tables import explain_lines, nose_load_line, sensitivity_lines, sim_lines, spread_lines
 from .options import JobBar, robot_options
 
 
@@ -44,11 +44,17 @@ from .options import JobBar, robot_options
 @click.option("--sensitivity/--no-sensitivity", default=None,
               help="Move each uncertain value alone to -/+2 sd and report the outcome at each end: the "
                    "values that decide the regime (default: with --samples, when its draws split).")
+@click.option("--explain", is_flag=True,
+              help="Say why: for a run that goes over, when and on what (the support points, how far the centre "
+                   "of mass is behind them and for how long, the servo torque); else how close it came. For "
+                   "every uncertain and design value, how far the outcome's threshold is (in its unit and its "
+                   "sd), and each uncertain value's -/+2 sd effect on nose rise and distance (some 300 runs: "
+                   "--cycles 2 is quicker).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of --samples.")
 @click.option("--verbose", "-v", is_flag=True,
               help="Also the linkage's kinematics: its Grashof class and worst transmission angle.")
 def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, still, still_push, board, check_convergence,
-        samples, seed, sensitivity, verbose):
+        samples, explain, seed, sensitivity, verbose):
     """Settle the robot on the floor, then run the bang-bang hop schedule.
 
     Every run is audited (non-finite state, loop closure, energy, MuJoCo warnings). A run
@@ -64,6 +70,7 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
       locust sim --preset large --set servo.stall_torque_nm=0.18 --video large.mp4
       locust sim --config calibration/robot.toml --samples 16   # with its spread
       locust sim --preset medium --samples 32 --json     # outcome shares
+      locust sim --preset small --explain --cycles 2     # why it goes over, what would change it
       locust sim --config calibration/robot.toml --leg-set large   # another leg set on it
       locust sim --preset small --still rest.png --still-push push.png   # for locust measure stance
     """
@@ -72,8 +79,9 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
     robot = resolve_robot(preset, config, sets)
     options = SimOptions(cycles=cycles, leg_set=leg_set_name, samples=samples or 0, seed=seed, sensitivity=sensitivity,
                          keep_states=False, check_convergence=check_convergence, video=video, camera=camera,
-                         still=still, still_push=still_push, board=board, invalid_linkage_result=as_json)
-    with JobBar(samples, f"{samples} draws") if samples else nullcontext() as bar:
+                         still=still, still_push=still_push, board=board, invalid_linkage_result=as_json,
+                         explain=explain)
+    with _bar(robot, samples, explain) as bar:
         result = run_simulation(robot, options, progress=bar.update if bar else None)
     if as_json:
         click.echo(json_text(result.to_json()), nl=False)
@@ -85,5 +93,19 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
     spread, sens = getattr(result, "spread", None), getattr(result, "sensitivity", None)
     for line in (spread_lines(spread) if spread is not None else []) + (sensitivity_lines(sens) if sens else []):
         click.echo(line)
+    for line in explain_lines(result.explanation) if result.explanation is not None else []:
+        click.echo(line)
     if not result.valid:
         sys.exit(1)
+
+
+def _bar(robot, samples: int | None, explain: bool):
+    """The progress bar of the draws and the explanation's runs (none without either)."""
+    if not (samples or explain):
+        return nullcontext()
+    from ..sim.explain import explain_runs
+
+    runs = explain_runs(robot) if explain else 0
+    label = " + ".join(p for p in (f"{samples} draws" if samples else "", f"explaining ({runs} runs at most)"
+                                   if explain else "") if p)
+    return JobBar((samples or 0) + runs, label)

@@ -50,6 +50,8 @@ class SimOptions:
         For the stills: the board beside the robot (None: the default board).
     invalid_linkage_result : bool
         A linkage that cannot be assembled is an invalid result with its reason, not an error.
+    explain : bool
+        Why the robot does what it does (``result.explanation``, :mod:`locust.sim.explain`).
     """
 
     cycles: int | None = None
@@ -65,6 +67,7 @@ class SimOptions:
     still_push: Path | None = None
     board: str | None = None
     invalid_linkage_result: bool = False
+    explain: bool = False
 
 
 def prepared(robot: Robot, options: SimOptions):
@@ -144,7 +147,8 @@ def simulated(robot: Robot, options: SimOptions, progress: Callable[[int], None]
         from .samples import check_draws
 
         check_draws(robot, options.samples, cycles)   # before the robot's own run
-    keep = options.keep_states or options.video is not None   # the video reuses the rollout
+    # the video and the explanation reuse the rollout
+    keep = options.keep_states or options.video is not None or options.explain
     result = dataclasses.replace(_run.run(robot, cycles=cycles, keep_states=keep), robot=robot)
     if result.valid:
         from .statics import standing_load
@@ -162,7 +166,37 @@ def simulated(robot: Robot, options: SimOptions, progress: Callable[[int], None]
         from .sensitivity import outcome_sensitivity
 
         result.sensitivity = outcome_sensitivity(robot, cycles=cycles)
+    if options.explain and result.valid:
+        result.explanation = explained(robot, result, cycles, progress)
+        if not options.keep_states and options.video is None:
+            result.trajectory = None
     return result
+
+
+def explained(robot: Robot, result: SimResult, cycles: int | None, progress: Callable[[int], None] | None):
+    """The explanation of ``result`` (:func:`locust.sim.explain.explain`, on its own rollout).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot simulated.
+    result : SimResult
+        Its valid run, its rollout kept.
+    cycles : int or None
+        Hop cycles.
+    progress : callable, optional
+        ``progress(k)`` as each batch of ``k`` runs is done.
+
+    Returns
+    -------
+    locust.sim.explain.Explanation
+    """
+    from .explain import explain
+    from .sensitivity import RunFigures
+
+    figures = RunFigures(outcome=result.outcome or "", nose_rise_m=result.hops[0].nose_apex_m if result.hops else 0.0,
+                         distance_m=result.distance_m)
+    return explain(robot, cycles, progress, trajectory=result.trajectory, figures=figures)
 
 
 def rendered(result: SimResult, robot: Robot, options: SimOptions, board) -> None:

@@ -209,6 +209,27 @@ def simulate_built(built: BuiltModel, plan: ControlPlan, keep_states: bool = Fal
     return simulate_batch([built], plan, keep_states=keep_states)[0]
 
 
+def servo_control(built: BuiltModel, plan: ControlPlan) -> np.ndarray:
+    """The actuators' commands of every step of ``plan`` on ``built``.
+
+    Parameters
+    ----------
+    built : BuiltModel
+        The model.
+    plan : ControlPlan
+        The servo command of every step.
+
+    Returns
+    -------
+    ndarray
+        ``(nstep, nu)`` each actuator's command at each step [rad].
+    """
+    control = np.zeros((plan.nstep, built.model.nu))
+    for act in built.servo_actuators:
+        control[:, act] = plan.ctrl_rad
+    return control
+
+
 def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: bool = False,
                    threads: int | None = None) -> list[Trajectory]:
     """Several models of one structure (a fit's candidates, draws of the uncertain values) on
@@ -239,9 +260,7 @@ def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: boo
     """
     models = [b.model for b in builts]
     starts = [initial_state(b) for b in builts]
-    control = np.zeros((len(models), plan.nstep, models[0].nu))
-    for act in builts[0].servo_actuators:
-        control[:, :, act] = plan.ctrl_rad
+    control = np.stack([servo_control(b, plan) for b in builts])
     n_threads = max(1, min(threads or available_cores(), len(models)))
     datas = [mujoco.MjData(models[0]) for _ in range(n_threads)]
     check_batch(models[0], len(models), plan.nstep, keep_states)
