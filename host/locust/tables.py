@@ -274,7 +274,7 @@ def explain_lines(expl) -> list[str]:
     -------
     list of str
     """
-    lines = [f"{INDENT}why ({expl.runs} runs of {expl.cycles} cycles):"]
+    lines = [f"{INDENT}why ({expl.runs} runs of {expl.cycles} cycle{'s' if expl.cycles != 1 else ''}):"]
     lines += [f"{INDENT * 2}{w}" for w in expl.words]
     rows = []
     for t in expl.thresholds[:EXPLAIN_ROWS]:
