@@ -98,6 +98,14 @@ def _big_study(argv: list[str]) -> bool:
 
 
 # (why it is slow, is it): each over about 20 s on a busy 2-core machine
+def _slow_explain(argv: list[str]) -> bool:
+    """``--explain`` runs some 300 simulations: more than one cycle each is slow."""
+    if "--explain" not in argv:
+        return False
+    cycles = argv[argv.index("--cycles") + 1] if "--cycles" in argv[:-1] else None
+    return cycles is None or int(cycles) > 1
+
+
 SLOW = (
     ("the whole toolkit, minutes", lambda argv: argv[:1] == ["demo"]),
     ("an optimisation of 30 trials or more", _big_study),
@@ -106,6 +114,7 @@ SLOW = (
     ("32 or more draws", _slow_samples),
     ("a sweep of 30 designs or more", _big_sweep),
     ("video rendered", lambda argv: "--video" in argv or "--side-by-side" in argv),
+    ("an explanation of more than one cycle", lambda argv: _slow_explain(argv)),
 )
 
 
