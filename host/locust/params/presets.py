@@ -173,6 +173,8 @@ def _seed_notebook() -> Robot:
             "solver.tolerance": 1e-8, "solver.control_hz": 60.0, "solver.settle_s": 0.0,
             "contact.self_collision": True, "contact.rounded_edges": False,
             "solver.loop_timeconst_s": 0.02, "solver.loop_dmin": 0.9, "solver.loop_dmax": 0.95,
+            # the notebook closed the loop with a bare connect: its loop fold had no spring
+            "folds.loop_stiffness_nm_per_rad": 0.0, "folds.loop_damping_nms_per_rad": 0.0,
         },
         prov,
     ).renamed("seed-notebook")
