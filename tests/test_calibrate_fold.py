@@ -230,6 +230,21 @@ def test_photos_missing_a_sticker_or_the_board_are_refused(tmp_path):
         read_state(tmp_path / "nothing.jpg", BOARD)
 
 
+def test_a_clip_of_each_state_is_read_frame_by_frame(tmp_path):
+    """A clip of the still fold (MPEG-4, 8 frames): each frame a photo of the state, its
+    stickers where the photo's are to a pixel."""
+    from locust.track.video import encode_video
+
+    image = cv2.imread(str(bundled_recording(LOADED)))
+    h, w = image.shape[:2]
+    clip = encode_video(tmp_path / "loaded.mp4", (image for _ in range(8)), 30.0, (w, h))
+    photos = read_state(clip, BOARD)
+    assert [p.name for p in photos] == [f"loaded.mp4#{k}" for k in range(8)]
+    still = read_state(bundled_recording(LOADED), BOARD)[0]
+    for n in FOLD_STICKERS:
+        assert np.hypot(*np.subtract(photos[-1].stickers_px[n], still.stickers_px[n])) < 1.0, n
+
+
 def test_bad_readings_are_refused():
     u, ld = bundled_recording(UNLOADED), bundled_recording(LOADED)
     with pytest.raises(CalibrationError, match="give the coin"):
