@@ -369,23 +369,33 @@ def fit_fold(unloaded: Sequence[FoldPhoto], loaded: Sequence[FoldPhoto], link: F
         moments_nm=(sign * moments[0], sign * moments[1]), link=link, load=load,
         sticker_sd_px=float(max(max(s.values()) for s in sds)),
         corner_sd_px=float(max(p.corner_sd_px for p in unloaded + loaded)), photos=(len(unloaded), len(loaded)),
-        draws=draws, curves=_curves(sign, k, rest, ta, tb, moments, fold), warnings=warnings,
+        draws=draws, curves=_curves(sign, k, rest, [[_state_angles([p], nominal) for p in _points(photos, sd, None)]
+                                                    for photos, sd in ((unloaded, sds[0]), (loaded, sds[1]))],
+                                    link, load, fold), warnings=warnings,
         notes=[f"link: {link.what}", f"coin: {load.what}, lever arm {load.arm_m * 1000:.1f} mm"])
     return fit
 
 
-def _curves(sign: float, k: float, rest: float, ta: float, tb: float, moments, fold: str) -> Curves:
-    """The weight's moment in each photo against the fold's angle, and the spring's line
-    ``k (theta - theta_0)`` that balances it (both in the model's sense of the fold)."""
-    x = np.array([sign * ta, sign * tb])
+def _curves(sign: float, k: float, rest: float, states, link: FreeLink, load: Load, fold: str) -> Curves:
+    """Each photo's weight moment against its fold angle, and the spring's line
+    ``k (theta - theta_0)`` that balances them (both in the model's sense of the fold): with
+    several photos of a state, the residuals are their scatter about it."""
+    side = upper_side(states[0][0][1])
+    x, data = [], []
+    for loaded, angles in enumerate(states):
+        for c, f in angles:
+            x.append(sign * fold_deg(c, f))
+            coin = (load.mass_kg, load.arm_m, load.above_m, side) if loaded else (0.0, 0.0, 0.0, side)
+            data.append(sign * weight_moment_nm(f, link.moment_kgm, *coin))
+    x = np.array(x)
     fine = np.linspace(min(*x, sign * rest) - 2.0, max(*x, sign * rest) + 2.0, 50)
 
     def line(deg):
         return k * np.radians(deg - sign * rest)
 
-    return Curves(x=x, data=sign * np.array(moments), model=line(x), x_label=f"{fold} fold angle [deg]",
+    return Curves(x=x, data=np.array(data), model=line(x), x_label=f"{fold} fold angle [deg]",
                   y_label="the weight's moment about the fold [N·m]",
-                  title=f"{fold} fold: unloaded and loaded, the spring line through them", model_x=fine,
+                  title=f"{fold} fold: each photo unloaded and loaded, the spring's line through them", model_x=fine,
                   model_fine=line(fine))
 
 

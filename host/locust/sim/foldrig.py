@@ -34,10 +34,9 @@ from ..errors import SimError
 from ..markers import FOLD_STICKER_COLOURS, hex_to_rgb01
 from ..params import GRAVITY_M_PER_S2
 from .stickers import STICKER_RADIUS_M
+from .still import CARDSTOCK_RGBA, STICKER_PROUD_M  # the stills' cardstock and stickers
 
 FOLD_STICKERS = tuple(FOLD_STICKER_COLOURS)   # axis, tip, base
-STICKER_PROUD_M = 0.0002        # a sticker's thickness on its face
-CARDSTOCK_RGBA = (0.3, 0.3, 0.3, 1.0)
 CLAMP_RGBA = (0.12, 0.12, 0.14, 1.0)
 COIN_RGBA = (0.72, 0.45, 0.20, 1.0)    # copper
 TABLE_RGBA = (0.55, 0.52, 0.48, 1.0)
