@@ -16,7 +16,7 @@ Functions (each with a numpydoc docstring: ``help(locust.simulate)``), named onc
 - ``sweep_designs(robot, vary, cycles)``: a ``SweepResults`` (``.to_dataframe()``, ``.plot()``, ``.best``).
 - ``track_markers(video, markers)``, ``read_tracks(path)``: ``Tracks`` (``.to_dataframe()``, ``.tidy()``:
   one row per marker per frame with velocity and acceleration, ``.plot()``, ``.write()``).
-- ``calibrate_beam/hinge/servo/ramp/hops(...)``: a ``Fit`` (``.parameters``, ``.to_dataframe()``,
+- ``calibrate_beam/hinge/servo/ramp/fold/hops(...)``: a ``Fit`` (``.parameters``, ``.to_dataframe()``,
   ``.plot()``, ``.apply(robot)``).
 - ``bundled_recording(name)``: the path of a SYNTHETIC recording the toolkit ships (``synthetic_beam.csv``, ...).
 - ``make_report(robot, measured)``: the HTML comparison of simulation and filmed hops.

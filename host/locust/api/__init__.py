@@ -18,6 +18,7 @@ name                   module                     what it is
 ``calibrate_hinge``    :mod:`.calibration`        a hinge's fit: ``Fit``
 ``calibrate_ramp``     :mod:`.calibration`        a ramp's friction fit: ``Fit``
 ``calibrate_servo``    :mod:`.calibration`        a servo's fit: ``Fit``
+``calibrate_fold``     :mod:`.calibration`        a fold's static test: ``Fit``
 ``calibrate_hops``     :mod:`.calibration`        a fit to filmed hops: ``Fit``
 ``Fit``                :mod:`.calibration`        fitted robot values (parameters, apply, plot)
 ``bundled_recording``  :mod:`locust.bundled`      the path of a recording the toolkit ships
@@ -31,7 +32,8 @@ name                   module                     what it is
 =====================  =========================  ====================================================
 
 The command line calls the same functions (``locust sim``, ``sweep``, ``report``, ``fab``,
-``calibrate beam|hinge|servo|ramp``, ``demo``, ``hop``). Every name is also at the package top: ``locust.simulate``.
+``calibrate beam|hinge|servo|ramp|fold``, ``demo``, ``hop``). Every name is also at the package top:
+``locust.simulate``.
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ EXPORTS = {
     "calibrate_hinge": "calibration",
     "calibrate_ramp": "calibration",
     "calibrate_servo": "calibration",
+    "calibrate_fold": "calibration",
     "calibrate_hops": "calibration",
     "Fit": "calibration",
     "bundled_recording": "locust.bundled",

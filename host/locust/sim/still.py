@@ -35,7 +35,7 @@ from ..errors import SimError
 from ..fileio import atomic_write_bytes, atomic_write_text, check_distinct
 from ..io.camera_json import CameraFile, MarkerPlane, write_camera_json
 from ..markers import STICKER_COLOURS, hex_to_rgb01
-from ..params import Robot
+from ..params import Robot, side_values
 from .audit import audit
 from .camera import PinholeCamera, frame_views
 from .clip import PoseRenderer, face_centre_m, seen_fraction, sidecar_paths, validate_size
@@ -61,7 +61,7 @@ class StillPose:
     qpos: np.ndarray
     command_deg: float          # the servos' command
     servo_deg: float            # the left servo joint's angle (its turn from the crank's start angle)
-    crank_deg: float            # the left crank from its ground link: crank_start_deg + servo_deg
+    crank_deg: float            # the left crank from its ground link: its start (tooth included) + servo_deg
 
 
 @dataclass(frozen=True)
@@ -122,7 +122,7 @@ def rest_pose(robot: Robot) -> StillPose:
     built = compile_spec(spec, asm, robot)
     qpos = _audited_final(built, _plan(robot, 0.0, 0.0), "rest")
     servo = _servo_deg(built.model, qpos)
-    return StillPose("rest", qpos, 0.0, servo, robot.geometry.crank_start_deg + servo)
+    return StillPose("rest", qpos, 0.0, servo, side_values(robot, "L").crank_start_deg + servo)
 
 
 def push_pose(robot: Robot, rest: StillPose) -> StillPose:
@@ -146,7 +146,6 @@ def push_pose(robot: Robot, rest: StillPose) -> StillPose:
     SimError
         The holding run fails its audit.
     """
-    g = robot.geometry
     chassis_z = float(rest.qpos[2])
     quat = rest.qpos[3:7]
     # the rest attitude as the chassis' euler (180, pitch, 180): a turn about y only
@@ -163,7 +162,7 @@ def push_pose(robot: Robot, rest: StillPose) -> StillPose:
     command = robot.schedule.push_deg
     qpos = _audited_final(built, _plan(held, math.radians(command), HOLD_S), "push")
     servo = _servo_deg(built.model, qpos)
-    return StillPose("push", qpos, command, servo, g.crank_start_deg + servo)
+    return StillPose("push", qpos, command, servo, side_values(robot, "L").crank_start_deg + servo)
 
 
 # -- the scene: stickers and the board ---------------------------------------------------
