@@ -12,7 +12,8 @@ simulate draws and one-at-a-time moves of the uncertain values; :mod:`.statics` 
 standing robot's load on its nose; :mod:`.kinematics` poses the markers at kept states;
 :mod:`.camera`, :mod:`.clip`, :mod:`.still` and :mod:`.stickers` render videos and stills with their
 ground truth (:mod:`.gl`: the OpenGL MuJoCo renders with, checked before MuJoCo is imported);
-:mod:`.live` steps the model as the virtual robot's servo commands arrive.
+:mod:`.live` steps the model as the virtual robot's servo commands arrive; :mod:`.push` simulates one
+push on the floor or held up, and :mod:`.pushclip` films it for ``locust measure stroke``.
 """
 
 import os
