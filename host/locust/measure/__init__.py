@@ -8,5 +8,6 @@
 - :mod:`.stroke`: the stroke the servo delivers and its speed, from side clips of a push on
   the floor and held up, beside the model's (``measure stroke``): the crank's angle over a
   clip from four stickers (:mod:`.crankclip`), the push's swing read from it (:mod:`.swing`),
-  the CSV and plot written (:mod:`.strokeout`).
+  the CSV and plot written (:mod:`.strokeout`); :mod:`.strokejob` is the job behind the
+  command and :func:`locust.measure_stroke`.
 """

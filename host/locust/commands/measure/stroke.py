@@ -7,7 +7,6 @@ from pathlib import Path
 
 import click
 
-from ...errors import MeasureError
 from ...fileio import json_text
 from ..options import robot_options
 
@@ -50,40 +49,22 @@ def stroke(clip, clip2, preset, config, sets, held_only, side, fps, csv_path, pl
     """
     from ...io.robot_toml import resolve_robot
     from ...measure.crankclip import SIDES
-    from ...measure.stroke import measure_stroke
-    from ...measure.strokeout import write_outputs
+    from ...measure.strokejob import StrokeOptions, stroke_job
     from ...track.pipeline import progress_bars
 
     robot = resolve_robot(preset, config, sets)
-    clips = [clip] + ([clip2] if clip2 is not None else [])
-    if held_only and clip2 is not None:
-        raise MeasureError("--held-only with two clips", "give the held clip alone, or leave out --held-only")
-    _check_outputs(csv_path, plot, force, clips)
-    result = measure_stroke(robot, clips, kinds=("held",) if held_only else ("floor", "held"),
-                            side=None if side is None else SIDES[side], fps=fps, draws=draws, seed=seed,
-                            bars=progress_bars)
-    written = write_outputs(result, csv_path, plot, force=force)
+    options = StrokeOptions(held_only=held_only, side=None if side is None else SIDES[side], fps=fps, csv=csv_path,
+                            plot=plot, force=force, draws=draws, seed=seed)
+    job = stroke_job(robot, [clip] + ([clip2] if clip2 is not None else []), options, bars=progress_bars)
     if as_json:
-        out = result.to_json()
-        out["written"] = [str(p) for p in written]
+        out = job.result.to_json()
+        out["written"] = [str(p) for p in job.written]
         click.echo(json_text(out), nl=False)
         return
-    for line in lines(result):
+    for line in lines(job.result):
         click.echo(line)
-    for path in written:
+    for path in job.written:
         click.echo(f"wrote {path}")
-
-
-def _check_outputs(csv_path: Path | None, plot: Path | None, force: bool, clips: list[Path]) -> None:
-    """Refuse outputs that would replace a file or an input, before any work."""
-    from ...fileio import check_distinct
-    from ...plotting import check_figure_path
-
-    if csv_path is not None and csv_path.exists() and not force:
-        raise MeasureError(f"--csv {csv_path} exists", "choose another path, or add --force to replace it")
-    if plot is not None:
-        check_figure_path(plot, force)
-    check_distinct({k: v for k, v in (("--csv", csv_path), ("--plot", plot)) if v is not None}, inputs=clips)
 
 
 def _cell(value: float | None, digits: int, width: int = 9, sign: str = "") -> str:
