@@ -50,6 +50,12 @@ SG90_SOURCE = {
                                            "the stall torque 0.15 N*m"),
     "servo.kv_nms_per_rad": Provenance(source="model", note="a hobby servo has no velocity feedback; fitted to "
                                                             "both recordings 0.002 +- 0.0015, RMS unchanged"),
+    # nobody has counted the team's horns: 21 is what the printed-horn spline libraries give an
+    # SG90 (a round-toothed 21T, 4.8-4.9 mm across), but makers' batches differ
+    "servo.spline_teeth": Provenance(source="estimate:SG90 spline", note=(
+        "21 teeth, 17.1 deg a tooth: the SG90 spline of OpenSCAD horn libraries (21T, about 4.9 mm over the "
+        "teeth) and of 9 g servo listings; some TowerPro micro servos are 20T (18 deg) and clones vary from batch "
+        "to batch: count your horn's teeth")),
 }
 
 
@@ -167,6 +173,8 @@ def _seed_notebook() -> Robot:
             "solver.tolerance": 1e-8, "solver.control_hz": 60.0, "solver.settle_s": 0.0,
             "contact.self_collision": True, "contact.rounded_edges": False,
             "solver.loop_timeconst_s": 0.02, "solver.loop_dmin": 0.9, "solver.loop_dmax": 0.95,
+            # the notebook closed the loop with a bare connect: its loop fold had no spring
+            "folds.loop_stiffness_nm_per_rad": 0.0, "folds.loop_damping_nms_per_rad": 0.0,
         },
         prov,
     ).renamed("seed-notebook")

@@ -26,7 +26,7 @@ import mujoco
 import numpy as np
 
 from ..errors import SimError
-from ..params import Robot, check_robot
+from ..params import Robot, check_robot, side_values
 from .audit import audit
 from .model import SIDES, build
 from .rollout import simulate_built
@@ -76,28 +76,6 @@ class PushRun:
     timestep_s: float
     push_deg: float
     push_s: float
-
-
-def crank_start_deg(robot: Robot, side: str) -> float:
-    """The side's crank angle from its ground link at the 0 deg command [deg].
-
-    Parameters
-    ----------
-    robot : Robot
-        The robot.
-    side : str
-        ``L`` or ``R``.
-
-    Returns
-    -------
-    float
-        [deg].
-    """
-    try:
-        from ..params.sides import side_values
-    except ImportError:      # a robot without sides: both cranks at geometry.crank_start_deg
-        return robot.geometry.crank_start_deg
-    return side_values(robot, side).crank_start_deg
 
 
 def _check(kind: str, side: str) -> None:
@@ -185,7 +163,7 @@ def simulate_push(robot: Robot, kind: str = "floor", side: str = "L", timestep_s
     qpos = traj.states[rows, 1:1 + model.nq]
     servo = np.degrees(qpos[:, model.jnt_qposadr[model.joint(f"{side}_servo").id]])
     command = np.degrees(plan.ctrl_rad[np.minimum(rows + 1, plan.nstep - 1)])
-    return PushRun(kind, side, t, command, crank_start_deg(robot, side) + servo,
+    return PushRun(kind, side, t, command, side_values(robot, side).crank_start_deg + servo,
                    _points(model, robot, side, qpos), qpos, dt, robot.schedule.push_deg, robot.schedule.push_s)
 
 
@@ -223,5 +201,4 @@ def frame_step_s(robot: Robot, fps: float) -> float:
     return period / math.ceil(period / robot.solver.timestep_s - 1e-9)
 
 
-__all__ = ["KINDS", "LEAD_S", "POINTS", "PushRun", "crank_start_deg", "frame_step_s", "point_offsets_m",
-           "simulate_push"]
+__all__ = ["KINDS", "LEAD_S", "POINTS", "PushRun", "frame_step_s", "point_offsets_m", "simulate_push"]

@@ -94,11 +94,13 @@ def back_emf_damping_nms_per_rad(servo: Servo) -> float:
 
 
 def configure(joint: mujoco.MjsJoint, actuator: mujoco.MjsActuator, servo: Servo,
-              joint_damping_nms_per_rad: float = 0.0) -> None:
+              joint_damping_nms_per_rad: float = 0.0, trim_rad: float = 0.0) -> None:
     """Make ``actuator`` (on ``joint``) the servo, in place on the spec.
 
     Sets the joint's linear damping and armature and the actuator's position gains and
-    force range (the clamp at the stall torque).
+    force range (the clamp at the stall torque). A trim is added to every command inside the
+    controller: the position actuator's bias ``kp * (trim - q)``, so the servo's target is
+    the command (clamped to the control range) plus the trim, as the firmware's is.
 
     Parameters
     ----------
@@ -111,12 +113,17 @@ def configure(joint: mujoco.MjsJoint, actuator: mujoco.MjsActuator, servo: Servo
     joint_damping_nms_per_rad : float
         The joint's own damping (a flexure hinge in parallel with the servo), added to the
         servo's back-EMF damping [N·m·s/rad].
+    trim_rad : float
+        The trim added to every command [rad].
     """
     damping = list(joint.damping)   # [linear, higher-order terms]
     damping[0] = joint_damping_nms_per_rad + back_emf_damping_nms_per_rad(servo)
     joint.damping = damping
     joint.armature = servo.armature_kgm2
     actuator.set_to_position(kp=servo.kp_nm_per_rad, kv=servo.kv_nms_per_rad)
+    bias = list(actuator.biasprm)   # [0, -kp, -kv, ...]: force = kp*ctrl + bias . (1, q, qdot)
+    bias[0] = servo.kp_nm_per_rad * trim_rad
+    actuator.biasprm = bias
     # the drive saturates: a hobby servo never exceeds its stall torque
     actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
     actuator.forcerange = [-servo.stall_torque_nm, servo.stall_torque_nm]

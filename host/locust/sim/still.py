@@ -35,12 +35,11 @@ from ..errors import SimError
 from ..fileio import atomic_write_bytes, atomic_write_text, check_distinct
 from ..io.camera_json import CameraFile, MarkerPlane, write_camera_json
 from ..markers import STICKER_COLOURS, hex_to_rgb01
-from ..params import Robot
+from ..params import Robot, side_values
 from .audit import audit
 from .camera import PinholeCamera, frame_views, side_azimuth_deg
 from .clip import PoseRenderer, face_centre_m, seen_fraction, sidecar_paths, validate_size
 from .model import SIDES, build_spec, compile_spec
-from .push import crank_start_deg
 from .rollout import simulate_built
 from .schedule import ControlPlan, steps_per_tick
 from .stickers import STICKER_RADIUS_M, STICKERS, on_bodies
@@ -61,8 +60,8 @@ class StillPose:
     kind: str                   # "rest" or "push"
     qpos: np.ndarray
     command_deg: float          # the servos' command
-    servo_deg: float            # the left servo joint's angle (its turn from the crank's start angle)
-    crank_deg: float            # the left crank from its ground link: crank_start_deg + servo_deg
+    servo_deg: float            # the side's servo joint's angle (its turn from the crank's start angle)
+    crank_deg: float            # the side's crank from its ground link: its start (tooth included) + servo_deg
 
 
 @dataclass(frozen=True)
@@ -125,7 +124,7 @@ def rest_pose(robot: Robot, side: str = "L") -> StillPose:
     built = compile_spec(spec, asm, robot)
     qpos = _audited_final(built, _plan(robot, 0.0, 0.0), "rest")
     servo = _servo_deg(built.model, qpos, side)
-    return StillPose("rest", qpos, 0.0, servo, crank_start_deg(robot, side) + servo)
+    return StillPose("rest", qpos, 0.0, servo, side_values(robot, side).crank_start_deg + servo)
 
 
 def held_model(robot: Robot, rest: StillPose):
@@ -188,7 +187,7 @@ def push_pose(robot: Robot, rest: StillPose, side: str = "L") -> StillPose:
     command = robot.schedule.push_deg
     qpos = _audited_final(built, _plan(held, math.radians(command), HOLD_S), "push")
     servo = _servo_deg(built.model, qpos, side)
-    return StillPose("push", qpos, command, servo, crank_start_deg(robot, side) + servo)
+    return StillPose("push", qpos, command, servo, side_values(robot, side).crank_start_deg + servo)
 
 
 # -- the scene: stickers and the board ---------------------------------------------------
