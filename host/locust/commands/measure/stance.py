@@ -34,24 +34,31 @@ from ..options import robot_options, say_written_from
 @click.option("--draws", type=click.IntRange(20, 5000), default=200, show_default=True,
               help="Bootstrap draws for the intervals.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of the bootstrap.")
+@click.option("--side", type=click.Choice(["left", "right"]), default=None,
+              help="The side photographed (the right leg is at -y: a photo from the robot's right); its crank's "
+                   "spline tooth is found, and --write writes it (left.crank_tooth or right.crank_tooth) alone.")
 def stance(rest, push, preset, config, sets, board, points, push_points, pixels, write, force, as_json, draws,
-           seed):
+           seed, side):
     """Fit the robot's stance to a side photo at rest (and one held at the push command).
 
     REST shows the robot standing at the 0 deg command, PUSH (optional) the robot held up at
     the push command (`locust pose -30 -30 --port P`), both from the robot's left with the
     board standing in the plane of the left leg and the six stickers in place (docs/measure.md).
-    The link lengths and the plate are the robot's (--preset, --config, --set).
+    The link lengths and the plate are the robot's (--preset, --config, --set). With --side,
+    the photos show that side (the board in that leg's plane), and the crank's tooth on its
+    spline is the nearest whole tooth off geometry.crank_start_deg.
 
     \b
     Examples:
       locust measure stance rest.jpg push.jpg --preset small --write measured.toml
       locust measure stance rest.jpg --preset large --point knee=412.5,633
+      locust measure stance rest_r.jpg --side right --config measured.toml --write measured_r.toml
     """
     from ...arucoboard import DEFAULT_BOARD, parse_board
     from ...fileio import check_distinct
     from ...io.robot_toml import resolve_robot, save_robot
     from ...measure.stance import fit_stance, given_points, model_servo_give, read_photo, with_stance
+    from ...measure.tooth import with_tooth
 
     robot = resolve_robot(preset, config, sets)
     say_written_from(preset, config, write)
@@ -65,10 +72,11 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
     photos = [read_photo(rest, spec, given_points(points, pixels, "--point"))]
     if push is not None:
         photos.append(read_photo(push, spec, given_points(push_points, pixels, "--push-point")))
-    result = fit_stance(robot, photos, model_servo_give(robot), draws=draws, seed=seed)
+    code = None if side is None else {"left": "L", "right": "R"}[side]
+    result = fit_stance(robot, photos, model_servo_give(robot, code or "L"), draws=draws, seed=seed, side=code)
 
     if write is not None:
-        save_robot(with_stance(robot, result, rest), write)
+        save_robot(with_stance(robot, result, rest) if code is None else with_tooth(robot, result.tooth, rest), write)
     if as_json:
         out = result.to_json()
         out["wrote"] = None if write is None else str(write)
@@ -98,7 +106,8 @@ def _lines(result, photos) -> list[str]:
 
     lines.append(f"{'value':28s} {'measured':>14s}  {'95 % interval':>22s}")
     for key, est in zip(STANCE_KEYS, result.values().values()):
-        lines.append(row(label(key), est, key))
+        if result.side is None or key != "geometry.crank_start_deg":   # a side's crank: its own row, below
+            lines.append(row(label(key), est, key))
     lines.append(row("plate pitch at rest", result.rest_pitch_deg, "rest_pitch_deg"))
     if result.push_turn_deg is not None:
         est = result.push_turn_deg
@@ -108,8 +117,21 @@ def _lines(result, photos) -> list[str]:
                      + ("" if same else ": the other way than the model turns it"))
     lines.append(f"the crank stood at {result.rest_crank_seen_deg:.2f} deg in {photos[0].path.name}; the model's servo "
                  f"gives {result.servo_give_deg:.2f} deg under the robot's weight, taken off")
+    if result.tooth is not None:
+        lines.extend(_tooth_lines(result, row))
     lines.append(f"intervals: parametric bootstrap, {result.draws} draws (stickers {result.sticker_sd_px:.2f} px, "
                  f"board corners {result.corner_sd_px:.2f} px)")
     return lines
+
+
+def _tooth_lines(result, row) -> list[str]:
+    """The side's crank and its tooth, its probability and margin."""
+    t = result.tooth
+    word = {"L": "left", "R": "right"}[t.side]
+    ref = f"{t.reference_deg:.2f} deg" + (f" ± {t.reference_sd_deg:.2f}" if t.reference_sd_deg else "")
+    return [row(f"{word} crank at 0 deg", result.side_crank_deg, "crank_deg"),
+            f"{t.key} = {t.tooth} (was {t.file_tooth}): {t.offset_teeth:+.3f} ± {t.sd_teeth:.3f} teeth of "
+            f"{t.tooth_deg:.2f} deg off geometry.crank_start_deg ({ref}); probability {t.probability:.3f}, "
+            f"{t.margin_sd:.1f} sd inside the tooth's half-tooth band"]
 
 
