@@ -10,10 +10,11 @@ and held up (:mod:`locust.sim.push`), its crank read from the same four points b
 rule, so that each figure is printed beside the model's with the difference.
 
 The model's figures come with no interval: they are the robot file's values run once. What
-the clips identify is the stroke and the speeds themselves; no robot value is fitted to them
-(the stroke and the speeds are set together by the servo's stall torque, no-load speed,
-gearbox inertia and holding gain, and the supply: two clips do not separate them, and
-``locust calibrate servo`` fits the servo from bench recordings).
+the clips measure is the stroke and the speeds themselves; no robot value is fitted to them.
+Each figure is set by the servo's stall torque, no-load speed, gearbox inertia and holding
+gain together; the whole curves would pin them only through the model of the legs, folds and
+floor around the servo, which the clips cannot check apart from it (``locust calibrate
+servo`` fits the servo on a bench rig of known load).
 """
 
 from __future__ import annotations
