@@ -259,3 +259,19 @@ def test_ten_hidden_servos_their_stroke_within_its_interval(tmp_path):
               f"(median); largest error {max(abs(e.value - t) for t, e in mine):.3f} deg")
         assert covered >= 8, kind
         assert max(abs(e.value - t) for t, e in mine) <= STROKE_TOL_DEG, kind
+
+
+def test_a_clip_from_the_right_of_a_robot_with_a_tooth_off_there(tmp_path):
+    """The right leg filmed from the robot's right (the camera at -y), its crank a tooth on:
+    the clip's side found, its stroke as the truth's, and the model read on that side."""
+    robot = preset("small").with_values({"right.crank_tooth": 1})
+    clip, = render_push_clips(robot, held_path=tmp_path / "right.mp4", side="R", width=SIZE[0], height=SIZE[1])
+    phone = as_phone_clip(clip.clip.video_path, tmp_path / "right_phone.mp4", seed=7)
+    result = measure_stroke(robot, [phone], kinds=("held",), side="R", draws=50)
+    r, = result.readings
+    truth = truth_of(clip)
+    assert r.series.side == "R"
+    assert r.estimates["rest_deg"].value == pytest.approx(truth["rest_deg"], abs=STROKE_TOL_DEG)
+    assert r.estimates["stroke_deg"].value == pytest.approx(truth["stroke_deg"], abs=STROKE_TOL_DEG)
+    assert r.model.rest_deg == pytest.approx(truth["rest_deg"], abs=1e-6)   # the file is the truth here
+    assert r.model.rest_deg > -90.0        # a tooth (17.1 deg) on from the left's -100
