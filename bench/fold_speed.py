@@ -3,9 +3,10 @@ loop fold's spring off, with no loop tendon at all (the model before the folds w
 their own), and with one crank a tooth off (the two legs no longer alike), side by side.
 
 Each leg set (small, medium, large) at its own default, the schedule's 6 hops, on one core;
-the variants are timed in turn, round after round, best of ``--repeat`` (the machine is shared
-and noisy), so a drift in the machine's load reaches every variant alike. Timed: the rollout
-of a built model (``locust.sim.rollout.simulate_built``), and apart from it the build.
+the variants are timed in turn, round after round, each round starting one variant later (so
+none is always first after a pause), best of ``--repeat`` (the machine is shared and noisy):
+a drift in the machine's load reaches every variant alike. Timed: the rollout of a built
+model (``locust.sim.rollout.simulate_built``), and apart from it the build.
 
 Last line: ``fold speed: default <R>x the model without the loop tendon, <T>x with a crank a
 tooth off`` (R, T: the worst ratio of rollout times over the leg sets; above 1 is slower).
@@ -49,7 +50,7 @@ def variants(name: str) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--repeat", type=int, default=7, help="rounds; each variant's best is kept")
+    ap.add_argument("--repeat", type=int, default=12, help="rounds; each variant's best is kept")
     args = ap.parse_args()
     print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"{'leg set':8s} {'variant':24s} {'build_s':>8s} {'rollout_s':>9s} {'vs no tendon':>12s} {'vs default':>10s}")
@@ -60,8 +61,10 @@ def main() -> None:
         plans = {v: control_plan(r.schedule, r.solver) for v, (r, _) in cases.items()}
         best_run = dict.fromkeys(cases, float("inf"))
         best_build = dict.fromkeys(cases, float("inf"))
-        for _ in range(args.repeat):
-            for v, (_, make) in cases.items():
+        names = list(cases)
+        for round_ in range(args.repeat):
+            for v in names[round_ % len(names):] + names[:round_ % len(names)]:
+                make = cases[v][1]
                 t0 = time.perf_counter()
                 make()
                 t1 = time.perf_counter()
@@ -74,7 +77,8 @@ def main() -> None:
             print(f"{name:8s} {v:24s} {best_build[v]:8.4f} {best_run[v]:9.4f} {best_run[v] / base:12.3f} "
                   f"{best_run[v] / default:10.3f}", flush=True)
         worst["default"] = max(worst["default"], default / base)
-        worst["left crank a tooth off"] = max(worst["left crank a tooth off"], best_run["left crank a tooth off"] / base)
+        tooth = "left crank a tooth off"
+        worst[tooth] = max(worst[tooth], best_run[tooth] / base)
     print(f"fold speed: default {worst['default']:.3f}x the model without the loop tendon, "
           f"{worst['left crank a tooth off']:.3f}x with a crank a tooth off")
 

@@ -200,3 +200,30 @@ def test_the_symmetric_default_without_the_loop_spring_is_the_model_before_it(na
     sprung = _figures(run(preset(name), cycles=3))
     assert sprung != got
     assert all(abs(a - b) < 1e-4 for hs, hg in zip(sprung, got) for a, b in list(zip(hs, hg))[:3])
+
+
+def test_a_per_side_robot_is_itself_in_the_virtual_robot_the_stills_and_the_standing_load():
+    """The live simulation (the virtual robot's plant), the stills and the statics build the
+    same per-side model as `locust sim`: the live run's hop is the rollout's bit for bit, the
+    still's crank angle is the left's own start, and the standing load is that of the robot
+    settled with its trim."""
+    from locust.sim.live import LiveSim
+    from locust.sim.statics import standing_load
+    from locust.sim.still import rest_pose
+
+    robot = preset("small").with_values({"left.crank_tooth": 1, "right.trim_deg": -3.0,
+                                         "right.knee_rest_offset_deg": 5.0})
+    sim = LiveSim(robot)
+    sch, hz = robot.schedule, robot.solver.control_hz
+    for i in range(int((sch.push_s + sch.wait_s) * hz + 1e-9)):
+        angle = sch.push_deg if i / hz < sch.push_s else 0.0
+        sim.set_servo_angles_deg(angle, angle)
+        sim.advance_to((i + 1) / hz)
+    live, ref = sim.close(), run(robot, cycles=1)
+    assert live["hops"] == [vars(hop) for hop in ref.hops]
+    symmetric = run(preset("small"), cycles=1)
+    assert abs(ref.hops[0].nose_apex_m - symmetric.hops[0].nose_apex_m) > 1e-4   # the sides changed the hop
+    rest = rest_pose(robot)
+    assert rest.crank_deg == pytest.approx(side_values(robot, "L").crank_start_deg + rest.servo_deg, abs=1e-12)
+    assert rest.crank_deg == pytest.approx(-100.0 + 360.0 / 21, abs=1.0)        # a tooth on, less the servo's give
+    assert standing_load(robot).nose_load_kg != standing_load(preset("small")).nose_load_kg
