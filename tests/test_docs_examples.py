@@ -63,7 +63,8 @@ NUMBER = r"\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
 LOCUST_COMMANDS = ("calibrate", "config", "demo", "fab", "flash", "hop", "measure", "optimize", "params", "ports",
                    "pose", "repl", "report", "sim", "sweep", "track", "virtual")
 BOARD_COMMANDS = {"flash", "hop", "pose", "config", "repl"}
-OUTPUT_OPTIONS = {"--video", "--still", "--still-push", "--out", "--trk", "--write", "--plot", "--pwm-log"}
+OUTPUT_OPTIONS = {"--video", "--still", "--still-push", "--out", "--trk", "--write", "--plot", "--pwm-log",
+                  "--push-clip", "--push-clip-held", "--csv"}
 # the reader's own recordings a page names, each stood in for by one of the same kind:
 # name -> (what stands in, where it is, made by rendering (slow))
 STAND_INS = {
@@ -113,7 +114,7 @@ SLOW = (
     ("a servo fit", lambda argv: argv[:2] == ["calibrate", "servo"]),
     ("32 or more draws", _slow_samples),
     ("a sweep of 30 designs or more", _big_sweep),
-    ("video rendered", lambda argv: "--video" in argv or "--side-by-side" in argv),
+    ("video rendered", lambda argv: "--video" in argv or "--side-by-side" in argv or "--push-clip" in argv),
     ("an explanation of more than one cycle", lambda argv: _slow_explain(argv)),
 )
 

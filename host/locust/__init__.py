@@ -24,6 +24,7 @@ Functions (each with a numpydoc docstring: ``help(locust.simulate)``), named onc
 - ``make_cut_files(robot_or_dxf, out=...)``: the laminate's cut files and their summary.
 - ``run_demo(out, cycles, trials, designs)``: ``locust demo``, the toolkit end to end on the virtual robot.
 - ``hop(port, cycles, ...)``: the hop schedule on the robot or the virtual robot (``port="sim"``), its ``RunRecord``.
+- ``measure_stroke(robot, floor, held)``: the servo's stroke and speed from clips of a push, beside the model's.
 
 Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
 """

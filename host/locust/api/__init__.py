@@ -27,6 +27,7 @@ name                   module                     what it is
 ``make_cut_files``     :mod:`.fabrication`        dict (the manufacturing summary)
 ``run_demo``           :mod:`.demos`              the toolkit end to end on the virtual robot
 ``hop``                :mod:`.hopping`            the hop schedule on a robot: its run.json's ``RunRecord``
+``measure_stroke``     :mod:`.measuring`          the servo's stroke from clips of a push, beside the model's
 ``Robot``              :mod:`locust.params`       the robot's parameters, each with its provenance
 ``LocustError``        :mod:`locust.errors`       every error the toolkit raises (message, hint)
 =====================  =========================  ====================================================
@@ -64,6 +65,7 @@ EXPORTS = {
     "make_cut_files": "fabrication",
     "run_demo": "demos",
     "hop": "hopping",
+    "measure_stroke": "measuring",
     "Robot": "locust.params",
     "LocustError": "locust.errors",
 }

@@ -15,7 +15,8 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
              leg_set: str | None = None, check_convergence: bool = False, video: str | os.PathLike | None = None,
              camera: str = "track", still: str | os.PathLike | None = None,
              still_push: str | os.PathLike | None = None, board: str | None = None,
-             explain: bool = False) -> SimResult:
+             push_clip: str | os.PathLike | None = None, push_clip_held: str | os.PathLike | None = None,
+             push_fps: int = 240, side: str = "left", explain: bool = False) -> SimResult:
     """Settle the robot on the floor, run its hop schedule, audit the run and measure the hops.
 
     Parameters
@@ -61,6 +62,15 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
         The same of the robot held up at the push command (the same camera).
     board : str, optional
         For the stills: the board beside the robot (default ``aruco:4X4_50:5x4:40:10``).
+    push_clip : path-like, optional
+        Render one push on the floor (MP4, fixed camera) with the stickers ``locust measure
+        stroke`` reads, and the crank's true angle beside it (``<clip>.crank.csv``).
+    push_clip_held : path-like, optional
+        The same push with the robot held up by its plate.
+    push_fps : int, default 240
+        The push clips' frames per second.
+    side : {"left", "right"}, default "left"
+        The side the stills and push clips show (the right leg is at -y, the camera there).
     explain : bool, default False
         Why the robot does what it does (``result.explanation``,
         :class:`locust.sim.explain.Explanation`): how it went over (when, on what, the centre
@@ -101,8 +111,18 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
                          video=None if video is None else Path(video), camera=camera,
                          still=None if still is None else Path(still),
                          still_push=None if still_push is None else Path(still_push), board=board,
-                         explain=explain)
+                         push_clip=None if push_clip is None else Path(push_clip),
+                         push_clip_held=None if push_clip_held is None else Path(push_clip_held), push_fps=push_fps,
+                         side=_side(side), explain=explain)
     return run_simulation(robot, options, progress=progress)
+
+
+def _side(side: str) -> str:
+    if side not in ("left", "right"):
+        from ..errors import SimError
+
+        raise SimError(f"side {side!r} is not known", "give side='left' or side='right'")
+    return "L" if side == "left" else "R"
 
 
 __all__ = ["SimResult", "simulate"]

@@ -15,7 +15,8 @@ standing robot's load on its nose; :mod:`.kinematics` poses the markers at kept 
 :mod:`.camera`, :mod:`.clip`, :mod:`.still` and :mod:`.stickers` render videos and stills with their
 ground truth, :mod:`.foldrig` and :mod:`.foldphotos` the virtual fold test and its photos
 (:mod:`.gl`: the OpenGL MuJoCo renders with, checked before MuJoCo is imported);
-:mod:`.live` steps the model as the virtual robot's servo commands arrive.
+:mod:`.live` steps the model as the virtual robot's servo commands arrive; :mod:`.push` simulates one
+push on the floor or held up, and :mod:`.pushclip` films it for ``locust measure stroke``.
 """
 
 import os
