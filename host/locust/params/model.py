@@ -189,12 +189,18 @@ class Contact:
 
 @dataclass(frozen=True)
 class Power:
-    """The servos' supply: both servos draw through one source resistance (USB cable, board,
-    breadboard), so the voltage at the servos sags under their current (docs/servo.md,
-    "Power")."""
+    """The servos' supply (docs/servo.md, "Power"): a source that holds ``supply_voltage_v`` at
+    the servo plug with the servos at rest (the board running on it too), sagging by
+    ``source_resistance_ohm`` for every ampere the servos draw (USB cable, board, breadboard),
+    and giving no more than ``current_limit_a`` in all (a USB port's power switch, a
+    polyfuse), the board's own ``board_current_a`` included. A servo whose plug falls below
+    ``brownout_v`` stops driving. The defaults: an ideal supply (the seed's model)."""
 
-    supply_voltage_v: float = 5.0
-    source_resistance_ohm: float = 0.0
+    supply_voltage_v: float = 5.0         # at the servo plug, servos at rest, the board drawing its own
+    source_resistance_ohm: float = 0.0    # shared by both servos
+    current_limit_a: float = math.inf     # the source's, the board's draw included (inf: none)
+    brownout_v: float = 0.0               # a servo's electronics stop driving below this at its plug
+    board_current_a: float = 0.0          # the ESP32 board's own draw from the same source
 
 
 @dataclass(frozen=True)

@@ -145,11 +145,23 @@ AS_BUILT: dict[str, tuple[Any, Provenance]] = {
     "servo.winding_resistance_ohm": (10.0, Provenance(_SG90, uncertainty=1.5,
         note="stall current about 0.6 A at 6 V")),
     "power.supply_voltage_v": (5.0, Provenance("datasheet:USB", uncertainty=0.25,
-        note="USB's 5 V +- 5 %: the top view shows the servos on the USB-powered ESP32's 5 V, through the "
-             "breadboard")),
+        note="USB's 5 V +- 5 % at the servo plug with the servos at rest: the top view shows the servos on the "
+             "USB-powered ESP32's 5 V, through the breadboard; the board's own 0.05 A through the cable takes "
+             "0.025 V of it, inside the sd (locust measure supply reads it)")),
     "power.source_resistance_ohm": (0.5, Provenance("estimate:USB", uncertainty=0.3,
         note="USB cable (about 0.2 ohm a conductor) and breadboard contacts; measure the servo plug's "
-             "voltage with both servos held stalled")),
+             "voltage with both servos held stalled (locust measure supply)")),
+    # the three below: docs/servo.md, "Power", cites where each figure comes from
+    "power.current_limit_a": (1.5, Provenance("estimate:USB port", uncertainty=0.5,
+        note="USB 2.0 promises a port 0.5 A; ports limit well above it: a TPS2051B-class power switch at "
+             "0.7 A (its minimum) to 1.3 A, polyfuses and USB 3 ports (0.9 A promised) at 1.1 to 2 A or "
+             "more; both servos stalled draw 0.9 A here")),
+    "power.brownout_v": (3.5, Provenance("estimate:SG90", uncertainty=0.5,
+        note="SG90 listings give 4.8-6 V (rated) and 3.0-3.5 V as the least it runs on; below about 4 V "
+             "servos jitter or stop holding")),
+    "power.board_current_a": (0.05, Provenance("estimate:ESP32 dev board", uncertainty=0.02,
+        note="an ESP32 running with its radio off draws 20-40 mA (Espressif), its AMS1117 regulator about "
+             "5 mA, the USB-serial bridge and the power LED a few mA more")),
 }
 
 
