@@ -465,7 +465,7 @@ SIDE_SECTIONS = {"L": "left", "R": "right"}
 # what a side takes from the servo section: its field "servo_X" inherits "servo.X"
 SIDE_SERVO_FIELDS = ("kp_nm_per_rad", "stall_torque_nm", "noload_speed_rad_per_s", "armature_kgm2", "kv_nms_per_rad")
 # keys for which +inf is a meaningful value ("no limit")
-UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s",
+UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s", "power.current_limit_a",
                             *(f"{side}.servo_noload_speed_rad_per_s" for side in SIDE_SECTIONS.values())})
 
 
