@@ -23,10 +23,11 @@ import numpy as np
 
 from ..errors import SimError
 from ..markers import MARKER_COLOURS, hex_to_rgb01
-from ..params import GRAVITY_M_PER_S2, Robot, Servo
+from ..params import GRAVITY_M_PER_S2, Power, Robot, Servo
 from .fourbar import Assembly, assemble
 from .servo import at_supply
 from .servo import configure as configure_servo
+from .supply import servo_torque_cap_nm, supply_limits
 
 SIDES = ("L", "R")  # left leg at +y (faces the default camera), right leg at -y
 LINK_RGBA = {  # the notebook's colours
@@ -103,6 +104,10 @@ class BuiltModel:
         The servos' actuator ids, (L, R).
     link_lengths_m : tuple of float
         Ground, crank, coupler and leg lengths [m].
+    supply : tuple of (Servo, Power) or None
+        Where the supply limits the servos (:func:`.supply.supply_limits`), the servo as
+        identified and the supply, for the model to be stepped (:mod:`.supply_rollout`); None
+        where the compiled numbers are the servos on their supply.
     """
 
     model: mujoco.MjModel
@@ -110,6 +115,7 @@ class BuiltModel:
     sensors: SensorLayout
     servo_actuators: tuple[int, int]   # actuator ids (L, R)
     link_lengths_m: tuple[float, float, float, float]  # ground, crank, coupler, leg
+    supply: tuple[Servo, Power] | None = None
 
 
 def _quat_euler_deg(x: float, y: float, z: float) -> np.ndarray:
@@ -276,7 +282,8 @@ def _add_leg(spec: mujoco.MjSpec, chassis, robot: Robot, side: str, asm: Assembl
                       solimp=[sol.loop_dmin, sol.loop_dmax, 0.001, 0.5, 2.0])
     act = spec.add_actuator(name=f"{side}_servo", target=f"{side}_servo",
                             trntype=mujoco.mjtTrn.mjTRN_JOINT)
-    configure_servo(servo_joint, act, s, joint_damping_nms_per_rad=c.hinge_damping_nms_per_rad)
+    configure_servo(servo_joint, act, s, joint_damping_nms_per_rad=c.hinge_damping_nms_per_rad,
+                    torque_cap_nm=servo_torque_cap_nm(robot.servo, robot.power))
     act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
     act.ctrlrange = [-math.radians(s.travel_deg), math.radians(s.travel_deg)]
 
@@ -498,8 +505,10 @@ def compile_spec(spec: mujoco.MjSpec, asm: Assembly, robot: Robot) -> BuiltModel
         raise SimError(f"MuJoCo could not compile the model: {exc}",
                        "check the robot parameters named in the message") from None
     ids = tuple(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, f"{s}_servo") for s in SIDES)
+    limiting = supply_limits(robot.servo, robot.power)
     return BuiltModel(model=model, assembly=asm, sensors=_layout(model), servo_actuators=ids,
-                      link_lengths_m=robot.link_lengths_m())  # type: ignore[arg-type]
+                      link_lengths_m=robot.link_lengths_m(),  # type: ignore[arg-type]
+                      supply=(robot.servo, robot.power) if limiting else None)
 
 
 def loop_closure_error_m(model: mujoco.MjModel, data: mujoco.MjData) -> float:
