@@ -39,7 +39,7 @@ from locust.sim.model import build
 from locust.sim.rollout import simulate_built
 from locust.sim.run import run
 from locust.sim.schedule import control_plan
-from locust.sim.supply import supply_limits
+from locust.sim.supply import ServoSupply, supply_limits
 
 CYCLES = 3
 LEG_SETS = ("small", "medium", "large")
@@ -56,7 +56,7 @@ def timed(fn, repeat: int):
 
 def forced_stepped(robot):
     """``run``'s figures with the model stepped on its supply, whether it limits or not."""
-    built = dataclasses.replace(build(robot), supply=(robot.servo, robot.power))
+    built = dataclasses.replace(build(robot), supply=ServoSupply((robot.servo,) * 2, robot.power))
     traj = simulate_built(built, control_plan(robot.schedule, robot.solver, CYCLES))
     if not audit(traj).valid:
         raise SystemExit(f"{robot.name}: the stepped run failed its audit")

@@ -104,7 +104,7 @@ def test_the_static_model_is_the_circuit_at_full_duty_on_a_supply_that_does_not_
     assert not supply.supply_limits(robot.servo, robot.power)
     built = build(robot)
     assert built.supply is None
-    forced = dataclasses.replace(built, supply=(robot.servo, robot.power))
+    forced = dataclasses.replace(built, supply=supply.ServoSupply((robot.servo,) * 2, robot.power))
     for speed in (0.0, -4.0):
         model, data = built.model, mujoco.MjData(built.model)
         dofs = [int(model.jnt_dofadr[model.actuator_trnid[a, 0]]) for a in built.servo_actuators]
@@ -124,12 +124,12 @@ def test_the_rail_and_the_meter_readings_by_hand():
     k = 5.0 / s.noload_speed_rad_per_s
     assert supply.backemf_v_s_per_rad(s) == pytest.approx(k, rel=1e-12)
     # one servo at full duty turning at 5 rad/s, the other at rest: V = (V0 + Rs*K*u*w/R) / (1 + Rs*u^2/R)
-    assert supply.rail_voltage_v(s, p, [1.0, 0.0], [5.0, 0.0]) == pytest.approx(
+    assert supply.rail_voltage_v([s, s], p, [1.0, 0.0], [5.0, 0.0]) == pytest.approx(
         (5.0 + 0.5 * k * 5.0 / 10.0) / (1.0 + 0.05), rel=1e-12)
-    assert supply.rail_voltage_v(s, p, [0.0, 0.0], [3.0, -3.0]) == 5.0
+    assert supply.rail_voltage_v([s, s], p, [0.0, 0.0], [3.0, -3.0]) == 5.0
     # over the limit: both stalled on a 0.5 A source, 0.45 A left for them: V = R * 0.45 / 2
     weak = dataclasses.replace(p, current_limit_a=0.5)
-    assert supply.rail_voltage_v(s, weak, [1.0, 1.0], [0.0, 0.0]) == pytest.approx(10.0 * 0.45 / 2, rel=1e-12)
+    assert supply.rail_voltage_v([s, s], weak, [1.0, 1.0], [0.0, 0.0]) == pytest.approx(10.0 * 0.45 / 2, rel=1e-12)
     readings = supply.plug_readings(robot)
     assert (readings.rest_v, readings.stall_v, readings.stall_a) == pytest.approx((5.0, 50 / 11, 10 / 11), rel=1e-12)
     assert not readings.browned_out
@@ -163,3 +163,17 @@ def test_the_live_robot_on_a_limiting_supply_is_the_rollout():
     ref = run(robot, cycles=1)
     assert live["valid"] and ref.valid
     assert live["max_nose_height_m"] == ref.max_nose_height_m and live["distance_m"] == ref.distance_m
+
+
+def test_the_stepper_scales_the_actuator_as_compiled_a_trims_bias_too():
+    """The stepped servo is the compiled actuator on the rail: a trim compiled into its bias
+    (kp * trim) moves its target, so a command of minus the trim at the rest angle asks nothing."""
+    robot = robot_on(current_limit_a=0.8)
+    built = build(robot)
+    model = built.model
+    for act in built.servo_actuators:
+        model.actuator_biasprm[act, 0] = model.actuator_gainprm[act, 0] * 0.1     # a 0.1 rad trim
+    force, _, stepper = stalled_drive(robot, command_rad=-0.1, built=built)
+    assert force == [0.0, 0.0] and stepper.rail_v == robot.power.supply_voltage_v
+    force, _, stepper = stalled_drive(robot, command_rad=PUSH_RAD - 0.1, built=built)
+    assert force == pytest.approx([-supply.servo_torque_cap_nm(robot.servo, robot.power)] * 2, rel=1e-12)

@@ -23,11 +23,11 @@ import numpy as np
 
 from ..errors import SimError
 from ..markers import MARKER_COLOURS, hex_to_rgb01
-from ..params import GRAVITY_M_PER_S2, Power, Robot, Servo
+from ..params import GRAVITY_M_PER_S2, Robot, Servo
 from .fourbar import Assembly, assemble
 from .servo import at_supply
 from .servo import configure as configure_servo
-from .supply import servo_torque_cap_nm, supply_limits
+from .supply import ServoSupply, servo_torque_cap_nm, supply_limits
 
 SIDES = ("L", "R")  # left leg at +y (faces the default camera), right leg at -y
 LINK_RGBA = {  # the notebook's colours
@@ -104,8 +104,8 @@ class BuiltModel:
         The servos' actuator ids, (L, R).
     link_lengths_m : tuple of float
         Ground, crank, coupler and leg lengths [m].
-    supply : tuple of (Servo, Power) or None
-        Where the supply limits the servos (:func:`.supply.supply_limits`), the servo as
+    supply : ServoSupply or None
+        Where the supply limits the servos (:func:`.supply.supply_limits`), each servo as
         identified and the supply, for the model to be stepped (:mod:`.supply_rollout`); None
         where the compiled numbers are the servos on their supply.
     """
@@ -115,7 +115,7 @@ class BuiltModel:
     sensors: SensorLayout
     servo_actuators: tuple[int, int]   # actuator ids (L, R)
     link_lengths_m: tuple[float, float, float, float]  # ground, crank, coupler, leg
-    supply: tuple[Servo, Power] | None = None
+    supply: ServoSupply | None = None
 
 
 def _quat_euler_deg(x: float, y: float, z: float) -> np.ndarray:
@@ -508,7 +508,7 @@ def compile_spec(spec: mujoco.MjSpec, asm: Assembly, robot: Robot) -> BuiltModel
     limiting = supply_limits(robot.servo, robot.power)
     return BuiltModel(model=model, assembly=asm, sensors=_layout(model), servo_actuators=ids,
                       link_lengths_m=robot.link_lengths_m(),  # type: ignore[arg-type]
-                      supply=(robot.servo, robot.power) if limiting else None)
+                      supply=ServoSupply((robot.servo,) * len(SIDES), robot.power) if limiting else None)
 
 
 def loop_closure_error_m(model: mujoco.MjModel, data: mujoco.MjData) -> float:

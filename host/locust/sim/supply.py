@@ -172,7 +172,8 @@ def supply_limits(servo: Servo, power: Power) -> bool:
     return s.current_limited or s.browned_out
 
 
-def rail_voltage_v(servo: Servo, power: Power, duties: Sequence[float], speeds_rad_per_s: Sequence[float]) -> float:
+def rail_voltage_v(servos: Sequence[Servo], power: Power, duties: Sequence[float],
+                   speeds_rad_per_s: Sequence[float]) -> float:
     """The rail with each servo at its duty and speed, the motors' currents settled
     (quasi-static): through the source's resistance, ``V = V0 - Rs * sum(u_i * I_i)``; where
     that would draw more than the current limit leaves the servos, the voltage at which they
@@ -180,8 +181,8 @@ def rail_voltage_v(servo: Servo, power: Power, duties: Sequence[float], speeds_r
 
     Parameters
     ----------
-    servo : Servo
-        As identified (its winding and back-EMF constant).
+    servos : sequence of Servo
+        Each servo as identified (its winding and back-EMF constant), one per duty.
     power : Power
         The supply.
     duties : sequence of float
@@ -194,14 +195,34 @@ def rail_voltage_v(servo: Servo, power: Power, duties: Sequence[float], speeds_r
     float
         The servo plug's voltage [V], at least 0.
     """
-    r, k, rs = servo.winding_resistance_ohm, backemf_v_s_per_rad(servo), power.source_resistance_ohm
-    uu = sum(u * u for u in duties)
-    uw = sum(u * w for u, w in zip(duties, speeds_rad_per_s))
-    volts = (power.supply_voltage_v + rs * k * uw / r) / (1.0 + rs * uu / r)
+    # sum(u_i * I_i) = a*V - b, with I_i = (u_i*V - K_i*w_i) / R_i
+    a = sum(u * u / s.winding_resistance_ohm for s, u in zip(servos, duties))
+    b = sum(u * backemf_v_s_per_rad(s) * w / s.winding_resistance_ohm
+            for s, u, w in zip(servos, duties, speeds_rad_per_s))
+    rs = power.source_resistance_ohm
+    volts = (power.supply_voltage_v + rs * b) / (1.0 + rs * a)
     limit = servos_current_a(power)
-    if uu > 0.0 and (volts * uu - k * uw) / r > limit:
-        volts = (r * limit + k * uw) / uu
+    if a > 0.0 and a * volts - b > limit:
+        volts = (limit + b) / a
     return max(volts, 0.0)
+
+
+@dataclass(frozen=True)
+class ServoSupply:
+    """The servos and the supply of a model whose supply limits them (:func:`supply_limits`),
+    for the model to be stepped (:mod:`.supply_rollout`).
+
+    Attributes
+    ----------
+    servos : tuple of Servo
+        Each servo as identified, at its reference voltage, in the order of the model's servo
+        actuators (L, R).
+    power : Power
+        The supply.
+    """
+
+    servos: tuple[Servo, ...]
+    power: Power
 
 
 @dataclass(frozen=True)
@@ -244,6 +265,6 @@ def plug_readings(robot: Robot) -> PlugReadings:
                         stall_a=SERVOS_ON_SUPPLY * s.current_a, browned_out=s.browned_out)
 
 
-__all__ = ["SERVOS_ON_SUPPLY", "PlugReadings", "StallPoint", "backemf_v_s_per_rad", "plug_readings",
+__all__ = ["SERVOS_ON_SUPPLY", "PlugReadings", "ServoSupply", "StallPoint", "backemf_v_s_per_rad", "plug_readings",
            "rail_voltage_v", "servo_torque_cap_nm", "servos_current_a", "stall_point", "supply_limits",
            "torque_constant_nm_per_a"]

@@ -3,11 +3,13 @@
 Where the supply's current limit or the servos' brown-out binds (:func:`.supply.supply_limits`),
 no fixed set of actuator numbers is the servo: its torque follows the rail, and the rail both
 servos' draw. :class:`SupplyStepper` takes each physics step's start: each servo's duty ``u``
-(its controller's torque over its stall torque, the command and angle as the actuator sees
-them) and speed, the rail from both (:func:`.supply.rail_voltage_v`: the source's resistance,
-or its current limit), and sets each servo to its motor on that rail for the step::
+(what its compiled actuator would ask, unclamped, over its stall torque on the supply: the
+controller's torque over its stall torque, trim and gains as compiled) and speed, the rail
+from both (:func:`.supply.rail_voltage_v`: the source's resistance, or its current limit),
+and sets each servo to its motor on that rail for the step::
 
-    kp, stall, kv  scaled by V / reference voltage   (the controller's duty gain is fixed)
+    gain and bias  the compiled ones scaled by V / (the rail they were compiled for)
+    clamp          stall_ref * V / reference voltage      (the duty saturates)
     damping        the motor's own back-EMF, stall_ref / noload_ref (the source acts through V)
 
 so MuJoCo's clamped position actuator and the joint's damping give ``k_t*(u*V - K*w)/R``
@@ -56,30 +58,38 @@ class SupplyStepper:
     def __init__(self, built: BuiltModel, steps_per_tick: int):
         if built.supply is None:
             raise ValueError("the model's supply does not limit its servos: nothing to step")
-        self.servo, self.power = built.supply
+        self.servos, self.power = built.supply.servos, built.supply.power
         self.model = copy.copy(built.model)
-        m, s = self.model, self.servo
+        m = self.model
         self.acts = list(built.servo_actuators)
         joints = [int(m.actuator_trnid[a, 0]) for a in self.acts]
         self.dofs = [int(m.jnt_dofadr[j]) for j in joints]
         self.qadr = [int(m.jnt_qposadr[j]) for j in joints]
-        self.ctrl_range = [tuple(m.actuator_ctrlrange[a]) for a in self.acts]
-        static = back_emf_damping_nms_per_rad(at_supply(s, self.power))
-        self.own_damping = [float(m.dof_damping[d]) - static for d in self.dofs]   # the joint's own (its hinge)
-        self.back_emf = back_emf_damping_nms_per_rad(s)
+        self.ctrl_range = [tuple(float(x) for x in m.actuator_ctrlrange[a]) for a in self.acts]
+        # the numbers compiled: each servo on the supply's rail at rest, through its resistance
+        statics = [at_supply(s, self.power) for s in self.servos]
+        self.static_stall = [s.stall_torque_nm for s in statics]
+        self.static_volts = [s.reference_voltage_v * st.stall_torque_nm / s.stall_torque_nm
+                             for s, st in zip(self.servos, statics)]
+        self.gain = [float(m.actuator_gainprm[a, 0]) for a in self.acts]
+        self.bias = [[float(x) for x in m.actuator_biasprm[a, :3]] for a in self.acts]
+        self.own_damping = [float(m.dof_damping[d]) - back_emf_damping_nms_per_rad(st)   # the joint's own (its hinge)
+                            for d, st in zip(self.dofs, statics)]
+        self.back_emf = [back_emf_damping_nms_per_rad(s) for s in self.servos]
+        self.stall_per_volt = [s.stall_torque_nm / s.reference_voltage_v for s in self.servos]
         self.per_tick = max(1, int(steps_per_tick))
         self.off = False
         self.rail_v = self.power.supply_voltage_v
 
     def duties(self, data: mujoco.MjData) -> tuple[list[float], list[float]]:
         """Each servo's duty (-1 to 1) and speed [rad/s] in ``data``'s state and command."""
-        s = self.servo
         duties, speeds = [], []
-        for act, dof, adr, (lo, hi) in zip(self.acts, self.dofs, self.qadr, self.ctrl_range):
+        for i, (act, dof, adr, (lo, hi)) in enumerate(zip(self.acts, self.dofs, self.qadr, self.ctrl_range)):
             command = min(max(float(data.ctrl[act]), lo), hi)
             w = float(data.qvel[dof])
-            u = (s.kp_nm_per_rad * (command - float(data.qpos[adr])) - s.kv_nms_per_rad * w) / s.stall_torque_nm
-            duties.append(min(max(u, -1.0), 1.0))
+            b0, b1, b2 = self.bias[i]
+            ask = self.gain[i] * command + b0 + b1 * float(data.qpos[adr]) + b2 * w   # unclamped
+            duties.append(min(max(ask / self.static_stall[i], -1.0), 1.0))
             speeds.append(w)
         return duties, speeds
 
@@ -97,23 +107,24 @@ class SupplyStepper:
             self.off = False          # the pulse restarts them: they drive, if the rail holds
         if not self.off:
             duties, speeds = self.duties(data)
-            self.rail_v = rail_voltage_v(self.servo, self.power, duties, speeds)
+            self.rail_v = rail_voltage_v(self.servos, self.power, duties, speeds)
             self.off = self.rail_v < self.power.brownout_v
         else:
             self.rail_v = self.power.supply_voltage_v   # nothing drawn: the rail at rest
-        self._set(0.0 if self.off else self.rail_v / self.servo.reference_voltage_v)
+        self._set(0.0 if self.off else self.rail_v)
 
-    def _set(self, scale: float) -> None:
-        """Each servo as its motor on ``scale`` times its reference voltage (0: off)."""
-        m, s = self.model, self.servo
-        kp, kv, stall = s.kp_nm_per_rad * scale, s.kv_nms_per_rad * scale, s.stall_torque_nm * scale
-        for act, dof, own in zip(self.acts, self.dofs, self.own_damping):
-            m.actuator_gainprm[act, 0] = kp
-            m.actuator_biasprm[act, 1] = -kp
-            m.actuator_biasprm[act, 2] = -kv
+    def _set(self, volts: float) -> None:
+        """Each servo as its motor on a rail of ``volts`` (0: off, no drive and no back-EMF)."""
+        m = self.model
+        for i, (act, dof) in enumerate(zip(self.acts, self.dofs)):
+            scale = volts / self.static_volts[i]
+            m.actuator_gainprm[act, 0] = self.gain[i] * scale
+            for k in range(3):
+                m.actuator_biasprm[act, k] = self.bias[i][k] * scale
+            stall = self.stall_per_volt[i] * volts
             m.actuator_forcerange[act, 0] = -stall
             m.actuator_forcerange[act, 1] = stall
-            m.dof_damping[dof] = own + (self.back_emf if scale > 0.0 else 0.0)
+            m.dof_damping[dof] = self.own_damping[i] + (self.back_emf[i] if volts > 0.0 else 0.0)
 
 
 def supply_stepper(built: BuiltModel, steps_per_tick: int) -> SupplyStepper | None:
