@@ -16,7 +16,7 @@ from locust.errors import MeasureError
 from locust.io.robot_toml import load_robot
 from locust.measure.meter import MeterSpec
 from locust.measure.supply import SOURCE, SupplyReadings, measure_supply, virtual_readings
-from locust.params import preset
+from locust.params import Provenance, preset
 
 VOLTS = MeterSpec(0.5, 2, 0.01)          # ±(0.5 % + 2 digits) on a 20 V range
 AMPS = MeterSpec(1.2, 3, 0.01)           # ±(1.2 % + 3 digits) on a 10 A range
@@ -25,7 +25,10 @@ S3 = math.sqrt(3)
 
 @pytest.fixture(scope="module")
 def small():
-    return preset("small")      # servo winding 10 ± 1.5 ohm, board 0.05 ± 0.02 A, 0.5 ohm, 1.5 A
+    """Small as built (servo winding 10 ± 1.5 ohm, 0.5 ohm, 1.5 A), its board's 0.05 A given an
+    sd of 0.02 A (as built it has none)."""
+    return preset("small").with_values({"power.board_current_a": 0.05},
+                                       Provenance("estimate:ESP32 dev board", uncertainty=0.02))
 
 
 def test_the_resistance_from_the_two_voltages_by_hand(small):
@@ -67,7 +70,10 @@ def test_the_current_limit_by_hand(small):
              "power.board_current_a": 0.02}
     assert res.sd_terms == pytest.approx(terms, rel=1e-12)
     assert res.bound == pytest.approx(10 * 1.18 / (2 * 3.80), rel=1e-12)                   # the resistance at most
-    assert res.predicted.stall_v == pytest.approx(3.80, rel=1e-12)
+    assert res.predicted.stall_v == pytest.approx(3.80, rel=1e-12) and res.notes == []
+    # the robot as built gives the board's draw no sd: counted as exact, and said so
+    exact = measure_supply(preset("small"), SupplyReadings(4.98, 3.80), VOLTS, solve="limit")
+    assert "power.board_current_a" not in exact.sd_terms and "no uncertainty" in exact.notes[0]
     with_amps = measure_supply(small, SupplyReadings(4.98, 3.80, 0.76), VOLTS, AMPS, solve="limit")
     assert with_amps.value.value == pytest.approx(0.76 + 0.05, rel=1e-12)
     assert with_amps.value.sd == pytest.approx(math.hypot(math.hypot(0.012 * 0.76 / S3, 0.03 / S3), 0.02), rel=1e-12)

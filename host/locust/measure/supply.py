@@ -22,7 +22,8 @@ The intervals: a meter's ``±(P % + N digits)`` (:mod:`.meter`): its percentage 
 common to the readings of one range (it cancels in ``Vr - Vs`` over ``Vs``, counts in full
 in ``Vs`` alone and in the sag over a current), its digits independent per reading; the
 winding's and the board's draw's uncertainties from the robot file; each term propagated to
-first order, added in quadrature, 95 % = ±1.96 sd. The voltage at rest is written too, as
+first order, added in quadrature, 95 % = ±1.96 sd (a value the file gives no sd counts as
+exact, and is said to). The voltage at rest is written too, as
 ``power.supply_voltage_v``; every value written has source ``data:measure supply``.
 """
 
@@ -256,6 +257,9 @@ def measure_supply(robot: Robot, readings: SupplyReadings, volts: MeterSpec, amp
     out = out.with_values({key: estimate.value}, Provenance(SOURCE, uncertainty=estimate.sd, date=date,
                                                             note=f"{said}; read as the source's {solve}"))
     notes = []
+    if solve == "limit" and _sd(robot, BOARD_KEY) == 0.0:
+        notes.append(f"{BOARD_KEY} ({robot.power.board_current_a:g} A) carries no uncertainty in the robot file: "
+                     "counted as exact (a USB meter between the port and the board reads it)")
     if readings.stall_v < robot.power.brownout_v:
         notes.append(f"the stalled plug, {readings.stall_v:g} V, is below the robot file's brown-out voltage "
                      f"({robot.power.brownout_v:g} V): if the servos held the stall without twitching, their "
