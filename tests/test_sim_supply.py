@@ -67,6 +67,9 @@ def test_the_current_limit_is_each_servos_torque_cap_at_stall():
     assert stepper.rail_v == pytest.approx(4.0, rel=1e-12) and not stepper.off
     assert force == pytest.approx([-cap, -cap], rel=1e-12)
     assert damper == [0.0, 0.0]
+    assert supply.limit_note(robot.servo, robot.power).startswith(
+        "the supply's current limit (0.8 A) holds each stalled servo to 0.400 A, 0.1200 N*m, its plug at 4.00 V")
+    assert supply.limit_note(preset("small").servo, preset("small").power) is None
     # the board's own draw takes its share of the limit: k_t * (0.8 - 0.05) / 2
     board = robot_on(source_resistance_ohm=0.0, current_limit_a=0.8, board_current_a=0.05)
     assert stalled_drive(board)[0] == pytest.approx([-k_t * 0.75 / 2] * 2, rel=1e-12)
@@ -93,6 +96,7 @@ def test_a_supply_whose_stall_voltage_is_below_the_brownout_gives_no_drive_at_st
     # supply that holds goes over)
     browned = run(robot, cycles=1)
     assert browned.valid and browned.hops[0].nose_apex_m < 1e-4 and browned.outcome == "stays_low"
+    assert any("falls to 2.50 V, under their 3.5 V" in n for n in browned.notes), browned.notes
     held = run(robot.with_values({"power.brownout_v": 0.0}), cycles=1)
     assert held.hops[0].nose_apex_m > 0.05
 

@@ -172,6 +172,29 @@ def supply_limits(servo: Servo, power: Power) -> bool:
     return s.current_limited or s.browned_out
 
 
+def limit_note(servo: Servo, power: Power) -> str | None:
+    """What a supply that limits the servos does to them at stall, in words (None: it does not).
+
+    Parameters
+    ----------
+    servo : Servo
+        As identified.
+    power : Power
+
+    Returns
+    -------
+    str or None
+    """
+    s = stall_point(servo, power)
+    if not (s.current_limited or s.browned_out):
+        return None
+    if s.browned_out:
+        return (f"the supply browns the servos out: stalled, their plug falls to {s.plug_v:.2f} V, under their "
+                f"{power.brownout_v:g} V (power.brownout_v), so they give no drive at stall (docs/servo.md, Power)")
+    return (f"the supply's current limit ({power.current_limit_a:g} A) holds each stalled servo to "
+            f"{s.current_a:.3f} A, {s.torque_nm:.4f} N*m, its plug at {s.plug_v:.2f} V (docs/servo.md, Power)")
+
+
 def rail_voltage_v(servos: Sequence[Servo], power: Power, duties: Sequence[float],
                    speeds_rad_per_s: Sequence[float]) -> float:
     """The rail with each servo at its duty and speed, the motors' currents settled
@@ -265,6 +288,6 @@ def plug_readings(robot: Robot) -> PlugReadings:
                         stall_a=SERVOS_ON_SUPPLY * s.current_a, browned_out=s.browned_out)
 
 
-__all__ = ["SERVOS_ON_SUPPLY", "PlugReadings", "ServoSupply", "StallPoint", "backemf_v_s_per_rad", "plug_readings",
-           "rail_voltage_v", "servo_torque_cap_nm", "servos_current_a", "stall_point", "supply_limits",
+__all__ = ["SERVOS_ON_SUPPLY", "PlugReadings", "ServoSupply", "StallPoint", "backemf_v_s_per_rad", "limit_note",
+           "plug_readings", "rail_voltage_v", "servo_torque_cap_nm", "servos_current_a", "stall_point", "supply_limits",
            "torque_constant_nm_per_a"]
