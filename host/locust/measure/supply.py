@@ -273,7 +273,9 @@ def measure_supply(robot: Robot, readings: SupplyReadings, volts: MeterSpec, amp
 def virtual_readings(robot: Robot, volts: MeterSpec, amps: MeterSpec | None = None, seed: int = 0) -> SupplyReadings:
     """What a meter of ``volts`` (and ``amps``) reads on ``robot``'s supply, at rest and stalled:
     the circuit's values (:func:`locust.sim.supply.plug_readings`) through the meter's error,
-    one gain error for both voltages (one range), the digits drawn per reading.
+    one gain error for both voltages (one range), the digits drawn per reading. (On a supply
+    that browns the servos out at stall, ``plug_readings(robot).browned_out``, no real meter
+    reads a steady stall: the servos reset as they stall.)
 
     Parameters
     ----------
