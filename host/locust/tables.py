@@ -330,6 +330,7 @@ UNIT_SUFFIXES = (   # a key's unit from its name's end (longest first): _nm_ is 
     ("_rad_per_s", "rad/s"), ("_m_per_s", "m/s"), ("_kg_per_m3", "kg/m³"), ("_kgm2", "kg·m²"), ("_nm2", "N·m²"),
     ("_kg", "kg"), ("_hz", "Hz"), ("_deg", "deg"), ("_mm", "mm"), ("_ms", "ms"), ("_nm", "N·m"), ("_ohm", "Ω"),
     ("_rad", "rad"), ("_us", "µs"), ("_m", "m"), ("_n", "N"), ("_s", "s"), ("_v", "V"),
+    ("_a", "A"),
 )
 
 

@@ -116,6 +116,13 @@ LIMITS: dict[str, Limit] = {
     "power.supply_voltage_v": Limit(1.0, 24.0, _SHUT, _SHUT, "a hobby servo's supply: 1 to 24 V (USB 5 V)"),
     "power.source_resistance_ohm": Limit(0.0, 100.0, _SHUT, _SHUT,
                                          "cables, board and battery: 0 to 100 ohm (USB about 0.5)"),
+    "power.current_limit_a": Limit(0.0, math.inf, _OPEN, _SHUT,
+                                   "a source's current limit: above 0 A (a USB 2.0 port's switch 0.7 to 1.3 A); "
+                                   "inf: none"),
+    "power.brownout_v": Limit(0.0, 24.0, _SHUT, _SHUT,
+                              "the voltage below which a servo stops driving: 0 (never) to 24 V (an SG90 about 3.5)"),
+    "power.board_current_a": Limit(0.0, 5.0, _SHUT, _SHUT,
+                                   "a board's own draw: 0 to 5 A (an ESP32 dev board about 0.05)"),
     "schedule.push_deg": Limit(_HOP["push_deg"][1], _HOP["push_deg"][2], _SHUT, _SHUT, _SCHEDULE),
     "schedule.push_s": Limit(_HOP["push_ms"][1] / 1000.0, _HOP["push_ms"][2] / 1000.0, _SHUT, _SHUT, _SCHEDULE),
     "schedule.wait_s": Limit(_HOP["wait_ms"][1] / 1000.0, _HOP["wait_ms"][2] / 1000.0, _SHUT, _SHUT, _SCHEDULE),
@@ -184,6 +191,7 @@ def problems(robot: Robot, cycles: int | None = None) -> list[str]:
     out += _side_problems(robot)
     if s.pulse_min_us >= s.pulse_max_us:
         out.append(f"servo.pulse_min_us = {s.pulse_min_us:g} must be below servo.pulse_max_us = {s.pulse_max_us:g}")
+    out += _supply_problems(robot)
     if sol.timestep_s > 0 and sol.control_hz * sol.timestep_s > 1.0 + 1e-9:
         out.append(f"solver.control_hz = {sol.control_hz:g} is faster than one command per physics step "
                    f"(1/solver.timestep_s = {1.0 / sol.timestep_s:g} Hz)")
@@ -209,6 +217,20 @@ def _side_problems(robot: Robot) -> list[str]:
                                                                                    side.trim_deg):
             out.append(f"{section}.trim_deg = {side.trim_deg:g} with servo.travel_deg = {s.travel_deg:g} exceeds half "
                        f"the pulse range's angle (servo.range_deg / 2 = {s.range_deg / 2:g}), as the firmware refuses")
+    return out
+
+
+def _supply_problems(robot: Robot) -> list[str]:
+    """A supply that cannot drive the servos at all: the board alone takes the source's whole
+    current limit, or the servos brown out at rest."""
+    p = robot.power
+    out = []
+    if p.board_current_a >= p.current_limit_a:
+        out.append(f"power.board_current_a = {p.board_current_a:g} A is the whole of the source's "
+                   f"power.current_limit_a = {p.current_limit_a:g} A: nothing is left for the servos")
+    if p.brownout_v >= p.supply_voltage_v:
+        out.append(f"power.brownout_v = {p.brownout_v:g} V is at or above power.supply_voltage_v = "
+                   f"{p.supply_voltage_v:g} V: the servos would never drive")
     return out
 
 

@@ -189,12 +189,18 @@ class Contact:
 
 @dataclass(frozen=True)
 class Power:
-    """The servos' supply: both servos draw through one source resistance (USB cable, board,
-    breadboard), so the voltage at the servos sags under their current (docs/servo.md,
-    "Power")."""
+    """The servos' supply (docs/servo.md, "Power"): a source that holds ``supply_voltage_v`` at
+    the servo plug with the servos at rest (the board running on it too), sagging by
+    ``source_resistance_ohm`` for every ampere the servos draw (USB cable, board, breadboard),
+    and giving no more than ``current_limit_a`` in all (a USB port's power switch, a
+    polyfuse), the board's own ``board_current_a`` included. A servo whose plug falls below
+    ``brownout_v`` stops driving. The defaults: an ideal supply (the seed's model)."""
 
-    supply_voltage_v: float = 5.0
-    source_resistance_ohm: float = 0.0
+    supply_voltage_v: float = 5.0         # at the servo plug, servos at rest, the board drawing its own
+    source_resistance_ohm: float = 0.0    # shared by both servos
+    current_limit_a: float = math.inf     # the source's, the board's draw included (inf: none)
+    brownout_v: float = 0.0               # a servo's electronics stop driving below this at its plug
+    board_current_a: float = 0.0          # the ESP32 board's own draw from the same source
 
 
 @dataclass(frozen=True)
@@ -459,7 +465,7 @@ SIDE_SECTIONS = {"L": "left", "R": "right"}
 # what a side takes from the servo section: its field "servo_X" inherits "servo.X"
 SIDE_SERVO_FIELDS = ("kp_nm_per_rad", "stall_torque_nm", "noload_speed_rad_per_s", "armature_kgm2", "kv_nms_per_rad")
 # keys for which +inf is a meaningful value ("no limit")
-UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s",
+UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s", "power.current_limit_a",
                             *(f"{side}.servo_noload_speed_rad_per_s" for side in SIDE_SECTIONS.values())})
 
 

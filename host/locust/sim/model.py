@@ -32,6 +32,7 @@ from ..params import GRAVITY_M_PER_S2, FoldValues, Robot, SideValues, side_value
 from .fourbar import Assembly, side_assembly
 from .servo import at_supply
 from .servo import configure as configure_servo
+from .supply import ServoSupply, servo_torque_cap_nm, supply_limits
 
 SIDES = ("L", "R")  # left leg at +y (faces the default camera), right leg at -y
 LINK_RGBA = {  # the notebook's colours
@@ -108,6 +109,10 @@ class BuiltModel:
         The servos' actuator ids, (L, R).
     link_lengths_m : tuple of float
         Ground, crank, coupler and leg lengths [m].
+    supply : ServoSupply or None
+        Where the supply limits the servos (:func:`.supply.supply_limits`), each servo as
+        identified and the supply, for the model to be stepped (:mod:`.supply_rollout`); None
+        where the compiled numbers are the servos on their supply.
     """
 
     model: mujoco.MjModel
@@ -115,6 +120,7 @@ class BuiltModel:
     sensors: SensorLayout
     servo_actuators: tuple[int, int]   # actuator ids (L, R)
     link_lengths_m: tuple[float, float, float, float]  # ground, crank, coupler, leg
+    supply: ServoSupply | None = None
 
 
 def _quat_euler_deg(x: float, y: float, z: float) -> np.ndarray:
@@ -288,7 +294,7 @@ def _add_leg(spec: mujoco.MjSpec, chassis, robot: Robot, values: SideValues, asm
     act = spec.add_actuator(name=f"{side}_servo", target=f"{side}_servo",
                             trntype=mujoco.mjtTrn.mjTRN_JOINT)
     configure_servo(servo_joint, act, s, joint_damping_nms_per_rad=folds["servo"].damping_nms_per_rad,
-                    trim_rad=trim)
+                    trim_rad=trim, torque_cap_nm=servo_torque_cap_nm(values.servo, robot.power))
     act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
     act.ctrlrange = [-math.radians(s.travel_deg), math.radians(s.travel_deg)]
 
@@ -549,8 +555,11 @@ def compile_spec(spec: mujoco.MjSpec, asms: dict[str, Assembly], robot: Robot) -
         raise SimError(f"MuJoCo could not compile the model: {exc}",
                        "check the robot parameters named in the message") from None
     ids = tuple(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, f"{s}_servo") for s in SIDES)
+    servos = tuple(side_values(robot, side).servo for side in SIDES)
+    limiting = any(supply_limits(servo, robot.power) for servo in servos)
     return BuiltModel(model=model, assemblies=asms, sensors=_layout(model), servo_actuators=ids,
-                      link_lengths_m=robot.link_lengths_m())  # type: ignore[arg-type]
+                      link_lengths_m=robot.link_lengths_m(),  # type: ignore[arg-type]
+                      supply=ServoSupply(servos, robot.power) if limiting else None)
 
 
 def loop_closure_error_m(model: mujoco.MjModel, data: mujoco.MjData) -> float:

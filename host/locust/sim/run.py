@@ -18,6 +18,7 @@ from .model import SIDES, build
 from .outcome import classify
 from .result import SimResult, invalid_result
 from .rollout import roll_out
+from .supply import limit_note
 
 # a robot whose nose ends the run this far above its standing height did not come back down
 # from a push (a robot that hops and lands again stands within a few millimetres of its start)
@@ -74,6 +75,8 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
         where = "" if len({a.transmission_deg for a in built.assemblies.values()}) == 1 else " on one leg"
         notes.append(f"poor transmission angle {asm.transmission_deg:.0f} deg at the start{where} "
                      f"(outside {lo:g}-{hi:g})")
+    if (supply := limit_note(robot.servo, robot.power)) is not None:
+        notes.append(supply)
     return SimResult(
         robot_name=robot.name, valid=verdict.valid, reasons=verdict.reasons,
         distance_m=summary.distance_m if summary else nan,

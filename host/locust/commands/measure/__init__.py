@@ -1,7 +1,7 @@
-"""``locust measure stance|nose-load|stroke``: the robot as built, from photos (docs/measure.md),
-a kitchen scale and clips of a push (docs/hardware.md).
+"""``locust measure stance|nose-load|stroke|supply``: the robot as built, from photos
+(docs/measure.md), a kitchen scale, clips of a push and a multimeter (docs/hardware.md).
 
-One module a subcommand (:mod:`.stance`, :mod:`.nose_load`, :mod:`.stroke`): each parses its
+One module a subcommand (:mod:`.stance`, :mod:`.nose_load`, :mod:`.stroke`, :mod:`.supply`): each parses its
 options, runs its job (:mod:`locust.measure`) and prints.
 """
 
@@ -12,13 +12,15 @@ import click
 from .nose_load import nose_load
 from .stance import stance
 from .stroke import stroke
+from .supply import supply
 
 
 @click.group()
 def measure():
     """Measure the robot as built: its stance from photos (docs/measure.md), its nose load on
-    a kitchen scale and its servo's stroke from clips of a push (docs/hardware.md)."""
+    a kitchen scale, its servo's stroke from clips of a push and its supply with a multimeter
+    (docs/hardware.md)."""
 
 
-for _command in (stance, nose_load, stroke):
+for _command in (stance, nose_load, stroke, supply):
     measure.add_command(_command)
