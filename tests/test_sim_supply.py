@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from locust.params import preset
+from locust.params import preset, side_values
 from locust.sim import supply
 from locust.sim.live import LiveSim
 from locust.sim.model import build
@@ -84,8 +84,11 @@ def test_a_supply_whose_stall_voltage_is_below_the_brownout_gives_no_drive_at_st
     assert point.plug_v == pytest.approx(2.5, rel=1e-12) and point.browned_out and not point.current_limited
     force, damper, stepper = stalled_drive(robot, speed_rad_per_s=-1.0)
     assert stepper.off and force == [0.0, 0.0]
-    own = robot.compliance.hinge_damping_nms_per_rad
-    assert damper == pytest.approx([own, own], rel=1e-9)   # the hinge's alone, at -1 rad/s
+    # the folds' alone, at -1 rad/s: the servo fold's and the loop fold's (its tendon runs over the
+    # servo joint: with the knee and ankle still, the loop fold turns as the crank does)
+    folds = side_values(robot, "L").folds
+    own = folds["servo"].damping_nms_per_rad + folds["loop"].damping_nms_per_rad
+    assert damper == pytest.approx([own, own], rel=1e-9)
     small = math.radians(1.0)
     force, _, stepper = stalled_drive(robot, command_rad=small)
     u = robot.servo.kp_nm_per_rad * small / robot.servo.stall_torque_nm
@@ -118,7 +121,8 @@ def test_the_static_model_is_the_circuit_at_full_duty_on_a_supply_that_does_not_
         static = [float(data.actuator_force[a] + data.qfrc_damper[d]) for a, d in zip(built.servo_actuators, dofs)]
         force, damper, _ = stalled_drive(robot, speed_rad_per_s=speed, built=forced)
         assert [f + b for f, b in zip(force, damper)] == pytest.approx(static, rel=1e-12, abs=1e-15)
-    stall, hinge = 0.15 * 10 / 11, robot.compliance.hinge_damping_nms_per_rad   # 5 V behind 10 + 2*0.5 ohm
+    folds = side_values(robot, "L").folds   # the servo fold's damping and the loop fold's, whose tendon runs over it
+    stall, hinge = 0.15 * 10 / 11, folds["servo"].damping_nms_per_rad + folds["loop"].damping_nms_per_rad
     assert -static[0] == pytest.approx(stall - (stall / 10.31 + hinge) * 4.0, rel=1e-12)
 
 
