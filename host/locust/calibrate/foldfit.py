@@ -279,7 +279,9 @@ def _check_range(loaded_free_deg: float, loaded_fold: float, turn_deg: float, lo
         "lighter weight, a paper clip weighed: --coin-mass-kg)")
 
 
-def _mirror(fold: str, side: str) -> float:
+def photo_sign(fold: str, side: str) -> float:
+    """+1 or -1: the model's fold angle per the photo's, for ``fold`` of the leg on ``side``
+    (a right leg's fold is photographed from the robot's right, mirrored)."""
     return PHOTO_SIGN[fold] * (-1.0 if side == "right" else 1.0)
 
 
@@ -344,7 +346,7 @@ def fit_fold(unloaded: Sequence[FoldPhoto], loaded: Sequence[FoldPhoto], link: F
     _check_turn(turn, float(np.std(turns, ddof=1)), load, source)
     _check_range(fb, tb, turn, load, source)
     _check_sign(k, turn, source)
-    sign = _mirror(fold, side)
+    sign = photo_sign(fold, side)
     rest_est = _estimate(sign * rest, sign * rows[:, 1])
     offset = None
     if assembled_deg is not None:

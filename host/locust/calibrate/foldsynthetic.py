@@ -21,12 +21,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..params import GRAVITY_M_PER_S2
+from ..params import GRAVITY_M_PER_S2, Robot, side_values
 from ..sim.foldphotos import FoldPhotos, FoldShot, render_fold_test
 from ..sim.foldrig import FoldRig, settle, with_placement
 from .coins import COINS, PUBLISHED_MASS_REL_SD, WEIGHED_SD_KG
-from .fold import coin_load
-from .foldfit import ARM_SD_M, LENGTH_SD_M, PLACEMENT_SD_M, TILT_SD_DEG, FreeLink, Load
+from .fold import assembled_deg, coin_load
+from .foldfit import ARM_SD_M, FOLD_LINKS, LENGTH_SD_M, PLACEMENT_SD_M, TILT_SD_DEG, FreeLink, Load, photo_sign
+from .foldmoments import wrap_deg
 
 STIFFNESS_RANGE_NM_PER_RAD = (5e-4, 5e-3)
 REST_RANGE_DEG = 20.0
@@ -147,6 +148,53 @@ def synthetic_fold_test(seed: int, folder: str | Path, frames: int = 1) -> Synth
     return SyntheticFoldTest(photos, readings)
 
 
+def robot_fold_test(robot: Robot, fold: str, side: str, seed: int, folder: str | Path) -> SyntheticFoldTest:
+    """A SYNTHETIC fold test of one of ``robot``'s own folds: the hinge the robot's (its
+    stiffness, and its rest angle as assembled plus its rest offset, :func:`locust.params.side_values`),
+    the links the robot's (its laminate's density as its file says), the rest as :func:`synthetic_fold_test`
+    draws it; the clamp turned so that the free link stands out within 20 deg of level, as a
+    student sets it (the coin's moment is largest there).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot whose fold is tested (its values the truth).
+    fold : {"servo", "knee", "ankle", "loop"}
+    side : {"left", "right"}
+    seed : int
+    folder : path-like
+        Where the SYNTHETIC photos and their truth go.
+
+    Returns
+    -------
+    SyntheticFoldTest
+    """
+    rng = np.random.default_rng(seed)
+    values = side_values(robot, "L" if side == "left" else "R").folds[fold]
+    rest = photo_sign(fold, side) * (assembled_deg(robot, fold, side) + values.rest_offset_deg)
+    clamped, free = FOLD_LINKS[fold]
+    name = list(COINS)[int(rng.integers(len(COINS)))]
+    c = COINS[name]
+    level = float(rng.choice([0.0, 180.0]) + rng.uniform(-20.0, 20.0))
+    rig = FoldRig(stiffness_nm_per_rad=values.stiffness_nm_per_rad, rest_deg=rest,
+                  clamped_deg=float(wrap_deg(level - 180.0 - rest)),
+                  clamped_length_m=robot.get(f"geometry.{clamped}_m"), free_length_m=robot.get(f"geometry.{free}_m"),
+                  width_m=robot.geometry.link_width_m, thickness_m=robot.geometry.link_thickness_m,
+                  density_kg_per_m3=robot.geometry.link_density_kg_per_m3,
+                  coin_mass_kg=float(c.mass_kg * (1.0 + rng.normal(0.0, PUBLISHED_MASS_REL_SD))),
+                  coin_radius_m=c.diameter_m / 2, coin_thickness_m=c.thickness_m)
+    rig = with_placement(_arm(rig, rng), rng, PLACEMENT_SD_M)
+    shot = FoldShot(yaw_deg=float(rng.uniform(-4, 4)), pitch_deg=float(rng.uniform(-4, 4)),
+                    roll_deg=float(rng.uniform(-3, 3)), distance_scale=float(rng.uniform(0.9, 1.15)),
+                    noise_levels=float(rng.uniform(1.0, 4.0)), board_tilt_deg=float(rng.normal(0.0, TILT_SD_DEG)))
+    readings = FoldReadings(coin=name, coin_mass_kg=None, arm_m=float(rig.coin_arm_m + rng.normal(0.0, ARM_SD_M)),
+                            link_mass_kg=None, link_length_m=float(rig.free_length_m + rng.normal(0.0, LENGTH_SD_M)),
+                            density_kg_per_m3=robot.geometry.link_density_kg_per_m3,
+                            density_sd_kg_per_m3=robot.source_of("geometry.link_density_kg_per_m3").uncertainty or 0.0)
+    photos = render_fold_test(rig, folder, shot, seed=seed, stem=f"synthetic_{fold}_fold_{seed}")
+    return SyntheticFoldTest(photos, readings)
+
+
 # the bundled example (calibration/recordings/synthetic_fold_*): the small robot's knee fold, its
 # crank clamped pointing up and back so that the coupler stands out level, a 1 euro cent on the
 # coupler 12 mm from the fold line; a film hinge stiffer than the as-built one, which a coin
@@ -175,4 +223,5 @@ def bundled_fold_test(folder: str | Path) -> FoldPhotos:
 
 
 __all__ = ["BUNDLED_RIG", "BUNDLED_SHOT", "FoldReadings", "SyntheticFoldTest", "bundled_fold_test", "draw_rig",
+           "robot_fold_test",
            "synthetic_fold_test"]
