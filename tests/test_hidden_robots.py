@@ -6,8 +6,10 @@ robot's outcome the hidden one's.
 Each hidden robot is the robot as built (``small``) with every fold's stiffness (3-35 times
 the film hinge's) and rest offset (+-8 deg) drawn, its crank angle at rest and its ground
 link's angle drawn, its right crank a tooth off either way, and a USB source that limits the
-stalled servos' current (0.55-0.85 A). It is measured: ``measure stance`` from two stills of
-its left (rest, push) and ``measure stance --side right`` from one of its right (the tooth);
+stalled servos' current (0.78-0.94 A: the robot as built draws 0.96 A stalled, its board's
+included, and below 0.75 A browns out and does not push). It is measured: ``measure stance``
+from two stills of its left (rest, push) and ``measure stance --side right`` from one of its
+right (the tooth);
 ``calibrate fold`` from a fold test of each of its left leg's folds (a coin on the free link);
 ``measure stroke`` from clips of a push on the floor and held up; ``measure supply`` from a
 multimeter's readings at the servo plug. The student's robot file (``small``) with those in
@@ -48,7 +50,7 @@ def hidden(seed: int):
     values = {"geometry.crank_start_deg": float(rng.uniform(-104.0, -96.0)),
               "geometry.ground_angle_deg": float(rng.uniform(-6.0, 6.0)),
               "right.crank_tooth": int(rng.choice([-1, 1])),
-              "power.current_limit_a": float(rng.uniform(0.55, 0.85))}
+              "power.current_limit_a": float(rng.uniform(0.78, 0.94))}
     for fold in FOLDS:
         values[f"folds.{fold}_stiffness_nm_per_rad"] = float(math.exp(rng.uniform(math.log(5e-4), math.log(5e-3))))
         values[f"folds.{fold}_rest_offset_deg"] = float(rng.uniform(-8.0, 8.0))

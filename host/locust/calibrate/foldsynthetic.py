@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import SimError
 from ..params import GRAVITY_M_PER_S2, Robot, side_values
 from ..sim.foldphotos import FoldPhotos, FoldShot, render_fold_test
 from ..sim.foldrig import FoldRig, settle, with_placement
@@ -148,6 +149,15 @@ def synthetic_fold_test(seed: int, folder: str | Path, frames: int = 1) -> Synth
     return SyntheticFoldTest(photos, readings)
 
 
+def _clear_of_vertical(rig: FoldRig) -> bool:
+    """The loaded link balances clear of the vertical (the fit's range check, with a margin)."""
+    try:
+        loaded = settle(rig, True, settle(rig, False).fold_deg)
+    except SimError:
+        return False
+    return abs(math.cos(math.radians(loaded.free_deg))) >= math.sin(math.radians(CLEAR_OF_VERTICAL_DEG))
+
+
 def robot_fold_test(robot: Robot, fold: str, side: str, seed: int, folder: str | Path) -> SyntheticFoldTest:
     """A SYNTHETIC fold test of one of ``robot``'s own folds: the hinge the robot's (its
     stiffness, and its rest angle as assembled plus its rest offset, :func:`locust.params.side_values`),
@@ -173,17 +183,25 @@ def robot_fold_test(robot: Robot, fold: str, side: str, seed: int, folder: str |
     values = side_values(robot, "L" if side == "left" else "R").folds[fold]
     rest = photo_sign(fold, side) * (assembled_deg(robot, fold, side) + values.rest_offset_deg)
     clamped, free = FOLD_LINKS[fold]
-    name = list(COINS)[int(rng.integers(len(COINS)))]
-    c = COINS[name]
     level = float(rng.choice([0.0, 180.0]) + rng.uniform(-20.0, 20.0))
-    rig = FoldRig(stiffness_nm_per_rad=values.stiffness_nm_per_rad, rest_deg=rest,
-                  clamped_deg=float(wrap_deg(level - 180.0 - rest)),
-                  clamped_length_m=robot.get(f"geometry.{clamped}_m"), free_length_m=robot.get(f"geometry.{free}_m"),
-                  width_m=robot.geometry.link_width_m, thickness_m=robot.geometry.link_thickness_m,
-                  density_kg_per_m3=robot.geometry.link_density_kg_per_m3,
-                  coin_mass_kg=float(c.mass_kg * (1.0 + rng.normal(0.0, PUBLISHED_MASS_REL_SD))),
-                  coin_radius_m=c.diameter_m / 2, coin_thickness_m=c.thickness_m)
-    rig = with_placement(_arm(rig, rng), rng, PLACEMENT_SD_M)
+    # a coin from the student's pocket; one that folds the link past the vertical even taped
+    # at the fold is swapped for the next lighter one (as the refusal's hint says)
+    order = sorted(COINS, key=lambda n: -COINS[n].mass_kg)
+    start = int(rng.integers(len(order)))
+    for name in order[start:] + order[:start][::-1]:
+        c = COINS[name]
+        rig = FoldRig(stiffness_nm_per_rad=values.stiffness_nm_per_rad, rest_deg=rest,
+                      clamped_deg=float(wrap_deg(level - 180.0 - rest)),
+                      clamped_length_m=robot.get(f"geometry.{clamped}_m"),
+                      free_length_m=robot.get(f"geometry.{free}_m"),
+                      width_m=robot.geometry.link_width_m, thickness_m=robot.geometry.link_thickness_m,
+                      density_kg_per_m3=robot.geometry.link_density_kg_per_m3,
+                      coin_mass_kg=float(c.mass_kg * (1.0 + rng.normal(0.0, PUBLISHED_MASS_REL_SD))),
+                      coin_radius_m=c.diameter_m / 2, coin_thickness_m=c.thickness_m)
+        rig = _arm(rig, rng)
+        if _clear_of_vertical(rig):
+            break
+    rig = with_placement(rig, rng, PLACEMENT_SD_M)
     shot = FoldShot(yaw_deg=float(rng.uniform(-4, 4)), pitch_deg=float(rng.uniform(-4, 4)),
                     roll_deg=float(rng.uniform(-3, 3)), distance_scale=float(rng.uniform(0.9, 1.15)),
                     noise_levels=float(rng.uniform(1.0, 4.0)), board_tilt_deg=float(rng.normal(0.0, TILT_SD_DEG)))
