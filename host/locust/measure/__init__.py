@@ -11,4 +11,7 @@
   clip from four stickers (:mod:`.crankclip`), the push's swing read from it (:mod:`.swing`),
   the CSV and plot written (:mod:`.strokeout`); :mod:`.strokejob` is the job behind the
   command and :func:`locust.measure_stroke`.
+- :mod:`.supply`: the supply's voltage and the source's resistance or current limit [ohm, A]
+  from a multimeter at the servo plug, at rest and stalled (``measure supply``); :mod:`.meter`
+  is a meter's accuracy, ±(P % + N digits), and the readings such a meter gives.
 """

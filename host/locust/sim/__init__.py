@@ -13,7 +13,9 @@ over (from :mod:`.support`: what it stands on, where its centre of mass is) and 
 threshold lies; :mod:`.statics` finds the
 standing robot's load on its nose; :mod:`.kinematics` poses the markers at kept states;
 :mod:`.camera`, :mod:`.clip`, :mod:`.still` and :mod:`.stickers` render videos and stills with their
-ground truth, :mod:`.foldrig` and :mod:`.foldphotos` the virtual fold test and its photos
+ground truth, :mod:`.foldrig` and :mod:`.foldphotos` the virtual fold test and its photos;
+:mod:`.supply` the servos' supply as a circuit, and :mod:`.supply_rollout` the model stepped on it
+where it limits them
 (:mod:`.gl`: the OpenGL MuJoCo renders with, checked before MuJoCo is imported);
 :mod:`.live` steps the model as the virtual robot's servo commands arrive; :mod:`.push` simulates one
 push on the floor or held up, and :mod:`.pushclip` films it for ``locust measure stroke``.
