@@ -99,7 +99,9 @@ class TipOver:
     com_behind_start_m : float
         The same at the stretch's first step [m].
     servo_torque_nm : tuple of float
-        Each servo's torque (left, right) then [N·m].
+        Each servo's torque (left, right) as it starts [N·m].
+    servo_torque_mean_nm : tuple of float
+        Each servo's torque over the stretch, its magnitude's mean [N·m].
     pitch_deg : float
         The plate's pitch then, less its standing pitch, nose up positive [deg].
     """
@@ -114,6 +116,7 @@ class TipOver:
     com_behind_m: float
     com_behind_start_m: float
     servo_torque_nm: tuple[float, float]
+    servo_torque_mean_nm: tuple[float, float]
     pitch_deg: float
 
 
@@ -378,12 +381,14 @@ def tip_over(traj: Trajectory) -> TipOver | None:
     phases = _phases(seen, behind, start, end, dt)
     row = push_row + start + 1   # state row i is after step i: the sensors' row i + 1
     torque = traj.sensordata[row, traj.built.sensors.actuator_force]
+    mean = np.abs(traj.sensordata[row:push_row + end + 2, traj.built.sensors.actuator_force]).mean(axis=0)
     return TipOver(
         cycle=cycle, start_s=(start + 1) * dt, duration_s=(end - start + 1) * dt, support=first.parts,
         support_after=tuple(parts), phases=phases,
         support_forward_m=tuple(p.forward_m - first.com_forward_m for p in first.support),
         com_behind_m=float(np.nanmax(behind[start:end + 1])), com_behind_start_m=first.com_behind_m,
-        servo_torque_nm=(float(torque[0]), float(torque[1])), pitch_deg=float(turn[row]))
+        servo_torque_nm=(float(torque[0]), float(torque[1])),
+        servo_torque_mean_nm=(float(mean[0]), float(mean[1])), pitch_deg=float(turn[row]))
 
 
 def _kind(part: str) -> str:
@@ -594,12 +599,12 @@ def words(outcome: str, tip: TipOver | None, near: Approach | None, found: list[
     """
     lines = []
     if outcome == GOES_OVER and tip is not None:
-        torque = max(abs(v) for v in tip.servo_torque_nm)
+        torque = max(abs(v) for v in tip.servo_torque_mean_nm)
         first, *later = tip.phases
         then = "".join(f", then on its {_parts(ph.parts)} (up to {ph.com_behind_max_m * 1000:.0f} mm)" for ph in later)
         lines.append(f"goes over in push {tip.cycle}: {tip.start_s:.2f} s into it, it stands on its "
                      f"{_parts(first.parts)} with its centre of mass up to {first.com_behind_max_m * 1000:.0f} mm "
-                     f"behind them{then}, the servos holding {torque:.3f} N·m as it starts, and falls over "
+                     f"behind them{then}, the servos holding {torque:.3f} N·m on average, and falls over "
                      f"backwards about them in {tip.duration_s:.2f} s")
     elif outcome == GOES_OVER:
         lines.append("goes over in the air: no point on the floor to tip about (its momentum turns it over)")
