@@ -1,7 +1,8 @@
 """Robot parameters: one typed model with each value's unit and source.
 
 - :mod:`.model`: the parameter types (geometry, compliance, folds, servo, left and right,
-  contact, power, schedule, solver), provenance, and access by dotted name.
+  contact, power, schedule, solver), provenance, and access by dotted name; :mod:`.legs`: the
+  leg's own sections (each fold's spring, what one leg has of its own).
 - :mod:`.sides`: each leg's values resolved (its own, else the folds', the film hinge's or the
   servo's).
 - :mod:`.limits`: each parameter's limits with their reasons; the checks before a simulation.
@@ -12,10 +13,10 @@
 ``robot.toml`` is read and written by :mod:`locust.io.robot_toml`.
 """
 
+from .legs import FOLDS, Folds, Side
 from .legsets import LEG_SETS, LegSet, leg_set, leg_set_spec, with_added_length
 from .limits import LIMITS, MAX_SIM_STEPS, Limit, check_robot, outside_limits, problems
 from .model import (
-    FOLDS,
     GRAVITY_M_PER_S2,
     INHERITS,
     PHYSICAL_SECTIONS,
@@ -23,14 +24,12 @@ from .model import (
     UNBOUNDED_KEYS,
     Compliance,
     Contact,
-    Folds,
     Geometry,
     Power,
     Provenance,
     Robot,
     Schedule,
     Servo,
-    Side,
     Solver,
     all_keys,
     as_dict,

@@ -10,7 +10,8 @@ from typing import NamedTuple
 from ..errors import ParamsError
 from ..firmware import config as fw_config
 from ..firmware import protocol
-from .model import FOLDS, SIDE_SECTIONS, SIDE_SERVO_FIELDS, Robot
+from .legs import FOLDS
+from .model import SIDE_SECTIONS, SIDE_SERVO_FIELDS, Robot
 
 # -- limits -------------------------------------------------------------------------
 # The robots this toolkit is for: a desk hopper of a few grams to a kilogram, links of

@@ -12,7 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from ..errors import ParamsError
-from .model import FOLDS, SIDE_SECTIONS, SIDE_SERVO_FIELDS, Robot, Servo
+from .legs import FOLDS
+from .model import SIDE_SECTIONS, SIDE_SERVO_FIELDS, Robot, Servo
 
 __all__ = ["FOLDS", "FoldValues", "SideValues", "side_values", "is_symmetric", "tooth_deg", "SIDES"]
 
