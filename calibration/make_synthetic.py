@@ -120,12 +120,20 @@ def ramp(out: Path) -> None:
     atomic_write_text(out / "synthetic_ramp_track.csv", synthetic.csv_text(head, cols, fmt))
 
 
+def fold(out: Path) -> None:
+    """Write the fold test's two photos (the small robot's knee: its crank clamped, its coupler
+    free, a 1 euro cent on it) and their truth into ``out``."""
+    from locust.calibrate.foldsynthetic import bundled_fold_test
+
+    bundled_fold_test(out)
+
+
 def main() -> None:
     """Write every recording into ``--out``."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "recordings")
     args = ap.parse_args()
-    for make in (beam, servo, ramp):
+    for make in (beam, servo, ramp, fold):
         make(args.out)
     print(f"wrote synthetic recordings to {args.out}")
 

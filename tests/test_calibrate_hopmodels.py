@@ -23,7 +23,8 @@ def test_physical_values_map_onto_model_numbers(candidates):
     _, cm = candidates
     fields = {k: (m.transform, sorted(e.field for e in m.entries)) for k, m in cm.maps.items()}
     assert fields == {"contact.foot_friction": ("value", ["geom_friction", "pair_friction"]),
-                      "compliance.hinge_stiffness_nm_per_rad": ("value", ["jnt_stiffness"]),
+                      # the film hinge's: the servo, knee and ankle folds' joints and the loop fold's tendon
+                      "compliance.hinge_stiffness_nm_per_rad": ("value", ["jnt_stiffness", "tendon_stiffness"]),
                       # the servo's back-EMF damping: stall torque over no-load speed
                       "servo.noload_speed_rad_per_s": ("reciprocal", ["dof_damping"])}
     assert "geometry.crank_m" not in cm.maps       # a length moves masses and poses: compiled

@@ -63,7 +63,8 @@ NUMBER = r"\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
 LOCUST_COMMANDS = ("calibrate", "config", "demo", "fab", "flash", "hop", "measure", "optimize", "params", "ports",
                    "pose", "repl", "report", "sim", "sweep", "track", "virtual")
 BOARD_COMMANDS = {"flash", "hop", "pose", "config", "repl"}
-OUTPUT_OPTIONS = {"--video", "--still", "--still-push", "--out", "--trk", "--write", "--plot", "--pwm-log"}
+OUTPUT_OPTIONS = {"--video", "--still", "--still-push", "--out", "--trk", "--write", "--plot", "--pwm-log",
+                  "--push-clip", "--push-clip-held", "--csv"}
 # the reader's own recordings a page names, each stood in for by one of the same kind:
 # name -> (what stands in, where it is, made by rendering (slow))
 STAND_INS = {
@@ -98,6 +99,14 @@ def _big_study(argv: list[str]) -> bool:
 
 
 # (why it is slow, is it): each over about 20 s on a busy 2-core machine
+def _slow_explain(argv: list[str]) -> bool:
+    """``--explain`` runs some 300 simulations: more than one cycle each is slow."""
+    if "--explain" not in argv:
+        return False
+    cycles = argv[argv.index("--cycles") + 1] if "--cycles" in argv[:-1] else None
+    return cycles is None or int(cycles) > 1
+
+
 SLOW = (
     ("the whole toolkit, minutes", lambda argv: argv[:1] == ["demo"]),
     ("an optimisation of 30 trials or more", _big_study),
@@ -105,7 +114,8 @@ SLOW = (
     ("a servo fit", lambda argv: argv[:2] == ["calibrate", "servo"]),
     ("32 or more draws", _slow_samples),
     ("a sweep of 30 designs or more", _big_sweep),
-    ("video rendered", lambda argv: "--video" in argv or "--side-by-side" in argv),
+    ("video rendered", lambda argv: "--video" in argv or "--side-by-side" in argv or "--push-clip" in argv),
+    ("an explanation of more than one cycle", lambda argv: _slow_explain(argv)),
 )
 
 

@@ -55,13 +55,20 @@ def test_a_results_header_of_ten_thousand_columns_is_cut_and_the_hint_kept(tmp_p
     assert not (tmp_path / "out").exists()
 
 
-def test_what_is_within_the_limit_is_printed_whole():
-    """The longest error the toolkit writes on purpose, `calibrate hop --fit` of a key no fit
-    takes, whose hint lists every fittable key (1,144 characters), is untouched; a text of the
-    limit is itself, one character more is cut to 900 + 240 of it."""
-    res = CliRunner().invoke(cli, ["calibrate", "hop", "small=nowhere", "--fit", "solver.timestep_s"])
+def test_what_is_within_the_limit_is_printed_whole(monkeypatch):
+    """An error of 1,150 characters (under the limit) raised inside a command reaches the
+    terminal untouched; a text of the limit is itself, one character more is cut to 900 + 240
+    of it."""
+    from locust.commands import params as params_command
+    from locust.errors import ParamsError
+
+    def refuse(*args):
+        raise ParamsError("e" * 1150, "h" * 1150)
+
+    monkeypatch.setattr(params_command.robot_toml, "resolve_robot", refuse)
+    res = CliRunner().invoke(cli, ["params", "--preset", "small"])
     assert res.exit_code == 2
-    assert max(len(ln) for ln in error_lines(res)) > 1100 and "left out" not in res.stderr
+    assert error_lines(res) == ["error: " + "e" * 1150, "  hint: " + "h" * 1150]
     assert bounded("a" * MAX_ERROR_CHARS) == "a" * MAX_ERROR_CHARS
     cut = bounded("a" * 900 + "b" * 61 + "c" * 240)
     assert cut == "a" * 900 + " … [61 characters left out] … " + "c" * 240

@@ -46,7 +46,7 @@ def imports_of(path: Path) -> set[str]:
 # job package -> the job packages it may import, each arrow one the code has: the table
 # docs/architecture.md draws
 ARROWS = {
-    "calibrate": ("sim", "trials"),
+    "calibrate": ("sim", "track", "trials"),
     "demo": ("calibrate", "device", "sim"),
     "device": ("sim",),
     "fab": (),

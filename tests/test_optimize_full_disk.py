@@ -27,8 +27,9 @@ def test_a_journal_torn_by_a_full_disk_is_refused_then_repaired(tmp_path, small_
     first = optimize("--trials", 5, "--out", tmp_path / "opt")
     assert first.exit_code == 0, first.output
     journal = small_disk / "study.journal"
-    shutil.copy(tmp_path / "opt" / "study.journal", journal)    # 7.5 kB: two pages of the tmpfs
-    (small_disk / "fill").write_bytes(b"x" * (64 * 1024 - 3 * 4096))   # leaves one page: about 3 trials
+    shutil.copy(tmp_path / "opt" / "study.journal", journal)    # 11 kB: three pages of the tmpfs
+    pages = -(-journal.stat().st_size // 4096)
+    (small_disk / "fill").write_bytes(b"x" * (64 * 1024 - (pages + 1) * 4096))   # leaves one page: a trial or two
 
     full = optimize("--trials", 20, "--out", tmp_path / "opt2", "--storage", journal)
     assert full.exit_code == 2, full.output

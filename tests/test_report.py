@@ -170,12 +170,13 @@ def test_measured_hops_match_the_synthetic_truth(world):
             assert d == pytest.approx(d_true, abs=0.0015), (label, k)
             assert a == pytest.approx(a_true, abs=0.005), (label, k)
             assert a <= a_true + 0.0015
-    # the true robot (softer hinges) hops 2.8 mm farther than the model over the two hops: the
-    # report shows that error, to the measurement's resolution
+    # the true robot (softer hinges) hops 3.1 mm farther than the model over the two hops (2.8
+    # mm before the loop fold had its spring): the report shows that error, to the
+    # measurement's resolution
     err = float(cells[("small", "marker_travel_error_mm")])
     true_total = world["truth"]["small-1"].distance_m
     model_total = sum(marker_distances(leg_set(preset("seed"), "small"), CYCLES))
-    assert (true_total - model_total) * 1000 == pytest.approx(2.76, abs=0.3)
+    assert (true_total - model_total) * 1000 == pytest.approx(3.08, abs=0.3)
     assert err == pytest.approx((true_total - model_total) * 1000, abs=0.6)
 
 

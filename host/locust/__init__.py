@@ -16,7 +16,7 @@ Functions (each with a numpydoc docstring: ``help(locust.simulate)``), named onc
 - ``sweep_designs(robot, vary, cycles)``: a ``SweepResults`` (``.to_dataframe()``, ``.plot()``, ``.best``).
 - ``track_markers(video, markers)``, ``read_tracks(path)``: ``Tracks`` (``.to_dataframe()``, ``.tidy()``:
   one row per marker per frame with velocity and acceleration, ``.plot()``, ``.write()``).
-- ``calibrate_beam/hinge/servo/ramp/hops(...)``: a ``Fit`` (``.parameters``, ``.to_dataframe()``,
+- ``calibrate_beam/hinge/servo/ramp/fold/hops(...)``: a ``Fit`` (``.parameters``, ``.to_dataframe()``,
   ``.plot()``, ``.apply(robot)``).
 - ``bundled_recording(name)``: the path of a SYNTHETIC recording the toolkit ships (``synthetic_beam.csv``, ...).
 - ``make_report(robot, measured)``: the HTML comparison of simulation and filmed hops.
@@ -24,6 +24,7 @@ Functions (each with a numpydoc docstring: ``help(locust.simulate)``), named onc
 - ``make_cut_files(robot_or_dxf, out=...)``: the laminate's cut files and their summary.
 - ``run_demo(out, cycles, trials, designs)``: ``locust demo``, the toolkit end to end on the virtual robot.
 - ``hop(port, cycles, ...)``: the hop schedule on the robot or the virtual robot (``port="sim"``), its ``RunRecord``.
+- ``measure_stroke(robot, floor, held)``: the servo's stroke and speed from clips of a push, beside the model's.
 
 Errors are :class:`locust.errors.LocustError` (``.message``, ``.hint``).
 """

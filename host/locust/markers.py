@@ -28,6 +28,16 @@ STICKER_COLOURS: dict[str, tuple[str, str]] = {
 }
 
 
+# Stickers for a fold's static test (``locust calibrate fold``, :mod:`locust.sim.foldrig`): three
+# hues far from one another and from a coin's copper or brass, read from a side photo of the fold.
+# name -> (#RRGGBB, where it sits)
+FOLD_STICKER_COLOURS: dict[str, tuple[str, str]] = {
+    "axis": ("#ff00ff", "on the clamped link's face, its centre on the fold line"),
+    "tip": ("#00ff00", "on the free link's face near its tip, its centre on the link's centre line"),
+    "base": ("#0000ff", "on the clamped link's face, its centre on the link's centre line, 2 to 3 cm from the fold"),
+}
+
+
 def hex_to_rgb01(hex_colour: str) -> tuple[float, float, float]:
     """A ``#RRGGBB`` colour as red, green and blue, each 0..1.
 

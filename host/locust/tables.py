@@ -252,6 +252,48 @@ def sensitivity_lines(sens) -> list[str]:
     return lines
 
 
+EXPLAIN_ROWS = 8   # thresholds and tornado bars printed (--json has every one)
+
+
+def _edge_text(key: str, edge) -> str:
+    if edge is None:
+        return "none probed"
+    sd = f" ({edge.distance_sd:+.1f} sd)" if edge.distance_sd is not None else ""
+    what = outcome_words(edge.outcome) if edge.outcome else "invalid"
+    return f"{quantity(key, edge.value, 3)}{sd} {what}"
+
+
+def explain_lines(expl) -> list[str]:
+    """``locust sim --explain``: the words, the nearest thresholds and the largest tornado bars.
+
+    Parameters
+    ----------
+    expl : locust.sim.explain.Explanation
+
+    Returns
+    -------
+    list of str
+    """
+    lines = [f"{INDENT}why ({expl.runs} runs of {expl.cycles} cycle{'s' if expl.cycles != 1 else ''}):"]
+    lines += [f"{INDENT * 2}{w}" for w in expl.words]
+    rows = []
+    for t in expl.thresholds[:EXPLAIN_ROWS]:
+        sd = quantity(t.key, t.sd, 2) if t.sd else "design"
+        rows.append([label(t.key), quantity(t.key, t.value, 4), sd, _edge_text(t.key, t.below),
+                     _edge_text(t.key, t.above)])
+    lines.append(f"{INDENT}where the outcome changes (each value alone; nearest first):")
+    lines += table(["value", "as given", "sd", "below", "above"], rows, indent=INDENT * 2)
+    bars = []
+    for b in expl.tornado[:EXPLAIN_ROWS]:
+        nose, dist = b.swing("nose_rise_m"), b.swing("distance_m")
+        bars.append([label(b.key), quantity(b.key, b.sd, 2), f"{nose * 1000:.1f}", f"{dist * 1000:.1f}"])
+    if bars:
+        lines.append(f"{INDENT}effect of each value at -/+{expl.k_sd:g} sd (first hop's nose rise, distance; largest "
+                     "first):")
+        lines += table(["value", "sd", "nose rise mm", "distance mm"], bars, indent=INDENT * 2)
+    return lines
+
+
 def plant_lines(summary: dict) -> list[str]:
     """``locust hop --port sim`` and ``locust virtual``: what the virtual robot's plant did
     (the dict its ``close()`` returns: the live MuJoCo model's audited run, one row per push,
@@ -288,6 +330,7 @@ UNIT_SUFFIXES = (   # a key's unit from its name's end (longest first): _nm_ is 
     ("_rad_per_s", "rad/s"), ("_m_per_s", "m/s"), ("_kg_per_m3", "kg/m³"), ("_kgm2", "kg·m²"), ("_nm2", "N·m²"),
     ("_kg", "kg"), ("_hz", "Hz"), ("_deg", "deg"), ("_mm", "mm"), ("_ms", "ms"), ("_nm", "N·m"), ("_ohm", "Ω"),
     ("_rad", "rad"), ("_us", "µs"), ("_m", "m"), ("_n", "N"), ("_s", "s"), ("_v", "V"),
+    ("_a", "A"),
 )
 
 
@@ -340,8 +383,13 @@ def for_person(key: str) -> tuple[str, float, str]:
     return name, factor, shown
 
 
+# keys whose last part alone would read the same as another's
+LABELS = {"schedule.push_deg": "push angle", "schedule.push_s": "push time"}
+
+
 def label(key: str) -> str:
-    """A dotted key's last part less its unit, in words: ``geometry.servo_axis_x_m`` -> ``servo axis x``.
+    """A dotted key's last part less its unit, in words: ``geometry.servo_axis_x_m`` -> ``servo axis x``
+    (``schedule.push_deg`` and ``schedule.push_s``: ``push angle``, ``push time``).
 
     Parameters
     ----------
@@ -351,7 +399,7 @@ def label(key: str) -> str:
     -------
     str
     """
-    return split_unit(key)[0].rpartition(".")[2].replace("_", " ")
+    return LABELS.get(key) or split_unit(key)[0].rpartition(".")[2].replace("_", " ")
 
 
 def quantity(key: str, value: float, digits: int = 4) -> str:

@@ -18,6 +18,7 @@ name                   module                     what it is
 ``calibrate_hinge``    :mod:`.calibration`        a hinge's fit: ``Fit``
 ``calibrate_ramp``     :mod:`.calibration`        a ramp's friction fit: ``Fit``
 ``calibrate_servo``    :mod:`.calibration`        a servo's fit: ``Fit``
+``calibrate_fold``     :mod:`.calibration`        a fold's static test: ``Fit``
 ``calibrate_hops``     :mod:`.calibration`        a fit to filmed hops: ``Fit``
 ``Fit``                :mod:`.calibration`        fitted robot values (parameters, apply, plot)
 ``bundled_recording``  :mod:`locust.bundled`      the path of a recording the toolkit ships
@@ -26,12 +27,14 @@ name                   module                     what it is
 ``make_cut_files``     :mod:`.fabrication`        dict (the manufacturing summary)
 ``run_demo``           :mod:`.demos`              the toolkit end to end on the virtual robot
 ``hop``                :mod:`.hopping`            the hop schedule on a robot: its run.json's ``RunRecord``
+``measure_stroke``     :mod:`.measuring`          the servo's stroke from clips of a push, beside the model's
 ``Robot``              :mod:`locust.params`       the robot's parameters, each with its provenance
 ``LocustError``        :mod:`locust.errors`       every error the toolkit raises (message, hint)
 =====================  =========================  ====================================================
 
 The command line calls the same functions (``locust sim``, ``sweep``, ``report``, ``fab``,
-``calibrate beam|hinge|servo|ramp``, ``demo``, ``hop``). Every name is also at the package top: ``locust.simulate``.
+``calibrate beam|hinge|servo|ramp|fold``, ``demo``, ``hop``). Every name is also at the package top:
+``locust.simulate``.
 """
 
 from __future__ import annotations
@@ -53,6 +56,7 @@ EXPORTS = {
     "calibrate_hinge": "calibration",
     "calibrate_ramp": "calibration",
     "calibrate_servo": "calibration",
+    "calibrate_fold": "calibration",
     "calibrate_hops": "calibration",
     "Fit": "calibration",
     "bundled_recording": "locust.bundled",
@@ -61,6 +65,7 @@ EXPORTS = {
     "make_cut_files": "fabrication",
     "run_demo": "demos",
     "hop": "hopping",
+    "measure_stroke": "measuring",
     "Robot": "locust.params",
     "LocustError": "locust.errors",
 }

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arucoboard import DEFAULT_BOARD
 from ..bundled import bundled_recording
 from ..calibrate import jobs
 from ..calibrate.ramp import READING_RESOLUTION_DEG
@@ -264,6 +265,53 @@ def calibrate_ramp(data: PathLike | Sequence[PathLike] | np.ndarray, *, into: st
                      imports=_imports(imports, units), timing=timing, resolution_deg=resolution_deg)
 
 
+def calibrate_fold(unloaded: PathLike, loaded: PathLike, fold: str, *, coin_arm_m: float, coin: str | None = None,
+                   coin_mass_kg: float | None = None, robot: Robot | None = None, side: str = "both",
+                   link_mass_kg: float | None = None, link_length_m: float | None = None,
+                   board: str = DEFAULT_BOARD) -> Fit:
+    """A fold's stiffness and rest offset from a static test: one link clamped, a photo of the
+    fold settled under the free link's weight and one with a coin taped on it.
+
+    Parameters
+    ----------
+    unloaded, loaded : path-like
+        The fold without and with the coin: each a photo, a folder of photos or a clip, with the
+        three fold stickers (``locust.markers.FOLD_STICKER_COLOURS``) and the ArUco board upright
+        in their plane.
+    fold : {"servo", "knee", "ankle", "loop"}
+        Which fold (the servo and loop folds with the ground link clamped, the knee with the
+        crank, the ankle with the coupler).
+    coin_arm_m : float
+        From the fold line to the coin's centre along the free link [m] (a ruler reading, ±0.5 mm).
+    coin : str, optional
+        A coin by name, its published mass (``eur-1c``, ``usd-1c``, ``gbp-1p``, ...:
+        ``locust.calibrate.coins.COINS``).
+    coin_mass_kg : float, optional
+        Instead: the coin weighed on a 0.01 g scale [kg].
+    robot : Robot, optional
+        The robot whose fold it is (its link's size and density, its assembled fold angle);
+        default: the one every door runs on (``calibration/robot.toml`` here, else ``small``).
+    side : {"both", "left", "right"}, default "both"
+        Which leg's fold: ``both`` writes the ``folds`` section, ``left``/``right`` that leg's
+        (a right fold photographed from the robot's right is read mirrored).
+    link_mass_kg : float, optional
+        The free link weighed [kg] (default: its size times the laminate's density).
+    link_length_m : float, optional
+        The free link from the fold line to its end [m] (default: the robot's link).
+    board : str
+        The ArUco board in the photos (``aruco:DICT:COLSxROWS:MARKER_MM:GAP_MM``).
+
+    Returns
+    -------
+    Fit
+        ``folds.<fold>_stiffness_nm_per_rad`` and ``folds.<fold>_rest_offset_deg`` (``left.``/
+        ``right.`` with one side), ``.result`` a :class:`locust.calibrate.foldfit.FoldFit` (the rest
+        angle, each photo's fold angle, the deflection, the moments).
+    """
+    return jobs.fold(unloaded, loaded, fold, coin_arm_m=coin_arm_m, robot=robot, coin=coin, coin_mass_kg=coin_mass_kg,
+                     side=side, link_mass_kg=link_mass_kg, link_length_m=link_length_m, board=board)
+
+
 def calibrate_hops(robot: Robot | None, runs: Mapping[str, PathLike] | Sequence[PathLike | object],
                    keys: Sequence[str] | None = None, *, max_iter: int = 30, progress=None) -> Fit:
     """Fit the model to filmed hops of one or more leg sets at once (the physics is shared).
@@ -323,5 +371,5 @@ def _tuple(value) -> tuple[float, ...]:
     return tuple(float(v) for v in value) if isinstance(value, Sequence) else (float(value),)
 
 
-__all__ = ["Fit", "bundled_recording", "calibrate_beam", "calibrate_hinge", "calibrate_hops", "calibrate_ramp",
-           "calibrate_servo", "fit_servo_recordings"]
+__all__ = ["Fit", "bundled_recording", "calibrate_beam", "calibrate_fold", "calibrate_hinge", "calibrate_hops",
+           "calibrate_ramp", "calibrate_servo", "fit_servo_recordings"]

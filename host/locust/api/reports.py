@@ -14,7 +14,7 @@ def make_report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str |
            added: Mapping[str, float] | None = None, marker: str = "nose", samples: int = 0,
            side_by_side: bool = False, before: Robot | None = None, robot_source: str | None = None,
            imports: ImportOptions = AS_IS, progress: Callable[[str], None] | None = None,
-           study: str | Path | None = None):
+           study: str | Path | None = None, explain: bool = False):
     """Simulate each leg set and compare it with its measured trials, in one HTML page.
 
     Parameters
@@ -51,6 +51,9 @@ def make_report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str |
         The robot before a fit: its predictions drawn too.
     study : path-like, optional
         A ``locust optimize --out`` folder: its Pareto front and picked designs.
+    explain : bool, default False
+        Explain each configuration (``locust sim --explain``): the tornado figure of its
+        uncertain values' -/+2 sd effects, why it goes over (or how close it comes) in words.
 
     Returns
     -------
@@ -70,7 +73,7 @@ def make_report(robot: Robot, measured: Mapping[str, str | Path | Sequence[str |
     return build_report(robot, groups, Path(out), robot_source=robot_source or robot.name, cycles=cycles,
                         sweep=Path(sweep) if sweep is not None else None, added=dict(added or {}), marker=marker,
                         progress=progress, side_by_side=side_by_side, samples=samples, before=before,
-                        study=Path(study) if study is not None else None)
+                        study=Path(study) if study is not None else None, explain=explain)
 
 
 __all__ = ["make_report"]

@@ -14,7 +14,9 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
              keep_states: bool = True, progress=None, sensitivity: bool | None = None, *,
              leg_set: str | None = None, check_convergence: bool = False, video: str | os.PathLike | None = None,
              camera: str = "track", still: str | os.PathLike | None = None,
-             still_push: str | os.PathLike | None = None, board: str | None = None) -> SimResult:
+             still_push: str | os.PathLike | None = None, board: str | None = None,
+             push_clip: str | os.PathLike | None = None, push_clip_held: str | os.PathLike | None = None,
+             push_fps: int = 240, side: str = "left", explain: bool = False) -> SimResult:
     """Settle the robot on the floor, run its hop schedule, audit the run and measure the hops.
 
     Parameters
@@ -36,7 +38,7 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
         runs of many cycles).
     progress : callable, optional
         ``progress(0)`` as the draws begin, then ``progress(k)`` as each batch of ``k`` draws
-        is done (``samples``).
+        is done (``samples``), then of ``k`` runs of the explanation (``explain``).
     sensitivity : bool, optional
         Which measured values decide the outcome: each uncertain value alone at -/+ 2 sd
         (``result.sensitivity``, :func:`locust.sim.sensitivity.outcome_sensitivity`). True:
@@ -60,6 +62,23 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
         The same of the robot held up at the push command (the same camera).
     board : str, optional
         For the stills: the board beside the robot (default ``aruco:4X4_50:5x4:40:10``).
+    push_clip : path-like, optional
+        Render one push on the floor (MP4, fixed camera) with the stickers ``locust measure
+        stroke`` reads, and the crank's true angle beside it (``<clip>.crank.csv``).
+    push_clip_held : path-like, optional
+        The same push with the robot held up by its plate.
+    push_fps : int, default 240
+        The push clips' frames per second.
+    side : {"left", "right"}, default "left"
+        The side the stills and push clips show (the right leg is at -y, the camera there).
+    explain : bool, default False
+        Why the robot does what it does (``result.explanation``,
+        :class:`locust.sim.explain.Explanation`): how it went over (when, on what, the centre
+        of mass's distance behind its supports, the servo torque), or how close it came; for
+        every uncertain and design value, how far the outcome's threshold is (in its unit and
+        its sd); the tornado of each uncertain value's -/+2 sd effect on nose rise and
+        distance; and it in plain words (``result.explanation.words``). Some 300 runs of the
+        robot: ``progress`` counts them.
 
     Returns
     -------
@@ -91,8 +110,19 @@ def simulate(robot: Robot, cycles: int | None = None, samples: int = 0, seed: in
                          keep_states=keep_states, check_convergence=check_convergence,
                          video=None if video is None else Path(video), camera=camera,
                          still=None if still is None else Path(still),
-                         still_push=None if still_push is None else Path(still_push), board=board)
+                         still_push=None if still_push is None else Path(still_push), board=board,
+                         push_clip=None if push_clip is None else Path(push_clip),
+                         push_clip_held=None if push_clip_held is None else Path(push_clip_held), push_fps=push_fps,
+                         side=_side(side), explain=explain)
     return run_simulation(robot, options, progress=progress)
+
+
+def _side(side: str) -> str:
+    if side not in ("left", "right"):
+        from ..errors import SimError
+
+        raise SimError(f"side {side!r} is not known", "give side='left' or side='right'")
+    return "L" if side == "left" else "R"
 
 
 __all__ = ["SimResult", "simulate"]

@@ -16,6 +16,11 @@ the result's ``estimates``; what is the rig's, not the robot's, under a name of 
 - :mod:`.servo`: a servo stepped while carrying a load (filmed horn or rate gyro) -> no-load
   speed, armature, kp and kv of the position-servo law the MuJoCo model uses.
 - :mod:`.ramp`: a ramp tilted until the robot slides -> static friction, mu = tan(theta).
+- :mod:`.fold`: a fold with one link clamped, photographed without and with a coin on its free
+  link -> the fold's stiffness and rest offset; :mod:`.foldread` reads each photo's board and
+  stickers, :mod:`.foldmoments` is its statics, :mod:`.foldfit` the fit and its intervals,
+  :mod:`.coins` the coins' published masses, :mod:`.foldsynthetic` SYNTHETIC fold tests of
+  known truth (the virtual rig of :mod:`locust.sim.foldrig`).
 - :mod:`.hop`: filmed hops -> what no bench experiment reaches (friction under impact, the
   folded hinges in the linkage, the servo on the robot's battery); :mod:`.hopruns` loads each
   run (a :class:`locust.trials.measured.Trial`), simulates it on its measured phase times and

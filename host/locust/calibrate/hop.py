@@ -33,7 +33,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import CalibrationError, ParamsError
-from ..params import fittable_keys, value_type
+from ..params import PHYSICAL_SECTIONS, fittable_keys, value_type
 from ..sim.gl import minimize  # MuJoCo's solver, as locust.sim imports MuJoCo (its OpenGL checked first)
 from ..trials.measured import Trial
 from .fitstats import Estimate, cluster_covariance
@@ -162,7 +162,8 @@ def check_fittable(keys: list[str]) -> None:
         if key not in fittable_keys():
             raise CalibrationError(f"--fit {key}: only the robot's real-valued physical parameters can be fitted "
                                    "(not the schedule it is given, nor how it is simulated)",
-                                   "fit any of " + ", ".join(fittable_keys()))
+                                   "fit a real value of the sections " + ", ".join(PHYSICAL_SECTIONS)
+                                   + " (`locust params` lists them), e.g. --fit " + ",".join(DEFAULT_KEYS))
 
 
 def check_keys(keys: list[str], runs: list[Trial]) -> None:

@@ -11,7 +11,9 @@ compiled again (about 40 ms a candidate). Which numbers, and the function, are f
 compiling the robot at three values of each fitted key and comparing every floating-point
 array of the model; a key whose numbers change in any other way (a length or an angle: the
 compiler derives masses, inertias and the standing pose from it), or that shares a number
-with another fitted key, is compiled for every candidate as before.
+with another fitted key, is compiled for every candidate as before. So is a candidate whose
+supply limits its servos (:func:`locust.sim.supply.supply_limits`): its stepped model takes the
+servo and the supply from the robot, not from the compiled numbers.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import numpy as np
 
 from ..params import Robot
 from ..sim.model import BuiltModel, build
+from ..sim.supply import supply_limits
 
 PROBES = (1.1, 1.3)              # the factors of the start value the map is found (and checked) at
 MATCH_RTOL = 1e-12               # how exactly the third compiled value must follow the map
@@ -118,11 +121,14 @@ class CandidateModels:
         self.compiled = 0          # candidates that needed the compiler
 
     def built(self, values: dict[str, float]) -> BuiltModel:
-        """The model with ``values`` (key -> value) in place of the robot's."""
+        """The model with ``values`` (key -> value) in place of the robot's (compiled where
+        its supply limits the servos: the stepped model takes its numbers from the robot)."""
         changed = {k: v for k, v in values.items() if v != self.robot.get(k)}
-        if any(k not in self.maps for k in changed):
+        candidate = self.robot.with_values(values, "fit") if changed else self.robot
+        if (any(k not in self.maps for k in changed) or self.base.supply is not None
+                or supply_limits(candidate.servo, candidate.power)):
             self.compiled += 1
-            return build(self.robot.with_values(values, "fit"))
+            return build(candidate)
         model = copy.copy(self.base.model)
         for key, value in changed.items():
             m = self.maps[key]

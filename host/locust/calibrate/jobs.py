@@ -1,6 +1,6 @@
 """Each calibration as one job: its recordings read, fitted, and returned as a
 :class:`~.result.Fit` (the robot values the recordings determine, each under its robot key).
-``locust calibrate beam|hinge|ramp|hop`` and ``locust.calibrate_beam/hinge/ramp/hops`` both run
+``locust calibrate beam|hinge|ramp|fold|hop`` and ``locust.calibrate_beam/hinge/ramp/fold/hops`` both run
 these, so the command line and the API cannot drift apart; :mod:`locust.api.calibration`
 documents every option.
 """
@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arucoboard import DEFAULT_BOARD
 from ..errors import CalibrationError
 from ..io.importing import AS_IS, ImportOptions
 from ..params import Robot
@@ -204,6 +205,44 @@ def ramp(data: PathLike | Sequence[PathLike] | np.ndarray, *, into: str = "foot"
     return Fit("ramp", source, identified(fit), fit,
                note=f"ramp, {fit.n_trials} trials, mean angle {fit.mean_angle_deg:.4g} deg",
                subtitle=f"mu {mu.value:.4g} from {fit.n_trials} trials", warnings=warnings)
+
+
+def fold(unloaded: PathLike, loaded: PathLike, fold: str, *, coin_arm_m: float, robot: Robot | None = None,
+         coin: str | None = None, coin_mass_kg: float | None = None, side: str = "both",
+         link_mass_kg: float | None = None, link_length_m: float | None = None, board: str = DEFAULT_BOARD) -> Fit:
+    """A fold's static test: its photos unloaded and with a coin on, fitted (:mod:`.fold`).
+
+    Parameters
+    ----------
+    unloaded, loaded : path-like
+        A photo, a folder of photos or a clip of each state.
+    fold : {"servo", "knee", "ankle", "loop"}
+    coin_arm_m : float
+        The coin's lever arm from the fold line [m].
+    robot : locust.params.Robot, optional
+        The robot whose fold it is; None: the one every door runs on
+        (:func:`locust.io.robot_toml.resolve_robot`).
+    coin, coin_mass_kg, side, link_mass_kg, link_length_m, board
+        As :func:`locust.api.calibration.calibrate_fold` takes them.
+
+    Returns
+    -------
+    Fit
+        ``folds.<fold>_stiffness_nm_per_rad`` and ``folds.<fold>_rest_offset_deg`` (``left.``/``right.``
+        for one side); ``.result`` the :class:`~.foldfit.FoldFit`.
+    """
+    from ..io.robot_toml import resolve_robot
+    from .fold import fold_test
+
+    robot = resolve_robot() if robot is None else robot
+    fit = fold_test(unloaded, loaded, fold, robot, coin_arm_m=coin_arm_m, coin_name=coin, coin_mass_kg=coin_mass_kg,
+                    side=side, link_mass_kg=link_mass_kg, link_length_m=link_length_m, board=board)
+    k = fit.stiffness_nm_per_rad
+    note = (f"fold test, {fold} fold ({side}), coin {fit.load.what} at {coin_arm_m * 1000:.1f} mm, link "
+            f"{fit.link.what}; rest {fit.rest_deg.value:.2f} deg, assembled {fit.assembled_deg:.2f} deg")
+    return Fit("fold", fit.source, identified(fit), fit, note=note,
+               subtitle=f"k {k.value:.4g} N*m/rad, rest {fit.rest_deg.value:.2f} deg, deflection "
+                        f"{fit.deflection_deg.value:.2f} deg", warnings=list(fit.warnings))
 
 
 def hops(robot: Robot | None, runs: Mapping[str, PathLike] | Sequence[PathLike | object],

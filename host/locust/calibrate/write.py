@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ..errors import CalibrationError
 from ..io.robot_toml import ROBOT_FILE, update_robot
-from ..params import Provenance, Robot, problems
+from ..params import FOLDS, Provenance, Robot, problems
 from .fitstats import Estimate
 
 DEFAULT_ROBOT_TOML = ROBOT_FILE   # a bare --write
@@ -31,6 +31,9 @@ PLAUSIBLE = {
     "servo.kv_nms_per_rad": (0.0, 10.0),
     "contact.foot_friction": (0.05, 5.0),                       # seed 1.7
     "contact.nose_friction": (0.05, 5.0),
+    # a fold's film hinge (the as-built 1.5e-4) and its rest offset (within half a turn)
+    **{f"{section}.{fold}_{name}": bounds for section in ("folds", "left", "right") for fold in FOLDS
+       for name, bounds in (("stiffness_nm_per_rad", (1e-6, 10.0)), ("rest_offset_deg", (-180.0, 180.0)))},
 }
 UNIT_HINT = ("check the recording's units: times in seconds (not ms), angles in degrees (not radians), "
              "tracks in metres (or --units cm|mm); the fit is shown but not written")

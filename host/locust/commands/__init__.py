@@ -35,7 +35,7 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
     "report": ("locust.commands.report", "report", "Compare simulation and measurement in an HTML report."),
     "demo": ("locust.commands.demo", "demo", "Run the whole toolkit end to end on the virtual robot."),
     "fab": ("locust.commands.fab", "fab", "Generate the five-layer laminate cut files (DXF)."),
-    "measure": ("locust.commands.measure", "measure", "Measure the robot as built from photos (stance)."),
+    "measure": ("locust.commands.measure", "measure", "Measure the robot: photos, a scale, clips, a multimeter."),
 }
 
 

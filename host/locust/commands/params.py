@@ -35,8 +35,7 @@ def params(preset, config, sets, as_json, write, force):
         return
     load, why = _standing(robot)
     if as_json:
-        out = {k: {"value": v, **{a: b for a, b in vars(robot.source_of(k)).items() if b is not None}}
-               for k, v in robot.flat().items()}
+        out = {k: {"value": v, **_source(robot, k)} for k, v in robot.flat().items()}
         click.echo(json_text({"name": robot.name, "leg_set": robot.leg_set,
                               "leg_set_added_m": robot_params.leg_set_spec(robot.leg_set).added_m, "values": out,
                               "nose_load_kg": load.nose_load_kg if load else None,
@@ -47,12 +46,20 @@ def params(preset, config, sets, as_json, write, force):
     click.echo(f"# leg set: {robot.leg_set} ({added_mm:+g} mm on every link of "
                "the cut file's strip)")
     for key, value in robot.flat().items():
-        prov = robot.source_of(key)
+        prov, parent = robot.source_of(key), robot.inherits(key)
         unc = f" ± {prov.uncertainty:g}" if prov.uncertainty is not None else ""
-        click.echo(f"{key:42s} {value!s:>12}{unc:12s}  [{prov.source}]")
+        click.echo(f"{key:42s} {value!s:>12}{unc:12s}  [{prov.source if parent is None else '= ' + parent}]")
     click.echo(f"# standing at rest: {load.nose_load_kg * 1000:.1f} g of its {load.total_mass_kg * 1000:.1f} g on the "
                "nose (a kitchen scale under it, feet level with the pan)" if load else
                f"# standing at rest: no nose load ({why})")
+
+
+def _source(robot: robot_params.Robot, key: str) -> dict:
+    """A value's provenance for --json; an inherited one names the key it takes its value from."""
+    parent = robot.inherits(key)
+    if parent is not None:
+        return {"inherits": parent}
+    return {a: b for a, b in vars(robot.source_of(key)).items() if b is not None}
 
 
 def _standing(robot: robot_params.Robot):

@@ -77,9 +77,13 @@ def headline(c) -> list[str]:
                    "curves, error bars on the predicted hops.")
 @click.option("--before", "before_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="The robot.toml before a fit (e.g. `locust calibrate hop`): its predictions are drawn too.")
+@click.option("--explain", is_flag=True,
+              help="Explain each configuration as `locust sim --explain` does: a tornado figure of each uncertain "
+                   "value's -/+2 sd effect on nose rise and distance, and why it goes over, in words (some 300 "
+                   "runs a configuration).")
 @import_options
 def report(measured, config, preset, sets, added, sweep, study, cycles, marker, out, side_by_side, samples, before_path,
-           imports):
+           explain, imports):
     """Compare simulation and measurement for each configuration in one self-contained HTML page.
 
     Each configuration (Small/Medium/Large: the --config/--preset robot with +0/+10/+20 mm on
@@ -106,7 +110,7 @@ def report(measured, config, preset, sets, added, sweep, study, cycles, marker, 
     result = build_report(robot, list(measured), out=out, robot_source=source, cycles=cycles, sweep=sweep,
                           added=parse_added(added), marker=marker, progress=_stage, side_by_side=side_by_side,
                           samples=samples or 0, before=load_robot(before_path) if before_path else None,
-                          imports=imports, study=study)
+                          imports=imports, study=study, explain=explain)
     for c in result.comparisons:
         for line in headline(c):
             click.echo(f"{c.config:8s} {line}", err=True)

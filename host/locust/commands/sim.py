@@ -11,7 +11,7 @@ import click
 from ..fileio import json_text
 from ..io.robot_toml import resolve_robot
 from ..params import LEG_SETS
-from ..tables import nose_load_line, sensitivity_lines, sim_lines, spread_lines
+from ..tables import explain_lines, nose_load_line, sensitivity_lines, sim_lines, spread_lines
 from .options import JobBar, robot_options
 
 
@@ -34,6 +34,15 @@ from .options import JobBar, robot_options
               help="The same of the robot held up at the push command (the same camera).")
 @click.option("--board", default=None, metavar="SPEC",
               help="For --still: the board beside the robot (default aruco:4X4_50:5x4:40:10).")
+@click.option("--push-clip", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Render one push on the floor (MP4, fixed camera, the stickers `locust measure stroke` reads), "
+                   "with the crank's true angle beside it (<clip>.crank.csv).")
+@click.option("--push-clip-held", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="The same push with the robot held up by its plate.")
+@click.option("--push-fps", type=click.IntRange(1, 1000), default=240, show_default=True,
+              help="For --push-clip: frames per second.")
+@click.option("--side", type=click.Choice(["left", "right"]), default="left", show_default=True,
+              help="For --still and --push-clip: the side filmed (the right leg is at -y, the camera there).")
 @click.option("--check-convergence", is_flag=True,
               help="Rerun at half the time step and report the relative change.")
 @click.option("--samples", type=click.IntRange(2, 4096), default=None, metavar="N",
@@ -44,11 +53,17 @@ from .options import JobBar, robot_options
 @click.option("--sensitivity/--no-sensitivity", default=None,
               help="Move each uncertain value alone to -/+2 sd and report the outcome at each end: the "
                    "values that decide the regime (default: with --samples, when its draws split).")
+@click.option("--explain", is_flag=True,
+              help="Say why: for a run that goes over, when and on what (the support points, how far the centre "
+                   "of mass is behind them and for how long, the servo torque); else how close it came. For "
+                   "every uncertain and design value, how far the outcome's threshold is (in its unit and its "
+                   "sd), and each uncertain value's -/+2 sd effect on nose rise and distance (some 300 runs: "
+                   "--cycles 2 is quicker).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of --samples.")
 @click.option("--verbose", "-v", is_flag=True,
               help="Also the linkage's kinematics: its Grashof class and worst transmission angle.")
-def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, still, still_push, board, check_convergence,
-        samples, seed, sensitivity, verbose):
+def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, still, still_push, board, push_clip,
+        push_clip_held, push_fps, side, check_convergence, samples, explain, seed, sensitivity, verbose):
     """Settle the robot on the floor, then run the bang-bang hop schedule.
 
     Every run is audited (non-finite state, loop closure, energy, MuJoCo warnings). A run
@@ -64,16 +79,20 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
       locust sim --preset large --set servo.stall_torque_nm=0.18 --video large.mp4
       locust sim --config calibration/robot.toml --samples 16   # with its spread
       locust sim --preset medium --samples 32 --json     # outcome shares
+      locust sim --preset small --explain --cycles 2     # why it goes over, what would change it
       locust sim --config calibration/robot.toml --leg-set large   # another leg set on it
       locust sim --preset small --still rest.png --still-push push.png   # for locust measure stance
+      locust sim --preset small --push-clip floor.mp4 --push-clip-held held.mp4   # for locust measure stroke
     """
     from ..sim.job import SimOptions, run_simulation
 
     robot = resolve_robot(preset, config, sets)
     options = SimOptions(cycles=cycles, leg_set=leg_set_name, samples=samples or 0, seed=seed, sensitivity=sensitivity,
                          keep_states=False, check_convergence=check_convergence, video=video, camera=camera,
-                         still=still, still_push=still_push, board=board, invalid_linkage_result=as_json)
-    with JobBar(samples, f"{samples} draws") if samples else nullcontext() as bar:
+                         still=still, still_push=still_push, board=board, push_clip=push_clip,
+                         push_clip_held=push_clip_held, push_fps=push_fps, side={"left": "L", "right": "R"}[side],
+                         invalid_linkage_result=as_json, explain=explain)
+    with _bar(robot, samples, explain) as bar:
         result = run_simulation(robot, options, progress=bar.update if bar else None)
     if as_json:
         click.echo(json_text(result.to_json()), nl=False)
@@ -85,5 +104,19 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
     spread, sens = getattr(result, "spread", None), getattr(result, "sensitivity", None)
     for line in (spread_lines(spread) if spread is not None else []) + (sensitivity_lines(sens) if sens else []):
         click.echo(line)
+    for line in explain_lines(result.explanation) if result.explanation is not None else []:
+        click.echo(line)
     if not result.valid:
         sys.exit(1)
+
+
+def _bar(robot, samples: int | None, explain: bool):
+    """The progress bar of the draws and the explanation's runs (none without either)."""
+    if not (samples or explain):
+        return nullcontext()
+    from ..sim.explain import explain_runs
+
+    runs = explain_runs(robot) if explain else 0
+    label = " + ".join(p for p in (f"{samples} draws" if samples else "", f"explaining ({runs} runs at most)"
+                                   if explain else "") if p)
+    return JobBar((samples or 0) + runs, label)

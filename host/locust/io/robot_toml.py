@@ -30,7 +30,7 @@ from ..errors import ParamsError
 from ..fileio import atomic_write_text, locked, storable
 from ..params.legsets import LEG_SETS
 from ..params.limits import check_robot
-from ..params.model import SECTIONS, Provenance, Robot, parse_set_options, shown_value, split_key
+from ..params.model import SECTIONS, Provenance, Robot, all_keys, parse_set_options, shown_value, split_key
 from ..params.presets import DEFAULT_PRESET, PRESETS, preset
 
 HEADER = (
@@ -77,7 +77,9 @@ def document_text(name: str, sections: dict[str, dict[str, tuple[Any, dict[str, 
         The robot's name.
     sections : dict
         ``{section: {field: (value, provenance)}}``, the provenance a dict of ``source``,
-        ``uncertainty`` (1 sigma, the value's unit), ``date`` and ``note`` (None: left out).
+        ``uncertainty`` (1 sigma, the value's unit), ``date`` and ``note`` (None: left out). A
+        value None (inherited) is absent from the file (TOML has no null): taken out of the
+        template's section, and a section of nothing else is not made.
     template : str, optional
         The TOML text of the file being replaced (valid TOML): its comments, order and layout
         are kept, its values replaced. None: a new file with the usual header.
@@ -100,12 +102,17 @@ def document_text(name: str, sections: dict[str, dict[str, tuple[Any, dict[str, 
         doc["leg_set"] = storable(leg_set)
     for section, entries in sections.items():
         table = doc.get(section)
+        given = {key: entry for key, entry in entries.items() if entry[0] is not None}
         if not isinstance(table, Table):
             if section in doc:
                 del doc[section]
+            if not given:
+                continue
             table = tomlkit.table()
             doc[section] = table
-        for key, (value, provenance) in entries.items():
+        for key in [k for k, (value, _) in entries.items() if value is None and k in table]:
+            del table[key]
+        for key, (value, provenance) in given.items():
             table[key] = _entry(value, provenance, table.get(key))
     return tomlkit.dumps(doc)
 
@@ -271,7 +278,7 @@ def to_toml(robot: Robot, template: str | None = None) -> str:
     str
     """
     sections = {
-        section: {f.name: (robot.get(f"{section}.{f.name}"),
+        section: {f.name: (robot.own(f"{section}.{f.name}"),
                            dataclasses.asdict(robot.source_of(f"{section}.{f.name}")))
                   for f in fields(SECTIONS[section])}
         for section in SECTIONS
@@ -293,8 +300,8 @@ def _read_back(robot: Robot, path: Path, tmp: Path) -> None:
     except ParamsError as exc:
         raise ParamsError(f"{path}: the robot file written does not read back ({exc.message}); "
                           "the old file is kept", "report this as a bug in locust, with the command run") from None
-    differ = [key for key, value in robot.flat().items()
-              if not _same(back.get(key), value)
+    differ = [key for key in all_keys()
+              if not _same(back.own(key), robot.own(key))
               or dataclasses.astuple(back.source_of(key)) != dataclasses.astuple(_stored(robot.source_of(key)))]
     if back.name != storable(robot.name):
         differ.insert(0, "name")

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SweepError
-from ..fileio import atomic_write_json, atomic_write_text, make_folder, try_lock
+from ..fileio import atomic_write_json, atomic_write_text, json_text, make_folder, try_lock
 
 RESULTS = "results.csv"
 META = "sweep.json"
@@ -277,7 +277,8 @@ class SweepStore:
                 old = json.loads(meta_path.read_text())
             except (OSError, ValueError) as exc:
                 raise SweepError(f"{meta_path}: unreadable ({exc})", "use a new --out folder") from None
-            if old.get("request") != meta["request"]:
+            # compared as stored: strict JSON has no inf (a supply without a current limit), it is null there
+            if old.get("request") != json.loads(json_text(meta["request"])):
                 raise SweepError(f"{folder} holds a different sweep (base, --vary, --cycles or parameters differ)",
                                  "use a new --out folder, or rerun the exact command that made it to resume")
             store.done = store._read_rows()

@@ -39,8 +39,9 @@ from ..calibrate.fitstats import Estimate
 from ..errors import GeometryError, MeasureError
 from ..fileio import opencv_path
 from ..io.trk import PIXEL_CONVENTIONS
-from ..params import Provenance, Robot
+from ..params import Provenance, Robot, side_values
 from ..sim.stickers import STICKERS, plate_points, to_view
+from .tooth import ToothEstimate, crank_tooth
 
 OBLIQUE_LIMIT = 0.05          # the board's scale may differ this much between opposite edges
 REACH_LIMIT_M = 0.003         # a sticker this far from any pose of the linkage is refused
@@ -66,7 +67,7 @@ class Photo:
 class StanceResult:
     """What the photos say, each value with its interval."""
 
-    crank_start_deg: Estimate           # the crank's angle from its ground link at the 0 deg command
+    crank_start_deg: Estimate           # geometry.crank_start_deg: the crank at the 0 deg command less its tooth
     ground_angle_deg: Estimate
     servo_axis_x_m: Estimate
     rest_pitch_deg: Estimate            # the plate's leg end above its nose end, at rest
@@ -79,6 +80,9 @@ class StanceResult:
     corner_sd_px: float
     draws: int
     mirrored: bool
+    side: str | None = None             # the side asked for (None: whichever the photos show)
+    tooth: ToothEstimate | None = None  # with a side: its crank's tooth
+    side_crank_deg: Estimate | None = None   # with a side: its crank from its ground link at the 0 deg command
 
     def values(self) -> dict[str, Estimate]:
         """The robot values the photos determine: crank start [deg], ground angle [deg] and
@@ -104,7 +108,8 @@ class StanceResult:
                 "servo_give_deg": self.servo_give_deg, "residual_mm": self.residual_mm,
                 "sticker_sd_px": self.sticker_sd_px, "corner_sd_px": self.corner_sd_px,
                 "interval_method": f"parametric bootstrap, {self.draws} draws of the pixel noise and the board's pose",
-                "mirrored": self.mirrored}
+                "mirrored": self.mirrored, "tooth": None if self.tooth is None else self.tooth.to_json(),
+                "side_crank_deg": None if self.side_crank_deg is None else self.side_crank_deg.as_dict()}
 
 
 # -- the board -------------------------------------------------------------------------
@@ -249,7 +254,7 @@ def read_photo(path: Path, spec: BoardSpec, given: dict[str, tuple[float, float]
     return Photo(path, stickers, corners_px, corners_m, corner_sd, sources)
 
 
-def model_servo_give(robot: Robot):
+def model_servo_give(robot: Robot, side: str = "L"):
     """The servo's give at rest as the model has it, for a stance (the measured robot settled
     on the floor at the 0 deg command, :func:`locust.sim.still.rest_pose`), in degrees.
 
@@ -257,17 +262,23 @@ def model_servo_give(robot: Robot):
     ----------
     robot : Robot
         The robot measured.
+    side : str
+        The side photographed: ``L`` or ``R``; its crank is the one given, the other keeps its
+        place relative to it (the teeth of the robot file).
 
     Returns
     -------
     callable
-        ``give(crank_start_deg, ground_angle_deg, servo_axis_x_m)`` -> the give [deg].
+        ``give(crank_deg, ground_angle_deg, servo_axis_x_m)`` -> the side's give [deg], its
+        crank at ``crank_deg`` from its ground link.
     """
     from ..sim.still import rest_pose
 
-    def give(crank_start_deg: float, ground_angle_deg: float, servo_axis_x_m: float) -> float:
-        return rest_pose(robot.with_values(dict(zip(STANCE_KEYS, (crank_start_deg, ground_angle_deg,
-                                                                  servo_axis_x_m))))).servo_deg
+    tooth = side_values(robot, side).crank_start_deg - robot.geometry.crank_start_deg
+
+    def give(crank_deg: float, ground_angle_deg: float, servo_axis_x_m: float) -> float:
+        values = dict(zip(STANCE_KEYS, (crank_deg - tooth, ground_angle_deg, servo_axis_x_m)))
+        return rest_pose(robot.with_values(values), side).servo_deg
     return give
 
 
@@ -446,9 +457,13 @@ def _estimate(value: float, draws: np.ndarray) -> Estimate:
 
 
 def fit_stance(robot: Robot, photos: list[Photo], servo_give_deg, draws: int = BOOTSTRAP_DRAWS,
-               seed: int = 0) -> StanceResult:
-    """Fit the stance to one photo (rest) or two (rest, push); ``servo_give_deg(crank_start_deg,
+               seed: int = 0, side: str | None = None) -> StanceResult:
+    """Fit the stance to one photo (rest) or two (rest, push); ``servo_give_deg(crank_deg,
     ground_angle_deg, servo_axis_x_m)`` is the servo's give at rest, as the model has it.
+
+    ``side``: the photos must show that side (``L``: the robot's left, ``R``: its right, a
+    mirrored view), and its crank's tooth is found (:mod:`.tooth`); None: whichever side they
+    show, the left crank's place taken as the robot's ``geometry.crank_start_deg``.
 
     Parameters
     ----------
@@ -462,14 +477,22 @@ def fit_stance(robot: Robot, photos: list[Photo], servo_give_deg, draws: int = B
         Bootstrap draws for the intervals.
     seed : int
         The bootstrap's seed.
+    side : str, optional
+        ``L`` or ``R``: the side the photos must show.
 
     Returns
     -------
     StanceResult
         Crank start and ground angle [deg], servo axis [m], each with its interval.
+
+    Raises
+    ------
+    MeasureError
+        A sticker no pose reaches, or photos of the other side than ``side``.
     """
     observed = np.vstack([_plane_points(ph) for ph in photos])
     p, mirrored, rss = fit_points(robot, observed)
+    _check_side(photos[0], mirrored, side)
     _check_reach(robot, photos, observed, p, mirrored)
     n_obs, n_par = observed.size, len(p)
     m_per_px = float(np.mean([_m_per_px(ph) for ph in photos]))
@@ -488,14 +511,29 @@ def fit_stance(robot: Robot, photos: list[Photo], servo_give_deg, draws: int = B
     give = servo_give_deg(p[5] - give, p[0], p[1])
     residual = {ph.path.name: {n: float(d) * 1000.0 for n, d in zip(STICKERS, dist)}
                 for ph, dist in zip(photos, _per_point_m(robot, p, observed, mirrored).reshape(len(photos), -1))}
+    crank = _estimate(p[5] - give, boot[:, 2] - give)
+    teeth = side_values(robot, side or "L").crank_start_deg - robot.geometry.crank_start_deg
     return StanceResult(
-        crank_start_deg=_estimate(p[5] - give, boot[:, 2] - give),
+        crank_start_deg=_estimate(p[5] - give - teeth, boot[:, 2] - give - teeth),
         ground_angle_deg=_estimate(p[0], boot[:, 0]),
         servo_axis_x_m=_estimate(p[1], boot[:, 1]),
         rest_pitch_deg=_estimate(_pitch_deg(robot, p, mirrored), boot[:, 3]),
         push_turn_deg=_estimate(p[9] - p[5], boot[:, 4]) if len(photos) > 1 else None,
         push_command_deg=robot.schedule.push_deg, rest_crank_seen_deg=float(p[5]), servo_give_deg=float(give),
-        residual_mm=residual, sticker_sd_px=sticker_sd, corner_sd_px=corner_sd, draws=draws, mirrored=mirrored)
+        residual_mm=residual, sticker_sd_px=sticker_sd, corner_sd_px=corner_sd, draws=draws, mirrored=mirrored,
+        side=side, tooth=None if side is None else crank_tooth(robot, side, crank),
+        side_crank_deg=None if side is None else crank)
+
+
+def _check_side(photo: Photo, mirrored: bool, side: str | None) -> None:
+    """Refuse photos of the other side than ``side`` (the right's view is the left's mirrored)."""
+    if side is None or mirrored == (side == "R"):
+        return
+    seen, want = ("right", "left") if mirrored else ("left", "right")
+    raise MeasureError(f"{photo.path.name} shows the robot's {seen} side, not its {want}: the stickers fit the "
+                       f"{seen} leg's view (its nose on the {'right' if mirrored else 'left'} of its tail)",
+                       f"photograph the robot from its {want}, the stickers on the {want} leg and the board in its "
+                       f"plane, or give --side {seen}")
 
 
 def given_points(items: Sequence[str], convention: str, option: str) -> dict[str, tuple[float, float]]:

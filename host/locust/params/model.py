@@ -20,6 +20,7 @@ from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 from ..errors import ParamsError
+from .legs import Folds, Side
 
 # Standard gravity, m/s^2 (9.80665 by definition, 3rd CGPM 1901), to the three figures of MuJoCo's
 # default option.gravity: the world's, not the robot's, but every model and fit uses this one.
@@ -90,6 +91,9 @@ class Servo:
     armature_kgm2: float = 4.65e-4         # rotor inertia x gear ratio^2, at the output shaft
     kv_nms_per_rad: float = 0.0            # velocity feedback inside the clamp (notebook: 0.0069)
     travel_deg: float = 45.0         # mechanical travel either side of rest
+    # the output shaft's spline: a horn (and the crank on it) sits on it in steps of
+    # 360 / spline_teeth deg (SG90_SOURCE: an estimate until counted)
+    spline_teeth: int = 21
     pulse_min_us: float = 500.0      # pulse at -range_deg/2
     pulse_max_us: float = 2500.0     # pulse at +range_deg/2
     range_deg: float = 180.0         # angle swept by pulse_min..pulse_max
@@ -120,12 +124,18 @@ class Contact:
 
 @dataclass(frozen=True)
 class Power:
-    """The servos' supply: both servos draw through one source resistance (USB cable, board,
-    breadboard), so the voltage at the servos sags under their current (docs/servo.md,
-    "Power")."""
+    """The servos' supply (docs/servo.md, "Power"): a source that holds ``supply_voltage_v`` at
+    the servo plug with the servos at rest (the board running on it too), sagging by
+    ``source_resistance_ohm`` for every ampere the servos draw (USB cable, board, breadboard),
+    and giving no more than ``current_limit_a`` in all (a USB port's power switch, a
+    polyfuse), the board's own ``board_current_a`` included. A servo whose plug falls below
+    ``brownout_v`` stops driving. The defaults: an ideal supply (the seed's model)."""
 
-    supply_voltage_v: float = 5.0
-    source_resistance_ohm: float = 0.0
+    supply_voltage_v: float = 5.0         # at the servo plug, servos at rest, the board drawing its own
+    source_resistance_ohm: float = 0.0    # shared by both servos
+    current_limit_a: float = math.inf     # the source's, the board's draw included (inf: none)
+    brownout_v: float = 0.0               # a servo's electronics stop driving below this at its plug
+    board_current_a: float = 0.0          # the ESP32 board's own draw from the same source
 
 
 @dataclass(frozen=True)
@@ -161,7 +171,10 @@ class Solver:
 SECTIONS: dict[str, type] = {
     "geometry": Geometry,
     "compliance": Compliance,
+    "folds": Folds,
     "servo": Servo,
+    "left": Side,
+    "right": Side,
     "contact": Contact,
     "power": Power,
     "schedule": Schedule,
@@ -188,13 +201,20 @@ class Robot:
     ``large`` add 1 and 2 cm to every link); :func:`locust.params.leg_set` swaps it for
     another, taking its own added length off first. It is part of the robot, written to and
     read from ``robot.toml``: nothing derives it from the name.
+
+    A value may be inherited (None in its section, absent from ``robot.toml``: a fold's
+    stiffness is the film hinge's until it is given, a side's servo gain the servo section's):
+    :meth:`get` gives the value in effect, :meth:`own` the robot's own (None: inherited).
     """
 
     name: str = "seed"
     leg_set: str = "small"
     geometry: Geometry = field(default_factory=Geometry)
     compliance: Compliance = field(default_factory=Compliance)
+    folds: Folds = field(default_factory=Folds)
     servo: Servo = field(default_factory=Servo)
+    left: Side = field(default_factory=Side)
+    right: Side = field(default_factory=Side)
     contact: Contact = field(default_factory=Contact)
     power: Power = field(default_factory=Power)
     schedule: Schedule = field(default_factory=Schedule)
@@ -203,7 +223,8 @@ class Robot:
 
     # -- dotted access ---------------------------------------------------------------
     def get(self, key: str) -> Any:
-        """A value by its dotted name.
+        """A value by its dotted name: the one in effect, an inherited value taken from the key it
+        inherits (:func:`inherited_from`, followed until a value is set).
 
         Parameters
         ----------
@@ -213,7 +234,31 @@ class Robot:
         Returns
         -------
         Any
-            The value, in the unit its name says.
+            The value, in the unit its name says (never None).
+
+        Raises
+        ------
+        locust.errors.ParamsError
+            Not a parameter of the model.
+        """
+        value = self.own(key)
+        while value is None:
+            key = INHERITS[key]
+            value = self.own(key)
+        return value
+
+    def own(self, key: str) -> Any:
+        """A value by its dotted name as this robot holds it: None where it is inherited.
+
+        Parameters
+        ----------
+        key : str
+            ``section.name``.
+
+        Returns
+        -------
+        Any
+            The value, or None (inherited: see :meth:`get`).
 
         Raises
         ------
@@ -222,6 +267,22 @@ class Robot:
         """
         section, name = split_key(key)
         return getattr(getattr(self, section), name)
+
+    def inherits(self, key: str) -> str | None:
+        """The key whose value ``key`` takes now, or None where the robot holds its own.
+
+        Parameters
+        ----------
+        key : str
+            A dotted name.
+
+        Returns
+        -------
+        str or None
+            The key it inherits from (``compliance.hinge_stiffness_nm_per_rad`` for an unset
+            ``folds.knee_stiffness_nm_per_rad``).
+        """
+        return INHERITS[key] if self.own(key) is None else None
 
     def source_of(self, key: str) -> Provenance:
         """Where a value comes from (an empty :class:`Provenance` when not recorded).
@@ -249,7 +310,9 @@ class Robot:
         Parameters
         ----------
         values : dict of str to Any
-            Dotted name -> value, in the unit the name says (coerced to the field's type).
+            Dotted name -> value, in the unit the name says (coerced to the field's type); for
+            a key that may inherit, None or ``"inherit"`` makes it inherit again (its
+            provenance dropped).
         source : str or Provenance
             Where the values come from.
 
@@ -267,8 +330,12 @@ class Robot:
         provenance = dict(self.provenance)
         for key, raw in values.items():
             section, name = split_key(key)
-            sections[section] = replace(sections[section], **{name: _coerce(key, raw)})
-            provenance[key] = prov
+            value = _coerce(key, raw)
+            sections[section] = replace(sections[section], **{name: value})
+            if value is None:
+                provenance.pop(key, None)
+            else:
+                provenance[key] = prov
         return replace(self, provenance=provenance, **sections)
 
     def with_provenance(self, key: str, prov: Provenance) -> Robot:
@@ -318,7 +385,7 @@ class Robot:
         return (g.ground_m, g.crank_m, g.coupler_m, g.leg_m)
 
     def flat(self) -> dict[str, Any]:
-        """Every value by its dotted name.
+        """Every value in effect by its dotted name (:meth:`get`: inherited ones resolved).
 
         Returns
         -------
@@ -328,8 +395,13 @@ class Robot:
         return {key: self.get(key) for key in all_keys()}
 
 
+# the sections a side's own values live in (the model's leg "L" at +y, "R" at -y)
+SIDE_SECTIONS = {"L": "left", "R": "right"}
+# what a side takes from the servo section: its field "servo_X" inherits "servo.X"
+SIDE_SERVO_FIELDS = ("kp_nm_per_rad", "stall_torque_nm", "noload_speed_rad_per_s", "armature_kgm2", "kv_nms_per_rad")
 # keys for which +inf is a meaningful value ("no limit")
-UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s"})
+UNBOUNDED_KEYS = frozenset({"servo.noload_speed_rad_per_s", "power.current_limit_a",
+                            *(f"{side}.servo_noload_speed_rad_per_s" for side in SIDE_SECTIONS.values())})
 
 
 def all_keys() -> list[str]:
@@ -368,9 +440,15 @@ def split_key(key: str) -> tuple[str, str]:
     return section, name
 
 
+def _field_type(key: str) -> str:
+    section, name = split_key(key)
+    ftype = {f.name: f.type for f in fields(SECTIONS[section])}[name]
+    return ftype if isinstance(ftype, str) else ftype.__name__
+
+
 def value_type(key: str) -> str:
     """The type of a dotted key's value: ``"float"``, ``"int"``, ``"bool"`` or ``"str"``
-    (ParamsError for an unknown key).
+    (ParamsError for an unknown key); a key that may inherit has its value's type.
 
     Parameters
     ----------
@@ -381,9 +459,61 @@ def value_type(key: str) -> str:
     -------
     str
     """
-    section, name = split_key(key)
-    ftype = {f.name: f.type for f in fields(SECTIONS[section])}[name]
-    return ftype if isinstance(ftype, str) else ftype.__name__
+    return _field_type(key).removesuffix(" | None")
+
+
+def is_optional(key: str) -> bool:
+    """Whether ``key`` may be unset, taking its value from another (:func:`inherited_from`).
+
+    Parameters
+    ----------
+    key : str
+        A dotted name.
+
+    Returns
+    -------
+    bool
+    """
+    return _field_type(key).endswith(" | None")
+
+
+def _parent(key: str) -> str:
+    """The key an unset ``key`` takes its value from (see :data:`INHERITS`)."""
+    section, name = key.split(".")
+    if section == "folds":
+        return "compliance.hinge_" + name.partition("_")[2]   # servo_stiffness_... -> hinge_stiffness_...
+    if name.startswith("servo_") and name.removeprefix("servo_") in SIDE_SERVO_FIELDS:
+        return "servo." + name.removeprefix("servo_")
+    return "folds." + name
+
+
+# an unset key -> the key it takes its value from: a fold's stiffness and damping the film
+# hinge's (compliance), a side's fold values the folds section's, a side's servo values the
+# servo section's; followed until a value is set (Robot.get)
+INHERITS: dict[str, str] = {key: _parent(key) for key in all_keys() if is_optional(key)}
+
+
+def inherited_from(key: str) -> str | None:
+    """The key whose value an unset ``key`` takes, or None for a key that is always set.
+
+    Parameters
+    ----------
+    key : str
+        A dotted name.
+
+    Returns
+    -------
+    str or None
+        E.g. ``compliance.hinge_stiffness_nm_per_rad`` for ``folds.knee_stiffness_nm_per_rad``,
+        ``folds.knee_stiffness_nm_per_rad`` for ``left.knee_stiffness_nm_per_rad``.
+
+    Raises
+    ------
+    locust.errors.ParamsError
+        Not a parameter of the model.
+    """
+    split_key(key)
+    return INHERITS.get(key)
 
 
 def real_keys() -> list[str]:
@@ -398,7 +528,7 @@ def real_keys() -> list[str]:
 
 # what the robot is (a fit may identify these), against what it is told to do (schedule) and
 # how it is simulated (solver)
-PHYSICAL_SECTIONS = ("geometry", "compliance", "servo", "contact", "power")
+PHYSICAL_SECTIONS = ("geometry", "compliance", "folds", "servo", "left", "right", "contact", "power")
 
 
 def fittable_keys() -> list[str]:
@@ -442,8 +572,14 @@ def _as_int(key: str, raw: Any) -> int:
 _CONVERT = {"bool": _as_bool, "float": _as_float, "int": _as_int}
 
 
+# what --set (or a robot file) gives to make a key that may inherit do so again
+INHERIT_TEXT = "inherit"
+
+
 def _coerce(key: str, raw: Any) -> Any:
     ftype = value_type(key)
+    if is_optional(key) and (raw is None or (isinstance(raw, str) and raw.strip().lower() == INHERIT_TEXT)):
+        return None
     try:
         if isinstance(raw, bool) and ftype in ("float", "int"):
             raise ValueError("true/false is not a number")

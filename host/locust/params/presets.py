@@ -50,6 +50,12 @@ SG90_SOURCE = {
                                            "the stall torque 0.15 N*m"),
     "servo.kv_nms_per_rad": Provenance(source="model", note="a hobby servo has no velocity feedback; fitted to "
                                                             "both recordings 0.002 +- 0.0015, RMS unchanged"),
+    # nobody has counted the team's horns: 21 is what the printed-horn spline libraries give an
+    # SG90 (a round-toothed 21T, 4.8-4.9 mm across), but makers' batches differ
+    "servo.spline_teeth": Provenance(source="estimate:SG90 spline", note=(
+        "21 teeth, 17.1 deg a tooth: the SG90 spline of OpenSCAD horn libraries (21T, about 4.9 mm over the "
+        "teeth) and of 9 g servo listings; some TowerPro micro servos are 20T (18 deg) and clones vary from batch "
+        "to batch: count your horn's teeth")),
 }
 
 
@@ -139,11 +145,27 @@ AS_BUILT: dict[str, tuple[Any, Provenance]] = {
     "servo.winding_resistance_ohm": (10.0, Provenance(_SG90, uncertainty=1.5,
         note="stall current about 0.6 A at 6 V")),
     "power.supply_voltage_v": (5.0, Provenance("datasheet:USB", uncertainty=0.25,
-        note="USB's 5 V +- 5 %: the top view shows the servos on the USB-powered ESP32's 5 V, through the "
-             "breadboard")),
+        note="USB's 5 V +- 5 % at the servo plug with the servos at rest: the top view shows the servos on the "
+             "USB-powered ESP32's 5 V, through the breadboard; the board's own 0.05 A through the cable takes "
+             "0.025 V of it, inside the sd (locust measure supply reads it)")),
     "power.source_resistance_ohm": (0.5, Provenance("estimate:USB", uncertainty=0.3,
         note="USB cable (about 0.2 ohm a conductor) and breadboard contacts; measure the servo plug's "
-             "voltage with both servos held stalled")),
+             "voltage with both servos held stalled (locust measure supply)")),
+    # the three below: estimates of a range, not drawn (no sd: docs/servo.md, "Power", says why
+    # and what their ranges do); each note cites where its figure comes from
+    "power.current_limit_a": (1.5, Provenance("estimate:USB port",
+        note="0.7 to 2.5 A: USB 2.0 promises a port 0.5 A; ports limit above it: TI's power switches for 500 mA "
+             "ports (TPS2041B/TPS2051B) at 0.7 A at the least, polyfuses and shared switches well beyond 0.6 A, "
+             "USB 3.0 ports promise 0.9 A, phones draw 2.5 A from some (UL, IEEE ISPCE 2015); both servos "
+             "stalled draw 0.91 A here (docs/servo.md, Power)")),
+    "power.brownout_v": (3.5, Provenance("estimate:SG90",
+        note="3 to 4.5 V: SG90 listings give 4.8-6 V rated and 3.0-3.5 V the least they run on; below about "
+             "4 V servos jitter or stop holding; at 4.8 V SG90s ran where an MG90S batch stopped "
+             "(roger-random.github.io, micro servo notes, 2020)")),
+    "power.board_current_a": (0.05, Provenance("estimate:ESP32 dev board",
+        note="0.03 to 0.07 A: an ESP32 with its radio off draws a base 20-40 mA (Espressif's low-power guide), "
+             "a DevKitC's AMS1117 regulator 3.2 mA (measured by taking it off, kohacraft.com), the USB-serial "
+             "bridge and the power LED a few mA")),
 }
 
 
@@ -167,6 +189,8 @@ def _seed_notebook() -> Robot:
             "solver.tolerance": 1e-8, "solver.control_hz": 60.0, "solver.settle_s": 0.0,
             "contact.self_collision": True, "contact.rounded_edges": False,
             "solver.loop_timeconst_s": 0.02, "solver.loop_dmin": 0.9, "solver.loop_dmax": 0.95,
+            # the notebook closed the loop with a bare connect: its loop fold had no spring
+            "folds.loop_stiffness_nm_per_rad": 0.0, "folds.loop_damping_nms_per_rad": 0.0,
         },
         prov,
     ).renamed("seed-notebook")

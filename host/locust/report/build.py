@@ -169,7 +169,7 @@ def build_report(robot: Robot, measured: dict[str, list[Trial]], out: Path, *, r
                  cycles: int | None = None, sweep: Path | None = None, added: dict[str, float] | None = None,
                  marker: str = "nose", progress: Callable[[str], None] | None = None,
                  side_by_side: bool = False, samples: int = 0, before: Robot | None = None,
-                 study: Path | None = None) -> ReportResult:
+                 study: Path | None = None, explain: bool = False) -> ReportResult:
     """Simulate each configuration, compare it with its trials, and write a new report folder.
 
     Parameters
@@ -201,6 +201,9 @@ def build_report(robot: Robot, measured: dict[str, list[Trial]], out: Path, *, r
         The robot before a fit; its predictions are drawn too.
     study : Path, optional
         A ``locust optimize`` folder; its Pareto front is drawn.
+    explain : bool
+        Explain each configuration's prediction (:mod:`locust.sim.explain`): the tornado of its
+        uncertain values, and why it goes over or how close it comes, in the caption.
 
     Returns
     -------
@@ -230,9 +233,16 @@ def build_report(robot: Robot, measured: dict[str, list[Trial]], out: Path, *, r
 
     configs, comps, spreads, befores = _simulate(robot, measured, added, cycles, marker, progress, side_by_side,
                                                  samples, before)
+    explained = _explain(configs, comps, progress) if explain else {}
 
     progress("drawing figures")
     figs = _figures(comps, configs, land, spreads, befores)
+    if explained:
+        from .tornado import tornado_caption, tornado_figure
+
+        labels = {configs[name].label: e for name, e in explained.items()}
+        figs.insert(-1, page.Figure("tornado", "What each uncertain value does to the prediction",
+                                    tornado_caption(labels), tornado_figure(labels)))
     if front is not None:
         figs.insert(-1, study_figure(front, views is not None))
     dash = figures.dashboard(comps, land, configs)
@@ -249,6 +259,7 @@ def build_report(robot: Robot, measured: dict[str, list[Trial]], out: Path, *, r
         sp, old = spreads.get(entry["name"]), befores.get(entry["name"])
         entry["predicted_spread"] = sp.to_json() if sp is not None else None
         entry["predicted_before_fit"] = old.result.to_json() if old is not None else None
+        entry["explanation"] = explained[entry["name"]].to_json() if entry["name"] in explained else None
 
     folder = unique_dir(out, "report")
     try:
@@ -294,6 +305,20 @@ def _simulate(robot: Robot, measured: dict[str, list[Trial]], added: dict[str, f
             old = configuration(before, name, added.get(name))
             befores[name] = predict(name, with_run_schedule(old.robot, sched), n_cycles, marker)
     return configs, comps, spreads, befores
+
+
+def _explain(configs: dict[str, Configuration], comps: list[Comparison], progress: Callable[[str], None]) -> dict:
+    """Each valid configuration's explanation (:func:`locust.sim.explain.explain`), on the cycles
+    its prediction ran."""
+    from ..sim.explain import explain
+
+    out = {}
+    for c in comps:
+        cfg = configs[c.config]
+        if c.prediction.result.valid:
+            progress(f"explaining {cfg.label}")
+            out[c.config] = explain(cfg.robot, c.prediction.result.cycles)
+    return out
 
 
 def _run_configuration(robot: Robot, name: str, trials: list[Trial], added_m: float | None,

@@ -8,11 +8,17 @@ again at a fine one, for the benchmarks); :mod:`.audit` invalidates a run that b
 and :mod:`.outcome` measure each hop and name the run's regime; :mod:`.run` does all of that for one
 robot and returns :mod:`.result`'s :class:`~.result.SimResult` (:mod:`.job`: ``locust sim``'s whole run,
 which :func:`locust.simulate` shares); :mod:`.samples` and :mod:`.sensitivity`
-simulate draws and one-at-a-time moves of the uncertain values; :mod:`.statics` finds the
+simulate draws and one-at-a-time moves of the uncertain values; :mod:`.explain` says why a robot goes
+over (from :mod:`.support`: what it stands on, where its centre of mass is) and where each value's
+threshold lies; :mod:`.statics` finds the
 standing robot's load on its nose; :mod:`.kinematics` poses the markers at kept states;
 :mod:`.camera`, :mod:`.clip`, :mod:`.still` and :mod:`.stickers` render videos and stills with their
-ground truth (:mod:`.gl`: the OpenGL MuJoCo renders with, checked before MuJoCo is imported);
-:mod:`.live` steps the model as the virtual robot's servo commands arrive.
+ground truth, :mod:`.foldrig` and :mod:`.foldphotos` the virtual fold test and its photos;
+:mod:`.supply` the servos' supply as a circuit, and :mod:`.supply_rollout` the model stepped on it
+where it limits them
+(:mod:`.gl`: the OpenGL MuJoCo renders with, checked before MuJoCo is imported);
+:mod:`.live` steps the model as the virtual robot's servo commands arrive; :mod:`.push` simulates one
+push on the floor or held up, and :mod:`.pushclip` films it for ``locust measure stroke``.
 """
 
 import os

@@ -249,12 +249,37 @@ def _distance_to_fit(half_width_m: float, half_height_m: float, fovy_deg: float,
     return max(half_height_m / tan_half, half_width_m / (tan_half * aspect))
 
 
+def side_azimuth_deg(side: str) -> float:
+    """The camera's azimuth for a side view of the robot's left (``L``: from +y, the default)
+    or right (``R``: from -y, looking along +y).
+
+    Parameters
+    ----------
+    side : str
+        ``L`` or ``R``.
+
+    Returns
+    -------
+    float
+        [deg].
+
+    Raises
+    ------
+    SimError
+        Not a side.
+    """
+    if side not in ("L", "R"):
+        raise SimError(f"side {side!r} is not known", "choose L (the robot's left) or R (its right)")
+    return AZIMUTH_DEG if side == "L" else -AZIMUTH_DEG
+
+
 def frame_views(points_m: np.ndarray, chassis_x_m: np.ndarray, body_length_m: float, plane_y_m: float,
-                fovy_deg: float, aspect: float) -> tuple[CameraView, CameraView]:
+                fovy_deg: float, aspect: float, azimuth_deg: float = AZIMUTH_DEG) -> tuple[CameraView, CameraView]:
     """The fixed view that holds every point of the run, and the tracking view (at x = 0).
 
     ``points_m`` (N, 3): positions the robot reaches (nose, foot, chassis ...). Both views
     look horizontally at the plane ``y = plane_y_m``; the floor (z = 0) stays in the frame.
+    ``azimuth_deg``: -90 looks along -y from +y (the robot's left), +90 along +y from -y.
 
     Parameters
     ----------
@@ -270,6 +295,8 @@ def frame_views(points_m: np.ndarray, chassis_x_m: np.ndarray, body_length_m: fl
         The camera's vertical field of view [deg].
     aspect : float
         Width over height of the frame.
+    azimuth_deg : float
+        The views' azimuth [deg] (:func:`side_azimuth_deg`).
 
     Returns
     -------
@@ -280,15 +307,18 @@ def frame_views(points_m: np.ndarray, chassis_x_m: np.ndarray, body_length_m: fl
     z_lo = min(0.0, float(np.min(points_m[:, 2]))) - MARGIN_M
     z_hi = float(np.max(points_m[:, 2])) + MARGIN_M
     z_mid = (z_lo + z_hi) / 2
-    # the camera stands at +y: what is nearer to it than the plane needs the wider view
-    nearer_m = max(0.0, float(np.max(points_m[:, 1])) - plane_y_m) + MARGIN_M
+    # the camera stands at +y (azimuth -90) or -y (+90): what is nearer to it than the plane
+    # needs the wider view
+    toward = -math.sin(math.radians(azimuth_deg))
+    nearer_m = max(0.0, float(np.max(toward * (points_m[:, 1] - plane_y_m)))) + MARGIN_M
     fixed = CameraView(((x_lo + x_hi) / 2, plane_y_m, z_mid),
-                       nearer_m + _distance_to_fit((x_hi - x_lo) / 2, (z_hi - z_lo) / 2, fovy_deg, aspect))
+                       nearer_m + _distance_to_fit((x_hi - x_lo) / 2, (z_hi - z_lo) / 2, fovy_deg, aspect),
+                       azimuth_deg)
     track_half_w = TRACK_HALF_WIDTH_OF_BODY * body_length_m
     track = CameraView((float(chassis_x_m[0]), plane_y_m, z_mid),
-                       nearer_m + _distance_to_fit(track_half_w, (z_hi - z_lo) / 2, fovy_deg, aspect))
+                       nearer_m + _distance_to_fit(track_half_w, (z_hi - z_lo) / 2, fovy_deg, aspect), azimuth_deg)
     return fixed, track
 
 
 __all__ = ["CAMERAS", "CameraView", "PinholeCamera", "frame_views", "free_camera_at", "pinhole_from_scene",
-           "set_scene_pinhole"]
+           "set_scene_pinhole", "side_azimuth_deg"]

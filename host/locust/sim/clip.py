@@ -179,9 +179,9 @@ def release_context(renderer: mujoco.Renderer) -> None:
         glfw.make_context_current(None)
 
 
-def face_centre_m(model: mujoco.MjModel, data: mujoco.MjData, geom_id: int) -> np.ndarray:
+def face_centre_m(model: mujoco.MjModel, data: mujoco.MjData, geom_id: int, toward_y: float = 1.0) -> np.ndarray:
     """Centre of what the camera sees of a marker posed in ``data``: a disc's camera-facing
-    (+y) face, a sphere's centre.
+    face (+y, or -y for a camera at -y), a sphere's centre.
 
     Parameters
     ----------
@@ -191,6 +191,8 @@ def face_centre_m(model: mujoco.MjModel, data: mujoco.MjData, geom_id: int) -> n
         Its data, posed.
     geom_id : int
         The marker's geom.
+    toward_y : float
+        +1: the camera at +y (the default side view); -1: at -y.
 
     Returns
     -------
@@ -200,7 +202,7 @@ def face_centre_m(model: mujoco.MjModel, data: mujoco.MjData, geom_id: int) -> n
     centre = data.geom_xpos[geom_id].copy()
     if model.geom_type[geom_id] == mujoco.mjtGeom.mjGEOM_CYLINDER:
         axis = data.geom_xmat[geom_id].reshape(3, 3)[:, 2]
-        centre += np.sign(axis[1]) * axis * float(model.geom_size[geom_id][1])  # the +y face
+        centre += toward_y * np.sign(axis[1]) * axis * float(model.geom_size[geom_id][1])  # the camera's face
     return centre
 
 
@@ -341,7 +343,8 @@ class ClipRecorder:
     """Renders frames from model states into a temporary MP4, collecting the truth.
 
     ``add_frame(qpos, t_s)`` poses and renders the model (:class:`PoseRenderer`), projects
-    the markers and appends the frame;
+    the markers (the videos' ``marker_<name>`` discs, or ``marker_geoms``: name -> geom, e.g. a
+    still's stickers; discs facing a camera at ``toward_y`` * y) and appends the frame;
     ``finish()`` writes the sidecars and moves the video into place; ``abort()`` leaves
     nothing behind.
     """
@@ -355,12 +358,16 @@ class ClipRecorder:
     view: CameraView
     robot_name: str = ""
     shadows: bool = True      # two shadow maps cost about two thirds of an OSMesa frame
+    marker_geoms: dict[str, str] | None = None   # marker -> its geom (None: the videos' marker_<name>)
+    toward_y: float = 1.0     # the camera's side: +1 at +y, -1 at -y
     rows: list[_TruthRow] = field(default_factory=list)
     cameras: list[PinholeCamera] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         m = self.model
-        self.marker_ids = {n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, f"marker_{n}") for n in MARKERS}
+        geoms = self.marker_geoms or {n: f"marker_{n}" for n in MARKERS}
+        self.marker_ids = {n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, g) for n, g in geoms.items()}
+        self.markers = tuple(geoms)
         self.chassis_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
         self.poser = PoseRenderer(m, self.width, self.height, self.shadows)
         self.data = self.poser.data
@@ -394,14 +401,14 @@ class ClipRecorder:
         rgb, cam = self.poser.render(view)
         self.writer.write(cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
         world = {n: self._marker_face_m(g) for n, g in self.marker_ids.items()}
-        px = {n: tuple(float(v) for v in cam.project(world[n])[0]) for n in MARKERS}
+        px = {n: tuple(float(v) for v in cam.project(world[n])[0]) for n in self.markers}
         seen = {n: self._seen_fraction(cam, world[n], self.marker_ids[n]) if self._in_image(px[n]) else 0.0
-                for n in MARKERS}
+                for n in self.markers}
         self.rows.append(_TruthRow(len(self.rows), float(t_s), px, seen, world))
         self.cameras.append(cam)
 
     def _marker_face_m(self, geom_id: int) -> np.ndarray:
-        return face_centre_m(self.model, self.data, geom_id)
+        return face_centre_m(self.model, self.data, geom_id, self.toward_y)
 
     def _in_image(self, px: tuple[float, float]) -> bool:
         return -0.5 <= px[0] <= self.width - 0.5 and -0.5 <= px[1] <= self.height - 0.5
@@ -421,11 +428,11 @@ class ClipRecorder:
         lines = [(f"# simulated ground truth: MuJoCo render of robot {self.robot_name!r}, camera {self.camera}; "
                   "pixels in the OpenCV convention (origin at the centre of the top-left pixel, x right, y down); "
                   "world x along the floor, z up, metres"),
-                 ",".join(["frame", "t_s"] + [f"{n}_{c}" for n in MARKERS
+                 ",".join(["frame", "t_s"] + [f"{n}_{c}" for n in self.markers
                                               for c in ("px", "py", "visible", "seen_frac", "x_m", "z_m")])]
         for r in self.rows:
             cells = [str(r.frame), f"{r.t_s:.6f}"]
-            for n in MARKERS:
+            for n in self.markers:
                 cells += [f"{r.px[n][0]:.4f}", f"{r.px[n][1]:.4f}", str(int(r.seen_frac[n] >= VISIBLE_FRAC)),
                           f"{r.seen_frac[n]:.3f}",
                           f"{r.world_m[n][0]:.6f}", f"{r.world_m[n][2]:.6f}"]
@@ -462,7 +469,7 @@ class ClipRecorder:
             Per marker, ``plane_y_m`` (the mean y) and ``max_off_plane_m`` [m].
         """
         out = {}
-        for n in MARKERS:
+        for n in self.markers:
             y = np.array([r.world_m[n][1] for r in self.rows])
             out[n] = {"plane_y_m": float(np.mean(y)), "max_off_plane_m": float(np.max(np.abs(y - np.mean(y))))}
         return out

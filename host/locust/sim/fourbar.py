@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import GeometryError
+from ..params import FOLDS, Robot, side_values
 
 # Transmission angles outside this band transmit force poorly; reported, not refused.
 GOOD_TRANSMISSION_DEG = (40.0, 140.0)
@@ -158,6 +159,59 @@ def assemble(ground_m: float, crank_m: float, coupler_m: float, leg_m: float,
         grashof=grashof_class(ground_m, crank_m, coupler_m, leg_m),
         closure_error_m=abs(closure),
     )
+
+
+def side_assembly(robot: Robot, side: str) -> Assembly:
+    """One leg assembled at rest: at its crank's start angle, its tooth included
+    (:func:`locust.params.side_values`).
+
+    Parameters
+    ----------
+    robot : Robot
+    side : str
+        ``"L"`` or ``"R"``.
+
+    Returns
+    -------
+    Assembly
+
+    Raises
+    ------
+    GeometryError
+        The loop cannot close at that crank angle.
+    """
+    g = robot.geometry
+    return assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, side_values(robot, side).crank_start_deg)
+
+
+def fold_angles_deg(robot: Robot, side: str) -> dict[str, float]:
+    """Each fold's angle in the robot assembled at rest (0 deg command), 0 where its two links
+    lie in line as on the flat strip (ground, crank, coupler, leg, glued back over the ground).
+
+    The loop runs P4 -> P1 along the ground link, then crank, coupler and leg back to P4; a
+    fold's angle is the turn from the link before it to the link after it, in the frame's
+    counter-clockwise sense (the sense the model's joints turn in), within half a turn. The
+    four add up to a whole turn (360 deg: the knee on the clockwise side turns the loop counter-clockwise).
+
+    Parameters
+    ----------
+    robot : Robot
+    side : str
+        ``"L"`` or ``"R"``.
+
+    Returns
+    -------
+    dict of str to float
+        Each fold of :data:`locust.params.FOLDS` -> its angle [deg].
+
+    Raises
+    ------
+    GeometryError
+        The loop cannot close at that side's crank angle.
+    """
+    asm = side_assembly(robot, side)
+    angles = (_wrap(asm.crank_deg - 180.0), asm.coupler_rel_deg, asm.leg_rel_deg, _wrap(180.0 - asm.leg_deg))
+    return dict(zip(FOLDS, angles))
 
 
 def _wrap(deg: float) -> float:

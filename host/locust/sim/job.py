@@ -48,8 +48,17 @@ class SimOptions:
         command, with their truth sidecars.
     board : str or None
         For the stills: the board beside the robot (None: the default board).
+    push_clip, push_clip_held : Path or None
+        Render one push on the floor, and one with the robot held up, for ``locust measure
+        stroke`` (:mod:`.pushclip`), with their truth sidecars.
+    push_fps : int
+        The push clips' frame rate [1/s].
+    side : str
+        The side the stills and push clips show: ``L`` (the robot's left) or ``R``.
     invalid_linkage_result : bool
         A linkage that cannot be assembled is an invalid result with its reason, not an error.
+    explain : bool
+        Why the robot does what it does (``result.explanation``, :mod:`locust.sim.explain`).
     """
 
     cycles: int | None = None
@@ -64,7 +73,12 @@ class SimOptions:
     still: Path | None = None
     still_push: Path | None = None
     board: str | None = None
+    push_clip: Path | None = None
+    push_clip_held: Path | None = None
+    push_fps: int = 240
+    side: str = "L"
     invalid_linkage_result: bool = False
+    explain: bool = False
 
 
 def prepared(robot: Robot, options: SimOptions):
@@ -99,10 +113,12 @@ def prepared(robot: Robot, options: SimOptions):
             robot = leg_set(robot, options.leg_set, source=f"leg-set:{options.leg_set}").renamed(
                 f"{robot.name} ({options.leg_set} legs)")
         robot = check_robot(robot)
-    if options.video is not None:
+    videos = [p for p in (options.video, options.push_clip, options.push_clip_held) if p is not None]
+    if videos:
         from .clip import check_video_path
 
-        check_video_path(options.video)
+        for path in videos:
+            check_video_path(path)
     if options.still is None and options.still_push is None:
         return robot, None
     from ..arucoboard import DEFAULT_BOARD, parse_board
@@ -144,7 +160,8 @@ def simulated(robot: Robot, options: SimOptions, progress: Callable[[int], None]
         from .samples import check_draws
 
         check_draws(robot, options.samples, cycles)   # before the robot's own run
-    keep = options.keep_states or options.video is not None   # the video reuses the rollout
+    # the video and the explanation reuse the rollout
+    keep = options.keep_states or options.video is not None or options.explain
     result = dataclasses.replace(_run.run(robot, cycles=cycles, keep_states=keep), robot=robot)
     if result.valid:
         from .statics import standing_load
@@ -162,11 +179,41 @@ def simulated(robot: Robot, options: SimOptions, progress: Callable[[int], None]
         from .sensitivity import outcome_sensitivity
 
         result.sensitivity = outcome_sensitivity(robot, cycles=cycles)
+    if options.explain and result.valid:
+        result.explanation = explained(robot, result, cycles, progress)
+        if not options.keep_states and options.video is None:
+            result.trajectory = None
     return result
 
 
+def explained(robot: Robot, result: SimResult, cycles: int | None, progress: Callable[[int], None] | None):
+    """The explanation of ``result`` (:func:`locust.sim.explain.explain`, on its own rollout).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot simulated.
+    result : SimResult
+        Its valid run, its rollout kept.
+    cycles : int or None
+        Hop cycles.
+    progress : callable, optional
+        ``progress(k)`` as each batch of ``k`` runs is done.
+
+    Returns
+    -------
+    locust.sim.explain.Explanation
+    """
+    from .explain import explain
+    from .sensitivity import RunFigures
+
+    figures = RunFigures(outcome=result.outcome or "", nose_rise_m=result.hops[0].nose_apex_m if result.hops else 0.0,
+                         distance_m=result.distance_m)
+    return explain(robot, cycles, progress, trajectory=result.trajectory, figures=figures)
+
+
 def rendered(result: SimResult, robot: Robot, options: SimOptions, board) -> None:
-    """Render the video and the stills asked for, each noted in ``result.notes``.
+    """Render the video, the stills and the push clips asked for, each noted in ``result.notes``.
 
     Parameters
     ----------
@@ -175,7 +222,8 @@ def rendered(result: SimResult, robot: Robot, options: SimOptions, board) -> Non
     robot : Robot
         The robot simulated.
     options : SimOptions
-        ``video``, ``camera``, ``still``, ``still_push``.
+        ``video``, ``camera``, ``still``, ``still_push``, ``push_clip``, ``push_clip_held``, ``push_fps``,
+        ``side``.
     board : locust.arucoboard.BoardSpec or None
         The stills' board.
 
@@ -189,15 +237,23 @@ def rendered(result: SimResult, robot: Robot, options: SimOptions, board) -> Non
             raise SimError("not rendering an invalid simulation", "fix the reasons listed above first")
         info = result.video(options.video, camera=options.camera)
         result.notes.append(f"video: {info.video_path} ({info.frames} frames); truth: {info.truth_path}")
-    if options.still is None and options.still_push is None:
-        return
-    from .still import render_stills
+    if options.still is not None or options.still_push is not None:
+        from .still import render_stills
 
-    if not result.valid:
-        raise SimError("not rendering stills of an invalid robot", "fix the reasons listed above first")
-    for still in render_stills(robot, options.still, options.still_push, board=board):
-        result.notes.append(f"still: {still.path} ({still.pose.kind}, crank {still.pose.crank_deg:.2f} deg from the "
-                            f"ground link); truth: {still.truth_path}")
+        if not result.valid:
+            raise SimError("not rendering stills of an invalid robot", "fix the reasons listed above first")
+        for still in render_stills(robot, options.still, options.still_push, board=board, side=options.side):
+            result.notes.append(f"still: {still.path} ({still.pose.kind}, crank {still.pose.crank_deg:.2f} deg from "
+                                f"the ground link); truth: {still.truth_path}")
+    if options.push_clip is not None or options.push_clip_held is not None:
+        from .pushclip import render_push_clips
+
+        if not result.valid:
+            raise SimError("not rendering push clips of an invalid robot", "fix the reasons listed above first")
+        for clip in render_push_clips(robot, options.push_clip, options.push_clip_held, side=options.side,
+                                      fps=options.push_fps):
+            result.notes.append(f"push clip: {clip.clip.video_path} ({clip.kind}, {clip.clip.frames} frames); crank "
+                                f"truth: {clip.crank_path}")
 
 
 def run_simulation(robot: Robot, options: SimOptions, progress: Callable[[int], None] | None = None) -> SimResult:

@@ -36,7 +36,8 @@ from .hops import summarise
 from .model import build
 from .outcome import classify
 from .rollout import Trajectory, roll_out
-from .schedule import ControlPlan
+from .schedule import ControlPlan, steps_per_tick
+from .supply_rollout import supply_stepper
 
 SIDES = ("left", "right")
 # The fixed camera is framed on a batch rollout of the planned schedule; the live run's
@@ -120,7 +121,9 @@ class LiveSim:
             path = check_video_path(video_path)
         self.robot = robot
         self.built = build(robot)
-        self.model = self.built.model
+        # a supply that limits the servos is solved each step (docs/servo.md, "Power")
+        self._stepper = supply_stepper(self.built, steps_per_tick(robot.solver.control_hz, robot.solver.timestep_s))
+        self.model = self.built.model if self._stepper is None else self._stepper.model
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         self.dt = float(self.model.opt.timestep)
@@ -222,7 +225,10 @@ class LiveSim:
         m, d, bad = self.model, self.data, self._divergence_warnings
         rows = np.empty((n, m.nsensordata))
         t0 = time.perf_counter()
+        stepper = self._stepper
         for i in range(n):
+            if stepper is not None:
+                stepper.before_step(d, self._steps + i)
             mujoco.mj_step(m, d)
             rows[i] = d.sensordata
             if bad[0].number or bad[1].number or bad[2].number:

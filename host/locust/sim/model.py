@@ -4,9 +4,14 @@ The chassis is a free body (a thin plate) carrying the two servo bodies; each le
 planar four-bar hung from it: ground link (fixed to the chassis at the servo axis, at
 ``geometry.ground_angle_deg`` to the plate) -> crank (servo joint) -> coupler (knee hinge) ->
 leg (ankle hinge) -> loop closed back onto the ground link's front pivot by a ``connect``
-equality. The floor's contacts are explicit pairs, each with its part's friction. Every body
-is placed in the assembled pose from :mod:`.fourbar`, so the loop is closed before the first
-step (``connect`` anchors are defined in the assembled pose).
+equality. Each of the four folds is a spring of its own (:func:`locust.params.side_values`):
+the servo, knee and ankle folds on their joints (``stiffness``, ``damping``, ``springref``
+relative to the assembled pose), the loop fold on a fixed tendon over the three joints whose
+length is that fold's deflection (:func:`loop_fold_coefficients`). The floor's contacts are
+explicit pairs, each with its part's friction. Every body is placed in its leg's assembled
+pose from :mod:`.fourbar` (each side's crank at its own start angle, its tooth included), so
+the loop is closed before the first step (``connect`` anchors are defined in the assembled
+pose).
 
 Numbers come from the robot parameters only; each one's provenance is in ``robot.toml``.
 The structure follows the notebook's Part 2 model so that the ``seed-notebook`` preset
@@ -23,10 +28,11 @@ import numpy as np
 
 from ..errors import SimError
 from ..markers import MARKER_COLOURS, hex_to_rgb01
-from ..params import GRAVITY_M_PER_S2, Robot, Servo
-from .fourbar import Assembly, assemble
+from ..params import GRAVITY_M_PER_S2, FoldValues, Robot, SideValues, side_values
+from .fourbar import Assembly, side_assembly
 from .servo import at_supply
 from .servo import configure as configure_servo
+from .supply import ServoSupply, servo_torque_cap_nm, supply_limits
 
 SIDES = ("L", "R")  # left leg at +y (faces the default camera), right leg at -y
 LINK_RGBA = {  # the notebook's colours
@@ -95,21 +101,26 @@ class BuiltModel:
     ----------
     model : mujoco.MjModel
         The compiled model.
-    assembly : Assembly
-        The linkage in the assembled pose every body was placed in.
+    assemblies : dict of str to Assembly
+        Each leg (``"L"``, ``"R"``) in the assembled pose its bodies were placed in.
     sensors : SensorLayout
         Where each sensor is in ``sensordata``.
     servo_actuators : tuple of int
         The servos' actuator ids, (L, R).
     link_lengths_m : tuple of float
         Ground, crank, coupler and leg lengths [m].
+    supply : ServoSupply or None
+        Where the supply limits the servos (:func:`.supply.supply_limits`), each servo as
+        identified and the supply, for the model to be stepped (:mod:`.supply_rollout`); None
+        where the compiled numbers are the servos on their supply.
     """
 
     model: mujoco.MjModel
-    assembly: Assembly
+    assemblies: dict[str, Assembly]
     sensors: SensorLayout
     servo_actuators: tuple[int, int]   # actuator ids (L, R)
     link_lengths_m: tuple[float, float, float, float]  # ground, crank, coupler, leg
+    supply: ServoSupply | None = None
 
 
 def _quat_euler_deg(x: float, y: float, z: float) -> np.ndarray:
@@ -118,32 +129,32 @@ def _quat_euler_deg(x: float, y: float, z: float) -> np.ndarray:
     return q
 
 
-def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
+def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, dict[str, Assembly]]:
     """The model as an ``MjSpec``, not yet compiled.
 
     Parameters
     ----------
     robot : Robot
-        The robot's parameters; the servo acts on its supply (:func:`.servo.at_supply`).
+        The robot's parameters, each leg's resolved by :func:`locust.params.side_values`; each
+        servo acts on the supply (:func:`.servo.at_supply`).
 
     Returns
     -------
     spec : mujoco.MjSpec
         The model's specification.
-    assembly : Assembly
-        The linkage in the assembled pose the bodies are placed in.
+    assemblies : dict of str to Assembly
+        Each leg's linkage in the assembled pose its bodies are placed in.
 
     Raises
     ------
     GeometryError
-        The link lengths make no four-bar, or its loop cannot close at
-        ``geometry.crank_start_deg``.
+        The link lengths make no four-bar, or a leg's loop cannot close at its crank's start
+        angle (``geometry.crank_start_deg`` and its tooth).
     SimError
         ``solver.integrator`` is not one of :data:`INTEGRATORS`.
     """
-    g, sol = robot.geometry, robot.solver
-    s = at_supply(robot.servo, robot.power)   # the servo on this supply (docs/servo.md, "Power")
-    asm = assemble(g.ground_m, g.crank_m, g.coupler_m, g.leg_m, g.crank_start_deg)
+    sol = robot.solver
+    asms = {side: side_assembly(robot, side) for side in SIDES}
     if sol.integrator not in INTEGRATORS:
         raise SimError(f"solver.integrator = {sol.integrator!r} is not known",
                        f"choose one of {', '.join(INTEGRATORS)}")
@@ -153,10 +164,10 @@ def build_spec(robot: Robot) -> tuple[mujoco.MjSpec, Assembly]:
     _add_scene(spec)
     chassis = _add_chassis(spec, robot)
     for side in SIDES:
-        _add_leg(spec, chassis, robot, side, asm, s)
+        _add_leg(spec, chassis, robot, side_values(robot, side), asms[side])
     _floor_pairs(spec, robot.contact)
     _add_sensors(spec)
-    return spec, asm
+    return spec, asms
 
 
 def _set_options(spec: mujoco.MjSpec, robot: Robot) -> None:
@@ -221,11 +232,14 @@ def _add_chassis(spec: mujoco.MjSpec, robot: Robot):
     return chassis
 
 
-def _add_leg(spec: mujoco.MjSpec, chassis, robot: Robot, side: str, asm: Assembly, s: Servo) -> None:
+def _add_leg(spec: mujoco.MjSpec, chassis, robot: Robot, values: SideValues, asm: Assembly) -> None:
     """One side's servo body and four-bar leg (ground, crank on the servo joint, coupler and
-    leg on folded hinges), the loop-closing equality and the servo's actuator; ``s`` is the
-    servo on the robot's supply."""
-    g, c, k, sol = robot.geometry, robot.compliance, robot.contact, robot.solver
+    leg on folded hinges), the loop-closing equality, the loop fold's tendon and the servo's
+    actuator (on the robot's supply, docs/servo.md "Power"), from the side's ``values``."""
+    g, k, sol = robot.geometry, robot.contact, robot.solver
+    side, folds = values.side, values.folds
+    s = at_supply(values.servo, robot.power)
+    trim = math.radians(values.trim_deg)
     half_w, half_t = g.link_width_m / 2, g.link_thickness_m / 2
     foot_material = [k.foot_friction, k.torsional_friction, k.rolling_friction]
     rho, selfc, rounded = g.link_density_kg_per_m3, bool(k.self_collision), bool(k.rounded_edges)
@@ -248,19 +262,21 @@ def _add_leg(spec: mujoco.MjSpec, chassis, robot: Robot, side: str, asm: Assembl
     # chain is the mirror image of the planar solution, closed at the same anchor.
     crank = ground.add_body(name=f"{side}_crank", pos=[-g.ground_m / 2, 0, 0],
                             quat=_quat_euler_deg(0, asm.crank_deg, 0))
-    # the crank turns on the servo shaft, in parallel with the laminate's folded hinge
+    # the crank turns on the servo shaft, in parallel with the laminate's folded hinge; the
+    # horn's travel about the rest its trim gives it
     servo_joint = crank.add_joint(name=f"{side}_servo", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
-                                  range=[-math.radians(s.travel_deg), math.radians(s.travel_deg)],
+                                  range=[trim - math.radians(s.travel_deg), trim + math.radians(s.travel_deg)],
                                   limited=mujoco.mjtLimited.mjLIMITED_TRUE,
-                                  stiffness=c.hinge_stiffness_nm_per_rad)
+                                  stiffness=folds["servo"].stiffness_nm_per_rad,
+                                  springref=math.radians(folds["servo"].rest_offset_deg))
     _link_box(crank, g.crank_m, half_w, half_t, LINK_RGBA["crank"], foot_material, rho, selfc, rounded)
     coupler = crank.add_body(name=f"{side}_coupler", pos=[g.crank_m, 0, 0],
                              quat=_quat_euler_deg(0, asm.coupler_rel_deg, 0))
-    _hinge(coupler, f"{side}_knee", c)
+    _hinge(coupler, f"{side}_knee", folds["knee"])
     _link_box(coupler, g.coupler_m, half_w, half_t, LINK_RGBA["coupler"], foot_material, rho, selfc, rounded)
     leg = coupler.add_body(name=f"{side}_leg", pos=[g.coupler_m, 0, 0],
                            quat=_quat_euler_deg(0, asm.leg_rel_deg, 0))
-    _hinge(leg, f"{side}_ankle", c)
+    _hinge(leg, f"{side}_ankle", folds["ankle"])
     _link_box(leg, g.leg_m, half_w, half_t, LINK_RGBA["leg"], foot_material, rho, selfc, rounded)
     leg.add_site(name=f"{side}_foot", pos=[0, 0, 0], size=[0.004, 0, 0])
     if side == "L":   # foot dot: on the leg's camera-facing face, up the leg from the foot
@@ -274,9 +290,11 @@ def _add_leg(spec: mujoco.MjSpec, chassis, robot: Robot, side: str, asm: Assembl
                       data=[g.ground_m / 2, 0, 0] + [0.0] * 7 + [1.0, 0.0],  # as MJCF fills it
                       solref=[sol.loop_timeconst_s, 1.0],
                       solimp=[sol.loop_dmin, sol.loop_dmax, 0.001, 0.5, 2.0])
+    _loop_fold(spec, side, folds["loop"])
     act = spec.add_actuator(name=f"{side}_servo", target=f"{side}_servo",
                             trntype=mujoco.mjtTrn.mjTRN_JOINT)
-    configure_servo(servo_joint, act, s, joint_damping_nms_per_rad=c.hinge_damping_nms_per_rad)
+    configure_servo(servo_joint, act, s, joint_damping_nms_per_rad=folds["servo"].damping_nms_per_rad,
+                    trim_rad=trim, torque_cap_nm=servo_torque_cap_nm(values.servo, robot.power))
     act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
     act.ctrlrange = [-math.radians(s.travel_deg), math.radians(s.travel_deg)]
 
@@ -339,9 +357,48 @@ def _floor_pairs(spec: mujoco.MjSpec, contact) -> None:
             geom.contype = geom.conaffinity = 0
 
 
-def _hinge(body, name: str, c) -> None:
+def _hinge(body, name: str, fold: FoldValues) -> None:
+    """A folded film hinge: a joint with the fold's spring, unloaded at its rest offset from
+    the assembled pose (qpos 0)."""
     body.add_joint(name=name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
-                   stiffness=c.hinge_stiffness_nm_per_rad, damping=c.hinge_damping_nms_per_rad)
+                   stiffness=fold.stiffness_nm_per_rad, damping=fold.damping_nms_per_rad,
+                   springref=math.radians(fold.rest_offset_deg))
+
+
+# The loop fold (leg end -> ground link's front pivot) has no joint: the connect equality
+# closes the loop and leaves the leg's end free to turn. Its angle is the ground link's
+# direction less the leg's, and the leg's is the crank's start angle plus the servo, knee and
+# ankle joints' turns (each joint turns the links after it the same way), so the fold's
+# deflection from the assembled pose is minus their sum: a fixed tendon of these coefficients
+LOOP_FOLD_JOINTS = ("servo", "knee", "ankle")
+
+
+def loop_fold_coefficients() -> dict[str, float]:
+    """The loop fold's tendon: each joint's coefficient in the fold's deflection.
+
+    Returns
+    -------
+    dict of str to float
+        Joint (without its side's prefix) -> coefficient: the deflection [rad] is
+        ``sum(coefficient * q)`` over the servo, knee and ankle joints.
+    """
+    return {joint: -1.0 for joint in LOOP_FOLD_JOINTS}
+
+
+# MuJoCo reads a spring length of (-1, -1) as "the length at the spring pose", not -1 rad
+_MUJOCO_UNSET_LENGTH = -1.0
+
+
+def _loop_fold(spec: mujoco.MjSpec, side: str, fold: FoldValues) -> None:
+    """The loop fold's spring: a fixed tendon whose length is the fold's deflection, its
+    spring unloaded at the fold's rest offset."""
+    rest = math.radians(fold.rest_offset_deg)
+    if rest == _MUJOCO_UNSET_LENGTH:
+        rest = math.nextafter(rest, 0.0)
+    tendon = spec.add_tendon(name=f"{side}_loop_fold", stiffness=[fold.stiffness_nm_per_rad, 0.0, 0.0],
+                             damping=[fold.damping_nms_per_rad, 0.0, 0.0], springlength=[rest, rest])
+    for joint, coefficient in loop_fold_coefficients().items():
+        tendon.wrap_joint(f"{side}_{joint}", coefficient)
 
 
 # Collision bits: the floor collides with everything; robot parts collide with the floor and,
@@ -465,11 +522,11 @@ def build(robot: Robot) -> BuiltModel:
     SimError
         An unknown integrator, or MuJoCo's compiler refused a value.
     """
-    spec, asm = build_spec(robot)
-    return compile_spec(spec, asm, robot)
+    spec, asms = build_spec(robot)
+    return compile_spec(spec, asms, robot)
 
 
-def compile_spec(spec: mujoco.MjSpec, asm: Assembly, robot: Robot) -> BuiltModel:
+def compile_spec(spec: mujoco.MjSpec, asms: dict[str, Assembly], robot: Robot) -> BuiltModel:
     """Compile a spec of ``robot``'s model (:func:`build_spec`, perhaps with parts added: a
     still's stickers, a hand holding the plate) into a :class:`BuiltModel`.
 
@@ -477,8 +534,8 @@ def compile_spec(spec: mujoco.MjSpec, asm: Assembly, robot: Robot) -> BuiltModel
     ----------
     spec : mujoco.MjSpec
         The specification, from :func:`build_spec`.
-    asm : Assembly
-        The assembly :func:`build_spec` returned with it.
+    asms : dict of str to Assembly
+        The assemblies :func:`build_spec` returned with it.
     robot : Robot
         The robot it was built from (its link lengths).
 
@@ -498,8 +555,11 @@ def compile_spec(spec: mujoco.MjSpec, asm: Assembly, robot: Robot) -> BuiltModel
         raise SimError(f"MuJoCo could not compile the model: {exc}",
                        "check the robot parameters named in the message") from None
     ids = tuple(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, f"{s}_servo") for s in SIDES)
-    return BuiltModel(model=model, assembly=asm, sensors=_layout(model), servo_actuators=ids,
-                      link_lengths_m=robot.link_lengths_m())  # type: ignore[arg-type]
+    servos = tuple(side_values(robot, side).servo for side in SIDES)
+    limiting = any(supply_limits(servo, robot.power) for servo in servos)
+    return BuiltModel(model=model, assemblies=asms, sensors=_layout(model), servo_actuators=ids,
+                      link_lengths_m=robot.link_lengths_m(),  # type: ignore[arg-type]
+                      supply=ServoSupply(servos, robot.power) if limiting else None)
 
 
 def loop_closure_error_m(model: mujoco.MjModel, data: mujoco.MjData) -> float:

@@ -70,6 +70,9 @@ def simulate_refined(built: BuiltModel, plan: ControlPlan, fine_s: float, window
                      keep_states: bool = False) -> Refined:
     """``plan`` on ``built`` at the plan's step, each contact change taken again at ``fine_s``
     for ``window_s`` (see the module docstring)."""
+    if built.supply is not None:   # its servos follow the rail step by step (supply_rollout), not the rollout
+        raise SimError("the refined step does not solve a supply that limits the servos (docs/servo.md, Power)",
+                       "simulate it at one step (locust.sim.run), or on a supply that holds the servos' stall")
     dt = plan.timestep_s
     per_coarse = int(round(dt / fine_s))
     if per_coarse < 1 or abs(per_coarse * fine_s - dt) > 1e-12 * dt:

@@ -64,11 +64,13 @@ class SimResult:
     nose_load_kg: float = float("nan")     # standing at the 0 deg command, the nose's share of the weight
     total_mass_kg: float = float("nan")
     sensitivity: object | None = field(default=None, repr=False, compare=False)  # sim.sensitivity.Sensitivity
+    explanation: object | None = field(default=None, repr=False, compare=False)  # sim.explain.Explanation
 
     def to_json(self) -> dict:
         """Every figure but the rollout and the robot; from :func:`locust.simulate`, also the standing
         load, with samples each outcome's share and figures (``outcomes``) and the draws
-        (``samples``), and with a sensitivity, ``sensitivity``. NaN and inf become null where it is
+        (``samples``), with a sensitivity, ``sensitivity``, with an explanation, ``explanation``. NaN
+        and inf become null where it is
         written (:func:`locust.fileio.json_text`).
 
         Returns
@@ -76,8 +78,9 @@ class SimResult:
         dict
             The figures by name, in SI units as the field names say.
         """
-        out = dataclasses.asdict(dataclasses.replace(self, trajectory=None, robot=None, spread=None, sensitivity=None))
-        for key in ("trajectory", "robot", "spread", "sensitivity"):
+        out = dataclasses.asdict(dataclasses.replace(self, trajectory=None, robot=None, spread=None, sensitivity=None,
+                                                     explanation=None))
+        for key in ("trajectory", "robot", "spread", "sensitivity", "explanation"):
             del out[key]
         out = {"robot": out.pop("robot_name"), **out}   # the JSON names the robot by its name
         if self.robot is None:   # a bare run (not locust.simulate's): no standing load was asked for
@@ -87,6 +90,8 @@ class SimResult:
             out.update(outcomes=sp["outcomes"], samples=sp)
         if self.sensitivity is not None:
             out["sensitivity"] = self.sensitivity.to_json()
+        if self.explanation is not None:
+            out["explanation"] = self.explanation.to_json()
         return out
 
     # -- tables ----------------------------------------------------------------------

@@ -18,6 +18,7 @@ from ..params import Robot, check_robot
 from .batching import check_batch, rollout_chunked
 from .model import BuiltModel, build
 from .schedule import ControlPlan, control_plan
+from .supply_rollout import stepped_rollout
 
 
 @dataclass
@@ -209,12 +210,35 @@ def simulate_built(built: BuiltModel, plan: ControlPlan, keep_states: bool = Fal
     return simulate_batch([built], plan, keep_states=keep_states)[0]
 
 
+def servo_control(built: BuiltModel, plan: ControlPlan) -> np.ndarray:
+    """The actuators' commands of every step of ``plan`` on ``built``.
+
+    Parameters
+    ----------
+    built : BuiltModel
+        The model.
+    plan : ControlPlan
+        The servo command of every step.
+
+    Returns
+    -------
+    ndarray
+        ``(nstep, nu)`` each actuator's command at each step [rad].
+    """
+    control = np.zeros((plan.nstep, built.model.nu))
+    for act in built.servo_actuators:
+        control[:, act] = plan.ctrl_rad
+    return control
+
+
 def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: bool = False,
                    threads: int | None = None) -> list[Trajectory]:
     """Several models of one structure (a fit's candidates, draws of the uncertain values) on
     one plan, in one ``mujoco.rollout`` call on ``threads`` threads (default: every core).
     MuJoCo counts its warnings per thread, not per model: when a batch raised any, each model
     is run again alone, so that every trajectory carries its own warnings for the audit.
+    Models whose supply limits their servos are stepped in Python instead
+    (:func:`.supply_rollout.stepped_rollout`), in a batch of their own.
 
     Parameters
     ----------
@@ -237,17 +261,27 @@ def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: boo
     SimError
         The batch's record would be over the memory limit.
     """
+    stepped = [b.supply is not None for b in builts]
+    if any(stepped) and not all(stepped):   # each kind in its own batch, the record in the given order
+        out: dict[int, Trajectory] = {}
+        for kind in (False, True):
+            index = [i for i, s in enumerate(stepped) if s == kind]
+            for i, traj in zip(index, simulate_batch([builts[i] for i in index], plan, keep_states, threads)):
+                out[i] = traj
+        return [out[i] for i in range(len(builts))]
     models = [b.model for b in builts]
     starts = [initial_state(b) for b in builts]
-    control = np.zeros((len(models), plan.nstep, models[0].nu))
-    for act in builts[0].servo_actuators:
-        control[:, :, act] = plan.ctrl_rad
-    n_threads = max(1, min(threads or available_cores(), len(models)))
-    datas = [mujoco.MjData(models[0]) for _ in range(n_threads)]
+    control = np.stack([servo_control(b, plan) for b in builts])
     check_batch(models[0], len(models), plan.nstep, keep_states)
     t0 = time.perf_counter()
-    states, sensordata, final, warnings = rollout_chunked(models, datas, np.array([s for s, _ in starts]), control,
-                                                          keep_states)
+    if stepped[0]:   # the supply limits them: stepped in Python (docs/servo.md, "Power")
+        states, sensordata, final, warnings = stepped_rollout(builts, np.array([s for s, _ in starts]), control,
+                                                              keep_states, plan.steps_per_tick)
+    else:
+        n_threads = max(1, min(threads or available_cores(), len(models)))
+        datas = [mujoco.MjData(models[0]) for _ in range(n_threads)]
+        states, sensordata, final, warnings = rollout_chunked(models, datas, np.array([s for s, _ in starts]),
+                                                              control, keep_states)
     wall = time.perf_counter() - t0
     nq = models[0].nq
     if len(models) > 1 and warnings:

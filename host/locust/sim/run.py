@@ -10,14 +10,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import GeometryError
-from ..params import Robot, check_robot
+from ..params import Robot, check_robot, side_values
 from .audit import audit
-from .fourbar import GOOD_TRANSMISSION_DEG
+from .fourbar import GOOD_TRANSMISSION_DEG, Assembly
 from .hops import summarise
-from .model import build
+from .model import SIDES, build
 from .outcome import classify
 from .result import SimResult, invalid_result
 from .rollout import roll_out
+from .supply import limit_note
 
 # a robot whose nose ends the run this far above its standing height did not come back down
 # from a push (a robot that hops and lands again stands within a few millimetres of its start)
@@ -64,14 +65,18 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
     summary = summarise(traj) if verdict.valid else None
     nan = float("nan")
     notes = list(verdict.notes)
-    asm = built.assembly
     lo, hi = GOOD_TRANSMISSION_DEG
     if summary and summary.end_nose_rise_m > STAYED_UP_M:
         notes.append(f"did not come back down: the nose ends {summary.end_nose_rise_m * 1000:.0f} mm above its "
                      "standing height (it went over onto its back), so a hop's nose rise after the one that "
                      "reared is its resting height, not a hop")
+    asm = worst_transmission(built.assemblies)
     if not lo <= asm.transmission_deg <= hi:
-        notes.append(f"poor transmission angle {asm.transmission_deg:.0f} deg at the start (outside {lo:g}-{hi:g})")
+        where = "" if len({a.transmission_deg for a in built.assemblies.values()}) == 1 else " on one leg"
+        notes.append(f"poor transmission angle {asm.transmission_deg:.0f} deg at the start{where} "
+                     f"(outside {lo:g}-{hi:g})")
+    if (supply := limit_note(robot.servo, robot.power)) is not None:
+        notes.append(supply)
     return SimResult(
         robot_name=robot.name, valid=verdict.valid, reasons=verdict.reasons,
         distance_m=summary.distance_m if summary else nan,
@@ -81,11 +86,27 @@ def run(robot: Robot, cycles: int | None = None, timestep_s: float | None = None
         duration_s=traj.plan.duration_s, wall_s=traj.wall_s,
         loop_residual_max_m=verdict.loop_residual_max_m, energy_surplus_max_j=verdict.energy_surplus_max_j,
         servo_work_j=verdict.servo_work_j, servo_peak_speed_rad_per_s=peak_servo_speed(traj),
-        servo_noload_speed_rad_per_s=robot.servo.noload_speed_rad_per_s, grashof=asm.grashof,
+        servo_noload_speed_rad_per_s=min(side_values(robot, side).servo.noload_speed_rad_per_s for side in SIDES),
+        grashof=asm.grashof,
         transmission_deg=asm.transmission_deg,
         notes=notes, trajectory=traj if keep_states else None,
         outcome=classify(summary.hops) if summary else None,
     )
+
+
+def worst_transmission(assemblies: dict[str, Assembly]) -> Assembly:
+    """Of the legs' assemblies, the one whose transmission angle is farthest from 90 deg.
+
+    Parameters
+    ----------
+    assemblies : dict of str to Assembly
+        Each leg's, as :attr:`.model.BuiltModel.assemblies`.
+
+    Returns
+    -------
+    Assembly
+    """
+    return max(assemblies.values(), key=lambda a: abs(a.transmission_deg - 90.0))
 
 
 def peak_servo_speed(traj) -> float:

@@ -11,16 +11,17 @@ settles the prediction. All the runs go in one batched rollout.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..errors import GeometryError
 from ..params import Provenance, Robot, problems
 from .audit import audit
 from .hops import summarise
-from .model import build
+from .model import BuiltModel, build
 from .outcome import classify
-from .rollout import simulate_batch
-from .samples import MIN_FRACTION, uncertain_values
+from .rollout import available_cores, simulate_batch
+from .samples import BATCH_PER_CORE, MIN_FRACTION, uncertain_values
 from .schedule import control_plan
 
 K_SD = 2.0
@@ -74,23 +75,76 @@ class Sensitivity:
         return out
 
 
-def _outcomes(robots: list[Robot], cycles: int | None) -> list[str | None]:
-    """Each robot's outcome, all simulated in one batch; None for one that cannot be run or
-    fails its audit."""
-    builts = []
-    for r in robots:
+@dataclass(frozen=True)
+class RunFigures:
+    """What one run of a batch gives: its outcome, its first hop's nose rise and its distance.
+
+    Attributes
+    ----------
+    outcome : str
+        One of :data:`~.outcome.OUTCOMES`.
+    nose_rise_m : float
+        The first hop's nose rise above standing [m] (``Hop.nose_apex_m``).
+    distance_m : float
+        The run's distance, start of the schedule to its end [m].
+    """
+
+    outcome: str
+    nose_rise_m: float
+    distance_m: float
+
+
+def run_figures(robots: list[Robot], cycles: int | None,
+                progress: Callable[[int], None] | None = None) -> list[RunFigures | None]:
+    """Each robot's outcome and figures, simulated in batched rollouts (one per hop schedule and
+    solver among them, in chunks of :data:`~.samples.BATCH_PER_CORE` a core when ``progress``
+    is given); None for one that cannot be built or run, or fails its audit.
+
+    Parameters
+    ----------
+    robots : list of Robot
+        The robots, all of one structure.
+    cycles : int or None
+        Hop cycles (None: each robot's schedule's).
+    progress : callable, optional
+        ``progress(k)`` as each chunk of ``k`` robots is done.
+
+    Returns
+    -------
+    list of RunFigures or None
+        One per robot, in order.
+    """
+    out: list[RunFigures | None] = [None] * len(robots)
+    builts: dict[int, BuiltModel] = {}
+    groups: dict[tuple, list[int]] = {}
+    for i, r in enumerate(robots):
         try:
-            builts.append(None if problems(r, cycles) else build(r))
+            if not problems(r, cycles):
+                builts[i] = build(r)
+                groups.setdefault((r.schedule, r.solver), []).append(i)
         except GeometryError:
-            builts.append(None)
-    ok = [b for b in builts if b is not None]
-    plan = control_plan(robots[0].schedule, robots[0].solver, cycles)
-    trajs = iter(simulate_batch(ok, plan) if ok else [])
-    out: list[str | None] = []
-    for b in builts:
-        traj = next(trajs) if b is not None else None
-        out.append(classify(summarise(traj).hops) if traj is not None and audit(traj).valid else None)
+            pass
+    if progress and len(builts) < len(robots):
+        progress(len(robots) - len(builts))
+    chunk = max(1, BATCH_PER_CORE * available_cores()) if progress else len(robots) or 1
+    for (schedule, solver), members in groups.items():
+        plan = control_plan(schedule, solver, cycles)
+        for start in range(0, len(members), chunk):
+            part = members[start:start + chunk]
+            for i, traj in zip(part, simulate_batch([builts[i] for i in part], plan)):
+                if audit(traj).valid:
+                    summary = summarise(traj)
+                    hops = summary.hops
+                    out[i] = RunFigures(outcome=classify(hops), nose_rise_m=hops[0].nose_apex_m if hops else 0.0,
+                                        distance_m=summary.distance_m)
+            if progress:
+                progress(len(part))
     return out
+
+
+def _outcomes(robots: list[Robot], cycles: int | None) -> list[str | None]:
+    """Each robot's outcome (:func:`run_figures`); None for one that cannot be run."""
+    return [f.outcome if f is not None else None for f in run_figures(robots, cycles)]
 
 
 def outcome_sensitivity(robot: Robot, cycles: int | None = None, k_sd: float = K_SD) -> Sensitivity:
@@ -129,4 +183,4 @@ def outcome_sensitivity(robot: Robot, cycles: int | None = None, k_sd: float = K
     return Sensitivity(nominal=kinds[0], k_sd=k_sd, effects=effects)
 
 
-__all__ = ["KeyEffect", "Sensitivity", "outcome_sensitivity", "K_SD"]
+__all__ = ["KeyEffect", "RunFigures", "Sensitivity", "outcome_sensitivity", "run_figures", "K_SD"]

@@ -21,16 +21,19 @@ the output shaft for a duty ``u`` in [-1, 1], terminal voltage ``V``, winding re
 ``R``, output-referred constant ``K`` and gearbox efficiency ``eta``: stall torque
 ``eta*K*V/R`` and no-load speed ``V/K`` both grow in proportion to ``V``, and the back-EMF
 damping ``eta*K^2/R`` is their ratio. Two servos on one supply of resistance ``R_s`` drawing
-the same current (the legs get the same command) see ``V = V_s - 2*R_s*I``: each acts as a
-motor on the full supply voltage behind ``R + 2*R_s``. So the servo's identified figures
-(at ``reference_voltage_v`` on its terminals) become, on the supply::
+the same current (the legs get the same command) see ``V = V_s - 2*R_s*I`` (``V_s`` the plug's
+voltage at rest, the board's own draw in it): each acts as a motor on ``V_s`` behind
+``R + 2*R_s``. So the servo's identified figures (at ``reference_voltage_v`` on its terminals)
+become, on the supply::
 
     stall  = stall_ref * (V_s / V_ref) * R / (R + 2 R_s)
     noload = noload_ref * (V_s / V_ref)
     kp     = kp_ref * stall / stall_ref          (the controller's duty gain is fixed)
 
 which are still a clamped position actuator plus joint damping: exact for the symmetric hop
-and integrated by MuJoCo itself (rollouts included), no per-step callback.
+at full duty and integrated by MuJoCo itself (rollouts included), no per-step callback. The
+source's current limit caps the clamp (:func:`.supply.servo_torque_cap_nm`: exact at stall);
+where it binds, or the servos brown out, the model is stepped instead (:mod:`.supply_rollout`).
 """
 
 from __future__ import annotations
@@ -42,8 +45,7 @@ import math
 import mujoco
 
 from ..params import Power, Servo
-
-SERVOS_ON_SUPPLY = 2   # both legs' servos share the supply (and its resistance)
+from .supply import SERVOS_ON_SUPPLY
 
 
 def at_supply(servo: Servo, power: Power) -> Servo:
@@ -55,7 +57,8 @@ def at_supply(servo: Servo, power: Power) -> Servo:
     servo : Servo
         The servo as identified at ``reference_voltage_v`` [V] on its terminals.
     power : Power
-        The supply: its voltage [V] and source resistance [ohm], shared by both servos.
+        The supply: its voltage at the servo plug at rest [V] and source resistance [ohm],
+        shared by both servos (its current limit is :func:`.supply.servo_torque_cap_nm`'s).
 
     Returns
     -------
@@ -94,11 +97,15 @@ def back_emf_damping_nms_per_rad(servo: Servo) -> float:
 
 
 def configure(joint: mujoco.MjsJoint, actuator: mujoco.MjsActuator, servo: Servo,
-              joint_damping_nms_per_rad: float = 0.0) -> None:
+              joint_damping_nms_per_rad: float = 0.0, trim_rad: float = 0.0,
+              torque_cap_nm: float = math.inf) -> None:
     """Make ``actuator`` (on ``joint``) the servo, in place on the spec.
 
     Sets the joint's linear damping and armature and the actuator's position gains and
-    force range (the clamp at the stall torque).
+    force range (the clamp at the stall torque, or at ``torque_cap_nm`` below it). A trim is
+    added to every command inside the controller: the position actuator's bias
+    ``kp * (trim - q)``, so the servo's target is the command (clamped to the control range)
+    plus the trim, as the firmware's is.
 
     Parameters
     ----------
@@ -111,15 +118,24 @@ def configure(joint: mujoco.MjsJoint, actuator: mujoco.MjsActuator, servo: Servo
     joint_damping_nms_per_rad : float
         The joint's own damping (a flexure hinge in parallel with the servo), added to the
         servo's back-EMF damping [N·m·s/rad].
+    trim_rad : float
+        The trim added to every command [rad].
+    torque_cap_nm : float
+        The drive's cap from the supply's current limit [N·m] (inf: none); the back-EMF damping
+        stays outside it.
     """
     damping = list(joint.damping)   # [linear, higher-order terms]
     damping[0] = joint_damping_nms_per_rad + back_emf_damping_nms_per_rad(servo)
     joint.damping = damping
     joint.armature = servo.armature_kgm2
     actuator.set_to_position(kp=servo.kp_nm_per_rad, kv=servo.kv_nms_per_rad)
+    bias = list(actuator.biasprm)   # [0, -kp, -kv, ...]: force = kp*ctrl + bias . (1, q, qdot)
+    bias[0] = servo.kp_nm_per_rad * trim_rad
+    actuator.biasprm = bias
     # the drive saturates: a hobby servo never exceeds its stall torque
     actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
-    actuator.forcerange = [-servo.stall_torque_nm, servo.stall_torque_nm]
+    clamp = min(servo.stall_torque_nm, torque_cap_nm)
+    actuator.forcerange = [-clamp, clamp]
 
 
 def with_servo(model: mujoco.MjModel, servo: Servo, joint_damping_nms_per_rad: float = 0.0,

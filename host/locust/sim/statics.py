@@ -19,6 +19,7 @@ from ..errors import SimError
 from ..params import Robot, check_robot
 from .model import build
 from .schedule import control_plan
+from .supply_rollout import supply_stepper
 
 AT_REST_REL = 0.01   # the floor's normal forces must carry the weight to 1 %: the robot is still
 # a robot whose schedule starts as it is dropped (seed-notebook: settle_s 0) still stands on the
@@ -78,11 +79,14 @@ def standing_load(robot: Robot) -> StandingLoad:
     if robot.solver.settle_s < MIN_SETTLE_S:
         robot = robot.with_values({"solver.settle_s": MIN_SETTLE_S}, "statics")
     built = build(robot)
-    model = built.model
-    data = mujoco.MjData(model)
     plan = control_plan(robot.schedule, robot.solver, 1)
+    stepper = supply_stepper(built, plan.steps_per_tick)   # a supply that limits the servos (docs/servo.md)
+    model = built.model if stepper is None else stepper.model
+    data = mujoco.MjData(model)
     for k in range(plan.settle_steps):
         data.ctrl[list(built.servo_actuators)] = plan.ctrl_rad[k]
+        if stepper is not None:
+            stepper.before_step(data, k)
         mujoco.mj_step(model, data)
     mujoco.mj_forward(model, data)
     geom = mujoco.mjtObj.mjOBJ_GEOM

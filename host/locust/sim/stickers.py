@@ -33,16 +33,18 @@ KNEE_UP_M = 0.008                   # the knee dot, up the leg from the coupler-
 FOOT_UP_M = 0.025                   # the leg's dot, up from the coupler-leg joint (the videos' foot dot)
 
 
-def on_bodies(g: Geometry) -> dict[str, tuple[str, float]]:
+def on_bodies(g: Geometry, side: str = "L") -> dict[str, tuple[str, float]]:
     """Sticker -> (the model's body it is on, distance along that body's x axis), metres.
 
     The plate's dots are on the chassis (its x axis runs along the plate); the link dots on
-    the left leg's links, whose bodies start at their first joint and run along the link.
+    the side's leg's links, whose bodies start at their first joint and run along the link.
 
     Parameters
     ----------
     g : Geometry
         The robot's geometry.
+    side : str
+        The leg the link dots are on: ``L`` (the default camera's, at +y) or ``R`` (at -y).
 
     Returns
     -------
@@ -51,10 +53,10 @@ def on_bodies(g: Geometry) -> dict[str, tuple[str, float]]:
     """
     return {"nose": ("chassis", g.nose_x_m + PLATE_INSET_M),
             "tail": ("chassis", g.body_length_m / 2 - PLATE_INSET_M),
-            "axis": ("L_crank", 0.0),
-            "crank": ("L_crank", g.crank_m - CRANK_INSET_M),
-            "knee": ("L_leg", KNEE_UP_M),
-            "foot": ("L_leg", FOOT_UP_M)}
+            "axis": (f"{side}_crank", 0.0),
+            "crank": (f"{side}_crank", g.crank_m - CRANK_INSET_M),
+            "knee": (f"{side}_leg", KNEE_UP_M),
+            "foot": (f"{side}_leg", FOOT_UP_M)}
 
 
 def plate_points(g: Geometry, crank_deg: float, ground_angle_deg: float, servo_axis_x_m: float) -> np.ndarray:

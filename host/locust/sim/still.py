@@ -35,9 +35,9 @@ from ..errors import SimError
 from ..fileio import atomic_write_bytes, atomic_write_text, check_distinct
 from ..io.camera_json import CameraFile, MarkerPlane, write_camera_json
 from ..markers import STICKER_COLOURS, hex_to_rgb01
-from ..params import Robot
+from ..params import Robot, side_values
 from .audit import audit
-from .camera import PinholeCamera, frame_views
+from .camera import PinholeCamera, frame_views, side_azimuth_deg
 from .clip import PoseRenderer, face_centre_m, seen_fraction, sidecar_paths, validate_size
 from .model import SIDES, build_spec, compile_spec
 from .rollout import simulate_built
@@ -60,8 +60,8 @@ class StillPose:
     kind: str                   # "rest" or "push"
     qpos: np.ndarray
     command_deg: float          # the servos' command
-    servo_deg: float            # the left servo joint's angle (its turn from the crank's start angle)
-    crank_deg: float            # the left crank from its ground link: crank_start_deg + servo_deg
+    servo_deg: float            # the side's servo joint's angle (its turn from the crank's start angle)
+    crank_deg: float            # the side's crank from its ground link: its start (tooth included) + servo_deg
 
 
 @dataclass(frozen=True)
@@ -96,17 +96,19 @@ def _audited_final(built, plan: ControlPlan, what: str) -> np.ndarray:
     return traj.states[-1, 1:1 + built.model.nq].copy()
 
 
-def _servo_deg(model: mujoco.MjModel, qpos: np.ndarray) -> float:
-    return math.degrees(float(qpos[model.jnt_qposadr[model.joint("L_servo").id]]))
+def _servo_deg(model: mujoco.MjModel, qpos: np.ndarray, side: str) -> float:
+    return math.degrees(float(qpos[model.jnt_qposadr[model.joint(f"{side}_servo").id]]))
 
 
-def rest_pose(robot: Robot) -> StillPose:
+def rest_pose(robot: Robot, side: str = "L") -> StillPose:
     """The robot settled on the floor at the 0 deg command (``solver.settle_s``), audited.
 
     Parameters
     ----------
     robot : Robot
         The robot.
+    side : str
+        The leg whose servo and crank the pose reports: ``L`` or ``R``.
 
     Returns
     -------
@@ -121,13 +123,13 @@ def rest_pose(robot: Robot) -> StillPose:
     spec, asm = build_spec(robot)
     built = compile_spec(spec, asm, robot)
     qpos = _audited_final(built, _plan(robot, 0.0, 0.0), "rest")
-    servo = _servo_deg(built.model, qpos)
-    return StillPose("rest", qpos, 0.0, servo, robot.geometry.crank_start_deg + servo)
+    servo = _servo_deg(built.model, qpos, side)
+    return StillPose("rest", qpos, 0.0, servo, side_values(robot, side).crank_start_deg + servo)
 
 
-def push_pose(robot: Robot, rest: StillPose) -> StillPose:
-    """The robot held by its plate :data:`HELD_ABOVE_M` above its rest pose, the push command
-    held for :data:`HOLD_S`, audited.
+def held_model(robot: Robot, rest: StillPose):
+    """The robot held by its plate :data:`HELD_ABOVE_M` above its rest pose: the model with the
+    hand (a weld of the plate to the world where it was built), and the robot it was built from.
 
     Parameters
     ----------
@@ -138,15 +140,11 @@ def push_pose(robot: Robot, rest: StillPose) -> StillPose:
 
     Returns
     -------
-    StillPose
-        The held pose at the push command, its servo and crank angles [deg].
-
-    Raises
-    ------
-    SimError
-        The holding run fails its audit.
+    built : BuiltModel
+        The held model.
+    held : Robot
+        ``robot`` raised to the hand: its drop height and pitch those of the rest pose.
     """
-    g = robot.geometry
     chassis_z = float(rest.qpos[2])
     quat = rest.qpos[3:7]
     # the rest attitude as the chassis' euler (180, pitch, 180): a turn about y only
@@ -159,19 +157,47 @@ def push_pose(robot: Robot, rest: StillPose) -> StillPose:
     # quaternion takes the relative pose from the reference configuration)
     spec.add_equality(name="hand", type=mujoco.mjtEq.mjEQ_WELD, objtype=mujoco.mjtObj.mjOBJ_BODY,
                       name1="chassis", name2="", data=[0.0, 0.0, 0.0, 0.0, 1.0, 0.0] + [0.0] * 4 + [1.0, 0.0])
-    built = compile_spec(spec, asm, held)
+    return compile_spec(spec, asm, held), held
+
+
+def push_pose(robot: Robot, rest: StillPose, side: str = "L") -> StillPose:
+    """The robot held by its plate :data:`HELD_ABOVE_M` above its rest pose, the push command
+    held for :data:`HOLD_S`, audited.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot.
+    rest : StillPose
+        Its rest pose (:func:`rest_pose`).
+    side : str
+        The leg whose servo and crank the pose reports: ``L`` or ``R``.
+
+    Returns
+    -------
+    StillPose
+        The held pose at the push command, its servo and crank angles [deg].
+
+    Raises
+    ------
+    SimError
+        The holding run fails its audit.
+    """
+    built, held = held_model(robot, rest)
     command = robot.schedule.push_deg
     qpos = _audited_final(built, _plan(held, math.radians(command), HOLD_S), "push")
-    servo = _servo_deg(built.model, qpos)
-    return StillPose("push", qpos, command, servo, g.crank_start_deg + servo)
+    servo = _servo_deg(built.model, qpos, side)
+    return StillPose("push", qpos, command, servo, side_values(robot, side).crank_start_deg + servo)
 
 
 # -- the scene: stickers and the board ---------------------------------------------------
-def _still_model(robot: Robot, board: BoardSpec, board_x_m: float | None) -> tuple[mujoco.MjModel, float]:
-    """The robot's model in cardstock grey with its stickers (and the board standing at
-    ``board_x_m``, its edge nearest the robot there; None: no board yet); and the plane
-    ``y`` of the left leg's outer face, where the board stands."""
+def sticker_model(robot: Robot, board: BoardSpec | None, board_x_m: float | None,
+                 side: str = "L") -> tuple[mujoco.MjModel, float]:
+    """The robot's model in cardstock grey with its stickers on the side ``side`` (and the board
+    standing at ``board_x_m``, its edge nearest the robot there; None: no board); and the plane
+    ``y`` of that leg's outer face, where the board stands."""
     g = robot.geometry
+    out = outward_y(side)
     spec, asm = build_spec(robot)
     for geom in spec.geoms:
         if geom.name.startswith("marker_"):          # the videos' dots: no second dot of a sticker's colour
@@ -182,24 +208,48 @@ def _still_model(robot: Robot, board: BoardSpec, board_x_m: float | None) -> tup
             geom.material = ""
     for site in spec.sites:                          # the nose site's red sphere is no sticker
         site.rgba = [0.0, 0.0, 0.0, 0.0]
-    face_y = g.leg_mount_y_m + g.link_width_m / 2
-    for name, (body, x) in on_bodies(g).items():
+    face_y = out * (g.leg_mount_y_m + g.link_width_m / 2)
+    for name, (body, x) in on_bodies(g, side).items():
         spec.add_material(name=f"sticker_{name}", rgba=[*hex_to_rgb01(STICKER_COLOURS[name][0]), 1.0], emission=1.0)
-        y = g.body_width_m / 2 if body == "chassis" else g.link_width_m / 2
+        y = out * ((g.body_width_m if body == "chassis" else g.link_width_m) / 2 + STICKER_PROUD_M / 2)
         spec.body(body).add_geom(name=f"sticker_{name}", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-                                 pos=[x, y + STICKER_PROUD_M / 2, 0.0], quat=_facing_plus_y(),
+                                 pos=[x, y, 0.0], quat=_facing(out),
                                  size=[STICKER_RADIUS_M, STICKER_PROUD_M / 2, 0], material=f"sticker_{name}",
                                  contype=0, conaffinity=0, mass=0.0, group=1)
-    if board_x_m is not None:
+    if board_x_m is not None and board is not None:
         _add_board(spec, board, board_x_m, face_y)
     spec.visual.global_.offwidth = 4096
     spec.visual.global_.offheight = 4096
     return compile_spec(spec, asm, robot).model, face_y
 
 
-def _facing_plus_y() -> list[float]:
+def outward_y(side: str) -> float:
+    """+1 for the left side (at +y, the default camera's), -1 for the right.
+
+    Parameters
+    ----------
+    side : str
+        ``L`` or ``R``.
+
+    Returns
+    -------
+    float
+        The sign of y on that side.
+
+    Raises
+    ------
+    SimError
+        Not a side.
+    """
+    if side not in SIDES:
+        raise SimError(f"side {side!r} is not known", f"choose one of {', '.join(SIDES)}")
+    return 1.0 if side == "L" else -1.0
+
+
+def _facing(out: float) -> list[float]:
+    """A cylinder's axis along ``out`` * y (its face toward a camera on that side)."""
     q = np.zeros(4)
-    mujoco.mju_euler2Quat(q, np.radians([-90.0, 0.0, 0.0]), "xyz")
+    mujoco.mju_euler2Quat(q, np.radians([-90.0 * out, 0.0, 0.0]), "xyz")
     return q.tolist()
 
 
@@ -210,24 +260,26 @@ def _board_size_m(board: BoardSpec) -> tuple[float, float]:
 
 def _add_board(spec: mujoco.MjSpec, board: BoardSpec, right_x_m: float, face_y_m: float) -> None:
     """The printed board on a thin card standing on the floor, its face in the plane
-    ``y = face_y_m``, its edge nearest the robot at ``x = right_x_m`` (it stands at -x)."""
+    ``y = face_y_m`` (toward the camera on that side), its edge nearest the robot at
+    ``x = right_x_m`` (it stands at -x)."""
     image = board.image(BOARD_PX_PER_MM)
     h, w = image.shape
     tex = spec.add_texture(name="board", type=mujoco.mjtTexture.mjTEXTURE_2D, width=w, height=h, nchannel=3)
-    # the box maps the texture's columns along world +x, which the camera (at +y) sees run
-    # to the left: the image goes in mirrored, to be read the right way round
-    tex.data = np.repeat(image[:, ::-1, None], 3, axis=2).tobytes()
+    # the box maps the texture's columns along world +x, which a camera at +y sees run to the
+    # left: the image goes in mirrored there, to be read the right way round
+    out = 1.0 if face_y_m > 0 else -1.0
+    tex.data = np.repeat((image[:, ::-1] if out > 0 else image)[:, :, None], 3, axis=2).tobytes()
     mat = spec.add_material(name="board", emission=0.6)
     mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "board"
     width_m, height_m = _board_size_m(board)
     half_t = 0.0005
     spec.worldbody.add_geom(name="board", type=mujoco.mjtGeom.mjGEOM_BOX,
-                            pos=[right_x_m - width_m / 2, face_y_m - half_t, height_m / 2],
+                            pos=[right_x_m - width_m / 2, face_y_m - out * half_t, height_m / 2],
                             size=[width_m / 2, half_t, height_m / 2], material="board", contype=0, conaffinity=0)
 
 
-def _sticker_world(model: mujoco.MjModel, data: mujoco.MjData) -> dict[str, np.ndarray]:
-    return {n: face_centre_m(model, data, model.geom(f"sticker_{n}").id) for n in STICKERS}
+def _sticker_world(model: mujoco.MjModel, data: mujoco.MjData, out: float = 1.0) -> dict[str, np.ndarray]:
+    return {n: face_centre_m(model, data, model.geom(f"sticker_{n}").id, out) for n in STICKERS}
 
 
 def _reach_m(model: mujoco.MjModel, poses: list[StillPose]) -> np.ndarray:
@@ -278,14 +330,15 @@ def check_still_path(path: str | os.PathLike) -> Path:
 
 
 def _truth_csv(robot: Robot, pose: StillPose, world: dict[str, np.ndarray], px: dict, seen: dict,
-               pitch_deg: float) -> str:
+               pitch_deg: float, side: str) -> str:
     what = ("settled on the floor at the 0 deg command" if pose.kind == "rest" else
             f"held clear of the floor at the {pose.command_deg:g} deg command")
-    lines = [f"# simulated ground truth: MuJoCo still of robot {robot.name!r}, {what}",
-             f"# servo_deg = {pose.servo_deg:.4f} (the left servo joint); crank_deg = {pose.crank_deg:.4f} "
+    name = {"L": "left", "R": "right"}[side]
+    lines = [f"# simulated ground truth: MuJoCo still of robot {robot.name!r}, {what}, seen from its {name}",
+             f"# servo_deg = {pose.servo_deg:.4f} (the {name} servo joint); crank_deg = {pose.crank_deg:.4f} "
              f"(the crank from its ground link); plate_pitch_deg = {pitch_deg:.4f} (leg end above nose end)",
              "# pixels in the OpenCV convention (origin at the centre of the top-left pixel, x right, y down); "
-             "world x along the floor, y toward the camera, z up, metres",
+             f"world x along the floor, y toward the {name} side, z up, metres",
              "point,px,py,seen_frac,x_m,y_m,z_m"]
     for n in STICKERS:
         x, y, z = world[n]
@@ -311,9 +364,12 @@ def _write_still(path: Path, rgb: np.ndarray) -> None:
 
 def render_stills(robot: Robot, rest_path: str | os.PathLike | None = None,
                   push_path: str | os.PathLike | None = None, board: str | BoardSpec = DEFAULT_BOARD,
-                  width: int = 1280, height: int = 960) -> list[StillInfo]:
+                  width: int = 1280, height: int = 960, side: str = "L") -> list[StillInfo]:
     """Render the rest still to ``rest_path`` and the push still to ``push_path`` (either may
     be None), through one fixed camera, each with its truth and camera sidecars.
+
+    ``side``: the robot seen from its left (``L``, the camera at +y, the stickers on the left
+    leg and the board in its plane) or from its right (``R``: all of it at -y).
 
     Parameters
     ----------
@@ -325,6 +381,8 @@ def render_stills(robot: Robot, rest_path: str | os.PathLike | None = None,
         The ArUco board lying behind the robot.
     width, height : int
         Image size [px].
+    side : str
+        ``L`` or ``R``: the side seen.
 
     Returns
     -------
@@ -345,17 +403,18 @@ def render_stills(robot: Robot, rest_path: str | os.PathLike | None = None,
     options = {"--still": paths["rest"], "--still-push": paths["push"]}
     check_distinct({f"{option}{what}": p for option, path in options.items() if path is not None
                     for what, p in zip(("", " truth", " camera"), (path, *sidecar_paths(path)))})
-    rest = rest_pose(robot)
-    poses = {"rest": rest, "push": push_pose(robot, rest)}
-    model, face_y = _still_model(robot, spec, None)
+    out_y = outward_y(side)
+    rest = rest_pose(robot, side)
+    poses = {"rest": rest, "push": push_pose(robot, rest, side)}
+    model, face_y = sticker_model(robot, spec, None, side)
     reach = _reach_m(model, list(poses.values()))
     board_right = float(reach[:, 0].min()) - BOARD_GAP_M
-    model, face_y = _still_model(robot, spec, board_right)
+    model, face_y = sticker_model(robot, spec, board_right, side)
     bw, bh = _board_size_m(spec)
     corners = np.array([[board_right - bw, face_y, 0.0], [board_right, face_y, bh]])
     points = np.vstack([reach, corners])
     fixed, _ = frame_views(points, points[:, 0], robot.geometry.body_length_m, face_y,
-                           float(model.vis.global_.fovy), width / height)
+                           float(model.vis.global_.fovy), width / height, azimuth_deg=side_azimuth_deg(side))
     renderer = PoseRenderer(model, width, height)
     out = []
     try:
@@ -365,14 +424,14 @@ def render_stills(robot: Robot, rest_path: str | os.PathLike | None = None,
                 continue
             data = renderer.pose(pose.qpos)
             rgb, cam = renderer.render(fixed)
-            world = _sticker_world(model, data)
+            world = _sticker_world(model, data, out_y)
             px = {n: tuple(float(v) for v in cam.project(world[n])[0]) for n in STICKERS}
             seen = {n: seen_fraction(model, data, cam, world[n], model.geom(f"sticker_{n}").id) for n in STICKERS}
             d = world["tail"] - world["nose"]
             pitch = math.degrees(math.atan2(d[2], abs(d[0])))
             truth_path, camera_path = sidecar_paths(path)
             _write_still(path, rgb)
-            atomic_write_text(truth_path, _truth_csv(robot, pose, world, px, seen, pitch))
+            atomic_write_text(truth_path, _truth_csv(robot, pose, world, px, seen, pitch, side))
             write_camera_json(camera_path, _camera_file(cam, {n: float(world[n][1]) for n in STICKERS}, fixed))
             out.append(StillInfo(path, truth_path, camera_path, pose, px, seen, pitch))
     finally:
@@ -380,5 +439,5 @@ def render_stills(robot: Robot, rest_path: str | os.PathLike | None = None,
     return out
 
 
-__all__ = ["HELD_ABOVE_M", "HOLD_S", "StillInfo", "StillPose", "check_still_path", "push_pose", "render_stills",
-           "rest_pose"]
+__all__ = ["HELD_ABOVE_M", "HOLD_S", "StillInfo", "StillPose", "check_still_path", "held_model", "outward_y",
+           "push_pose", "render_stills", "rest_pose", "sticker_model"]

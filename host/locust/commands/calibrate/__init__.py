@@ -1,6 +1,6 @@
-"""``locust calibrate beam|hinge|servo|ramp|hop``: recordings in, fitted values (and robot.toml) out.
+"""``locust calibrate beam|hinge|servo|ramp|fold|hop``: recordings in, fitted values (and robot.toml) out.
 
-One module a subcommand (:mod:`.beam`, :mod:`.hinge`, :mod:`.servo`, :mod:`.ramp`, :mod:`.hop`):
+One module a subcommand (:mod:`.beam`, :mod:`.hinge`, :mod:`.servo`, :mod:`.ramp`, :mod:`.fold`, :mod:`.hop`):
 each parses its options, runs its job (:mod:`locust.calibrate.jobs`, what ``locust.calibrate_*``
 runs too) and prints (:mod:`.output`); the options they share are in :mod:`.options`.
 """
@@ -10,6 +10,7 @@ from __future__ import annotations
 import click
 
 from .beam import beam
+from .fold import fold
 from .hinge import hinge
 from .hop import hop
 from .ramp import ramp
@@ -25,6 +26,7 @@ def calibrate() -> None:
     hinge  a link swinging on a flexure hinge     -> hinge stiffness, damping (large angles)
     servo  servo steps: filmed angle, gyro on the horn -> no-load speed, armature, kp
     ramp   ramp tilted until the robot slides      -> static friction mu
+    fold   a fold clamped, photos without and with a coin -> a fold's stiffness, rest angle
     hop    filmed hops of one or more leg sets     -> any parameters, jointly
 
     Each prints the fitted values with 95% confidence intervals, draws a fit plot, and with
@@ -33,5 +35,5 @@ def calibrate() -> None:
     """
 
 
-for _command in (beam, hinge, servo, ramp, hop):
+for _command in (beam, hinge, servo, ramp, fold, hop):
     calibrate.add_command(_command)

@@ -1,5 +1,4 @@
-"""``locust measure``: the robot as built, from photos (docs/measure.md) and a kitchen scale
-(docs/hardware.md)."""
+"""``locust measure stance``: the stance from side photos (docs/measure.md)."""
 
 from __future__ import annotations
 
@@ -7,23 +6,14 @@ from pathlib import Path
 
 import click
 
-from ..errors import MeasureError
-from ..fileio import json_text
-from ..io import robot_toml
-from ..io.trk import PIXEL_CONVENTIONS
-from ..tables import for_person, label
-from .options import POSITIVE, robot_options, say_written_from
-
-TERMS_SHOWN = 3
+from ...errors import MeasureError
+from ...fileio import json_text
+from ...io.trk import PIXEL_CONVENTIONS
+from ...tables import for_person, label
+from ..options import robot_options, say_written_from
 
 
-@click.group()
-def measure():
-    """Measure the robot as built: its stance from photos (docs/measure.md), its nose load on
-    a kitchen scale (docs/hardware.md)."""
-
-
-@measure.command()
+@click.command()
 @click.argument("rest", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.argument("push", type=click.Path(exists=True, dir_okay=False, path_type=Path), required=False)
 @robot_options
@@ -44,24 +34,31 @@ def measure():
 @click.option("--draws", type=click.IntRange(20, 5000), default=200, show_default=True,
               help="Bootstrap draws for the intervals.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of the bootstrap.")
+@click.option("--side", type=click.Choice(["left", "right"]), default=None,
+              help="The side photographed (the right leg is at -y: a photo from the robot's right); its crank's "
+                   "spline tooth is found, and --write writes it (left.crank_tooth or right.crank_tooth) alone.")
 def stance(rest, push, preset, config, sets, board, points, push_points, pixels, write, force, as_json, draws,
-           seed):
+           seed, side):
     """Fit the robot's stance to a side photo at rest (and one held at the push command).
 
     REST shows the robot standing at the 0 deg command, PUSH (optional) the robot held up at
     the push command (`locust pose -30 -30 --port P`), both from the robot's left with the
     board standing in the plane of the left leg and the six stickers in place (docs/measure.md).
-    The link lengths and the plate are the robot's (--preset, --config, --set).
+    The link lengths and the plate are the robot's (--preset, --config, --set). With --side,
+    the photos show that side (the board in that leg's plane), and the crank's tooth on its
+    spline is the nearest whole tooth off geometry.crank_start_deg.
 
     \b
     Examples:
       locust measure stance rest.jpg push.jpg --preset small --write measured.toml
       locust measure stance rest.jpg --preset large --point knee=412.5,633
+      locust measure stance rest_r.jpg --side right --config measured.toml --write measured_r.toml
     """
-    from ..arucoboard import DEFAULT_BOARD, parse_board
-    from ..fileio import check_distinct
-    from ..io.robot_toml import resolve_robot, save_robot
-    from ..measure.stance import fit_stance, given_points, model_servo_give, read_photo, with_stance
+    from ...arucoboard import DEFAULT_BOARD, parse_board
+    from ...fileio import check_distinct
+    from ...io.robot_toml import resolve_robot, save_robot
+    from ...measure.stance import fit_stance, given_points, model_servo_give, read_photo, with_stance
+    from ...measure.tooth import with_tooth
 
     robot = resolve_robot(preset, config, sets)
     say_written_from(preset, config, write)
@@ -75,10 +72,11 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
     photos = [read_photo(rest, spec, given_points(points, pixels, "--point"))]
     if push is not None:
         photos.append(read_photo(push, spec, given_points(push_points, pixels, "--push-point")))
-    result = fit_stance(robot, photos, model_servo_give(robot), draws=draws, seed=seed)
+    code = None if side is None else {"left": "L", "right": "R"}[side]
+    result = fit_stance(robot, photos, model_servo_give(robot, code or "L"), draws=draws, seed=seed, side=code)
 
     if write is not None:
-        save_robot(with_stance(robot, result, rest), write)
+        save_robot(with_stance(robot, result, rest) if code is None else with_tooth(robot, result.tooth, rest), write)
     if as_json:
         out = result.to_json()
         out["wrote"] = None if write is None else str(write)
@@ -91,7 +89,7 @@ def stance(rest, push, preset, config, sets, board, points, push_points, pixels,
 
 
 def _lines(result, photos) -> list[str]:
-    from ..measure.stance import STANCE_KEYS
+    from ...measure.stance import STANCE_KEYS
 
     lines = []
     for ph in photos:
@@ -108,7 +106,8 @@ def _lines(result, photos) -> list[str]:
 
     lines.append(f"{'value':28s} {'measured':>14s}  {'95 % interval':>22s}")
     for key, est in zip(STANCE_KEYS, result.values().values()):
-        lines.append(row(label(key), est, key))
+        if result.side is None or key != "geometry.crank_start_deg":   # a side's crank: its own row, below
+            lines.append(row(label(key), est, key))
     lines.append(row("plate pitch at rest", result.rest_pitch_deg, "rest_pitch_deg"))
     if result.push_turn_deg is not None:
         est = result.push_turn_deg
@@ -118,69 +117,21 @@ def _lines(result, photos) -> list[str]:
                      + ("" if same else ": the other way than the model turns it"))
     lines.append(f"the crank stood at {result.rest_crank_seen_deg:.2f} deg in {photos[0].path.name}; the model's servo "
                  f"gives {result.servo_give_deg:.2f} deg under the robot's weight, taken off")
+    if result.tooth is not None:
+        lines.extend(_tooth_lines(result, row))
     lines.append(f"intervals: parametric bootstrap, {result.draws} draws (stickers {result.sticker_sd_px:.2f} px, "
                  f"board corners {result.corner_sd_px:.2f} px)")
     return lines
 
 
-def _mm(e) -> str:
-    lo, hi = e.ci95
-    return f"{e.value * 1000:.1f} ± {e.sd * 1000:.1f} mm (95 %: {lo * 1000:.1f} to {hi * 1000:.1f})"
+def _tooth_lines(result, row) -> list[str]:
+    """The side's crank and its tooth, its probability and margin."""
+    t = result.tooth
+    word = {"L": "left", "R": "right"}[t.side]
+    ref = f"{t.reference_deg:.2f} deg" + (f" ± {t.reference_sd_deg:.2f}" if t.reference_sd_deg else "")
+    return [row(f"{word} crank at 0 deg", result.side_crank_deg, "crank_deg"),
+            f"{t.key} = {t.tooth} (was {t.file_tooth}): {t.offset_teeth:+.3f} ± {t.sd_teeth:.3f} teeth of "
+            f"{t.tooth_deg:.2f} deg off geometry.crank_start_deg ({ref}); probability {t.probability:.3f}, "
+            f"{t.margin_sd:.1f} sd inside the tooth's half-tooth band"]
 
 
-@measure.command("nose-load")
-@click.argument("grams", type=POSITIVE)
-@robot_options
-@click.option("--resolution-g", type=POSITIVE, default=1.0, show_default=True,
-              help="The scale's resolution (its last digit), in grams.")
-@click.option("--total-g", type=POSITIVE, default=None,
-              help="The whole robot weighed on the same scale, in grams: sets the plate's mass first.")
-@click.option("--write", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Write the whole robot with the measured values in place (refuses to overwrite).")
-@click.option("--force", is_flag=True, help="With --write: overwrite an existing file.")
-@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
-def nose_load(grams, preset, config, sets, resolution_g, total_g, write, force, as_json):
-    """Place the servo axis along the plate from the nose's weight on a kitchen scale.
-
-    Stand the robot with its nose on the scale's pan and its feet level with the pan (on a
-    book as thick as the scale), servos at rest (0 deg), and read GRAMS. The model's robot
-    is moved along geometry.servo_axis_x_m until it reads the same (docs/hardware.md says why
-    that value); the interval counts the scale's resolution and every other uncertain value
-    of the robot file, and is combined with the file's own interval for the axis.
-
-    \b
-    Examples:
-      locust measure nose-load 4 --preset medium
-      locust measure nose-load 4.2 --resolution-g 0.1 --total-g 31.3 --config measured.toml --write robot.toml
-    """
-    from ..measure.nose_load import AXIS_KEY, PLATE_KEY, measure_nose_load
-
-    robot = robot_toml.resolve_robot(preset, config, sets)
-    say_written_from(preset, config, write)
-    if write is not None and write.exists() and not force:
-        raise MeasureError(f"{write} exists", "choose another path, or add --force to overwrite it")
-    res = measure_nose_load(robot, grams / 1000, resolution_g / 1000, None if total_g is None else total_g / 1000)
-    if write is not None:
-        robot_toml.save_robot(res.robot, write)
-    if as_json:
-        out = res.to_json()
-        out["written"] = str(write) if write is not None else None
-        click.echo(json_text(out), nl=False)
-        return
-    click.echo(f"{robot.name}: nose {grams:g} g on a {resolution_g:g} g scale"
-               + (f", the whole robot {total_g:g} g" if total_g is not None else ""))
-    if res.plate_mass is not None:
-        lo, hi = res.plate_mass.ci95
-        click.echo(f"  plate mass: {res.plate_mass.value * 1000:.2f} ± {res.plate_mass.sd * 1000:.2f} g "
-                   f"(95 %: {lo * 1000:.2f} to {hi * 1000:.2f}; the robot's {PLATE_KEY})")
-    click.echo(f"  servo axis from the plate's middle, from the scale alone: {_mm(res.axis_from_scale)} "
-               f"(the robot's {AXIS_KEY})")
-    terms = sorted(res.axis_sd_terms_m.items(), key=lambda kv: -kv[1])[:TERMS_SHOWN]
-    click.echo("    its largest sd terms: " + ", ".join(f"{k} {v * 1000:.1f} mm" for k, v in terms))
-    if res.axis_before is not None:
-        click.echo(f"  the robot file's: {_mm(res.axis_before)}")
-        click.echo(f"  combined: {_mm(res.axis)}")
-    click.echo(f"  the model then reads {res.predicted_nose_load_kg * 1000:.2f} g; centre of mass "
-               f"{res.com_from_nose_m * 1000:.1f} mm from the nose along the plate")
-    if write is not None:
-        click.echo(f"wrote {write}")
