@@ -56,19 +56,22 @@ def start_demo(out: Path) -> tuple[subprocess.Popen, list[str]]:
     return proc, lines
 
 
-def in_hops_stage(proc: subprocess.Popen, lines: list[str]) -> set[int]:
-    """Wait until two `locust hop` children run, each with its virtual robot; their tree."""
+def in_hops_stage(proc: subprocess.Popen, lines: list[str], hops: Path) -> set[int]:
+    """Wait until two `locust hop` children run, each with its virtual robot, and each has made
+    its run folder in ``hops`` (a hop makes it after it starts: listing the folder before then
+    would race it); their tree."""
     def hopping() -> bool:
         kids = [k for k in descendants(proc.pid) if b"hop" in Path(f"/proc/{k}/cmdline").read_bytes()]
-        return len(kids) >= 2 and len(descendants(proc.pid)) >= 4
-    wait_for(hopping, 120, "two filmed hops running")
+        return (len(kids) >= 2 and len(descendants(proc.pid)) >= 4 and hops.is_dir()
+                and len(list(hops.iterdir())) >= 2)
+    wait_for(hopping, 120, "two filmed hops running, their folders made")
     return descendants(proc.pid)
 
 
 @pytest.mark.parametrize("how", ["TERM", "Ctrl-C"])
 def test_one_signal_ends_the_demo_and_its_commands_within_two_seconds(tmp_path, how):
     proc, lines = start_demo(tmp_path)
-    tree = in_hops_stage(proc, lines)
+    tree = in_hops_stage(proc, lines, tmp_path / "run" / "hops")
     folders = set((tmp_path / "run" / "hops").iterdir())
     t0 = time.perf_counter()
     if how == "TERM":
@@ -90,7 +93,7 @@ def test_one_signal_ends_the_demo_and_its_commands_within_two_seconds(tmp_path, 
 
 def test_a_kill_9_takes_its_commands_with_it(tmp_path):
     proc, lines = start_demo(tmp_path)
-    tree = in_hops_stage(proc, lines)
+    tree = in_hops_stage(proc, lines, tmp_path / "run" / "hops")
     proc.kill()
     proc.wait(timeout=30)
     wait_for(lambda: not [p for p in tree if alive(p)], GONE_S, "the demo's commands ending with it")
