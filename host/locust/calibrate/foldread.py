@@ -95,14 +95,11 @@ class FoldPhoto:
 
     def m_per_px(self) -> float:
         """The plane's scale at the stickers [m/px] (the mean of the three)."""
+        from ..track.board import scale_px_per_m
+
         H, _ = cv2.findHomography(self.corners_px, self.corners_m, 0)
         px = np.array([self.stickers_px[n] for n in FOLD_STICKERS], float)
-        scales = []
-        for x, y in px:
-            v = H @ np.array([x, y, 1.0])
-            J = (H[:2, :2] * v[2] - np.outer(v[:2], H[2, :2])) / v[2] ** 2
-            scales.append(math.sqrt(abs(np.linalg.det(J))))
-        return float(np.mean(scales))
+        return float(np.mean([scale_px_per_m(H, x, y) for x, y in px]))   # image -> plane: m per px
 
 
 def noise_levels(image_bgr: np.ndarray) -> float:
@@ -207,12 +204,6 @@ def centre_sd_px(image_bgr: np.ndarray, name: str, centre_px: tuple[float, float
     return max(float(np.sqrt(np.mean(d ** 2))), MIN_STICKER_SD_PX)
 
 
-def _scale_px_per_m(H: np.ndarray, x: float, y: float) -> float:
-    v = H @ np.array([x, y, 1.0])
-    J = (H[:2, :2] * v[2] - np.outer(v[:2], H[2, :2])) / v[2] ** 2
-    return math.sqrt(abs(np.linalg.det(J)))
-
-
 def board_corners(spec: BoardSpec, image_bgr: np.ndarray, photo: str) -> tuple[np.ndarray, np.ndarray, float, float]:
     """The board's detected corners [px], their board places [m], their reprojection scatter
     [px] and how oblique the board is seen (the larger edge's scale over the opposite one's, less 1).
@@ -236,23 +227,15 @@ def board_corners(spec: BoardSpec, image_bgr: np.ndarray, photo: str) -> tuple[n
     locust.errors.CalibrationError
         The board is not found.
     """
-    from ..track.board import board_points
+    from ..track.board import board_view, edge_scales
 
-    found = board_points(spec, image_bgr)
-    if found is None:
+    view = board_view(spec, image_bgr)
+    if view is None:
         raise CalibrationError(f"{photo}: board {spec.text()} not found",
                                "the whole board must be in the photo, sharp and uncovered, standing upright in the "
                                "stickers' plane; check --board against the printed one (`locust track board`)")
-    img, plane = found
-    H, _ = cv2.findHomography(plane, img, 0)
-    back = cv2.perspectiveTransform(plane[None], H)[0]
-    sd = float(np.sqrt(np.sum((back - img) ** 2) / max(2 * len(img) - 8, 1)))
-    w, h = spec.width_mm / 1000.0, spec.height_mm / 1000.0
-    ratios = []
-    for pa, pb in (((0.0, h / 2), (w, h / 2)), ((w / 2, 0.0), (w / 2, h))):
-        sa, sb = _scale_px_per_m(H, *pa), _scale_px_per_m(H, *pb)
-        ratios.append(max(sa, sb) / min(sa, sb) - 1.0)
-    return img, plane, sd, float(max(ratios))
+    oblique = max(max(sa, sb) / min(sa, sb) - 1.0 for sa, sb in edge_scales(view.homography, spec).values())
+    return view.corners_px, view.corners_m, view.sd_px, float(oblique)
 
 
 def read_image(image_bgr: np.ndarray, name: str, spec: BoardSpec, rng: np.random.Generator) -> FoldPhoto:

@@ -140,36 +140,23 @@ def board_corners(spec: BoardSpec, image_bgr: np.ndarray, path: Path) -> tuple[n
     locust.errors.MeasureError
         The board is not found, or is seen at too much of a slant.
     """
-    from ..track.board import board_points
+    from ..track.board import board_view
 
-    found = board_points(spec, image_bgr)
-    if found is None:
+    view = board_view(spec, image_bgr)
+    if view is None:
         raise MeasureError(f"{path.name}: board {spec.text()} not found",
                            "the whole board must be in the photo, sharp and not covered; check --board "
                            "(dictionary, markers, sizes) against the printed one (`locust track board`)")
-    img, plane = found
-    H, _ = cv2.findHomography(plane, img, 0)
-    back = cv2.perspectiveTransform(plane[None], H)[0]
-    dof = max(2 * len(img) - 8, 1)
-    sd = float(np.sqrt(np.sum((back - img) ** 2) / dof))
-    _check_square(H, spec, path)
-    return img, plane, sd
-
-
-def _scale_px_per_m(H: np.ndarray, x: float, y: float) -> float:
-    """Local scale of the plane -> image map at board point (x, y): sqrt of its Jacobian."""
-    v = H @ np.array([x, y, 1.0])
-    J = (H[:2, :2] * v[2] - np.outer(v[:2], H[2, :2])) / v[2] ** 2
-    return math.sqrt(abs(np.linalg.det(J)))
+    _check_square(view.homography, spec, path)
+    return view.corners_px, view.corners_m, view.sd_px
 
 
 def _check_square(H: np.ndarray, spec: BoardSpec, path: Path) -> None:
     """Refuse a photo whose board is foreshortened: a sticker off the board's plane (the
     plate's edge, the leg's face) then reads off by an amount that grows with the slant."""
-    w, h = spec.width_mm / 1000.0, spec.height_mm / 1000.0
-    pairs = {("left", "right"): ((0.0, h / 2), (w, h / 2)), ("bottom", "top"): ((w / 2, 0.0), (w / 2, h))}
-    for (a, b), (pa, pb) in pairs.items():
-        sa, sb = _scale_px_per_m(H, *pa), _scale_px_per_m(H, *pb)
+    from ..track.board import edge_scales
+
+    for (a, b), (sa, sb) in edge_scales(H, spec).items():
         ratio = max(sa, sb) / min(sa, sb) - 1.0
         if ratio > OBLIQUE_LIMIT:
             near, far = (a, b) if sa > sb else (b, a)
@@ -438,9 +425,11 @@ def _plane_points(photo: Photo, corner_noise: np.ndarray | None = None,
 
 
 def _m_per_px(photo: Photo) -> float:
+    from ..track.board import scale_px_per_m
+
     H, _ = cv2.findHomography(photo.corners_m, photo.corners_px, 0)
     centre = photo.corners_m.mean(axis=0)
-    return 1.0 / _scale_px_per_m(H, float(centre[0]), float(centre[1]))
+    return 1.0 / scale_px_per_m(H, float(centre[0]), float(centre[1]))
 
 
 def _pitch_deg(robot: Robot, p: np.ndarray, mirrored: bool) -> float:

@@ -181,6 +181,94 @@ def board_points(spec: BoardSpec, image_bgr: np.ndarray) -> tuple[np.ndarray, np
     return img.reshape(-1, 2).astype(np.float64), plane
 
 
+@dataclass(frozen=True)
+class BoardView:
+    """A board found in one photo: its corners, the homography from its plane onto the photo,
+    and the corners' reprojection scatter.
+
+    Attributes
+    ----------
+    corners_px : ndarray
+        (N, 2) detected corners [px].
+    corners_m : ndarray
+        (N, 2) their places on the board [m], x right, y up.
+    homography : ndarray
+        (3, 3) board plane [m] -> photo [px] (``cv2.findHomography``, all corners).
+    sd_px : float
+        The corners' reprojection scatter, one coordinate [px] (the fit's 8 parameters taken off).
+    """
+
+    corners_px: np.ndarray
+    corners_m: np.ndarray
+    homography: np.ndarray
+    sd_px: float
+
+
+def board_view(spec: BoardSpec, image_bgr: np.ndarray) -> BoardView | None:
+    """The board in a photo (:func:`board_points`) with its homography and scatter; None when
+    it is not found.
+
+    Parameters
+    ----------
+    spec : BoardSpec
+        The printed board.
+    image_bgr : ndarray
+        The photo, BGR.
+
+    Returns
+    -------
+    BoardView or None
+    """
+    found = board_points(spec, image_bgr)
+    if found is None:
+        return None
+    img, plane = found
+    H, _ = cv2.findHomography(plane, img, 0)
+    back = cv2.perspectiveTransform(plane[None], H)[0]
+    sd = float(np.sqrt(np.sum((back - img) ** 2) / max(2 * len(img) - 8, 1)))
+    return BoardView(img, plane, H, sd)
+
+
+def scale_px_per_m(H: np.ndarray, x: float, y: float) -> float:
+    """The local scale of a plane -> image homography at plane point (x, y): the square root of
+    its Jacobian's determinant [px/m].
+
+    Parameters
+    ----------
+    H : ndarray
+        (3, 3) plane [m] -> image [px].
+    x, y : float
+        The plane point [m].
+
+    Returns
+    -------
+    float
+    """
+    v = H @ np.array([x, y, 1.0])
+    J = (H[:2, :2] * v[2] - np.outer(v[:2], H[2, :2])) / v[2] ** 2
+    return math.sqrt(abs(np.linalg.det(J)))
+
+
+def edge_scales(H: np.ndarray, spec: BoardSpec) -> dict[tuple[str, str], tuple[float, float]]:
+    """The scale at the middle of each pair of the board's opposite edges: a board seen square
+    has them equal, one seen at a slant has its nearer edge larger.
+
+    Parameters
+    ----------
+    H : ndarray
+        (3, 3) board plane [m] -> photo [px].
+    spec : BoardSpec
+
+    Returns
+    -------
+    dict
+        ``("left", "right")`` and ``("bottom", "top")`` -> the two edges' scales [px/m].
+    """
+    w, h = spec.width_mm / 1000.0, spec.height_mm / 1000.0
+    pairs = {("left", "right"): ((0.0, h / 2), (w, h / 2)), ("bottom", "top"): ((w / 2, 0.0), (w / 2, h))}
+    return {names: (scale_px_per_m(H, *pa), scale_px_per_m(H, *pb)) for names, (pa, pb) in pairs.items()}
+
+
 def board_homography(info, clip, spec: BoardSpec, frames: int = DETECT_FRAMES) -> PlaneHomography:
     """Fit the plane to the board's corners in every one of the clip's first ``frames`` frames
     that shows it (a still camera: the corners' noise averages out over the frames).
