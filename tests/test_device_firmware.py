@@ -27,7 +27,7 @@ def test_compiles_with_mpy_cross(src, tmp_path):
     assert mpy_version(out.read_bytes()[:4]) == 6  # the format of MicroPython >= 1.22
 
 
-def test_unit_tests_pass_under_micropython():
+def test_unit_tests_pass_under_micropython(board_timing):
     expected = sum(len(re.findall(r"^def test_", (UNIT_DIR / f"{m}.py").read_text(), re.M)) for m in MODULES)
     env = dict(os.environ, MICROPYPATH=f"{ROOT / 'firmware'}:{UNIT_DIR}:{SHIM_DIR}")
     proc = subprocess.run([micropython_executable(), str(UNIT_DIR / "mp_run.py"), *MODULES],
@@ -37,6 +37,10 @@ def test_unit_tests_pass_under_micropython():
                                            capture_output=True, text=True).stdout
     last = proc.stdout.strip().splitlines()[-1]
     assert last == f"RESULT {expected} 0", proc.stdout[-3000:] + proc.stderr[-2000:]
+    # the hop's phases started within the board's 2 ms (test_controller prints how late each was)
+    timing = [line.split()[1] for line in proc.stdout.splitlines() if line.startswith("TIMING ")]
+    assert len(timing) == 1, proc.stdout[-3000:]
+    board_timing([int(e) for e in timing[0].split(",")])
 
 
 def test_firmware_fallback_servo_config_is_the_robot_parameters():

