@@ -47,8 +47,9 @@ def params(preset, config, sets, as_json, write, force):
                "the cut file's strip)")
     for key, value in robot.flat().items():
         prov, parent = robot.source_of(key), robot.inherits(key)
-        unc = f" ± {prov.uncertainty:g}" if prov.uncertainty is not None else ""
-        click.echo(f"{key:42s} {value!s:>12}{unc:12s}  [{prov.source if parent is None else '= ' + parent}]")
+        unc = f" ± {prov.uncertainty:.3g}" if prov.uncertainty is not None else ""
+        shown = f"{value:.6g}" if isinstance(value, float) else str(value)
+        click.echo(f"{key:42s} {shown:>12}{unc:12s}  [{prov.source if parent is None else '= ' + parent}]")
     click.echo(f"# standing at rest: {load.nose_load_kg * 1000:.1f} g of its {load.total_mass_kg * 1000:.1f} g on the "
                "nose (a kitchen scale under it, feet level with the pan)" if load else
                f"# standing at rest: no nose load ({why})")
