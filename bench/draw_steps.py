@@ -34,12 +34,10 @@ from locust.errors import GeometryError
 from locust.params import preset, problems
 from locust.sim.audit import audit
 from locust.sim.hops import summarise
-from locust.sim.model import build
 from locust.sim.outcome import classify
-from locust.sim.refine import simulate_refined
+from locust.sim.rollout import roll_out
 from locust.sim.run import CONVERGED_MM, CONVERGED_REL
 from locust.sim.samples import draw, sample
-from locust.sim.schedule import control_plan
 
 
 def converged(coarse, fine, cycles: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -116,11 +114,12 @@ def refined_spread(robot, n: int, cycles: int, coarse: float, fine: float, windo
     linkage that cannot close, or an audit failed)."""
     out = SimpleNamespace(distance_m=[], max_nose_height_m=[], outcome=[])
     for r in draw(robot, n):
-        r = r.with_values({"solver.timestep_s": coarse})
+        r = r.with_values({"solver.timestep_s": coarse, "solver.refine_timestep_s": fine,
+                           "solver.refine_window_s": window})
         summary = None
         if not problems(r, cycles):
             try:
-                traj = simulate_refined(build(r), control_plan(r.schedule, r.solver, cycles), fine, window).trajectory
+                traj = roll_out(r, cycles=cycles)
                 summary = summarise(traj) if audit(traj).valid else None
             except GeometryError:
                 pass

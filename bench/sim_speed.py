@@ -30,10 +30,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from locust.params import preset
 from locust.sim.audit import audit
 from locust.sim.hops import summarise
-from locust.sim.model import build
-from locust.sim.refine import simulate_refined
+from locust.sim.rollout import roll_out
 from locust.sim.run import run
-from locust.sim.schedule import control_plan
 from notebook_reference import notebook_run
 
 CYCLES = 3
@@ -62,11 +60,11 @@ REFINED = [(4e-3, 5e-4, 0.04), (4e-3, 1e-3, 0.04)]   # (step, fine step, window 
 def refined_run(robot, coarse: float, fine: float, window: float):
     """Build, simulate refined, audit and summarise: what ``run`` does, on the refined route.
     Returns (the hop summary, model steps taken)."""
-    stepped = robot.with_values({"solver.timestep_s": coarse})
-    out = simulate_refined(build(stepped), control_plan(stepped.schedule, stepped.solver, CYCLES), fine, window)
-    if not audit(out.trajectory).valid:
+    traj = roll_out(robot.with_values({"solver.timestep_s": coarse, "solver.refine_timestep_s": fine,
+                                       "solver.refine_window_s": window}), cycles=CYCLES)
+    if not audit(traj).valid:
         raise SystemExit(f"the refined route {coarse:g}/{fine:g} s failed its audit")
-    return summarise(out.trajectory), out.model_steps
+    return summarise(traj), traj.model_steps
 
 
 def timed(fn, repeat: int):
@@ -105,7 +103,7 @@ def main() -> None:
         valid = "" if r.valid else "  INVALID: " + "; ".join(r.reasons)
         print(f"{name:34s} {robot.solver.timestep_s:8.1e} {t:7.3f} {nb_t / t:7.2f} {r.distance_m * 1000 / CYCLES:7.3f} "
               f"{dev_half:7.2f} {mm_half:11.3f} {dev_ref:6.2f}{valid}", flush=True)
-    # the step refined where the floor contacts change (locust.sim.refine; not a route of locust sim yet)
+    # the step refined where the floor contacts and the commands change (solver.refine_timestep_s)
     for coarse, fine, window in REFINED:
         name = f"rk4 {coarse * 1e3:g} ms, {fine * 1e3:g} ms at contacts"
         t, (r, steps) = timed(lambda c=coarse, f=fine, w=window: refined_run(default, c, f, w), args.repeat)

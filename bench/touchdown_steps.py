@@ -22,12 +22,9 @@ import argparse
 import os
 
 from locust.params import preset, problems
-from locust.sim.model import build
-from locust.sim.refine import simulate_refined
 from locust.sim.rollout import roll_out
 from locust.sim.run import CONVERGED_MM, CONVERGED_REL
 from locust.sim.samples import draw
-from locust.sim.schedule import control_plan
 
 ROUTES = [  # (coarse step, fine step, window after a contact change) [s]
     (2e-3, 5e-4, 0.02), (2e-3, 5e-4, 0.04), (4e-3, 5e-4, 0.02), (4e-3, 5e-4, 0.04), (4e-3, 1e-3, 0.04),
@@ -48,9 +45,9 @@ def uniform(robot, dt: float, cycles: int) -> tuple[float, int]:
 
 def refined(robot, coarse: float, fine: float, window: float, cycles: int) -> tuple[float, int]:
     """Chassis x at the end [mm] and model steps taken on ``locust.sim.refine``'s route."""
-    robot = robot.with_values({"solver.timestep_s": coarse})
-    out = simulate_refined(build(robot), control_plan(robot.schedule, robot.solver, cycles), fine, window)
-    return float(out.trajectory.final_qpos[0]) * 1000, out.model_steps
+    traj = roll_out(robot.with_values({"solver.timestep_s": coarse, "solver.refine_timestep_s": fine,
+                                       "solver.refine_window_s": window}), cycles=cycles)
+    return float(traj.final_qpos[0]) * 1000, traj.model_steps
 
 
 def main() -> None:

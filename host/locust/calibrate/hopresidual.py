@@ -149,14 +149,13 @@ class HopResidual:
         """``run``'s robot, its step times ``coarsen``."""
         if coarsen == 1:
             return run.robot
-        return run.robot.with_values({"solver.timestep_s": run.robot.solver.timestep_s * coarsen},
-                                     "fit: starting grid")
+        return run.robot.with_values(run.robot.solver.steps_scaled(coarsen), "fit: starting grid")
 
     def robots_at(self, run: Trial, xs: np.ndarray, refine: int = 1) -> list[Robot]:
         """``run``'s robot at each row of ``xs`` (its step divided by ``refine``)."""
         robot = run.robot
         if refine > 1:
-            robot = robot.with_values({"solver.timestep_s": robot.solver.timestep_s / refine}, "fit: time step check")
+            robot = robot.with_values(robot.solver.steps_scaled(1 / refine), "fit: time step check")
         return [robot.with_values(values, "fit") for values in self.values_at(xs)]
 
     def residuals_of(self, robots: Callable[[Trial], list[Robot]],

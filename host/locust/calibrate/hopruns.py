@@ -261,13 +261,13 @@ def converged_step(run: Trial, robot: Robot | None = None, tally: Tally | None =
     values (the run's own when None), halved at most ``MAX_HALVINGS`` times; and that last
     move (nan: a simulation failed, the step is kept)."""
     at = robot or run.robot
-    step = run.robot.solver.timestep_s
+    scale = 1.0     # of every step of the run's solver
     change = math.nan
     for halvings in range(MAX_HALVINGS + 1):
         pair = []
-        for dt in (step, step / 2):
+        for f in (scale, scale / 2):
             try:
-                robot_dt = at.with_values({"solver.timestep_s": dt}, "fit: time step check")
+                robot_dt = at.with_values(run.robot.solver.steps_scaled(f), "fit: time step check")
                 pair.append(simulate_markers(run, [robot_dt])[0])
                 if tally:
                     tally.add(1)
@@ -278,11 +278,11 @@ def converged_step(run: Trial, robot: Robot | None = None, tally: Tally | None =
         change = float(np.sqrt(np.mean((aligned_residual(run, pair[0])[0] - aligned_residual(run, pair[1])[0]) ** 2)))
         if change <= STEP_TOLERANCE_M or halvings == MAX_HALVINGS:
             break
-        step /= 2
-    if step != run.robot.solver.timestep_s:
+        scale /= 2
+    if scale != 1.0:
         note = f"halved until dt/2 moved the markers by at most {STEP_TOLERANCE_M * 1e3:g} mm (hop fit's check)"
-        run = replace(run, robot=run.robot.with_values({"solver.timestep_s": step}, Provenance("fit: time step check",
-                                                                                                note=note)))
+        run = replace(run, robot=run.robot.with_values(run.robot.solver.steps_scaled(scale),
+                                                       Provenance("fit: time step check", note=note)))
     return run, change
 
 

@@ -129,6 +129,10 @@ LIMITS: dict[str, Limit] = {
     "schedule.wait_s": Limit(_HOP["wait_ms"][1] / 1000.0, _HOP["wait_ms"][2] / 1000.0, _SHUT, _SHUT, _SCHEDULE),
     "schedule.cycles": Limit(_HOP["cycles"][1], _HOP["cycles"][2], _SHUT, _SHUT, _SCHEDULE),
     "solver.timestep_s": Limit(0.0, 0.01, _OPEN, _SHUT, "a step of at most 10 ms resolves a hop (docs/servo.md)"),
+    "solver.refine_timestep_s": Limit(0.0, 0.01, _SHUT, _SHUT, "the step where contacts change: 0 (off) to 10 ms, "
+                                      "a whole fraction of solver.timestep_s"),
+    "solver.refine_window_s": Limit(0.0, 1.0, _OPEN, _SHUT, "how long the fine step runs after a contact change: "
+                                    "above 0 to 1 s"),
     "solver.iterations": Limit(1, 10000, _SHUT, _SHUT, "MuJoCo's solver iterations: 1 to 10000"),
     "solver.tolerance": Limit(0.0, 1.0, _SHUT, _OPEN, "MuJoCo's solver tolerance: 0 to below 1"),
     "solver.control_hz": Limit(0.0, 10000.0, _OPEN, _SHUT, "a servo command rate: above 0 to 10 kHz (PWM 50 Hz)"),
@@ -196,6 +200,9 @@ def problems(robot: Robot, cycles: int | None = None) -> list[str]:
     if sol.timestep_s > 0 and sol.control_hz * sol.timestep_s > 1.0 + 1e-9:
         out.append(f"solver.control_hz = {sol.control_hz:g} is faster than one command per physics step "
                    f"(1/solver.timestep_s = {1.0 / sol.timestep_s:g} Hz)")
+    if sol.refined and abs((k := sol.timestep_s / sol.refine_timestep_s) - round(k)) > 1e-6 * k:
+        out.append(f"solver.refine_timestep_s = {sol.refine_timestep_s:g} does not divide solver.timestep_s = "
+                   f"{sol.timestep_s:g} into whole steps (choose {sol.timestep_s:g} s over 2, 4, 8, ...)")
     if not out:
         n = sch.cycles if cycles is None else cycles
         steps = (sol.settle_s + n * (sch.push_s + sch.wait_s)) / sol.timestep_s

@@ -155,6 +155,10 @@ class Solver:
     # rk4 at 1 ms: the seed design within 0.1 mm per hop of dt/2 with the SG90 of both servo
     # recordings (0.066 mm at 1 ms, 0.29 mm at 2 ms; docs/servo.md, "Time step")
     timestep_s: float = 1e-3
+    # where the floor contacts change, the step taken again at this finer one for
+    # refine_window_s (sim/refine.py): 0 steps uniformly at timestep_s, which it must divide
+    refine_timestep_s: float = 0.0
+    refine_window_s: float = 0.04
     integrator: str = "rk4"          # euler | implicitfast | implicit | rk4
     iterations: int = 10
     tolerance: float = 1e-6
@@ -166,6 +170,35 @@ class Solver:
     loop_timeconst_s: float = 0.01   # (notebook: 0.02)
     loop_dmin: float = 0.9999        # impedance at zero violation (notebook: 0.9)
     loop_dmax: float = 0.9999        # impedance at full violation (notebook: 0.95)
+
+    @property
+    def refined(self) -> bool:
+        """Whether a run refines its step where the floor contacts change."""
+        return 0.0 < self.refine_timestep_s < self.timestep_s
+
+    def steps_scaled(self, factor: float) -> dict[str, float]:
+        """The values that scale every step by ``factor`` (``--check-convergence``: 0.5):
+        ``timestep_s`` and, where the run refines, ``refine_timestep_s`` (the window is a time).
+
+        Parameters
+        ----------
+        factor : float
+
+        Returns
+        -------
+        dict of str to float
+            Dotted names -> values, for :meth:`Robot.with_values`.
+        """
+        values = {"solver.timestep_s": self.timestep_s * factor}
+        if self.refined:
+            values["solver.refine_timestep_s"] = self.refine_timestep_s * factor
+        return values
+
+    @property
+    def finest_step_s(self) -> float:
+        """The finest step a run takes [s]: the step of one that steps uniformly in real time
+        (the virtual robot)."""
+        return self.refine_timestep_s if self.refined else self.timestep_s
 
 
 SECTIONS: dict[str, type] = {

@@ -82,6 +82,22 @@ def check_batch(model: mujoco.MjModel, n_models: int, nstep: int, keep_states: b
                        "a few cycles is the prediction's")
 
 
+def add_warnings(data: mujoco.MjData, into: dict[str, int]) -> None:
+    """Add the warnings MuJoCo counted on ``data`` in its last call to ``into`` (name -> count).
+
+    Parameters
+    ----------
+    data : mujoco.MjData
+        A data a rollout call ran on (each call counts afresh).
+    into : dict of str to int
+        The counts so far, added to.
+    """
+    for i in range(len(data.warning)):
+        if data.warning[i].number:
+            name = mujoco.mjtWarning(i).name
+            into[name] = into.get(name, 0) + int(data.warning[i].number)
+
+
 def chunk_bounds(nstep: int, n_models: int) -> list[tuple[int, int]]:
     """The ``[start, stop)`` steps of each rollout call for ``n_models`` over ``nstep`` steps.
 
@@ -152,10 +168,7 @@ def rollout_chunked(models: list[mujoco.MjModel], datas: list[mujoco.MjData], in
             states[:, a:b] = chunk_state
         state = chunk_state[:, -1].copy()
         for data in datas:
-            for i in range(len(data.warning)):
-                if data.warning[i].number:
-                    name = mujoco.mjtWarning(i).name
-                    warnings[name] = warnings.get(name, 0) + int(data.warning[i].number)
+            add_warnings(data, warnings)
         if n == 1:   # one model on one data: its warm start goes on to the next chunk
             warmstart = datas[0].qacc_warmstart.copy()[None]
     return states, sensordata, state, warnings

@@ -120,9 +120,10 @@ class LiveSim:
             validate_size(fps, width, height)
             path = check_video_path(video_path)
         self.robot = robot
-        self.built = build(robot)
+        # stepped uniformly in real time: at the finest step a simulation of it takes
+        self.built = build(robot.with_values({"solver.timestep_s": robot.solver.finest_step_s}))
         # a supply that limits the servos is solved each step (docs/servo.md, "Power")
-        self._stepper = supply_stepper(self.built, steps_per_tick(robot.solver.control_hz, robot.solver.timestep_s))
+        self._stepper = supply_stepper(self.built, steps_per_tick(robot.solver.control_hz, robot.solver.finest_step_s))
         self.model = self.built.model if self._stepper is None else self._stepper.model
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)

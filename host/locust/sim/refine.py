@@ -1,26 +1,25 @@
-"""A run at a coarse step, refined where the floor contacts change (docs/performance.md).
+"""Runs at a coarse step, refined where the floor contacts change (docs/performance.md).
 
 Fixed-step rk4 is first order across a contact that arrives or leaves between two steps: on
 the seed design nearly all of a coarse step's error is made in the touchdown after each
-return stroke. :func:`simulate_refined` steps the plan with ``mujoco.rollout`` at the plan's
-step in chunks; where the number of floor contacts (the ``floor_contact`` sensor, a count)
-changes from one row to the next, the step that changed it is taken again from the state
-before it, and the ``window_s`` after it at ``fine_s`` (a whole number of fine steps per
-coarse one, the control held as the plan holds it). The record stays on the coarse grid
-(row i at t = i*dt, every ``dt/fine_s``-th fine row), so the audit and the per-hop figures
-read it as any other trajectory.
+return stroke. :func:`refine_batch` steps each model at the plan's step in chunks of
+:data:`CHUNK_STEPS`; where the number of floor contacts (the ``floor_contact`` sensor, a
+count) changes from one row to the next, the step that changed it is taken again from the
+state before it, and the plan's ``refine_window_s`` after it at its ``fine_timestep_s`` (a
+whole number of fine steps per coarse one, the control held as the plan holds it). Each
+model is refined at its own contact changes: the models that step coarsely go in one
+``mujoco.rollout`` call over every core, those in a fine window in another. The record stays
+on the coarse grid (row i at t = i*dt, every ``dt/fine``-th fine row), so the audit and the
+per-hop figures read it as any other trajectory.
 
-Not a route of ``locust sim`` (its settings are not robot parameters), and not yet as true
-as uniform rk4 at 1 ms on a design's draws: on medium's 32 it sends the draw nearest the
-threshold over where every uniform step has it rear and come back (docs/performance.md,
-``bench/draw_steps.py --refined``). Measured by ``bench/sim_speed.py`` and
-``bench/draw_steps.py``.
+The plan's refinement comes from ``solver.refine_timestep_s`` and ``solver.refine_window_s``
+(:func:`.schedule.control_plan`); :func:`.rollout.simulate_batch` takes this route for every
+refined plan whose models' supply holds their servos.
 """
 
 from __future__ import annotations
 
 import copy
-import time
 from dataclasses import dataclass
 
 import mujoco
@@ -28,30 +27,40 @@ import numpy as np
 from mujoco import rollout as mj_rollout
 
 from ..errors import SimError
+from .batching import add_warnings
 from .model import BuiltModel
-from .rollout import Trajectory, initial_state
 from .schedule import ControlPlan
 
 CHUNK_STEPS = 25    # coarse steps a rollout call: the work thrown away after a change found in it
 
 
-@dataclass(frozen=True)
+@dataclass
 class Refined:
-    """A refined rollout: the record on the coarse grid and what it cost.
+    """One model's refined rollout: its record on the coarse grid and what it cost.
 
     Attributes
     ----------
-    trajectory : Trajectory
-        The record, one row per coarse step.
+    sensordata : ndarray
+        ``(nstep, nsensordata)`` the sensors of each coarse step.
+    states : ndarray or None
+        ``(nstep, nstate)`` the state after each coarse step, when kept.
+    final_state : ndarray
+        ``(nstate,)`` the state after the last step.
+    warnings : dict of str to int
+        MuJoCo's warnings of the calls it ran in (of every model in them: see
+        :func:`refine_batch`).
     coarse_steps : int
         Coarse steps taken, those thrown away after a contact change found in a chunk included.
     fine_steps : int
         Fine steps taken in the windows after each contact change.
     """
 
-    trajectory: Trajectory
-    coarse_steps: int    # coarse steps taken (those thrown away after a change included)
-    fine_steps: int      # fine steps taken
+    sensordata: np.ndarray
+    states: np.ndarray | None
+    final_state: np.ndarray
+    warnings: dict[str, int]
+    coarse_steps: int = 0
+    fine_steps: int = 0
 
     @property
     def model_steps(self) -> int:
@@ -59,80 +68,125 @@ class Refined:
         return self.coarse_steps + self.fine_steps
 
 
-def _warnings(data: mujoco.MjData, into: dict[str, int]) -> None:
-    for i in range(len(data.warning)):
-        if data.warning[i].number:
-            name = mujoco.mjtWarning(i).name
-            into[name] = into.get(name, 0) + int(data.warning[i].number)
+def check_refinement(plan: ControlPlan) -> int:
+    """Fine steps per coarse step of a refined ``plan``.
+
+    Raises
+    ------
+    SimError
+        The fine step does not divide the coarse one.
+    """
+    dt, fine = plan.timestep_s, plan.fine_timestep_s
+    per_coarse = int(round(dt / fine))
+    if per_coarse < 2 or abs(per_coarse * fine - dt) > 1e-9 * dt:
+        raise SimError(f"a fine step of {fine:g} s does not divide the step {dt:g} s into whole steps",
+                       "set solver.refine_timestep_s to solver.timestep_s over 2, 4, 8, ...")
+    return per_coarse
 
 
-def simulate_refined(built: BuiltModel, plan: ControlPlan, fine_s: float, window_s: float,
-                     keep_states: bool = False) -> Refined:
-    """``plan`` on ``built`` at the plan's step, each contact change taken again at ``fine_s``
-    for ``window_s`` (see the module docstring)."""
-    if built.supply is not None:   # its servos follow the rail step by step (supply_rollout), not the rollout
-        raise SimError("the refined step does not solve a supply that limits the servos (docs/servo.md, Power)",
-                       "simulate it at one step (locust.sim.run), or on a supply that holds the servos' stall")
-    dt = plan.timestep_s
-    per_coarse = int(round(dt / fine_s))
-    if per_coarse < 1 or abs(per_coarse * fine_s - dt) > 1e-12 * dt:
-        raise SimError(f"a fine step of {fine_s:g} s does not divide the step {dt:g} s",
-                       "choose a fine step of the step divided by a whole number")
-    window = max(1, int(round(window_s / dt)))
-    coarse_model = built.model
-    fine_model = copy.copy(coarse_model)
-    fine_model.opt.timestep = fine_s
-    data = mujoco.MjData(coarse_model)
-    col = built.sensors.floor_contact.start
-    start, sensor0 = initial_state(built)
-    ctrl = np.zeros((plan.nstep, coarse_model.nu))
-    for act in built.servo_actuators:
-        ctrl[:, act] = plan.ctrl_rad
-    nstep = plan.nstep
-    sensordata = np.empty((nstep, coarse_model.nsensordata))
-    states = np.empty((nstep, start.size)) if keep_states else None
+def _padded(ctrl: np.ndarray, a: int, n: int) -> np.ndarray:
+    """Rows ``a .. a+n`` of ``ctrl``, the last row repeated past its end."""
+    rows = ctrl[a:a + n]
+    if len(rows) < n:
+        rows = np.concatenate([rows, np.repeat(ctrl[-1:], n - len(rows), axis=0)])
+    return rows
+
+
+def refine_batch(builts: list[BuiltModel], plan: ControlPlan, starts: np.ndarray, control: np.ndarray,
+                 keep_states: bool = False, threads: int = 1) -> list[Refined]:
+    """``plan`` on each of ``builts`` (one structure), each refined at its own contact changes
+    (see the module docstring).
+
+    Parameters
+    ----------
+    builts : list of BuiltModel
+        The models; their supply holds the servos (no Python per step).
+    plan : ControlPlan
+        A refined plan (:attr:`.schedule.ControlPlan.refined`).
+    starts : ndarray
+        ``(n_models, nstate)`` full-physics start states.
+    control : ndarray
+        ``(n_models, nstep, nu)`` each model's commands at each coarse step [rad].
+    keep_states : bool
+        Keep the state after each coarse step.
+    threads : int
+        Threads of each ``mujoco.rollout`` call.
+
+    Returns
+    -------
+    list of Refined
+        One per model, in order. MuJoCo counts warnings per thread, not per model: each
+        carries those of every call it was in.
+    """
+    per_coarse = check_refinement(plan)
+    nstep, n = plan.nstep, len(builts)
+    window = max(1, int(round(plan.refine_window_s / plan.timestep_s)))
+    coarse_models = [b.model for b in builts]
+    fine_models = []
+    for m in coarse_models:
+        f = copy.copy(m)
+        f.opt.timestep = plan.fine_timestep_s
+        fine_models.append(f)
+    col = builts[0].sensors.floor_contact.start
+    datas = [mujoco.MjData(coarse_models[0]) for _ in range(max(1, min(threads, n)))]
+    out = [Refined(sensordata=np.empty((nstep, coarse_models[0].nsensordata)),
+                   states=np.empty((nstep, starts.shape[1])) if keep_states else None,
+                   final_state=starts[k].copy(), warnings={}) for k in range(n)]
+    # the steps at which a servo's command changes (the push, the return): taken at the fine step
+    command_changes = np.zeros(control.shape[:2], dtype=bool)
+    command_changes[:, 1:] = (control[:, 1:] != control[:, :-1]).any(axis=2)
+    at = np.zeros(n, dtype=int)             # each model's next coarse step
+    fine_next = np.zeros(n, dtype=bool)     # whether it is to take its next steps fine
     warnings: dict[str, int] = {}
-    coarse_steps = fine_steps = 0
-    state, warm, i = start, None, 0
-    t0 = time.perf_counter()
-    while i < nstep:
-        b = min(nstep, i + CHUNK_STEPS)
-        st, sd = mj_rollout.rollout(coarse_model, data, state, ctrl[None, i:b], initial_warmstart=warm)
-        st, sd = st[0], sd[0]
-        _warnings(data, warnings)
-        coarse_steps += b - i
-        # row m is the state before step i+m: a count that differs from the row before was
-        # changed by the step before it
-        changed = np.flatnonzero(sd[1:, col] != sd[:-1, col])
-        if changed.size == 0:
-            # keep every row but the last: its step is taken again, so a change in it is seen
-            keep = b - i if b == nstep else b - i - 1
-            sensordata[i:i + keep] = sd[:keep]
-            if keep_states:
-                states[i:i + keep] = st[:keep]
-            state = st[keep - 1] if keep else state
-            warm = data.qacc_warmstart.copy()[None] if b == nstep else None
-            i += keep
-            continue
-        c = int(changed[0])                     # step i+c changed the count
-        sensordata[i:i + c] = sd[:c]
-        if keep_states:
-            states[i:i + c] = st[:c]
-        state = st[c - 1] if c else state       # the state before step i+c
-        i += c
-        w = min(window, nstep - i)
-        fine_ctrl = np.repeat(ctrl[i:i + w], per_coarse, axis=0)
-        fst, fsd = mj_rollout.rollout(fine_model, data, state, fine_ctrl[None])
-        fst, fsd = fst[0], fsd[0]
-        _warnings(data, warnings)
-        fine_steps += w * per_coarse
-        sensordata[i:i + w] = fsd[::per_coarse]
-        if keep_states:
-            states[i:i + w] = fst[per_coarse - 1::per_coarse]
-        state, warm = fst[-1], None
-        i += w
-    wall = time.perf_counter() - t0
-    nq = coarse_model.nq
-    traj = Trajectory(built=built, plan=plan, initial_sensordata=sensor0, sensordata=sensordata,
-                      final_qpos=state[1:1 + nq].copy(), warnings=warnings, wall_s=wall, states=states)
-    return Refined(trajectory=traj, coarse_steps=coarse_steps, fine_steps=fine_steps)
+
+    def call(models: list[mujoco.MjModel], ks: list[int], ctrl: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        use = datas[:min(len(datas), len(ks))]
+        st, sd = mj_rollout.rollout([models[k] for k in ks], use, np.stack([out[k].final_state for k in ks]),
+                                    ctrl, persistent_pool=len(use) > 1)
+        for d in use:
+            add_warnings(d, warnings)
+        return st, sd
+
+    while (at < nstep).any():
+        coarse = [k for k in range(n) if at[k] < nstep and not fine_next[k]]
+        if coarse:
+            st, sd = call(coarse_models, coarse, np.stack([_padded(control[k], at[k], CHUNK_STEPS) for k in coarse]))
+            for j, k in enumerate(coarse):
+                r, i = out[k], int(at[k])
+                rows = min(CHUNK_STEPS, nstep - i)
+                r.coarse_steps += rows
+                # sensor row m is taken before step i+m: a count that differs from the row
+                # before was changed by the step before it
+                changed = np.flatnonzero(sd[j, 1:rows, col] != sd[j, :rows - 1, col])
+                commanded = np.flatnonzero(command_changes[k, i:i + rows])
+                if changed.size or commanded.size:
+                    keep = min(int(a[0]) for a in (changed, commanded) if a.size)
+                    fine_next[k] = True
+                else:
+                    # every row but the last, whose step is taken again (a change in it is seen
+                    # only from the row after it), unless the run ends there
+                    keep = rows if i + rows == nstep else rows - 1
+                r.sensordata[i:i + keep] = sd[j, :keep]
+                if keep_states:
+                    r.states[i:i + keep] = st[j, :keep]
+                if keep:
+                    r.final_state = st[j, keep - 1].copy()
+                at[k] = i + keep
+        fine = [k for k in range(n) if at[k] < nstep and fine_next[k]]
+        if fine:
+            # each model's commands held per_coarse fine steps each
+            ctrl = np.stack([np.repeat(_padded(control[k], at[k], window), per_coarse, axis=0) for k in fine])
+            st, sd = call(fine_models, fine, ctrl)
+            for j, k in enumerate(fine):
+                r, i = out[k], int(at[k])
+                w = min(window, nstep - i)
+                r.fine_steps += w * per_coarse
+                r.sensordata[i:i + w] = sd[j, :w * per_coarse:per_coarse]
+                if keep_states:
+                    r.states[i:i + w] = st[j, per_coarse - 1:w * per_coarse:per_coarse]
+                r.final_state = st[j, w * per_coarse - 1].copy()
+                at[k] = i + w
+                fine_next[k] = False
+    for r in out:
+        r.warnings = dict(warnings)
+    return out

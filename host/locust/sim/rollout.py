@@ -17,6 +17,7 @@ from mujoco import rollout as mj_rollout
 from ..params import Robot, check_robot
 from .batching import check_batch, rollout_chunked
 from .model import BuiltModel, build
+from .refine import check_refinement, refine_batch
 from .schedule import ControlPlan, control_plan
 from .supply_rollout import stepped_rollout
 
@@ -46,6 +47,9 @@ class Trajectory:
         Wall-clock time of the rollout call [s] (of the whole batch it ran in).
     states : ndarray or None
         ``(nstep, nstate)`` full-physics states, kept on request (video, traces).
+    model_steps : int
+        Every step MuJoCo took (a refined run's coarse and fine ones, those taken again
+        included): what the run cost; 0 where not counted.
     """
 
     built: BuiltModel
@@ -56,6 +60,7 @@ class Trajectory:
     warnings: dict[str, int]         # MuJoCo warning name -> count
     wall_s: float
     states: np.ndarray | None = None  # (nstep, nstate) FULLPHYSICS states, kept on request (video, traces)
+    model_steps: int = 0              # every step MuJoCo took (the run's cost); 0: not counted
 
     @property
     def timestep_s(self) -> float:
@@ -274,9 +279,21 @@ def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: boo
     control = np.stack([servo_control(b, plan) for b in builts])
     check_batch(models[0], len(models), plan.nstep, keep_states)
     t0 = time.perf_counter()
+    costs = [plan.nstep] * len(models)
     if stepped[0]:   # the supply limits them: stepped in Python (docs/servo.md, "Power")
+        # a refined plan's supply is stepped uniformly at its fine step
+        substeps = check_refinement(plan) if plan.refined else 1
         states, sensordata, final, warnings = stepped_rollout(builts, np.array([s for s, _ in starts]), control,
-                                                              keep_states, plan.steps_per_tick)
+                                                              keep_states, plan.steps_per_tick, substeps)
+        costs = [plan.nstep * substeps] * len(models)
+    elif plan.refined:   # each refined at its own contact changes (sim/refine.py)
+        runs = refine_batch(builts, plan, np.array([s for s, _ in starts]), control, keep_states,
+                            threads or available_cores())
+        states = np.stack([r.states for r in runs]) if keep_states else None
+        sensordata = np.stack([r.sensordata for r in runs])
+        final = np.stack([r.final_state for r in runs])
+        warnings = runs[0].warnings
+        costs = [r.model_steps for r in runs]
     else:
         n_threads = max(1, min(threads or available_cores(), len(models)))
         datas = [mujoco.MjData(models[0]) for _ in range(n_threads)]
@@ -289,5 +306,5 @@ def simulate_batch(builts: list[BuiltModel], plan: ControlPlan, keep_states: boo
     # FULLPHYSICS state starts with time, then qpos
     return [Trajectory(built=b, plan=plan, initial_sensordata=sensor0, sensordata=sensordata[k],
                        final_qpos=final[k, 1:1 + nq].copy(), warnings=dict(warnings), wall_s=wall,
-                       states=states[k] if keep_states else None)
+                       states=states[k] if keep_states else None, model_steps=costs[k])
             for k, (b, (_, sensor0)) in enumerate(zip(builts, starts))]

@@ -132,7 +132,7 @@ CONVERGED_MM = 0.1       # ... or within 0.1 mm (per hop for the distance)
 
 
 def check_convergence(robot: Robot, result: SimResult, cycles: int | None = None) -> dict[str, float | bool]:
-    """Rerun at half the time step: change of distance (mm per hop and %) and of nose height
+    """Rerun with every step halved (``Solver.steps_scaled``): change of distance (mm per hop and %) and of nose height
     (mm and %); ``converged`` when each is within 1 % or 0.1 mm (per hop).
 
     Parameters
@@ -150,7 +150,8 @@ def check_convergence(robot: Robot, result: SimResult, cycles: int | None = None
         The half step [s], its validity, distance [m] and nose height [m], the changes (in mm
         per hop, mm, and relative) and ``converged``.
     """
-    half = run(robot, cycles=cycles, timestep_s=result.timestep_s / 2)
+    at = robot.with_values({"solver.timestep_s": result.timestep_s})
+    half = run(at.with_values(at.solver.steps_scaled(0.5)), cycles=cycles)
     hops = max(len(result.hops), 1)
 
     def rel(a: float, b: float) -> float:

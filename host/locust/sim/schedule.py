@@ -32,6 +32,11 @@ class ControlPlan:
         Steps before the first push.
     cycle_start_steps : ndarray
         ``(cycles + 1,)`` step index where each cycle starts; the last is the end.
+    fine_timestep_s : float
+        Where the floor contacts change, the step taken again at this one [s]; 0: uniform
+        steps (``solver.refine_timestep_s``, :mod:`.refine`).
+    refine_window_s : float
+        How long the fine step runs after a change [s].
     """
 
     ctrl_rad: np.ndarray          # (nstep,) servo command for every physics step, radians
@@ -39,6 +44,13 @@ class ControlPlan:
     steps_per_tick: int
     settle_steps: int             # steps before the first push
     cycle_start_steps: np.ndarray  # (cycles + 1,) step index where each cycle starts; last = end
+    fine_timestep_s: float = 0.0   # the step where the floor contacts change; 0: uniform
+    refine_window_s: float = 0.0   # how long it runs after a change
+
+    @property
+    def refined(self) -> bool:
+        """Whether the run refines its step where the floor contacts change."""
+        return 0.0 < self.fine_timestep_s < self.timestep_s
 
     @property
     def nstep(self) -> int:
@@ -107,7 +119,10 @@ def control_plan(schedule: Schedule, solver: Solver, cycles: int | None = None,
     ctrl = np.repeat(tick_ctrl, per_tick)
     starts = [settle_ticks + int(round(c * cycle_s * hz)) for c in range(n_cycles)]
     starts.append(settle_ticks + hop_ticks)
+    # the solver's refinement, with its own step (an explicit step steps uniformly)
+    fine = solver.refine_timestep_s if timestep_s is None and solver.refined else 0.0
     return ControlPlan(
         ctrl_rad=ctrl, timestep_s=dt, steps_per_tick=per_tick, settle_steps=settle_ticks * per_tick,
-        cycle_start_steps=np.asarray(starts) * per_tick,
+        cycle_start_steps=np.asarray(starts) * per_tick, fine_timestep_s=fine,
+        refine_window_s=solver.refine_window_s if fine else 0.0,
     )

@@ -26,6 +26,7 @@ import copy
 import mujoco
 import numpy as np
 
+from .batching import add_warnings
 from .model import BuiltModel
 from .servo import at_supply, back_emf_damping_nms_per_rad
 from .supply import rail_voltage_v
@@ -144,8 +145,13 @@ def supply_stepper(built: BuiltModel, steps_per_tick: int) -> SupplyStepper | No
 
 
 def stepped_rollout(builts: list[BuiltModel], initial_state: np.ndarray, control: np.ndarray, keep_states: bool,
-                    steps_per_tick: int) -> tuple[np.ndarray | None, np.ndarray, np.ndarray, dict[str, int]]:
+                    steps_per_tick: int, substeps: int = 1
+                    ) -> tuple[np.ndarray | None, np.ndarray, np.ndarray, dict[str, int]]:
     """:func:`.batching.rollout_chunked`'s record, each model stepped on its supply in Python.
+
+    With ``substeps`` > 1 each row of ``control`` is that many steps of the model's step over
+    ``substeps`` (a refined plan's fine step, taken uniformly: :mod:`.refine` does not step a
+    supply), recorded on the rows' grid.
 
     Parameters
     ----------
@@ -158,14 +164,16 @@ def stepped_rollout(builts: list[BuiltModel], initial_state: np.ndarray, control
     keep_states : bool
         Whether every step's state is returned.
     steps_per_tick : int
-        Physics steps per PWM period.
+        Rows per PWM period.
+    substeps : int
+        Physics steps a row.
 
     Returns
     -------
     states : ndarray or None
-        ``(n_models, nstep, nstate)`` the state after each step, or None without ``keep_states``.
+        ``(n_models, nstep, nstate)`` the state after each row, or None without ``keep_states``.
     sensordata : ndarray
-        ``(n_models, nstep, nsensordata)`` the sensors of each step (evaluated at its start).
+        ``(n_models, nstep, nsensordata)`` the sensors of each row (evaluated at its start).
     final : ndarray
         ``(n_models, nstate)`` the state after the last step.
     warnings : dict of str to int
@@ -180,17 +188,20 @@ def stepped_rollout(builts: list[BuiltModel], initial_state: np.ndarray, control
     final = np.empty((n, nstate))
     warnings: dict[str, int] = {}
     for k, built in enumerate(builts):
-        stepper = SupplyStepper(built, steps_per_tick)
+        stepper = SupplyStepper(built, steps_per_tick * substeps)
         m = stepper.model
+        m.opt.timestep = built.model.opt.timestep / substeps
         d = mujoco.MjData(m)
         mujoco.mj_setState(m, d, initial_state[k], spec)
         row = np.empty(nstate)
         stop = nstep
         for i in range(nstep):
             d.ctrl[:] = control[k, i]
-            stepper.before_step(d, i)
-            mujoco.mj_step(m, d)
-            sensordata[k, i] = d.sensordata
+            for j in range(substeps):
+                stepper.before_step(d, i * substeps + j)
+                mujoco.mj_step(m, d)
+                if j == 0:
+                    sensordata[k, i] = d.sensordata
             if keep_states:
                 mujoco.mj_getState(m, d, states[k, i], spec)
             if any(d.warning[int(w)].number for w in STOPPING_WARNINGS):
@@ -202,10 +213,7 @@ def stepped_rollout(builts: list[BuiltModel], initial_state: np.ndarray, control
                 states[k, stop:] = states[k, stop - 1]
         mujoco.mj_getState(m, d, row, spec)
         final[k] = row
-        for w in range(len(d.warning)):
-            if d.warning[w].number:
-                name = mujoco.mjtWarning(w).name
-                warnings[name] = warnings.get(name, 0) + int(d.warning[w].number)
+        add_warnings(d, warnings)
     return states, sensordata, final, warnings
 
 
