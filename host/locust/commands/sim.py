@@ -92,7 +92,7 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
                          still=still, still_push=still_push, board=board, push_clip=push_clip,
                          push_clip_held=push_clip_held, push_fps=push_fps, side={"left": "L", "right": "R"}[side],
                          invalid_linkage_result=as_json, explain=explain)
-    with _bar(robot, samples, explain) as bar:
+    with _bar(robot, options) as bar:
         result = run_simulation(robot, options, progress=bar.update if bar else None)
     if as_json:
         click.echo(json_text(result.to_json()), nl=False)
@@ -110,13 +110,11 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
         sys.exit(1)
 
 
-def _bar(robot, samples: int | None, explain: bool):
-    """The progress bar of the draws and the explanation's runs (none without either)."""
-    if not (samples or explain):
+def _bar(robot, options):
+    """The progress bar of every run of the draws, the sensitivity and the explanation (none
+    without one of them)."""
+    if not (options.samples or options.sensitivity or options.explain):
         return nullcontext()
-    from ..sim.explain import explain_runs
+    from ..sim.job import planned_runs
 
-    runs = explain_runs(robot) if explain else 0
-    label = " + ".join(p for p in (f"{samples} draws" if samples else "", f"explaining ({runs} runs at most)"
-                                   if explain else "") if p)
-    return JobBar((samples or 0) + runs, label)
+    return JobBar(*planned_runs(robot, options))

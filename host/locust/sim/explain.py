@@ -18,7 +18,7 @@ Three parts, each from simulations of the robot itself:
   effect on the first hop's nose rise and on the run's distance (these runs are probes of the
   threshold search).
 
-All runs of one stage go in batched rollouts (:func:`.sensitivity.run_figures`).
+All runs of one stage go in batched rollouts (:func:`.figures.run_figures`).
 """
 
 from __future__ import annotations
@@ -32,11 +32,12 @@ import numpy as np
 
 from ..params import Provenance, Robot
 from ..tables import label, quantity, split_unit
+from .figures import RunFigures, run_figures
 from .hops import plate_pitch_deg
 from .outcome import GOES_OVER, OVER_TURN_DEG
 from .rollout import Trajectory, servo_control
 from .samples import MIN_FRACTION, uncertain_values
-from .sensitivity import K_SD, RunFigures, run_figures
+from .sensitivity import K_SD
 from .support import Stance, stances
 
 # what a student can change on the robot they build, beside what carries an uncertainty

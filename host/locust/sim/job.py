@@ -141,7 +141,8 @@ def simulated(robot: Robot, options: SimOptions, progress: Callable[[int], None]
         ``cycles``, ``samples``, ``seed``, ``sensitivity``, ``keep_states`` (and ``video``,
         which keeps the states).
     progress : callable, optional
-        ``progress(0)`` as the draws begin, then ``progress(k)`` as each batch of ``k`` is done.
+        ``progress(0)`` as the run begins, then ``progress(k)`` as each ``k`` runs are done (the
+        run, each batch of draws and sensitivity ends, the explanation's: :func:`planned_runs`).
 
     Returns
     -------
@@ -160,30 +161,84 @@ def simulated(robot: Robot, options: SimOptions, progress: Callable[[int], None]
         from .samples import check_draws
 
         check_draws(robot, options.samples, cycles)   # before the robot's own run
+    if progress:
+        progress(0)
     # the video and the explanation reuse the rollout
     keep = options.keep_states or options.video is not None or options.explain
     result = dataclasses.replace(_run.run(robot, cycles=cycles, keep_states=keep), robot=robot)
+    if progress:
+        progress(1)
     if result.valid:
         from .statics import standing_load
 
         load = standing_load(robot)
         result.nose_load_kg, result.total_mass_kg = load.nose_load_kg, load.total_mass_kg
-    if options.samples and result.valid:
-        from .samples import sample
-
-        if progress:
-            progress(0)
-        result.spread = sample(robot, options.samples, cycles=cycles, seed=options.seed, progress=progress)
-    mixed = result.spread is not None and max(o.share for o in result.spread.outcomes.values()) < 1.0
-    if result.valid and (options.sensitivity or (options.sensitivity is None and mixed)):
-        from .sensitivity import outcome_sensitivity
-
-        result.sensitivity = outcome_sensitivity(robot, cycles=cycles)
+    _draws_and_ends(robot, result, options, progress)
     if options.explain and result.valid:
         result.explanation = explained(robot, result, cycles, progress)
         if not options.keep_states and options.video is None:
             result.trajectory = None
     return result
+
+
+def planned_runs(robot: Robot, options: SimOptions) -> tuple[int, str]:
+    """The runs :func:`simulated` reports to its ``progress``, at most, and what they are
+    (a progress bar's length and label): the run itself, the draws, the sensitivity's ends
+    (asked for, or with the draws: run only when they split, else counted done) and the
+    explanation's runs.
+
+    Parameters
+    ----------
+    robot : Robot
+    options : SimOptions
+
+    Returns
+    -------
+    runs : int
+    label : str
+    """
+    from .sensitivity import end_robots
+
+    parts, runs = ["the run"], 1
+    if options.samples:
+        parts.append(f"{options.samples} draws")
+        runs += options.samples
+    if options.sensitivity or (options.sensitivity is None and options.samples):
+        ends = len(end_robots(robot))
+        parts.append(f"{ends} sensitivity ends" + (" (if the draws split)" if options.sensitivity is None else ""))
+        runs += ends
+    if options.explain:
+        from .explain import explain_runs
+
+        parts.append(f"explaining ({explain_runs(robot)} runs at most)")
+        runs += explain_runs(robot)
+    return runs, " + ".join(parts)
+
+
+def _draws_and_ends(robot: Robot, result: SimResult, options: SimOptions,
+                    progress: Callable[[int], None] | None) -> None:
+    """The draws (``result.spread``) and the sensitivity (``result.sensitivity``) of a valid
+    run: asked for together, their runs go in one batched pass; the sensitivity asked for
+    only where the draws split runs after them (or is counted done, where they do not)."""
+    from .figures import run_figures
+    from .samples import draw, spread_of
+    from .sensitivity import end_robots, sensitivity_of
+
+    n, cycles = options.samples, options.cycles
+    ends = end_robots(robot) if result.valid and (options.sensitivity or (options.sensitivity is None and n)) else []
+    if not result.valid:
+        return
+    together = ends if options.sensitivity else []
+    figures = run_figures((draw(robot, n, options.seed) if n else []) + together, cycles, progress)
+    if n:
+        result.spread = spread_of(robot, n, options.seed, figures[:n])
+    mixed = result.spread is not None and max(o.share for o in result.spread.outcomes.values()) < 1.0
+    if together:
+        result.sensitivity = sensitivity_of(robot, result.outcome, figures[n:])
+    elif ends and mixed:
+        result.sensitivity = sensitivity_of(robot, result.outcome, run_figures(ends, cycles, progress))
+    elif ends and progress:
+        progress(len(ends))      # the draws agree: no sensitivity to run
 
 
 def explained(robot: Robot, result: SimResult, cycles: int | None, progress: Callable[[int], None] | None):
@@ -205,7 +260,7 @@ def explained(robot: Robot, result: SimResult, cycles: int | None, progress: Cal
     locust.sim.explain.Explanation
     """
     from .explain import explain
-    from .sensitivity import RunFigures
+    from .figures import RunFigures
 
     figures = RunFigures(outcome=result.outcome or "", nose_rise_m=result.hops[0].nose_apex_m if result.hops else 0.0,
                          distance_m=result.distance_m)
@@ -267,7 +322,8 @@ def run_simulation(robot: Robot, options: SimOptions, progress: Callable[[int], 
     options : SimOptions
         The settings.
     progress : callable, optional
-        ``progress(0)`` as the draws begin, then ``progress(k)`` as each batch of ``k`` is done.
+        ``progress(0)`` as the run begins, then ``progress(k)`` as each ``k`` runs are done (the
+        run, each batch of draws and sensitivity ends, the explanation's: :func:`planned_runs`).
 
     Returns
     -------
@@ -298,4 +354,4 @@ def run_simulation(robot: Robot, options: SimOptions, progress: Callable[[int], 
     return result
 
 
-__all__ = ["SimOptions", "prepared", "rendered", "run_simulation", "simulated"]
+__all__ = ["SimOptions", "planned_runs", "prepared", "rendered", "run_simulation", "simulated"]

@@ -23,13 +23,12 @@ from ..errors import GeometryError
 from ..params import Provenance, Robot, check_robot, problems, real_keys
 from .audit import audit
 from .batching import check_batch
-from .hops import summarise
+from .figures import BATCH_PER_CORE, RunFigures, figures_of
 from .model import build
-from .outcome import OutcomeFigures, classify, outcome_shares
+from .outcome import OutcomeFigures, outcome_shares
 from .rollout import Trajectory, available_cores, simulate_batch
 from .schedule import control_plan
 
-BATCH_PER_CORE = 4      # draws per core in one rollout call when progress is shown
 MIN_FRACTION = 0.1      # a positive value's draws are kept above this fraction of it
 
 
@@ -253,12 +252,31 @@ def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0,
     ParamsError, GeometryError, SimError
         As :func:`check_draws`, before anything is drawn.
     """
-    dist, nose, kind = [], [], []
-    for traj in simulate_draws(robot, n, cycles, seed, progress=progress):
-        summary = summarise(traj) if traj is not None else None
-        dist.append(summary.distance_m if summary else math.nan)
-        nose.append(summary.max_nose_height_m if summary else math.nan)
-        kind.append(classify(summary.hops) if summary else None)
+    trajs = simulate_draws(robot, n, cycles, seed, progress=progress)
+    return spread_of(robot, n, seed, [figures_of(t) if t is not None else None for t in trajs])
+
+
+def spread_of(robot: Robot, n: int, seed: int, figures: list[RunFigures | None]) -> Samples:
+    """The spread of the draws ``draw(robot, n, seed)`` from each one's figures.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot drawn about.
+    n : int
+        Draws.
+    seed : int
+        Their seed.
+    figures : list of RunFigures or None
+        Each draw's figures, in order (None: outside the limits, not built, or not audited).
+
+    Returns
+    -------
+    Samples
+    """
+    dist = [f.distance_m if f else math.nan for f in figures]
+    nose = [f.max_nose_height_m if f else math.nan for f in figures]
+    kind = [f.outcome if f else None for f in figures]
     d, h = np.array(dist), np.array(nose)
     valid = np.isfinite(d) & np.isfinite(h)
 

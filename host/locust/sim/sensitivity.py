@@ -14,15 +14,9 @@ import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from ..errors import GeometryError
-from ..params import Provenance, Robot, problems
-from .audit import audit
-from .hops import summarise
-from .model import BuiltModel, build
-from .outcome import classify
-from .rollout import available_cores, simulate_batch
-from .samples import BATCH_PER_CORE, MIN_FRACTION, uncertain_values
-from .schedule import control_plan
+from ..params import Provenance, Robot
+from .figures import RunFigures, run_figures
+from .samples import MIN_FRACTION, uncertain_values
 
 K_SD = 2.0
 
@@ -75,79 +69,58 @@ class Sensitivity:
         return out
 
 
-@dataclass(frozen=True)
-class RunFigures:
-    """What one run of a batch gives: its outcome, its first hop's nose rise and its distance.
-
-    Attributes
-    ----------
-    outcome : str
-        One of :data:`~.outcome.OUTCOMES`.
-    nose_rise_m : float
-        The first hop's nose rise above standing [m] (``Hop.nose_apex_m``).
-    distance_m : float
-        The run's distance, start of the schedule to its end [m].
-    """
-
-    outcome: str
-    nose_rise_m: float
-    distance_m: float
-
-
-def run_figures(robots: list[Robot], cycles: int | None,
-                progress: Callable[[int], None] | None = None) -> list[RunFigures | None]:
-    """Each robot's outcome and figures, simulated in batched rollouts (one per hop schedule and
-    solver among them, in chunks of :data:`~.samples.BATCH_PER_CORE` a core when ``progress``
-    is given); None for one that cannot be built or run, or fails its audit.
+def end_robots(robot: Robot, k_sd: float = K_SD) -> list[Robot]:
+    """``robot`` with each uncertain value alone at -``k_sd`` sd and at +``k_sd`` sd, in the
+    robot file's order (two robots a value; a positive value kept above a tenth of itself, as
+    the draws of ``--samples`` are).
 
     Parameters
     ----------
-    robots : list of Robot
-        The robots, all of one structure.
-    cycles : int or None
-        Hop cycles (None: each robot's schedule's).
-    progress : callable, optional
-        ``progress(k)`` as each chunk of ``k`` robots is done.
+    robot : Robot
+    k_sd : float
 
     Returns
     -------
-    list of RunFigures or None
-        One per robot, in order.
+    list of Robot
     """
-    out: list[RunFigures | None] = [None] * len(robots)
-    builts: dict[int, BuiltModel] = {}
-    groups: dict[tuple, list[int]] = {}
-    for i, r in enumerate(robots):
-        try:
-            if not problems(r, cycles):
-                builts[i] = build(r)
-                groups.setdefault((r.schedule, r.solver), []).append(i)
-        except GeometryError:
-            pass
-    if progress and len(builts) < len(robots):
-        progress(len(robots) - len(builts))
-    chunk = max(1, BATCH_PER_CORE * available_cores()) if progress else len(robots) or 1
-    for (schedule, solver), members in groups.items():
-        plan = control_plan(schedule, solver, cycles)
-        for start in range(0, len(members), chunk):
-            part = members[start:start + chunk]
-            for i, traj in zip(part, simulate_batch([builts[i] for i in part], plan)):
-                if audit(traj).valid:
-                    summary = summarise(traj)
-                    hops = summary.hops
-                    out[i] = RunFigures(outcome=classify(hops), nose_rise_m=hops[0].nose_apex_m if hops else 0.0,
-                                        distance_m=summary.distance_m)
-            if progress:
-                progress(len(part))
+    prov = Provenance(source="sensitivity", note=f"one value at -/+{k_sd:g} sd")
+    out = []
+    for key, sd in uncertain_values(robot).items():
+        centre = robot.get(key)
+        for sign in (-1.0, 1.0):
+            value = centre + sign * k_sd * sd
+            out.append(robot.with_values({key: max(value, MIN_FRACTION * centre) if centre > 0 else value}, prov))
     return out
 
 
-def _outcomes(robots: list[Robot], cycles: int | None) -> list[str | None]:
-    """Each robot's outcome (:func:`run_figures`); None for one that cannot be run."""
-    return [f.outcome if f is not None else None for f in run_figures(robots, cycles)]
+def sensitivity_of(robot: Robot, nominal: str | None, ends: list[RunFigures | None],
+                   k_sd: float = K_SD) -> Sensitivity:
+    """The sensitivity from the runs of :func:`end_robots` (their figures, in order).
+
+    Parameters
+    ----------
+    robot : Robot
+    nominal : str or None
+        ``robot``'s own outcome.
+    ends : list of RunFigures or None
+        The figures of ``end_robots(robot, k_sd)``.
+    k_sd : float
+
+    Returns
+    -------
+    Sensitivity
+    """
+    sds = uncertain_values(robot)
+    robots = end_robots(robot, k_sd)
+    kinds = [f.outcome if f is not None else None for f in ends]
+    effects = [KeyEffect(key=key, sd=sd, low_value=robots[2 * i].get(key), low_outcome=kinds[2 * i],
+                         high_value=robots[2 * i + 1].get(key), high_outcome=kinds[2 * i + 1])
+               for i, (key, sd) in enumerate(sds.items())]
+    return Sensitivity(nominal=nominal, k_sd=k_sd, effects=effects)
 
 
-def outcome_sensitivity(robot: Robot, cycles: int | None = None, k_sd: float = K_SD) -> Sensitivity:
+def outcome_sensitivity(robot: Robot, cycles: int | None = None, k_sd: float = K_SD,
+                        progress: Callable[[int], None] | None = None) -> Sensitivity:
     """The outcome of ``robot`` and of each uncertain value moved alone to -/+ ``k_sd`` sd.
 
     Parameters
@@ -158,6 +131,8 @@ def outcome_sensitivity(robot: Robot, cycles: int | None = None, k_sd: float = K
         Hop cycles; default the robot's ``schedule.cycles``.
     k_sd : float, default 2
         How far each value moves, in its standard deviations (2: its 95 % interval).
+    progress : callable, optional
+        ``progress(k)`` as each batch of ``k`` runs is done (:func:`.figures.run_figures`).
 
     Returns
     -------
@@ -166,21 +141,9 @@ def outcome_sensitivity(robot: Robot, cycles: int | None = None, k_sd: float = K
         uncertain value) and ``deciding`` (those whose interval holds another outcome).
         A positive value is kept above a tenth of itself, as the draws of ``--samples`` are.
     """
-    sds = uncertain_values(robot)
-    ends = []
-    for key, sd in sds.items():
-        centre = robot.get(key)
-        for sign in (-1.0, 1.0):
-            value = centre + sign * k_sd * sd
-            ends.append(max(value, MIN_FRACTION * centre) if centre > 0 else value)
-    prov = Provenance(source="sensitivity", note=f"one value at -/+{k_sd:g} sd")
-    robots = [robot] + [robot.with_values({key: ends[2 * i + j]}, prov)
-                        for i, key in enumerate(sds) for j in range(2)]
-    kinds = _outcomes(robots, cycles)
-    effects = [KeyEffect(key=key, sd=sd, low_value=ends[2 * i], low_outcome=kinds[1 + 2 * i],
-                         high_value=ends[2 * i + 1], high_outcome=kinds[2 + 2 * i])
-               for i, (key, sd) in enumerate(sds.items())]
-    return Sensitivity(nominal=kinds[0], k_sd=k_sd, effects=effects)
+    figures = run_figures([robot] + end_robots(robot, k_sd), cycles, progress)
+    return sensitivity_of(robot, figures[0].outcome if figures[0] is not None else None, figures[1:], k_sd)
 
 
-__all__ = ["KeyEffect", "RunFigures", "Sensitivity", "outcome_sensitivity", "run_figures", "K_SD"]
+__all__ = ["KeyEffect", "RunFigures", "Sensitivity", "end_robots", "outcome_sensitivity", "run_figures",
+           "sensitivity_of", "K_SD"]
