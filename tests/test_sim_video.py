@@ -18,7 +18,7 @@ from locust.commands import cli
 from locust.errors import SimError
 from locust.markers import MARKER_COLOURS
 from locust.params import preset
-from locust.sim.clip import VISIBLE_FRAC, render_video
+from locust.sim.clip import VIDEO_QUALITY, VISIBLE_FRAC, render_video
 from locust.sim.rollout import roll_out
 from locust.sim.run import run
 
@@ -216,6 +216,30 @@ def test_renders_an_audited_run_without_simulating_again(clips, tmp_path):
     assert info.camera_path.read_text() == infos["fixed"].camera_path.read_text()
     with pytest.raises(SimError, match="kept no states"):
         render_video(robot, tmp_path / "stateless.mp4", trajectory=roll_out(robot, cycles=1))
+
+
+def test_a_video_renders_at_its_own_quality_and_leaves_the_model_its_own(clips, tmp_path):
+    """A video's frames are rendered without multisampling and with a 1024 px shadow map (2.3-3x
+    faster: bench/video_speed.py) on a copy of the model: the stills and photos rendered from
+    the same model after it keep its 4 samples and 2048 px shadows. Its markers' blobs are
+    where the truth says (test_truth_pixels_match_marker_blobs) as at the model's quality."""
+    robot, _ = clips
+    traj = run(robot, cycles=1, keep_states=True).trajectory
+    quality = traj.built.model.vis.quality
+    own = (quality.offsamples, quality.shadowsize)
+    assert (VIDEO_QUALITY.msaa_samples, VIDEO_QUALITY.shadow_map_px) == (0, 1024) and own == (4, 2048)
+    fast = render_video(robot, tmp_path / "fast.mp4", camera="fixed", fps=FPS, width=W, height=H, trajectory=traj)
+    assert (quality.offsamples, quality.shadowsize) == own
+    full = render_video(robot, tmp_path / "full.mp4", camera="fixed", fps=FPS, width=W, height=H, trajectory=traj,
+                        quality=None)
+    assert fast.truth_path.read_text() == full.truth_path.read_text()   # the truth is the scene's, not the image's
+    a, b = cv2.VideoCapture(str(fast.video_path)), cv2.VideoCapture(str(full.video_path))
+    differ = []
+    for _ in range(fast.frames):
+        (_, fa), (_, fb) = a.read(), b.read()
+        differ.append(float(np.abs(fa.astype(float) - fb.astype(float)).mean()))
+    # the same picture, its edges aliased and its shadows softer: under a grey level apart on average
+    assert 0.0 < float(np.mean(differ)) < 2.0       # 0.70 measured; a black or another frame: tens
 
 
 def test_refuses_to_overwrite_and_bad_names(tmp_path):

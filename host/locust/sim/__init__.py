@@ -3,12 +3,14 @@ film.
 
 :mod:`.fourbar` solves the leg linkage; :mod:`.servo` and :mod:`.model` build the MuJoCo model (MjSpec);
 :mod:`.schedule` turns the hop schedule into a per-step command; :mod:`.rollout` and :mod:`.batching` run
-it with ``mujoco.rollout`` (:mod:`.refine`: a coarse step with each floor-contact change taken
-again at a fine one, for the benchmarks); :mod:`.audit` invalidates a run that breaks its own physics; :mod:`.hops`
+it with ``mujoco.rollout`` (:mod:`.refine`: where ``solver.refine_timestep_s`` is set, a coarse
+step with each floor-contact and command change taken again at a fine one); :mod:`.audit`
+invalidates a run that breaks its own physics; :mod:`.hops`
 and :mod:`.outcome` measure each hop and name the run's regime; :mod:`.run` does all of that for one
 robot and returns :mod:`.result`'s :class:`~.result.SimResult` (:mod:`.job`: ``locust sim``'s whole run,
 which :func:`locust.simulate` shares); :mod:`.samples` and :mod:`.sensitivity`
-simulate draws and one-at-a-time moves of the uncertain values; :mod:`.explain` says why a robot goes
+simulate draws and one-at-a-time moves of the uncertain values (:mod:`.figures`: many robots' runs
+in batches, reduced to their figures); :mod:`.explain` says why a robot goes
 over (from :mod:`.support`: what it stands on, where its centre of mass is) and where each value's
 threshold lies; :mod:`.statics` finds the
 standing robot's load on its nose; :mod:`.kinematics` poses the markers at kept states;
