@@ -181,6 +181,39 @@ def convergence_line(c: dict) -> str:
             f"{said}")
 
 
+def ensemble_convergence_lines(ec) -> list[str]:
+    """``--check-convergence`` with ``--samples``: the draws' shares and percentiles at half the
+    step against their intervals, and the draws that flip (:mod:`locust.sim.ensemble`).
+
+    Parameters
+    ----------
+    ec : locust.sim.ensemble.EnsembleConvergence
+
+    Returns
+    -------
+    list of str
+    """
+    said = "converged" if ec.converged else "NOT converged (a share or a percentile outside its interval)"
+    lines = [f"{INDENT}the {ec.n} draws at half the time step ({ec.half_timestep_s:g} s): {said}"]
+    for sh in ec.shares:
+        mark = "" if sh.within else "  OUTSIDE"
+        lines.append(f"{INDENT * 2}{outcome_words(sh.outcome):17s} {sh.share * 100:5.1f} % -> "
+                     f"{sh.half_share * 100:5.1f} %  (95 % binomial interval {sh.low * 100:.1f}-{sh.high * 100:.1f} %)"
+                     f"{mark}")
+    for q in ec.quantiles:
+        mark = "" if q.within else "  OUTSIDE"
+        what = "distance" if q.figure == "distance_m" else "highest nose"
+        lines.append(f"{INDENT * 2}{what} {q.q * 100:.0f}th percentile {q.value_m * 1000:8.2f} -> "
+                     f"{q.half_value_m * 1000:8.2f} mm  (95 % bootstrap interval {q.low_m * 1000:.2f} to "
+                     f"{q.high_m * 1000:.2f} mm){mark}")
+    for f in ec.flips:
+        a = outcome_words(f.outcome) if f.outcome else "invalid"
+        b = outcome_words(f.half_outcome) if f.half_outcome else "invalid"
+        lines.append(f"{INDENT * 2}draw {f.draw} {a} at the step, {b} at half of it: on the threshold "
+                     "(a single draw's flip, judged by the shares above)")
+    return lines
+
+
 def mean_sd(mean: float, sd: float, scale: float = 1000.0) -> str:
     """``mean +- sd`` to sensible digits: the sd to two significant figures, the mean to the
     same decimal place (a single draw: its value, one decimal). Values in SI times ``scale``.

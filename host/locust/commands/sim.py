@@ -11,7 +11,14 @@ import click
 from ..fileio import json_text
 from ..io.robot_toml import resolve_robot
 from ..params import LEG_SETS
-from ..tables import explain_lines, nose_load_line, sensitivity_lines, sim_lines, spread_lines
+from ..tables import (
+    ensemble_convergence_lines,
+    explain_lines,
+    nose_load_line,
+    sensitivity_lines,
+    sim_lines,
+    spread_lines,
+)
 from .options import JobBar, robot_options
 
 
@@ -44,7 +51,10 @@ from .options import JobBar, robot_options
 @click.option("--side", type=click.Choice(["left", "right"]), default="left", show_default=True,
               help="For --still and --push-clip: the side filmed (the right leg is at -y, the camera there).")
 @click.option("--check-convergence", is_flag=True,
-              help="Rerun at half the time step and report the relative change.")
+              help="Rerun with every step halved and report the relative change; with --samples, also the "
+                   "draws again: each outcome's share against its 95 % binomial interval, the distance's and "
+                   "highest nose's 10/50/90th percentiles against their bootstrap intervals, and the draws that "
+                   "flip outcome (on the threshold).")
 @click.option("--samples", type=click.IntRange(2, 4096), default=None, metavar="N",
               help="Also simulate N draws of the values that carry an uncertainty in the robot file "
                    "(one batched rollout) and report each outcome's share of them and its own distance "
@@ -104,6 +114,9 @@ def sim(preset, config, sets, leg_set_name, cycles, as_json, video, camera, stil
     spread, sens = getattr(result, "spread", None), getattr(result, "sensitivity", None)
     for line in (spread_lines(spread) if spread is not None else []) + (sensitivity_lines(sens) if sens else []):
         click.echo(line)
+    if result.ensemble_convergence is not None:
+        for line in ensemble_convergence_lines(result.ensemble_convergence):
+            click.echo(line)
     for line in explain_lines(result.explanation) if result.explanation is not None else []:
         click.echo(line)
     if not result.valid:

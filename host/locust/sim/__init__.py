@@ -10,7 +10,8 @@ and :mod:`.outcome` measure each hop and name the run's regime; :mod:`.run` does
 robot and returns :mod:`.result`'s :class:`~.result.SimResult` (:mod:`.job`: ``locust sim``'s whole run,
 which :func:`locust.simulate` shares); :mod:`.samples` and :mod:`.sensitivity`
 simulate draws and one-at-a-time moves of the uncertain values (:mod:`.figures`: many robots' runs
-in batches, reduced to their figures); :mod:`.explain` says why a robot goes
+in batches, reduced to their figures; :mod:`.ensemble`: the draws' shares and percentiles at
+dt/2); :mod:`.explain` says why a robot goes
 over (from :mod:`.support`: what it stands on, where its centre of mass is) and where each value's
 threshold lies; :mod:`.statics` finds the
 standing robot's load on its nose; :mod:`.kinematics` poses the markers at kept states;

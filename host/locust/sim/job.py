@@ -184,8 +184,8 @@ def simulated(robot: Robot, options: SimOptions, progress: Callable[[int], None]
 def planned_runs(robot: Robot, options: SimOptions) -> tuple[int, str]:
     """The runs :func:`simulated` reports to its ``progress``, at most, and what they are
     (a progress bar's length and label): the run itself, the draws, the sensitivity's ends
-    (asked for, or with the draws: run only when they split, else counted done) and the
-    explanation's runs.
+    (asked for, or with the draws: run only when they split, else counted done), the
+    explanation's runs, and the run and its draws again at dt/2 (``check_convergence``).
 
     Parameters
     ----------
@@ -212,6 +212,9 @@ def planned_runs(robot: Robot, options: SimOptions) -> tuple[int, str]:
 
         parts.append(f"explaining ({explain_runs(robot)} runs at most)")
         runs += explain_runs(robot)
+    if options.check_convergence:
+        parts.append("the run" + (f" and its {options.samples} draws" if options.samples else "") + " at dt/2")
+        runs += 1 + options.samples
     return runs, " + ".join(parts)
 
 
@@ -350,6 +353,12 @@ def run_simulation(robot: Robot, options: SimOptions, progress: Callable[[int], 
         result = dataclasses.replace(_run.invalid_result(robot, reason, options.cycles), robot=robot)
     if options.check_convergence and result.valid:
         result.convergence = _run.check_convergence(robot, result, cycles=options.cycles)
+        if progress:
+            progress(1)
+        if result.spread is not None:   # the draws' shares and percentiles at dt/2 (sim/ensemble.py)
+            from .ensemble import ensemble_convergence
+
+            result.ensemble_convergence = ensemble_convergence(robot, result.spread, options.cycles, progress)
     rendered(result, robot, options, board)
     return result
 

@@ -65,11 +65,14 @@ class SimResult:
     total_mass_kg: float = float("nan")
     sensitivity: object | None = field(default=None, repr=False, compare=False)  # sim.sensitivity.Sensitivity
     explanation: object | None = field(default=None, repr=False, compare=False)  # sim.explain.Explanation
+    # with --check-convergence and --samples: the draws at dt/2 (sim.ensemble.EnsembleConvergence)
+    ensemble_convergence: object | None = field(default=None, repr=False, compare=False)
 
     def to_json(self) -> dict:
         """Every figure but the rollout and the robot; from :func:`locust.simulate`, also the standing
         load, with samples each outcome's share and figures (``outcomes``) and the draws
-        (``samples``), with a sensitivity, ``sensitivity``, with an explanation, ``explanation``. NaN
+        (``samples``), with a sensitivity, ``sensitivity``, with an explanation, ``explanation``, with
+        the draws checked at half the step, ``ensemble_convergence``. NaN
         and inf become null where it is
         written (:func:`locust.fileio.json_text`).
 
@@ -79,8 +82,8 @@ class SimResult:
             The figures by name, in SI units as the field names say.
         """
         out = dataclasses.asdict(dataclasses.replace(self, trajectory=None, robot=None, spread=None, sensitivity=None,
-                                                     explanation=None))
-        for key in ("trajectory", "robot", "spread", "sensitivity", "explanation"):
+                                                     explanation=None, ensemble_convergence=None))
+        for key in ("trajectory", "robot", "spread", "sensitivity", "explanation", "ensemble_convergence"):
             del out[key]
         out = {"robot": out.pop("robot_name"), **out}   # the JSON names the robot by its name
         if self.robot is None:   # a bare run (not locust.simulate's): no standing load was asked for
@@ -92,6 +95,8 @@ class SimResult:
             out["sensitivity"] = self.sensitivity.to_json()
         if self.explanation is not None:
             out["explanation"] = self.explanation.to_json()
+        if self.ensemble_convergence is not None:
+            out["ensemble_convergence"] = self.ensemble_convergence.to_json()
         return out
 
     # -- tables ----------------------------------------------------------------------
