@@ -133,6 +133,8 @@ LIMITS: dict[str, Limit] = {
                                       "a whole fraction of solver.timestep_s"),
     "solver.refine_window_s": Limit(0.0, 1.0, _OPEN, _SHUT, "how long the fine step runs after a contact change: "
                                     "above 0 to 1 s"),
+    "solver.refine_command_window_s": Limit(0.0, 1.0, _SHUT, _SHUT, "how long the fine step runs after a command "
+                                            "change: 0 to 1 s"),
     "solver.iterations": Limit(1, 10000, _SHUT, _SHUT, "MuJoCo's solver iterations: 1 to 10000"),
     "solver.tolerance": Limit(0.0, 1.0, _SHUT, _OPEN, "MuJoCo's solver tolerance: 0 to below 1"),
     "solver.control_hz": Limit(0.0, 10000.0, _OPEN, _SHUT, "a servo command rate: above 0 to 10 kHz (PWM 50 Hz)"),

@@ -159,6 +159,10 @@ class Solver:
     # refine_window_s (sim/refine.py): 0 steps uniformly at timestep_s, which it must divide
     refine_timestep_s: float = 0.0
     refine_window_s: float = 0.04
+    # after a change of the servos' command the fine step runs this long: the push and the
+    # return each set off ~90 ms of touchdowns and foot bounces (contacts that last 0.4-2 ms, a
+    # coarse step over them leaving the count as it was; docs/performance.md)
+    refine_command_window_s: float = 0.1
     integrator: str = "rk4"          # euler | implicitfast | implicit | rk4
     iterations: int = 10
     tolerance: float = 1e-6

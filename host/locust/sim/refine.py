@@ -6,7 +6,10 @@ return stroke. :func:`refine_batch` steps each model at the plan's step in chunk
 :data:`CHUNK_STEPS`; where the number of floor contacts (the ``floor_contact`` sensor, a
 count) changes from one row to the next, the step that changed it is taken again from the
 state before it, and the plan's ``refine_window_s`` after it at its ``fine_timestep_s`` (a
-whole number of fine steps per coarse one, the control held as the plan holds it). Each
+whole number of fine steps per coarse one, the control held as the plan holds it). A change
+of the servos' command is taken so too, for the plan's ``command_window_s``: the push and the
+return each set off a train of touchdowns and foot bounces, contacts that last under a
+coarse step and leave the count as it was from one coarse row to the next. Each
 model is refined at its own contact changes: the models that step coarsely go in one
 ``mujoco.rollout`` call over every core, those in a fine window in another. The record stays
 on the coarse grid (row i at t = i*dt, every ``dt/fine``-th fine row), so the audit and the
@@ -31,7 +34,7 @@ from .batching import add_warnings
 from .model import BuiltModel
 from .schedule import ControlPlan
 
-CHUNK_STEPS = 25    # coarse steps a rollout call: the work thrown away after a change found in it
+CHUNK_STEPS = 10    # coarse steps a rollout call: the work thrown away after a change found in it
 
 
 @dataclass
@@ -121,6 +124,8 @@ def refine_batch(builts: list[BuiltModel], plan: ControlPlan, starts: np.ndarray
     per_coarse = check_refinement(plan)
     nstep, n = plan.nstep, len(builts)
     window = max(1, int(round(plan.refine_window_s / plan.timestep_s)))
+    command_window = max(window, int(round(plan.command_window_s / plan.timestep_s)))
+    windows = np.full(n, window)            # each model's next fine window [coarse steps]
     coarse_models = [b.model for b in builts]
     fine_models = []
     for m in coarse_models:
@@ -161,6 +166,7 @@ def refine_batch(builts: list[BuiltModel], plan: ControlPlan, starts: np.ndarray
                 commanded = np.flatnonzero(command_changes[k, i:i + rows])
                 if changed.size or commanded.size:
                     keep = min(int(a[0]) for a in (changed, commanded) if a.size)
+                    windows[k] = command_window if commanded.size and commanded[0] == keep else window
                     fine_next[k] = True
                 else:
                     # every row but the last, whose step is taken again (a change in it is seen
@@ -175,11 +181,12 @@ def refine_batch(builts: list[BuiltModel], plan: ControlPlan, starts: np.ndarray
         fine = [k for k in range(n) if at[k] < nstep and fine_next[k]]
         if fine:
             # each model's commands held per_coarse fine steps each
-            ctrl = np.stack([np.repeat(_padded(control[k], at[k], window), per_coarse, axis=0) for k in fine])
+            longest = int(max(windows[k] for k in fine))
+            ctrl = np.stack([np.repeat(_padded(control[k], at[k], longest), per_coarse, axis=0) for k in fine])
             st, sd = call(fine_models, fine, ctrl)
             for j, k in enumerate(fine):
                 r, i = out[k], int(at[k])
-                w = min(window, nstep - i)
+                w = min(int(windows[k]), nstep - i)
                 r.fine_steps += w * per_coarse
                 r.sensordata[i:i + w] = sd[j, :w * per_coarse:per_coarse]
                 if keep_states:

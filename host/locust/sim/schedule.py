@@ -36,7 +36,9 @@ class ControlPlan:
         Where the floor contacts change, the step taken again at this one [s]; 0: uniform
         steps (``solver.refine_timestep_s``, :mod:`.refine`).
     refine_window_s : float
-        How long the fine step runs after a change [s].
+        How long the fine step runs after a contact change [s].
+    command_window_s : float
+        How long it runs after a change of the command [s].
     """
 
     ctrl_rad: np.ndarray          # (nstep,) servo command for every physics step, radians
@@ -45,7 +47,8 @@ class ControlPlan:
     settle_steps: int             # steps before the first push
     cycle_start_steps: np.ndarray  # (cycles + 1,) step index where each cycle starts; last = end
     fine_timestep_s: float = 0.0   # the step where the floor contacts change; 0: uniform
-    refine_window_s: float = 0.0   # how long it runs after a change
+    refine_window_s: float = 0.0   # how long it runs after a contact change
+    command_window_s: float = 0.0  # ... and after a change of the command
 
     @property
     def refined(self) -> bool:
@@ -125,4 +128,5 @@ def control_plan(schedule: Schedule, solver: Solver, cycles: int | None = None,
         ctrl_rad=ctrl, timestep_s=dt, steps_per_tick=per_tick, settle_steps=settle_ticks * per_tick,
         cycle_start_steps=np.asarray(starts) * per_tick, fine_timestep_s=fine,
         refine_window_s=solver.refine_window_s if fine else 0.0,
+        command_window_s=solver.refine_command_window_s if fine else 0.0,
     )
