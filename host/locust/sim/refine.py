@@ -35,6 +35,7 @@ from .model import BuiltModel
 from .schedule import ControlPlan
 
 CHUNK_STEPS = 10    # coarse steps a rollout call: the work thrown away after a change found in it
+MAX_CHUNK_STEPS = 80   # ... doubled after each chunk without a change, up to this (a robot at rest)
 
 
 @dataclass
@@ -140,6 +141,8 @@ def refine_batch(builts: list[BuiltModel], plan: ControlPlan, starts: np.ndarray
     # the steps at which a servo's command changes (the push, the return): taken at the fine step
     command_changes = np.zeros(control.shape[:2], dtype=bool)
     command_changes[:, 1:] = (control[:, 1:] != control[:, :-1]).any(axis=2)
+    commands = [np.flatnonzero(command_changes[k]) for k in range(n)]
+    chunk = np.full(n, CHUNK_STEPS)          # each model's next coarse chunk [steps]
     at = np.zeros(n, dtype=int)             # each model's next coarse step
     fine_next = np.zeros(n, dtype=bool)     # whether it is to take its next steps fine
     warnings: dict[str, int] = {}
@@ -152,13 +155,24 @@ def refine_batch(builts: list[BuiltModel], plan: ControlPlan, starts: np.ndarray
             add_warnings(d, warnings)
         return st, sd
 
+    def chunk_rows(k: int) -> int:
+        """Model ``k``'s next coarse chunk: its size, ending at its next command change (whose
+        step is then the one taken again) or the run's end."""
+        i = int(at[k])
+        upcoming = commands[k][np.searchsorted(commands[k], i, side="right"):]
+        rows = min(int(chunk[k]), nstep - i)
+        return min(rows, int(upcoming[0]) - i + 1) if upcoming.size else rows
+
     while (at < nstep).any():
-        coarse = [k for k in range(n) if at[k] < nstep and not fine_next[k]]
-        if coarse:
-            st, sd = call(coarse_models, coarse, np.stack([_padded(control[k], at[k], CHUNK_STEPS) for k in coarse]))
+        waiting = [k for k in range(n) if at[k] < nstep and not fine_next[k]]
+        sizes = {k: chunk_rows(k) for k in waiting}
+        # the models of one chunk size in one call: a model's chunks are its own, whatever the batch
+        for size in sorted(set(sizes.values())):
+            coarse = [k for k in waiting if sizes[k] == size]
+            st, sd = call(coarse_models, coarse, np.stack([_padded(control[k], at[k], size) for k in coarse]))
             for j, k in enumerate(coarse):
                 r, i = out[k], int(at[k])
-                rows = min(CHUNK_STEPS, nstep - i)
+                rows = size
                 r.coarse_steps += rows
                 # sensor row m is taken before step i+m: a count that differs from the row
                 # before was changed by the step before it
@@ -168,7 +182,9 @@ def refine_batch(builts: list[BuiltModel], plan: ControlPlan, starts: np.ndarray
                     keep = min(int(a[0]) for a in (changed, commanded) if a.size)
                     windows[k] = command_window if commanded.size and commanded[0] == keep else window
                     fine_next[k] = True
+                    chunk[k] = CHUNK_STEPS
                 else:
+                    chunk[k] = min(2 * int(chunk[k]), MAX_CHUNK_STEPS)
                     # every row but the last, whose step is taken again (a change in it is seen
                     # only from the row after it), unless the run ends there
                     keep = rows if i + rows == nstep else rows - 1
