@@ -52,8 +52,12 @@ def main() -> None:
     ap.add_argument("--cycles", type=int, default=3)
     ap.add_argument("--preset", default="medium")
     ap.add_argument("--repeat", type=int, default=3, help="best of this many (the machine is shared and noisy)")
+    ap.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                    help="a robot value, as locust's --set (e.g. solver.timestep_s=0.005 with "
+                         "solver.refine_timestep_s=0.001: the refined route)")
     args = ap.parse_args()
     robot = preset(args.preset)
+    robot = robot.with_values(dict(kv.split("=", 1) for kv in args.sets))
     n, cycles = args.draws, args.cycles
     print(f"{args.preset}: {n} draws of its {len(uncertain_values(robot))} uncertain values, "
           f"{cycles} hops, {robot.solver.integrator} at {robot.solver.timestep_s:g} s; "

@@ -60,9 +60,13 @@ def main() -> None:
     ap.add_argument("--grid-designs", type=int, default=1000, help="designs in the 4-parameter grid (>= 1000)")
     ap.add_argument("--grid-cycles", type=int, default=1, help="hop cycles per grid design")
     ap.add_argument("--skip-grid", action="store_true")
+    ap.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                    help="a robot value, as locust's --set (e.g. solver.timestep_s=0.005 with "
+                         "solver.refine_timestep_s=0.001: the refined route)")
     args = ap.parse_args()
     jobs = default_jobs()
     base = preset("seed")
+    base = base.with_values(dict(kv.split("=", 1) for kv in args.sets))
     deltas = np.linspace(0.0, 0.05, 30)
     print(f"machine: {jobs} local cores; MuJoCo {mujoco.__version__}")
 
