@@ -27,9 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..params import Robot
-from .figures import run_figures
 from .outcome import OUTCOMES
-from .samples import Samples, draw, spread_of
+from .samples import Samples, sample
 
 Z_95 = 1.959963984540054
 QUANTILES = (0.1, 0.5, 0.9)
@@ -233,8 +232,7 @@ def ensemble_convergence(robot: Robot, spread: Samples, cycles: int | None = Non
     EnsembleConvergence
     """
     half_robot = robot.with_values(robot.solver.steps_scaled(0.5))
-    figures = run_figures(draw(half_robot, spread.n, spread.seed), cycles, progress)
-    half = spread_of(half_robot, spread.n, spread.seed, figures)
+    half = sample(half_robot, spread.n, cycles, spread.seed, progress)
     return compare(spread, half, half_robot.solver.timestep_s)
 
 

@@ -227,10 +227,10 @@ def _draws_and_ends(robot: Robot, result: SimResult, options: SimOptions,
     from .samples import draw, spread_of
     from .sensitivity import end_robots, sensitivity_of
 
-    n, cycles = options.samples, options.cycles
-    ends = end_robots(robot) if result.valid and (options.sensitivity or (options.sensitivity is None and n)) else []
     if not result.valid:
         return
+    n, cycles = options.samples, options.cycles
+    ends = end_robots(robot) if options.sensitivity or (options.sensitivity is None and n) else []
     together = ends if options.sensitivity else []
     figures = run_figures((draw(robot, n, options.seed) if n else []) + together, cycles, progress)
     if n:

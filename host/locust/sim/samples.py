@@ -23,7 +23,7 @@ from ..errors import GeometryError
 from ..params import Provenance, Robot, check_robot, problems, real_keys
 from .audit import audit
 from .batching import check_batch
-from .figures import BATCH_PER_CORE, RunFigures, figures_of
+from .figures import BATCH_PER_CORE, RunFigures, run_figures
 from .model import build
 from .outcome import OutcomeFigures, outcome_shares
 from .rollout import Trajectory, available_cores, simulate_batch
@@ -252,8 +252,8 @@ def sample(robot: Robot, n: int, cycles: int | None = None, seed: int = 0,
     ParamsError, GeometryError, SimError
         As :func:`check_draws`, before anything is drawn.
     """
-    trajs = simulate_draws(robot, n, cycles, seed, progress=progress)
-    return spread_of(robot, n, seed, [figures_of(t) if t is not None else None for t in trajs])
+    check_draws(robot, n, cycles)
+    return spread_of(robot, n, seed, run_figures(draw(robot, n, seed), cycles, progress))
 
 
 def spread_of(robot: Robot, n: int, seed: int, figures: list[RunFigures | None]) -> Samples:
